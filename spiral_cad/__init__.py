@@ -1,0 +1,29 @@
+"""spiral_cad: exact curvature-continuous (G2) cubic Bézier spirals for CAD.
+
+The numeric core (this namespace and ``spiral_cad.batch``) needs only numpy,
+scipy and numba; the CAD adapters import OCP when they are used.
+"""
+
+from .chain import Chain, Join
+from .errors import NoSolutionError, Status
+from .segments import Arc, Circle, Line, Segment
+from .spiral import BezierSpiral
+from .transitions import Transition, circle_in_circle, circle_to_circle, line_to_circle, line_to_line
+
+__all__ = [
+    "Arc",
+    "BezierSpiral",
+    "Chain",
+    "Circle",
+    "Join",
+    "Line",
+    "NoSolutionError",
+    "Segment",
+    "Status",
+    "Transition",
+    "circle_in_circle",
+    "circle_to_circle",
+    "line_to_circle",
+    "line_to_line",
+]
+__version__ = "0.1.0"

@@ -1,0 +1,181 @@
+"""Chains: G2-checked sequences of lines, arcs and Bézier spirals."""
+
+from __future__ import annotations
+
+from collections.abc import Iterable, Sequence
+from typing import Any
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from ._inputs import as_xy
+from .segments import Arc, Join, Line, Segment, measure_join
+from .transitions import Transition
+
+#: Default join tolerance: gap / chain size, tangent angle (rad) and
+#: curvature jump × chain size must each stay below it.
+JOIN_TOLERANCE = 1e-9
+
+
+class Chain:
+    """An ordered, G2-continuous path of ``Line``, ``Arc`` and ``BezierSpiral``.
+
+    Consecutive segments must share end point, unit tangent and signed
+    curvature: gap ≤ tol·size, tangent angle ≤ tol and |Δκ|·size ≤ tol,
+    where size is the diagonal of the control-point bounding box and tol is
+    ``tolerance`` (default 1e-9).
+
+    Args:
+        segments: the segments in travel order (at least one).
+        tolerance: relative join tolerance.
+
+    Raises:
+        ValueError: a joint exceeds the tolerance (the message names the joint
+            index and the three mismatches), or no segments were given.
+    """
+
+    def __init__(self, segments: Iterable[Segment], tolerance: float = JOIN_TOLERANCE):
+        self._segments: tuple[Segment, ...] = tuple(segments)
+        if not self._segments:
+            raise ValueError("Chain needs at least one segment")
+        for seg in self._segments:
+            if not isinstance(seg, Segment):
+                raise ValueError(f"Chain segments must be Line, Arc or BezierSpiral; got {seg!r}")
+        self.tolerance = float(tolerance)
+        lengths = np.array([s.length for s in self._segments])
+        self._stations = np.concatenate([[0.0], np.cumsum(lengths)])
+        pts = np.array([p for s in self._segments for p in (s.start, s.end, s.point(0.5))])
+        self.size = float(np.hypot(*(pts.max(axis=0) - pts.min(axis=0)))) or 1.0
+        for j in self.joins():
+            if j.gap > tolerance * self.size or j.angle > tolerance or j.curvature_jump * self.size > tolerance:
+                raise ValueError(
+                    f"Chain is not G2 at joint {j.index} (between segments {j.index} and {j.index + 1}): "
+                    f"gap {j.gap:.3g}, tangent angle {j.angle:.3g} rad, curvature jump {j.curvature_jump:.3g} "
+                    f"(tolerance {tolerance:g} relative to chain size {self.size:.6g})"
+                )
+
+    @classmethod
+    def join(
+        cls,
+        parts: Sequence[Transition | Segment],
+        start: Any = None,
+        end: Any = None,
+        tolerance: float = JOIN_TOLERANCE,
+    ) -> Chain:
+        """Chain transitions and segments, filling each gap with the right connector.
+
+        Between two parts, a gap is bridged by an arc of the circle the first
+        part ends on (its ``end_circle``, travelled in its sense for the sweep
+        up to the next contact) or, when it ends on a line, by a line.
+        ``start``/``end`` add a leading/trailing line to those points.
+
+        Example:
+            ``Chain.join([line_to_circle(...), circle_to_line(...)], start=a, end=b)``
+            gives line → spiral → arc → spiral → line.
+        """
+        segments: list[Segment] = []
+        previous: Transition | Segment | None = None
+        if start is not None:
+            first = parts[0]
+            segments.append(Line(as_xy(start, "start"), first.start))
+        for part in parts:
+            if previous is not None:
+                segments.extend(_connector(previous, part, tolerance))
+            segments.extend(part.spirals if isinstance(part, Transition) else [part])
+            previous = part
+        if end is not None:
+            segments.append(Line(parts[-1].end, as_xy(end, "end")))
+        return cls(segments, tolerance)
+
+    # ------------------------------------------------------------- access
+
+    @property
+    def segments(self) -> tuple[Segment, ...]:
+        return self._segments
+
+    def __len__(self) -> int:
+        return len(self._segments)
+
+    def __iter__(self):
+        return iter(self._segments)
+
+    def __getitem__(self, index: int) -> Segment:
+        return self._segments[index]
+
+    def __repr__(self) -> str:
+        kinds = " → ".join(type(s).__name__ for s in self._segments)
+        return f"Chain({len(self)} segments, length {self.length:.6g}: {kinds})"
+
+    @property
+    def length(self) -> float:
+        return float(self._stations[-1])
+
+    @property
+    def stations(self) -> NDArray:
+        """Arc length at the start of each segment, plus the total (len + 1)."""
+        return self._stations.copy()
+
+    @property
+    def start(self) -> NDArray:
+        return self._segments[0].start
+
+    @property
+    def end(self) -> NDArray:
+        return self._segments[-1].end
+
+    def joins(self) -> list[Join]:
+        """Mismatches at every internal joint, in order."""
+        return [measure_join(a, b, i) for i, (a, b) in enumerate(zip(self._segments, self._segments[1:]))]
+
+    def reversed(self) -> Chain:
+        return Chain([s.reversed() for s in reversed(self._segments)], self.tolerance)
+
+    # --------------------------------------------------- station queries
+
+    def _locate(self, s: ArrayLike) -> tuple[NDArray, NDArray]:
+        s = np.asarray(s, dtype=float)
+        if np.any((s < -1e-12 * self.length) | (s > self.length * (1 + 1e-12))):
+            raise ValueError(f"stations must lie in [0, {self.length}]; got {s.min()} … {s.max()}")
+        index = np.clip(np.searchsorted(self._stations, s, side="right") - 1, 0, len(self) - 1)
+        return index, s - self._stations[index]
+
+    def _at(self, s: ArrayLike, method: str, width: tuple[int, ...]) -> NDArray:
+        s = np.asarray(s, dtype=float)
+        index, local = self._locate(s)
+        out = np.empty(s.shape + width)
+        for i in np.unique(index):
+            mask = index == i
+            seg = self._segments[i]
+            out[mask] = getattr(seg, method)(seg.parameter_at(local[mask]))
+        return out
+
+    def point_at(self, s: ArrayLike) -> NDArray:
+        """Points at stations ``s`` (arc length from the start)."""
+        return self._at(s, "point", (2,))
+
+    def tangent_at(self, s: ArrayLike) -> NDArray:
+        """Unit tangents at stations ``s``."""
+        return self._at(s, "tangent", (2,))
+
+    def curvature_at(self, s: ArrayLike) -> NDArray:
+        """Signed curvature at stations ``s``."""
+        return self._at(s, "curvature", ())
+
+    def sample(self, per_segment: int = 32) -> NDArray:
+        """Points along the chain, ``per_segment`` per segment plus the end (for plots)."""
+        u = np.linspace(0.0, 1.0, per_segment, endpoint=False)
+        pts = [seg.point(u) for seg in self._segments]
+        return np.vstack(pts + [self.end[None]])
+
+
+def _connector(previous: Transition | Segment, part: Transition | Segment, tolerance: float) -> list[Segment]:
+    """The line or arc that bridges ``previous``'s end to ``part``'s start (none if they meet)."""
+    a, b = previous.end, part.start
+    if np.hypot(*(b - a)) <= tolerance * max(previous.length, part.length):
+        return []
+    circle = previous.end_circle if isinstance(previous, Transition) else None
+    if circle is None and isinstance(previous, Arc):
+        circle = previous.circle
+    if circle is not None:
+        return [Arc.between(circle.center, circle.radius, a, b)]
+    return [Line(a, b)]

@@ -1,0 +1,133 @@
+"""Errors and the per-row status codes shared by the scalar and batch solvers."""
+
+from __future__ import annotations
+
+from enum import IntEnum
+
+
+class NoSolutionError(ValueError):
+    """The input is well formed but no spiral transition of that kind exists.
+
+    The message names the violated condition and its numbers.
+    """
+
+
+class Status(IntEnum):
+    """Outcome of one solver row (``spiral_cad.batch`` results carry these)."""
+
+    OK = 0
+    NOT_FINITE = 1
+    ZERO_DIRECTION = 2
+    BAD_RADIUS = 3
+    COINCIDENT = 4
+    SIGN_MISMATCH = 5
+    CIRCLE_MEETS_LINE = 6
+    CIRCLES_ENCLOSED = 7
+    CIRCLES_OVERLAP = 8
+    CORNER_STRAIGHT = 9
+    CORNER_REVERSAL = 10
+    LEGS_TOO_SHORT = 11
+    OUTSIDE_NESTED_BAND = 12
+    EQUAL_RADII = 13
+    UNVERIFIED = 14
+    BAD_CURVATURE = 15
+
+
+#: Codes that mean "malformed input" (plain ValueError); the rest are NoSolutionError.
+MALFORMED = frozenset(
+    {
+        Status.NOT_FINITE,
+        Status.ZERO_DIRECTION,
+        Status.BAD_RADIUS,
+        Status.COINCIDENT,
+        Status.SIGN_MISMATCH,
+        Status.BAD_CURVATURE,
+    }
+)
+
+
+def _g(value: float) -> str:
+    return f"{value:.6g}"
+
+
+def describe(case: str, status: int, measure: float, inputs: dict[str, object]) -> str:
+    """Human-readable reason for a failed row of solver ``case``.
+
+    Args:
+        case: solver name, e.g. ``"line_to_circle"``.
+        status: a ``Status`` code other than ``OK``.
+        measure: the feasibility number the kernel reported for the row.
+        inputs: the row's inputs by argument name (shown in the message).
+    """
+    from ._kernels import nested_band_lower  # late: keeps this module kernel-free
+
+    status = Status(status)
+    shown = ", ".join(f"{k}={v}" for k, v in inputs.items())
+    r0 = inputs.get("radius0")
+    r1 = inputs.get("radius1")
+    if status is Status.NOT_FINITE:
+        return f"{case}: every input must be finite; got {shown}"
+    if status is Status.ZERO_DIRECTION:
+        return f"{case}: direction must be a non-zero vector; got {inputs.get('direction')}"
+    if status is Status.BAD_RADIUS:
+        if case == "line_to_circle":
+            return f"line_to_circle: radius must be positive (the turn side follows the centre); got {inputs.get('radius')}"
+        return f"{case}: radii must be non-zero (the sign is the travel sense); got radius0={r0}, radius1={r1}"
+    if status is Status.COINCIDENT:
+        if case == "line_to_line":
+            return f"line_to_line: p0 and p1 must differ from the corner; got {shown}"
+        return f"{case}: the circle centres coincide at {inputs.get('center0')}"
+    if status is Status.SIGN_MISMATCH:
+        return (
+            f"{case}: nested circles are travelled in one sense, so the radii must share "
+            f"their sign; got radius0={r0}, radius1={r1}"
+        )
+    if status is Status.BAD_CURVATURE:
+        return f"{case}: curvature must be a positive finite number or None; got {inputs.get('curvature')}"
+    if status is Status.CIRCLE_MEETS_LINE:
+        return (
+            "line_to_circle: the circle must lie clear of the line (radius r smaller than the "
+            f"distance d from the line to the centre); here d/r = {measure:.5f}"
+        )
+    if status is Status.CIRCLES_ENCLOSED:
+        return (
+            "circle_to_circle (broken-back C): neither circle may enclose the other, "
+            f"D > ||r1| - |r0||; here D/||r1| - |r0|| = {measure:.5f}"
+        )
+    if status is Status.CIRCLES_OVERLAP:
+        return (
+            "circle_to_circle (S): the circles must be disjoint, D > |r0| + |r1|; "
+            f"here D/(|r0| + |r1|) = {measure:.5f}"
+        )
+    if status is Status.CORNER_STRAIGHT:
+        return "line_to_line: p0, corner and p1 are collinear (θ = 0): there is no turn to make"
+    if status is Status.CORNER_REVERSAL:
+        return "line_to_line: the path folds back on itself at the corner (θ = π/2): no spiral pair exists"
+    if status is Status.LEGS_TOO_SHORT:
+        return (
+            f"line_to_line: curvature {inputs.get('curvature')} puts the spiral starts {_g(measure)} "
+            "times the shorter leg away from the corner; it must be ≤ 1 (raise the curvature, "
+            "or pass curvature=None for the largest pair that fits)"
+        )
+    if status is Status.OUTSIDE_NESTED_BAND:
+        big, small = sorted((abs(float(r0)), abs(float(r1))), reverse=True)
+        q = small / big
+        return (
+            "circle_in_circle: a single Bézier spiral exists only for "
+            f"{nested_band_lower(q):.5f} ≤ D/(r0 − r1) < 1 at r1/r0 = {q:.2f}; "
+            f"here D/(r0 − r1) = {measure:.5f}"
+        )
+    if status is Status.EQUAL_RADII:
+        return f"circle_in_circle: nested circles need different radii; got |radius0| = |radius1| = {abs(float(r0))}"
+    if status is Status.UNVERIFIED:
+        return (
+            f"{case}: the root found does not reproduce the joins to 1e-9 (a false root, "
+            f"typically θ within rounding of π/2); nothing is returned for {shown}"
+        )
+    raise AssertionError(f"no description for status {status!r}")
+
+
+def error_for(case: str, status: int, measure: float, inputs: dict[str, object]) -> ValueError:
+    """The exception the scalar API raises for a failed row."""
+    message = describe(case, status, measure, inputs)
+    return ValueError(message) if Status(status) in MALFORMED else NoSolutionError(message)

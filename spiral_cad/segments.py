@@ -1,0 +1,249 @@
+"""Path segments with one evaluation interface: Line, Arc and the base class.
+
+Every segment is parametrised by u ∈ [0, 1] in travel order; curvature is
+signed (positive turns left).
+"""
+
+from __future__ import annotations
+
+import math
+from abc import ABC, abstractmethod
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from ._inputs import as_float, as_xy
+
+TAU = 2.0 * math.pi
+
+
+class Segment(ABC):
+    """Common interface of ``Line``, ``Arc`` and ``BezierSpiral``."""
+
+    @abstractmethod
+    def point(self, u: ArrayLike) -> NDArray:
+        """Points at parameters ``u`` (shape ``u.shape + (2,)``)."""
+
+    @abstractmethod
+    def tangent(self, u: ArrayLike) -> NDArray:
+        """Unit tangents in travel direction at ``u``."""
+
+    @abstractmethod
+    def curvature(self, u: ArrayLike) -> NDArray | float:
+        """Signed curvature at ``u``."""
+
+    @property
+    @abstractmethod
+    def length(self) -> float:
+        """Arc length."""
+
+    @abstractmethod
+    def reversed(self) -> Segment:
+        """The same curve travelled the other way (curvature changes sign)."""
+
+    @abstractmethod
+    def piece(self, t0: float, t1: float) -> Segment:
+        """The part between parameters ``t0`` < ``t1`` as a segment on [0, 1]."""
+
+    def parameter_at(self, s: ArrayLike) -> NDArray:
+        """Parameters u where the arc length from the start equals ``s``."""
+        return _u(s) / self.length
+
+    @property
+    def start(self) -> NDArray:
+        return self.point(0.0)
+
+    @property
+    def end(self) -> NDArray:
+        return self.point(1.0)
+
+    @property
+    def start_tangent(self) -> NDArray:
+        return self.tangent(0.0)
+
+    @property
+    def end_tangent(self) -> NDArray:
+        return self.tangent(1.0)
+
+    @property
+    def start_curvature(self) -> float:
+        return float(self.curvature(0.0))
+
+    @property
+    def end_curvature(self) -> float:
+        return float(self.curvature(1.0))
+
+
+def _u(u: ArrayLike) -> NDArray:
+    return np.asarray(u, dtype=float)
+
+
+class Line(Segment):
+    """Straight segment from ``start`` to ``end`` (distinct points)."""
+
+    __slots__ = ("_a", "_b")
+
+    def __init__(self, start: Any, end: Any):
+        self._a = np.array(as_xy(start, "start"))
+        self._b = np.array(as_xy(end, "end"))
+        if np.array_equal(self._a, self._b):
+            raise ValueError(f"Line needs distinct end points; both are {tuple(self._a)}")
+
+    def __repr__(self) -> str:
+        return f"Line({tuple(self._a)}, {tuple(self._b)})"
+
+    @property
+    def start(self) -> NDArray:
+        return self._a.copy()
+
+    @property
+    def end(self) -> NDArray:
+        return self._b.copy()
+
+    @property
+    def length(self) -> float:
+        return float(np.hypot(*(self._b - self._a)))
+
+    def point(self, u: ArrayLike) -> NDArray:
+        return self._a + _u(u)[..., None] * (self._b - self._a)
+
+    def tangent(self, u: ArrayLike) -> NDArray:
+        d = (self._b - self._a) / self.length
+        return np.broadcast_to(d, _u(u).shape + (2,)).copy()
+
+    def curvature(self, u: ArrayLike) -> NDArray | float:
+        return np.zeros_like(_u(u))[()]
+
+    def reversed(self) -> Line:
+        return Line(self._b, self._a)
+
+    def piece(self, t0: float, t1: float) -> Line:
+        return Line(self.point(t0), self.point(t1))
+
+
+@dataclass(frozen=True)
+class Ray:
+    """A directed line: a point on it and its travel direction."""
+
+    point: tuple[float, float]
+    direction: tuple[float, float]
+
+    def reversed(self) -> Ray:
+        return Ray(self.point, (-self.direction[0], -self.direction[1]))
+
+
+@dataclass(frozen=True)
+class Circle:
+    """A circle with a travel sense: ``radius`` > 0 counterclockwise, < 0 clockwise."""
+
+    center: tuple[float, float]
+    radius: float
+
+    def reversed(self) -> Circle:
+        return Circle(self.center, -self.radius)
+
+
+class Arc(Segment):
+    """Circular arc travelled ``sweep`` radians from polar angle ``start_angle``.
+
+    Args:
+        center: centre point.
+        radius: signed radius; positive travels counterclockwise.
+        start_angle: polar angle of the start point about ``center`` (radians).
+        sweep: angle travelled, ≥ 0 (radians); the sense comes from ``radius``.
+    """
+
+    __slots__ = ("_c", "_r", "_a0", "_sweep")
+
+    def __init__(self, center: Any, radius: float, start_angle: float, sweep: float):
+        self._c = np.array(as_xy(center, "center"))
+        self._r = as_float(radius, "radius")
+        if self._r == 0.0:
+            raise ValueError("Arc radius must be non-zero (its sign is the travel sense); got 0.0")
+        self._a0 = as_float(start_angle, "start_angle")
+        self._sweep = as_float(sweep, "sweep")
+        if self._sweep < 0.0:
+            raise ValueError(f"Arc sweep must be ≥ 0 (the sense comes from the radius); got {sweep}")
+
+    @classmethod
+    def between(cls, center: Any, radius: float, start: Any, end: Any) -> Arc:
+        """Arc on circle (center, radius) from the polar angle of ``start`` to that of ``end``.
+
+        The sweep is taken in the travel sense of ``radius`` and lies in [0, 2π).
+        """
+        cx, cy = as_xy(center, "center")
+        sx, sy = as_xy(start, "start")
+        ex, ey = as_xy(end, "end")
+        radius = as_float(radius, "radius")
+        a0 = math.atan2(sy - cy, sx - cx)
+        a1 = math.atan2(ey - cy, ex - cx)
+        sweep = math.copysign(1.0, radius) * (a1 - a0) % TAU
+        return cls((cx, cy), radius, a0, sweep)
+
+    def __repr__(self) -> str:
+        return f"Arc(center={tuple(self._c)}, radius={self._r}, start_angle={self._a0}, sweep={self._sweep})"
+
+    @property
+    def center(self) -> NDArray:
+        return self._c.copy()
+
+    @property
+    def radius(self) -> float:
+        return self._r
+
+    @property
+    def start_angle(self) -> float:
+        return self._a0
+
+    @property
+    def sweep(self) -> float:
+        return self._sweep
+
+    @property
+    def circle(self) -> Circle:
+        return Circle((float(self._c[0]), float(self._c[1])), self._r)
+
+    @property
+    def length(self) -> float:
+        return abs(self._r) * self._sweep
+
+    def _angle(self, u: ArrayLike) -> NDArray:
+        return self._a0 + math.copysign(self._sweep, self._r) * _u(u)
+
+    def point(self, u: ArrayLike) -> NDArray:
+        a = self._angle(u)
+        return self._c + abs(self._r) * np.stack([np.cos(a), np.sin(a)], axis=-1)
+
+    def tangent(self, u: ArrayLike) -> NDArray:
+        a = self._angle(u)
+        s = math.copysign(1.0, self._r)
+        return s * np.stack([-np.sin(a), np.cos(a)], axis=-1)
+
+    def curvature(self, u: ArrayLike) -> NDArray | float:
+        return np.full_like(_u(u), 1.0 / self._r)[()]
+
+    def reversed(self) -> Arc:
+        return Arc(self._c, -self._r, float(self._angle(1.0)), self._sweep)
+
+    def piece(self, t0: float, t1: float) -> Arc:
+        return Arc(self._c, self._r, float(self._angle(t0)), self._sweep * (t1 - t0))
+
+
+@dataclass(frozen=True)
+class Join:
+    """Mismatch at the joint between segments ``index`` and ``index + 1``."""
+
+    index: int
+    gap: float
+    angle: float
+    curvature_jump: float
+
+
+def measure_join(a: Segment, b: Segment, index: int = 0) -> Join:
+    """Position gap, tangent angle (rad) and curvature jump from ``a``'s end to ``b``'s start."""
+    ta, tb = a.end_tangent, b.start_tangent
+    angle = abs(math.atan2(ta[0] * tb[1] - ta[1] * tb[0], ta[0] * tb[0] + ta[1] * tb[1]))
+    gap = float(np.hypot(*(b.start - a.end)))
+    return Join(index, gap, angle, abs(b.start_curvature - a.end_curvature))

@@ -1,0 +1,132 @@
+"""The Walton–Meek cubic Bézier spiral (Theorem 3.1) as a path segment."""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from . import bezier
+from ._inputs import as_float, as_unit, as_xy
+from ._kernels import put_spiral
+from .segments import Segment
+
+
+class BezierSpiral(Segment):
+    """A cubic Bézier spiral: curvature grows monotonically from 0 to ``curvature``.
+
+    Built by Theorem 3.1 of Walton & Meek (1996): control points
+    B0, B1 = B0 + gT, B2 = B1 + gT, B3 = B2 + h·rot(T, θ) with
+    g = 25 tan|θ| / (54 |c| cos θ) and h = 5 tan|θ| / (9 |c|).
+
+    Args:
+        start: start point B0, where the curvature is 0.
+        direction: start tangent (any non-zero length).
+        theta: signed turn angle, 0 < |θ| < π/2 (positive turns left).
+        curvature: signed end curvature, same sign as ``theta``.
+
+    Raises:
+        ValueError: non-finite input, zero direction, |θ| ∉ (0, π/2), zero
+            curvature or signs that differ.
+
+    Pieces (``piece``) and reversals (``reversed``) are exact Bézier curves
+    of the same kind; for them ``start_curvature`` need not be 0.
+    """
+
+    __slots__ = ("_cp",)
+
+    def __init__(self, start: Any, direction: Any, theta: float, curvature: float):
+        bx, by = as_xy(start, "start")
+        tx, ty = as_unit(direction, "direction")
+        theta = as_float(theta, "theta")
+        curvature = as_float(curvature, "curvature")
+        if not 0.0 < abs(theta) < math.pi / 2:
+            raise ValueError(f"|theta| must lie in (0, π/2); got theta = {theta}")
+        if curvature == 0.0 or (curvature > 0.0) != (theta > 0.0):
+            raise ValueError(
+                f"curvature must be non-zero with the sign of theta; got theta = {theta}, curvature = {curvature}"
+            )
+        side = math.copysign(1.0, theta)
+        cp = np.empty((4, 2))
+        put_spiral(cp, bx, by, tx, ty, -side * ty, side * tx, math.sin(abs(theta)), math.cos(theta), 1.0 / abs(curvature))
+        self._cp = cp
+        cp.flags.writeable = False
+
+    @classmethod
+    def from_control_points(cls, control_points: ArrayLike) -> BezierSpiral:
+        """Wrap control points that are known to form a spiral (or a piece of one).
+
+        No check is made that the curvature is monotone; use the solvers or
+        the constructor to make spirals.
+        """
+        cp = np.array(control_points, dtype=float)
+        if cp.shape != (4, 2):
+            raise ValueError(f"control_points must have shape (4, 2); got {cp.shape}")
+        if not np.isfinite(cp).all():
+            raise ValueError(f"control_points must be finite; got {cp.tolist()}")
+        spiral = cls.__new__(cls)
+        cp.flags.writeable = False
+        spiral._cp = cp
+        return spiral
+
+    def __repr__(self) -> str:
+        return f"BezierSpiral.from_control_points({self._cp.tolist()})"
+
+    @property
+    def control_points(self) -> NDArray:
+        """(4, 2) float64 control points in travel order (read-only)."""
+        return self._cp
+
+    @property
+    def start(self) -> NDArray:
+        return self._cp[0].copy()
+
+    @property
+    def end(self) -> NDArray:
+        return self._cp[3].copy()
+
+    @property
+    def theta(self) -> float:
+        """Signed angle from the start tangent to the end tangent."""
+        a = self._cp[1] - self._cp[0]
+        b = self._cp[3] - self._cp[2]
+        return math.atan2(a[0] * b[1] - a[1] * b[0], a[0] * b[0] + a[1] * b[1])
+
+    @property
+    def length(self) -> float:
+        """Arc length by composite Gauss–Legendre (≤ 1e-14 relative for |θ| ≤ 80°)."""
+        return bezier.arc_length(self._cp)
+
+    def parameter_at(self, s: ArrayLike) -> NDArray:
+        """Parameters u with arc length ``s`` from the start (Newton, to 1e-14·length)."""
+        s = np.asarray(s, dtype=float)
+        total = self.length
+        u = np.clip(s / total, 0.0, 1.0)
+        for _ in range(30):
+            step = (bezier.arc_length(self._cp, u) - s) / np.linalg.norm(bezier.derivative(self._cp, u), axis=-1)
+            u = np.clip(u - step, 0.0, 1.0)
+            if np.all(np.abs(step) <= 1e-14):
+                break
+        return u
+
+    def point(self, u: ArrayLike) -> NDArray:
+        return bezier.point(self._cp, u)
+
+    def tangent(self, u: ArrayLike) -> NDArray:
+        return bezier.tangent(self._cp, u)
+
+    def curvature(self, u: ArrayLike) -> NDArray | float:
+        return bezier.curvature(self._cp, u)[()]
+
+    def piece(self, t0: float, t1: float) -> BezierSpiral:
+        """Exact sub-curve on [t0, t1] (de Casteljau) as a Bézier on [0, 1]."""
+        t0 = as_float(t0, "t0")
+        t1 = as_float(t1, "t1")
+        if not 0.0 <= t0 < t1 <= 1.0:
+            raise ValueError(f"piece needs 0 ≤ t0 < t1 ≤ 1; got t0 = {t0}, t1 = {t1}")
+        return BezierSpiral.from_control_points(bezier.split(self._cp, t0, t1))
+
+    def reversed(self) -> BezierSpiral:
+        return BezierSpiral.from_control_points(self._cp[::-1])

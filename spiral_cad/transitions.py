@@ -1,0 +1,215 @@
+"""The five G2 transitions of Walton & Meek (1996), one problem at a time.
+
+Each solver returns a :class:`Transition` whose ``spirals`` read in travel
+order. The work is done by the row kernels that ``spiral_cad.batch`` runs
+over arrays, so scalar and batch results agree bit for bit.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, replace
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from . import _kernels as K
+from ._inputs import as_float, as_xy
+from .errors import Status, error_for
+from .segments import Arc, Circle, Join, Line, Ray, Segment, measure_join
+from .spiral import BezierSpiral
+
+
+@dataclass(frozen=True)
+class Transition:
+    """A solved transition.
+
+    Attributes:
+        kind: ``"line-circle"``, ``"circle-line"``, ``"C"``, ``"S"``,
+            ``"line-line"`` or ``"circle-circle-nested"``.
+        spirals: the Bézier spirals in travel order.
+        theta: the theorem's spiral angle θ ∈ (0, π/2) (each spiral's own
+            signed turn is ``spiral.theta``).
+        start_circle: the circle the path leaves (travel-sense radius), if any.
+        end_circle: the circle the path reaches, if any.
+        start_line, end_line: the given lines the path leaves / reaches, if any.
+        parameter: nested case only: the parameter t ∈ (0, 1) of the full
+            Theorem 3.1 spiral where it meets the larger circle.
+    """
+
+    kind: str
+    spirals: list[BezierSpiral]
+    theta: float
+    start_circle: Circle | None = None
+    end_circle: Circle | None = None
+    parameter: float | None = None
+    start_line: Ray | None = None
+    end_line: Ray | None = None
+
+    @property
+    def start(self) -> NDArray:
+        """Contact point where the transition leaves the first line/circle."""
+        return self.spirals[0].start
+
+    @property
+    def start_tangent(self) -> NDArray:
+        return self.spirals[0].start_tangent
+
+    @property
+    def end(self) -> NDArray:
+        """Contact point where the transition reaches the last line/circle."""
+        return self.spirals[-1].end
+
+    @property
+    def end_tangent(self) -> NDArray:
+        return self.spirals[-1].end_tangent
+
+    @property
+    def joint(self) -> NDArray | None:
+        """Where two spirals meet (two-spiral cases), else None."""
+        return self.spirals[0].end if len(self.spirals) == 2 else None
+
+    @property
+    def length(self) -> float:
+        return sum(s.length for s in self.spirals)
+
+    def reversed(self) -> Transition:
+        """The same curve travelled the other way (e.g. circle → line)."""
+        kinds = {"line-circle": "circle-line", "circle-line": "line-circle"}
+        return replace(
+            self,
+            kind=kinds.get(self.kind, self.kind),
+            spirals=[s.reversed() for s in reversed(self.spirals)],
+            start_circle=self.end_circle and self.end_circle.reversed(),
+            end_circle=self.start_circle and self.start_circle.reversed(),
+            start_line=self.end_line and self.end_line.reversed(),
+            end_line=self.start_line and self.start_line.reversed(),
+        )
+
+    def joins(self) -> list[Join]:
+        """Mismatches (gap, tangent angle, curvature jump) at every contact, in travel order.
+
+        The first and last entries compare the spirals with the given lines or
+        circles, the others the joints between spirals.
+        """
+        first = _contact_piece(self.start_circle, self.start_line, self.start, before=True)
+        last = _contact_piece(self.end_circle, self.end_line, self.end, before=False)
+        chain: list[Segment] = [first, *self.spirals, last]
+        return [measure_join(a, b, i) for i, (a, b) in enumerate(zip(chain, chain[1:]))]
+
+
+def _contact_piece(circle: Circle | None, line: Ray | None, point: NDArray, before: bool) -> Segment:
+    """A short piece of the given circle/line ending (``before``) or starting at the foot of ``point``."""
+    if circle is not None:
+        cx, cy = circle.center
+        angle = math.atan2(point[1] - cy, point[0] - cx)
+        step = 1e-3 * math.copysign(1.0, circle.radius)
+        return Arc(circle.center, circle.radius, angle - step if before else angle, 1e-3)
+    (px, py), direction = line.point, np.asarray(line.direction) / np.hypot(*line.direction)
+    foot = np.array([px, py]) + np.dot(point - (px, py), direction) * direction
+    return Line(foot - direction, foot) if before else Line(foot, foot + direction)
+
+
+def _solve(case: str, row, count: int, args: tuple[float, ...], inputs: dict[str, Any]):
+    out = np.empty((count, 4, 2))
+    status, theta, measure, extra = row(*args, out)
+    if status != Status.OK:
+        raise error_for(case, status, measure, inputs)
+    return [BezierSpiral.from_control_points(cp) for cp in out], theta, extra
+
+
+def line_to_circle(point: Any, direction: Any, center: Any, radius: float) -> Transition:
+    """Theorem 4.1: spiral from a directed line onto a circle.
+
+    Travel runs along ``direction`` and turns toward the side of the line the
+    circle lies on. Use ``.reversed()`` for circle → line.
+
+    Args:
+        point: any point of the line.
+        direction: travel direction of the line (non-zero).
+        center: circle centre, off the line.
+        radius: circle radius, > 0.
+
+    Raises:
+        NoSolutionError: the circle touches or crosses the line (r ≥ d).
+        ValueError: malformed input.
+    """
+    px, py = as_xy(point, "point")
+    dx, dy = as_xy(direction, "direction")
+    cx, cy = as_xy(center, "center")
+    r = as_float(radius, "radius")
+    inputs = dict(point=(px, py), direction=(dx, dy), center=(cx, cy), radius=r)
+    spirals, theta, _ = _solve("line_to_circle", K.line_to_circle_row, 1, (px, py, dx, dy, cx, cy, r), inputs)
+    sense = math.copysign(r, spirals[0].theta)
+    line = Ray((px, py), (dx, dy))
+    return Transition("line-circle", spirals, theta, end_circle=Circle((cx, cy), sense), start_line=line)
+
+
+def circle_to_circle(center0: Any, radius0: float, center1: Any, radius1: float) -> Transition:
+    """Theorems 4.2 and 4.3: two spirals from circle 0 to circle 1.
+
+    The sign of each radius is the travel sense on that circle (positive:
+    counterclockwise). Same signs give a broken-back C (zero curvature at the
+    joint), opposite signs an S (an inflection at the joint).
+
+    Raises:
+        NoSolutionError: C with one circle enclosing the other, or S with
+            circles that touch or overlap.
+        ValueError: malformed input (zero radius, coincident centres, …).
+    """
+    c0 = as_xy(center0, "center0")
+    c1 = as_xy(center1, "center1")
+    r0 = as_float(radius0, "radius0")
+    r1 = as_float(radius1, "radius1")
+    inputs = dict(center0=c0, radius0=r0, center1=c1, radius1=r1)
+    spirals, theta, _ = _solve("circle_to_circle", K.circle_to_circle_row, 2, (*c0, r0, *c1, r1), inputs)
+    kind = "S" if (r0 > 0) != (r1 > 0) else "C"
+    return Transition(kind, spirals, theta, Circle(c0, r0), Circle(c1, r1))
+
+
+def line_to_line(p0: Any, corner: Any, p1: Any, curvature: float | None = None) -> Transition:
+    """Theorem 4.4: two spirals from the line p0→corner to the line corner→p1.
+
+    Args:
+        p0: a point on the incoming line (before the corner).
+        corner: the lines' intersection.
+        p1: a point on the outgoing line (after the corner).
+        curvature: joint curvature magnitude (> 0). ``None`` applies
+            Corollary 4.5: the largest pair, starting exactly at the nearer of
+            p0 and p1.
+
+    Raises:
+        NoSolutionError: collinear or folded-back legs, or a curvature so
+            small that the spirals would start beyond p0 or p1.
+        ValueError: malformed input.
+    """
+    a = as_xy(p0, "p0")
+    p = as_xy(corner, "corner")
+    b = as_xy(p1, "p1")
+    k = math.nan if curvature is None else as_float(curvature, "curvature")
+    inputs = dict(p0=a, corner=p, p1=b, curvature=curvature)
+    spirals, theta, _ = _solve("line_to_line", K.line_to_line_row, 2, (*a, *p, *b, k), inputs)
+    return Transition("line-line", spirals, theta, start_line=Ray(p, (p[0] - a[0], p[1] - a[1])), end_line=Ray(p, (b[0] - p[0], b[1] - p[1])))
+
+
+def circle_in_circle(center0: Any, radius0: float, center1: Any, radius1: float) -> Transition:
+    """The fifth case: one spiral between nested circles, either way.
+
+    Radii are signed by travel sense and must share the sign. The larger
+    circle is met at an interior parameter t of the full spiral, so the
+    returned spiral is the exact piece [t, 1] (reversed when travelling out
+    of the smaller circle). Solutions exist only in a thin band just inside
+    internal tangency (see ``NoSolutionError`` messages).
+
+    Raises:
+        NoSolutionError: centre distance outside the band, or equal radii.
+        ValueError: malformed input or radii of different signs.
+    """
+    c0 = as_xy(center0, "center0")
+    c1 = as_xy(center1, "center1")
+    r0 = as_float(radius0, "radius0")
+    r1 = as_float(radius1, "radius1")
+    inputs = dict(center0=c0, radius0=r0, center1=c1, radius1=r1)
+    spirals, theta, t = _solve("circle_in_circle", K.circle_in_circle_row, 1, (*c0, r0, *c1, r1), inputs)
+    return Transition("circle-circle-nested", spirals, theta, Circle(c0, r0), Circle(c1, r1), parameter=t)
