@@ -53,7 +53,9 @@ class BatchResult:
         """Why row ``i`` failed (the scalar API's error message), or ``"ok"``."""
         if self.status[i] == Status.OK:
             return "ok"
-        row = {k: v[i].tolist() for k, v in self.inputs.items()}
+        row = {k: tuple(v[i].tolist()) if v.ndim > 1 else float(v[i]) for k, v in self.inputs.items()}
+        if self.case == "line_to_line" and np.isnan(row["curvature"]):
+            row["curvature"] = None
         return describe(self.case, int(self.status[i]), float(self.measure[i]), row)
 
 

@@ -17,24 +17,30 @@ _U = ((np.arange(_PANELS)[:, None] + 0.5 * (_GL_NODES[None, :] + 1.0)) / _PANELS
 _W = np.tile(_GL_WEIGHTS / (2.0 * _PANELS), _PANELS)
 
 
-def _bernstein(u: NDArray, order: int) -> NDArray:
-    """Basis (…, 4) of the cubic (order 0), of its first or second derivative."""
+def _bernstein(u: NDArray, degree: int) -> NDArray:
+    """Bernstein basis of ``degree`` (1, 2 or 3) at ``u``, shape ``u.shape + (degree + 1,)``."""
     v = 1.0 - u
-    if order == 0:
+    if degree == 3:
         return np.stack([v**3, 3.0 * u * v * v, 3.0 * u * u * v, u**3], axis=-1)
-    if order == 1:
-        return np.stack([-3.0 * v * v, 3.0 * v * (v - 2.0 * u), 3.0 * u * (2.0 * v - u), 3.0 * u * u], axis=-1)
-    return np.stack([6.0 * v, 6.0 * (u - 2.0 * v), 6.0 * (v - 2.0 * u), 6.0 * u], axis=-1)
+    if degree == 2:
+        return np.stack([v * v, 2.0 * u * v, u * u], axis=-1)
+    return np.stack([v, u], axis=-1)
 
 
 def point(cp: NDArray, u: ArrayLike) -> NDArray:
     """Points Q(u), shape ``u.shape + (2,)``."""
-    return _bernstein(np.asarray(u, dtype=float), 0) @ cp
+    return _bernstein(np.asarray(u, dtype=float), 3) @ cp
 
 
 def derivative(cp: NDArray, u: ArrayLike, order: int = 1) -> NDArray:
-    """First or second derivative Q'(u) / Q''(u)."""
-    return _bernstein(np.asarray(u, dtype=float), order) @ cp
+    """First or second derivative Q'(u) / Q''(u).
+
+    Built from control-point differences (the hodograph), which keeps full
+    relative accuracy for small curves far from the origin.
+    """
+    diff = np.diff(cp, n=order, axis=0)
+    scale = 3.0 if order == 1 else 6.0
+    return scale * (_bernstein(np.asarray(u, dtype=float), 3 - order) @ diff)
 
 
 def tangent(cp: NDArray, u: ArrayLike) -> NDArray:

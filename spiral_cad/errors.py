@@ -121,8 +121,8 @@ def describe(case: str, status: int, measure: float, inputs: dict[str, object]) 
         return f"circle_in_circle: nested circles need different radii; got |radius0| = |radius1| = {abs(float(r0))}"
     if status is Status.UNVERIFIED:
         return (
-            f"{case}: the root found does not reproduce the joins to 1e-9 (a false root, "
-            f"typically θ within rounding of π/2); nothing is returned for {shown}"
+            f"{case}: the solution does not reproduce its joins to 1e-9 (a false root, or θ so "
+            f"close to π/2 that the control points outgrow double precision); nothing is returned for {shown}"
         )
     raise AssertionError(f"no description for status {status!r}")
 

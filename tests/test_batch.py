@@ -1,0 +1,116 @@
+"""Batch solvers: same kernels as the scalar API, one status per row."""
+
+import math
+
+import numpy as np
+import pytest
+
+import spiral_cad as sc
+from spiral_cad import Status, batch
+from spiral_cad.errors import MALFORMED
+
+rng = np.random.default_rng(7)
+N = 400
+
+
+def scalar_rows(solve, rows):
+    """Scalar result per row: control points, or the error message."""
+    out = []
+    for args in rows:
+        try:
+            t = solve(*args)
+            out.append(np.stack([s.control_points for s in t.spirals]))
+        except ValueError as e:
+            out.append(e)
+    return out
+
+
+def check_same(result, expected):
+    for i, exp in enumerate(expected):
+        if isinstance(exp, ValueError):
+            assert result.status[i] != Status.OK
+            if isinstance(exp, sc.NoSolutionError):
+                assert result.reason(i) == str(exp)
+            else:  # malformed: the scalar API names the argument itself
+                assert Status(result.status[i]) in MALFORMED
+            assert all(np.isnan(s[i]).all() for s in result.spirals)
+        else:
+            assert result.status[i] == Status.OK, result.reason(i)
+            got = np.stack([s[i] for s in result.spirals])
+            assert np.array_equal(got, exp)  # same kernel: bit for bit
+
+
+def test_line_to_circle_batch_equals_scalar():
+    p = rng.normal(size=(N, 2))
+    d = rng.normal(size=(N, 2))
+    c = rng.normal(size=(N, 2)) * 4
+    r = rng.uniform(0.2, 3, N)
+    r[5] = 0.0
+    d[6] = 0.0
+    c[7, 0] = np.nan
+    res = batch.line_to_circle(p, d, c, r)
+    assert res.spirals[0].shape == (N, 4, 2) and len(res.spirals) == 1
+    expected = scalar_rows(sc.line_to_circle, zip(p.tolist(), d.tolist(), c.tolist(), r.tolist()))
+    check_same(res, expected)
+    assert 0 < res.ok.sum() < N  # both feasible and infeasible rows present
+    assert res.status[5] == Status.BAD_RADIUS and res.status[6] == Status.ZERO_DIRECTION
+    assert res.status[7] == Status.NOT_FINITE
+
+
+def test_circle_to_circle_batch_equals_scalar_for_c_and_s():
+    c0 = rng.normal(size=(N, 2)) * 5
+    c1 = rng.normal(size=(N, 2)) * 5
+    r0 = rng.uniform(0.2, 3, N) * rng.choice([-1, 1], N)
+    r1 = rng.uniform(0.2, 3, N) * rng.choice([-1, 1], N)
+    res = batch.circle_to_circle(c0, r0, c1, r1)
+    assert len(res.spirals) == 2
+    expected = scalar_rows(sc.circle_to_circle, zip(c0.tolist(), r0.tolist(), c1.tolist(), r1.tolist()))
+    check_same(res, expected)
+    assert {Status.CIRCLES_OVERLAP, Status.OK} <= set(res.status.tolist())
+
+
+def test_line_to_line_batch_equals_scalar_with_auto_and_given_curvature():
+    p = rng.normal(size=(N, 2)) * 3
+    p0 = p + rng.normal(size=(N, 2)) * 5
+    p1 = p + rng.normal(size=(N, 2)) * 5
+    k = np.where(rng.random(N) < 0.5, np.nan, rng.uniform(0.05, 3, N))
+    res = batch.line_to_line(p0, p, p1, k)
+    rows = [(a, b, c, None if math.isnan(kk) else kk) for a, b, c, kk in zip(p0.tolist(), p.tolist(), p1.tolist(), k.tolist())]
+    check_same(res, scalar_rows(sc.line_to_line, rows))
+    assert {Status.LEGS_TOO_SHORT, Status.OK} <= set(res.status.tolist())
+
+
+def test_circle_in_circle_batch_equals_scalar():
+    n = 60
+    big = rng.uniform(1, 5, n)
+    q = rng.uniform(0.1, 0.9, n)
+    frac = rng.uniform(0.97, 1.0, n)
+    ang = rng.uniform(-np.pi, np.pi, n)
+    c0 = rng.normal(size=(n, 2))
+    c1 = c0 + (big * (1 - q) * frac)[:, None] * np.stack([np.cos(ang), np.sin(ang)], 1)
+    r0, r1 = big, big * q
+    swap = rng.random(n) < 0.5  # outward rows
+    c0[swap], c1[swap] = c1[swap].copy(), c0[swap].copy()
+    r0, r1 = np.where(swap, r1, r0), np.where(swap, r0, r1)
+    res = batch.circle_in_circle(c0, r0, c1, r1)
+    expected = scalar_rows(sc.circle_in_circle, zip(c0.tolist(), r0.tolist(), c1.tolist(), r1.tolist()))
+    check_same(res, expected)
+    ok = res.ok
+    assert ok.any() and (~ok).any()
+    assert np.all((res.parameter[ok] > 0) & (res.parameter[ok] < 1))
+
+
+def test_broadcasting_a_shared_radius_and_direction():
+    centers = np.array([[0, 2.0], [0, 3.0], [0, 0.5]])
+    res = batch.line_to_circle((0, 0), (1, 0), centers, 1.0)
+    assert res.status.tolist() == [Status.OK, Status.OK, Status.CIRCLE_MEETS_LINE]
+    assert res.measure[2] == pytest.approx(0.5)
+    assert "d/r = 0.50000" in res.reason(2)
+    assert res.reason(0) == "ok"
+
+
+def test_bad_shapes_are_rejected():
+    with pytest.raises(ValueError, match="point must have shape"):
+        batch.line_to_circle(np.zeros((3, 3)), (1, 0), (0, 2), 1.0)
+    with pytest.raises(ValueError):
+        batch.line_to_circle(np.zeros((3, 2)), (1, 0), np.zeros((4, 2)), 1.0)
