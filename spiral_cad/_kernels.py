@@ -166,7 +166,10 @@ def finite(*values):
 
 @jit
 def line_to_circle_row(px, py, dx, dy, cx, cy, r, out):
-    """Theorem 4.1: spiral from the directed line (p, d) to circle (c, r > 0)."""
+    """Theorem 4.1: spiral from the directed line (p, d) to circle (c, r > 0).
+
+    ``extra`` is the turn side: +1 left, −1 right.
+    """
     if not finite(px, py, dx, dy, cx, cy, r):
         return NOT_FINITE, NAN, NAN, NAN
     length = norm(dx, dy)
@@ -195,7 +198,7 @@ def line_to_circle_row(px, py, dx, dy, cx, cy, r, out):
     if not end_residual(out[0], vx, vy, side * r) <= VERIFY_TOL:
         return UNVERIFIED, NAN, measure, NAN
     place(out, px, py, 1.0)
-    return OK, math.atan2(sin_t, cos_t), measure, NAN
+    return OK, math.atan2(sin_t, cos_t), measure, side
 
 
 # ---------------------------------------------------- circle to circle
@@ -215,7 +218,7 @@ def _broken_back_w(a_hat, delta, one_minus_a):
     """Root w = sin²θ in (0, 1) of the broken-back C equation, scaled by B.
 
     f(w) = 9Â(1−w)(9−4w)² + w(13+12w)² − 729 D̂²(1−w)², with δ = D̂² − Â > 0.
-    Safeguarded Newton on the bracket f(0) = −729δ < 0 < f(1) = 625.
+    Safeguarded Halley iteration (~3 steps) on the bracket f(0) = −729δ < 0 < f(1) = 625.
     """
     d2 = delta + a_hat
     c0 = -729.0 * delta
@@ -234,11 +237,12 @@ def _broken_back_w(a_hat, delta, one_minus_a):
         else:
             hi = w
         df = (3.0 * c3 * w + 2.0 * c2) * w + c1
-        step = f / df if df != 0.0 else 0.0
-        new = w - step
+        ddf = 6.0 * c3 * w + 2.0 * c2
+        den = 2.0 * df * df - f * ddf
+        new = w - 2.0 * f * df / den if den != 0.0 else 0.5 * (lo + hi)  # Halley
         if not (lo < new < hi):
             new = 0.5 * (lo + hi)
-        if abs(new - w) <= 2e-16 * new or new == w:
+        if abs(new - w) <= 1e-15 * new or new == w:
             return new
         w = new
     return w
@@ -378,7 +382,7 @@ def line_to_line_row(p0x, p0y, px, py, p1x, p1y, curvature, out):
     if not gap <= VERIFY_TOL * a:
         return UNVERIFIED, NAN, measure, NAN
     place(out, px, py, 1.0)
-    return OK, math.atan2(sin_t, cos_t), measure, NAN
+    return OK, math.atan2(sin_t, cos_t), measure, side
 
 
 # --------------------------------------------- circle inside circle

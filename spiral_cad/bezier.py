@@ -17,30 +17,43 @@ _U = ((np.arange(_PANELS)[:, None] + 0.5 * (_GL_NODES[None, :] + 1.0)) / _PANELS
 _W = np.tile(_GL_WEIGHTS / (2.0 * _PANELS), _PANELS)
 
 
-def _bernstein(u: NDArray, degree: int) -> NDArray:
-    """Bernstein basis of ``degree`` (1, 2 or 3) at ``u``, shape ``u.shape + (degree + 1,)``."""
-    v = 1.0 - u
-    if degree == 3:
-        return np.stack([v**3, 3.0 * u * v * v, 3.0 * u * u * v, u**3], axis=-1)
-    if degree == 2:
-        return np.stack([v * v, 2.0 * u * v, u * u], axis=-1)
-    return np.stack([v, u], axis=-1)
+def _power_coefficients(cp: NDArray, order: int = 0) -> NDArray:
+    """Power-basis coefficients of Q (order 0), Q' (1) or Q'' (2), lowest first.
+
+    Formed from control-point differences, so they keep full relative accuracy
+    for small curves far from the origin.
+    """
+    d1 = np.diff(cp, axis=0)  # ΔP0..ΔP2
+    d2 = np.diff(d1, axis=0)  # Δ²P0, Δ²P1
+    d3 = d2[1] - d2[0]
+    if order == 0:
+        return np.array([cp[0], 3.0 * d1[0], 3.0 * d2[0], d3])
+    if order == 1:
+        return np.array([3.0 * d1[0], 6.0 * d2[0], 3.0 * d3])
+    return np.array([6.0 * d2[0], 6.0 * d3])
+
+
+def _horner(coefficients: NDArray, u: ArrayLike) -> NDArray:
+    """Evaluate a 2-D polynomial (coefficients lowest first) at ``u``."""
+    u = np.asarray(u, dtype=float)
+    out = np.empty(u.shape + (2,))
+    for j in range(2):
+        acc = np.full(u.shape, coefficients[-1, j])
+        for c in coefficients[-2::-1, j]:
+            acc *= u
+            acc += c
+        out[..., j] = acc
+    return out
 
 
 def point(cp: NDArray, u: ArrayLike) -> NDArray:
     """Points Q(u), shape ``u.shape + (2,)``."""
-    return _bernstein(np.asarray(u, dtype=float), 3) @ cp
+    return _horner(_power_coefficients(cp), u)
 
 
 def derivative(cp: NDArray, u: ArrayLike, order: int = 1) -> NDArray:
-    """First or second derivative Q'(u) / Q''(u).
-
-    Built from control-point differences (the hodograph), which keeps full
-    relative accuracy for small curves far from the origin.
-    """
-    diff = np.diff(cp, n=order, axis=0)
-    scale = 3.0 if order == 1 else 6.0
-    return scale * (_bernstein(np.asarray(u, dtype=float), 3 - order) @ diff)
+    """First or second derivative Q'(u) / Q''(u)."""
+    return _horner(_power_coefficients(cp, order), u)
 
 
 def tangent(cp: NDArray, u: ArrayLike) -> NDArray:
@@ -51,10 +64,19 @@ def tangent(cp: NDArray, u: ArrayLike) -> NDArray:
 
 def curvature(cp: NDArray, u: ArrayLike) -> NDArray:
     """Signed curvature (Q' × Q'')/|Q'|³ (positive turns left)."""
-    d1 = derivative(cp, u, 1)
-    d2 = derivative(cp, u, 2)
-    cross = d1[..., 0] * d2[..., 1] - d1[..., 1] * d2[..., 0]
-    return cross / np.hypot(d1[..., 0], d1[..., 1]) ** 3
+    u = np.asarray(u, dtype=float)
+    (b0x, b0y), (b1x, b1y), (b2x, b2y) = _power_coefficients(cp, 1).tolist()
+    (c0x, c0y), (c1x, c1y) = _power_coefficients(cp, 2).tolist()
+    u2 = u * u
+    dx = b2x * u2 + b1x * u + b0x
+    dy = b2y * u2 + b1y * u + b0y
+    cross = dx * (c1y * u + c0y)
+    cross -= dy * (c1x * u + c0x)
+    dx *= dx
+    dy *= dy
+    dx += dy  # |Q'|²
+    cross /= dx * np.sqrt(dx)
+    return cross
 
 
 def arc_length(cp: NDArray, u: ArrayLike = 1.0) -> NDArray | float:

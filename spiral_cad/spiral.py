@@ -66,7 +66,12 @@ class BezierSpiral(Segment):
             raise ValueError(f"control_points must have shape (4, 2); got {cp.shape}")
         if not np.isfinite(cp).all():
             raise ValueError(f"control_points must be finite; got {cp.tolist()}")
-        spiral = cls.__new__(cls)
+        return cls._wrap(cp)
+
+    @classmethod
+    def _wrap(cls, cp: NDArray) -> BezierSpiral:
+        """Adopt a finite (4, 2) float64 array without copying or checks (solver output)."""
+        spiral = object.__new__(cls)
         cp.flags.writeable = False
         spiral._cp = cp
         return spiral
@@ -90,9 +95,9 @@ class BezierSpiral(Segment):
     @property
     def theta(self) -> float:
         """Signed angle from the start tangent to the end tangent."""
-        a = self._cp[1] - self._cp[0]
-        b = self._cp[3] - self._cp[2]
-        return math.atan2(a[0] * b[1] - a[1] * b[0], a[0] * b[0] + a[1] * b[1])
+        (x0, y0), (x1, y1), (x2, y2), (x3, y3) = self._cp.tolist()
+        ax, ay, bx, by = x1 - x0, y1 - y0, x3 - x2, y3 - y2
+        return math.atan2(ax * by - ay * bx, ax * bx + ay * by)
 
     @property
     def length(self) -> float:
@@ -126,7 +131,7 @@ class BezierSpiral(Segment):
         t1 = as_float(t1, "t1")
         if not 0.0 <= t0 < t1 <= 1.0:
             raise ValueError(f"piece needs 0 ≤ t0 < t1 ≤ 1; got t0 = {t0}, t1 = {t1}")
-        return BezierSpiral.from_control_points(bezier.split(self._cp, t0, t1))
+        return BezierSpiral._wrap(bezier.split(self._cp, t0, t1))
 
     def reversed(self) -> BezierSpiral:
-        return BezierSpiral.from_control_points(self._cp[::-1])
+        return BezierSpiral._wrap(self._cp[::-1].copy())

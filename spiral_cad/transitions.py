@@ -116,7 +116,7 @@ def _solve(case: str, row, count: int, args: tuple[float, ...], inputs: dict[str
     status, theta, measure, extra = row(*args, out)
     if status != Status.OK:
         raise error_for(case, status, measure, inputs)
-    return [BezierSpiral.from_control_points(cp) for cp in out], theta, extra
+    return [BezierSpiral._wrap(cp) for cp in out], theta, extra
 
 
 def line_to_circle(point: Any, direction: Any, center: Any, radius: float) -> Transition:
@@ -140,8 +140,8 @@ def line_to_circle(point: Any, direction: Any, center: Any, radius: float) -> Tr
     cx, cy = as_xy(center, "center")
     r = as_float(radius, "radius")
     inputs = dict(point=(px, py), direction=(dx, dy), center=(cx, cy), radius=r)
-    spirals, theta, _ = _solve("line_to_circle", K.line_to_circle_row, 1, (px, py, dx, dy, cx, cy, r), inputs)
-    sense = math.copysign(r, spirals[0].theta)
+    spirals, theta, side = _solve("line_to_circle", K.line_to_circle_row, 1, (px, py, dx, dy, cx, cy, r), inputs)
+    sense = side * r
     line = Ray((px, py), (dx, dy))
     return Transition("line-circle", spirals, theta, end_circle=Circle((cx, cy), sense), start_line=line)
 
