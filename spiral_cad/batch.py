@@ -75,9 +75,19 @@ def _rows(**arrays: tuple[ArrayLike, tuple[int, ...]]) -> dict[str, NDArray]:
     }
 
 
-def _run(case: str, kernel, spirals: int, rows: dict[str, NDArray], extra: bool = False) -> BatchResult:
+def _output(out: NDArray | None, n: int, spirals: int) -> NDArray:
+    """The (N, k, 4, 2) control-point buffer: ``out`` if given (checked), else new."""
+    shape = (n, spirals, 4, 2)
+    if out is None:
+        return np.empty(shape)
+    if out.shape != shape or out.dtype != np.float64 or not out.flags.c_contiguous or not out.flags.writeable:
+        raise ValueError(f"out must be a writeable C-contiguous float64 array of shape {shape}; got {out.dtype} {out.shape}")
+    return out
+
+
+def _run(case: str, kernel, spirals: int, rows: dict[str, NDArray], out: NDArray | None, extra: bool = False) -> BatchResult:
     n = len(next(iter(rows.values())))
-    out = np.empty((n, spirals, 4, 2))
+    out = _output(out, n, spirals)
     status = np.empty(n, dtype=np.int8)
     theta = np.empty(n)
     measure = np.empty(n)
@@ -87,26 +97,39 @@ def _run(case: str, kernel, spirals: int, rows: dict[str, NDArray], extra: bool 
     return BatchResult(case, tuple(out[:, k] for k in range(spirals)), theta, status, measure, parameter, rows)
 
 
-def line_to_circle(points: ArrayLike, directions: ArrayLike, centers: ArrayLike, radii: ArrayLike) -> BatchResult:
-    """Theorem 4.1 for N rows: points, directions, centers (N, 2); radii (N,) > 0."""
+def line_to_circle(
+    points: ArrayLike, directions: ArrayLike, centers: ArrayLike, radii: ArrayLike, out: NDArray | None = None
+) -> BatchResult:
+    """Theorem 4.1 for N rows: points, directions, centers (N, 2); radii (N,) > 0.
+
+    Every solver accepts inputs of shape (N, …) or a single row that is
+    broadcast, and ``out``: an optional (N, k, 4, 2) float64 buffer reused for
+    the control points (saves the allocation in repeated calls).
+    """
     rows = _rows(point=(points, (2,)), direction=(directions, (2,)), center=(centers, (2,)), radius=(radii, ()))
-    return _run("line_to_circle", K.line_to_circle_batch, 1, rows)
+    return _run("line_to_circle", K.line_to_circle_batch, 1, rows, out)
 
 
-def circle_to_circle(centers0: ArrayLike, radii0: ArrayLike, centers1: ArrayLike, radii1: ArrayLike) -> BatchResult:
+def circle_to_circle(
+    centers0: ArrayLike, radii0: ArrayLike, centers1: ArrayLike, radii1: ArrayLike, out: NDArray | None = None
+) -> BatchResult:
     """Theorems 4.2/4.3 for N rows (signed travel-sense radii: C or S per row)."""
     rows = _rows(center0=(centers0, (2,)), radius0=(radii0, ()), center1=(centers1, (2,)), radius1=(radii1, ()))
-    return _run("circle_to_circle", K.circle_to_circle_batch, 2, rows)
+    return _run("circle_to_circle", K.circle_to_circle_batch, 2, rows, out)
 
 
-def line_to_line(p0: ArrayLike, corners: ArrayLike, p1: ArrayLike, curvatures: ArrayLike | None = None) -> BatchResult:
+def line_to_line(
+    p0: ArrayLike, corners: ArrayLike, p1: ArrayLike, curvatures: ArrayLike | None = None, out: NDArray | None = None
+) -> BatchResult:
     """Theorem 4.4 for N corners; ``curvatures`` NaN (or None) applies Corollary 4.5."""
     k = np.nan if curvatures is None else curvatures
     rows = _rows(p0=(p0, (2,)), corner=(corners, (2,)), p1=(p1, (2,)), curvature=(k, ()))
-    return _run("line_to_line", K.line_to_line_batch, 2, rows)
+    return _run("line_to_line", K.line_to_line_batch, 2, rows, out)
 
 
-def circle_in_circle(centers0: ArrayLike, radii0: ArrayLike, centers1: ArrayLike, radii1: ArrayLike) -> BatchResult:
+def circle_in_circle(
+    centers0: ArrayLike, radii0: ArrayLike, centers1: ArrayLike, radii1: ArrayLike, out: NDArray | None = None
+) -> BatchResult:
     """The fifth case for N rows (nested circles, same-sign radii)."""
     rows = _rows(center0=(centers0, (2,)), radius0=(radii0, ()), center1=(centers1, (2,)), radius1=(radii1, ()))
-    return _run("circle_in_circle", K.circle_in_circle_batch, 1, rows, extra=True)
+    return _run("circle_in_circle", K.circle_in_circle_batch, 1, rows, out, extra=True)

@@ -74,17 +74,14 @@ class Chain:
             gives line → spiral → arc → spiral → line.
         """
         segments: list[Segment] = []
-        previous: Transition | Segment | None = None
         if start is not None:
-            first = parts[0]
-            segments.append(Line(as_xy(start, "start"), first.start))
-        for part in parts:
+            segments.extend(_bridge(np.array(as_xy(start, "start")), parts[0].start, parts[0].length, tolerance))
+        for previous, part in zip([None, *parts], parts):
             if previous is not None:
                 segments.extend(_connector(previous, part, tolerance))
             segments.extend(part.spirals if isinstance(part, Transition) else [part])
-            previous = part
         if end is not None:
-            segments.append(Line(parts[-1].end, as_xy(end, "end")))
+            segments.extend(_bridge(parts[-1].end, np.array(as_xy(end, "end")), parts[-1].length, tolerance))
         return cls(segments, tolerance)
 
     # ------------------------------------------------------------- access
@@ -167,15 +164,61 @@ class Chain:
         pts = [seg.point(u) for seg in self._segments]
         return np.vstack(pts + [self.end[None]])
 
+    # ------------------------------------------- CAD (imported when used)
+
+    def to_edges(self, plane: Any = None) -> list:
+        """The exact build123d edges (LINE, CIRCLE, BEZIER) in travel order.
+
+        Args:
+            plane: a build123d ``Plane`` holding the chain's 2-D coordinates
+                (None: ``Plane.XY``).
+        """
+        from build123d import Edge
+
+        from .occ import segment_edges
+
+        return [Edge(e) for e in segment_edges(self._segments, _ax3(plane))]
+
+    def to_wire(self, plane: Any = None) -> Any:
+        """The chain as one build123d ``Wire`` on ``plane`` (None: ``Plane.XY``)."""
+        from build123d import Wire
+
+        from .occ import chain_wire
+
+        return Wire(chain_wire(self._segments, _ax3(plane)))
+
+    def to_nurbs(self) -> Any:
+        """The whole chain as one exact rational cubic B-spline (``spiral_cad.nurbs.Nurbs``)."""
+        from .nurbs import chain_to_nurbs
+
+        return chain_to_nurbs(self._segments)
+
+
+def _ax3(plane: Any) -> Any:
+    """A build123d ``Plane`` (or None) as the OCP ``gp_Ax3`` the edge makers take."""
+    if plane is None:
+        return None
+    to_gp_ax3 = getattr(plane, "to_gp_ax3", None)
+    if to_gp_ax3 is None:
+        raise ValueError(f"plane must be a build123d Plane or None; got {plane!r}")
+    return to_gp_ax3()
+
 
 def _connector(previous: Transition | Segment, part: Transition | Segment, tolerance: float) -> list[Segment]:
     """The line or arc that bridges ``previous``'s end to ``part``'s start (none if they meet)."""
     a, b = previous.end, part.start
-    if np.hypot(*(b - a)) <= tolerance * max(previous.length, part.length):
-        return []
     circle = previous.end_circle if isinstance(previous, Transition) else None
     if circle is None and isinstance(previous, Arc):
         circle = previous.circle
-    if circle is not None:
-        return [Arc.between(circle.center, circle.radius, a, b)]
-    return [Line(a, b)]
+    if circle is None or _meet(a, b, max(previous.length, part.length), tolerance):
+        return _bridge(a, b, max(previous.length, part.length), tolerance)
+    return [Arc.between(circle.center, circle.radius, a, b)]
+
+
+def _meet(a: NDArray, b: NDArray, scale: float, tolerance: float) -> bool:
+    return bool(np.hypot(*(b - a)) <= tolerance * scale)
+
+
+def _bridge(a: NDArray, b: NDArray, scale: float, tolerance: float) -> list[Segment]:
+    """A line from ``a`` to ``b``, or nothing when they meet."""
+    return [] if _meet(a, b, scale, tolerance) else [Line(a, b)]

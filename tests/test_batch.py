@@ -114,3 +114,13 @@ def test_bad_shapes_are_rejected():
         batch.line_to_circle(np.zeros((3, 3)), (1, 0), (0, 2), 1.0)
     with pytest.raises(ValueError):
         batch.line_to_circle(np.zeros((3, 2)), (1, 0), np.zeros((4, 2)), 1.0)
+
+
+def test_out_buffer_is_filled_in_place_and_checked():
+    centers = np.array([[0, 2.0], [0, 3.0]])
+    buf = np.zeros((2, 1, 4, 2))
+    res = batch.line_to_circle((0, 0), (1, 0), centers, 1.0, out=buf)
+    assert np.shares_memory(res.spirals[0], buf)
+    assert np.array_equal(buf[:, 0], batch.line_to_circle((0, 0), (1, 0), centers, 1.0).spirals[0])
+    with pytest.raises(ValueError, match="out must be"):
+        batch.line_to_circle((0, 0), (1, 0), centers, 1.0, out=np.zeros((2, 2, 4, 2)))
