@@ -42,12 +42,29 @@ def _demo(args: argparse.Namespace) -> int:
     return 0
 
 
+def _check(args: argparse.Namespace) -> int:
+    from .continuity import main_check  # imports OCP, so only when used
+
+    return main_check(args)
+
+
+def _add_check(sub: argparse._SubParsersAction) -> None:
+    check = sub.add_parser("check", help="report G0/G1/G2 continuity at every joint of a STEP/IGES file")
+    check.add_argument("file", help="a .step/.stp or .igs/.iges file")
+    check.add_argument("--require", choices=["G0", "G1", "G2"], help="exit 1 if any joint is below this level")
+    check.add_argument("--gap-tol", type=float, default=1e-7, help="G0 gap, absolute model units (default 1e-7)")
+    check.add_argument("--angle-tol", type=float, default=1e-7, help="G1 tangent angle, radians (default 1e-7)")
+    check.add_argument("--curvature-tol", type=float, default=1e-6, help="G2 curvature jump, relative (default 1e-6)")
+    check.set_defaults(run=_check)
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     parser = argparse.ArgumentParser(prog="spiral-cad", description="Exact G2 cubic Bézier spiral transitions for CAD.")
     sub = parser.add_subparsers(dest="command", required=True)
     demo = sub.add_parser("demo", help="solve the built-in default design and write its outputs")
     demo.add_argument("--out", default="out", help="output folder (default: out)")
     demo.set_defaults(run=_demo)
+    _add_check(sub)
     args = parser.parse_args(argv)
     return args.run(args)
 

@@ -1,0 +1,173 @@
+"""OpenCASCADE (OCP) edges and wires: the one place where segments become OCCT geometry.
+
+Lines become ``Geom_Line`` edges, arcs true ``Geom_Circle`` edges and
+spirals ``Geom_BezierCurve`` edges with their exact four control points, so
+every CAD adapter and exporter hands the kernel the analytic curves rather
+than approximations. All edges run in travel order (their curve parameter
+increases along the path), which keeps wires, sweeps and exports free of
+orientation flips.
+
+A 2-D point (x, y) is placed at ``origin + x·X + y·Y`` of an optional
+``gp_Ax3`` (None: the global XY plane); counterclockwise arcs turn from X
+towards Y.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Iterable
+from typing import TYPE_CHECKING
+
+from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeEdge, BRepBuilderAPI_MakeWire
+from OCP.Geom import Geom_BezierCurve, Geom_BSplineCurve
+from OCP.gp import gp_Ax2, gp_Ax3, gp_Circ, gp_Dir, gp_Pnt
+from OCP.TColgp import TColgp_Array1OfPnt
+from OCP.TColStd import TColStd_Array1OfInteger, TColStd_Array1OfReal
+from OCP.TopoDS import TopoDS_Edge, TopoDS_Wire
+
+from .segments import Arc, Line, Segment
+from .spiral import BezierSpiral
+
+if TYPE_CHECKING:
+    from .nurbs import Nurbs
+
+
+class _Frame:
+    """Maps plane coordinates to 3-D points; precomputed once per call, not per edge."""
+
+    __slots__ = ("ox", "oy", "oz", "xx", "xy", "xz", "yx", "yy", "yz", "normal", "x_dir", "flat")
+
+    def __init__(self, plane: gp_Ax3 | None):
+        if plane is None:
+            origin, x, y = (0.0, 0.0, 0.0), (1.0, 0.0, 0.0), (0.0, 1.0, 0.0)
+        else:
+            if not isinstance(plane, gp_Ax3):
+                raise ValueError(f"plane must be an OCP gp_Ax3 or None; got {plane!r}")
+            loc, xd, yd = plane.Location(), plane.XDirection(), plane.YDirection()
+            origin, x, y = (loc.X(), loc.Y(), loc.Z()), (xd.X(), xd.Y(), xd.Z()), (yd.X(), yd.Y(), yd.Z())
+        self.ox, self.oy, self.oz = origin
+        self.xx, self.xy, self.xz = x
+        self.yx, self.yy, self.yz = y
+        # The circle axis is X × Y (not the plane's main direction, which points
+        # the other way for a left-handed gp_Ax3) so "counterclockwise" always
+        # means turning from X towards Y.
+        self.normal = gp_Dir(x[1] * y[2] - x[2] * y[1], x[2] * y[0] - x[0] * y[2], x[0] * y[1] - x[1] * y[0])
+        self.x_dir = gp_Dir(*x)
+        self.flat = plane is None or (origin == (0.0, 0.0, 0.0) and x == (1.0, 0.0, 0.0) and y == (0.0, 1.0, 0.0))
+
+    def pnt(self, x: float, y: float) -> gp_Pnt:
+        if self.flat:
+            return gp_Pnt(x, y, 0.0)
+        return gp_Pnt(
+            self.ox + x * self.xx + y * self.yx,
+            self.oy + x * self.xy + y * self.yy,
+            self.oz + x * self.xz + y * self.yz,
+        )
+
+    def poles(self, points: list[list[float]]) -> TColgp_Array1OfPnt:
+        array = TColgp_Array1OfPnt(1, len(points))
+        for i, (x, y) in enumerate(points, 1):
+            array.SetValue(i, self.pnt(x, y))
+        return array
+
+
+_XY = _Frame(None)
+
+
+def _frame(plane: gp_Ax3 | None) -> _Frame:
+    return _XY if plane is None else _Frame(plane)
+
+
+def _line_edge(line: Line, frame: _Frame) -> TopoDS_Edge:
+    (ax, ay), (bx, by) = line._a.tolist(), line._b.tolist()
+    # MakeEdge(P1, P2) builds the Geom_Line trimmed to [0, |P1P2|] (GC_MakeSegment's result).
+    if frame.flat:  # the common case, spelled out: it runs once per edge
+        return BRepBuilderAPI_MakeEdge(gp_Pnt(ax, ay, 0.0), gp_Pnt(bx, by, 0.0)).Edge()
+    return BRepBuilderAPI_MakeEdge(frame.pnt(ax, ay), frame.pnt(bx, by)).Edge()
+
+
+def _arc_edge(arc: Arc, frame: _Frame) -> TopoDS_Edge:
+    cx, cy = arc.center.tolist()
+    radius, a0, sweep = arc.radius, arc.start_angle, arc.sweep
+    if radius > 0.0:
+        axis, first = frame.normal, a0
+    else:
+        # Clockwise travel: the circle's axis is flipped so its parameter still
+        # increases along the path; the point at plane angle a has parameter -a.
+        axis, first = frame.normal.Reversed(), -a0
+    circle = gp_Circ(gp_Ax2(frame.pnt(cx, cy), axis, frame.x_dir), abs(radius))
+    return BRepBuilderAPI_MakeEdge(circle, first, first + sweep).Edge()
+
+
+def _bezier_edge(spiral: BezierSpiral, frame: _Frame) -> TopoDS_Edge:
+    curve = Geom_BezierCurve(frame.poles(spiral.control_points.tolist()))
+    return BRepBuilderAPI_MakeEdge(curve).Edge()
+
+
+_MAKERS = {Line: _line_edge, Arc: _arc_edge, BezierSpiral: _bezier_edge}
+
+
+def _maker(segment: Segment) -> Callable[[Segment, _Frame], TopoDS_Edge]:
+    """The edge maker for ``segment`` (subclasses included)."""
+    for kind, maker in _MAKERS.items():
+        if isinstance(segment, kind):
+            return maker
+    raise ValueError(f"segment must be a Line, Arc or BezierSpiral; got {segment!r}")
+
+
+def segment_edge(segment: Segment, plane: gp_Ax3 | None = None) -> TopoDS_Edge:
+    """The exact OCCT edge of one segment, running in travel order.
+
+    Args:
+        segment: a ``Line`` (edge on a ``Geom_Line``), ``Arc`` (on a
+            ``Geom_Circle``) or ``BezierSpiral`` (``Geom_BezierCurve`` with
+            its four control points).
+        plane: local frame of the 2-D coordinates; None is the XY plane.
+
+    Raises:
+        ValueError: an unsupported segment type or a ``plane`` that is not a
+            ``gp_Ax3``.
+    """
+    maker = _MAKERS.get(type(segment)) or _maker(segment)
+    return maker(segment, _XY if plane is None else _Frame(plane))
+
+
+def segment_edges(segments: Iterable[Segment], plane: gp_Ax3 | None = None) -> list[TopoDS_Edge]:
+    """``segment_edge`` for many segments sharing one frame (a chain, a transition's spirals)."""
+    frame = _frame(plane)
+    makers = _MAKERS
+    return [(makers.get(type(s)) or _maker(s))(s, frame) for s in segments]
+
+
+def chain_wire(chain: Iterable[Segment], plane: gp_Ax3 | None = None) -> TopoDS_Wire:
+    """One wire of the exact edges of ``chain`` (a ``Chain`` or any segments in travel order).
+
+    Raises:
+        ValueError: the segments do not connect into a wire (OCCT's
+            vertex tolerance, 1e-7, is exceeded) or there are none.
+    """
+    maker = BRepBuilderAPI_MakeWire()
+    count = 0
+    for edge in segment_edges(chain, plane):
+        maker.Add(edge)
+        count += 1
+        if not maker.IsDone():
+            raise ValueError(f"segment {count - 1} does not connect to the previous one ({maker.Error()})")
+    if count == 0:
+        raise ValueError("chain_wire needs at least one segment")
+    return maker.Wire()
+
+
+def nurbs_edge(nurbs: Nurbs, plane: gp_Ax3 | None = None) -> TopoDS_Edge:
+    """The OCCT edge on the rational B-spline ``nurbs`` (same knots, so same parameters)."""
+    frame = _frame(plane)
+    poles = frame.poles(nurbs.control_points.tolist())
+    weights = TColStd_Array1OfReal(1, len(nurbs.weights))
+    for i, w in enumerate(nurbs.weights.tolist(), 1):
+        weights.SetValue(i, w)
+    knots = TColStd_Array1OfReal(1, len(nurbs.knots))
+    mults = TColStd_Array1OfInteger(1, len(nurbs.knots))
+    for i, (k, m) in enumerate(zip(nurbs.knots.tolist(), nurbs.multiplicities.tolist()), 1):
+        knots.SetValue(i, k)
+        mults.SetValue(i, m)
+    curve = Geom_BSplineCurve(poles, weights, knots, mults, nurbs.degree)
+    return BRepBuilderAPI_MakeEdge(curve).Edge()

@@ -1,0 +1,339 @@
+"""G2 checker on real OCCT geometry (raw OCP edges, build123d for STEP export)."""
+
+from __future__ import annotations
+
+import math
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+pytest.importorskip("OCP")
+
+import build123d as bd  # noqa: E402
+from OCP.BRep import BRep_Builder  # noqa: E402
+from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeEdge, BRepBuilderAPI_MakeWire, BRepBuilderAPI_Transform  # noqa: E402
+from OCP.BRepTools import BRepTools_WireExplorer  # noqa: E402
+from OCP.GC import GC_MakeArcOfCircle  # noqa: E402
+from OCP.Geom import Geom_BezierCurve  # noqa: E402
+from OCP.gp import gp_Ax1, gp_Ax2, gp_Circ, gp_Dir, gp_Pnt, gp_Trsf, gp_Vec  # noqa: E402
+from OCP.IGESControl import IGESControl_Writer  # noqa: E402
+from OCP.TColgp import TColgp_Array1OfPnt  # noqa: E402
+from OCP.TopAbs import TopAbs_REVERSED  # noqa: E402
+from OCP.TopoDS import TopoDS, TopoDS_Wire  # noqa: E402
+
+import spiral_cad as sc  # noqa: E402
+from spiral_cad.cli import main  # noqa: E402
+from spiral_cad.continuity import Continuity, check_continuity  # noqa: E402
+
+G0, G1, G2, NONE = Continuity.G0, Continuity.G1, Continuity.G2, Continuity.NONE
+
+
+# ------------------------------------------------------------ raw OCCT edges
+
+
+def _pnt(p) -> gp_Pnt:
+    return gp_Pnt(float(p[0]), float(p[1]), float(p[2]) if len(p) > 2 else 0.0)
+
+
+def line(a, b):
+    return BRepBuilderAPI_MakeEdge(_pnt(a), _pnt(b)).Edge()
+
+
+def bezier(control_points):
+    poles = TColgp_Array1OfPnt(1, len(control_points))
+    for i, p in enumerate(control_points, 1):
+        poles.SetValue(i, _pnt(p))
+    return BRepBuilderAPI_MakeEdge(Geom_BezierCurve(poles)).Edge()
+
+
+def ccw_arc(center, radius, a0, a1):
+    """Counterclockwise arc in the XY plane from polar angle a0 to a1."""
+    circle = gp_Circ(gp_Ax2(_pnt(center), gp_Dir(0, 0, 1)), radius)
+    return BRepBuilderAPI_MakeEdge(GC_MakeArcOfCircle(circle, a0, a1, True).Value()).Edge()
+
+
+def wire(*edges) -> TopoDS_Wire:
+    maker = BRepBuilderAPI_MakeWire()
+    for e in edges:
+        maker.Add(e)
+        assert maker.IsDone(), maker.Error()
+    return maker.Wire()
+
+
+def loose_wire(*edges) -> TopoDS_Wire:
+    """A wire holding edges that need not connect (BRepBuilderAPI_MakeWire refuses those)."""
+    builder, w = BRep_Builder(), TopoDS_Wire()
+    builder.MakeWire(w)
+    for e in edges:
+        builder.Add(w, e)
+    return w
+
+
+def spiral_path(point=(0.0, 0.0), direction=(1.0, 0.0), center=(0.0, 1.05), radius=1.0, lead=2.0, sweep=1.0):
+    """Edges of line → spiral (line_to_circle) → arc of the circle, in travel order."""
+    t = sc.line_to_circle(point, direction, center, radius)
+    cp = t.spirals[0].control_points
+    ux, uy = t.spirals[0].start_tangent
+    circle = t.end_circle
+    a0 = math.atan2(cp[3][1] - circle.center[1], cp[3][0] - circle.center[0])
+    start = (cp[0][0] - lead * ux, cp[0][1] - lead * uy)
+    if circle.radius > 0:
+        arc = ccw_arc(circle.center, radius, a0, a0 + sweep)
+    else:  # clockwise travel: the counterclockwise arc run backwards
+        arc = TopoDS.Edge_s(ccw_arc(circle.center, radius, a0 - sweep, a0).Reversed())
+    return [line(start, cp[0]), bezier(cp.tolist()), arc]
+
+
+def levels(report, wire_index=0):
+    return [j.level for j in report.wires[wire_index].joints]
+
+
+# ------------------------------------------------------------------ levels
+
+
+def test_levels_are_ordered_and_parse():
+    assert NONE < G0 < G1 < G2
+    assert Continuity.parse("g2") is G2 and Continuity.parse("none") is NONE and Continuity.parse(1) is G0
+    assert str(NONE) == "none" and str(G1) == "G1"
+    with pytest.raises(ValueError, match="G3"):
+        Continuity.parse("G3")
+
+
+def test_line_then_tangent_arc_is_g1_not_g2():
+    report = check_continuity(wire(line((-2, 0), (0, 0)), ccw_arc((0, 1), 1.0, -math.pi / 2, 0.0)))
+    (joint,) = report.wires[0].joints
+    assert joint.level is G1
+    assert joint.gap < 1e-12 and joint.angle < 1e-12
+    assert joint.curvature_before == pytest.approx(0.0, abs=1e-12)
+    assert joint.curvature_after == pytest.approx(1.0, rel=1e-12)
+    assert joint.curvature_jump == pytest.approx(1.0, rel=1e-12)
+    assert report.passes("G1") and not report.passes("G2")
+
+
+def test_line_spiral_arc_is_g2_at_both_joints():
+    report = check_continuity(wire(*spiral_path()))
+    w = report.wires[0]
+    assert (w.edge_count, w.closed) == (3, False)
+    assert levels(report) == [G2, G2]
+    # The spiral starts with zero curvature (where OCCT's own analysis fails) and ends at 1/r.
+    assert w.joints[0].curvature_after == pytest.approx(0.0, abs=1e-12)
+    assert w.joints[1].curvature_before == pytest.approx(1.0, rel=1e-12)
+    assert report.min_level is G2 and report.passes(G2)
+
+
+@settings(max_examples=25)
+@given(
+    px=st.floats(-50, 50),
+    py=st.floats(-50, 50),
+    heading=st.floats(-math.pi, math.pi),
+    radius=st.floats(0.05, 20.0),
+    clearance=st.floats(1.01, 3.0),
+    side=st.sampled_from([1.0, -1.0]),
+)
+def test_any_line_to_circle_transition_is_g2(px, py, heading, radius, clearance, side):
+    tx, ty = math.cos(heading), math.sin(heading)
+    d = radius * clearance
+    center = (px - side * d * ty, py + side * d * tx)
+    edges = spiral_path((px, py), (tx, ty), center, radius, lead=radius, sweep=0.5)
+    assert levels(check_continuity(wire(*edges))) == [G2, G2]
+
+
+def test_corner_is_g0_with_its_angle():
+    (joint,) = check_continuity(wire(line((0, 0), (1, 0)), line((1, 0), (1 + math.cos(0.3), math.sin(0.3))))).joints
+    assert joint.level is G0
+    assert joint.angle == pytest.approx(0.3, rel=1e-12)
+
+
+def test_disconnected_pair_is_below_g0():
+    report = check_continuity(loose_wire(line((0, 0), (1, 0)), line((1.001, 0), (2, 0))))
+    (joint,) = report.joints
+    assert joint.level is NONE
+    assert joint.gap == pytest.approx(1e-3, rel=1e-9)
+    assert not report.passes("G0")
+
+
+def test_loose_edges_are_chained_in_order_and_orientation():
+    # Shuffled, with the first line pointing backwards: chaining must restore line → spiral → arc.
+    _, spiral, arc = spiral_path()
+    b0 = sc.line_to_circle((0, 0), (1, 0), (0, 1.05), 1.0).spirals[0].control_points[0]
+    report = check_continuity([arc, line(b0, (b0[0] - 2.0, 0.0)), spiral])
+    (w,) = report.wires
+    assert w.loose and w.edge_count == 3
+    assert levels(report) == [G2, G2]
+
+
+def test_separate_loose_curves_stay_separate_but_a_small_gap_is_reported():
+    far = check_continuity([line((0, 0), (1, 0)), line((5, 0), (6, 0))])
+    assert [w.edge_count for w in far.wires] == [1, 1] and far.joints == []
+    near = check_continuity([line((0, 0), (1, 0)), line((1.0 + 1e-6, 0), (2, 0))])
+    assert levels(near) == [NONE]
+    assert near.joints[0].gap == pytest.approx(1e-6, rel=1e-6)
+    # The gap tolerance is absolute: the same gap passes when allowed.
+    assert levels(check_continuity([line((0, 0), (1, 0)), line((1.0 + 1e-6, 0), (2, 0))], gap_tol=1e-5)) == [G2]
+
+
+def test_reversed_edge_runs_from_last_to_first_parameter():
+    first, _, arc = spiral_path()
+    t = sc.line_to_circle((0, 0), (1, 0), (0, 1.05), 1.0)
+    backwards = bezier(t.spirals[0].control_points[::-1].tolist())  # parameter runs arc → line
+    w = wire(first, TopoDS.Edge_s(backwards.Reversed()), arc)
+    explorer = BRepTools_WireExplorer(w)
+    explorer.Next()
+    assert explorer.Current().Orientation() == TopAbs_REVERSED
+    report = check_continuity(w)
+    assert levels(report) == [G2, G2]
+    assert max(j.gap for j in report.joints) < 1e-12
+
+
+def test_opposite_curvature_of_equal_size_is_only_g1():
+    # Two quarter arcs, counterclockwise then clockwise (an S of arcs): |κ| matches, the
+    # curvature vectors point opposite ways, so this is G1. The clockwise arc is a
+    # REVERSED edge, which also checks that orientation does not flip curvature vectors.
+    ccw = ccw_arc((0, 1), 1.0, -math.pi / 2, 0.0)  # (0, 0) → (1, 1), heading +y
+    cw = TopoDS.Edge_s(ccw_arc((2, 1), 1.0, math.pi / 2, math.pi).Reversed())  # (1, 1) → (2, 2)
+    (joint,) = check_continuity(wire(ccw, cw)).joints
+    assert joint.angle < 1e-12
+    assert joint.curvature_before == pytest.approx(joint.curvature_after, rel=1e-12)
+    assert joint.level is G1
+    assert joint.curvature_jump == pytest.approx(2.0, rel=1e-12)
+
+
+def test_s_transition_inflection_is_g2():
+    t = sc.circle_to_circle((0, 0), -2.0, (5, 1), 1.0)
+    edges = [bezier(s.control_points.tolist()) for s in t.spirals]
+    (joint,) = check_continuity(wire(*edges)).joints
+    assert joint.level is G2
+    assert joint.curvature_before == pytest.approx(0.0, abs=1e-12)
+
+
+def test_closed_wire_checks_its_closing_joint():
+    # line → tangent arc (3/4 turn) → line back down to the start: the closing joint is a corner.
+    edges = [line((0, 0), (1, 0)), ccw_arc((1, 1), 1.0, -math.pi / 2, math.pi), line((0, 1), (0, 0))]
+    (w,) = check_continuity(wire(*edges)).wires
+    assert w.closed and w.edge_count == 3
+    assert [j.index for j in w.joints] == [0, 1, 2]
+    assert [j.level for j in w.joints] == [G1, G1, G0]
+    assert w.joints[2].angle == pytest.approx(math.pi / 2, rel=1e-12)
+
+
+def test_single_closed_edge_has_one_joint():
+    (joint,) = check_continuity(bd.Circle(2.0)).joints  # build123d face: its circle wire
+    assert joint.level is G2 and joint.curvature_after == pytest.approx(0.5)
+
+
+def test_solid_faces_and_shape_wrappers():
+    report = check_continuity(bd.Box(1, 2, 3))
+    assert len(report.wires) == 6 and all(w.closed and w.edge_count == 4 for w in report.wires)
+    assert all(j.level is G0 and j.angle == pytest.approx(math.pi / 2) for j in report.joints)
+
+
+def test_rotated_3d_copy_keeps_its_levels():
+    trsf = gp_Trsf()
+    trsf.SetRotation(gp_Ax1(gp_Pnt(1, 2, 3), gp_Dir(0.3, -0.5, 0.8)), 1.1)
+    trsf.SetTranslationPart(gp_Vec(10, -4, 7))
+    rotated = BRepBuilderAPI_Transform(wire(*spiral_path()), trsf, True).Shape()
+    assert levels(check_continuity(rotated)) == [G2, G2]
+    tangent_arc = wire(line((-2, 0), (0, 0)), ccw_arc((0, 1), 1.0, -math.pi / 2, 0.0))
+    assert levels(check_continuity(BRepBuilderAPI_Transform(tangent_arc, trsf, True).Shape())) == [G1]
+
+
+def test_degenerate_end_derivative_still_gives_a_tangent():
+    # First two poles coincide: r'(0) = 0, the tangent comes from P2 − P0.
+    curve = bezier([(0, 0), (0, 0), (1, 0), (2, 1)])
+    (joint,) = check_continuity(wire(line((-1, 0), (0, 0)), curve)).joints
+    assert joint.gap == 0.0 and joint.angle < 1e-9
+    assert joint.level is G1  # the curvature is unbounded at such an end
+
+
+def test_bad_tolerance_is_rejected():
+    with pytest.raises(ValueError, match="gap_tol"):
+        check_continuity(wire(line((0, 0), (1, 0))), gap_tol=-1.0)
+
+
+# ----------------------------------------------------------------- files
+
+
+CASES = {
+    "spiral": lambda: spiral_path(),
+    "tangent-arc": lambda: [line((-2, 0), (0, 0)), ccw_arc((0, 1), 1.0, -math.pi / 2, 0.0)],
+    "corner": lambda: [line((0, 0), (1, 0)), line((1, 0), (1, 1))],
+}
+
+
+@pytest.mark.parametrize("case", sorted(CASES))
+def test_step_round_trip_keeps_the_classification(case, tmp_path):
+    w = wire(*CASES[case]())
+    path = tmp_path / f"{case}.step"
+    bd.export_step(bd.Wire(w), str(path))
+    assert levels(check_continuity(path)) == levels(check_continuity(w))
+
+
+@pytest.mark.parametrize("case", sorted(CASES))
+def test_iges_round_trip_keeps_the_classification(case, tmp_path):
+    w = wire(*CASES[case]())
+    path = tmp_path / f"{case}.igs"
+    writer = IGESControl_Writer("MM", 0)
+    writer.AddShape(w)
+    writer.ComputeModel()
+    assert writer.Write(str(path))
+    assert levels(check_continuity(str(path))) == levels(check_continuity(w))
+
+
+def test_unreadable_files_raise_value_error(tmp_path):
+    bad = tmp_path / "bad.step"
+    bad.write_text("not a step file\n")
+    for path in (bad, tmp_path / "missing.step", tmp_path / "model.txt"):
+        with pytest.raises(ValueError, match="cannot read"):
+            check_continuity(path)
+
+
+def test_format_table_lists_every_wire_and_joint():
+    text = check_continuity(wire(*spiral_path())).format_table()
+    assert "wire 0: 3 edge(s), open, 2 joint(s), worst G2" in text
+    assert text.count(" G2\n") + text.endswith(" G2") >= 2
+
+
+# ------------------------------------------------------------------- CLI
+
+
+@pytest.fixture()
+def step_files(tmp_path) -> dict[str, Path]:
+    files = {}
+    for case in ("spiral", "tangent-arc"):
+        files[case] = tmp_path / f"{case}.step"
+        bd.export_step(bd.Wire(wire(*CASES[case]())), str(files[case]))
+    return files
+
+
+def test_cli_check_reports_and_exits_by_requirement(step_files, capsys):
+    assert main(["check", str(step_files["tangent-arc"])]) == 0
+    assert "worst G1" in capsys.readouterr().out
+    assert main(["check", str(step_files["tangent-arc"]), "--require", "G1"]) == 0
+    assert main(["check", str(step_files["tangent-arc"]), "--require", "G2"]) == 1
+    assert "FAIL" in capsys.readouterr().out
+    assert main(["check", str(step_files["spiral"]), "--require", "G2"]) == 0
+    # A huge curvature tolerance lets the tangent arc pass G2.
+    assert main(["check", str(step_files["tangent-arc"]), "--require", "G2", "--curvature-tol", "2"]) == 0
+
+
+def test_cli_check_unreadable_file_exits_2(tmp_path, capsys):
+    bad = tmp_path / "bad.igs"
+    bad.write_text("garbage\n")
+    assert main(["check", str(bad)]) == 2
+    assert main(["check", str(tmp_path / "missing.step")]) == 2
+    assert "cannot read" in capsys.readouterr().err
+
+
+def test_cli_script_runs(step_files):
+    script = Path(sys.executable).parent / "spiral-cad"
+    if not script.exists():
+        pytest.skip("spiral-cad script not installed next to this interpreter")
+    done = subprocess.run(
+        [str(script), "check", str(step_files["tangent-arc"]), "--require", "G2"], capture_output=True, text=True
+    )
+    assert done.returncode == 1
+    assert "worst G1" in done.stdout
