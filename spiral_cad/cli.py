@@ -1,11 +1,13 @@
-"""Command line: ``spiral-cad demo``."""
+"""Command line: ``spiral-cad demo | build | check``."""
 
 from __future__ import annotations
 
 import argparse
 import math
 import sys
+import time
 from collections.abc import Sequence
+from pathlib import Path
 
 from . import circle_in_circle, circle_to_circle, line_to_circle, line_to_line
 from .transitions import Transition
@@ -37,9 +39,84 @@ def transition_table(rows: Sequence[tuple[str, Transition]]) -> str:
     return "\n".join(lines)
 
 
-def _demo(args: argparse.Namespace) -> int:
-    print(transition_table(core_examples()))
+#: The built-in default design of ``spiral-cad demo`` (the JSON format of ``build``).
+DEMO_DESIGN: dict = {
+    "units": "m",
+    "designs": [
+        {
+            "name": "highway",
+            "type": "alignment",
+            "pis": [[0, 0], [600, 120], [1150, -80], [1700, 260], [2300, 200]],
+            "radii": [450, 400, 600],
+            "spiral_angles_deg": [[8, 8], [7, 10], 6],
+            "start_station": 10000,
+        },
+        {
+            "name": "circles",
+            "type": "circle_chain",
+            "circles": [
+                {"center": [0, 0], "radius": 60},
+                {"center": [0, -29.85], "radius": 30},
+                {"center": [150, -10], "radius": 40},
+                {"center": [280, 30], "radius": -35},
+                {"center": [400, -20], "radius": -50},
+            ],
+        },
+        {
+            "name": "robot",
+            "type": "rounded_polyline",
+            "points": [[0, 0], [1.0, 0.1], [1.4, 0.9], [2.4, 1.0], [2.6, 0.2], [3.6, 0.4]],
+            "max_curvature": 6.0,
+        },
+    ],
+}
+
+
+def _write_design(design: dict | str, out: Path) -> int:
+    from .designfile import DesignError, build, summary, write
+
+    started = time.perf_counter()
+    try:
+        units, built = build(design)
+    except DesignError as e:
+        print(f"error: {e}", file=sys.stderr)
+        return 2
+    print(f"built {len(built)} design(s); writing to {out}/", flush=True)
+    written = write(built, out, units, progress=lambda line: print(line, flush=True))
+    print()
+    print(summary(built, units))
+    print(f"\nwrote {len(written)} files to {out}/ in {time.perf_counter() - started:.1f} s")
     return 0
+
+
+def _demo(args: argparse.Namespace) -> int:
+    out = Path(args.out)
+    print("The five transitions of Walton & Meek (1996), one instance each:\n")
+    print(transition_table(core_examples()))
+    print()
+    status = _write_design(DEMO_DESIGN, out)
+    if status == 0:
+        _paper_plots(out)
+    return status
+
+
+def _paper_plots(out: Path) -> None:
+    """The paper's Fig. 6 family and the Bézier spiral against a clothoid."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from .plots import plot_fig6, plot_vs_clothoid
+
+    for name, fig in (("fig6.png", plot_fig6()), ("bezier_vs_clothoid.png", plot_vs_clothoid(math.radians(30), 1.0))):
+        fig.savefig(out / name, dpi=110)
+        plt.close(fig)
+        print(f"  {out / name}")
+
+
+def _build(args: argparse.Namespace) -> int:
+    return _write_design(args.design, Path(args.out))
 
 
 def _check(args: argparse.Namespace) -> int:
@@ -58,12 +135,30 @@ def _add_check(sub: argparse._SubParsersAction) -> None:
     check.set_defaults(run=_check)
 
 
+def _design_format() -> str:
+    from .designfile import FORMAT
+
+    return FORMAT
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     parser = argparse.ArgumentParser(prog="spiral-cad", description="Exact G2 cubic Bézier spiral transitions for CAD.")
     sub = parser.add_subparsers(dest="command", required=True)
-    demo = sub.add_parser("demo", help="solve the built-in default design and write its outputs")
+    demo = sub.add_parser(
+        "demo",
+        help="build the built-in design (highway alignment, circle chain, rounded robot path) and write every output",
+    )
     demo.add_argument("--out", default="out", help="output folder (default: out)")
     demo.set_defaults(run=_demo)
+    build = sub.add_parser(
+        "build",
+        help="build a JSON design file and write STEP, IGES, DXF, SVG, plots, tables and a continuity report",
+        description="Design file format:\n\n" + _design_format(),
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
+    build.add_argument("design", help="the design file (.json)")
+    build.add_argument("--out", default="out", help="output folder (default: out)")
+    build.set_defaults(run=_build)
     _add_check(sub)
     args = parser.parse_args(argv)
     return args.run(args)

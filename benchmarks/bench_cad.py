@@ -1,0 +1,140 @@
+"""CAD layer: a 10,000-segment chain → OCCT wire → STEP, against raw OCP calls.
+
+Run: ``.venv/bin/python benchmarks/bench_cad.py [--segments N] [--repeat R] [--out FILE]``.
+The peer builds the very same edges (Geom_Line, Geom_Circle, Geom_BezierCurve)
+from plain float lists with direct OCP calls, in the same run; the ratio is
+ours / raw (goal ≤ 1.2). Also reports the G2 checker's throughput.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import platform
+import statistics
+import tempfile
+import time
+
+import numpy as np
+from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeEdge, BRepBuilderAPI_MakeWire
+from OCP.Geom import Geom_BezierCurve
+from OCP.gp import gp_Ax2, gp_Circ, gp_Dir, gp_Pnt
+from OCP.TColgp import TColgp_Array1OfPnt
+
+from spiral_cad import Arc, Chain, Line, circle_to_circle
+from spiral_cad.export import export_step
+from spiral_cad.occ import chain_wire
+
+try:
+    from spiral_cad.continuity import check_continuity
+except ImportError:  # pragma: no cover - reported in the table
+    check_continuity = None
+
+
+def snake(segments: int) -> Chain:
+    """Circles of alternating sense joined by S transitions: arc, spiral, spiral, …"""
+    circles = segments // 3 + 1
+    parts = []
+    for i in range(circles - 1):
+        r0 = 40.0 if i % 2 == 0 else -40.0
+        parts.append(circle_to_circle((100.0 * i, 0.0), r0, (100.0 * (i + 1), 0.0), -r0))
+    return Chain.join(parts)
+
+
+def plain_description(chain: Chain) -> list[tuple]:
+    """What a user of raw OCP would start from: plain numbers per segment."""
+    rows = []
+    for seg in chain:
+        if isinstance(seg, Line):
+            rows.append(("line", *seg.start.tolist(), *seg.end.tolist()))
+        elif isinstance(seg, Arc):
+            rows.append(("arc", *seg.center.tolist(), seg.radius, seg.start_angle, seg.sweep))
+        else:
+            rows.append(("bezier", seg.control_points.tolist()))
+    return rows
+
+
+def raw_ocp_wire(rows: list[tuple]):
+    """The same edges and wire with direct OCP calls."""
+    up, down, x = gp_Dir(0, 0, 1), gp_Dir(0, 0, -1), gp_Dir(1, 0, 0)
+    wire = BRepBuilderAPI_MakeWire()
+    for row in rows:
+        if row[0] == "line":
+            edge = BRepBuilderAPI_MakeEdge(gp_Pnt(row[1], row[2], 0), gp_Pnt(row[3], row[4], 0)).Edge()
+        elif row[0] == "arc":
+            _, cx, cy, r, a0, sweep = row
+            axis, first = (up, a0) if r > 0 else (down, -a0)
+            edge = BRepBuilderAPI_MakeEdge(gp_Circ(gp_Ax2(gp_Pnt(cx, cy, 0), axis, x), abs(r)), first, first + sweep).Edge()
+        else:
+            poles = TColgp_Array1OfPnt(1, 4)
+            for i, (px, py) in enumerate(row[1], 1):
+                poles.SetValue(i, gp_Pnt(px, py, 0))
+            edge = BRepBuilderAPI_MakeEdge(Geom_BezierCurve(poles)).Edge()
+        wire.Add(edge)
+    return wire.Wire()
+
+
+def median(fn, repeat: int) -> float:
+    times = []
+    for _ in range(repeat):
+        t0 = time.perf_counter()
+        fn()
+        times.append(time.perf_counter() - t0)
+    return statistics.median(times)
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--segments", type=int, default=10_000)
+    parser.add_argument("--repeat", type=int, default=5)
+    parser.add_argument("--out", help="also write the table to this markdown file")
+    args = parser.parse_args()
+    t0 = time.perf_counter()
+    chain = snake(args.segments)
+    build_chain = time.perf_counter() - t0
+    rows = plain_description(chain)
+    print(f"chain of {len(chain):,} segments built and G2-checked in {build_chain:.2f} s", flush=True)
+    with tempfile.TemporaryDirectory() as tmp:
+        ours_path, raw_path = os.path.join(tmp, "ours.step"), os.path.join(tmp, "raw.step")
+        t_ours_wire = median(lambda: chain_wire(chain), args.repeat)
+        t_raw_wire = median(lambda: raw_ocp_wire(rows), args.repeat)
+        t_ours = median(lambda: export_step(chain, ours_path), args.repeat)
+        t_raw = median(lambda: _write_step(raw_ocp_wire(rows), raw_path), args.repeat)
+        wire = chain_wire(chain)
+        t_check = median(lambda: check_continuity(wire), max(1, args.repeat // 2)) if check_continuity else float("nan")
+        report = check_continuity(wire) if check_continuity else None
+    joints = len(chain) - 1
+    table = [
+        ("segments", f"{len(chain):,}", ""),
+        ("chain → OCCT wire, ours (median)", f"{t_ours_wire * 1e3:,.1f} ms", ""),
+        ("same edges + wire, raw OCP calls", f"{t_raw_wire * 1e3:,.1f} ms", ""),
+        ("ratio ours / raw (wire)", f"{t_ours_wire / t_raw_wire:.2f}×", "goal ≤ 1.2"),
+        ("chain → wire → STEP file, ours", f"{t_ours * 1e3:,.1f} ms", ""),
+        ("raw OCP edges → wire → STEP file", f"{t_raw * 1e3:,.1f} ms", ""),
+        ("ratio ours / raw (wire + STEP)", f"{t_ours / t_raw:.2f}×", "goal ≤ 1.2"),
+        ("G2 checker", f"{joints / t_check:,.0f} joints/s", f"{joints:,} joints, min level {report.min_level if report else '-'}"),
+    ]
+    machine = f"{platform.machine()}, {os.cpu_count()} cores, Python {platform.python_version()}"
+    for name, value, note in table:
+        print(f"  {name:38} {value:>18}  {note}")
+    print(f"machine: {machine}")
+    if args.out:
+        with open(args.out, "w", encoding="utf-8") as fh:
+            fh.write(f"# CAD benchmark\n\nMachine: {machine}. Median of {args.repeat} runs.\n\n")
+            fh.write("| measurement | value | note |\n|---|---:|---|\n")
+            for row in table:
+                fh.write("| " + " | ".join(row) + " |\n")
+
+
+def _write_step(shape, path: str) -> None:
+    from OCP.IFSelect import IFSelect_RetDone
+    from OCP.STEPControl import STEPControl_AsIs, STEPControl_Writer
+
+    writer = STEPControl_Writer()
+    writer.Transfer(shape, STEPControl_AsIs)
+    if writer.Write(path) != IFSelect_RetDone:
+        raise RuntimeError(f"could not write {path}")
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,23 @@
+"""Design tools built on the core: horizontal alignments, circle chains, corner rounding.
+
+Pure numpy/numba: nothing here imports a CAD kernel.
+"""
+
+from .alignment import Alignment, CurveData, curvature_rate, peak_curvature_rate
+from .circles import CircleChain, circle_chain
+from .rounding import CornerBatch, RoundedCorner, RoundedPath, corner_legs, round_corners, round_corners_batch
+
+__all__ = [
+    "Alignment",
+    "CircleChain",
+    "CornerBatch",
+    "CurveData",
+    "RoundedCorner",
+    "RoundedPath",
+    "circle_chain",
+    "corner_legs",
+    "curvature_rate",
+    "peak_curvature_rate",
+    "round_corners",
+    "round_corners_batch",
+]

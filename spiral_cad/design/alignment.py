@@ -1,0 +1,400 @@
+"""Horizontal alignments: tangent–spiral–arc–spiral–tangent at every PI.
+
+A road or railway centre line is given by its points of intersection (PIs):
+straight tangents between them, and at every interior PI a circular curve of
+given radius entered and left through Bézier spirals (Theorem 4.1). The
+result is one G2 :class:`~spiral_cad.Chain` plus a stationing table.
+"""
+
+from __future__ import annotations
+
+import csv
+import math
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+from scipy.optimize import brentq, minimize_scalar
+
+from .. import bezier
+from .._inputs import as_float, as_points
+from .._kernels import shape_g1
+from ..chain import JOIN_TOLERANCE, Chain
+from ..errors import NoSolutionError
+from ..spiral import BezierSpiral
+from ..transitions import Transition, line_to_circle
+from ._paths import chain_through
+
+#: |sin(deflection)| at or below this counts as a straight PI.
+COLLINEAR_TOL = 1e-12
+#: θ range searched when a spiral length is requested.
+_THETA_RANGE = (1e-7, math.pi / 2 * (1.0 - 1e-9))
+
+
+# ------------------------------------------------- rate of curvature
+
+
+def curvature_rate(control_points: ArrayLike, u: ArrayLike) -> NDArray:
+    """dκ/ds of a cubic Bézier at parameters ``u``.
+
+    dκ/ds = κ'(u)/|Q'| with κ = (Q' × Q'')/|Q'|³, i.e.
+    ``((Q' × Q''')|Q'|² − 3 (Q' × Q'')(Q' · Q'')) / |Q'|⁶``. For a Bézier
+    spiral this is not constant: curvature is not linear in arc length.
+    """
+    cp = np.asarray(control_points, dtype=float)
+    d1 = bezier.derivative(cp, u, 1)
+    d2 = bezier.derivative(cp, u, 2)
+    d3 = 6.0 * np.diff(cp, n=3, axis=0)[0]
+    cross12 = d1[..., 0] * d2[..., 1] - d1[..., 1] * d2[..., 0]
+    cross13 = d1[..., 0] * d3[1] - d1[..., 1] * d3[0]
+    speed2 = d1[..., 0] ** 2 + d1[..., 1] ** 2
+    dot12 = d1[..., 0] * d2[..., 0] + d1[..., 1] * d2[..., 1]
+    return (cross13 * speed2 - 3.0 * cross12 * dot12) / speed2**3
+
+
+def peak_curvature_rate(spiral: BezierSpiral, samples: int = 257) -> tuple[float, float]:
+    """The largest |dκ/ds| on a spiral and the parameter u where it occurs.
+
+    Dense sampling finds the peak's neighbourhood, a bounded scalar search
+    refines it (the peak may sit at an end: for small θ it is at κ = 0).
+    """
+    cp = spiral.control_points
+    u = np.linspace(0.0, 1.0, samples)
+    rate = np.abs(curvature_rate(cp, u))
+    j = int(np.argmax(rate))
+    lo, hi = u[max(j - 1, 0)], u[min(j + 1, samples - 1)]
+    best = minimize_scalar(lambda x: -abs(float(curvature_rate(cp, x))), bounds=(lo, hi), method="bounded", options={"xatol": 1e-12})
+    if -best.fun > rate[j]:
+        return float(-best.fun), float(best.x)
+    return float(rate[j]), float(u[j])
+
+
+def theta_for_length(length: float, radius: float) -> float:
+    """The θ whose Theorem 3.1 spiral with end radius ``radius`` has arc length ``length``.
+
+    Length grows monotonically with θ for a fixed radius (and is
+    proportional to the radius), so a bracketed 1-D root gives θ.
+
+    Raises:
+        NoSolutionError: ``length`` outside the reachable range.
+    """
+
+    def excess(theta: float) -> float:
+        return BezierSpiral((0.0, 0.0), (1.0, 0.0), theta, 1.0).length - length / radius
+
+    lo, hi = _THETA_RANGE
+    if not excess(lo) < 0.0 < excess(hi):
+        raise NoSolutionError(
+            f"spiral length {length:.6g} is outside the range a spiral onto radius {radius:.6g} "
+            f"can have ({radius * (excess(lo) + length / radius):.3g} … {radius * (excess(hi) + length / radius):.3g})"
+        )
+    return float(brentq(excess, lo, hi, xtol=1e-16, rtol=1e-15, maxiter=200))
+
+
+# -------------------------------------------------------- the model
+
+
+@dataclass(frozen=True)
+class CurveData:
+    """One PI's curve: geometry, stationing and spiral quality numbers.
+
+    Angles are radians; chainages are arc length along the alignment plus
+    the alignment's start station.
+
+    Attributes:
+        index: the PI's index in the input points.
+        pi: the PI coordinates.
+        deflection: signed deflection angle at the PI (positive turns left).
+        radius: circular radius (> 0).
+        center: circle centre.
+        theta_in, theta_out: spiral angles of the entry and exit spirals.
+        spiral_in_length, spiral_out_length, arc_length: lengths.
+        ts, sc, cs, st: chainages of tangent→spiral, spiral→curve,
+            curve→spiral and spiral→tangent.
+        peak_rate_in, peak_rate_out: the largest |dκ/ds| along each spiral.
+        entry, exit: the solved transitions (line→circle, circle→line).
+    """
+
+    index: int
+    pi: tuple[float, float]
+    deflection: float
+    radius: float
+    center: tuple[float, float]
+    theta_in: float
+    theta_out: float
+    spiral_in_length: float
+    spiral_out_length: float
+    arc_length: float
+    ts: float
+    sc: float
+    cs: float
+    st: float
+    peak_rate_in: float
+    peak_rate_out: float
+    entry: Transition
+    exit: Transition
+
+    def row(self) -> dict[str, float]:
+        """The table row: lengths, chainages, angles in degrees, rates in 1/length²."""
+        return {
+            "pi": self.index,
+            "x": self.pi[0],
+            "y": self.pi[1],
+            "deflection_deg": math.degrees(self.deflection),
+            "radius": self.radius,
+            "theta_in_deg": math.degrees(self.theta_in),
+            "theta_out_deg": math.degrees(self.theta_out),
+            "spiral_in_length": self.spiral_in_length,
+            "arc_length": self.arc_length,
+            "spiral_out_length": self.spiral_out_length,
+            "TS": self.ts,
+            "SC": self.sc,
+            "CS": self.cs,
+            "ST": self.st,
+            "peak_dk_ds_in": self.peak_rate_in,
+            "mean_dk_ds_in": 1.0 / (self.radius * self.spiral_in_length),
+            "peak_dk_ds_out": self.peak_rate_out,
+            "mean_dk_ds_out": 1.0 / (self.radius * self.spiral_out_length),
+        }
+
+
+@dataclass(frozen=True)
+class Alignment:
+    """A horizontal alignment: the G2 chain from the first to the last PI and its curves."""
+
+    chain: Chain
+    curves: list[CurveData]
+    start_station: float = 0.0
+
+    @classmethod
+    def from_pis(
+        cls,
+        points: ArrayLike,
+        radii: ArrayLike,
+        spiral_angles: Any = None,
+        spiral_lengths: Any = None,
+        start_station: float = 0.0,
+        tolerance: float = JOIN_TOLERANCE,
+    ) -> Alignment:
+        """Build tangent–spiral–arc–spiral–tangent at every interior PI.
+
+        Args:
+            points: (n ≥ 3, 2) PIs in travel order; the first and last are the
+                alignment's start and end.
+            radii: circular radius per interior PI (> 0), or one for all.
+            spiral_angles: spiral angle θ (radians, in (0, π/2)): one value for
+                all, one per interior PI, or one ``(θ_in, θ_out)`` pair per PI.
+            spiral_lengths: spiral arc lengths, shaped like ``spiral_angles``
+                (give exactly one of the two).
+            start_station: chainage of the first PI.
+            tolerance: the chain's relative join tolerance (``Chain``). The
+                joins are exact up to rounding of the absolute control
+                points: with survey coordinates (~1e6) the curvature at a
+                join is only good to ~ε·|coordinates|/(h·sin θ), which can
+                exceed 1e-9 relative to the chain size.
+
+        The circle centre lies at distance r·g1(θ_in) from the incoming
+        tangent and r·g1(θ_out) from the outgoing one (Theorem 4.1), which
+        fixes it for symmetric and asymmetric curves alike.
+
+        Raises:
+            ValueError: malformed input (fewer than 3 PIs, repeated PIs,
+                collinear PIs, bad radius or spiral spec); messages name the PI.
+            NoSolutionError: a deflection too small for its spirals, or two
+                curves overlapping on their shared tangent.
+        """
+        pts = as_points(points, "points")
+        if pts.ndim != 2 or len(pts) < 3:
+            raise ValueError(f"an alignment needs at least 3 PIs as an (n, 2) array; got shape {pts.shape}")
+        if not np.isfinite(pts).all():
+            raise ValueError("PI coordinates must be finite")
+        count = len(pts) - 2
+        seg = np.diff(pts, axis=0)
+        lengths = np.hypot(seg[:, 0], seg[:, 1])
+        for k, length in enumerate(lengths):
+            if not length > 0.0:
+                raise ValueError(f"PI {k} and PI {k + 1} coincide at {pts[k].tolist()}")
+        units = seg / lengths[:, None]
+        radius = _per_pi(radii, count, "radii")
+        if (spiral_angles is None) == (spiral_lengths is None):
+            raise ValueError("give exactly one of spiral_angles and spiral_lengths")
+        by_length = spiral_lengths is not None
+        spec = _sides(spiral_lengths if by_length else spiral_angles, count, "spiral_lengths" if by_length else "spiral_angles")
+        origin = float(as_float(start_station, "start_station"))
+
+        solved = []
+        for j in range(count):
+            i = j + 1
+            r = radius[j]
+            if not r > 0.0:
+                raise ValueError(f"PI {i}: radius must be positive; got {r}")
+            t_in, t_out = units[j], units[j + 1]
+            sin_d = t_in[0] * t_out[1] - t_in[1] * t_out[0]
+            cos_d = float(np.dot(t_in, t_out))
+            if abs(sin_d) <= COLLINEAR_TOL:
+                what = "folds straight back" if cos_d < 0.0 else "is collinear with its neighbours (zero deflection)"
+                raise ValueError(f"PI {i} at {pts[i].tolist()} {what}: no curve can be placed there")
+            deflection = math.atan2(sin_d, cos_d)
+            if by_length:
+                for side, value in zip(("entry", "exit"), spec[j]):
+                    if not value > 0.0:
+                        raise ValueError(f"PI {i}: {side} spiral length must be positive; got {value}")
+                thetas = [_theta_at(value, r, i, side) for side, value in zip(("entry", "exit"), spec[j])]
+            else:
+                thetas = list(spec[j])
+                for side, value in zip(("entry", "exit"), thetas):
+                    if not 0.0 < value < math.pi / 2:
+                        raise ValueError(f"PI {i}: {side} spiral angle must lie in (0, π/2); got {value}")
+            theta_in, theta_out = thetas
+            sweep = abs(deflection) - theta_in - theta_out
+            if sweep < -1e-12:
+                raise NoSolutionError(
+                    f"PI {i}: deflection {math.degrees(abs(deflection)):.6g}° is smaller than "
+                    f"θ_in + θ_out = {math.degrees(theta_in):.6g}° + {math.degrees(theta_out):.6g}°: the circular arc "
+                    f"would have negative sweep {math.degrees(sweep):.4g}°; use shorter spirals or a smaller radius"
+                )
+            solved.append(_curve(pts[i], t_in, t_out, deflection, r, theta_in, theta_out))
+
+        _check_tangents(pts, lengths, units, solved)
+        parts: list[Transition] = [t for s in solved for t in s[:2]]
+        chain = chain_through(pts[0], parts, pts[-1], tolerance)
+        return cls(chain, _curve_data(chain, pts, solved, radius, origin), origin)
+
+    # ------------------------------------------------------- table
+
+    def rows(self) -> list[dict[str, float]]:
+        """One dict per curve (see :meth:`CurveData.row`), in travel order."""
+        return [c.row() for c in self.curves]
+
+    @property
+    def end_station(self) -> float:
+        return self.start_station + self.chain.length
+
+    def table(self, digits: int = 8) -> str:
+        """The stationing table as aligned text (for printing)."""
+        rows = self.rows()
+        head = list(rows[0])
+        cells = [[f"{v:.{digits}g}" if isinstance(v, float) else str(v) for v in row.values()] for row in rows]
+        widths = [max(len(h), *(len(c[k]) for c in cells)) for k, h in enumerate(head)]
+        lines = ["  ".join(h.rjust(w) for h, w in zip(head, widths))]
+        lines += ["  ".join(c.rjust(w) for c, w in zip(row, widths)) for row in cells]
+        lines.append(f"start {self.start_station:.{digits}g}  end {self.end_station:.{digits}g}  length {self.chain.length:.{digits}g}")
+        return "\n".join(lines)
+
+    def to_csv(self, path: str | Path) -> Path:
+        """Write the stationing table (one row per PI curve, full precision) to ``path``."""
+        path = Path(path)
+        rows = self.rows()
+        with path.open("w", newline="") as f:
+            writer = csv.DictWriter(f, fieldnames=list(rows[0]))
+            writer.writeheader()
+            for row in rows:
+                writer.writerow({k: repr(v) if isinstance(v, float) else v for k, v in row.items()})
+        return path
+
+
+def _per_pi(value: Any, count: int, name: str) -> NDArray:
+    array = np.asarray(value, dtype=float)
+    if array.ndim == 0:
+        array = np.full(count, float(array))
+    if array.shape != (count,):
+        raise ValueError(f"{name} needs one value or one per interior PI ({count}); got shape {array.shape}")
+    if not np.isfinite(array).all():
+        raise ValueError(f"{name} must be finite; got {array.tolist()}")
+    return array
+
+
+def _sides(value: Any, count: int, name: str) -> NDArray:
+    """(count, 2) entry/exit values from a scalar, one per PI, or (in, out) pairs."""
+    if not isinstance(value, (list, tuple, np.ndarray)):
+        array = np.full((count, 2), as_float(value, name))
+    else:
+        try:  # each entry a number (both sides) or an (in, out) pair
+            array = np.array([np.broadcast_to(np.asarray(v, dtype=float), (2,)) for v in value])
+        except (TypeError, ValueError):
+            raise ValueError(f"{name} entries must be numbers or (in, out) pairs; got {value!r}") from None
+    if array.shape != (count, 2):
+        raise ValueError(f"{name} needs one value, one per interior PI ({count}) or ({count}, 2) in/out pairs; got shape {array.shape}")
+    if not np.isfinite(array).all():
+        raise ValueError(f"{name} must be finite; got {array.tolist()}")
+    return array
+
+
+def _theta_at(length: float, radius: float, index: int, side: str) -> float:
+    try:
+        return theta_for_length(length, radius)
+    except NoSolutionError as error:
+        raise NoSolutionError(f"PI {index}: {side} {error}") from None
+
+
+def _curve(pi: NDArray, t_in: NDArray, t_out: NDArray, deflection: float, r: float, theta_in: float, theta_out: float):
+    """Entry and exit transitions at one PI, and the circle centre."""
+    side = math.copysign(1.0, deflection)
+    n_in = side * np.array([-t_in[1], t_in[0]])
+    n_out = side * np.array([-t_out[1], t_out[0]])
+    # Theorem 4.1: offset d = r·g1(θ) of the centre from each tangent.
+    d_in = r * shape_g1(math.sin(theta_in), math.cos(theta_in))
+    d_out = r * shape_g1(math.sin(theta_out), math.cos(theta_out))
+    center = pi + np.linalg.solve(np.array([n_in, n_out]), np.array([d_in, d_out]))
+    entry = line_to_circle(pi, t_in, center, r)
+    exit_ = line_to_circle(pi, -t_out, center, r).reversed()
+    return entry, exit_, center, deflection
+
+
+def _check_tangents(pts: NDArray, lengths: NDArray, units: NDArray, solved) -> None:
+    """Each tangent must hold the ST of one curve before the TS of the next (§5)."""
+    back = [0.0] + [float(np.dot(pts[j + 1] - s[0].start, units[j])) for j, s in enumerate(solved)]
+    ahead = [float(np.dot(s[1].end - pts[j + 1], units[j + 1])) for j, s in enumerate(solved)] + [0.0]
+    last = len(pts) - 1
+    for k, length in enumerate(lengths):
+        used = ahead[k - 1] if k > 0 else 0.0
+        used_next = back[k + 1] if k + 1 < len(back) else 0.0
+        if used + used_next > length * (1.0 + 1e-12):
+            if k == 0:
+                where = f"the TS of PI 1 lies {used_next:.6g} before PI 1, beyond the start point PI 0"
+            elif k + 1 == last:
+                where = f"the ST of PI {k} lies {used:.6g} after PI {k}, beyond the end point PI {last}"
+            else:
+                where = (
+                    f"the curves at PI {k} and PI {k + 1} overlap on their shared tangent: the ST of PI {k} is "
+                    f"{used:.6g} after PI {k} and the TS of PI {k + 1} is {used_next:.6g} before PI {k + 1}"
+                )
+            raise NoSolutionError(
+                f"{where}; together {used + used_next:.6g} > tangent length {length:.6g}. "
+                "Move the PIs apart, or reduce the radii or spiral lengths"
+            )
+
+
+def _curve_data(chain: Chain, pts: NDArray, solved, radius: NDArray, origin: float) -> list[CurveData]:
+    stations = chain.stations
+    where = {id(seg): k for k, seg in enumerate(chain.segments)}
+    curves = []
+    for j, (entry, exit_, center, deflection) in enumerate(solved):
+        first, last = entry.spirals[0], exit_.spirals[0]
+        a, b = where[id(first)], where[id(last)]
+        ts, sc, cs, st = (origin + stations[k] for k in (a, a + 1, b, b + 1))
+        curves.append(
+            CurveData(
+                index=j + 1,
+                pi=(float(pts[j + 1][0]), float(pts[j + 1][1])),
+                deflection=deflection,
+                radius=float(radius[j]),
+                center=(float(center[0]), float(center[1])),
+                theta_in=abs(first.theta),
+                theta_out=abs(last.theta),
+                spiral_in_length=first.length,
+                spiral_out_length=last.length,
+                arc_length=float(cs - sc),
+                ts=float(ts),
+                sc=float(sc),
+                cs=float(cs),
+                st=float(st),
+                peak_rate_in=peak_curvature_rate(first)[0],
+                peak_rate_out=peak_curvature_rate(last)[0],
+                entry=entry,
+                exit=exit_,
+            )
+        )
+    return curves

@@ -1,0 +1,399 @@
+"""G2 corner rounding of polylines with pairs of Bézier spirals.
+
+Two spiral pairs are offered at each corner:
+
+* ``"walton-meek"``: Theorem 4.4 of Walton & Meek (1996), two equal-leg
+  spirals (the ``line_to_line`` transition); peak curvature
+  ``(40/27) sin θ / (d cos² θ)``.
+* ``"g2cbs"``: the curvature-bounded pair of Yang & Sukkarieh (2010) with
+  unequal legs g/h = c2 = 2(√6 − 1)/5, the smallest ratio that keeps the
+  curvature monotone; peak curvature ``c4 sin θ / (d cos² θ)`` with
+  c4 ≈ 1.12249, i.e. about 24 % lower than Walton–Meek for the same corner
+  distance d (c4 / (40/27) ≈ 0.758).
+
+Here θ is half the corner's deflection and d the distance from the corner to
+where each spiral leaves its leg. The array functions (``corner_legs``,
+``round_corners_batch``) handle millions of corners; ``round_corners`` builds
+a checked :class:`~spiral_cad.Chain` for one polyline.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from .. import batch
+from .._inputs import as_float, as_points
+from ..chain import JOIN_TOLERANCE, Chain
+from ..errors import NoSolutionError, Status
+from ..segments import Ray, Segment
+from ..spiral import BezierSpiral
+from ..transitions import Transition
+from ._paths import chain_through
+
+#: Yang & Sukkarieh's leg ratio g/h: the smallest that keeps κ monotone.
+G2CBS_C2 = 2.0 * (math.sqrt(6.0) - 1.0) / 5.0
+#: Exact c1 = (c2 + 1)(c2 + 4) (the paper prints a rounded value that leaves a gap).
+G2CBS_C1 = (G2CBS_C2 + 1.0) * (G2CBS_C2 + 4.0)
+#: h = c3·d.
+G2CBS_C3 = (G2CBS_C2 + 4.0) / (G2CBS_C1 + 6.0)
+#: κmax = c4 sin β / (d cos² β).
+G2CBS_C4 = (G2CBS_C2 + 4.0) ** 2 / (54.0 * G2CBS_C3)
+
+#: Peak-curvature factor of each method: κ = factor · sin θ / (d cos² θ).
+CORNER_FACTOR = {"walton-meek": 40.0 / 27.0, "g2cbs": G2CBS_C4}
+METHODS = tuple(CORNER_FACTOR)
+
+#: Relative |sin| below which three points count as collinear (passed through).
+COLLINEAR_TOL = 1e-12
+
+
+def corner_scale(theta_sin: ArrayLike, theta_cos: ArrayLike, value: ArrayLike, method: str) -> NDArray:
+    """``factor · sin θ / (value · cos² θ)`` of ``method``.
+
+    The relation between the corner distance d and the peak (joint) curvature κ
+    of a spiral pair is symmetric: pass κ to get d, or d to get κ.
+    """
+    return CORNER_FACTOR[method] * np.asarray(theta_sin) / (np.asarray(value) * np.asarray(theta_cos) ** 2)
+
+
+def g2cbs_control_points(corners: NDArray, t_in: NDArray, t_out: NDArray, distance: NDArray, theta_cos: NDArray) -> NDArray:
+    """Control points (N, 2, 4, 2) of Yang & Sukkarieh's spiral pairs, in travel order.
+
+    The first spiral leaves the incoming leg at ``corner − d·t_in`` with legs
+    g = c2·h, h = c3·d along ``t_in`` and k = 6h cos θ / (c2 + 4) along the
+    joint tangent ``unit(t_in + t_out)``; k = 6h² cos θ/(g + 4h) makes κ'(1) = 0
+    and d = g + h + k / cos θ puts the end on the corner's bisector, where the
+    mirrored second spiral meets it with equal curvature (G2). Peak curvature
+    (at the joint) is ``G2CBS_C4 · sin θ / (d cos² θ)``.
+
+    Args:
+        corners: (N, 2) corner points.
+        t_in, t_out: (N, 2) unit directions of the incoming and outgoing legs.
+        distance: (N,) corner-to-spiral-start distance d.
+        theta_cos: (N,) cos θ, θ = half the deflection.
+    """
+    d = distance[:, None]
+    h = G2CBS_C3 * d
+    g = G2CBS_C2 * h
+    k = 6.0 * h * theta_cos[:, None] / (G2CBS_C2 + 4.0)
+    joint = t_in + t_out
+    joint /= np.linalg.norm(joint, axis=1, keepdims=True)
+    out = np.empty((len(corners), 2, 4, 2))
+    first = out[:, 0]
+    first[:, 0] = corners - d * t_in
+    first[:, 1] = first[:, 0] + g * t_in
+    first[:, 2] = first[:, 1] + h * t_in
+    first[:, 3] = first[:, 2] + k * joint
+    second = out[:, 1]  # built from the far end, then read in travel order
+    second[:, 3] = corners + d * t_out
+    second[:, 2] = second[:, 3] - g * t_out
+    second[:, 1] = second[:, 2] - h * t_out
+    second[:, 0] = first[:, 3]  # the joint; the mirror image agrees to rounding
+    return out
+
+
+# ------------------------------------------------------------ array API
+
+
+@dataclass(frozen=True)
+class CornerBatch:
+    """Spiral pairs for N corners (one row per corner).
+
+    Attributes:
+        method: ``"walton-meek"`` or ``"g2cbs"``.
+        control_points: (N, 2, 4, 2) the two spirals of each corner in travel
+            order; NaN where ``status`` ≠ 0.
+        theta: (N,) half the deflection (each spiral's turn), NaN when undefined.
+        distance: (N,) corner-to-spiral-start distance used (or required).
+        curvature: (N,) peak |κ| of the pair (at its joint), used or required.
+        available: (N,) the longest distance the legs allow.
+        status: (N,) ``spiral_cad.Status`` codes; 0 where rounded.
+        corners: (N, 2) the corner points.
+    """
+
+    method: str
+    control_points: NDArray
+    theta: NDArray
+    distance: NDArray
+    curvature: NDArray
+    available: NDArray
+    status: NDArray
+    corners: NDArray
+    requested: NDArray
+
+    @property
+    def ok(self) -> NDArray:
+        return self.status == Status.OK
+
+    def __len__(self) -> int:
+        return len(self.status)
+
+    def reason(self, i: int, label: str | None = None) -> str:
+        """Why corner ``i`` could not be rounded (``"ok"`` if it was)."""
+        status = Status(int(self.status[i]))
+        name = label or f"corner {i}"
+        where = f"{name} at ({self.corners[i, 0]:.10g}, {self.corners[i, 1]:.10g})"
+        if status is Status.OK:
+            return "ok"
+        if status is Status.LEGS_TOO_SHORT:
+            return (
+                f"{where}: curvature {self.requested[i]:.6g} needs the spirals to start "
+                f"{self.distance[i]:.6g} from the corner but only {self.available[i]:.6g} is available "
+                f"(each corner may use half of an interior leg); this corner needs curvature "
+                f"≥ {self.curvature[i]:.6g} ({self.method})"
+            )
+        if status is Status.CORNER_REVERSAL:
+            return f"{where}: the path folds back (deflection ≥ 180°); no spiral pair exists"
+        if status is Status.CORNER_STRAIGHT:
+            return f"{where}: the legs are collinear, there is nothing to round"
+        if status is Status.COINCIDENT:
+            return f"{where}: a leg has zero length"
+        return f"{where}: no spiral pair ({status.name})"
+
+
+def _half_deflection(p0: NDArray, corners: NDArray, p1: NDArray):
+    """Unit leg directions, leg lengths and sin/cos of half the deflection."""
+    vin = corners - p0
+    vout = p1 - corners
+    lin = np.hypot(vin[:, 0], vin[:, 1])
+    lout = np.hypot(vout[:, 0], vout[:, 1])
+    with np.errstate(invalid="ignore", divide="ignore"):
+        t_in = vin / lin[:, None]
+        t_out = vout / lout[:, None]
+        joint = t_in + t_out
+        joint /= np.hypot(joint[:, 0], joint[:, 1])[:, None]
+    sin_t = np.abs(t_in[:, 0] * joint[:, 1] - t_in[:, 1] * joint[:, 0])
+    cos_t = np.einsum("ij,ij->i", t_in, joint)
+    return t_in, t_out, lin, lout, sin_t, cos_t
+
+
+def _requested(curvature: ArrayLike | None, max_curvature: ArrayLike | None, n: int) -> NDArray:
+    if curvature is not None and max_curvature is not None:
+        raise ValueError("give curvature or max_curvature, not both")
+    value = curvature if curvature is not None else max_curvature
+    name = "curvature" if curvature is not None else "max_curvature"
+    if value is None:
+        return np.full(n, np.nan)
+    k = np.broadcast_to(np.asarray(value, dtype=float), (n,))
+    bad = ~(np.isfinite(k) & (k > 0.0))
+    if bad.any():
+        i = int(np.argmax(bad))
+        raise ValueError(f"{name} must be positive and finite; got {k[i]} (corner {i})")
+    return np.ascontiguousarray(k)
+
+
+def round_corners_batch(
+    p0: ArrayLike,
+    corners: ArrayLike,
+    p1: ArrayLike,
+    *,
+    curvature: ArrayLike | None = None,
+    max_curvature: ArrayLike | None = None,
+    method: str = "walton-meek",
+) -> CornerBatch:
+    """Round N independent corners ``p0 → corner → p1`` with spiral pairs.
+
+    The spirals of a corner must start between ``p0`` and the corner and end
+    between the corner and ``p1``: pass the leg ends each corner may use (see
+    :func:`corner_legs` for polylines).
+
+    Args:
+        p0, corners, p1: (N, 2) arrays (or broadcastable (2,)).
+        curvature: joint curvature (scalar or (N,)); the pair peaks there.
+        max_curvature: a bound κmax: each corner uses the smallest distance
+            that respects it, i.e. its joint curvature equals κmax.
+        method: ``"walton-meek"`` (Theorem 4.4 via ``spiral_cad.batch``) or
+            ``"g2cbs"`` (Yang & Sukkarieh).
+
+    With neither curvature given, each corner uses all of its shorter leg
+    (Corollary 4.5: the lowest curvature that fits). Rows that fail carry a
+    status (``CornerBatch.reason`` explains); the others are unaffected.
+    """
+    if method not in CORNER_FACTOR:
+        raise ValueError(f"method must be one of {METHODS}; got {method!r}")
+    arrays = np.broadcast_arrays(as_points(p0, "p0"), as_points(corners, "corners"), as_points(p1, "p1"))
+    p0, corners, p1 = (np.ascontiguousarray(a.reshape(-1, 2)) for a in arrays)
+    n = len(corners)
+    k = _requested(curvature, max_curvature, n)
+    t_in, t_out, lin, lout, sin_t, cos_t = _half_deflection(p0, corners, p1)
+    available = np.minimum(lin, lout)
+    fit = np.isnan(k)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        distance = np.where(fit, available, corner_scale(sin_t, cos_t, k, method))
+        needed = corner_scale(sin_t, cos_t, available, method)
+    if method == "walton-meek":
+        result = batch.line_to_line(p0, corners, p1, k)
+        control_points = np.stack(result.spirals, axis=1)
+        status = result.status.astype(np.int8)
+    else:
+        status = np.zeros(n, dtype=np.int8)
+        status[~(sin_t > 0.0)] = Status.CORNER_STRAIGHT
+        status[~(cos_t > 0.0)] = Status.CORNER_REVERSAL
+        status[(status == 0) & ~(distance <= available * (1.0 + 1e-12))] = Status.LEGS_TOO_SHORT
+        status[(lin == 0.0) | (lout == 0.0)] = Status.COINCIDENT
+        status[~np.isfinite(np.hstack([p0, corners, p1])).all(axis=1)] = Status.NOT_FINITE
+        control_points = np.full((n, 2, 4, 2), np.nan)
+        good = status == 0
+        control_points[good] = g2cbs_control_points(corners[good], t_in[good], t_out[good], np.minimum(distance[good], available[good]), cos_t[good])
+    ok = status == 0
+    theta = np.where(sin_t > 0.0, np.arctan2(sin_t, cos_t), np.nan)
+    # Failed rows report what they would need: the distance asked for and the
+    # curvature that would exactly fit the available legs.
+    peak = np.where(ok, np.where(fit, needed, k), needed)
+    return CornerBatch(method, control_points, theta, distance, peak, available, status, corners, k)
+
+
+def corner_legs(points: ArrayLike) -> tuple[NDArray, NDArray, NDArray, NDArray]:
+    """The leg ends each interior corner of a polyline may use.
+
+    Interior segments are shared half-and-half between their two corners; the
+    first and last segments belong wholly to their one corner, so spirals of
+    neighbouring corners never overlap. Collinear interior points (forward)
+    are dropped: they need no rounding.
+
+    Returns:
+        ``(p0, corners, p1, index)``: (M, 2) leg ends and corners, and the
+        index of each corner in ``points``.
+
+    Raises:
+        ValueError: fewer than 3 points, non-finite or repeated consecutive
+            points, or a polyline that folds straight back on itself.
+    """
+    pts = as_points(points, "points")
+    if pts.ndim != 2 or len(pts) < 3:
+        raise ValueError(f"points must be an (n ≥ 3, 2) polyline; got shape {pts.shape}")
+    if not np.isfinite(pts).all():
+        i = int(np.argmax(~np.isfinite(pts).all(axis=1)))
+        raise ValueError(f"points must be finite; point {i} is {pts[i].tolist()}")
+    seg = np.diff(pts, axis=0)
+    length = np.hypot(seg[:, 0], seg[:, 1])
+    if not (length > 0.0).all():
+        i = int(np.argmax(~(length > 0.0)))
+        raise ValueError(f"points {i} and {i + 1} coincide at {pts[i].tolist()}")
+    unit = seg / length[:, None]
+    cross = unit[:-1, 0] * unit[1:, 1] - unit[:-1, 1] * unit[1:, 0]
+    dot = np.einsum("ij,ij->i", unit[:-1], unit[1:])
+    straight = np.abs(cross) <= COLLINEAR_TOL
+    folds = straight & (dot < 0.0)
+    if folds.any():
+        i = int(np.argmax(folds)) + 1
+        raise ValueError(f"the polyline folds straight back at point {i} {pts[i].tolist()}")
+    index = np.concatenate([[0], np.flatnonzero(~straight) + 1, [len(pts) - 1]])
+    kept = pts[index]
+    seg = np.diff(kept, axis=0)
+    length = np.hypot(seg[:, 0], seg[:, 1])
+    unit = seg / length[:, None]
+    share = np.full(len(length), 0.5)
+    share_in = share[:-1].copy()
+    share_out = share[1:].copy()
+    if len(share_in):
+        share_in[0] = 1.0
+        share_out[-1] = 1.0
+    corners = kept[1:-1]
+    p0 = corners - (share_in * length[:-1])[:, None] * unit[:-1]
+    p1 = corners + (share_out * length[1:])[:, None] * unit[1:]
+    # Exact leg ends at the polyline's end points (no rounding drift there).
+    if len(corners):
+        p0[0] = kept[0]
+        p1[-1] = kept[-1]
+    return p0, corners, p1, index[1:-1]
+
+
+# ------------------------------------------------------------ chain API
+
+
+@dataclass(frozen=True)
+class RoundedCorner:
+    """One rounded corner: its index in the input points and its spiral pair."""
+
+    index: int
+    theta: float
+    distance: float
+    curvature: float
+    spirals: tuple[BezierSpiral, BezierSpiral]
+
+
+@dataclass(frozen=True)
+class RoundedPath:
+    """A rounded polyline: the G2 chain and the data of every rounded corner."""
+
+    chain: Chain
+    corners: list[RoundedCorner]
+    method: str
+
+    @property
+    def max_curvature(self) -> float:
+        """Largest peak |κ| over the corners (0 for a straight polyline)."""
+        return max((c.curvature for c in self.corners), default=0.0)
+
+
+def round_corners(
+    points: ArrayLike,
+    *,
+    curvature: float | None = None,
+    max_curvature: float | None = None,
+    method: str = "walton-meek",
+    tolerance: float = JOIN_TOLERANCE,
+) -> RoundedPath:
+    """Round every corner of a polyline with a G2 spiral pair.
+
+    Args:
+        points: (n ≥ 3, 2) polyline vertices.
+        curvature: joint (peak) curvature of every corner's pair.
+        max_curvature: bound κmax; each corner uses the smallest distance
+            from the corner that respects it (so its peak equals κmax).
+        method: ``"walton-meek"`` (Theorem 4.4) or ``"g2cbs"`` (Yang &
+            Sukkarieh: about 24 % lower peak curvature for the same corner
+            distance).
+        tolerance: the chain's relative join tolerance (``Chain``). Joins are
+            exact up to rounding of the absolute control points, i.e. a
+            relative curvature error of about ε·|coordinates| / (g·h·sin θ):
+            a tiny spiral pair at a nearly straight corner under a tight
+            curvature bound can need a looser tolerance than 1e-9.
+
+    With neither curvature given, each corner uses as much of its legs as it
+    may (Corollary 4.5): half of every interior segment, all of the first and
+    last. Collinear interior points are passed through.
+
+    Returns:
+        A :class:`RoundedPath`: chain from the first to the last point.
+
+    Raises:
+        NoSolutionError: a corner's legs are too short for the curvature
+            (the message names the corner index and the curvature it needs).
+        ValueError: malformed input.
+    """
+    for name, value in (("curvature", curvature), ("max_curvature", max_curvature)):
+        if value is not None:
+            as_float(value, name)
+    pts = as_points(points, "points")
+    p0, corners, p1, index = corner_legs(pts)
+    parts: list[Transition | Segment] = []
+    rounded: list[RoundedCorner] = []
+    if len(corners):
+        result = round_corners_batch(p0, corners, p1, curvature=curvature, max_curvature=max_curvature, method=method)
+        for j in np.flatnonzero(~result.ok):
+            message = result.reason(int(j), label=f"corner {index[j]}")
+            if result.status[j] in (Status.LEGS_TOO_SHORT, Status.CORNER_REVERSAL):
+                raise NoSolutionError(message)
+            raise ValueError(message)
+        for j, cp in enumerate(result.control_points):
+            spirals = (BezierSpiral.from_control_points(cp[0]), BezierSpiral.from_control_points(cp[1]))
+            corner = tuple(corners[j])
+            parts.append(
+                Transition(
+                    "line-line",
+                    list(spirals),
+                    float(result.theta[j]),
+                    start_line=Ray(corner, tuple(corners[j] - p0[j])),
+                    end_line=Ray(corner, tuple(p1[j] - corners[j])),
+                )
+            )
+            rounded.append(RoundedCorner(int(index[j]), float(result.theta[j]), float(result.distance[j]), float(result.curvature[j]), spirals))
+    return RoundedPath(chain_through(pts[0], parts, pts[-1], tolerance), rounded, method)
+

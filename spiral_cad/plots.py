@@ -1,0 +1,232 @@
+"""Matplotlib views of chains and spirals: plan with curvature comb, curvature plots.
+
+Figures are built with ``matplotlib.figure.Figure`` (Agg canvas, no pyplot
+state, nothing is shown); every function takes an optional ``ax`` and
+returns the figure so callers can ``fig.savefig(...)``.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+from matplotlib.axes import Axes
+from matplotlib.collections import LineCollection
+from matplotlib.figure import Figure
+from numpy.typing import NDArray
+from scipy.special import fresnel
+
+from . import bezier
+from .chain import Chain
+from .spiral import BezierSpiral
+
+#: Colour per segment type (plan, comb and curvature plots).
+SEGMENT_COLORS = {"Line": "0.35", "Arc": "tab:blue", "BezierSpiral": "tab:red"}
+
+
+def _axes(ax: Axes | None, **figure_kw) -> tuple[Figure, Axes]:
+    if ax is not None:
+        return ax.figure, ax
+    fig = Figure(**figure_kw)
+    return fig, fig.add_subplot()
+
+
+def _kind(segment) -> str:
+    return type(segment).__name__
+
+
+@dataclass(frozen=True)
+class Comb:
+    """Curvature comb samples of a chain: teeth from ``points`` to ``tips``.
+
+    ``tips = points − scale · curvature · normals`` (normals point left of
+    travel, so teeth stand on the convex side). ``segment`` is the index of
+    the segment each sample belongs to.
+    """
+
+    stations: NDArray
+    points: NDArray
+    normals: NDArray
+    curvature: NDArray
+    tips: NDArray
+    segment: NDArray
+    scale: float
+
+
+def curvature_comb(chain: Chain, per_segment: int = 24, scale: float | None = None) -> Comb:
+    """Comb samples, ``per_segment`` per segment (ends included).
+
+    Args:
+        chain: the path.
+        per_segment: samples per segment.
+        scale: tooth length per unit curvature; by default the longest tooth
+            is a fifth of the chain's size.
+    """
+    u = np.linspace(0.0, 1.0, per_segment)
+    stations, points, normals, kappa, owner = [], [], [], [], []
+    for i, seg in enumerate(chain.segments):
+        # Stations from the segment's own arc-length parametrisation.
+        s = chain.stations[i] + (bezier.arc_length(seg.control_points, u) if isinstance(seg, BezierSpiral) else u * seg.length)
+        t = seg.tangent(u)
+        stations.append(s)
+        points.append(seg.point(u))
+        normals.append(np.stack([-t[:, 1], t[:, 0]], axis=1))
+        kappa.append(np.broadcast_to(seg.curvature(u), u.shape))
+        owner.append(np.full(per_segment, i))
+    kappa_all = np.concatenate(kappa)
+    if scale is None:
+        peak = float(np.abs(kappa_all).max())
+        scale = 0.2 * chain.size / peak if peak > 0.0 else 0.0
+    pts, nrm = np.vstack(points), np.vstack(normals)
+    tips = pts - scale * kappa_all[:, None] * nrm
+    return Comb(np.concatenate(stations), pts, nrm, kappa_all, tips, np.concatenate(owner), float(scale))
+
+
+def plot_plan(chain: Chain, comb: bool = True, ax: Axes | None = None, per_segment: int = 48) -> Figure:
+    """Plan view of ``chain``, coloured by segment type, with an optional curvature comb.
+
+    Artists: one line per segment; with ``comb``, per segment one
+    ``LineCollection`` of teeth and one envelope line through the tips.
+    """
+    fig, ax = _axes(ax, figsize=(8, 5))
+    data = curvature_comb(chain, per_segment) if comb else None
+    seen: set[str] = set()
+    u = np.linspace(0.0, 1.0, per_segment)
+    for i, seg in enumerate(chain.segments):
+        kind = _kind(seg)
+        color = SEGMENT_COLORS.get(kind, "k")
+        xy = seg.point(u)
+        ax.plot(xy[:, 0], xy[:, 1], color=color, lw=2.0, label=None if kind in seen else kind, gid=f"segment-{i}")
+        seen.add(kind)
+        if data is not None:
+            mask = data.segment == i
+            teeth = np.stack([data.points[mask], data.tips[mask]], axis=1)
+            ax.add_collection(LineCollection(teeth, colors=color, linewidths=0.6, alpha=0.5, gid=f"comb-{i}"))
+            ax.plot(data.tips[mask, 0], data.tips[mask, 1], color=color, lw=0.8, alpha=0.8, gid=f"envelope-{i}")
+    ax.set_aspect("equal", adjustable="datalim")
+    ax.autoscale_view()
+    ax.set_xlabel("x")
+    ax.set_ylabel("y")
+    title = f"Plan: {len(chain)} segments, length {chain.length:.6g}"
+    if data is not None:
+        title += f" (comb: {data.scale:.3g} per unit curvature)"
+    ax.set_title(title)
+    ax.legend(loc="best", fontsize="small")
+    ax.grid(True, alpha=0.3)
+    return fig
+
+
+def plot_curvature(chain: Chain, ax: Axes | None = None, per_segment: int = 64) -> Figure:
+    """Signed curvature against arc length, one line per segment coloured by type."""
+    fig, ax = _axes(ax, figsize=(8, 4))
+    data = curvature_comb(chain, per_segment, scale=0.0)
+    seen: set[str] = set()
+    for i, seg in enumerate(chain.segments):
+        kind = _kind(seg)
+        mask = data.segment == i
+        ax.plot(data.stations[mask], data.curvature[mask], color=SEGMENT_COLORS.get(kind, "k"), lw=1.8,
+                label=None if kind in seen else kind, gid=f"curvature-{i}")
+        seen.add(kind)
+    ax.axhline(0.0, color="0.6", lw=0.6)
+    ax.set_xlabel("arc length s")
+    ax.set_ylabel("curvature κ")
+    ax.set_title("Curvature profile")
+    ax.legend(loc="best", fontsize="small")
+    ax.grid(True, alpha=0.3)
+    return fig
+
+
+def plot_fig6(ax: Axes | None = None, samples: int = 200) -> Figure:
+    """Walton & Meek's Fig. 6: curvature against arc length for θ = 10°, 20°, …, 80°.
+
+    As in the paper, each spiral has unit curvature at u = 1 and its arc
+    length is scaled to the total length of the θ = 10° spiral; the dashed
+    line is the clothoid's linear profile.
+    """
+    fig, ax = _axes(ax, figsize=(7, 5))
+    u = np.linspace(0.0, 1.0, samples)
+    reference = BezierSpiral((0.0, 0.0), (1.0, 0.0), math.radians(10.0), 1.0).length
+    colors = [f"C{k}" for k in range(8)]
+    for k, degrees in enumerate(range(10, 90, 10)):
+        spiral = BezierSpiral((0.0, 0.0), (1.0, 0.0), math.radians(degrees), 1.0)
+        s = bezier.arc_length(spiral.control_points, u) * reference / spiral.length
+        ax.plot(s, spiral.curvature(u), color=colors[k], lw=1.4, label=f"θ = {degrees}°")
+    ax.plot([0.0, reference], [0.0, 1.0], "k--", lw=1.0, label="clothoid")
+    ax.set_xlabel("arc length (scaled to the θ = 10° spiral)")
+    ax.set_ylabel("curvature")
+    ax.set_title("Cubic Bézier spiral: curvature vs arc length (Walton & Meek, Fig. 6)")
+    ax.legend(loc="lower right", fontsize="small", ncol=2)
+    ax.grid(True, alpha=0.3)
+    return fig
+
+
+def clothoid_points(theta: float, curvature: float, s: NDArray) -> NDArray:
+    """Points of the clothoid from the origin along +x with turn ``theta`` and end curvature.
+
+    Length L = 2θ/c and heading φ(s) = c s²/(2L); with a = √(πL/c),
+    (x, y) = a·(C(s/a), S(s/a)) in Fresnel integrals. Negative θ mirrors.
+    """
+    c, th = abs(curvature), abs(theta)
+    length = 2.0 * th / c
+    a = math.sqrt(math.pi * length / c)
+    fs, fc = fresnel(np.asarray(s) / a)
+    return np.stack([a * fc, math.copysign(1.0, theta) * a * fs], axis=-1)
+
+
+def plot_vs_clothoid(theta: float, curvature: float, ax: Axes | Sequence[Axes] | None = None, samples: int = 200) -> Figure:
+    """Bézier spiral against the clothoid with the same turn ``theta`` and end ``curvature``.
+
+    Left: curvature against arc length (the clothoid's is linear). Right:
+    both curves from the origin along +x, with their end circles; the legend
+    gives each curve's length and its circle's offset p from the start
+    tangent (the "shift" of highway design).
+
+    Args:
+        theta: turn angle (radians, 0 < |θ| < π/2).
+        curvature: end curvature (same sign as θ).
+        ax: a pair of axes, or None for a new two-panel figure.
+    """
+    if ax is None:
+        fig = Figure(figsize=(11, 4.5))
+        left, right = fig.subplots(1, 2)
+    else:
+        left, right = ax
+        fig = left.figure
+    spiral = BezierSpiral((0.0, 0.0), (1.0, 0.0), theta, curvature)
+    u = np.linspace(0.0, 1.0, samples)
+    s_bez = bezier.arc_length(spiral.control_points, u)
+    length_clo = 2.0 * abs(theta) / abs(curvature)
+    s_clo = np.linspace(0.0, length_clo, samples)
+    left.plot(s_bez, spiral.curvature(u), color="tab:red", lw=1.8, label=f"Bézier spiral (L = {spiral.length:.4g})")
+    left.plot(s_clo, curvature * s_clo / length_clo, "k--", lw=1.4, label=f"clothoid (L = {length_clo:.4g})")
+    left.set_xlabel("arc length s")
+    left.set_ylabel("curvature κ")
+    left.set_title(f"θ = {math.degrees(theta):.4g}°, end curvature {curvature:.4g}")
+    left.legend(loc="best", fontsize="small")
+    left.grid(True, alpha=0.3)
+
+    radius = 1.0 / curvature
+    xy_clo = clothoid_points(theta, curvature, s_clo)
+    end_normal = np.array([-math.sin(theta), math.cos(theta)])  # both curves end with heading θ
+    for xy, color, style, name in ((spiral.point(u), "tab:red", "-", "Bézier"), (xy_clo, "k", "--", "clothoid")):
+        center = xy[-1] + radius * end_normal
+        shift = abs(center[1]) - abs(radius)
+        right.plot(xy[:, 0], xy[:, 1], color=color, ls=style, lw=1.6, label=f"{name}: shift p = {shift:.4g}")
+        phi = np.linspace(0.0, 2.0 * math.pi, 200)
+        right.plot(center[0] + abs(radius) * np.cos(phi), center[1] + abs(radius) * np.sin(phi), color=color, ls=":", lw=0.8)
+    right.axhline(0.0, color="0.6", lw=0.6)
+    # Frame the spirals (the full end circles would dwarf them).
+    both = np.vstack([spiral.point(u), xy_clo])
+    low, high = both.min(axis=0), both.max(axis=0)
+    pad = 0.15 * float(np.max(high - low))
+    right.set_xlim(low[0] - pad, high[0] + pad)
+    right.set_ylim(low[1] - pad, high[1] + pad)
+    right.set_aspect("equal", adjustable="box")
+    right.set_xlabel("x")
+    right.set_ylabel("y")
+    right.set_title("Plan (end circles dotted)")
+    right.legend(loc="best", fontsize="small")
+    right.grid(True, alpha=0.3)
+    return fig

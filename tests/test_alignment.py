@@ -1,0 +1,168 @@
+"""Horizontal alignments from PIs: geometry, stationing, dκ/ds, CSV and validation."""
+
+import csv
+import math
+
+import numpy as np
+import pytest
+
+from spiral_cad import Arc, BezierSpiral, NoSolutionError
+from spiral_cad.design import Alignment, curvature_rate, peak_curvature_rate
+from spiral_cad.design.alignment import theta_for_length
+
+PIS = np.array([(0.0, 0.0), (1000.0, 0.0), (1600.0, 700.0), (2500.0, 600.0)])
+ORIGIN = np.array([6.5e5, 5.4e6])  # survey-sized coordinates
+
+
+def assert_joins(chain, tol=1e-9):
+    for j in chain.joins():
+        assert j.gap <= tol * chain.size and j.angle <= tol and j.curvature_jump * chain.size <= tol
+
+
+def test_symmetric_curves_are_g2_and_honour_theta():
+    al = Alignment.from_pis(PIS, [300.0, 400.0], spiral_angles=0.2)
+    assert_joins(al.chain)
+    assert np.allclose(al.chain.start, PIS[0]) and np.allclose(al.chain.end, PIS[-1])
+    for c in al.curves:
+        assert c.theta_in == pytest.approx(0.2, rel=1e-12) and c.theta_out == pytest.approx(0.2, rel=1e-12)
+        assert c.spiral_in_length == pytest.approx(c.spiral_out_length, rel=1e-12)
+        # Total turning: spirals plus arc sweep equal the deflection.
+        sweep = c.arc_length / c.radius
+        assert c.theta_in + sweep + c.theta_out == pytest.approx(abs(c.deflection), rel=1e-12)
+        # Symmetric curve: centre on the bisector, equidistant from both tangents.
+        center = np.array(c.center)
+        assert np.hypot(*(c.entry.end - center)) == pytest.approx(c.radius, rel=1e-12)
+
+
+@pytest.mark.parametrize("origin", [np.zeros(2), ORIGIN])
+def test_asymmetric_angles(origin):
+    # Survey coordinates: the join curvature is only as exact as ε·|x|/(h sin θ)
+    # (about 1e-9 relative to the chain size here), so the check is 1e-8 there.
+    tol = 1e-9 if origin[0] == 0 else 1e-8
+    al = Alignment.from_pis(PIS + origin, [300.0, 400.0], spiral_angles=[(0.15, 0.35), (0.3, 0.1)], tolerance=tol)
+    assert_joins(al.chain, tol)
+    got = [(c.theta_in, c.theta_out) for c in al.curves]
+    assert np.allclose(got, [(0.15, 0.35), (0.3, 0.1)], rtol=1e-9, atol=0)
+    assert al.curves[0].spiral_in_length < al.curves[0].spiral_out_length
+    for c in al.curves:
+        assert abs(c.entry.spirals[0].end_curvature) == pytest.approx(1 / c.radius, rel=1e-9)
+
+
+def test_spiral_length_spec_is_honoured():
+    lengths = [(80.0, 120.0), 100.0]
+    al = Alignment.from_pis(PIS, [300.0, 400.0], spiral_lengths=lengths)
+    assert_joins(al.chain)
+    assert al.curves[0].spiral_in_length == pytest.approx(80.0, rel=1e-9)
+    assert al.curves[0].spiral_out_length == pytest.approx(120.0, rel=1e-9)
+    assert al.curves[1].spiral_in_length == pytest.approx(100.0, rel=1e-9)
+    assert al.curves[1].spiral_out_length == pytest.approx(100.0, rel=1e-9)
+
+
+def test_theta_for_length_round_trip():
+    for theta in (0.01, 0.3, 1.2):
+        length = BezierSpiral((0, 0), (1, 0), theta, 1 / 250.0).length
+        assert theta_for_length(length, 250.0) == pytest.approx(theta, rel=1e-12)
+    with pytest.raises(NoSolutionError, match="outside the range"):
+        theta_for_length(1e-12, 250.0)
+
+
+def test_stationing_is_monotone_and_consistent():
+    al = Alignment.from_pis(PIS, [300.0, 400.0], spiral_lengths=90.0, start_station=1000.0)
+    keys = [k for c in al.curves for k in (c.ts, c.sc, c.cs, c.st)]
+    assert all(a < b for a, b in zip(keys, keys[1:]))
+    assert al.start_station < keys[0] and keys[-1] < al.end_station
+    assert al.end_station - al.start_station == pytest.approx(al.chain.length, rel=1e-15)
+    for c in al.curves:
+        assert c.sc - c.ts == pytest.approx(c.spiral_in_length, rel=1e-12)
+        assert c.st - c.cs == pytest.approx(c.spiral_out_length, rel=1e-12)
+        # Chainages locate the key points on the chain.
+        for station, point in ((c.ts, c.entry.start), (c.sc, c.entry.end), (c.cs, c.exit.start), (c.st, c.exit.end)):
+            assert np.allclose(al.chain.point_at(station - al.start_station), point, atol=1e-9 * al.chain.size)
+    # Arcs in the chain have the tabled lengths.
+    arcs = [s for s in al.chain.segments if isinstance(s, Arc)]
+    assert [a.length for a in arcs] == pytest.approx([c.arc_length for c in al.curves], rel=1e-9)
+
+
+def test_csv_round_trip(tmp_path):
+    al = Alignment.from_pis(PIS, [300.0, 400.0], spiral_angles=[(0.15, 0.35), 0.25])
+    path = al.to_csv(tmp_path / "stations.csv")
+    with path.open() as f:
+        rows = list(csv.DictReader(f))
+    assert len(rows) == 2
+    for row, curve in zip(rows, al.curves):
+        assert int(row["pi"]) == curve.index
+        assert float(row["TS"]) == curve.ts and float(row["ST"]) == curve.st
+        assert float(row["theta_in_deg"]) == pytest.approx(math.degrees(curve.theta_in))
+    text = al.table()
+    assert "TS" in text and "peak_dk_ds_in" in text and len(text.splitlines()) == 4
+
+
+def test_curvature_rate_matches_finite_differences():
+    spiral = BezierSpiral((0, 0), (1, 0), 0.6, 0.02)
+    u, h = 0.37, 1e-6
+    dk = (spiral.curvature(u + h) - spiral.curvature(u - h)) / (2 * h)
+    ds = np.linalg.norm(spiral.point(u + h) - spiral.point(u - h)) / 1.0
+    assert curvature_rate(spiral.control_points, u) == pytest.approx(dk * 2 * h / ds, rel=1e-6)
+
+
+@pytest.mark.parametrize("theta", [0.1, 0.6, 1.0])
+def test_peak_rate_exceeds_mean_and_matches_sampling(theta):
+    al = Alignment.from_pis(PIS, 300.0, spiral_angles=theta * 0.4)
+    for c in al.curves:
+        mean = 1.0 / (c.radius * c.spiral_in_length)
+        assert c.peak_rate_in >= mean  # curvature is not linear in arc length
+        s = np.linspace(c.ts, c.sc, 4001)
+        k = al.chain.curvature_at(s - al.start_station)
+        fd = np.abs(np.gradient(k, s)).max()
+        assert c.peak_rate_in == pytest.approx(fd, rel=2e-3)
+    # Reversed spiral (exit) has the same peak magnitude.
+    spiral = al.curves[0].entry.spirals[0]
+    assert peak_curvature_rate(spiral.reversed())[0] == pytest.approx(peak_curvature_rate(spiral)[0], rel=1e-9)
+
+
+def test_small_angle_peak_is_about_1_84_times_mean():
+    al = Alignment.from_pis(PIS, 300.0, spiral_angles=0.02)
+    c = al.curves[0]
+    assert c.peak_rate_in * c.radius * c.spiral_in_length == pytest.approx(1.84, abs=0.02)
+
+
+# ------------------------------------------------------------ validation
+
+
+def test_deflection_too_small_names_pi():
+    with pytest.raises(NoSolutionError, match=r"PI 1: deflection 49\.\d+° is smaller than θ_in \+ θ_out"):
+        Alignment.from_pis(PIS, [300.0, 400.0], spiral_angles=[(0.5, 0.5), 0.1])
+
+
+def test_overlapping_curves_name_both_pis():
+    with pytest.raises(NoSolutionError, match=r"curves at PI 1 and PI 2 overlap .* tangent length"):
+        Alignment.from_pis(PIS, [900.0, 900.0], spiral_angles=0.2)
+
+
+def test_curve_beyond_start_point():
+    with pytest.raises(NoSolutionError, match="TS of PI 1 .* beyond the start point PI 0"):
+        Alignment.from_pis([(900, 0), (1000, 0), (1600, 700), (2500, 600)], 300.0, spiral_angles=0.2)
+
+
+@pytest.mark.parametrize(
+    ("points", "radii", "pattern"),
+    [
+        (PIS, [300.0, -1.0], r"PI 2: radius must be positive; got -1\.0"),
+        (PIS, [300.0, 0.0], r"PI 2: radius must be positive"),
+        ([(0, 0), (1000, 0), (2000, 0), (2500, 600)], 300.0, r"PI 1 .* collinear"),
+        ([(0, 0), (1000, 0), (1000, 0), (2500, 600)], 300.0, r"PI 1 and PI 2 coincide"),
+        ([(0, 0), (1000, 0)], 300.0, "at least 3 PIs"),
+    ],
+)
+def test_malformed_input_names_pi(points, radii, pattern):
+    with pytest.raises(ValueError, match=pattern):
+        Alignment.from_pis(points, radii, spiral_angles=0.1)
+
+
+def test_spec_errors():
+    with pytest.raises(ValueError, match="exactly one"):
+        Alignment.from_pis(PIS, 300.0)
+    with pytest.raises(ValueError, match=r"PI 2: exit spiral angle must lie in \(0, π/2\)"):
+        Alignment.from_pis(PIS, 300.0, spiral_angles=[0.1, (0.1, 2.0)])
+    with pytest.raises(ValueError, match="PI 1: entry spiral length must be positive"):
+        Alignment.from_pis(PIS, 300.0, spiral_lengths=[(-5.0, 10.0), 10.0])

@@ -1,0 +1,105 @@
+"""Plots: artists, saved PNGs, and that plotted data is the chain's own."""
+
+import math
+
+import numpy as np
+import pytest
+from matplotlib.collections import LineCollection
+from matplotlib.figure import Figure
+
+from spiral_cad import BezierSpiral, plots
+from spiral_cad.design import Alignment, round_corners
+
+PNG = b"\x89PNG\r\n\x1a\n"
+
+
+@pytest.fixture(scope="module")
+def chain():
+    pts = [(0.0, 0.0), (1000.0, 0.0), (1600.0, 700.0), (2500.0, 600.0)]
+    return Alignment.from_pis(pts, [300.0, 400.0], spiral_angles=[(0.2, 0.3), 0.25]).chain
+
+
+def saved(fig, tmp_path, name):
+    path = tmp_path / name
+    fig.savefig(path)
+    return path.read_bytes()[:8] == PNG
+
+
+def test_plan_with_comb(chain, tmp_path):
+    fig = plots.plot_plan(chain)
+    assert isinstance(fig, Figure)
+    ax = fig.axes[0]
+    assert len(ax.lines) == 2 * len(chain)  # segment + comb envelope each
+    combs = [c for c in ax.collections if isinstance(c, LineCollection)]
+    assert len(combs) == len(chain)
+    assert saved(fig, tmp_path, "plan.png")
+
+
+def test_plan_without_comb_on_given_axes(chain):
+    fig = Figure()
+    ax = fig.add_subplot()
+    assert plots.plot_plan(chain, comb=False, ax=ax) is fig
+    assert len(ax.lines) == len(chain) and not ax.collections
+
+
+def test_comb_matches_chain_curvature(chain):
+    comb = plots.curvature_comb(chain, per_segment=16)
+    inside = (comb.stations > 0) & (comb.stations < chain.length)
+    assert np.allclose(comb.curvature[inside], chain.curvature_at(comb.stations[inside]), rtol=1e-9, atol=1e-12)
+    assert np.allclose(comb.points[inside], chain.point_at(comb.stations[inside]), atol=1e-6)
+    teeth = np.hypot(*(comb.tips - comb.points).T)
+    assert np.allclose(teeth, comb.scale * np.abs(comb.curvature), rtol=1e-12, atol=1e-9)
+    # Teeth stand on the convex side: opposite the left normal for a left turn.
+    left = comb.curvature > 0
+    assert np.all(np.einsum("ij,ij->i", comb.tips[left] - comb.points[left], comb.normals[left]) < 0)
+
+
+def test_curvature_plot_data(chain, tmp_path):
+    fig = plots.plot_curvature(chain)
+    lines = [l for l in fig.axes[0].lines if (l.get_gid() or "").startswith("curvature-")]
+    assert len(lines) == len(chain) and len(fig.axes[0].lines) == len(chain) + 1  # + zero line
+    for line in lines:
+        s, k = line.get_xdata(), line.get_ydata()
+        inner = (s > 0) & (s < chain.length)
+        assert np.allclose(k[inner], chain.curvature_at(s[inner]), rtol=1e-9, atol=1e-12)
+    assert saved(fig, tmp_path, "curvature.png")
+
+
+def test_fig6(tmp_path):
+    fig = plots.plot_fig6()
+    lines = fig.axes[0].lines
+    assert len(lines) == 9  # θ = 10°…80° and the clothoid
+    ends = {(round(l.get_xdata()[-1], 12), round(l.get_ydata()[-1], 12)) for l in lines}
+    assert len(ends) == 1  # all normalised to the same length and unit end curvature
+    assert [l.get_ydata()[0] for l in lines] == [0.0] * 9
+    assert saved(fig, tmp_path, "fig6.png")
+
+
+def test_vs_clothoid(tmp_path):
+    theta, k = math.radians(30.0), 0.01
+    fig = plots.plot_vs_clothoid(theta, k)
+    left, right = fig.axes
+    bez, clo = left.lines
+    assert clo.get_xdata()[-1] == pytest.approx(2 * theta / k)
+    assert np.allclose(np.diff(clo.get_ydata(), 2), 0.0, atol=1e-15)  # linear
+    assert bez.get_xdata()[-1] == pytest.approx(BezierSpiral((0, 0), (1, 0), theta, k).length)
+    assert len(right.lines) == 5  # two curves, two end circles, the axis line
+    assert saved(fig, tmp_path, "vs_clothoid.png")
+
+
+def test_clothoid_points_turn_and_length():
+    theta, k = 0.5, 0.2
+    length = 2 * theta / k
+    s = np.linspace(0, length, 20001)
+    xy = plots.clothoid_points(theta, k, s)
+    step = np.diff(xy, axis=0)
+    assert np.hypot(*step.T).sum() == pytest.approx(length, rel=1e-6)
+    end = step[-1] / np.hypot(*step[-1])
+    assert math.atan2(end[1], end[0]) == pytest.approx(theta, abs=1e-3)
+    assert np.allclose(plots.clothoid_points(-theta, -k, s)[:, 1], -xy[:, 1])
+
+
+def test_rounded_path_plots(tmp_path):
+    path = round_corners([(0, 0), (2, 0), (3, 1), (5, 1)], method="g2cbs")
+    fig = plots.plot_plan(path.chain)
+    assert saved(fig, tmp_path, "rounded.png")
