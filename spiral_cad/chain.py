@@ -23,7 +23,10 @@ class Chain:
     Consecutive segments must share end point, unit tangent and signed
     curvature: gap ≤ tol·size, tangent angle ≤ tol and |Δκ|·size ≤ tol,
     where size is the diagonal of the control-point bounding box and tol is
-    ``tolerance`` (default 1e-9).
+    ``tolerance`` (default 1e-9). Each bound is widened by what float64
+    rounding of the stored coordinates can hide at that joint
+    (``Segment.rounding_floor``), so survey coordinates (~1e6) and tiny
+    spirals are judged by their geometry, not by their last bits.
 
     Args:
         segments: the segments in travel order (at least one).
@@ -46,8 +49,13 @@ class Chain:
         self._stations = np.concatenate([[0.0], np.cumsum(lengths)])
         pts = np.array([p for s in self._segments for p in (s.start, s.end, s.point(0.5))])
         self.size = float(np.hypot(*(pts.max(axis=0) - pts.min(axis=0)))) or 1.0
-        for j in self.joins():
-            if j.gap > tolerance * self.size or j.angle > tolerance or j.curvature_jump * self.size > tolerance:
+        for j, a, b in zip(self.joins(), self._segments, self._segments[1:]):
+            floor = np.add(a.rounding_floor(True), b.rounding_floor(False))
+            if (
+                j.gap > tolerance * self.size + floor[0]
+                or j.angle > tolerance + floor[1]
+                or j.curvature_jump > tolerance / self.size + floor[2]
+            ):
                 raise ValueError(
                     f"Chain is not G2 at joint {j.index} (between segments {j.index} and {j.index + 1}): "
                     f"gap {j.gap:.3g}, tangent angle {j.angle:.3g} rad, curvature jump {j.curvature_jump:.3g} "

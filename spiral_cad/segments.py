@@ -17,6 +17,7 @@ from numpy.typing import ArrayLike, NDArray
 from ._inputs import as_float, as_xy
 
 TAU = 2.0 * math.pi
+EPS = float(np.finfo(float).eps)
 
 
 class Segment(ABC):
@@ -50,6 +51,11 @@ class Segment(ABC):
     def parameter_at(self, s: ArrayLike) -> NDArray:
         """Parameters u where the arc length from the start equals ``s``."""
         return _u(s) / self.length
+
+    def rounding_floor(self, at_end: bool) -> tuple[float, float, float]:
+        """(gap, tangent angle, curvature) that float64 rounding of the stored
+        coordinates can hide at the start or end (exact types: only the gap)."""
+        return 4.0 * EPS * float(np.abs(self.end if at_end else self.start).max()), 0.0, 0.0
 
     @property
     def start(self) -> NDArray:
@@ -118,6 +124,10 @@ class Line(Segment):
 
     def reversed(self) -> Line:
         return Line(self._b, self._a)
+
+    def rounding_floor(self, at_end: bool) -> tuple[float, float, float]:
+        delta = 4.0 * EPS * float(np.abs(np.concatenate([self._a, self._b])).max())
+        return delta, delta / self.length, 0.0
 
     def piece(self, t0: float, t1: float) -> Line:
         return Line(self.point(t0), self.point(t1))

@@ -11,7 +11,7 @@ from numpy.typing import ArrayLike, NDArray
 from . import bezier
 from ._inputs import as_float, as_unit, as_xy
 from ._kernels import put_spiral
-from .segments import Segment
+from .segments import EPS, Segment
 
 
 class BezierSpiral(Segment):
@@ -124,6 +124,15 @@ class BezierSpiral(Segment):
 
     def curvature(self, u: ArrayLike) -> NDArray | float:
         return bezier.curvature(self._cp, u)[()]
+
+    def rounding_floor(self, at_end: bool) -> tuple[float, float, float]:
+        """Rounding floor of the end frame: κ comes from differences of rounded
+        control points, (2/3)(a × b)/|a|³ with a the end leg and b the middle leg."""
+        delta = 4.0 * EPS * float(np.abs(self._cp).max())
+        legs = np.hypot(*np.diff(self._cp, axis=0).T)
+        a, b = (legs[2], legs[1]) if at_end else (legs[0], legs[1])
+        kappa = abs(self.end_curvature if at_end else self.start_curvature)
+        return delta, delta / a, 2.0 / 3.0 * delta * (a + b) / a**3 + 3.0 * kappa * delta / a
 
     def piece(self, t0: float, t1: float) -> BezierSpiral:
         """Exact sub-curve on [t0, t1] (de Casteljau) as a Bézier on [0, 1]."""

@@ -92,3 +92,14 @@ def test_arc_between_takes_the_travel_sense():
 def test_single_spiral_chain_and_repr():
     chain = Chain([BezierSpiral((0, 0), (1, 0), 0.5, 1.0)])
     assert "BezierSpiral" in repr(chain) and len(chain) == 1
+
+
+def test_survey_coordinates_build_at_the_default_tolerance_and_still_catch_g1():
+    o = np.array([6.5e5, 5.4e6])
+    enter = line_to_circle(o, (1, 0), o + (100, 350), 300.0)
+    leave = line_to_circle(o + (900, 300), (-1, -0.2), o + (100, 350), 300.0).reversed()
+    chain = Chain.join([enter, leave])  # default 1e-9 plus the rounding floor of 1e6 coordinates
+    assert len(chain) == 3
+    tangent_arc = Arc.between(o + (0, 300), 300.0, o, o + (300, 300))
+    with pytest.raises(ValueError, match="curvature jump 0.00333"):
+        Chain([Line(o - (100, 0), o), tangent_arc])

@@ -148,7 +148,7 @@ def test_max_curvature_bound_is_respected(steps, factor, method):
     kmax = factor * fit.max_curvature
     # Tight bounds make tiny pairs at gentle corners, whose join curvature is
     # only as exact as ε·|coordinates|/(g·h·sin θ): check G2 to 1e-7 here.
-    path = round_corners(np.array(pts), max_curvature=kmax, method=method, tolerance=1e-7)
+    path = round_corners(np.array(pts), max_curvature=kmax, method=method)
     assert measured_peak(path.chain) <= kmax * (1 + 1e-9)
     for c in path.corners:
         assert c.curvature == pytest.approx(kmax, rel=1e-12)

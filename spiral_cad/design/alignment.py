@@ -189,11 +189,8 @@ class Alignment:
             spiral_lengths: spiral arc lengths, shaped like ``spiral_angles``
                 (give exactly one of the two).
             start_station: chainage of the first PI.
-            tolerance: the chain's relative join tolerance (``Chain``). The
-                joins are exact up to rounding of the absolute control
-                points: with survey coordinates (~1e6) the curvature at a
-                join is only good to ~ε·|coordinates|/(h·sin θ), which can
-                exceed 1e-9 relative to the chain size.
+            tolerance: the chain's relative join tolerance (``Chain``, which
+                also allows for the rounding of survey coordinates).
 
         The circle centre lies at distance r·g1(θ_in) from the incoming
         tangent and r·g1(θ_out) from the outgoing one (Theorem 4.1), which

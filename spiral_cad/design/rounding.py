@@ -350,11 +350,7 @@ def round_corners(
         method: ``"walton-meek"`` (Theorem 4.4) or ``"g2cbs"`` (Yang &
             Sukkarieh: about 24 % lower peak curvature for the same corner
             distance).
-        tolerance: the chain's relative join tolerance (``Chain``). Joins are
-            exact up to rounding of the absolute control points, i.e. a
-            relative curvature error of about ε·|coordinates| / (g·h·sin θ):
-            a tiny spiral pair at a nearly straight corner under a tight
-            curvature bound can need a looser tolerance than 1e-9.
+        tolerance: the chain's relative join tolerance (``Chain``).
 
     With neither curvature given, each corner uses as much of its legs as it
     may (Corollary 4.5): half of every interior segment, all of the first and
