@@ -96,8 +96,8 @@ def test_single_spiral_chain_and_repr():
 
 def test_survey_coordinates_build_at_the_default_tolerance_and_still_catch_g1():
     o = np.array([6.5e5, 5.4e6])
-    enter = line_to_circle(o, (1, 0), o + (100, 350), 300.0)
-    leave = line_to_circle(o + (900, 300), (-1, -0.2), o + (100, 350), 300.0).reversed()
+    enter = line_to_circle(o, (1, 0), o + (600, 360), 300.0)
+    leave = line_to_circle(o + (1800, 900), (-1, -1), o + (600, 360), 300.0).reversed()
     chain = Chain.join([enter, leave])  # default 1e-9 plus the rounding floor of 1e6 coordinates
     assert len(chain) == 3
     tangent_arc = Arc.between(o + (0, 300), 300.0, o, o + (300, 300))
