@@ -15,7 +15,6 @@ import statistics
 import tempfile
 import time
 
-import numpy as np
 from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeEdge, BRepBuilderAPI_MakeWire
 from OCP.Geom import Geom_BezierCurve
 from OCP.gp import gp_Ax2, gp_Circ, gp_Dir, gp_Pnt

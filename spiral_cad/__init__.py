@@ -8,7 +8,13 @@ from .chain import Chain, Join
 from .errors import NoSolutionError, Status
 from .segments import Arc, Circle, Line, Segment
 from .spiral import BezierSpiral
-from .transitions import Transition, circle_in_circle, circle_to_circle, line_to_circle, line_to_line
+from .transitions import (
+    Transition,
+    circle_in_circle,
+    circle_to_circle,
+    line_to_circle,
+    line_to_line,
+)
 
 __all__ = [
     "Arc",

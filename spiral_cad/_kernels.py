@@ -16,11 +16,9 @@ from __future__ import annotations
 
 import math
 
-import numpy as np
 from numba import njit, prange
 
 from .errors import Status
-
 
 jit = njit(cache=True, nogil=True)
 

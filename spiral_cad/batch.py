@@ -9,7 +9,6 @@ that the scalar API uses (in parallel over rows) and returns a
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray

@@ -16,12 +16,26 @@ from __future__ import annotations
 
 from collections.abc import Iterable
 
-from build123d import BaseLineObject, BuildLine, Mode, SkipClean, Vector, VectorLike, Wire
+from build123d import (
+    BaseLineObject,
+    BuildLine,
+    Mode,
+    SkipClean,
+    Vector,
+    VectorLike,
+    Wire,
+)
 
 from .chain import Chain
 from .occ import chain_wire
 from .segments import Segment
-from .transitions import Transition, circle_in_circle, circle_to_circle, line_to_circle, line_to_line
+from .transitions import (
+    Transition,
+    circle_in_circle,
+    circle_to_circle,
+    line_to_circle,
+    line_to_line,
+)
 
 
 def _xy(value: VectorLike, name: str) -> tuple[float, float]:

@@ -39,7 +39,13 @@ from OCP.gp import gp_Ax3
 from .chain import Chain
 from .occ import chain_wire, segment_edges
 from .segments import Segment
-from .transitions import Transition, circle_in_circle, circle_to_circle, line_to_circle, line_to_line
+from .transitions import (
+    Transition,
+    circle_in_circle,
+    circle_to_circle,
+    line_to_circle,
+    line_to_line,
+)
 
 W = TypeVar("W", bound=cq.Workplane)
 

@@ -56,10 +56,9 @@ DEMO_DESIGN: dict = {
             "type": "circle_chain",
             "circles": [
                 {"center": [0, 0], "radius": 60},
-                {"center": [0, -29.85], "radius": 30},
+                {"center": [29.85, 0], "radius": 30},
                 {"center": [150, -10], "radius": 40},
-                {"center": [280, 30], "radius": -35},
-                {"center": [400, -20], "radius": -50},
+                {"center": [150, 120], "radius": -35},
             ],
         },
         {

@@ -32,18 +32,15 @@ Classification (tolerances are keyword arguments of :func:`check_continuity`):
 from __future__ import annotations
 
 import argparse
-import sys
 import math
 import os
-from collections.abc import Iterable, Iterator, Sequence
-from contextlib import contextmanager
+import sys
+from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
 from enum import IntEnum
-from pathlib import Path
 from typing import Any
 
 import numpy as np
-
 from OCP.BRep import BRep_Builder, BRep_Tool
 from OCP.BRepAdaptor import BRepAdaptor_Curve
 from OCP.BRepLProp import BRepLProp_CLProps
@@ -52,15 +49,22 @@ from OCP.gp import gp_Dir, gp_Pnt, gp_Vec, gp_XYZ
 from OCP.ShapeAnalysis import ShapeAnalysis_WireOrder
 from OCP.TopAbs import TopAbs_EDGE, TopAbs_REVERSED, TopAbs_WIRE
 from OCP.TopExp import TopExp, TopExp_Explorer
-from OCP.TopoDS import TopoDS, TopoDS_Compound, TopoDS_Edge, TopoDS_Iterator, TopoDS_Shape, TopoDS_Wire
+from OCP.TopoDS import (
+    TopoDS,
+    TopoDS_Compound,
+    TopoDS_Edge,
+    TopoDS_Iterator,
+    TopoDS_Shape,
+    TopoDS_Wire,
+)
 from OCP.TopTools import TopTools_IndexedMapOfShape
+
+from .occ import read_shape
 
 #: Loose edges whose ends lie closer than this fraction of the model size are
 #: chained into one group (and their gap is then judged against ``gap_tol``).
 LINK_FRACTION = 1e-3
 
-STEP_SUFFIXES = (".step", ".stp")
-IGES_SUFFIXES = (".iges", ".igs")
 
 
 class Continuity(IntEnum):
@@ -196,55 +200,6 @@ class ContinuityReport:
 
 
 # --------------------------------------------------------------- input
-
-
-def read_shape(path: str | os.PathLike[str]) -> TopoDS_Shape:
-    """Read a STEP (.step/.stp) or IGES (.igs/.iges) file into one shape.
-
-    Raises:
-        ValueError: unknown suffix, missing file, or a file the reader rejects.
-    """
-    p = Path(path)
-    suffix = p.suffix.lower()
-    if suffix not in STEP_SUFFIXES + IGES_SUFFIXES:
-        raise ValueError(f"cannot read {str(p)!r}: expected a .step/.stp or .igs/.iges file")
-    if not p.is_file():
-        raise ValueError(f"cannot read {str(p)!r}: no such file")
-    from OCP.IFSelect import IFSelect_RetDone
-
-    if suffix in STEP_SUFFIXES:
-        from OCP.STEPControl import STEPControl_Reader
-
-        reader = STEPControl_Reader()
-    else:
-        from OCP.IGESControl import IGESControl_Reader
-
-        reader = IGESControl_Reader()
-    with _quiet_occt():
-        status = reader.ReadFile(str(p))
-        if status != IFSelect_RetDone:
-            raise ValueError(f"cannot read {str(p)!r}: the {suffix[1:].upper()} reader failed ({status.name})")
-        reader.TransferRoots()
-        shape = reader.OneShape()
-    if shape.IsNull():
-        raise ValueError(f"cannot read {str(p)!r}: no transferable geometry")
-    return shape
-
-
-@contextmanager
-def _quiet_occt() -> Iterator[None]:
-    """Silence OCCT's informational console messages (warnings and errors still print)."""
-    from OCP.Message import Message, Message_Gravity
-
-    printers = list(Message.DefaultMessenger_s().Printers())
-    levels = [p.GetTraceLevel() for p in printers]
-    for p in printers:
-        p.SetTraceLevel(Message_Gravity.Message_Warning)
-    try:
-        yield
-    finally:
-        for p, level in zip(printers, levels):
-            p.SetTraceLevel(level)
 
 
 def as_occ_shape(obj: Any) -> TopoDS_Shape:

@@ -79,8 +79,12 @@ def export_step(obj: Any, path: PathLike) -> None:
     from OCP.STEPControl import STEPControl_AsIs, STEPControl_Writer
     from OCP.StepData import StepData_StepWriter
 
+    from .occ import quiet_messages
+
     writer = STEPControl_Writer()
-    if writer.Transfer(_shape(obj), STEPControl_AsIs) != IFSelect_ReturnStatus.IFSelect_RetDone:
+    with quiet_messages():
+        status = writer.Transfer(_shape(obj), STEPControl_AsIs)
+    if status != IFSelect_ReturnStatus.IFSelect_RetDone:
         raise OSError(f"STEP transfer failed for {obj!r}")
     # STEPControl_Writer.Write prints 13 significant digits; 17 keep every double.
     printer = StepData_StepWriter(writer.Model())
@@ -113,51 +117,22 @@ def export_iges(obj: Any, path: PathLike) -> None:
     from OCP.IGESSelect import IGESSelect_WorkLibrary
     from OCP.Interface import Interface_Static
 
+    from .occ import quiet_messages
+
     IGESControl_Controller.Init_s()
     Interface_Static.SetIVal_s("write.iges.brep.mode", 1)
     Interface_Static.SetIVal_s("write.convertsurface.mode", 0)
     writer = IGESControl_Writer("MM", 1)
-    if not writer.AddShape(_shape(obj)):
-        raise OSError(f"IGES transfer failed for {obj!r}")
-    writer.ComputeModel()
+    with quiet_messages():
+        if not writer.AddShape(_shape(obj)):
+            raise OSError(f"IGES transfer failed for {obj!r}")
+        writer.ComputeModel()
     # IGESControl_Writer.Write prints reals with 9 decimals (~5e-10 absolute);
     # printing the model ourselves with 17 significant digits keeps every double.
     printer = IGESData_IGESWriter(writer.Model())
     printer.FloatWriter().SetFormat("%.16E")
     printer.SendModel(IGESSelect_WorkLibrary.DefineProtocol_s())
     _print_to(printer, path, "IGES")
-
-
-def import_step(path: PathLike):
-    """Read a STEP file into one OCP shape.
-
-    Raises:
-        OSError: the file is missing or unreadable.
-    """
-    from OCP.IFSelect import IFSelect_ReturnStatus
-    from OCP.STEPControl import STEPControl_Reader
-
-    reader = STEPControl_Reader()
-    if reader.ReadFile(os.fspath(path)) != IFSelect_ReturnStatus.IFSelect_RetDone:
-        raise OSError(f"could not read STEP file {os.fspath(path)!r}")
-    reader.TransferRoots()
-    return reader.OneShape()
-
-
-def import_iges(path: PathLike):
-    """Read an IGES file into one OCP shape.
-
-    Raises:
-        OSError: the file is missing or unreadable.
-    """
-    from OCP.IFSelect import IFSelect_ReturnStatus
-    from OCP.IGESControl import IGESControl_Reader
-
-    reader = IGESControl_Reader()
-    if reader.ReadFile(os.fspath(path)) != IFSelect_ReturnStatus.IFSelect_RetDone:
-        raise OSError(f"could not read IGES file {os.fspath(path)!r}")
-    reader.TransferRoots()
-    return reader.OneShape()
 
 
 # ------------------------------------------------------------------------ DXF

@@ -14,7 +14,10 @@ towards Y.
 
 from __future__ import annotations
 
-from collections.abc import Callable, Iterable
+import os
+from collections.abc import Callable, Iterable, Iterator
+from contextlib import contextmanager
+from pathlib import Path
 from typing import TYPE_CHECKING
 
 from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeEdge, BRepBuilderAPI_MakeWire
@@ -22,7 +25,7 @@ from OCP.Geom import Geom_BezierCurve, Geom_BSplineCurve
 from OCP.gp import gp_Ax2, gp_Ax3, gp_Circ, gp_Dir, gp_Pnt
 from OCP.TColgp import TColgp_Array1OfPnt
 from OCP.TColStd import TColStd_Array1OfInteger, TColStd_Array1OfReal
-from OCP.TopoDS import TopoDS_Edge, TopoDS_Wire
+from OCP.TopoDS import TopoDS_Edge, TopoDS_Shape, TopoDS_Wire
 
 from .segments import Arc, Line, Segment
 from .spiral import BezierSpiral
@@ -171,3 +174,58 @@ def nurbs_edge(nurbs: Nurbs, plane: gp_Ax3 | None = None) -> TopoDS_Edge:
         mults.SetValue(i, m)
     curve = Geom_BSplineCurve(poles, weights, knots, mults, nurbs.degree)
     return BRepBuilderAPI_MakeEdge(curve).Edge()
+
+
+# ------------------------------------------------------------- file input
+
+STEP_SUFFIXES = (".step", ".stp")
+IGES_SUFFIXES = (".iges", ".igs")
+
+
+def read_shape(path: str | os.PathLike) -> TopoDS_Shape:
+    """Read a STEP (.step/.stp) or IGES (.igs/.iges) file into one shape.
+
+    Raises:
+        ValueError: unknown suffix, missing file, or a file the reader rejects.
+    """
+    p = Path(path)
+    suffix = p.suffix.lower()
+    if suffix not in STEP_SUFFIXES + IGES_SUFFIXES:
+        raise ValueError(f"cannot read {str(p)!r}: expected a .step/.stp or .igs/.iges file")
+    if not p.is_file():
+        raise ValueError(f"cannot read {str(p)!r}: no such file")
+    from OCP.IFSelect import IFSelect_RetDone
+
+    if suffix in STEP_SUFFIXES:
+        from OCP.STEPControl import STEPControl_Reader
+
+        reader = STEPControl_Reader()
+    else:
+        from OCP.IGESControl import IGESControl_Reader
+
+        reader = IGESControl_Reader()
+    with quiet_messages():
+        status = reader.ReadFile(str(p))
+        if status != IFSelect_RetDone:
+            raise ValueError(f"cannot read {str(p)!r}: the {suffix[1:].upper()} reader failed ({status.name})")
+        reader.TransferRoots()
+        shape = reader.OneShape()
+    if shape.IsNull():
+        raise ValueError(f"cannot read {str(p)!r}: no transferable geometry")
+    return shape
+
+
+@contextmanager
+def quiet_messages() -> Iterator[None]:
+    """Silence OCCT's informational console messages (warnings and errors still print)."""
+    from OCP.Message import Message, Message_Gravity
+
+    printers = list(Message.DefaultMessenger_s().Printers())
+    levels = [p.GetTraceLevel() for p in printers]
+    for p in printers:
+        p.SetTraceLevel(Message_Gravity.Message_Warning)
+    try:
+        yield
+    finally:
+        for p, level in zip(printers, levels):
+            p.SetTraceLevel(level)

@@ -15,7 +15,11 @@ pytest.importorskip("OCP")
 
 import build123d as bd  # noqa: E402
 from OCP.BRep import BRep_Builder  # noqa: E402
-from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeEdge, BRepBuilderAPI_MakeWire, BRepBuilderAPI_Transform  # noqa: E402
+from OCP.BRepBuilderAPI import (  # noqa: E402
+    BRepBuilderAPI_MakeEdge,
+    BRepBuilderAPI_MakeWire,
+    BRepBuilderAPI_Transform,
+)
 from OCP.BRepTools import BRepTools_WireExplorer  # noqa: E402
 from OCP.GC import GC_MakeArcOfCircle  # noqa: E402
 from OCP.Geom import Geom_BezierCurve  # noqa: E402

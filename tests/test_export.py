@@ -10,6 +10,7 @@ import pytest
 pytest.importorskip("OCP")
 ezdxf = pytest.importorskip("ezdxf")
 
+from cad_cases import curvature_vector, transition_chains
 from OCP.BRepAdaptor import BRepAdaptor_Curve
 from OCP.BRepLProp import BRepLProp_CLProps
 from OCP.GeomAbs import GeomAbs_CurveType
@@ -17,7 +18,6 @@ from OCP.TopAbs import TopAbs_EDGE, TopAbs_REVERSED
 from OCP.TopExp import TopExp_Explorer
 from OCP.TopoDS import TopoDS
 
-from cad_cases import curvature_vector, transition_chains
 from spiral_cad import Arc, BezierSpiral, Line
 from spiral_cad.export import (
     BEZIER_KNOTS,
@@ -25,12 +25,11 @@ from spiral_cad.export import (
     export_iges,
     export_step,
     export_svg,
-    import_iges,
-    import_step,
 )
+from spiral_cad.occ import read_shape
 
 CHAINS = transition_chains()
-FORMATS = {"step": (export_step, import_step), "iges": (export_iges, import_iges)}
+FORMATS = {"step": (export_step, read_shape), "iges": (export_iges, read_shape)}
 
 
 def vec(p) -> np.ndarray:
@@ -137,11 +136,11 @@ def test_build123d_shapes_are_written_as_they_are(tmp_path):
     )
     path = tmp_path / "solid.step"
     export_step(solid, path)
-    back = build123d.Solid(import_step(path))
+    back = build123d.Solid(read_shape(path))
     assert back.is_valid and back.volume == pytest.approx(solid.volume, rel=1e-9)
     iges = tmp_path / "rail.iges"
     export_iges(rail, iges)
-    assert len(edges_of(import_iges(iges))) == len(chain)
+    assert len(edges_of(read_shape(iges))) == len(chain)
 
 
 def test_writers_reject_other_objects(tmp_path):

@@ -6,9 +6,9 @@ import sys
 
 import numpy as np
 import pytest
+from cad_cases import transition_chains
 from scipy.interpolate import BSpline
 
-from cad_cases import transition_chains
 from spiral_cad import Arc, Chain, Line
 from spiral_cad.nurbs import Nurbs, chain_to_nurbs
 

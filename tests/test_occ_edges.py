@@ -9,6 +9,7 @@ from hypothesis import strategies as st
 
 pytest.importorskip("OCP")
 
+from cad_cases import transition_chains
 from OCP.BRep import BRep_Tool
 from OCP.BRepAdaptor import BRepAdaptor_Curve
 from OCP.BRepCheck import BRepCheck_Analyzer
@@ -16,7 +17,6 @@ from OCP.BRepTools import BRepTools_WireExplorer
 from OCP.GeomAbs import GeomAbs_CurveType
 from OCP.gp import gp_Ax3, gp_Dir, gp_Pnt, gp_Vec
 
-from cad_cases import transition_chains
 from spiral_cad import Arc, BezierSpiral, Line
 from spiral_cad.occ import chain_wire, segment_edge, segment_edges
 

@@ -5,7 +5,14 @@ Pure numpy/numba: nothing here imports a CAD kernel.
 
 from .alignment import Alignment, CurveData, curvature_rate, peak_curvature_rate
 from .circles import CircleChain, circle_chain
-from .rounding import CornerBatch, RoundedCorner, RoundedPath, corner_legs, round_corners, round_corners_batch
+from .rounding import (
+    CornerBatch,
+    RoundedCorner,
+    RoundedPath,
+    corner_legs,
+    round_corners,
+    round_corners_batch,
+)
 
 __all__ = [
     "Alignment",
