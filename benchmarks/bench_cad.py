@@ -10,8 +10,6 @@ from __future__ import annotations
 
 import argparse
 import os
-import platform
-import statistics
 import tempfile
 import time
 
@@ -23,6 +21,7 @@ from OCP.TColgp import TColgp_Array1OfPnt
 from spiral_cad import Arc, Chain, Line, circle_to_circle
 from spiral_cad.export import export_step
 from spiral_cad.occ import chain_wire
+from timing import machine, median_time, write_markdown
 
 try:
     from spiral_cad.continuity import check_continuity
@@ -73,15 +72,6 @@ def raw_ocp_wire(rows: list[tuple]):
     return wire.Wire()
 
 
-def median(fn, repeat: int) -> float:
-    times = []
-    for _ in range(repeat):
-        t0 = time.perf_counter()
-        fn()
-        times.append(time.perf_counter() - t0)
-    return statistics.median(times)
-
-
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--segments", type=int, default=10_000)
@@ -95,12 +85,12 @@ def main() -> None:
     print(f"chain of {len(chain):,} segments built and G2-checked in {build_chain:.2f} s", flush=True)
     with tempfile.TemporaryDirectory() as tmp:
         ours_path, raw_path = os.path.join(tmp, "ours.step"), os.path.join(tmp, "raw.step")
-        t_ours_wire = median(lambda: chain_wire(chain), args.repeat)
-        t_raw_wire = median(lambda: raw_ocp_wire(rows), args.repeat)
-        t_ours = median(lambda: export_step(chain, ours_path), args.repeat)
-        t_raw = median(lambda: _write_step(raw_ocp_wire(rows), raw_path), args.repeat)
+        t_ours_wire = median_time(lambda: chain_wire(chain), args.repeat)
+        t_raw_wire = median_time(lambda: raw_ocp_wire(rows), args.repeat)
+        t_ours = median_time(lambda: export_step(chain, ours_path), args.repeat)
+        t_raw = median_time(lambda: _write_step(raw_ocp_wire(rows), raw_path), args.repeat)
         wire = chain_wire(chain)
-        t_check = median(lambda: check_continuity(wire), max(1, args.repeat // 2)) if check_continuity else float("nan")
+        t_check = median_time(lambda: check_continuity(wire), max(1, args.repeat // 2)) if check_continuity else float("nan")
         report = check_continuity(wire) if check_continuity else None
     joints = len(chain) - 1
     table = [
@@ -113,16 +103,11 @@ def main() -> None:
         ("ratio ours / raw (wire + STEP)", f"{t_ours / t_raw:.2f}×", "goal ≤ 1.2"),
         ("G2 checker", f"{joints / t_check:,.0f} joints/s", f"{joints:,} joints, min level {report.min_level if report else '-'}"),
     ]
-    machine = f"{platform.machine()}, {os.cpu_count()} cores, Python {platform.python_version()}"
     for name, value, note in table:
         print(f"  {name:38} {value:>18}  {note}")
-    print(f"machine: {machine}")
+    print(f"machine: {machine()}")
     if args.out:
-        with open(args.out, "w", encoding="utf-8") as fh:
-            fh.write(f"# CAD benchmark\n\nMachine: {machine}. Median of {args.repeat} runs.\n\n")
-            fh.write("| measurement | value | note |\n|---|---:|---|\n")
-            for row in table:
-                fh.write("| " + " | ".join(row) + " |\n")
+        write_markdown(args.out, "CAD benchmark", f"Median of {args.repeat} runs.", ("measurement", "value", "note"), table)
 
 
 def _write_step(shape, path: str) -> None:

@@ -8,10 +8,6 @@ the same run so the ratios hold on a noisy shared machine.
 from __future__ import annotations
 
 import argparse
-import os
-import platform
-import statistics
-import time
 import timeit
 
 import numpy as np
@@ -20,16 +16,7 @@ from scipy.special import fresnel
 import spiral_cad as sc
 from spiral_cad import batch
 from spiral_cad._kernels import nested_band_lower
-
-
-def median_time(fn, repeat: int) -> float:
-    fn()  # warm-up (compilation, caches)
-    times = []
-    for _ in range(repeat):
-        t0 = time.perf_counter()
-        fn()
-        times.append(time.perf_counter() - t0)
-    return statistics.median(times)
+from timing import machine, median_time, write_markdown
 
 
 def line_circle_problems(n: int, rng: np.random.Generator):
@@ -163,14 +150,10 @@ def main() -> None:
     add("evaluation point(u)", n / t_pt / 1e6, "M points/s", "goal ≥ 30")
     add("evaluation curvature(u)", n / t_k / 1e6, "M points/s", "goal ≥ 30")
 
-    machine = f"{platform.machine()}, {os.cpu_count()} cores, {platform.python_implementation()} {platform.python_version()}, numpy {np.__version__}"
-    print(f"machine: {machine}")
+    print(f"machine: {machine()}")
     if args.out:
-        with open(args.out, "w", encoding="utf-8") as fh:
-            fh.write(f"# Core benchmark\n\nMachine: {machine}. {n:,} rows per batch, median of {rep} runs.\n\n")
-            fh.write("| measurement | value | unit | goal |\n|---|---:|---|---|\n")
-            for row in rows:
-                fh.write("| " + " | ".join(row) + " |\n")
+        note = f"{n:,} rows per batch, median of {rep} runs."
+        write_markdown(args.out, "Core benchmark", note, ("measurement", "value", "unit", "goal"), rows)
 
 
 if __name__ == "__main__":

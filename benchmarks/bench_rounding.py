@@ -9,24 +9,11 @@ medians over ``repeat`` runs. Goal: 1 M corners in ≤ 1 s.
 from __future__ import annotations
 
 import argparse
-import os
-import platform
-import statistics
-import time
 
 import numpy as np
 
 from spiral_cad.design import corner_legs, round_corners_batch
-
-
-def median_time(fn, repeat: int) -> float:
-    fn()  # warm-up (compilation, caches)
-    times = []
-    for _ in range(repeat):
-        t0 = time.perf_counter()
-        fn()
-        times.append(time.perf_counter() - t0)
-    return statistics.median(times)
+from timing import machine, median_time
 
 
 def random_polyline(corners: int, rng: np.random.Generator) -> np.ndarray:
@@ -43,13 +30,19 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--corners", type=int, default=1_000_000)
     parser.add_argument("--repeat", type=int, default=5)
+    parser.add_argument("--out", help="also write the table to this markdown file")
     args = parser.parse_args()
+    lines: list[str] = []
+
+    def emit(line: str = "") -> None:
+        print(line, flush=True)
+        lines.append(line)
+
     points = random_polyline(args.corners, np.random.default_rng(1))
-    print(f"machine: {platform.platform()}, {platform.processor() or platform.machine()}, {os.cpu_count()} CPUs, "
-          f"python {platform.python_version()}")
-    print(f"{args.corners:,} corners, median of {args.repeat} runs\n")
-    print("| case | time (s) | corners/s | 1 M corners ≤ 1 s |")
-    print("|---|---:|---:|:---:|")
+    emit(f"machine: {machine()}")
+    emit(f"{args.corners:,} corners, median of {args.repeat} runs\n")
+    emit("| case | time (s) | corners/s | 1 M corners ≤ 1 s |")
+    emit("|---|---:|---:|:---:|")
     legs_time = median_time(lambda: corner_legs(points), args.repeat)
     p0, corners, p1, _ = corner_legs(points)
     cases = [
@@ -65,9 +58,13 @@ def main() -> None:
         label = name if method is None else f"{name} (+ legs)"
         per_million = total * 1e6 / args.corners
         goal = "yes" if per_million <= 1.0 else "no"
-        print(f"| {label} | {total:.3f} | {args.corners / total:,.0f} | {goal} |")
+        emit(f"| {label} | {total:.3f} | {args.corners / total:,.0f} | {goal} |")
     result = round_corners_batch(p0, corners, p1, max_curvature=2.0)
-    print(f"\nκmax = 2: {result.ok.sum():,} corners rounded, {(~result.ok).sum():,} report legs too short")
+    emit(f"\nκmax = 2: {result.ok.sum():,} corners rounded, {(~result.ok).sum():,} report legs too short")
+
+    if args.out:
+        with open(args.out, "w", encoding="utf-8") as fh:
+            fh.write("# Corner rounding benchmark\n\n" + "\n".join(lines) + "\n")
 
 
 if __name__ == "__main__":

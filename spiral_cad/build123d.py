@@ -109,7 +109,24 @@ class SpiralLineToCircle(_TransitionObject):
         super().__init__(transition, mode)
 
 
-class SpiralCircleToCircle(_TransitionObject):
+class _CirclePairObject(_TransitionObject):
+    """A transition between two circles given by centres and signed radii."""
+
+    _solve = staticmethod(circle_to_circle)
+
+    def __init__(
+        self,
+        center0: VectorLike,
+        radius0: float,
+        center1: VectorLike,
+        radius1: float,
+        mode: Mode = Mode.ADD,
+    ):
+        transition = self._solve(_xy(center0, "center0"), radius0, _xy(center1, "center1"), radius1)
+        super().__init__(transition, mode)
+
+
+class SpiralCircleToCircle(_CirclePairObject):
     """Line Object: Spiral Circle To Circle
 
     Two G2 spirals from circle 0 to circle 1: a C when the signed radii
@@ -126,16 +143,7 @@ class SpiralCircleToCircle(_TransitionObject):
         NoSolutionError: the circles admit no such transition.
     """
 
-    def __init__(
-        self,
-        center0: VectorLike,
-        radius0: float,
-        center1: VectorLike,
-        radius1: float,
-        mode: Mode = Mode.ADD,
-    ):
-        transition = circle_to_circle(_xy(center0, "center0"), radius0, _xy(center1, "center1"), radius1)
-        super().__init__(transition, mode)
+    _solve = staticmethod(circle_to_circle)
 
 
 class SpiralLineToLine(_TransitionObject):
@@ -168,7 +176,7 @@ class SpiralLineToLine(_TransitionObject):
         super().__init__(transition, mode)
 
 
-class SpiralCircleInCircle(_TransitionObject):
+class SpiralCircleInCircle(_CirclePairObject):
     """Line Object: Spiral Circle In Circle
 
     One G2 spiral between two nested circles (either way: in or out).
@@ -185,16 +193,7 @@ class SpiralCircleInCircle(_TransitionObject):
             single spiral exists.
     """
 
-    def __init__(
-        self,
-        center0: VectorLike,
-        radius0: float,
-        center1: VectorLike,
-        radius1: float,
-        mode: Mode = Mode.ADD,
-    ):
-        transition = circle_in_circle(_xy(center0, "center0"), radius0, _xy(center1, "center1"), radius1)
-        super().__init__(transition, mode)
+    _solve = staticmethod(circle_in_circle)
 
 
 class SpiralChain(_ExactLineObject):

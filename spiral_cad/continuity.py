@@ -35,13 +35,13 @@ import argparse
 import math
 import os
 import sys
-from collections.abc import Iterable, Sequence
+from collections.abc import Sequence
 from dataclasses import dataclass
 from enum import IntEnum
 from typing import Any
 
 import numpy as np
-from OCP.BRep import BRep_Builder, BRep_Tool
+from OCP.BRep import BRep_Tool
 from OCP.BRepAdaptor import BRepAdaptor_Curve
 from OCP.BRepLProp import BRepLProp_CLProps
 from OCP.BRepTools import BRepTools_WireExplorer
@@ -51,7 +51,6 @@ from OCP.TopAbs import TopAbs_EDGE, TopAbs_REVERSED, TopAbs_WIRE
 from OCP.TopExp import TopExp, TopExp_Explorer
 from OCP.TopoDS import (
     TopoDS,
-    TopoDS_Compound,
     TopoDS_Edge,
     TopoDS_Iterator,
     TopoDS_Shape,
@@ -59,7 +58,7 @@ from OCP.TopoDS import (
 )
 from OCP.TopTools import TopTools_IndexedMapOfShape
 
-from .occ import read_shape
+from .occ import as_occ_shape
 
 #: Loose edges whose ends lie closer than this fraction of the model size are
 #: chained into one group (and their gap is then judged against ``gap_tol``).
@@ -200,26 +199,6 @@ class ContinuityReport:
 
 
 # --------------------------------------------------------------- input
-
-
-def as_occ_shape(obj: Any) -> TopoDS_Shape:
-    """A ``TopoDS_Shape`` from an OCP shape, a build123d/CadQuery shape (``.wrapped``),
-    an iterable of those (made into a compound) or a STEP/IGES file path."""
-    if isinstance(obj, TopoDS_Shape):
-        return obj
-    if isinstance(obj, (str, os.PathLike)):
-        return read_shape(obj)
-    wrapped = getattr(obj, "wrapped", None)
-    if isinstance(wrapped, TopoDS_Shape):
-        return wrapped
-    if isinstance(obj, Iterable):
-        builder = BRep_Builder()
-        compound = TopoDS_Compound()
-        builder.MakeCompound(compound)
-        for item in obj:
-            builder.Add(compound, as_occ_shape(item))
-        return compound
-    raise ValueError(f"expected an OCP/build123d/CadQuery shape or a STEP/IGES path; got {type(obj).__name__}")
 
 
 # ---------------------------------------------------- edge end frames

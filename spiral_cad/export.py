@@ -38,29 +38,6 @@ def _chains(obj: Any) -> list[Chain]:
     raise ValueError(f"expected a Chain or a list of Chains; got {obj!r}")
 
 
-def _shape(obj: Any):
-    """``obj`` as one OCP ``TopoDS_Shape``: chains become wires, shapes pass through."""
-    from OCP.BRep import BRep_Builder
-    from OCP.TopoDS import TopoDS_Compound, TopoDS_Shape
-
-    from .occ import chain_wire
-
-    if isinstance(obj, TopoDS_Shape):
-        return obj
-    wrapped = getattr(obj, "wrapped", None)  # build123d / CadQuery shapes
-    if isinstance(wrapped, TopoDS_Shape):
-        return wrapped
-    chains = _chains(obj)
-    if len(chains) == 1:
-        return chain_wire(chains[0])
-    compound = TopoDS_Compound()
-    builder = BRep_Builder()
-    builder.MakeCompound(compound)
-    for chain in chains:
-        builder.Add(compound, chain_wire(chain))
-    return compound
-
-
 # ------------------------------------------------------------------ STEP / IGES
 
 
@@ -79,11 +56,11 @@ def export_step(obj: Any, path: PathLike) -> None:
     from OCP.STEPControl import STEPControl_AsIs, STEPControl_Writer
     from OCP.StepData import StepData_StepWriter
 
-    from .occ import quiet_messages
+    from .occ import as_occ_shape, quiet_messages
 
     writer = STEPControl_Writer()
     with quiet_messages():
-        status = writer.Transfer(_shape(obj), STEPControl_AsIs)
+        status = writer.Transfer(as_occ_shape(obj), STEPControl_AsIs)
     if status != IFSelect_ReturnStatus.IFSelect_RetDone:
         raise OSError(f"STEP transfer failed for {obj!r}")
     # STEPControl_Writer.Write prints 13 significant digits; 17 keep every double.
@@ -117,14 +94,14 @@ def export_iges(obj: Any, path: PathLike) -> None:
     from OCP.IGESSelect import IGESSelect_WorkLibrary
     from OCP.Interface import Interface_Static
 
-    from .occ import quiet_messages
+    from .occ import as_occ_shape, quiet_messages
 
     IGESControl_Controller.Init_s()
     Interface_Static.SetIVal_s("write.iges.brep.mode", 1)
     Interface_Static.SetIVal_s("write.convertsurface.mode", 0)
     writer = IGESControl_Writer("MM", 1)
     with quiet_messages():
-        if not writer.AddShape(_shape(obj)):
+        if not writer.AddShape(as_occ_shape(obj)):
             raise OSError(f"IGES transfer failed for {obj!r}")
         writer.ComputeModel()
     # IGESControl_Writer.Write prints reals with 9 decimals (~5e-10 absolute);

@@ -18,14 +18,15 @@ import os
 from collections.abc import Callable, Iterable, Iterator
 from contextlib import contextmanager
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
+from OCP.BRep import BRep_Builder
 from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeEdge, BRepBuilderAPI_MakeWire
 from OCP.Geom import Geom_BezierCurve, Geom_BSplineCurve
 from OCP.gp import gp_Ax2, gp_Ax3, gp_Circ, gp_Dir, gp_Pnt
 from OCP.TColgp import TColgp_Array1OfPnt
 from OCP.TColStd import TColStd_Array1OfInteger, TColStd_Array1OfReal
-from OCP.TopoDS import TopoDS_Edge, TopoDS_Shape, TopoDS_Wire
+from OCP.TopoDS import TopoDS_Compound, TopoDS_Edge, TopoDS_Shape, TopoDS_Wire
 
 from .segments import Arc, Line, Segment
 from .spiral import BezierSpiral
@@ -229,3 +230,32 @@ def quiet_messages() -> Iterator[None]:
     finally:
         for p, level in zip(printers, levels):
             p.SetTraceLevel(level)
+
+
+def as_occ_shape(obj: Any) -> TopoDS_Shape:
+    """One ``TopoDS_Shape`` from an OCP shape, a build123d/CadQuery shape
+    (``.wrapped``), a ``Chain`` (its wire), a STEP/IGES path, or an iterable
+    of those (made into a compound).
+
+    Raises:
+        ValueError: anything else.
+    """
+    from .chain import Chain  # chain.py imports this module lazily in turn
+
+    if isinstance(obj, TopoDS_Shape):
+        return obj
+    if isinstance(obj, (str, os.PathLike)):
+        return read_shape(obj)
+    wrapped = getattr(obj, "wrapped", None)
+    if isinstance(wrapped, TopoDS_Shape):
+        return wrapped
+    if isinstance(obj, Chain):
+        return chain_wire(obj)
+    if isinstance(obj, Iterable):
+        builder = BRep_Builder()
+        compound = TopoDS_Compound()
+        builder.MakeCompound(compound)
+        for item in obj:
+            builder.Add(compound, as_occ_shape(item))
+        return compound
+    raise ValueError(f"expected a Chain, an OCP/build123d/CadQuery shape or a STEP/IGES path; got {type(obj).__name__}")

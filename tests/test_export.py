@@ -145,8 +145,10 @@ def test_build123d_shapes_are_written_as_they_are(tmp_path):
 
 def test_writers_reject_other_objects(tmp_path):
     for write in (export_step, export_iges, export_dxf, export_svg):
-        with pytest.raises(ValueError, match="Chain"):
-            write("not a chain", tmp_path / "x")
+        with pytest.raises(ValueError, match="expected a Chain"):
+            write(42, tmp_path / "x")
+    with pytest.raises(ValueError, match="cannot read"):
+        export_step("not a file.txt", tmp_path / "x.step")
 
 
 @pytest.mark.parametrize("name", sorted(CHAINS))

@@ -1,0 +1,50 @@
+"""Regenerate the README pictures in docs/images from the project's own outputs.
+
+Run: ``make pictures`` (or ``.venv/bin/python docs/make_pictures.py``).
+"""
+
+import shutil
+import subprocess
+import sys
+import tempfile
+from pathlib import Path
+
+import cadquery as cq
+
+ROOT = Path(__file__).resolve().parent.parent
+IMAGES = ROOT / "docs" / "images"
+
+
+def run(*args: str) -> None:
+    subprocess.run([sys.executable, *args], check=True, cwd=ROOT, stdout=subprocess.DEVNULL)
+
+
+def main() -> None:
+    IMAGES.mkdir(parents=True, exist_ok=True)
+    with tempfile.TemporaryDirectory() as tmp:
+        tmp = Path(tmp)
+        run("-m", "spiral_cad.cli", "demo", "--out", str(tmp / "demo"))
+        run("examples/robot_path.py", str(tmp / "robot"))
+        run("examples/build123d_road.py", str(tmp / "road"))
+        run("examples/cadquery_plugin.py", str(tmp / "cq" / "tube.step"))
+        picks = {
+            "demo/highway_plan.png": "highway_plan.png",
+            "demo/highway_curvature.png": "highway_curvature.png",
+            "demo/circles_plan.png": "circles_plan.png",
+            "demo/fig6.png": "fig6.png",
+            "demo/bezier_vs_clothoid.png": "bezier_vs_clothoid.png",
+            "robot/robot_path.png": "robot_path.png",
+            "road/road.svg": "road.svg",
+        }
+        for source, target in picks.items():
+            shutil.copy(tmp / source, IMAGES / target)
+        tube = cq.importers.importStep(str(tmp / "cq" / "tube.step"))
+        cq.exporters.export(
+            tube, str(IMAGES / "cadquery_tube.svg"), opt={"projectionDir": (0.4, -1.0, 0.5), "showHidden": False}
+        )
+    for path in sorted(IMAGES.iterdir()):
+        print(path.relative_to(ROOT))
+
+
+if __name__ == "__main__":
+    main()
