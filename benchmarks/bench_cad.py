@@ -17,16 +17,12 @@ from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeEdge, BRepBuilderAPI_MakeWire
 from OCP.Geom import Geom_BezierCurve
 from OCP.gp import gp_Ax2, gp_Circ, gp_Dir, gp_Pnt
 from OCP.TColgp import TColgp_Array1OfPnt
-
-from spiral_cad import Arc, Chain, Line, circle_to_circle
-from spiral_cad.export import export_step
-from spiral_cad.occ import chain_wire
 from timing import machine, median_time, write_markdown
 
-try:
-    from spiral_cad.continuity import check_continuity
-except ImportError:  # pragma: no cover - reported in the table
-    check_continuity = None
+from spiral_cad import Arc, Chain, Line, circle_to_circle
+from spiral_cad.continuity import check_continuity
+from spiral_cad.export import export_step
+from spiral_cad.occ import chain_wire
 
 
 def snake(segments: int) -> Chain:
@@ -52,10 +48,10 @@ def plain_description(chain: Chain) -> list[tuple]:
     return rows
 
 
-def raw_ocp_wire(rows: list[tuple]):
-    """The same edges and wire with direct OCP calls."""
+def raw_ocp_edges(rows: list[tuple]) -> list:
+    """The same edges with direct OCP calls."""
     up, down, x = gp_Dir(0, 0, 1), gp_Dir(0, 0, -1), gp_Dir(1, 0, 0)
-    wire = BRepBuilderAPI_MakeWire()
+    edges = []
     for row in rows:
         if row[0] == "line":
             edge = BRepBuilderAPI_MakeEdge(gp_Pnt(row[1], row[2], 0), gp_Pnt(row[3], row[4], 0)).Edge()
@@ -68,6 +64,14 @@ def raw_ocp_wire(rows: list[tuple]):
             for i, (px, py) in enumerate(row[1], 1):
                 poles.SetValue(i, gp_Pnt(px, py, 0))
             edge = BRepBuilderAPI_MakeEdge(Geom_BezierCurve(poles)).Edge()
+        edges.append(edge)
+    return edges
+
+
+def raw_ocp_wire(rows: list[tuple]):
+    """The usual way: those edges added one by one to BRepBuilderAPI_MakeWire."""
+    wire = BRepBuilderAPI_MakeWire()
+    for edge in raw_ocp_edges(rows):
         wire.Add(edge)
     return wire.Wire()
 
@@ -86,22 +90,25 @@ def main() -> None:
     with tempfile.TemporaryDirectory() as tmp:
         ours_path, raw_path = os.path.join(tmp, "ours.step"), os.path.join(tmp, "raw.step")
         t_ours_wire = median_time(lambda: chain_wire(chain), args.repeat)
+        t_raw_edges = median_time(lambda: raw_ocp_edges(rows), args.repeat)
         t_raw_wire = median_time(lambda: raw_ocp_wire(rows), args.repeat)
         t_ours = median_time(lambda: export_step(chain, ours_path), args.repeat)
         t_raw = median_time(lambda: _write_step(raw_ocp_wire(rows), raw_path), args.repeat)
         wire = chain_wire(chain)
-        t_check = median_time(lambda: check_continuity(wire), max(1, args.repeat // 2)) if check_continuity else float("nan")
-        report = check_continuity(wire) if check_continuity else None
+        t_check = median_time(lambda: check_continuity(wire), args.repeat)
+        report = check_continuity(wire)
     joints = len(chain) - 1
+    ms = lambda t: f"{t * 1e3:,.1f} ms"  # noqa: E731
     table = [
-        ("segments", f"{len(chain):,}", ""),
-        ("chain → OCCT wire, ours (median)", f"{t_ours_wire * 1e3:,.1f} ms", ""),
-        ("same edges + wire, raw OCP calls", f"{t_raw_wire * 1e3:,.1f} ms", ""),
-        ("ratio ours / raw (wire)", f"{t_ours_wire / t_raw_wire:.2f}×", "goal ≤ 1.2"),
-        ("chain → wire → STEP file, ours", f"{t_ours * 1e3:,.1f} ms", ""),
-        ("raw OCP edges → wire → STEP file", f"{t_raw * 1e3:,.1f} ms", ""),
+        ("segments", f"{len(chain):,}", "line, arc and spiral edges"),
+        ("ours: chain → OCCT wire", ms(t_ours_wire), "edges share vertices, wire assembled directly"),
+        ("raw OCP: the same edges only", ms(t_raw_edges), "MakeEdge per segment, no wire"),
+        ("ratio ours (whole wire) / raw edges", f"{t_ours_wire / t_raw_edges:.2f}×", "goal ≤ 1.2"),
+        ("raw OCP: edges + BRepBuilderAPI_MakeWire", ms(t_raw_wire), "the usual way; Add is linear in the wire size"),
+        ("ours: chain → wire → STEP file", ms(t_ours), "17 significant digits"),
+        ("raw OCP: edges → MakeWire → STEP file", ms(t_raw), "STEPControl_Writer defaults"),
         ("ratio ours / raw (wire + STEP)", f"{t_ours / t_raw:.2f}×", "goal ≤ 1.2"),
-        ("G2 checker", f"{joints / t_check:,.0f} joints/s", f"{joints:,} joints, min level {report.min_level if report else '-'}"),
+        ("G2 checker", f"{joints / t_check:,.0f} joints/s", f"{joints:,} joints, min level {report.min_level}"),
     ]
     for name, value, note in table:
         print(f"  {name:38} {value:>18}  {note}")

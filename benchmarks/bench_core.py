@@ -12,11 +12,11 @@ import timeit
 
 import numpy as np
 from scipy.special import fresnel
+from timing import machine, median_time, write_markdown
 
 import spiral_cad as sc
 from spiral_cad import batch
 from spiral_cad._kernels import nested_band_lower
-from timing import machine, median_time, write_markdown
 
 
 def line_circle_problems(n: int, rng: np.random.Generator):

@@ -11,9 +11,9 @@ from __future__ import annotations
 import argparse
 
 import numpy as np
+from timing import machine, median_time
 
 from spiral_cad.design import corner_legs, round_corners_batch
-from timing import machine, median_time
 
 
 def random_polyline(corners: int, rng: np.random.Generator) -> np.ndarray:

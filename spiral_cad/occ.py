@@ -15,15 +15,22 @@ towards Y.
 from __future__ import annotations
 
 import os
-from collections.abc import Callable, Iterable, Iterator
+from collections.abc import Iterable, Iterator
 from contextlib import contextmanager
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from OCP.BRep import BRep_Builder
-from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeEdge, BRepBuilderAPI_MakeWire
-from OCP.Geom import Geom_BezierCurve, Geom_BSplineCurve
-from OCP.gp import gp_Ax2, gp_Ax3, gp_Circ, gp_Dir, gp_Pnt
+from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeEdge, BRepBuilderAPI_MakeVertex
+from OCP.Geom import (
+    Geom_BezierCurve,
+    Geom_BSplineCurve,
+    Geom_Circle,
+    Geom_Curve,
+    Geom_Line,
+)
+from OCP.gp import gp_Ax2, gp_Ax3, gp_Dir, gp_Pnt, gp_Vec
+from OCP.Precision import Precision
 from OCP.TColgp import TColgp_Array1OfPnt
 from OCP.TColStd import TColStd_Array1OfInteger, TColStd_Array1OfReal
 from OCP.TopoDS import TopoDS_Compound, TopoDS_Edge, TopoDS_Shape, TopoDS_Wire
@@ -81,15 +88,18 @@ def _frame(plane: gp_Ax3 | None) -> _Frame:
     return _XY if plane is None else _Frame(plane)
 
 
-def _line_edge(line: Line, frame: _Frame) -> TopoDS_Edge:
+# Each segment becomes (curve, first, last): its exact OCCT curve and the
+# parameter range that runs in travel order.
+CurveSpan = tuple[Geom_Curve, float, float]
+
+
+def _line_curve(line: Line, frame: _Frame) -> CurveSpan:
     (ax, ay), (bx, by) = line._a.tolist(), line._b.tolist()
-    # MakeEdge(P1, P2) builds the Geom_Line trimmed to [0, |P1P2|] (GC_MakeSegment's result).
-    if frame.flat:  # the common case, spelled out: it runs once per edge
-        return BRepBuilderAPI_MakeEdge(gp_Pnt(ax, ay, 0.0), gp_Pnt(bx, by, 0.0)).Edge()
-    return BRepBuilderAPI_MakeEdge(frame.pnt(ax, ay), frame.pnt(bx, by)).Edge()
+    a, b = frame.pnt(ax, ay), frame.pnt(bx, by)
+    return Geom_Line(a, gp_Dir(gp_Vec(a, b))), 0.0, a.Distance(b)
 
 
-def _arc_edge(arc: Arc, frame: _Frame) -> TopoDS_Edge:
+def _arc_curve(arc: Arc, frame: _Frame) -> CurveSpan:
     cx, cy = arc.center.tolist()
     radius, a0, sweep = arc.radius, arc.start_angle, arc.sweep
     if radius > 0.0:
@@ -98,24 +108,25 @@ def _arc_edge(arc: Arc, frame: _Frame) -> TopoDS_Edge:
         # Clockwise travel: the circle's axis is flipped so its parameter still
         # increases along the path; the point at plane angle a has parameter -a.
         axis, first = frame.normal.Reversed(), -a0
-    circle = gp_Circ(gp_Ax2(frame.pnt(cx, cy), axis, frame.x_dir), abs(radius))
-    return BRepBuilderAPI_MakeEdge(circle, first, first + sweep).Edge()
+    circle = Geom_Circle(gp_Ax2(frame.pnt(cx, cy), axis, frame.x_dir), abs(radius))
+    return circle, first, first + sweep
 
 
-def _bezier_edge(spiral: BezierSpiral, frame: _Frame) -> TopoDS_Edge:
-    curve = Geom_BezierCurve(frame.poles(spiral.control_points.tolist()))
-    return BRepBuilderAPI_MakeEdge(curve).Edge()
+def _bezier_curve(spiral: BezierSpiral, frame: _Frame) -> CurveSpan:
+    return Geom_BezierCurve(frame.poles(spiral.control_points.tolist())), 0.0, 1.0
 
 
-_MAKERS = {Line: _line_edge, Arc: _arc_edge, BezierSpiral: _bezier_edge}
+_MAKERS = {Line: _line_curve, Arc: _arc_curve, BezierSpiral: _bezier_curve}
 
 
-def _maker(segment: Segment) -> Callable[[Segment, _Frame], TopoDS_Edge]:
-    """The edge maker for ``segment`` (subclasses included)."""
-    for kind, maker in _MAKERS.items():
-        if isinstance(segment, kind):
-            return maker
-    raise ValueError(f"segment must be a Line, Arc or BezierSpiral; got {segment!r}")
+def _curve_span(segment: Segment, frame: _Frame) -> CurveSpan:
+    """The exact curve of ``segment`` (subclasses included) and its travel-order range."""
+    maker = _MAKERS.get(type(segment))
+    if maker is None:
+        maker = next((m for kind, m in _MAKERS.items() if isinstance(segment, kind)), None)
+        if maker is None:
+            raise ValueError(f"segment must be a Line, Arc or BezierSpiral; got {segment!r}")
+    return maker(segment, frame)
 
 
 def segment_edge(segment: Segment, plane: gp_Ax3 | None = None) -> TopoDS_Edge:
@@ -131,34 +142,46 @@ def segment_edge(segment: Segment, plane: gp_Ax3 | None = None) -> TopoDS_Edge:
         ValueError: an unsupported segment type or a ``plane`` that is not a
             ``gp_Ax3``.
     """
-    maker = _MAKERS.get(type(segment)) or _maker(segment)
-    return maker(segment, _XY if plane is None else _Frame(plane))
+    return BRepBuilderAPI_MakeEdge(*_curve_span(segment, _frame(plane))).Edge()
 
 
 def segment_edges(segments: Iterable[Segment], plane: gp_Ax3 | None = None) -> list[TopoDS_Edge]:
     """``segment_edge`` for many segments sharing one frame (a chain, a transition's spirals)."""
     frame = _frame(plane)
-    makers = _MAKERS
-    return [(makers.get(type(s)) or _maker(s))(s, frame) for s in segments]
+    return [BRepBuilderAPI_MakeEdge(*_curve_span(s, frame)).Edge() for s in segments]
 
 
 def chain_wire(chain: Iterable[Segment], plane: gp_Ax3 | None = None) -> TopoDS_Wire:
     """One wire of the exact edges of ``chain`` (a ``Chain`` or any segments in travel order).
 
+    Consecutive edges share their vertex, and the wire is assembled directly
+    (linear time: ``BRepBuilderAPI_MakeWire`` searches every vertex so far at
+    each ``Add``, quadratic for long chains). A chain whose end meets its
+    start gives a closed wire.
+
     Raises:
-        ValueError: the segments do not connect into a wire (OCCT's
-            vertex tolerance, 1e-7, is exceeded) or there are none.
+        ValueError: consecutive segments are further apart than OCCT's
+            vertex tolerance (1e-7), or there are none.
     """
-    maker = BRepBuilderAPI_MakeWire()
-    count = 0
-    for edge in segment_edges(chain, plane):
-        maker.Add(edge)
-        count += 1
-        if not maker.IsDone():
-            raise ValueError(f"segment {count - 1} does not connect to the previous one ({maker.Error()})")
-    if count == 0:
+    frame = _frame(plane)
+    spans = [_curve_span(s, frame) for s in chain]
+    if not spans:
         raise ValueError("chain_wire needs at least one segment")
-    return maker.Wire()
+    ends = [(curve.Value(first), curve.Value(last)) for curve, first, last in spans]
+    vertices = [BRepBuilderAPI_MakeVertex(ends[0][0]).Vertex()]
+    for i, ((_, end), (start, _)) in enumerate(zip(ends, ends[1:])):
+        if end.Distance(start) > Precision.Confusion_s():
+            raise ValueError(f"segment {i + 1} does not connect to segment {i}: gap {end.Distance(start):.3g}")
+        vertices.append(BRepBuilderAPI_MakeVertex(end).Vertex())
+    closed = len(spans) > 1 and ends[-1][1].Distance(ends[0][0]) <= Precision.Confusion_s()
+    vertices.append(vertices[0] if closed else BRepBuilderAPI_MakeVertex(ends[-1][1]).Vertex())
+    builder = BRep_Builder()
+    wire = TopoDS_Wire()
+    builder.MakeWire(wire)
+    for (curve, first, last), v0, v1 in zip(spans, vertices, vertices[1:]):
+        builder.Add(wire, BRepBuilderAPI_MakeEdge(curve, v0, v1, first, last).Edge())
+    wire.Closed(closed)
+    return wire
 
 
 def nurbs_edge(nurbs: Nurbs, plane: gp_Ax3 | None = None) -> TopoDS_Edge:

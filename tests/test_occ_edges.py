@@ -17,7 +17,7 @@ from OCP.BRepTools import BRepTools_WireExplorer
 from OCP.GeomAbs import GeomAbs_CurveType
 from OCP.gp import gp_Ax3, gp_Dir, gp_Pnt, gp_Vec
 
-from spiral_cad import Arc, BezierSpiral, Line
+from spiral_cad import Arc, BezierSpiral, Chain, Line, line_to_circle
 from spiral_cad.occ import chain_wire, segment_edge, segment_edges
 
 EXPECTED_TYPE = {
@@ -124,3 +124,26 @@ def test_bad_inputs_name_the_problem():
         chain_wire([])
     with pytest.raises(ValueError, match="does not connect"):
         chain_wire([Line((0, 0), (1, 0)), Line((5, 5), (6, 5))])
+
+
+def test_chain_wire_shares_vertices_and_closes_loops():
+    from OCP.TopExp import TopExp
+    from OCP.TopoDS import TopoDS_Vertex
+
+    enter = line_to_circle((0, 0), (1, 0), (5, 3), 2.0)
+    open_chain = Chain.join([enter], start=(-20, 0))
+    wire = chain_wire(open_chain)
+    assert BRepCheck_Analyzer(wire).IsValid() and not wire.Closed()
+    first, second = segment_edges_of(wire)
+    assert TopExp.CommonVertex_s(first, second, TopoDS_Vertex())  # one vertex object at the joint
+    loop = Chain([Arc((0, 0), 1.0, 0.0, 3.0), Arc((0, 0), 1.0, 3.0, 2 * np.pi - 3.0)])
+    ring = chain_wire(loop)
+    assert ring.Closed() and BRepCheck_Analyzer(ring).IsValid()
+
+
+def segment_edges_of(wire):
+    edges, explorer = [], BRepTools_WireExplorer(wire)
+    while explorer.More():
+        edges.append(explorer.Current())
+        explorer.Next()
+    return edges
