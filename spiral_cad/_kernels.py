@@ -109,14 +109,16 @@ def end_residual(cp, cx, cy, radius):
     ay = cp[2, 1] - cp[1, 1]
     bx = cp[3, 0] - cp[2, 0]
     by = cp[3, 1] - cp[2, 1]
-    lb = norm(bx, by)
-    kappa = 2.0 / 3.0 * (ax * by - ay * bx) / (lb * lb * lb)
-    if not (lb > 0.0 and kappa != 0.0):
+    lb2 = bx * bx + by * by
+    cross = ax * by - ay * bx
+    if not (lb2 > 0.0 and cross != 0.0):
         return math.inf
-    ox = cp[3, 0] - by / lb / kappa
-    oy = cp[3, 1] + bx / lb / kappa
-    centre = norm(ox - cx, oy - cy) / abs(radius)
-    return max(centre, abs(kappa * radius - 1.0))
+    # κ = (2/3)·cross/|b|³, so the centre P3 + rot90(b)/(|b|·κ) needs no root.
+    to_centre = 1.5 * lb2 / cross
+    ox = cp[3, 0] - by * to_centre - cx
+    oy = cp[3, 1] + bx * to_centre - cy
+    kappa_r = radius / (to_centre * math.sqrt(lb2))
+    return max(math.sqrt(ox * ox + oy * oy) / abs(radius), abs(kappa_r - 1.0))
 
 
 @jit
