@@ -18,7 +18,7 @@ _W = np.tile(_GL_WEIGHTS / (2.0 * _PANELS), _PANELS)
 
 
 def _power_coefficients(cp: NDArray, order: int = 0) -> NDArray:
-    """Power-basis coefficients of Q (order 0), Q' (1) or Q'' (2), lowest first.
+    """Power-basis coefficients of Q (order 0) or of its derivative of order 1-3, lowest first.
 
     Formed from control-point differences, so they keep full relative accuracy
     for small curves far from the origin.
@@ -30,7 +30,9 @@ def _power_coefficients(cp: NDArray, order: int = 0) -> NDArray:
         return np.array([cp[0], 3.0 * d1[0], 3.0 * d2[0], d3])
     if order == 1:
         return np.array([3.0 * d1[0], 6.0 * d2[0], 3.0 * d3])
-    return np.array([6.0 * d2[0], 6.0 * d3])
+    if order == 2:
+        return np.array([6.0 * d2[0], 6.0 * d3])
+    return np.array([6.0 * d3])
 
 
 def _horner(coefficients: NDArray, u: ArrayLike) -> NDArray:
@@ -52,7 +54,7 @@ def point(cp: NDArray, u: ArrayLike) -> NDArray:
 
 
 def derivative(cp: NDArray, u: ArrayLike, order: int = 1) -> NDArray:
-    """First or second derivative Q'(u) / Q''(u)."""
+    """Derivative of ``order`` 1, 2 or 3 at ``u``."""
     return _horner(_power_coefficients(cp, order), u)
 
 

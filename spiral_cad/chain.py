@@ -75,12 +75,18 @@ class Chain:
         Between two parts, a gap is bridged by an arc of the circle the first
         part ends on (its ``end_circle``, travelled in its sense for the sweep
         up to the next contact) or, when it ends on a line, by a line.
-        ``start``/``end`` add a leading/trailing line to those points.
+        ``start``/``end`` add a leading/trailing line to those points
+        (none where a part already starts or ends there; with no parts the
+        chain is the line from ``start`` to ``end``).
 
         Example:
             ``Chain.join([line_to_circle(...), circle_to_line(...)], start=a, end=b)``
             gives line → spiral → arc → spiral → line.
         """
+        if not parts:
+            if start is None or end is None:
+                raise ValueError("Chain.join needs parts, or both start and end for a straight chain")
+            return cls([Line(as_xy(start, "start"), as_xy(end, "end"))], tolerance)
         segments: list[Segment] = []
         if start is not None:
             segments.extend(_bridge(np.array(as_xy(start, "start")), parts[0].start, parts[0].length, tolerance))

@@ -168,8 +168,9 @@ def test_line_to_line_start_distance_formula():
 
 # 0.25 ≤ r1/r0 ≤ 0.8: for smaller ratios the larger circle is met where the
 # spiral is nearly straight (t → 0), for larger ones the piece turns little;
-# either way its end curvatures are only good to ~1e-12 over the conditioning.
-@given(st.floats(0.25, 0.8), st.floats(0.02, 0.98), angles, st.booleans(), signs)
+# either way its end curvatures are only good to ~1e-12 over the conditioning;
+# f ≤ 0.9 keeps θ above ~10° (θ → 0 as D → r0 − r1).
+@given(st.floats(0.25, 0.8), st.floats(0.02, 0.9), angles, st.booleans(), signs)
 def test_circle_in_circle_is_g2_both_ways(q, f, a, inward, sign):
     r_big, r_small = 3.0, 3.0 * q
     low = nested_band_lower(q)

@@ -25,7 +25,6 @@ from ..chain import JOIN_TOLERANCE, Chain
 from ..errors import NoSolutionError
 from ..spiral import BezierSpiral
 from ..transitions import Transition, line_to_circle
-from ._paths import chain_through
 
 #: |sin(deflection)| at or below this counts as a straight PI.
 COLLINEAR_TOL = 1e-12
@@ -46,9 +45,9 @@ def curvature_rate(control_points: ArrayLike, u: ArrayLike) -> NDArray:
     cp = np.asarray(control_points, dtype=float)
     d1 = bezier.derivative(cp, u, 1)
     d2 = bezier.derivative(cp, u, 2)
-    d3 = 6.0 * np.diff(cp, n=3, axis=0)[0]
+    d3 = bezier.derivative(cp, u, 3)
     cross12 = d1[..., 0] * d2[..., 1] - d1[..., 1] * d2[..., 0]
-    cross13 = d1[..., 0] * d3[1] - d1[..., 1] * d3[0]
+    cross13 = d1[..., 0] * d3[..., 1] - d1[..., 1] * d3[..., 0]
     speed2 = d1[..., 0] ** 2 + d1[..., 1] ** 2
     dot12 = d1[..., 0] * d2[..., 0] + d1[..., 1] * d2[..., 1]
     return (cross13 * speed2 - 3.0 * cross12 * dot12) / speed2**3
@@ -256,7 +255,7 @@ class Alignment:
 
         _check_tangents(pts, lengths, units, solved)
         parts: list[Transition] = [t for s in solved for t in s[:2]]
-        chain = chain_through(pts[0], parts, pts[-1], tolerance)
+        chain = Chain.join(parts, pts[0], pts[-1], tolerance)
         return cls(chain, _curve_data(chain, pts, solved, radius, origin), origin)
 
     # ------------------------------------------------------- table

@@ -32,7 +32,6 @@ from ..errors import NoSolutionError, Status
 from ..segments import Ray, Segment
 from ..spiral import BezierSpiral
 from ..transitions import Transition
-from ._paths import chain_through
 
 #: Yang & Sukkarieh's leg ratio g/h: the smallest that keeps κ monotone.
 G2CBS_C2 = 2.0 * (math.sqrt(6.0) - 1.0) / 5.0
@@ -390,5 +389,5 @@ def round_corners(
                 )
             )
             rounded.append(RoundedCorner(int(index[j]), float(result.theta[j]), float(result.distance[j]), float(result.curvature[j]), spirals))
-    return RoundedPath(chain_through(pts[0], parts, pts[-1], tolerance), rounded, method)
+    return RoundedPath(Chain.join(parts, pts[0], pts[-1], tolerance), rounded, method)
 
