@@ -141,7 +141,17 @@ def _design_format() -> str:
 
 
 def main(argv: Sequence[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(prog="spiral-cad", description="Exact G2 cubic Bézier spiral transitions for CAD.")
+    parser = argparse.ArgumentParser(
+        prog="spiral-cad",
+        description="Exact G2 (curvature-continuous) cubic Bézier spiral transitions for CAD.",
+        epilog=(
+            "examples:\n"
+            "  spiral-cad demo --out out                  the built-in design: STEP, IGES, DXF, SVG, plots, CSV\n"
+            "  spiral-cad build examples/design.json      your own design file (spiral-cad build --help for the format)\n"
+            "  spiral-cad check out/highway.step --require G2   G0/G1/G2 at every joint; exit 1 below G2"
+        ),
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
     sub = parser.add_subparsers(dest="command", required=True)
     demo = sub.add_parser(
         "demo",
