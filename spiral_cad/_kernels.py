@@ -70,6 +70,17 @@ def spiral_legs(sin_t, cos_t, radius):
     return g, h
 
 
+#: Theorem 4.4: a = (40/27)·tan θ/(c cos θ) between corner distance a and joint curvature c.
+WALTON_MEEK_CORNER = 40.0 / 27.0
+
+
+@jit
+def corner_relation(sin_t, cos_t, value, factor):
+    """factor·sin θ/(value·cos² θ): a spiral pair's corner distance from its joint
+    curvature, or the curvature from the distance (the relation is symmetric)."""
+    return factor * sin_t / (value * cos_t * cos_t)
+
+
 @jit
 def put_spiral(out, bx, by, tx, ty, nx, ny, sin_t, cos_t, radius):
     """Write the Theorem 3.1 control points into ``out`` (4, 2).
@@ -370,11 +381,11 @@ def line_to_line_row(p0x, p0y, px, py, p1x, p1y, curvature, out):
     if math.isnan(curvature):
         a = shortest
     else:
-        a = 40.0 * sin_t / (27.0 * curvature * cos_t * cos_t)
+        a = corner_relation(sin_t, cos_t, curvature, WALTON_MEEK_CORNER)
     measure = a / shortest
     if not measure <= 1.0 + 1e-12:
         return LEGS_TOO_SHORT, math.atan2(sin_t, cos_t), measure, NAN
-    radius = 27.0 * a * cos_t * cos_t / (40.0 * sin_t)
+    radius = 1.0 / corner_relation(sin_t, cos_t, a, WALTON_MEEK_CORNER)
     put_spiral(out[0], -a * t0x, -a * t0y, t0x, t0y, -side * t0y, side * t0x, sin_t, cos_t, radius)
     put_spiral(out[1], -a * t1x, -a * t1y, t1x, t1y, side * t1y, -side * t1x, sin_t, cos_t, radius)
     reverse_in_place(out[1])

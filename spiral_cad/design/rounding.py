@@ -27,6 +27,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from .. import batch
 from .._inputs import as_float, as_points
+from .._kernels import WALTON_MEEK_CORNER, corner_relation
 from ..chain import JOIN_TOLERANCE, Chain
 from ..errors import NoSolutionError, Status
 from ..segments import Ray, Segment
@@ -43,7 +44,7 @@ G2CBS_C3 = (G2CBS_C2 + 4.0) / (G2CBS_C1 + 6.0)
 G2CBS_C4 = (G2CBS_C2 + 4.0) ** 2 / (54.0 * G2CBS_C3)
 
 #: Peak-curvature factor of each method: κ = factor · sin θ / (d cos² θ).
-CORNER_FACTOR = {"walton-meek": 40.0 / 27.0, "g2cbs": G2CBS_C4}
+CORNER_FACTOR = {"walton-meek": WALTON_MEEK_CORNER, "g2cbs": G2CBS_C4}
 METHODS = tuple(CORNER_FACTOR)
 
 #: Relative |sin| below which three points count as collinear (passed through).
@@ -56,7 +57,8 @@ def corner_scale(theta_sin: ArrayLike, theta_cos: ArrayLike, value: ArrayLike, m
     The relation between the corner distance d and the peak (joint) curvature κ
     of a spiral pair is symmetric: pass κ to get d, or d to get κ.
     """
-    return CORNER_FACTOR[method] * np.asarray(theta_sin) / (np.asarray(value) * np.asarray(theta_cos) ** 2)
+    sin_t, cos_t, value = np.broadcast_arrays(*(np.asarray(v, dtype=float) for v in (theta_sin, theta_cos, value)))
+    return corner_relation(sin_t, cos_t, value, CORNER_FACTOR[method])
 
 
 def g2cbs_control_points(corners: NDArray, t_in: NDArray, t_out: NDArray, distance: NDArray, theta_cos: NDArray) -> NDArray:
