@@ -35,7 +35,7 @@ class BezierSpiral(Segment):
     of the same kind; for them ``start_curvature`` need not be 0.
     """
 
-    __slots__ = ("_cp",)
+    __slots__ = ("_cp", "_length")
 
     def __init__(self, start: Any, direction: Any, theta: float, curvature: float):
         bx, by = as_xy(start, "start")
@@ -52,6 +52,7 @@ class BezierSpiral(Segment):
         cp = np.empty((4, 2))
         put_spiral(cp, bx, by, tx, ty, -side * ty, side * tx, math.sin(abs(theta)), math.cos(theta), 1.0 / abs(curvature))
         self._cp = cp
+        self._length = None
         cp.flags.writeable = False
 
     @classmethod
@@ -74,6 +75,7 @@ class BezierSpiral(Segment):
         spiral = object.__new__(cls)
         cp.flags.writeable = False
         spiral._cp = cp
+        spiral._length = None
         return spiral
 
     def __repr__(self) -> str:
@@ -102,7 +104,9 @@ class BezierSpiral(Segment):
     @property
     def length(self) -> float:
         """Arc length by composite Gauss–Legendre (≤ 1e-14 relative for |θ| ≤ 80°)."""
-        return bezier.arc_length(self._cp)
+        if self._length is None:  # immutable curve: integrate once
+            self._length = bezier.arc_length(self._cp)
+        return self._length
 
     def parameter_at(self, s: ArrayLike) -> NDArray:
         """Parameters u with arc length ``s`` from the start (Newton, to 1e-14·length)."""
