@@ -124,3 +124,10 @@ def test_out_buffer_is_filled_in_place_and_checked():
     assert np.array_equal(buf[:, 0], batch.line_to_circle((0, 0), (1, 0), centers, 1.0).spirals[0])
     with pytest.raises(ValueError, match="out must be"):
         batch.line_to_circle((0, 0), (1, 0), centers, 1.0, out=np.zeros((2, 2, 4, 2)))
+
+
+def test_batch_theta_matches_the_scalar_theta():
+    centers = np.stack([np.linspace(-3, 3, 50), np.linspace(1.2, 40, 50)], axis=1)
+    res = batch.line_to_circle((0, 0), (1, 0), centers, 1.0)
+    scalar = [sc.line_to_circle((0, 0), (1, 0), c, 1.0).theta for c in centers.tolist()]
+    np.testing.assert_allclose(res.theta, scalar, rtol=4e-16, atol=0)
