@@ -393,7 +393,7 @@ def line_to_line_row(p0x, p0y, px, py, p1x, p1y, curvature, out):
     if not gap <= VERIFY_TOL * a:
         return UNVERIFIED, NAN, measure, NAN
     place(out, px, py, 1.0)
-    return OK, math.atan2(sin_t, cos_t), measure, side
+    return OK, math.atan2(sin_t, cos_t), measure, NAN
 
 
 # --------------------------------------------- circle inside circle

@@ -57,12 +57,13 @@ def plane_ax3(plane: cq.Plane) -> gp_Ax3:
 
 def _push_edges(wp: W, segments: Iterable[Segment], make_wire: bool, for_construction: bool) -> W:
     """Place ``segments`` on ``wp``'s plane as edges (or one wire) and queue them as pending."""
-    edges = [cq.Edge(e) for e in segment_edges(segments, plane_ax3(wp.plane))]
+    plane = plane_ax3(wp.plane)
     if make_wire:
-        wire = cq.Wire.assembleEdges(edges)
+        wire = cq.Wire(chain_wire(segments, plane))
         if not for_construction:
             wp._addPendingWire(wire)
         return wp.newObject([wire])
+    edges = [cq.Edge(e) for e in segment_edges(segments, plane)]
     if not for_construction:
         for edge in edges:
             wp._addPendingEdge(edge)
@@ -147,12 +148,7 @@ def spiralChain(self: W, chain: Chain, makeWire: bool = True, forConstruction: b
     """
     if not isinstance(chain, Chain):
         raise ValueError(f"chain must be a spiral_cad.Chain; got {chain!r}")
-    if not makeWire:
-        return _push_edges(self, chain.segments, False, forConstruction)
-    wire = cq.Wire(chain_wire(chain, plane_ax3(self.plane)))
-    if not forConstruction:
-        self._addPendingWire(wire)
-    return self.newObject([wire])
+    return _push_edges(self, chain.segments, makeWire, forConstruction)
 
 
 METHODS = (

@@ -221,12 +221,13 @@ def _ax3(plane: Any) -> Any:
 def _connector(previous: Transition | Segment, part: Transition | Segment, tolerance: float) -> list[Segment]:
     """The line or arc that bridges ``previous``'s end to ``part``'s start (none if they meet)."""
     a, b = previous.end, part.start
+    scale = max(previous.length, part.length)
     circle = previous.end_circle if isinstance(previous, Transition) else None
     if circle is None and isinstance(previous, Arc):
         circle = previous.circle
-    if circle is None or _meet(a, b, max(previous.length, part.length), tolerance):
-        return _bridge(a, b, max(previous.length, part.length), tolerance)
-    return [Arc.between(circle.center, circle.radius, a, b)]
+    if circle is None:
+        return _bridge(a, b, scale, tolerance)
+    return [] if _meet(a, b, scale, tolerance) else [Arc.between(circle.center, circle.radius, a, b)]
 
 
 def _meet(a: NDArray, b: NDArray, scale: float, tolerance: float) -> bool:
