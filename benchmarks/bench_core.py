@@ -16,7 +16,7 @@ from timing import machine, median_time, write_markdown
 
 import spiral_cad as sc
 from spiral_cad import batch
-from spiral_cad._kernels import nested_band_lower
+from spiral_cad.core._kernels import nested_band_lower
 
 
 def line_circle_problems(n: int, rng: np.random.Generator):

@@ -4,11 +4,11 @@ The numeric core (this namespace and ``spiral_cad.batch``) needs only numpy,
 scipy and numba; the CAD adapters import OCP when they are used.
 """
 
-from .chain import Chain, Join
-from .errors import NoSolutionError, Status
-from .segments import Arc, Circle, Line, Segment
-from .spiral import BezierSpiral
-from .transitions import (
+from .core.chain import Chain, Join
+from .core.errors import NoSolutionError, Status
+from .core.segments import Arc, Circle, Line, Segment
+from .core.spiral import BezierSpiral
+from .core.transitions import (
     Transition,
     circle_in_circle,
     circle_to_circle,

@@ -10,7 +10,7 @@ from collections.abc import Sequence
 from pathlib import Path
 
 from . import circle_in_circle, circle_to_circle, line_to_circle, line_to_line
-from .transitions import Transition
+from .core.transitions import Transition
 
 
 def core_examples() -> list[tuple[str, Transition]]:
@@ -119,7 +119,7 @@ def _build(args: argparse.Namespace) -> int:
 
 
 def _check(args: argparse.Namespace) -> int:
-    from .continuity import main_check  # imports OCP, so only when used
+    from .cad.continuity import main_check  # imports OCP, so only when used
 
     return main_check(args)
 

@@ -17,8 +17,8 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from .chain import Chain
-from .errors import NoSolutionError
+from .core.chain import Chain
+from .core.errors import NoSolutionError
 
 FORMAT = """\
 {
@@ -222,7 +222,7 @@ def _rounded(d: dict, where: str) -> Built:
 
 
 def _transition(d: dict, where: str) -> Built:
-    from . import transitions
+    from .core import transitions
 
     case = d.get("case")
     if case not in TRANSITION_ARGS:
@@ -278,7 +278,7 @@ def write(
     Files go to a temporary folder first and move into ``out`` only when all
     of them were written.
     """
-    from .continuity import check_continuity
+    from .cad.continuity import check_continuity
     from .export import export_dxf, export_iges, export_step, export_svg
 
     out = Path(out)

@@ -17,9 +17,9 @@ from xml.sax.saxutils import quoteattr
 
 import numpy as np
 
-from .chain import Chain
-from .segments import Arc, Line, Segment
-from .spiral import BezierSpiral
+from .core.chain import Chain
+from .core.segments import Arc, Line, Segment
+from .core.spiral import BezierSpiral
 
 PathLike = str | os.PathLike
 
@@ -56,7 +56,7 @@ def export_step(obj: Any, path: PathLike) -> None:
     from OCP.STEPControl import STEPControl_AsIs, STEPControl_Writer
     from OCP.StepData import StepData_StepWriter
 
-    from .occ import as_occ_shape, quiet_messages
+    from .cad.occ import as_occ_shape, quiet_messages
 
     writer = STEPControl_Writer()
     with quiet_messages():
@@ -94,7 +94,7 @@ def export_iges(obj: Any, path: PathLike) -> None:
     from OCP.IGESSelect import IGESSelect_WorkLibrary
     from OCP.Interface import Interface_Static
 
-    from .occ import as_occ_shape, quiet_messages
+    from .cad.occ import as_occ_shape, quiet_messages
 
     IGESControl_Controller.Init_s()
     Interface_Static.SetIVal_s("write.iges.brep.mode", 1)

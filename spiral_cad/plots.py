@@ -18,9 +18,9 @@ from matplotlib.figure import Figure
 from numpy.typing import NDArray
 from scipy.special import fresnel
 
-from . import bezier
-from .chain import Chain
-from .spiral import BezierSpiral
+from .core import bezier
+from .core.chain import Chain
+from .core.spiral import BezierSpiral
 
 #: Colour per segment type (plan, comb and curvature plots).
 SEGMENT_COLORS = {"Line": "0.35", "Arc": "tab:blue", "BezierSpiral": "tab:red"}

@@ -7,7 +7,7 @@ import pytest
 
 import spiral_cad as sc
 from spiral_cad import Status, batch
-from spiral_cad.errors import MALFORMED
+from spiral_cad.core.errors import MALFORMED
 
 rng = np.random.default_rng(7)
 N = 400

@@ -8,7 +8,7 @@ CAD_MODULES = ("OCP", "build123d", "cadquery")
 
 def test_core_imports_without_the_cad_kernel():
     code = (
-        "import sys, spiral_cad, spiral_cad.batch, spiral_cad.chain, spiral_cad.nurbs\n"
+        "import sys, spiral_cad, spiral_cad.batch, spiral_cad.core, spiral_cad.nurbs\n"
         "import importlib.util\n"
         "for extra in ('spiral_cad.design', 'spiral_cad.plots'):\n"
         "    if importlib.util.find_spec(extra): importlib.import_module(extra)\n"

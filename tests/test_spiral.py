@@ -8,8 +8,9 @@ from hypothesis import given
 from hypothesis import strategies as st
 from scipy.integrate import quad
 
-from spiral_cad import BezierSpiral, bezier, line_to_circle
-from spiral_cad._kernels import spiral_curvature_ratio
+from spiral_cad import BezierSpiral, line_to_circle
+from spiral_cad.core import bezier
+from spiral_cad.core._kernels import spiral_curvature_ratio
 
 thetas = st.floats(0.05, 1.45).flatmap(lambda t: st.sampled_from([t, -t]))
 curvatures = st.floats(1e-3, 1e3)

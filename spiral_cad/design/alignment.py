@@ -18,13 +18,13 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy.optimize import brentq, minimize_scalar
 
-from .. import bezier
-from .._inputs import as_float, as_points
-from .._kernels import shape_g1
-from ..chain import JOIN_TOLERANCE, Chain
-from ..errors import NoSolutionError
-from ..spiral import BezierSpiral
-from ..transitions import Transition, line_to_circle
+from ..core import bezier
+from ..core._inputs import as_float, as_points
+from ..core._kernels import shape_g1
+from ..core.chain import JOIN_TOLERANCE, Chain
+from ..core.errors import NoSolutionError
+from ..core.spiral import BezierSpiral
+from ..core.transitions import Transition, line_to_circle
 
 #: |sin(deflection)| at or below this counts as a straight PI.
 COLLINEAR_TOL = 1e-12

@@ -31,11 +31,11 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from .._inputs import as_float, as_xy
-from ..chain import Chain
-from ..errors import NoSolutionError
-from ..segments import TAU, Circle
-from ..transitions import Transition, circle_in_circle, circle_to_circle
+from ..core._inputs import as_float, as_xy
+from ..core.chain import Chain
+from ..core.errors import NoSolutionError
+from ..core.segments import TAU, Circle
+from ..core.transitions import Transition, circle_in_circle, circle_to_circle
 
 #: Belt sweeps within this of 2π count as 0 (coincident tangent points).
 _FULL_TURN_TOL = 1e-9

@@ -25,14 +25,14 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from .. import batch
-from .._inputs import as_float, as_points
-from .._kernels import WALTON_MEEK_CORNER, corner_relation
-from ..chain import JOIN_TOLERANCE, Chain
-from ..errors import NoSolutionError, Status
-from ..segments import Ray, Segment
-from ..spiral import BezierSpiral
-from ..transitions import Transition
+from ..core import batch
+from ..core._inputs import as_float, as_points
+from ..core._kernels import WALTON_MEEK_CORNER, corner_relation
+from ..core.chain import JOIN_TOLERANCE, Chain
+from ..core.errors import NoSolutionError, Status
+from ..core.segments import Ray, Segment
+from ..core.spiral import BezierSpiral
+from ..core.transitions import Transition
 
 #: Yang & Sukkarieh's leg ratio g/h: the smallest that keeps κ monotone.
 G2CBS_C2 = 2.0 * (math.sqrt(6.0) - 1.0) / 5.0

@@ -189,7 +189,7 @@ class Chain:
         """
         from build123d import Edge
 
-        from .occ import segment_edges
+        from ..cad.occ import segment_edges
 
         return [Edge(e) for e in segment_edges(self._segments, _ax3(plane))]
 
@@ -197,7 +197,7 @@ class Chain:
         """The chain as one build123d ``Wire`` on ``plane`` (None: ``Plane.XY``)."""
         from build123d import Wire
 
-        from .occ import chain_wire
+        from ..cad.occ import chain_wire
 
         return Wire(chain_wire(self._segments, _ax3(plane)))
 

@@ -1,0 +1,166 @@
+"""CadQuery plugin: G2 spiral transitions and chains as ``cq.Workplane`` methods.
+
+Importing this module adds these methods to ``cadquery.Workplane``:
+
+* ``spiralLineToCircle(point, direction, center, radius)``
+* ``spiralCircleToCircle(c0, r0, c1, r1)``
+* ``spiralLineToLine(p0, corner, p1, curvature=None)``
+* ``spiralCircleInCircle(c0, r0, c1, r1)``
+* ``spiralTransition(transition)`` — an already solved ``Transition``
+* ``spiralChain(chain)`` — a whole ``spiral_cad.Chain`` as one wire
+
+All coordinates are 2-D and local to the workplane (``x`` along its
+``xDir``, ``y`` along ``zDir × xDir``); radii are signed by travel sense as
+in the core solvers. Lines become LINE edges, arcs true CIRCLE edges and
+spirals BEZIER edges with their exact control points (``spiral_cad.occ``).
+
+Following CadQuery's plugin convention the results are pushed with
+``newObject`` and queued as pending edges (transitions) or a pending wire
+(chains), so ``.wire()``, ``.sweep(...)`` and — for closed chains —
+``.extrude(...)`` work as with the built-in 2-D methods. The transitions sit
+where their geometry puts them; they do not start at the current point, but
+the last edge's end becomes the current point for ``lineTo`` and friends.
+
+Example:
+    >>> import cadquery as cq
+    >>> import spiral_cad.cadquery  # registers the methods
+    >>> path = cq.Workplane("XY").spiralChain(chain)
+    >>> solid = cq.Workplane("YZ").circle(0.1).sweep(path)
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable
+from typing import Any, TypeVar
+
+import cadquery as cq
+from OCP.gp import gp_Ax3
+
+from ..core.chain import Chain
+from .occ import chain_wire, segment_edges
+from ..core.segments import Segment
+from ..core.transitions import (
+    Transition,
+    circle_in_circle,
+    circle_to_circle,
+    line_to_circle,
+    line_to_line,
+)
+
+__all__ = ["METHODS", "plane_ax3", "spiralChain", "spiralCircleInCircle", "spiralCircleToCircle", "spiralLineToCircle", "spiralLineToLine", "spiralTransition"]
+
+W = TypeVar("W", bound=cq.Workplane)
+
+
+def plane_ax3(plane: cq.Plane) -> gp_Ax3:
+    """The ``gp_Ax3`` of a CadQuery plane: same origin, X direction and normal."""
+    return gp_Ax3(plane.origin.toPnt(), plane.zDir.toDir(), plane.xDir.toDir())
+
+
+def _push_edges(wp: W, segments: Iterable[Segment], make_wire: bool, for_construction: bool) -> W:
+    """Place ``segments`` on ``wp``'s plane as edges (or one wire) and queue them as pending."""
+    plane = plane_ax3(wp.plane)
+    if make_wire:
+        wire = cq.Wire(chain_wire(segments, plane))
+        if not for_construction:
+            wp._addPendingWire(wire)
+        return wp.newObject([wire])
+    edges = [cq.Edge(e) for e in segment_edges(segments, plane)]
+    if not for_construction:
+        for edge in edges:
+            wp._addPendingEdge(edge)
+    return wp.newObject(edges)
+
+
+def spiralTransition(self: W, transition: Transition, makeWire: bool = False, forConstruction: bool = False) -> W:
+    """Place the spirals of a solved ``Transition`` (workplane-local coordinates).
+
+    Args:
+        transition: e.g. the result of ``spiral_cad.line_to_circle``.
+        makeWire: queue one wire instead of separate edges.
+        forConstruction: do not queue anything (reference geometry).
+
+    Returns:
+        A new ``Workplane`` whose objects are the BEZIER edges (or the wire).
+    """
+    if not isinstance(transition, Transition):
+        raise ValueError(f"transition must be a spiral_cad.Transition; got {transition!r}")
+    return _push_edges(self, transition.spirals, makeWire, forConstruction)
+
+
+def spiralLineToCircle(
+    self: W, point: Any, direction: Any, center: Any, radius: float, makeWire: bool = False, forConstruction: bool = False
+) -> W:
+    """Spiral from the directed line (``point``, ``direction``) onto a circle (``spiral_cad.line_to_circle``).
+
+    Raises:
+        NoSolutionError: the circle touches or crosses the line.
+    """
+    return spiralTransition(self, line_to_circle(point, direction, center, radius), makeWire, forConstruction)
+
+
+def spiralCircleToCircle(
+    self: W, c0: Any, r0: float, c1: Any, r1: float, makeWire: bool = False, forConstruction: bool = False
+) -> W:
+    """Two spirals from circle 0 to circle 1, C or S shaped by the radius signs (``spiral_cad.circle_to_circle``).
+
+    Raises:
+        NoSolutionError: no transition of that kind exists for these circles.
+    """
+    return spiralTransition(self, circle_to_circle(c0, r0, c1, r1), makeWire, forConstruction)
+
+
+def spiralLineToLine(
+    self: W,
+    p0: Any,
+    corner: Any,
+    p1: Any,
+    curvature: float | None = None,
+    makeWire: bool = False,
+    forConstruction: bool = False,
+) -> W:
+    """Two spirals rounding the corner p0 → ``corner`` → p1 (``spiral_cad.line_to_line``).
+
+    Raises:
+        NoSolutionError: collinear/folded legs or a curvature too small for the legs.
+    """
+    return spiralTransition(self, line_to_line(p0, corner, p1, curvature), makeWire, forConstruction)
+
+
+def spiralCircleInCircle(
+    self: W, c0: Any, r0: float, c1: Any, r1: float, makeWire: bool = False, forConstruction: bool = False
+) -> W:
+    """One spiral between nested circles (``spiral_cad.circle_in_circle``).
+
+    Raises:
+        NoSolutionError: the circles are outside the solvable nesting band.
+    """
+    return spiralTransition(self, circle_in_circle(c0, r0, c1, r1), makeWire, forConstruction)
+
+
+def spiralChain(self: W, chain: Chain, makeWire: bool = True, forConstruction: bool = False) -> W:
+    """Place a whole ``Chain`` — LINE, CIRCLE and BEZIER edges — as one wire (workplane-local coordinates).
+
+    A chain whose end meets its start gives a closed wire, ready for ``extrude``.
+
+    Args:
+        chain: a ``spiral_cad.Chain``.
+        makeWire: True (default) queues one wire; False queues the edges.
+        forConstruction: do not queue anything.
+    """
+    if not isinstance(chain, Chain):
+        raise ValueError(f"chain must be a spiral_cad.Chain; got {chain!r}")
+    return _push_edges(self, chain.segments, makeWire, forConstruction)
+
+
+METHODS = (
+    spiralTransition,
+    spiralLineToCircle,
+    spiralCircleToCircle,
+    spiralLineToLine,
+    spiralCircleInCircle,
+    spiralChain,
+)
+
+for _method in METHODS:
+    setattr(cq.Workplane, _method.__name__, _method)

@@ -1,0 +1,136 @@
+"""Vectorised transition solvers: N problems per call, one status per row.
+
+Each function broadcasts its inputs to N rows, runs the compiled row kernel
+that the scalar API uses (in parallel over rows) and returns a
+:class:`BatchResult`. A row that is infeasible or malformed gets a non-zero
+``status`` and NaN control points; the other rows are unaffected.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from . import _kernels as K
+from .errors import Status, describe
+
+__all__ = ["BatchResult", "circle_in_circle", "circle_to_circle", "line_to_circle", "line_to_line"]
+
+
+@dataclass(frozen=True)
+class BatchResult:
+    """Solutions of N problems of one kind.
+
+    Attributes:
+        spirals: one (N, 4, 2) control-point array per spiral of the case, in
+            travel order (one for line→circle and nested circles, two for
+            C, S and line→line).
+        theta: (N,) the theorem's θ per row (NaN where not solved).
+        status: (N,) ``Status`` codes; 0 where solved.
+        measure: (N,) the feasibility number of each row (see ``reason``).
+        parameter: (N,) nested case only (else None): t where the spiral
+            meets the larger circle.
+    """
+
+    case: str
+    spirals: tuple[NDArray, ...]
+    theta: NDArray
+    status: NDArray
+    measure: NDArray
+    parameter: NDArray | None
+    inputs: dict[str, NDArray]
+
+    @property
+    def ok(self) -> NDArray:
+        """Boolean mask of solved rows."""
+        return self.status == Status.OK
+
+    def __len__(self) -> int:
+        return len(self.status)
+
+    def reason(self, i: int) -> str:
+        """Why row ``i`` failed (the scalar API's error message), or ``"ok"``."""
+        if self.status[i] == Status.OK:
+            return "ok"
+        row = {k: tuple(v[i].tolist()) if v.ndim > 1 else float(v[i]) for k, v in self.inputs.items()}
+        if self.case == "line_to_line" and np.isnan(row["curvature"]):
+            row["curvature"] = None
+        return describe(self.case, int(self.status[i]), float(self.measure[i]), row)
+
+
+def _rows(**arrays: tuple[ArrayLike, tuple[int, ...]]) -> dict[str, NDArray]:
+    """Broadcast named inputs (value, trailing shape) to common N rows."""
+    parsed = {}
+    for name, (value, trailing) in arrays.items():
+        a = np.asarray(value, dtype=np.float64)
+        if a.shape[a.ndim - len(trailing) :] != trailing or a.ndim > len(trailing) + 1:
+            raise ValueError(f"{name} must have shape (N, {', '.join(map(str, trailing))}) or {trailing}; got {a.shape}")
+        parsed[name] = a
+    n = np.broadcast_shapes(*(a.shape[: a.ndim - len(t)] for a, (_, t) in zip(parsed.values(), arrays.values())))
+    n = n[0] if n else 1
+    return {
+        name: np.ascontiguousarray(np.broadcast_to(a, (n,) + arrays[name][1]))
+        for name, a in parsed.items()
+    }
+
+
+def _output(out: NDArray | None, n: int, spirals: int) -> NDArray:
+    """The (N, k, 4, 2) control-point buffer: ``out`` if given (checked), else new."""
+    shape = (n, spirals, 4, 2)
+    if out is None:
+        return np.empty(shape)
+    if out.shape != shape or out.dtype != np.float64 or not out.flags.c_contiguous or not out.flags.writeable:
+        raise ValueError(f"out must be a writeable C-contiguous float64 array of shape {shape}; got {out.dtype} {out.shape}")
+    return out
+
+
+def _run(case: str, kernel, spirals: int, rows: dict[str, NDArray], out: NDArray | None, extra: bool = False) -> BatchResult:
+    n = len(next(iter(rows.values())))
+    out = _output(out, n, spirals)
+    status = np.empty(n, dtype=np.int8)
+    theta = np.empty(n)
+    measure = np.empty(n)
+    parameter = np.empty(n) if extra else None
+    args = (*rows.values(), out, status, theta, measure) + ((parameter,) if extra else ())
+    kernel(*args)
+    return BatchResult(case, tuple(out[:, k] for k in range(spirals)), theta, status, measure, parameter, rows)
+
+
+def line_to_circle(
+    points: ArrayLike, directions: ArrayLike, centers: ArrayLike, radii: ArrayLike, out: NDArray | None = None
+) -> BatchResult:
+    """Theorem 4.1 for N rows: points, directions, centers (N, 2); radii (N,) > 0.
+
+    Every solver accepts inputs of shape (N, …) or a single row that is
+    broadcast, and ``out``: an optional (N, k, 4, 2) float64 buffer reused for
+    the control points (saves the allocation in repeated calls).
+    """
+    rows = _rows(point=(points, (2,)), direction=(directions, (2,)), center=(centers, (2,)), radius=(radii, ()))
+    return _run("line_to_circle", K.line_to_circle_batch, 1, rows, out)
+
+
+def circle_to_circle(
+    centers0: ArrayLike, radii0: ArrayLike, centers1: ArrayLike, radii1: ArrayLike, out: NDArray | None = None
+) -> BatchResult:
+    """Theorems 4.2/4.3 for N rows (signed travel-sense radii: C or S per row)."""
+    rows = _rows(center0=(centers0, (2,)), radius0=(radii0, ()), center1=(centers1, (2,)), radius1=(radii1, ()))
+    return _run("circle_to_circle", K.circle_to_circle_batch, 2, rows, out)
+
+
+def line_to_line(
+    p0: ArrayLike, corners: ArrayLike, p1: ArrayLike, curvatures: ArrayLike | None = None, out: NDArray | None = None
+) -> BatchResult:
+    """Theorem 4.4 for N corners; ``curvatures`` NaN (or None) applies Corollary 4.5."""
+    k = np.nan if curvatures is None else curvatures
+    rows = _rows(p0=(p0, (2,)), corner=(corners, (2,)), p1=(p1, (2,)), curvature=(k, ()))
+    return _run("line_to_line", K.line_to_line_batch, 2, rows, out)
+
+
+def circle_in_circle(
+    centers0: ArrayLike, radii0: ArrayLike, centers1: ArrayLike, radii1: ArrayLike, out: NDArray | None = None
+) -> BatchResult:
+    """The fifth case for N rows (nested circles, same-sign radii)."""
+    rows = _rows(center0=(centers0, (2,)), radius0=(radii0, ()), center1=(centers1, (2,)), radius1=(radii1, ()))
+    return _run("circle_in_circle", K.circle_in_circle_batch, 1, rows, out, extra=True)
