@@ -136,7 +136,7 @@ def test_parameter_at_inverts_arc_length():
         (((0, 0), (1, 0), 0.5, -1.0), "sign of theta"),
         (((0, 0), (1, 0), 0.5, 0.0), "non-zero"),
         (((0, 0), (0, 0), 0.5, 1.0), "direction must be a non-zero"),
-        (((0, math.nan), (1, 0), 0.5, 1.0), "start must be finite"),
+        (((0, math.nan), (1, 0), 0.5, 1.0), r"start\[1\] must be finite"),
         (((0, 0), (1, 0), math.inf, 1.0), "theta must be finite"),
         (((0, 0, 1), (1, 0), 0.5, 1.0), "2 coordinates"),
         (("ab", (1, 0), 0.5, 1.0), "start"),

@@ -1,41 +1,62 @@
-"""Coercion of user input to floats, with errors that name the argument."""
+"""Coercion of user input to floats, with errors that name the argument.
+
+Only real numbers are accepted: bools, strings, bytes, complex numbers,
+mappings and sets are refused by name rather than read as numbers (a string
+``'12'`` is not the point (1, 2), a dict is not its keys).
+"""
 
 from __future__ import annotations
 
 import math
+import numbers
+from collections.abc import Mapping, Set
 from typing import Any
 
 import numpy as np
+from numpy.typing import NDArray
+
+#: Array dtype kinds that hold real numbers (signed, unsigned, floating).
+_REAL_KINDS = "iuf"
+
+
+def _refused(value: Any) -> bool:
+    """Values that Python or numpy would turn into numbers but that are not real numbers."""
+    return isinstance(value, (bool, np.bool_, str, bytes, complex, np.complexfloating, Mapping, Set)) or value is None
 
 
 def as_float(value: Any, name: str) -> float:
     """``value`` as a finite float, else ValueError naming ``name``."""
+    if isinstance(value, np.ndarray) and value.ndim == 0 and value.dtype.kind in _REAL_KINDS:
+        value = value[()]
+    if _refused(value) or not isinstance(value, numbers.Real):
+        raise ValueError(f"{name} must be a real number; got {type(value).__name__} {value!r:.80}")
     try:
         number = float(value)
-    except (TypeError, ValueError):
-        raise ValueError(f"{name} must be a number; got {value!r}") from None
+    except OverflowError:
+        raise ValueError(f"{name} is too large for float64; got {value!r:.80}") from None
     if not math.isfinite(number):
         raise ValueError(f"{name} must be finite; got {number}")
     return number
 
 
 def as_xy(value: Any, name: str) -> tuple[float, float]:
-    """``value`` (any 2-sequence, or a 3-vector with z = 0) as two finite floats."""
+    """``value`` (a 2-sequence, or a 3-vector with z = 0) as two finite floats."""
+    if _refused(value):
+        raise ValueError(f"{name} must be a 2-D point or vector; got {type(value).__name__} {value!r:.80}")
     try:
-        coords = [float(c) for c in value]
-    except (TypeError, ValueError):
-        raise ValueError(f"{name} must be a 2-D point or vector; got {value!r}") from None
+        items = list(value)
+    except TypeError:
+        raise ValueError(f"{name} must be a 2-D point or vector; got {type(value).__name__} {value!r:.80}") from None
+    coords = [as_float(c, f"{name}[{i}]") for i, c in enumerate(items)]
     if len(coords) == 3 and coords[2] == 0.0:
         coords = coords[:2]
     if len(coords) != 2:
-        raise ValueError(f"{name} must have 2 coordinates; got {value!r}")
-    if not (math.isfinite(coords[0]) and math.isfinite(coords[1])):
-        raise ValueError(f"{name} must be finite; got {tuple(coords)}")
+        raise ValueError(f"{name} must have 2 coordinates; got {value!r:.80}")
     return coords[0], coords[1]
 
 
 def as_unit(value: Any, name: str) -> tuple[float, float]:
-    """A non-zero 2-vector normalised to unit length."""
+    """A non-zero 2-vector normalised to unit length (``math.hypot`` neither overflows nor underflows)."""
     x, y = as_xy(value, name)
     length = math.hypot(x, y)
     if length == 0.0:
@@ -43,9 +64,31 @@ def as_unit(value: Any, name: str) -> tuple[float, float]:
     return x / length, y / length
 
 
-def as_points(value: Any, name: str, shape: tuple[int, ...] = (2,)) -> np.ndarray:
+def as_real_array(value: Any, name: str) -> NDArray:
+    """``value`` as a float64 array of real numbers (no bools, strings, complex or objects that are not numbers)."""
+    if _refused(value):
+        raise ValueError(f"{name} must be an array of real numbers; got {type(value).__name__} {value!r:.80}")
+    try:
+        array = np.asarray(value)
+    except ValueError as error:  # ragged nesting
+        raise ValueError(f"{name} must be a rectangular array of real numbers: {error}") from None
+    if array.dtype.kind == "O":
+        flat = array.ravel()
+        bad = next((v for v in flat if _refused(v) or not isinstance(v, numbers.Real)), None)
+        if bad is not None:
+            raise ValueError(f"{name} must hold real numbers only; got {type(bad).__name__} {bad!r:.80}")
+        try:
+            return array.astype(np.float64)
+        except (OverflowError, ValueError):
+            raise ValueError(f"{name} holds a number too large for float64") from None
+    if array.dtype.kind not in _REAL_KINDS:
+        raise ValueError(f"{name} must hold real numbers; got an array of {array.dtype} ({array.dtype.kind!r})")
+    return array.astype(np.float64, copy=False)
+
+
+def as_points(value: Any, name: str, shape: tuple[int, ...] = (2,)) -> NDArray:
     """``value`` as a float64 array whose trailing shape is ``shape``."""
-    array = np.asarray(value, dtype=float)
+    array = as_real_array(value, name)
     if array.shape[array.ndim - len(shape) :] != shape:
         raise ValueError(f"{name} must have trailing shape {shape}; got {array.shape}")
     return array

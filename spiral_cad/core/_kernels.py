@@ -3,13 +3,28 @@
 Each ``*_row`` function solves one problem from plain floats and writes the
 control points into ``out`` (shape ``(k, 4, 2)``); it returns
 ``(status, theta, measure, extra)``.  ``status`` is one of the codes below,
-``measure`` is the number that decides feasibility (reported in errors) and
-``extra`` is case specific (the contact parameter ``t`` of the nested case).
-The batch kernels loop over rows; the scalar API calls the row functions.
+``measure`` is the number that decides feasibility (reported in errors; for
+``UNVERIFIED`` the residual that failed) and ``extra`` is case specific (the
+contact parameter ``t`` of the nested case). The batch kernels loop over
+rows; the scalar API calls the row functions.
 
-All work is done relative to one input point (survey coordinates stay exact)
-and in a mirrored frame when the configuration turns right, so each theorem is
-coded for its canonical left-turning case only.
+Every row works in the same steps:
+
+1. check its inputs (finite, non-zero directions and radii);
+2. move to a normalised frame: translated to one input point and scaled by a
+   power of two near the problem's natural length, so inputs of magnitude
+   1e-300 … 1e300 behave like 1 and the scaling itself is exact;
+3. apply the theorem for the canonical left-turning case (a mirrored frame
+   when the configuration turns right);
+4. map the control points back to world coordinates;
+5. verify what is returned: every contact and joint, measured from the world
+   control points, must hold to ``VERIFY_TOL`` (relative), else the row
+   fails with ``UNVERIFIED`` and the residual as its measure. Non-finite or
+   coinciding control points count as an infinite residual.
+
+Kernels use numpy's floating-point error model: a division by zero gives
+inf/NaN (caught by step 5) instead of raising, so no input can make a batch
+raise.
 """
 
 from __future__ import annotations
@@ -20,7 +35,26 @@ from numba import njit, prange
 
 from .errors import Status
 
-jit = njit(cache=True, nogil=True)
+
+def _compile(parallel: bool = False):
+    """``njit`` with an on-disk cache where one can be written, else per process.
+
+    Numba refuses to decorate a cached function when it finds no writable
+    cache location (a read-only install without a writable home): then the
+    kernels compile in memory at first use instead.
+    """
+
+    def wrap(function):
+        options = dict(nogil=True, error_model="numpy", parallel=parallel)
+        try:
+            return njit(cache=True, **options)(function)
+        except RuntimeError:
+            return njit(cache=False, **options)(function)
+
+    return wrap
+
+
+jit = _compile()
 
 # Row status codes as compile-time ints (meanings: ``errors.Status``).
 OK = int(Status.OK)
@@ -39,12 +73,15 @@ OUTSIDE_NESTED_BAND = int(Status.OUTSIDE_NESTED_BAND)
 EQUAL_RADII = int(Status.EQUAL_RADII)
 UNVERIFIED = int(Status.UNVERIFIED)
 BAD_CURVATURE = int(Status.BAD_CURVATURE)
+BAD_ANGLE = int(Status.BAD_ANGLE)
 
-# A returned root must reproduce its joins to this relative accuracy; it
-# guards against false roots, the accuracy actually achieved is ~1e-15.
+#: What is returned must reproduce its contacts and joints to this relative
+#: accuracy (gap / spiral size, tangent angle, curvature error / curvature);
+#: the accuracy actually achieved on well-conditioned input is ~1e-15.
 VERIFY_TOL = 1e-9
 
 NAN = math.nan
+INF = math.inf
 
 
 # ---------------------------------------------------------------- shape
@@ -108,28 +145,48 @@ def spiral_curvature_ratio(u, cos_t):
     return 216.0 * u * c2 * cos_t / base**1.5
 
 
-@jit
-def end_residual(cp, cx, cy, radius):
-    """How far the end of Bézier ``cp`` is from joining circle (c, radius) G2.
+# ------------------------------------------------- frames and numbers
 
-    ``radius`` is signed by travel sense (positive: counterclockwise). Returns
-    max(|centre error| / |radius|, |κ·radius − 1|) of the osculating circle at
-    u = 1, or +inf when the end is degenerate.
-    """
-    ax = cp[2, 0] - cp[1, 0]
-    ay = cp[2, 1] - cp[1, 1]
-    bx = cp[3, 0] - cp[2, 0]
-    by = cp[3, 1] - cp[2, 1]
-    lb2 = bx * bx + by * by
-    cross = ax * by - ay * bx
-    if not (lb2 > 0.0 and cross != 0.0):
-        return math.inf
-    # κ = (2/3)·cross/|b|³, so the centre P3 + rot90(b)/(|b|·κ) needs no root.
-    to_centre = 1.5 * lb2 / cross
-    ox = cp[3, 0] - by * to_centre - cx
-    oy = cp[3, 1] + bx * to_centre - cy
-    kappa_r = radius / (to_centre * math.sqrt(lb2))
-    return max(math.sqrt(ox * ox + oy * oy) / abs(radius), abs(kappa_r - 1.0))
+
+@jit
+def norm(x, y):
+    """√(x² + y²) for values of moderate size (normalised frames; ``math.hypot`` is slower)."""
+    return math.sqrt(x * x + y * y)
+
+
+@jit
+def power_of_two_near(x):
+    """A power of two within a factor 2 of ``x`` > 0: scaling by it is exact."""
+    return math.ldexp(1.0, math.frexp(x)[1] - 1)
+
+
+@jit
+def unit(x, y):
+    """(x, y) / |(x, y)| without overflow or underflow; (0, 0) for a zero or non-finite vector."""
+    big = max(abs(x), abs(y))
+    if not (big > 0.0 and big < INF):
+        return 0.0, 0.0
+    s = power_of_two_near(big)
+    x /= s
+    y /= s
+    n = norm(x, y)
+    return x / n, y / n
+
+
+@jit
+def finite(*values):
+    for v in values:
+        if not math.isfinite(v):
+            return False
+    return True
+
+
+@jit
+def worst(a, b):
+    """max(a, b), with NaN counted as infinitely bad."""
+    if a != a or b != b:
+        return INF
+    return a if a > b else b
 
 
 @jit
@@ -142,18 +199,12 @@ def reverse_in_place(cp):
 
 
 @jit
-def place(out, ox, oy, flip):
-    """Map local points (x, flip·y relative to o) back to world coordinates."""
+def place(out, ox, oy, scale, flip):
+    """Map normalised points (x, flip·y) back to world coordinates o + scale·(x, flip·y)."""
     for i in range(out.shape[0]):
         for k in range(4):
-            out[i, k, 0] = ox + out[i, k, 0]
-            out[i, k, 1] = oy + flip * out[i, k, 1]
-
-
-@jit
-def norm(x, y):
-    """√(x² + y²) (``math.hypot`` is several times slower and its overflow guard is not needed here)."""
-    return math.sqrt(x * x + y * y)
+            out[i, k, 0] = ox + scale * out[i, k, 0]
+            out[i, k, 1] = oy + scale * flip * out[i, k, 1]
 
 
 @jit
@@ -164,12 +215,111 @@ def fill_nan(out):
             out[i, k, 1] = NAN
 
 
+# ------------------------------------------- verification (world coordinates)
+# Differences of world control points are multiplied by ``inv`` (a power of
+# two, 1/scale of the row) before they are squared, so the residuals neither
+# overflow nor underflow; they are relative and so do not depend on ``inv``.
+
+
 @jit
-def finite(*values):
-    for v in values:
-        if not math.isfinite(v):
-            return False
-    return True
+def _osculating_end(cp, inv):
+    """Centre of the osculating circle at u = 1, relative to cp[3] and scaled by
+    ``inv``, and the scaled signed curvature there (NaN where undefined)."""
+    ax = (cp[2, 0] - cp[1, 0]) * inv
+    ay = (cp[2, 1] - cp[1, 1]) * inv
+    bx = (cp[3, 0] - cp[2, 0]) * inv
+    by = (cp[3, 1] - cp[2, 1]) * inv
+    lb2 = bx * bx + by * by
+    cross = ax * by - ay * bx
+    if not (lb2 > 0.0 and cross != 0.0):
+        return NAN, NAN, NAN
+    # κ = (2/3)·cross/|b|³, so the centre P3 + rot90(b)/(|b|·κ) needs no root.
+    to_centre = 1.5 * lb2 / cross
+    return -by * to_centre, bx * to_centre, 1.0 / (to_centre * math.sqrt(lb2))
+
+
+@jit
+def end_residual(cp, cx, cy, radius, inv):
+    """How far the end of Bézier ``cp`` is from osculating circle (c, radius):
+    max(|centre error| / |radius|, |κ·radius − 1|). ``radius`` is signed by
+    the travel sense of ``cp`` (positive: counterclockwise)."""
+    ox, oy, kappa = _osculating_end(cp, inv)
+    ox += (cp[3, 0] - cx) * inv
+    oy += (cp[3, 1] - cy) * inv
+    scaled = radius * inv
+    return worst(norm(ox / scaled, oy / scaled), abs(kappa * scaled - 1.0))
+
+
+@jit
+def line_residual(cp, px, py, tx, ty, inv):
+    """How far the start of spiral ``cp`` is from leaving the line through p along
+    unit t with zero curvature: max(distance / spiral size, tangent angle,
+    |κ(0)| / |κ(1)|)."""
+    ax = (cp[1, 0] - cp[0, 0]) * inv
+    ay = (cp[1, 1] - cp[0, 1]) * inv
+    bx = (cp[2, 0] - cp[1, 0]) * inv
+    by = (cp[2, 1] - cp[1, 1]) * inv
+    la = norm(ax, ay)
+    size = la + norm(bx, by) + norm((cp[3, 0] - cp[2, 0]) * inv, (cp[3, 1] - cp[2, 1]) * inv)
+    if not (la > 0.0 and tx * ax + ty * ay > 0.0):
+        return INF
+    distance = abs(tx * (cp[0, 1] - py) * inv - ty * (cp[0, 0] - px) * inv) / size
+    angle = abs(tx * ay - ty * ax) / la
+    kappa0 = abs(2.0 / 3.0 * (ax * by - ay * bx) / (la * la * la))
+    kappa1 = _osculating_end(cp, inv)[2]
+    return worst(worst(distance, angle), kappa0 / abs(kappa1))
+
+
+@jit
+def joint_residual(cp_a, cp_b, inv):
+    """How far two spirals that meet at their ends (u = 1 of both, travelled
+    towards each other) are from sharing the osculating circle there."""
+    ax, ay, ka = _osculating_end(cp_a, inv)
+    bx, by, kb = _osculating_end(cp_b, inv)
+    dx = (cp_a[3, 0] - cp_b[3, 0]) * inv + ax - bx
+    dy = (cp_a[3, 1] - cp_b[3, 1]) * inv + ay - by
+    return worst(norm(dx * ka, dy * ka), abs(ka + kb) / abs(ka))
+
+
+# ---------------------------------------------------------- one spiral
+
+
+@jit
+def spiral_row(bx, by, dx, dy, theta, curvature, out):
+    """Theorem 3.1: the spiral from (bx, by) along d turning by θ to curvature c."""
+    if not finite(bx, by, dx, dy, theta, curvature):
+        return NOT_FINITE, NAN, NAN, NAN
+    tx, ty = unit(dx, dy)
+    if tx == 0.0 and ty == 0.0:
+        return ZERO_DIRECTION, NAN, NAN, NAN
+    if not 0.0 < abs(theta) < math.pi / 2.0:
+        return BAD_ANGLE, NAN, NAN, NAN
+    if curvature == 0.0 or (curvature > 0.0) != (theta > 0.0):
+        return BAD_CURVATURE, NAN, NAN, NAN
+    side = 1.0 if theta > 0.0 else -1.0
+    sin_t = math.sin(abs(theta))
+    cos_t = math.cos(theta)
+    radius = 1.0 / abs(curvature)
+    # The legs set the scale: the spiral's own size, not its end radius.
+    g = spiral_legs(sin_t, cos_t, radius)[0]
+    if not (g > 0.0 and g < INF):
+        return UNVERIFIED, NAN, INF, NAN
+    scale = power_of_two_near(g)
+    inv = 1.0 / scale
+    nx = -side * ty
+    ny = side * tx
+    local_radius = radius * inv
+    put_spiral(out[0], 0.0, 0.0, tx, ty, nx, ny, sin_t, cos_t, local_radius)
+    place(out, bx, by, scale, 1.0)
+    # The end circle's centre B0 + r·(g2·T + g1·N) (MATH.md §1).
+    g1 = shape_g1(sin_t, cos_t) * local_radius
+    g2 = shape_g2(sin_t, cos_t) * local_radius
+    cx = bx + scale * (g2 * tx + g1 * nx)
+    cy = by + scale * (g2 * ty + g1 * ny)
+    res = worst(line_residual(out[0], bx, by, tx, ty, inv), end_residual(out[0], cx, cy, side * radius, inv))
+    if not res <= VERIFY_TOL:
+        return UNVERIFIED, NAN, res, NAN
+    return OK, theta, NAN, NAN
 
 
 # ------------------------------------------------------ line to circle
@@ -183,32 +333,36 @@ def line_to_circle_row(px, py, dx, dy, cx, cy, r, out):
     """
     if not finite(px, py, dx, dy, cx, cy, r):
         return NOT_FINITE, NAN, NAN, NAN
-    length = norm(dx, dy)
-    if length == 0.0:
+    tx, ty = unit(dx, dy)
+    if tx == 0.0 and ty == 0.0:
         return ZERO_DIRECTION, NAN, NAN, NAN
     if not r > 0.0:
         return BAD_RADIUS, NAN, NAN, NAN
-    tx = dx / length
-    ty = dy / length
-    vx = cx - px
-    vy = cy - py
+    scale = power_of_two_near(r)
+    inv = 1.0 / scale
+    rs = r * inv
+    vx = (cx - px) * inv
+    vy = (cy - py) * inv
+    if not finite(vx, vy):
+        return UNVERIFIED, NAN, INF, NAN
     d = tx * vy - ty * vx
     side = 1.0 if d > 0.0 else -1.0
-    measure = abs(d) / r
-    if not abs(d) > r:
+    measure = abs(d) / rs
+    if not abs(d) > rs:
         return CIRCLE_MEETS_LINE, NAN, measure, NAN
     # cos θ = 10 / (9ρ + √(81ρ² − 80)), with 1 − cos θ formed without cancellation.
-    eps = (abs(d) - r) / r
+    eps = (abs(d) - rs) / rs
     z = 81.0 * eps * (2.0 + eps)
     s = math.sqrt(1.0 + z)
     den = 9.0 * measure + s
     cos_t = 10.0 / den
     sin_t = math.sqrt((9.0 * eps + z / (s + 1.0)) / den * (1.0 + cos_t))
-    a = vx * tx + vy * ty - r * shape_g2(sin_t, cos_t)
-    put_spiral(out[0], a * tx, a * ty, tx, ty, -side * ty, side * tx, sin_t, cos_t, r)
-    if not end_residual(out[0], vx, vy, side * r) <= VERIFY_TOL:
-        return UNVERIFIED, NAN, measure, NAN
-    place(out, px, py, 1.0)
+    a = vx * tx + vy * ty - rs * shape_g2(sin_t, cos_t)
+    put_spiral(out[0], a * tx, a * ty, tx, ty, -side * ty, side * tx, sin_t, cos_t, rs)
+    place(out, px, py, scale, 1.0)
+    res = worst(line_residual(out[0], px, py, tx, ty, inv), end_residual(out[0], cx, cy, side * r, inv))
+    if not res <= VERIFY_TOL:
+        return UNVERIFIED, NAN, res, NAN
     return OK, math.atan2(sin_t, cos_t), measure, side
 
 
@@ -218,10 +372,7 @@ def line_to_circle_row(px, py, dx, dy, cx, cy, r, out):
 @jit
 def _frame_from_offset(dx, dy, p, q):
     """Unit T with (dx, dy) = p·T + q·rot90(T) (up to scale)."""
-    tx = p * dx + q * dy
-    ty = p * dy - q * dx
-    n = norm(tx, ty)
-    return tx / n, ty / n
+    return unit(p * dx + q * dy, p * dy - q * dx)
 
 
 @jit
@@ -289,13 +440,17 @@ def circle_to_circle_row(c0x, c0y, r0, c1x, c1y, r1, out):
         return NOT_FINITE, NAN, NAN, NAN
     if r0 == 0.0 or r1 == 0.0:
         return BAD_RADIUS, NAN, NAN, NAN
-    dx = c1x - c0x
-    dy = c1y - c0y
-    dist = norm(dx, dy)
-    if dist == 0.0:
+    if c0x == c1x and c0y == c1y:
         return COINCIDENT, NAN, NAN, NAN
-    a0 = abs(r0)
-    a1 = abs(r1)
+    scale = power_of_two_near(max(abs(r0), abs(r1)))
+    inv = 1.0 / scale
+    dx = (c1x - c0x) * inv
+    dy = (c1y - c0y) * inv
+    a0 = abs(r0) * inv
+    a1 = abs(r1) * inv
+    dist = norm(dx, dy)
+    if not (dist < INF):
+        return UNVERIFIED, NAN, INF, NAN
     s_shape = (r0 > 0.0) != (r1 > 0.0)
     # Canonical frames: C with both counterclockwise, S with circle 1 counterclockwise.
     flip = 1.0 if r1 > 0.0 else -1.0
@@ -316,7 +471,7 @@ def circle_to_circle_row(c0x, c0y, r0, c1x, c1y, r1, out):
         q = gap * shape_g1(sin_t, cos_t)
     else:
         gap = abs(a1 - a0)
-        measure = dist / gap if gap > 0.0 else math.inf
+        measure = dist / gap if gap > 0.0 else INF
         if not dist > gap:
             return CIRCLES_ENCLOSED, NAN, measure, NAN
         big = (a0 + a1) * (a0 + a1)
@@ -328,15 +483,36 @@ def circle_to_circle_row(c0x, c0y, r0, c1x, c1y, r1, out):
         q = (a1 - a0) * shape_g1(sin_t, cos_t)
     tx, ty = _frame_from_offset(dx, dy, p, q)
     _two_spirals(out, dx, dy, tx, ty, a0, a1, sin_t, cos_t, s_shape)
-    res0 = end_residual(out[0, ::-1], 0.0, 0.0, -flip * r0)
-    res1 = end_residual(out[1], dx, dy, flip * r1)
-    if not max(res0, res1) <= VERIFY_TOL:
-        return UNVERIFIED, NAN, measure, NAN
-    place(out, c0x, c0y, flip)
+    place(out, c0x, c0y, scale, flip)
+    # In world coordinates: Q0 leaves circle 0, Q1 reaches circle 1, and both
+    # leave their common start B0 along ∓T with zero curvature.
+    wtx = tx
+    wty = flip * ty
+    res = worst(end_residual(out[0, ::-1], c0x, c0y, -r0, inv), end_residual(out[1], c1x, c1y, r1, inv))
+    res = worst(res, line_residual(out[1], out[1, 0, 0], out[1, 0, 1], wtx, wty, inv))
+    res = worst(res, line_residual(out[0, ::-1], out[1, 0, 0], out[1, 0, 1], -wtx, -wty, inv))
+    if not res <= VERIFY_TOL:
+        return UNVERIFIED, NAN, res, NAN
     return OK, math.atan2(sin_t, cos_t), measure, NAN
 
 
 # -------------------------------------------------------- line to line
+
+
+@jit
+def corner_residual(out, px, py, t0x, t0y, t1x, t1y, joint_curvature, inv):
+    """Verification of a corner's spiral pair ``out`` (2, 4, 2) in travel order.
+
+    The first spiral must leave the line through corner p along t0, the second
+    (read backwards) the line through p along t1 (pointing at the corner);
+    they must share the osculating circle where they meet, with curvature
+    ``joint_curvature`` (magnitude, scaled by ``inv``).
+    """
+    second = out[1, ::-1]
+    res = worst(line_residual(out[0], px, py, t0x, t0y, inv), line_residual(second, px, py, t1x, t1y, inv))
+    res = worst(res, joint_residual(out[0], second, inv))
+    kappa = abs(_osculating_end(out[0], inv)[2])
+    return worst(res, abs(kappa / joint_curvature - 1.0))
 
 
 @jit
@@ -350,25 +526,27 @@ def line_to_line_row(p0x, p0y, px, py, p1x, p1y, curvature, out):
         return NOT_FINITE, NAN, NAN, NAN
     if not (math.isnan(curvature) or (curvature > 0.0 and math.isfinite(curvature))):
         return BAD_CURVATURE, NAN, NAN, NAN
+    if (p0x == px and p0y == py) or (p1x == px and p1y == py):
+        return COINCIDENT, NAN, NAN, NAN
     ux = px - p0x
     uy = py - p0y
     vx = px - p1x
     vy = py - p1y
+    if not finite(ux, uy, vx, vy):
+        return UNVERIFIED, NAN, INF, NAN
+    scale = power_of_two_near(max(max(abs(ux), abs(uy)), max(abs(vx), abs(vy))))
+    inv = 1.0 / scale
+    ux *= inv
+    uy *= inv
+    vx *= inv
+    vy *= inv
     l0 = norm(ux, uy)
     l1 = norm(vx, vy)
-    if l0 == 0.0 or l1 == 0.0:
-        return COINCIDENT, NAN, NAN, NAN
-    t0x = ux / l0
-    t0y = uy / l0
-    t1x = vx / l1
-    t1y = vy / l1
-    bx = t0x - t1x
-    by = t0y - t1y
-    lb = norm(bx, by)
-    if lb == 0.0:
+    t0x, t0y = unit(ux, uy)
+    t1x, t1y = unit(vx, vy)
+    bx, by = unit(t0x - t1x, t0y - t1y)
+    if bx == 0.0 and by == 0.0:
         return CORNER_REVERSAL, math.pi / 2.0, NAN, NAN
-    bx /= lb
-    by /= lb
     cross = t0x * by - t0y * bx
     sin_t = abs(cross)
     cos_t = t0x * bx + t0y * by
@@ -381,18 +559,19 @@ def line_to_line_row(p0x, p0y, px, py, p1x, p1y, curvature, out):
     if math.isnan(curvature):
         a = shortest
     else:
-        a = corner_relation(sin_t, cos_t, curvature, WALTON_MEEK_CORNER)
+        a = corner_relation(sin_t, cos_t, curvature * scale, WALTON_MEEK_CORNER)
     measure = a / shortest
     if not measure <= 1.0 + 1e-12:
         return LEGS_TOO_SHORT, math.atan2(sin_t, cos_t), measure, NAN
-    radius = 1.0 / corner_relation(sin_t, cos_t, a, WALTON_MEEK_CORNER)
+    joint = corner_relation(sin_t, cos_t, a, WALTON_MEEK_CORNER)
+    radius = 1.0 / joint
     put_spiral(out[0], -a * t0x, -a * t0y, t0x, t0y, -side * t0y, side * t0x, sin_t, cos_t, radius)
     put_spiral(out[1], -a * t1x, -a * t1y, t1x, t1y, side * t1y, -side * t1x, sin_t, cos_t, radius)
     reverse_in_place(out[1])
-    gap = norm(out[0, 3, 0] - out[1, 0, 0], out[0, 3, 1] - out[1, 0, 1])
-    if not gap <= VERIFY_TOL * a:
-        return UNVERIFIED, NAN, measure, NAN
-    place(out, px, py, 1.0)
+    place(out, px, py, scale, 1.0)
+    res = corner_residual(out, px, py, t0x, t0y, t1x, t1y, joint, inv)
+    if not res <= VERIFY_TOL:
+        return UNVERIFIED, NAN, res, NAN
     return OK, math.atan2(sin_t, cos_t), measure, NAN
 
 
@@ -552,20 +731,23 @@ def circle_in_circle_row(c0x, c0y, r0, c1x, c1y, r1, out):
     small_r = r1 if inward else -r0
     ox = c0x if inward else c1x
     oy = c0y if inward else c1y
-    dx = (c1x - c0x) if inward else (c0x - c1x)
-    dy = (c1y - c0y) if inward else (c0y - c1y)
+    scale = power_of_two_near(abs(big_r))
+    inv = 1.0 / scale
+    dx = ((c1x - c0x) if inward else (c0x - c1x)) * inv
+    dy = ((c1y - c0y) if inward else (c0y - c1y)) * inv
+    if not finite(dx, dy):
+        return UNVERIFIED, NAN, INF, NAN
     flip = 1.0 if big_r > 0.0 else -1.0
     piece = out[0]
-    status, theta, ratio, t = _nested_canonical(dx, flip * dy, abs(big_r), abs(small_r), piece)
+    status, theta, ratio, t = _nested_canonical(dx, flip * dy, abs(big_r) * inv, abs(small_r) * inv, piece)
     if status != OK:
         return status, NAN, ratio, NAN
-    res0 = end_residual(piece[::-1], 0.0, 0.0, -abs(big_r))
-    res1 = end_residual(piece, dx, flip * dy, abs(small_r))
-    if not max(res0, res1) <= VERIFY_TOL:
-        return UNVERIFIED, NAN, ratio, NAN
     if not inward:
         reverse_in_place(piece)
-    place(out, ox, oy, flip)
+    place(out, ox, oy, scale, flip)
+    res = worst(end_residual(piece[::-1], c0x, c0y, -r0, inv), end_residual(piece, c1x, c1y, r1, inv))
+    if not res <= VERIFY_TOL:
+        return UNVERIFIED, NAN, res, NAN
     return OK, theta, ratio, t
 
 
@@ -583,29 +765,47 @@ def _record(i, result, out, status, theta, measure):
     return result[3]
 
 
-@njit(cache=True, nogil=True, parallel=True)
+@_compile(parallel=True)
 def line_to_circle_batch(p, d, c, r, out, status, theta, measure):
     for i in prange(p.shape[0]):
         row = line_to_circle_row(p[i, 0], p[i, 1], d[i, 0], d[i, 1], c[i, 0], c[i, 1], r[i], out[i])
         _record(i, row, out, status, theta, measure)
 
 
-@njit(cache=True, nogil=True, parallel=True)
+@_compile(parallel=True)
 def circle_to_circle_batch(c0, r0, c1, r1, out, status, theta, measure):
     for i in prange(c0.shape[0]):
         row = circle_to_circle_row(c0[i, 0], c0[i, 1], r0[i], c1[i, 0], c1[i, 1], r1[i], out[i])
         _record(i, row, out, status, theta, measure)
 
 
-@njit(cache=True, nogil=True, parallel=True)
+@_compile(parallel=True)
 def line_to_line_batch(p0, p, p1, k, out, status, theta, measure):
     for i in prange(p0.shape[0]):
         row = line_to_line_row(p0[i, 0], p0[i, 1], p[i, 0], p[i, 1], p1[i, 0], p1[i, 1], k[i], out[i])
         _record(i, row, out, status, theta, measure)
 
 
-@njit(cache=True, nogil=True, parallel=True)
+@_compile(parallel=True)
 def circle_in_circle_batch(c0, r0, c1, r1, out, status, theta, measure, param):
     for i in prange(c0.shape[0]):
         row = circle_in_circle_row(c0[i, 0], c0[i, 1], r0[i], c1[i, 0], c1[i, 1], r1[i], out[i])
         param[i] = _record(i, row, out, status, theta, measure)
+
+
+@_compile(parallel=True)
+def verify_corners_batch(out, corners, t_in, t_out, curvature, status, measure):
+    """``corner_residual`` for spiral pairs made elsewhere (e.g. G2CBS): rows
+    with status OK that fail become ``UNVERIFIED`` (NaN control points)."""
+    for i in prange(out.shape[0]):
+        if status[i] != OK:
+            continue
+        scale = power_of_two_near(1.0 / abs(curvature[i]))
+        inv = 1.0 / scale
+        res = corner_residual(
+            out[i], corners[i, 0], corners[i, 1], t_in[i, 0], t_in[i, 1], -t_out[i, 0], -t_out[i, 1], curvature[i] * scale, inv
+        )
+        if not res <= VERIFY_TOL:
+            status[i] = UNVERIFIED
+            measure[i] = res
+            fill_nan(out[i])

@@ -14,6 +14,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from . import _kernels as K
+from ._inputs import as_real_array
 from .errors import Status, describe
 
 __all__ = ["BatchResult", "circle_in_circle", "circle_to_circle", "line_to_circle", "line_to_line"]
@@ -61,19 +62,30 @@ class BatchResult:
 
 
 def _rows(**arrays: tuple[ArrayLike, tuple[int, ...]]) -> dict[str, NDArray]:
-    """Broadcast named inputs (value, trailing shape) to common N rows."""
+    """Named inputs (value, trailing shape) as C-contiguous float64 arrays of N rows.
+
+    Each input has N rows or is one row broadcast to all; a mismatch names
+    both arguments. The arrays handed to the kernels always have the same
+    type (contiguous, writeable, float64), so each kernel compiles once.
+    """
     parsed = {}
     for name, (value, trailing) in arrays.items():
-        a = np.asarray(value, dtype=np.float64)
-        if a.shape[a.ndim - len(trailing) :] != trailing or a.ndim > len(trailing) + 1:
+        a = as_real_array(value, name)
+        if a.shape[a.ndim - len(trailing) :] != trailing or not len(trailing) <= a.ndim <= len(trailing) + 1:
             raise ValueError(f"{name} must have shape (N, {', '.join(map(str, trailing))}) or {trailing}; got {a.shape}")
         parsed[name] = a
-    n = np.broadcast_shapes(*(a.shape[: a.ndim - len(t)] for a, (_, t) in zip(parsed.values(), arrays.values())))
-    n = n[0] if n else 1
-    return {
-        name: np.ascontiguousarray(np.broadcast_to(a, (n,) + arrays[name][1]))
-        for name, a in parsed.items()
-    }
+    counts = {name: len(a) for name, a in parsed.items() if a.ndim > len(arrays[name][1])}
+    n = max(counts.values(), default=1)
+    for name, count in counts.items():
+        if count not in (1, n):
+            longest = max(counts, key=counts.get)
+            raise ValueError(f"{name} has {count} rows but {longest} has {n}; each input needs N rows or one")
+    rows = {}
+    for name, a in parsed.items():
+        a = np.broadcast_to(a, (n,) + arrays[name][1])
+        ready = a.flags.c_contiguous and a.flags.writeable and a.flags.aligned and a.dtype == np.float64
+        rows[name] = a if ready else np.array(a, dtype=np.float64, order="C")
+    return rows
 
 
 def _output(out: NDArray | None, n: int, spirals: int) -> NDArray:
@@ -81,6 +93,8 @@ def _output(out: NDArray | None, n: int, spirals: int) -> NDArray:
     shape = (n, spirals, 4, 2)
     if out is None:
         return np.empty(shape)
+    if not isinstance(out, np.ndarray):
+        raise ValueError(f"out must be a numpy array of shape {shape}; got {type(out).__name__}")
     if out.shape != shape or out.dtype != np.float64 or not out.flags.c_contiguous or not out.flags.writeable:
         raise ValueError(f"out must be a writeable C-contiguous float64 array of shape {shape}; got {out.dtype} {out.shape}")
     return out
@@ -105,7 +119,14 @@ def line_to_circle(
 
     Every solver accepts inputs of shape (N, …) or a single row that is
     broadcast, and ``out``: an optional (N, k, 4, 2) float64 buffer reused for
-    the control points (saves the allocation in repeated calls).
+    the control points (saves the allocation in repeated calls). Every row of
+    ``out`` is written: solved rows with their control points, failed rows
+    with NaN.
+
+    Raises:
+        ValueError: an input that is not an array of real numbers, of the
+            wrong shape or row count, or a bad ``out`` (the message names it).
+            No row's values raise: they become that row's status.
     """
     rows = _rows(point=(points, (2,)), direction=(directions, (2,)), center=(centers, (2,)), radius=(radii, ()))
     return _run("line_to_circle", K.line_to_circle_batch, 1, rows, out)

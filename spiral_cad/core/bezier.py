@@ -7,6 +7,8 @@ shape is that of ``u``.
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
@@ -58,17 +60,27 @@ def derivative(cp: NDArray, u: ArrayLike, order: int = 1) -> NDArray:
     return _horner(_power_coefficients(cp, order), u)
 
 
+def _scale(coefficients: NDArray) -> float:
+    """A power of two near the largest coefficient (1 for zeros): dividing by it
+    is exact and keeps squares and cubes of curves from 1e-300 to 1e300 in range."""
+    big = float(np.abs(coefficients).max())
+    return math.ldexp(1.0, math.frexp(big)[1]) if 0.0 < big < math.inf else 1.0
+
+
 def tangent(cp: NDArray, u: ArrayLike) -> NDArray:
     """Unit tangents Q'(u)/|Q'(u)|."""
-    d = derivative(cp, u)
+    coefficients = _power_coefficients(cp, 1)
+    d = _horner(coefficients / _scale(coefficients), u)
     return d / np.linalg.norm(d, axis=-1, keepdims=True)
 
 
 def curvature(cp: NDArray, u: ArrayLike) -> NDArray:
     """Signed curvature (Q' × Q'')/|Q'|³ (positive turns left)."""
     u = np.asarray(u, dtype=float)
-    (b0x, b0y), (b1x, b1y), (b2x, b2y) = _power_coefficients(cp, 1).tolist()
-    (c0x, c0y), (c1x, c1y) = _power_coefficients(cp, 2).tolist()
+    first, second = _power_coefficients(cp, 1), _power_coefficients(cp, 2)
+    scale = _scale(first)
+    (b0x, b0y), (b1x, b1y), (b2x, b2y) = (first / scale).tolist()
+    (c0x, c0y), (c1x, c1y) = (second / scale).tolist()
     u2 = u * u
     dx = b2x * u2 + b1x * u + b0x
     dy = b2y * u2 + b1y * u + b0y
@@ -77,7 +89,7 @@ def curvature(cp: NDArray, u: ArrayLike) -> NDArray:
     dx *= dx
     dy *= dy
     dx += dy  # |Q'|²
-    cross /= dx * np.sqrt(dx)
+    cross /= dx * np.sqrt(dx) * scale
     return cross
 
 
@@ -88,8 +100,10 @@ def arc_length(cp: NDArray, u: ArrayLike = 1.0) -> NDArray | float:
     exact to ~1e-15 relative (checked against adaptive quadrature).
     """
     u = np.asarray(u, dtype=float)
-    speed = np.linalg.norm(derivative(cp, u[..., None] * _U), axis=-1)
-    result = speed @ _W * u
+    coefficients = _power_coefficients(cp, 1)
+    scale = _scale(coefficients)
+    speed = np.linalg.norm(_horner(coefficients / scale, u[..., None] * _U), axis=-1)
+    result = speed @ _W * u * scale
     return float(result) if result.ndim == 0 else result
 
 

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 from enum import IntEnum
 
 
@@ -31,6 +32,7 @@ class Status(IntEnum):
     EQUAL_RADII = 13
     UNVERIFIED = 14
     BAD_CURVATURE = 15
+    BAD_ANGLE = 16
 
 
 #: Codes that mean "malformed input" (plain ValueError); the rest are NoSolutionError.
@@ -42,6 +44,7 @@ MALFORMED = frozenset(
         Status.COINCIDENT,
         Status.SIGN_MISMATCH,
         Status.BAD_CURVATURE,
+        Status.BAD_ANGLE,
     }
 )
 
@@ -83,6 +86,11 @@ def describe(case: str, status: int, measure: float, inputs: dict[str, object]) 
             f"their sign; got radius0={r0}, radius1={r1}"
         )
     if status is Status.BAD_CURVATURE:
+        if case == "BezierSpiral":
+            return (
+                f"BezierSpiral: curvature must be non-zero with the sign of theta; got "
+                f"theta = {inputs.get('theta')}, curvature = {inputs.get('curvature')}"
+            )
         return f"{case}: curvature must be a positive finite number or None; got {inputs.get('curvature')}"
     if status is Status.CIRCLE_MEETS_LINE:
         return (
@@ -120,10 +128,19 @@ def describe(case: str, status: int, measure: float, inputs: dict[str, object]) 
     if status is Status.EQUAL_RADII:
         return f"circle_in_circle: nested circles need different radii; got |radius0| = |radius1| = {abs(float(r0))}"
     if status is Status.UNVERIFIED:
+        if not math.isfinite(measure):
+            return (
+                f"{case}: the solution does not fit in float64 (its control points overflow, underflow "
+                f"or coincide); nothing is returned for {shown}"
+            )
         return (
-            f"{case}: the solution does not reproduce its joins to 1e-9 (a false root, or θ so "
-            f"close to π/2 that the control points outgrow double precision); nothing is returned for {shown}"
+            f"{case}: the solution reproduces its contacts only to {measure:.2g} (relative; at most "
+            f"1e-9 is returned): at these coordinates float64 cannot hold it (a transition tiny "
+            f"against its coordinates, or one so close to θ = π/2 that its legs dwarf the radius); "
+            f"nothing is returned for {shown}"
         )
+    if status is Status.BAD_ANGLE:
+        return f"{case}: |theta| must lie in (0, π/2); got theta = {inputs.get('theta')}"
     raise AssertionError(f"no description for status {status!r}")
 
 

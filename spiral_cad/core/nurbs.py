@@ -136,8 +136,8 @@ def chain_to_nurbs(chain) -> Nurbs:
     gaps (at most its join tolerance) are the only difference.
 
     Raises:
-        ValueError: no segments, or a segment of zero length (it would need
-            an empty knot span).
+        ValueError: no segments (segments themselves have positive length by
+            construction, so every knot span is non-empty).
     """
     points: list[NDArray] = []
     weights: list[NDArray] = []
@@ -145,8 +145,6 @@ def chain_to_nurbs(chain) -> Nurbs:
     owners: list[int] = []
     for index, segment in enumerate(chain):
         for cp, w, length in _pieces(segment):
-            if not length > 0.0:
-                raise ValueError(f"segment {index} ({segment!r}) has zero length; it cannot take a knot span")
             points.append(cp if not points else cp[1:])
             weights.append(w if not weights else w[1:])
             spans.append(length)

@@ -86,6 +86,15 @@ def _u(u: ArrayLike) -> NDArray:
     return np.asarray(u, dtype=float)
 
 
+def piece_range(t0: Any, t1: Any) -> tuple[float, float]:
+    """``(t0, t1)`` as floats with 0 ≤ t0 < t1 ≤ 1, else ValueError naming both."""
+    t0 = as_float(t0, "t0")
+    t1 = as_float(t1, "t1")
+    if not 0.0 <= t0 < t1 <= 1.0:
+        raise ValueError(f"piece needs 0 ≤ t0 < t1 ≤ 1; got t0 = {t0}, t1 = {t1}")
+    return t0, t1
+
+
 class Line(Segment):
     """Straight segment from ``start`` to ``end`` (distinct points)."""
 
@@ -96,6 +105,8 @@ class Line(Segment):
         self._b = np.array(as_xy(end, "end"))
         if np.array_equal(self._a, self._b):
             raise ValueError(f"Line needs distinct end points; both are {tuple(self._a)}")
+        if not math.isfinite(self.length):
+            raise ValueError(f"Line end points {tuple(self._a)} and {tuple(self._b)} are too far apart for float64")
 
     def __repr__(self) -> str:
         return f"Line({tuple(self._a)}, {tuple(self._b)})"
@@ -130,6 +141,7 @@ class Line(Segment):
         return delta, delta / self.length, 0.0
 
     def piece(self, t0: float, t1: float) -> Line:
+        t0, t1 = piece_range(t0, t1)
         return Line(self.point(t0), self.point(t1))
 
 
@@ -162,7 +174,11 @@ class Arc(Segment):
         center: centre point.
         radius: signed radius; positive travels counterclockwise.
         start_angle: polar angle of the start point about ``center`` (radians).
-        sweep: angle travelled, ≥ 0 (radians); the sense comes from ``radius``.
+        sweep: angle travelled, in (0, 2π] (radians); the sense comes from ``radius``.
+
+    Raises:
+        ValueError: non-finite values, zero radius, a sweep outside (0, 2π],
+            or a radius too small to resolve at the centre's coordinates.
     """
 
     __slots__ = ("_c", "_r", "_a0", "_sweep")
@@ -174,14 +190,20 @@ class Arc(Segment):
             raise ValueError("Arc radius must be non-zero (its sign is the travel sense); got 0.0")
         self._a0 = as_float(start_angle, "start_angle")
         self._sweep = as_float(sweep, "sweep")
-        if self._sweep < 0.0:
-            raise ValueError(f"Arc sweep must be ≥ 0 (the sense comes from the radius); got {sweep}")
+        if not 0.0 < self._sweep <= TAU:
+            raise ValueError(f"Arc sweep must lie in (0, 2π] (the sense comes from the radius); got {self._sweep}")
+        if not abs(self._r) > 4.0 * EPS * float(np.abs(self._c).max()) or not self.length > 0.0:
+            raise ValueError(
+                f"Arc radius {self._r} with sweep {self._sweep} is below float64's resolution at centre "
+                f"{tuple(self._c.tolist())}: its points would coincide"
+            )
 
     @classmethod
     def between(cls, center: Any, radius: float, start: Any, end: Any) -> Arc:
         """Arc on circle (center, radius) from the polar angle of ``start`` to that of ``end``.
 
-        The sweep is taken in the travel sense of ``radius`` and lies in [0, 2π).
+        The sweep is taken in the travel sense of ``radius`` and lies in (0, 2π):
+        ``start`` and ``end`` must lie at different polar angles.
         """
         cx, cy = as_xy(center, "center")
         sx, sy = as_xy(start, "start")
@@ -238,6 +260,7 @@ class Arc(Segment):
         return Arc(self._c, -self._r, float(self._angle(1.0)), self._sweep)
 
     def piece(self, t0: float, t1: float) -> Arc:
+        t0, t1 = piece_range(t0, t1)
         return Arc(self._c, self._r, float(self._angle(t0)), self._sweep * (t1 - t0))
 
 

@@ -9,9 +9,10 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from . import bezier
-from ._inputs import as_float, as_unit, as_xy
-from ._kernels import put_spiral
-from .segments import EPS, Segment
+from ._inputs import as_float, as_xy
+from ._kernels import spiral_row
+from .errors import Status, error_for
+from .segments import EPS, Segment, piece_range
 
 
 class BezierSpiral(Segment):
@@ -30,6 +31,8 @@ class BezierSpiral(Segment):
     Raises:
         ValueError: non-finite input, zero direction, |θ| ∉ (0, π/2), zero
             curvature or signs that differ.
+        NoSolutionError: a spiral that float64 cannot hold to 1e-9 where it
+            is placed (e.g. curvature 5e-324, or a tiny spiral at 1e12).
 
     Pieces (``piece``) and reversals (``reversed``) are exact Bézier curves
     of the same kind; for them ``start_curvature`` need not be 0.
@@ -39,21 +42,17 @@ class BezierSpiral(Segment):
 
     def __init__(self, start: Any, direction: Any, theta: float, curvature: float):
         bx, by = as_xy(start, "start")
-        tx, ty = as_unit(direction, "direction")
+        dx, dy = as_xy(direction, "direction")
         theta = as_float(theta, "theta")
         curvature = as_float(curvature, "curvature")
-        if not 0.0 < abs(theta) < math.pi / 2:
-            raise ValueError(f"|theta| must lie in (0, π/2); got theta = {theta}")
-        if curvature == 0.0 or (curvature > 0.0) != (theta > 0.0):
-            raise ValueError(
-                f"curvature must be non-zero with the sign of theta; got theta = {theta}, curvature = {curvature}"
-            )
-        side = math.copysign(1.0, theta)
-        cp = np.empty((4, 2))
-        put_spiral(cp, bx, by, tx, ty, -side * ty, side * tx, math.sin(abs(theta)), math.cos(theta), 1.0 / abs(curvature))
-        self._cp = cp
+        out = np.empty((1, 4, 2))
+        status, _, measure, _ = spiral_row(bx, by, dx, dy, theta, curvature, out)
+        if status != Status.OK:
+            inputs = dict(start=(bx, by), direction=(dx, dy), theta=theta, curvature=curvature)
+            raise error_for("BezierSpiral", status, measure, inputs)
+        self._cp = out[0]
         self._length = None
-        cp.flags.writeable = False
+        self._cp.flags.writeable = False
 
     @classmethod
     def from_control_points(cls, control_points: ArrayLike) -> BezierSpiral:
@@ -61,12 +60,22 @@ class BezierSpiral(Segment):
 
         No check is made that the curvature is monotone; use the solvers or
         the constructor to make spirals.
+
+        Raises:
+            ValueError: not a finite (4, 2) array, or an end leg of zero
+                length (no end tangent: a degenerate spiral).
         """
         cp = np.array(control_points, dtype=float)
         if cp.shape != (4, 2):
             raise ValueError(f"control_points must have shape (4, 2); got {cp.shape}")
         if not np.isfinite(cp).all():
             raise ValueError(f"control_points must be finite; got {cp.tolist()}")
+        for leg, (a, b) in (("first", (0, 1)), ("last", (2, 3))):
+            if np.array_equal(cp[a], cp[b]) or not np.isfinite(cp[b] - cp[a]).all():
+                raise ValueError(
+                    f"control_points make a degenerate spiral: the {leg} leg from {cp[a].tolist()} to "
+                    f"{cp[b].tolist()} has no direction"
+                )
         return cls._wrap(cp)
 
     @classmethod
@@ -140,11 +149,8 @@ class BezierSpiral(Segment):
 
     def piece(self, t0: float, t1: float) -> BezierSpiral:
         """Exact sub-curve on [t0, t1] (de Casteljau) as a Bézier on [0, 1]."""
-        t0 = as_float(t0, "t0")
-        t1 = as_float(t1, "t1")
-        if not 0.0 <= t0 < t1 <= 1.0:
-            raise ValueError(f"piece needs 0 ≤ t0 < t1 ≤ 1; got t0 = {t0}, t1 = {t1}")
-        return BezierSpiral._wrap(bezier.split(self._cp, t0, t1))
+        t0, t1 = piece_range(t0, t1)
+        return BezierSpiral.from_control_points(bezier.split(self._cp, t0, t1))
 
     def reversed(self) -> BezierSpiral:
         return BezierSpiral._wrap(self._cp[::-1].copy())

@@ -93,22 +93,28 @@ class Transition:
         The first and last entries compare the spirals with the given lines or
         circles, the others the joints between spirals.
         """
-        first = _contact_piece(self.start_circle, self.start_line, self.start, before=True)
-        last = _contact_piece(self.end_circle, self.end_line, self.end, before=False)
+        size = self.length
+        first = _contact_piece(self.start_circle, self.start_line, self.start, True, size)
+        last = _contact_piece(self.end_circle, self.end_line, self.end, False, size)
         chain: list[Segment] = [first, *self.spirals, last]
         return [measure_join(a, b, i) for i, (a, b) in enumerate(zip(chain, chain[1:]))]
 
 
-def _contact_piece(circle: Circle | None, line: Ray | None, point: NDArray, before: bool) -> Segment:
-    """A short piece of the given circle/line ending (``before``) or starting at the foot of ``point``."""
+def _contact_piece(circle: Circle | None, line: Ray | None, point: NDArray, before: bool, size: float) -> Segment:
+    """A short piece of the given circle/line ending (``before``) or starting at the foot of ``point``.
+
+    A line piece is ``size`` long (the transition's length), so it stays
+    resolvable at any coordinate magnitude the solvers accept.
+    """
     if circle is not None:
         cx, cy = circle.center
         angle = math.atan2(point[1] - cy, point[0] - cx)
         step = 1e-3 * math.copysign(1.0, circle.radius)
         return Arc(circle.center, circle.radius, angle - step if before else angle, 1e-3)
-    (px, py), direction = line.point, np.asarray(line.direction) / np.hypot(*line.direction)
+    (px, py), direction = line.point, np.asarray(line.direction) / math.hypot(*line.direction)
     foot = np.array([px, py]) + np.dot(point - (px, py), direction) * direction
-    return Line(foot - direction, foot) if before else Line(foot, foot + direction)
+    step = size * direction
+    return Line(foot - step, foot) if before else Line(foot, foot + step)
 
 
 def _solve(case: str, row, count: int, args: tuple[float, ...], inputs: dict[str, Any]):

@@ -20,7 +20,7 @@ from scipy.optimize import brentq, minimize_scalar
 
 from ..core import bezier
 from ..core._inputs import as_float, as_points
-from ..core._kernels import shape_g1
+from ..core._kernels import put_spiral, shape_g1
 from ..core.chain import JOIN_TOLERANCE, Chain
 from ..core.errors import NoSolutionError
 from ..core.spiral import BezierSpiral
@@ -80,8 +80,11 @@ def theta_for_length(length: float, radius: float) -> float:
         NoSolutionError: ``length`` outside the reachable range.
     """
 
+    cp = np.empty((4, 2))
+
     def excess(theta: float) -> float:
-        return BezierSpiral((0.0, 0.0), (1.0, 0.0), theta, 1.0).length - length / radius
+        put_spiral(cp, 0.0, 0.0, 1.0, 0.0, 0.0, 1.0, math.sin(theta), math.cos(theta), 1.0)
+        return bezier.arc_length(cp) - length / radius
 
     lo, hi = _THETA_RANGE
     if not excess(lo) < 0.0 < excess(hi):
