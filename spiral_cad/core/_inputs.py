@@ -26,6 +26,13 @@ def _refused(value: Any) -> bool:
 
 def as_float(value: Any, name: str) -> float:
     """``value`` as a finite float, else ValueError naming ``name``."""
+    if type(value) is float or type(value) is int:  # the common case, checked cheaply
+        try:
+            number = float(value)
+        except OverflowError:
+            number = math.inf
+        if math.isfinite(number):
+            return number
     if isinstance(value, np.ndarray) and value.ndim == 0 and value.dtype.kind in _REAL_KINDS:
         value = value[()]
     if _refused(value) or not isinstance(value, numbers.Real):
@@ -41,6 +48,8 @@ def as_float(value: Any, name: str) -> float:
 
 def as_xy(value: Any, name: str) -> tuple[float, float]:
     """``value`` (a 2-sequence, or a 3-vector with z = 0) as two finite floats."""
+    if type(value) is tuple and len(value) == 2:  # the common case, checked cheaply
+        return as_float(value[0], f"{name}[0]"), as_float(value[1], f"{name}[1]")
     if _refused(value):
         raise ValueError(f"{name} must be a 2-D point or vector; got {type(value).__name__} {value!r:.80}")
     try:

@@ -161,14 +161,28 @@ def power_of_two_near(x):
 
 
 @jit
+def frame_scale(length):
+    """The normalising scale for a problem of natural size ``length`` > 0.
+
+    Any power of two scales exactly; 1 is used where squares and cubes of
+    lengths cannot overflow or underflow (1e-60 … 1e60), so ordinary inputs
+    are solved without any rescaling at all.
+    """
+    if 1e-60 < length < 1e60:
+        return 1.0
+    return power_of_two_near(length)
+
+
+@jit
 def unit(x, y):
     """(x, y) / |(x, y)| without overflow or underflow; (0, 0) for a zero or non-finite vector."""
     big = max(abs(x), abs(y))
     if not (big > 0.0 and big < INF):
         return 0.0, 0.0
-    s = power_of_two_near(big)
-    x /= s
-    y /= s
+    if not 1e-60 < big < 1e60:
+        s = power_of_two_near(big)
+        x /= s
+        y /= s
     n = norm(x, y)
     return x / n, y / n
 
@@ -251,23 +265,21 @@ def end_residual(cp, cx, cy, radius, inv):
 
 
 @jit
-def line_residual(cp, px, py, tx, ty, inv):
+def line_residual(cp, px, py, tx, ty, end_radius, inv):
     """How far the start of spiral ``cp`` is from leaving the line through p along
-    unit t with zero curvature: max(distance / spiral size, tangent angle,
-    |κ(0)| / |κ(1)|)."""
+    unit t with zero curvature: max(distance / first leg, tangent angle,
+    |κ(0)|·r) with r the spiral's end radius."""
     ax = (cp[1, 0] - cp[0, 0]) * inv
     ay = (cp[1, 1] - cp[0, 1]) * inv
     bx = (cp[2, 0] - cp[1, 0]) * inv
     by = (cp[2, 1] - cp[1, 1]) * inv
     la = norm(ax, ay)
-    size = la + norm(bx, by) + norm((cp[3, 0] - cp[2, 0]) * inv, (cp[3, 1] - cp[2, 1]) * inv)
     if not (la > 0.0 and tx * ax + ty * ay > 0.0):
         return INF
-    distance = abs(tx * (cp[0, 1] - py) * inv - ty * (cp[0, 0] - px) * inv) / size
+    distance = abs(tx * (cp[0, 1] - py) * inv - ty * (cp[0, 0] - px) * inv) / la
     angle = abs(tx * ay - ty * ax) / la
     kappa0 = abs(2.0 / 3.0 * (ax * by - ay * bx) / (la * la * la))
-    kappa1 = _osculating_end(cp, inv)[2]
-    return worst(worst(distance, angle), kappa0 / abs(kappa1))
+    return worst(worst(distance, angle), kappa0 * abs(end_radius * inv))
 
 
 @jit
@@ -304,7 +316,7 @@ def spiral_row(bx, by, dx, dy, theta, curvature, out):
     g = spiral_legs(sin_t, cos_t, radius)[0]
     if not (g > 0.0 and g < INF):
         return UNVERIFIED, NAN, INF, NAN
-    scale = power_of_two_near(g)
+    scale = frame_scale(g)
     inv = 1.0 / scale
     nx = -side * ty
     ny = side * tx
@@ -316,7 +328,7 @@ def spiral_row(bx, by, dx, dy, theta, curvature, out):
     g2 = shape_g2(sin_t, cos_t) * local_radius
     cx = bx + scale * (g2 * tx + g1 * nx)
     cy = by + scale * (g2 * ty + g1 * ny)
-    res = worst(line_residual(out[0], bx, by, tx, ty, inv), end_residual(out[0], cx, cy, side * radius, inv))
+    res = worst(line_residual(out[0], bx, by, tx, ty, radius, inv), end_residual(out[0], cx, cy, side * radius, inv))
     if not res <= VERIFY_TOL:
         return UNVERIFIED, NAN, res, NAN
     return OK, theta, NAN, NAN
@@ -338,7 +350,7 @@ def line_to_circle_row(px, py, dx, dy, cx, cy, r, out):
         return ZERO_DIRECTION, NAN, NAN, NAN
     if not r > 0.0:
         return BAD_RADIUS, NAN, NAN, NAN
-    scale = power_of_two_near(r)
+    scale = frame_scale(r)
     inv = 1.0 / scale
     rs = r * inv
     vx = (cx - px) * inv
@@ -360,7 +372,7 @@ def line_to_circle_row(px, py, dx, dy, cx, cy, r, out):
     a = vx * tx + vy * ty - rs * shape_g2(sin_t, cos_t)
     put_spiral(out[0], a * tx, a * ty, tx, ty, -side * ty, side * tx, sin_t, cos_t, rs)
     place(out, px, py, scale, 1.0)
-    res = worst(line_residual(out[0], px, py, tx, ty, inv), end_residual(out[0], cx, cy, side * r, inv))
+    res = worst(line_residual(out[0], px, py, tx, ty, r, inv), end_residual(out[0], cx, cy, side * r, inv))
     if not res <= VERIFY_TOL:
         return UNVERIFIED, NAN, res, NAN
     return OK, math.atan2(sin_t, cos_t), measure, side
@@ -442,7 +454,7 @@ def circle_to_circle_row(c0x, c0y, r0, c1x, c1y, r1, out):
         return BAD_RADIUS, NAN, NAN, NAN
     if c0x == c1x and c0y == c1y:
         return COINCIDENT, NAN, NAN, NAN
-    scale = power_of_two_near(max(abs(r0), abs(r1)))
+    scale = frame_scale(max(abs(r0), abs(r1)))
     inv = 1.0 / scale
     dx = (c1x - c0x) * inv
     dy = (c1y - c0y) * inv
@@ -489,8 +501,8 @@ def circle_to_circle_row(c0x, c0y, r0, c1x, c1y, r1, out):
     wtx = tx
     wty = flip * ty
     res = worst(end_residual(out[0, ::-1], c0x, c0y, -r0, inv), end_residual(out[1], c1x, c1y, r1, inv))
-    res = worst(res, line_residual(out[1], out[1, 0, 0], out[1, 0, 1], wtx, wty, inv))
-    res = worst(res, line_residual(out[0, ::-1], out[1, 0, 0], out[1, 0, 1], -wtx, -wty, inv))
+    res = worst(res, line_residual(out[1], out[1, 0, 0], out[1, 0, 1], wtx, wty, r1, inv))
+    res = worst(res, line_residual(out[0, ::-1], out[1, 0, 0], out[1, 0, 1], -wtx, -wty, r0, inv))
     if not res <= VERIFY_TOL:
         return UNVERIFIED, NAN, res, NAN
     return OK, math.atan2(sin_t, cos_t), measure, NAN
@@ -509,7 +521,8 @@ def corner_residual(out, px, py, t0x, t0y, t1x, t1y, joint_curvature, inv):
     ``joint_curvature`` (magnitude, scaled by ``inv``).
     """
     second = out[1, ::-1]
-    res = worst(line_residual(out[0], px, py, t0x, t0y, inv), line_residual(second, px, py, t1x, t1y, inv))
+    radius = 1.0 / (joint_curvature * inv)  # in world units, as line_residual takes it
+    res = worst(line_residual(out[0], px, py, t0x, t0y, radius, inv), line_residual(second, px, py, t1x, t1y, radius, inv))
     res = worst(res, joint_residual(out[0], second, inv))
     kappa = abs(_osculating_end(out[0], inv)[2])
     return worst(res, abs(kappa / joint_curvature - 1.0))
@@ -534,7 +547,7 @@ def line_to_line_row(p0x, p0y, px, py, p1x, p1y, curvature, out):
     vy = py - p1y
     if not finite(ux, uy, vx, vy):
         return UNVERIFIED, NAN, INF, NAN
-    scale = power_of_two_near(max(max(abs(ux), abs(uy)), max(abs(vx), abs(vy))))
+    scale = frame_scale(max(max(abs(ux), abs(uy)), max(abs(vx), abs(vy))))
     inv = 1.0 / scale
     ux *= inv
     uy *= inv
@@ -731,7 +744,7 @@ def circle_in_circle_row(c0x, c0y, r0, c1x, c1y, r1, out):
     small_r = r1 if inward else -r0
     ox = c0x if inward else c1x
     oy = c0y if inward else c1y
-    scale = power_of_two_near(abs(big_r))
+    scale = frame_scale(abs(big_r))
     inv = 1.0 / scale
     dx = ((c1x - c0x) if inward else (c0x - c1x)) * inv
     dy = ((c1y - c0y) if inward else (c0y - c1y)) * inv
@@ -800,7 +813,7 @@ def verify_corners_batch(out, corners, t_in, t_out, curvature, status, measure):
     for i in prange(out.shape[0]):
         if status[i] != OK:
             continue
-        scale = power_of_two_near(1.0 / abs(curvature[i]))
+        scale = frame_scale(1.0 / abs(curvature[i]))
         inv = 1.0 / scale
         res = corner_residual(
             out[i], corners[i, 0], corners[i, 1], t_in[i, 0], t_in[i, 1], -t_out[i, 0], -t_out[i, 1], curvature[i] * scale, inv

@@ -2,19 +2,46 @@
 
 from __future__ import annotations
 
+import math
 from collections.abc import Iterable, Sequence
 from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from ._inputs import as_xy
+from ._inputs import as_float, as_real_array, as_xy
 from .segments import Arc, Join, Line, Segment, measure_join
 from .transitions import Transition
 
 #: Default join tolerance: gap / chain size, tangent angle (rad) and
 #: curvature jump × chain size must each stay below it.
 JOIN_TOLERANCE = 1e-9
+#: Largest join tolerance a chain accepts: looser joins are not G2.
+MAX_JOIN_TOLERANCE = 1e-3
+#: Largest allowance for float64 rounding at a joint (relative, like the
+#: tolerance): a rounding floor above it means the segment is too small for
+#: its coordinates, and the joint is judged as if exact.
+ROUNDING_CAP = 1e-6
+
+
+def join_tolerance(value: Any) -> float:
+    """A chain's join tolerance: finite and in (0, MAX_JOIN_TOLERANCE], else ValueError."""
+    tolerance = as_float(value, "tolerance")
+    if not 0.0 < tolerance <= MAX_JOIN_TOLERANCE:
+        raise ValueError(f"tolerance must lie in (0, {MAX_JOIN_TOLERANCE:g}]; got {tolerance!r}")
+    return tolerance
+
+
+def _segment_tuple(segments: Any) -> tuple[Segment, ...]:
+    if isinstance(segments, (Segment, Transition, str, bytes)) or not isinstance(segments, Iterable):
+        raise ValueError(f"segments must be a list of Line, Arc and BezierSpiral; got {type(segments).__name__}")
+    items = tuple(segments)
+    if not items:
+        raise ValueError("Chain needs at least one segment")
+    for i, seg in enumerate(items):
+        if not isinstance(seg, Segment):
+            raise ValueError(f"Chain segment {i} must be a Line, Arc or BezierSpiral; got {type(seg).__name__} {seg!r:.80}")
+    return items
 
 
 class Chain:
@@ -34,23 +61,28 @@ class Chain:
 
     Raises:
         ValueError: a joint exceeds the tolerance (the message names the joint
-            index and the three mismatches), or no segments were given.
+            index and the three mismatches), no segments were given, or the
+            tolerance is not in (0, 1e-3].
+
+    The rounding allowance per joint is capped at ``ROUNDING_CAP`` (1e-6,
+    relative), so a segment too small for its coordinates can never hide a
+    kink.
     """
 
     def __init__(self, segments: Iterable[Segment], tolerance: float = JOIN_TOLERANCE):
-        self._segments: tuple[Segment, ...] = tuple(segments)
-        if not self._segments:
-            raise ValueError("Chain needs at least one segment")
-        for seg in self._segments:
-            if not isinstance(seg, Segment):
-                raise ValueError(f"Chain segments must be Line, Arc or BezierSpiral; got {seg!r}")
-        self.tolerance = float(tolerance)
+        self._segments: tuple[Segment, ...] = _segment_tuple(segments)
+        self.tolerance = join_tolerance(tolerance)
         lengths = np.array([s.length for s in self._segments])
         self._stations = np.concatenate([[0.0], np.cumsum(lengths)])
+        if not math.isfinite(self._stations[-1]):
+            raise ValueError(f"Chain length overflows float64 ({len(self)} segments)")
         pts = np.array([p for s in self._segments for p in (s.start, s.end, s.point(0.5))])
-        self.size = float(np.hypot(*(pts.max(axis=0) - pts.min(axis=0)))) or 1.0
+        self.size = float(math.hypot(*(pts.max(axis=0) - pts.min(axis=0)))) or 1.0
+        if not math.isfinite(self.size):
+            raise ValueError("Chain extent overflows float64")
+        cap = np.array([ROUNDING_CAP * self.size, ROUNDING_CAP, ROUNDING_CAP / self.size])
         for j, a, b in zip(self.joins(), self._segments, self._segments[1:]):
-            floor = np.add(a.rounding_floor(True), b.rounding_floor(False))
+            floor = np.minimum(np.add(a.rounding_floor(True), b.rounding_floor(False)), cap)
             if (
                 j.gap > tolerance * self.size + floor[0]
                 or j.angle > tolerance + floor[1]
@@ -83,6 +115,14 @@ class Chain:
             ``Chain.join([line_to_circle(...), circle_to_line(...)], start=a, end=b)``
             gives line → spiral → arc → spiral → line.
         """
+        if isinstance(parts, (Segment, Transition, str, bytes)) or not isinstance(parts, Sequence):
+            raise ValueError(
+                f"parts must be a list of transitions and segments; got {type(parts).__name__} (wrap one part in a list)"
+            )
+        for i, part in enumerate(parts):
+            if not isinstance(part, (Transition, Segment)):
+                raise ValueError(f"parts[{i}] must be a Transition or a segment; got {type(part).__name__} {part!r:.80}")
+        tolerance = join_tolerance(tolerance)
         if not parts:
             if start is None or end is None:
                 raise ValueError("Chain.join needs parts, or both start and end for a straight chain")
@@ -144,21 +184,26 @@ class Chain:
     # --------------------------------------------------- station queries
 
     def _locate(self, s: ArrayLike) -> tuple[NDArray, NDArray]:
-        s = np.asarray(s, dtype=float)
-        if np.any((s < -1e-12 * self.length) | (s > self.length * (1 + 1e-12))):
-            raise ValueError(f"stations must lie in [0, {self.length}]; got {s.min()} … {s.max()}")
+        s = as_real_array(s, "stations")
+        if not np.all((s >= -1e-12 * self.length) & (s <= self.length * (1 + 1e-12))):
+            bad = s[~((s >= -1e-12 * self.length) & (s <= self.length * (1 + 1e-12)))].ravel()[0]
+            raise ValueError(f"stations must lie in [0, {self.length}]; got {bad}")
         index = np.clip(np.searchsorted(self._stations, s, side="right") - 1, 0, len(self) - 1)
         return index, s - self._stations[index]
 
     def _at(self, s: ArrayLike, method: str, width: tuple[int, ...]) -> NDArray:
-        s = np.asarray(s, dtype=float)
         index, local = self._locate(s)
-        out = np.empty(s.shape + width)
-        for i in np.unique(index):
-            mask = index == i
-            seg = self._segments[i]
-            out[mask] = getattr(seg, method)(seg.parameter_at(local[mask]))
-        return out
+        flat_index, flat_local = index.ravel(), local.ravel()
+        out = np.empty(flat_index.shape + width)
+        # Group the samples by segment in one sort (linear in the samples, not
+        # samples × segments).
+        order = np.argsort(flat_index, kind="stable")
+        bounds = np.flatnonzero(np.diff(flat_index[order])) + 1
+        for group in np.split(order, bounds):
+            if len(group):
+                seg = self._segments[flat_index[group[0]]]
+                out[group] = getattr(seg, method)(seg.parameter_at(flat_local[group]))
+        return out.reshape(index.shape + width)
 
     def point_at(self, s: ArrayLike) -> NDArray:
         """Points at stations ``s`` (arc length from the start)."""

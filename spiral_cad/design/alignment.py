@@ -19,7 +19,7 @@ from numpy.typing import ArrayLike, NDArray
 from scipy.optimize import brentq, minimize_scalar
 
 from ..core import bezier
-from ..core._inputs import as_float, as_points
+from ..core._inputs import as_float, as_points, as_real_array
 from ..core._kernels import put_spiral, shape_g1
 from ..core.chain import JOIN_TOLERANCE, Chain
 from ..core.errors import NoSolutionError
@@ -295,7 +295,7 @@ class Alignment:
 
 
 def _per_pi(value: Any, count: int, name: str) -> NDArray:
-    array = np.asarray(value, dtype=float)
+    array = as_real_array(value, name)
     if array.ndim == 0:
         array = np.full(count, float(array))
     if array.shape != (count,):
@@ -311,9 +311,9 @@ def _sides(value: Any, count: int, name: str) -> NDArray:
         array = np.full((count, 2), as_float(value, name))
     else:
         try:  # each entry a number (both sides) or an (in, out) pair
-            array = np.array([np.broadcast_to(np.asarray(v, dtype=float), (2,)) for v in value])
-        except (TypeError, ValueError):
-            raise ValueError(f"{name} entries must be numbers or (in, out) pairs; got {value!r}") from None
+            array = np.array([np.broadcast_to(as_real_array(v, f"{name}[{i}]"), (2,)) for i, v in enumerate(value)])
+        except ValueError as error:
+            raise ValueError(f"{name} entries must be numbers or (in, out) pairs: {error}") from None
     if array.shape != (count, 2):
         raise ValueError(f"{name} needs one value, one per interior PI ({count}) or ({count}, 2) in/out pairs; got shape {array.shape}")
     if not np.isfinite(array).all():

@@ -24,7 +24,7 @@ backwards: the circles are reported and no chain is built.
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
+from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
 from typing import Any
 
@@ -63,6 +63,8 @@ def _as_circle(value: Any, index: int) -> Circle:
     if isinstance(value, Circle):
         center, radius = value.center, value.radius
     else:
+        if isinstance(value, (str, bytes, dict)) or not isinstance(value, Iterable):
+            raise ValueError(f"circle {index} must be a Circle, (center, radius) or (x, y, radius); got {value!r:.80}")
         items = list(value)
         if len(items) == 3:
             center, radius = items[:2], items[2]
@@ -136,6 +138,8 @@ def circle_chain(circles: Sequence[Any]) -> CircleChain:
             (the message names it and its neighbours to move or resize).
         ValueError: malformed input.
     """
+    if isinstance(circles, (str, bytes, dict)) or not isinstance(circles, Iterable):
+        raise ValueError(f"circles must be a list of circles; got {type(circles).__name__}")
     items = [_as_circle(c, i) for i, c in enumerate(circles)]
     if len(items) < 2:
         raise ValueError(f"circle_chain needs at least 2 circles; got {len(items)}")

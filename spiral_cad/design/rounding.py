@@ -25,8 +25,9 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from ..core import _kernels as K
 from ..core import batch
-from ..core._inputs import as_float, as_points
+from ..core._inputs import as_float, as_points, as_real_array
 from ..core._kernels import WALTON_MEEK_CORNER, corner_relation
 from ..core.chain import JOIN_TOLERANCE, Chain
 from ..core.errors import NoSolutionError, Status
@@ -114,6 +115,9 @@ class CornerBatch:
         available: (N,) the longest distance the legs allow.
         status: (N,) ``spiral_cad.Status`` codes; 0 where rounded.
         corners: (N, 2) the corner points.
+        requested: (N,) the curvature asked for (NaN: as large as fits).
+        residual: (N,) for ``UNVERIFIED`` rows, how far the pair's joins are
+            off (relative); NaN elsewhere.
     """
 
     method: str
@@ -125,6 +129,7 @@ class CornerBatch:
     status: NDArray
     corners: NDArray
     requested: NDArray
+    residual: NDArray
 
     @property
     def ok(self) -> NDArray:
@@ -153,6 +158,12 @@ class CornerBatch:
             return f"{where}: the legs are collinear, there is nothing to round"
         if status is Status.COINCIDENT:
             return f"{where}: a leg has zero length"
+        if status is Status.UNVERIFIED:
+            return (
+                f"{where}: the spiral pair for curvature {self.curvature[i]:.6g} would start "
+                f"{self.distance[i]:.3g} from the corner, too small for float64 at these coordinates: its joins "
+                f"hold only to {self.residual[i]:.2g} (at most 1e-9 is returned); use a lower curvature"
+            )
         return f"{where}: no spiral pair ({status.name})"
 
 
@@ -179,7 +190,10 @@ def _requested(curvature: ArrayLike | None, max_curvature: ArrayLike | None, n: 
     name = "curvature" if curvature is not None else "max_curvature"
     if value is None:
         return np.full(n, np.nan)
-    k = np.broadcast_to(np.asarray(value, dtype=float), (n,))
+    k = as_real_array(value, name)
+    if k.ndim > 1 or k.size not in (1, n):
+        raise ValueError(f"{name} needs one value or one per corner ({n}); got shape {k.shape}")
+    k = np.broadcast_to(k.reshape(-1), (n,))
     bad = ~(np.isfinite(k) & (k > 0.0))
     if bad.any():
         i = int(np.argmax(bad))
@@ -214,7 +228,7 @@ def round_corners_batch(
     (Corollary 4.5: the lowest curvature that fits). Rows that fail carry a
     status (``CornerBatch.reason`` explains); the others are unaffected.
     """
-    if method not in CORNER_FACTOR:
+    if not isinstance(method, str) or method not in CORNER_FACTOR:
         raise ValueError(f"method must be one of {METHODS}; got {method!r}")
     arrays = np.broadcast_arrays(as_points(p0, "p0"), as_points(corners, "corners"), as_points(p1, "p1"))
     p0, corners, p1 = (np.ascontiguousarray(a.reshape(-1, 2)) for a in arrays)
@@ -230,6 +244,7 @@ def round_corners_batch(
         result = batch.line_to_line(p0, corners, p1, k)
         control_points = np.stack(result.spirals, axis=1)
         status = result.status.astype(np.int8)
+        residual = np.where(status == Status.UNVERIFIED, result.measure, np.nan)
     else:
         status = np.zeros(n, dtype=np.int8)
         status[~(sin_t > 0.0)] = Status.CORNER_STRAIGHT
@@ -240,12 +255,16 @@ def round_corners_batch(
         control_points = np.full((n, 2, 4, 2), np.nan)
         good = status == 0
         control_points[good] = g2cbs_control_points(corners[good], t_in[good], t_out[good], np.minimum(distance[good], available[good]), cos_t[good])
+        with np.errstate(invalid="ignore", divide="ignore"):
+            peak_used = np.where(fit, needed, k)
+        residual = np.full(n, np.nan)
+        K.verify_corners_batch(control_points, corners, t_in, t_out, peak_used, status, residual)
     ok = status == 0
     theta = np.where(sin_t > 0.0, np.arctan2(sin_t, cos_t), np.nan)
     # Failed rows report what they would need: the distance asked for and the
     # curvature that would exactly fit the available legs.
     peak = np.where(ok, np.where(fit, needed, k), needed)
-    return CornerBatch(method, control_points, theta, distance, peak, available, status, corners, k)
+    return CornerBatch(method, control_points, theta, distance, peak, available, status, corners, k, residual)
 
 
 def corner_legs(points: ArrayLike) -> tuple[NDArray, NDArray, NDArray, NDArray]:
@@ -375,7 +394,7 @@ def round_corners(
         result = round_corners_batch(p0, corners, p1, curvature=curvature, max_curvature=max_curvature, method=method)
         for j in np.flatnonzero(~result.ok):
             message = result.reason(int(j), label=f"corner {index[j]}")
-            if result.status[j] in (Status.LEGS_TOO_SHORT, Status.CORNER_REVERSAL):
+            if result.status[j] in (Status.LEGS_TOO_SHORT, Status.CORNER_REVERSAL, Status.UNVERIFIED):
                 raise NoSolutionError(message)
             raise ValueError(message)
         for j, cp in enumerate(result.control_points):
