@@ -1,207 +1,136 @@
-"""Writers for STEP, IGES, DXF and SVG, plus the STEP/IGES readers used to check them.
+"""Files from chains: STEP, IGES, DXF, SVG (and OpenDRIVE for alignments).
 
-Every format receives the exact curves: true lines and circular arcs, and
-each spiral as its cubic Bézier (STEP/IGES through the OCCT edges of
-``spiral_cad.occ``; DXF as a degree-3 SPLINE with the four control points
-and Bézier knots; SVG as a ``C`` command).
+Every writer takes the chain's own length unit and declares it the way its
+readers expect, and takes a ``name`` (default: the file name's stem) that
+becomes the STEP product, the IGES product id, the DXF layer and the SVG id
+and title. The originating system is ``spiral_cad <version>``. How each
+format stores a spiral:
+
+=======  ==========================================================  ==================================
+format   spiral stored as                                             unit declared by
+=======  ==========================================================  ==================================
+STEP     B_SPLINE_CURVE_WITH_KNOTS, degree 3, 4 poles, Bézier knots   SI_UNIT (+ prefix) / CONVERSION_BASED_UNIT
+IGES     entity 126 (rational B-spline, degree 3, 4 poles, weights 1)  global section unit flag and name
+DXF      SPLINE, degree 3, 4 control points, knots 0 0 0 0 1 1 1 1    $INSUNITS and $MEASUREMENT
+SVG      one cubic ``C`` command (the Bézier itself)                  width/height in mm or in; viewBox
+=======  ==========================================================  ==================================
+
+Each is exactly the same cubic; see README for what each round trip keeps.
 """
 
 from __future__ import annotations
 
-import io
-import math
 import os
 from collections.abc import Iterable
+from pathlib import Path
 from typing import Any
-from xml.sax.saxutils import quoteattr
-
-import numpy as np
 
 from .core.chain import Chain
-from .core.segments import Arc, Line, Segment
-from .core.spiral import BezierSpiral
+from .core.units import DEFAULT_UNITS, length_unit
 
 PathLike = str | os.PathLike
 
-#: Knot vector of one cubic Bézier written as a B-spline (DXF SPLINE).
-BEZIER_KNOTS = (0.0, 0.0, 0.0, 0.0, 1.0, 1.0, 1.0, 1.0)
+__all__ = ["export_dxf", "export_iges", "export_step", "export_svg", "originating_system"]
 
 
-def _chains(obj: Any) -> list[Chain]:
-    """``obj`` as a list of chains (a Chain or an iterable of Chains)."""
+def originating_system() -> str:
+    """``spiral_cad <version>``: the originating system written into every file."""
+    from . import __version__
+
+    return f"spiral_cad {__version__}"
+
+
+def _chains(obj: Any) -> list[Chain] | None:
+    """``obj`` as a list of chains, or None when it holds something else."""
     if isinstance(obj, Chain):
         return [obj]
-    if isinstance(obj, Iterable) and not isinstance(obj, (str, bytes)):
-        chains = list(obj)
-        if chains and all(isinstance(c, Chain) for c in chains):
-            return chains
-    raise ValueError(f"expected a Chain or a list of Chains; got {obj!r}")
+    if isinstance(obj, Iterable) and not isinstance(obj, (str, bytes, os.PathLike)):
+        items = list(obj)
+        if items and all(isinstance(c, Chain) for c in items):
+            return items
+    return None
 
 
-# ------------------------------------------------------------------ STEP / IGES
+def _require_chains(obj: Any) -> list[Chain]:
+    chains = _chains(obj)
+    if chains is None:
+        raise ValueError(f"expected a Chain or a non-empty list of Chains; got {type(obj).__name__}")
+    return chains
 
 
-def export_step(obj: Any, path: PathLike) -> None:
-    """Write ``obj`` (Chain, list of Chains, build123d/CadQuery or OCP shape) as STEP (AP214).
-
-    Reals are written with 17 significant digits, so coordinates survive
-    the round trip bit for bit.
-
-    Raises:
-        ValueError: ``obj`` is of an unsupported kind.
-        OSError: the writer failed.
-    """
-    from OCP.IFSelect import IFSelect_ReturnStatus
-    from OCP.StepAP214 import StepAP214
-    from OCP.STEPControl import STEPControl_AsIs, STEPControl_Writer
-    from OCP.StepData import StepData_StepWriter
-
-    from .cad.occ import as_occ_shape, quiet_messages
-
-    writer = STEPControl_Writer()
-    with quiet_messages():
-        status = writer.Transfer(as_occ_shape(obj), STEPControl_AsIs)
-    if status != IFSelect_ReturnStatus.IFSelect_RetDone:
-        raise OSError(f"STEP transfer failed for {obj!r}")
-    # STEPControl_Writer.Write prints 13 significant digits; 17 keep every double.
-    printer = StepData_StepWriter(writer.Model())
-    printer.FloatWriter().SetFormat("%.16E")
-    printer.SendModel(StepAP214.Protocol_s())
-    _print_to(printer, path, "STEP")
+def _name(name: str | None, path: PathLike) -> str:
+    text = Path(path).stem if name is None else name
+    if not isinstance(text, str) or not text.strip():
+        raise ValueError(f"name must be a non-empty string; got {name!r}")
+    return text
 
 
-def _print_to(printer, path: PathLike, kind: str) -> None:
-    """Write what an OCCT ``*_Writer`` printer holds to ``path``."""
-    buffer = io.BytesIO()
-    if not printer.Print(buffer):
-        raise OSError(f"could not print the {kind} model for {os.fspath(path)!r}")
-    with open(path, "wb") as handle:
-        handle.write(buffer.getvalue())
+def _units(chains: list[Chain] | None, units: str | None) -> str:
+    """The file's unit: the chains' own (they must agree, and ``units`` may only confirm it), else ``units`` or mm."""
+    if chains is None:
+        return DEFAULT_UNITS if units is None else length_unit(units)
+    found = {c.units for c in chains}
+    if len(found) > 1:
+        raise ValueError(f"chains in one file must share a unit; got {', '.join(sorted(found))}")
+    (own,) = found
+    if units is not None and length_unit(units) != own:
+        raise ValueError(f"the chain is in {own}; units={units!r} would mislabel it (nothing is rescaled)")
+    return own
 
 
-def export_iges(obj: Any, path: PathLike) -> None:
-    """Write ``obj`` as IGES in BRep mode, keeping circles (entity 100) and Béziers (126, exact).
+def export_step(obj: Any, path: PathLike, *, name: str | None = None, units: str | None = None) -> None:
+    """Write STEP (AP214).
 
-    BRep mode (``write.iges.brep.mode`` = 1) writes the edges' own curves;
-    nothing is converted to B-spline approximations.
-
-    Raises:
-        ValueError: ``obj`` is of an unsupported kind.
-        OSError: the writer failed.
-    """
-    from OCP.IGESControl import IGESControl_Controller, IGESControl_Writer
-    from OCP.IGESData import IGESData_IGESWriter
-    from OCP.IGESSelect import IGESSelect_WorkLibrary
-    from OCP.Interface import Interface_Static
-
-    from .cad.occ import as_occ_shape, quiet_messages
-
-    IGESControl_Controller.Init_s()
-    Interface_Static.SetIVal_s("write.iges.brep.mode", 1)
-    Interface_Static.SetIVal_s("write.convertsurface.mode", 0)
-    writer = IGESControl_Writer("MM", 1)
-    with quiet_messages():
-        if not writer.AddShape(as_occ_shape(obj)):
-            raise OSError(f"IGES transfer failed for {obj!r}")
-        writer.ComputeModel()
-    # IGESControl_Writer.Write prints reals with 9 decimals (~5e-10 absolute);
-    # printing the model ourselves with 17 significant digits keeps every double.
-    printer = IGESData_IGESWriter(writer.Model())
-    printer.FloatWriter().SetFormat("%.16E")
-    printer.SendModel(IGESSelect_WorkLibrary.DefineProtocol_s())
-    _print_to(printer, path, "IGES")
-
-
-# ------------------------------------------------------------------------ DXF
-
-
-def _dxf_add(msp, seg: Segment) -> None:
-    if isinstance(seg, Line):
-        msp.add_line(tuple(seg.start), tuple(seg.end))
-    elif isinstance(seg, Arc):
-        # DXF arcs run counterclockwise: a clockwise arc is written from its end.
-        a, b = math.degrees(seg.start_angle), math.degrees(seg.start_angle + math.copysign(seg.sweep, seg.radius))
-        start, end = (a, b) if seg.radius > 0 else (b, a)
-        msp.add_arc(tuple(seg.center), abs(seg.radius), start, end)
-    elif isinstance(seg, BezierSpiral):
-        spline = msp.add_open_spline([(*p, 0.0) for p in seg.control_points.tolist()], degree=3, knots=BEZIER_KNOTS)
-        spline.dxf.flags |= spline.PLANAR
-    else:
-        raise ValueError(f"segment must be a Line, Arc or BezierSpiral; got {seg!r}")
-
-
-def export_dxf(obj: Chain | Iterable[Chain], path: PathLike) -> None:
-    """Write chains as DXF (R2010): LINE, ARC and exact cubic SPLINE entities, in travel order.
-
-    A full-circle arc is written as an ARC from an angle to itself plus 360°.
-    """
-    import ezdxf
-
-    doc = ezdxf.new("R2010", setup=False)
-    msp = doc.modelspace()
-    for chain in _chains(obj):
-        for seg in chain:
-            _dxf_add(msp, seg)
-    doc.saveas(os.fspath(path))
-
-
-# ------------------------------------------------------------------------ SVG
-
-
-def _num(value: float) -> str:
-    return f"{value:.15g}"
-
-
-def _svg_point(p) -> str:
-    return f"{_num(p[0])} {_num(-p[1])}"  # SVG's y axis points down
-
-
-def _svg_commands(seg: Segment) -> list[str]:
-    if isinstance(seg, Line):
-        return [f"L {_svg_point(seg.end)}"]
-    if isinstance(seg, BezierSpiral):
-        _, b1, b2, b3 = seg.control_points
-        return [f"C {_svg_point(b1)} {_svg_point(b2)} {_svg_point(b3)}"]
-    if isinstance(seg, Arc):
-        # Pieces of at most 180° need no large-arc flag; with y flipped a
-        # counterclockwise arc turns with sweep-flag 0.
-        pieces = max(1, math.ceil(seg.sweep / math.pi - 1e-12))
-        r, flag = _num(abs(seg.radius)), 0 if seg.radius > 0 else 1
-        ends = seg.point(np.arange(1, pieces + 1) / pieces)
-        return [f"A {r} {r} 0 0 {flag} {_svg_point(p)}" for p in ends]
-    raise ValueError(f"segment must be a Line, Arc or BezierSpiral; got {seg!r}")
-
-
-def svg_path(chain: Chain) -> str:
-    """The ``d`` attribute of one SVG path for ``chain`` (y flipped)."""
-    commands = [f"M {_svg_point(chain.start)}"]
-    for seg in chain:
-        commands.extend(_svg_commands(seg))
-    return " ".join(commands)
-
-
-def export_svg(obj: Chain | Iterable[Chain], path: PathLike, margin: float = 0.05) -> None:
-    """Write chains as an SVG drawing: one ``path`` per chain, viewBox fitted.
+    Chains are written directly (``spiral_cad.formats.step``): one connected
+    wire per chain, exact lines, circles and Bézier spirals, in the chain's
+    unit. Any other shape (build123d, CadQuery, OCP) goes through OCCT's
+    writer, declared in ``units`` (default mm, build123d's convention) and
+    printed with 17 significant digits.
 
     Args:
-        obj: a Chain or a list of Chains.
-        path: output file.
-        margin: border around the drawing, as a fraction of its size.
+        obj: a Chain, a list of Chains, or a build123d/CadQuery/OCP shape.
+        path: the file to write.
+        name: product name (default: the file name's stem).
+        units: for shapes, their length unit; for chains only a check.
+
+    Raises:
+        ValueError: an unsupported object, unknown or contradicting units.
+        OSError: the file could not be written.
     """
     chains = _chains(obj)
-    points = np.vstack([c.sample(64) for c in chains])
-    lo, hi = points.min(axis=0), points.max(axis=0)
-    size = float(np.hypot(*(hi - lo))) or 1.0
-    pad = margin * size
-    x, y = lo[0] - pad, -hi[1] - pad
-    width, height = hi[0] - lo[0] + 2 * pad, hi[1] - lo[1] + 2 * pad
-    stroke = _num(0.004 * size)
-    lines = [
-        '<?xml version="1.0" encoding="UTF-8"?>',
-        f'<svg xmlns="http://www.w3.org/2000/svg" viewBox="{_num(x)} {_num(y)} {_num(width)} {_num(height)}">',
-        f'<g fill="none" stroke="black" stroke-width="{stroke}" stroke-linecap="round" stroke-linejoin="round">',
-    ]
-    lines += [f"<path d={quoteattr(svg_path(chain))}/>" for chain in chains]
-    lines += ["</g>", "</svg>", ""]
-    with open(path, "w", encoding="utf-8") as handle:
-        handle.write("\n".join(lines))
+    label, unit = _name(name, path), _units(chains, units)
+    if chains is not None:
+        from .formats.step import write_step
+
+        write_step(chains, path, label, unit, originating_system())
+    else:
+        from .formats.step_occ import write_shape_step
+
+        write_shape_step(obj, path, label, unit, originating_system())
+
+
+def export_iges(obj: Any, path: PathLike, *, name: str | None = None, units: str | None = None) -> None:
+    """Write IGES 5.3 in BRep mode through OCCT (lines 110, circles 100, spirals exact 126); needs OCP.
+
+    Args and errors as :func:`export_step`.
+    """
+    from .formats.iges import write_iges
+
+    chains = _chains(obj)
+    write_iges(obj, path, _name(name, path), _units(chains, units), originating_system())
+
+
+def export_dxf(obj: Chain | Iterable[Chain], path: PathLike, *, name: str | None = None) -> None:
+    """Write chains as DXF R2010 (LINE, ARC, exact SPLINE) on layer ``name``, in the chains' unit; needs ezdxf."""
+    from .formats.dxf import write_dxf
+
+    chains = _require_chains(obj)
+    write_dxf(chains, path, _name(name, path), _units(chains, None))
+
+
+def export_svg(obj: Chain | Iterable[Chain], path: PathLike, *, name: str | None = None, margin: float = 0.05) -> None:
+    """Write chains as SVG at true size (one path per chain; ``margin`` a fraction of the drawing's size)."""
+    from .formats.svg import write_svg
+
+    chains = _require_chains(obj)
+    write_svg(chains, path, _name(name, path), _units(chains, None), margin)

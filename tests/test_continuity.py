@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+import re
 import subprocess
 import sys
 from pathlib import Path
@@ -30,6 +31,8 @@ from OCP.TopAbs import TopAbs_REVERSED  # noqa: E402
 from OCP.TopoDS import TopoDS, TopoDS_Wire  # noqa: E402
 
 import spiral_cad as sc  # noqa: E402
+import spiral_cad.design  # noqa: E402,F401
+import spiral_cad.export  # noqa: E402,F401
 from spiral_cad.cli import main  # noqa: E402
 from spiral_cad.continuity import Continuity, check_continuity  # noqa: E402
 
@@ -295,10 +298,30 @@ def test_unreadable_files_raise_value_error(tmp_path):
             check_continuity(path)
 
 
-def test_format_table_lists_every_wire_and_joint():
+def test_format_table_states_what_was_found_and_lists_every_joint():
     text = check_continuity(wire(*spiral_path())).format_table()
-    assert "wire 0: 3 edge(s), open, 2 joint(s), worst G2" in text
+    assert text.startswith("TopoDS_Wire: 1 wire of 3 edges; worst joint G2")
+    assert "wire 0: 3 edges, open, 2 joint(s), worst G2" in text
     assert text.count(" G2\n") + text.endswith(" G2") >= 2
+    two = check_continuity([line((0, 0), (1, 0)), line((50, 0), (51, 0)), line((51, 0), (52, 1))])
+    assert two.describe() == "2 loose pieces (1, 2 edges)" and two.pieces == 2
+    assert not two.passes("G0") and two.passes("G0", pieces=2)
+
+
+def test_a_gap_within_the_snap_distance_fails_g0_instead_of_splitting_the_path():
+    # two loose lines 0.5 apart in a 100-unit model: one piece with a broken joint
+    report = check_continuity([line((0, 0), (49.75, 0)), line((50.25, 0), (100, 0))])
+    assert report.pieces == 1 and levels(report) == [NONE]
+    assert report.joints[0].gap == pytest.approx(0.5)
+    assert not report.passes("G0")
+    # beyond the snap distance they are two pieces, and --require still fails on the count
+    assert check_continuity([line((0, 0), (49.75, 0)), line((50.25, 0), (100, 0))], snap=0.1).pieces == 2
+
+
+def test_survey_coordinates_are_not_failed_on_their_last_bit():
+    x = 5.4e9  # millimetres: a survey coordinate
+    report = check_continuity([line((x, 0), (x + 1000, 0)), line((x + 1000 + 2 * math.ulp(x), 0), (x + 2000, 0))])
+    assert levels(report) == [G2]
 
 
 # ------------------------------------------------------------------- CLI
@@ -329,7 +352,36 @@ def test_cli_check_unreadable_file_exits_2(tmp_path, capsys):
     bad.write_text("garbage\n")
     assert main(["check", str(bad)]) == 2
     assert main(["check", str(tmp_path / "missing.step")]) == 2
-    assert "cannot read" in capsys.readouterr().err
+    assert "error: cannot read" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("suffix", ["step", "igs"])
+def test_a_truncated_file_exits_2_with_the_readers_reason_and_no_chatter(tmp_path, capfd, suffix):
+    chain = sc.design.Alignment.from_pis([(0, 0), (600, 120), (1150, -80), (1700, 260)], [450, 400], spiral_angles=0.12).chain
+    whole = tmp_path / f"road.{suffix}"
+    (sc.export.export_step if suffix == "step" else sc.export.export_iges)(chain, whole)
+    assert main(["check", str(whole), "--require", "G2"]) == 0
+    assert "1 wire of 9 edges" in capfd.readouterr().out
+    lines = whole.read_text().splitlines(keepends=True)
+    cut = tmp_path / f"cut.{suffix}"
+    reason = {"step": "the STEP reader reports: .*unexpected end of file", "igs": "no IGES terminate section"}[suffix]
+    for kept, why in ((lines[: len(lines) // 2], reason), (lines[: len(lines) // 2] + lines[-1:], "declares|reader reports")):
+        cut.write_text("".join(kept))
+        assert main(["check", str(cut), "--require", "G2"]) == 2
+        out, err = capfd.readouterr()
+        assert re.match(f"error: cannot read 'cut.{suffix}': .*({why})", err), err
+        assert "\x1b[" not in out + err and "Traceback" not in err
+
+
+def test_cli_counts_pieces(tmp_path, capsys):
+    first = sc.design.round_corners([(0, 0), (10, 0), (10, 10)]).chain
+    second = sc.design.round_corners([(30, 0), (40, 0), (40, 10)]).chain
+    path = tmp_path / "two.step"
+    sc.export.export_step([first, second], path)
+    assert main(["check", str(path), "--require", "G2"]) == 1
+    assert "2 separate pieces, expected 1" in capsys.readouterr().out
+    assert main(["check", str(path), "--require", "G2", "--pieces", "2"]) == 0
+    assert "OK: 2 wires (2, 2 edges)" in capsys.readouterr().out  # Cor. 4.5: spirals use the whole legs
 
 
 def test_cli_script_runs(step_files):

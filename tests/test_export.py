@@ -1,4 +1,8 @@
-"""STEP/IGES/DXF/SVG writers: re-read files and compare geometry and G2 joins."""
+"""STEP/IGES/DXF/SVG: every file re-read by a reader we did not write and compared with the chain.
+
+Readers: OCCT's STEP and IGES readers (asked for another unit than the
+file's), steputils (an independent STEP parser), ezdxf and svgelements.
+"""
 
 import math
 import re
@@ -9,34 +13,51 @@ import pytest
 
 pytest.importorskip("OCP")
 ezdxf = pytest.importorskip("ezdxf")
+svgelements = pytest.importorskip("svgelements")
+p21 = pytest.importorskip("steputils.p21")
 
 from cad_cases import curvature_vector, transition_chains
 from OCP.BRepAdaptor import BRepAdaptor_Curve
+from OCP.GCPnts import GCPnts_AbscissaPoint
 from OCP.BRepLProp import BRepLProp_CLProps
+from OCP.BRepTools import BRepTools_WireExplorer
 from OCP.GeomAbs import GeomAbs_CurveType
-from OCP.TopAbs import TopAbs_EDGE, TopAbs_REVERSED
-from OCP.TopExp import TopExp_Explorer
+from OCP.TopAbs import TopAbs_EDGE, TopAbs_REVERSED, TopAbs_WIRE
+from OCP.TopExp import TopExp, TopExp_Explorer
 from OCP.TopoDS import TopoDS
 
-from spiral_cad import Arc, BezierSpiral, Line
-from spiral_cad.export import (
-    BEZIER_KNOTS,
-    export_dxf,
-    export_iges,
-    export_step,
-    export_svg,
-)
+import spiral_cad as sc
+from spiral_cad import Arc, BezierSpiral, Chain, Line
+from spiral_cad.core.units import MM_PER_UNIT, UNITS
+from spiral_cad.design import Alignment
+from spiral_cad.export import export_dxf, export_iges, export_step, export_svg, originating_system
+from spiral_cad.formats.dxf import BEZIER_KNOTS, INSUNITS
 from spiral_cad.occ import read_shape
 
 CHAINS = transition_chains()
-FORMATS = {"step": (export_step, read_shape), "iges": (export_iges, read_shape)}
+WRITERS = {"step": export_step, "igs": export_iges}
+#: a unit to read each file unit back in (never the file's own)
+OTHER_UNIT = {"mm": "in", "cm": "m", "m": "mm", "km": "m", "in": "mm", "ft": "m"}
 
 
 def vec(p) -> np.ndarray:
     return np.array([p.X(), p.Y(), p.Z()])
 
 
-def edges_of(shape) -> list:
+def wires_of(shape) -> list[list]:
+    """Each wire's edges in connection order."""
+    wires, explorer = [], TopExp_Explorer(shape, TopAbs_WIRE)
+    while explorer.More():
+        walk, edges = BRepTools_WireExplorer(TopoDS.Wire_s(explorer.Current())), []
+        while walk.More():
+            edges.append(walk.Current())
+            walk.Next()
+        wires.append(edges)
+        explorer.Next()
+    return wires
+
+
+def all_edges(shape) -> list:
     found, explorer = [], TopExp_Explorer(shape, TopAbs_EDGE)
     while explorer.More():
         found.append(explorer.Current())
@@ -45,110 +66,194 @@ def edges_of(shape) -> list:
 
 
 def travel_range(edge) -> tuple[BRepAdaptor_Curve, float, float]:
-    """The edge's curve and its parameters at the start and end of travel."""
     curve = BRepAdaptor_Curve(TopoDS.Edge_s(edge))
     first, last = curve.FirstParameter(), curve.LastParameter()
     return (curve, last, first) if edge.Orientation() == TopAbs_REVERSED else (curve, first, last)
 
 
-def derivatives(edge, t: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    props = BRepLProp_CLProps(BRepAdaptor_Curve(TopoDS.Edge_s(edge)), t, 2, 1e-12)
-    return vec(props.Value()), vec(props.D1()), vec(props.D2())
+def length_of(shape) -> float:
+    """Total edge length, integrated to 1e-13 (GProp's default integration is looser)."""
+    return sum(GCPnts_AbscissaPoint.Length_s(BRepAdaptor_Curve(TopoDS.Edge_s(e)), 1e-13) for e in all_edges(shape))
 
 
-def assert_same_geometry(edge, seg, tol):
+def assert_same_geometry(edge, seg, tol, scale=1.0):
+    """``edge`` (read in a unit ``scale`` times smaller than the chain's) is ``seg``: same kind, same curve."""
     curve, t0, t1 = travel_range(edge)
     u = np.linspace(0.0, 1.0, 33)
-    got = np.array([vec(curve.Value(t0 + ui * (t1 - t0))) for ui in u])
+    got = np.array([vec(curve.Value(t0 + ui * (t1 - t0))) for ui in u]) / scale
     assert np.abs(got[:, 2]).max() <= tol
     kind = curve.GetType()
+    assert np.abs(got[:, :2] - seg.point(u)).max() <= tol
     if isinstance(seg, Line):
         assert kind == GeomAbs_CurveType.GeomAbs_Line
-        assert np.abs(got[:, :2] - seg.point(u)).max() <= tol
     elif isinstance(seg, Arc):
         assert kind == GeomAbs_CurveType.GeomAbs_Circle
-        circle = curve.Circle()
-        assert abs(circle.Radius() - abs(seg.radius)) <= tol
-        assert np.abs(vec(circle.Location())[:2] - seg.center).max() <= tol
-        assert np.abs(got[:, :2] - seg.point(u)).max() <= tol  # angle-linear both ways
+        assert abs(curve.Circle().Radius() / scale - abs(seg.radius)) <= tol
     else:
-        # IGES and STEP carry a Bézier as a one-span B-spline with the same poles
-        assert kind in (GeomAbs_CurveType.GeomAbs_BSplineCurve, GeomAbs_CurveType.GeomAbs_BezierCurve)
-        spline = curve.BSpline() if kind == GeomAbs_CurveType.GeomAbs_BSplineCurve else curve.Bezier()
+        assert kind == GeomAbs_CurveType.GeomAbs_BSplineCurve
+        spline = curve.BSpline()
         assert spline.Degree() == 3 and not spline.IsRational() and spline.NbPoles() == 4
-        poles = np.array([vec(spline.Pole(i))[:2] for i in range(1, 5)])
+        poles = np.array([vec(spline.Pole(i))[:2] for i in range(1, 5)]) / scale
         if edge.Orientation() == TopAbs_REVERSED:
             poles = poles[::-1]
         assert np.abs(poles - seg.control_points).max() <= tol
-        assert np.abs(got[:, :2] - seg.point(u)).max() <= tol
 
 
 def assert_g2_joins(edges, size):
+    def derivatives(edge, t):
+        props = BRepLProp_CLProps(BRepAdaptor_Curve(TopoDS.Edge_s(edge)), t, 2, 1e-12)
+        return vec(props.Value()), vec(props.D1()), vec(props.D2())
+
     for a, b in zip(edges, edges[1:]):
-        _, _, end_a = travel_range(a)
-        _, start_b, _ = travel_range(b)
-        pa, d1a, d2a = derivatives(a, end_a)
-        pb, d1b, d2b = derivatives(b, start_b)
+        pa, d1a, d2a = derivatives(a, travel_range(a)[2])
+        pb, d1b, d2b = derivatives(b, travel_range(b)[1])
         assert np.linalg.norm(pa - pb) <= 1e-9 * size
         ta, tb = d1a / np.linalg.norm(d1a), d1b / np.linalg.norm(d1b)
-        if a.Orientation() == TopAbs_REVERSED:
-            ta = -ta
-        if b.Orientation() == TopAbs_REVERSED:
-            tb = -tb
+        ta, tb = (-ta if a.Orientation() == TopAbs_REVERSED else ta), (-tb if b.Orientation() == TopAbs_REVERSED else tb)
         assert np.linalg.norm(ta - tb) <= 1e-9
-        # the curvature vector does not depend on parametrisation or direction
         assert np.linalg.norm(curvature_vector(d1a, d2a) - curvature_vector(d1b, d2b)) * size <= 1e-8
 
 
+# ------------------------------------------------------------ STEP and IGES
+
+
 @pytest.mark.parametrize("name", sorted(CHAINS))
-@pytest.mark.parametrize("fmt", sorted(FORMATS))
-def test_step_and_iges_round_trip_keeps_exact_curves_and_g2_joins(tmp_path, name, fmt):
+@pytest.mark.parametrize("fmt", sorted(WRITERS))
+def test_each_chain_reads_back_as_one_connected_wire_of_exact_curves(tmp_path, name, fmt):
     chain = CHAINS[name]
-    write, read = FORMATS[fmt]
     path = tmp_path / f"chain.{fmt}"
-    write(chain, path)
-    edges = edges_of(read(path))
+    WRITERS[fmt](chain, path)
+    (edges,) = wires_of(read_shape(path))
     assert len(edges) == len(chain)
+    for a, b in zip(edges, edges[1:]):  # shared vertices: one connected wire
+        assert TopExp.LastVertex_s(TopoDS.Edge_s(a), True).IsSame(TopExp.FirstVertex_s(TopoDS.Edge_s(b), True))
     for edge, seg in zip(edges, chain):
         assert_same_geometry(edge, seg, 1e-9)
     assert_g2_joins(edges, chain.size)
 
 
-@pytest.mark.parametrize("fmt", sorted(FORMATS))
-def test_several_chains_become_several_wires(tmp_path, fmt):
-    write, read = FORMATS[fmt]
+def test_step_keeps_every_double_and_iges_loses_at_most_two_ulp(tmp_path):
+    chain = CHAINS["mixed"]
+    for fmt, exact in (("step", True), ("igs", False)):
+        path = tmp_path / f"mixed.{fmt}"
+        WRITERS[fmt](chain, path)
+        (edges,) = wires_of(read_shape(path))
+        for edge, seg in zip(edges, chain):
+            curve, _, _ = travel_range(edge)
+            if isinstance(seg, BezierSpiral):
+                poles = np.array([vec(curve.BSpline().Pole(i))[:2] for i in range(1, 5)])
+                poles = poles[::-1] if edge.Orientation() == TopAbs_REVERSED else poles
+                assert np.array_equal(poles, seg.control_points)  # spirals: bit for bit in both
+            elif isinstance(seg, Arc):
+                radius, centre = curve.Circle().Radius(), vec(curve.Circle().Location())[:2]
+                ulps = abs(radius - abs(seg.radius)) / math.ulp(abs(seg.radius))
+                assert (ulps == 0) if exact else (ulps <= 2)
+                assert np.array_equal(centre, seg.center)
+
+
+@pytest.mark.parametrize("units", UNITS)
+@pytest.mark.parametrize("fmt", sorted(WRITERS))
+def test_files_declare_their_unit_so_readers_convert_to_the_right_size(tmp_path, units, fmt):
+    chain = Chain(CHAINS["mixed"].segments, units=units)
+    path = tmp_path / f"mixed.{fmt}"
+    WRITERS[fmt](chain, path)
+    target = OTHER_UNIT[units]
+    scale = MM_PER_UNIT[units] / MM_PER_UNIT[target]
+    shape = read_shape(path, units=target)
+    assert length_of(shape) == pytest.approx(chain.length * scale, rel=1e-12)
+    (edges,) = wires_of(shape)
+    for edge, seg in zip(edges, chain):
+        assert_same_geometry(edge, seg, 1e-9, scale)
+
+
+def test_demo_highway_reads_back_as_2398180_mm(tmp_path):
+    from spiral_cad.cli import DEMO_DESIGN
+
+    design = DEMO_DESIGN["designs"][0]
+    angles = [tuple(map(math.radians, a)) if isinstance(a, list) else math.radians(a) for a in design["spiral_angles_deg"]]
+    angles = [a if isinstance(a, tuple) else (a, a) for a in angles]
+    chain = Alignment.from_pis(design["pis"], design["radii"], spiral_angles=angles, units="m").chain
+    for fmt in WRITERS:
+        WRITERS[fmt](chain, tmp_path / f"highway.{fmt}")
+        assert length_of(read_shape(tmp_path / f"highway.{fmt}")) == pytest.approx(2_398_180.013, abs=1e-3)
+
+
+@pytest.mark.parametrize("fmt", sorted(WRITERS))
+def test_two_chains_read_back_as_exactly_two_wires(tmp_path, fmt):
     chains = [CHAINS["S"], CHAINS["line-line"]]
     path = tmp_path / f"two.{fmt}"
-    write(chains, path)
-    shape = read(path)
-    edges = edges_of(shape)
-    assert len(edges) == sum(len(c) for c in chains)
-    for edge, seg in zip(edges, [s for c in chains for s in c]):
-        assert_same_geometry(edge, seg, 1e-9)
+    WRITERS[fmt](chains, path)
+    wires = wires_of(read_shape(path))
+    assert [len(w) for w in wires] == [len(c) for c in chains]
+    for edges, chain in zip(wires, chains):
+        for edge, seg in zip(edges, chain):
+            assert_same_geometry(edge, seg, 1e-9)
 
 
-def test_build123d_shapes_are_written_as_they_are(tmp_path):
+def test_step_header_product_and_units_read_by_an_independent_parser(tmp_path):
+    chain = Chain(CHAINS["C"].segments, units="ft")
+    path = tmp_path / "ramp.step"
+    export_step(chain, path, name="Ramp 'B' — north")
+    step = p21.readfile(str(path))  # steputils parses the whole exchange structure
+    text = path.read_text()
+    assert step.header["FILE_NAME"].params[4] == originating_system()
+    assert "Open CASCADE" not in text and "Author" not in text
+    products = [i for i in step.data[0].instances.values() if getattr(i, "entity", None) and i.entity.name == "PRODUCT"]
+    assert products and products[0].entity.params[0] == "Ramp 'B' — north"
+    assert "CONVERSION_BASED_UNIT('FOOT'" in text and "LENGTH_MEASURE(304.8)" in text
+    assert text.count("COMPOSITE_CURVE(") == 1 and "CONT_SAME_GRADIENT_SAME_CURVATURE" in text
+
+
+def test_iges_global_section_names_the_design_and_no_login(tmp_path):
+    import getpass
+
+    path = tmp_path / "loop.igs"
+    export_iges(Chain(CHAINS["S"].segments, units="m"), path)
+    globals_ = "".join(line[:72] for line in path.read_text().splitlines() if line[72:73] == "G")
+    assert "4Hloop" in globals_ and originating_system() in globals_
+    assert ",6,1HM," in globals_  # unit flag 6, unit name M
+    assert f"H{getpass.getuser()}," not in globals_
+
+
+def test_build123d_shapes_are_written_in_their_unit(tmp_path):
     build123d = pytest.importorskip("build123d")
     chain = CHAINS["C"]
     rail = chain.to_wire(build123d.Plane.XZ)
-    solid = build123d.sweep(
-        build123d.Plane(origin=rail @ 0, z_dir=rail % 0) * build123d.Circle(0.1), path=rail
-    )
+    solid = build123d.sweep(build123d.Plane(origin=rail @ 0, z_dir=rail % 0) * build123d.Circle(0.1), path=rail)
     path = tmp_path / "solid.step"
-    export_step(solid, path)
-    back = build123d.Solid(read_shape(path))
-    assert back.is_valid and back.volume == pytest.approx(solid.volume, rel=1e-9)
+    export_step(solid, path, units="cm", name="tube")
+    back = build123d.Solid(read_shape(path))  # read in mm: 10× the numbers
+    assert back.is_valid and back.volume == pytest.approx(solid.volume * 1000, rel=1e-9)
+    assert "PRODUCT('tube" in path.read_text()
     iges = tmp_path / "rail.iges"
     export_iges(rail, iges)
-    assert len(edges_of(read_shape(iges))) == len(chain)
+    assert len(all_edges(read_shape(iges))) == len(chain)
 
 
-def test_writers_reject_other_objects(tmp_path):
-    for write in (export_step, export_iges, export_dxf, export_svg):
+def test_writers_reject_other_objects_and_mislabelled_units(tmp_path):
+    for write in (export_dxf, export_svg):
         with pytest.raises(ValueError, match="expected a Chain"):
             write(42, tmp_path / "x")
-    with pytest.raises(ValueError, match="cannot read"):
-        export_step("not a file.txt", tmp_path / "x.step")
+    for write in (export_step, export_iges):
+        with pytest.raises(ValueError, match="expected a Chain"):
+            write(42, tmp_path / "x")
+    with pytest.raises(ValueError, match="would mislabel"):
+        export_step(CHAINS["C"], tmp_path / "x.step", units="m")
+    with pytest.raises(ValueError, match="share a unit"):
+        export_svg([CHAINS["C"], Chain(CHAINS["S"].segments, units="m")], tmp_path / "x.svg")
+
+
+# ---------------------------------------------------------------------- DXF
+
+
+@pytest.mark.parametrize("units", UNITS)
+def test_dxf_header_declares_the_unit_both_ways(tmp_path, units):
+    path = tmp_path / "d.dxf"
+    export_dxf(Chain(CHAINS["C"].segments, units=units), path, name="ramp-3")
+    doc = ezdxf.readfile(path)
+    assert doc.header["$INSUNITS"] == INSUNITS[units] == {"in": 1, "ft": 2, "mm": 4, "cm": 5, "m": 6, "km": 7}[units]
+    assert doc.header["$MEASUREMENT"] == (0 if units in ("in", "ft") else 1)
+    assert {e.dxf.layer for e in doc.modelspace()} == {"ramp-3"}
 
 
 @pytest.mark.parametrize("name", sorted(CHAINS))
@@ -157,9 +262,7 @@ def test_dxf_has_lines_arcs_and_exact_bezier_splines(tmp_path, name):
     path = tmp_path / "chain.dxf"
     export_dxf(chain, path)
     entities = list(ezdxf.readfile(path).modelspace())
-    assert [e.dxftype() for e in entities] == [
-        {Line: "LINE", Arc: "ARC", BezierSpiral: "SPLINE"}[type(s)] for s in chain
-    ]
+    assert [e.dxftype() for e in entities] == [{Line: "LINE", Arc: "ARC", BezierSpiral: "SPLINE"}[type(s)] for s in chain]
     tol = 1e-9 * chain.size
     for entity, seg in zip(entities, chain):
         if isinstance(seg, Line):
@@ -167,25 +270,53 @@ def test_dxf_has_lines_arcs_and_exact_bezier_splines(tmp_path, name):
             assert np.abs(got - [seg.start, seg.end]).max() <= tol
         elif isinstance(seg, Arc):
             assert abs(entity.dxf.radius - abs(seg.radius)) <= tol
-            assert np.abs(np.array(entity.dxf.center)[:2] - seg.center).max() <= tol
             ends = [seg.start, seg.end] if seg.radius > 0 else [seg.end, seg.start]  # DXF arcs run CCW
-            got = np.array([entity.start_point, entity.end_point])[:, :2]
-            assert np.abs(got - ends).max() <= tol
-            span = (entity.dxf.end_angle - entity.dxf.start_angle) % 360.0 or 360.0
-            assert math.radians(span) == pytest.approx(seg.sweep, abs=1e-9)
+            assert np.abs(np.array([entity.start_point, entity.end_point])[:, :2] - ends).max() <= tol
         else:
-            assert entity.dxf.degree == 3
-            assert list(entity.knots) == list(BEZIER_KNOTS)
-            assert len(entity.weights) == 0
-            points = np.array(entity.control_points)
-            assert np.abs(points[:, :2] - seg.control_points).max() <= 1e-12 * chain.size
-            assert np.abs(points[:, 2]).max() == 0.0
+            assert entity.dxf.degree == 3 and list(entity.knots) == list(BEZIER_KNOTS) and len(entity.weights) == 0
+            assert np.array_equal(np.array(entity.control_points)[:, :2], seg.control_points)
 
 
-def test_dxf_takes_several_chains(tmp_path):
-    path = tmp_path / "two.dxf"
-    export_dxf([CHAINS["C"], CHAINS["nested"]], path)
-    assert len(ezdxf.readfile(path).modelspace()) == len(CHAINS["C"]) + len(CHAINS["nested"])
+# ---------------------------------------------------------------------- SVG
+
+
+@pytest.mark.parametrize("units", ["mm", "m", "ft"])
+def test_svg_is_drawn_at_true_size_with_model_units_in_the_viewbox(tmp_path, units):
+    chain = Chain(CHAINS["mixed"].segments, units=units)
+    path = tmp_path / "mixed.svg"
+    export_svg(chain, path, name="mixed", margin=0.0)
+    svg = svgelements.SVG.parse(str(path), reify=True)
+    pixels_per_unit = MM_PER_UNIT[units] / 25.4 * 96.0  # svgelements: CSS px at 96 per inch
+    extent = chain.sample(256)
+    width = extent[:, 0].max() - extent[:, 0].min()
+    assert svg.width == pytest.approx(width * pixels_per_unit, rel=1e-3)
+    root = ET.parse(path).getroot()
+    assert root.find("{http://www.w3.org/2000/svg}title").text.startswith("mixed")
+    (element,) = [e for e in svg.elements() if isinstance(e, svgelements.Path)]
+    assert element.id == "mixed"
+    # the path as svgelements reads it, mapped back through the viewBox, is the chain (y flipped)
+    vx, vy, _, _ = map(float, root.get("viewBox").split())
+
+    def model(point) -> np.ndarray:
+        return np.array([point.x / pixels_per_unit + vx, -(point.y / pixels_per_unit + vy)])
+
+    drawn = [piece for piece in element if not isinstance(piece, svgelements.Move)]
+    tol = 1e-6 * chain.size  # svgelements maps through mm → px → user units in its own arithmetic
+    for seg in chain:
+        if isinstance(seg, Arc):
+            count = math.ceil(seg.sweep / math.pi - 1e-12)
+            pieces, drawn = drawn[:count], drawn[count:]
+            assert all(isinstance(p, svgelements.Arc) for p in pieces)
+            assert np.abs(model(pieces[-1].end) - seg.end).max() <= tol
+            continue
+        piece, drawn = drawn[0], drawn[1:]
+        if isinstance(seg, Line):
+            assert isinstance(piece, svgelements.Line) and np.abs(model(piece.end) - seg.end).max() <= tol
+        else:
+            assert isinstance(piece, svgelements.CubicBezier)
+            got = np.array([model(p) for p in (piece.start, piece.control1, piece.control2, piece.end)])
+            assert np.abs(got - seg.control_points).max() <= tol
+    assert not drawn
 
 
 def parse_path(d: str) -> list[tuple[str, list[float]]]:
@@ -206,12 +337,9 @@ def test_svg_paths_use_exact_commands_with_y_flipped(tmp_path, name):
     chain = CHAINS[name]
     path = tmp_path / "chain.svg"
     export_svg(chain, path)
-    root = ET.parse(path).getroot()
-    assert root.tag == "{http://www.w3.org/2000/svg}svg"
-    paths = root.findall(".//{http://www.w3.org/2000/svg}path")
+    paths = ET.parse(path).getroot().findall(".//{http://www.w3.org/2000/svg}path")
     assert len(paths) == 1
     commands = parse_path(paths[0].get("d"))
-    assert commands[0] == ("M", [pytest.approx(chain.start[0], abs=1e-9), pytest.approx(-chain.start[1], abs=1e-9)])
     flip = np.array([1.0, -1.0])
     rest = iter(commands[1:])
     tol = 1e-12 * chain.size
@@ -221,8 +349,7 @@ def test_svg_paths_use_exact_commands_with_y_flipped(tmp_path, name):
             assert letter == "L" and np.abs(np.array(numbers) - seg.end * flip).max() <= tol
         elif isinstance(seg, BezierSpiral):
             letter, numbers = next(rest)
-            assert letter == "C"
-            assert np.abs(np.reshape(numbers, (3, 2)) - seg.control_points[1:] * flip).max() <= tol
+            assert letter == "C" and np.abs(np.reshape(numbers, (3, 2)) - seg.control_points[1:] * flip).max() <= tol
         else:
             pieces = math.ceil(seg.sweep / math.pi - 1e-12)
             for k in range(1, pieces + 1):
@@ -231,14 +358,10 @@ def test_svg_paths_use_exact_commands_with_y_flipped(tmp_path, name):
                 assert (rot, large) == (0, 0) and sweep_flag == (0 if seg.radius > 0 else 1)
                 assert np.abs(np.array([x, y]) - seg.point(k / pieces) * flip).max() <= tol
     assert next(rest, None) is None
-    # viewBox holds the whole drawing
-    vx, vy, vw, vh = map(float, root.get("viewBox").split())
-    pts = chain.sample(64) * flip
-    assert np.all(pts[:, 0] > vx) and np.all(pts[:, 0] < vx + vw)
-    assert np.all(pts[:, 1] > vy) and np.all(pts[:, 1] < vy + vh)
 
 
-def test_svg_draws_one_path_per_chain(tmp_path):
+def test_svg_draws_one_named_path_per_chain(tmp_path):
     path = tmp_path / "two.svg"
-    export_svg([CHAINS["S"], CHAINS["mixed"]], path)
-    assert len(ET.parse(path).getroot().findall(".//{http://www.w3.org/2000/svg}path")) == 2
+    export_svg([CHAINS["S"], CHAINS["mixed"]], path, name="pair")
+    ids = [p.get("id") for p in ET.parse(path).getroot().findall(".//{http://www.w3.org/2000/svg}path")]
+    assert ids == ["pair-1", "pair-2"]

@@ -24,7 +24,7 @@ mp.mp.dps = 40
 
 
 def end_frame(cp, at_end=True):
-    """Point, unit tangent (travel sense) and signed curvature of a cubic at u = 1 (or 0), in mpmath."""
+    """Point, unit tangent (travel sense), signed curvature and end-leg length of a cubic at u = 1 (or 0), in mpmath."""
     p = [[mp.mpf(float(v)) for v in row] for row in cp]
     if not at_end:
         p = p[::-1]
@@ -35,22 +35,26 @@ def end_frame(cp, at_end=True):
     tangent = [d1[0] / speed, d1[1] / speed]
     if not at_end:  # read backwards: the tangent and the curvature change sign
         tangent, kappa = [-tangent[0], -tangent[1]], -kappa
-    return p[3], tangent, kappa
+    return p[3], tangent, kappa, speed / 3
 
 
 def assert_on_circle(cp, center, radius, at_end, tol=1e-9):
-    """The spiral end (or start) osculates the circle (centre, signed travel-sense radius)."""
-    point, tangent, kappa = end_frame(cp, at_end)
+    """The spiral end (or start) joins the circle (centre, signed travel-sense radius) G2, by the
+    documented measures: gap / L, tangent angle, curvature error × L, L = min(end leg, |radius|)."""
+    point, tangent, kappa, leg = end_frame(cp, at_end)
     r = mp.mpf(float(radius))
-    centre = [point[0] - tangent[1] * r, point[1] + tangent[0] * r]
-    error = mp.sqrt((centre[0] - center[0]) ** 2 + (centre[1] - center[1]) ** 2) / abs(r)
-    assert error <= tol, float(error)
-    assert abs(kappa * r - 1) <= tol, float(kappa * r - 1)
+    length = min(leg, abs(r))
+    radial = [(point[0] - center[0]) / r, (point[1] - center[1]) / r]
+    distance = mp.sqrt(radial[0] ** 2 + radial[1] ** 2)
+    assert abs(distance - 1) * abs(r) / length <= tol
+    assert abs(tangent[0] * radial[0] + tangent[1] * radial[1]) / distance <= tol
+    assert radial[0] * tangent[1] - radial[1] * tangent[0] > 0  # travels in the circle's sense
+    assert abs(kappa - 1 / r) * length <= tol
 
 
 def assert_meet_g2(cp_a, cp_b, size, tol=1e-9):
-    pa, ta, ka = end_frame(cp_a, True)
-    pb, tb, kb = end_frame(cp_b, False)
+    pa, ta, ka, _ = end_frame(cp_a, True)
+    pb, tb, kb, _ = end_frame(cp_b, False)
     assert mp.sqrt((pa[0] - pb[0]) ** 2 + (pa[1] - pb[1]) ** 2) <= tol * size
     assert abs(ta[0] * tb[1] - ta[1] * tb[0]) <= tol and ta[0] * tb[0] + ta[1] * tb[1] > 0
     assert abs(ka - kb) * size <= tol * max(1, abs(ka) * size)
@@ -68,7 +72,7 @@ def assert_meet_g2(cp_a, cp_b, size, tol=1e-9):
         lambda: sc.line_to_line((0, 0), (100, 0), (160, 80), curvature=1e12),
         lambda: sc.line_to_circle((1e12, 0), (1, 0), (1e12, 105), 100),
         lambda: sc.BezierSpiral((0, 0), (1, 0), 0.6, 5e-324),
-        lambda: sc.BezierSpiral((0, 0), (1, 0), 1e-300, 1.0),
+        lambda: sc.BezierSpiral((5, 5), (1, 0), 1e-300, 1.0),  # legs of 1e-300 vanish at 5
     ],
 )
 def test_extreme_input_is_refused_by_name_never_crashes(call):
@@ -86,6 +90,8 @@ def test_extreme_but_representable_geometry_works_at_any_magnitude():
         assert_on_circle(c.spirals[0].control_points, (0, 0), 2 * scale, False)
     spiral = sc.BezierSpiral((0, 0), (1, 0), 0.6, 1e-300)
     assert spiral.length > 1e299 and math.isclose(spiral.end_curvature, 1e-300, rel_tol=1e-9)
+    tiny = sc.BezierSpiral((0, 0), (1, 0), 1e-300, 1.0)  # legs of 1e-300 near the origin are representable
+    assert 0 < tiny.length < 1e-299 and abs(tiny.end_curvature - 1.0) * tiny.length <= 1e-9
 
 
 def test_line_to_line_diagnoses_huge_and_tiny_directions_correctly():

@@ -19,7 +19,9 @@ first):
 Classification (tolerances are keyword arguments of :func:`check_continuity`):
 
 * ``G0``: gap ≤ ``gap_tol`` — an **absolute** length in model units (the
-  unit the file was read in; STEP and IGES files are read in millimetres).
+  unit the file was read in; STEP and IGES files are read in millimetres),
+  plus what float64 rounding can hide at that coordinate (16 ulp of its
+  largest coordinate), so survey coordinates are not failed on their last bit.
 * ``G1``: G0 and angle ≤ ``angle_tol`` (absolute, radians).
 * ``G2``: G1 and curvature jump ≤ ``curvature_tol · scale`` — **relative**
   with ``scale = max(|K_a|, |K_b|, 1/size)``, ``size`` being the diagonal of
@@ -27,6 +29,15 @@ Classification (tolerances are keyword arguments of :func:`check_continuity`):
   floor ``1/size`` keeps joints between straight and almost-straight pieces
   from failing on rounding noise.
 * otherwise ``none`` (disconnected).
+
+Pieces: every wire is one piece, judged in wire order (with the closing
+joint of a closed wire). Edges that belong to no wire are chained by nearest
+ends: ends closer than the **snap distance** (``SNAP_FRACTION`` = 1 % of the
+model size, or ``snap`` in model units) are joined, and a joint whose gap
+then exceeds ``gap_tol`` is a G0 failure at that joint — so a small gap can
+never split a path into two pieces that each look perfect. Ends further
+apart start a new piece. A report that finds more pieces than expected
+(one, unless told otherwise) does not pass.
 """
 
 from __future__ import annotations
@@ -41,12 +52,12 @@ from enum import IntEnum
 from typing import Any
 
 import numpy as np
+from scipy.spatial import cKDTree
 from OCP.BRep import BRep_Tool
 from OCP.BRepAdaptor import BRepAdaptor_Curve
 from OCP.BRepLProp import BRepLProp_CLProps
 from OCP.BRepTools import BRepTools_WireExplorer
-from OCP.gp import gp_Dir, gp_Pnt, gp_Vec, gp_XYZ
-from OCP.ShapeAnalysis import ShapeAnalysis_WireOrder
+from OCP.gp import gp_Dir, gp_Pnt, gp_Vec
 from OCP.TopAbs import TopAbs_EDGE, TopAbs_REVERSED, TopAbs_WIRE
 from OCP.TopExp import TopExp, TopExp_Explorer
 from OCP.TopoDS import (
@@ -58,13 +69,15 @@ from OCP.TopoDS import (
 )
 from OCP.TopTools import TopTools_IndexedMapOfShape
 
-from .occ import as_occ_shape
+from .occ import as_occ_shape, read_shape
 
 __all__ = ["Continuity", "ContinuityReport", "JointReport", "WireReport", "check_continuity"]
 
 #: Loose edges whose ends lie closer than this fraction of the model size are
-#: chained into one group (and their gap is then judged against ``gap_tol``).
-LINK_FRACTION = 1e-3
+#: chained into one piece (and their gap is then judged against ``gap_tol``).
+SNAP_FRACTION = 1e-2
+#: A gap of this many ulp of the joint's largest coordinate is float64 rounding, not a gap.
+ROUNDING_ULPS = 16
 
 
 
@@ -125,7 +138,7 @@ class WireReport:
 
     Attributes:
         index: position in the report.
-        edge_count: non-degenerate edges in the group.
+        edge_count: non-degenerate edges in the piece.
         closed: the last edge ends where the first starts (shared vertex or
             within ``gap_tol``); the closing joint is then reported last.
         joints: one report per joint.
@@ -146,12 +159,13 @@ class WireReport:
 
 @dataclass(frozen=True)
 class ContinuityReport:
-    """Joint continuity of every wire of a shape.
+    """Joint continuity of every piece (wire or chain of loose edges) of a shape.
 
     Attributes:
-        wires: one report per wire / loose-edge chain.
+        wires: one report per piece.
         gap_tol, angle_tol, curvature_tol: the tolerances used.
         size: the model size behind the relative curvature floor.
+        snap: the distance within which loose ends were chained.
         source: file name or shape description, for the table heading.
     """
 
@@ -160,34 +174,53 @@ class ContinuityReport:
     angle_tol: float
     curvature_tol: float
     size: float
+    snap: float = 0.0
     source: str = ""
 
     @property
     def joints(self) -> list[JointReport]:
-        """All joints of all wires."""
+        """All joints of all pieces."""
         return [j for w in self.wires for j in w.joints]
 
     @property
+    def pieces(self) -> int:
+        """How many separate pieces the shape holds (wires plus chains of loose edges)."""
+        return len(self.wires)
+
+    @property
     def min_level(self) -> Continuity:
-        """Worst joint level over all wires (G2 when there is no joint)."""
+        """Worst joint level over all pieces (G2 when there is no joint)."""
         return min((w.min_level for w in self.wires), default=Continuity.G2)
 
-    def passes(self, required: str | int | Continuity) -> bool:
-        """True when every joint reaches ``required`` (e.g. ``"G2"``)."""
-        return self.min_level >= Continuity.parse(required)
+    def passes(self, required: str | int | Continuity, pieces: int = 1) -> bool:
+        """True when every joint reaches ``required`` (e.g. ``"G2"``) and the
+        shape holds exactly ``pieces`` separate pieces (default one path)."""
+        return self.pieces == pieces and self.min_level >= Continuity.parse(required)
+
+    def describe(self) -> str:
+        """What was found, e.g. ``"1 wire of 13 edges"`` or ``"1 wire of 5 edges and 2 loose pieces (3, 1 edges)"``."""
+        parts = []
+        for loose, noun in ((False, "wire"), (True, "loose piece")):
+            counts = [w.edge_count for w in self.wires if w.loose == loose]
+            if len(counts) == 1:
+                parts.append(f"1 {noun} of {_edges(counts[0])}")
+            elif counts:
+                parts.append(f"{len(counts)} {noun}s ({', '.join(map(str, counts))} edges)")
+        return " and ".join(parts) or "no edges"
 
     def format_table(self) -> str:
-        """Readable text: a heading per wire and one line per joint."""
+        """Readable text: what was found, then a heading per piece and one line per joint."""
         out = [
-            f"{self.source or 'shape'}: {len(self.wires)} wire(s), worst joint {self.min_level}  "
-            f"(gap_tol {self.gap_tol:g} abs, angle_tol {self.angle_tol:g} rad, "
-            f"curvature_tol {self.curvature_tol:g} rel, size {self.size:.6g})"
+            f"{self.source or 'shape'}: {self.describe()}; worst joint {self.min_level}",
+            f"  tolerances: gap {self.gap_tol:g} (model units), angle {self.angle_tol:g} rad, "
+            f"curvature jump {self.curvature_tol:g} relative; loose ends snapped within {self.snap:.3g}; "
+            f"model size {self.size:.6g}",
         ]
         head = f"  {'joint':>5} {'gap':>10} {'angle rad':>10} {'κ before':>11} {'κ after':>11} {'|Δκ|':>10} {'Δκ rel':>9} level"
         for w in self.wires:
-            kind = "loose-edge chain" if w.loose else "wire"
+            kind = "loose piece" if w.loose else "wire"
             out.append(
-                f"{kind} {w.index}: {w.edge_count} edge(s), {'closed' if w.closed else 'open'}, "
+                f"{kind} {w.index}: {_edges(w.edge_count)}, {'closed' if w.closed else 'open'}, "
                 f"{len(w.joints)} joint(s), worst {w.min_level}"
             )
             if w.joints:
@@ -198,6 +231,10 @@ class ContinuityReport:
                     f"{j.curvature_jump:10.3e} {j.relative_curvature_jump:9.2e} {j.level}"
                 )
         return "\n".join(out)
+
+
+def _edges(count: int) -> str:
+    return f"{count} edge" + ("" if count == 1 else "s")
 
 
 # --------------------------------------------------------------- input
@@ -335,28 +372,45 @@ def _collect(shape: TopoDS_Shape) -> tuple[list[_Group], list[tuple[Frame, Frame
     return groups, loose_ends, points
 
 
-def _chain_loose(ends: list[tuple[Frame, Frame]], link_tol: float, gap_tol: float) -> list[_Group]:
-    """Order loose edges into chains (ShapeAnalysis_WireOrder), splitting where ends are > ``link_tol`` apart."""
-    order = ShapeAnalysis_WireOrder(True, link_tol)
-    for start, end in ends:
-        order.Add(gp_XYZ(*start[:3]), gp_XYZ(*end[:3]))
-    order.Perform()
-    if not order.IsDone():
-        sequence = list(range(1, len(ends) + 1))
-    else:
-        sequence = [order.Ordered(k) for k in range(1, len(ends) + 1)]
-    oriented = [ends[n - 1] if n > 0 else (_flip(ends[-n - 1][1]), _flip(ends[-n - 1][0])) for n in sequence]
+def _chain_loose(ends: list[tuple[Frame, Frame]], snap: float, gap_tol: float) -> list[_Group]:
+    """Chain loose edges by nearest ends: each piece grows at both ends by the
+    unused edge end nearest to it, while that is within ``snap``."""
+    points = np.array([f[:3] for pair in ends for f in pair])  # edge k: start 2k, end 2k + 1
+    tree = cKDTree(points)
+    used = np.zeros(len(ends), dtype=bool)
+
+    def nearest(frame: Frame) -> int | None:
+        """Index (2k or 2k + 1) of the nearest end of an unused edge within ``snap``."""
+        count = 8
+        while True:
+            distances, found = tree.query(frame[:3], k=min(count, len(points)), distance_upper_bound=snap)
+            for d, i in zip(np.atleast_1d(distances), np.atleast_1d(found)):
+                if math.isfinite(d) and not used[i // 2]:
+                    return int(i)
+            if count >= len(points) or not math.isfinite(np.atleast_1d(distances)[-1]):
+                return None
+            count *= 4
+
     groups: list[_Group] = []
-    current: list[tuple[Frame, Frame]] = []
-    for item in oriented:
-        if current and _distance(current[-1][1], item[0]) > link_tol:
-            groups.append(_Group(current, False, True))
-            current = []
-        current.append(item)
-    if current:
-        groups.append(_Group(current, False, True))
-    for g in groups:
-        g.closed = _distance(g.ends[-1][1], g.ends[0][0]) <= gap_tol
+    for first in range(len(ends)):
+        if used[first]:
+            continue
+        used[first] = True
+        piece = [ends[first]]
+        for forward in (True, False):
+            while True:
+                found = nearest(piece[-1][1] if forward else piece[0][0])
+                if found is None:
+                    break
+                k, at_start = found // 2, found % 2 == 0
+                used[k] = True
+                start, end = ends[k]
+                if forward:  # joined at its start: as it is; at its end: run backwards
+                    piece.append((start, end) if at_start else (_flip(end), _flip(start)))
+                else:  # joined before the piece: its end meets our start
+                    piece.insert(0, (start, end) if not at_start else (_flip(end), _flip(start)))
+        closed = len(piece) > 1 and _distance(piece[-1][1], piece[0][0]) <= gap_tol
+        groups.append(_Group(piece, closed, True))
     return groups
 
 
@@ -370,6 +424,7 @@ def _distance(a: Frame, b: Frame) -> float:
 def _joint(index: int, a: Frame, b: Frame, gap_tol: float, angle_tol: float, curvature_tol: float, floor: float) -> JointReport:
     """Measure and classify the joint from end frame ``a`` to start frame ``b``."""
     gap = math.sqrt((a[0] - b[0]) ** 2 + (a[1] - b[1]) ** 2 + (a[2] - b[2]) ** 2)
+    gap_tol += ROUNDING_ULPS * math.ulp(max(abs(v) for v in a[:3]))
     cx, cy, cz = a[4] * b[5] - a[5] * b[4], a[5] * b[3] - a[3] * b[5], a[3] * b[4] - a[4] * b[3]
     angle = math.atan2(math.sqrt(cx * cx + cy * cy + cz * cz), a[3] * b[3] + a[4] * b[4] + a[5] * b[5])
     ka = math.sqrt(a[6] * a[6] + a[7] * a[7] + a[8] * a[8])
@@ -393,17 +448,18 @@ def check_continuity(
     gap_tol: float = 1e-7,
     angle_tol: float = 1e-7,
     curvature_tol: float = 1e-6,
-    link_tol: float | None = None,
+    snap: float | None = None,
+    units: str = "mm",
+    label: str | None = None,
 ) -> ContinuityReport:
-    """Measure and classify every joint of every wire of a shape or STEP/IGES file.
+    """Measure and classify every joint of every piece of a shape or STEP/IGES file.
 
     Wires are walked in connection order (``BRepTools_WireExplorer``), with
     the closing joint of closed wires. Edges that belong to no wire are
-    ordered into chains (``ShapeAnalysis_WireOrder``): consecutive loose
-    edges whose ends are within ``link_tol`` form one chain, so a small gap
-    is reported (and fails G0) while separate curves stay separate.
-    Degenerated edges (surface poles) are skipped. See the module docstring
-    for the measures and the meaning of the tolerances.
+    chained by nearest ends within ``snap`` (see the module docstring), so a
+    small gap is reported as a G0 failure rather than splitting the path.
+    Degenerated edges (surface poles) are skipped. A file is read whole or
+    not at all (``spiral_cad.occ.read_shape``).
 
     Args:
         shape_or_path: ``TopoDS_Shape``, build123d/CadQuery shape, iterable of
@@ -412,24 +468,31 @@ def check_continuity(
         angle_tol: largest G1 tangent angle, radians.
         curvature_tol: largest G2 curvature jump relative to
             ``max(|K_a|, |K_b|, 1/size)``.
-        link_tol: chaining distance for loose edges (model units); default
-            ``LINK_FRACTION · size``.
+        snap: chaining distance for loose edges (model units); default
+            ``SNAP_FRACTION · size``.
+        units: the unit a file is read in (the model units of the report).
+        label: name shown in the report (default: the file's name).
 
     Raises:
-        ValueError: unreadable input or a negative/non-finite tolerance.
+        ValueError: an unreadable or incompletely read file (``ReadError``,
+            with the reader's reason), or a negative/non-finite tolerance.
     """
     for name, value in (("gap_tol", gap_tol), ("angle_tol", angle_tol), ("curvature_tol", curvature_tol)):
-        if not (math.isfinite(value) and value >= 0.0):
-            raise ValueError(f"{name} must be finite and ≥ 0; got {value}")
-    source = str(shape_or_path) if isinstance(shape_or_path, (str, os.PathLike)) else type(shape_or_path).__name__
-    shape = as_occ_shape(shape_or_path)
+        if not (isinstance(value, (int, float)) and math.isfinite(value) and value >= 0.0):
+            raise ValueError(f"{name} must be finite and ≥ 0; got {value!r}")
+    if isinstance(shape_or_path, (str, os.PathLike)):
+        source = os.path.basename(os.fspath(shape_or_path))
+        shape = read_shape(shape_or_path, units)
+    else:
+        source = type(shape_or_path).__name__
+        shape = as_occ_shape(shape_or_path)
     groups, loose_ends, points = _collect(shape)
     size = _diagonal(points)
     floor = 1.0 / size if size > 0.0 else 0.0
+    link = SNAP_FRACTION * size if snap is None else snap
+    if not (isinstance(link, (int, float)) and math.isfinite(link) and link >= 0.0):
+        raise ValueError(f"snap must be finite and ≥ 0; got {snap!r}")
     if loose_ends:
-        link = LINK_FRACTION * size if link_tol is None else float(link_tol)
-        if not (math.isfinite(link) and link >= 0.0):
-            raise ValueError(f"link_tol must be finite and ≥ 0; got {link_tol}")
         groups += _chain_loose(loose_ends, link, gap_tol)
     wires = []
     for w, g in enumerate(groups):
@@ -440,7 +503,7 @@ def check_continuity(
             for i in range(pairs)
         )
         wires.append(WireReport(w, len(ends), g.closed, joints, g.loose))
-    return ContinuityReport(tuple(wires), gap_tol, angle_tol, curvature_tol, size, source)
+    return ContinuityReport(tuple(wires), gap_tol, angle_tol, curvature_tol, size, link, label or source)
 
 
 def _diagonal(points: Sequence[tuple[float, float, float]]) -> float:
@@ -454,21 +517,28 @@ def _diagonal(points: Sequence[tuple[float, float, float]]) -> float:
 
 
 def main_check(args: argparse.Namespace) -> int:
-    """Run ``spiral-cad check``: print the joint table; exit code 0 ok, 1 below ``--require``, 2 unreadable."""
+    """Run ``spiral-cad check``: the joint table; exit 0 ok, 1 below ``--require`` or the wrong
+    number of pieces, 2 unreadable (``error: …`` with the reader's reason)."""
     try:
         report = check_continuity(
-            args.file, gap_tol=args.gap_tol, angle_tol=args.angle_tol, curvature_tol=args.curvature_tol
+            args.file, gap_tol=args.gap_tol, angle_tol=args.angle_tol, curvature_tol=args.curvature_tol, snap=args.snap
         )
     except ValueError as exc:
-        print(f"spiral-cad check: {exc}", file=sys.stderr)
+        print(f"error: {exc}", file=sys.stderr)
         return 2
     if not report.wires:
-        print(f"spiral-cad check: {args.file!r} contains no edges to check", file=sys.stderr)
+        print(f"error: {os.path.basename(args.file)!r} contains no edges to check", file=sys.stderr)
         return 2
     print(report.format_table())
-    if args.require and not report.passes(args.require):
+    if not args.require:
+        return 0
+    expected = 1 if args.pieces is None else args.pieces
+    if report.pieces != expected:
+        hint = "" if args.pieces is not None else " (pass --pieces N if the file holds N separate paths)"
+        print(f"FAIL: {report.describe()}: {report.pieces} separate pieces, expected {expected}{hint}")
+        return 1
+    if not report.passes(args.require, expected):
         print(f"FAIL: worst joint is {report.min_level}, below the required {args.require}")
         return 1
-    if args.require:
-        print(f"OK: every joint is at least {args.require}")
+    print(f"OK: {report.describe()}, every joint at least {args.require}")
     return 0

@@ -75,9 +75,10 @@ UNVERIFIED = int(Status.UNVERIFIED)
 BAD_CURVATURE = int(Status.BAD_CURVATURE)
 BAD_ANGLE = int(Status.BAD_ANGLE)
 
-#: What is returned must reproduce its contacts and joints to this relative
-#: accuracy (gap / spiral size, tangent angle, curvature error / curvature);
-#: the accuracy actually achieved on well-conditioned input is ~1e-15.
+#: What is returned must reproduce its contacts and joints to this accuracy:
+#: gap / L, tangent angle (radians) and curvature error × L, with L the
+#: smaller of the spiral's leg at that end and the radius there; the accuracy
+#: achieved on well-conditioned input is ~1e-15.
 VERIFY_TOL = 1e-9
 
 NAN = math.nan
@@ -230,45 +231,56 @@ def fill_nan(out):
 
 
 # ------------------------------------------- verification (world coordinates)
-# Differences of world control points are multiplied by ``inv`` (a power of
-# two, 1/scale of the row) before they are squared, so the residuals neither
-# overflow nor underflow; they are relative and so do not depend on ``inv``.
+# A contact or joint is measured like a chain's joint: gap / L, tangent angle
+# (radians) and curvature error × L, where L is the smaller of the spiral's
+# leg at that end and the radius there (so the curvature error is relative
+# to max(|κ|, 1/leg), as in the G2 checker); the residual is the largest. Differences of world
+# control points are multiplied by ``inv`` (a power of two, 1/scale of the
+# row) before they are squared, so nothing overflows or underflows; the
+# residuals are relative and do not depend on ``inv``.
 
 
 @jit
-def _osculating_end(cp, inv):
-    """Centre of the osculating circle at u = 1, relative to cp[3] and scaled by
-    ``inv``, and the scaled signed curvature there (NaN where undefined)."""
+def _end_frame(cp, inv):
+    """At u = 1 of Bézier ``cp``: unit tangent, scaled signed curvature and the
+    scaled length of the last leg (NaN where the end is degenerate)."""
     ax = (cp[2, 0] - cp[1, 0]) * inv
     ay = (cp[2, 1] - cp[1, 1]) * inv
     bx = (cp[3, 0] - cp[2, 0]) * inv
     by = (cp[3, 1] - cp[2, 1]) * inv
-    lb2 = bx * bx + by * by
-    cross = ax * by - ay * bx
-    if not (lb2 > 0.0 and cross != 0.0):
-        return NAN, NAN, NAN
-    # κ = (2/3)·cross/|b|³, so the centre P3 + rot90(b)/(|b|·κ) needs no root.
-    to_centre = 1.5 * lb2 / cross
-    return -by * to_centre, bx * to_centre, 1.0 / (to_centre * math.sqrt(lb2))
+    lb = norm(bx, by)
+    if not lb > 0.0:
+        return NAN, NAN, NAN, NAN
+    return bx / lb, by / lb, 2.0 / 3.0 * (ax * by - ay * bx) / (lb * lb * lb), lb
 
 
 @jit
 def end_residual(cp, cx, cy, radius, inv):
-    """How far the end of Bézier ``cp`` is from osculating circle (c, radius):
-    max(|centre error| / |radius|, |κ·radius − 1|). ``radius`` is signed by
-    the travel sense of ``cp`` (positive: counterclockwise)."""
-    ox, oy, kappa = _osculating_end(cp, inv)
-    ox += (cp[3, 0] - cx) * inv
-    oy += (cp[3, 1] - cy) * inv
+    """How far the end of Bézier ``cp`` is from joining circle (c, radius) G2.
+
+    ``radius`` is signed by the travel sense of ``cp`` (positive:
+    counterclockwise): the end must lie on the circle, run along it in that
+    sense and have curvature 1/radius.
+    """
+    tx, ty, kappa, leg = _end_frame(cp, inv)
+    ox = (cp[3, 0] - cx) * inv
+    oy = (cp[3, 1] - cy) * inv
     scaled = radius * inv
-    return worst(norm(ox / scaled, oy / scaled), abs(kappa * scaled - 1.0))
+    # (dx, dy) is the radial direction times the travel sense, so the tangent
+    # must be rot90 of it in either sense.
+    dx = ox / scaled
+    dy = oy / scaled
+    distance = norm(dx, dy)
+    length = min(leg, abs(scaled))  # the smaller feature sets the scale
+    gap = abs(distance - 1.0) * abs(scaled) / length
+    angle = abs(tx * dx + ty * dy) / distance + (INF if dx * ty - dy * tx <= 0.0 else 0.0)
+    return worst(worst(gap, angle), abs(kappa - 1.0 / scaled) * length)
 
 
 @jit
-def line_residual(cp, px, py, tx, ty, end_radius, inv):
+def line_residual(cp, px, py, tx, ty, inv):
     """How far the start of spiral ``cp`` is from leaving the line through p along
-    unit t with zero curvature: max(distance / first leg, tangent angle,
-    |κ(0)|·r) with r the spiral's end radius."""
+    unit t with zero curvature (gap, tangent angle, κ(0) × first leg)."""
     ax = (cp[1, 0] - cp[0, 0]) * inv
     ay = (cp[1, 1] - cp[0, 1]) * inv
     bx = (cp[2, 0] - cp[1, 0]) * inv
@@ -278,19 +290,21 @@ def line_residual(cp, px, py, tx, ty, end_radius, inv):
         return INF
     distance = abs(tx * (cp[0, 1] - py) * inv - ty * (cp[0, 0] - px) * inv) / la
     angle = abs(tx * ay - ty * ax) / la
-    kappa0 = abs(2.0 / 3.0 * (ax * by - ay * bx) / (la * la * la))
-    return worst(worst(distance, angle), kappa0 * abs(end_radius * inv))
+    kappa0 = abs(2.0 / 3.0 * (ax * by - ay * bx) / (la * la))  # κ(0) × first leg
+    return worst(worst(distance, angle), kappa0)
 
 
 @jit
 def joint_residual(cp_a, cp_b, inv):
     """How far two spirals that meet at their ends (u = 1 of both, travelled
-    towards each other) are from sharing the osculating circle there."""
-    ax, ay, ka = _osculating_end(cp_a, inv)
-    bx, by, kb = _osculating_end(cp_b, inv)
-    dx = (cp_a[3, 0] - cp_b[3, 0]) * inv + ax - bx
-    dy = (cp_a[3, 1] - cp_b[3, 1]) * inv + ay - by
-    return worst(norm(dx * ka, dy * ka), abs(ka + kb) / abs(ka))
+    towards each other) are from a G2 joint: gap, tangent angle, curvature jump × leg."""
+    tax, tay, ka, la = _end_frame(cp_a, inv)
+    tbx, tby, kb, lb = _end_frame(cp_b, inv)
+    length = min(min(la, lb), 1.0 / abs(ka))
+    gap = norm((cp_a[3, 0] - cp_b[3, 0]) * inv, (cp_a[3, 1] - cp_b[3, 1]) * inv) / length
+    # Travelling towards each other, the tangents are opposite and so are the signed curvatures.
+    angle = abs(tax * tby - tay * tbx) + (INF if tax * tbx + tay * tby >= 0.0 else 0.0)
+    return worst(worst(gap, angle), abs(ka + kb) * length)
 
 
 # ---------------------------------------------------------- one spiral
@@ -328,7 +342,7 @@ def spiral_row(bx, by, dx, dy, theta, curvature, out):
     g2 = shape_g2(sin_t, cos_t) * local_radius
     cx = bx + scale * (g2 * tx + g1 * nx)
     cy = by + scale * (g2 * ty + g1 * ny)
-    res = worst(line_residual(out[0], bx, by, tx, ty, radius, inv), end_residual(out[0], cx, cy, side * radius, inv))
+    res = worst(line_residual(out[0], bx, by, tx, ty, inv), end_residual(out[0], cx, cy, side * radius, inv))
     if not res <= VERIFY_TOL:
         return UNVERIFIED, NAN, res, NAN
     return OK, theta, NAN, NAN
@@ -372,7 +386,7 @@ def line_to_circle_row(px, py, dx, dy, cx, cy, r, out):
     a = vx * tx + vy * ty - rs * shape_g2(sin_t, cos_t)
     put_spiral(out[0], a * tx, a * ty, tx, ty, -side * ty, side * tx, sin_t, cos_t, rs)
     place(out, px, py, scale, 1.0)
-    res = worst(line_residual(out[0], px, py, tx, ty, r, inv), end_residual(out[0], cx, cy, side * r, inv))
+    res = worst(line_residual(out[0], px, py, tx, ty, inv), end_residual(out[0], cx, cy, side * r, inv))
     if not res <= VERIFY_TOL:
         return UNVERIFIED, NAN, res, NAN
     return OK, math.atan2(sin_t, cos_t), measure, side
@@ -501,8 +515,8 @@ def circle_to_circle_row(c0x, c0y, r0, c1x, c1y, r1, out):
     wtx = tx
     wty = flip * ty
     res = worst(end_residual(out[0, ::-1], c0x, c0y, -r0, inv), end_residual(out[1], c1x, c1y, r1, inv))
-    res = worst(res, line_residual(out[1], out[1, 0, 0], out[1, 0, 1], wtx, wty, r1, inv))
-    res = worst(res, line_residual(out[0, ::-1], out[1, 0, 0], out[1, 0, 1], -wtx, -wty, r0, inv))
+    res = worst(res, line_residual(out[1], out[1, 0, 0], out[1, 0, 1], wtx, wty, inv))
+    res = worst(res, line_residual(out[0, ::-1], out[1, 0, 0], out[1, 0, 1], -wtx, -wty, inv))
     if not res <= VERIFY_TOL:
         return UNVERIFIED, NAN, res, NAN
     return OK, math.atan2(sin_t, cos_t), measure, NAN
@@ -521,11 +535,10 @@ def corner_residual(out, px, py, t0x, t0y, t1x, t1y, joint_curvature, inv):
     ``joint_curvature`` (magnitude, scaled by ``inv``).
     """
     second = out[1, ::-1]
-    radius = 1.0 / (joint_curvature * inv)  # in world units, as line_residual takes it
-    res = worst(line_residual(out[0], px, py, t0x, t0y, radius, inv), line_residual(second, px, py, t1x, t1y, radius, inv))
+    res = worst(line_residual(out[0], px, py, t0x, t0y, inv), line_residual(second, px, py, t1x, t1y, inv))
     res = worst(res, joint_residual(out[0], second, inv))
-    kappa = abs(_osculating_end(out[0], inv)[2])
-    return worst(res, abs(kappa / joint_curvature - 1.0))
+    _, _, kappa, leg = _end_frame(out[0], inv)
+    return worst(res, abs(abs(kappa) - joint_curvature) * min(leg, 1.0 / joint_curvature))
 
 
 @jit

@@ -12,6 +12,7 @@ from numpy.typing import ArrayLike, NDArray
 from ._inputs import as_float, as_real_array, as_xy
 from .segments import Arc, Join, Line, Segment, measure_join
 from .transitions import Transition
+from .units import DEFAULT_UNITS, length_unit
 
 #: Default join tolerance: gap / chain size, tangent angle (rad) and
 #: curvature jump × chain size must each stay below it.
@@ -58,6 +59,9 @@ class Chain:
     Args:
         segments: the segments in travel order (at least one).
         tolerance: relative join tolerance.
+        units: the length unit of the coordinates (``spiral_cad.core.units``:
+            mm, cm, m, km, in, ft; default mm as in build123d/CadQuery). It
+            travels with the chain into every file written from it.
 
     Raises:
         ValueError: a joint exceeds the tolerance (the message names the joint
@@ -69,9 +73,10 @@ class Chain:
     kink.
     """
 
-    def __init__(self, segments: Iterable[Segment], tolerance: float = JOIN_TOLERANCE):
+    def __init__(self, segments: Iterable[Segment], tolerance: float = JOIN_TOLERANCE, units: str = DEFAULT_UNITS):
         self._segments: tuple[Segment, ...] = _segment_tuple(segments)
         self.tolerance = join_tolerance(tolerance)
+        self.units = length_unit(units)
         lengths = np.array([s.length for s in self._segments])
         self._stations = np.concatenate([[0.0], np.cumsum(lengths)])
         if not math.isfinite(self._stations[-1]):
@@ -101,6 +106,7 @@ class Chain:
         start: Any = None,
         end: Any = None,
         tolerance: float = JOIN_TOLERANCE,
+        units: str = DEFAULT_UNITS,
     ) -> Chain:
         """Chain transitions and segments, filling each gap with the right connector.
 
@@ -126,7 +132,7 @@ class Chain:
         if not parts:
             if start is None or end is None:
                 raise ValueError("Chain.join needs parts, or both start and end for a straight chain")
-            return cls([Line(as_xy(start, "start"), as_xy(end, "end"))], tolerance)
+            return cls([Line(as_xy(start, "start"), as_xy(end, "end"))], tolerance, units)
         segments: list[Segment] = []
         if start is not None:
             segments.extend(_bridge(np.array(as_xy(start, "start")), parts[0].start, parts[0].length, tolerance))
@@ -136,7 +142,7 @@ class Chain:
             segments.extend(part.spirals if isinstance(part, Transition) else [part])
         if end is not None:
             segments.extend(_bridge(parts[-1].end, np.array(as_xy(end, "end")), parts[-1].length, tolerance))
-        return cls(segments, tolerance)
+        return cls(segments, tolerance, units)
 
     # ------------------------------------------------------------- access
 
@@ -155,7 +161,7 @@ class Chain:
 
     def __repr__(self) -> str:
         kinds = " → ".join(type(s).__name__ for s in self._segments)
-        return f"Chain({len(self)} segments, length {self.length:.6g}: {kinds})"
+        return f"Chain({len(self)} segments, length {self.length:.6g} {self.units}: {kinds})"
 
     @property
     def length(self) -> float:
@@ -179,7 +185,7 @@ class Chain:
         return [measure_join(a, b, i) for i, (a, b) in enumerate(zip(self._segments, self._segments[1:]))]
 
     def reversed(self) -> Chain:
-        return Chain([s.reversed() for s in reversed(self._segments)], self.tolerance)
+        return Chain([s.reversed() for s in reversed(self._segments)], self.tolerance, self.units)
 
     # --------------------------------------------------- station queries
 

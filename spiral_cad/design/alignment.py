@@ -22,6 +22,7 @@ from ..core import bezier
 from ..core._inputs import as_float, as_points, as_real_array
 from ..core._kernels import put_spiral, shape_g1
 from ..core.chain import JOIN_TOLERANCE, Chain
+from ..core.units import DEFAULT_UNITS
 from ..core.errors import NoSolutionError
 from ..core.spiral import BezierSpiral
 from ..core.transitions import Transition, line_to_circle
@@ -179,6 +180,7 @@ class Alignment:
         spiral_lengths: Any = None,
         start_station: float = 0.0,
         tolerance: float = JOIN_TOLERANCE,
+        units: str = DEFAULT_UNITS,
     ) -> Alignment:
         """Build tangent–spiral–arc–spiral–tangent at every interior PI.
 
@@ -193,6 +195,8 @@ class Alignment:
             start_station: chainage of the first PI.
             tolerance: the chain's relative join tolerance (``Chain``, which
                 also allows for the rounding of survey coordinates).
+            units: length unit of the PIs, radii and spiral lengths (default
+                mm; road designs usually m or ft).
 
         The circle centre lies at distance r·g1(θ_in) from the incoming
         tangent and r·g1(θ_out) from the outgoing one (Theorem 4.1), which
@@ -215,7 +219,7 @@ class Alignment:
         for k, length in enumerate(lengths):
             if not length > 0.0:
                 raise ValueError(f"PI {k} and PI {k + 1} coincide at {pts[k].tolist()}")
-        units = seg / lengths[:, None]
+        directions = seg / lengths[:, None]
         radius = _per_pi(radii, count, "radii")
         if (spiral_angles is None) == (spiral_lengths is None):
             raise ValueError("give exactly one of spiral_angles and spiral_lengths")
@@ -229,7 +233,7 @@ class Alignment:
             r = radius[j]
             if not r > 0.0:
                 raise ValueError(f"PI {i}: radius must be positive; got {r}")
-            t_in, t_out = units[j], units[j + 1]
+            t_in, t_out = directions[j], directions[j + 1]
             sin_d = t_in[0] * t_out[1] - t_in[1] * t_out[0]
             cos_d = float(np.dot(t_in, t_out))
             if abs(sin_d) <= COLLINEAR_TOL:
@@ -256,9 +260,9 @@ class Alignment:
                 )
             solved.append(_curve(pts[i], t_in, t_out, deflection, r, theta_in, theta_out))
 
-        _check_tangents(pts, lengths, units, solved)
+        _check_tangents(pts, lengths, directions, solved)
         parts: list[Transition] = [t for s in solved for t in s[:2]]
-        chain = Chain.join(parts, pts[0], pts[-1], tolerance)
+        chain = Chain.join(parts, pts[0], pts[-1], tolerance, units)
         return cls(chain, _curve_data(chain, pts, solved, radius, origin), origin)
 
     # ------------------------------------------------------- table
@@ -342,10 +346,10 @@ def _curve(pi: NDArray, t_in: NDArray, t_out: NDArray, deflection: float, r: flo
     return entry, exit_, center, deflection
 
 
-def _check_tangents(pts: NDArray, lengths: NDArray, units: NDArray, solved) -> None:
+def _check_tangents(pts: NDArray, lengths: NDArray, directions: NDArray, solved) -> None:
     """Each tangent must hold the ST of one curve before the TS of the next (§5)."""
-    back = [0.0] + [float(np.dot(pts[j + 1] - s[0].start, units[j])) for j, s in enumerate(solved)]
-    ahead = [float(np.dot(s[1].end - pts[j + 1], units[j + 1])) for j, s in enumerate(solved)] + [0.0]
+    back = [0.0] + [float(np.dot(pts[j + 1] - s[0].start, directions[j])) for j, s in enumerate(solved)]
+    ahead = [float(np.dot(s[1].end - pts[j + 1], directions[j + 1])) for j, s in enumerate(solved)] + [0.0]
     last = len(pts) - 1
     for k, length in enumerate(lengths):
         used = ahead[k - 1] if k > 0 else 0.0

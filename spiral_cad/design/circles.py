@@ -33,6 +33,7 @@ from numpy.typing import NDArray
 
 from ..core._inputs import as_float, as_xy
 from ..core.chain import Chain
+from ..core.units import DEFAULT_UNITS
 from ..core.errors import NoSolutionError
 from ..core.segments import TAU, Circle
 from ..core.transitions import Transition, circle_in_circle, circle_to_circle
@@ -120,13 +121,14 @@ def _sense_angle(circle: Circle, a: NDArray, b: NDArray) -> float:
     return math.pi - (math.pi - turn) % TAU
 
 
-def circle_chain(circles: Sequence[Any]) -> CircleChain:
+def circle_chain(circles: Sequence[Any], units: str = DEFAULT_UNITS) -> CircleChain:
     """A G2 path round ``circles`` in order, with spiral transitions between them.
 
     Args:
         circles: at least two circles, each a ``Circle``, ``(center, radius)``
             or ``(x, y, radius)``; the radius sign is the travel sense
             (positive counterclockwise).
+        units: length unit of centres and radii (default mm).
 
     Each consecutive pair gets ``circle_in_circle`` when nested (same sense,
     one inside the other) and ``circle_to_circle`` otherwise (C for equal
@@ -153,7 +155,7 @@ def circle_chain(circles: Sequence[Any]) -> CircleChain:
     sweeps = []
     for k in range(1, len(items) - 1):
         sweeps.append(_arc_sweep(items, transitions, k))
-    return CircleChain(Chain.join(transitions), items, transitions, sweeps)
+    return CircleChain(Chain.join(transitions, units=units), items, transitions, sweeps)
 
 
 def _arc_sweep(items: list[Circle], transitions: list[Transition], k: int) -> float:

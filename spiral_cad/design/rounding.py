@@ -30,6 +30,7 @@ from ..core import batch
 from ..core._inputs import as_float, as_points, as_real_array
 from ..core._kernels import WALTON_MEEK_CORNER, corner_relation
 from ..core.chain import JOIN_TOLERANCE, Chain
+from ..core.units import DEFAULT_UNITS
 from ..core.errors import NoSolutionError, Status
 from ..core.segments import Ray, Segment
 from ..core.spiral import BezierSpiral
@@ -358,6 +359,7 @@ def round_corners(
     max_curvature: float | None = None,
     method: str = "walton-meek",
     tolerance: float = JOIN_TOLERANCE,
+    units: str = DEFAULT_UNITS,
 ) -> RoundedPath:
     """Round every corner of a polyline with a G2 spiral pair.
 
@@ -370,6 +372,7 @@ def round_corners(
             Sukkarieh: about 24 % lower peak curvature for the same corner
             distance).
         tolerance: the chain's relative join tolerance (``Chain``).
+        units: length unit of the points (default mm); curvatures are per unit.
 
     With neither curvature given, each corner uses as much of its legs as it
     may (Corollary 4.5): half of every interior segment, all of the first and
@@ -410,5 +413,5 @@ def round_corners(
                 )
             )
             rounded.append(RoundedCorner(int(index[j]), float(result.theta[j]), float(result.distance[j]), float(result.curvature[j]), spirals))
-    return RoundedPath(Chain.join(parts, pts[0], pts[-1], tolerance), rounded, method)
+    return RoundedPath(Chain.join(parts, pts[0], pts[-1], tolerance, units), rounded, method)
 

@@ -1,0 +1,34 @@
+"""Length units: every chain's numbers are in one of these, and every file says which.
+
+The API default is millimetres, as in build123d and CadQuery; design files
+name their unit (``"units": "m"``). Each writer declares the unit the way its
+readers expect (see ``spiral_cad.export``); nothing is rescaled on the way.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+#: Size of one unit in millimetres, per unit name.
+MM_PER_UNIT = {"mm": 1.0, "cm": 10.0, "m": 1000.0, "km": 1.0e6, "in": 25.4, "ft": 304.8}
+UNITS = tuple(MM_PER_UNIT)
+DEFAULT_UNITS = "mm"
+#: Units of US customary designs (speeds in mph, the US forms of road formulas).
+IMPERIAL = frozenset({"in", "ft"})
+
+
+def length_unit(value: Any, name: str = "units") -> str:
+    """``value`` as a known unit name, else ValueError naming ``name`` and the choices."""
+    if not isinstance(value, str) or value not in MM_PER_UNIT:
+        raise ValueError(f"{name} must be one of {', '.join(UNITS)}; got {value!r:.80}")
+    return value
+
+
+def to_metres(units: str) -> float:
+    """Metres per unit."""
+    return MM_PER_UNIT[units] / 1000.0
+
+
+def speed_unit(units: str) -> str:
+    """The speed unit that goes with a length unit: km/h for metric designs, mph for in/ft."""
+    return "mph" if units in IMPERIAL else "km/h"

@@ -1,0 +1,221 @@
+"""STEP (ISO 10303-21, AP214) for chains, written directly: exact curves, one wire per chain.
+
+Each chain becomes one ``COMPOSITE_CURVE`` whose segments run in travel order
+and record the continuity at each joint (``CONT_SAME_GRADIENT_SAME_CURVATURE``
+between G2 segments, ``DISCONTINUOUS`` after the last one of an open chain).
+All composite curves sit in one ``GEOMETRIC_CURVE_SET`` of a
+``GEOMETRICALLY_BOUNDED_WIREFRAME_SHAPE_REPRESENTATION``: the shape of a
+``PRODUCT`` named after the design. OCCT's reader, and so FreeCAD, turns each
+composite curve into one connected ``TopoDS_Wire``.
+
+The curves:
+
+* ``Line``: a ``TRIMMED_CURVE`` of a ``LINE`` (unit direction), parameters 0 … length;
+* ``Arc``: a ``TRIMMED_CURVE`` of a ``CIRCLE`` whose placement's x axis points
+  at the arc's start, its axis +Z for counterclockwise travel and −Z for
+  clockwise, parameters 0 … sweep (radians);
+* ``BezierSpiral``: a ``B_SPLINE_CURVE_WITH_KNOTS`` of degree 3 with the
+  spiral's four control points and knots (0, 1) of multiplicity 4
+  (``PIECEWISE_BEZIER_KNOTS``): the same polynomial as the Bézier.
+
+The length unit is declared in the representation context (an ``SI_UNIT``
+with its prefix for mm, cm, m, km; a ``CONVERSION_BASED_UNIT`` of 25.4 mm or
+304.8 mm for in and ft), so readers that convert (OCCT reads into mm by
+default) get the right size. Every real is the shortest decimal that reads
+back to the same double (at most 17 significant digits).
+
+Needs no CAD kernel.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+from collections.abc import Sequence
+from datetime import datetime, timezone
+
+from ..core.chain import Chain
+from ..core.segments import Arc, Line, Segment, measure_join
+from ..core.spiral import BezierSpiral
+from ..core.units import MM_PER_UNIT
+
+#: STEP's name for each unit: an SI prefix of the metre, or a conversion-based unit.
+_SI_PREFIX = {"mm": ".MILLI.", "cm": ".CENTI.", "m": "$", "km": ".KILO."}
+_CONVERSION = {"in": "INCH", "ft": "FOOT"}
+
+#: The AP214 schema (what OCCT, FreeCAD and most CAD systems write and read).
+SCHEMA = "AUTOMOTIVE_DESIGN { 1 0 10303 214 1 1 1 1 }"
+
+
+def real(value: float) -> str:
+    """A STEP real: the shortest round-trip decimal, always with a decimal point."""
+    if not math.isfinite(value):
+        raise ValueError(f"STEP cannot hold the non-finite number {value}")
+    text = repr(float(value)).upper()
+    mantissa, _, exponent = text.partition("E")
+    if "." not in mantissa:
+        mantissa += "."
+    return f"{mantissa}E{exponent}" if exponent else mantissa
+
+
+def string(text: str) -> str:
+    """A STEP string literal: quotes and backslashes doubled, non-ASCII as \\X2\\ … \\X0\\."""
+    out = []
+    for ch in text:
+        if ch == "'":
+            out.append("''")
+        elif ch == "\\":
+            out.append("\\\\")
+        elif 32 <= ord(ch) < 127:
+            out.append(ch)
+        else:
+            code = ch.encode("utf-16-be").hex().upper()
+            out.append(f"\\X2\\{code}\\X0\\")
+    return "'" + "".join(out) + "'"
+
+
+class _Entities:
+    """Numbered DATA-section instances (#1, #2, …)."""
+
+    def __init__(self) -> None:
+        self.lines: list[str] = []
+
+    def add(self, text: str) -> str:
+        self.lines.append(text)
+        return f"#{len(self.lines)}"
+
+    def point(self, x: float, y: float) -> str:
+        return self.add(f"CARTESIAN_POINT('',({real(x)},{real(y)},0.))")
+
+    def direction(self, x: float, y: float, z: float = 0.0) -> str:
+        return self.add(f"DIRECTION('',({real(x)},{real(y)},{real(z)}))")
+
+
+def _line(data: _Entities, line: Line) -> str:
+    (ax, ay), (bx, by) = line.start.tolist(), line.end.tolist()
+    length = line.length
+    a, b = data.point(ax, ay), data.point(bx, by)
+    vector = data.add(f"VECTOR('',{data.direction((bx - ax) / length, (by - ay) / length)},1.)")
+    basis = data.add(f"LINE('',{a},{vector})")
+    return data.add(f"TRIMMED_CURVE('',{basis},(PARAMETER_VALUE(0.),{a}),(PARAMETER_VALUE({real(length)}),{b}),.T.,.PARAMETER.)")
+
+
+def _arc(data: _Entities, arc: Arc) -> str:
+    cx, cy = arc.center.tolist()
+    a0 = arc.start_angle
+    axis = data.direction(0.0, 0.0, 1.0 if arc.radius > 0 else -1.0)
+    placement = data.add(f"AXIS2_PLACEMENT_3D('',{data.point(cx, cy)},{axis},{data.direction(math.cos(a0), math.sin(a0))})")
+    basis = data.add(f"CIRCLE('',{placement},{real(abs(arc.radius))})")
+    (sx, sy), (ex, ey) = arc.start.tolist(), arc.end.tolist()
+    start, end = data.point(sx, sy), data.point(ex, ey)
+    return data.add(
+        f"TRIMMED_CURVE('',{basis},(PARAMETER_VALUE(0.),{start}),(PARAMETER_VALUE({real(arc.sweep)}),{end}),.T.,.PARAMETER.)"
+    )
+
+
+def _spiral(data: _Entities, spiral: BezierSpiral) -> str:
+    poles = ",".join(data.point(x, y) for x, y in spiral.control_points.tolist())
+    return data.add(f"B_SPLINE_CURVE_WITH_KNOTS('',3,({poles}),.UNSPECIFIED.,.F.,.F.,(4,4),(0.,1.),.PIECEWISE_BEZIER_KNOTS.)")
+
+
+_CURVES = {Line: _line, Arc: _arc, BezierSpiral: _spiral}
+
+
+def _curve(data: _Entities, segment: Segment) -> str:
+    for kind, make in _CURVES.items():
+        if isinstance(segment, kind):
+            return make(data, segment)
+    raise ValueError(f"segment must be a Line, Arc or BezierSpiral; got {segment!r}")
+
+
+def _closing_transition(chain: Chain) -> str | None:
+    """The transition code of a closed chain's closing joint (None when the chain is open)."""
+    join = measure_join(chain[-1], chain[0])
+    tol = chain.tolerance
+    if join.gap > tol * chain.size:
+        return None
+    if join.angle > tol:
+        return ".CONTINUOUS."
+    if join.curvature_jump * chain.size > tol:
+        return ".CONT_SAME_GRADIENT."
+    return ".CONT_SAME_GRADIENT_SAME_CURVATURE."
+
+
+def _composite(data: _Entities, chain: Chain, label: str) -> str:
+    """One COMPOSITE_CURVE in travel order; internal joints are G2 (the chain checked them)."""
+    closing = _closing_transition(chain) if len(chain) > 1 else None
+    segments = []
+    for i, segment in enumerate(chain):
+        last = i == len(chain) - 1
+        code = (closing or ".DISCONTINUOUS.") if last else ".CONT_SAME_GRADIENT_SAME_CURVATURE."
+        segments.append(data.add(f"COMPOSITE_CURVE_SEGMENT({code},.T.,{_curve(data, segment)})"))
+    return data.add(f"COMPOSITE_CURVE({string(label)},({','.join(segments)}),.F.)")
+
+
+def _units(data: _Entities, units: str, uncertainty: float) -> str:
+    """The representation context: length unit, radians, steradians and the uncertainty."""
+    if units in _SI_PREFIX:
+        length = data.add(f"(LENGTH_UNIT()NAMED_UNIT(*)SI_UNIT({_SI_PREFIX[units]},.METRE.))")
+    else:
+        millimetre = data.add("(LENGTH_UNIT()NAMED_UNIT(*)SI_UNIT(.MILLI.,.METRE.))")
+        size = data.add(f"LENGTH_MEASURE_WITH_UNIT(LENGTH_MEASURE({real(MM_PER_UNIT[units])}),{millimetre})")
+        dimensions = data.add("DIMENSIONAL_EXPONENTS(1.,0.,0.,0.,0.,0.,0.)")
+        length = data.add(f"(CONVERSION_BASED_UNIT('{_CONVERSION[units]}',{size})LENGTH_UNIT()NAMED_UNIT({dimensions}))")
+    angle = data.add("(NAMED_UNIT(*)PLANE_ANGLE_UNIT()SI_UNIT($,.RADIAN.))")
+    solid = data.add("(NAMED_UNIT(*)SI_UNIT($,.STERADIAN.)SOLID_ANGLE_UNIT())")
+    accuracy = data.add(
+        f"UNCERTAINTY_MEASURE_WITH_UNIT(LENGTH_MEASURE({real(uncertainty)}),{length},'distance_accuracy_value','confusion accuracy')"
+    )
+    return data.add(
+        f"(GEOMETRIC_REPRESENTATION_CONTEXT(3)GLOBAL_UNCERTAINTY_ASSIGNED_CONTEXT(({accuracy}))"
+        f"GLOBAL_UNIT_ASSIGNED_CONTEXT(({length},{angle},{solid}))REPRESENTATION_CONTEXT('',''))"
+    )
+
+
+def _uncertainty(chains: Sequence[Chain], units: str) -> float:
+    """1e-7 mm in the file's unit, but at least what float64 can resolve at the largest coordinate."""
+    largest = max(float(abs(p).max()) for c in chains for s in c for p in (s.start, s.end))
+    return max(1e-7 / MM_PER_UNIT[units], 16.0 * math.ulp(largest))
+
+
+def step_text(chains: Sequence[Chain], name: str, units: str, originating_system: str, timestamp: datetime | None = None) -> str:
+    """The whole STEP file for ``chains`` (one product ``name``, one wire per chain)."""
+    when = (timestamp or datetime.now(timezone.utc)).strftime("%Y-%m-%dT%H:%M:%S")
+    data = _Entities()
+    context = data.add("APPLICATION_CONTEXT('core data for automotive mechanical design processes')")
+    data.add(f"APPLICATION_PROTOCOL_DEFINITION('international standard','automotive_design',2000,{context})")
+    product_context = data.add(f"PRODUCT_CONTEXT('',{context},'mechanical')")
+    product = data.add(f"PRODUCT({string(name)},{string(name)},'',({product_context}))")
+    data.add(f"PRODUCT_RELATED_PRODUCT_CATEGORY('part',$,({product}))")
+    formation = data.add(f"PRODUCT_DEFINITION_FORMATION('','',{product})")
+    definition_context = data.add(f"PRODUCT_DEFINITION_CONTEXT('part definition',{context},'design')")
+    definition = data.add(f"PRODUCT_DEFINITION('design','',{formation},{definition_context})")
+    shape = data.add(f"PRODUCT_DEFINITION_SHAPE('','',{definition})")
+    representation_context = _units(data, units, _uncertainty(chains, units))
+    origin = data.add(
+        f"AXIS2_PLACEMENT_3D('',{data.point(0.0, 0.0)},{data.direction(0.0, 0.0, 1.0)},{data.direction(1.0, 0.0)})"
+    )
+    labels = [name] if len(chains) == 1 else [f"{name}-{i + 1}" for i in range(len(chains))]
+    curves = [_composite(data, chain, label) for chain, label in zip(chains, labels)]
+    curve_set = data.add(f"GEOMETRIC_CURVE_SET({string(name)},({','.join(curves)}))")
+    representation = data.add(
+        f"GEOMETRICALLY_BOUNDED_WIREFRAME_SHAPE_REPRESENTATION({string(name)},({curve_set},{origin}),{representation_context})"
+    )
+    data.add(f"SHAPE_DEFINITION_REPRESENTATION({shape},{representation})")
+    header = [
+        "ISO-10303-21;",
+        "HEADER;",
+        f"FILE_DESCRIPTION(({string(f'{name}: exact G2 curves (lines, circles, cubic Bezier spirals)')}),'2;1');",
+        f"FILE_NAME({string(name)},'{when}',(''),(''),{string(originating_system)},{string(originating_system)},'');",
+        f"FILE_SCHEMA(('{SCHEMA}'));",
+        "ENDSEC;",
+        "DATA;",
+    ]
+    body = [f"#{i}={line};" for i, line in enumerate(data.lines, 1)]
+    return "\n".join(header + body + ["ENDSEC;", "END-ISO-10303-21;", ""])
+
+
+def write_step(chains: Sequence[Chain], path: str | os.PathLike, name: str, units: str, originating_system: str) -> None:
+    """Write ``chains`` as one STEP file (see the module docstring)."""
+    with open(path, "w", encoding="ascii", newline="\n") as handle:
+        handle.write(step_text(chains, name, units, originating_system))
