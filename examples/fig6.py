@@ -21,7 +21,7 @@ out.mkdir(parents=True, exist_ok=True)
 print(f"{'θ°':>4} {'length·c':>9} {'peak/mean dκ/ds':>16}")
 for degrees in range(10, 90, 10):
     spiral = BezierSpiral((0, 0), (1, 0), math.radians(degrees), 1.0)
-    peak, _ = peak_curvature_rate(spiral)
+    peak, _ = peak_curvature_rate(spiral.control_points)
     print(f"{degrees:4d} {spiral.length:9.5f} {peak / (1.0 / spiral.length):16.4f}")
 
 plot_fig6().savefig(out / "fig6.png", dpi=110)

@@ -65,10 +65,11 @@ def curvature_comb(chain: Chain, per_segment: int = 24, scale: float | None = No
             is a fifth of the chain's size.
     """
     u = np.linspace(0.0, 1.0, per_segment)
+    starts = chain.stations
     stations, points, normals, kappa, owner = [], [], [], [], []
     for i, seg in enumerate(chain.segments):
         # Stations from the segment's own arc-length parametrisation.
-        s = chain.stations[i] + (bezier.arc_length(seg.control_points, u) if isinstance(seg, BezierSpiral) else u * seg.length)
+        s = starts[i] + (bezier.arc_length(seg.control_points, u) if isinstance(seg, BezierSpiral) else u * seg.length)
         t = seg.tangent(u)
         stations.append(s)
         points.append(seg.point(u))
@@ -84,54 +85,74 @@ def curvature_comb(chain: Chain, per_segment: int = 24, scale: float | None = No
     return Comb(np.concatenate(stations), pts, nrm, kappa_all, tips, np.concatenate(owner), float(scale))
 
 
-def plot_plan(chain: Chain, comb: bool = True, ax: Axes | None = None, per_segment: int = 48) -> Figure:
+def _by_kind(chain: Chain) -> dict[str, NDArray]:
+    """Segment indices per segment type, in order of first appearance."""
+    kinds = np.array([_kind(seg) for seg in chain.segments])
+    return {kind: np.flatnonzero(kinds == kind) for kind in dict.fromkeys(kinds.tolist())}
+
+
+#: Samples drawn per figure at most: long chains get fewer per segment, so a
+#: 40 000-segment alignment plots in seconds, not minutes.
+MAX_SAMPLES = 100_000
+
+
+def _samples(chain: Chain, per_segment: int | None, most: int) -> int:
+    return per_segment if per_segment is not None else max(4, min(most, MAX_SAMPLES // len(chain)))
+
+
+def plot_plan(chain: Chain, comb: bool = True, ax: Axes | None = None, per_segment: int | None = None) -> Figure:
     """Plan view of ``chain``, coloured by segment type, with an optional curvature comb.
 
-    Artists: one line per segment; with ``comb``, per segment one
-    ``LineCollection`` of teeth and one envelope line through the tips.
+    Artists (one set per segment type; at most ``MAX_SAMPLES`` points unless
+    ``per_segment`` is given, so long chains draw in seconds): a ``LineCollection`` of the segments (gid
+    ``plan-KIND``), and with ``comb`` one of teeth (``comb-KIND``) and one of
+    the envelopes through the tips (``envelope-KIND``), each holding one
+    polyline per segment in chain order.
     """
     fig, ax = _axes(ax, figsize=(8, 5))
+    per_segment = _samples(chain, per_segment, 48)
     data = curvature_comb(chain, per_segment) if comb else None
-    seen: set[str] = set()
     u = np.linspace(0.0, 1.0, per_segment)
-    for i, seg in enumerate(chain.segments):
-        kind = _kind(seg)
+    for kind, index in _by_kind(chain).items():
         color = SEGMENT_COLORS.get(kind, "k")
-        xy = seg.point(u)
-        ax.plot(xy[:, 0], xy[:, 1], color=color, lw=2.0, label=None if kind in seen else kind, gid=f"segment-{i}")
-        seen.add(kind)
+        ax.add_collection(
+            LineCollection([chain.segments[i].point(u) for i in index], colors=color, linewidths=2.0, label=kind, gid=f"plan-{kind}")
+        )
         if data is not None:
-            mask = data.segment == i
-            teeth = np.stack([data.points[mask], data.tips[mask]], axis=1)
-            ax.add_collection(LineCollection(teeth, colors=color, linewidths=0.6, alpha=0.5, gid=f"comb-{i}"))
-            ax.plot(data.tips[mask, 0], data.tips[mask, 1], color=color, lw=0.8, alpha=0.8, gid=f"envelope-{i}")
+            rows = (index[:, None] * per_segment + np.arange(per_segment)).ravel()
+            teeth = np.stack([data.points[rows], data.tips[rows]], axis=1)
+            ax.add_collection(LineCollection(teeth, colors=color, linewidths=0.6, alpha=0.5, gid=f"comb-{kind}"))
+            envelopes = data.tips[rows].reshape(len(index), per_segment, 2)
+            ax.add_collection(LineCollection(envelopes, colors=color, linewidths=0.8, alpha=0.8, gid=f"envelope-{kind}"))
     ax.set_aspect("equal", adjustable="datalim")
     ax.autoscale_view()
-    ax.set_xlabel("x")
-    ax.set_ylabel("y")
-    title = f"Plan: {len(chain)} segments, length {chain.length:.6g}"
+    unit = f" ({chain.units})"
+    ax.set_xlabel("x" + unit)
+    ax.set_ylabel("y" + unit)
+    title = f"Plan: {len(chain)} segments, length {chain.length:.6g} {chain.units}"
     if data is not None:
-        title += f" (comb: {data.scale:.3g} per unit curvature)"
+        title += f" (comb: {data.scale:.3g} {chain.units}² per unit curvature)"
     ax.set_title(title)
     ax.legend(loc="best", fontsize="small")
     ax.grid(True, alpha=0.3)
     return fig
 
 
-def plot_curvature(chain: Chain, ax: Axes | None = None, per_segment: int = 64) -> Figure:
-    """Signed curvature against arc length, one line per segment coloured by type."""
+def plot_curvature(chain: Chain, ax: Axes | None = None, per_segment: int | None = None) -> Figure:
+    """Signed curvature against arc length: one ``LineCollection`` per segment type
+    (gid ``curvature-KIND``, one polyline per segment)."""
     fig, ax = _axes(ax, figsize=(8, 4))
+    per_segment = _samples(chain, per_segment, 64)
     data = curvature_comb(chain, per_segment, scale=0.0)
-    seen: set[str] = set()
-    for i, seg in enumerate(chain.segments):
-        kind = _kind(seg)
-        mask = data.segment == i
-        ax.plot(data.stations[mask], data.curvature[mask], color=SEGMENT_COLORS.get(kind, "k"), lw=1.8,
-                label=None if kind in seen else kind, gid=f"curvature-{i}")
-        seen.add(kind)
+    profile = np.stack([data.stations, data.curvature], axis=1).reshape(len(chain), per_segment, 2)
+    for kind, index in _by_kind(chain).items():
+        ax.add_collection(
+            LineCollection(profile[index], colors=SEGMENT_COLORS.get(kind, "k"), linewidths=1.8, label=kind, gid=f"curvature-{kind}")
+        )
+    ax.autoscale_view()
     ax.axhline(0.0, color="0.6", lw=0.6)
-    ax.set_xlabel("arc length s")
-    ax.set_ylabel("curvature κ")
+    ax.set_xlabel(f"arc length s ({chain.units})")
+    ax.set_ylabel(f"curvature κ (1/{chain.units})")
     ax.set_title("Curvature profile")
     ax.legend(loc="best", fontsize="small")
     ax.grid(True, alpha=0.3)

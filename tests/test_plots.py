@@ -25,13 +25,23 @@ def saved(fig, tmp_path, name):
     return path.read_bytes()[:8] == PNG
 
 
+def collections(ax, prefix):
+    return [c for c in ax.collections if (c.get_gid() or "").startswith(prefix)]
+
+
 def test_plan_with_comb(chain, tmp_path):
     fig = plots.plot_plan(chain)
     assert isinstance(fig, Figure)
     ax = fig.axes[0]
-    assert len(ax.lines) == 2 * len(chain)  # segment + comb envelope each
-    combs = [c for c in ax.collections if isinstance(c, LineCollection)]
-    assert len(combs) == len(chain)
+    kinds = {type(s).__name__ for s in chain}
+    for prefix in ("plan-", "comb-", "envelope-"):
+        assert {c.get_gid()[len(prefix):] for c in collections(ax, prefix)} == kinds
+    # every segment drawn once, on its own polyline, through the segment's points
+    drawn = sum(len(c.get_segments()) for c in collections(ax, "plan-"))
+    assert drawn == len(chain)
+    (spirals,) = collections(ax, "plan-BezierSpiral")
+    first = next(s for s in chain if isinstance(s, BezierSpiral))
+    assert np.allclose(spirals.get_segments()[0][[0, -1]], [first.start, first.end])
     assert saved(fig, tmp_path, "plan.png")
 
 
@@ -39,7 +49,7 @@ def test_plan_without_comb_on_given_axes(chain):
     fig = Figure()
     ax = fig.add_subplot()
     assert plots.plot_plan(chain, comb=False, ax=ax) is fig
-    assert len(ax.lines) == len(chain) and not ax.collections
+    assert not collections(ax, "comb-") and sum(len(c.get_segments()) for c in collections(ax, "plan-")) == len(chain)
 
 
 def test_comb_matches_chain_curvature(chain):
@@ -56,10 +66,10 @@ def test_comb_matches_chain_curvature(chain):
 
 def test_curvature_plot_data(chain, tmp_path):
     fig = plots.plot_curvature(chain)
-    lines = [l for l in fig.axes[0].lines if (l.get_gid() or "").startswith("curvature-")]
-    assert len(lines) == len(chain) and len(fig.axes[0].lines) == len(chain) + 1  # + zero line
-    for line in lines:
-        s, k = line.get_xdata(), line.get_ydata()
+    profiles = [p for c in collections(fig.axes[0], "curvature-") for p in c.get_segments()]
+    assert len(profiles) == len(chain)
+    for profile in profiles:
+        s, k = profile[:, 0], profile[:, 1]
         inner = (s > 0) & (s < chain.length)
         assert np.allclose(k[inner], chain.curvature_at(s[inner]), rtol=1e-9, atol=1e-12)
     assert saved(fig, tmp_path, "curvature.png")

@@ -49,16 +49,23 @@ class Chain:
     """An ordered, G2-continuous path of ``Line``, ``Arc`` and ``BezierSpiral``.
 
     Consecutive segments must share end point, unit tangent and signed
-    curvature: gap ≤ tol·size, tangent angle ≤ tol and |Δκ|·size ≤ tol,
-    where size is the diagonal of the control-point bounding box and tol is
-    ``tolerance`` (default 1e-9). Each bound is widened by what float64
-    rounding of the stored coordinates can hide at that joint
+    curvature. Each joint is judged on its own scale, as the G2 checker
+    judges files: with L_short and L_long the lengths of its two segments,
+
+    * gap ≤ tol · L_short,
+    * tangent angle ≤ tol (radians),
+    * |Δκ| ≤ tol · max(|κ_before|, |κ_after|, 1/L_long),
+
+    where tol is ``tolerance`` (default 1e-9). Each bound is widened by what
+    float64 rounding of the stored coordinates can hide at that joint
     (``Segment.rounding_floor``), so survey coordinates (~1e6) and tiny
-    spirals are judged by their geometry, not by their last bits.
+    spirals are judged by their geometry, not by their last bits; that
+    allowance is capped at ``ROUNDING_CAP`` (1e-6) on the same scales, so a
+    segment too small for its coordinates can never hide a kink.
 
     Args:
         segments: the segments in travel order (at least one).
-        tolerance: relative join tolerance.
+        tolerance: relative join tolerance, in (0, 1e-3].
         units: the length unit of the coordinates (``spiral_cad.core.units``:
             mm, cm, m, km, in, ft; default mm as in build123d/CadQuery). It
             travels with the chain into every file written from it.
@@ -67,10 +74,6 @@ class Chain:
         ValueError: a joint exceeds the tolerance (the message names the joint
             index and the three mismatches), no segments were given, or the
             tolerance is not in (0, 1e-3].
-
-    The rounding allowance per joint is capped at ``ROUNDING_CAP`` (1e-6,
-    relative), so a segment too small for its coordinates can never hide a
-    kink.
     """
 
     def __init__(self, segments: Iterable[Segment], tolerance: float = JOIN_TOLERANCE, units: str = DEFAULT_UNITS):
@@ -85,18 +88,18 @@ class Chain:
         self.size = float(math.hypot(*(pts.max(axis=0) - pts.min(axis=0)))) or 1.0
         if not math.isfinite(self.size):
             raise ValueError("Chain extent overflows float64")
-        cap = np.array([ROUNDING_CAP * self.size, ROUNDING_CAP, ROUNDING_CAP / self.size])
-        for j, a, b in zip(self.joins(), self._segments, self._segments[1:]):
-            floor = np.minimum(np.add(a.rounding_floor(True), b.rounding_floor(False)), cap)
-            if (
-                j.gap > tolerance * self.size + floor[0]
-                or j.angle > tolerance + floor[1]
-                or j.curvature_jump > tolerance / self.size + floor[2]
-            ):
+        tol = self.tolerance
+        for j, a, b, la, lb in zip(self.joins(), self._segments, self._segments[1:], lengths, lengths[1:]):
+            short, long = min(la, lb), max(la, lb)
+            kappa = max(abs(a.end_curvature), abs(b.start_curvature), 1.0 / long)
+            scale = np.array([short, 1.0, kappa])
+            floor = np.minimum(np.add(a.rounding_floor(True), b.rounding_floor(False)), ROUNDING_CAP * scale)
+            if j.gap > tol * short + floor[0] or j.angle > tol + floor[1] or j.curvature_jump > tol * kappa + floor[2]:
                 raise ValueError(
                     f"Chain is not G2 at joint {j.index} (between segments {j.index} and {j.index + 1}): "
                     f"gap {j.gap:.3g}, tangent angle {j.angle:.3g} rad, curvature jump {j.curvature_jump:.3g} "
-                    f"(tolerance {tolerance:g} relative to chain size {self.size:.6g})"
+                    f"(tolerance {tol:g}: gap relative to the shorter segment, {short:.6g} {self.units}; "
+                    f"curvature jump relative to {kappa:.6g} 1/{self.units})"
                 )
 
     @classmethod

@@ -9,6 +9,7 @@ from __future__ import annotations
 import math
 from abc import ABC, abstractmethod
 from dataclasses import dataclass
+from functools import cached_property
 from typing import Any
 
 import numpy as np
@@ -20,8 +21,21 @@ TAU = 2.0 * math.pi
 EPS = float(np.finfo(float).eps)
 
 
+#: One end of a segment as plain floats: x, y, unit tangent (travel sense) and signed curvature.
+End = tuple[float, float, float, float, float]
+
+
 class Segment(ABC):
     """Common interface of ``Line``, ``Arc`` and ``BezierSpiral``."""
+
+    @abstractmethod
+    def _end_frames(self) -> tuple[End, End]:
+        """Start and end frames, computed with plain floats (chains check thousands of joints)."""
+
+    @cached_property
+    def ends(self) -> tuple[End, End]:
+        """(start, end) frames: point, unit tangent in travel sense and signed curvature, as floats."""
+        return self._end_frames()
 
     @abstractmethod
     def point(self, u: ArrayLike) -> NDArray:
@@ -55,31 +69,32 @@ class Segment(ABC):
     def rounding_floor(self, at_end: bool) -> tuple[float, float, float]:
         """(gap, tangent angle, curvature) that float64 rounding of the stored
         coordinates can hide at the start or end (exact types: only the gap)."""
-        return 4.0 * EPS * float(np.abs(self.end if at_end else self.start).max()), 0.0, 0.0
+        x, y = self.ends[1 if at_end else 0][:2]
+        return 4.0 * EPS * max(abs(x), abs(y)), 0.0, 0.0
 
     @property
     def start(self) -> NDArray:
-        return self.point(0.0)
+        return np.array(self.ends[0][:2])
 
     @property
     def end(self) -> NDArray:
-        return self.point(1.0)
+        return np.array(self.ends[1][:2])
 
     @property
     def start_tangent(self) -> NDArray:
-        return self.tangent(0.0)
+        return np.array(self.ends[0][2:4])
 
     @property
     def end_tangent(self) -> NDArray:
-        return self.tangent(1.0)
+        return np.array(self.ends[1][2:4])
 
     @property
     def start_curvature(self) -> float:
-        return float(self.curvature(0.0))
+        return self.ends[0][4]
 
     @property
     def end_curvature(self) -> float:
-        return float(self.curvature(1.0))
+        return self.ends[1][4]
 
 
 def _u(u: ArrayLike) -> NDArray:
@@ -98,7 +113,6 @@ def piece_range(t0: Any, t1: Any) -> tuple[float, float]:
 class Line(Segment):
     """Straight segment from ``start`` to ``end`` (distinct points)."""
 
-    __slots__ = ("_a", "_b")
 
     def __init__(self, start: Any, end: Any):
         self._a = np.array(as_xy(start, "start"))
@@ -111,13 +125,11 @@ class Line(Segment):
     def __repr__(self) -> str:
         return f"Line({tuple(self._a)}, {tuple(self._b)})"
 
-    @property
-    def start(self) -> NDArray:
-        return self._a.copy()
-
-    @property
-    def end(self) -> NDArray:
-        return self._b.copy()
+    def _end_frames(self) -> tuple[End, End]:
+        (ax, ay), (bx, by) = self._a.tolist(), self._b.tolist()
+        length = self.length
+        tx, ty = (bx - ax) / length, (by - ay) / length
+        return (ax, ay, tx, ty, 0.0), (bx, by, tx, ty, 0.0)
 
     @property
     def length(self) -> float:
@@ -137,7 +149,7 @@ class Line(Segment):
         return Line(self._b, self._a)
 
     def rounding_floor(self, at_end: bool) -> tuple[float, float, float]:
-        delta = 4.0 * EPS * float(np.abs(np.concatenate([self._a, self._b])).max())
+        delta = 4.0 * EPS * max(abs(v) for v in (*self.ends[0][:2], *self.ends[1][:2]))
         return delta, delta / self.length, 0.0
 
     def piece(self, t0: float, t1: float) -> Line:
@@ -181,7 +193,6 @@ class Arc(Segment):
             or a radius too small to resolve at the centre's coordinates.
     """
 
-    __slots__ = ("_c", "_r", "_a0", "_sweep")
 
     def __init__(self, center: Any, radius: float, start_angle: float, sweep: float):
         self._c = np.array(as_xy(center, "center"))
@@ -241,6 +252,15 @@ class Arc(Segment):
     def length(self) -> float:
         return abs(self._r) * self._sweep
 
+    def _end_frames(self) -> tuple[End, End]:
+        (cx, cy), r = self._c.tolist(), abs(self._r)
+        sense = math.copysign(1.0, self._r)
+        frames = []
+        for angle in (self._a0, self._a0 + sense * self._sweep):
+            c, s = math.cos(angle), math.sin(angle)
+            frames.append((cx + r * c, cy + r * s, -sense * s, sense * c, 1.0 / self._r))
+        return frames[0], frames[1]
+
     def _angle(self, u: ArrayLike) -> NDArray:
         return self._a0 + math.copysign(self._sweep, self._r) * _u(u)
 
@@ -276,7 +296,7 @@ class Join:
 
 def measure_join(a: Segment, b: Segment, index: int = 0) -> Join:
     """Position gap, tangent angle (rad) and curvature jump from ``a``'s end to ``b``'s start."""
-    ta, tb = a.end_tangent, b.start_tangent
-    angle = abs(math.atan2(ta[0] * tb[1] - ta[1] * tb[0], ta[0] * tb[0] + ta[1] * tb[1]))
-    gap = float(np.hypot(*(b.start - a.end)))
-    return Join(index, gap, angle, abs(b.start_curvature - a.end_curvature))
+    ax, ay, tax, tay, ka = a.ends[1]
+    bx, by, tbx, tby, kb = b.ends[0]
+    angle = abs(math.atan2(tax * tby - tay * tbx, tax * tbx + tay * tby))
+    return Join(index, math.hypot(bx - ax, by - ay), angle, abs(kb - ka))

@@ -12,7 +12,7 @@ from . import bezier
 from ._inputs import as_float, as_xy
 from ._kernels import spiral_row
 from .errors import Status, error_for
-from .segments import EPS, Segment, piece_range
+from .segments import EPS, End, Segment, piece_range
 
 
 class BezierSpiral(Segment):
@@ -38,7 +38,6 @@ class BezierSpiral(Segment):
     of the same kind; for them ``start_curvature`` need not be 0.
     """
 
-    __slots__ = ("_cp", "_length")
 
     def __init__(self, start: Any, direction: Any, theta: float, curvature: float):
         bx, by = as_xy(start, "start")
@@ -95,13 +94,15 @@ class BezierSpiral(Segment):
         """(4, 2) float64 control points in travel order (read-only)."""
         return self._cp
 
-    @property
-    def start(self) -> NDArray:
-        return self._cp[0].copy()
-
-    @property
-    def end(self) -> NDArray:
-        return self._cp[3].copy()
+    def _end_frames(self) -> tuple[End, End]:
+        (x0, y0), (x1, y1), (x2, y2), (x3, y3) = self._cp.tolist()
+        legs = ((x1 - x0, y1 - y0), (x2 - x1, y2 - y1), (x3 - x2, y3 - y2))
+        scale = max(abs(v) for leg in legs for v in leg)  # keeps |leg|³ in range at any magnitude
+        (ax, ay), (bx, by), (cx, cy) = ((u / scale, v / scale) for u, v in legs)
+        la, lc = math.hypot(ax, ay), math.hypot(cx, cy)
+        k0 = 2.0 / 3.0 * (ax * by - ay * bx) / la**3 / scale
+        k1 = 2.0 / 3.0 * (bx * cy - by * cx) / lc**3 / scale
+        return (x0, y0, ax / la, ay / la, k0), (x3, y3, cx / lc, cy / lc, k1)
 
     @property
     def theta(self) -> float:
@@ -141,9 +142,10 @@ class BezierSpiral(Segment):
     def rounding_floor(self, at_end: bool) -> tuple[float, float, float]:
         """Rounding floor of the end frame: κ comes from differences of rounded
         control points, (2/3)(a × b)/|a|³ with a the end leg and b the middle leg."""
-        delta = 4.0 * EPS * float(np.abs(self._cp).max())
-        legs = np.hypot(*np.diff(self._cp, axis=0).T)
-        a, b = (legs[2], legs[1]) if at_end else (legs[0], legs[1])
+        (x0, y0), (x1, y1), (x2, y2), (x3, y3) = self._cp.tolist()
+        delta = 4.0 * EPS * max(abs(x0), abs(y0), abs(x1), abs(y1), abs(x2), abs(y2), abs(x3), abs(y3))
+        middle = math.hypot(x2 - x1, y2 - y1)
+        a, b = (math.hypot(x3 - x2, y3 - y2), middle) if at_end else (math.hypot(x1 - x0, y1 - y0), middle)
         kappa = abs(self.end_curvature if at_end else self.start_curvature)
         return delta, delta / a, 2.0 / 3.0 * delta * (a + b) / a**3 + 3.0 * kappa * delta / a
 

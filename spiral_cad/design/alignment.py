@@ -16,9 +16,10 @@ from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
-from scipy.optimize import brentq, minimize_scalar
+from scipy.optimize import brentq
 
 from ..core import bezier
+from ..core.bezier import curvature_rate, peak_curvature_rate  # noqa: F401  (public here too)
 from ..core._inputs import as_float, as_points, as_real_array
 from ..core._kernels import put_spiral, shape_g1
 from ..core.chain import JOIN_TOLERANCE, Chain
@@ -31,44 +32,6 @@ from ..core.transitions import Transition, line_to_circle
 COLLINEAR_TOL = 1e-12
 #: θ range searched when a spiral length is requested.
 _THETA_RANGE = (1e-7, math.pi / 2 * (1.0 - 1e-9))
-
-
-# ------------------------------------------------- rate of curvature
-
-
-def curvature_rate(control_points: ArrayLike, u: ArrayLike) -> NDArray:
-    """dκ/ds of a cubic Bézier at parameters ``u``.
-
-    dκ/ds = κ'(u)/|Q'| with κ = (Q' × Q'')/|Q'|³, i.e.
-    ``((Q' × Q''')|Q'|² − 3 (Q' × Q'')(Q' · Q'')) / |Q'|⁶``. For a Bézier
-    spiral this is not constant: curvature is not linear in arc length.
-    """
-    cp = np.asarray(control_points, dtype=float)
-    d1 = bezier.derivative(cp, u, 1)
-    d2 = bezier.derivative(cp, u, 2)
-    d3 = bezier.derivative(cp, u, 3)
-    cross12 = d1[..., 0] * d2[..., 1] - d1[..., 1] * d2[..., 0]
-    cross13 = d1[..., 0] * d3[..., 1] - d1[..., 1] * d3[..., 0]
-    speed2 = d1[..., 0] ** 2 + d1[..., 1] ** 2
-    dot12 = d1[..., 0] * d2[..., 0] + d1[..., 1] * d2[..., 1]
-    return (cross13 * speed2 - 3.0 * cross12 * dot12) / speed2**3
-
-
-def peak_curvature_rate(spiral: BezierSpiral, samples: int = 257) -> tuple[float, float]:
-    """The largest |dκ/ds| on a spiral and the parameter u where it occurs.
-
-    Dense sampling finds the peak's neighbourhood, a bounded scalar search
-    refines it (the peak may sit at an end: for small θ it is at κ = 0).
-    """
-    cp = spiral.control_points
-    u = np.linspace(0.0, 1.0, samples)
-    rate = np.abs(curvature_rate(cp, u))
-    j = int(np.argmax(rate))
-    lo, hi = u[max(j - 1, 0)], u[min(j + 1, samples - 1)]
-    best = minimize_scalar(lambda x: -abs(float(curvature_rate(cp, x))), bounds=(lo, hi), method="bounded", options={"xatol": 1e-12})
-    if -best.fun > rate[j]:
-        return float(-best.fun), float(best.x)
-    return float(rate[j]), float(u[j])
 
 
 def theta_for_length(length: float, radius: float) -> float:
@@ -372,6 +335,8 @@ def _check_tangents(pts: NDArray, lengths: NDArray, directions: NDArray, solved)
 
 def _curve_data(chain: Chain, pts: NDArray, solved, radius: NDArray, origin: float) -> list[CurveData]:
     stations = chain.stations
+    spirals = np.array([[s[0].spirals[0].control_points, s[1].spirals[0].control_points] for s in solved])
+    peaks = peak_curvature_rate(spirals.reshape(-1, 4, 2))[0] if len(spirals) else []
     where = {id(seg): k for k, seg in enumerate(chain.segments)}
     curves = []
     for j, (entry, exit_, center, deflection) in enumerate(solved):
@@ -394,8 +359,8 @@ def _curve_data(chain: Chain, pts: NDArray, solved, radius: NDArray, origin: flo
                 sc=float(sc),
                 cs=float(cs),
                 st=float(st),
-                peak_rate_in=peak_curvature_rate(first)[0],
-                peak_rate_out=peak_curvature_rate(last)[0],
+                peak_rate_in=float(peaks[2 * j]),
+                peak_rate_out=float(peaks[2 * j + 1]),
                 entry=entry,
                 exit=exit_,
             )
