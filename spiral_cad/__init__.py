@@ -32,4 +32,4 @@ __all__ = [
     "line_to_circle",
     "line_to_line",
 ]
-__version__ = "0.1.0"
+__version__ = "0.2.0"

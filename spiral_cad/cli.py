@@ -4,8 +4,10 @@ from __future__ import annotations
 
 import argparse
 import math
+import os
 import sys
 import time
+from importlib.util import find_spec
 from collections.abc import Sequence
 from pathlib import Path
 
@@ -71,20 +73,22 @@ DEMO_DESIGN: dict = {
 }
 
 
-def _write_design(design: dict | str, out: Path) -> int:
-    from .designfile import DesignError, build, summary, write
+PIP_CAD = 'pip install "spiral_cad[cad]"'
+
+
+def _write_design(design: dict | str, out: Path, plots: bool) -> int:
+    from .designfile import build, summary, write
 
     started = time.perf_counter()
-    try:
-        units, built = build(design)
-    except DesignError as e:
-        print(f"error: {e}", file=sys.stderr)
-        return 2
+    units, built = build(design)
     print(f"built {len(built)} design(s); writing to {out}/", flush=True)
-    written = write(built, out, units, progress=lambda line: print(line, flush=True))
+    written = write(built, out, units, progress=lambda line: print(line, flush=True), plots=plots)
     print()
     print(summary(built, units))
-    print(f"\nwrote {len(written)} files to {out}/ in {time.perf_counter() - started:.1f} s")
+    print(f"\nwrote {len(written.files)} files to {out}/ in {time.perf_counter() - started:.1f} s")
+    if written.skipped:
+        print(f"error: not written: {'; '.join(written.skipped)}. Install the CAD extra: {PIP_CAD}", file=sys.stderr)
+        return 2
     return 0
 
 
@@ -93,32 +97,31 @@ def _demo(args: argparse.Namespace) -> int:
     print("The five transitions of Walton & Meek (1996), one instance each:\n")
     print(transition_table(core_examples()))
     print()
-    status = _write_design(DEMO_DESIGN, out)
-    if status == 0:
+    status = _write_design(DEMO_DESIGN, out, plots=not args.no_plots)
+    if status == 0 and not args.no_plots:
         _paper_plots(out)
     return status
 
 
 def _paper_plots(out: Path) -> None:
-    """The paper's Fig. 6 family and the Bézier spiral against a clothoid."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
+    """The paper's Fig. 6 family and the Bézier spiral against a clothoid (each file replaced whole)."""
     from .plots import plot_fig6, plot_vs_clothoid
 
     for name, fig in (("fig6.png", plot_fig6()), ("bezier_vs_clothoid.png", plot_vs_clothoid(math.radians(30), 1.0))):
-        fig.savefig(out / name, dpi=110)
-        plt.close(fig)
+        partial = out / f".{name}.partial"
+        fig.savefig(partial, dpi=110, format="png")
+        os.replace(partial, out / name)
         print(f"  {out / name}")
 
 
 def _build(args: argparse.Namespace) -> int:
-    return _write_design(args.design, Path(args.out))
+    return _write_design(args.design, Path(args.out), plots=not args.no_plots)
 
 
 def _check(args: argparse.Namespace) -> int:
+    if find_spec("OCP") is None:
+        print(f"error: spiral-cad check reads STEP/IGES with OCCT, which comes with the CAD extra: {PIP_CAD}", file=sys.stderr)
+        return 2
     from .cad.continuity import main_check  # imports OCP, so only when used
 
     return main_check(args)
@@ -145,6 +148,10 @@ def _design_format() -> str:
 
 
 def main(argv: Sequence[str] | None = None) -> int:
+    """Run the command line; returns the exit status (0 ok, 1 check failed, 2 error, 130 interrupted).
+
+    Every error is printed as ``error: …`` on stderr, never as a traceback.
+    """
     parser = argparse.ArgumentParser(
         prog="spiral-cad",
         description="Exact G2 (curvature-continuous) cubic Bézier spiral transitions for CAD.",
@@ -162,6 +169,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         help="build the built-in design (highway alignment, circle chain, rounded robot path) and write every output",
     )
     demo.add_argument("--out", default="out", help="output folder (default: out)")
+    demo.add_argument("--no-plots", action="store_true", help="skip the PNG plots (the slowest output for long chains)")
     demo.set_defaults(run=_demo)
     build = sub.add_parser(
         "build",
@@ -171,10 +179,21 @@ def main(argv: Sequence[str] | None = None) -> int:
     )
     build.add_argument("design", help="the design file (.json)")
     build.add_argument("--out", default="out", help="output folder (default: out)")
+    build.add_argument("--no-plots", action="store_true", help="skip the PNG plots (the slowest output for long chains)")
     build.set_defaults(run=_build)
     _add_check(sub)
     args = parser.parse_args(argv)
-    return args.run(args)
+    try:
+        return args.run(args)
+    except KeyboardInterrupt:
+        print("error: interrupted; the output folder was left as it was", file=sys.stderr)
+        return 130
+    except (ValueError, OSError) as error:  # DesignError, NoSolutionError, file system errors
+        print(f"error: {error}", file=sys.stderr)
+        return 2
+    except Exception as error:  # a bug: still no traceback, but say so
+        print(f"error: internal error ({type(error).__name__}: {error}); please report it", file=sys.stderr)
+        return 2
 
 
 if __name__ == "__main__":

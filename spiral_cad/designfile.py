@@ -1,28 +1,40 @@
 """JSON design files: validation, building and writing every output.
 
 A design file holds ``units`` and a list of ``designs``; each design has a
-``name``, a ``type`` and the fields of that type (see ``FORMAT``). Every
-field is checked before anything is built, and every design is built before
-anything is written, so a bad file writes nothing.
+``name``, a ``type`` and the fields of that type (see ``FORMAT``). Any byte
+sequence is either a valid design or a ``DesignError`` naming the field and
+the value: the file is decoded, parsed and every field checked before
+anything is built, and every design is built before anything is written.
+Files are written into a staging folder inside the output folder and moved
+into place only when all of them were written; any failure or interrupt
+(Ctrl-C, SIGTERM, SIGHUP) removes the staging folder.
 """
 
 from __future__ import annotations
 
 import json
 import math
+import os
+import re
 import shutil
+import signal
 import tempfile
-from collections.abc import Callable
+import threading
+import time
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
 from dataclasses import dataclass, field
+from importlib.util import find_spec
 from pathlib import Path
 from typing import Any
 
 from .core.chain import Chain
 from .core.errors import NoSolutionError
+from .core.units import UNITS
 
 FORMAT = """\
 {
-  "units": "m",                          one of m, mm, cm, km, in, ft (labels and CSV)
+  "units": "m",                          required: mm, cm, m, km, in or ft (every length below)
   "designs": [
     {"name": "highway", "type": "alignment",
      "pis": [[x, y], ...],               ≥ 3 points of intersection, in travel order
@@ -38,9 +50,9 @@ FORMAT = """\
     {"name": "t", "type": "transition", "case": "line_to_circle" | "circle_to_circle" |
      "line_to_line" | "circle_in_circle", ...that function's arguments by name...}
   ]
-}"""
+}
+Names: 1–64 characters of A–Z, a–z, 0–9, - and _ (they name the output files)."""
 
-UNITS = ("m", "mm", "cm", "km", "in", "ft")
 TRANSITION_ARGS = {
     "line_to_circle": ("point", "direction", "center", "radius"),
     "circle_to_circle": ("center0", "radius0", "center1", "radius1"),
@@ -48,6 +60,12 @@ TRANSITION_ARGS = {
     "circle_in_circle": ("center0", "radius0", "center1", "radius1"),
 }
 OPTIONAL = {"curvature"}
+NAME = re.compile(r"[A-Za-z0-9][A-Za-z0-9_-]{0,63}")
+#: JSON integers longer than this are refused (they cannot be lengths in float64 anyway).
+MAX_DIGITS = 308
+#: The packages of the ``cad`` extra and what needs them.
+CAD_EXTRA = {"OCP": "IGES and the continuity check", "ezdxf": "DXF", "matplotlib": "plots"}
+STAGING_PREFIX = ".spiral-cad-build-"
 
 
 class DesignError(ValueError):
@@ -69,22 +87,28 @@ class Built:
 
 
 def _number(value: Any, where: str, positive: bool = False) -> float:
-    if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
-        raise DesignError(f"{where}: must be a finite number; got {value!r}")
-    if positive and not value > 0:
-        raise DesignError(f"{where}: must be positive; got {value!r}")
-    return float(value)
+    if isinstance(value, bool) or not isinstance(value, (int, float)):
+        raise DesignError(f"{where}: must be a finite number; got {value!r:.80}")
+    try:
+        number = float(value)
+    except OverflowError:
+        raise DesignError(f"{where}: must be a finite number; got an integer of {len(str(value))} digits") from None
+    if not math.isfinite(number):
+        raise DesignError(f"{where}: must be a finite number; got {value!r:.80}")
+    if positive and not number > 0:
+        raise DesignError(f"{where}: must be positive; got {value!r:.80}")
+    return number
 
 
 def _point(value: Any, where: str) -> tuple[float, float]:
-    if not isinstance(value, (list, tuple)) or len(value) != 2:
-        raise DesignError(f"{where}: must be a point [x, y]; got {value!r}")
+    if not isinstance(value, list) or len(value) != 2:
+        raise DesignError(f"{where}: must be a point [x, y]; got {value!r:.80}")
     return _number(value[0], f"{where}[0]"), _number(value[1], f"{where}[1]")
 
 
 def _points(value: Any, where: str, minimum: int) -> list[tuple[float, float]]:
     if not isinstance(value, list) or len(value) < minimum:
-        raise DesignError(f"{where}: must be a list of at least {minimum} points [x, y]; got {value!r}")
+        raise DesignError(f"{where}: must be a list of at least {minimum} points [x, y]; got {value!r:.80}")
     return [_point(p, f"{where}[{i}]") for i, p in enumerate(value)]
 
 
@@ -99,7 +123,7 @@ def _pairs(value: Any, where: str, count: int, convert: Callable[[Any, str], flo
     for i, item in enumerate(value):
         if isinstance(item, list):
             if len(item) != 2:
-                raise DesignError(f"{where}[{i}]: must be a number or [in, out]; got {item!r}")
+                raise DesignError(f"{where}[{i}]: must be a number or [in, out]; got {item!r:.80}")
             out.append((convert(item[0], f"{where}[{i}][0]"), convert(item[1], f"{where}[{i}][1]")))
         else:
             v = convert(item, f"{where}[{i}]")
@@ -110,7 +134,7 @@ def _pairs(value: Any, where: str, count: int, convert: Callable[[Any, str], flo
 def _degrees(value: Any, where: str) -> float:
     v = _number(value, where)
     if not 0 < v < 90:
-        raise DesignError(f"{where}: spiral angles are in degrees and must lie in (0, 90); got {value!r}")
+        raise DesignError(f"{where}: spiral angles are in degrees and must lie in (0, 90); got {value!r:.80}")
     return math.radians(v)
 
 
@@ -123,90 +147,125 @@ def _fields(design: dict, where: str, required: tuple[str, ...], optional: tuple
         raise DesignError(f"{where}: unknown field(s) {', '.join(unknown)}")
 
 
+def _choice(value: Any, where: str, choices) -> str:
+    if not isinstance(value, str) or value not in choices:
+        raise DesignError(f"{where}: must be one of {', '.join(choices)}; got {value!r:.80}")
+    return value
+
+
+def _json_integer(text: str) -> int:
+    if len(text.lstrip("-")) > MAX_DIGITS:
+        raise DesignError(f"an integer of {len(text.lstrip('-'))} digits is not a length or a count")
+    return int(text)
+
+
+def _json_constant(text: str) -> float:
+    raise DesignError(f"{text} is not a number in JSON")
+
+
+def _parse(source: str | Path) -> Any:
+    """The JSON value in the file ``source``; any byte sequence either parses or raises DesignError."""
+    label = Path(source).name
+    try:
+        raw = Path(source).read_bytes()
+    except OSError as e:
+        raise DesignError(f"cannot read design file {label}: {e.strerror}") from None
+    try:
+        text = raw.decode("utf-8")
+    except UnicodeDecodeError as e:
+        raise DesignError(f"{label}: not UTF-8 text (byte {e.start}: 0x{raw[e.start]:02x})") from None
+    try:
+        return json.loads(text, parse_int=_json_integer, parse_constant=_json_constant)
+    except DesignError as e:
+        raise DesignError(f"{label}: {e}") from None
+    except json.JSONDecodeError as e:
+        raise DesignError(f"{label}: malformed JSON at line {e.lineno}, column {e.colno}: {e.msg}") from None
+    except RecursionError:
+        raise DesignError(f"{label}: JSON nested too deeply") from None
+    except ValueError as e:  # e.g. number conversions the json module refuses
+        raise DesignError(f"{label}: {e}") from None
+
+
 def load(source: str | Path | dict) -> tuple[str, list[dict]]:
     """Parse and check the top level of a design (a JSON file path or a dict): (units, designs)."""
-    if isinstance(source, dict):
-        data = source
-    else:
-        try:
-            text = Path(source).read_text(encoding="utf-8")
-        except OSError as e:
-            raise DesignError(f"cannot read design file {source}: {e.strerror}") from None
-        try:
-            data = json.loads(text)
-        except json.JSONDecodeError as e:
-            raise DesignError(f"{source}: malformed JSON at line {e.lineno}, column {e.colno}: {e.msg}") from None
+    data = source if isinstance(source, dict) else _parse(source)
     if not isinstance(data, dict):
         raise DesignError(f"the design must be a JSON object with 'units' and 'designs'; got {type(data).__name__}")
-    units = data.get("units", "m")
-    if units not in UNITS:
-        raise DesignError(f"units: must be one of {', '.join(UNITS)}; got {units!r}")
+    unknown = sorted(set(data) - {"units", "designs"})
+    if unknown:
+        raise DesignError(f"unknown top-level field(s) {', '.join(map(repr, unknown))}")
+    if "units" not in data:
+        raise DesignError(f"units: required, one of {', '.join(UNITS)}")
+    units = _choice(data["units"], "units", UNITS)
     designs = data.get("designs")
     if not isinstance(designs, list) or not designs:
         raise DesignError("designs: must be a non-empty list of designs")
     names = set()
     for i, d in enumerate(designs):
         if not isinstance(d, dict):
-            raise DesignError(f"designs[{i}]: must be an object; got {d!r}")
+            raise DesignError(f"designs[{i}]: must be an object; got {d!r:.80}")
         name = d.get("name")
-        if not isinstance(name, str) or not name or not all(c.isalnum() or c in "-_" for c in name):
-            raise DesignError(f"designs[{i}].name: must be a non-empty name of letters, digits, - and _; got {name!r}")
+        if not isinstance(name, str) or not NAME.fullmatch(name):
+            raise DesignError(
+                f"designs[{i}].name: must be 1–64 characters of A–Z, a–z, 0–9, - and _ (starting with a letter or "
+                f"digit); got {name!r:.80}"
+            )
         if name in names:
             raise DesignError(f"designs[{i}].name: {name!r} is used twice")
         names.add(name)
-        if d.get("type") not in BUILDERS:
-            raise DesignError(f"designs[{i}].type: must be one of {', '.join(BUILDERS)}; got {d.get('type')!r}")
+        _choice(d.get("type"), f"designs[{i}].type", tuple(BUILDERS))
     return units, designs
 
 
 # ------------------------------------------------------------- building
 
 
-def _alignment(d: dict, where: str) -> Built:
+def _alignment(d: dict, where: str, units: str) -> Built:
     from .design import Alignment
 
     _fields(d, where, ("pis", "radii"), ("spiral_angles_deg", "spiral_lengths", "start_station"))
     pis = _points(d["pis"], f"{where}.pis", 3)
     count = len(pis) - 2
     radii = d["radii"]
-    radii = [_number(r, f"{where}.radii[{i}]", positive=True) for i, r in enumerate(radii)] if isinstance(radii, list) else _number(radii, f"{where}.radii", positive=True)
-    if isinstance(radii, list) and len(radii) != count:
-        raise DesignError(f"{where}.radii: needs one radius per interior PI ({count}); got {len(radii)}")
+    if isinstance(radii, list):
+        if len(radii) != count:
+            raise DesignError(f"{where}.radii: needs one radius per interior PI ({count}); got {len(radii)}")
+        radii = [_number(r, f"{where}.radii[{i}]", positive=True) for i, r in enumerate(radii)]
+    else:
+        radii = _number(radii, f"{where}.radii", positive=True)
     if ("spiral_angles_deg" in d) == ("spiral_lengths" in d):
         raise DesignError(f"{where}: give exactly one of spiral_angles_deg and spiral_lengths")
     kw = {}
     if "spiral_angles_deg" in d:
         kw["spiral_angles"] = _pairs(d["spiral_angles_deg"], f"{where}.spiral_angles_deg", count, _degrees)
     else:
-        kw["spiral_lengths"] = _pairs(
-            d["spiral_lengths"], f"{where}.spiral_lengths", count, lambda v, w: _number(v, w, positive=True)
-        )
+        kw["spiral_lengths"] = _pairs(d["spiral_lengths"], f"{where}.spiral_lengths", count, lambda v, w: _number(v, w, positive=True))
     start = _number(d.get("start_station", 0.0), f"{where}.start_station")
-    alignment = Alignment.from_pis(pis, radii, start_station=start, **kw)
+    alignment = Alignment.from_pis(pis, radii, start_station=start, units=units, **kw)
     return Built(d["name"], "alignment", alignment.chain, alignment)
 
 
-def _circle_chain(d: dict, where: str) -> Built:
+def _circle_chain(d: dict, where: str, units: str) -> Built:
     from .design import circle_chain
 
     _fields(d, where, ("circles",))
     circles = d["circles"]
     if not isinstance(circles, list) or len(circles) < 2:
-        raise DesignError(f"{where}.circles: must be a list of at least 2 circles; got {circles!r}")
+        raise DesignError(f"{where}.circles: must be a list of at least 2 circles; got {circles!r:.80}")
     parsed = []
     for i, c in enumerate(circles):
         w = f"{where}.circles[{i}]"
         if not isinstance(c, dict) or set(c) != {"center", "radius"}:
-            raise DesignError(f"{w}: must be {{\"center\": [x, y], \"radius\": r}}; got {c!r}")
+            raise DesignError(f'{w}: must be {{"center": [x, y], "radius": r}}; got {c!r:.80}')
         radius = _number(c["radius"], f"{w}.radius")
         if radius == 0:
             raise DesignError(f"{w}.radius: must be non-zero (its sign is the travel sense); got 0")
         parsed.append((_point(c["center"], f"{w}.center"), radius))
-    result = circle_chain(parsed)
+    result = circle_chain(parsed, units=units)
     return Built(d["name"], "circle_chain", result.chain, result)
 
 
-def _rounded(d: dict, where: str) -> Built:
+def _rounded(d: dict, where: str, units: str) -> Built:
     from .design import round_corners
 
     _fields(d, where, ("points",), ("curvature", "max_curvature", "method"))
@@ -214,32 +273,27 @@ def _rounded(d: dict, where: str) -> Built:
     if "curvature" in d and "max_curvature" in d:
         raise DesignError(f"{where}: give at most one of curvature and max_curvature")
     kw = {k: _number(d[k], f"{where}.{k}", positive=True) for k in ("curvature", "max_curvature") if k in d}
-    method = d.get("method", "walton-meek")
-    if method not in ("walton-meek", "g2cbs"):
-        raise DesignError(f"{where}.method: must be 'walton-meek' or 'g2cbs'; got {method!r}")
-    result = round_corners(points, method=method, **kw)
+    method = _choice(d.get("method", "walton-meek"), f"{where}.method", ("walton-meek", "g2cbs"))
+    result = round_corners(points, method=method, units=units, **kw)
     return Built(d["name"], "rounded_polyline", result.chain, result)
 
 
-def _transition(d: dict, where: str) -> Built:
+def _transition(d: dict, where: str, units: str) -> Built:
     from .core import transitions
 
-    case = d.get("case")
-    if case not in TRANSITION_ARGS:
-        raise DesignError(f"{where}.case: must be one of {', '.join(TRANSITION_ARGS)}; got {case!r}")
+    case = _choice(d.get("case"), f"{where}.case", tuple(TRANSITION_ARGS))
     names = TRANSITION_ARGS[case]
     _fields(d, where, tuple(n for n in names if n not in OPTIONAL) + ("case",), tuple(n for n in names if n in OPTIONAL))
     args = {}
     for n in names:
-        if n not in d:
-            continue
-        value = d[n]
-        args[n] = _point(value, f"{where}.{n}") if isinstance(value, list) else _number(value, f"{where}.{n}")
+        if n in d:
+            value = d[n]
+            args[n] = _point(value, f"{where}.{n}") if isinstance(value, list) else _number(value, f"{where}.{n}")
     t = getattr(transitions, case)(**args)
-    return Built(d["name"], f"transition ({t.kind})", Chain(t.spirals), t)
+    return Built(d["name"], f"transition ({t.kind})", Chain(t.spirals, units=units), t)
 
 
-BUILDERS: dict[str, Callable[[dict, str], Built]] = {
+BUILDERS: dict[str, Callable[[dict, str, str], Built]] = {
     "alignment": _alignment,
     "circle_chain": _circle_chain,
     "rounded_polyline": _rounded,
@@ -259,7 +313,7 @@ def build(source: str | Path | dict) -> tuple[str, list[Built]]:
     for i, d in enumerate(designs):
         where = f"designs[{i}] ({d['name']})"
         try:
-            built.append(BUILDERS[d["type"]](d, where))
+            built.append(BUILDERS[d["type"]](d, where, units))
         except DesignError:
             raise
         except (NoSolutionError, ValueError) as e:
@@ -270,67 +324,147 @@ def build(source: str | Path | dict) -> tuple[str, list[Built]]:
 # -------------------------------------------------------------- writing
 
 
+def missing_cad_extra() -> list[str]:
+    """The packages of the ``cad`` extra that are not installed."""
+    return [name for name in CAD_EXTRA if find_spec(name) is None]
+
+
+@dataclass
+class Written:
+    """What ``write`` produced: the files, and what it could not write without the CAD extra."""
+
+    files: list[Path]
+    skipped: list[str]
+
+
 def write(
-    built: list[Built], out: str | Path, units: str = "m", progress: Callable[[str], None] = print
-) -> list[Path]:
-    """Write STEP, IGES, DXF, SVG, plots, tables and a continuity report per design.
+    built: list[Built], out: str | Path, units: str, progress: Callable[[str], None] = print, plots: bool = True
+) -> Written:
+    """Write every output of every design into ``out`` (see the module docstring).
 
-    Files go to a temporary folder first and move into ``out`` only when all
-    of them were written.
+    Per design: STEP and SVG (always), the stationing CSV of alignments, and
+    with the ``cad`` extra IGES, DXF, the plan and curvature plots (unless
+    ``plots`` is False) and the continuity report of the STEP file as OCCT
+    reads it. Without the extra those are skipped and named in
+    ``Written.skipped``.
+
+    Raises:
+        DesignError: ``out`` is a file, or cannot be created.
     """
-    from .cad.continuity import check_continuity
-    from .export import export_dxf, export_iges, export_step, export_svg
-
     out = Path(out)
-    out.mkdir(parents=True, exist_ok=True)
-    written: list[Path] = []
-    with tempfile.TemporaryDirectory(dir=out) as tmp:
-        stage = Path(tmp)
-        for b in built:
-            progress(f"  {b.name}: {b.kind}, {len(b.chain)} segments, length {b.chain.length:.6g} {units}")
-            files = {ext: stage / f"{b.name}.{ext}" for ext in ("step", "igs", "dxf", "svg")}
-            export_step(b.chain, files["step"])
-            export_iges(b.chain, files["igs"])
-            export_dxf(b.chain, files["dxf"])
-            export_svg(b.chain, files["svg"])
-            report = check_continuity(files["step"])
-            b.notes["continuity"] = str(report.min_level)
-            (stage / f"{b.name}_continuity.txt").write_text(report.format_table() + "\n", encoding="utf-8")
-            _plots(b, stage)
-            if hasattr(b.source, "to_csv"):
-                b.source.to_csv(stage / f"{b.name}_stations.csv")
-        for path in sorted(stage.iterdir()):
-            target = out / path.name
-            shutil.move(str(path), target)
-            written.append(target)
-    return written
+    if out.exists() and not out.is_dir():
+        raise DesignError(f"--out {str(out)!r} is a file, not a folder")
+    try:
+        out.mkdir(parents=True, exist_ok=True)
+    except OSError as e:
+        raise DesignError(f"cannot create the output folder {str(out)!r}: {e.strerror}") from None
+    _remove_stale_staging(out)
+    missing = missing_cad_extra()
+    stage = Path(tempfile.mkdtemp(prefix=f"{STAGING_PREFIX}{os.getpid()}-", dir=out))
+    try:
+        with _interrupts_raise():
+            for b in built:
+                started = time.perf_counter()
+                names = _write_design(b, stage, units, missing, plots)
+                progress(
+                    f"  {b.name}: {b.kind}, {len(b.chain)} segments, length {b.chain.length:.6g} {units} "
+                    f"→ {', '.join(names)} ({time.perf_counter() - started:.1f} s)"
+                )
+            written = []
+            for path in sorted(stage.iterdir()):
+                target = out / path.name
+                os.replace(path, target)
+                written.append(target)
+    finally:
+        shutil.rmtree(stage, ignore_errors=True)
+    skipped = [f"{CAD_EXTRA[name]} (needs {name})" for name in missing if plots or name != "matplotlib"]
+    return Written(written, skipped)
+
+
+def _write_design(b: Built, stage: Path, units: str, missing: list[str], plots: bool) -> list[str]:
+    """Write one design's files into ``stage``; returns the suffixes written."""
+    from .export import export_step, export_svg
+
+    step = stage / f"{b.name}.step"
+    export_step(b.chain, step, name=b.name)
+    export_svg(b.chain, stage / f"{b.name}.svg", name=b.name)
+    names = ["step", "svg"]
+    if hasattr(b.source, "to_csv"):
+        b.source.to_csv(stage / f"{b.name}_stations.csv")
+        names.append("stations.csv")
+    if "OCP" not in missing:
+        from .cad.continuity import check_continuity
+        from .export import export_iges
+
+        export_iges(b.chain, stage / f"{b.name}.igs", name=b.name)
+        report = check_continuity(step, label=step.name, units=units)
+        b.notes["continuity"] = f"{report.min_level} ({report.describe()})"
+        (stage / f"{b.name}_continuity.txt").write_text(report.format_table() + "\n", encoding="utf-8")
+        names += ["igs", "continuity.txt"]
+    if "ezdxf" not in missing:
+        from .export import export_dxf
+
+        export_dxf(b.chain, stage / f"{b.name}.dxf", name=b.name)
+        names.append("dxf")
+    if plots and "matplotlib" not in missing:
+        _plots(b, stage)
+        names.append("png")
+    return names
 
 
 def _plots(b: Built, stage: Path) -> None:
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
     from .plots import plot_curvature, plot_plan
 
     for suffix, plot in (("plan", plot_plan), ("curvature", plot_curvature)):
         fig = plot(b.chain)
         fig.suptitle(f"{b.name} — {b.kind}")
         fig.savefig(stage / f"{b.name}_{suffix}.png", dpi=110)
-        plt.close(fig)
 
 
-def summary(built: list[Built], units: str = "m") -> str:
+def _remove_stale_staging(out: Path) -> None:
+    """Remove staging folders left by builds that were killed outright (SIGKILL cannot be caught)."""
+    for folder in out.glob(f"{STAGING_PREFIX}*"):
+        pid = folder.name[len(STAGING_PREFIX) :].split("-")[0]
+        if pid.isdigit() and not _alive(int(pid)):
+            shutil.rmtree(folder, ignore_errors=True)
+
+
+def _alive(pid: int) -> bool:
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except PermissionError:
+        return True
+    return True
+
+
+@contextmanager
+def _interrupts_raise() -> Iterator[None]:
+    """Turn SIGTERM and SIGHUP into KeyboardInterrupt while files are written, so cleanup runs."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+
+    def interrupt(signum, frame):
+        raise KeyboardInterrupt(f"signal {signum}")
+
+    names = [s for s in ("SIGTERM", "SIGHUP") if hasattr(signal, s)]
+    previous = {name: signal.signal(getattr(signal, name), interrupt) for name in names}
+    try:
+        yield
+    finally:
+        for name, handler in previous.items():
+            signal.signal(getattr(signal, name), handler)
+
+
+def summary(built: list[Built], units: str) -> str:
     """One line per design: kind, segments, length, peak |κ| and the checked continuity."""
-    import numpy as np
-
-    head = f"{'design':14} {'kind':30} {'segments':>8} {'length ' + units:>12} {'max |κ|':>10} {'continuity':>10}"
+    head = f"{'design':14} {'kind':30} {'segments':>8} {'length ' + units:>12} {'max |κ|':>10}  continuity (of the STEP file)"
     lines = [head, "-" * len(head)]
     for b in built:
-        s = np.linspace(0, b.chain.length, 4001)
-        peak = float(np.abs(b.chain.curvature_at(s)).max())
+        peak = max(max(abs(seg.start_curvature), abs(seg.end_curvature)) for seg in b.chain)  # spirals are monotone
         lines.append(
-            f"{b.name:14} {b.kind:30} {len(b.chain):8d} {b.chain.length:12.3f} {peak:10.5f} {b.notes.get('continuity', '-'):>10}"
+            f"{b.name:14} {b.kind:30} {len(b.chain):8d} {b.chain.length:12.3f} {peak:10.5f}  {b.notes.get('continuity', '-')}"
         )
     return "\n".join(lines)

@@ -84,18 +84,19 @@ def test_stationing_is_monotone_and_consistent():
     assert [a.length for a in arcs] == pytest.approx([c.arc_length for c in al.curves], rel=1e-9)
 
 
-def test_csv_round_trip(tmp_path):
-    al = Alignment.from_pis(PIS, [300.0, 400.0], spiral_angles=[(0.15, 0.35), 0.25])
+def test_csv_round_trip_with_units_in_the_headers(tmp_path):
+    al = Alignment.from_pis(PIS, [300.0, 400.0], spiral_angles=[(0.15, 0.35), 0.25], units="ft")
     path = al.to_csv(tmp_path / "stations.csv")
     with path.open() as f:
         rows = list(csv.DictReader(f))
     assert len(rows) == 2
+    assert {"radius [ft]", "TS [ft]", "peak_dk_ds_in [1/ft²]", "theta_in_deg"} <= set(rows[0])
     for row, curve in zip(rows, al.curves):
         assert int(row["pi"]) == curve.index
-        assert float(row["TS"]) == curve.ts and float(row["ST"]) == curve.st
+        assert float(row["TS [ft]"]) == curve.ts and float(row["ST [ft]"]) == curve.st
         assert float(row["theta_in_deg"]) == pytest.approx(math.degrees(curve.theta_in))
     text = al.table()
-    assert "TS" in text and "peak_dk_ds_in" in text and len(text.splitlines()) == 4
+    assert "TS [ft]" in text and "peak_dk_ds_in [1/ft²]" in text and len(text.splitlines()) == 4
 
 
 def test_curvature_rate_matches_finite_differences():

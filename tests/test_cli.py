@@ -36,7 +36,7 @@ def test_build_example_design_and_check_it(tmp_path):
     for name in ("rail", "loop", "cnc", "ramp"):
         assert main(["check", str(tmp_path / f"{name}.step"), "--require", "G2"]) == 0
     header = (tmp_path / "rail_stations.csv").read_text().splitlines()[0]
-    assert "TS" in header and "ST" in header
+    assert "TS [m]" in header and "ST [m]" in header
 
 
 def bad(path, edit):

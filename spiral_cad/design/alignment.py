@@ -8,7 +8,6 @@ result is one G2 :class:`~spiral_cad.Chain` plus a stationing table.
 
 from __future__ import annotations
 
-import csv
 import math
 from dataclasses import dataclass
 from pathlib import Path
@@ -24,6 +23,7 @@ from ..core._inputs import as_float, as_points, as_real_array
 from ..core._kernels import put_spiral, shape_g1
 from ..core.chain import JOIN_TOLERANCE, Chain
 from ..core.units import DEFAULT_UNITS
+from .tables import text_table, write_csv
 from ..core.errors import NoSolutionError
 from ..core.spiral import BezierSpiral
 from ..core.transitions import Transition, line_to_circle
@@ -239,26 +239,25 @@ class Alignment:
         return self.start_station + self.chain.length
 
     def table(self, digits: int = 8) -> str:
-        """The stationing table as aligned text (for printing)."""
-        rows = self.rows()
-        head = list(rows[0])
-        cells = [[f"{v:.{digits}g}" if isinstance(v, float) else str(v) for v in row.values()] for row in rows]
-        widths = [max(len(h), *(len(c[k]) for c in cells)) for k, h in enumerate(head)]
-        lines = ["  ".join(h.rjust(w) for h, w in zip(head, widths))]
-        lines += ["  ".join(c.rjust(w) for c, w in zip(row, widths)) for row in cells]
-        lines.append(f"start {self.start_station:.{digits}g}  end {self.end_station:.{digits}g}  length {self.chain.length:.{digits}g}")
-        return "\n".join(lines)
+        """The stationing table as aligned text (for printing), units in the headers."""
+        units = self.chain.units
+        return (
+            text_table(self.rows(), STATION_DIMENSIONS, units, digits)
+            + f"\nstart {self.start_station:.{digits}g}  end {self.end_station:.{digits}g}  "
+            f"length {self.chain.length:.{digits}g} {units}"
+        )
 
     def to_csv(self, path: str | Path) -> Path:
-        """Write the stationing table (one row per PI curve, full precision) to ``path``."""
-        path = Path(path)
-        rows = self.rows()
-        with path.open("w", newline="") as f:
-            writer = csv.DictWriter(f, fieldnames=list(rows[0]))
-            writer.writeheader()
-            for row in rows:
-                writer.writerow({k: repr(v) if isinstance(v, float) else v for k, v in row.items()})
-        return path
+        """Write the stationing table (one row per PI curve, full precision, units in the headers) to ``path``."""
+        return write_csv(path, self.rows(), STATION_DIMENSIONS, self.chain.units)
+
+
+#: Dimension of each stationing column (``L`` the design's length unit).
+STATION_DIMENSIONS = {
+    **dict.fromkeys(["x", "y", "radius", "spiral_in_length", "arc_length", "spiral_out_length"], "L"),
+    **dict.fromkeys(["TS", "SC", "CS", "ST"], "L"),
+    **dict.fromkeys(["peak_dk_ds_in", "mean_dk_ds_in", "peak_dk_ds_out", "mean_dk_ds_out"], "1/L²"),
+}
 
 
 def _per_pi(value: Any, count: int, name: str) -> NDArray:
