@@ -3,6 +3,10 @@ PYTHON ?= python3
 VENV   := .venv
 BIN    := $(VENV)/bin
 STAMP  := $(VENV)/.installed
+# OpenDRIVE validators (ASAM quality checker with the 1.8 XSD, pyxodr): they pin
+# numpy < 2, so they live in their own small environment, never in .venv.
+TOOLS       := .venv-tools
+TOOLS_STAMP := $(TOOLS)/.installed
 
 .PHONY: setup demo test bench pictures clean
 
@@ -14,13 +18,20 @@ $(STAMP): requirements.lock pyproject.toml
 	$(BIN)/python -m pip check
 	touch $(STAMP)
 
+$(TOOLS_STAMP): tools/xodr-tools.lock
+	test -x $(TOOLS)/bin/python || $(PYTHON) -m venv $(TOOLS)
+	$(TOOLS)/bin/python -m pip install -q pip==26.3
+	$(TOOLS)/bin/python -m pip install -q -r tools/xodr-tools.lock
+	$(TOOLS)/bin/python -m pip check
+	touch $(TOOLS_STAMP)
+
 setup: $(STAMP)
 
 demo: $(STAMP)
 	$(BIN)/spiral-cad demo --out out
 
-test: $(STAMP)
-	$(BIN)/python -m pytest -q
+test: $(STAMP) $(TOOLS_STAMP)
+	SPIRAL_CAD_XODR_TOOLS=$(abspath $(TOOLS))/bin/python $(BIN)/python -m pytest -q
 
 bench: $(STAMP)
 	$(BIN)/python benchmarks/bench_core.py --out benchmarks/results_core.md
@@ -31,4 +42,4 @@ pictures: $(STAMP)
 	$(BIN)/python docs/make_pictures.py
 
 clean:
-	rm -rf $(VENV) out .pytest_cache .hypothesis
+	rm -rf $(VENV) $(TOOLS) out build .pytest_cache .hypothesis

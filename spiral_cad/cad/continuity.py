@@ -5,30 +5,8 @@ OCCT's own tools do not answer this question: ``GeomLProp``/``BRepLProp``
 where the curvature is zero — exactly at a spiral's start. So the joint
 quantities are measured here from first and second derivatives.
 
-Measures at the joint from edge *a* (its end) to edge *b* (its start), both
-in travel order (a REVERSED edge runs from its curve's last parameter to its
-first):
-
-* **gap** — distance between the two points, in model units.
-* **angle** — angle between the unit tangents, in radians.
-* **curvature jump** — ``|K_a − K_b|`` with the curvature vector
-  ``K = κ·N = ((r' × r'') × r') / |r'|⁴`` (1/model unit). ``K`` is defined
-  where κ = 0 (it is the zero vector) and does not depend on the direction
-  of travel, so it works for 3-D wires and reversed edges alike.
-
-Classification (tolerances are keyword arguments of :func:`check_continuity`):
-
-* ``G0``: gap ≤ ``gap_tol`` — an **absolute** length in model units (the
-  unit the file was read in; STEP and IGES files are read in millimetres),
-  plus what float64 rounding can hide at that coordinate (16 ulp of its
-  largest coordinate), so survey coordinates are not failed on their last bit.
-* ``G1``: G0 and angle ≤ ``angle_tol`` (absolute, radians).
-* ``G2``: G1 and curvature jump ≤ ``curvature_tol · scale`` — **relative**
-  with ``scale = max(|K_a|, |K_b|, 1/size)``, ``size`` being the diagonal of
-  the bounding box of the checked edges' start, middle and end points. The
-  floor ``1/size`` keeps joints between straight and almost-straight pieces
-  from failing on rounding noise.
-* otherwise ``none`` (disconnected).
+Measures and classification: ``spiral_cad.formats.joints`` (shared with the
+OpenDRIVE checker).
 
 Pieces: every wire is one piece, judged in wire order (with the closing
 joint of a closed wire). Edges that belong to no wire are chained by nearest
@@ -46,9 +24,7 @@ import argparse
 import math
 import os
 import sys
-from collections.abc import Sequence
 from dataclasses import dataclass
-from enum import IntEnum
 from typing import Any
 
 import numpy as np
@@ -69,6 +45,19 @@ from OCP.TopoDS import (
 )
 from OCP.TopTools import TopTools_IndexedMapOfShape
 
+from ..formats.joints import (
+    Continuity,
+    ContinuityReport,
+    Frame,
+    JointReport,
+    WireReport,
+    check_tolerances,
+    classify_pieces,
+    diagonal,
+    distance,
+    flip,
+    print_report,
+)
 from .occ import as_occ_shape, read_shape
 
 __all__ = ["Continuity", "ContinuityReport", "JointReport", "WireReport", "check_continuity"]
@@ -76,176 +65,13 @@ __all__ = ["Continuity", "ContinuityReport", "JointReport", "WireReport", "check
 #: Loose edges whose ends lie closer than this fraction of the model size are
 #: chained into one piece (and their gap is then judged against ``gap_tol``).
 SNAP_FRACTION = 1e-2
-#: A gap of this many ulp of the joint's largest coordinate is float64 rounding, not a gap.
-ROUNDING_ULPS = 16
 
-
-
-class Continuity(IntEnum):
-    """Geometric continuity level of a joint; compares as none < G0 < G1 < G2."""
-
-    NONE = 0
-    G0 = 1
-    G1 = 2
-    G2 = 3
-
-    def __str__(self) -> str:
-        return "none" if self is Continuity.NONE else self.name
-
-    @classmethod
-    def parse(cls, value: str | int | Continuity) -> Continuity:
-        """The level named ``"none"``, ``"G0"``, ``"G1"`` or ``"G2"`` (case-insensitive), or an int 0–3."""
-        if isinstance(value, str):
-            key = value.strip().upper()
-            if key in ("NONE", "G0", "G1", "G2"):
-                return cls[key]
-            raise ValueError(f"continuity level must be one of none, G0, G1, G2; got {value!r}")
-        try:
-            return cls(value)
-        except ValueError:
-            raise ValueError(f"continuity level must be one of none, G0, G1, G2 (0–3); got {value!r}") from None
-
-
-@dataclass(frozen=True)
-class JointReport:
-    """Measurements at the joint from edge ``index`` to edge ``index + 1`` (mod the edge count).
-
-    Attributes:
-        index: joint number; the closing joint of a closed wire is the last.
-        gap: distance between the two end points (model units).
-        angle: angle between the unit tangents (radians).
-        curvature_jump: ``|K_a − K_b|`` of the curvature vectors (1/model unit).
-        level: the continuity the tolerances grant.
-        curvature_before: curvature magnitude at the end of edge ``index``.
-        curvature_after: curvature magnitude at the start of the next edge.
-        relative_curvature_jump: ``curvature_jump / max(|K_a|, |K_b|, 1/size)``,
-            the value compared with ``curvature_tol``.
-    """
-
-    index: int
-    gap: float
-    angle: float
-    curvature_jump: float
-    level: Continuity
-    curvature_before: float = 0.0
-    curvature_after: float = 0.0
-    relative_curvature_jump: float = 0.0
-
-
-@dataclass(frozen=True)
-class WireReport:
-    """The joints of one wire (or one chain of loose edges) in travel order.
-
-    Attributes:
-        index: position in the report.
-        edge_count: non-degenerate edges in the piece.
-        closed: the last edge ends where the first starts (shared vertex or
-            within ``gap_tol``); the closing joint is then reported last.
-        joints: one report per joint.
-        loose: True for a chain assembled from edges that belong to no wire.
-    """
-
-    index: int
-    edge_count: int
-    closed: bool
-    joints: tuple[JointReport, ...]
-    loose: bool = False
-
-    @property
-    def min_level(self) -> Continuity:
-        """Worst joint level (G2 when there is no joint)."""
-        return min((j.level for j in self.joints), default=Continuity.G2)
-
-
-@dataclass(frozen=True)
-class ContinuityReport:
-    """Joint continuity of every piece (wire or chain of loose edges) of a shape.
-
-    Attributes:
-        wires: one report per piece.
-        gap_tol, angle_tol, curvature_tol: the tolerances used.
-        size: the model size behind the relative curvature floor.
-        snap: the distance within which loose ends were chained.
-        source: file name or shape description, for the table heading.
-    """
-
-    wires: tuple[WireReport, ...]
-    gap_tol: float
-    angle_tol: float
-    curvature_tol: float
-    size: float
-    snap: float = 0.0
-    source: str = ""
-
-    @property
-    def joints(self) -> list[JointReport]:
-        """All joints of all pieces."""
-        return [j for w in self.wires for j in w.joints]
-
-    @property
-    def pieces(self) -> int:
-        """How many separate pieces the shape holds (wires plus chains of loose edges)."""
-        return len(self.wires)
-
-    @property
-    def min_level(self) -> Continuity:
-        """Worst joint level over all pieces (G2 when there is no joint)."""
-        return min((w.min_level for w in self.wires), default=Continuity.G2)
-
-    def passes(self, required: str | int | Continuity, pieces: int = 1) -> bool:
-        """True when every joint reaches ``required`` (e.g. ``"G2"``) and the
-        shape holds exactly ``pieces`` separate pieces (default one path)."""
-        return self.pieces == pieces and self.min_level >= Continuity.parse(required)
-
-    def describe(self) -> str:
-        """What was found, e.g. ``"1 wire of 13 edges"`` or ``"1 wire of 5 edges and 2 loose pieces (3, 1 edges)"``."""
-        parts = []
-        for loose, noun in ((False, "wire"), (True, "loose piece")):
-            counts = [w.edge_count for w in self.wires if w.loose == loose]
-            if len(counts) == 1:
-                parts.append(f"1 {noun} of {_edges(counts[0])}")
-            elif counts:
-                parts.append(f"{len(counts)} {noun}s ({', '.join(map(str, counts))} edges)")
-        return " and ".join(parts) or "no edges"
-
-    def format_table(self) -> str:
-        """Readable text: what was found, then a heading per piece and one line per joint."""
-        out = [
-            f"{self.source or 'shape'}: {self.describe()}; worst joint {self.min_level}",
-            f"  tolerances: gap {self.gap_tol:g} (model units), angle {self.angle_tol:g} rad, "
-            f"curvature jump {self.curvature_tol:g} relative; loose ends snapped within {self.snap:.3g}; "
-            f"model size {self.size:.6g}",
-        ]
-        head = f"  {'joint':>5} {'gap':>10} {'angle rad':>10} {'κ before':>11} {'κ after':>11} {'|Δκ|':>10} {'Δκ rel':>9} level"
-        for w in self.wires:
-            kind = "loose piece" if w.loose else "wire"
-            out.append(
-                f"{kind} {w.index}: {_edges(w.edge_count)}, {'closed' if w.closed else 'open'}, "
-                f"{len(w.joints)} joint(s), worst {w.min_level}"
-            )
-            if w.joints:
-                out.append(head)
-            for j in w.joints:
-                out.append(
-                    f"  {j.index:5d} {j.gap:10.3e} {j.angle:10.3e} {j.curvature_before:11.5g} {j.curvature_after:11.5g} "
-                    f"{j.curvature_jump:10.3e} {j.relative_curvature_jump:9.2e} {j.level}"
-                )
-        return "\n".join(out)
-
-
-def _edges(count: int) -> str:
-    return f"{count} edge" + ("" if count == 1 else "s")
 
 
 # --------------------------------------------------------------- input
 
 
 # ---------------------------------------------------- edge end frames
-
-# An end frame is a 9-tuple of floats: point, unit tangent (travel sense)
-# and curvature vector. Plain floats: cheaper than numpy for 3-vectors.
-Frame = tuple[float, float, float, float, float, float, float, float, float]
-
 
 def _frame(curve: BRepAdaptor_Curve, u: float, inward: float) -> Frame:
     """Frame at parameter ``u`` in the curve's parameter direction; ``inward`` (±1) points into the edge."""
@@ -293,13 +119,8 @@ def _edge_ends(edge: TopoDS_Edge) -> tuple[Frame, Frame, tuple[float, float, flo
     mid = curve.Value(0.5 * (u0 + u1))
     middle = (mid.X(), mid.Y(), mid.Z())
     if edge.Orientation() == TopAbs_REVERSED:
-        return _flip(last), _flip(first), middle
+        return flip(last), flip(first), middle
     return first, last, middle
-
-
-def _flip(f: Frame) -> Frame:
-    """The frame seen travelling the other way: the tangent flips, the curvature vector does not."""
-    return (f[0], f[1], f[2], -f[3], -f[4], -f[5], f[6], f[7], f[8])
 
 
 # ----------------------------------------------------------- grouping
@@ -406,40 +227,15 @@ def _chain_loose(ends: list[tuple[Frame, Frame]], snap: float, gap_tol: float) -
                 used[k] = True
                 start, end = ends[k]
                 if forward:  # joined at its start: as it is; at its end: run backwards
-                    piece.append((start, end) if at_start else (_flip(end), _flip(start)))
+                    piece.append((start, end) if at_start else (flip(end), flip(start)))
                 else:  # joined before the piece: its end meets our start
-                    piece.insert(0, (start, end) if not at_start else (_flip(end), _flip(start)))
-        closed = len(piece) > 1 and _distance(piece[-1][1], piece[0][0]) <= gap_tol
+                    piece.insert(0, (start, end) if not at_start else (flip(end), flip(start)))
+        closed = len(piece) > 1 and distance(piece[-1][1], piece[0][0]) <= gap_tol
         groups.append(_Group(piece, closed, True))
     return groups
 
 
-def _distance(a: Frame, b: Frame) -> float:
-    return math.sqrt((a[0] - b[0]) ** 2 + (a[1] - b[1]) ** 2 + (a[2] - b[2]) ** 2)
-
-
 # -------------------------------------------------------- measurement
-
-
-def _joint(index: int, a: Frame, b: Frame, gap_tol: float, angle_tol: float, curvature_tol: float, floor: float) -> JointReport:
-    """Measure and classify the joint from end frame ``a`` to start frame ``b``."""
-    gap = math.sqrt((a[0] - b[0]) ** 2 + (a[1] - b[1]) ** 2 + (a[2] - b[2]) ** 2)
-    gap_tol += ROUNDING_ULPS * math.ulp(max(abs(v) for v in a[:3]))
-    cx, cy, cz = a[4] * b[5] - a[5] * b[4], a[5] * b[3] - a[3] * b[5], a[3] * b[4] - a[4] * b[3]
-    angle = math.atan2(math.sqrt(cx * cx + cy * cy + cz * cz), a[3] * b[3] + a[4] * b[4] + a[5] * b[5])
-    ka = math.sqrt(a[6] * a[6] + a[7] * a[7] + a[8] * a[8])
-    kb = math.sqrt(b[6] * b[6] + b[7] * b[7] + b[8] * b[8])
-    jump = math.sqrt((a[6] - b[6]) ** 2 + (a[7] - b[7]) ** 2 + (a[8] - b[8]) ** 2)
-    relative = jump / max(ka, kb, floor)
-    if gap > gap_tol:
-        level = Continuity.NONE
-    elif angle > angle_tol:
-        level = Continuity.G0
-    elif relative > curvature_tol:
-        level = Continuity.G1
-    else:
-        level = Continuity.G2
-    return JointReport(index, gap, angle, jump, level, ka, kb, relative)
 
 
 def check_continuity(
@@ -477,9 +273,7 @@ def check_continuity(
         ValueError: an unreadable or incompletely read file (``ReadError``,
             with the reader's reason), or a negative/non-finite tolerance.
     """
-    for name, value in (("gap_tol", gap_tol), ("angle_tol", angle_tol), ("curvature_tol", curvature_tol)):
-        if not (isinstance(value, (int, float)) and math.isfinite(value) and value >= 0.0):
-            raise ValueError(f"{name} must be finite and ≥ 0; got {value!r}")
+    check_tolerances(gap_tol=gap_tol, angle_tol=angle_tol, curvature_tol=curvature_tol)
     if isinstance(shape_or_path, (str, os.PathLike)):
         source = os.path.basename(os.fspath(shape_or_path))
         shape = read_shape(shape_or_path, units)
@@ -487,30 +281,14 @@ def check_continuity(
         source = type(shape_or_path).__name__
         shape = as_occ_shape(shape_or_path)
     groups, loose_ends, points = _collect(shape)
-    size = _diagonal(points)
-    floor = 1.0 / size if size > 0.0 else 0.0
-    link = SNAP_FRACTION * size if snap is None else snap
-    if not (isinstance(link, (int, float)) and math.isfinite(link) and link >= 0.0):
-        raise ValueError(f"snap must be finite and ≥ 0; got {snap!r}")
+    link = SNAP_FRACTION * diagonal(points) if snap is None else snap
+    check_tolerances(snap=link)
     if loose_ends:
         groups += _chain_loose(loose_ends, link, gap_tol)
-    wires = []
-    for w, g in enumerate(groups):
-        ends = g.ends
-        pairs = len(ends) if g.closed else len(ends) - 1
-        joints = tuple(
-            _joint(i, ends[i][1], ends[(i + 1) % len(ends)][0], gap_tol, angle_tol, curvature_tol, floor)
-            for i in range(pairs)
-        )
-        wires.append(WireReport(w, len(ends), g.closed, joints, g.loose))
-    return ContinuityReport(tuple(wires), gap_tol, angle_tol, curvature_tol, size, link, label or source)
-
-
-def _diagonal(points: Sequence[tuple[float, float, float]]) -> float:
-    if not points:
-        return 0.0
-    xyz = np.array(points)
-    return float(np.linalg.norm(xyz.max(axis=0) - xyz.min(axis=0)))
+    pieces = [("loose piece" if g.loose else "wire", g.ends, g.closed) for g in groups]
+    return classify_pieces(
+        pieces, points, gap_tol=gap_tol, angle_tol=angle_tol, curvature_tol=curvature_tol, snap=link, source=label or source
+    )
 
 
 # ------------------------------------------------------------------ CLI
@@ -529,16 +307,4 @@ def main_check(args: argparse.Namespace) -> int:
     if not report.wires:
         print(f"error: {os.path.basename(args.file)!r} contains no edges to check", file=sys.stderr)
         return 2
-    print(report.format_table())
-    if not args.require:
-        return 0
-    expected = 1 if args.pieces is None else args.pieces
-    if report.pieces != expected:
-        hint = "" if args.pieces is not None else " (pass --pieces N if the file holds N separate paths)"
-        print(f"FAIL: {report.describe()}: {report.pieces} separate pieces, expected {expected}{hint}")
-        return 1
-    if not report.passes(args.require, expected):
-        print(f"FAIL: worst joint is {report.min_level}, below the required {args.require}")
-        return 1
-    print(f"OK: {report.describe()}, every joint at least {args.require}")
-    return 0
+    return print_report(report, args)
