@@ -50,7 +50,8 @@ DEMO_DESIGN: dict = {
             "type": "alignment",
             "pis": [[0, 0], [600, 120], [1150, -80], [1700, 260], [2300, 200]],
             "radii": [450, 400, 600],
-            "spiral_angles_deg": [[8, 8], [7, 10], 6],
+            "design_speed": 80,
+            "max_jerk": 0.6,
             "start_station": 10000,
         },
         {
@@ -77,13 +78,16 @@ PIP_CAD = 'pip install "spiral_cad[cad]"'
 
 
 def _write_design(design: dict | str, out: Path, plots: bool) -> int:
-    from .designfile import build, summary, write
+    from .designfile import build, criteria_tables, summary, write
 
     started = time.perf_counter()
     units, built = build(design)
     print(f"built {len(built)} design(s); writing to {out}/", flush=True)
     written = write(built, out, units, progress=lambda line: print(line, flush=True), plots=plots)
     print()
+    tables = criteria_tables(built)
+    if tables:
+        print(tables + "\n")
     print(summary(built, units))
     print(f"\nwrote {len(written.files)} files to {out}/ in {time.perf_counter() - started:.1f} s")
     if written.skipped:
@@ -119,6 +123,12 @@ def _build(args: argparse.Namespace) -> int:
 
 
 def _check(args: argparse.Namespace) -> int:
+    if Path(args.file).suffix.lower() == ".xodr":
+        from .formats.joints import print_report
+        from .formats.opendrive import check_opendrive
+
+        report = check_opendrive(args.file, gap_tol=args.gap_tol, angle_tol=args.angle_tol, curvature_tol=args.curvature_tol)
+        return print_report(report, args)
     if find_spec("OCP") is None:
         print(f"error: spiral-cad check reads STEP/IGES with OCCT, which comes with the CAD extra: {PIP_CAD}", file=sys.stderr)
         return 2
@@ -128,8 +138,8 @@ def _check(args: argparse.Namespace) -> int:
 
 
 def _add_check(sub: argparse._SubParsersAction) -> None:
-    check = sub.add_parser("check", help="report G0/G1/G2 continuity at every joint of a STEP/IGES file")
-    check.add_argument("file", help="a .step/.stp or .igs/.iges file")
+    check = sub.add_parser("check", help="report G0/G1/G2 continuity at every joint of a STEP, IGES or OpenDRIVE file")
+    check.add_argument("file", help="a .step/.stp, .igs/.iges or .xodr file (OpenDRIVE: one piece per road)")
     check.add_argument(
         "--require", choices=["G0", "G1", "G2"], help="exit 1 if any joint is below this level or the file is not in --pieces pieces"
     )
@@ -159,7 +169,8 @@ def main(argv: Sequence[str] | None = None) -> int:
             "examples:\n"
             "  spiral-cad demo --out out                  the built-in design: STEP, IGES, DXF, SVG, plots, CSV\n"
             "  spiral-cad build examples/design.json      your own design file (spiral-cad build --help for the format)\n"
-            "  spiral-cad check out/highway.step --require G2   G0/G1/G2 at every joint; exit 1 below G2"
+            "  spiral-cad check out/highway.step --require G2   G0/G1/G2 at every joint; exit 1 below G2\n"
+            "  spiral-cad check out/highway.xodr --require G2   the same for every road of an OpenDRIVE file"
         ),
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )

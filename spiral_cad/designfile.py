@@ -40,7 +40,20 @@ FORMAT = """\
      "pis": [[x, y], ...],               ≥ 3 points of intersection, in travel order
      "radii": [r, ...],                  one positive radius per interior PI (or one number)
      "spiral_angles_deg": [θ | [θin, θout], ...]   or "spiral_lengths": [L | [Lin, Lout], ...]
-     "start_station": 0},                optional chainage of the first PI
+                                         or neither, with "design_speed": the shortest spirals
+                                         that meet every criterion
+     "start_station": 0,                 optional chainage of the first PI
+     "design_speed": V,                  optional: km/h (metric units) or mph (in, ft)
+     "criteria": "road" | "rail",        default road; road keys: "max_jerk" (m/s³, 0.6),
+                                         "superelevation_max" (0.08), "side_friction",
+                                         "shift_min", "shift_max"; rail keys (mm, mm/s, mm/m):
+                                         "cant_max", "cant_deficiency_max", "cant_rate_max",
+                                         "cant_deficiency_rate_max", "cant_gradient_max",
+                                         "gauge", "cant"
+     "strict": false,                    true: a violated criterion is an error
+     "cross_section": {"driving_lanes": 1, "lane_width": 3.5, "shoulder_width": 2.5,
+                       "rule": "RHT"},   OpenDRIVE lanes (m)
+     "geo_reference": "+proj=utm ..."},  OpenDRIVE geoReference
     {"name": "oval", "type": "circle_chain",
      "circles": [{"center": [x, y], "radius": r}, ...]},   signed radius = travel sense (+ ccw)
     {"name": "robot", "type": "rounded_polyline",
@@ -220,10 +233,63 @@ def load(source: str | Path | dict) -> tuple[str, list[dict]]:
 # ------------------------------------------------------------- building
 
 
+#: Design-file keys of the criteria, by kind (values as the criteria classes take them).
+ROAD_KEYS = ("max_jerk", "superelevation_max", "side_friction", "shift_min", "shift_max")
+RAIL_KEYS = ("cant_max", "cant_deficiency_max", "cant_rate_max", "cant_deficiency_rate_max", "cant_gradient_max", "gauge", "cant")
+CROSS_SECTION_KEYS = {"driving_lanes": int, "lane_width": float, "shoulder_width": float, "rule": str}
+
+
+def _design_criteria(d: dict, where: str):
+    """The RoadCriteria / RailCriteria of an alignment design, or None."""
+    from .design import RailCriteria, RoadCriteria
+
+    kind = _choice(d.get("criteria", "road"), f"{where}.criteria", ("road", "rail"))
+    own, other = (ROAD_KEYS, RAIL_KEYS) if kind == "road" else (RAIL_KEYS, ROAD_KEYS)
+    stray = [k for k in other if k in d]
+    if stray:
+        raise DesignError(f"{where}: {', '.join(stray)} belong(s) to {'rail' if kind == 'road' else 'road'} criteria, not {kind}")
+    given = {k: _number(d[k], f"{where}.{k}") for k in own if k in d}
+    if "design_speed" not in d:
+        if given or "criteria" in d or "strict" in d:
+            raise DesignError(f"{where}: design criteria need design_speed")
+        return None
+    speed = _number(d["design_speed"], f"{where}.design_speed", positive=True)
+    try:
+        return (RoadCriteria if kind == "road" else RailCriteria)(speed, **given)
+    except ValueError as e:
+        raise DesignError(f"{where}: {e}") from None
+
+
+def _cross_section(d: dict, where: str):
+    from .formats.opendrive import CrossSection
+
+    value = d.get("cross_section", {})
+    if not isinstance(value, dict) or set(value) - set(CROSS_SECTION_KEYS):
+        raise DesignError(f"{where}.cross_section: must be an object with {', '.join(CROSS_SECTION_KEYS)}; got {value!r:.80}")
+    fields = {}
+    for key, kind in CROSS_SECTION_KEYS.items():
+        if key in value:
+            item = value[key]
+            if kind is str:
+                fields[key] = _choice(item, f"{where}.cross_section.{key}", ("RHT", "LHT"))
+            elif kind is int:
+                if isinstance(item, bool) or not isinstance(item, int) or not 1 <= item <= 10:
+                    raise DesignError(f"{where}.cross_section.{key}: must be an integer from 1 to 10; got {item!r:.80}")
+                fields[key] = item
+            else:
+                fields[key] = _number(item, f"{where}.cross_section.{key}")
+    try:
+        return CrossSection(**fields)
+    except ValueError as e:
+        raise DesignError(f"{where}.cross_section: {e}") from None
+
+
 def _alignment(d: dict, where: str, units: str) -> Built:
     from .design import Alignment
 
-    _fields(d, where, ("pis", "radii"), ("spiral_angles_deg", "spiral_lengths", "start_station"))
+    optional = ("spiral_angles_deg", "spiral_lengths", "start_station", "design_speed", "criteria", "strict",
+                "cross_section", "geo_reference") + ROAD_KEYS + RAIL_KEYS  # fmt: skip
+    _fields(d, where, ("pis", "radii"), optional)
     pis = _points(d["pis"], f"{where}.pis", 3)
     count = len(pis) - 2
     radii = d["radii"]
@@ -233,16 +299,26 @@ def _alignment(d: dict, where: str, units: str) -> Built:
         radii = [_number(r, f"{where}.radii[{i}]", positive=True) for i, r in enumerate(radii)]
     else:
         radii = _number(radii, f"{where}.radii", positive=True)
-    if ("spiral_angles_deg" in d) == ("spiral_lengths" in d):
-        raise DesignError(f"{where}: give exactly one of spiral_angles_deg and spiral_lengths")
+    criteria = _design_criteria(d, where)
+    if "spiral_angles_deg" in d and "spiral_lengths" in d:
+        raise DesignError(f"{where}: give at most one of spiral_angles_deg and spiral_lengths")
+    if criteria is None and "spiral_angles_deg" not in d and "spiral_lengths" not in d:
+        raise DesignError(f"{where}: give spiral_angles_deg, spiral_lengths or design_speed (to choose the spirals)")
     kw = {}
     if "spiral_angles_deg" in d:
         kw["spiral_angles"] = _pairs(d["spiral_angles_deg"], f"{where}.spiral_angles_deg", count, _degrees)
-    else:
+    elif "spiral_lengths" in d:
         kw["spiral_lengths"] = _pairs(d["spiral_lengths"], f"{where}.spiral_lengths", count, lambda v, w: _number(v, w, positive=True))
+    strict = d.get("strict", False)
+    if not isinstance(strict, bool):
+        raise DesignError(f"{where}.strict: must be true or false; got {strict!r:.80}")
+    geo = d.get("geo_reference")
+    if geo is not None and (not isinstance(geo, str) or len(geo) > 1000):
+        raise DesignError(f"{where}.geo_reference: must be a PROJ string; got {geo!r:.80}")
     start = _number(d.get("start_station", 0.0), f"{where}.start_station")
-    alignment = Alignment.from_pis(pis, radii, start_station=start, units=units, **kw)
-    return Built(d["name"], "alignment", alignment.chain, alignment)
+    alignment = Alignment.from_pis(pis, radii, start_station=start, units=units, criteria=criteria, strict=strict, **kw)
+    notes = {"cross_section": _cross_section(d, where), "geo_reference": geo}
+    return Built(d["name"], "alignment", alignment.chain, alignment, notes)
 
 
 def _circle_chain(d: dict, where: str, units: str) -> Built:
@@ -389,9 +465,16 @@ def _write_design(b: Built, stage: Path, units: str, missing: list[str], plots: 
     export_step(b.chain, step, name=b.name)
     export_svg(b.chain, stage / f"{b.name}.svg", name=b.name)
     names = ["step", "svg"]
-    if hasattr(b.source, "to_csv"):
+    if b.kind == "alignment":
+        from .export import export_opendrive
+
         b.source.to_csv(stage / f"{b.name}_stations.csv")
-        names.append("stations.csv")
+        export_opendrive(b.source, stage / f"{b.name}.xodr", name=b.name, cross_section=b.notes["cross_section"],
+                         geo_reference=b.notes["geo_reference"])  # fmt: skip
+        names += ["stations.csv", "xodr"]
+        if b.source.checks:
+            b.source.criteria_to_csv(stage / f"{b.name}_criteria.csv")
+            names.append("criteria.csv")
     if "OCP" not in missing:
         from .cad.continuity import check_continuity
         from .export import export_iges
@@ -456,6 +539,17 @@ def _interrupts_raise() -> Iterator[None]:
     finally:
         for name, handler in previous.items():
             signal.signal(getattr(signal, name), handler)
+
+
+def criteria_tables(built: list[Built]) -> str:
+    """The criteria table of every alignment designed with criteria, with its violations."""
+    parts = []
+    for b in built:
+        if b.kind == "alignment" and b.source.checks:
+            broken = sum(1 for c in b.source.checks if not c.ok)
+            verdict = "every curve meets the criteria" if not broken else f"{broken} curve(s) violate the criteria"
+            parts.append(f"{b.name}: {b.source.criteria_table()}\n{b.name}: {verdict}")
+    return "\n\n".join(parts)
 
 
 def summary(built: list[Built], units: str) -> str:

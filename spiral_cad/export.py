@@ -20,6 +20,7 @@ Each is exactly the same cubic; see README for what each round trip keeps.
 
 from __future__ import annotations
 
+import math
 import os
 from collections.abc import Iterable
 from pathlib import Path
@@ -27,10 +28,11 @@ from typing import Any
 
 from .core.chain import Chain
 from .core.units import DEFAULT_UNITS, length_unit
+from .formats.opendrive import CrossSection
 
 PathLike = str | os.PathLike
 
-__all__ = ["export_dxf", "export_iges", "export_step", "export_svg", "originating_system"]
+__all__ = ["CrossSection", "export_dxf", "export_iges", "export_opendrive", "export_step", "export_svg", "originating_system"]
 
 
 def originating_system() -> str:
@@ -134,3 +136,53 @@ def export_svg(obj: Chain | Iterable[Chain], path: PathLike, *, name: str | None
 
     chains = _require_chains(obj)
     write_svg(chains, path, _name(name, path), _units(chains, None), margin)
+
+
+def export_opendrive(
+    obj: Any,
+    path: PathLike,
+    *,
+    name: str | None = None,
+    cross_section: CrossSection = CrossSection(),
+    geo_reference: str | None = None,
+) -> None:
+    """Write ASAM OpenDRIVE 1.8: one road per alignment or chain, spirals as exact ``paramPoly3``.
+
+    An ``Alignment`` brings its start station (as ``userData``) and, when it
+    was designed with criteria, the superelevation of every curve (a
+    ``lateralProfile`` ramped along the spirals). See
+    ``spiral_cad.formats.opendrive`` for the mapping; lengths are converted
+    to metres, OpenDRIVE's unit.
+
+    Args:
+        obj: an ``Alignment``, a ``Chain``, or a list of them.
+        path: the .xodr file to write.
+        name: the header's and each road's name (default: the file name's stem).
+        cross_section: the lanes of every road (default: one 3.5 m driving
+            lane each way and 2.5 m shoulders).
+        geo_reference: a PROJ string for the header's ``geoReference``.
+
+    Raises:
+        ValueError: an unsupported object, or chains of different units.
+    """
+    from .design.alignment import Alignment
+    from .formats.opendrive import Banking, _Road, write_opendrive
+
+    items = list(obj) if isinstance(obj, (list, tuple)) else [obj]
+    if not items or not all(isinstance(i, (Alignment, Chain)) for i in items):
+        raise ValueError(f"expected an Alignment, a Chain or a list of them; got {type(obj).__name__}")
+    label = _name(name, path)
+    roads = []
+    for k, item in enumerate(items):
+        road_name = label if len(items) == 1 else f"{label}-{k + 1}"
+        if isinstance(item, Chain):
+            roads.append(_Road(item, road_name))
+            continue
+        banking = [
+            Banking(c.ts - item.start_station, c.sc - item.start_station, c.cs - item.start_station,
+                    c.st - item.start_station, check.cross_slope, math.copysign(1.0, c.deflection))
+            for c, check in zip(item.curves, item.checks)
+        ]  # fmt: skip
+        roads.append(_Road(item.chain, road_name, item.start_station, banking))
+    units = _units([r.chain for r in roads], None)
+    write_opendrive(roads, path, label, units, originating_system(), cross_section, geo_reference)

@@ -162,8 +162,10 @@ def test_malformed_input_names_pi(points, radii, pattern):
 
 
 def test_spec_errors():
-    with pytest.raises(ValueError, match="exactly one"):
+    with pytest.raises(ValueError, match="give spiral_angles or spiral_lengths, or design criteria"):
         Alignment.from_pis(PIS, 300.0)
+    with pytest.raises(ValueError, match="at most one of spiral_angles and spiral_lengths"):
+        Alignment.from_pis(PIS, 300.0, spiral_angles=0.1, spiral_lengths=50.0)
     with pytest.raises(ValueError, match=r"PI 2: exit spiral angle must lie in \(0, π/2\)"):
         Alignment.from_pis(PIS, 300.0, spiral_angles=[0.1, (0.1, 2.0)])
     with pytest.raises(ValueError, match="PI 1: entry spiral length must be positive"):

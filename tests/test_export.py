@@ -166,16 +166,15 @@ def test_files_declare_their_unit_so_readers_convert_to_the_right_size(tmp_path,
         assert_same_geometry(edge, seg, 1e-9, scale)
 
 
-def test_demo_highway_reads_back_as_2398180_mm(tmp_path):
+def test_demo_highway_in_metres_reads_back_in_millimetres(tmp_path):
     from spiral_cad.cli import DEMO_DESIGN
+    from spiral_cad.designfile import build
 
-    design = DEMO_DESIGN["designs"][0]
-    angles = [tuple(map(math.radians, a)) if isinstance(a, list) else math.radians(a) for a in design["spiral_angles_deg"]]
-    angles = [a if isinstance(a, tuple) else (a, a) for a in angles]
-    chain = Alignment.from_pis(design["pis"], design["radii"], spiral_angles=angles, units="m").chain
+    chain = build(DEMO_DESIGN)[1][0].chain
+    assert chain.units == "m" and 2398 < chain.length < 2399
     for fmt in WRITERS:
         WRITERS[fmt](chain, tmp_path / f"highway.{fmt}")
-        assert length_of(read_shape(tmp_path / f"highway.{fmt}")) == pytest.approx(2_398_180.013, abs=1e-3)
+        assert length_of(read_shape(tmp_path / f"highway.{fmt}")) == pytest.approx(chain.length * 1000, rel=1e-12)
 
 
 @pytest.mark.parametrize("fmt", sorted(WRITERS))

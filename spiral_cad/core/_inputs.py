@@ -48,8 +48,12 @@ def as_float(value: Any, name: str) -> float:
 
 def as_xy(value: Any, name: str) -> tuple[float, float]:
     """``value`` (a 2-sequence, or a 3-vector with z = 0) as two finite floats."""
-    if type(value) is tuple and len(value) == 2:  # the common case, checked cheaply
+    if type(value) is tuple and len(value) == 2:  # the common cases, checked cheaply
         return as_float(value[0], f"{name}[0]"), as_float(value[1], f"{name}[1]")
+    if type(value) is np.ndarray and value.shape == (2,) and value.dtype == np.float64:
+        x, y = value.tolist()
+        if math.isfinite(x) and math.isfinite(y):
+            return x, y
     if _refused(value):
         raise ValueError(f"{name} must be a 2-D point or vector; got {type(value).__name__} {value!r:.80}")
     try:

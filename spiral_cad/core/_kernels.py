@@ -348,6 +348,13 @@ def spiral_row(bx, by, dx, dy, theta, curvature, out):
     return OK, theta, NAN, NAN
 
 
+@jit
+def unit_spirals_batch(sin_t, cos_t, out):
+    """Theorem 3.1 spirals from the origin along +x, turning left by θ to end radius 1 (one per row)."""
+    for i in range(sin_t.shape[0]):
+        put_spiral(out[i], 0.0, 0.0, 1.0, 0.0, 0.0, 1.0, sin_t[i], cos_t[i], 1.0)
+
+
 # ------------------------------------------------------ line to circle
 
 

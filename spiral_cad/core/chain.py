@@ -11,6 +11,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from ._inputs import as_float, as_real_array, as_xy
 from .segments import Arc, Join, Line, Segment, measure_join
+from .spiral import BezierSpiral
 from .transitions import Transition
 from .units import DEFAULT_UNITS, length_unit
 
@@ -49,7 +50,8 @@ class Chain:
     """An ordered, G2-continuous path of ``Line``, ``Arc`` and ``BezierSpiral``.
 
     Consecutive segments must share end point, unit tangent and signed
-    curvature. Each joint is judged on its own scale, as the G2 checker
+    curvature. ``size`` is the diagonal of the box around the segments'
+    outlines (``Segment.outline``). Each joint is judged on its own scale, as the G2 checker
     judges files: with L_short and L_long the lengths of its two segments,
 
     * gap ≤ tol · L_short,
@@ -78,13 +80,14 @@ class Chain:
 
     def __init__(self, segments: Iterable[Segment], tolerance: float = JOIN_TOLERANCE, units: str = DEFAULT_UNITS):
         self._segments: tuple[Segment, ...] = _segment_tuple(segments)
+        BezierSpiral.measure_lengths(self._segments)
         self.tolerance = join_tolerance(tolerance)
         self.units = length_unit(units)
         lengths = np.array([s.length for s in self._segments])
         self._stations = np.concatenate([[0.0], np.cumsum(lengths)])
         if not math.isfinite(self._stations[-1]):
             raise ValueError(f"Chain length overflows float64 ({len(self)} segments)")
-        pts = np.array([p for s in self._segments for p in (s.start, s.end, s.point(0.5))])
+        pts = np.array([p for s in self._segments for p in s.outline()])
         self.size = float(math.hypot(*(pts.max(axis=0) - pts.min(axis=0)))) or 1.0
         if not math.isfinite(self.size):
             raise ValueError("Chain extent overflows float64")
@@ -132,6 +135,7 @@ class Chain:
             if not isinstance(part, (Transition, Segment)):
                 raise ValueError(f"parts[{i}] must be a Transition or a segment; got {type(part).__name__} {part!r:.80}")
         tolerance = join_tolerance(tolerance)
+        BezierSpiral.measure_lengths(s for p in parts for s in (p.spirals if isinstance(p, Transition) else [p]))
         if not parts:
             if start is None or end is None:
                 raise ValueError("Chain.join needs parts, or both start and end for a straight chain")

@@ -66,6 +66,12 @@ class Segment(ABC):
         """Parameters u where the arc length from the start equals ``s``."""
         return _u(s) / self.length
 
+    def outline(self) -> list[tuple[float, float]]:
+        """A few points whose box is about the segment's box (start, end and middle; a
+        spiral gives its control points, whose hull holds it)."""
+        mid = self.point(0.5)
+        return [self.ends[0][:2], self.ends[1][:2], (float(mid[0]), float(mid[1]))]
+
     def rounding_floor(self, at_end: bool) -> tuple[float, float, float]:
         """(gap, tangent angle, curvature) that float64 rounding of the stored
         coordinates can hide at the start or end (exact types: only the gap)."""
@@ -124,6 +130,9 @@ class Line(Segment):
 
     def __repr__(self) -> str:
         return f"Line({tuple(self._a)}, {tuple(self._b)})"
+
+    def outline(self) -> list[tuple[float, float]]:
+        return [self.ends[0][:2], self.ends[1][:2]]
 
     def _end_frames(self) -> tuple[End, End]:
         (ax, ay), (bx, by) = self._a.tolist(), self._b.tolist()

@@ -94,6 +94,9 @@ class BezierSpiral(Segment):
         """(4, 2) float64 control points in travel order (read-only)."""
         return self._cp
 
+    def outline(self) -> list[tuple[float, float]]:
+        return [tuple(p) for p in self._cp.tolist()]
+
     def _end_frames(self) -> tuple[End, End]:
         (x0, y0), (x1, y1), (x2, y2), (x3, y3) = self._cp.tolist()
         legs = ((x1 - x0, y1 - y0), (x2 - x1, y2 - y1), (x3 - x2, y3 - y2))
@@ -110,6 +113,14 @@ class BezierSpiral(Segment):
         (x0, y0), (x1, y1), (x2, y2), (x3, y3) = self._cp.tolist()
         ax, ay, bx, by = x1 - x0, y1 - y0, x3 - x2, y3 - y2
         return math.atan2(ax * by - ay * bx, ax * bx + ay * by)
+
+    @classmethod
+    def measure_lengths(cls, spirals) -> None:
+        """Measure the arc lengths of many spirals in one vectorised quadrature (each caches its own)."""
+        todo = [s for s in spirals if isinstance(s, cls) and s._length is None]
+        if todo:
+            for spiral, length in zip(todo, bezier.arc_length(np.stack([s._cp for s in todo])).tolist()):
+                spiral._length = length
 
     @property
     def length(self) -> float:

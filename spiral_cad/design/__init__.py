@@ -5,6 +5,7 @@ Pure numpy/numba: nothing here imports a CAD kernel.
 
 from .alignment import Alignment, CurveData, curvature_rate, peak_curvature_rate
 from .circles import CircleChain, circle_chain
+from .criteria import CriteriaRow, RailCriteria, RoadCriteria
 from .rounding import (
     CornerBatch,
     RoundedCorner,
@@ -18,7 +19,10 @@ __all__ = [
     "Alignment",
     "CircleChain",
     "CornerBatch",
+    "CriteriaRow",
     "CurveData",
+    "RailCriteria",
+    "RoadCriteria",
     "RoundedCorner",
     "RoundedPath",
     "circle_chain",

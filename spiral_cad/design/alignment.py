@@ -22,7 +22,8 @@ from ..core.bezier import curvature_rate, peak_curvature_rate  # noqa: F401  (pu
 from ..core._inputs import as_float, as_points, as_real_array
 from ..core._kernels import put_spiral, shape_g1
 from ..core.chain import JOIN_TOLERANCE, Chain
-from ..core.units import DEFAULT_UNITS
+from ..core.units import DEFAULT_UNITS, length_unit, speed_unit
+from .criteria import CRITERIA_DIMENSIONS, THETA_RANGE, Criteria, CriteriaRow, RailCriteria, RoadCriteria, length_factor
 from .tables import text_table, write_csv
 from ..core.errors import NoSolutionError
 from ..core.spiral import BezierSpiral
@@ -128,11 +129,21 @@ class CurveData:
 
 @dataclass(frozen=True)
 class Alignment:
-    """A horizontal alignment: the G2 chain from the first to the last PI and its curves."""
+    """A horizontal alignment: the G2 chain from the first to the last PI and its curves.
+
+    Attributes:
+        chain: the G2 chain (tangent–spiral–arc–spiral–tangent at every PI).
+        curves: one ``CurveData`` per interior PI.
+        start_station: chainage of the first PI.
+        criteria: the design criteria the curves were chosen or checked by, if any.
+        checks: one ``CriteriaRow`` per curve when there are criteria.
+    """
 
     chain: Chain
     curves: list[CurveData]
     start_station: float = 0.0
+    criteria: Criteria | None = None
+    checks: tuple[CriteriaRow, ...] = ()
 
     @classmethod
     def from_pis(
@@ -144,6 +155,11 @@ class Alignment:
         start_station: float = 0.0,
         tolerance: float = JOIN_TOLERANCE,
         units: str = DEFAULT_UNITS,
+        *,
+        design_speed: float | None = None,
+        max_jerk: float | None = None,
+        criteria: Criteria | None = None,
+        strict: bool = False,
     ) -> Alignment:
         """Build tangent–spiral–arc–spiral–tangent at every interior PI.
 
@@ -160,6 +176,20 @@ class Alignment:
                 also allows for the rounding of survey coordinates).
             units: length unit of the PIs, radii and spiral lengths (default
                 mm; road designs usually m or ft).
+            design_speed: V (km/h for metric units, mph for in/ft): judges
+                every curve by ``RoadCriteria(V, max_jerk)``.
+            max_jerk: C, the largest rate of change of lateral acceleration
+                (m/s³; default 0.6), with ``design_speed``.
+            criteria: a ``RoadCriteria`` or ``RailCriteria`` (instead of
+                ``design_speed``/``max_jerk``, with every value settable).
+            strict: raise when a given spiral or radius violates a criterion
+                (by default violations are listed in ``checks``).
+
+        With criteria and neither ``spiral_angles`` nor ``spiral_lengths``,
+        each spiral is the shortest that meets every criterion (its peak
+        dκ/ds, not the clothoid's mean, sets the jerk); when the criteria
+        conflict (the jerk needs more length than p_max or the deflection
+        allows) the error names the PI and the numbers.
 
         The circle centre lies at distance r·g1(θ_in) from the incoming
         tangent and r·g1(θ_out) from the outgoing one (Theorem 4.1), which
@@ -184,11 +214,23 @@ class Alignment:
                 raise ValueError(f"PI {k} and PI {k + 1} coincide at {pts[k].tolist()}")
         directions = seg / lengths[:, None]
         radius = _per_pi(radii, count, "radii")
-        if (spiral_angles is None) == (spiral_lengths is None):
-            raise ValueError("give exactly one of spiral_angles and spiral_lengths")
-        by_length = spiral_lengths is not None
-        spec = _sides(spiral_lengths if by_length else spiral_angles, count, "spiral_lengths" if by_length else "spiral_angles")
+        units = length_unit(units)
+        criteria = _criteria(design_speed, max_jerk, criteria)
         origin = float(as_float(start_station, "start_station"))
+        if spiral_angles is not None and spiral_lengths is not None:
+            raise ValueError("give at most one of spiral_angles and spiral_lengths")
+        by_length = spiral_lengths is not None
+        if spiral_angles is None and spiral_lengths is None:
+            if criteria is None:
+                raise ValueError("give spiral_angles or spiral_lengths, or design criteria (design_speed) to choose them")
+            bad = radius[~(radius > 0.0)]
+            if bad.size:
+                raise ValueError(f"PI {int(np.argmax(~(radius > 0.0))) + 1}: radius must be positive; got {bad[0]}")
+            shortest, longest = criteria.choose(radius, units)
+            spec = np.stack([shortest, shortest], axis=1)
+        else:
+            shortest = longest = None
+            spec = _sides(spiral_lengths if by_length else spiral_angles, count, "spiral_lengths" if by_length else "spiral_angles")
 
         solved = []
         for j in range(count):
@@ -203,6 +245,8 @@ class Alignment:
                 what = "folds straight back" if cos_d < 0.0 else "is collinear with its neighbours (zero deflection)"
                 raise ValueError(f"PI {i} at {pts[i].tolist()} {what}: no curve can be placed there")
             deflection = math.atan2(sin_d, cos_d)
+            if shortest is not None:
+                _check_choice(i, r, deflection, shortest[j], longest[j], criteria, units)
             if by_length:
                 for side, value in zip(("entry", "exit"), spec[j]):
                     if not value > 0.0:
@@ -226,13 +270,45 @@ class Alignment:
         _check_tangents(pts, lengths, directions, solved)
         parts: list[Transition] = [t for s in solved for t in s[:2]]
         chain = Chain.join(parts, pts[0], pts[-1], tolerance, units)
-        return cls(chain, _curve_data(chain, pts, solved, radius, origin), origin)
+        curves = _curve_data(chain, pts, solved, radius, origin)
+        checks = () if criteria is None else _judge(curves, criteria, units, shortest, longest, strict)
+        return cls(chain, curves, origin, criteria, checks)
 
     # ------------------------------------------------------- table
 
     def rows(self) -> list[dict[str, float]]:
-        """One dict per curve (see :meth:`CurveData.row`), in travel order."""
-        return [c.row() for c in self.curves]
+        """One dict per curve (see :meth:`CurveData.row`), in travel order; with a design
+        speed also the peak lateral jerk (roads) or cant deficiency rate (rail) of each spiral."""
+        rows = [c.row() for c in self.curves]
+        for row, check in zip(rows, self.checks):
+            name = check.quantity.replace(" ", "_")
+            row[f"{name}_in"], row[f"{name}_out"] = (float(v) for v in check.peak_rates)
+        return rows
+
+    def _dimensions(self) -> dict[str, str]:
+        extra = {}
+        for check in self.checks[:1]:
+            name = check.quantity.replace(" ", "_")
+            extra = {f"{name}_in": check.rate_unit, f"{name}_out": check.rate_unit, "limit": check.rate_unit}
+            extra["banking"] = "m/m" if check.rate_unit == "m/s³" else "mm"
+        return extra
+
+    def criteria_rows(self) -> list[dict[str, Any]]:
+        """One dict per curve: R vs R_min, L and its bounds, shifts, peak rates, banking, verdict."""
+        return [c.row() for c in self.checks]
+
+    def criteria_table(self, digits: int = 6) -> str:
+        """The criteria table as text (empty without criteria)."""
+        if not self.checks:
+            return ""
+        speed = f"design speed {self.criteria.design_speed:g} {speed_unit(self.chain.units)}"
+        return f"{type(self.criteria).__name__}, {speed}\n" + text_table(
+            self.criteria_rows(), {**CRITERIA_DIMENSIONS, **self._dimensions()}, self.chain.units, digits
+        )
+
+    def criteria_to_csv(self, path: str | Path) -> Path:
+        """Write the criteria table (units in the headers) to ``path``."""
+        return write_csv(path, self.criteria_rows(), {**CRITERIA_DIMENSIONS, **self._dimensions()}, self.chain.units)
 
     @property
     def end_station(self) -> float:
@@ -242,14 +318,14 @@ class Alignment:
         """The stationing table as aligned text (for printing), units in the headers."""
         units = self.chain.units
         return (
-            text_table(self.rows(), STATION_DIMENSIONS, units, digits)
+            text_table(self.rows(), {**STATION_DIMENSIONS, **self._dimensions()}, units, digits)
             + f"\nstart {self.start_station:.{digits}g}  end {self.end_station:.{digits}g}  "
             f"length {self.chain.length:.{digits}g} {units}"
         )
 
     def to_csv(self, path: str | Path) -> Path:
         """Write the stationing table (one row per PI curve, full precision, units in the headers) to ``path``."""
-        return write_csv(path, self.rows(), STATION_DIMENSIONS, self.chain.units)
+        return write_csv(path, self.rows(), {**STATION_DIMENSIONS, **self._dimensions()}, self.chain.units)
 
 
 #: Dimension of each stationing column (``L`` the design's length unit).
@@ -258,6 +334,59 @@ STATION_DIMENSIONS = {
     **dict.fromkeys(["TS", "SC", "CS", "ST"], "L"),
     **dict.fromkeys(["peak_dk_ds_in", "mean_dk_ds_in", "peak_dk_ds_out", "mean_dk_ds_out"], "1/L²"),
 }
+
+
+def _criteria(design_speed: Any, max_jerk: Any, criteria: Any) -> Criteria | None:
+    """The criteria object from ``criteria`` or from ``design_speed``/``max_jerk``."""
+    if criteria is not None:
+        if design_speed is not None or max_jerk is not None:
+            raise ValueError("give criteria, or design_speed and max_jerk, not both")
+        if not isinstance(criteria, (RoadCriteria, RailCriteria)):
+            raise ValueError(f"criteria must be a RoadCriteria or RailCriteria; got {type(criteria).__name__}")
+        return criteria
+    if design_speed is None:
+        if max_jerk is not None:
+            raise ValueError("max_jerk needs a design_speed")
+        return None
+    return RoadCriteria(design_speed) if max_jerk is None else RoadCriteria(design_speed, max_jerk)
+
+
+def _check_choice(i: int, r: float, deflection: float, shortest: float, longest: float, criteria: Criteria, units: str) -> None:
+    """Refuse, naming the PI and the numbers, when no spiral meets every criterion of curve ``i``."""
+    length = lambda theta: float(length_factor(theta) * r)  # noqa: E731
+    if math.isnan(shortest):
+        raise NoSolutionError(
+            f"PI {i}: no spiral onto R = {r:.6g} {units} up to θ = {math.degrees(THETA_RANGE[1]):.0f}° meets the "
+            f"criteria at {criteria.design_speed:g} {speed_unit(units)}; use a larger radius"
+        )
+    if shortest > longest * (1 + 1e-12):
+        raise NoSolutionError(
+            f"PI {i}: the criteria conflict at R = {r:.6g} {units}: the rate limits need spirals of at least "
+            f"{length(shortest):.6g} {units} (θ ≥ {math.degrees(shortest):.4g}°), the shift limit allows at most "
+            f"{length(longest):.6g} {units} (θ ≤ {math.degrees(longest):.4g}°); use a larger radius or relax the limits"
+        )
+    if 2.0 * shortest > abs(deflection):
+        raise NoSolutionError(
+            f"PI {i}: the shortest spirals that meet the criteria turn 2 × {math.degrees(shortest):.4g}° but the "
+            f"deflection is only {math.degrees(abs(deflection)):.4g}°; use a larger radius"
+        )
+
+
+def _judge(curves: list[CurveData], criteria: Criteria, units: str, shortest, longest, strict: bool) -> tuple[CriteriaRow, ...]:
+    """The criteria row of every curve; with ``strict`` any violation raises."""
+    radii = np.array([c.radius for c in curves])
+    if shortest is None:
+        shortest, longest = criteria.choose(radii, units)
+    spirals_low, spirals_high = (length_factor(np.nan_to_num(t, nan=THETA_RANGE[1])) * radii for t in (shortest, longest))
+    thetas = np.array([(c.theta_in, c.theta_out) for c in curves])
+    lengths = np.array([(c.spiral_in_length, c.spiral_out_length) for c in curves])
+    rates = np.array([(c.peak_rate_in, c.peak_rate_out) for c in curves])
+    bounds = np.stack([spirals_low, spirals_high], axis=1)
+    rows = tuple(criteria.evaluate([c.index for c in curves], radii, thetas, units, bounds, lengths, rates))
+    broken = [f"PI {row.pi}: {'; '.join(row.violations)}" for row in rows if row.violations]
+    if strict and broken:
+        raise NoSolutionError("design criteria violated: " + " | ".join(broken))
+    return rows
 
 
 def _per_pi(value: Any, count: int, name: str) -> NDArray:

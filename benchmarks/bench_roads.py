@@ -1,0 +1,68 @@
+"""Road design at scale: choosing spirals from criteria, OpenDRIVE out and in, plots, for long alignments.
+
+Run: ``.venv/bin/python benchmarks/bench_roads.py [--pis N ...] [--repeat R] [--out FILE]``.
+Prints a markdown table of medians over ``repeat`` runs for alignments of
+N PIs (a zigzag of 1 km tangents, R = 800 m, 80 km/h). Goals: choosing the
+spirals of 1 000 PIs and writing/reading their OpenDRIVE each well under a
+second; plots linear in the chain length. The peer is the same alignment
+built from given spiral angles (no criteria), measured in the same run.
+"""
+
+from __future__ import annotations
+
+import argparse
+import tempfile
+from pathlib import Path
+
+from timing import machine, median_time, write_markdown
+
+from spiral_cad.design import Alignment
+from spiral_cad.export import export_opendrive
+from spiral_cad.formats.opendrive import check_opendrive, read_opendrive
+
+
+def zigzag(count: int) -> list[list[float]]:
+    return [[1000.0 * k, 250.0 * (k % 2)] for k in range(count + 2)]
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--pis", type=int, nargs="+", default=[250, 1000, 4000])
+    parser.add_argument("--repeat", type=int, default=3)
+    parser.add_argument("--out", help="also write the table to this markdown file")
+    args = parser.parse_args()
+    rows = []
+    folder = Path(tempfile.mkdtemp())
+    for count in args.pis:
+        pis = zigzag(count)
+        given = median_time(lambda: Alignment.from_pis(pis, 800.0, spiral_angles=0.08, units="m"), args.repeat)
+        chosen = median_time(lambda: Alignment.from_pis(pis, 800.0, units="m", design_speed=80, max_jerk=0.6), args.repeat)
+        alignment = Alignment.from_pis(pis, 800.0, units="m", design_speed=80, max_jerk=0.6)
+        path = folder / "road.xodr"
+        write = median_time(lambda: export_opendrive(alignment, path), args.repeat)
+        read = median_time(lambda: read_opendrive(path)[0].chain(), args.repeat)
+        check = median_time(lambda: check_opendrive(path), args.repeat)
+        import matplotlib
+
+        matplotlib.use("Agg")
+        from spiral_cad.plots import plot_plan
+
+        plot = median_time(lambda: plot_plan(alignment.chain).savefig(folder / "plan.png", dpi=110), 1)
+        per_k = 1000.0 / count
+        rows.append([
+            f"{count:,}", f"{len(alignment.chain):,}", f"{given * per_k:.3f}", f"{chosen * per_k:.3f}",
+            f"{chosen / given:.2f}×", f"{write * per_k:.3f}", f"{read * per_k:.3f}", f"{check * per_k:.3f}", f"{plot:.2f}",
+        ])  # fmt: skip
+        print(" | ".join(rows[-1]), flush=True)
+    header = ["PIs", "segments", "given spirals, s/1000 PIs", "chosen by criteria, s/1000 PIs", "ratio",
+              "write .xodr, s/1000 PIs", "read .xodr → Chain, s/1000 PIs", "check .xodr, s/1000 PIs", "plot_plan + PNG, s"]  # fmt: skip
+    print("| " + " | ".join(header) + " |")
+    for row in rows:
+        print("| " + " | ".join(row) + " |")
+    print(f"machine: {machine()}")
+    if args.out:
+        write_markdown(args.out, "Road design at scale", f"Medians of {args.repeat} runs.", header, rows)
+
+
+if __name__ == "__main__":
+    main()
