@@ -38,6 +38,9 @@ def main() -> None:
         }
         for source, target in picks.items():
             shutil.copy(tmp / source, IMAGES / target)
+        from spiral_cad.plots import plot_jerk_length
+
+        plot_jerk_length().savefig(IMAGES / "jerk_length.png", dpi=100)
         tube = cq.importers.importStep(str(tmp / "cq" / "tube.step"))
         cq.exporters.export(
             tube, str(IMAGES / "cadquery_tube.svg"), opt={"projectionDir": (0.4, -1.0, 0.5), "showHidden": False}

@@ -124,6 +124,9 @@ def _build(args: argparse.Namespace) -> int:
 
 def _check(args: argparse.Namespace) -> int:
     if Path(args.file).suffix.lower() == ".xodr":
+        if args.comb:
+            print("error: --comb draws STEP/IGES edges; it does not apply to OpenDRIVE", file=sys.stderr)
+            return 2
         from .formats.joints import print_report
         from .formats.opendrive import check_opendrive
 
@@ -145,6 +148,7 @@ def _add_check(sub: argparse._SubParsersAction) -> None:
     )
     check.add_argument("--pieces", type=int, help="how many separate paths the file should hold (default 1, with --require)")
     check.add_argument("--snap", type=float, help="chain loose ends closer than this (model units; default 1%% of the model size)")
+    check.add_argument("--comb", metavar="OUT.step", help="also write the curvature comb of every edge as STEP (STEP/IGES input)")
     check.add_argument("--gap-tol", type=float, default=1e-7, help="G0 gap, absolute model units (default 1e-7)")
     check.add_argument("--angle-tol", type=float, default=1e-7, help="G1 tangent angle, radians (default 1e-7)")
     check.add_argument("--curvature-tol", type=float, default=1e-6, help="G2 curvature jump, relative (default 1e-6)")

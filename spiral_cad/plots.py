@@ -251,3 +251,43 @@ def plot_vs_clothoid(theta: float, curvature: float, ax: Axes | Sequence[Axes] |
     right.legend(loc="best", fontsize="small")
     right.grid(True, alpha=0.3)
     return fig
+
+
+def plot_jerk_length(design_speed: float = 80.0, max_jerk: float = 0.6, ax: Sequence[Axes] | None = None) -> Figure:
+    """How much longer a Bézier spiral must be than the clothoid rule for the same lateral jerk.
+
+    Left: the ratio L_Bézier / L_clothoid against the spiral angle θ, where
+    the Bézier spiral's *peak* jerk v³·max dκ/ds equals the clothoid's
+    constant v³/(R·L): it is ℓ(θ)·F(θ) (unit spiral's length × peak dκ/ds),
+    1.84 for small θ. Right: both lengths against the radius at
+    ``design_speed`` (km/h) and ``max_jerk`` (m/s³), metric units.
+    """
+    from .design.criteria import RoadCriteria, length_factor, peak_factor
+
+    if ax is None:
+        fig = Figure(figsize=(11, 4.5))
+        left, right = fig.subplots(1, 2)
+    else:
+        left, right = ax
+        fig = left.figure
+    theta = np.radians(np.linspace(0.5, 60.0, 400))
+    ratio = length_factor(theta) * peak_factor(theta)
+    left.plot(np.degrees(theta), ratio, color="tab:red", lw=1.8)
+    left.axhline(1.0, color="k", ls="--", lw=1.0, label="clothoid (dκ/ds constant)")
+    left.set_xlabel("spiral angle θ (°)")
+    left.set_ylabel("L_Bézier / L_clothoid at equal peak jerk")
+    left.set_title("Length needed for the same peak lateral jerk")
+    left.legend(loc="best", fontsize="small")
+    left.grid(True, alpha=0.3)
+    radii = np.linspace(150.0, 3000.0, 120)
+    criteria = RoadCriteria(design_speed, max_jerk, shift_min=0.0, shift_max=1e9)
+    shortest, _ = criteria.choose(radii, "m")
+    v = criteria.speed("m")
+    right.plot(radii, length_factor(shortest) * radii, color="tab:red", lw=1.8, label="Bézier spiral (peak jerk = C)")
+    right.plot(radii, v**3 / (radii * max_jerk), "k--", lw=1.4, label="clothoid rule L = v³/(R·C)")
+    right.set_xlabel("radius R (m)")
+    right.set_ylabel("spiral length L (m)")
+    right.set_title(f"V = {design_speed:g} km/h, C = {max_jerk:g} m/s³")
+    right.legend(loc="best", fontsize="small")
+    right.grid(True, alpha=0.3)
+    return fig

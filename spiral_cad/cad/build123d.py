@@ -17,16 +17,26 @@ from __future__ import annotations
 from collections.abc import Iterable
 
 from build123d import (
+    Align,
     BaseLineObject,
+    BaseSketchObject,
+    Builder,
     BuildLine,
+    BuildSketch,
+    Compound,
+    Face,
     Mode,
+    Sketch,
     SkipClean,
     Vector,
     VectorLike,
+    Vertex,
     Wire,
 )
 
 from ..core.chain import Chain
+from ..design.fillets import continuous_polygon, continuous_rectangle, continuous_slot
+from .fillet import fillet_face, fillet_wire
 from .occ import chain_wire
 from ..core.segments import Segment
 from ..core.transitions import (
@@ -37,7 +47,18 @@ from ..core.transitions import (
     line_to_line,
 )
 
-__all__ = ["SpiralChain", "SpiralCircleInCircle", "SpiralCircleToCircle", "SpiralLineToCircle", "SpiralLineToLine"]
+__all__ = [
+    "ContinuousPolygon",
+    "ContinuousRectangle",
+    "ContinuousSlot",
+    "SpiralChain",
+    "SpiralCircleInCircle",
+    "SpiralCircleToCircle",
+    "SpiralLineToCircle",
+    "SpiralLineToLine",
+    "curvature_comb",
+    "g2_fillet",
+]
 
 
 def _xy(value: VectorLike, name: str) -> tuple[float, float]:
@@ -214,3 +235,161 @@ class SpiralChain(_ExactLineObject):
             raise ValueError(f"chain must be a spiral_cad.Chain; got {chain!r}")
         super().__init__(_wire(chain), mode=mode)
         self.chain = chain
+
+
+# ------------------------------------------------------------------ G2 fillets
+
+
+def _points(vertices) -> list[tuple[float, float, float]] | None:
+    if vertices is None:
+        return None
+    items = [vertices] if isinstance(vertices, Vertex) else list(vertices)
+    for item in items:
+        if not isinstance(item, Vertex):
+            raise ValueError(f"vertices must be build123d Vertex objects; got {type(item).__name__}")
+    return [tuple(Vector(v)) for v in items]
+
+
+def g2_fillet(
+    target: Wire | Face | Sketch | Vertex | Iterable[Vertex],
+    radius: float,
+    vertices: Iterable[Vertex] | None = None,
+    transition: float = 0.5,
+    same_sense: str = "nested",
+) -> Wire | Face | Sketch:
+    """Operation: G2 Fillet
+
+    Round corners with curvature-continuous fillets ("continuous corners"):
+    each corner becomes transition → arc of ``radius`` → transition, joined G2
+    on both sides (``spiral_cad.design.fillets``), with exact LINE, CIRCLE and
+    BEZIER edges and a G2 closing joint.
+
+    Used like build123d's ``fillet``: given a planar ``Wire``, ``Face`` or
+    ``Sketch`` (on any plane) it returns the same kind with the chosen
+    corners (default: all) rounded; inside ``BuildSketch``/``BuildLine``,
+    given vertices (e.g. ``sketch.vertices()``), it rounds those vertices of
+    the builder's object and replaces it (``Mode.REPLACE``).
+
+    Args:
+        target: the shape to round, or the vertices to round in a builder.
+        radius (float): the smallest radius of curvature in each corner.
+        vertices (Iterable[Vertex], optional): corners to round; default all.
+        transition (float, optional): share of each corner's turn made by the
+            transitions, in (0, 1]; 1 gives a spiral pair with no arc. Defaults to 0.5
+        same_sense (str, optional): ``"nested"`` or ``"C"`` for an arc that
+            turns the same way as its corner. Defaults to "nested"
+
+    Raises:
+        ValueError: non-planar input, edges other than lines and arcs.
+        NoSolutionError: a corner that cannot be rounded (named, with numbers).
+    """
+    context = Builder._get_context("g2_fillet")
+    in_builder = isinstance(target, Vertex) or (
+        isinstance(target, Iterable) and not isinstance(target, (Wire, Face, Sketch, Compound))
+    )
+    if in_builder:
+        if context is None or context._obj is None:
+            raise ValueError("g2_fillet of vertices needs a BuildSketch or BuildLine with an object")
+        vertices, target = target, context._obj
+    points = _points(vertices)
+    if isinstance(target, Face) and not isinstance(target, Sketch):
+        result = Face(fillet_face(target.wrapped, radius, points, transition=transition, same_sense=same_sense))
+    elif isinstance(target, Wire) or (hasattr(target, "_dim") and target._dim == 1):
+        wire = target if isinstance(target, Wire) else Wire(target.wires()[0].wrapped)
+        result = Wire(fillet_wire(wire.wrapped, radius, points, transition=transition, same_sense=same_sense)[0])
+    elif isinstance(target, (Sketch, Compound)) and target.faces():
+        faces = [Face(fillet_face(f.wrapped, radius, points, transition=transition, same_sense=same_sense)) for f in target.faces()]
+        result = Sketch(Compound(faces).wrapped)
+    else:
+        raise ValueError(f"g2_fillet rounds a Wire, Face or Sketch; got {type(target).__name__}")
+    if in_builder:
+        context._add_to_context(result, mode=Mode.REPLACE)
+    return result
+
+
+class _ContinuousSketch(BaseSketchObject):
+    """A face bounded by a closed chain with continuous corners (``spiral_cad.design.fillets``)."""
+
+    _applies_to = [BuildSketch._tag]
+
+    def __init__(self, path, rotation: float, align, mode: Mode):
+        self.filleted = path  # the chain and the corners (build123d's Shape owns the name "path")
+        super().__init__(Face(path.chain.to_wire()), rotation, align, mode)
+
+
+class ContinuousRectangle(_ContinuousSketch):
+    """Sketch Object: Continuous Rectangle
+
+    A rectangle whose corners are G2 ("continuous corners"): spiral → arc of
+    ``radius`` → spiral, curvature continuous everywhere.
+
+    Args:
+        width (float): rectangle width
+        height (float): rectangle height
+        radius (float): the smallest radius of curvature of each corner
+        transition (float, optional): share of each corner's turn made by the spirals, in (0, 1]. Defaults to 0.5
+        rotation (float, optional): angle to rotate object. Defaults to 0
+        align (Align | tuple[Align, Align], optional): align MIN, CENTER, or MAX of object.
+            Defaults to (Align.CENTER, Align.CENTER)
+        mode (Mode, optional): combination mode. Defaults to Mode.ADD
+    """
+
+    def __init__(self, width: float, height: float, radius: float, transition: float = 0.5, rotation: float = 0,
+                 align: Align | tuple[Align, Align] | None = (Align.CENTER, Align.CENTER), mode: Mode = Mode.ADD):  # fmt: skip
+        super().__init__(continuous_rectangle(width, height, radius, transition), rotation, align, mode)
+
+
+class ContinuousPolygon(_ContinuousSketch):
+    """Sketch Object: Continuous Polygon
+
+    A regular polygon whose corners are G2 fillets.
+
+    Args:
+        radius (float): construction radius
+        side_count (int): number of sides
+        corner_radius (float): the smallest radius of curvature of each corner
+        transition (float, optional): share of each corner's turn made by the spirals. Defaults to 0.5
+        major_radius (bool, optional): radius is the circumscribed (True) or inscribed circle's. Defaults to True
+        rotation (float, optional): angle to rotate object. Defaults to 0
+        align (Align | tuple[Align, Align], optional): align MIN, CENTER, or MAX of object. Defaults to None
+        mode (Mode, optional): combination mode. Defaults to Mode.ADD
+    """
+
+    def __init__(self, radius: float, side_count: int, corner_radius: float, transition: float = 0.5,
+                 major_radius: bool = True, rotation: float = 0, align: Align | tuple[Align, Align] | None = None,
+                 mode: Mode = Mode.ADD):  # fmt: skip
+        path = continuous_polygon(radius, side_count, corner_radius, transition, major_radius)
+        super().__init__(path, rotation, align, mode)
+
+
+class ContinuousSlot(_ContinuousSketch):
+    """Sketch Object: Continuous Slot
+
+    A slot of overall ``width`` and ``height`` whose ends are curvature
+    continuous all the way round (each end: two G2 corners meeting in its middle).
+
+    Args:
+        width (float): overall width of slot
+        height (float): overall height (the width of the ends)
+        transition (float, optional): share of each 90° corner made by the spirals. Defaults to 0.5
+        rotation (float, optional): angle to rotate object. Defaults to 0
+        align (Align | tuple[Align, Align], optional): align MIN, CENTER, or MAX of object.
+            Defaults to (Align.CENTER, Align.CENTER)
+        mode (Mode, optional): combination mode. Defaults to Mode.ADD
+    """
+
+    def __init__(self, width: float, height: float, transition: float = 0.5, rotation: float = 0,
+                 align: Align | tuple[Align, Align] | None = (Align.CENTER, Align.CENTER), mode: Mode = Mode.ADD):  # fmt: skip
+        super().__init__(continuous_slot(width, height, transition), rotation, align, mode)
+
+
+def curvature_comb(shape_or_chain, scale: float | None = None, per_edge: int = 24) -> Compound:
+    """The curvature comb (teeth and envelope) of a chain, wire, face or part as a build123d ``Compound`` of edges.
+
+    Show it beside the part (CQ-editor, ``show``) to see where the curvature
+    jumps: a circular fillet's comb steps from nothing to 1/r, a G2 corner's
+    ramps.
+    """
+    from .continuity import curvature_comb as comb
+
+    return Compound(comb(shape_or_chain, scale=scale, per_edge=per_edge))

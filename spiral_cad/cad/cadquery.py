@@ -8,6 +8,11 @@ Importing this module adds these methods to ``cadquery.Workplane``:
 * ``spiralCircleInCircle(c0, r0, c1, r1)``
 * ``spiralTransition(transition)`` — an already solved ``Transition``
 * ``spiralChain(chain)`` — a whole ``spiral_cad.Chain`` as one wire
+* ``g2Fillet(radius, transition=0.5)`` — G2 fillets on every corner of the pending wires
+* ``continuousRect``, ``continuousPolygon``, ``continuousSlot2D`` — shapes with G2 corners
+
+and to ``cadquery.Sketch``: ``g2fillet(radius, transition=0.5)`` on the
+selected vertices (like ``Sketch.fillet``) and ``continuousRect``.
 
 All coordinates are 2-D and local to the workplane (``x`` along its
 ``xDir``, ``y`` along ``zDir × xDir``); radii are signed by travel sense as
@@ -37,6 +42,8 @@ import cadquery as cq
 from OCP.gp import gp_Ax3
 
 from ..core.chain import Chain
+from ..design.fillets import continuous_polygon, continuous_rectangle, continuous_slot
+from .fillet import fillet_face, fillet_wire
 from .occ import chain_wire, segment_edges
 from ..core.segments import Segment
 from ..core.transitions import (
@@ -47,9 +54,24 @@ from ..core.transitions import (
     line_to_line,
 )
 
-__all__ = ["METHODS", "plane_ax3", "spiralChain", "spiralCircleInCircle", "spiralCircleToCircle", "spiralLineToCircle", "spiralLineToLine", "spiralTransition"]
+__all__ = [
+    "METHODS",
+    "SKETCH_METHODS",
+    "continuousPolygon",
+    "continuousRect",
+    "continuousSlot2D",
+    "g2Fillet",
+    "plane_ax3",
+    "spiralChain",
+    "spiralCircleInCircle",
+    "spiralCircleToCircle",
+    "spiralLineToCircle",
+    "spiralLineToLine",
+    "spiralTransition",
+]
 
 W = TypeVar("W", bound=cq.Workplane)
+S = TypeVar("S", bound=cq.Sketch)
 
 
 def plane_ax3(plane: cq.Plane) -> gp_Ax3:
@@ -153,6 +175,48 @@ def spiralChain(self: W, chain: Chain, makeWire: bool = True, forConstruction: b
     return _push_edges(self, chain.segments, makeWire, forConstruction)
 
 
+def g2Fillet(self: W, radius: float, transition: float = 0.5, same_sense: str = "nested") -> W:
+    """Round every corner of the pending wires with G2 fillets (``spiral_cad.design.fillets``).
+
+    Each corner becomes transition → arc of ``radius`` → transition, curvature
+    continuous; the wires stay pending (e.g. for ``.extrude``).
+
+    Raises:
+        ValueError: no pending wires, non-planar wires or edges other than lines and arcs.
+        NoSolutionError: a corner that cannot be rounded (named, with numbers).
+    """
+    wires = list(self.ctx.pendingWires)
+    if not wires:
+        raise ValueError("g2Fillet rounds the pending wires; there are none (draw a closed wire first)")
+    rounded = [cq.Wire(fillet_wire(w.wrapped, radius, transition=transition, same_sense=same_sense)[0]) for w in wires]
+    self.ctx.pendingWires = []
+    result = self.newObject(rounded)
+    for wire in rounded:
+        result._addPendingWire(wire)
+    return result
+
+
+def _place_closed(self: W, path) -> W:
+    """A closed chain built at the workplane origin, placed at every point on the stack (as ``rect``)."""
+    wire = cq.Wire(chain_wire(path.segments))
+    return self.eachpoint(lambda loc: wire.moved(loc), True)
+
+
+def continuousRect(self: W, xLen: float, yLen: float, radius: float, transition: float = 0.5) -> W:
+    """A centred rectangle with G2 corners ("continuous corners") at each point on the stack, as a pending wire."""
+    return _place_closed(self, continuous_rectangle(xLen, yLen, radius, transition))
+
+
+def continuousPolygon(self: W, nSides: int, diameter: float, radius: float, transition: float = 0.5) -> W:
+    """A regular polygon (circumscribed ``diameter``) with G2 corners, as a pending wire."""
+    return _place_closed(self, continuous_polygon(diameter / 2.0, nSides, radius, transition))
+
+
+def continuousSlot2D(self: W, length: float, diameter: float, transition: float = 0.5) -> W:
+    """A slot of overall ``length`` and width ``diameter`` whose ends are G2 all round, as a pending wire."""
+    return _place_closed(self, continuous_slot(length, diameter, transition))
+
+
 METHODS = (
     spiralTransition,
     spiralLineToCircle,
@@ -160,7 +224,39 @@ METHODS = (
     spiralLineToLine,
     spiralCircleInCircle,
     spiralChain,
+    g2Fillet,
+    continuousRect,
+    continuousPolygon,
+    continuousSlot2D,
 )
 
 for _method in METHODS:
     setattr(cq.Workplane, _method.__name__, _method)
+
+
+# ------------------------------------------------------------------ cq.Sketch
+
+
+def sketch_g2fillet(self: S, radius: float, transition: float = 0.5, same_sense: str = "nested") -> S:
+    """``cq.Sketch.g2fillet``: round the selected vertices with G2 fillets, as ``Sketch.fillet`` does with arcs."""
+    faces = self._matchFacesToVertices()
+    self._faces = cq.Compound.makeCompound(
+        cq.Face(fillet_face(face.wrapped, radius, [v.toTuple() for v in vertices], transition=transition, same_sense=same_sense))
+        if vertices else face
+        for face, vertices in faces.items()
+    )  # fmt: skip
+    return self
+
+
+def sketch_continuous_rect(self: S, w: float, h: float, radius: float, transition: float = 0.5, angle: float = 0,
+                           mode: str = "a", tag: str | None = None) -> S:  # fmt: skip
+    """``cq.Sketch.continuousRect``: a rectangular face with G2 corners (as ``Sketch.rect``)."""
+    face = cq.Face.makeFromWires(cq.Wire(chain_wire(continuous_rectangle(w, h, radius, transition).segments)))
+    face = face.rotate(cq.Vector(), cq.Vector(0, 0, 1), angle)
+    return self.each(lambda location: face.located(location), mode, tag)
+
+
+SKETCH_METHODS = {"g2fillet": sketch_g2fillet, "continuousRect": sketch_continuous_rect}
+
+for _name, _method in SKETCH_METHODS.items():
+    setattr(cq.Sketch, _name, _method)

@@ -178,7 +178,7 @@ def chain_wire(chain: Iterable[Segment], plane: gp_Ax3 | None = None) -> TopoDS_
         if end.Distance(start) > Precision.Confusion_s():
             raise ValueError(f"segment {i + 1} does not connect to segment {i}: gap {end.Distance(start):.3g}")
         vertices.append(BRepBuilderAPI_MakeVertex(end).Vertex())
-    closed = len(spans) > 1 and ends[-1][1].Distance(ends[0][0]) <= Precision.Confusion_s()
+    closed = ends[-1][1].Distance(ends[0][0]) <= Precision.Confusion_s()
     vertices.append(vertices[0] if closed else BRepBuilderAPI_MakeVertex(ends[-1][1]).Vertex())
     builder = BRep_Builder()
     wire = TopoDS_Wire()

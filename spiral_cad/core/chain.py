@@ -26,6 +26,23 @@ MAX_JOIN_TOLERANCE = 1e-3
 ROUNDING_CAP = 1e-6
 
 
+def g2_mismatch(a: Segment, b: Segment, tolerance: float, units: str = "", index: int = 0) -> str | None:
+    """Why the joint from ``a`` to ``b`` is not G2 (see ``Chain``), or None when it is."""
+    j = measure_join(a, b, index)
+    la, lb = a.length, b.length
+    short, long = min(la, lb), max(la, lb)
+    kappa = max(abs(a.end_curvature), abs(b.start_curvature), 1.0 / long)
+    scale = np.array([short, 1.0, kappa])
+    floor = np.minimum(np.add(a.rounding_floor(True), b.rounding_floor(False)), ROUNDING_CAP * scale)
+    if j.gap > tolerance * short + floor[0] or j.angle > tolerance + floor[1] or j.curvature_jump > tolerance * kappa + floor[2]:
+        return (
+            f"joint {index} (between segments {index} and {index + 1}): gap {j.gap:.3g}, tangent angle "
+            f"{j.angle:.3g} rad, curvature jump {j.curvature_jump:.3g} (tolerance {tolerance:g}: gap relative to the "
+            f"shorter segment, {short:.6g} {units}; curvature jump relative to {kappa:.6g} 1/{units})"
+        )
+    return None
+
+
 def join_tolerance(value: Any) -> float:
     """A chain's join tolerance: finite and in (0, MAX_JOIN_TOLERANCE], else ValueError."""
     tolerance = as_float(value, "tolerance")
@@ -91,19 +108,10 @@ class Chain:
         self.size = float(math.hypot(*(pts.max(axis=0) - pts.min(axis=0)))) or 1.0
         if not math.isfinite(self.size):
             raise ValueError("Chain extent overflows float64")
-        tol = self.tolerance
-        for j, a, b, la, lb in zip(self.joins(), self._segments, self._segments[1:], lengths, lengths[1:]):
-            short, long = min(la, lb), max(la, lb)
-            kappa = max(abs(a.end_curvature), abs(b.start_curvature), 1.0 / long)
-            scale = np.array([short, 1.0, kappa])
-            floor = np.minimum(np.add(a.rounding_floor(True), b.rounding_floor(False)), ROUNDING_CAP * scale)
-            if j.gap > tol * short + floor[0] or j.angle > tol + floor[1] or j.curvature_jump > tol * kappa + floor[2]:
-                raise ValueError(
-                    f"Chain is not G2 at joint {j.index} (between segments {j.index} and {j.index + 1}): "
-                    f"gap {j.gap:.3g}, tangent angle {j.angle:.3g} rad, curvature jump {j.curvature_jump:.3g} "
-                    f"(tolerance {tol:g}: gap relative to the shorter segment, {short:.6g} {self.units}; "
-                    f"curvature jump relative to {kappa:.6g} 1/{self.units})"
-                )
+        for index, (a, b) in enumerate(zip(self._segments, self._segments[1:])):
+            problem = g2_mismatch(a, b, self.tolerance, self.units, index)
+            if problem:
+                raise ValueError(f"Chain is not G2 at {problem}")
 
     @classmethod
     def join(

@@ -1,0 +1,180 @@
+"""G2 fillets on OCCT wires and faces: planar lines and arcs in, exact LINE/CIRCLE/BEZIER edges out.
+
+The numeric work is ``spiral_cad.design.fillets``; this module reads a
+planar OCCT wire into lines and arcs in its plane, rounds the chosen
+vertices and builds the wire (or face) again with shared vertices, closing
+joint included. build123d's ``g2_fillet`` and the CadQuery plugin call it.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Iterable, Sequence
+
+from OCP.BRep import BRep_Tool
+from OCP.BRepAdaptor import BRepAdaptor_Curve
+from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeFace
+from OCP.BRepLib import BRepLib_FindSurface
+from OCP.BRepTools import BRepTools, BRepTools_WireExplorer
+from OCP.GeomAbs import GeomAbs_CurveType, GeomAbs_SurfaceType
+from OCP.GeomAdaptor import GeomAdaptor_Surface
+from OCP.gp import gp_Ax3, gp_Pnt, gp_Vec
+from OCP.TopAbs import TopAbs_REVERSED
+from OCP.TopoDS import TopoDS, TopoDS_Face, TopoDS_Wire
+
+from ..core.segments import Arc, Line, Segment
+from ..design.fillets import FilletedPath, fillet_path
+from .occ import chain_wire
+
+__all__ = ["fillet_face", "fillet_wire", "planar_frame", "wire_path"]
+
+#: Points further than this (relative to the wire's size) from its plane make it non-planar.
+PLANAR_TOL = 1e-9
+
+
+def planar_frame(shape) -> gp_Ax3:
+    """The plane of a planar wire or face as a ``gp_Ax3`` (a face's own plane, oriented as the face).
+
+    Raises:
+        ValueError: the shape does not lie in one plane.
+    """
+    if isinstance(shape, TopoDS_Face):
+        surface = GeomAdaptor_Surface(BRep_Tool.Surface_s(shape))
+        if surface.GetType() != GeomAbs_SurfaceType.GeomAbs_Plane:
+            raise ValueError("g2 fillets need a planar face; this face is curved")
+        frame = surface.Plane().Position()
+        if shape.Orientation() == TopAbs_REVERSED:
+            frame.ZReverse()
+        return frame
+    finder = BRepLib_FindSurface(shape, 1e-7, True)
+    if not finder.Found():
+        raise ValueError("g2 fillets need a planar wire; this wire does not lie in one plane (or is a single straight line)")
+    return GeomAdaptor_Surface(finder.Surface()).Plane().Position()
+
+
+def _local(frame: gp_Ax3, p: gp_Pnt) -> tuple[float, float, float]:
+    v = gp_Vec(frame.Location(), p)
+    return v.Dot(gp_Vec(frame.XDirection())), v.Dot(gp_Vec(frame.YDirection())), v.Dot(gp_Vec(frame.Direction()))
+
+
+def wire_path(wire: TopoDS_Wire, frame: gp_Ax3) -> tuple[list[Segment], bool]:
+    """The wire's edges, in connection order, as lines and arcs in the frame's plane coordinates.
+
+    Raises:
+        ValueError: an edge other than a line or circular arc (named by its
+            index and curve type), or a point off the plane.
+    """
+    segments: list[Segment] = []
+    lifts: list[float] = []
+    explorer = BRepTools_WireExplorer(wire)
+    while explorer.More():
+        edge = TopoDS.Edge_s(explorer.Current())
+        index = len(segments)
+        curve = BRepAdaptor_Curve(edge)
+        first, last = curve.FirstParameter(), curve.LastParameter()
+        reverse = edge.Orientation() == TopAbs_REVERSED
+        t0, t1 = (last, first) if reverse else (first, last)
+        (x0, y0, z0), (x1, y1, z1) = _local(frame, curve.Value(t0)), _local(frame, curve.Value(t1))
+        lifts += [z0, z1]
+        kind = curve.GetType()
+        if kind == GeomAbs_CurveType.GeomAbs_Line:
+            segments.append(Line((x0, y0), (x1, y1)))
+        elif kind == GeomAbs_CurveType.GeomAbs_Circle:
+            cx, cy, cz = _local(frame, curve.Circle().Location())
+            lifts.append(cz)
+            derivative = curve.DN(t0, 1)
+            dx, dy = derivative.Dot(gp_Vec(frame.XDirection())), derivative.Dot(gp_Vec(frame.YDirection()))
+            sense = 1.0 if ((x0 - cx) * dy - (y0 - cy) * dx) * (-1.0 if reverse else 1.0) > 0 else -1.0
+            radius = sense * curve.Circle().Radius()
+            sweep = abs(t1 - t0)  # circle parameters are angles
+            segments.append(Arc((cx, cy), radius, math.atan2(y0 - cy, x0 - cx), sweep))
+        else:
+            raise ValueError(f"g2 fillets round lines and circular arcs; edge {index} is a {kind.name.removeprefix('GeomAbs_')} curve")
+        explorer.Next()
+    if not segments:
+        raise ValueError("the wire has no edges")
+    size = max(s.length for s in segments)
+    lift = max(abs(z) for z in lifts)
+    if lift > PLANAR_TOL * size + 1e-7:
+        raise ValueError(f"g2 fillets need a planar wire; its points leave the plane by {lift:.3g}")
+    closed = BRep_Tool.IsClosed_s(wire) or math.dist(segments[-1].ends[1][:2], segments[0].ends[0][:2]) <= 1e-9 * size
+    return segments, closed
+
+
+def _vertex_indices(segments: Sequence[Segment], closed: bool, frame: gp_Ax3, points: Iterable | None) -> list[int] | None:
+    """Indices of the wire's vertices at ``points`` (3-D tuples); None means every corner."""
+    if points is None:
+        return None
+    size = max(s.length for s in segments)
+    starts = [s.ends[0][:2] for s in segments]
+    chosen = []
+    for point in points:
+        x, y, _ = _local(frame, gp_Pnt(*point))
+        for i, (sx, sy) in enumerate(starts):
+            if math.hypot(x - sx, y - sy) <= 1e-7 * max(size, 1.0) and (closed or i > 0):
+                chosen.append(i)
+    return chosen
+
+
+def fillet_wire(
+    wire: TopoDS_Wire,
+    radius: float,
+    vertices: Iterable | None = None,
+    *,
+    transition: float = 0.5,
+    same_sense: str = "nested",
+    frame: gp_Ax3 | None = None,
+) -> tuple[TopoDS_Wire, FilletedPath]:
+    """Round the wire's corners at ``vertices`` (3-D points; None: every corner) with G2 fillets.
+
+    Returns the new wire (LINE, CIRCLE and BEZIER edges on shared vertices,
+    closed when the input was) and the numeric result. Vertices that are not
+    corners of this wire are ignored (they may belong to another wire of a face).
+
+    Raises:
+        ValueError: a non-planar wire or an edge that is not a line or arc.
+        NoSolutionError: a corner that cannot be rounded (named, with numbers).
+    """
+    frame = planar_frame(wire) if frame is None else frame
+    segments, closed = wire_path(wire, frame)
+    chosen = _vertex_indices(segments, closed, frame, vertices)
+    if chosen is not None and not chosen:
+        chosen = []
+    result = fillet_path(segments, radius, transition=transition, vertices=chosen, closed=closed, same_sense=same_sense)
+    if not result.corners:  # nothing to round: the wire stays as it was
+        return wire, result
+    return chain_wire(result.segments, frame), result
+
+
+def fillet_face(
+    face: TopoDS_Face, radius: float, vertices: Iterable | None = None, *, transition: float = 0.5, same_sense: str = "nested"
+) -> TopoDS_Face:
+    """Round the corners of a planar face (outer and inner wires) at ``vertices`` (None: every corner).
+
+    Raises:
+        ValueError, NoSolutionError: as ``fillet_wire``; the face is rebuilt
+        on its own plane and keeps its orientation.
+    """
+    frame = planar_frame(face)
+    points = None if vertices is None else list(vertices)
+    outer = BRepTools.OuterWire_s(face)
+    wires = [outer] + [w for w in _wires(face) if not w.IsSame(outer)]
+    rounded = [fillet_wire(w, radius, points, transition=transition, same_sense=same_sense, frame=frame)[0] for w in wires]
+    maker = BRepBuilderAPI_MakeFace(BRep_Tool.Surface_s(face), rounded[0], True)
+    for inner in rounded[1:]:
+        maker.Add(inner)
+    if not maker.IsDone():
+        raise ValueError(f"the rounded wires do not make a face ({maker.Error().name})")
+    result = maker.Face()
+    return TopoDS.Face_s(result.Reversed()) if face.Orientation() != result.Orientation() else result
+
+
+def _wires(face: TopoDS_Face) -> list[TopoDS_Wire]:
+    from OCP.TopAbs import TopAbs_WIRE
+    from OCP.TopExp import TopExp_Explorer
+
+    found, explorer = [], TopExp_Explorer(face, TopAbs_WIRE)
+    while explorer.More():
+        found.append(TopoDS.Wire_s(explorer.Current()))
+        explorer.Next()
+    return found
