@@ -27,6 +27,7 @@ def main() -> None:
         run("examples/robot_path.py", str(tmp / "robot"))
         run("examples/build123d_road.py", str(tmp / "road"))
         run("examples/cadquery_plugin.py", str(tmp / "cq" / "tube.step"))
+        run("examples/continuous_corners.py", str(tmp / "corners"))
         picks = {
             "demo/highway_plan.png": "highway_plan.png",
             "demo/highway_curvature.png": "highway_curvature.png",
@@ -35,6 +36,7 @@ def main() -> None:
             "demo/bezier_vs_clothoid.png": "bezier_vs_clothoid.png",
             "robot/robot_path.png": "robot_path.png",
             "road/road.svg": "road.svg",
+            "corners/continuous_corners.png": "continuous_corners.png",
         }
         for source, target in picks.items():
             shutil.copy(tmp / source, IMAGES / target)

@@ -12,6 +12,7 @@ OUTPUTS = {
     "robot_path.py": ["robot_path.png", "robot_path.svg"],
     "fig6.py": ["fig6.png", "bezier_vs_clothoid.png"],
     "cadquery_plugin.py": ["cadquery_plugin.step"],
+    "continuous_corners.py": ["slab.step", "continuous_corners.png"],
 }
 
 

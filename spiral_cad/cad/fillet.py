@@ -89,7 +89,8 @@ def wire_path(wire: TopoDS_Wire, frame: gp_Ax3) -> tuple[list[Segment], bool]:
             sweep = abs(t1 - t0)  # circle parameters are angles
             segments.append(Arc((cx, cy), radius, math.atan2(y0 - cy, x0 - cx), sweep))
         else:
-            raise ValueError(f"g2 fillets round lines and circular arcs; edge {index} is a {kind.name.removeprefix('GeomAbs_')} curve")
+            name = kind.name.removeprefix("GeomAbs_").removesuffix("Curve").upper()
+            raise ValueError(f"g2 fillets round lines and circular arcs; edge {index} is a {name} curve")
         explorer.Next()
     if not segments:
         raise ValueError("the wire has no edges")

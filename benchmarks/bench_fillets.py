@@ -1,0 +1,81 @@
+"""G2 fillets at scale: every corner of an N-corner polygon rounded into a face, against build123d's fillet_2d.
+
+Run: ``.venv/bin/python benchmarks/bench_fillets.py [--corners N ...] [--peer-corners N ...] [--out FILE]``.
+
+The polygon is a zigzag round a circle (alternating radii, every corner
+turning about 77°), filleted with radius 5 % of its shortest side. Ours is
+``spiral_cad.build123d.g2_fillet`` on the ``Face`` (spiral → arc → spiral at
+every corner, exact edges, a valid face). The peer is build123d's
+``Face.fillet_2d`` (OCCT's BRepFilletAPI_MakeFillet2d, circular arcs) on the
+same face in the same run; it grows quadratically, so it is measured up to
+``--peer-corners`` and the growth exponent fitted to those points is used to
+estimate it at the larger sizes (marked "est."). Goal: no slower than
+fillet_2d at 10 000 corners.
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+import time
+
+import build123d as bd
+import numpy as np
+from timing import machine, write_markdown
+
+from spiral_cad.build123d import g2_fillet
+
+
+def zigzag_face(corners: int) -> tuple[bd.Face, float]:
+    k = np.arange(corners)
+    step = 2.0 * math.pi * 100.0 / corners
+    radius = np.where(k % 2 == 0, 100.0, 100.0 - 0.8 * step)
+    angle = 2.0 * math.pi * k / corners
+    points = [(float(x), float(y)) for x, y in zip(radius * np.cos(angle), radius * np.sin(angle))]
+    side = min(math.dist(points[i], points[(i + 1) % corners]) for i in range(corners))
+    return bd.Face(bd.Polyline(*points, close=True)), 0.05 * side
+
+
+def timed(fn) -> tuple[float, object]:
+    started = time.perf_counter()
+    result = fn()
+    return time.perf_counter() - started, result
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--corners", type=int, nargs="+", default=[1000, 10_000])
+    parser.add_argument("--peer-corners", type=int, nargs="+", default=[100, 200, 400])
+    parser.add_argument("--out", help="also write the table to this markdown file")
+    args = parser.parse_args()
+    rows, peer = [], {}
+    for n in sorted(set(args.peer_corners)):
+        face, radius = zigzag_face(n)
+        seconds, theirs = timed(lambda: face.fillet_2d(radius, face.vertices()))
+        assert theirs.is_valid
+        peer[n] = seconds
+        ours, mine = timed(lambda: g2_fillet(face, radius))
+        assert mine.is_valid
+        rows.append([f"{n:,}", f"{ours:.3f}", f"{seconds:.3f}", f"{seconds / ours:.1f}×"])
+        print(" | ".join(rows[-1]), flush=True)
+    sizes = np.array(sorted(peer))
+    exponent, scale = np.polyfit(np.log(sizes), np.log([peer[n] for n in sizes]), 1)
+    for n in args.corners:
+        face, radius = zigzag_face(n)
+        ours, mine = timed(lambda: g2_fillet(face, radius))
+        assert mine.is_valid and len(mine.edges()) == 4 * n
+        estimate = math.exp(scale) * n**exponent
+        rows.append([f"{n:,}", f"{ours:.3f}", f"est. {estimate:,.0f}", f"est. {estimate / ours:,.0f}×"])
+        print(" | ".join(rows[-1]), flush=True)
+    header = ["corners", "g2_fillet (ours), s", "fillet_2d (peer), s", "peer / ours"]
+    note = f"Single runs; fillet_2d grows as N^{exponent:.2f} (fitted to {', '.join(map(str, sizes))} corners)."
+    print("| " + " | ".join(header) + " |")
+    for row in rows:
+        print("| " + " | ".join(row) + " |")
+    print(f"{note} machine: {machine()}")
+    if args.out:
+        write_markdown(args.out, "G2 fillets at scale", note, header, rows)
+
+
+if __name__ == "__main__":
+    main()
