@@ -113,3 +113,13 @@ def test_rounded_path_plots(tmp_path):
     path = round_corners([(0, 0), (2, 0), (3, 1), (5, 1)], method="g2cbs")
     fig = plots.plot_plan(path.chain)
     assert saved(fig, tmp_path, "rounded.png")
+
+
+def test_jerk_length_plot_shows_the_bezier_needs_more_length(tmp_path):
+    fig = plots.plot_jerk_length()
+    left, right = fig.axes
+    ratio = left.lines[0].get_ydata()
+    assert ratio[0] == pytest.approx(1.84, abs=0.01) and ratio.min() > 1.2  # always longer than the clothoid rule
+    bezier, clothoid = right.lines
+    assert np.all(bezier.get_ydata() > clothoid.get_ydata())
+    assert saved(fig, tmp_path, "jerk.png")

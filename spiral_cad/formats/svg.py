@@ -23,7 +23,8 @@ from ..core.units import IMPERIAL, MM_PER_UNIT
 
 
 def _num(value: float) -> str:
-    return f"{value:.15g}"
+    """The shortest decimal that reads back to the same double."""
+    return repr(float(value) + 0.0)
 
 
 def _point(p) -> str:
