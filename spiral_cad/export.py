@@ -166,7 +166,7 @@ def export_opendrive(
         ValueError: an unsupported object, or chains of different units.
     """
     from .design.alignment import Alignment
-    from .formats.opendrive import Banking, _Road, write_opendrive
+    from .formats.opendrive import Banking, RoadToWrite, write_opendrive
 
     items = list(obj) if isinstance(obj, (list, tuple)) else [obj]
     if not items or not all(isinstance(i, (Alignment, Chain)) for i in items):
@@ -176,13 +176,13 @@ def export_opendrive(
     for k, item in enumerate(items):
         road_name = label if len(items) == 1 else f"{label}-{k + 1}"
         if isinstance(item, Chain):
-            roads.append(_Road(item, road_name))
+            roads.append(RoadToWrite(item, road_name))
             continue
         banking = [
             Banking(c.ts - item.start_station, c.sc - item.start_station, c.cs - item.start_station,
                     c.st - item.start_station, check.cross_slope, math.copysign(1.0, c.deflection))
             for c, check in zip(item.curves, item.checks)
         ]  # fmt: skip
-        roads.append(_Road(item.chain, road_name, item.start_station, banking))
+        roads.append(RoadToWrite(item.chain, road_name, item.start_station, banking))
     units = _units([r.chain for r in roads], None)
     write_opendrive(roads, path, label, units, originating_system(), cross_section, geo_reference)

@@ -33,6 +33,14 @@ def _axes(ax: Axes | None, **figure_kw) -> tuple[Figure, Axes]:
     return fig, fig.add_subplot()
 
 
+def _axes_pair(ax: tuple[Axes, Axes] | None) -> tuple[Figure, tuple[Axes, Axes]]:
+    """The given pair of axes, or a new two-panel figure."""
+    if ax is not None:
+        return ax[0].figure, tuple(ax)
+    fig = Figure(figsize=(11, 4.5))
+    return fig, tuple(fig.subplots(1, 2))
+
+
 def _kind(segment) -> str:
     return type(segment).__name__
 
@@ -209,12 +217,7 @@ def plot_vs_clothoid(theta: float, curvature: float, ax: Axes | Sequence[Axes] |
         curvature: end curvature (same sign as θ).
         ax: a pair of axes, or None for a new two-panel figure.
     """
-    if ax is None:
-        fig = Figure(figsize=(11, 4.5))
-        left, right = fig.subplots(1, 2)
-    else:
-        left, right = ax
-        fig = left.figure
+    fig, (left, right) = _axes_pair(ax)
     spiral = BezierSpiral((0.0, 0.0), (1.0, 0.0), theta, curvature)
     u = np.linspace(0.0, 1.0, samples)
     s_bez = bezier.arc_length(spiral.control_points, u)
@@ -264,12 +267,7 @@ def plot_jerk_length(design_speed: float = 80.0, max_jerk: float = 0.6, ax: Sequ
     """
     from .design.criteria import RoadCriteria, length_factor, peak_factor
 
-    if ax is None:
-        fig = Figure(figsize=(11, 4.5))
-        left, right = fig.subplots(1, 2)
-    else:
-        left, right = ax
-        fig = left.figure
+    fig, (left, right) = _axes_pair(ax)
     theta = np.radians(np.linspace(0.5, 60.0, 400))
     ratio = length_factor(theta) * peak_factor(theta)
     left.plot(np.degrees(theta), ratio, color="tab:red", lw=1.8)

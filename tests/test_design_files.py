@@ -1,8 +1,6 @@
 """Design files and the CLI: any byte sequence gives ``error: …`` and exit 2, units reach every file."""
 
 import json
-import math
-import os
 import signal
 import subprocess
 import sys
@@ -170,7 +168,7 @@ def test_units_of_a_design_reach_every_file(tmp_path, capsys, units, factor):
             explorer.Next()
         assert length == pytest.approx(chain.length * factor, rel=1e-12)
     assert ezdxf.readfile(out / "road.dxf").header["$INSUNITS"] == {"mm": 4, "m": 6}[units]
-    assert f'width="' in (svg := (out / "road.svg").read_text()) and "mm\"" in svg
+    assert 'width="' in (svg := (out / "road.svg").read_text()) and "mm\"" in svg
     assert f"TS [{units}]" in (out / "road_stations.csv").read_text().splitlines()[0]
     assert "1 wire of 9 edges" in (out / "road_continuity.txt").read_text().splitlines()[0]
     assert (out / "road_continuity.txt").read_text().startswith("road.step:")  # no staging path

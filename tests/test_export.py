@@ -26,10 +26,8 @@ from OCP.TopAbs import TopAbs_EDGE, TopAbs_REVERSED, TopAbs_WIRE
 from OCP.TopExp import TopExp, TopExp_Explorer
 from OCP.TopoDS import TopoDS
 
-import spiral_cad as sc
 from spiral_cad import Arc, BezierSpiral, Chain, Line
 from spiral_cad.core.units import MM_PER_UNIT, UNITS
-from spiral_cad.design import Alignment
 from spiral_cad.export import export_dxf, export_iges, export_step, export_svg, originating_system
 from spiral_cad.formats.dxf import BEZIER_KNOTS, INSUNITS
 from spiral_cad.occ import read_shape

@@ -6,8 +6,7 @@ import numpy as np
 import pytest
 
 import spiral_cad as sc
-from spiral_cad import Arc, BezierSpiral, Line, NoSolutionError
-from spiral_cad.core.bezier import curvature_rate
+from spiral_cad import Arc, BezierSpiral, Line
 from spiral_cad.core.segments import measure_join
 from spiral_cad.design.fillets import (
     continuous_polygon,

@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 import spiral_cad as sc
-from spiral_cad import Arc, BezierSpiral, Chain, Line
+from spiral_cad import Arc, BezierSpiral
 from spiral_cad.cli import main
 from spiral_cad.design import Alignment, round_corners
 from spiral_cad.export import CrossSection, export_opendrive

@@ -4,7 +4,6 @@ import math
 
 import numpy as np
 import pytest
-from matplotlib.collections import LineCollection
 from matplotlib.figure import Figure
 
 from spiral_cad import BezierSpiral, plots

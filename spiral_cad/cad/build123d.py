@@ -133,9 +133,7 @@ class SpiralLineToCircle(_TransitionObject):
 
 
 class _CirclePairObject(_TransitionObject):
-    """A transition between two circles given by centres and signed radii."""
-
-    _solve = staticmethod(circle_to_circle)
+    """A transition between two circles given by centres and signed radii (``_solve``: the subclass's solver)."""
 
     def __init__(
         self,

@@ -19,7 +19,8 @@ from OCP.BRepTools import BRepTools, BRepTools_WireExplorer
 from OCP.GeomAbs import GeomAbs_CurveType, GeomAbs_SurfaceType
 from OCP.GeomAdaptor import GeomAdaptor_Surface
 from OCP.gp import gp_Ax3, gp_Pnt, gp_Vec
-from OCP.TopAbs import TopAbs_REVERSED
+from OCP.TopAbs import TopAbs_REVERSED, TopAbs_WIRE
+from OCP.TopExp import TopExp_Explorer
 from OCP.TopoDS import TopoDS, TopoDS_Face, TopoDS_Wire
 
 from ..core.segments import Arc, Line, Segment
@@ -139,8 +140,6 @@ def fillet_wire(
     frame = planar_frame(wire) if frame is None else frame
     segments, closed = wire_path(wire, frame)
     chosen = _vertex_indices(segments, closed, frame, vertices)
-    if chosen is not None and not chosen:
-        chosen = []
     result = fillet_path(segments, radius, transition=transition, vertices=chosen, closed=closed, same_sense=same_sense)
     if not result.corners:  # nothing to round: the wire stays as it was
         return wire, result
@@ -171,9 +170,6 @@ def fillet_face(
 
 
 def _wires(face: TopoDS_Face) -> list[TopoDS_Wire]:
-    from OCP.TopAbs import TopAbs_WIRE
-    from OCP.TopExp import TopExp_Explorer
-
     found, explorer = [], TopExp_Explorer(face, TopAbs_WIRE)
     while explorer.More():
         found.append(TopoDS.Wire_s(explorer.Current()))

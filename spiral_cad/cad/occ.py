@@ -14,6 +14,7 @@ towards Y.
 
 from __future__ import annotations
 
+import io
 import os
 import re
 import sys
@@ -364,6 +365,23 @@ def captured_messages() -> Iterator[list[str]]:
             sink.seek(0)
             text = _ANSI.sub("", sink.read().decode("utf-8", "replace"))
             lines.extend(line for line in text.splitlines() if line.strip())
+
+
+def print_model(printer: Any, protocol: Any, path: str | os.PathLike, kind: str) -> None:
+    """Print an OCCT model (``printer``: its STEP or IGES writer) to ``path`` with 17 significant digits.
+
+    OCCT's writers print 9 (IGES) or 13 (STEP) by default; 17 keep every double.
+
+    Raises:
+        OSError: the printer failed; nothing is written.
+    """
+    printer.FloatWriter().SetFormat("%.16E")
+    printer.SendModel(protocol)
+    buffer = io.BytesIO()
+    if not printer.Print(buffer):
+        raise OSError(f"could not print the {kind} model for {os.fspath(path)!r}")
+    with open(path, "wb") as handle:
+        handle.write(buffer.getvalue())
 
 
 def as_occ_shape(obj: Any) -> TopoDS_Shape:

@@ -152,6 +152,12 @@ def line_to_circle(point: Any, direction: Any, center: Any, radius: float) -> Tr
     return Transition("line-circle", spirals, theta, end_circle=Circle((cx, cy), sense), start_line=line)
 
 
+def _two_circles(center0: Any, radius0: Any, center1: Any, radius1: Any) -> dict[str, Any]:
+    """The two circles' arguments coerced and named, in argument order."""
+    return dict(center0=as_xy(center0, "center0"), radius0=as_float(radius0, "radius0"),
+                center1=as_xy(center1, "center1"), radius1=as_float(radius1, "radius1"))  # fmt: skip
+
+
 def circle_to_circle(center0: Any, radius0: float, center1: Any, radius1: float) -> Transition:
     """Theorems 4.2 and 4.3: two spirals from circle 0 to circle 1.
 
@@ -164,11 +170,8 @@ def circle_to_circle(center0: Any, radius0: float, center1: Any, radius1: float)
             circles that touch or overlap.
         ValueError: malformed input (zero radius, coincident centres, …).
     """
-    c0 = as_xy(center0, "center0")
-    c1 = as_xy(center1, "center1")
-    r0 = as_float(radius0, "radius0")
-    r1 = as_float(radius1, "radius1")
-    inputs = dict(center0=c0, radius0=r0, center1=c1, radius1=r1)
+    inputs = _two_circles(center0, radius0, center1, radius1)
+    c0, r0, c1, r1 = inputs.values()
     spirals, theta, _ = _solve("circle_to_circle", K.circle_to_circle_row, 2, (*c0, r0, *c1, r1), inputs)
     kind = "S" if (r0 > 0) != (r1 > 0) else "C"
     return Transition(kind, spirals, theta, Circle(c0, r0), Circle(c1, r1))
@@ -212,10 +215,7 @@ def circle_in_circle(center0: Any, radius0: float, center1: Any, radius1: float)
         NoSolutionError: centre distance outside the band, or equal radii.
         ValueError: malformed input or radii of different signs.
     """
-    c0 = as_xy(center0, "center0")
-    c1 = as_xy(center1, "center1")
-    r0 = as_float(radius0, "radius0")
-    r1 = as_float(radius1, "radius1")
-    inputs = dict(center0=c0, radius0=r0, center1=c1, radius1=r1)
+    inputs = _two_circles(center0, radius0, center1, radius1)
+    c0, r0, c1, r1 = inputs.values()
     spirals, theta, t = _solve("circle_in_circle", K.circle_in_circle_row, 1, (*c0, r0, *c1, r1), inputs)
     return Transition("circle-circle-nested", spirals, theta, Circle(c0, r0), Circle(c1, r1), parameter=t)

@@ -17,16 +17,14 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy.optimize import brentq
 
-from ..core import bezier
 from ..core.bezier import curvature_rate, peak_curvature_rate  # noqa: F401  (public here too)
 from ..core._inputs import as_float, as_points, as_real_array
-from ..core._kernels import put_spiral, shape_g1
+from ..core._kernels import shape_g1
 from ..core.chain import JOIN_TOLERANCE, Chain
 from ..core.units import DEFAULT_UNITS, length_unit, speed_unit
 from .criteria import CRITERIA_DIMENSIONS, THETA_RANGE, Criteria, CriteriaRow, RailCriteria, RoadCriteria, length_factor
 from .tables import text_table, write_csv
 from ..core.errors import NoSolutionError
-from ..core.spiral import BezierSpiral
 from ..core.transitions import Transition, line_to_circle
 
 #: |sin(deflection)| at or below this counts as a straight PI.
@@ -45,11 +43,8 @@ def theta_for_length(length: float, radius: float) -> float:
         NoSolutionError: ``length`` outside the reachable range.
     """
 
-    cp = np.empty((4, 2))
-
     def excess(theta: float) -> float:
-        put_spiral(cp, 0.0, 0.0, 1.0, 0.0, 0.0, 1.0, math.sin(theta), math.cos(theta), 1.0)
-        return bezier.arc_length(cp) - length / radius
+        return float(length_factor(theta)) - length / radius
 
     lo, hi = _THETA_RANGE
     if not excess(lo) < 0.0 < excess(hi):
@@ -214,6 +209,9 @@ class Alignment:
                 raise ValueError(f"PI {k} and PI {k + 1} coincide at {pts[k].tolist()}")
         directions = seg / lengths[:, None]
         radius = _per_pi(radii, count, "radii")
+        for j, r in enumerate(radius):
+            if not r > 0.0:
+                raise ValueError(f"PI {j + 1}: radius must be positive; got {r}")
         units = length_unit(units)
         criteria = _criteria(design_speed, max_jerk, criteria)
         origin = float(as_float(start_station, "start_station"))
@@ -223,9 +221,6 @@ class Alignment:
         if spiral_angles is None and spiral_lengths is None:
             if criteria is None:
                 raise ValueError("give spiral_angles or spiral_lengths, or design criteria (design_speed) to choose them")
-            bad = radius[~(radius > 0.0)]
-            if bad.size:
-                raise ValueError(f"PI {int(np.argmax(~(radius > 0.0))) + 1}: radius must be positive; got {bad[0]}")
             shortest, longest = criteria.choose(radius, units)
             spec = np.stack([shortest, shortest], axis=1)
         else:
@@ -236,8 +231,6 @@ class Alignment:
         for j in range(count):
             i = j + 1
             r = radius[j]
-            if not r > 0.0:
-                raise ValueError(f"PI {i}: radius must be positive; got {r}")
             t_in, t_out = directions[j], directions[j + 1]
             sin_d = t_in[0] * t_out[1] - t_in[1] * t_out[0]
             cos_d = float(np.dot(t_in, t_out))

@@ -9,7 +9,6 @@ sender's product id and the file name; the originating system is
 
 from __future__ import annotations
 
-import io
 import os
 from typing import Any
 
@@ -19,7 +18,7 @@ from OCP.IGESSelect import IGESSelect_WorkLibrary
 from OCP.Interface import Interface_Static
 from OCP.TCollection import TCollection_HAsciiString
 
-from ..cad.occ import as_occ_shape, captured_messages
+from ..cad.occ import as_occ_shape, captured_messages, print_model
 from ..core.units import MM_PER_UNIT
 
 #: IGES unit names as OCCT's writer takes them.
@@ -56,11 +55,4 @@ def write_iges(obj: Any, path: str | os.PathLike, name: str, units: str, origina
         if not writer.AddShape(as_occ_shape(obj)):
             raise OSError(f"IGES transfer failed for {name!r}")
         writer.ComputeModel()
-    printer = IGESData_IGESWriter(model)
-    printer.FloatWriter().SetFormat("%.16E")
-    printer.SendModel(IGESSelect_WorkLibrary.DefineProtocol_s())
-    buffer = io.BytesIO()
-    if not printer.Print(buffer):
-        raise OSError(f"could not print the IGES model for {os.fspath(path)!r}")
-    with open(path, "wb") as handle:
-        handle.write(buffer.getvalue())
+    print_model(IGESData_IGESWriter(model), IGESSelect_WorkLibrary.DefineProtocol_s(), path, "IGES")

@@ -228,7 +228,7 @@ def distance(a: Frame, b: Frame) -> float:
 
 def classify_joint(index: int, a: Frame, b: Frame, gap_tol: float, angle_tol: float, curvature_tol: float, floor: float) -> JointReport:
     """Measure and classify the joint from end frame ``a`` to start frame ``b``."""
-    gap = math.sqrt((a[0] - b[0]) ** 2 + (a[1] - b[1]) ** 2 + (a[2] - b[2]) ** 2)
+    gap = distance(a, b)
     gap_tol += ROUNDING_ULPS * math.ulp(max(abs(v) for v in a[:3]))
     cx, cy, cz = a[4] * b[5] - a[5] * b[4], a[5] * b[3] - a[3] * b[5], a[3] * b[4] - a[4] * b[3]
     angle = math.atan2(math.sqrt(cx * cx + cy * cy + cz * cz), a[3] * b[3] + a[4] * b[4] + a[5] * b[5])
@@ -252,8 +252,6 @@ def diagonal(points: Sequence[tuple[float, float, float]]) -> float:
         return 0.0
     xyz = np.array(points)
     return float(np.linalg.norm(xyz.max(axis=0) - xyz.min(axis=0)))
-
-
 
 
 def classify_pieces(

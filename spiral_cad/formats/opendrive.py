@@ -52,17 +52,15 @@ from ..core.chain import Chain
 from ..core.segments import Arc, Line, Segment
 from ..core.spiral import BezierSpiral
 from ..core.units import to_metres
+from .decimals import shortest_decimal
 from .joints import ContinuityReport, Frame, check_tolerances, classify_pieces
 
 REV_MAJOR, REV_MINOR = 1, 8
 
 
 def number(value: float) -> str:
-    """The shortest decimal that reads back to the same double (≤ 17 significant digits)."""
-    value = float(value)
-    if not math.isfinite(value):
-        raise ValueError(f"OpenDRIVE cannot hold the non-finite number {value}")
-    return repr(value + 0.0)  # + 0.0 turns -0.0 into 0.0
+    """An OpenDRIVE number: the shortest round-trip decimal."""
+    return shortest_decimal(value, "OpenDRIVE")
 
 
 # ------------------------------------------------------------------ export
@@ -115,7 +113,7 @@ class Banking:
 
 
 @dataclass
-class _Road:
+class RoadToWrite:
     """One road to write: its chain and what goes with it."""
 
     chain: Chain
@@ -144,7 +142,7 @@ def _segment_record(segment: Segment, scale: float) -> tuple[tuple[float, float,
     raise ValueError(f"segment must be a Line, Arc or BezierSpiral; got {segment!r}")
 
 
-def _superelevation(road: _Road, scale: float) -> list[tuple[float, float, float]]:
+def _superelevation(road: RoadToWrite, scale: float) -> list[tuple[float, float, float]]:
     """(s, a, b) records of the roll angle: linear ramps along the spirals, constant on the arcs.
 
     OpenDRIVE's superelevation is the roll angle, positive when the road falls
@@ -194,7 +192,7 @@ def _lanes(parent: ET.Element, section: CrossSection) -> None:
 
 
 def opendrive_tree(
-    roads: Sequence[_Road],
+    roads: Sequence[RoadToWrite],
     name: str,
     units: str,
     originating_system: str,
@@ -242,7 +240,7 @@ def opendrive_tree(
     return ET.ElementTree(root)
 
 
-def write_opendrive(roads: Sequence[_Road], path: str | os.PathLike, name: str, units: str, originating_system: str,
+def write_opendrive(roads: Sequence[RoadToWrite], path: str | os.PathLike, name: str, units: str, originating_system: str,
                     cross_section: CrossSection = CrossSection(), geo_reference: str | None = None) -> None:  # fmt: skip
     """Write ``roads`` as one .xodr file (UTF-8, XML declaration)."""
     tree = opendrive_tree(roads, name, units, originating_system, cross_section, geo_reference)

@@ -38,6 +38,7 @@ from ..core.chain import Chain
 from ..core.segments import Arc, Line, Segment, measure_join
 from ..core.spiral import BezierSpiral
 from ..core.units import MM_PER_UNIT
+from .decimals import shortest_decimal
 
 #: STEP's name for each unit: an SI prefix of the metre, or a conversion-based unit.
 _SI_PREFIX = {"mm": ".MILLI.", "cm": ".CENTI.", "m": "$", "km": ".KILO."}
@@ -49,9 +50,7 @@ SCHEMA = "AUTOMOTIVE_DESIGN { 1 0 10303 214 1 1 1 1 }"
 
 def real(value: float) -> str:
     """A STEP real: the shortest round-trip decimal, always with a decimal point."""
-    if not math.isfinite(value):
-        raise ValueError(f"STEP cannot hold the non-finite number {value}")
-    text = repr(float(value)).upper()
+    text = shortest_decimal(value, "STEP").upper()
     mantissa, _, exponent = text.partition("E")
     if "." not in mantissa:
         mantissa += "."

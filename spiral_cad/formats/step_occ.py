@@ -9,7 +9,6 @@ organisation. Reals are printed with 17 significant digits.
 
 from __future__ import annotations
 
-import io
 import os
 from typing import Any
 
@@ -21,7 +20,7 @@ from OCP.STEPControl import STEPControl_AsIs, STEPControl_Writer
 from OCP.StepData import StepData_StepWriter
 from OCP.TCollection import TCollection_HAsciiString
 
-from ..cad.occ import as_occ_shape, captured_messages
+from ..cad.occ import as_occ_shape, captured_messages, print_model
 from ..core.units import MM_PER_UNIT
 
 #: OCCT's names for ``write.step.unit``.
@@ -51,12 +50,4 @@ def write_shape_step(obj: Any, path: str | os.PathLike, name: str, units: str, o
     header.SetAuthorValue(1, TCollection_HAsciiString(""))
     header.SetOrganizationValue(1, TCollection_HAsciiString(""))
     header.SetAuthorisation(TCollection_HAsciiString(""))
-    # STEPControl_Writer.Write prints 13 significant digits; 17 keep every double.
-    printer = StepData_StepWriter(writer.Model())
-    printer.FloatWriter().SetFormat("%.16E")
-    printer.SendModel(StepAP214.Protocol_s())
-    buffer = io.BytesIO()
-    if not printer.Print(buffer):
-        raise OSError(f"could not print the STEP model for {os.fspath(path)!r}")
-    with open(path, "wb") as handle:
-        handle.write(buffer.getvalue())
+    print_model(StepData_StepWriter(writer.Model()), StepAP214.Protocol_s(), path, "STEP")

@@ -20,11 +20,11 @@ from ..core.chain import Chain
 from ..core.segments import Arc, Line, Segment
 from ..core.spiral import BezierSpiral
 from ..core.units import IMPERIAL, MM_PER_UNIT
+from .decimals import shortest_decimal
 
 
 def _num(value: float) -> str:
-    """The shortest decimal that reads back to the same double."""
-    return repr(float(value) + 0.0)
+    return shortest_decimal(value, "SVG")
 
 
 def _point(p) -> str:
