@@ -19,7 +19,7 @@ from scipy.optimize import brentq
 
 from ..core.bezier import curvature_rate, peak_curvature_rate  # noqa: F401  (public here too)
 from ..core._inputs import as_float, as_points, as_real_array
-from ..core._kernels import shape_g1
+from ..core._kernels import WALTON_MEEK, shape_g1
 from ..core.chain import JOIN_TOLERANCE, Chain
 from ..core.units import DEFAULT_UNITS, length_unit, speed_unit
 from .criteria import CRITERIA_DIMENSIONS, THETA_RANGE, Criteria, CriteriaRow, RailCriteria, RoadCriteria, length_factor
@@ -422,8 +422,8 @@ def _curve(pi: NDArray, t_in: NDArray, t_out: NDArray, deflection: float, r: flo
     n_in = side * np.array([-t_in[1], t_in[0]])
     n_out = side * np.array([-t_out[1], t_out[0]])
     # Theorem 4.1: offset d = r·g1(θ) of the centre from each tangent.
-    d_in = r * shape_g1(math.sin(theta_in), math.cos(theta_in))
-    d_out = r * shape_g1(math.sin(theta_out), math.cos(theta_out))
+    d_in = r * shape_g1(WALTON_MEEK, math.sin(theta_in), math.cos(theta_in))
+    d_out = r * shape_g1(WALTON_MEEK, math.sin(theta_out), math.cos(theta_out))
     center = pi + np.linalg.solve(np.array([n_in, n_out]), np.array([d_in, d_out]))
     entry = line_to_circle(pi, t_in, center, r)
     exit_ = line_to_circle(pi, -t_out, center, r).reversed()

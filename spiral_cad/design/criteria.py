@@ -72,7 +72,7 @@ def unit_spirals(theta: NDArray) -> NDArray:
     """Control points (N, 4, 2) of Theorem 3.1 spirals of angles ``theta`` and end radius 1."""
     theta = np.asarray(theta, dtype=float).ravel()
     out = np.empty((len(theta), 4, 2))
-    K.unit_spirals_batch(np.sin(theta), np.cos(theta), out)
+    K.unit_spirals_batch(np.sin(theta), np.cos(theta), K.WALTON_MEEK, out)
     return out
 
 
@@ -230,7 +230,7 @@ class _Criteria(ABC):
     @staticmethod
     def _shifts(theta: NDArray, radius: NDArray) -> NDArray:
         """The shift p = r·(g1(θ) − 1) of each spiral's circle (design units)."""
-        g1 = np.array([K.shape_g1(math.sin(t), math.cos(t)) for t in np.ravel(theta)]).reshape(np.shape(theta))
+        g1 = np.array([K.shape_g1(K.WALTON_MEEK, math.sin(t), math.cos(t)) for t in np.ravel(theta)]).reshape(np.shape(theta))
         return radius * (g1 - 1.0)
 
 

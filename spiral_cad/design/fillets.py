@@ -127,20 +127,20 @@ def _side_geometry(segment: Segment, at_end: bool) -> tuple[str, Any]:
 
 
 def _offset_g1(theta: float) -> float:
-    return K.shape_g1(math.sin(theta), math.cos(theta))
+    return K.shape_g1(K.WALTON_MEEK, math.sin(theta), math.cos(theta))
 
 
 def _center_distance(kind: str, theta: float, side_radius: float, r: float) -> float:
     """Distance from an arc side's centre to the fillet circle's for transition angle θ."""
     a0, a1 = abs(side_radius), r
     s, c = math.sin(theta), math.cos(theta)
-    g1, g2 = K.shape_g1(s, c), K.shape_g2(s, c)
+    g1, g2 = K.shape_g1(K.WALTON_MEEK, s, c), K.shape_g2(K.WALTON_MEEK, s, c)
     if kind == "S":
         return (a0 + a1) * math.hypot(g1, g2)
     if kind == "C":
         return math.hypot((a0 + a1) * g2, (a1 - a0) * g1)
     big, small = max(a0, a1), min(a0, a1)
-    x, y = K._nested_geometry(theta, big, small)[:2]
+    x, y = K.nested_center_offset(theta, big, small, K.WALTON_MEEK)[:2]
     return math.hypot(x, y)
 
 
@@ -421,7 +421,7 @@ def corner_distance(radius: float, turn: float, transition: float) -> float:
     """How far from a line–line corner of turn Δ its fillet starts: r·(g1(θ)·tan(Δ/2) + g2(θ)), θ = transition·Δ/2."""
     theta = transition * abs(turn) / 2.0
     s, c = math.sin(theta), math.cos(theta)
-    return radius * (K.shape_g1(s, c) * math.tan(abs(turn) / 2.0) + K.shape_g2(s, c))
+    return radius * (K.shape_g1(K.WALTON_MEEK, s, c) * math.tan(abs(turn) / 2.0) + K.shape_g2(K.WALTON_MEEK, s, c))
 
 
 def continuous_rectangle(width: float, height: float, radius: float, transition: float = 0.5, units: str = DEFAULT_UNITS) -> FilletedPath:

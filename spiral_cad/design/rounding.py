@@ -28,7 +28,6 @@ from numpy.typing import ArrayLike, NDArray
 from ..core import _kernels as K
 from ..core import batch
 from ..core._inputs import as_float, as_points, as_real_array
-from ..core._kernels import WALTON_MEEK_CORNER, corner_relation
 from ..core.chain import JOIN_TOLERANCE, Chain
 from ..core.units import DEFAULT_UNITS
 from ..core.errors import NoSolutionError, Status
@@ -46,7 +45,7 @@ G2CBS_C3 = (G2CBS_C2 + 4.0) / (G2CBS_C1 + 6.0)
 G2CBS_C4 = (G2CBS_C2 + 4.0) ** 2 / (54.0 * G2CBS_C3)
 
 #: Peak-curvature factor of each method: κ = factor · sin θ / (d cos² θ).
-CORNER_FACTOR = {"walton-meek": WALTON_MEEK_CORNER, "g2cbs": G2CBS_C4}
+CORNER_FACTOR = {"walton-meek": 40.0 / 27.0, "g2cbs": G2CBS_C4}
 METHODS = tuple(CORNER_FACTOR)
 
 #: Relative |sin| below which three points count as collinear (passed through).
@@ -60,7 +59,7 @@ def corner_scale(theta_sin: ArrayLike, theta_cos: ArrayLike, value: ArrayLike, m
     of a spiral pair is symmetric: pass κ to get d, or d to get κ.
     """
     sin_t, cos_t, value = np.broadcast_arrays(*(np.asarray(v, dtype=float) for v in (theta_sin, theta_cos, value)))
-    return corner_relation(sin_t, cos_t, value, CORNER_FACTOR[method])
+    return CORNER_FACTOR[method] * sin_t / (value * cos_t * cos_t)
 
 
 def g2cbs_control_points(corners: NDArray, t_in: NDArray, t_out: NDArray, distance: NDArray, theta_cos: NDArray) -> NDArray:
