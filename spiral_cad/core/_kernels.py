@@ -174,6 +174,13 @@ def shape_g2(shape, sin_t, cos_t):
 
 
 @jit
+def shape_offsets_batch(shape, sin_t, cos_t, e1, e2):
+    """``shape_offsets`` over arrays of sin θ and cos θ, into ``e1`` and ``e2``."""
+    for i in range(sin_t.shape[0]):
+        e1[i], e2[i] = shape_offsets(shape, sin_t[i], cos_t[i])
+
+
+@jit
 def corner_factor(shape, sin_t, cos_t):
     """K(θ): a symmetric spiral pair at a corner of deflection 2θ starts K/κ from the
     corner, κ its joint curvature (1996 spiral: (40/27)·sin θ/cos²θ, Theorem 4.4).
