@@ -1,4 +1,4 @@
-"""Design tools built on the core: horizontal alignments, circle chains, corner rounding.
+"""Design tools built on the core: horizontal alignments, circle chains, corner rounding, G2 fillets.
 
 Pure numpy/numba: nothing here imports a CAD kernel.
 """
@@ -6,6 +6,7 @@ Pure numpy/numba: nothing here imports a CAD kernel.
 from .alignment import Alignment, CurveData, curvature_rate, peak_curvature_rate
 from .circles import CircleChain, circle_chain
 from .criteria import CriteriaRow, RailCriteria, RoadCriteria
+from .fillets import FilletCorner, FilletedPath, fillet_path
 from .rounding import (
     CornerBatch,
     RoundedCorner,
@@ -21,6 +22,8 @@ __all__ = [
     "CornerBatch",
     "CriteriaRow",
     "CurveData",
+    "FilletCorner",
+    "FilletedPath",
     "RailCriteria",
     "RoadCriteria",
     "RoundedCorner",
@@ -28,6 +31,7 @@ __all__ = [
     "circle_chain",
     "corner_legs",
     "curvature_rate",
+    "fillet_path",
     "peak_curvature_rate",
     "round_corners",
     "round_corners_batch",
