@@ -291,6 +291,7 @@ def g2_fillet(
         isinstance(target, Iterable) and not isinstance(target, (Shape, str, bytes))
     )
     if in_builder:
+        _points(target)  # only vertices select corners of a builder's object
         if context is None or context._obj is None:
             raise ValueError("g2_fillet of vertices needs a BuildSketch or BuildLine with an object")
         vertices, target = target, context._obj
