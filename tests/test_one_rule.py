@@ -99,10 +99,12 @@ def test_scaled_chain_joins_of_the_issue_hold():
 PIS = [(0, 0), (1000, 0), (2000, 800), (3000, 600)]
 
 
-@given(LOG_SCALE, OFFSET, OFFSET, st.floats(0.02, 2.0), st.floats(0.01, 1.5), st.floats(-400, 400))
-def test_from_pis_returns_a_checked_alignment_or_refuses(log_scale, ox, oy, radius, theta, wiggle):
+@given(LOG_SCALE, OFFSET, OFFSET, st.floats(0.02, 2.0), st.floats(0.01, 1.5), st.floats(-400, 400), st.booleans())
+def test_from_pis_returns_a_checked_alignment_or_refuses(log_scale, ox, oy, radius, theta, wiggle, by_length):
     pis = placed([(0, 0), (1000, 0), (2000, 800 + wiggle), (3000, 600)], log_scale, ox, oy)
-    alignment = outcome(lambda: Alignment.from_pis(pis, 300 * radius * 10.0**log_scale, spiral_angles=theta))
+    r = 300 * radius * 10.0**log_scale
+    spiral = {"spiral_lengths": theta * r} if by_length else {"spiral_angles": theta}
+    alignment = outcome(lambda: Alignment.from_pis(pis, r, **spiral))
     if alignment is not None:
         assert_rechecked(alignment.chain)
         assert_at(alignment.chain.start, pis[0], alignment.chain.size)
