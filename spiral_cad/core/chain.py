@@ -57,10 +57,12 @@ def rounding_floor(segment: Segment, at_end: bool) -> tuple[float, float, float]
         return segment.rounding_floor(at_end)
     except ArithmeticError:
         pass
+    rebuild = getattr(type(segment), "from_control_points", None)  # spirals: the only floors that can raise
+    if rebuild is None:
+        return math.inf, math.inf, math.inf
     exponent = math.frexp(segment.length)[1]
     try:
-        copy = type(segment).from_control_points(np.ldexp(segment.control_points, -exponent))
-        gap, angle, curvature = copy.rounding_floor(at_end)
+        gap, angle, curvature = rebuild(np.ldexp(segment.control_points, -exponent)).rounding_floor(at_end)
     except (ArithmeticError, ValueError):
         return math.inf, math.inf, math.inf
     return math.ldexp(gap, exponent), angle, math.ldexp(curvature, -exponent)
