@@ -94,6 +94,17 @@ def test_scaled_chain_joins_of_the_issue_hold():
                           start=(-20, 0), end=(400, 250)).length, rel=1e-9)  # fmt: skip
 
 
+@pytest.mark.parametrize("exponent", [400, -400, 1000, -1000])
+def test_rounding_floor_scales_with_the_spiral_where_its_own_formula_leaves_float64(exponent):
+    from spiral_cad.core.chain import rounding_floor
+
+    cp = sc.line_to_circle((3, 1), (1, 0.2), (40, 30), 12).spirals[0].control_points
+    unit, scaled = (sc.BezierSpiral.from_control_points(cp * 2.0**e) for e in (0, exponent))
+    for at_end in (True, False):
+        gap, angle, curvature = rounding_floor(unit, at_end)
+        assert rounding_floor(scaled, at_end) == (gap * 2.0**exponent, angle, curvature * 2.0**-exponent)
+
+
 # ---------------------------------------------------------------- alignments
 
 PIS = [(0, 0), (1000, 0), (2000, 800), (3000, 600)]
