@@ -24,9 +24,11 @@ from build123d import (
     BuildLine,
     BuildSketch,
     Compound,
+    Curve,
     Face,
     Mode,
     Sketch,
+    Shape,
     SkipClean,
     Vector,
     VectorLike,
@@ -36,7 +38,7 @@ from build123d import (
 
 from ..core.chain import Chain
 from ..design.fillets import continuous_polygon, continuous_rectangle, continuous_slot
-from .fillet import fillet_face, fillet_wire
+from .fillet import fillet_face, fillet_wire, planar_frame
 from .occ import chain_wire
 from ..core.segments import Segment
 from ..core.transitions import (
@@ -249,12 +251,12 @@ def _points(vertices) -> list[tuple[float, float, float]] | None:
 
 
 def g2_fillet(
-    target: Wire | Face | Sketch | Vertex | Iterable[Vertex],
+    target: Wire | Face | Sketch | Curve | Vertex | Iterable[Vertex],
     radius: float,
     vertices: Iterable[Vertex] | None = None,
     transition: float = 0.5,
     same_sense: str = "nested",
-) -> Wire | Face | Sketch:
+) -> Wire | Face | Sketch | Curve:
     """Operation: G2 Fillet
 
     Round corners with curvature-continuous fillets ("continuous corners"):
@@ -262,11 +264,12 @@ def g2_fillet(
     on both sides (``spiral_cad.design.fillets``), with exact LINE, CIRCLE and
     BEZIER edges and a G2 closing joint.
 
-    Used like build123d's ``fillet``: given a planar ``Wire``, ``Face`` or
-    ``Sketch`` (on any plane) it returns the same kind with the chosen
-    corners (default: all) rounded; inside ``BuildSketch``/``BuildLine``,
-    given vertices (e.g. ``sketch.vertices()``), it rounds those vertices of
-    the builder's object and replaces it (``Mode.REPLACE``).
+    Used like build123d's ``fillet``: given a planar ``Wire``, ``Face``,
+    ``Sketch`` or ``Curve`` (on any plane) it returns the same kind with the
+    chosen corners (default: all) rounded, every wire and every face of it;
+    inside ``BuildSketch``/``BuildLine``, given vertices (e.g.
+    ``sketch.vertices()``), it rounds those vertices of the builder's object
+    and replaces it (``Mode.REPLACE``).
 
     Args:
         target: the shape to round, or the vertices to round in a builder.
@@ -278,31 +281,59 @@ def g2_fillet(
             turns the same way as its corner. Defaults to "nested"
 
     Raises:
-        ValueError: non-planar input, edges other than lines and arcs.
+        ValueError: a solid or shell (round one of its faces, or use build123d's
+            ``fillet`` on its edges), non-planar input, edges other than lines
+            and arcs, or edges that belong to no wire or face.
         NoSolutionError: a corner that cannot be rounded (named, with numbers).
     """
     context = Builder._get_context("g2_fillet")
     in_builder = isinstance(target, Vertex) or (
-        isinstance(target, Iterable) and not isinstance(target, (Wire, Face, Sketch, Compound))
+        isinstance(target, Iterable) and not isinstance(target, (Shape, str, bytes))
     )
     if in_builder:
+        _points(target)  # only vertices select corners of a builder's object
         if context is None or context._obj is None:
             raise ValueError("g2_fillet of vertices needs a BuildSketch or BuildLine with an object")
         vertices, target = target, context._obj
     points = _points(vertices)
-    if isinstance(target, Face) and not isinstance(target, Sketch):
-        result = Face(fillet_face(target.wrapped, radius, points, transition=transition, same_sense=same_sense))
-    elif isinstance(target, Wire) or (hasattr(target, "_dim") and target._dim == 1):
-        wire = target if isinstance(target, Wire) else Wire(target.wires()[0].wrapped)
-        result = Wire(fillet_wire(wire.wrapped, radius, points, transition=transition, same_sense=same_sense)[0])
-    elif isinstance(target, (Sketch, Compound)) and target.faces():
-        faces = [Face(fillet_face(f.wrapped, radius, points, transition=transition, same_sense=same_sense)) for f in target.faces()]
-        result = Sketch(Compound(faces).wrapped)
+    options = dict(transition=transition, same_sense=same_sense)
+    if not isinstance(target, Shape):
+        raise ValueError(f"g2_fillet rounds a Wire, Face, Sketch or Curve; got {type(target).__name__}")
+    solids = target.solids() or target.shells()
+    if solids or getattr(target, "_dim", None) == 3:
+        raise ValueError(
+            f"g2_fillet rounds planar wires, faces and sketches; got a {type(target).__name__} with "
+            f"{len(target.solids())} solid(s) and {len(target.shells())} shell(s): round one of its faces, or use "
+            "build123d's fillet on its edges"
+        )
+    if isinstance(target, Wire):
+        result = Wire(fillet_wire(target.wrapped, radius, points, **options)[0])
+    elif isinstance(target, Face) and not isinstance(target, Sketch):
+        result = Face(fillet_face(target.wrapped, radius, points, **options))
     else:
-        raise ValueError(f"g2_fillet rounds a Wire, Face or Sketch; got {type(target).__name__}")
+        faces, wires = target.faces(), [] if target.faces() else target.wires()
+        _refuse_loose_edges(target, faces or wires)
+        if faces:
+            result = Sketch(Compound([Face(fillet_face(f.wrapped, radius, points, **options)) for f in faces]).wrapped)
+        else:  # one plane for all the wires (a straight wire alone has none; here it passes through)
+            frame = planar_frame(target.wrapped)
+            rounded = [fillet_wire(w.wrapped, radius, points, frame=frame, **options)[0] for w in wires]
+            result = Curve(Compound([Wire(w) for w in rounded]).wrapped)
     if in_builder:
         context._add_to_context(result, mode=Mode.REPLACE)
     return result
+
+
+def _refuse_loose_edges(target: Shape, parts: list[Shape]) -> None:
+    """ValueError unless every edge of ``target`` belongs to one of ``parts`` (its faces or its wires)."""
+    held = sum(len(p.edges()) for p in parts)
+    edges = len(target.edges())
+    if not parts or held < edges:
+        what = "faces" if parts and isinstance(parts[0], Face) else "wires"
+        raise ValueError(
+            f"g2_fillet rounds whole wires and faces; this {type(target).__name__} has {edges - held} of its "
+            f"{edges} edge(s) outside its {what}"
+        )
 
 
 class _ContinuousSketch(BaseSketchObject):

@@ -24,7 +24,7 @@ from ..core.chain import JOIN_TOLERANCE, Chain
 from ..core.units import DEFAULT_UNITS, length_unit, speed_unit
 from .criteria import CRITERIA_DIMENSIONS, THETA_RANGE, Criteria, CriteriaRow, RailCriteria, RoadCriteria, length_factor
 from .tables import text_table, write_csv
-from ..core.errors import NoSolutionError
+from ..core.errors import JointError, NoSolutionError
 from ..core.transitions import Transition, line_to_circle
 
 #: |sin(deflection)| at or below this counts as a straight PI.
@@ -214,6 +214,8 @@ class Alignment:
                 raise ValueError(f"PI {j + 1}: radius must be positive; got {r}")
         units = length_unit(units)
         criteria = _criteria(design_speed, max_jerk, criteria)
+        if criteria is not None:
+            criteria.minimum_radius(units)  # a design speed outside the side friction table is named first
         origin = float(as_float(start_station, "start_station"))
         if spiral_angles is not None and spiral_lengths is not None:
             raise ValueError("give at most one of spiral_angles and spiral_lengths")
@@ -258,11 +260,17 @@ class Alignment:
                     f"θ_in + θ_out = {math.degrees(theta_in):.6g}° + {math.degrees(theta_out):.6g}°: the circular arc "
                     f"would have negative sweep {math.degrees(sweep):.4g}°; use shorter spirals or a smaller radius"
                 )
-            solved.append(_curve(pts[i], t_in, t_out, deflection, r, theta_in, theta_out))
+            try:
+                solved.append(_curve(pts[i], t_in, t_out, deflection, r, theta_in, theta_out))
+            except NoSolutionError as error:
+                raise NoSolutionError(f"PI {i}: {error}") from None
 
         _check_tangents(pts, lengths, directions, solved)
         parts: list[Transition] = [t for s in solved for t in s[:2]]
-        chain = Chain.join(parts, pts[0], pts[-1], tolerance, units)
+        try:
+            chain = Chain.join(parts, pts[0], pts[-1], tolerance, units)
+        except JointError as error:
+            raise NoSolutionError(f"PI {error.part // 2 + 1}: float64 cannot hold its curve G2 at these coordinates: {error}") from None
         curves = _curve_data(chain, pts, solved, radius, origin)
         checks = () if criteria is None else _judge(curves, criteria, units, shortest, longest, strict)
         return cls(chain, curves, origin, criteria, checks)
@@ -457,7 +465,8 @@ def _check_tangents(pts: NDArray, lengths: NDArray, directions: NDArray, solved)
 def _curve_data(chain: Chain, pts: NDArray, solved, radius: NDArray, origin: float) -> list[CurveData]:
     stations = chain.stations
     spirals = np.array([[s[0].spirals[0].control_points, s[1].spirals[0].control_points] for s in solved])
-    peaks = peak_curvature_rate(spirals.reshape(-1, 4, 2))[0] if len(spirals) else []
+    with np.errstate(over="ignore", divide="ignore", invalid="ignore"):  # 1/L² beyond float64 is inf
+        peaks = peak_curvature_rate(spirals.reshape(-1, 4, 2))[0] if len(spirals) else []
     where = {id(seg): k for k, seg in enumerate(chain.segments)}
     curves = []
     for j, (entry, exit_, center, deflection) in enumerate(solved):

@@ -31,10 +31,10 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from ..core._inputs import as_float, as_xy
+from ..core._inputs import as_float, as_xy, shown
 from ..core.chain import Chain
 from ..core.units import DEFAULT_UNITS
-from ..core.errors import NoSolutionError
+from ..core.errors import JointError, NoSolutionError
 from ..core.segments import TAU, Circle
 from ..core.transitions import Transition, circle_in_circle, circle_to_circle
 
@@ -65,14 +65,14 @@ def _as_circle(value: Any, index: int) -> Circle:
         center, radius = value.center, value.radius
     else:
         if isinstance(value, (str, bytes, dict)) or not isinstance(value, Iterable):
-            raise ValueError(f"circle {index} must be a Circle, (center, radius) or (x, y, radius); got {value!r:.80}")
+            raise ValueError(f"circle {index} must be a Circle, (center, radius) or (x, y, radius); got {shown(value):.80}")
         items = list(value)
         if len(items) == 3:
             center, radius = items[:2], items[2]
         elif len(items) == 2:
             center, radius = items
         else:
-            raise ValueError(f"circle {index} must be a Circle, (center, radius) or (x, y, radius); got {value!r}")
+            raise ValueError(f"circle {index} must be a Circle, (center, radius) or (x, y, radius); got {shown(value):.80}")
     center = as_xy(center, f"circle {index} center")
     radius = as_float(radius, f"circle {index} radius")
     if radius == 0.0:
@@ -110,7 +110,7 @@ def _reference(circle: Circle, other: Circle, contact: NDArray | None) -> NDArra
         return contact
     c, o = np.array(circle.center), np.array(other.center)
     away = (o - c) if abs(circle.radius) > abs(other.radius) else (c - o)
-    return c + abs(circle.radius) * away / np.hypot(*away)
+    return c + abs(circle.radius) * (away / np.hypot(*away))  # unit vector first: r·away may overflow
 
 
 def _sense_angle(circle: Circle, a: NDArray, b: NDArray) -> float:
@@ -155,7 +155,12 @@ def circle_chain(circles: Sequence[Any], units: str = DEFAULT_UNITS) -> CircleCh
     sweeps = []
     for k in range(1, len(items) - 1):
         sweeps.append(_arc_sweep(items, transitions, k))
-    return CircleChain(Chain.join(transitions, units=units), items, transitions, sweeps)
+    try:
+        chain = Chain.join(transitions, units=units)
+    except JointError as error:
+        k = error.part
+        raise NoSolutionError(f"circles {k} and {k + 1}: float64 cannot hold the path G2 at these coordinates: {error}") from None
+    return CircleChain(chain, items, transitions, sweeps)
 
 
 def _arc_sweep(items: list[Circle], transitions: list[Transition], k: int) -> float:

@@ -48,9 +48,9 @@ from numpy.typing import NDArray
 from scipy.interpolate import CubicSpline
 
 from ..core import _kernels as K
-from ..core import batch
-from ..core._inputs import as_float
+from ..core._inputs import as_float, shown
 from ..core.bezier import arc_length, curvature_rate, peak_curvature_rate
+from ..core.factors import shift_factor
 from ..core.units import IMPERIAL, speed_unit, to_metres
 
 GRAVITY = 9.80665
@@ -74,15 +74,6 @@ def unit_spirals(theta: NDArray) -> NDArray:
     out = np.empty((len(theta), 4, 2))
     K.unit_spirals_batch(np.sin(theta), np.cos(theta), K.WALTON_MEEK, out)
     return out
-
-
-def shift_angle(shift: NDArray, radius: NDArray) -> NDArray:
-    """The θ whose spiral shifts its circle ``shift`` off the tangent (p = r(g1(θ) − 1), Theorem 4.1);
-    0 for a shift ≤ 0 (every spiral shifts its circle)."""
-    shift, radius = np.broadcast_arrays(np.asarray(shift, dtype=float), np.asarray(radius, dtype=float))
-    centres = np.stack([np.zeros(shift.size), (radius + np.maximum(shift, 0.0)).ravel()], axis=1)
-    theta = batch.line_to_circle([0.0, 0.0], [1.0, 0.0], centres, radius.ravel()).theta.reshape(shift.shape)
-    return np.where(shift > 0.0, theta, 0.0)
 
 
 @lru_cache(maxsize=1)
@@ -195,6 +186,18 @@ class _Criteria(ABC):
         speed = as_float(self.design_speed, "design_speed")
         if not speed > 0:
             raise ValueError(f"design_speed must be positive; got {speed!r}")
+        object.__setattr__(self, "design_speed", speed)  # a plain float (not numpy) in tables and messages
+
+    def _set_floats(self, names: tuple[str, ...], positive: bool) -> None:
+        """Each field in ``names`` (None skipped) as a plain float, > 0 (``positive``) or ≥ 0, else ValueError."""
+        for name in names:
+            value = getattr(self, name)
+            if value is None:
+                continue
+            number = as_float(value, name)
+            if not (number > 0.0 if positive else number >= 0.0):
+                raise ValueError(f"{name} must be {'positive' if positive else '≥ 0'}; got {shown(value)}")
+            object.__setattr__(self, name, number)
 
     def speed(self, units: str) -> float:
         """The design speed in m/s (given in km/h for metric designs, mph for in/ft)."""
@@ -218,6 +221,7 @@ class _Criteria(ABC):
         spiral angles ``thetas`` (N, 2), the length ``bounds`` (N, 2) the criteria allow, and the
         spirals' measured ``lengths`` (N, 2, design units) and ``peak_rates`` of dκ/ds (N, 2, 1/unit²)."""
 
+    @np.errstate(over="ignore", divide="ignore", invalid="ignore")  # inf/NaN fail the bounds; no warnings
     def choose(self, radii: NDArray, units: str) -> tuple[NDArray, NDArray]:
         """The shortest spiral angle meeting every lower bound, and the longest meeting
         every upper bound, for each radius (NaN where none exists)."""
@@ -229,9 +233,10 @@ class _Criteria(ABC):
 
     @staticmethod
     def _shifts(theta: NDArray, radius: NDArray) -> NDArray:
-        """The shift p = r·(g1(θ) − 1) of each spiral's circle (design units)."""
-        g1 = np.array([K.shape_g1(K.WALTON_MEEK, math.sin(t), math.cos(t)) for t in np.ravel(theta)]).reshape(np.shape(theta))
-        return radius * (g1 - 1.0)
+        """The shift p = r·(g1(θ) − 1) of each spiral's circle off its tangent (design units; Theorem 4.1).
+
+        p grows with θ, so the shift bounds are bounds on θ."""
+        return radius * shift_factor(theta, "walton-meek")
 
 
 @dataclass(frozen=True)
@@ -255,13 +260,8 @@ class RoadCriteria(_Criteria):
 
     def __post_init__(self) -> None:
         super().__post_init__()
-        for name in ("max_jerk", "superelevation_max"):
-            if not as_float(getattr(self, name), name) > 0:
-                raise ValueError(f"{name} must be positive; got {getattr(self, name)!r}")
-        for name in ("side_friction", "shift_min", "shift_max"):
-            value = getattr(self, name)
-            if value is not None and not as_float(value, name) >= 0:
-                raise ValueError(f"{name} must be ≥ 0; got {value!r}")
+        self._set_floats(("max_jerk", "superelevation_max"), positive=True)
+        self._set_floats(("side_friction", "shift_min", "shift_max"), positive=False)
 
     def friction(self, units: str) -> float:
         """f: given, or AASHTO's table value at the design speed (linear between rows)."""
@@ -280,8 +280,8 @@ class RoadCriteria(_Criteria):
         """R_min in the design's unit."""
         e_f = self.superelevation_max + self.friction(units)
         if units in IMPERIAL:
-            return self.design_speed**2 / (15.0 * e_f) * 0.3048 / to_metres(units)
-        return self.design_speed**2 / (127.0 * e_f) / to_metres(units)
+            return self.design_speed * self.design_speed / (15.0 * e_f) * 0.3048 / to_metres(units)
+        return self.design_speed * self.design_speed / (127.0 * e_f) / to_metres(units)
 
     def superelevation(self, radius: float, units: str) -> float:
         """e = e_max·R_min/R, at most e_max (AASHTO's method 1)."""
@@ -294,30 +294,33 @@ class RoadCriteria(_Criteria):
         return low, high
 
     def _jerk(self, theta: NDArray, radius: NDArray, units: str) -> NDArray:
-        return self.speed(units) ** 3 * peak_factor(theta) / (radius * to_metres(units)) ** 2
+        v = self.speed(units)  # v·v·v: inf, not OverflowError, for a design speed of 1e300
+        return v * v * v * peak_factor(theta) / (radius * to_metres(units)) ** 2
 
     def _lower_ok(self, theta, radius, units):
         low = self.shifts(units)[0]
-        return (self._jerk(theta, radius, units) <= self.max_jerk) & (theta >= shift_angle(low, radius))
+        return (self._jerk(theta, radius, units) <= self.max_jerk) & (self._shifts(theta, radius) >= low)
 
     def _upper_ok(self, theta, radius, units):
-        return theta <= shift_angle(self.shifts(units)[1], radius)
+        return self._shifts(theta, radius) <= self.shifts(units)[1]
 
+    @np.errstate(over="ignore", divide="ignore", invalid="ignore")  # inf/NaN rates are violations (``not x <= limit``)
     def evaluate(self, pis, radii, thetas, units: str, bounds, lengths, peak_rates) -> list[CriteriaRow]:
         radii = np.asarray(radii, dtype=float)
         shifts = self._shifts(np.asarray(thetas), radii[:, None])
-        jerks = self.speed(units) ** 3 * np.asarray(peak_rates) / to_metres(units) ** 2
+        v = self.speed(units)
+        jerks = v * v * v * np.asarray(peak_rates) / to_metres(units) ** 2
         low, high = self.shifts(units)
         r_min = self.minimum_radius(units)
         rows = []
         for pi, radius, length, shift, jerk, bound in zip(pis, radii, lengths, shifts, jerks, bounds):
-            violations = [f"R = {radius:.6g} < R_min = {r_min:.6g}"] if radius < r_min * (1 - 1e-12) else []
+            violations = [f"R = {radius:.6g} < R_min = {r_min:.6g}"] if not radius >= r_min * (1 - 1e-12) else []
             for side, j, p in zip(("in", "out"), jerk, shift):
-                if j > self.max_jerk * (1 + 1e-9):
+                if not j <= self.max_jerk * (1 + 1e-9):
                     violations.append(f"{side}: peak jerk {j:.4g} m/s³ > C = {self.max_jerk:g}")
-                if p < low * (1 - 1e-9):
+                if not p >= low * (1 - 1e-9):
                     violations.append(f"{side}: shift p = {p:.4g} < p_min = {low:.4g}")
-                if p > high * (1 + 1e-9):
+                if not p <= high * (1 + 1e-9):
                     violations.append(f"{side}: shift p = {p:.4g} > p_max = {high:.4g}")
             e = self.superelevation(radius, units)
             rows.append(CriteriaRow(int(pi), float(radius), r_min, tuple(map(float, length)), tuple(map(float, bound)),
@@ -339,20 +342,18 @@ class RailCriteria(_Criteria):
 
     def __post_init__(self) -> None:
         super().__post_init__()
-        for name in ("cant_max", "cant_deficiency_max", "cant_rate_max", "cant_deficiency_rate_max", "cant_gradient_max", "gauge"):
-            if not as_float(getattr(self, name), name) > 0:
-                raise ValueError(f"{name} must be positive; got {getattr(self, name)!r}")
-        if self.cant is not None and not as_float(self.cant, "cant") >= 0:
-            raise ValueError(f"cant must be ≥ 0 mm; got {self.cant!r}")
+        limits = ("cant_max", "cant_deficiency_max", "cant_rate_max", "cant_deficiency_rate_max", "cant_gradient_max", "gauge")
+        self._set_floats(limits, positive=True)
+        self._set_floats(("cant",), positive=False)
 
     def minimum_radius(self, units: str) -> float:
         """R_min = G·v²/(g·(D_max + I_max)), in the design's unit."""
-        metres = self.gauge * self.speed(units) ** 2 / (GRAVITY * (self.cant_max + self.cant_deficiency_max))
+        metres = self.gauge * self.speed(units) * self.speed(units) / (GRAVITY * (self.cant_max + self.cant_deficiency_max))
         return metres / to_metres(units)
 
     def equilibrium_cant(self, radius: NDArray, units: str) -> NDArray:
         """E = G·v²/(g·R) in mm."""
-        return self.gauge * self.speed(units) ** 2 / (GRAVITY * np.asarray(radius) * to_metres(units))
+        return self.gauge * self.speed(units) * self.speed(units) / (GRAVITY * np.asarray(radius) * to_metres(units))
 
     def applied_cant(self, radius: NDArray, units: str) -> NDArray:
         """D: the given cant, else min(E, cant_max), in mm."""
@@ -381,6 +382,7 @@ class RailCriteria(_Criteria):
     def _upper_ok(self, theta, radius, units):
         return np.ones(np.shape(theta), dtype=bool)
 
+    @np.errstate(over="ignore", divide="ignore", invalid="ignore")  # inf/NaN rates are violations (``not x <= limit``)
     def evaluate(self, pis, radii, thetas, units: str, bounds, lengths, peak_rates) -> list[CriteriaRow]:
         radii = np.asarray(radii, dtype=float)
         thetas = np.asarray(thetas)
@@ -396,12 +398,12 @@ class RailCriteria(_Criteria):
                   ("cant deficiency rate", self.cant_deficiency_rate_max))  # fmt: skip
         rows = []
         for k, (pi, radius) in enumerate(zip(pis, radii)):
-            violations = [f"R = {radius:.6g} < R_min = {r_min:.6g}"] if radius < r_min * (1 - 1e-12) else []
-            if deficiencies[k] > self.cant_deficiency_max * (1 + 1e-9):
+            violations = [f"R = {radius:.6g} < R_min = {r_min:.6g}"] if not radius >= r_min * (1 - 1e-12) else []
+            if not deficiencies[k] <= self.cant_deficiency_max * (1 + 1e-9):
                 violations.append(f"cant deficiency {deficiencies[k]:.4g} mm > {self.cant_deficiency_max:g}")
             for j, side in enumerate(("in", "out")):
                 for values, (what, limit) in zip((cant_rates, gradients, deficiency_rates), limits):
-                    if values[k, j] > limit * (1 + 1e-9):
+                    if not values[k, j] <= limit * (1 + 1e-9):
                         violations.append(f"{side}: {what} {values[k, j]:.4g} > {limit:g}")
             rows.append(CriteriaRow(int(pi), float(radius), r_min, tuple(map(float, lengths[k])), tuple(map(float, bounds[k])),
                                     tuple(map(float, shifts[k])), tuple(map(float, deficiency_rates[k])),

@@ -33,6 +33,7 @@ reach. Corners that are already tangent are left as they are.
 from __future__ import annotations
 
 import math
+import operator
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
 from typing import Any
@@ -41,7 +42,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ..core import _kernels as K
-from ..core._inputs import as_float, as_points
+from ..core._inputs import as_float, as_points, shown
 from ..core.chain import JOIN_TOLERANCE, Chain, g2_mismatch, join_tolerance
 from ..core.errors import NoSolutionError
 from ..core.segments import Arc, Circle, Line, Ray, Segment
@@ -89,6 +90,8 @@ class FilletedPath:
     corners: list[FilletCorner]
     closed: bool
     units: str = DEFAULT_UNITS
+    #: The vertex of the corner each segment belongs to (None: a trimmed original edge).
+    owners: tuple[int | None, ...] = ()
 
     @property
     def chain(self) -> Chain:
@@ -115,7 +118,32 @@ def _as_segments(path: Any) -> list[Segment]:
     points = as_points(path, "path")
     if points.ndim != 2 or len(points) < 2:
         raise ValueError(f"path must be lines and arcs, or (n ≥ 2, 2) points; got shape {points.shape}")
+    for i, (a, b) in enumerate(zip(points[:-1], points[1:])):
+        if np.array_equal(a, b):
+            raise ValueError(f"path points {i} and {i + 1} coincide at {tuple(a.tolist())}")
     return [Line(a, b) for a, b in zip(points[:-1], points[1:])]
+
+
+def _integer(value: Any) -> int | None:
+    """``value`` as an int when it is an integer (numpy integers too; not a bool, float or string), else None."""
+    if isinstance(value, (bool, np.bool_)):
+        return None
+    try:
+        return operator.index(value)
+    except TypeError:
+        return None
+
+
+def _vertex_indices(vertices: Any) -> list[int]:
+    """``vertices`` as sorted distinct ints; anything that is not an integer (1.5, '1', True) is refused by name."""
+    if isinstance(vertices, (str, bytes)) or not isinstance(vertices, Iterable):
+        raise ValueError(f"vertices must be a list of vertex indices; got {type(vertices).__name__} {shown(vertices):.80}")
+    items = list(vertices)
+    indices = [_integer(v) for v in items]
+    for i, (v, index) in enumerate(zip(items, indices)):
+        if index is None:
+            raise ValueError(f"vertices[{i}] must be a vertex index (an integer); got {type(v).__name__} {shown(v):.80}")
+    return sorted(set(indices))
 
 
 def _side_geometry(segment: Segment, at_end: bool) -> tuple[str, Any]:
@@ -164,7 +192,24 @@ def _locus(kind: str, geometry: Any, theta: float, r: float, turn: float, same_s
 
 
 def _intersect(a, b, near: NDArray) -> NDArray | None:
-    """The intersection of two loci nearest ``near`` (None when they do not meet)."""
+    """The intersection of two loci nearest ``near`` (None when they do not meet).
+
+    Solved relative to ``near`` and scaled by a power of two (exact), so the
+    squares of distances neither overflow nor underflow at any magnitude.
+    """
+    offsets = [float(np.abs(point - near).max()) for _, point, _ in (a, b)]
+    size = max(offsets + [abs(distance) for kind, _, distance in (a, b) if kind == "circle"])
+    exponent = math.frexp(size)[1] if math.isfinite(size) else 0
+    local = [(kind, np.ldexp(point - near, -exponent), other if kind == "line" else math.ldexp(other, -exponent))
+             for kind, point, other in (a, b)]  # fmt: skip
+    root = _nearest_intersection(*local)
+    if root is None or not np.isfinite(root).all():
+        return None
+    return near + np.ldexp(root, exponent)
+
+
+def _nearest_intersection(a, b) -> NDArray | None:
+    """The intersection of two loci nearest the origin (None when they do not meet)."""
     if a[0] == "circle" and b[0] == "line":
         a, b = b, a
     if a[0] == "line" and b[0] == "line":
@@ -194,7 +239,7 @@ def _intersect(a, b, near: NDArray) -> NDArray | None:
         base = c0 + along * unit
         normal = np.array([-unit[1], unit[0]])
         roots = [base + h * normal, base - h * normal]
-    return min(roots, key=lambda x: float(np.hypot(*(x - near))))
+    return min(roots, key=lambda x: float(np.hypot(*x)))
 
 
 def _transition_onto(kind: str, geometry: Any, center: NDArray, r: float, same_sense: str) -> Transition:
@@ -286,8 +331,8 @@ def _trim(segment: Segment, index: int, start: NDArray | None, end: NDArray | No
 def _parameter(segment: Segment, point: NDArray) -> float:
     """The parameter u of ``point`` (on the segment's line or circle)."""
     if isinstance(segment, Line):
-        a, b = segment.start, segment.end
-        return float(np.dot(point - a, b - a) / np.dot(b - a, b - a))
+        (ax, ay, tx, ty, _), length = segment.ends[0], segment.length  # unit tangent: no |b − a|² to overflow
+        return float((point[0] - ax) * tx + (point[1] - ay) * ty) / length
     c = segment.center
     angle = math.atan2(point[1] - c[1], point[0] - c[0]) - segment.start_angle
     travelled = (math.copysign(1.0, segment.radius) * angle) % (2.0 * math.pi)
@@ -352,7 +397,7 @@ def fillet_path(
     if vertices is None:
         chosen = list(candidates)
     else:
-        chosen = sorted({int(v) for v in vertices})
+        chosen = _vertex_indices(vertices)
         unknown = [v for v in chosen if v not in pairs]
         if unknown:
             raise ValueError(f"vertices {unknown} are not corners of this path (corners: {list(candidates)})")
@@ -363,11 +408,15 @@ def fillet_path(
         if abs(math.atan2(tx0 * ty1 - ty0 * tx1, tx0 * tx1 + ty0 * ty1)) > TANGENT_TOL:
             corners.append(_round_corner(v, before, after, radius, transition, same_sense))
     tolerance = join_tolerance(tolerance)
-    return FilletedPath(tuple(_assemble(segments, corners, closed, tolerance)), corners, closed, units)
+    pieces, owners = _assemble(segments, corners, closed, tolerance)
+    return FilletedPath(tuple(pieces), corners, closed, units, tuple(owners))
 
 
-def _assemble(segments: list[Segment], corners: list[FilletCorner], closed: bool, tolerance: float) -> list[Segment]:
-    """Trimmed edges and each corner's transition – arc – transition, in travel order.
+def _assemble(
+    segments: list[Segment], corners: list[FilletCorner], closed: bool, tolerance: float
+) -> tuple[list[Segment], list[int | None]]:
+    """Trimmed edges and each corner's transition – arc – transition, in travel order, with the
+    corner each piece belongs to.
 
     A closed path's pieces start where edge 0 resumes after corner 0 and end
     with corner 0. Every joint that touches a rounded corner is checked G2;
@@ -406,7 +455,7 @@ def _assemble(segments: list[Segment], corners: list[FilletCorner], closed: bool
             problem = g2_mismatch(pieces[a], pieces[b], tolerance)
             if problem:
                 raise NoSolutionError(f"corner {vertex}: the fillet is not G2 at {problem}")
-    return pieces
+    return pieces, owners
 
 
 # ---------------------------------------------------------- shapes with continuous corners
@@ -432,7 +481,7 @@ def continuous_rectangle(width: float, height: float, radius: float, transition:
     """
     w, h = as_float(width, "width") / 2.0, as_float(height, "height") / 2.0
     if not (w > 0 and h > 0):
-        raise ValueError(f"width and height must be positive; got {width!r}, {height!r}")
+        raise ValueError(f"width and height must be positive; got {shown(width)}, {shown(height)}")
     return _polygon([(-w, -h), (w, -h), (w, h), (-w, h)], radius, transition, units)
 
 
@@ -445,8 +494,10 @@ def continuous_polygon(radius: float, side_count: int, corner_radius: float, tra
         side_count: number of sides (≥ 3).
         corner_radius: the fillet circle's radius at each corner.
     """
-    if isinstance(side_count, bool) or not isinstance(side_count, int) or side_count < 3:
-        raise ValueError(f"side_count must be an integer ≥ 3; got {side_count!r}")
+    count = _integer(side_count)
+    if count is None or count < 3:
+        raise ValueError(f"side_count must be an integer ≥ 3; got {shown(side_count)}")
+    side_count = count
     outer = as_float(radius, "radius") / (1.0 if major_radius else math.cos(math.pi / side_count))
     if not outer > 0:
         raise ValueError(f"radius must be positive; got {radius!r}")
@@ -464,7 +515,7 @@ def continuous_slot(width: float, height: float, transition: float = 0.5, units:
     """
     w, h = as_float(width, "width"), as_float(height, "height")
     if not (w > h > 0):
-        raise ValueError(f"a slot needs width > height > 0; got width {width!r}, height {height!r}")
+        raise ValueError(f"a slot needs width > height > 0; got width {shown(width)}, height {shown(height)}")
     transition = as_float(transition, "transition")
     if not 0.0 < transition <= 1.0:
         raise ValueError(f"transition must lie in (0, 1]; got {transition!r}")

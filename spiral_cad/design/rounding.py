@@ -30,7 +30,7 @@ from ..core import batch
 from ..core._inputs import as_float, as_points, as_real_array
 from ..core.chain import JOIN_TOLERANCE, Chain
 from ..core.units import DEFAULT_UNITS
-from ..core.errors import NoSolutionError, Status
+from ..core.errors import JointError, NoSolutionError, Status
 from ..core.segments import Ray, Segment
 from ..core.spiral import BezierSpiral
 from ..core.transitions import Transition
@@ -412,5 +412,9 @@ def round_corners(
                 )
             )
             rounded.append(RoundedCorner(int(index[j]), float(result.theta[j]), float(result.distance[j]), float(result.curvature[j]), spirals))
-    return RoundedPath(Chain.join(parts, pts[0], pts[-1], tolerance, units), rounded, method)
+    try:
+        chain = Chain.join(parts, pts[0], pts[-1], tolerance, units)
+    except JointError as error:
+        raise NoSolutionError(f"corner {index[error.part]}: float64 cannot hold its spirals G2 at these coordinates: {error}") from None
+    return RoundedPath(chain, rounded, method)
 
