@@ -262,3 +262,27 @@ def test_scalar_and_batch_agree_bit_for_bit():
         assert np.array_equal(res.spirals[0][i], t.spirals[0].control_points) and res.parameter[i] == t.parameter
     bad = batch.line_to_circle([0, 0], [1, 0], [0, 150], 100, shape="near-linear")
     assert not bad.ok[0] and "walton-meek shape reaches it" in bad.reason(0)
+
+
+# ------------------------------------------------ roads at a jerk limit
+
+
+def test_a_100_kmh_highway_builds_at_the_clothoid_length():
+    """100 km/h, R = 500 and 700 m, C = 0.5 m/s³: refused with the 1996 spiral, built with near-linear ones."""
+    from spiral_cad.design import Alignment, RoadCriteria
+
+    pis = [[0, 0], [900, 150], [1900, -120], [2900, 60]]
+    criteria = RoadCriteria(100, max_jerk=0.5)
+    with pytest.raises(sc.NoSolutionError, match="criteria conflict"):
+        Alignment.from_pis(pis, [500, 700], units="m", criteria=criteria, shape="walton-meek")
+    road = Alignment.from_pis(pis, [500, 700], units="m", criteria=criteria)
+    v = 100 / 3.6
+    for curve, check in zip(road.curves, road.checks):
+        assert check.ok, check.violations
+        clothoid = v**3 / (curve.radius * 0.5)
+        for spiral in (curve.entry.spirals[0], curve.exit.spirals[0]):
+            assert spiral.shape == "near-linear"
+            s, kappa = curvature_profile(spiral.control_points)
+            assert abs(s[-1] / clothoid - 1) < 0.01
+            assert v**3 * np.abs(np.diff(kappa) / np.diff(s)).max() <= 0.5 * (1 + 1e-6)
+    assert road.curves[0].spiral_in_length == pytest.approx(86.19, abs=0.02)  # NEAR_LINEAR.md's table
