@@ -66,10 +66,7 @@ def check_name(value: Any, argument: str = "name", *, limit: int = MAX_NAME_LENG
         raise ValueError(f"{argument} has {len(value)} characters; at most {limit} are allowed")
     for position, character in enumerate(value):
         if _refused(character, multiline):
-            raise ValueError(
-                f"{argument} holds the control or non-text character U+{ord(character):04X} at position {position}; "
-                f"names are printable text"
-            )
+            raise ValueError(f"{argument} must be printable text; it holds U+{ord(character):04X} at position {position}")
     return value
 
 
