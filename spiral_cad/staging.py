@@ -86,24 +86,31 @@ def remove_stale(out: Path) -> list[Path]:
     """Remove staging folders of builds that were killed (see the module docstring); returns them."""
     removed = []
     for folder in out.iterdir():
-        found = _FOLDER.fullmatch(folder.name)
-        if not found or folder.is_symlink() or not folder.is_dir():
-            continue
-        pid = int(found.group(1))
-        marker = folder / MARKER
-        expected = _marker_text(pid).encode()
-        try:
-            if marker.is_symlink() or not marker.is_file():
-                continue
-            with open(marker, "rb") as handle:
-                ours = handle.read(len(expected) + 1) == expected
-        except OSError:
-            continue
-        backups = folder / BACKUP
-        if ours and not _alive(pid) and not (backups.is_dir() and any(backups.iterdir())):
+        if _is_stale(folder):
             shutil.rmtree(folder, ignore_errors=True)
             removed.append(folder)
     return removed
+
+
+def _is_stale(folder: Path) -> bool:
+    """True for our staging folder (named and marked by us) of a process that has ended, without backups."""
+    found = _FOLDER.fullmatch(folder.name)
+    if not found:
+        return False
+    pid = int(found.group(1))
+    marker, backups = folder / MARKER, folder / BACKUP
+    expected = _marker_text(pid).encode()
+    try:
+        if folder.is_symlink() or not folder.is_dir() or marker.is_symlink() or not marker.is_file():
+            return False
+        with open(marker, "rb") as handle:
+            if handle.read(len(expected) + 1) != expected:
+                return False
+        if backups.exists() and (not backups.is_dir() or any(backups.iterdir())):
+            return False
+    except OSError:  # unreadable: not ours to judge
+        return False
+    return not _alive(pid)
 
 
 def _alive(pid: int) -> bool:

@@ -8,6 +8,8 @@ import sys
 import xml.etree.ElementTree as ET
 
 import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
 
 pytest.importorskip("OCP")
 ezdxf = pytest.importorskip("ezdxf")
@@ -34,6 +36,7 @@ HOSTILE = [
     '<&>"\'',
     "1 road",
     "a;b,c 3H",  # IGES delimiters and a Hollerith look-alike
+    "x/*y*/ #1=",  # STEP comment and instance look-alikes
     " Defpoints ",
     "😀" * MAX_NAME_LENGTH,  # the longest name, every character outside the BMP
 ]
@@ -250,3 +253,28 @@ def test_a_control_character_in_geo_reference_is_refused(tmp_path):
     with pytest.raises(ValueError, match="^geo_reference .*U\\+0001"):
         export_opendrive(CHAIN, path, geo_reference="+proj=utm\x01")
     assert not path.exists()
+
+
+def _passes_the_policy(name: str) -> bool:
+    try:
+        check_name(name)
+    except ValueError:
+        return False
+    return True
+
+
+@settings(max_examples=30, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
+@given(st.text(min_size=1, max_size=40).filter(_passes_the_policy))
+def test_any_name_the_policy_passes_reads_back_from_every_file(tmp_path, name):
+    export_step(CHAIN, tmp_path / "a.step", name=name)
+    read_shape(tmp_path / "a.step")
+    assert step_products(tmp_path / "a.step") == [name]
+    export_iges(CHAIN, tmp_path / "a.igs", name=name)
+    read_shape(tmp_path / "a.igs")
+    assert iges_names(tmp_path / "a.igs")[0] == iges_text(name)
+    export_dxf(CHAIN, tmp_path / "a.dxf", name=name)
+    assert {e.dxf.layer for e in ezdxf.readfile(tmp_path / "a.dxf").modelspace()} == {dxf_layer_name(name)}
+    export_svg(CHAIN, tmp_path / "a.svg", name=name)
+    assert ET.parse(tmp_path / "a.svg").getroot().find("{http://www.w3.org/2000/svg}title").text == f"{name} (units: m)"
+    export_opendrive(CHAIN, tmp_path / "a.xodr", name=name)
+    assert read_opendrive(tmp_path / "a.xodr")[0].name == name

@@ -24,7 +24,7 @@ def out(tmp_path):
 
 
 def contents(folder) -> dict[str, str]:
-    return {p.name: p.read_text() if p.is_file() else "<folder>" for p in sorted(folder.iterdir())}
+    return {p.name: p.read_text() if p.is_file() else "<not a file>" for p in sorted(folder.iterdir())}
 
 
 def stage_new_files(stage: Staging, names=("a.step", "b.svg", "c.csv", "d.dxf")) -> None:
@@ -42,85 +42,76 @@ def test_commit_replaces_every_file_and_leaves_the_rest(out):
 
 @pytest.mark.parametrize("blocker", ["folder", "fifo", "read-only"])
 def test_a_blocked_destination_is_found_before_anything_is_replaced(out, blocker):
-    before = contents(out)
     target = out / "b.svg"
-    target.unlink()
-    if blocker == "folder":
-        target.mkdir()
-    elif blocker == "fifo":
-        os.mkfifo(target)
-    else:
+    if blocker == "read-only":
         if os.geteuid() == 0:
             pytest.skip("root may write to read-only files")
-        target.write_text("old b")
         target.chmod(stat.S_IRUSR)
+    else:
+        target.unlink()
+        target.mkdir() if blocker == "folder" else os.mkfifo(target)
+    before = contents(out)
     expected = {"folder": "b.svg is a folder", "fifo": "b.svg is not a regular file", "read-only": "b.svg is read-only"}
-    before = contents(out) if blocker != "fifo" else {k: v for k, v in before.items() if k != "b.svg"}
     with pytest.raises(OutputError, match=f"{expected[blocker]}; nothing there was changed"):
         with Staging(out) as stage:
             stage_new_files(stage)
             stage.commit()
-    now = contents(out) if blocker != "fifo" else {k: v for k, v in contents(out).items() if k != "b.svg"}
-    assert now == before
+    assert contents(out) == before
     assert not any(p.name.startswith(staging.PREFIX) for p in out.iterdir())
+
+
+def commit_while(out, monkeypatch, event) -> None:
+    """Stage new files and commit them, calling ``event(n)`` before the n-th move (os.replace)."""
+    real_replace, calls = os.replace, []
+
+    def replace(source, target):
+        calls.append(target)
+        event(len(calls))
+        real_replace(source, target)
+
+    monkeypatch.setattr(staging.os, "replace", replace)
+    try:
+        with Staging(out) as stage:
+            stage_new_files(stage)
+            stage.commit()
+    finally:
+        monkeypatch.undo()
 
 
 @pytest.mark.parametrize("failing", [1, 2, 5, 6, 7])
 def test_a_failed_move_restores_every_destination(out, monkeypatch, failing):
     """Moves: 1 a.step to the backups, 2 the new a.step in place, 3–4 b.svg, 5–6 c.csv, 7 the new d.dxf."""
     before = contents(out)
-    real_replace, calls = os.replace, []
 
-    def failing_replace(source, target):
-        calls.append(target)
-        if len(calls) == failing:
+    def fail(n):
+        if n == failing:
             raise OSError(28, "No space left on device")
-        real_replace(source, target)
 
-    monkeypatch.setattr(staging.os, "replace", failing_replace)
     with pytest.raises(OSError, match="No space left"):
-        with Staging(out) as stage:
-            stage_new_files(stage)
-            stage.commit()
-    monkeypatch.undo()
+        commit_while(out, monkeypatch, fail)
     assert contents(out) == before
 
 
 def test_an_interrupt_during_the_moves_restores_every_destination(out, monkeypatch):
     before = contents(out)
-    real_replace, calls = os.replace, []
 
-    def interrupted_replace(source, target):
-        calls.append(target)
-        if len(calls) == 3:
+    def interrupt(n):
+        if n == 3:
             os.kill(os.getpid(), signal.SIGINT)  # recorded, acted on before the next move
-        real_replace(source, target)
 
-    monkeypatch.setattr(staging.os, "replace", interrupted_replace)
     with pytest.raises(KeyboardInterrupt):
-        with Staging(out) as stage:
-            stage_new_files(stage)
-            stage.commit()
-    monkeypatch.undo()
+        commit_while(out, monkeypatch, interrupt)
     assert contents(out) == before
     assert signal.getsignal(signal.SIGINT) is signal.default_int_handler
 
 
 def test_a_failed_restore_keeps_the_backups_and_names_them(out, monkeypatch):
-    real_replace, calls = os.replace, []
-
-    def broken_replace(source, target):
-        calls.append(target)
-        if len(calls) >= 4:  # the third move fails, and so does every restore
+    def break_down(n):
+        if n >= 4:  # from the new b.svg on every move fails, the restores too
             raise OSError(5, "Input/output error")
-        real_replace(source, target)
 
-    monkeypatch.setattr(staging.os, "replace", broken_replace)
     with pytest.raises(OSError, match="could not restore .*a.step.*the previous files are in"):
-        with Staging(out) as stage:
-            stage_new_files(stage)
-            stage.commit()
-    monkeypatch.undo()
+        commit_while(out, monkeypatch, break_down)
     (kept,) = [p for p in out.iterdir() if p.name.startswith(staging.PREFIX)]
     assert (kept / staging.BACKUP / "a.step").read_text() == "old a"
     remove_stale(out)  # it holds backups: never removed, even once its process has ended
