@@ -149,25 +149,38 @@ class Staging:
 
     def __init__(self, out: str | os.PathLike) -> None:
         self.out = Path(out)
-        self.folder = Path()  # set on entry
+        self._folder: Path | None = None  # made on entry
         self._keep = False
         self._created: list[Path] = []
+
+    @property
+    def folder(self) -> Path:
+        """The staging folder (inside ``out``) to write the files into."""
+        if self._folder is None:
+            raise RuntimeError("the staging folder exists only inside the with block")
+        return self._folder
 
     def __enter__(self) -> Staging:
         self._created = prepare_folder(self.out)
         remove_stale(self.out)
         try:
-            self.folder = Path(tempfile.mkdtemp(prefix=f"{PREFIX}{os.getpid()}-", dir=self.out))
-            (self.folder / MARKER).write_text(_marker_text(os.getpid()), encoding="utf-8")
+            self._folder = Path(tempfile.mkdtemp(prefix=f"{PREFIX}{os.getpid()}-", dir=self.out))
+            (self._folder / MARKER).write_text(_marker_text(os.getpid()), encoding="utf-8")
         except OSError as e:
+            self._remove(failed=True)
             raise OutputError(f"cannot write into the output folder {str(self.out)!r}: {e.strerror}") from None
         return self
 
     def __exit__(self, kind: type[BaseException] | None, error: BaseException | None, trace: TracebackType | None) -> None:
-        if self._keep:
-            return
-        shutil.rmtree(self.folder, ignore_errors=True)
-        if error is not None:  # nothing was written: remove the folders made for it (if still empty)
+        if not self._keep:
+            self._remove(failed=error is not None)
+
+    def _remove(self, failed: bool) -> None:
+        """Remove the staging folder and, after a failure, the output folders made for it (if empty)."""
+        if self._folder is not None:
+            shutil.rmtree(self._folder, ignore_errors=True)
+            self._folder = None
+        if failed:
             for folder in reversed(self._created):
                 try:
                     folder.rmdir()
