@@ -327,3 +327,20 @@ def test_mutated_example_designs_build_or_fail_with_a_design_error(tmp_path, edi
     except ValueError:
         return
     assert written.files and all(p.is_file() and p.parent == out for p in written.files)
+
+
+def test_messages_and_reprs_show_plain_numbers():
+    """sc.Line((0, 0), (0, 0)) once said "both are (np.float64(0.0), np.float64(0.0))"."""
+    import numpy as np
+
+    import spiral_cad as sc
+
+    f = np.float64
+    texts = [repr(sc.Line((f(0), 0), (1, f(2)))), repr(sc.Arc((f(0), 0), f(1), f(0), f(1))),
+             repr(sc.Chain(sc.line_to_circle((0, 0), (1, 0), (0, f(1.05)), f(1)).spirals))]  # fmt: skip
+    for bad in (lambda: sc.Line((f(0), f(0)), (0, 0)), lambda: sc.Line((f(-1e308), 0), (f(1e308), 0))):
+        with pytest.raises(ValueError) as error:
+            bad()
+        texts.append(str(error.value))
+    assert texts[3] == "Line needs distinct end points; both are (0.0, 0.0)"
+    assert not [t for t in texts if "np." in t or "float64(" in t], texts
