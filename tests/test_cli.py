@@ -112,32 +112,47 @@ def test_help_lists_the_commands():
 # ------------------------------------------------------------------ manners
 
 
-def launch(args: list[str]) -> subprocess.Popen:
+LAUNCH = """
+import os, signal, sys
+
+class InterruptOnImport:  # Ctrl-C exactly while the package imports numpy and numba
+    def find_spec(self, name, path=None, target=None):
+        if name == os.environ.get("INTERRUPT_ON_IMPORT"):
+            os.kill(os.getpid(), signal.SIGINT)
+
+sys.meta_path.insert(0, InterruptOnImport())
+from spiral_cad_launcher import main
+sys.exit(main())
+"""
+
+
+def launch(args: list[str], interrupt_on_import: str = "") -> subprocess.Popen:
     """``spiral-cad`` as its console script starts it, with Ctrl-C delivered as in a terminal."""
+    import os
     import signal
 
-    code = "import sys; from spiral_cad_launcher import main; sys.exit(main())"
-    return subprocess.Popen([sys.executable, "-c", code, *args], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
-                            preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))  # fmt: skip
+    env = {**os.environ, "INTERRUPT_ON_IMPORT": interrupt_on_import}
+    return subprocess.Popen([sys.executable, "-c", LAUNCH, *args], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                            env=env, preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))  # fmt: skip
 
 
 @pytest.mark.parametrize("moment", ["importing spiral_cad", "building and writing"])
 def test_ctrl_c_at_any_moment_is_one_line_and_130(tmp_path, moment):
     """Ctrl-C during the long imports once printed a traceback or 'internal error (ImportError …)'."""
     import signal
-    import time
 
     out = tmp_path / "out"
     out.mkdir()
     (out / "rail.step").write_text("from before")
-    process = launch(["build", str(EXAMPLES / "design.json"), "--out", str(out)])
+    args = ["build", str(EXAMPLES / "design.json"), "--out", str(out)]
     if moment == "importing spiral_cad":
-        time.sleep(0.15)
+        process = launch(args, interrupt_on_import="spiral_cad.core.chain")
     else:
+        process = launch(args)
         for line in process.stdout:
             if line.startswith("built "):
                 break
-    process.send_signal(signal.SIGINT)
+        process.send_signal(signal.SIGINT)
     _, err = process.communicate(timeout=120)
     assert process.returncode == 130, err
     assert len(err.splitlines()) == 1 and err.startswith("error: interrupted"), err
