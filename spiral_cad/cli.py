@@ -4,11 +4,14 @@ from __future__ import annotations
 
 import argparse
 import math
-import os
+import signal
 import sys
+import threading
 import time
+import warnings
+from collections.abc import Callable, Iterator, Sequence
+from contextlib import contextmanager
 from importlib.util import find_spec
-from collections.abc import Sequence
 from pathlib import Path
 
 from . import circle_in_circle, circle_to_circle, line_to_circle, line_to_line
@@ -77,19 +80,27 @@ DEMO_DESIGN: dict = {
 PIP_CAD = 'pip install "spiral_cad[cad]"'
 
 
-def _write_design(design: dict | str, out: Path, plots: bool) -> int:
+def _write_design(design: dict | str, out: Path, plots: bool, extra: Callable[[Path], None] | None = None) -> int:
     from .designfile import build, criteria_tables, summary, write
 
     started = time.perf_counter()
     units, built = build(design)
     print(f"built {len(built)} design(s); writing to {out}/", flush=True)
-    written = write(built, out, units, progress=lambda line: print(line, flush=True), plots=plots)
-    print()
-    tables = criteria_tables(built)
-    if tables:
-        print(tables + "\n")
-    print(summary(built, units))
-    print(f"\nwrote {len(written.files)} files to {out}/ in {time.perf_counter() - started:.1f} s")
+    try:
+        written = write(built, out, units, progress=lambda line: print(line, flush=True), plots=plots, extra=extra)
+    except KeyboardInterrupt as interrupt:
+        if interrupt.args:
+            raise
+        raise KeyboardInterrupt(f"nothing in {out}/ was changed") from None
+    try:
+        print()
+        tables = criteria_tables(built)
+        if tables:
+            print(tables + "\n")
+        print(summary(built, units))
+        print(f"\nwrote {len(written.files)} files to {out}/ in {time.perf_counter() - started:.1f} s")
+    except KeyboardInterrupt:
+        raise KeyboardInterrupt(f"every file had been written to {out}/") from None
     if written.skipped:
         print(f"error: not written: {'; '.join(written.skipped)}. Install the CAD extra: {PIP_CAD}", file=sys.stderr)
         return 2
@@ -97,25 +108,21 @@ def _write_design(design: dict | str, out: Path, plots: bool) -> int:
 
 
 def _demo(args: argparse.Namespace) -> int:
-    out = Path(args.out)
     print("The five transitions of Walton & Meek (1996), one instance each:\n")
     print(transition_table(core_examples()))
     print()
-    status = _write_design(DEMO_DESIGN, out, plots=not args.no_plots)
-    if status == 0 and not args.no_plots:
-        _paper_plots(out)
-    return status
+    return _write_design(DEMO_DESIGN, Path(args.out), plots=not args.no_plots, extra=None if args.no_plots else _paper_plots)
 
 
-def _paper_plots(out: Path) -> None:
-    """The paper's Fig. 6 family and the Bézier spiral against a clothoid (each file replaced whole)."""
+def _paper_plots(folder: Path) -> None:
+    """The paper's Fig. 6 family and the Bézier spiral against a clothoid, written into ``folder``
+    (nothing without matplotlib: the missing plots are reported with the rest)."""
+    if find_spec("matplotlib") is None:
+        return
     from .plots import plot_fig6, plot_vs_clothoid
 
-    for name, fig in (("fig6.png", plot_fig6()), ("bezier_vs_clothoid.png", plot_vs_clothoid(math.radians(30), 1.0))):
-        partial = out / f".{name}.partial"
-        fig.savefig(partial, dpi=110, format="png")
-        os.replace(partial, out / name)
-        print(f"  {out / name}")
+    plot_fig6().savefig(folder / "fig6.png", dpi=110, format="png")
+    plot_vs_clothoid(math.radians(30), 1.0).savefig(folder / "bezier_vs_clothoid.png", dpi=110, format="png")
 
 
 def _build(args: argparse.Namespace) -> int:
@@ -161,11 +168,28 @@ def _design_format() -> str:
     return FORMAT
 
 
-def main(argv: Sequence[str] | None = None) -> int:
-    """Run the command line; returns the exit status (0 ok, 1 check failed, 2 error, 130 interrupted).
+@contextmanager
+def _interrupt_watch() -> Iterator[list[int]]:
+    """Ctrl-C raises KeyboardInterrupt as usual and is also recorded in the yielded list, so an
+    interrupt that a library turned into another exception (OCP's "ImportError: initialization
+    failed" during a long import) is still reported as an interrupt."""
+    received: list[int] = []
+    if threading.current_thread() is not threading.main_thread():
+        yield received
+        return
 
-    Every error is printed as ``error: …`` on stderr, never as a traceback.
-    """
+    def interrupt(signum, frame):
+        received.append(signum)
+        raise KeyboardInterrupt
+
+    previous = signal.signal(signal.SIGINT, interrupt)
+    try:
+        yield received
+    finally:
+        signal.signal(signal.SIGINT, previous)
+
+
+def _parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(
         prog="spiral-cad",
         description="Exact G2 (curvature-continuous) cubic Bézier spiral transitions for CAD.",
@@ -197,18 +221,33 @@ def main(argv: Sequence[str] | None = None) -> int:
     build.add_argument("--no-plots", action="store_true", help="skip the PNG plots (the slowest output for long chains)")
     build.set_defaults(run=_build)
     _add_check(sub)
-    args = parser.parse_args(argv)
-    try:
-        return args.run(args)
-    except KeyboardInterrupt:
-        print("error: interrupted; the output folder was left as it was", file=sys.stderr)
-        return 130
-    except (ValueError, OSError) as error:  # DesignError, NoSolutionError, file system errors
-        print(f"error: {error}", file=sys.stderr)
-        return 2
-    except Exception as error:  # a bug: still no traceback, but say so
-        print(f"error: internal error ({type(error).__name__}: {error}); please report it", file=sys.stderr)
-        return 2
+    return parser
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Run the command line; returns the exit status (0 ok, 1 check failed, 2 error, 130 interrupted).
+
+    Every error is printed as one ``error: …`` line on stderr, never as a
+    traceback; Ctrl-C at any moment gives ``error: interrupted`` and 130;
+    Python warnings are not shown (what matters is an error or in the report).
+    """
+    with _interrupt_watch() as interrupted, warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        try:
+            args = _parser().parse_args(argv)
+            return args.run(args)
+        except KeyboardInterrupt as interrupt:
+            print(f"error: interrupted{f'; {interrupt}' if str(interrupt) else ''}", file=sys.stderr)
+            return 130
+        except Exception as error:
+            if interrupted:  # Ctrl-C, wrapped by a library into another exception
+                print("error: interrupted", file=sys.stderr)
+                return 130
+            if isinstance(error, (ValueError, OSError)):  # DesignError, NoSolutionError, file system errors
+                print(f"error: {error}", file=sys.stderr)
+            else:  # a bug: still no traceback, but say so
+                print(f"error: internal error ({type(error).__name__}: {error}); please report it", file=sys.stderr)
+            return 2
 
 
 if __name__ == "__main__":

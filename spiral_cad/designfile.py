@@ -3,11 +3,14 @@
 A design file holds ``units`` and a list of ``designs``; each design has a
 ``name``, a ``type`` and the fields of that type (see ``FORMAT``). Any byte
 sequence is either a valid design or a ``DesignError`` naming the field and
-the value: the file is decoded, parsed and every field checked before
-anything is built, and every design is built before anything is written.
-Files are written into a staging folder inside the output folder and moved
-into place only when all of them were written; any failure or interrupt
-(Ctrl-C, SIGTERM, SIGHUP) removes the staging folder.
+the value: the file must be a regular file of at most ``MAX_DESIGN_BYTES``
+(checked before it is read), it is decoded, parsed and every field checked
+before anything is built, and every design is built before anything is
+written. Output is all or nothing (``spiral_cad.staging``): files are
+written into a staging folder inside the output folder and moved into place
+only when all of them were written and every destination was checked; a
+failure or an interrupt (Ctrl-C, SIGTERM, SIGHUP) leaves the output folder
+as it was.
 """
 
 from __future__ import annotations
@@ -16,9 +19,8 @@ import json
 import math
 import os
 import re
-import shutil
 import signal
-import tempfile
+import stat
 import threading
 import time
 from collections.abc import Callable, Iterator
@@ -31,6 +33,8 @@ from typing import Any
 from .core.chain import Chain
 from .core.errors import NoSolutionError
 from .core.units import UNITS
+from .formats.names import MAX_TEXT_LENGTH, check_name
+from .staging import Staging
 
 FORMAT = """\
 {
@@ -53,7 +57,7 @@ FORMAT = """\
      "strict": false,                    true: a violated criterion is an error
      "cross_section": {"driving_lanes": 1, "lane_width": 3.5, "shoulder_width": 2.5,
                        "rule": "RHT"},   OpenDRIVE lanes (m)
-     "geo_reference": "+proj=utm ..."},  OpenDRIVE geoReference
+     "geo_reference": "+proj=utm ..."},  OpenDRIVE geoReference (printable text, ≤ 10 000 characters)
     {"name": "oval", "type": "circle_chain",
      "circles": [{"center": [x, y], "radius": r}, ...]},   signed radius = travel sense (+ ccw)
     {"name": "robot", "type": "rounded_polyline",
@@ -64,7 +68,8 @@ FORMAT = """\
      "line_to_line" | "circle_in_circle", ...that function's arguments by name...}
   ]
 }
-Names: 1–64 characters of A–Z, a–z, 0–9, - and _ (they name the output files)."""
+Names: 1–64 characters of A–Z, a–z, 0–9, - and _ (they name the output files; no two may
+differ only in case). The file: UTF-8 JSON, a regular file of at most 10 MB."""
 
 TRANSITION_ARGS = {
     "line_to_circle": ("point", "direction", "center", "radius"),
@@ -76,9 +81,10 @@ OPTIONAL = {"curvature"}
 NAME = re.compile(r"[A-Za-z0-9][A-Za-z0-9_-]{0,63}")
 #: JSON integers longer than this are refused (they cannot be lengths in float64 anyway).
 MAX_DIGITS = 308
+#: Design files larger than this are refused before they are read.
+MAX_DESIGN_BYTES = 10_000_000
 #: The packages of the ``cad`` extra and what needs them.
 CAD_EXTRA = {"OCP": "IGES and the continuity check", "ezdxf": "DXF", "matplotlib": "plots"}
-STAGING_PREFIX = ".spiral-cad-build-"
 
 
 class DesignError(ValueError):
@@ -176,13 +182,44 @@ def _json_constant(text: str) -> float:
     raise DesignError(f"{text} is not a number in JSON")
 
 
+def _read(source: str | Path) -> bytes:
+    """The bytes of the design file ``source``: a regular file of at most ``MAX_DESIGN_BYTES``.
+
+    The file is opened without blocking and inspected before anything is
+    read, so a FIFO, a device (/dev/zero), a folder or an enormous file is
+    refused at once.
+    """
+    label = Path(source).name or str(source)
+    flags = os.O_RDONLY | getattr(os, "O_NONBLOCK", 0) | getattr(os, "O_NOCTTY", 0) | getattr(os, "O_BINARY", 0)
+    try:
+        descriptor = os.open(source, flags)
+    except OSError as e:
+        raise DesignError(f"cannot read design file {label}: {e.strerror}") from None
+    except ValueError as e:  # e.g. a NUL character in the path
+        raise DesignError(f"cannot read design file {label!r}: {e}") from None
+    try:
+        info = os.fstat(descriptor)
+        if stat.S_ISDIR(info.st_mode):
+            raise DesignError(f"design file {label} is a folder, not a file")
+        if not stat.S_ISREG(info.st_mode):
+            raise DesignError(f"design file {label} is not a regular file (a device, pipe or socket)")
+        if info.st_size > MAX_DESIGN_BYTES:
+            raise DesignError(f"design file {label} has {info.st_size} bytes; at most {MAX_DESIGN_BYTES} are read")
+        with os.fdopen(descriptor, "rb", closefd=False) as handle:
+            raw = handle.read(MAX_DESIGN_BYTES + 1)
+    except OSError as e:
+        raise DesignError(f"cannot read design file {label}: {e.strerror}") from None
+    finally:
+        os.close(descriptor)
+    if len(raw) > MAX_DESIGN_BYTES:  # it grew after it was inspected
+        raise DesignError(f"design file {label} has more than {MAX_DESIGN_BYTES} bytes")
+    return raw
+
+
 def _parse(source: str | Path) -> Any:
     """The JSON value in the file ``source``; any byte sequence either parses or raises DesignError."""
     label = Path(source).name
-    try:
-        raw = Path(source).read_bytes()
-    except OSError as e:
-        raise DesignError(f"cannot read design file {label}: {e.strerror}") from None
+    raw = _read(source)
     try:
         text = raw.decode("utf-8")
     except UnicodeDecodeError as e:
@@ -223,9 +260,9 @@ def load(source: str | Path | dict) -> tuple[str, list[dict]]:
                 f"designs[{i}].name: must be 1–64 characters of A–Z, a–z, 0–9, - and _ (starting with a letter or "
                 f"digit); got {name!r:.80}"
             )
-        if name in names:
-            raise DesignError(f"designs[{i}].name: {name!r} is used twice")
-        names.add(name)
+        if name.casefold() in names:
+            raise DesignError(f"designs[{i}].name: {name!r} is used twice (names may not differ only in case: they name files)")
+        names.add(name.casefold())
         _choice(d.get("type"), f"designs[{i}].type", tuple(BUILDERS))
     return units, designs
 
@@ -313,8 +350,11 @@ def _alignment(d: dict, where: str, units: str) -> Built:
     if not isinstance(strict, bool):
         raise DesignError(f"{where}.strict: must be true or false; got {strict!r:.80}")
     geo = d.get("geo_reference")
-    if geo is not None and (not isinstance(geo, str) or len(geo) > 1000):
-        raise DesignError(f"{where}.geo_reference: must be a PROJ string; got {geo!r:.80}")
+    if geo is not None:
+        try:
+            check_name(geo, f"{where}.geo_reference", limit=MAX_TEXT_LENGTH, multiline=True)
+        except ValueError as e:
+            raise DesignError(f"{e} (a PROJ string or WKT)") from None
     start = _number(d.get("start_station", 0.0), f"{where}.start_station")
     alignment = Alignment.from_pis(pis, radii, start_station=start, units=units, criteria=criteria, strict=strict, **kw)
     notes = {"cross_section": _cross_section(d, where), "geo_reference": geo}
@@ -414,51 +454,51 @@ class Written:
 
 
 def write(
-    built: list[Built], out: str | Path, units: str, progress: Callable[[str], None] = print, plots: bool = True
+    built: list[Built],
+    out: str | Path,
+    units: str,
+    progress: Callable[[str], None] = print,
+    plots: bool = True,
+    extra: Callable[[Path], None] | None = None,
 ) -> Written:
-    """Write every output of every design into ``out`` (see the module docstring).
+    """Write every output of every design into ``out``, all or nothing (see the module docstring).
 
     Per design: STEP and SVG (always), the stationing CSV of alignments, and
     with the ``cad`` extra IGES, DXF, the plan and curvature plots (unless
     ``plots`` is False) and the continuity report of the STEP file as OCCT
     reads it. Without the extra those are skipped and named in
-    ``Written.skipped``.
+    ``Written.skipped``. ``extra``, if given, writes more files into the
+    folder it is passed (the staging folder); they are committed with the rest.
 
     Raises:
-        DesignError: ``out`` is a file, or cannot be created.
+        ValueError: ``out`` is a file, cannot be created or written, or a
+            file in it cannot be replaced (a folder, read-only); nothing in
+            ``out`` was changed.
+        OSError: writing or moving a file failed; nothing in ``out`` was changed.
+        KeyboardInterrupt: Ctrl-C, SIGTERM or SIGHUP; nothing in ``out`` was changed.
     """
-    out = Path(out)
-    if out.exists() and not out.is_dir():
-        raise DesignError(f"--out {str(out)!r} is a file, not a folder")
-    try:
-        out.mkdir(parents=True, exist_ok=True)
-    except OSError as e:
-        raise DesignError(f"cannot create the output folder {str(out)!r}: {e.strerror}") from None
-    _remove_stale_staging(out)
     missing = missing_cad_extra()
-    stage = Path(tempfile.mkdtemp(prefix=f"{STAGING_PREFIX}{os.getpid()}-", dir=out))
-    try:
-        with _interrupts_raise():
-            for b in built:
-                started = time.perf_counter()
-                names = _write_design(b, stage, units, missing, plots)
-                progress(
-                    f"  {b.name}: {b.kind}, {len(b.chain)} segments, length {b.chain.length:.6g} {units} "
-                    f"→ {', '.join(names)} ({time.perf_counter() - started:.1f} s)"
-                )
-            written = []
-            for path in sorted(stage.iterdir()):
-                target = out / path.name
-                os.replace(path, target)
-                written.append(target)
-    finally:
-        shutil.rmtree(stage, ignore_errors=True)
+    with Staging(out) as staging, _interrupts_raise():
+        for b in built:
+            started = time.perf_counter()
+            names = _write_design(b, staging.folder, units, missing, plots)
+            progress(
+                f"  {b.name}: {b.kind}, {len(b.chain)} segments, length {b.chain.length:.6g} {units} "
+                f"→ {', '.join(names)} ({time.perf_counter() - started:.1f} s)"
+            )
+        if extra is not None:
+            before = set(staging.files())
+            extra(staging.folder)
+            added = [p.name for p in staging.files() if p not in before]
+            if added:
+                progress(f"  also → {', '.join(added)}")
+        written = staging.commit()
     skipped = [f"{CAD_EXTRA[name]} (needs {name})" for name in missing if plots or name != "matplotlib"]
     return Written(written, skipped)
 
 
 def _write_design(b: Built, stage: Path, units: str, missing: list[str], plots: bool) -> list[str]:
-    """Write one design's files into ``stage``; returns the suffixes written."""
+    """Write one design's files into ``stage``; returns what follows the name of each file written."""
     from .export import export_step, export_svg
 
     step = stage / f"{b.name}.step"
@@ -490,36 +530,20 @@ def _write_design(b: Built, stage: Path, units: str, missing: list[str], plots: 
         export_dxf(b.chain, stage / f"{b.name}.dxf", name=b.name)
         names.append("dxf")
     if plots and "matplotlib" not in missing:
-        _plots(b, stage)
-        names.append("png")
+        names += _plots(b, stage)
     return names
 
 
-def _plots(b: Built, stage: Path) -> None:
+def _plots(b: Built, stage: Path) -> list[str]:
     from .plots import plot_curvature, plot_plan
 
+    names = []
     for suffix, plot in (("plan", plot_plan), ("curvature", plot_curvature)):
         fig = plot(b.chain)
         fig.suptitle(f"{b.name} — {b.kind}")
         fig.savefig(stage / f"{b.name}_{suffix}.png", dpi=110)
-
-
-def _remove_stale_staging(out: Path) -> None:
-    """Remove staging folders left by builds that were killed outright (SIGKILL cannot be caught)."""
-    for folder in out.glob(f"{STAGING_PREFIX}*"):
-        pid = folder.name[len(STAGING_PREFIX) :].split("-")[0]
-        if pid.isdigit() and not _alive(int(pid)):
-            shutil.rmtree(folder, ignore_errors=True)
-
-
-def _alive(pid: int) -> bool:
-    try:
-        os.kill(pid, 0)
-    except ProcessLookupError:
-        return False
-    except PermissionError:  # it exists, owned by another user
-        pass
-    return True
+        names.append(f"{suffix}.png")
+    return names
 
 
 @contextmanager
@@ -530,7 +554,7 @@ def _interrupts_raise() -> Iterator[None]:
         return
 
     def interrupt(signum, frame):
-        raise KeyboardInterrupt(f"signal {signum}")
+        raise KeyboardInterrupt
 
     names = [s for s in ("SIGTERM", "SIGHUP") if hasattr(signal, s)]
     previous = {name: signal.signal(getattr(signal, name), interrupt) for name in names}

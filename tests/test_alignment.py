@@ -90,11 +90,11 @@ def test_csv_round_trip_with_units_in_the_headers(tmp_path):
     with path.open() as f:
         rows = list(csv.DictReader(f))
     assert len(rows) == 2
-    assert {"radius [ft]", "TS [ft]", "peak_dk_ds_in [1/ft²]", "theta_in_deg"} <= set(rows[0])
+    assert {"radius [ft]", "TS [ft]", "peak_dk_ds_in [1/ft²]", "theta_in [deg]"} <= set(rows[0])
     for row, curve in zip(rows, al.curves):
         assert int(row["pi"]) == curve.index
         assert float(row["TS [ft]"]) == curve.ts and float(row["ST [ft]"]) == curve.st
-        assert float(row["theta_in_deg"]) == pytest.approx(math.degrees(curve.theta_in))
+        assert float(row["theta_in [deg]"]) == pytest.approx(math.degrees(curve.theta_in))
     text = al.table()
     assert "TS [ft]" in text and "peak_dk_ds_in [1/ft²]" in text and len(text.splitlines()) == 4
 

@@ -107,15 +107,14 @@ class CurveData:
         return self.entry.shape
 
     def row(self) -> dict[str, float]:
-        """The table row: lengths, chainages, angles in degrees, rates in 1/length²."""
-        return {
-            "pi": self.index,
+        """The table row (Python numbers): lengths, chainages, angles in degrees, rates in 1/length²."""
+        values = {
             "x": self.pi[0],
             "y": self.pi[1],
-            "deflection_deg": math.degrees(self.deflection),
+            "deflection": math.degrees(self.deflection),
             "radius": self.radius,
-            "theta_in_deg": math.degrees(self.theta_in),
-            "theta_out_deg": math.degrees(self.theta_out),
+            "theta_in": math.degrees(self.theta_in),
+            "theta_out": math.degrees(self.theta_out),
             "spiral_in_length": self.spiral_in_length,
             "arc_length": self.arc_length,
             "spiral_out_length": self.spiral_out_length,
@@ -129,6 +128,7 @@ class CurveData:
             "mean_dk_ds_out": 1.0 / (self.radius * self.spiral_out_length),
             "spiral_shape": self.shape,
         }
+        return {"pi": int(self.index), **{key: float(value) for key, value in values.items()}}
 
 
 @dataclass(frozen=True)
@@ -350,6 +350,7 @@ class Alignment:
 #: Dimension of each stationing column (``L`` the design's length unit).
 STATION_DIMENSIONS = {
     **dict.fromkeys(["x", "y", "radius", "spiral_in_length", "arc_length", "spiral_out_length"], "L"),
+    **dict.fromkeys(["deflection", "theta_in", "theta_out"], "deg"),
     **dict.fromkeys(["TS", "SC", "CS", "ST"], "L"),
     **dict.fromkeys(["peak_dk_ds_in", "mean_dk_ds_in", "peak_dk_ds_out", "mean_dk_ds_out"], "1/L²"),
 }

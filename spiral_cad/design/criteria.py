@@ -103,8 +103,8 @@ class CriteriaRow:
         return not self.violations
 
     def row(self) -> dict[str, Any]:
-        return {
-            "pi": self.pi,
+        """The table row: Python numbers, and the verdict as text."""
+        values = {
             "radius": self.radius,
             "R_min": self.minimum_radius,
             "L_in": self.spiral_lengths[0],
@@ -117,8 +117,9 @@ class CriteriaRow:
             f"{self.quantity.replace(' ', '_')}_out": self.peak_rates[1],
             "limit": self.limit,
             "banking": self.banking,
-            "verdict": "ok" if self.ok else "; ".join(self.violations),
         }
+        verdict = "ok" if self.ok else "; ".join(self.violations)
+        return {"pi": int(self.pi), **{key: float(value) for key, value in values.items()}, "verdict": verdict}
 
 
 @dataclass(frozen=True)
