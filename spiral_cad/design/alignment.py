@@ -107,7 +107,7 @@ class CurveData:
         return self.entry.shape
 
     def row(self) -> dict[str, float]:
-        """The table row (Python numbers): lengths, chainages, angles in degrees, rates in 1/length²."""
+        """The table row (Python numbers): lengths, chainages, angles in degrees, rates in 1/length², and the spiral shape."""
         values = {
             "x": self.pi[0],
             "y": self.pi[1],
@@ -126,9 +126,8 @@ class CurveData:
             "mean_dk_ds_in": 1.0 / (self.radius * self.spiral_in_length),
             "peak_dk_ds_out": self.peak_rate_out,
             "mean_dk_ds_out": 1.0 / (self.radius * self.spiral_out_length),
-            "spiral_shape": self.shape,
         }
-        return {"pi": int(self.index), **{key: float(value) for key, value in values.items()}}
+        return {"pi": int(self.index), **{key: float(value) for key, value in values.items()}, "spiral_shape": self.shape}
 
 
 @dataclass(frozen=True)

@@ -97,6 +97,7 @@ class CriteriaRow:
     violations: tuple[str, ...] = ()
     quantity: str = "peak lateral jerk"
     rate_unit: str = "m/s³"
+    shape: str = "near-linear"
 
     @property
     def ok(self) -> bool:
@@ -119,7 +120,8 @@ class CriteriaRow:
             "banking": self.banking,
         }
         verdict = "ok" if self.ok else "; ".join(self.violations)
-        return {"pi": int(self.pi), **{key: float(value) for key, value in values.items()}, "verdict": verdict}
+        numbers = {key: float(value) for key, value in values.items()}
+        return {"pi": int(self.pi), **numbers, "spiral_shape": self.shape, "verdict": verdict}
 
 
 @dataclass(frozen=True)
@@ -274,7 +276,8 @@ class RoadCriteria(_Criteria):
                     violations.append(f"{side}: shift p = {p:.4g} > p_max = {high:.4g}")
             e = self.superelevation(radius, units)
             rows.append(CriteriaRow(int(pi), float(radius), r_min, tuple(map(float, length)), tuple(map(float, bound)),
-                                    tuple(map(float, shift)), tuple(map(float, jerk)), self.max_jerk, e, e, tuple(violations)))  # fmt: skip
+                                    tuple(map(float, shift)), tuple(map(float, jerk)), self.max_jerk, e, e, tuple(violations),
+                                    shape=shape))  # fmt: skip
         return rows
 
 
@@ -358,7 +361,7 @@ class RailCriteria(_Criteria):
             rows.append(CriteriaRow(int(pi), float(radius), r_min, tuple(map(float, lengths[k])), tuple(map(float, bounds[k])),
                                     tuple(map(float, shifts[k])), tuple(map(float, deficiency_rates[k])),
                                     self.cant_deficiency_rate_max, float(cants[k]), float(cants[k]) / self.gauge,
-                                    tuple(violations), "peak cant deficiency rate", "mm/s"))  # fmt: skip
+                                    tuple(violations), "peak cant deficiency rate", "mm/s", shape))  # fmt: skip
         return rows
 
 
