@@ -115,14 +115,15 @@ def _demo(args: argparse.Namespace) -> int:
 
 
 def _paper_plots(folder: Path) -> None:
-    """The paper's Fig. 6 family and the Bézier spiral against a clothoid, written into ``folder``
-    (nothing without matplotlib: the missing plots are reported with the rest)."""
+    """The paper's Fig. 6 family beside the near-linear one, and both spirals against a clothoid,
+    written into ``folder`` (nothing without matplotlib: the missing plots are reported with the rest)."""
     if find_spec("matplotlib") is None:
         return
-    from .plots import plot_fig6, plot_vs_clothoid
+    from .plots import plot_fig6_shapes, plot_vs_clothoid
 
-    plot_fig6().savefig(folder / "fig6.png", dpi=110, format="png")
-    plot_vs_clothoid(math.radians(30), 1.0).savefig(folder / "bezier_vs_clothoid.png", dpi=110, format="png")
+    plot_fig6_shapes().savefig(folder / "fig6.png", dpi=110, format="png")
+    both = ("walton-meek", "near-linear")
+    plot_vs_clothoid(math.radians(8), 1.0, shapes=both).savefig(folder / "bezier_vs_clothoid.png", dpi=110, format="png")
 
 
 def _build(args: argparse.Namespace) -> int:
