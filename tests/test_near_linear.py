@@ -356,3 +356,61 @@ def test_cad_objects_take_the_shape():
     solid = cq.Workplane("XY").rect(40, 20).g2Fillet(4, shape="near-linear").extrude(5).val()
     assert solid.isValid()
     assert check_continuity(cq.Workplane().continuousRect(30, 20, 3, shape="near-linear").val().wrapped).passes("G2")
+
+
+def test_the_100_kmh_design_file_builds_end_to_end(tmp_path):
+    """Through ``spiral-cad build``: criteria met at the clothoid's length, and the .xodr holds the
+    near-linear spirals exactly (read back by our reader here; the XSD, the ASAM checker and pyxodr
+    read the demo highway, which is near-linear too, in test_opendrive)."""
+    import csv
+    import json
+    import subprocess
+    import sys
+
+    from spiral_cad.design import Alignment, RoadCriteria
+    from spiral_cad.formats.opendrive import read_opendrive
+
+    pis = [[0, 0], [900, 150], [1900, -120], [2900, 60]]
+    design = {"units": "m", "designs": [{"name": "autobahn", "type": "alignment", "pis": pis, "radii": [500, 700],
+                                         "design_speed": 100, "max_jerk": 0.5, "strict": True}]}  # fmt: skip
+    path = tmp_path / "design.json"
+    path.write_text(json.dumps(design))
+    done = subprocess.run([sys.executable, "-m", "spiral_cad.cli", "build", str(path), "--out", str(tmp_path / "out"), "--no-plots"],
+                          capture_output=True, text=True, timeout=300)  # fmt: skip
+    assert done.returncode == 0, done.stderr
+    with open(tmp_path / "out" / "autobahn_criteria.csv", newline="") as handle:
+        rows = list(csv.DictReader(handle))
+    v = 100 / 3.6
+    for row in rows:
+        assert row["verdict"] == "ok" and row["spiral_shape"] == "near-linear"
+        clothoid = v**3 / (float(row["radius [m]"]) * 0.5)
+        assert abs(float(row["L_in [m]"]) / clothoid - 1) < 0.01
+        assert float(row["peak_lateral_jerk_in [m/s³]"]) <= 0.5 * (1 + 1e-9)
+    (road,) = read_opendrive(tmp_path / "out" / "autobahn.xodr")
+    ours = Alignment.from_pis(pis, [500, 700], units="m", criteria=RoadCriteria(100, 0.5)).chain
+    back = road.chain()
+    assert len(back) == len(ours)
+    for a, b in zip(ours, back):
+        if isinstance(a, sc.BezierSpiral):
+            assert np.allclose(b.control_points, a.control_points, rtol=0, atol=1e-9)
+
+
+def test_design_files_name_the_spiral_shape():
+    from spiral_cad.designfile import DesignError, build
+
+    def one(design):
+        return build({"units": "m", "designs": [design]})[1][0]
+
+    highway = {"name": "h", "type": "alignment", "pis": [[0, 0], [600, 120], [1150, -80]], "radii": [450], "design_speed": 80}
+    assert one(highway).source.shape == "near-linear"
+    assert one({**highway, "spiral_shape": "walton-meek"}).source.shape == "walton-meek"
+    with pytest.raises(DesignError, match=r"designs\[0\] \(h\)\.spiral_shape: must be one of walton-meek, near-linear; got 'g2cbs'"):
+        one({**highway, "spiral_shape": "g2cbs"})
+    robot = {"name": "r", "type": "rounded_polyline", "points": [[0, 0], [2, 0], [3, 1]]}
+    assert one({**robot, "spiral_shape": "g2cbs"}).source.shape == "g2cbs"
+    assert one({**robot, "method": "g2cbs"}).source.shape == "g2cbs"
+    with pytest.raises(DesignError, match="give spiral_shape or method"):
+        one({**robot, "method": "g2cbs", "spiral_shape": "g2cbs"})
+    t = one({"name": "t", "type": "transition", "case": "line_to_circle", "point": [0, 0], "direction": [1, 0],
+             "center": [0, 105], "radius": 100, "spiral_shape": "near-linear"})  # fmt: skip
+    assert t.source.shape == "near-linear"
