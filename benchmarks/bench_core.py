@@ -16,7 +16,7 @@ from timing import machine, median_time, write_markdown
 
 import spiral_cad as sc
 from spiral_cad import batch
-from spiral_cad.core._kernels import nested_band_lower
+from spiral_cad.core._kernels import WALTON_MEEK, nested_band_lower
 
 
 def line_circle_problems(n: int, rng: np.random.Generator):
@@ -92,6 +92,12 @@ def main() -> None:
     clothoid = median_time(lambda: clothoid_line_to_circle(c, r), rep)
     add("batch line→circle (new output arrays)", n / ours / 1e6, "M/s", "goal ≥ 20")
     add("batch line→circle (out= reused buffer)", n / ours_reused / 1e6, "M/s", "goal ≥ 20")
+    # near-linear spirals reach shifts q = d/r − 1 < 0.115; the equal-leg closed form covers q < 1/27
+    near = np.stack([c[:, 0], r * rng.uniform(1.0005, 1.11, n)], axis=1)
+    t_nl = median_time(lambda: batch.line_to_circle(p, d, near, r, shape="near-linear"), rep)
+    t_wm_same = median_time(lambda: batch.line_to_circle(p, d, near, r), rep)
+    add("batch line→circle near-linear (new arrays)", n / t_nl / 1e6, "M/s", f"walton-meek on the same rows {n / t_wm_same / 1e6:,.2f}")
+    assert batch.line_to_circle(p, d, near, r, shape="near-linear").ok.all()
     add("  peer: same closed form, plain numpy", n / numpy_cf / 1e6, "M/s")
     add("  peer: clothoid, Newton on fresnel (1e-12)", n / clothoid / 1e6, "M/s")
     add("  ratio ours (new arrays) / clothoid", clothoid / ours, "×", "goal ≥ 3")
@@ -126,7 +132,7 @@ def main() -> None:
 
     m = n // 20
     q = rng.uniform(0.1, 0.9, m)
-    low = np.array([nested_band_lower(x) for x in q])
+    low = np.array([nested_band_lower(x, WALTON_MEEK) for x in q])
     dist = (1 - q) * (low + rng.uniform(0.05, 0.95, m) * (1 - low))
     t_n = median_time(lambda: batch.circle_in_circle(c0[:m], 1.0, c0[:m] + dist[:, None] * unit[:m], q), rep)
     add("batch circle in circle (iterative)", m / t_n / 1e6, "M/s")

@@ -19,25 +19,31 @@ from .core.transitions import Transition
 
 
 def core_examples() -> list[tuple[str, Transition]]:
-    """One solved instance of each of the five cases (the core demo's input)."""
+    """One solved instance of each of the five cases with each spiral shape (the core demo's input)."""
+    nl = "near-linear"
     return [
         ("line → circle (Thm 4.1)", line_to_circle((0, 0), (1, 0), (0, 1.05), 1.0)),
         ("circle → circle, C (Thm 4.2)", circle_to_circle((0, 0), 2.0, (5, 1), 1.0)),
         ("circle → circle, S (Thm 4.3)", circle_to_circle((0, 0), -2.0, (5, 1), 1.0)),
         ("line → line (Cor 4.5)", line_to_line((0, 0), (10, 0), (15, 8))),
         ("circle in circle (5th case)", circle_in_circle((0, 0), 1.0, (0, 0.595), 0.4)),
+        ("line → circle", line_to_circle((0, 0), (1, 0), (0, 1.01), 1.0, nl)),
+        ("circle → circle, C", circle_to_circle((0, 0), 2.0, (2.5, 0.5), 1.0, nl)),
+        ("circle → circle, S", circle_to_circle((0, 0), -2.0, (4, 0.5), 1.0, nl)),
+        ("line → line", line_to_line((0, 0), (10, 0), (15, 8), shape=nl)),
+        ("circle in circle", circle_in_circle((0, 0), 1.0, (0, 0.595), 0.4, nl)),
     ]
 
 
 def transition_table(rows: Sequence[tuple[str, Transition]]) -> str:
-    """Table of θ, end curvatures and the worst join residuals per transition."""
-    head = f"{'case':30} {'θ°':>9} {'κ start':>10} {'κ end':>10} {'gap/len':>9} {'angle':>9} {'Δκ·len':>9}"
+    """Table of the shape, θ, end curvatures and the worst join residuals per transition."""
+    head = f"{'case':30} {'shape':12} {'θ°':>9} {'κ start':>10} {'κ end':>10} {'gap/len':>9} {'angle':>9} {'Δκ·len':>9}"
     lines = [head, "-" * len(head)]
     for name, t in rows:
         joins = t.joins()
         size = t.length
         lines.append(
-            f"{name:30} {math.degrees(t.theta):9.4f} {t.spirals[0].start_curvature:10.5f} "
+            f"{name:30} {t.shape:12} {math.degrees(t.theta):9.4f} {t.spirals[0].start_curvature:10.5f} "
             f"{t.spirals[-1].end_curvature:10.5f} {max(j.gap for j in joins) / size:9.1e} "
             f"{max(j.angle for j in joins):9.1e} {max(j.curvature_jump for j in joins) * size:9.1e}"
         )
@@ -108,21 +114,22 @@ def _write_design(design: dict | str, out: Path, plots: bool, extra: Callable[[P
 
 
 def _demo(args: argparse.Namespace) -> int:
-    print("The five transitions of Walton & Meek (1996), one instance each:\n")
+    print("The five transitions of Walton & Meek (1996), one instance each with each spiral shape:\n")
     print(transition_table(core_examples()))
     print()
     return _write_design(DEMO_DESIGN, Path(args.out), plots=not args.no_plots, extra=None if args.no_plots else _paper_plots)
 
 
 def _paper_plots(folder: Path) -> None:
-    """The paper's Fig. 6 family and the Bézier spiral against a clothoid, written into ``folder``
-    (nothing without matplotlib: the missing plots are reported with the rest)."""
+    """The paper's Fig. 6 family beside the near-linear one, and both spirals against a clothoid,
+    written into ``folder`` (nothing without matplotlib: the missing plots are reported with the rest)."""
     if find_spec("matplotlib") is None:
         return
-    from .plots import plot_fig6, plot_vs_clothoid
+    from .plots import plot_fig6_shapes, plot_vs_clothoid
 
-    plot_fig6().savefig(folder / "fig6.png", dpi=110, format="png")
-    plot_vs_clothoid(math.radians(30), 1.0).savefig(folder / "bezier_vs_clothoid.png", dpi=110, format="png")
+    plot_fig6_shapes().savefig(folder / "fig6.png", dpi=110, format="png")
+    both = ("walton-meek", "near-linear")
+    plot_vs_clothoid(math.radians(8), 1.0, shapes=both).savefig(folder / "bezier_vs_clothoid.png", dpi=110, format="png")
 
 
 def _build(args: argparse.Namespace) -> int:

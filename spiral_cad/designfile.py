@@ -32,6 +32,8 @@ from typing import Any
 
 from .core.chain import Chain
 from .core.errors import NoSolutionError
+from .core.shapes import CORNER_SHAPES, DEFAULT_SHAPE, TRANSITION_SHAPES
+from .core.spiral import BezierSpiral
 from .core.units import UNITS
 from .formats.names import MAX_TEXT_LENGTH, check_name
 from .staging import Staging
@@ -55,17 +57,22 @@ FORMAT = """\
                                          "cant_deficiency_rate_max", "cant_gradient_max",
                                          "gauge", "cant"
      "strict": false,                    true: a violated criterion is an error
+     "spiral_shape": "near-linear",      default; or "walton-meek" (the 1996 spiral, 1.6–1.8× longer
+                                         for the same jerk)
      "cross_section": {"driving_lanes": 1, "lane_width": 3.5, "shoulder_width": 2.5,
                        "rule": "RHT"},   OpenDRIVE lanes (m)
      "geo_reference": "+proj=utm ..."},  OpenDRIVE geoReference (printable text, ≤ 10 000 characters)
     {"name": "oval", "type": "circle_chain",
-     "circles": [{"center": [x, y], "radius": r}, ...]},   signed radius = travel sense (+ ccw)
+     "circles": [{"center": [x, y], "radius": r}, ...],    signed radius = travel sense (+ ccw)
+     "spiral_shape": "walton-meek" | "near-linear"},        default walton-meek
     {"name": "robot", "type": "rounded_polyline",
      "points": [[x, y], ...],
      "max_curvature": k  | "curvature": k  | neither (as large as fits),
-     "method": "walton-meek" | "g2cbs"},
+     "spiral_shape": "walton-meek" | "near-linear" | "g2cbs"},   default walton-meek
+                                         ("method" is its former name)
     {"name": "t", "type": "transition", "case": "line_to_circle" | "circle_to_circle" |
-     "line_to_line" | "circle_in_circle", ...that function's arguments by name...}
+     "line_to_line" | "circle_in_circle", ...that function's arguments by name...,
+     "spiral_shape": "walton-meek" | "near-linear"}          default walton-meek
   ]
 }
 Names: 1–64 characters of A–Z, a–z, 0–9, - and _ (they name the output files; no two may
@@ -321,11 +328,16 @@ def _cross_section(d: dict, where: str):
         raise DesignError(f"{where}.cross_section: {e}") from None
 
 
+def _shape(d: dict, where: str, choices: tuple[str, ...], default: str = DEFAULT_SHAPE) -> str:
+    """The design's ``spiral_shape`` (one of ``choices``), or ``default``."""
+    return _choice(d.get("spiral_shape", default), f"{where}.spiral_shape", choices)
+
+
 def _alignment(d: dict, where: str, units: str) -> Built:
     from .design import Alignment
 
     optional = ("spiral_angles_deg", "spiral_lengths", "start_station", "design_speed", "criteria", "strict",
-                "cross_section", "geo_reference") + ROAD_KEYS + RAIL_KEYS  # fmt: skip
+                "cross_section", "geo_reference", "spiral_shape") + ROAD_KEYS + RAIL_KEYS  # fmt: skip
     _fields(d, where, ("pis", "radii"), optional)
     pis = _points(d["pis"], f"{where}.pis", 3)
     count = len(pis) - 2
@@ -356,7 +368,8 @@ def _alignment(d: dict, where: str, units: str) -> Built:
         except ValueError as e:
             raise DesignError(f"{e} (a PROJ string or WKT)") from None
     start = _number(d.get("start_station", 0.0), f"{where}.start_station")
-    alignment = Alignment.from_pis(pis, radii, start_station=start, units=units, criteria=criteria, strict=strict, **kw)
+    shape = _shape(d, where, TRANSITION_SHAPES, "near-linear")
+    alignment = Alignment.from_pis(pis, radii, start_station=start, units=units, criteria=criteria, strict=strict, shape=shape, **kw)
     notes = {"cross_section": _cross_section(d, where), "geo_reference": geo}
     return Built(d["name"], "alignment", alignment.chain, alignment, notes)
 
@@ -364,7 +377,7 @@ def _alignment(d: dict, where: str, units: str) -> Built:
 def _circle_chain(d: dict, where: str, units: str) -> Built:
     from .design import circle_chain
 
-    _fields(d, where, ("circles",))
+    _fields(d, where, ("circles",), ("spiral_shape",))
     circles = d["circles"]
     if not isinstance(circles, list) or len(circles) < 2:
         raise DesignError(f"{where}.circles: must be a list of at least 2 circles; got {circles!r:.80}")
@@ -377,20 +390,22 @@ def _circle_chain(d: dict, where: str, units: str) -> Built:
         if radius == 0:
             raise DesignError(f"{w}.radius: must be non-zero (its sign is the travel sense); got 0")
         parsed.append((_point(c["center"], f"{w}.center"), radius))
-    result = circle_chain(parsed, units=units)
+    result = circle_chain(parsed, units=units, shape=_shape(d, where, TRANSITION_SHAPES))
     return Built(d["name"], "circle_chain", result.chain, result)
 
 
 def _rounded(d: dict, where: str, units: str) -> Built:
     from .design import round_corners
 
-    _fields(d, where, ("points",), ("curvature", "max_curvature", "method"))
+    _fields(d, where, ("points",), ("curvature", "max_curvature", "spiral_shape", "method"))
     points = _points(d["points"], f"{where}.points", 3)
     if "curvature" in d and "max_curvature" in d:
         raise DesignError(f"{where}: give at most one of curvature and max_curvature")
     kw = {k: _number(d[k], f"{where}.{k}", positive=True) for k in ("curvature", "max_curvature") if k in d}
-    method = _choice(d.get("method", "walton-meek"), f"{where}.method", ("walton-meek", "g2cbs"))
-    result = round_corners(points, method=method, units=units, **kw)
+    if "method" in d and "spiral_shape" in d:
+        raise DesignError(f"{where}: give spiral_shape or method (its former name), not both")
+    shape = _choice(d["method"], f"{where}.method", CORNER_SHAPES) if "method" in d else _shape(d, where, CORNER_SHAPES)
+    result = round_corners(points, shape=shape, units=units, **kw)
     return Built(d["name"], "rounded_polyline", result.chain, result)
 
 
@@ -399,13 +414,15 @@ def _transition(d: dict, where: str, units: str) -> Built:
 
     case = _choice(d.get("case"), f"{where}.case", tuple(TRANSITION_ARGS))
     names = TRANSITION_ARGS[case]
-    _fields(d, where, tuple(n for n in names if n not in OPTIONAL) + ("case",), tuple(n for n in names if n in OPTIONAL))
+    optional = tuple(n for n in names if n in OPTIONAL) + ("spiral_shape",)
+    _fields(d, where, tuple(n for n in names if n not in OPTIONAL) + ("case",), optional)
     args = {}
     for n in names:
         if n in d:
             value = d[n]
             args[n] = _point(value, f"{where}.{n}") if isinstance(value, list) else _number(value, f"{where}.{n}")
-    t = getattr(transitions, case)(**args)
+    shapes = CORNER_SHAPES if case == "line_to_line" else TRANSITION_SHAPES
+    t = getattr(transitions, case)(**args, shape=_shape(d, where, shapes))
     return Built(d["name"], f"transition ({t.kind})", Chain(t.spirals, units=units), t)
 
 
@@ -577,12 +594,17 @@ def criteria_tables(built: list[Built]) -> str:
 
 
 def summary(built: list[Built], units: str) -> str:
-    """One line per design: kind, segments, length, peak |κ| and the checked continuity."""
-    head = f"{'design':14} {'kind':30} {'segments':>8} {'length ' + units:>12} {'max |κ|':>10}  continuity (of the STEP file)"
+    """One line per design: kind, spiral shape, segments, length, peak |κ| and the checked continuity."""
+    head = (
+        f"{'design':14} {'kind':30} {'spiral shape':13} {'segments':>8} {'length ' + units:>12} {'max |κ|':>10}  "
+        "continuity (of the STEP file)"
+    )
     lines = [head, "-" * len(head)]
     for b in built:
         peak = max(max(abs(seg.start_curvature), abs(seg.end_curvature)) for seg in b.chain)  # spirals are monotone
+        shapes = sorted({seg.shape or "not stated" for seg in b.chain if isinstance(seg, BezierSpiral)}) or ["-"]
         lines.append(
-            f"{b.name:14} {b.kind:30} {len(b.chain):8d} {b.chain.length:12.3f} {peak:10.5f}  {b.notes.get('continuity', '-')}"
+            f"{b.name:14} {b.kind:30} {'+'.join(shapes):13} {len(b.chain):8d} {b.chain.length:12.3f} {peak:10.5f}  "
+            f"{b.notes.get('continuity', '-')}"
         )
     return "\n".join(lines)

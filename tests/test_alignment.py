@@ -123,9 +123,18 @@ def test_peak_rate_exceeds_mean_and_matches_sampling(theta):
 
 
 def test_small_angle_peak_is_about_1_84_times_mean():
+    al = Alignment.from_pis(PIS, 300.0, spiral_angles=0.02, shape="walton-meek")
+    c = al.curves[0]
+    assert al.shape == c.shape == "walton-meek"
+    assert c.peak_rate_in * c.radius * c.spiral_in_length == pytest.approx(1.84, abs=0.02)
+
+
+def test_near_linear_alignments_by_default_peak_at_their_mean():
     al = Alignment.from_pis(PIS, 300.0, spiral_angles=0.02)
     c = al.curves[0]
-    assert c.peak_rate_in * c.radius * c.spiral_in_length == pytest.approx(1.84, abs=0.02)
+    assert al.shape == c.shape == c.entry.spirals[0].shape == "near-linear"
+    assert c.peak_rate_in * c.radius * c.spiral_in_length == pytest.approx(1.0, abs=0.002)
+    assert al.rows()[0]["spiral_shape"] == "near-linear"
 
 
 # ------------------------------------------------------------ validation

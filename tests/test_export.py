@@ -141,7 +141,9 @@ def test_step_keeps_every_double_and_iges_loses_at_most_two_ulp(tmp_path):
             if isinstance(seg, BezierSpiral):
                 poles = np.array([vec(curve.BSpline().Pole(i))[:2] for i in range(1, 5)])
                 poles = poles[::-1] if edge.Orientation() == TopAbs_REVERSED else poles
-                assert np.array_equal(poles, seg.control_points)  # spirals: bit for bit in both
+                # STEP keeps every bit; OCCT's IGES reader parses decimals to within an ulp or two
+                ulps = np.abs(poles - seg.control_points) / np.spacing(np.abs(seg.control_points))
+                assert np.all(ulps == 0) if exact else np.all(ulps <= 2)
             elif isinstance(seg, Arc):
                 radius, centre = curve.Circle().Radius(), vec(curve.Circle().Location())[:2]
                 ulps = abs(radius - abs(seg.radius)) / math.ulp(abs(seg.radius))

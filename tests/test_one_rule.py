@@ -421,4 +421,4 @@ def test_a_joint_float64_cannot_hold_names_the_pi():
     """Spirals of θ ≈ 1e-4 rad on R = 300 m at 1 km from the origin: their end curvature holds
     only to ~1e-6 relative, which no G2 check accepts."""
     with pytest.raises(sc.NoSolutionError, match=r"^PI 1: float64 cannot hold its curve G2 at these coordinates: Chain is not G2 at joint \d .*\(at parts\[[01]\]\)$"):
-        Alignment.from_pis(PIS, 300, units="m", criteria=RoadCriteria(5, side_friction=0.1, shift_min=0))
+        Alignment.from_pis(PIS, 300, units="m", criteria=RoadCriteria(5, side_friction=0.1, shift_min=0), shape="walton-meek")

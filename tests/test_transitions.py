@@ -14,7 +14,12 @@ from spiral_cad import (
     line_to_circle,
     line_to_line,
 )
-from spiral_cad.core._kernels import nested_band_lower
+from spiral_cad.core._kernels import WALTON_MEEK
+from spiral_cad.core._kernels import nested_band_lower as band_lower
+
+
+def nested_band_lower(q):
+    return band_lower(q, WALTON_MEEK)
 
 TOL = 1e-12
 UTM = np.array([6.5e5, 5.4e6])

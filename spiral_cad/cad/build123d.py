@@ -37,6 +37,7 @@ from build123d import (
 )
 
 from ..core.chain import Chain
+from ..core.shapes import DEFAULT_SHAPE
 from ..design.fillets import continuous_polygon, continuous_rectangle, continuous_slot
 from .fillet import fillet_face, fillet_wire, planar_frame
 from .occ import chain_wire
@@ -116,6 +117,7 @@ class SpiralLineToCircle(_TransitionObject):
         direction (VectorLike): travel direction of the line
         center (VectorLike): circle centre, off the line
         radius (float): circle radius (> 0, smaller than the centre's distance to the line)
+        shape (str, optional): spiral shape, "walton-meek" or "near-linear". Defaults to "walton-meek"
         mode (Mode, optional): combination mode. Defaults to Mode.ADD
 
     Raises:
@@ -128,9 +130,10 @@ class SpiralLineToCircle(_TransitionObject):
         direction: VectorLike,
         center: VectorLike,
         radius: float,
+        shape: str = DEFAULT_SHAPE,
         mode: Mode = Mode.ADD,
     ):
-        transition = line_to_circle(_xy(point, "point"), _xy(direction, "direction"), _xy(center, "center"), radius)
+        transition = line_to_circle(_xy(point, "point"), _xy(direction, "direction"), _xy(center, "center"), radius, shape)
         super().__init__(transition, mode)
 
 
@@ -143,9 +146,10 @@ class _CirclePairObject(_TransitionObject):
         radius0: float,
         center1: VectorLike,
         radius1: float,
+        shape: str = DEFAULT_SHAPE,
         mode: Mode = Mode.ADD,
     ):
-        transition = self._solve(_xy(center0, "center0"), radius0, _xy(center1, "center1"), radius1)
+        transition = self._solve(_xy(center0, "center0"), radius0, _xy(center1, "center1"), radius1, shape)
         super().__init__(transition, mode)
 
 
@@ -160,6 +164,7 @@ class SpiralCircleToCircle(_CirclePairObject):
         radius0 (float): its signed radius
         center1 (VectorLike): centre of the circle reached
         radius1 (float): its signed radius
+        shape (str, optional): spiral shape, "walton-meek" or "near-linear". Defaults to "walton-meek"
         mode (Mode, optional): combination mode. Defaults to Mode.ADD
 
     Raises:
@@ -181,6 +186,7 @@ class SpiralLineToLine(_TransitionObject):
         p1 (VectorLike): a point on the outgoing line
         curvature (float, optional): curvature at the joint; None takes the
             largest spirals that fit between p0 and p1. Defaults to None
+        shape (str, optional): "walton-meek", "near-linear" or "g2cbs". Defaults to "walton-meek"
         mode (Mode, optional): combination mode. Defaults to Mode.ADD
 
     Raises:
@@ -193,9 +199,10 @@ class SpiralLineToLine(_TransitionObject):
         corner: VectorLike,
         p1: VectorLike,
         curvature: float | None = None,
+        shape: str = DEFAULT_SHAPE,
         mode: Mode = Mode.ADD,
     ):
-        transition = line_to_line(_xy(p0, "p0"), _xy(corner, "corner"), _xy(p1, "p1"), curvature)
+        transition = line_to_line(_xy(p0, "p0"), _xy(corner, "corner"), _xy(p1, "p1"), curvature, shape)
         super().__init__(transition, mode)
 
 
@@ -209,6 +216,7 @@ class SpiralCircleInCircle(_CirclePairObject):
         radius0 (float): its signed radius
         center1 (VectorLike): centre of the circle reached
         radius1 (float): its signed radius (same sign as radius0)
+        shape (str, optional): spiral shape, "walton-meek" or "near-linear". Defaults to "walton-meek"
         mode (Mode, optional): combination mode. Defaults to Mode.ADD
 
     Raises:
@@ -256,6 +264,7 @@ def g2_fillet(
     vertices: Iterable[Vertex] | None = None,
     transition: float = 0.5,
     same_sense: str = "nested",
+    shape: str = DEFAULT_SHAPE,
 ) -> Wire | Face | Sketch | Curve:
     """Operation: G2 Fillet
 
@@ -279,6 +288,8 @@ def g2_fillet(
             transitions, in (0, 1]; 1 gives a spiral pair with no arc. Defaults to 0.5
         same_sense (str, optional): ``"nested"`` or ``"C"`` for an arc that
             turns the same way as its corner. Defaults to "nested"
+        shape (str, optional): spiral shape of the transitions, "walton-meek" or
+            "near-linear" (curvature almost linear in arc length). Defaults to "walton-meek"
 
     Raises:
         ValueError: a solid or shell (round one of its faces, or use build123d's
@@ -296,7 +307,7 @@ def g2_fillet(
             raise ValueError("g2_fillet of vertices needs a BuildSketch or BuildLine with an object")
         vertices, target = target, context._obj
     points = _points(vertices)
-    options = dict(transition=transition, same_sense=same_sense)
+    options = dict(transition=transition, same_sense=same_sense, shape=shape)
     if not isinstance(target, Shape):
         raise ValueError(f"g2_fillet rounds a Wire, Face, Sketch or Curve; got {type(target).__name__}")
     solids = target.solids() or target.shells()
@@ -357,6 +368,7 @@ class ContinuousRectangle(_ContinuousSketch):
         height (float): rectangle height
         radius (float): the smallest radius of curvature of each corner
         transition (float, optional): share of each corner's turn made by the spirals, in (0, 1]. Defaults to 0.5
+        shape (str, optional): spiral shape, "walton-meek" or "near-linear". Defaults to "walton-meek"
         rotation (float, optional): angle to rotate object. Defaults to 0
         align (Align | tuple[Align, Align], optional): align MIN, CENTER, or MAX of object.
             Defaults to (Align.CENTER, Align.CENTER)
@@ -364,8 +376,9 @@ class ContinuousRectangle(_ContinuousSketch):
     """
 
     def __init__(self, width: float, height: float, radius: float, transition: float = 0.5, rotation: float = 0,
-                 align: Align | tuple[Align, Align] | None = (Align.CENTER, Align.CENTER), mode: Mode = Mode.ADD):  # fmt: skip
-        super().__init__(continuous_rectangle(width, height, radius, transition), rotation, align, mode)
+                 align: Align | tuple[Align, Align] | None = (Align.CENTER, Align.CENTER), shape: str = DEFAULT_SHAPE,
+                 mode: Mode = Mode.ADD):  # fmt: skip
+        super().__init__(continuous_rectangle(width, height, radius, transition, shape=shape), rotation, align, mode)
 
 
 class ContinuousPolygon(_ContinuousSketch):
@@ -378,6 +391,7 @@ class ContinuousPolygon(_ContinuousSketch):
         side_count (int): number of sides
         corner_radius (float): the smallest radius of curvature of each corner
         transition (float, optional): share of each corner's turn made by the spirals. Defaults to 0.5
+        shape (str, optional): spiral shape, "walton-meek" or "near-linear". Defaults to "walton-meek"
         major_radius (bool, optional): radius is the circumscribed (True) or inscribed circle's. Defaults to True
         rotation (float, optional): angle to rotate object. Defaults to 0
         align (Align | tuple[Align, Align], optional): align MIN, CENTER, or MAX of object. Defaults to None
@@ -386,8 +400,8 @@ class ContinuousPolygon(_ContinuousSketch):
 
     def __init__(self, radius: float, side_count: int, corner_radius: float, transition: float = 0.5,
                  major_radius: bool = True, rotation: float = 0, align: Align | tuple[Align, Align] | None = None,
-                 mode: Mode = Mode.ADD):  # fmt: skip
-        path = continuous_polygon(radius, side_count, corner_radius, transition, major_radius)
+                 shape: str = DEFAULT_SHAPE, mode: Mode = Mode.ADD):  # fmt: skip
+        path = continuous_polygon(radius, side_count, corner_radius, transition, major_radius, shape=shape)
         super().__init__(path, rotation, align, mode)
 
 
@@ -401,6 +415,7 @@ class ContinuousSlot(_ContinuousSketch):
         width (float): overall width of slot
         height (float): overall height (the width of the ends)
         transition (float, optional): share of each 90° corner made by the spirals. Defaults to 0.5
+        shape (str, optional): spiral shape, "walton-meek" or "near-linear". Defaults to "walton-meek"
         rotation (float, optional): angle to rotate object. Defaults to 0
         align (Align | tuple[Align, Align], optional): align MIN, CENTER, or MAX of object.
             Defaults to (Align.CENTER, Align.CENTER)
@@ -408,8 +423,9 @@ class ContinuousSlot(_ContinuousSketch):
     """
 
     def __init__(self, width: float, height: float, transition: float = 0.5, rotation: float = 0,
-                 align: Align | tuple[Align, Align] | None = (Align.CENTER, Align.CENTER), mode: Mode = Mode.ADD):  # fmt: skip
-        super().__init__(continuous_slot(width, height, transition), rotation, align, mode)
+                 align: Align | tuple[Align, Align] | None = (Align.CENTER, Align.CENTER), shape: str = DEFAULT_SHAPE,
+                 mode: Mode = Mode.ADD):  # fmt: skip
+        super().__init__(continuous_slot(width, height, transition, shape=shape), rotation, align, mode)
 
 
 def curvature_comb(shape_or_chain, scale: float | None = None, per_edge: int = 24) -> Compound:

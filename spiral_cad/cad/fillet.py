@@ -135,6 +135,7 @@ def fillet_wire(
     *,
     transition: float = 0.5,
     same_sense: str = "nested",
+    shape: str = "walton-meek",
     frame: gp_Ax3 | None = None,
 ) -> tuple[TopoDS_Wire, FilletedPath]:
     """Round the wire's corners at ``vertices`` (3-D points; None: every corner) with G2 fillets.
@@ -151,7 +152,7 @@ def fillet_wire(
     frame = planar_frame(wire) if frame is None else frame
     segments, closed = wire_path(wire, frame)
     chosen = _vertex_indices(segments, closed, frame, vertices)
-    result = fillet_path(segments, radius, transition=transition, vertices=chosen, closed=closed, same_sense=same_sense)
+    result = fillet_path(segments, radius, transition=transition, vertices=chosen, closed=closed, same_sense=same_sense, shape=shape)
     if not result.corners:  # nothing to round: the wire stays as it was
         return wire, result
     shortest = 2.0 * Precision.Confusion_s()
@@ -192,7 +193,13 @@ def _verify(wire: TopoDS_Wire, result: FilletedPath) -> None:
 
 
 def fillet_face(
-    face: TopoDS_Face, radius: float, vertices: Iterable | None = None, *, transition: float = 0.5, same_sense: str = "nested"
+    face: TopoDS_Face,
+    radius: float,
+    vertices: Iterable | None = None,
+    *,
+    transition: float = 0.5,
+    same_sense: str = "nested",
+    shape: str = "walton-meek",
 ) -> TopoDS_Face:
     """Round the corners of a planar face (outer and inner wires) at ``vertices`` (None: every corner).
 
@@ -204,7 +211,8 @@ def fillet_face(
     points = None if vertices is None else list(vertices)
     outer = BRepTools.OuterWire_s(face)
     wires = [outer] + [w for w in _wires(face) if not w.IsSame(outer)]
-    rounded = [fillet_wire(w, radius, points, transition=transition, same_sense=same_sense, frame=frame)[0] for w in wires]
+    options = dict(transition=transition, same_sense=same_sense, shape=shape, frame=frame)
+    rounded = [fillet_wire(w, radius, points, **options)[0] for w in wires]
     maker = BRepBuilderAPI_MakeFace(BRep_Tool.Surface_s(face), rounded[0], True)
     for inner in rounded[1:]:
         maker.Add(inner)

@@ -74,6 +74,7 @@ EQUAL_RADII = int(Status.EQUAL_RADII)
 UNVERIFIED = int(Status.UNVERIFIED)
 BAD_CURVATURE = int(Status.BAD_CURVATURE)
 BAD_ANGLE = int(Status.BAD_ANGLE)
+OUTSIDE_SHAPE = int(Status.OUTSIDE_SHAPE)
 
 #: What is returned must reproduce its contacts and joints to this accuracy:
 #: gap / L, tangent angle (radians) and curvature error × L, with L the
@@ -85,65 +86,160 @@ NAN = math.nan
 INF = math.inf
 
 
-# ---------------------------------------------------------------- shape
+# ---------------------------------------------------------------- shapes
+# A spiral turning by θ onto end radius R has control points
+#   B1 = B0 + a·T,  B2 = B1 + b·T,  B3 = B2 + c·T1   (T1 = T turned by θ),
+# with curvature 0 at B0 (B0, B1, B2 collinear) and 1/R at B3 when
+# b = 3c²/(2R sin θ). Each shape is a choice of the legs (a, b, c) as a
+# function of θ; every formula below (centre offsets, corner distances,
+# curvature along the curve) is written once for any legs.
+
+#: Shape codes (names in ``spiral_cad.core.shapes``).
+WALTON_MEEK = 0
+NEAR_LINEAR = 1
+G2CBS = 2
+
+#: Near-linear: the equal-leg member a = b = c = (2/3)·R·sin θ is used while
+#: its curvature is monotone (cos θ > 5/6, θ < 33.557°); there κ'(1) = 0, the
+#: curvature maximum reaches u = 1, and the family continues through members
+#: that keep it there (see ``boundary_ratio``).
+EQUAL_LEG_COS = 5.0 / 6.0
+#: Largest spiral angle of the near-linear family (50°): its continuation
+#: stays monotone to 53.13° and closer to linear than the 1996 spiral.
+NEAR_LINEAR_MAX_THETA = 5.0 * math.pi / 18.0
+NEAR_LINEAR_MIN_COS = math.cos(NEAR_LINEAR_MAX_THETA)
+#: Yang & Sukkarieh's leg ratio a/b = 2(√6 − 1)/5: the smallest for which a
+#: member with κ'(1) = 0 is monotone at every θ (Walton, Meek & Ali 2003).
+G2CBS_RATIO = 2.0 * (math.sqrt(6.0) - 1.0) / 5.0
 
 
 @jit
-def shape_g1(sin_t, cos_t):
-    """g1(θ) = (5/9) tan θ sin θ + cos θ = (5 + 4cos²θ) / (9 cos θ), for θ ≥ 0."""
-    return (5.0 + 4.0 * cos_t * cos_t) / (9.0 * cos_t)
+def boundary_ratio(shape, cos_t):
+    """Leg ratio r = a/b of a member whose curvature peaks exactly at u = 1.
+
+    κ'(1) = 0 means c = 6b·cos θ/(r + 4) (Walton, Meek & Ali 2003): the 1996
+    spiral is r = 1, G2CBS r = 2(√6 − 1)/5; the near-linear continuation past
+    the equal-leg range takes r = 1.8·cos θ − 0.5, which is 1 at cos θ = 5/6
+    (where it meets the equal-leg member) and follows the ratio that
+    minimises the peak dκ/ds among these members (0.77 at 45°).
+    """
+    if shape == WALTON_MEEK:
+        return 1.0
+    if shape == G2CBS:
+        return G2CBS_RATIO
+    return 1.8 * cos_t - 0.5
 
 
 @jit
-def shape_g2(sin_t, cos_t):
-    """g2(θ) = 25 tan θ / (27 cos θ) − (4/9) sin θ, for θ ≥ 0."""
-    return sin_t * (25.0 - 12.0 * cos_t * cos_t) / (27.0 * cos_t * cos_t)
+def leg_factors(shape, cos_t):
+    """(α, β, γ): the legs (a, b, c) of the spiral turning by θ onto radius R are R·sin θ·(α, β, γ)."""
+    if shape == NEAR_LINEAR and cos_t >= EQUAL_LEG_COS:
+        return 2.0 / 3.0, 2.0 / 3.0, 2.0 / 3.0
+    r = boundary_ratio(shape, cos_t)
+    k = r + 4.0
+    beta = k * k / (54.0 * cos_t * cos_t)
+    return r * beta, beta, k / (9.0 * cos_t)
 
 
 @jit
-def spiral_legs(sin_t, cos_t, radius):
-    """Leg lengths (g, h) of Theorem 3.1 for |θ| and end radius 1/|c|."""
-    g = 25.0 * sin_t * radius / (54.0 * cos_t * cos_t)
-    h = 5.0 * sin_t * radius / (9.0 * cos_t)
-    return g, h
-
-
-#: Theorem 4.4: a = (40/27)·tan θ/(c cos θ) between corner distance a and joint curvature c.
-WALTON_MEEK_CORNER = 40.0 / 27.0
+def in_shape_domain(shape, cos_t):
+    """Whether the shape has a spiral of this angle (cos θ > 0; near-linear: θ ≤ 50°)."""
+    if shape == NEAR_LINEAR:
+        return cos_t >= NEAR_LINEAR_MIN_COS
+    return cos_t > 0.0
 
 
 @jit
-def corner_relation(sin_t, cos_t, value, factor):
-    """factor·sin θ/(value·cos² θ): a spiral pair's corner distance from its joint
-    curvature, or the curvature from the distance (the relation is symmetric)."""
-    return factor * sin_t / (value * cos_t * cos_t)
+def shape_offsets(shape, sin_t, cos_t):
+    """(e1, e2) with g1(θ) = 1 + sin²θ·e1 and g2(θ) = sin θ·e2.
+
+    The end circle's centre is B0 + R·(g2·T + g1·N) (N the normal towards
+    it): g1 − 1 is the circle's shift off the start line over R, and both
+    are formed without cancellation as θ → 0.
+    """
+    alpha, beta, gamma = leg_factors(shape, cos_t)
+    return gamma - 1.0 / (1.0 + cos_t), alpha + beta + gamma * cos_t - 1.0
 
 
 @jit
-def put_spiral(out, bx, by, tx, ty, nx, ny, sin_t, cos_t, radius):
-    """Write the Theorem 3.1 control points into ``out`` (4, 2).
+def shape_g1(shape, sin_t, cos_t):
+    """g1(θ): the end circle's centre lies R·g1 off the start line (1996 spiral: (5 + 4cos²θ)/(9 cos θ))."""
+    return 1.0 + sin_t * sin_t * shape_offsets(shape, sin_t, cos_t)[0]
+
+
+@jit
+def shape_g2(shape, sin_t, cos_t):
+    """g2(θ): the end circle's centre lies R·g2 along the start line (1996 spiral: 25 tan θ/(27 cos θ) − (4/9) sin θ)."""
+    return sin_t * shape_offsets(shape, sin_t, cos_t)[1]
+
+
+@jit
+def shape_offsets_batch(shape, sin_t, cos_t, e1, e2):
+    """``shape_offsets`` over arrays of sin θ and cos θ, into ``e1`` and ``e2``."""
+    for i in range(sin_t.shape[0]):
+        e1[i], e2[i] = shape_offsets(shape, sin_t[i], cos_t[i])
+
+
+@jit
+def corner_factor(shape, sin_t, cos_t):
+    """K(θ): a symmetric spiral pair at a corner of deflection 2θ starts K/κ from the
+    corner, κ its joint curvature (1996 spiral: (40/27)·sin θ/cos²θ, Theorem 4.4).
+
+    The end of each spiral lies on the corner's bisector: d = a + b + c/cos θ.
+    """
+    alpha, beta, gamma = leg_factors(shape, cos_t)
+    return sin_t * (alpha + beta + gamma / cos_t)
+
+
+@jit
+def corner_factor_batch(shape, sin_t, cos_t, out):
+    """``corner_factor`` over arrays of sin θ and cos θ, into ``out``."""
+    for i in range(sin_t.shape[0]):
+        out[i] = corner_factor(shape, sin_t[i], cos_t[i])
+
+
+@jit
+def corner_relation(shape, sin_t, cos_t, value):
+    """K(θ)/value: a spiral pair's corner distance from its joint curvature, or the
+    curvature from the distance (the relation is symmetric)."""
+    return corner_factor(shape, sin_t, cos_t) / value
+
+
+@jit
+def put_spiral(out, bx, by, tx, ty, nx, ny, sin_t, cos_t, radius, shape):
+    """Write the spiral's control points into ``out`` (4, 2).
 
     Starts at (bx, by) along unit (tx, ty) and turns by |θ| towards the unit
     normal (nx, ny), reaching radius ``radius`` at the end.
     """
-    g, h = spiral_legs(sin_t, cos_t, radius)
+    alpha, beta, gamma = leg_factors(shape, cos_t)
+    size = radius * sin_t
+    a = alpha * size
+    b = a + beta * size
+    c = gamma * size
     out[0, 0] = bx
     out[0, 1] = by
-    out[1, 0] = bx + g * tx
-    out[1, 1] = by + g * ty
-    out[2, 0] = bx + 2.0 * g * tx
-    out[2, 1] = by + 2.0 * g * ty
-    out[3, 0] = out[2, 0] + h * (cos_t * tx + sin_t * nx)
-    out[3, 1] = out[2, 1] + h * (cos_t * ty + sin_t * ny)
+    out[1, 0] = bx + a * tx
+    out[1, 1] = by + a * ty
+    out[2, 0] = bx + b * tx
+    out[2, 1] = by + b * ty
+    out[3, 0] = out[2, 0] + c * (cos_t * tx + sin_t * nx)
+    out[3, 1] = out[2, 1] + c * (cos_t * ty + sin_t * ny)
 
 
 @jit
-def spiral_curvature_ratio(u, cos_t):
-    """κ(u)/c of the Theorem 3.1 spiral (the paper's closed form)."""
-    c2 = cos_t * cos_t
-    u2 = u * u
-    base = 25.0 + 10.0 * u2 * (6.0 * c2 - 5.0) + u2 * u2 * (25.0 - 24.0 * c2)
-    return 216.0 * u * c2 * cos_t / base**1.5
+def curvature_ratio(sigma, alpha, beta, gamma, sin_t, cos_t):
+    """κ(u)/κ(1) at u = 1 − σ of the spiral with leg factors (α, β, γ).
+
+    With the legs as vectors, Q' × Q'' = 18·u·c·sin θ·(a(1 − u) + b·u), so
+    κ(u)/κ(1) = u·c³·(a(1 − u) + b·u) / (b·|Q'(u)/3|³); written in σ to keep
+    1 − u exact near the end.
+    """
+    u = 1.0 - sigma
+    x = sigma * sigma * alpha + 2.0 * u * sigma * beta + u * u * gamma * cos_t
+    y = u * u * gamma * sin_t
+    speed2 = x * x + y * y
+    return u * gamma * gamma * gamma * (alpha * sigma + beta * u) / (beta * speed2 * math.sqrt(speed2))
 
 
 # ------------------------------------------------- frames and numbers
@@ -311,8 +407,8 @@ def joint_residual(cp_a, cp_b, inv):
 
 
 @jit
-def spiral_row(bx, by, dx, dy, theta, curvature, out):
-    """Theorem 3.1: the spiral from (bx, by) along d turning by θ to curvature c."""
+def spiral_row(bx, by, dx, dy, theta, curvature, shape, out):
+    """Theorem 3.1 (or the shape's own legs): the spiral from (bx, by) along d turning by θ to curvature c."""
     if not finite(bx, by, dx, dy, theta, curvature):
         return NOT_FINITE, NAN, NAN, NAN
     tx, ty = unit(dx, dy)
@@ -325,21 +421,23 @@ def spiral_row(bx, by, dx, dy, theta, curvature, out):
     side = 1.0 if theta > 0.0 else -1.0
     sin_t = math.sin(abs(theta))
     cos_t = math.cos(theta)
+    if not in_shape_domain(shape, cos_t):
+        return OUTSIDE_SHAPE, NAN, abs(theta), NAN
     radius = 1.0 / abs(curvature)
     # The legs set the scale: the spiral's own size, not its end radius.
-    g = spiral_legs(sin_t, cos_t, radius)[0]
-    if not (g > 0.0 and g < INF):
+    size = leg_factors(shape, cos_t)[1] * sin_t * radius
+    if not (size > 0.0 and size < INF):
         return UNVERIFIED, NAN, INF, NAN
-    scale = frame_scale(g)
+    scale = frame_scale(size)
     inv = 1.0 / scale
     nx = -side * ty
     ny = side * tx
     local_radius = radius * inv
-    put_spiral(out[0], 0.0, 0.0, tx, ty, nx, ny, sin_t, cos_t, local_radius)
+    put_spiral(out[0], 0.0, 0.0, tx, ty, nx, ny, sin_t, cos_t, local_radius, shape)
     place(out, bx, by, scale, 1.0)
-    # The end circle's centre B0 + r·(g2·T + g1·N) (MATH.md §1).
-    g1 = shape_g1(sin_t, cos_t) * local_radius
-    g2 = shape_g2(sin_t, cos_t) * local_radius
+    # The end circle's centre B0 + r·(g2·T + g1·N).
+    g1 = shape_g1(shape, sin_t, cos_t) * local_radius
+    g2 = shape_g2(shape, sin_t, cos_t) * local_radius
     cx = bx + scale * (g2 * tx + g1 * nx)
     cy = by + scale * (g2 * ty + g1 * ny)
     res = worst(line_residual(out[0], bx, by, tx, ty, inv), end_residual(out[0], cx, cy, side * radius, inv))
@@ -349,17 +447,95 @@ def spiral_row(bx, by, dx, dy, theta, curvature, out):
 
 
 @jit
-def unit_spirals_batch(sin_t, cos_t, out):
-    """Theorem 3.1 spirals from the origin along +x, turning left by θ to end radius 1 (one per row)."""
+def unit_spirals_batch(sin_t, cos_t, shape, out):
+    """Spirals of ``shape`` from the origin along +x, turning left by θ to end radius 1 (one per row)."""
     for i in range(sin_t.shape[0]):
-        put_spiral(out[i], 0.0, 0.0, 1.0, 0.0, 0.0, 1.0, sin_t[i], cos_t[i], 1.0)
+        put_spiral(out[i], 0.0, 0.0, 1.0, 0.0, 0.0, 1.0, sin_t[i], cos_t[i], 1.0, shape)
+
+
+# ------------------------------------------------------------ 1-D roots
+
+
+@jit
+def _secant(lo, f_lo, hi, f_hi):
+    """The regula falsi point of the bracket [lo, hi] (its middle if that falls outside)."""
+    x = (lo * f_hi - hi * f_lo) / (f_hi - f_lo)
+    return x if lo < x < hi else 0.5 * (lo + hi)
+
+
+@jit
+def _illinois(lo, f_lo, hi, f_hi, side, x, f):
+    """Bracket [lo, hi] of an increasing function updated with the new point (x, f).
+
+    The Illinois rule halves the value kept at an end that stays twice in a
+    row, so regula falsi converges superlinearly from both sides.
+    """
+    if f < 0.0:
+        if side == -1:
+            f_hi *= 0.5
+        return x, f, hi, f_hi, -1
+    if side == 1:
+        f_lo *= 0.5
+    return lo, f_lo, x, f, 1
+
+
+# Which centre-offset equation ``_offset_measure`` evaluates.
+LINE_CASE = 0
+S_CASE = 1
+C_CASE = 2
+
+
+@jit
+def shape_max_w(shape):
+    """The largest sin²θ of the shape's family (1: any θ < π/2)."""
+    if shape == NEAR_LINEAR:
+        return 1.0 - NEAR_LINEAR_MIN_COS * NEAR_LINEAR_MIN_COS
+    return 1.0
+
+
+@jit
+def _offset_measure(case, shape, w, a_hat):
+    """The left-hand side of a transition's equation in w = sin²θ, increasing from 0.
+
+    Line → circle: g1 − 1 = w·e1 (the shift over R). S: g1² + g2² − 1.
+    C: Â·(g1² − 1) + g2² with Â = (r1 − r0)²/(r1 + r0)².
+    """
+    sin_t = math.sqrt(w)
+    cos_t = math.sqrt(1.0 - w)
+    e1, e2 = shape_offsets(shape, sin_t, cos_t)
+    if case == LINE_CASE:
+        return w * e1
+    g1_squared_less_one = e1 * (2.0 + w * e1)
+    if case == S_CASE:
+        return w * (g1_squared_less_one + e2 * e2)
+    return w * (a_hat * g1_squared_less_one + e2 * e2)
+
+
+@jit
+def _solve_offset(case, shape, target, a_hat):
+    """w = sin²θ where ``_offset_measure`` reaches ``target`` > 0; NaN beyond the shape's range."""
+    hi = shape_max_w(shape)
+    f_hi = _offset_measure(case, shape, hi, a_hat) - target
+    if not f_hi > 0.0:
+        return NAN
+    lo = 0.0
+    f_lo = -target
+    side = 0
+    w = hi
+    for _ in range(200):
+        w = _secant(lo, f_lo, hi, f_hi)
+        f = _offset_measure(case, shape, w, a_hat) - target
+        if f == 0.0 or hi - lo <= 4e-16 * w:
+            break
+        lo, f_lo, hi, f_hi, side = _illinois(lo, f_lo, hi, f_hi, side, w, f)
+    return w
 
 
 # ------------------------------------------------------ line to circle
 
 
 @jit
-def line_to_circle_row(px, py, dx, dy, cx, cy, r, out):
+def line_to_circle_row(px, py, dx, dy, cx, cy, r, shape, out):
     """Theorem 4.1: spiral from the directed line (p, d) to circle (c, r > 0).
 
     ``extra`` is the turn side: +1 left, −1 right.
@@ -383,15 +559,27 @@ def line_to_circle_row(px, py, dx, dy, cx, cy, r, out):
     measure = abs(d) / rs
     if not abs(d) > rs:
         return CIRCLE_MEETS_LINE, NAN, measure, NAN
-    # cos θ = 10 / (9ρ + √(81ρ² − 80)), with 1 − cos θ formed without cancellation.
-    eps = (abs(d) - rs) / rs
-    z = 81.0 * eps * (2.0 + eps)
-    s = math.sqrt(1.0 + z)
-    den = 9.0 * measure + s
-    cos_t = 10.0 / den
-    sin_t = math.sqrt((9.0 * eps + z / (s + 1.0)) / den * (1.0 + cos_t))
-    a = vx * tx + vy * ty - rs * shape_g2(sin_t, cos_t)
-    put_spiral(out[0], a * tx, a * ty, tx, ty, -side * ty, side * tx, sin_t, cos_t, rs)
+    shift = (abs(d) - rs) / rs  # q = g1(θ) − 1
+    if shape == WALTON_MEEK:
+        # cos θ = 10 / (9ρ + √(81ρ² − 80)), with 1 − cos θ formed without cancellation.
+        z = 81.0 * shift * (2.0 + shift)
+        s = math.sqrt(1.0 + z)
+        den = 9.0 * measure + s
+        cos_t = 10.0 / den
+        sin_t = math.sqrt((9.0 * shift + z / (s + 1.0)) / den * (1.0 + cos_t))
+    elif shape == NEAR_LINEAR and shift < 1.0 / 27.0:
+        # Equal legs: 2cos²θ − 3cos θ + 1 + 3q = 0, so 1 − cos θ = 6q / (1 + √(1 − 24q)).
+        versine = 6.0 * shift / (1.0 + math.sqrt(1.0 - 24.0 * shift))
+        cos_t = 1.0 - versine
+        sin_t = math.sqrt(versine * (2.0 - versine))
+    else:
+        w = _solve_offset(LINE_CASE, shape, shift, 0.0)
+        if not w > 0.0:
+            return OUTSIDE_SHAPE, NAN, measure, NAN
+        sin_t = math.sqrt(w)
+        cos_t = math.sqrt(1.0 - w)
+    a = vx * tx + vy * ty - rs * shape_g2(shape, sin_t, cos_t)
+    put_spiral(out[0], a * tx, a * ty, tx, ty, -side * ty, side * tx, sin_t, cos_t, rs, shape)
     place(out, px, py, scale, 1.0)
     res = worst(line_residual(out[0], px, py, tx, ty, inv), end_residual(out[0], cx, cy, side * r, inv))
     if not res <= VERIFY_TOL:
@@ -444,7 +632,7 @@ def _broken_back_w(a_hat, delta, one_minus_a):
 
 
 @jit
-def _two_spirals(out, ox, oy, tx, ty, r0, r1, sin_t, cos_t, s_shape):
+def _two_spirals(out, ox, oy, tx, ty, r0, r1, sin_t, cos_t, s_shape, shape):
     """Write Q0 (reversed) and Q1 leaving their common start of the C/S pair.
 
     (ox, oy) is circle 1's centre relative to circle 0's; the common start is
@@ -453,18 +641,18 @@ def _two_spirals(out, ox, oy, tx, ty, r0, r1, sin_t, cos_t, s_shape):
     """
     nx = -ty
     ny = tx
-    g1 = shape_g1(sin_t, cos_t)
-    g2 = shape_g2(sin_t, cos_t)
+    g1 = shape_g1(shape, sin_t, cos_t)
+    g2 = shape_g2(shape, sin_t, cos_t)
     bx = ox - r1 * (g2 * tx + g1 * nx)
     by = oy - r1 * (g2 * ty + g1 * ny)
     side0 = -1.0 if s_shape else 1.0
-    put_spiral(out[1], bx, by, tx, ty, nx, ny, sin_t, cos_t, r1)
-    put_spiral(out[0], bx, by, -tx, -ty, side0 * nx, side0 * ny, sin_t, cos_t, r0)
+    put_spiral(out[1], bx, by, tx, ty, nx, ny, sin_t, cos_t, r1, shape)
+    put_spiral(out[0], bx, by, -tx, -ty, side0 * nx, side0 * ny, sin_t, cos_t, r0, shape)
     reverse_in_place(out[0])
 
 
 @jit
-def circle_to_circle_row(c0x, c0y, r0, c1x, c1y, r1, out):
+def circle_to_circle_row(c0x, c0y, r0, c1x, c1y, r1, shape, out):
     """Theorems 4.2/4.3: from circle 0 to circle 1, radii signed by travel sense.
 
     Same signs give a broken-back C, opposite signs an S.
@@ -494,14 +682,19 @@ def circle_to_circle_row(c0x, c0y, r0, c1x, c1y, r1, out):
         if not dist > gap:
             return CIRCLES_OVERLAP, NAN, measure, NAN
         eps = (dist - gap) / gap
-        gamma = -729.0 * eps * (2.0 + eps)
-        beta = 1458.0 * measure * measure - 1208.0
-        alpha = 1104.0 - 729.0 * measure * measure
-        w = -2.0 * gamma / (beta + math.sqrt(beta * beta - 4.0 * alpha * gamma))
+        if shape == WALTON_MEEK:  # a quadratic in w = sin²θ
+            gamma = -729.0 * eps * (2.0 + eps)
+            beta = 1458.0 * measure * measure - 1208.0
+            alpha = 1104.0 - 729.0 * measure * measure
+            w = -2.0 * gamma / (beta + math.sqrt(beta * beta - 4.0 * alpha * gamma))
+        else:
+            w = _solve_offset(S_CASE, shape, eps * (2.0 + eps), 0.0)
+            if not w > 0.0:
+                return OUTSIDE_SHAPE, NAN, measure, NAN
         sin_t = math.sqrt(w)
         cos_t = math.sqrt(1.0 - w)
-        p = gap * shape_g2(sin_t, cos_t)
-        q = gap * shape_g1(sin_t, cos_t)
+        p = gap * shape_g2(shape, sin_t, cos_t)
+        q = gap * shape_g1(shape, sin_t, cos_t)
     else:
         gap = abs(a1 - a0)
         measure = dist / gap if gap > 0.0 else INF
@@ -509,13 +702,18 @@ def circle_to_circle_row(c0x, c0y, r0, c1x, c1y, r1, out):
             return CIRCLES_ENCLOSED, NAN, measure, NAN
         big = (a0 + a1) * (a0 + a1)
         delta = (dist - gap) * (dist + gap) / big
-        w = _broken_back_w(gap * gap / big, delta, 4.0 * a0 * a1 / big)
+        if shape == WALTON_MEEK:  # a cubic in w = sin²θ
+            w = _broken_back_w(gap * gap / big, delta, 4.0 * a0 * a1 / big)
+        else:
+            w = _solve_offset(C_CASE, shape, delta, gap * gap / big)
+            if not w > 0.0:
+                return OUTSIDE_SHAPE, NAN, measure, NAN
         sin_t = math.sqrt(w)
         cos_t = math.sqrt(1.0 - w)
-        p = (a0 + a1) * shape_g2(sin_t, cos_t)
-        q = (a1 - a0) * shape_g1(sin_t, cos_t)
+        p = (a0 + a1) * shape_g2(shape, sin_t, cos_t)
+        q = (a1 - a0) * shape_g1(shape, sin_t, cos_t)
     tx, ty = _frame_from_offset(dx, dy, p, q)
-    _two_spirals(out, dx, dy, tx, ty, a0, a1, sin_t, cos_t, s_shape)
+    _two_spirals(out, dx, dy, tx, ty, a0, a1, sin_t, cos_t, s_shape, shape)
     place(out, c0x, c0y, scale, flip)
     # In world coordinates: Q0 leaves circle 0, Q1 reaches circle 1, and both
     # leave their common start B0 along ∓T with zero curvature.
@@ -549,7 +747,7 @@ def corner_residual(out, px, py, t0x, t0y, t1x, t1y, joint_curvature, inv):
 
 
 @jit
-def line_to_line_row(p0x, p0y, px, py, p1x, p1y, curvature, out):
+def line_to_line_row(p0x, p0y, px, py, p1x, p1y, curvature, shape, out):
     """Theorem 4.4: two spirals from line p0→p to line p→p1.
 
     ``curvature`` > 0 is the joint curvature magnitude; NaN applies Corollary
@@ -587,19 +785,21 @@ def line_to_line_row(p0x, p0y, px, py, p1x, p1y, curvature, out):
         return CORNER_STRAIGHT, 0.0, NAN, NAN
     if not cos_t > 0.0:
         return CORNER_REVERSAL, math.pi / 2.0, NAN, NAN
+    if not in_shape_domain(shape, cos_t):
+        return OUTSIDE_SHAPE, math.atan2(sin_t, cos_t), math.atan2(sin_t, cos_t), NAN
     side = 1.0 if cross > 0.0 else -1.0
     shortest = min(l0, l1)
     if math.isnan(curvature):
         a = shortest
     else:
-        a = corner_relation(sin_t, cos_t, curvature * scale, WALTON_MEEK_CORNER)
+        a = corner_relation(shape, sin_t, cos_t, curvature * scale)
     measure = a / shortest
     if not measure <= 1.0 + 1e-12:
         return LEGS_TOO_SHORT, math.atan2(sin_t, cos_t), measure, NAN
-    joint = corner_relation(sin_t, cos_t, a, WALTON_MEEK_CORNER)
+    joint = corner_relation(shape, sin_t, cos_t, a)
     radius = 1.0 / joint
-    put_spiral(out[0], -a * t0x, -a * t0y, t0x, t0y, -side * t0y, side * t0x, sin_t, cos_t, radius)
-    put_spiral(out[1], -a * t1x, -a * t1y, t1x, t1y, side * t1y, -side * t1x, sin_t, cos_t, radius)
+    put_spiral(out[0], -a * t0x, -a * t0y, t0x, t0y, -side * t0y, side * t0x, sin_t, cos_t, radius, shape)
+    put_spiral(out[1], -a * t1x, -a * t1y, t1x, t1y, side * t1y, -side * t1x, sin_t, cos_t, radius, shape)
     reverse_in_place(out[1])
     place(out, px, py, scale, 1.0)
     res = corner_residual(out, px, py, t0x, t0y, t1x, t1y, joint, inv)
@@ -612,140 +812,138 @@ def line_to_line_row(p0x, p0y, px, py, p1x, p1y, curvature, out):
 
 
 @jit
-def nested_band_lower(q):
-    """Infimum of D/(r0 − r1) for one spiral between nested circles, q = r1/r0.
-
-    The limit θ → π/2 of the fifth case: (q^⅓ − q)·√(5/4 + q^−⅔)/(1 − q).
-    """
-    c = q ** (1.0 / 3.0)
-    return (c - q) * math.sqrt(1.25 + 1.0 / (c * c)) / (1.0 - q)
+def shape_max_theta(shape):
+    """The largest spiral angle of the shape's family (π/2, exclusive, for the κ'(1) = 0 members)."""
+    return NEAR_LINEAR_MAX_THETA if shape == NEAR_LINEAR else math.pi / 2.0
 
 
 @jit
-def _nested_sigma(cos_t, q):
-    """σ = 1 − t where κ(t) = q·c on the spiral of angle θ (safeguarded Newton).
+def nested_band_lower(q, shape):
+    """Infimum of D/(r0 − r1) for one spiral between nested circles, q = r1/r0.
 
-    Solves H(σ) = B^{3/2} − 216·t·cos³θ/q = 0 with B the denominator base of
-    κ(u) (``spiral_curvature_ratio``), written in σ to keep 1 − t exact.
+    The distance between the centres falls as the spiral angle grows, so the
+    band ends at the family's largest angle: for the 1996 spiral the limit
+    θ → π/2 in closed form, (q^⅓ − q)·√(5/4 + q^−⅔)/(1 − q); for near-linear
+    spirals the value at 50°.
     """
-    e2 = cos_t * cos_t
-    k = 216.0 * e2 * cos_t / q
-    lam = 1.2 * math.sqrt(q ** (-2.0 / 3.0) - 1.0)
-    sigma = min(0.5 * lam * cos_t, 0.5)
+    if shape == WALTON_MEEK:
+        c = q ** (1.0 / 3.0)
+        return (c - q) * math.sqrt(1.25 + 1.0 / (c * c)) / (1.0 - q)
+    x, y = nested_center_offset(shape_max_theta(shape), 1.0, q, shape)[:2]
+    return norm(x, y) / (1.0 - q)
+
+
+@jit
+def _nested_sigma(q, alpha, beta, gamma, sin_t, cos_t):
+    """σ = 1 − t where κ(t) = q·κ(1): κ grows along the spiral, so an Illinois
+    search on σ ∈ (0, 1) of q − κ(1 − σ)/κ(1) (increasing in σ)."""
     lo = 0.0
+    f_lo = q - 1.0
     hi = 1.0
+    f_hi = q
+    side = 0
+    sigma = 0.5
     for _ in range(200):
-        t = 1.0 - sigma
-        w2 = sigma * (2.0 - sigma)
-        t2 = t * t
-        base = 25.0 * w2 * w2 + e2 * t2 * (60.0 - 24.0 * t2)
-        root = math.sqrt(base)
-        f = base * root - k * t
-        if f == 0.0:
-            return sigma
-        if f < 0.0:
-            lo = sigma
-        else:
-            hi = sigma
-        dbase_dt = -100.0 * t * w2 + e2 * (120.0 * t - 96.0 * t2 * t)
-        df = -(1.5 * root * dbase_dt - k)
-        new = sigma - f / df if df != 0.0 else 0.5 * (lo + hi)
-        if not (lo < new < hi):
-            new = 0.5 * (lo + hi)
-        if abs(new - sigma) <= 1e-16 * new:
-            return new
-        sigma = new
+        sigma = _secant(lo, f_lo, hi, f_hi)
+        f = q - curvature_ratio(sigma, alpha, beta, gamma, sin_t, cos_t)
+        if f == 0.0 or hi - lo <= 2e-16 * sigma:
+            break
+        lo, f_lo, hi, f_hi, side = _illinois(lo, f_lo, hi, f_hi, side, sigma, f)
     return sigma
 
 
 @jit
-def _nested_geometry(theta, r0, r1):
-    """Centre offset (x, y) in the (T, N) frame for spiral angle θ, plus σ and sin/cos."""
+def nested_center_offset(theta, r0, r1, shape):
+    """The fifth case for spiral angle θ: circle 1's centre relative to circle 0's.
+
+    The spiral of ``shape`` turning by θ onto r1 meets the larger circle r0
+    at u = t = 1 − σ (where κ(t) = 1/r0). Returns (x, y) in the frame (T, N)
+    of the spiral's start, σ, sin θ, cos θ and the piece [t, 1] as control
+    points relative to the spiral's end B3 (first three; the fourth is 0).
+    The piece is de Casteljau's, each step written as Y + σ(X − Y) relative
+    to B3 so that short pieces keep their digits.
+    """
     sin_t = math.sin(theta)
     cos_t = math.cos(theta)
-    sigma = _nested_sigma(cos_t, r1 / r0)
-    t = 1.0 - sigma
-    g, h = spiral_legs(sin_t, cos_t, r1)
-    num = 6.0 * t * t * sin_t * cos_t
-    den = 5.0 * sigma * (2.0 - sigma) + 6.0 * t * t * cos_t * cos_t
-    n = norm(num, den)
-    sin_p = num / n
-    cos_p = den / n
-    tail = h * sigma * (3.0 - 3.0 * sigma + sigma * sigma)
-    x = g * sigma * sigma * (3.0 - sigma) + tail * cos_t - r1 * sin_t + r0 * sin_p
-    y = tail * sin_t + r1 * cos_t - r0 * cos_p
-    return x, y, sigma, sin_t, cos_t
+    alpha, beta, gamma = leg_factors(shape, cos_t)
+    sigma = _nested_sigma(r1 / r0, alpha, beta, gamma, sin_t, cos_t)
+    size = r1 * sin_t
+    a = alpha * size
+    b = beta * size
+    c = gamma * size
+    d2x = -c * cos_t  # B2 − B3
+    d2y = -c * sin_t
+    d1x = d2x - b  # B1 − B3
+    d0x = d1x - a  # B0 − B3
+    e0x = d1x + sigma * (d0x - d1x)
+    e0y = d2y
+    e1x = d2x + sigma * (d1x - d2x)
+    e1y = d2y
+    e2x = sigma * d2x
+    e2y = sigma * d2y
+    f0x = e1x + sigma * (e0x - e1x)
+    f0y = e1y + sigma * (e0y - e1y)
+    f1x = e2x + sigma * (e1x - e2x)
+    f1y = e2y + sigma * (e1y - e2y)
+    gx = f1x + sigma * (f0x - f1x)  # Q(t) − B3
+    gy = f1y + sigma * (f0y - f1y)
+    tx, ty = unit(f1x - f0x, f1y - f0y)  # tangent at t
+    # C1 − C0 = (B3 + r1·N1) − (Q(t) + r0·N(t)), N = the left normal.
+    x = -gx - r1 * sin_t + r0 * ty
+    y = -gy + r1 * cos_t - r0 * tx
+    return x, y, sigma, sin_t, cos_t, gx, gy, f1x, f1y, e2x, e2y
 
 
 @jit
-def _nested_canonical(dx, dy, r0, r1, out):
+def _nested_canonical(dx, dy, r0, r1, shape, out):
     """Fifth case, r0 > r1 > 0: the spiral piece [t, 1] from Ω0 to Ω1.
 
-    Solves |C1 − C0|(θ) = D by Illinois regula falsi on θ ∈ (0, π/2), where
-    the distance falls from r0 − r1 (θ → 0) to the band's lower end (θ → π/2).
-    Writes the piece relative to C0 and returns (status, θ, D/(r0 − r1), t).
+    Solves |C1 − C0|(θ) = D by Illinois regula falsi on θ between 0 and the
+    family's largest angle, where the distance falls from r0 − r1 to the
+    band's lower end. Writes the piece relative to C0 and returns
+    (status, θ, D/(r0 − r1), t).
     """
     dist = norm(dx, dy)
     ratio = dist / (r0 - r1)
-    if not (nested_band_lower(r1 / r0) < ratio < 1.0):
+    lower = nested_band_lower(r1 / r0, shape)
+    if not (lower < ratio < 1.0):
         return OUTSIDE_NESTED_BAND, NAN, ratio, NAN
     lo = 0.0
-    hi = math.pi / 2.0
-    f_lo = (r0 - r1) - dist
-    f_hi = nested_band_lower(r1 / r0) * (r0 - r1) - dist
+    hi = shape_max_theta(shape)
+    f_lo = dist - (r0 - r1)  # dist − |C1 − C0|(θ), increasing in θ
+    f_hi = dist - lower * (r0 - r1)
     theta = 0.5 * hi
     side = 0
     for _ in range(200):
-        theta = (lo * f_hi - hi * f_lo) / (f_hi - f_lo)
-        if not (lo < theta < hi):
-            theta = 0.5 * (lo + hi)
-        x, y, sigma, sin_t, cos_t = _nested_geometry(theta, r0, r1)
-        f = norm(x, y) - dist
+        theta = _secant(lo, f_lo, hi, f_hi)
+        x, y = nested_center_offset(theta, r0, r1, shape)[:2]
+        f = dist - norm(x, y)
         if f == 0.0 or hi - lo <= 4e-16 * theta:
             break
-        if f > 0.0:
-            lo = theta
-            f_lo = f
-            if side == 1:
-                f_hi *= 0.5
-            side = 1
-        else:
-            hi = theta
-            f_hi = f
-            if side == -1:
-                f_lo *= 0.5
-            side = -1
-    x, y, sigma, sin_t, cos_t = _nested_geometry(theta, r0, r1)
-    g, h = spiral_legs(sin_t, cos_t, r1)
+        lo, f_lo, hi, f_hi, side = _illinois(lo, f_lo, hi, f_hi, side, theta, f)
+    x, y, sigma, sin_t, cos_t, p0x, p0y, p1x, p1y, p2x, p2y = nested_center_offset(theta, r0, r1, shape)
     tx, ty = _frame_from_offset(dx, dy, x, y)
     nx = -ty
     ny = tx
-    # Local (T, N) coordinates of the piece relative to Q(1), then moved to
-    # world axes relative to C0 in place.
-    e1x = cos_t
-    e1y = sin_t
-    locs = out
-    tail = h * sigma * (3.0 - 3.0 * sigma + sigma * sigma)
-    locs[3, 0] = 0.0
-    locs[3, 1] = 0.0
-    locs[2, 0] = -sigma * h * e1x
-    locs[2, 1] = -sigma * h * e1y
-    locs[0, 0] = -g * sigma * sigma * (3.0 - sigma) - tail * e1x
-    locs[0, 1] = -tail * e1y
-    lead = (1.0 - sigma) * (1.0 - sigma)
-    locs[1, 0] = locs[0, 0] + sigma * (g * sigma * (2.0 - sigma) + h * lead * e1x)
-    locs[1, 1] = locs[0, 1] + sigma * h * lead * e1y
-    # C1 = Q(1) + r1·N1 with N1 = (−sin θ, cos θ) in the local frame.
+    out[0, 0] = p0x
+    out[0, 1] = p0y
+    out[1, 0] = p1x
+    out[1, 1] = p1y
+    out[2, 0] = p2x
+    out[2, 1] = p2y
+    out[3, 0] = 0.0
+    out[3, 1] = 0.0
+    # Relative to C1 = B3 + r1·N1 with N1 = (−sin θ, cos θ), then to world axes relative to C0.
     for k in range(4):
-        lx = locs[k, 0] + r1 * sin_t
-        ly = locs[k, 1] - r1 * cos_t
+        lx = out[k, 0] + r1 * sin_t
+        ly = out[k, 1] - r1 * cos_t
         out[k, 0] = dx + lx * tx + ly * nx
         out[k, 1] = dy + lx * ty + ly * ny
     return OK, theta, ratio, 1.0 - sigma
 
 
 @jit
-def circle_in_circle_row(c0x, c0y, r0, c1x, c1y, r1, out):
+def circle_in_circle_row(c0x, c0y, r0, c1x, c1y, r1, shape, out):
     """Fifth case: one spiral from circle 0 to the nested circle 1 (or out of it).
 
     Radii are signed by travel sense and must share the sign.
@@ -758,6 +956,8 @@ def circle_in_circle_row(c0x, c0y, r0, c1x, c1y, r1, out):
         return SIGN_MISMATCH, NAN, NAN, NAN
     if abs(r0) == abs(r1):
         return EQUAL_RADII, NAN, NAN, NAN
+    if shape == G2CBS:
+        return OUTSIDE_SHAPE, NAN, NAN, NAN
     inward = abs(r0) > abs(r1)
     # Outward travel is the reverse of inward travel with both senses flipped.
     big_r = r0 if inward else -r1
@@ -772,7 +972,7 @@ def circle_in_circle_row(c0x, c0y, r0, c1x, c1y, r1, out):
         return UNVERIFIED, NAN, INF, NAN
     flip = 1.0 if big_r > 0.0 else -1.0
     piece = out[0]
-    status, theta, ratio, t = _nested_canonical(dx, flip * dy, abs(big_r) * inv, abs(small_r) * inv, piece)
+    status, theta, ratio, t = _nested_canonical(dx, flip * dy, abs(big_r) * inv, abs(small_r) * inv, shape, piece)
     if status != OK:
         return status, NAN, ratio, NAN
     if not inward:
@@ -799,46 +999,28 @@ def _record(i, result, out, status, theta, measure):
 
 
 @_compile(parallel=True)
-def line_to_circle_batch(p, d, c, r, out, status, theta, measure):
+def line_to_circle_batch(p, d, c, r, shape, out, status, theta, measure):
     for i in prange(p.shape[0]):
-        row = line_to_circle_row(p[i, 0], p[i, 1], d[i, 0], d[i, 1], c[i, 0], c[i, 1], r[i], out[i])
+        row = line_to_circle_row(p[i, 0], p[i, 1], d[i, 0], d[i, 1], c[i, 0], c[i, 1], r[i], shape, out[i])
         _record(i, row, out, status, theta, measure)
 
 
 @_compile(parallel=True)
-def circle_to_circle_batch(c0, r0, c1, r1, out, status, theta, measure):
+def circle_to_circle_batch(c0, r0, c1, r1, shape, out, status, theta, measure):
     for i in prange(c0.shape[0]):
-        row = circle_to_circle_row(c0[i, 0], c0[i, 1], r0[i], c1[i, 0], c1[i, 1], r1[i], out[i])
+        row = circle_to_circle_row(c0[i, 0], c0[i, 1], r0[i], c1[i, 0], c1[i, 1], r1[i], shape, out[i])
         _record(i, row, out, status, theta, measure)
 
 
 @_compile(parallel=True)
-def line_to_line_batch(p0, p, p1, k, out, status, theta, measure):
+def line_to_line_batch(p0, p, p1, k, shape, out, status, theta, measure):
     for i in prange(p0.shape[0]):
-        row = line_to_line_row(p0[i, 0], p0[i, 1], p[i, 0], p[i, 1], p1[i, 0], p1[i, 1], k[i], out[i])
+        row = line_to_line_row(p0[i, 0], p0[i, 1], p[i, 0], p[i, 1], p1[i, 0], p1[i, 1], k[i], shape, out[i])
         _record(i, row, out, status, theta, measure)
 
 
 @_compile(parallel=True)
-def circle_in_circle_batch(c0, r0, c1, r1, out, status, theta, measure, param):
+def circle_in_circle_batch(c0, r0, c1, r1, shape, out, status, theta, measure, param):
     for i in prange(c0.shape[0]):
-        row = circle_in_circle_row(c0[i, 0], c0[i, 1], r0[i], c1[i, 0], c1[i, 1], r1[i], out[i])
+        row = circle_in_circle_row(c0[i, 0], c0[i, 1], r0[i], c1[i, 0], c1[i, 1], r1[i], shape, out[i])
         param[i] = _record(i, row, out, status, theta, measure)
-
-
-@_compile(parallel=True)
-def verify_corners_batch(out, corners, t_in, t_out, curvature, status, measure):
-    """``corner_residual`` for spiral pairs made elsewhere (e.g. G2CBS): rows
-    with status OK that fail become ``UNVERIFIED`` (NaN control points)."""
-    for i in prange(out.shape[0]):
-        if status[i] != OK:
-            continue
-        scale = frame_scale(1.0 / abs(curvature[i]))
-        inv = 1.0 / scale
-        res = corner_residual(
-            out[i], corners[i, 0], corners[i, 1], t_in[i, 0], t_in[i, 1], -t_out[i, 0], -t_out[i, 1], curvature[i] * scale, inv
-        )
-        if not res <= VERIFY_TOL:
-            status[i] = UNVERIFIED
-            measure[i] = res
-            fill_nan(out[i])

@@ -16,6 +16,7 @@ from numpy.typing import ArrayLike, NDArray
 from . import _kernels as K
 from ._inputs import as_real_array
 from .errors import Status, describe
+from .shapes import CORNER_SHAPES, DEFAULT_SHAPE, TRANSITION_SHAPES, shape_code
 
 __all__ = ["BatchResult", "circle_in_circle", "circle_to_circle", "line_to_circle", "line_to_line"]
 
@@ -33,6 +34,7 @@ class BatchResult:
         measure: (N,) the feasibility number of each row (see ``reason``).
         parameter: (N,) nested case only (else None): t where the spiral
             meets the larger circle.
+        shape: the spiral shape of every row.
     """
 
     case: str
@@ -42,6 +44,7 @@ class BatchResult:
     measure: NDArray
     parameter: NDArray | None
     inputs: dict[str, NDArray]
+    shape: str = DEFAULT_SHAPE
 
     @property
     def ok(self) -> NDArray:
@@ -58,6 +61,7 @@ class BatchResult:
         row = {k: tuple(v[i].tolist()) if v.ndim > 1 else float(v[i]) for k, v in self.inputs.items()}
         if self.case == "line_to_line" and np.isnan(row["curvature"]):
             row["curvature"] = None
+        row["shape"] = self.shape
         return describe(self.case, int(self.status[i]), float(self.measure[i]), row)
 
 
@@ -100,59 +104,82 @@ def _output(out: NDArray | None, n: int, spirals: int) -> NDArray:
     return out
 
 
-def _run(case: str, kernel, spirals: int, rows: dict[str, NDArray], out: NDArray | None, extra: bool = False) -> BatchResult:
+def _run(case: str, kernel, spirals: int, rows: dict[str, NDArray], out: NDArray | None, shape: str, extra: bool = False) -> BatchResult:
     n = len(next(iter(rows.values())))
     out = _output(out, n, spirals)
     status = np.empty(n, dtype=np.int8)
     theta = np.empty(n)
     measure = np.empty(n)
     parameter = np.empty(n) if extra else None
-    args = (*rows.values(), out, status, theta, measure) + ((parameter,) if extra else ())
+    code = shape_code(shape, CORNER_SHAPES if case == "line_to_line" else TRANSITION_SHAPES)
+    args = (*rows.values(), code, out, status, theta, measure) + ((parameter,) if extra else ())
     kernel(*args)
-    return BatchResult(case, tuple(out[:, k] for k in range(spirals)), theta, status, measure, parameter, rows)
+    return BatchResult(case, tuple(out[:, k] for k in range(spirals)), theta, status, measure, parameter, rows, shape)
 
 
 def line_to_circle(
-    points: ArrayLike, directions: ArrayLike, centers: ArrayLike, radii: ArrayLike, out: NDArray | None = None
+    points: ArrayLike,
+    directions: ArrayLike,
+    centers: ArrayLike,
+    radii: ArrayLike,
+    out: NDArray | None = None,
+    shape: str = DEFAULT_SHAPE,
 ) -> BatchResult:
     """Theorem 4.1 for N rows: points, directions, centers (N, 2); radii (N,) > 0.
 
     Every solver accepts inputs of shape (N, …) or a single row that is
-    broadcast, and ``out``: an optional (N, k, 4, 2) float64 buffer reused for
-    the control points (saves the allocation in repeated calls). Every row of
-    ``out`` is written: solved rows with their control points, failed rows
-    with NaN.
+    broadcast, ``out``: an optional (N, k, 4, 2) float64 buffer reused for
+    the control points (saves the allocation in repeated calls), and
+    ``shape``: the spiral shape of every row (as in the scalar solvers).
+    Every row of ``out`` is written: solved rows with their control points,
+    failed rows with NaN.
 
     Raises:
         ValueError: an input that is not an array of real numbers (a masked
             array included: numpy would drop its mask), of the wrong shape or
-            row count, or a bad ``out`` (the message names it). No row's
-            values raise: they become that row's status.
+            row count, a bad ``out`` or an unknown shape (the message names
+            it). No row's values raise: they become that row's status.
     """
     rows = _rows(point=(points, (2,)), direction=(directions, (2,)), center=(centers, (2,)), radius=(radii, ()))
-    return _run("line_to_circle", K.line_to_circle_batch, 1, rows, out)
+    return _run("line_to_circle", K.line_to_circle_batch, 1, rows, out, shape)
 
 
 def circle_to_circle(
-    centers0: ArrayLike, radii0: ArrayLike, centers1: ArrayLike, radii1: ArrayLike, out: NDArray | None = None
+    centers0: ArrayLike,
+    radii0: ArrayLike,
+    centers1: ArrayLike,
+    radii1: ArrayLike,
+    out: NDArray | None = None,
+    shape: str = DEFAULT_SHAPE,
 ) -> BatchResult:
     """Theorems 4.2/4.3 for N rows (signed travel-sense radii: C or S per row)."""
     rows = _rows(center0=(centers0, (2,)), radius0=(radii0, ()), center1=(centers1, (2,)), radius1=(radii1, ()))
-    return _run("circle_to_circle", K.circle_to_circle_batch, 2, rows, out)
+    return _run("circle_to_circle", K.circle_to_circle_batch, 2, rows, out, shape)
 
 
 def line_to_line(
-    p0: ArrayLike, corners: ArrayLike, p1: ArrayLike, curvatures: ArrayLike | None = None, out: NDArray | None = None
+    p0: ArrayLike,
+    corners: ArrayLike,
+    p1: ArrayLike,
+    curvatures: ArrayLike | None = None,
+    out: NDArray | None = None,
+    shape: str = DEFAULT_SHAPE,
 ) -> BatchResult:
-    """Theorem 4.4 for N corners; ``curvatures`` NaN (or None) applies Corollary 4.5."""
+    """Theorem 4.4 for N corners; ``curvatures`` NaN (or None) applies Corollary 4.5.
+    ``shape`` may also be ``"g2cbs"`` (a corner shape)."""
     k = np.nan if curvatures is None else curvatures
     rows = _rows(p0=(p0, (2,)), corner=(corners, (2,)), p1=(p1, (2,)), curvature=(k, ()))
-    return _run("line_to_line", K.line_to_line_batch, 2, rows, out)
+    return _run("line_to_line", K.line_to_line_batch, 2, rows, out, shape)
 
 
 def circle_in_circle(
-    centers0: ArrayLike, radii0: ArrayLike, centers1: ArrayLike, radii1: ArrayLike, out: NDArray | None = None
+    centers0: ArrayLike,
+    radii0: ArrayLike,
+    centers1: ArrayLike,
+    radii1: ArrayLike,
+    out: NDArray | None = None,
+    shape: str = DEFAULT_SHAPE,
 ) -> BatchResult:
     """The fifth case for N rows (nested circles, same-sign radii)."""
     rows = _rows(center0=(centers0, (2,)), radius0=(radii0, ()), center1=(centers1, (2,)), radius1=(radii1, ()))
-    return _run("circle_in_circle", K.circle_in_circle_batch, 1, rows, out, extra=True)
+    return _run("circle_in_circle", K.circle_in_circle_batch, 1, rows, out, shape, extra=True)

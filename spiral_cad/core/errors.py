@@ -47,6 +47,7 @@ class Status(IntEnum):
     UNVERIFIED = 14
     BAD_CURVATURE = 15
     BAD_ANGLE = 16
+    OUTSIDE_SHAPE = 17
 
 
 #: Codes that mean "malformed input" (plain ValueError); the rest are NoSolutionError.
@@ -77,11 +78,13 @@ def describe(case: str, status: int, measure: float, inputs: dict[str, object]) 
         inputs: the row's inputs by argument name (shown in the message).
     """
     from ._kernels import nested_band_lower  # late: keeps this module kernel-free
+    from .shapes import SHAPE_CODES
 
     status = Status(status)
-    shown = ", ".join(f"{k}={v}" for k, v in inputs.items())
+    shown = ", ".join(f"{k}={v!r}" if isinstance(v, str) else f"{k}={v}" for k, v in inputs.items())
     r0 = inputs.get("radius0")
     r1 = inputs.get("radius1")
+    shape = inputs.get("shape", "walton-meek")
     if status is Status.NOT_FINITE:
         return f"{case}: every input must be finite; got {shown}"
     if status is Status.ZERO_DIRECTION:
@@ -135,10 +138,12 @@ def describe(case: str, status: int, measure: float, inputs: dict[str, object]) 
         big, small = sorted((abs(float(r0)), abs(float(r1))), reverse=True)
         q = small / big
         return (
-            "circle_in_circle: a single Bézier spiral exists only for "
-            f"{nested_band_lower(q):.5f} ≤ D/(r0 − r1) < 1 at r1/r0 = {q:.2f}; "
+            f"circle_in_circle: a single {shape} spiral exists only for "
+            f"{nested_band_lower(q, SHAPE_CODES[shape]):.5f} ≤ D/(r0 − r1) < 1 at r1/r0 = {q:.2f}; "
             f"here D/(r0 − r1) = {measure:.5f}"
         )
+    if status is Status.OUTSIDE_SHAPE:
+        return _outside_shape(case, shape, measure, inputs)
     if status is Status.EQUAL_RADII:
         return f"circle_in_circle: nested circles need different radii; got |radius0| = |radius1| = {abs(float(r0))}"
     if status is Status.UNVERIFIED:
@@ -156,6 +161,41 @@ def describe(case: str, status: int, measure: float, inputs: dict[str, object]) 
     if status is Status.BAD_ANGLE:
         return f"{case}: |theta| must lie in (0, π/2); got theta = {inputs.get('theta')}"
     raise AssertionError(f"no description for status {status!r}")
+
+
+def _outside_shape(case: str, shape: str, measure: float, inputs: dict[str, object]) -> str:
+    """Why a problem lies beyond what spirals of ``shape`` reach (its largest spiral angle)."""
+    from .shapes import shape_limits
+
+    limits = shape_limits(shape)
+    largest = f"{math.degrees(limits['theta']):g}°"
+    advice = "; the walton-meek shape reaches it" if shape != "walton-meek" else ""
+    if case == "BezierSpiral":
+        return f"BezierSpiral: {shape} spirals turn by at most {largest}; got |theta| = {math.degrees(measure):.6g}°{advice}"
+    if case == "line_to_line":
+        return (
+            f"line_to_line: {shape} spiral pairs round corners of at most {2 * math.degrees(limits['theta']):g}° "
+            f"deflection (spiral angle {largest}); this corner deflects {2 * math.degrees(measure):.6g}°{advice}"
+        )
+    if case == "line_to_circle":
+        return (
+            f"line_to_circle: a {shape} spiral (at most {largest}) reaches circles only up to d/r < "
+            f"{limits['line_circle']:.6g} (d the centre's distance from the line); here d/r = {measure:.6g}{advice}"
+        )
+    if case == "circle_to_circle":
+        r0, r1 = abs(float(inputs["radius0"])), abs(float(inputs["radius1"]))
+        if (float(inputs["radius0"]) > 0) != (float(inputs["radius1"]) > 0):
+            return (
+                f"circle_to_circle (S): a {shape} pair (at most {largest} each) needs D/(|r0| + |r1|) < "
+                f"{limits['s_pair']:.6g}; here {measure:.6g}{advice}"
+            )
+        reach = math.hypot((r0 + r1) * limits["g2"], (r1 - r0) * limits["g1"])
+        distance = measure * abs(r1 - r0) if r1 != r0 else math.dist(inputs["center0"], inputs["center1"])
+        return (
+            f"circle_to_circle (broken-back C): a {shape} pair (at most {largest} each) reaches centres only "
+            f"up to D < {reach:.6g} apart for these radii; here D = {distance:.6g}{advice}"
+        )
+    return f"{case}: the {shape} shape has no spiral for {', '.join(f'{k}={v}' for k, v in inputs.items())}{advice}"
 
 
 def error_for(case: str, status: int, measure: float, inputs: dict[str, object]) -> ValueError:

@@ -1,4 +1,4 @@
-"""The Walton–Meek cubic Bézier spiral (Theorem 3.1) as a path segment."""
+"""The cubic Bézier spiral (Walton & Meek's Theorem 3.1, or another shape) as a path segment."""
 
 from __future__ import annotations
 
@@ -13,57 +13,71 @@ from ._inputs import as_float, as_xy
 from ._kernels import spiral_row
 from .errors import Status, error_for
 from .segments import EPS, End, Segment, piece_range
+from .shapes import DEFAULT_SHAPE, SHAPE_CODES, TRANSITION_SHAPES, shape_code
 
 
 class BezierSpiral(Segment):
     """A cubic Bézier spiral: curvature grows monotonically from 0 to ``curvature``.
 
-    Built by Theorem 3.1 of Walton & Meek (1996): control points
-    B0, B1 = B0 + gT, B2 = B1 + gT, B3 = B2 + h·rot(T, θ) with
-    g = 25 tan|θ| / (54 |c| cos θ) and h = 5 tan|θ| / (9 |c|).
+    Control points B0, B1 = B0 + a·T, B2 = B1 + b·T, B3 = B2 + c·rot(T, θ),
+    with legs (a, b, c) set by ``shape`` (``spiral_cad.core.shapes``):
+    ``"walton-meek"`` is Theorem 3.1 of Walton & Meek (1996), a = b =
+    25 tan|θ| / (54 |κ| cos θ), c = 5 tan|θ| / (9 |κ|); ``"near-linear"``
+    has curvature almost linear in arc length (a = b = c = (2/3)·sin|θ|/|κ|
+    up to |θ| = 33.56°, defined up to 50°).
 
     Args:
         start: start point B0, where the curvature is 0.
         direction: start tangent (any non-zero length).
         theta: signed turn angle, 0 < |θ| < π/2 (positive turns left).
         curvature: signed end curvature, same sign as ``theta``.
+        shape: ``"walton-meek"`` (default) or ``"near-linear"``.
 
     Raises:
         ValueError: non-finite input, zero direction, |θ| ∉ (0, π/2), zero
-            curvature or signs that differ.
-        NoSolutionError: a spiral that float64 cannot hold to 1e-9 where it
-            is placed (e.g. curvature 5e-324, or a tiny spiral at 1e12).
+            curvature, signs that differ or an unknown shape.
+        NoSolutionError: |θ| beyond the shape's range (near-linear: 50°), or
+            a spiral that float64 cannot hold to 1e-9 where it is placed
+            (e.g. curvature 5e-324, or a tiny spiral at 1e12).
 
     Pieces (``piece``) and reversals (``reversed``) are exact Bézier curves
-    of the same kind; for them ``start_curvature`` need not be 0.
+    of the same shape; for them ``start_curvature`` need not be 0.
     """
 
-
-    def __init__(self, start: Any, direction: Any, theta: float, curvature: float):
+    def __init__(self, start: Any, direction: Any, theta: float, curvature: float, shape: str = DEFAULT_SHAPE):
         bx, by = as_xy(start, "start")
         dx, dy = as_xy(direction, "direction")
         theta = as_float(theta, "theta")
         curvature = as_float(curvature, "curvature")
+        code = shape_code(shape, TRANSITION_SHAPES)
         out = np.empty((1, 4, 2))
-        status, _, measure, _ = spiral_row(bx, by, dx, dy, theta, curvature, out)
+        status, _, measure, _ = spiral_row(bx, by, dx, dy, theta, curvature, code, out)
         if status != Status.OK:
-            inputs = dict(start=(bx, by), direction=(dx, dy), theta=theta, curvature=curvature)
+            inputs = dict(start=(bx, by), direction=(dx, dy), theta=theta, curvature=curvature, shape=shape)
             raise error_for("BezierSpiral", status, measure, inputs)
         self._cp = out[0]
         self._length = None
+        self._shape = shape
         self._cp.flags.writeable = False
 
     @classmethod
-    def from_control_points(cls, control_points: ArrayLike) -> BezierSpiral:
+    def from_control_points(cls, control_points: ArrayLike, shape: str | None = None) -> BezierSpiral:
         """Wrap control points that are known to form a spiral (or a piece of one).
 
-        No check is made that the curvature is monotone; use the solvers or
-        the constructor to make spirals.
+        No check is made that the curvature is monotone or that the legs are
+        those of ``shape``; use the solvers or the constructor to make spirals.
+
+        Args:
+            control_points: (4, 2) control points in travel order.
+            shape: the shape the points were made with, if known (reported
+                by ``shape``; None: not stated).
 
         Raises:
-            ValueError: not a finite (4, 2) array, or an end leg of zero
-                length (no end tangent: a degenerate spiral).
+            ValueError: not a finite (4, 2) array, an end leg of zero
+                length (no end tangent: a degenerate spiral), or an unknown shape.
         """
+        if shape is not None and shape not in SHAPE_CODES:
+            shape_code(shape, tuple(SHAPE_CODES))
         cp = np.array(control_points, dtype=float)
         if cp.shape != (4, 2):
             raise ValueError(f"control_points must have shape (4, 2); got {cp.shape}")
@@ -75,19 +89,25 @@ class BezierSpiral(Segment):
                     f"control_points make a degenerate spiral: the {leg} leg from {cp[a].tolist()} to "
                     f"{cp[b].tolist()} has no direction"
                 )
-        return cls._wrap(cp)
+        return cls._wrap(cp, shape)
 
     @classmethod
-    def _wrap(cls, cp: NDArray) -> BezierSpiral:
+    def _wrap(cls, cp: NDArray, shape: str | None) -> BezierSpiral:
         """Adopt a finite (4, 2) float64 array without copying or checks (solver output)."""
         spiral = object.__new__(cls)
         cp.flags.writeable = False
         spiral._cp = cp
         spiral._length = None
+        spiral._shape = shape
         return spiral
 
     def __repr__(self) -> str:
-        return f"BezierSpiral.from_control_points({self._cp.tolist()})"
+        return f"BezierSpiral.from_control_points({self._cp.tolist()}, shape={self._shape!r})"
+
+    @property
+    def shape(self) -> str | None:
+        """The shape the spiral was made with (``"walton-meek"``, ``"near-linear"``, ``"g2cbs"``; None if not stated)."""
+        return self._shape
 
     @property
     def control_points(self) -> NDArray:
@@ -163,7 +183,7 @@ class BezierSpiral(Segment):
     def piece(self, t0: float, t1: float) -> BezierSpiral:
         """Exact sub-curve on [t0, t1] (de Casteljau) as a Bézier on [0, 1]."""
         t0, t1 = piece_range(t0, t1)
-        return BezierSpiral.from_control_points(bezier.split(self._cp, t0, t1))
+        return BezierSpiral.from_control_points(bezier.split(self._cp, t0, t1), self._shape)
 
     def reversed(self) -> BezierSpiral:
-        return BezierSpiral._wrap(self._cp[::-1].copy())
+        return BezierSpiral._wrap(self._cp[::-1].copy(), self._shape)

@@ -1,8 +1,10 @@
 """The five G2 transitions of Walton & Meek (1996), one problem at a time.
 
 Each solver returns a :class:`Transition` whose ``spirals`` read in travel
-order. The work is done by the row kernels that ``spiral_cad.batch`` runs
-over arrays, so scalar and batch results agree bit for bit.
+order, made with the spiral ``shape`` asked for (``spiral_cad.core.shapes``:
+``"walton-meek"`` by default, or ``"near-linear"``). The work is done by the
+row kernels that ``spiral_cad.batch`` runs over arrays, so scalar and batch
+results agree bit for bit.
 """
 
 from __future__ import annotations
@@ -18,6 +20,7 @@ from . import _kernels as K
 from ._inputs import as_float, as_xy
 from .errors import Status, error_for
 from .segments import Arc, Circle, Join, Line, Ray, Segment, measure_join
+from .shapes import CORNER_SHAPES, DEFAULT_SHAPE, TRANSITION_SHAPES, shape_code
 from .spiral import BezierSpiral
 
 
@@ -35,7 +38,8 @@ class Transition:
         end_circle: the circle the path reaches, if any.
         start_line, end_line: the given lines the path leaves / reaches, if any.
         parameter: nested case only: the parameter t ∈ (0, 1) of the full
-            Theorem 3.1 spiral where it meets the larger circle.
+            spiral where it meets the larger circle.
+        shape: the spiral shape (``"walton-meek"``, ``"near-linear"``, ``"g2cbs"``).
     """
 
     kind: str
@@ -46,6 +50,7 @@ class Transition:
     parameter: float | None = None
     start_line: Ray | None = None
     end_line: Ray | None = None
+    shape: str = DEFAULT_SHAPE
 
     @property
     def start(self) -> NDArray:
@@ -117,15 +122,17 @@ def _contact_piece(circle: Circle | None, line: Ray | None, point: NDArray, befo
     return Line(foot - step, foot) if before else Line(foot, foot + step)
 
 
-def _solve(case: str, row, count: int, args: tuple[float, ...], inputs: dict[str, Any]):
+def _solve(case: str, row, count: int, args: tuple[float, ...], inputs: dict[str, Any], allowed=TRANSITION_SHAPES):
+    shape = inputs["shape"]
+    code = shape_code(shape, allowed)
     out = np.empty((count, 4, 2))
-    status, theta, measure, extra = row(*args, out)
+    status, theta, measure, extra = row(*args, code, out)
     if status != Status.OK:
         raise error_for(case, status, measure, inputs)
-    return [BezierSpiral._wrap(cp) for cp in out], theta, extra
+    return [BezierSpiral._wrap(cp, shape) for cp in out], theta, extra
 
 
-def line_to_circle(point: Any, direction: Any, center: Any, radius: float) -> Transition:
+def line_to_circle(point: Any, direction: Any, center: Any, radius: float, shape: str = DEFAULT_SHAPE) -> Transition:
     """Theorem 4.1: spiral from a directed line onto a circle.
 
     Travel runs along ``direction`` and turns toward the side of the line the
@@ -136,48 +143,58 @@ def line_to_circle(point: Any, direction: Any, center: Any, radius: float) -> Tr
         direction: travel direction of the line (non-zero).
         center: circle centre, off the line.
         radius: circle radius, > 0.
+        shape: ``"walton-meek"`` (any shift q = (d − r)/r > 0) or
+            ``"near-linear"`` (q < 0.1152: θ ≤ 50°; the equal-leg closed form
+            for q < 1/27).
 
     Raises:
-        NoSolutionError: the circle touches or crosses the line (r ≥ d).
+        NoSolutionError: the circle touches or crosses the line (r ≥ d), or
+            lies beyond the shape's reach.
         ValueError: malformed input.
     """
     px, py = as_xy(point, "point")
     dx, dy = as_xy(direction, "direction")
     cx, cy = as_xy(center, "center")
     r = as_float(radius, "radius")
-    inputs = dict(point=(px, py), direction=(dx, dy), center=(cx, cy), radius=r)
+    inputs = dict(point=(px, py), direction=(dx, dy), center=(cx, cy), radius=r, shape=shape)
     spirals, theta, side = _solve("line_to_circle", K.line_to_circle_row, 1, (px, py, dx, dy, cx, cy, r), inputs)
     sense = side * r
     line = Ray((px, py), (dx, dy))
-    return Transition("line-circle", spirals, theta, end_circle=Circle((cx, cy), sense), start_line=line)
+    return Transition("line-circle", spirals, theta, end_circle=Circle((cx, cy), sense), start_line=line, shape=shape)
 
 
-def _two_circles(center0: Any, radius0: Any, center1: Any, radius1: Any) -> dict[str, Any]:
+def _two_circles(center0: Any, radius0: Any, center1: Any, radius1: Any, shape: str) -> dict[str, Any]:
     """The two circles' arguments coerced and named, in argument order."""
     return dict(center0=as_xy(center0, "center0"), radius0=as_float(radius0, "radius0"),
-                center1=as_xy(center1, "center1"), radius1=as_float(radius1, "radius1"))  # fmt: skip
+                center1=as_xy(center1, "center1"), radius1=as_float(radius1, "radius1"), shape=shape)  # fmt: skip
 
 
-def circle_to_circle(center0: Any, radius0: float, center1: Any, radius1: float) -> Transition:
+def circle_to_circle(center0: Any, radius0: float, center1: Any, radius1: float, shape: str = DEFAULT_SHAPE) -> Transition:
     """Theorems 4.2 and 4.3: two spirals from circle 0 to circle 1.
 
     The sign of each radius is the travel sense on that circle (positive:
     counterclockwise). Same signs give a broken-back C (zero curvature at the
     joint), opposite signs an S (an inflection at the joint).
 
+    Args:
+        center0, radius0: the circle left (signed radius: travel sense).
+        center1, radius1: the circle reached.
+        shape: ``"walton-meek"`` or ``"near-linear"`` (S: D < 1.4108·(r0 + r1);
+            C: D < √((r0 + r1)²·0.8642² + (r1 − r0)²·1.1152²), its 50° limit).
+
     Raises:
-        NoSolutionError: C with one circle enclosing the other, or S with
-            circles that touch or overlap.
+        NoSolutionError: C with one circle enclosing the other, S with
+            circles that touch or overlap, or circles beyond the shape's reach.
         ValueError: malformed input (zero radius, coincident centres, …).
     """
-    inputs = _two_circles(center0, radius0, center1, radius1)
-    c0, r0, c1, r1 = inputs.values()
+    inputs = _two_circles(center0, radius0, center1, radius1, shape)
+    c0, r0, c1, r1 = (inputs[k] for k in ("center0", "radius0", "center1", "radius1"))
     spirals, theta, _ = _solve("circle_to_circle", K.circle_to_circle_row, 2, (*c0, r0, *c1, r1), inputs)
     kind = "S" if (r0 > 0) != (r1 > 0) else "C"
-    return Transition(kind, spirals, theta, Circle(c0, r0), Circle(c1, r1))
+    return Transition(kind, spirals, theta, Circle(c0, r0), Circle(c1, r1), shape=shape)
 
 
-def line_to_line(p0: Any, corner: Any, p1: Any, curvature: float | None = None) -> Transition:
+def line_to_line(p0: Any, corner: Any, p1: Any, curvature: float | None = None, shape: str = DEFAULT_SHAPE) -> Transition:
     """Theorem 4.4: two spirals from the line p0→corner to the line corner→p1.
 
     Args:
@@ -187,35 +204,41 @@ def line_to_line(p0: Any, corner: Any, p1: Any, curvature: float | None = None) 
         curvature: joint curvature magnitude (> 0). ``None`` applies
             Corollary 4.5: the largest pair, starting exactly at the nearer of
             p0 and p1.
+        shape: ``"walton-meek"``, ``"near-linear"`` (deflections up to 100°)
+            or ``"g2cbs"``; the pair starts K(θ)/κ from the corner, K the
+            shape's corner factor.
 
     Raises:
-        NoSolutionError: collinear or folded-back legs, or a curvature so
-            small that the spirals would start beyond p0 or p1.
+        NoSolutionError: collinear or folded-back legs, a deflection beyond
+            the shape's range, or a curvature so small that the spirals would
+            start beyond p0 or p1.
         ValueError: malformed input.
     """
     a = as_xy(p0, "p0")
     p = as_xy(corner, "corner")
     b = as_xy(p1, "p1")
     k = math.nan if curvature is None else as_float(curvature, "curvature")
-    inputs = dict(p0=a, corner=p, p1=b, curvature=curvature)
-    spirals, theta, _ = _solve("line_to_line", K.line_to_line_row, 2, (*a, *p, *b, k), inputs)
-    return Transition("line-line", spirals, theta, start_line=Ray(p, (p[0] - a[0], p[1] - a[1])), end_line=Ray(p, (b[0] - p[0], b[1] - p[1])))
+    inputs = dict(p0=a, corner=p, p1=b, curvature=curvature, shape=shape)
+    spirals, theta, _ = _solve("line_to_line", K.line_to_line_row, 2, (*a, *p, *b, k), inputs, CORNER_SHAPES)
+    start, end = Ray(p, (p[0] - a[0], p[1] - a[1])), Ray(p, (b[0] - p[0], b[1] - p[1]))
+    return Transition("line-line", spirals, theta, start_line=start, end_line=end, shape=shape)
 
 
-def circle_in_circle(center0: Any, radius0: float, center1: Any, radius1: float) -> Transition:
+def circle_in_circle(center0: Any, radius0: float, center1: Any, radius1: float, shape: str = DEFAULT_SHAPE) -> Transition:
     """The fifth case: one spiral between nested circles, either way.
 
     Radii are signed by travel sense and must share the sign. The larger
     circle is met at an interior parameter t of the full spiral, so the
     returned spiral is the exact piece [t, 1] (reversed when travelling out
     of the smaller circle). Solutions exist only in a thin band just inside
-    internal tangency (see ``NoSolutionError`` messages).
+    internal tangency, whose lower end depends on the shape (see
+    ``NoSolutionError`` messages).
 
     Raises:
         NoSolutionError: centre distance outside the band, or equal radii.
         ValueError: malformed input or radii of different signs.
     """
-    inputs = _two_circles(center0, radius0, center1, radius1)
-    c0, r0, c1, r1 = inputs.values()
+    inputs = _two_circles(center0, radius0, center1, radius1, shape)
+    c0, r0, c1, r1 = (inputs[k] for k in ("center0", "radius0", "center1", "radius1"))
     spirals, theta, t = _solve("circle_in_circle", K.circle_in_circle_row, 1, (*c0, r0, *c1, r1), inputs)
-    return Transition("circle-circle-nested", spirals, theta, Circle(c0, r0), Circle(c1, r1), parameter=t)
+    return Transition("circle-circle-nested", spirals, theta, Circle(c0, r0), Circle(c1, r1), parameter=t, shape=shape)

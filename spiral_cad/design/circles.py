@@ -36,6 +36,7 @@ from ..core.chain import Chain
 from ..core.units import DEFAULT_UNITS
 from ..core.errors import JointError, NoSolutionError
 from ..core.segments import TAU, Circle
+from ..core.shapes import DEFAULT_SHAPE, TRANSITION_SHAPES, shape_code
 from ..core.transitions import Transition, circle_in_circle, circle_to_circle
 
 #: Belt sweeps within this of 2π count as 0 (coincident tangent points).
@@ -58,6 +59,11 @@ class CircleChain:
     circles: list[Circle]
     transitions: list[Transition]
     sweeps: list[float]
+
+    @property
+    def shape(self) -> str:
+        """The spiral shape of the transitions."""
+        return self.transitions[0].shape
 
 
 def _as_circle(value: Any, index: int) -> Circle:
@@ -121,7 +127,7 @@ def _sense_angle(circle: Circle, a: NDArray, b: NDArray) -> float:
     return math.pi - (math.pi - turn) % TAU
 
 
-def circle_chain(circles: Sequence[Any], units: str = DEFAULT_UNITS) -> CircleChain:
+def circle_chain(circles: Sequence[Any], units: str = DEFAULT_UNITS, shape: str = DEFAULT_SHAPE) -> CircleChain:
     """A G2 path round ``circles`` in order, with spiral transitions between them.
 
     Args:
@@ -129,6 +135,9 @@ def circle_chain(circles: Sequence[Any], units: str = DEFAULT_UNITS) -> CircleCh
             or ``(x, y, radius)``; the radius sign is the travel sense
             (positive counterclockwise).
         units: length unit of centres and radii (default mm).
+        shape: spiral shape of every transition: ``"walton-meek"`` (default,
+            the paper's geometry) or ``"near-linear"`` (curvature closer to
+            linear in arc length; C and S pairs reach less far apart circles).
 
     Each consecutive pair gets ``circle_in_circle`` when nested (same sense,
     one inside the other) and ``circle_to_circle`` otherwise (C for equal
@@ -143,13 +152,14 @@ def circle_chain(circles: Sequence[Any], units: str = DEFAULT_UNITS) -> CircleCh
     if isinstance(circles, (str, bytes, dict)) or not isinstance(circles, Iterable):
         raise ValueError(f"circles must be a list of circles; got {type(circles).__name__}")
     items = [_as_circle(c, i) for i, c in enumerate(circles)]
+    shape_code(shape, TRANSITION_SHAPES)
     if len(items) < 2:
         raise ValueError(f"circle_chain needs at least 2 circles; got {len(items)}")
     transitions = []
     for i, (a, b) in enumerate(zip(items, items[1:])):
         solve = circle_in_circle if _nested(a, b) else circle_to_circle
         try:
-            transitions.append(solve(a.center, a.radius, b.center, b.radius))
+            transitions.append(solve(a.center, a.radius, b.center, b.radius, shape=shape))
         except NoSolutionError as error:
             raise NoSolutionError(f"circles {i} and {i + 1}: {error}") from None
     sweeps = []
