@@ -7,6 +7,7 @@ import math
 import os
 import sys
 import time
+import warnings
 from importlib.util import find_spec
 from collections.abc import Sequence
 from pathlib import Path
@@ -122,7 +123,32 @@ def _build(args: argparse.Namespace) -> int:
     return _write_design(args.design, Path(args.out), plots=not args.no_plots)
 
 
+#: Exit status of ``check`` when its output pipe closes early (``| head -1``): 128 + SIGPIPE,
+#: what a shell reports for a command a closed pipe stopped.
+CLOSED_PIPE = 141
+
+
 def _check(args: argparse.Namespace) -> int:
+    """``spiral-cad check``: 0 ok, 1 below ``--require``, 2 error, 141 when stdout closed early.
+
+    Non-finite measures are graded "unmeasurable" on purpose, so numpy's
+    warnings about them are not shown.
+    """
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        try:
+            status = _check_file(args)
+            sys.stdout.flush()
+        except BrokenPipeError:
+            try:  # the interpreter's last flush must not fail again
+                os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+            except (OSError, ValueError, AttributeError):
+                pass
+            return CLOSED_PIPE
+    return status
+
+
+def _check_file(args: argparse.Namespace) -> int:
     if Path(args.file).suffix.lower() == ".xodr":
         if args.comb:
             print("error: --comb draws STEP/IGES edges; it does not apply to OpenDRIVE", file=sys.stderr)
