@@ -421,7 +421,8 @@ class Road:
             except (ValueError, ArithmeticError) as error:  # a geometry at the edge of the float range
                 raise ValueError(f"road {self.id}, planView geometry {g.index} <{g.kind}>: no exact segment ({error})") from None
         try:
-            return Chain(segments, tolerance, units="m")
+            with np.errstate(all="ignore"):  # a joint at the edge of the float range is refused, not warned about
+                return Chain(segments, tolerance, units="m")
         except (ValueError, ArithmeticError) as error:
             raise ValueError(f"road {self.id}: {error}") from None
 
