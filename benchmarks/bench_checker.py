@@ -1,6 +1,6 @@
 """G2 checker on files: the price of reading in a child process, against OCCT reading in-process.
 
-Run: ``.venv/bin/python benchmarks/bench_checker.py [--segments N] [--repeat R] [--out FILE]``.
+Run: ``.venv/bin/python benchmarks/bench_checker.py [--repeat R] [--out FILE]``.
 
 The peer reads the same file with OCCT's reader in the calling process
 (``ReadFile`` + ``TransferRoots``) and measures it with the same code, as
@@ -46,8 +46,7 @@ def in_process_check(path: Path) -> None:
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--segments", type=int, default=10_000)
-    parser.add_argument("--repeat", type=int, default=5)
+    parser.add_argument("--repeat", type=int, default=5, help="timed runs per large file (20× that per small file)")
     parser.add_argument("--out", help="also write the table to this markdown file")
     args = parser.parse_args()
     rows = []
@@ -55,7 +54,7 @@ def main() -> None:
         files = []
         highway = Alignment.from_pis([[0, 0], [600, 120], [1150, -80], [1700, 260], [2300, 200]], [450, 400, 600],
                                      units="m", design_speed=80).chain  # fmt: skip
-        big = snake(args.segments)
+        big = snake(10_000)
         for name, chain in (("highway (demo, 13 edges)", highway), (f"snake ({len(big):,} edges)", big)):
             for suffix, write in (("step", export_step), ("igs", export_iges)):
                 path = Path(folder) / f"{name.split()[0]}.{suffix}"

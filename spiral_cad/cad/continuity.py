@@ -328,22 +328,21 @@ def _report(measured: Measured, unit: str, source: str, gap_tol: float, angle_to
 
 def main_check(args: argparse.Namespace) -> int:
     """Run ``spiral-cad check`` on a STEP/IGES file: the joint table; exit 0 ok, 1 below
-    ``--require`` or the wrong number of pieces, 2 unreadable (``error: …`` with the reason)."""
-    check_tolerances(gap_tol=args.gap_tol, angle_tol=args.angle_tol, curvature_tol=args.curvature_tol)
-    if args.snap is not None:
-        check_tolerances(snap=args.snap)
+    ``--require`` or the wrong number of pieces, 2 unreadable (``error: …`` with the reason).
+
+    The table is ``check_continuity(file).format_table()``, as in the demo's
+    ``NAME_continuity.txt``: the same numbers for the same file.
+    """
     comb = _comb_path(args.comb, args.file) if args.comb else None
-    extract = _measure if comb is None else _measure_and_comb
-    unit, data = read_file(args.file, None, extract)
-    measured, samples = (data, None) if comb is None else data
-    source = os.path.basename(args.file)
-    report = _report(measured, unit, source, args.gap_tol, args.angle_tol, args.curvature_tol, args.snap)
+    report = check_continuity(args.file, gap_tol=args.gap_tol, angle_tol=args.angle_tol, curvature_tol=args.curvature_tol,
+                              snap=args.snap)  # fmt: skip
     if not report.wires:
-        raise ValueError(f"{source!r} contains no edges to check")
+        raise ValueError(f"{report.source!r} contains no edges to check")
     if comb is not None:
         from ..export import export_step
 
-        export_step(_comb_compound(samples, None), comb, name=f"{source} curvature comb", units=unit)
+        comb_shape = curvature_comb(args.file, units=report.units)  # in the unit the report is in
+        export_step(comb_shape, comb, name=f"{report.source} curvature comb", units=report.units)
     return print_report(report, args)
 
 
@@ -359,17 +358,10 @@ def _comb_path(comb: str, checked: str) -> Path:
     return path
 
 
-def _measure_and_comb(shape: TopoDS_Shape) -> tuple[Measured, list]:
-    return _measure(shape), _comb_samples(shape, COMB_SAMPLES)
-
-
 # ------------------------------------------------------------------ comb
 
-#: Samples per edge of a curvature comb.
-COMB_SAMPLES = 24
 
-
-def curvature_comb(shape_or_path: Any, *, scale: float | None = None, per_edge: int = COMB_SAMPLES, units: str = "mm"):
+def curvature_comb(shape_or_path: Any, *, scale: float | None = None, per_edge: int = 24, units: str = "mm"):
     """The curvature comb of every edge as OCCT geometry: teeth and the envelope through their tips.
 
     A tooth runs from a point of the curve against its curvature vector

@@ -242,33 +242,40 @@ def _iges_unit(reader: Any) -> float:
 # ------------------------------------------------------- curve accounting
 
 
-def _step_curves(model: Any) -> list[tuple[Any, Any, int]]:
-    """``(curve, container, position)`` of every curve the STEP reader must turn into an edge.
+def _leaves(curve: Any, container: Any, position: int, parts: Callable[[Any], list | None], found: list, depth: int = 0) -> None:
+    """Append ``(curve, container, position)``, or for a composite curve (``parts(curve)``: its
+    ``(position, member)`` pairs, None for a curve that is not composite) those of its leaves.
 
-    Every ``EDGE_CURVE`` (its geometry), every leaf segment of a composite
-    curve in a geometric set, every other curve of a geometric set. A missing
-    curve is listed as None (it is certainly dropped).
+    A member that is missing is listed as None (it is certainly dropped); a
+    composite nested deeper than ``_MAX_NESTING`` as ``_NESTED``.
     """
+    members = parts(curve)
+    if members is None:
+        found.append((curve, container, position))
+    elif depth > _MAX_NESTING:
+        found.append((_NESTED, curve, 0))
+    else:
+        for k, member in members:
+            if member is None:
+                found.append((None, curve, k))
+            else:
+                _leaves(member, curve, k, parts, found, depth + 1)
+
+
+def _step_curves(model: Any) -> list[tuple[Any, Any, int]]:
+    """``(curve, container, position)`` of every curve the STEP reader must turn into an edge:
+    every ``EDGE_CURVE`` (its geometry), every leaf segment of a composite curve in a geometric
+    set, every other curve of a geometric set."""
     from OCP.StepGeom import StepGeom_CompositeCurve, StepGeom_Curve
     from OCP.StepShape import StepShape_EdgeCurve, StepShape_GeometricSet
 
-    found: list[tuple[Any, Any, int]] = []
-
-    def leaves(curve: Any, container: Any, position: int, depth: int) -> None:
+    def parts(curve: Any) -> list | None:
         if not isinstance(curve, StepGeom_CompositeCurve):
-            found.append((curve, container, position))
-            return
-        if depth > _MAX_NESTING:
-            found.append((_NESTED, curve, 0))
-            return
-        for k in range(1, curve.NbSegments() + 1):
-            segment = curve.SegmentsValue(k)
-            parent = segment.ParentCurve() if segment is not None else None
-            if parent is None:
-                found.append((None, curve, k))
-            else:
-                leaves(parent, curve, k, depth + 1)
+            return None
+        segments = (curve.SegmentsValue(k) for k in range(1, curve.NbSegments() + 1))
+        return [(k, s.ParentCurve() if s is not None else None) for k, s in enumerate(segments, 1)]
 
+    found: list[tuple[Any, Any, int]] = []
     for i in range(1, model.NbEntities() + 1):
         entity = model.Value(i)
         if isinstance(entity, StepShape_EdgeCurve):
@@ -277,7 +284,7 @@ def _step_curves(model: Any) -> list[tuple[Any, Any, int]]:
             for k in range(1, entity.NbElements() + 1):
                 curve = entity.ElementsValue(k).Curve()
                 if isinstance(curve, StepGeom_Curve):
-                    leaves(curve, entity, k, 0)
+                    _leaves(curve, entity, k, parts, found)
     return found
 
 
@@ -288,34 +295,23 @@ def _iges_curves(model: Any) -> list[tuple[Any, Any, int]]:
     other non-curves among them are skipped); an entity that is a member of a
     composite is not counted again on its own.
     """
-    found: list[tuple[Any, Any, int]] = []
-    members = set()
     entities = [model.Entity(i) for i in range(1, model.NbEntities() + 1)]
 
     def is_curve(entity: Any) -> bool:
         kind = entity.TypeNumber()
         return kind in _IGES_CURVES and (kind != 106 or entity.FormNumber() in _IGES_POLYLINE_FORMS)
 
-    def leaves(curve: Any, container: Any, position: int, depth: int) -> None:
+    def parts(curve: Any) -> list | None:
         if curve.TypeNumber() != 102:
-            found.append((curve, container, position))
-            return
-        if depth > _MAX_NESTING:
-            found.append((_NESTED, curve, 0))
-            return
-        for k in range(1, curve.NbCurves() + 1):
-            member = curve.Curve(k)
-            if member is None:
-                found.append((None, curve, k))
-            elif is_curve(member):
-                leaves(member, curve, k, depth + 1)
+            return None
+        members = ((k, curve.Curve(k)) for k in range(1, curve.NbCurves() + 1))
+        return [(k, m) for k, m in members if m is None or is_curve(m)]
 
-    for entity in entities:
-        if entity.TypeNumber() == 102:
-            members.update(model.DNum(m) for m in (entity.Curve(k) for k in range(1, entity.NbCurves() + 1)) if m is not None)
+    members = {model.DNum(m) for e in entities if e.TypeNumber() == 102 for _, m in parts(e) if m is not None}
+    found: list[tuple[Any, Any, int]] = []
     for entity in entities:
         if is_curve(entity) and entity.SubordinateStatus() % 2 == 0 and model.DNum(entity) not in members:
-            leaves(entity, None, 0, 0)
+            _leaves(entity, None, 0, parts, found)
     return found
 
 

@@ -18,6 +18,7 @@ from __future__ import annotations
 
 import faulthandler
 import marshal
+import math
 import os
 import select
 import signal
@@ -122,12 +123,13 @@ def run_isolated(task: Callable[..., Any], *args: Any, what: str, subject: str) 
 def _receive(fd: int, deadline: float) -> bytes | None:
     """Everything written to ``fd`` until the child closes it, or None at ``deadline``."""
     chunks = []
+    poller = select.poll()  # not select(): it fails on descriptors above 1023
+    poller.register(fd, select.POLLIN)
     while True:
         remaining = deadline - time.monotonic()
         if remaining <= 0.0:
             return None
-        ready, _, _ = select.select([fd], [], [], remaining)
-        if ready:
+        if poller.poll(max(1, math.ceil(remaining * 1000))):
             chunk = os.read(fd, 1 << 20)
             if not chunk:
                 return b"".join(chunks)

@@ -121,6 +121,7 @@ class WireReport:
         joints: one report per joint.
         kind: ``"wire"``, ``"loose piece"`` (edges that belong to no wire,
             chained by nearest ends) or ``"road"`` (an OpenDRIVE planView).
+        name: what the file calls it, if anything (an OpenDRIVE road's id).
     """
 
     index: int
@@ -128,6 +129,7 @@ class WireReport:
     closed: bool
     joints: tuple[JointReport, ...]
     kind: str = "wire"
+    name: str = ""
 
     @property
     def loose(self) -> bool:
@@ -211,7 +213,8 @@ class ContinuityReport:
         head = f"  {'joint':>5} {'gap':>10} {'angle rad':>10} {'κ before':>11} {'κ after':>11} {'|Δκ|':>10} {'Δκ rel':>9} level"
         for w in self.wires:
             out.append(
-                f"{w.kind} {w.index}: {_count(w.edge_count, self.element)}, {'closed' if w.closed else 'open'}, "
+                f"{w.kind} {w.index}{f' (id {w.name})' if w.name else ''}: {_count(w.edge_count, self.element)}, "
+                f"{'closed' if w.closed else 'open'}, "
                 f"{len(w.joints)} joint(s), worst {w.min_level}"
             )
             if w.joints:
@@ -300,7 +303,7 @@ def model_size(points: Sequence[tuple[float, float, float]], source: str = "") -
 
 
 def classify_pieces(
-    pieces: Sequence[tuple[str, Sequence[tuple[Frame, Frame]], bool]],
+    pieces: Sequence[tuple],
     size: float,
     *,
     gap_tol: float,
@@ -311,17 +314,17 @@ def classify_pieces(
     element: str = "edge",
     units: str = "",
 ) -> ContinuityReport:
-    """Classify every joint of ``pieces`` — (kind, element end frames in travel order, closed) —
+    """Classify every joint of ``pieces`` — (kind, element end frames in travel order, closed[, name]) —
     in a model of ``size`` (``model_size`` of the elements' start, middle and end points)."""
     floor = 1.0 / size if size > 0.0 else 0.0
     wires = []
-    for w, (kind, ends, closed) in enumerate(pieces):
+    for w, (kind, ends, closed, *name) in enumerate(pieces):
         pairs = len(ends) if closed else len(ends) - 1
         joints = tuple(
             classify_joint(i, ends[i][1], ends[(i + 1) % len(ends)][0], gap_tol, angle_tol, curvature_tol, floor)
             for i in range(pairs)
         )
-        wires.append(WireReport(w, len(ends), closed, joints, kind))
+        wires.append(WireReport(w, len(ends), closed, joints, kind, *name))
     return ContinuityReport(tuple(wires), gap_tol, angle_tol, curvature_tol, size, snap, source, element, units)
 
 

@@ -550,7 +550,7 @@ def check_opendrive(
     check_tolerances(gap_tol=gap_tol, angle_tol=angle_tol, curvature_tol=curvature_tol)
     roads = read_opendrive(path)
     source = os.path.basename(os.fspath(path))
-    pieces = [("road", [g.frames() for g in road.geometries], False) for road in roads]
+    pieces = [("road", [g.frames() for g in road.geometries], False, road.id) for road in roads]
     points = [f[:3] for road in roads for g in road.geometries for f in g._start_end_middle]
     return classify_pieces(
         pieces, model_size(points, source), gap_tol=gap_tol, angle_tol=angle_tol, curvature_tol=curvature_tol,
