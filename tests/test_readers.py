@@ -81,6 +81,17 @@ def test_every_way_a_task_can_fail_is_a_value_error(task, message):
         sandbox.run_isolated(task, what="the test task", subject="x")
 
 
+def test_no_process_to_spare_is_a_value_error(monkeypatch):
+    import errno
+
+    def refuse() -> int:
+        raise OSError(errno.EAGAIN, os.strerror(errno.EAGAIN))
+
+    monkeypatch.setattr(os, "fork", refuse)
+    with pytest.raises(ValueError, match=r"failed on 'x' \(no process could be started for it: Resource temporarily"):
+        sandbox.run_isolated(int, what="the test task", subject="x")
+
+
 def test_a_hang_is_stopped_at_the_time_limit(monkeypatch):
     monkeypatch.setattr(sandbox, "TIME_LIMIT", 0.5)
     started = time.monotonic()
@@ -260,3 +271,13 @@ def test_what_is_not_a_readable_file_is_refused_before_any_reader_runs(tmp_path)
                          (tmp_path / "none.step", "no such file"), (tmp_path / "x.txt", "expected a .step")):  # fmt: skip
         with pytest.raises(ValueError, match=reason):
             read_shape(path)
+
+
+def test_a_curve_listed_twice_is_one_curve(files, tmp_path):
+    # the same composite twice in the curve set: OCCT transfers it once, and so it is counted
+    def twice(text: str) -> str:
+        match = re.search(r"GEOMETRIC_CURVE_SET\('circles',\((#\d+)\)\)", text)
+        return text.replace(match.group(0), f"GEOMETRIC_CURVE_SET('circles',({match.group(1)},{match.group(1)}))")
+
+    report = check_continuity(variant(files, tmp_path, "twice.step", twice))
+    assert report.describe() == "1 wire of 7 edges" and report.passes("G2")

@@ -265,7 +265,7 @@ def _leaves(curve: Any, container: Any, position: int, parts: Callable[[Any], li
 def _step_curves(model: Any) -> list[tuple[Any, Any, int]]:
     """``(curve, container, position)`` of every curve the STEP reader must turn into an edge:
     every ``EDGE_CURVE`` (its geometry), every leaf segment of a composite curve in a geometric
-    set, every other curve of a geometric set."""
+    set, every other curve of a geometric set (each listed curve once, as OCCT transfers it)."""
     from OCP.StepGeom import StepGeom_CompositeCurve, StepGeom_Curve
     from OCP.StepShape import StepShape_EdgeCurve, StepShape_GeometricSet
 
@@ -276,6 +276,7 @@ def _step_curves(model: Any) -> list[tuple[Any, Any, int]]:
         return [(k, s.ParentCurve() if s is not None else None) for k, s in enumerate(segments, 1)]
 
     found: list[tuple[Any, Any, int]] = []
+    listed: dict[int, Any] = {}  # a curve listed in two sets is transferred once (kept alive: ids stay unique)
     for i in range(1, model.NbEntities() + 1):
         entity = model.Value(i)
         if isinstance(entity, StepShape_EdgeCurve):
@@ -283,7 +284,8 @@ def _step_curves(model: Any) -> list[tuple[Any, Any, int]]:
         elif isinstance(entity, StepShape_GeometricSet):
             for k in range(1, entity.NbElements() + 1):
                 curve = entity.ElementsValue(k).Curve()
-                if isinstance(curve, StepGeom_Curve):
+                if isinstance(curve, StepGeom_Curve) and id(curve) not in listed:
+                    listed[id(curve)] = curve
                     _leaves(curve, entity, k, parts, found)
     return found
 

@@ -77,16 +77,21 @@ def run_isolated(task: Callable[..., Any], *args: Any, what: str, subject: str) 
             stream.flush()
         except (OSError, ValueError):
             pass
+    failed = f"{what} failed on {subject!r}"
     with warnings.catch_warnings():
         # Python ≥ 3.12 warns about forking with threads running (numpy's BLAS
         # pool): the child only runs ``task`` and leaves with os._exit.
         warnings.simplefilter("ignore", DeprecationWarning)
-        pid = os.fork()
+        try:
+            pid = os.fork()
+        except OSError as error:  # no process to spare
+            os.close(read_fd)
+            os.close(write_fd)
+            raise ValueError(f"{failed} (no process could be started for it: {error.strerror})") from None
     if pid == 0:  # the child: never returns
         os.close(read_fd)
         _child(task, args, write_fd, memory)
     os.close(write_fd)
-    failed = f"{what} failed on {subject!r}"
     status = None
     try:
         payload = _receive(read_fd, time.monotonic() + TIME_LIMIT)
