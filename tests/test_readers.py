@@ -281,3 +281,15 @@ def test_a_curve_listed_twice_is_one_curve(files, tmp_path):
 
     report = check_continuity(variant(files, tmp_path, "twice.step", twice))
     assert report.describe() == "1 wire of 7 edges" and report.passes("G2")
+
+
+def test_a_control_point_at_1e300_is_measured_with_no_word_of_snap(files, tmp_path, capfd):
+    # it used to overflow the model size: "snap must be finite" (no --snap given) and a numpy warning
+    def far(text: str) -> str:
+        pole = splines(text)[2].group(2)  # the first pole of the third spline: its joint with the arc breaks
+        return re.sub(rf"({pole}=CARTESIAN_POINT\('',\()[^,]*", r"\g<1>1.E300", text, count=1)
+
+    path = variant(files, tmp_path, "far.step", far)
+    assert main(["check", str(path), "--require", "G2"]) == 1
+    out, err = capfd.readouterr()
+    assert err == "" and re.search(r"model size [0-9.]+e\+(299|300) m", out) and "FAIL: worst joint is none" in out

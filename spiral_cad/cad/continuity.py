@@ -6,7 +6,8 @@ where the curvature is zero — exactly at a spiral's start. So the joint
 quantities are measured here from first and second derivatives.
 
 Measures and classification: ``spiral_cad.formats.joints`` (shared with the
-OpenDRIVE checker).
+OpenDRIVE checker). Files are read and measured in a child process
+(``spiral_cad.cad.readers``): only the measured numbers come back.
 
 Pieces: every wire is one piece, judged in wire order (with the closing
 joint of a closed wire). Edges that belong to no wire are chained by nearest
