@@ -104,12 +104,16 @@ def test_exhaustion_is_stopped_at_the_memory_limit(monkeypatch, files, tmp_path)
     monkeypatch.setattr(sandbox, "MEMORY_LIMIT", 64 << 20)
     with pytest.raises(ValueError, match=r"out of memory: more than 0.0625 GiB"):
         sandbox.run_isolated(bytearray, 1 << 30, what="the test task", subject="x")
-    # the reader itself on 200 000 entities with no memory to spare: an error, not our crash
-    points = "".join(f"#{n}=CARTESIAN_POINT('',({n}.,0.,0.));\n" for n in range(100_000, 300_000))
-    big = variant(files, tmp_path, "big.step", lambda text: text.replace("ENDSEC;\nEND-ISO", points + "ENDSEC;\nEND-ISO"))
-    monkeypatch.setattr(sandbox, "MEMORY_LIMIT", 0)
-    with pytest.raises(ReadError, match=r"^the STEP reader failed on 'big.step' \((out of memory|signal)"):
-        read_shape(big)
+    # the reader itself, asked for a B-spline of 10⁸ poles (GBs of arrays) under a 64 MiB cap: an
+    # error at once, whatever memory the calling process has spare
+    lines = files["igs"].read_text().splitlines(keepends=True)
+    index = next(i for i, line in enumerate(lines) if line.startswith("126,3,3,1,0,1,0,0.0000000000000000E+00,"))
+    content = lines[index][:64].rstrip().replace("126,3,3,1,0,1,0,0.0000000000000000E+00,", "126,99999999,3,1,0,1,0,0.,")
+    lines[index] = content.ljust(64) + lines[index][64:]
+    huge = tmp_path / "huge.igs"
+    huge.write_text("".join(lines))
+    with pytest.raises(ReadError, match=r"^the IGES reader failed on 'huge.igs' \((out of memory|signal)"):
+        read_shape(huge)
 
 
 def test_large_results_and_the_childs_output_stay_where_they_belong(capfd):
