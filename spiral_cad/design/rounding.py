@@ -221,7 +221,7 @@ def round_corners_batch(
     lin, lout, sin_t, cos_t = _half_deflection(p0, corners, p1)
     available = np.minimum(lin, lout)
     fit = np.isnan(k)
-    with np.errstate(invalid="ignore", divide="ignore"):
+    with np.errstate(invalid="ignore", divide="ignore", over="ignore"):  # a tiny leg: the curvature it needs overflows
         distance = np.where(fit, available, corner_scale(sin_t, cos_t, k, shape))
         needed = corner_scale(sin_t, cos_t, available, shape)
     result = batch.line_to_line(p0, corners, p1, k, shape=shape)
