@@ -7,9 +7,10 @@ than approximations. All edges run in travel order (their curve parameter
 increases along the path), which keeps wires, sweeps and exports free of
 orientation flips.
 
-A 2-D point (x, y) is placed at ``origin + x·X + y·Y`` of an optional
-``gp_Ax3`` (None: the global XY plane); counterclockwise arcs turn from X
-towards Y.
+A plane point (x, y) is placed at ``origin + x·X + y·Y`` of an optional
+``gp_Ax3`` (None: the global XY plane), a point in space (x, y, z) of a 3-D
+chain at ``origin + x·X + y·Y + z·(X × Y)``; counterclockwise plane arcs turn
+from X towards Y, arcs in space about their own normal.
 """
 
 from __future__ import annotations
@@ -51,9 +52,13 @@ if TYPE_CHECKING:
 
 
 class _Frame:
-    """Maps plane coordinates to 3-D points; precomputed once per call, not per edge."""
+    """Maps chain coordinates to 3-D points; precomputed once per call, not per edge.
 
-    __slots__ = ("ox", "oy", "oz", "xx", "xy", "xz", "yx", "yy", "yz", "normal", "x_dir", "flat")
+    A chain's (x, y) — or (x, y, z) in space — lie at origin + x·X + y·Y + z·Z
+    of the frame, Z = X × Y (the global coordinates when there is no plane).
+    """
+
+    __slots__ = ("origin", "x", "y", "z", "flat")
 
     def __init__(self, plane: gp_Ax3 | None):
         if plane is None:
@@ -63,29 +68,37 @@ class _Frame:
                 raise ValueError(f"plane must be an OCP gp_Ax3 or None; got {plane!r}")
             loc, xd, yd = plane.Location(), plane.XDirection(), plane.YDirection()
             origin, x, y = (loc.X(), loc.Y(), loc.Z()), (xd.X(), xd.Y(), xd.Z()), (yd.X(), yd.Y(), yd.Z())
-        self.ox, self.oy, self.oz = origin
-        self.xx, self.xy, self.xz = x
-        self.yx, self.yy, self.yz = y
-        # The circle axis is X × Y (not the plane's main direction, which points
-        # the other way for a left-handed gp_Ax3) so "counterclockwise" always
-        # means turning from X towards Y.
-        self.normal = gp_Dir(x[1] * y[2] - x[2] * y[1], x[2] * y[0] - x[0] * y[2], x[0] * y[1] - x[1] * y[0])
-        self.x_dir = gp_Dir(*x)
+        self.origin, self.x, self.y = origin, x, y
+        # Z is X × Y (not the plane's main direction, which points the other way
+        # for a left-handed gp_Ax3) so "counterclockwise" always means turning from X towards Y.
+        self.z = (x[1] * y[2] - x[2] * y[1], x[2] * y[0] - x[0] * y[2], x[0] * y[1] - x[1] * y[0])
         self.flat = plane is None or (origin == (0.0, 0.0, 0.0) and x == (1.0, 0.0, 0.0) and y == (0.0, 1.0, 0.0))
 
-    def pnt(self, x: float, y: float) -> gp_Pnt:
-        if self.flat:
-            return gp_Pnt(x, y, 0.0)
-        return gp_Pnt(
-            self.ox + x * self.xx + y * self.yx,
-            self.oy + x * self.xy + y * self.yy,
-            self.oz + x * self.xz + y * self.yz,
+    def _map(self, coords: list[float] | tuple[float, ...], origin: tuple[float, float, float]) -> tuple[float, float, float]:
+        x, y, z = (*coords, 0.0) if len(coords) == 2 else coords
+        (xx, xy, xz), (yx, yy, yz), (zx, zy, zz) = self.x, self.y, self.z
+        return (
+            origin[0] + x * xx + y * yx + z * zx,
+            origin[1] + x * xy + y * yy + z * zy,
+            origin[2] + x * xz + y * yz + z * zz,
         )
+
+    def pnt(self, *coords: float) -> gp_Pnt:
+        """The point at chain coordinates (x, y) or (x, y, z)."""
+        if self.flat:
+            return gp_Pnt(*coords) if len(coords) == 3 else gp_Pnt(coords[0], coords[1], 0.0)
+        return gp_Pnt(*self._map(coords, self.origin))
+
+    def dir(self, *coords: float) -> gp_Dir:
+        """The direction of the chain vector (x, y[, z])."""
+        if self.flat:
+            return gp_Dir(*coords) if len(coords) == 3 else gp_Dir(coords[0], coords[1], 0.0)
+        return gp_Dir(*self._map(coords, (0.0, 0.0, 0.0)))
 
     def poles(self, points: list[list[float]]) -> TColgp_Array1OfPnt:
         array = TColgp_Array1OfPnt(1, len(points))
-        for i, (x, y) in enumerate(points, 1):
-            array.SetValue(i, self.pnt(x, y))
+        for i, p in enumerate(points, 1):
+            array.SetValue(i, self.pnt(*p))
         return array
 
 
@@ -102,21 +115,18 @@ CurveSpan = tuple[Geom_Curve, float, float]
 
 
 def _line_curve(line: Line, frame: _Frame) -> CurveSpan:
-    (ax, ay), (bx, by) = line._a.tolist(), line._b.tolist()
-    a, b = frame.pnt(ax, ay), frame.pnt(bx, by)
+    a, b = frame.pnt(*line._a.tolist()), frame.pnt(*line._b.tolist())
     return Geom_Line(a, gp_Dir(gp_Vec(a, b))), 0.0, a.Distance(b)
 
 
 def _arc_curve(arc: Arc, frame: _Frame) -> CurveSpan:
-    cx, cy = arc.center.tolist()
+    """A ``Geom_Circle`` about the arc's normal (flipped for clockwise travel, so the
+    parameter increases along the path: the point at polar angle a has parameter -a)."""
     radius, a0, sweep = arc.radius, arc.start_angle, arc.sweep
-    if radius > 0.0:
-        axis, first = frame.normal, a0
-    else:
-        # Clockwise travel: the circle's axis is flipped so its parameter still
-        # increases along the path; the point at plane angle a has parameter -a.
-        axis, first = frame.normal.Reversed(), -a0
-    circle = Geom_Circle(gp_Ax2(frame.pnt(cx, cy), axis, frame.x_dir), abs(radius))
+    e1, e2 = arc.basis.tolist()
+    normal = frame.dir(e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2], e1[0] * e2[1] - e1[1] * e2[0])
+    axis, first = (normal, a0) if radius > 0.0 else (normal.Reversed(), -a0)
+    circle = Geom_Circle(gp_Ax2(frame.pnt(*arc.center.tolist()), axis, frame.dir(*e1)), abs(radius))
     return circle, first, first + sweep
 
 
@@ -144,7 +154,8 @@ def segment_edge(segment: Segment, plane: gp_Ax3 | None = None) -> TopoDS_Edge:
         segment: a ``Line`` (edge on a ``Geom_Line``), ``Arc`` (on a
             ``Geom_Circle``) or ``BezierSpiral`` (``Geom_BezierCurve`` with
             its four control points).
-        plane: local frame of the 2-D coordinates; None is the XY plane.
+        plane: local frame of the coordinates (plane segments: its XY plane;
+            segments in space: its coordinate system); None is the global one.
 
     Raises:
         ValueError: an unsupported segment type or a ``plane`` that is not a
