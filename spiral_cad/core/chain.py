@@ -16,10 +16,10 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from ._chain_kernels import ARC, LINE, SPIRAL, connectors
-from ._inputs import as_float, as_real_array
+from ._inputs import as_float, as_point, as_real_array
 from .errors import JointError
 from .rows import SegmentRows
-from .segments import Arc, Join, Line, Segment, as_point, joint_table, lifted
+from .segments import Arc, Join, Line, Segment, joint_table, lifted
 from .space import PlaneFrame
 from .spiral import BezierSpiral
 from .transitions import Transition
@@ -131,7 +131,7 @@ class Chain:
     def __init__(self, segments: Iterable[Segment], tolerance: float = JOIN_TOLERANCE, units: str = DEFAULT_UNITS):
         items = _segment_tuple(segments)
         rows = SegmentRows.of_segments(items)
-        keep = all(s.dim == rows.dim for s in items)  # plane segments of a space chain are made again in 3-D
+        keep = rows.dim == 2 or all(s._dim == 3 for s in items)  # plane segments of a space chain are made again in 3-D
         self._setup(rows, rows.measure(), list(items) if keep else None, join_tolerance(tolerance), length_unit(units))
 
     @classmethod
@@ -359,7 +359,7 @@ class Chain:
 
         from ..cad.occ import segment_edges
 
-        return [Edge(e) for e in segment_edges(self.segments, _ax3(plane))]
+        return [Edge(e) for e in segment_edges(self, _ax3(plane))]
 
     def to_wire(self, plane: Any = None) -> Any:
         """The chain as one build123d ``Wire`` in ``plane``'s coordinates (None: ``Plane.XY``)."""
@@ -367,7 +367,7 @@ class Chain:
 
         from ..cad.occ import chain_wire
 
-        return Wire(chain_wire(self.segments, _ax3(plane)))
+        return Wire(chain_wire(self, _ax3(plane)))
 
     def to_nurbs(self) -> Any:
         """The whole chain as one exact rational cubic B-spline (``spiral_cad.nurbs.Nurbs``).

@@ -19,7 +19,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from . import bezier
 from ._chain_kernels import ARC, LINE, SPIRAL
-from .segments import Arc, Line, Segment, row_frames
+from .segments import _XY_BASIS, Arc, Line, Segment, row_frames
 from .shapes import SHAPE_CODES, SHAPE_NAMES
 from .space import place
 from .spiral import BezierSpiral
@@ -91,36 +91,36 @@ class SegmentRows:
         (one quadrature for all), and cached in the objects as well.
         """
         BezierSpiral.measure_lengths(segments)
-        dim = max((s.dim for s in segments), default=2)
-        rows = cls.empty(len(segments), dim)
-        groups: dict[type, list[int]] = {Line: [], Arc: [], BezierSpiral: []}
+        dims = [s._dim for s in segments]
+        rows = cls.empty(len(segments), max(dims, default=2))
+        kinds = (Line, Arc, BezierSpiral)
+        groups: dict[type, list[int]] = {k: [] for k in kinds}
         for i, s in enumerate(segments):
-            kind = type(s) if type(s) in groups else next(k for k in groups if isinstance(s, k))  # subclasses too
-            groups[kind].append(i)
-        for cls_, index in groups.items():
-            if not index:
-                continue
-            items = [segments[i] for i in index]
-            kind_rows = rows.geometry[index]
-            if cls_ is Line:
-                rows.kind[index] = LINE
-                for j, s in enumerate(items):
-                    kind_rows[j, 0, : s._dim] = s._a
-                    kind_rows[j, 1, : s._dim] = s._b
-            elif cls_ is Arc:
-                rows.kind[index] = ARC
-                rows.params[index] = [(s._r, s._a0, s._sweep) for s in items]
-                kind_rows[:, 1:3] = [_basis(s) for s in items]
-                for j, s in enumerate(items):
-                    kind_rows[j, 0, : s._dim] = s._c
-            else:
-                rows.kind[index] = SPIRAL
-                rows.shapes[index] = [shape_number(s._shape) for s in items]
-                rows.lengths[index] = [s._length for s in items]
-                for j, s in enumerate(items):
-                    kind_rows[j, :, : s._dim] = s._cp
-            rows.geometry[index] = kind_rows
+            kind = type(s)
+            (groups[kind] if kind in groups else groups[next(k for k in kinds if isinstance(s, k))]).append(i)  # subclasses too
+        for kind, index in groups.items():
+            for dim in (2, 3):  # one array per kind and dimension
+                rows._fill(kind, [i for i in index if dims[i] == dim], [segments[i] for i in index if dims[i] == dim], dim)
         return rows
+
+    def _fill(self, kind: type, index: list[int], items: list[Segment], dim: int) -> None:
+        if not index:
+            return
+        g = self.geometry
+        if kind is Line:
+            self.kind[index] = LINE
+            g[index, 0, :dim] = [s._a for s in items]
+            g[index, 1, :dim] = [s._b for s in items]
+        elif kind is Arc:
+            self.kind[index] = ARC
+            self.params[index] = [(s._r, s._a0, s._sweep) for s in items]
+            g[index, 0, :dim] = [s._c for s in items]
+            g[index, 1:3] = _XY_BASIS if dim == 2 else [s._basis for s in items]
+        else:
+            self.kind[index] = SPIRAL
+            self.shapes[index] = [shape_number(s._shape) for s in items]
+            self.lengths[index] = [s._length for s in items]
+            g[index, :, :dim] = [s._cp for s in items]
 
     @classmethod
     def concatenate(cls, parts: Sequence[SegmentRows]) -> SegmentRows:
@@ -184,7 +184,3 @@ class SegmentRows:
         g[arc, 0] = place(g[arc, 0, :2], origin, x_dir, y_dir)
         g[arc, 1], g[arc, 2] = x_dir, y_dir
         return SegmentRows(rows.kind, g, rows.params, rows.shapes, 3, np.where(arc, rows.lengths, np.nan))
-
-
-def _basis(arc: Arc) -> NDArray:
-    return np.array([[1.0, 0.0, 0.0], [0.0, 1.0, 0.0]]) if arc._basis is None else arc._basis

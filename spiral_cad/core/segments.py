@@ -24,7 +24,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from . import _chain_kernels as CK
-from ._inputs import _refuse_masked, _refused, as_float, as_xy, shown
+from ._inputs import as_float, as_point, as_xy
 from .space import PlaneFrame
 
 
@@ -36,26 +36,6 @@ PLANE_TOL = 1e-9
 
 #: One end of a plane segment as plain floats: x, y, unit tangent (travel sense) and signed curvature.
 End = tuple[float, float, float, float, float]
-
-
-def as_point(value: Any, name: str) -> tuple[float, ...]:
-    """``value`` as a plane point (x, y) or a space point (x, y, z), finite floats.
-
-    A 3-D point with z = 0 is the plane point (x, y), as for every plane input.
-    """
-    if (type(value) is tuple and len(value) == 2) or (type(value) is np.ndarray and value.shape == (2,)):
-        return as_xy(value, name)
-    _refuse_masked(value, name)
-    if _refused(value):
-        raise ValueError(f"{name} must be a 2-D or 3-D point; got {type(value).__name__} {shown(value):.80}")
-    try:
-        items = list(value)
-    except TypeError:
-        raise ValueError(f"{name} must be a 2-D or 3-D point; got {type(value).__name__} {shown(value):.80}") from None
-    coords = tuple(as_float(c, f"{name}[{i}]") for i, c in enumerate(items))
-    if len(coords) not in (2, 3):
-        raise ValueError(f"{name} must have 2 or 3 coordinates; got {shown(value):.80}")
-    return coords[:2] if len(coords) == 3 and coords[2] == 0.0 else coords
 
 
 def lifted(point: tuple[float, ...], dim: int) -> tuple[float, ...]:
@@ -229,13 +209,6 @@ def piece_range(t0: Any, t1: Any) -> tuple[float, float]:
     return t0, t1
 
 
-def _padded(points: NDArray, rows: int) -> NDArray:
-    """(rows, 3) float64: ``points`` (k ≤ rows, 2 or 3) with z = 0 and zero rows appended."""
-    out = np.zeros((rows, 3))
-    out[: len(points), : points.shape[1]] = points
-    return out
-
-
 class Line(Segment):
     """Straight segment from ``start`` to ``end`` (distinct points, 2-D or 3-D).
 
@@ -268,7 +241,9 @@ class Line(Segment):
         return f"Line({tuple(self._a.tolist())}, {tuple(self._b.tolist())})"
 
     def _row(self) -> tuple[int, NDArray, tuple[float, float, float]]:
-        return CK.LINE, _padded(np.array([self._a, self._b]), 4), (0.0, 0.0, 0.0)
+        geometry = np.zeros((4, 3))
+        geometry[0, : self._dim], geometry[1, : self._dim] = self._a, self._b
+        return CK.LINE, geometry, (0.0, 0.0, 0.0)
 
     def outline(self) -> list[tuple[float, ...]]:
         return [tuple(self._a.tolist()), tuple(self._b.tolist())]
