@@ -186,7 +186,9 @@ def main() -> None:
         for name, _ in workers:
             times = [statistics.median(results[(job, n, name)]) for n in sizes if (job, n, name) in results]
             if len(times) == len(sizes):
-                notes.append(f"{labels[job]}: growth exponent {exponent(list(sizes), times):.2f} ({name})")
+                # Over every size, and over the largest three (where a fixed cost no longer hides the growth).
+                notes.append(f"{labels[job]} ({name}): growth exponent {exponent(list(sizes), times):.2f} over "
+                             f"{sizes[0]:,}…{sizes[-1]:,}, {exponent(list(sizes[-3:]), times[-3:]):.2f} over {sizes[-3]:,}…{sizes[-1]:,}")  # fmt: skip
     for job, goal in GOALS.items():
         if (job, 10_000, "ours") in results:
             t = statistics.median(results[(job, 10_000, "ours")])

@@ -8,6 +8,8 @@ import math
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 import spiral_cad as sc
 from spiral_cad import Arc, BezierSpiral, Chain, Line
@@ -315,3 +317,34 @@ def test_a_chain_in_space_reaches_occt_as_exact_edges_and_checks_g2():
     (edge,) = Chain([clockwise]).to_edges()
     p = edge.position_at(0.5)
     assert np.allclose((p.X, p.Y, p.Z), clockwise.point(0.5), atol=1e-12)
+
+
+# ------------------------------------------------------------ the one rule in space
+
+UNIT = st.tuples(st.floats(-1, 1), st.floats(-1, 1), st.floats(-1, 1)).filter(lambda v: 0.1 < math.hypot(*v))
+
+
+@settings(max_examples=40)
+@given(st.floats(-300, 300), st.floats(-3, 12), UNIT, UNIT)
+def test_a_placed_chain_at_any_scale_and_offset_is_checked_or_refused_by_name(log_scale, log_offset, normal, direction):
+    """The road chain, scaled by 10**log_scale, placed in a plane of any orientation 10**log_offset
+    sizes from the origin: a 3-D chain that starts and ends where the plane puts it, or a plain ValueError."""
+    scale = 10.0**log_scale
+    enter = sc.line_to_circle((0, 0), (1, 0), (100 * scale, 60 * scale), 50 * scale)
+    leave = sc.line_to_circle((300 * scale, 150 * scale), (-1, -1), (100 * scale, 60 * scale), 50 * scale).reversed()
+    flat = Chain.join([enter, leave], start=(-20 * scale, 0), end=(400 * scale, 250 * scale))
+    if abs(np.dot(normal, direction)) > 0.99 * math.hypot(*normal) * math.hypot(*direction):
+        return  # x_dir along the normal: no frame
+    origin = np.array(direction) * 10.0**log_offset * 400 * scale
+    try:
+        frame = PlaneFrame(origin, x_dir=direction, normal=normal)
+        space = flat.placed(frame)
+    except ValueError as error:
+        message = str(error)
+        assert message and "np." not in message and "array(" not in message, message
+        return
+    assert space.dim == 3 and len(space) == len(flat)
+    rounding = 64 * np.spacing(np.abs(origin).max() + flat.size)  # what the placed coordinates can hold
+    for got, want in ((space.start, flat.start), (space.end, flat.end)):
+        assert math.dist(got, frame.point(want)) <= 1e-9 * space.size + rounding
+    assert space.length == pytest.approx(flat.length, rel=1e-9, abs=len(flat) * rounding)
