@@ -213,7 +213,7 @@ class Chain:
         objects = [s for own in owned for s in own]
         rows = SegmentRows.of_segments(objects)
         counts = np.array([len(own) for own in owned])
-        circles = PartCircles.of_parts(parts, rows.dim)
+        circles = PartCircles.of_parts(parts)
         return join_rows(rows, counts, circles, first, last, tolerance, length_unit(units), objects)
 
     # ------------------------------------------------------------- access
@@ -427,7 +427,8 @@ class PartCircles:
         self.basis[:, 0, 0] = self.basis[:, 1, 1] = 1.0
 
     @classmethod
-    def of_parts(cls, parts: Sequence[Transition | Segment], dim: int) -> PartCircles:
+    def of_parts(cls, parts: Sequence[Transition | Segment]) -> PartCircles:
+        """A transition's ``end_circle``; an ``Arc``'s own circle (in its plane); none after other segments."""
         circles = cls(len(parts))
         for k, part in enumerate(parts):
             if isinstance(part, Transition):
@@ -461,6 +462,21 @@ def join_rows(
     The connectors (lines and arcs, ``_chain_kernels.connectors``) are made
     for every gap at once and the chain is checked in one pass; ``objects``
     (the segment objects of ``rows``, if any) are kept as the chain's segments.
+    The design tools build their chains this way, e.g. a rounded polyline
+    (in the plane, or in space after ``space.place``)::
+
+        rows = SegmentRows.spirals(pairs.reshape(-1, 4, d), shape)   # (N, 2, 4, d) corner pairs
+        join_rows(rows, np.full(N, 2), PartCircles(N), start, end, tolerance, units)
+
+    Args:
+        rows: every part's segments in travel order.
+        counts: (P,) how many rows each part has (P ≥ 1; none: the line ``start`` → ``end``).
+        circles: the circle each part ends on (``PartCircles``).
+        start, end: points (2 or 3 coordinates) for a leading / trailing line, or None.
+        tolerance, units: checked values (``join_tolerance``, ``length_unit``).
+
+    Raises:
+        ValueError: as ``Chain.join``.
     """
     if not len(counts):
         if start is None or end is None:

@@ -5,8 +5,7 @@ A chain of 40 000 segments is four arrays, not 40 000 objects: ``kind``
 layout of ``spiral_cad.core._chain_kernels`` (always three coordinates; a
 plane chain has z = 0 and ``dim`` 2). ``Line``, ``Arc`` and ``BezierSpiral``
 objects are made from rows only when asked for (``segment``), and rows are
-made from objects, from batch results (``spirals``) or from two point arrays
-(``lines``) without an object per segment.
+made from objects or from batch results (``spirals``: no object per segment).
 """
 
 from __future__ import annotations
@@ -63,24 +62,14 @@ class SegmentRows:
                    np.full(n, np.nan))  # fmt: skip
 
     @classmethod
-    def lines(cls, a: NDArray, b: NDArray, dim: int) -> SegmentRows:
-        """Rows of lines from ``a`` to ``b`` ((n, 2) or (n, 3))."""
-        rows = cls.empty(len(a), dim)
-        rows.kind[:] = LINE
-        rows.geometry[:, 0, : a.shape[1]] = a
-        rows.geometry[:, 1, : b.shape[1]] = b
-        return rows
-
-    @classmethod
-    def spirals(cls, control_points: ArrayLike, shape: str | None = None, lengths: ArrayLike | None = None) -> SegmentRows:
-        """Rows of spirals from (n, 4, 2) or (n, 4, 3) control points (solver output: no checks)."""
+    def spirals(cls, control_points: ArrayLike, shape: str | None = None) -> SegmentRows:
+        """Rows of spirals from (n, 4, 2) or (n, 4, 3) control points (solver output, e.g. ``spiral_cad.batch``
+        rows placed by ``space.place``: no checks)."""
         cp = np.asarray(control_points, dtype=float)
         rows = cls.empty(len(cp), cp.shape[2])
         rows.kind[:] = SPIRAL
         rows.geometry[:, :, : cp.shape[2]] = cp
         rows.shapes[:] = shape_number(shape)
-        if lengths is not None:
-            rows.lengths[:] = lengths
         return rows
 
     @classmethod
