@@ -17,6 +17,8 @@ _GL_NODES, _GL_WEIGHTS = np.polynomial.legendre.leggauss(16)
 _PANELS = 4
 _U = ((np.arange(_PANELS)[:, None] + 0.5 * (_GL_NODES[None, :] + 1.0)) / _PANELS).ravel()
 _W = np.tile(_GL_WEIGHTS / (2.0 * _PANELS), _PANELS)
+#: Curves per block of a many-curve ``arc_length``.
+_BLOCK = 512
 
 
 def _power_coefficients(cp: NDArray, order: int = 0) -> NDArray:
@@ -116,7 +118,10 @@ def arc_length(cp: ArrayLike, u: ArrayLike = 1.0) -> NDArray | float:
     exact to ~1e-15 relative (checked against adaptive quadrature).
     """
     u = np.asarray(u, dtype=float)
-    coefficients = _power_coefficients(np.asarray(cp, dtype=float), 1)
+    cp = np.asarray(cp, dtype=float)
+    if cp.ndim == 3 and u.ndim == 0 and len(cp) > _BLOCK:  # blocks whose temporaries stay in cache (same bits)
+        return np.concatenate([arc_length(cp[i : i + _BLOCK], u) for i in range(0, len(cp), _BLOCK)])
+    coefficients = _power_coefficients(cp, 1)
     scale = _scale(coefficients)
     c = coefficients / scale
     nodes = u[..., None] * _U

@@ -19,7 +19,7 @@ from ._chain_kernels import ARC, LINE, SPIRAL, connectors
 from ._inputs import as_float, as_point, as_real_array
 from .errors import JointError
 from .rows import SegmentRows
-from .segments import Arc, Join, Line, Segment, joint_table, lifted
+from .segments import _XY_BASIS, Arc, Join, Line, Segment, joint_table, lifted
 from .space import PlaneFrame
 from .spiral import BezierSpiral
 from .transitions import Transition
@@ -430,21 +430,19 @@ class PartCircles:
     def of_parts(cls, parts: Sequence[Transition | Segment]) -> PartCircles:
         """A transition's ``end_circle``; an ``Arc``'s own circle (in its plane); none after other segments."""
         circles = cls(len(parts))
+        found = []
         for k, part in enumerate(parts):
-            if isinstance(part, Transition):
-                circle = part.end_circle
-                if circle is not None:
-                    circles.set(k, circle.center, circle.radius)
+            circle = part.end_circle if isinstance(part, Transition) else None
+            if circle is not None:
+                found.append((k, circle.center + (0.0,), circle.radius, _XY_BASIS))
             elif isinstance(part, Arc):
-                circles.set(k, part.center, part.radius, part.basis)
+                found.append((k, tuple(lifted(tuple(part._c.tolist()), 3)), part._r, part.basis))
+        if found:
+            index, centers, radii, bases = zip(*found)
+            index = list(index)
+            circles.present[index] = True
+            circles.center[index], circles.radius[index], circles.basis[index] = centers, radii, bases
         return circles
-
-    def set(self, k: int, center: Any, radius: float, basis: NDArray | None = None) -> None:
-        self.present[k] = True
-        self.center[k, : len(center)] = center
-        self.radius[k] = radius
-        if basis is not None:
-            self.basis[k] = basis
 
 
 def join_rows(

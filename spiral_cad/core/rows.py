@@ -79,7 +79,6 @@ class SegmentRows:
         Spiral lengths are measured here where the objects have not yet
         (one quadrature for all), and cached in the objects as well.
         """
-        BezierSpiral.measure_lengths(segments)
         dims = [s._dim for s in segments]
         rows = cls.empty(len(segments), max(dims, default=2))
         kinds = (Line, Arc, BezierSpiral)
@@ -90,6 +89,12 @@ class SegmentRows:
         for kind, index in groups.items():
             for dim in (2, 3):  # one array per kind and dimension
                 rows._fill(kind, [i for i in index if dims[i] == dim], [segments[i] for i in index if dims[i] == dim], dim)
+        for dim in (2, 3):  # spirals not yet measured: one quadrature for all (in their own dimension)
+            todo = [i for i in groups[BezierSpiral] if dims[i] == dim and segments[i]._length is None]
+            if todo:
+                rows.lengths[todo] = bezier.arc_length(rows.geometry[todo, :, :dim])
+                for i, length in zip(todo, rows.lengths[todo].tolist()):
+                    segments[i]._length = length
         return rows
 
     def _fill(self, kind: type, index: list[int], items: list[Segment], dim: int) -> None:
@@ -108,7 +113,7 @@ class SegmentRows:
         else:
             self.kind[index] = SPIRAL
             self.shapes[index] = [shape_number(s._shape) for s in items]
-            self.lengths[index] = [s._length for s in items]
+            self.lengths[index] = [np.nan if s._length is None else s._length for s in items]
             g[index, :, :dim] = [s._cp for s in items]
 
     @classmethod

@@ -155,16 +155,6 @@ class BezierSpiral(Segment):
             raise ValueError("a straight spiral in space has no plane")
         return n / size
 
-    @classmethod
-    def measure_lengths(cls, spirals) -> None:
-        """Measure the arc lengths of many spirals in one vectorised quadrature (each caches its own)."""
-        todo = [s for s in spirals if isinstance(s, cls) and s._length is None]
-        for dim in (2, 3):
-            group = [s for s in todo if s._dim == dim]
-            if group:
-                for spiral, length in zip(group, bezier.arc_length(np.stack([s._cp for s in group])).tolist()):
-                    spiral._length = length
-
     @property
     def length(self) -> float:
         """Arc length by composite Gauss–Legendre (≤ 1e-14 relative for |θ| ≤ 80°)."""
