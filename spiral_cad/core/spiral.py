@@ -43,7 +43,10 @@ class BezierSpiral(Segment):
             (e.g. curvature 5e-324, or a tiny spiral at 1e12).
 
     Pieces (``piece``) and reversals (``reversed``) are exact Bézier curves
-    of the same shape; for them ``start_curvature`` need not be 0.
+    of the same shape; for them ``start_curvature`` need not be 0. A spiral
+    in space — ``placed`` in a ``PlaneFrame``, or ``from_control_points``
+    with (4, 3) points in one plane — is the same planar cubic; its curvature
+    is κ ≥ 0 and ``normal`` is the binormal it turns about.
     """
 
     def __init__(self, start: Any, direction: Any, theta: float, curvature: float, shape: str = DEFAULT_SHAPE):
@@ -123,7 +126,7 @@ class BezierSpiral(Segment):
 
     @property
     def control_points(self) -> NDArray:
-        """(4, 2) float64 control points in travel order (read-only)."""
+        """(4, 2) float64 control points in travel order, (4, 3) in space (read-only)."""
         return self._cp
 
     def _row(self) -> tuple[int, NDArray, tuple[float, float, float]]:
