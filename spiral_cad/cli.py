@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import argparse
 import math
+import os
 import signal
 import sys
 import threading
@@ -136,7 +137,30 @@ def _build(args: argparse.Namespace) -> int:
     return _write_design(args.design, Path(args.out), plots=not args.no_plots)
 
 
+#: Exit status of ``check`` when its output pipe closes early (``| head -1``): 128 + SIGPIPE,
+#: what a shell reports for a command a closed pipe stopped.
+CLOSED_PIPE = 141
+
+
 def _check(args: argparse.Namespace) -> int:
+    """``spiral-cad check``: 0 ok, 1 below ``--require``, 2 error, 141 when stdout closed early.
+
+    (Non-finite measures are graded "unmeasurable" on purpose; ``main`` keeps
+    numpy's warnings about them off the terminal.)
+    """
+    try:
+        status = _check_file(args)
+        sys.stdout.flush()
+    except BrokenPipeError:
+        try:  # the interpreter's last flush must not fail again
+            os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        except (OSError, ValueError, AttributeError):
+            pass
+        return CLOSED_PIPE
+    return status
+
+
+def _check_file(args: argparse.Namespace) -> int:
     if Path(args.file).suffix.lower() == ".xodr":
         if args.comb:
             print("error: --comb draws STEP/IGES edges; it does not apply to OpenDRIVE", file=sys.stderr)
@@ -155,14 +179,20 @@ def _check(args: argparse.Namespace) -> int:
 
 
 def _add_check(sub: argparse._SubParsersAction) -> None:
-    check = sub.add_parser("check", help="report G0/G1/G2 continuity at every joint of a STEP, IGES or OpenDRIVE file")
+    check = sub.add_parser(
+        "check",
+        help="report G0/G1/G2 continuity at every joint of a STEP, IGES or OpenDRIVE file",
+        description="Report G0/G1/G2 continuity at every joint, in the unit the file declares. Exit status: 0 ok, "
+        "1 below --require (or not --pieces pieces), 2 unreadable file or bad option, 141 output pipe closed early.",
+    )
     check.add_argument("file", help="a .step/.stp, .igs/.iges or .xodr file (OpenDRIVE: one piece per road)")
     check.add_argument(
         "--require", choices=["G0", "G1", "G2"], help="exit 1 if any joint is below this level or the file is not in --pieces pieces"
     )
     check.add_argument("--pieces", type=int, help="how many separate paths the file should hold (default 1, with --require)")
     check.add_argument("--snap", type=float, help="chain loose ends closer than this (model units; default 1%% of the model size)")
-    check.add_argument("--comb", metavar="OUT.step", help="also write the curvature comb of every edge as STEP (STEP/IGES input)")
+    check.add_argument("--comb", metavar="OUT.step",
+                       help="also write the curvature comb of every edge as STEP (STEP/IGES input; never the checked file)")  # fmt: skip
     check.add_argument("--gap-tol", type=float, default=1e-7, help="G0 gap, absolute model units (default 1e-7)")
     check.add_argument("--angle-tol", type=float, default=1e-7, help="G1 tangent angle, radians (default 1e-7)")
     check.add_argument("--curvature-tol", type=float, default=1e-6, help="G2 curvature jump, relative (default 1e-6)")

@@ -36,10 +36,12 @@ from __future__ import annotations
 
 import math
 import os
+import warnings
 import xml.etree.ElementTree as ET
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from datetime import datetime, timezone
+from functools import cached_property
 
 import numpy as np
 from numpy.typing import NDArray
@@ -53,7 +55,7 @@ from ..core.segments import Arc, Line, Segment
 from ..core.spiral import BezierSpiral
 from ..core.units import to_metres
 from .decimals import shortest_decimal
-from .joints import ContinuityReport, Frame, check_tolerances, classify_pieces
+from .joints import ContinuityReport, Frame, check_tolerances, classify_pieces, model_size
 
 REV_MAJOR, REV_MINOR = 1, 8
 
@@ -305,12 +307,20 @@ class Geometry:
         rotation = np.array([[c, s], [-s, c]])  # row vectors times this rotate by hdg
         return points @ rotation + (self.x, self.y), tangents @ rotation, curvature
 
+    @cached_property
+    def _start_end_middle(self) -> tuple[Frame, Frame, Frame]:
+        """Start, end and middle frames, evaluated once (NaN where a tangent or curvature is not defined)."""
+        with np.errstate(all="ignore"), warnings.catch_warnings():
+            warnings.simplefilter("ignore")  # scipy's quad on a poly3 that is not a function of u
+            points, tangents, curvature = self.evaluate([0.0, 1.0, 0.5])
+        return tuple(
+            (p[0], p[1], 0.0, t[0], t[1], 0.0, -t[1] * k, t[0] * k, 0.0)
+            for p, t, k in zip(points.tolist(), tangents.tolist(), curvature.tolist())
+        )
+
     def frames(self) -> tuple[Frame, Frame]:
         """Start and end frames (point, unit tangent, curvature vector; z = 0) for the joint checks."""
-        points, tangents, curvature = self.evaluate([0.0, 1.0])
-        return tuple(
-            (p[0], p[1], 0.0, t[0], t[1], 0.0, -t[1] * k, t[0] * k, 0.0) for p, t, k in zip(points, tangents, curvature)
-        )
+        return self._start_end_middle[0], self._start_end_middle[1]
 
     def segment(self) -> Segment | None:
         """The exact segment (Line, Arc, BezierSpiral for paramPoly3), or None (clothoid, poly3)."""
@@ -374,7 +384,8 @@ def _parametric(u: tuple, v: tuple, p: NDArray):
     """Points, unit tangents and curvature of the parametric cubic (u(p), v(p))."""
     (x, x1, x2), (y, y1, y2) = _cubic(u, p), _cubic(v, p)
     speed = np.hypot(x1, y1)
-    return np.stack([x, y], axis=-1), np.stack([x1 / speed, y1 / speed], axis=-1), (x1 * y2 - y1 * x2) / speed**3
+    with np.errstate(divide="ignore", invalid="ignore"):  # speed 0 (bU = bV = 0): no tangent, NaN
+        return np.stack([x, y], axis=-1), np.stack([x1 / speed, y1 / speed], axis=-1), (x1 * y2 - y1 * x2) / speed**3
 
 
 @dataclass(frozen=True)
@@ -402,9 +413,17 @@ class Road:
         if not self.exact:
             kinds = sorted({g.kind for g in self.geometries} - {"line", "arc", "paramPoly3"})
             raise ValueError(f"road {self.id}: {', '.join(kinds)} geometries have no exact Chain form")
+        segments = []
+        for g in self.geometries:
+            try:
+                with np.errstate(all="ignore"):
+                    segments.append(g.segment())
+            except (ValueError, ArithmeticError) as error:  # a geometry at the edge of the float range
+                raise ValueError(f"road {self.id}, planView geometry {g.index} <{g.kind}>: no exact segment ({error})") from None
         try:
-            return Chain([g.segment() for g in self.geometries], tolerance, units="m")
-        except ValueError as error:
+            with np.errstate(all="ignore"):  # a joint at the edge of the float range is refused, not warned about
+                return Chain(segments, tolerance, units="m")
+        except (ValueError, ArithmeticError) as error:
             raise ValueError(f"road {self.id}: {error}") from None
 
     def sample(self, per_geometry: int = 32) -> NDArray:
@@ -435,6 +454,11 @@ def _real(element: ET.Element, name: str, where: str) -> float:
     return value
 
 
+def _label(value: str) -> str:
+    """A road id for messages: as written if short and printable, else quoted and cut."""
+    return value if value.isprintable() and 0 < len(value) <= 64 else repr(value[:40]) + ("…" if len(value) > 40 else "")
+
+
 def _geometry(road: str, index: int, element: ET.Element) -> Geometry:
     where = f"road {road}, planView geometry {index}"
     s, x, y, hdg, length = (_real(element, name, where) for name in ("s", "x", "y", "hdg", "length"))
@@ -454,19 +478,35 @@ def _geometry(road: str, index: int, element: ET.Element) -> Geometry:
         params["pRange"] = shape.get("pRange", "normalized")
         if params["pRange"] not in ("normalized", "arcLength"):
             raise ValueError(f"{where} <paramPoly3>: pRange must be normalized or arcLength; got {params['pRange']!r:.40}")
-    return Geometry(road, index, s, x, y, hdg, length, shape.tag, params)
+    geometry = Geometry(road, index, s, x, y, hdg, length, shape.tag, params)
+    numbers = ", ".join(f"{k}={v!r}" for k, v in {"x": x, "y": y, "hdg": hdg, "length": length, **params}.items())
+    try:
+        ends = geometry._start_end_middle
+    except (ValueError, ArithmeticError, RuntimeError) as error:  # e.g. a clothoid whose phase overflows
+        raise ValueError(f"{where} <{shape.tag}>: cannot be evaluated ({error}; {numbers})") from None
+    bad = next((name for name, f in zip(("start", "end", "middle"), ends) if not all(map(math.isfinite, f[:2]))), None)
+    if bad is not None:
+        raise ValueError(f"{where} <{shape.tag}>: its {bad} point is not a finite number ({numbers})")
+    return geometry
 
 
 def read_opendrive(path: str | os.PathLike) -> list[Road]:
     """Every road's planView of an OpenDRIVE file (any revision), in metres.
 
+    Every geometry is evaluated at its start, middle and end as it is read,
+    so a road whose points are not finite numbers (a line at 1e308, an arc
+    of curvature 1e308) is refused here rather than measured as NaN.
+
     Raises:
         ValueError: unreadable or malformed XML, a root that is not
             ``OpenDRIVE``, a road without a planView, an unknown or missing
-            geometry element, a non-finite or non-positive length, or
-            geometries out of ``s`` order — naming the road id and the element.
+            geometry element, a number that is not finite, a non-positive
+            length, geometries out of ``s`` order, or a geometry that does
+            not evaluate to finite points — naming the road id and the element.
     """
     label = os.path.basename(os.fspath(path))
+    if not os.path.isfile(path):
+        raise ValueError(f"cannot read {label}: " + ("not a regular file" if os.path.exists(path) else "no such file"))
     try:
         root = ET.parse(os.fspath(path)).getroot()
     except ET.ParseError as error:
@@ -477,7 +517,7 @@ def read_opendrive(path: str | os.PathLike) -> list[Road]:
         raise ValueError(f"{label}: the root element is <{root.tag}>, not <OpenDRIVE>")
     roads = []
     for number_, element in enumerate(root.findall("road")):
-        road_id = element.get("id", f"#{number_}")
+        road_id = _label(element.get("id", f"#{number_}"))
         plan = element.find("planView")
         if plan is None:
             raise ValueError(f"{label}: road {road_id} has no planView")
@@ -487,8 +527,10 @@ def read_opendrive(path: str | os.PathLike) -> list[Road]:
         for a, b in zip(geometries, geometries[1:]):
             if not b.s > a.s:
                 raise ValueError(f"{label}: road {road_id}, planView geometry {b.index}: s = {b.s!r} is not after s = {a.s!r} of geometry {a.index}")
-        length = element.get("length")
-        roads.append(Road(road_id, element.get("name", ""), float(length) if length else sum(g.length for g in geometries), geometries))
+        length = _real(element, "length", f"{label}: road {road_id}") if element.get("length") else sum(g.length for g in geometries)
+        if not length > 0.0:
+            raise ValueError(f"{label}: road {road_id}: length must be positive; got {length!r}")
+        roads.append(Road(road_id, element.get("name", ""), length, geometries))
     if not roads:
         raise ValueError(f"{label}: no <road> elements")
     return roads
@@ -507,14 +549,10 @@ def check_opendrive(
     """
     check_tolerances(gap_tol=gap_tol, angle_tol=angle_tol, curvature_tol=curvature_tol)
     roads = read_opendrive(path)
-    pieces, points = [], []
-    for road in roads:
-        frames = [g.frames() for g in road.geometries]
-        pieces.append(("road", frames, False))
-        for g, (start, end) in zip(road.geometries, frames):
-            middle = g.evaluate([0.5])[0][0]
-            points += [start[:3], end[:3], (middle[0], middle[1], 0.0)]
+    source = os.path.basename(os.fspath(path))
+    pieces = [("road", [g.frames() for g in road.geometries], False, road.id) for road in roads]
+    points = [f[:3] for road in roads for g in road.geometries for f in g._start_end_middle]
     return classify_pieces(
-        pieces, points, gap_tol=gap_tol, angle_tol=angle_tol, curvature_tol=curvature_tol,
-        source=os.path.basename(os.fspath(path)), element="geometry",
+        pieces, model_size(points, source), gap_tol=gap_tol, angle_tol=angle_tol, curvature_tol=curvature_tol,
+        source=source, element="geometry", units="m",
     )  # fmt: skip
