@@ -299,13 +299,20 @@ def _corner_rows(p0: ArrayLike, corners: ArrayLike, p1: ArrayLike) -> tuple[NDAr
 
 def _in_corner_planes(p0: NDArray, corners: NDArray, p1: NDArray) -> tuple[NDArray, NDArray, NDArray, NDArray]:
     """Plane coordinates of corners in space: (p0, p1) local (N, 2) with the corner at the origin,
-    and each corner's frame (x_dir, y_dir) (N, 3)."""
+    and each corner's frame (x_dir, y_dir) (N, 3).
+
+    p0 lies on the x axis; p1 at its distance along the turn (cos, sin) = (t_in·t_out,
+    |t_in × t_out|): legs that are collinear to the last bit stay exactly collinear.
+    """
     x_dir, y_dir = corner_frames(p0, corners, p1)
     local_p0 = np.zeros((len(corners), 2))
-    local_p0[:, 0] = -norms(corners - p0)  # on the x axis by construction
+    local_p0[:, 0] = -norms(corners - p0)
     out = p1 - corners
-    local_p1 = np.stack([np.einsum("ij,ij->i", out, x_dir), np.einsum("ij,ij->i", out, y_dir)], axis=1)
-    return local_p0, local_p1, x_dir, y_dir
+    length = norms(out)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        t_out = out / length[:, None]
+    turn = np.stack([np.einsum("ij,ij->i", x_dir, t_out), norms(np.cross(x_dir, t_out))], axis=1)
+    return local_p0, length[:, None] * turn, x_dir, y_dir
 
 
 def round_corners_batch(
@@ -453,7 +460,8 @@ def corner_legs(points: ArrayLike) -> tuple[NDArray, NDArray, NDArray, NDArray]:
     if not np.isfinite(pts).all():
         i = int(np.argmax(~np.isfinite(pts).all(axis=1)))
         raise ValueError(f"points must be finite; point {i} is {pts[i].tolist()}")
-    seg = np.diff(pts, axis=0)
+    with np.errstate(over="ignore"):  # legs wider than float64: refused below by name
+        seg = np.diff(pts, axis=0)
     length = norms(seg)
     if not (length > 0.0).all():
         i = int(np.argmax(~(length > 0.0)))
