@@ -28,6 +28,8 @@ corners in different planes still join G2. The array functions
 from __future__ import annotations
 
 import math
+import re
+from collections.abc import Iterable
 from dataclasses import dataclass
 
 import numpy as np
@@ -36,14 +38,16 @@ from numpy.typing import ArrayLike, NDArray
 from ..core import _kernels as K
 from ..core import batch
 from ..core._inputs import as_real_array
-from ..core.chain import JOIN_TOLERANCE, Chain, PartCircles, join_rows, join_tolerance
+from ..core.chain import JOIN_TOLERANCE, Chain, PartCircles, g2_mismatch, join_rows, join_tolerance
 from ..core.errors import JointError, NoSolutionError, Status
 from ..core.factors import length_factor
 from ..core.rows import SegmentRows
 from ..core.shapes import CORNER_SHAPES, DEFAULT_SHAPE, SHAPE_CODES, shape_code
-from ..core.space import corner_frames, norms, place, placed_pair_residuals
+from ..core.segments import Line, Segment
+from ..core.space import PlaneFrame, corner_frames, norms, place, placed_pair_residuals
 from ..core.spiral import BezierSpiral
 from ..core.units import DEFAULT_UNITS, length_unit
+from .fillets import FilletCorner, _vertex_indices, fillet_path
 
 #: Yang & Sukkarieh's leg ratio g/h: the smallest that keeps κ monotone.
 G2CBS_C2 = K.G2CBS_RATIO
@@ -632,3 +636,141 @@ def round_corners(
     except JointError as error:
         raise NoSolutionError(f"corner {index[error.part]}: float64 cannot hold its spirals G2 at these coordinates: {error}") from None
     return RoundedPath(chain, rounded, shape)
+
+
+# ------------------------------------------------------------ fillets in space
+
+
+@dataclass(frozen=True)
+class SpaceFillet:
+    """One filleted corner of a polyline in space: its vertex, the plane of its two edges
+    (``frame``, origin at the vertex) and the fillet in that plane's coordinates."""
+
+    vertex: int
+    frame: PlaneFrame
+    fillet: FilletCorner
+
+
+@dataclass(frozen=True)
+class FilletedPolyline:
+    """A polyline in space with G2 fillets: its segments in travel order (closed when the polyline
+    was), the corner each segment belongs to (None: a trimmed edge) and the fillets."""
+
+    segments: tuple[Segment, ...]
+    owners: tuple[int | None, ...]
+    corners: list[SpaceFillet]
+    closed: bool
+    units: str = DEFAULT_UNITS
+
+    @property
+    def chain(self) -> Chain:
+        """The path as a ``Chain`` (every joint G2: every corner rounded).
+
+        Raises:
+            ValueError: a vertex left sharp, named as a joint.
+        """
+        return Chain(self.segments, units=self.units)
+
+
+_INNER_CORNER = re.compile(r"^corner 1( at \([^)]*\))?: ")
+
+
+def fillet_polyline(
+    points: ArrayLike,
+    radius: float,
+    *,
+    transition: float = 0.5,
+    vertices: Iterable[int] | None = None,
+    closed: bool = False,
+    same_sense: str = "nested",
+    shape: str = DEFAULT_SHAPE,
+    tolerance: float = JOIN_TOLERANCE,
+    units: str = DEFAULT_UNITS,
+) -> FilletedPolyline:
+    """G2 fillets at the corners of a polyline in space, each in the plane of its two edges.
+
+    Every chosen corner becomes transition → arc of ``radius`` → transition
+    exactly as a plane corner does (``spiral_cad.design.fillets.fillet_path``,
+    solved in the corner's plane and placed back): the same ``radius``,
+    ``transition`` and ``shape``. An edge between two rounded corners is
+    shared half-and-half (an edge with one rounded corner belongs wholly to it).
+
+    Args:
+        points: (n, 3) vertices (an (n, 2) polyline works too, in the XY plane).
+        radius: the fillet arc's radius, the smallest radius of curvature in each corner.
+        transition: the share of each corner's turn made by its spirals, in (0, 1].
+        vertices: the vertex indices to round (default every corner).
+        closed: the polyline closes (its last point joins its first; a repeated
+            first point at the end is dropped): vertex 0 is a corner too.
+        same_sense, shape, tolerance, units: as ``fillet_path``.
+
+    Raises:
+        ValueError: malformed input, a vertex index that is no corner.
+        NoSolutionError: a corner that cannot be rounded (named, with numbers).
+    """
+    pts = _polyline(points) if not closed else _coordinates(points, "points")
+    if closed and len(pts) > 1 and np.array_equal(pts[0], pts[-1]):
+        pts = pts[:-1]
+    if pts.ndim != 2 or len(pts) < 3:
+        raise ValueError(f"points must be an (n ≥ 3, 3) polyline; got shape {pts.shape}")
+    if not np.isfinite(pts).all():
+        i = int(np.argmax(~np.isfinite(pts).all(axis=1)))
+        raise ValueError(f"points must be finite; point {i} is {pts[i].tolist()}")
+    count = len(pts)
+    edges = count if closed else count - 1
+    ends = [(pts[i], pts[(i + 1) % count]) for i in range(edges)]
+    for i, (a, b) in enumerate(ends):
+        if np.array_equal(a, b):
+            raise ValueError(f"points {i} and {(i + 1) % count} coincide at {a.tolist()}")
+    candidates = list(range(count)) if closed else list(range(1, count - 1))
+    chosen = candidates if vertices is None else _vertex_indices(vertices)
+    unknown = [v for v in chosen if v not in candidates]
+    if unknown:
+        raise ValueError(f"vertices {unknown} are not corners of this polyline (corners: {candidates})")
+    rounded = {}
+    for v in chosen:
+        d_in, d_out = (ends[v - 1][1] - ends[v - 1][0]), (ends[v % edges][1] - ends[v % edges][0])
+        if _sin_turn(d_in[None] / norms(d_in), d_out[None] / norms(d_out))[0] > COLLINEAR_TOL:
+            rounded[v] = None  # a corner (straight vertices stay as they are)
+    pieces: dict[int, list[Segment]] = {}
+    fillets = []
+    for v in rounded:
+        before, after = pts[v - 1], pts[(v + 1) % count]
+        share_in = 0.5 if (v - 1) % count in rounded and (closed or v - 1 > 0) else 1.0
+        share_out = 0.5 if (v + 1) % count in rounded and (closed or v + 1 < count - 1) else 1.0
+        frame = PlaneFrame.of_corner(before, pts[v], after)
+        legs = frame.local([pts[v] + share_in * (before - pts[v]), pts[v] + share_out * (after - pts[v])])
+        try:
+            result = fillet_path([legs[0], (0.0, 0.0), legs[1]], radius, transition=transition, same_sense=same_sense,
+                                 shape=shape, tolerance=tolerance)  # fmt: skip
+        except ValueError as error:
+            where = f"corner {v} at ({', '.join(f'{c:.10g}' for c in pts[v].tolist())})"
+            message = _INNER_CORNER.sub("", str(error))  # the plane solve's own corner and edges are 1, 0 and 1
+            message = re.sub(r"edge ([01])\b", lambda m: f"edge {(v - 1) % count if m.group(1) == '0' else v}", message)
+            shared = " (each corner may use half of an edge it shares with another rounded corner)" if "edge" in message else ""
+            raise type(error)(f"{where}: {message}{shared}") from None
+        pieces[v] = [s.placed(frame) for s, owner in zip(result.segments, result.owners) if owner is not None]
+        fillets.append(SpaceFillet(v, frame, result.corners[0]))
+    segments: list[Segment] = []
+    owners: list[int | None] = []
+    for i, (a, b) in enumerate(ends):
+        start = pieces[i][-1].point(1.0) if i in pieces else a
+        j = (i + 1) % count
+        stop = pieces[j][0].point(0.0) if j in pieces else b
+        if not np.array_equal(start, stop):
+            segments.append(Line(start, stop))
+            owners.append(None)
+        if j in pieces and (closed or j < count - 1):
+            segments += pieces[j]
+            owners += [j] * len(pieces[j])
+    tolerance = join_tolerance(tolerance)
+    pairs = list(zip(range(len(segments) - 1), range(1, len(segments))))
+    if closed:
+        pairs.append((len(segments) - 1, 0))
+    for a, b in pairs:
+        vertex = owners[a] if owners[a] is not None else owners[b]
+        if vertex is not None:
+            problem = g2_mismatch(segments[a], segments[b], tolerance)
+            if problem:
+                raise NoSolutionError(f"corner {vertex}: float64 cannot hold its fillet G2 at these coordinates ({problem})")
+    return FilletedPolyline(tuple(segments), tuple(owners), fillets, closed, length_unit(units))
