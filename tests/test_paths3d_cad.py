@@ -143,3 +143,20 @@ def test_samples_for_machines(tmp_path):
                        ({"step": 1e-9}, "samples"), ({"step": 1.0, "chord_tolerance": 1.0}, "one of them")):  # fmt: skip
         with pytest.raises(ValueError, match=match):
             export_samples(chain, tmp_path / "bad.csv", **bad)
+
+
+def test_samples_of_a_plane_chain_with_arcs_carry_signed_curvature(tmp_path):
+    from spiral_cad.design import Alignment
+    from spiral_cad.formats.samples import sample_path
+
+    chain = Alignment.from_pis([(0, 0), (300, 60), (560, -40), (820, 90)], radii=[220, 260], spiral_angles=0.12, units="m").chain
+    for options in ({"step": 2.0}, {"chord_tolerance": 0.001}):
+        table = sample_path(chain, **options)
+        assert np.all(table[:, 3] == 0.0) and np.all(table[:, 6] == 0.0)
+        assert np.allclose(table[:, 1:3], chain.point_at(table[:, 0]), atol=1e-9)
+        assert np.allclose(table[:, 7], chain.curvature_at(table[:, 0]), atol=1e-12)
+        assert table[:, 7].min() < 0 < table[:, 7].max()  # turns both ways
+        if "step" in options:
+            assert np.diff(table[:, 0]).max() <= 2.0
+    assert export_samples(chain, tmp_path / "a.csv", step=2.0) == len(sample_path(chain, step=2.0))
+    assert (tmp_path / "a.csv").read_text().splitlines()[0].startswith("s [m],x [m]")
