@@ -278,3 +278,18 @@ def test_magnitudes_from_tiny_to_huge():
         path = round_corners(pts * scale, max_deviation=0.4 * scale)
         assert path.chain.length / scale == pytest.approx(reference.chain.length, rel=1e-9)
         assert path.max_deviation <= 0.4 * scale
+
+
+def test_a_bad_row_of_a_batch_in_space_fails_alone():
+    p0, corners, p1, _ = corner_legs(helix(8))
+    p0, corners = p0.copy(), corners.copy()
+    corners[1, 2] = np.nan
+    p0[3] = (1e300, -1e300, 1e300)
+    good = round_corners_batch(*corner_legs(helix(8))[:3], max_deviation=0.4)
+    mixed = round_corners_batch(p0, corners, p1, max_deviation=0.4)
+    assert mixed.ok.tolist() == [True, False, True, False, True, True]
+    assert "corner 1 at (" in mixed.reason(1) and "nan" in mixed.reason(1)
+    assert mixed.reason(3).startswith("corner 3 at (") and "float64 cannot round it at these magnitudes" in mixed.reason(3)
+    assert np.isnan(mixed.control_points[[1, 3]]).all() and np.isnan(mixed.deviation[[1, 3]]).all()
+    for i in (0, 2, 4, 5):
+        assert np.array_equal(mixed.control_points[i], good.control_points[i])

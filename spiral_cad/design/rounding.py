@@ -228,18 +228,24 @@ class CornerBatch:
         """The reason of a ``LEGS_TOO_SHORT`` row, in the terms it was asked in."""
         available = f"only {self.available[i]:.6g} is available (each corner may use half of an interior leg)"
         largest = f"this corner needs curvature ≥ {self.curvature[i]:.6g} ({self.shape})"
-        length, bound = self.spiral_length[i], self.max_deviation[i]
+        length, bound, kmax = self.spiral_length[i], self.max_deviation[i], self.max_curvature[i]
+        if bound == bound and kmax == kmax and self.curvature[i] > kmax:
+            return (
+                f"within max_deviation {bound:.6g} and its legs the spiral pair may start at most "
+                f"{self.distance[i]:.6g} from the corner, which needs curvature {self.curvature[i]:.6g}, above "
+                f"max_curvature {kmax:.6g}; allow a larger deviation or curvature"
+            )
+        if self.distance[i] <= self.available[i]:  # the legs allow it: the plane solver could not hold the sizes
+            return (
+                f"float64 cannot round it at these magnitudes: the spirals would start {self.distance[i]:.6g} from the "
+                f"corner and the legs allow {self.available[i]:.6g}, but the legs differ in size by more than float64 "
+                "can hold in one corner; bring the points to a common scale"
+            )
         if length == length:
             longest = float(length_factor(self.theta[i], self.shape) / self.curvature[i])
             return (
                 f"spirals {length:.6g} long need to start {self.distance[i]:.6g} from the corner but {available}; "
                 f"its spirals may be at most {longest:.6g} long ({self.shape})"
-            )
-        if bound == bound:
-            return (
-                f"within max_deviation {bound:.6g} and its legs the spiral pair may start at most "
-                f"{self.distance[i]:.6g} from the corner, which needs curvature {self.curvature[i]:.6g}, above "
-                f"max_curvature {self.max_curvature[i]:.6g}; allow a larger deviation or curvature"
             )
         return (
             f"curvature {self.requested[i]:.6g} needs the spirals to start {self.distance[i]:.6g} from the corner "
