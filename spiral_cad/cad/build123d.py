@@ -36,6 +36,7 @@ from build123d import (
 
 from ..core.chain import Chain
 from ..design.fillets import continuous_polygon, continuous_rectangle, continuous_slot
+from .corridor import Corridor, centerline_wire, corridor
 from .fillet import fillet_face, fillet_wire
 from .occ import chain_wire
 from ..core.segments import Segment
@@ -51,11 +52,14 @@ __all__ = [
     "ContinuousPolygon",
     "ContinuousRectangle",
     "ContinuousSlot",
+    "Corridor",
     "SpiralChain",
     "SpiralCircleInCircle",
     "SpiralCircleToCircle",
     "SpiralLineToCircle",
     "SpiralLineToLine",
+    "centerline_wire",
+    "corridor",
     "curvature_comb",
     "g2_fillet",
 ]
