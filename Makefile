@@ -39,6 +39,7 @@ bench: $(STAMP)
 	$(BIN)/python benchmarks/bench_rounding.py --out benchmarks/results_rounding.md
 	$(BIN)/python benchmarks/bench_roads.py --out benchmarks/results_roads.md
 	$(BIN)/python benchmarks/bench_fillets.py --out benchmarks/results_fillets.md
+	$(BIN)/python benchmarks/bench_shapes.py --out benchmarks/results_shapes.md
 
 pictures: $(STAMP)
 	$(BIN)/python docs/make_pictures.py

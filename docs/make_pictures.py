@@ -42,7 +42,7 @@ def main() -> None:
             shutil.copy(tmp / source, IMAGES / target)
         from spiral_cad.plots import plot_jerk_length
 
-        plot_jerk_length().savefig(IMAGES / "jerk_length.png", dpi=100)
+        plot_jerk_length(shapes=("walton-meek", "near-linear")).savefig(IMAGES / "jerk_length.png", dpi=100)
         tube = cq.importers.importStep(str(tmp / "cq" / "tube.step"))
         cq.exporters.export(
             tube, str(IMAGES / "cadquery_tube.svg"), opt={"projectionDir": (0.4, -1.0, 0.5), "showHidden": False}

@@ -7,10 +7,11 @@ Run: ``python examples/continuous_corners.py [OUT_DIR]`` (default ./out).
 * ``continuous_corners.png``: one 90° corner rounded three ways with the same
   footprint (the corner's tangent points 10 mm from the vertex) — curvature
   against arc length, and the curvature combs;
-* a printed table: max curvature, largest curvature jump and whether the
-  curvature rises and falls monotonically, for build123d's ``fillet_2d``
-  (circular), ``BlendCurve`` (C2 quintic, its tangent scale tuned for the
-  lowest peak curvature) and ``g2_fillet``.
+* a printed table: max curvature, largest curvature jump, peak rate of change
+  of curvature dκ/ds and whether the curvature rises and falls monotonically,
+  for build123d's ``fillet_2d`` (circular), ``BlendCurve`` (C2 quintic, its
+  tangent scale tuned for the lowest peak curvature) and ``g2_fillet`` with
+  the 1996 spiral and with the near-linear spiral.
 """
 
 import math
@@ -48,6 +49,7 @@ print(f"slab: volume {slab.volume:.1f} mm³, outline {report.describe()}, every 
 # ------------------------------------------------------- one corner, three ways
 FOOTPRINT, LEG, TRANSITION = 10.0, 25.0, 0.6
 radius = FOOTPRINT / corner_distance(1.0, math.pi / 2, TRANSITION)
+radius_nl = FOOTPRINT / corner_distance(1.0, math.pi / 2, TRANSITION, "near-linear")
 corner = bd.Polyline((0, 0), (LEG, 0), (LEG, LEG))
 vertex = [v for v in corner.vertices() if (bd.Vector(v) - bd.Vector(LEG, 0)).length < 1e-9]
 first = bd.Edge.make_line((0, 0), (LEG - FOOTPRINT, 0))
@@ -69,6 +71,9 @@ ways = {
         [first, bd.BlendCurve(first, second, tangent_scalars=(tension, tension)), second]
     ),
     f"spiral_cad g2_fillet (r = {radius:.2f}, transition {TRANSITION})": g2_fillet(corner, radius, transition=TRANSITION),
+    f"spiral_cad g2_fillet near-linear (r = {radius_nl:.2f})": g2_fillet(
+        corner, radius_nl, transition=TRANSITION, shape="near-linear"
+    ),
 }
 
 
@@ -89,13 +94,14 @@ def profile(wire: bd.Wire, per_edge: int = 400):
 
 rows = []
 fig, (left, right) = plt.subplots(1, 2, figsize=(12, 5))
-for (name, wire), color in zip(ways.items(), ("tab:blue", "tab:green", "tab:red")):
+for (name, wire), color in zip(ways.items(), ("tab:blue", "tab:green", "tab:red", "tab:purple")):
     pieces = profile(wire)
     kappa = np.concatenate([k for _, k in pieces])
     jump = max(abs(a[1][-1] - b[1][0]) for a, b in zip(pieces, pieces[1:]))
+    rate = max(float(np.max(np.abs(np.diff(k) / np.diff(s)))) for s, k in pieces)  # within edges: jumps are not rates
     peak = int(np.argmax(kappa))
     monotone = bool(np.all(np.diff(kappa[: peak + 1]) >= -1e-9) and np.all(np.diff(kappa[peak:]) <= 1e-9))
-    rows.append((name, kappa.max(), jump, "yes" if monotone else "no", "yes" if jump < 1e-6 else "no"))
+    rows.append((name, kappa.max(), jump, rate, "yes" if monotone else "no", "yes" if jump < 1e-6 else "no"))
     for s, k in pieces:
         left.plot(s - LEG + FOOTPRINT, k, color=color, lw=1.8, label=name if s is pieces[0][0] else None)
     teeth = curvature_comb(wire, scale=40.0, per_edge=30)
@@ -119,9 +125,9 @@ right.grid(True, alpha=0.3)
 fig.tight_layout()
 fig.savefig(out / "continuous_corners.png", dpi=100)
 
-header = f"{'corner':66} {'max κ (1/mm)':>12} {'κ jump':>9} {'monotone':>9} {'G2':>4}"
+header = f"{'corner':66} {'max κ (1/mm)':>12} {'κ jump':>9} {'max dκ/ds (1/mm²)':>18} {'monotone':>9} {'G2':>4}"
 print(header)
 print("-" * len(header))
-for name, peak, jump, monotone, g2 in rows:
-    print(f"{name:66} {peak:12.5f} {jump:9.5f} {monotone:>9} {g2:>4}")
+for name, peak, jump, rate, monotone, g2 in rows:
+    print(f"{name:66} {peak:12.5f} {jump:9.5f} {rate:18.5f} {monotone:>9} {g2:>4}")
 print(f"wrote {out / 'continuous_corners.png'}")

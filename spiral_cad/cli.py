@@ -4,11 +4,14 @@ from __future__ import annotations
 
 import argparse
 import math
-import os
+import signal
 import sys
+import threading
 import time
+import warnings
+from collections.abc import Callable, Iterator, Sequence
+from contextlib import contextmanager
 from importlib.util import find_spec
-from collections.abc import Sequence
 from pathlib import Path
 
 from . import circle_in_circle, circle_to_circle, line_to_circle, line_to_line
@@ -16,25 +19,31 @@ from .core.transitions import Transition
 
 
 def core_examples() -> list[tuple[str, Transition]]:
-    """One solved instance of each of the five cases (the core demo's input)."""
+    """One solved instance of each of the five cases with each spiral shape (the core demo's input)."""
+    nl = "near-linear"
     return [
         ("line → circle (Thm 4.1)", line_to_circle((0, 0), (1, 0), (0, 1.05), 1.0)),
         ("circle → circle, C (Thm 4.2)", circle_to_circle((0, 0), 2.0, (5, 1), 1.0)),
         ("circle → circle, S (Thm 4.3)", circle_to_circle((0, 0), -2.0, (5, 1), 1.0)),
         ("line → line (Cor 4.5)", line_to_line((0, 0), (10, 0), (15, 8))),
         ("circle in circle (5th case)", circle_in_circle((0, 0), 1.0, (0, 0.595), 0.4)),
+        ("line → circle", line_to_circle((0, 0), (1, 0), (0, 1.01), 1.0, nl)),
+        ("circle → circle, C", circle_to_circle((0, 0), 2.0, (2.5, 0.5), 1.0, nl)),
+        ("circle → circle, S", circle_to_circle((0, 0), -2.0, (4, 0.5), 1.0, nl)),
+        ("line → line", line_to_line((0, 0), (10, 0), (15, 8), shape=nl)),
+        ("circle in circle", circle_in_circle((0, 0), 1.0, (0, 0.595), 0.4, nl)),
     ]
 
 
 def transition_table(rows: Sequence[tuple[str, Transition]]) -> str:
-    """Table of θ, end curvatures and the worst join residuals per transition."""
-    head = f"{'case':30} {'θ°':>9} {'κ start':>10} {'κ end':>10} {'gap/len':>9} {'angle':>9} {'Δκ·len':>9}"
+    """Table of the shape, θ, end curvatures and the worst join residuals per transition."""
+    head = f"{'case':30} {'shape':12} {'θ°':>9} {'κ start':>10} {'κ end':>10} {'gap/len':>9} {'angle':>9} {'Δκ·len':>9}"
     lines = [head, "-" * len(head)]
     for name, t in rows:
         joins = t.joins()
         size = t.length
         lines.append(
-            f"{name:30} {math.degrees(t.theta):9.4f} {t.spirals[0].start_curvature:10.5f} "
+            f"{name:30} {t.shape:12} {math.degrees(t.theta):9.4f} {t.spirals[0].start_curvature:10.5f} "
             f"{t.spirals[-1].end_curvature:10.5f} {max(j.gap for j in joins) / size:9.1e} "
             f"{max(j.angle for j in joins):9.1e} {max(j.curvature_jump for j in joins) * size:9.1e}"
         )
@@ -77,19 +86,27 @@ DEMO_DESIGN: dict = {
 PIP_CAD = 'pip install "spiral_cad[cad]"'
 
 
-def _write_design(design: dict | str, out: Path, plots: bool) -> int:
+def _write_design(design: dict | str, out: Path, plots: bool, extra: Callable[[Path], None] | None = None) -> int:
     from .designfile import build, criteria_tables, summary, write
 
     started = time.perf_counter()
     units, built = build(design)
     print(f"built {len(built)} design(s); writing to {out}/", flush=True)
-    written = write(built, out, units, progress=lambda line: print(line, flush=True), plots=plots)
-    print()
-    tables = criteria_tables(built)
-    if tables:
-        print(tables + "\n")
-    print(summary(built, units))
-    print(f"\nwrote {len(written.files)} files to {out}/ in {time.perf_counter() - started:.1f} s")
+    try:
+        written = write(built, out, units, progress=lambda line: print(line, flush=True), plots=plots, extra=extra)
+    except KeyboardInterrupt as interrupt:
+        if interrupt.args:
+            raise
+        raise KeyboardInterrupt(f"nothing in {out}/ was changed") from None
+    try:
+        print()
+        tables = criteria_tables(built)
+        if tables:
+            print(tables + "\n")
+        print(summary(built, units))
+        print(f"\nwrote {len(written.files)} files to {out}/ in {time.perf_counter() - started:.1f} s")
+    except KeyboardInterrupt:
+        raise KeyboardInterrupt(f"every file had been written to {out}/") from None
     if written.skipped:
         print(f"error: not written: {'; '.join(written.skipped)}. Install the CAD extra: {PIP_CAD}", file=sys.stderr)
         return 2
@@ -97,25 +114,22 @@ def _write_design(design: dict | str, out: Path, plots: bool) -> int:
 
 
 def _demo(args: argparse.Namespace) -> int:
-    out = Path(args.out)
-    print("The five transitions of Walton & Meek (1996), one instance each:\n")
+    print("The five transitions of Walton & Meek (1996), one instance each with each spiral shape:\n")
     print(transition_table(core_examples()))
     print()
-    status = _write_design(DEMO_DESIGN, out, plots=not args.no_plots)
-    if status == 0 and not args.no_plots:
-        _paper_plots(out)
-    return status
+    return _write_design(DEMO_DESIGN, Path(args.out), plots=not args.no_plots, extra=None if args.no_plots else _paper_plots)
 
 
-def _paper_plots(out: Path) -> None:
-    """The paper's Fig. 6 family and the Bézier spiral against a clothoid (each file replaced whole)."""
-    from .plots import plot_fig6, plot_vs_clothoid
+def _paper_plots(folder: Path) -> None:
+    """The paper's Fig. 6 family beside the near-linear one, and both spirals against a clothoid,
+    written into ``folder`` (nothing without matplotlib: the missing plots are reported with the rest)."""
+    if find_spec("matplotlib") is None:
+        return
+    from .plots import plot_fig6_shapes, plot_vs_clothoid
 
-    for name, fig in (("fig6.png", plot_fig6()), ("bezier_vs_clothoid.png", plot_vs_clothoid(math.radians(30), 1.0))):
-        partial = out / f".{name}.partial"
-        fig.savefig(partial, dpi=110, format="png")
-        os.replace(partial, out / name)
-        print(f"  {out / name}")
+    plot_fig6_shapes().savefig(folder / "fig6.png", dpi=110, format="png")
+    both = ("walton-meek", "near-linear")
+    plot_vs_clothoid(math.radians(8), 1.0, shapes=both).savefig(folder / "bezier_vs_clothoid.png", dpi=110, format="png")
 
 
 def _build(args: argparse.Namespace) -> int:
@@ -161,11 +175,28 @@ def _design_format() -> str:
     return FORMAT
 
 
-def main(argv: Sequence[str] | None = None) -> int:
-    """Run the command line; returns the exit status (0 ok, 1 check failed, 2 error, 130 interrupted).
+@contextmanager
+def _interrupt_watch() -> Iterator[list[int]]:
+    """Ctrl-C raises KeyboardInterrupt as usual and is also recorded in the yielded list, so an
+    interrupt that a library turned into another exception (OCP's "ImportError: initialization
+    failed" during a long import) is still reported as an interrupt."""
+    received: list[int] = []
+    if threading.current_thread() is not threading.main_thread():
+        yield received
+        return
 
-    Every error is printed as ``error: …`` on stderr, never as a traceback.
-    """
+    def interrupt(signum, frame):
+        received.append(signum)
+        raise KeyboardInterrupt
+
+    previous = signal.signal(signal.SIGINT, interrupt)
+    try:
+        yield received
+    finally:
+        signal.signal(signal.SIGINT, previous)
+
+
+def _parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(
         prog="spiral-cad",
         description="Exact G2 (curvature-continuous) cubic Bézier spiral transitions for CAD.",
@@ -197,18 +228,33 @@ def main(argv: Sequence[str] | None = None) -> int:
     build.add_argument("--no-plots", action="store_true", help="skip the PNG plots (the slowest output for long chains)")
     build.set_defaults(run=_build)
     _add_check(sub)
-    args = parser.parse_args(argv)
-    try:
-        return args.run(args)
-    except KeyboardInterrupt:
-        print("error: interrupted; the output folder was left as it was", file=sys.stderr)
-        return 130
-    except (ValueError, OSError) as error:  # DesignError, NoSolutionError, file system errors
-        print(f"error: {error}", file=sys.stderr)
-        return 2
-    except Exception as error:  # a bug: still no traceback, but say so
-        print(f"error: internal error ({type(error).__name__}: {error}); please report it", file=sys.stderr)
-        return 2
+    return parser
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Run the command line; returns the exit status (0 ok, 1 check failed, 2 error, 130 interrupted).
+
+    Every error is printed as one ``error: …`` line on stderr, never as a
+    traceback; Ctrl-C at any moment gives ``error: interrupted`` and 130;
+    Python warnings are not shown (what matters is an error or in the report).
+    """
+    with _interrupt_watch() as interrupted, warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        try:
+            args = _parser().parse_args(argv)
+            return args.run(args)
+        except KeyboardInterrupt as interrupt:
+            print(f"error: interrupted{f'; {interrupt}' if str(interrupt) else ''}", file=sys.stderr)
+            return 130
+        except Exception as error:
+            if interrupted:  # Ctrl-C, wrapped by a library into another exception
+                print("error: interrupted", file=sys.stderr)
+                return 130
+            if isinstance(error, (ValueError, OSError)):  # DesignError, NoSolutionError, file system errors
+                print(f"error: {error}", file=sys.stderr)
+            else:  # a bug: still no traceback, but say so
+                print(f"error: internal error ({type(error).__name__}: {error}); please report it", file=sys.stderr)
+            return 2
 
 
 if __name__ == "__main__":

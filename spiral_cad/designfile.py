@@ -3,11 +3,14 @@
 A design file holds ``units`` and a list of ``designs``; each design has a
 ``name``, a ``type`` and the fields of that type (see ``FORMAT``). Any byte
 sequence is either a valid design or a ``DesignError`` naming the field and
-the value: the file is decoded, parsed and every field checked before
-anything is built, and every design is built before anything is written.
-Files are written into a staging folder inside the output folder and moved
-into place only when all of them were written; any failure or interrupt
-(Ctrl-C, SIGTERM, SIGHUP) removes the staging folder.
+the value: the file must be a regular file of at most ``MAX_DESIGN_BYTES``
+(checked before it is read), it is decoded, parsed and every field checked
+before anything is built, and every design is built before anything is
+written. Output is all or nothing (``spiral_cad.staging``): files are
+written into a staging folder inside the output folder and moved into place
+only when all of them were written and every destination was checked; a
+failure or an interrupt (Ctrl-C, SIGTERM, SIGHUP) leaves the output folder
+as it was.
 """
 
 from __future__ import annotations
@@ -16,9 +19,8 @@ import json
 import math
 import os
 import re
-import shutil
 import signal
-import tempfile
+import stat
 import threading
 import time
 from collections.abc import Callable, Iterator
@@ -30,7 +32,11 @@ from typing import Any
 
 from .core.chain import Chain
 from .core.errors import NoSolutionError
+from .core.shapes import CORNER_SHAPES, DEFAULT_SHAPE, TRANSITION_SHAPES
+from .core.spiral import BezierSpiral
 from .core.units import UNITS
+from .formats.names import MAX_TEXT_LENGTH, check_name
+from .staging import Staging
 
 FORMAT = """\
 {
@@ -51,20 +57,26 @@ FORMAT = """\
                                          "cant_deficiency_rate_max", "cant_gradient_max",
                                          "gauge", "cant"
      "strict": false,                    true: a violated criterion is an error
+     "spiral_shape": "near-linear",      default; or "walton-meek" (the 1996 spiral, 1.6–1.8× longer
+                                         for the same jerk)
      "cross_section": {"driving_lanes": 1, "lane_width": 3.5, "shoulder_width": 2.5,
                        "rule": "RHT"},   OpenDRIVE lanes (m)
-     "geo_reference": "+proj=utm ..."},  OpenDRIVE geoReference
+     "geo_reference": "+proj=utm ..."},  OpenDRIVE geoReference (printable text, ≤ 10 000 characters)
     {"name": "oval", "type": "circle_chain",
-     "circles": [{"center": [x, y], "radius": r}, ...]},   signed radius = travel sense (+ ccw)
+     "circles": [{"center": [x, y], "radius": r}, ...],    signed radius = travel sense (+ ccw)
+     "spiral_shape": "walton-meek" | "near-linear"},        default walton-meek
     {"name": "robot", "type": "rounded_polyline",
      "points": [[x, y], ...],
      "max_curvature": k  | "curvature": k  | neither (as large as fits),
-     "method": "walton-meek" | "g2cbs"},
+     "spiral_shape": "walton-meek" | "near-linear" | "g2cbs"},   default walton-meek
+                                         ("method" is its former name)
     {"name": "t", "type": "transition", "case": "line_to_circle" | "circle_to_circle" |
-     "line_to_line" | "circle_in_circle", ...that function's arguments by name...}
+     "line_to_line" | "circle_in_circle", ...that function's arguments by name...,
+     "spiral_shape": "walton-meek" | "near-linear"}          default walton-meek
   ]
 }
-Names: 1–64 characters of A–Z, a–z, 0–9, - and _ (they name the output files)."""
+Names: 1–64 characters of A–Z, a–z, 0–9, - and _ (they name the output files; no two may
+differ only in case). The file: UTF-8 JSON, a regular file of at most 10 MB."""
 
 TRANSITION_ARGS = {
     "line_to_circle": ("point", "direction", "center", "radius"),
@@ -76,9 +88,10 @@ OPTIONAL = {"curvature"}
 NAME = re.compile(r"[A-Za-z0-9][A-Za-z0-9_-]{0,63}")
 #: JSON integers longer than this are refused (they cannot be lengths in float64 anyway).
 MAX_DIGITS = 308
+#: Design files larger than this are refused before they are read.
+MAX_DESIGN_BYTES = 10_000_000
 #: The packages of the ``cad`` extra and what needs them.
 CAD_EXTRA = {"OCP": "IGES and the continuity check", "ezdxf": "DXF", "matplotlib": "plots"}
-STAGING_PREFIX = ".spiral-cad-build-"
 
 
 class DesignError(ValueError):
@@ -176,13 +189,44 @@ def _json_constant(text: str) -> float:
     raise DesignError(f"{text} is not a number in JSON")
 
 
+def _read(source: str | Path) -> bytes:
+    """The bytes of the design file ``source``: a regular file of at most ``MAX_DESIGN_BYTES``.
+
+    The file is opened without blocking and inspected before anything is
+    read, so a FIFO, a device (/dev/zero), a folder or an enormous file is
+    refused at once.
+    """
+    label = Path(source).name or str(source)
+    flags = os.O_RDONLY | getattr(os, "O_NONBLOCK", 0) | getattr(os, "O_NOCTTY", 0) | getattr(os, "O_BINARY", 0)
+    try:
+        descriptor = os.open(source, flags)
+    except OSError as e:
+        raise DesignError(f"cannot read design file {label}: {e.strerror}") from None
+    except ValueError as e:  # e.g. a NUL character in the path
+        raise DesignError(f"cannot read design file {label!r}: {e}") from None
+    try:
+        info = os.fstat(descriptor)
+        if stat.S_ISDIR(info.st_mode):
+            raise DesignError(f"design file {label} is a folder, not a file")
+        if not stat.S_ISREG(info.st_mode):
+            raise DesignError(f"design file {label} is not a regular file (a device, pipe or socket)")
+        if info.st_size > MAX_DESIGN_BYTES:
+            raise DesignError(f"design file {label} has {info.st_size} bytes; at most {MAX_DESIGN_BYTES} are read")
+        with os.fdopen(descriptor, "rb", closefd=False) as handle:
+            raw = handle.read(MAX_DESIGN_BYTES + 1)
+    except OSError as e:
+        raise DesignError(f"cannot read design file {label}: {e.strerror}") from None
+    finally:
+        os.close(descriptor)
+    if len(raw) > MAX_DESIGN_BYTES:  # it grew after it was inspected
+        raise DesignError(f"design file {label} has more than {MAX_DESIGN_BYTES} bytes")
+    return raw
+
+
 def _parse(source: str | Path) -> Any:
     """The JSON value in the file ``source``; any byte sequence either parses or raises DesignError."""
     label = Path(source).name
-    try:
-        raw = Path(source).read_bytes()
-    except OSError as e:
-        raise DesignError(f"cannot read design file {label}: {e.strerror}") from None
+    raw = _read(source)
     try:
         text = raw.decode("utf-8")
     except UnicodeDecodeError as e:
@@ -223,9 +267,9 @@ def load(source: str | Path | dict) -> tuple[str, list[dict]]:
                 f"designs[{i}].name: must be 1–64 characters of A–Z, a–z, 0–9, - and _ (starting with a letter or "
                 f"digit); got {name!r:.80}"
             )
-        if name in names:
-            raise DesignError(f"designs[{i}].name: {name!r} is used twice")
-        names.add(name)
+        if name.casefold() in names:
+            raise DesignError(f"designs[{i}].name: {name!r} is used twice (names may not differ only in case: they name files)")
+        names.add(name.casefold())
         _choice(d.get("type"), f"designs[{i}].type", tuple(BUILDERS))
     return units, designs
 
@@ -284,11 +328,16 @@ def _cross_section(d: dict, where: str):
         raise DesignError(f"{where}.cross_section: {e}") from None
 
 
+def _shape(d: dict, where: str, choices: tuple[str, ...], default: str = DEFAULT_SHAPE) -> str:
+    """The design's ``spiral_shape`` (one of ``choices``), or ``default``."""
+    return _choice(d.get("spiral_shape", default), f"{where}.spiral_shape", choices)
+
+
 def _alignment(d: dict, where: str, units: str) -> Built:
     from .design import Alignment
 
     optional = ("spiral_angles_deg", "spiral_lengths", "start_station", "design_speed", "criteria", "strict",
-                "cross_section", "geo_reference") + ROAD_KEYS + RAIL_KEYS  # fmt: skip
+                "cross_section", "geo_reference", "spiral_shape") + ROAD_KEYS + RAIL_KEYS  # fmt: skip
     _fields(d, where, ("pis", "radii"), optional)
     pis = _points(d["pis"], f"{where}.pis", 3)
     count = len(pis) - 2
@@ -313,10 +362,14 @@ def _alignment(d: dict, where: str, units: str) -> Built:
     if not isinstance(strict, bool):
         raise DesignError(f"{where}.strict: must be true or false; got {strict!r:.80}")
     geo = d.get("geo_reference")
-    if geo is not None and (not isinstance(geo, str) or len(geo) > 1000):
-        raise DesignError(f"{where}.geo_reference: must be a PROJ string; got {geo!r:.80}")
+    if geo is not None:
+        try:
+            check_name(geo, f"{where}.geo_reference", limit=MAX_TEXT_LENGTH, multiline=True)
+        except ValueError as e:
+            raise DesignError(f"{e} (a PROJ string or WKT)") from None
     start = _number(d.get("start_station", 0.0), f"{where}.start_station")
-    alignment = Alignment.from_pis(pis, radii, start_station=start, units=units, criteria=criteria, strict=strict, **kw)
+    shape = _shape(d, where, TRANSITION_SHAPES, "near-linear")
+    alignment = Alignment.from_pis(pis, radii, start_station=start, units=units, criteria=criteria, strict=strict, shape=shape, **kw)
     notes = {"cross_section": _cross_section(d, where), "geo_reference": geo}
     return Built(d["name"], "alignment", alignment.chain, alignment, notes)
 
@@ -324,7 +377,7 @@ def _alignment(d: dict, where: str, units: str) -> Built:
 def _circle_chain(d: dict, where: str, units: str) -> Built:
     from .design import circle_chain
 
-    _fields(d, where, ("circles",))
+    _fields(d, where, ("circles",), ("spiral_shape",))
     circles = d["circles"]
     if not isinstance(circles, list) or len(circles) < 2:
         raise DesignError(f"{where}.circles: must be a list of at least 2 circles; got {circles!r:.80}")
@@ -337,20 +390,22 @@ def _circle_chain(d: dict, where: str, units: str) -> Built:
         if radius == 0:
             raise DesignError(f"{w}.radius: must be non-zero (its sign is the travel sense); got 0")
         parsed.append((_point(c["center"], f"{w}.center"), radius))
-    result = circle_chain(parsed, units=units)
+    result = circle_chain(parsed, units=units, shape=_shape(d, where, TRANSITION_SHAPES))
     return Built(d["name"], "circle_chain", result.chain, result)
 
 
 def _rounded(d: dict, where: str, units: str) -> Built:
     from .design import round_corners
 
-    _fields(d, where, ("points",), ("curvature", "max_curvature", "method"))
+    _fields(d, where, ("points",), ("curvature", "max_curvature", "spiral_shape", "method"))
     points = _points(d["points"], f"{where}.points", 3)
     if "curvature" in d and "max_curvature" in d:
         raise DesignError(f"{where}: give at most one of curvature and max_curvature")
     kw = {k: _number(d[k], f"{where}.{k}", positive=True) for k in ("curvature", "max_curvature") if k in d}
-    method = _choice(d.get("method", "walton-meek"), f"{where}.method", ("walton-meek", "g2cbs"))
-    result = round_corners(points, method=method, units=units, **kw)
+    if "method" in d and "spiral_shape" in d:
+        raise DesignError(f"{where}: give spiral_shape or method (its former name), not both")
+    shape = _choice(d["method"], f"{where}.method", CORNER_SHAPES) if "method" in d else _shape(d, where, CORNER_SHAPES)
+    result = round_corners(points, shape=shape, units=units, **kw)
     return Built(d["name"], "rounded_polyline", result.chain, result)
 
 
@@ -359,13 +414,15 @@ def _transition(d: dict, where: str, units: str) -> Built:
 
     case = _choice(d.get("case"), f"{where}.case", tuple(TRANSITION_ARGS))
     names = TRANSITION_ARGS[case]
-    _fields(d, where, tuple(n for n in names if n not in OPTIONAL) + ("case",), tuple(n for n in names if n in OPTIONAL))
+    optional = tuple(n for n in names if n in OPTIONAL) + ("spiral_shape",)
+    _fields(d, where, tuple(n for n in names if n not in OPTIONAL) + ("case",), optional)
     args = {}
     for n in names:
         if n in d:
             value = d[n]
             args[n] = _point(value, f"{where}.{n}") if isinstance(value, list) else _number(value, f"{where}.{n}")
-    t = getattr(transitions, case)(**args)
+    shapes = CORNER_SHAPES if case == "line_to_line" else TRANSITION_SHAPES
+    t = getattr(transitions, case)(**args, shape=_shape(d, where, shapes))
     return Built(d["name"], f"transition ({t.kind})", Chain(t.spirals, units=units), t)
 
 
@@ -414,51 +471,51 @@ class Written:
 
 
 def write(
-    built: list[Built], out: str | Path, units: str, progress: Callable[[str], None] = print, plots: bool = True
+    built: list[Built],
+    out: str | Path,
+    units: str,
+    progress: Callable[[str], None] = print,
+    plots: bool = True,
+    extra: Callable[[Path], None] | None = None,
 ) -> Written:
-    """Write every output of every design into ``out`` (see the module docstring).
+    """Write every output of every design into ``out``, all or nothing (see the module docstring).
 
     Per design: STEP and SVG (always), the stationing CSV of alignments, and
     with the ``cad`` extra IGES, DXF, the plan and curvature plots (unless
     ``plots`` is False) and the continuity report of the STEP file as OCCT
     reads it. Without the extra those are skipped and named in
-    ``Written.skipped``.
+    ``Written.skipped``. ``extra``, if given, writes more files into the
+    folder it is passed (the staging folder); they are committed with the rest.
 
     Raises:
-        DesignError: ``out`` is a file, or cannot be created.
+        ValueError: ``out`` is a file, cannot be created or written, or a
+            file in it cannot be replaced (a folder, read-only); nothing in
+            ``out`` was changed.
+        OSError: writing or moving a file failed; nothing in ``out`` was changed.
+        KeyboardInterrupt: Ctrl-C, SIGTERM or SIGHUP; nothing in ``out`` was changed.
     """
-    out = Path(out)
-    if out.exists() and not out.is_dir():
-        raise DesignError(f"--out {str(out)!r} is a file, not a folder")
-    try:
-        out.mkdir(parents=True, exist_ok=True)
-    except OSError as e:
-        raise DesignError(f"cannot create the output folder {str(out)!r}: {e.strerror}") from None
-    _remove_stale_staging(out)
     missing = missing_cad_extra()
-    stage = Path(tempfile.mkdtemp(prefix=f"{STAGING_PREFIX}{os.getpid()}-", dir=out))
-    try:
-        with _interrupts_raise():
-            for b in built:
-                started = time.perf_counter()
-                names = _write_design(b, stage, units, missing, plots)
-                progress(
-                    f"  {b.name}: {b.kind}, {len(b.chain)} segments, length {b.chain.length:.6g} {units} "
-                    f"→ {', '.join(names)} ({time.perf_counter() - started:.1f} s)"
-                )
-            written = []
-            for path in sorted(stage.iterdir()):
-                target = out / path.name
-                os.replace(path, target)
-                written.append(target)
-    finally:
-        shutil.rmtree(stage, ignore_errors=True)
+    with Staging(out) as staging, _interrupts_raise():
+        for b in built:
+            started = time.perf_counter()
+            names = _write_design(b, staging.folder, units, missing, plots)
+            progress(
+                f"  {b.name}: {b.kind}, {len(b.chain)} segments, length {b.chain.length:.6g} {units} "
+                f"→ {', '.join(names)} ({time.perf_counter() - started:.1f} s)"
+            )
+        if extra is not None:
+            before = set(staging.files())
+            extra(staging.folder)
+            added = [p.name for p in staging.files() if p not in before]
+            if added:
+                progress(f"  also → {', '.join(added)}")
+        written = staging.commit()
     skipped = [f"{CAD_EXTRA[name]} (needs {name})" for name in missing if plots or name != "matplotlib"]
     return Written(written, skipped)
 
 
 def _write_design(b: Built, stage: Path, units: str, missing: list[str], plots: bool) -> list[str]:
-    """Write one design's files into ``stage``; returns the suffixes written."""
+    """Write one design's files into ``stage``; returns what follows the name of each file written."""
     from .export import export_step, export_svg
 
     step = stage / f"{b.name}.step"
@@ -490,36 +547,20 @@ def _write_design(b: Built, stage: Path, units: str, missing: list[str], plots: 
         export_dxf(b.chain, stage / f"{b.name}.dxf", name=b.name)
         names.append("dxf")
     if plots and "matplotlib" not in missing:
-        _plots(b, stage)
-        names.append("png")
+        names += _plots(b, stage)
     return names
 
 
-def _plots(b: Built, stage: Path) -> None:
+def _plots(b: Built, stage: Path) -> list[str]:
     from .plots import plot_curvature, plot_plan
 
+    names = []
     for suffix, plot in (("plan", plot_plan), ("curvature", plot_curvature)):
         fig = plot(b.chain)
         fig.suptitle(f"{b.name} — {b.kind}")
         fig.savefig(stage / f"{b.name}_{suffix}.png", dpi=110)
-
-
-def _remove_stale_staging(out: Path) -> None:
-    """Remove staging folders left by builds that were killed outright (SIGKILL cannot be caught)."""
-    for folder in out.glob(f"{STAGING_PREFIX}*"):
-        pid = folder.name[len(STAGING_PREFIX) :].split("-")[0]
-        if pid.isdigit() and not _alive(int(pid)):
-            shutil.rmtree(folder, ignore_errors=True)
-
-
-def _alive(pid: int) -> bool:
-    try:
-        os.kill(pid, 0)
-    except ProcessLookupError:
-        return False
-    except PermissionError:  # it exists, owned by another user
-        pass
-    return True
+        names.append(f"{suffix}.png")
+    return names
 
 
 @contextmanager
@@ -530,7 +571,7 @@ def _interrupts_raise() -> Iterator[None]:
         return
 
     def interrupt(signum, frame):
-        raise KeyboardInterrupt(f"signal {signum}")
+        raise KeyboardInterrupt
 
     names = [s for s in ("SIGTERM", "SIGHUP") if hasattr(signal, s)]
     previous = {name: signal.signal(getattr(signal, name), interrupt) for name in names}
@@ -553,12 +594,17 @@ def criteria_tables(built: list[Built]) -> str:
 
 
 def summary(built: list[Built], units: str) -> str:
-    """One line per design: kind, segments, length, peak |κ| and the checked continuity."""
-    head = f"{'design':14} {'kind':30} {'segments':>8} {'length ' + units:>12} {'max |κ|':>10}  continuity (of the STEP file)"
+    """One line per design: kind, spiral shape, segments, length, peak |κ| and the checked continuity."""
+    head = (
+        f"{'design':14} {'kind':30} {'spiral shape':13} {'segments':>8} {'length ' + units:>12} {'max |κ|':>10}  "
+        "continuity (of the STEP file)"
+    )
     lines = [head, "-" * len(head)]
     for b in built:
         peak = max(max(abs(seg.start_curvature), abs(seg.end_curvature)) for seg in b.chain)  # spirals are monotone
+        shapes = sorted({seg.shape or "not stated" for seg in b.chain if isinstance(seg, BezierSpiral)}) or ["-"]
         lines.append(
-            f"{b.name:14} {b.kind:30} {len(b.chain):8d} {b.chain.length:12.3f} {peak:10.5f}  {b.notes.get('continuity', '-')}"
+            f"{b.name:14} {b.kind:30} {'+'.join(shapes):13} {len(b.chain):8d} {b.chain.length:12.3f} {peak:10.5f}  "
+            f"{b.notes.get('continuity', '-')}"
         )
     return "\n".join(lines)

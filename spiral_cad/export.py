@@ -2,9 +2,11 @@
 
 Every writer takes the chain's own length unit and declares it the way its
 readers expect, and takes a ``name`` (default: the file name's stem) that
-becomes the STEP product, the IGES product id, the DXF layer and the SVG id
-and title. The originating system is ``spiral_cad <version>``. How each
-format stores a spiral:
+becomes the STEP product, the IGES product id and entity name, the DXF
+layer and the SVG id and title. A name is 1 to 255 characters of printable
+text (no control characters); each format escapes or replaces what it cannot
+hold (``spiral_cad.formats.names``). The originating system is
+``spiral_cad <version>``. How each format stores a spiral:
 
 =======  ==========================================================  ==================================
 format   spiral stored as                                             unit declared by
@@ -28,6 +30,7 @@ from typing import Any
 
 from .core.chain import Chain
 from .core.units import DEFAULT_UNITS, length_unit
+from .formats.names import MAX_TEXT_LENGTH, check_name
 from .formats.opendrive import CrossSection
 
 PathLike = str | os.PathLike
@@ -61,10 +64,9 @@ def _require_chains(obj: Any) -> list[Chain]:
 
 
 def _name(name: str | None, path: PathLike) -> str:
-    text = Path(path).stem if name is None else name
-    if not isinstance(text, str) or not text.strip():
-        raise ValueError(f"name must be a non-empty string; got {name!r}")
-    return text
+    if name is None:
+        return check_name(Path(path).stem, "name (the file name's stem, used when no name is given)")
+    return check_name(name)
 
 
 def _units(chains: list[Chain] | None, units: str | None) -> str:
@@ -96,7 +98,8 @@ def export_step(obj: Any, path: PathLike, *, name: str | None = None, units: str
         units: for shapes, their length unit; for chains only a check.
 
     Raises:
-        ValueError: an unsupported object, unknown or contradicting units.
+        ValueError: an unsupported object, unknown or contradicting units, a
+            name that is not 1–255 characters of printable text.
         OSError: the file could not be written.
     """
     chains = _chains(obj)
@@ -160,10 +163,12 @@ def export_opendrive(
         name: the header's and each road's name (default: the file name's stem).
         cross_section: the lanes of every road (default: one 3.5 m driving
             lane each way and 2.5 m shoulders).
-        geo_reference: a PROJ string for the header's ``geoReference``.
+        geo_reference: a PROJ string (or WKT, up to 10 000 characters of
+            printable text, newlines allowed) for the header's ``geoReference``.
 
     Raises:
-        ValueError: an unsupported object, or chains of different units.
+        ValueError: an unsupported object, chains of different units, or a
+            name or ``geo_reference`` that is not printable text.
     """
     from .design.alignment import Alignment
     from .formats.opendrive import Banking, RoadToWrite, write_opendrive
@@ -172,6 +177,8 @@ def export_opendrive(
     if not items or not all(isinstance(i, (Alignment, Chain)) for i in items):
         raise ValueError(f"expected an Alignment, a Chain or a list of them; got {type(obj).__name__}")
     label = _name(name, path)
+    if geo_reference is not None:
+        check_name(geo_reference, "geo_reference", limit=MAX_TEXT_LENGTH, multiline=True)
     roads = []
     for k, item in enumerate(items):
         road_name = label if len(items) == 1 else f"{label}-{k + 1}"

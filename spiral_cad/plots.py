@@ -20,6 +20,8 @@ from scipy.special import fresnel
 
 from .core import bezier
 from .core.chain import Chain
+from .core.factors import length_factor, peak_rate_factor, search_range
+from .core.shapes import shape_limits
 from .core.spiral import BezierSpiral
 
 #: Colour per segment type (plan, comb and curvature plots).
@@ -167,27 +169,42 @@ def plot_curvature(chain: Chain, ax: Axes | None = None, per_segment: int | None
     return fig
 
 
-def plot_fig6(ax: Axes | None = None, samples: int = 200) -> Figure:
+#: Line colour of each spiral shape in the comparison plots.
+SHAPE_COLORS = {"walton-meek": "tab:red", "near-linear": "tab:green"}
+
+
+def plot_fig6(ax: Axes | None = None, samples: int = 200, shape: str = "walton-meek") -> Figure:
     """Walton & Meek's Fig. 6: curvature against arc length for θ = 10°, 20°, …, 80°.
 
     As in the paper, each spiral has unit curvature at u = 1 and its arc
     length is scaled to the total length of the θ = 10° spiral; the dashed
-    line is the clothoid's linear profile.
+    line is the clothoid's linear profile. ``shape="near-linear"`` draws the
+    near-linear family instead (θ = 10° … 50°, its range).
     """
     fig, ax = _axes(ax, figsize=(7, 5))
     u = np.linspace(0.0, 1.0, samples)
-    reference = BezierSpiral((0.0, 0.0), (1.0, 0.0), math.radians(10.0), 1.0).length
-    colors = [f"C{k}" for k in range(8)]
-    for k, degrees in enumerate(range(10, 90, 10)):
-        spiral = BezierSpiral((0.0, 0.0), (1.0, 0.0), math.radians(degrees), 1.0)
+    reference = BezierSpiral((0.0, 0.0), (1.0, 0.0), math.radians(10.0), 1.0, shape=shape).length
+    largest = math.degrees(shape_limits(shape)["theta"])
+    for k, degrees in enumerate(d for d in range(10, 90, 10) if d <= largest + 1e-9):
+        spiral = BezierSpiral((0.0, 0.0), (1.0, 0.0), math.radians(degrees), 1.0, shape=shape)
         s = bezier.arc_length(spiral.control_points, u) * reference / spiral.length
-        ax.plot(s, spiral.curvature(u), color=colors[k], lw=1.4, label=f"θ = {degrees}°")
+        ax.plot(s, spiral.curvature(u), color=f"C{k}", lw=1.4, label=f"θ = {degrees}°")
     ax.plot([0.0, reference], [0.0, 1.0], "k--", lw=1.0, label="clothoid")
     ax.set_xlabel("arc length (scaled to the θ = 10° spiral)")
     ax.set_ylabel("curvature")
-    ax.set_title("Cubic Bézier spiral: curvature vs arc length (Walton & Meek, Fig. 6)")
+    name = "Cubic Bézier spiral (Walton & Meek, Fig. 6)" if shape == "walton-meek" else f"{shape} cubic spiral"
+    ax.set_title(f"{name}: curvature vs arc length")
     ax.legend(loc="lower right", fontsize="small", ncol=2)
     ax.grid(True, alpha=0.3)
+    return fig
+
+
+def plot_fig6_shapes(samples: int = 200) -> Figure:
+    """Fig. 6 extended: the 1996 spiral's family (left) beside the near-linear one (right)."""
+    fig = Figure(figsize=(13, 5))
+    left, right = fig.subplots(1, 2, sharey=True)
+    plot_fig6(left, samples, "walton-meek")
+    plot_fig6(right, samples, "near-linear")
     return fig
 
 
@@ -204,8 +221,14 @@ def clothoid_points(theta: float, curvature: float, s: NDArray) -> NDArray:
     return np.stack([a * fc, math.copysign(1.0, theta) * a * fs], axis=-1)
 
 
-def plot_vs_clothoid(theta: float, curvature: float, ax: Axes | Sequence[Axes] | None = None, samples: int = 200) -> Figure:
-    """Bézier spiral against the clothoid with the same turn ``theta`` and end ``curvature``.
+def plot_vs_clothoid(
+    theta: float,
+    curvature: float,
+    ax: Axes | Sequence[Axes] | None = None,
+    samples: int = 200,
+    shapes: Sequence[str] = ("walton-meek",),
+) -> Figure:
+    """Bézier spirals of ``shapes`` against the clothoid with the same turn ``theta`` and end ``curvature``.
 
     Left: curvature against arc length (the clothoid's is linear). Right:
     both curves from the origin along +x, with their end circles; the legend
@@ -216,14 +239,16 @@ def plot_vs_clothoid(theta: float, curvature: float, ax: Axes | Sequence[Axes] |
         theta: turn angle (radians, 0 < |θ| < π/2).
         curvature: end curvature (same sign as θ).
         ax: a pair of axes, or None for a new two-panel figure.
+        shapes: the spiral shapes drawn (``"walton-meek"``, ``"near-linear"``).
     """
     fig, (left, right) = _axes_pair(ax)
-    spiral = BezierSpiral((0.0, 0.0), (1.0, 0.0), theta, curvature)
+    spirals = {shape: BezierSpiral((0.0, 0.0), (1.0, 0.0), theta, curvature, shape=shape) for shape in shapes}
     u = np.linspace(0.0, 1.0, samples)
-    s_bez = bezier.arc_length(spiral.control_points, u)
     length_clo = 2.0 * abs(theta) / abs(curvature)
     s_clo = np.linspace(0.0, length_clo, samples)
-    left.plot(s_bez, spiral.curvature(u), color="tab:red", lw=1.8, label=f"Bézier spiral (L = {spiral.length:.4g})")
+    for shape, spiral in spirals.items():
+        s_bez = bezier.arc_length(spiral.control_points, u)
+        left.plot(s_bez, spiral.curvature(u), color=SHAPE_COLORS[shape], lw=1.8, label=f"{shape} (L = {spiral.length:.4g})")
     left.plot(s_clo, curvature * s_clo / length_clo, "k--", lw=1.4, label=f"clothoid (L = {length_clo:.4g})")
     left.set_xlabel("arc length s")
     left.set_ylabel("curvature κ")
@@ -234,54 +259,64 @@ def plot_vs_clothoid(theta: float, curvature: float, ax: Axes | Sequence[Axes] |
     radius = 1.0 / curvature
     xy_clo = clothoid_points(theta, curvature, s_clo)
     end_normal = np.array([-math.sin(theta), math.cos(theta)])  # both curves end with heading θ
-    for xy, color, style, name in ((spiral.point(u), "tab:red", "-", "Bézier"), (xy_clo, "k", "--", "clothoid")):
+    curves = [(spiral.point(u), SHAPE_COLORS[shape], "-", shape) for shape, spiral in spirals.items()]
+    for xy, color, style, name in (*curves, (xy_clo, "k", "--", "clothoid")):
         center = xy[-1] + radius * end_normal
         shift = abs(center[1]) - abs(radius)
         right.plot(xy[:, 0], xy[:, 1], color=color, ls=style, lw=1.6, label=f"{name}: shift p = {shift:.4g}")
-        phi = np.linspace(0.0, 2.0 * math.pi, 200)
+        phi = np.linspace(0.0, 2.0 * math.pi, 4000)  # smooth when zoomed onto the spirals
         right.plot(center[0] + abs(radius) * np.cos(phi), center[1] + abs(radius) * np.sin(phi), color=color, ls=":", lw=0.8)
     right.axhline(0.0, color="0.6", lw=0.6)
     # Frame the spirals (the full end circles would dwarf them).
-    both = np.vstack([spiral.point(u), xy_clo])
+    both = np.vstack([*(xy for xy, *_ in curves), xy_clo])
     low, high = both.min(axis=0), both.max(axis=0)
-    pad = 0.15 * float(np.max(high - low))
-    right.set_xlim(low[0] - pad, high[0] + pad)
-    right.set_ylim(low[1] - pad, high[1] + pad)
-    right.set_aspect("equal", adjustable="box")
+    width, height = high - low
+    flat = height < 0.2 * width  # small turns: stretch y so the shifts can be told apart
+    pad = 0.15 * (max(width, height) if not flat else 0.0)
+    right.set_xlim(low[0] - pad - 0.05 * width * flat, high[0] + pad + 0.05 * width * flat)
+    right.set_ylim(low[1] - pad - 0.3 * height * flat, high[1] + pad + 0.3 * height * flat)
+    right.set_aspect("auto" if flat else "equal", adjustable="box")
     right.set_xlabel("x")
     right.set_ylabel("y")
-    right.set_title("Plan (end circles dotted)")
+    right.set_title("Plan (end circles dotted" + ("; y stretched)" if flat else ")"))
     right.legend(loc="best", fontsize="small")
     right.grid(True, alpha=0.3)
     return fig
 
 
-def plot_jerk_length(design_speed: float = 80.0, max_jerk: float = 0.6, ax: Sequence[Axes] | None = None) -> Figure:
+def plot_jerk_length(
+    design_speed: float = 80.0,
+    max_jerk: float = 0.6,
+    ax: Sequence[Axes] | None = None,
+    shapes: Sequence[str] = ("walton-meek",),
+) -> Figure:
     """How much longer a Bézier spiral must be than the clothoid rule for the same lateral jerk.
 
     Left: the ratio L_Bézier / L_clothoid against the spiral angle θ, where
-    the Bézier spiral's *peak* jerk v³·max dκ/ds equals the clothoid's
-    constant v³/(R·L): it is ℓ(θ)·F(θ) (unit spiral's length × peak dκ/ds),
-    1.84 for small θ. Right: both lengths against the radius at
-    ``design_speed`` (km/h) and ``max_jerk`` (m/s³), metric units.
+    the spiral's *peak* jerk v³·max dκ/ds equals the clothoid's constant
+    v³/(R·L): it is ℓ(θ)·F(θ) (unit spiral's length × peak dκ/ds), 1.84 for
+    the 1996 spiral at small θ and 1.0009 for the near-linear one. Right: the
+    lengths against the radius at ``design_speed`` (km/h) and ``max_jerk``
+    (m/s³), metric units, one line per shape in ``shapes``.
     """
-    from .design.criteria import RoadCriteria, length_factor, peak_factor
+    from .design.criteria import RoadCriteria
 
     fig, (left, right) = _axes_pair(ax)
-    theta = np.radians(np.linspace(0.5, 60.0, 400))
-    ratio = length_factor(theta) * peak_factor(theta)
-    left.plot(np.degrees(theta), ratio, color="tab:red", lw=1.8)
+    radii = np.linspace(150.0, 3000.0, 120)
+    criteria = RoadCriteria(design_speed, max_jerk, shift_min=0.0, shift_max=1e9)
+    v = criteria.speed("m")
+    for shape in shapes:
+        theta = np.radians(np.linspace(0.5, min(60.0, math.degrees(search_range(shape)[1])), 400))
+        ratio = length_factor(theta, shape) * peak_rate_factor(theta, shape)
+        left.plot(np.degrees(theta), ratio, color=SHAPE_COLORS[shape], lw=1.8, label=shape)
+        shortest, _ = criteria.choose(radii, "m", shape)
+        right.plot(radii, length_factor(shortest, shape) * radii, color=SHAPE_COLORS[shape], lw=1.8, label=f"{shape} (peak jerk = C)")
     left.axhline(1.0, color="k", ls="--", lw=1.0, label="clothoid (dκ/ds constant)")
     left.set_xlabel("spiral angle θ (°)")
-    left.set_ylabel("L_Bézier / L_clothoid at equal peak jerk")
+    left.set_ylabel("L_spiral / L_clothoid at equal peak jerk")
     left.set_title("Length needed for the same peak lateral jerk")
     left.legend(loc="best", fontsize="small")
     left.grid(True, alpha=0.3)
-    radii = np.linspace(150.0, 3000.0, 120)
-    criteria = RoadCriteria(design_speed, max_jerk, shift_min=0.0, shift_max=1e9)
-    shortest, _ = criteria.choose(radii, "m")
-    v = criteria.speed("m")
-    right.plot(radii, length_factor(shortest) * radii, color="tab:red", lw=1.8, label="Bézier spiral (peak jerk = C)")
     right.plot(radii, v**3 / (radii * max_jerk), "k--", lw=1.4, label="clothoid rule L = v³/(R·C)")
     right.set_xlabel("radius R (m)")
     right.set_ylabel("spiral length L (m)")

@@ -90,11 +90,11 @@ def test_csv_round_trip_with_units_in_the_headers(tmp_path):
     with path.open() as f:
         rows = list(csv.DictReader(f))
     assert len(rows) == 2
-    assert {"radius [ft]", "TS [ft]", "peak_dk_ds_in [1/ft²]", "theta_in_deg"} <= set(rows[0])
+    assert {"radius [ft]", "TS [ft]", "peak_dk_ds_in [1/ft²]", "theta_in [deg]"} <= set(rows[0])
     for row, curve in zip(rows, al.curves):
         assert int(row["pi"]) == curve.index
         assert float(row["TS [ft]"]) == curve.ts and float(row["ST [ft]"]) == curve.st
-        assert float(row["theta_in_deg"]) == pytest.approx(math.degrees(curve.theta_in))
+        assert float(row["theta_in [deg]"]) == pytest.approx(math.degrees(curve.theta_in))
     text = al.table()
     assert "TS [ft]" in text and "peak_dk_ds_in [1/ft²]" in text and len(text.splitlines()) == 4
 
@@ -123,9 +123,18 @@ def test_peak_rate_exceeds_mean_and_matches_sampling(theta):
 
 
 def test_small_angle_peak_is_about_1_84_times_mean():
+    al = Alignment.from_pis(PIS, 300.0, spiral_angles=0.02, shape="walton-meek")
+    c = al.curves[0]
+    assert al.shape == c.shape == "walton-meek"
+    assert c.peak_rate_in * c.radius * c.spiral_in_length == pytest.approx(1.84, abs=0.02)
+
+
+def test_near_linear_alignments_by_default_peak_at_their_mean():
     al = Alignment.from_pis(PIS, 300.0, spiral_angles=0.02)
     c = al.curves[0]
-    assert c.peak_rate_in * c.radius * c.spiral_in_length == pytest.approx(1.84, abs=0.02)
+    assert al.shape == c.shape == c.entry.spirals[0].shape == "near-linear"
+    assert c.peak_rate_in * c.radius * c.spiral_in_length == pytest.approx(1.0, abs=0.002)
+    assert al.rows()[0]["spiral_shape"] == "near-linear"
 
 
 # ------------------------------------------------------------ validation

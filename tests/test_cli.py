@@ -16,10 +16,37 @@ from spiral_cad.design import circle_chain
 EXAMPLES = Path(__file__).resolve().parent.parent / "examples"
 
 
+def assert_plain_csv(path: Path) -> None:
+    """Every header carries a unit in brackets, every cell is a plain number (never a numpy repr),
+    except the documented text columns."""
+    import csv
+
+    from spiral_cad.design.tables import TEXT_COLUMNS
+
+    with path.open(newline="", encoding="utf-8") as handle:
+        head, *rows = list(csv.reader(handle))
+    assert rows
+    for k, column in enumerate(head):
+        if column in TEXT_COLUMNS:
+            continue
+        assert re.fullmatch(r"\S+ \[[^\]]+\]", column), (path.name, column)
+        for row in rows:
+            assert re.fullmatch(r"-?\d+(\.\d+)?(e[-+]\d+)?", row[k]), (path.name, column, row[k])
+            float(row[k])
+
+
 def test_demo_writes_every_output(tmp_path, capsys):
     assert main(["demo", "--out", str(tmp_path)]) == 0
     text = capsys.readouterr().out
     names = {p.name for p in tmp_path.iterdir()}
+    # "wrote N files" counts what is there and what the progress lines list
+    (count,) = map(int, re.findall(r"wrote (\d+) files", text))
+    progress = re.findall(r"^  \S.* → (.*?)(?: \(\d+\.\d s\))?$", text, re.MULTILINE)
+    listed = sum(len(files.split(", ")) for files in progress)
+    assert count == listed == len(names) == 26
+    for csv_file in ("highway_stations.csv", "highway_criteria.csv"):
+        assert_plain_csv(tmp_path / csv_file)
+    assert "np.float64" not in text
     for design in ("highway", "circles", "robot"):
         for suffix in (".step", ".igs", ".dxf", ".svg", "_plan.png", "_curvature.png", "_continuity.txt"):
             assert design + suffix in names
@@ -80,3 +107,90 @@ def test_help_lists_the_commands():
     assert run.returncode == 0
     for word in ("demo", "build", "check"):
         assert word in run.stdout
+
+
+# ------------------------------------------------------------------ manners
+
+
+LAUNCH = """
+import os, signal, sys
+
+class InterruptOnImport:  # Ctrl-C exactly while the package imports numpy and numba
+    def find_spec(self, name, path=None, target=None):
+        if name == os.environ.get("INTERRUPT_ON_IMPORT"):
+            os.kill(os.getpid(), signal.SIGINT)
+
+sys.meta_path.insert(0, InterruptOnImport())
+from spiral_cad_launcher import main
+sys.exit(main())
+"""
+
+
+def launch(args: list[str], interrupt_on_import: str = "") -> subprocess.Popen:
+    """``spiral-cad`` as its console script starts it, with Ctrl-C delivered as in a terminal."""
+    import os
+    import signal
+
+    env = {**os.environ, "INTERRUPT_ON_IMPORT": interrupt_on_import}
+    return subprocess.Popen([sys.executable, "-c", LAUNCH, *args], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                            env=env, preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))  # fmt: skip
+
+
+@pytest.mark.parametrize("moment", ["importing spiral_cad", "building and writing"])
+def test_ctrl_c_at_any_moment_is_one_line_and_130(tmp_path, moment):
+    """Ctrl-C during the long imports once printed a traceback or 'internal error (ImportError …)'."""
+    import signal
+
+    out = tmp_path / "out"
+    out.mkdir()
+    (out / "rail.step").write_text("from before")
+    args = ["build", str(EXAMPLES / "design.json"), "--out", str(out)]
+    if moment == "importing spiral_cad":
+        process = launch(args, interrupt_on_import="spiral_cad.core.chain")
+    else:
+        process = launch(args)
+        for line in process.stdout:
+            if line.startswith("built "):
+                break
+        process.send_signal(signal.SIGINT)
+    _, err = process.communicate(timeout=120)
+    assert process.returncode == 130, err
+    assert len(err.splitlines()) == 1 and err.startswith("error: interrupted"), err
+    assert [p.name for p in out.iterdir()] == ["rail.step"] and (out / "rail.step").read_text() == "from before"
+
+
+def test_an_interrupt_a_library_turned_into_another_exception_is_still_an_interrupt(tmp_path, capsys, monkeypatch):
+    """OCP's modules turn Ctrl-C during their import into ImportError('initialization failed')."""
+    import os
+    import signal
+    import time
+
+    from spiral_cad import designfile
+
+    def import_interrupted(*args, **kwargs):
+        try:
+            os.kill(os.getpid(), signal.SIGINT)
+            time.sleep(5)
+        except KeyboardInterrupt:
+            raise ImportError("initialization failed") from None
+
+    monkeypatch.setattr(designfile, "_write_design", import_interrupted)
+    assert main(["build", str(EXAMPLES / "design.json"), "--out", str(tmp_path / "out"), "--no-plots"]) == 130
+    assert capsys.readouterr().err == "error: interrupted\n"
+    assert not (tmp_path / "out").exists()
+
+
+def test_warnings_never_reach_the_terminal(tmp_path, capsys, monkeypatch, recwarn):
+    import warnings
+
+    from spiral_cad import designfile
+
+    summary = designfile.summary
+
+    def noisy_summary(*args):
+        warnings.warn("overflow encountered in multiply", RuntimeWarning)
+        return summary(*args)
+
+    monkeypatch.setattr(designfile, "summary", noisy_summary)
+    assert main(["build", str(EXAMPLES / "design.json"), "--out", str(tmp_path), "--no-plots"]) == 0
+    assert capsys.readouterr().err == "" and len(recwarn) == 0  # not shown, and not left for anyone to show

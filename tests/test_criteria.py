@@ -34,9 +34,10 @@ def test_minimum_radius_follows_the_published_formulas():
     assert [v for v, _ in SIDE_FRICTION_KMH] == sorted(v for v, _ in SIDE_FRICTION_KMH)
 
 
+@pytest.mark.parametrize("shape", ["walton-meek", "near-linear"])
 @pytest.mark.parametrize("speed, jerk", [(80, 0.6), (60, 0.3), (70, 0.9)])
-def test_chosen_spirals_are_the_shortest_whose_peak_jerk_meets_the_limit(speed, jerk):
-    a = Alignment.from_pis(PIS, [450, 400, 600], units="m", design_speed=speed, max_jerk=jerk)
+def test_chosen_spirals_are_the_shortest_whose_peak_jerk_meets_the_limit(speed, jerk, shape):
+    a = Alignment.from_pis(PIS, [450, 400, 600], units="m", design_speed=speed, max_jerk=jerk, shape=shape)
     v = speed / 3.6
     low, high = a.criteria.shifts("m")
     for curve, check in zip(a.curves, a.checks):
@@ -48,34 +49,38 @@ def test_chosen_spirals_are_the_shortest_whose_peak_jerk_meets_the_limit(speed, 
         binding_shift = math.isclose(check.shifts[0], low, rel_tol=1e-6)
         assert binding_jerk or binding_shift  # the shortest spiral sits on one of its lower bounds
         shorter = curve.theta_in * (1 - 1e-4)
-        spiral = sc.BezierSpiral((0, 0), (1, 0), shorter, 1 / curve.radius)
+        spiral = sc.BezierSpiral((0, 0), (1, 0), shorter, 1 / curve.radius, shape=shape)
         peak, length = peak_curvature_rate(spiral.control_points)[0], spiral.length
         (row,) = a.criteria.evaluate([curve.index], [curve.radius], [[shorter, shorter]], "m", [check.length_bounds],
-                                     [[length, length]], [[peak, peak]])  # fmt: skip
+                                     [[length, length]], [[peak, peak]], shape)  # fmt: skip
         assert row.violations  # any shorter spiral breaks a criterion
 
 
 def test_the_bezier_spiral_needs_more_length_than_the_clothoid_rule():
     r, v, c = 1000.0, 100 / 3.6, 0.6
-    a = Alignment.from_pis([[0, 0], [1000, 0], [2000, 600]], r, units="m", criteria=RoadCriteria(100, c, shift_min=0.0))
+    criteria = RoadCriteria(100, c, shift_min=0.0)
+    a = Alignment.from_pis([[0, 0], [1000, 0], [2000, 600]], r, units="m", criteria=criteria, shape="walton-meek")
     clothoid = v**3 / (r * c)
     ratio = a.curves[0].spiral_in_length / clothoid
     assert 1.7 < ratio < 1.85  # small θ: the peak dκ/ds is ~1.84× the mean
+    near = Alignment.from_pis([[0, 0], [1000, 0], [2000, 600]], r, units="m", criteria=criteria)
+    assert 1.0 < near.curves[0].spiral_in_length / clothoid < 1.002  # the near-linear spiral: the clothoid's length
 
 
 def test_conflicting_criteria_name_the_pi_and_the_numbers():
     with pytest.raises(NoSolutionError, match=r"PI 1: the criteria conflict at R = 450 m: .* at least 136\.\d+ m .* at most 130\.\d+ m"):
-        Alignment.from_pis(PIS, [450, 400, 600], units="m", design_speed=100)
+        Alignment.from_pis(PIS, [450, 400, 600], units="m", design_speed=100, shape="walton-meek")
+    assert all(check.ok for check in Alignment.from_pis(PIS, [450, 400, 600], units="m", design_speed=100).checks)
     with pytest.raises(NoSolutionError, match=r"PI 1: the shortest spirals that meet the criteria turn 2 × .* deflection is only"):
         Alignment.from_pis([[0, 0], [1000, 0], [2000, 30]], 3000, units="m", design_speed=80)
 
 
 def test_given_spirals_are_checked_and_violations_listed_or_raised():
-    a = Alignment.from_pis(PIS, [450, 400, 600], spiral_angles=0.05, units="m", design_speed=80)
+    a = Alignment.from_pis(PIS, [450, 400, 600], spiral_angles=0.05, units="m", design_speed=80, shape="walton-meek")
     broken = [c for c in a.checks if not c.ok]
     assert broken and any("peak jerk" in v for v in broken[0].violations)
     with pytest.raises(NoSolutionError, match=r"design criteria violated: PI 1: in: peak jerk"):
-        Alignment.from_pis(PIS, [450, 400, 600], spiral_angles=0.05, units="m", design_speed=80, strict=True)
+        Alignment.from_pis(PIS, [450, 400, 600], spiral_angles=0.05, units="m", design_speed=80, strict=True, shape="walton-meek")
     small = Alignment.from_pis(PIS, [150, 400, 600], spiral_angles=0.1, units="m", design_speed=80)
     assert "R = 150 < R_min = 229.062" in small.checks[0].violations[0]
 

@@ -276,6 +276,38 @@ def test_dxf_has_lines_arcs_and_exact_bezier_splines(tmp_path, name):
             assert np.array_equal(np.array(entity.control_points)[:, :2], seg.control_points)
 
 
+@pytest.mark.parametrize("name", sorted(CHAINS))
+def test_dxf_extents_and_limits_are_the_drawings(tmp_path, name):
+    """$EXTMIN/$EXTMAX are the exact bounding box (not ezdxf's ±1e20), $LIMMIN/$LIMMAX that box
+    with a margin, in the drawing's unit (not a 420 × 297 page)."""
+    chain = Chain(CHAINS[name].segments, units="m")
+    path = tmp_path / "d.dxf"
+    export_dxf(chain, path)
+    doc = ezdxf.readfile(path)
+    low, high = np.array(doc.header["$EXTMIN"])[:2], np.array(doc.header["$EXTMAX"])[:2]
+    dense = np.vstack([seg.point(np.linspace(0.0, 1.0, 4097)) for seg in chain])
+    tol = 1e-6 * chain.size  # a dense sample misses an extreme by at most this
+    assert np.all(dense.min(axis=0) >= low - 1e-12 * chain.size) and np.all(dense.max(axis=0) <= high + 1e-12 * chain.size)
+    assert np.allclose(dense.min(axis=0), low, atol=tol) and np.allclose(dense.max(axis=0), high, atol=tol)
+    lim_low, lim_high = np.array(doc.header["$LIMMIN"]), np.array(doc.header["$LIMMAX"])
+    pad = 0.05 * np.hypot(*(high - low))
+    assert np.allclose(lim_low, low - pad) and np.allclose(lim_high, high + pad)
+    msp = doc.modelspace()
+    assert np.allclose(np.array(msp.dxf.extmin)[:2], low) and np.allclose(np.array(msp.dxf.limmax)[:2], lim_high)
+
+
+def test_iges_names_the_top_entity_so_importers_show_the_design(tmp_path):
+    """FreeCAD imports through OCCT's XDE reader, which labels a shape by its IGES name (406-15)."""
+    from test_names import iges_names
+
+    path = tmp_path / "pair.igs"
+    export_iges([CHAINS["S"], CHAINS["C"]], path, name="highway ramps")
+    assert iges_names(path) == ("highway ramps", ["highway ramps"])
+    entities = "".join(line[:64] for line in path.read_text().splitlines() if line[72:73] == "P")
+    assert entities.count("406,1,13Hhighway ramps;") == 1
+    assert entities.count("406,1,15Hhighway ramps-1;") == entities.count("406,1,15Hhighway ramps-2;") == 1
+
+
 # ---------------------------------------------------------------------- SVG
 
 

@@ -84,6 +84,17 @@ def test_fig6(tmp_path):
     assert saved(fig, tmp_path, "fig6.png")
 
 
+def test_fig6_of_both_shapes(tmp_path):
+    fig = plots.plot_fig6_shapes()
+    left, right = fig.axes
+    assert len(left.lines) == 9 and len(right.lines) == 6  # the near-linear family ends at 50°
+    clothoid = right.lines[-1]
+    for line in right.lines[:-1]:  # every near-linear profile stays close to the clothoid's straight line
+        s, k = line.get_xdata(), line.get_ydata()
+        assert np.max(np.abs(k - s / clothoid.get_xdata()[-1])) < 0.1
+    assert saved(fig, tmp_path, "fig6_shapes.png")
+
+
 def test_vs_clothoid(tmp_path):
     theta, k = math.radians(30.0), 0.01
     fig = plots.plot_vs_clothoid(theta, k)
@@ -112,6 +123,17 @@ def test_rounded_path_plots(tmp_path):
     path = round_corners([(0, 0), (2, 0), (3, 1), (5, 1)], method="g2cbs")
     fig = plots.plot_plan(path.chain)
     assert saved(fig, tmp_path, "rounded.png")
+
+
+def test_jerk_length_plot_compares_both_shapes_with_the_clothoid(tmp_path):
+    fig = plots.plot_jerk_length(shapes=("walton-meek", "near-linear"))
+    left, right = fig.axes
+    walton_meek, near_linear = (line.get_ydata() for line in left.lines[:2])
+    assert walton_meek[0] == pytest.approx(1.84, abs=0.01) and near_linear[0] == pytest.approx(1.0, abs=0.001)
+    wm_length, nl_length, clothoid = (line.get_ydata() for line in right.lines)
+    highway = right.lines[0].get_xdata() >= 300.0  # radii of an 80 km/h road (R_min = 229 m): small spiral angles
+    assert np.all(nl_length < wm_length) and np.all(np.abs(nl_length / clothoid - 1)[highway] < 0.02)
+    assert saved(fig, tmp_path, "jerk_shapes.png")
 
 
 def test_jerk_length_plot_shows_the_bezier_needs_more_length(tmp_path):

@@ -24,9 +24,11 @@ from build123d import (
     BuildLine,
     BuildSketch,
     Compound,
+    Curve,
     Face,
     Mode,
     Sketch,
+    Shape,
     SkipClean,
     Vector,
     VectorLike,
@@ -35,9 +37,10 @@ from build123d import (
 )
 
 from ..core.chain import Chain
+from ..core.shapes import DEFAULT_SHAPE
 from ..design.fillets import continuous_polygon, continuous_rectangle, continuous_slot
 from .corridor import Corridor, centerline_wire, corridor
-from .fillet import fillet_face, fillet_wire
+from .fillet import fillet_face, fillet_wire, planar_frame
 from .occ import chain_wire
 from ..core.segments import Segment
 from ..core.transitions import (
@@ -118,6 +121,7 @@ class SpiralLineToCircle(_TransitionObject):
         direction (VectorLike): travel direction of the line
         center (VectorLike): circle centre, off the line
         radius (float): circle radius (> 0, smaller than the centre's distance to the line)
+        shape (str, optional): spiral shape, "walton-meek" or "near-linear". Defaults to "walton-meek"
         mode (Mode, optional): combination mode. Defaults to Mode.ADD
 
     Raises:
@@ -130,9 +134,10 @@ class SpiralLineToCircle(_TransitionObject):
         direction: VectorLike,
         center: VectorLike,
         radius: float,
+        shape: str = DEFAULT_SHAPE,
         mode: Mode = Mode.ADD,
     ):
-        transition = line_to_circle(_xy(point, "point"), _xy(direction, "direction"), _xy(center, "center"), radius)
+        transition = line_to_circle(_xy(point, "point"), _xy(direction, "direction"), _xy(center, "center"), radius, shape)
         super().__init__(transition, mode)
 
 
@@ -145,9 +150,10 @@ class _CirclePairObject(_TransitionObject):
         radius0: float,
         center1: VectorLike,
         radius1: float,
+        shape: str = DEFAULT_SHAPE,
         mode: Mode = Mode.ADD,
     ):
-        transition = self._solve(_xy(center0, "center0"), radius0, _xy(center1, "center1"), radius1)
+        transition = self._solve(_xy(center0, "center0"), radius0, _xy(center1, "center1"), radius1, shape)
         super().__init__(transition, mode)
 
 
@@ -162,6 +168,7 @@ class SpiralCircleToCircle(_CirclePairObject):
         radius0 (float): its signed radius
         center1 (VectorLike): centre of the circle reached
         radius1 (float): its signed radius
+        shape (str, optional): spiral shape, "walton-meek" or "near-linear". Defaults to "walton-meek"
         mode (Mode, optional): combination mode. Defaults to Mode.ADD
 
     Raises:
@@ -183,6 +190,7 @@ class SpiralLineToLine(_TransitionObject):
         p1 (VectorLike): a point on the outgoing line
         curvature (float, optional): curvature at the joint; None takes the
             largest spirals that fit between p0 and p1. Defaults to None
+        shape (str, optional): "walton-meek", "near-linear" or "g2cbs". Defaults to "walton-meek"
         mode (Mode, optional): combination mode. Defaults to Mode.ADD
 
     Raises:
@@ -195,9 +203,10 @@ class SpiralLineToLine(_TransitionObject):
         corner: VectorLike,
         p1: VectorLike,
         curvature: float | None = None,
+        shape: str = DEFAULT_SHAPE,
         mode: Mode = Mode.ADD,
     ):
-        transition = line_to_line(_xy(p0, "p0"), _xy(corner, "corner"), _xy(p1, "p1"), curvature)
+        transition = line_to_line(_xy(p0, "p0"), _xy(corner, "corner"), _xy(p1, "p1"), curvature, shape)
         super().__init__(transition, mode)
 
 
@@ -211,6 +220,7 @@ class SpiralCircleInCircle(_CirclePairObject):
         radius0 (float): its signed radius
         center1 (VectorLike): centre of the circle reached
         radius1 (float): its signed radius (same sign as radius0)
+        shape (str, optional): spiral shape, "walton-meek" or "near-linear". Defaults to "walton-meek"
         mode (Mode, optional): combination mode. Defaults to Mode.ADD
 
     Raises:
@@ -253,12 +263,13 @@ def _points(vertices) -> list[tuple[float, float, float]] | None:
 
 
 def g2_fillet(
-    target: Wire | Face | Sketch | Vertex | Iterable[Vertex],
+    target: Wire | Face | Sketch | Curve | Vertex | Iterable[Vertex],
     radius: float,
     vertices: Iterable[Vertex] | None = None,
     transition: float = 0.5,
     same_sense: str = "nested",
-) -> Wire | Face | Sketch:
+    shape: str = DEFAULT_SHAPE,
+) -> Wire | Face | Sketch | Curve:
     """Operation: G2 Fillet
 
     Round corners with curvature-continuous fillets ("continuous corners"):
@@ -266,11 +277,12 @@ def g2_fillet(
     on both sides (``spiral_cad.design.fillets``), with exact LINE, CIRCLE and
     BEZIER edges and a G2 closing joint.
 
-    Used like build123d's ``fillet``: given a planar ``Wire``, ``Face`` or
-    ``Sketch`` (on any plane) it returns the same kind with the chosen
-    corners (default: all) rounded; inside ``BuildSketch``/``BuildLine``,
-    given vertices (e.g. ``sketch.vertices()``), it rounds those vertices of
-    the builder's object and replaces it (``Mode.REPLACE``).
+    Used like build123d's ``fillet``: given a planar ``Wire``, ``Face``,
+    ``Sketch`` or ``Curve`` (on any plane) it returns the same kind with the
+    chosen corners (default: all) rounded, every wire and every face of it;
+    inside ``BuildSketch``/``BuildLine``, given vertices (e.g.
+    ``sketch.vertices()``), it rounds those vertices of the builder's object
+    and replaces it (``Mode.REPLACE``).
 
     Args:
         target: the shape to round, or the vertices to round in a builder.
@@ -280,33 +292,63 @@ def g2_fillet(
             transitions, in (0, 1]; 1 gives a spiral pair with no arc. Defaults to 0.5
         same_sense (str, optional): ``"nested"`` or ``"C"`` for an arc that
             turns the same way as its corner. Defaults to "nested"
+        shape (str, optional): spiral shape of the transitions, "walton-meek" or
+            "near-linear" (curvature almost linear in arc length). Defaults to "walton-meek"
 
     Raises:
-        ValueError: non-planar input, edges other than lines and arcs.
+        ValueError: a solid or shell (round one of its faces, or use build123d's
+            ``fillet`` on its edges), non-planar input, edges other than lines
+            and arcs, or edges that belong to no wire or face.
         NoSolutionError: a corner that cannot be rounded (named, with numbers).
     """
     context = Builder._get_context("g2_fillet")
     in_builder = isinstance(target, Vertex) or (
-        isinstance(target, Iterable) and not isinstance(target, (Wire, Face, Sketch, Compound))
+        isinstance(target, Iterable) and not isinstance(target, (Shape, str, bytes))
     )
     if in_builder:
+        _points(target)  # only vertices select corners of a builder's object
         if context is None or context._obj is None:
             raise ValueError("g2_fillet of vertices needs a BuildSketch or BuildLine with an object")
         vertices, target = target, context._obj
     points = _points(vertices)
-    if isinstance(target, Face) and not isinstance(target, Sketch):
-        result = Face(fillet_face(target.wrapped, radius, points, transition=transition, same_sense=same_sense))
-    elif isinstance(target, Wire) or (hasattr(target, "_dim") and target._dim == 1):
-        wire = target if isinstance(target, Wire) else Wire(target.wires()[0].wrapped)
-        result = Wire(fillet_wire(wire.wrapped, radius, points, transition=transition, same_sense=same_sense)[0])
-    elif isinstance(target, (Sketch, Compound)) and target.faces():
-        faces = [Face(fillet_face(f.wrapped, radius, points, transition=transition, same_sense=same_sense)) for f in target.faces()]
-        result = Sketch(Compound(faces).wrapped)
+    options = dict(transition=transition, same_sense=same_sense, shape=shape)
+    if not isinstance(target, Shape):
+        raise ValueError(f"g2_fillet rounds a Wire, Face, Sketch or Curve; got {type(target).__name__}")
+    solids = target.solids() or target.shells()
+    if solids or getattr(target, "_dim", None) == 3:
+        raise ValueError(
+            f"g2_fillet rounds planar wires, faces and sketches; got a {type(target).__name__} with "
+            f"{len(target.solids())} solid(s) and {len(target.shells())} shell(s): round one of its faces, or use "
+            "build123d's fillet on its edges"
+        )
+    if isinstance(target, Wire):
+        result = Wire(fillet_wire(target.wrapped, radius, points, **options)[0])
+    elif isinstance(target, Face) and not isinstance(target, Sketch):
+        result = Face(fillet_face(target.wrapped, radius, points, **options))
     else:
-        raise ValueError(f"g2_fillet rounds a Wire, Face or Sketch; got {type(target).__name__}")
+        faces, wires = target.faces(), [] if target.faces() else target.wires()
+        _refuse_loose_edges(target, faces or wires)
+        if faces:
+            result = Sketch(Compound([Face(fillet_face(f.wrapped, radius, points, **options)) for f in faces]).wrapped)
+        else:  # one plane for all the wires (a straight wire alone has none; here it passes through)
+            frame = planar_frame(target.wrapped)
+            rounded = [fillet_wire(w.wrapped, radius, points, frame=frame, **options)[0] for w in wires]
+            result = Curve(Compound([Wire(w) for w in rounded]).wrapped)
     if in_builder:
         context._add_to_context(result, mode=Mode.REPLACE)
     return result
+
+
+def _refuse_loose_edges(target: Shape, parts: list[Shape]) -> None:
+    """ValueError unless every edge of ``target`` belongs to one of ``parts`` (its faces or its wires)."""
+    held = sum(len(p.edges()) for p in parts)
+    edges = len(target.edges())
+    if not parts or held < edges:
+        what = "faces" if parts and isinstance(parts[0], Face) else "wires"
+        raise ValueError(
+            f"g2_fillet rounds whole wires and faces; this {type(target).__name__} has {edges - held} of its "
+            f"{edges} edge(s) outside its {what}"
+        )
 
 
 class _ContinuousSketch(BaseSketchObject):
@@ -330,6 +372,7 @@ class ContinuousRectangle(_ContinuousSketch):
         height (float): rectangle height
         radius (float): the smallest radius of curvature of each corner
         transition (float, optional): share of each corner's turn made by the spirals, in (0, 1]. Defaults to 0.5
+        shape (str, optional): spiral shape, "walton-meek" or "near-linear". Defaults to "walton-meek"
         rotation (float, optional): angle to rotate object. Defaults to 0
         align (Align | tuple[Align, Align], optional): align MIN, CENTER, or MAX of object.
             Defaults to (Align.CENTER, Align.CENTER)
@@ -337,8 +380,9 @@ class ContinuousRectangle(_ContinuousSketch):
     """
 
     def __init__(self, width: float, height: float, radius: float, transition: float = 0.5, rotation: float = 0,
-                 align: Align | tuple[Align, Align] | None = (Align.CENTER, Align.CENTER), mode: Mode = Mode.ADD):  # fmt: skip
-        super().__init__(continuous_rectangle(width, height, radius, transition), rotation, align, mode)
+                 align: Align | tuple[Align, Align] | None = (Align.CENTER, Align.CENTER), shape: str = DEFAULT_SHAPE,
+                 mode: Mode = Mode.ADD):  # fmt: skip
+        super().__init__(continuous_rectangle(width, height, radius, transition, shape=shape), rotation, align, mode)
 
 
 class ContinuousPolygon(_ContinuousSketch):
@@ -351,6 +395,7 @@ class ContinuousPolygon(_ContinuousSketch):
         side_count (int): number of sides
         corner_radius (float): the smallest radius of curvature of each corner
         transition (float, optional): share of each corner's turn made by the spirals. Defaults to 0.5
+        shape (str, optional): spiral shape, "walton-meek" or "near-linear". Defaults to "walton-meek"
         major_radius (bool, optional): radius is the circumscribed (True) or inscribed circle's. Defaults to True
         rotation (float, optional): angle to rotate object. Defaults to 0
         align (Align | tuple[Align, Align], optional): align MIN, CENTER, or MAX of object. Defaults to None
@@ -359,8 +404,8 @@ class ContinuousPolygon(_ContinuousSketch):
 
     def __init__(self, radius: float, side_count: int, corner_radius: float, transition: float = 0.5,
                  major_radius: bool = True, rotation: float = 0, align: Align | tuple[Align, Align] | None = None,
-                 mode: Mode = Mode.ADD):  # fmt: skip
-        path = continuous_polygon(radius, side_count, corner_radius, transition, major_radius)
+                 shape: str = DEFAULT_SHAPE, mode: Mode = Mode.ADD):  # fmt: skip
+        path = continuous_polygon(radius, side_count, corner_radius, transition, major_radius, shape=shape)
         super().__init__(path, rotation, align, mode)
 
 
@@ -374,6 +419,7 @@ class ContinuousSlot(_ContinuousSketch):
         width (float): overall width of slot
         height (float): overall height (the width of the ends)
         transition (float, optional): share of each 90° corner made by the spirals. Defaults to 0.5
+        shape (str, optional): spiral shape, "walton-meek" or "near-linear". Defaults to "walton-meek"
         rotation (float, optional): angle to rotate object. Defaults to 0
         align (Align | tuple[Align, Align], optional): align MIN, CENTER, or MAX of object.
             Defaults to (Align.CENTER, Align.CENTER)
@@ -381,8 +427,9 @@ class ContinuousSlot(_ContinuousSketch):
     """
 
     def __init__(self, width: float, height: float, transition: float = 0.5, rotation: float = 0,
-                 align: Align | tuple[Align, Align] | None = (Align.CENTER, Align.CENTER), mode: Mode = Mode.ADD):  # fmt: skip
-        super().__init__(continuous_slot(width, height, transition), rotation, align, mode)
+                 align: Align | tuple[Align, Align] | None = (Align.CENTER, Align.CENTER), shape: str = DEFAULT_SHAPE,
+                 mode: Mode = Mode.ADD):  # fmt: skip
+        super().__init__(continuous_slot(width, height, transition, shape=shape), rotation, align, mode)
 
 
 def curvature_comb(shape_or_chain, scale: float | None = None, per_edge: int = 24) -> Compound:

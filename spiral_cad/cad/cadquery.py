@@ -42,6 +42,7 @@ import cadquery as cq
 from OCP.gp import gp_Ax3
 
 from ..core.chain import Chain
+from ..core.shapes import DEFAULT_SHAPE
 from ..design.fillets import continuous_polygon, continuous_rectangle, continuous_slot
 from .fillet import fillet_face, fillet_wire
 from .occ import chain_wire, segment_edges
@@ -111,25 +112,40 @@ def spiralTransition(self: W, transition: Transition, makeWire: bool = False, fo
 
 
 def spiralLineToCircle(
-    self: W, point: Any, direction: Any, center: Any, radius: float, makeWire: bool = False, forConstruction: bool = False
+    self: W,
+    point: Any,
+    direction: Any,
+    center: Any,
+    radius: float,
+    makeWire: bool = False,
+    forConstruction: bool = False,
+    shape: str = DEFAULT_SHAPE,
 ) -> W:
-    """Spiral from the directed line (``point``, ``direction``) onto a circle (``spiral_cad.line_to_circle``).
+    """Spiral from the directed line (``point``, ``direction``) onto a circle (``spiral_cad.line_to_circle``);
+    ``shape`` is the spiral shape (``"walton-meek"`` or ``"near-linear"``), as in every method here.
 
     Raises:
         NoSolutionError: the circle touches or crosses the line.
     """
-    return spiralTransition(self, line_to_circle(point, direction, center, radius), makeWire, forConstruction)
+    return spiralTransition(self, line_to_circle(point, direction, center, radius, shape), makeWire, forConstruction)
 
 
 def spiralCircleToCircle(
-    self: W, c0: Any, r0: float, c1: Any, r1: float, makeWire: bool = False, forConstruction: bool = False
+    self: W,
+    c0: Any,
+    r0: float,
+    c1: Any,
+    r1: float,
+    makeWire: bool = False,
+    forConstruction: bool = False,
+    shape: str = DEFAULT_SHAPE,
 ) -> W:
     """Two spirals from circle 0 to circle 1, C or S shaped by the radius signs (``spiral_cad.circle_to_circle``).
 
     Raises:
         NoSolutionError: no transition of that kind exists for these circles.
     """
-    return spiralTransition(self, circle_to_circle(c0, r0, c1, r1), makeWire, forConstruction)
+    return spiralTransition(self, circle_to_circle(c0, r0, c1, r1, shape), makeWire, forConstruction)
 
 
 def spiralLineToLine(
@@ -140,24 +156,32 @@ def spiralLineToLine(
     curvature: float | None = None,
     makeWire: bool = False,
     forConstruction: bool = False,
+    shape: str = DEFAULT_SHAPE,
 ) -> W:
-    """Two spirals rounding the corner p0 → ``corner`` → p1 (``spiral_cad.line_to_line``).
+    """Two spirals rounding the corner p0 → ``corner`` → p1 (``spiral_cad.line_to_line``; ``shape`` may also be ``"g2cbs"``).
 
     Raises:
         NoSolutionError: collinear/folded legs or a curvature too small for the legs.
     """
-    return spiralTransition(self, line_to_line(p0, corner, p1, curvature), makeWire, forConstruction)
+    return spiralTransition(self, line_to_line(p0, corner, p1, curvature, shape), makeWire, forConstruction)
 
 
 def spiralCircleInCircle(
-    self: W, c0: Any, r0: float, c1: Any, r1: float, makeWire: bool = False, forConstruction: bool = False
+    self: W,
+    c0: Any,
+    r0: float,
+    c1: Any,
+    r1: float,
+    makeWire: bool = False,
+    forConstruction: bool = False,
+    shape: str = DEFAULT_SHAPE,
 ) -> W:
     """One spiral between nested circles (``spiral_cad.circle_in_circle``).
 
     Raises:
         NoSolutionError: the circles are outside the solvable nesting band.
     """
-    return spiralTransition(self, circle_in_circle(c0, r0, c1, r1), makeWire, forConstruction)
+    return spiralTransition(self, circle_in_circle(c0, r0, c1, r1, shape), makeWire, forConstruction)
 
 
 def spiralChain(self: W, chain: Chain, makeWire: bool = True, forConstruction: bool = False) -> W:
@@ -175,7 +199,7 @@ def spiralChain(self: W, chain: Chain, makeWire: bool = True, forConstruction: b
     return _push_edges(self, chain.segments, makeWire, forConstruction)
 
 
-def g2Fillet(self: W, radius: float, transition: float = 0.5, same_sense: str = "nested") -> W:
+def g2Fillet(self: W, radius: float, transition: float = 0.5, same_sense: str = "nested", shape: str = DEFAULT_SHAPE) -> W:
     """Round every corner of the pending wires with G2 fillets (``spiral_cad.design.fillets``).
 
     Each corner becomes transition → arc of ``radius`` → transition, curvature
@@ -188,7 +212,8 @@ def g2Fillet(self: W, radius: float, transition: float = 0.5, same_sense: str = 
     wires = list(self.ctx.pendingWires)
     if not wires:
         raise ValueError("g2Fillet rounds the pending wires; there are none (draw a closed wire first)")
-    rounded = [cq.Wire(fillet_wire(w.wrapped, radius, transition=transition, same_sense=same_sense)[0]) for w in wires]
+    options = dict(transition=transition, same_sense=same_sense, shape=shape)
+    rounded = [cq.Wire(fillet_wire(w.wrapped, radius, **options)[0]) for w in wires]
     self.ctx.pendingWires = []
     result = self.newObject(rounded)
     for wire in rounded:
@@ -202,19 +227,21 @@ def _place_closed(self: W, path) -> W:
     return self.eachpoint(lambda loc: wire.moved(loc), True)
 
 
-def continuousRect(self: W, xLen: float, yLen: float, radius: float, transition: float = 0.5) -> W:
+def continuousRect(self: W, xLen: float, yLen: float, radius: float, transition: float = 0.5, shape: str = DEFAULT_SHAPE) -> W:
     """A centred rectangle with G2 corners ("continuous corners") at each point on the stack, as a pending wire."""
-    return _place_closed(self, continuous_rectangle(xLen, yLen, radius, transition))
+    return _place_closed(self, continuous_rectangle(xLen, yLen, radius, transition, shape=shape))
 
 
-def continuousPolygon(self: W, nSides: int, diameter: float, radius: float, transition: float = 0.5) -> W:
+def continuousPolygon(
+    self: W, nSides: int, diameter: float, radius: float, transition: float = 0.5, shape: str = DEFAULT_SHAPE
+) -> W:
     """A regular polygon (circumscribed ``diameter``) with G2 corners, as a pending wire."""
-    return _place_closed(self, continuous_polygon(diameter / 2.0, nSides, radius, transition))
+    return _place_closed(self, continuous_polygon(diameter / 2.0, nSides, radius, transition, shape=shape))
 
 
-def continuousSlot2D(self: W, length: float, diameter: float, transition: float = 0.5) -> W:
+def continuousSlot2D(self: W, length: float, diameter: float, transition: float = 0.5, shape: str = DEFAULT_SHAPE) -> W:
     """A slot of overall ``length`` and width ``diameter`` whose ends are G2 all round, as a pending wire."""
-    return _place_closed(self, continuous_slot(length, diameter, transition))
+    return _place_closed(self, continuous_slot(length, diameter, transition, shape=shape))
 
 
 METHODS = (
@@ -237,11 +264,12 @@ for _method in METHODS:
 # ------------------------------------------------------------------ cq.Sketch
 
 
-def sketch_g2fillet(self: S, radius: float, transition: float = 0.5, same_sense: str = "nested") -> S:
+def sketch_g2fillet(self: S, radius: float, transition: float = 0.5, same_sense: str = "nested", shape: str = DEFAULT_SHAPE) -> S:
     """``cq.Sketch.g2fillet``: round the selected vertices with G2 fillets, as ``Sketch.fillet`` does with arcs."""
     faces = self._matchFacesToVertices()
+    options = dict(transition=transition, same_sense=same_sense, shape=shape)
     self._faces = cq.Compound.makeCompound(
-        cq.Face(fillet_face(face.wrapped, radius, [v.toTuple() for v in vertices], transition=transition, same_sense=same_sense))
+        cq.Face(fillet_face(face.wrapped, radius, [v.toTuple() for v in vertices], **options))
         if vertices else face
         for face, vertices in faces.items()
     )  # fmt: skip
@@ -249,9 +277,10 @@ def sketch_g2fillet(self: S, radius: float, transition: float = 0.5, same_sense:
 
 
 def sketch_continuous_rect(self: S, w: float, h: float, radius: float, transition: float = 0.5, angle: float = 0,
-                           mode: str = "a", tag: str | None = None) -> S:  # fmt: skip
+                           mode: str = "a", tag: str | None = None, shape: str = DEFAULT_SHAPE) -> S:  # fmt: skip
     """``cq.Sketch.continuousRect``: a rectangular face with G2 corners (as ``Sketch.rect``)."""
-    face = cq.Face.makeFromWires(cq.Wire(chain_wire(continuous_rectangle(w, h, radius, transition).segments)))
+    path = continuous_rectangle(w, h, radius, transition, shape=shape)
+    face = cq.Face.makeFromWires(cq.Wire(chain_wire(path.segments)))
     face = face.rotate(cq.Vector(), cq.Vector(0, 0, 1), angle)
     return self.each(lambda location: face.located(location), mode, tag)
 

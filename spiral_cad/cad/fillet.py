@@ -19,10 +19,13 @@ from OCP.BRepTools import BRepTools, BRepTools_WireExplorer
 from OCP.GeomAbs import GeomAbs_CurveType, GeomAbs_SurfaceType
 from OCP.GeomAdaptor import GeomAdaptor_Surface
 from OCP.gp import gp_Ax3, gp_Pnt, gp_Vec
+from OCP.Precision import Precision
 from OCP.TopAbs import TopAbs_REVERSED, TopAbs_WIRE
 from OCP.TopExp import TopExp_Explorer
 from OCP.TopoDS import TopoDS, TopoDS_Face, TopoDS_Wire
 
+from ..core.errors import NoSolutionError
+from ..formats.joints import Continuity
 from ..core.segments import Arc, Line, Segment
 from ..design.fillets import FilletedPath, fillet_path
 from .occ import chain_wire
@@ -36,6 +39,10 @@ PLANAR_TOL = 1e-9
 def planar_frame(shape) -> gp_Ax3:
     """The plane of a planar wire or face as a ``gp_Ax3`` (a face's own plane, oriented as the face).
 
+    The frame's origin is the plane's point nearest the world origin, so plane
+    coordinates are as large as world ones: a corner far from the origin is
+    judged with the rounding its world coordinates really carry.
+
     Raises:
         ValueError: the shape does not lie in one plane.
     """
@@ -46,11 +53,14 @@ def planar_frame(shape) -> gp_Ax3:
         frame = surface.Plane().Position()
         if shape.Orientation() == TopAbs_REVERSED:
             frame.ZReverse()
-        return frame
-    finder = BRepLib_FindSurface(shape, 1e-7, True)
-    if not finder.Found():
-        raise ValueError("g2 fillets need a planar wire; this wire does not lie in one plane (or is a single straight line)")
-    return GeomAdaptor_Surface(finder.Surface()).Plane().Position()
+    else:
+        finder = BRepLib_FindSurface(shape, 1e-7, True)
+        if not finder.Found():
+            raise ValueError("g2 fillets need a planar wire; this wire does not lie in one plane (or is a single straight line)")
+        frame = GeomAdaptor_Surface(finder.Surface()).Plane().Position()
+    location, normal = gp_Vec(frame.Location().XYZ()), gp_Vec(frame.Direction())
+    frame.SetLocation(gp_Pnt(normal.Multiplied(location.Dot(normal)).XYZ()))
+    return frame
 
 
 def _local(frame: gp_Ax3, p: gp_Pnt) -> tuple[float, float, float]:
@@ -125,6 +135,7 @@ def fillet_wire(
     *,
     transition: float = 0.5,
     same_sense: str = "nested",
+    shape: str = "walton-meek",
     frame: gp_Ax3 | None = None,
 ) -> tuple[TopoDS_Wire, FilletedPath]:
     """Round the wire's corners at ``vertices`` (3-D points; None: every corner) with G2 fillets.
@@ -135,19 +146,60 @@ def fillet_wire(
 
     Raises:
         ValueError: a non-planar wire or an edge that is not a line or arc.
-        NoSolutionError: a corner that cannot be rounded (named, with numbers).
+        NoSolutionError: a corner that cannot be rounded (named, with numbers),
+            also when a piece of it would be shorter than OCCT can hold (2e-7).
     """
     frame = planar_frame(wire) if frame is None else frame
     segments, closed = wire_path(wire, frame)
     chosen = _vertex_indices(segments, closed, frame, vertices)
-    result = fillet_path(segments, radius, transition=transition, vertices=chosen, closed=closed, same_sense=same_sense)
+    result = fillet_path(segments, radius, transition=transition, vertices=chosen, closed=closed, same_sense=same_sense, shape=shape)
     if not result.corners:  # nothing to round: the wire stays as it was
         return wire, result
-    return chain_wire(result.segments, frame), result
+    shortest = 2.0 * Precision.Confusion_s()
+    for i, (segment, owner) in enumerate(zip(result.segments, result.owners)):
+        if not segment.length > shortest:
+            near = owner if owner is not None else next(o for o in result.owners[i:] + result.owners[:i] if o is not None)
+            what = "the fillet" if owner is not None else "the edge it trims"
+            raise NoSolutionError(
+                f"corner {near}: a {type(segment).__name__} of {what} is {segment.length:.3g} long; OCCT merges "
+                f"points closer than {Precision.Confusion_s():g} model units, so no edge can be shorter than "
+                f"{shortest:g}: use a larger radius, or a smaller unit for the model"
+            )
+    rounded = chain_wire(result.segments, frame)
+    _verify(rounded, result)
+    return rounded, result
+
+
+def _verify(wire: TopoDS_Wire, result: FilletedPath) -> None:
+    """NoSolutionError unless the G2 checker (``spiral_cad.continuity``, default tolerances) grades
+    every joint of every rounded corner G2 in the built wire: float64 rounding of 3-D coordinates
+    may break what held in the plane (a tiny fillet far from the origin or on a tilted plane)."""
+    from .continuity import check_continuity  # late: the checker imports the edge makers of this layer
+
+    report = check_continuity(wire)
+    count = len(result.segments)
+    if report.pieces != 1 or report.wires[0].edge_count != count:
+        raise NoSolutionError(f"the rounded wire does not read back as one wire of {count} edges: {report.describe()}")
+    for joint in report.wires[0].joints:
+        owner = result.owners[joint.index]
+        owner = owner if owner is not None else result.owners[(joint.index + 1) % count]
+        if owner is not None and joint.level < Continuity.G2:
+            raise NoSolutionError(
+                f"corner {owner}: in 3-D its wire is only {joint.level.name} at joint {joint.index} (gap {joint.gap:.3g}, "
+                f"tangent angle {joint.angle:.3g} rad, relative curvature jump {joint.relative_curvature_jump:.3g}; the "
+                f"G2 checker allows {report.gap_tol:g}, {report.angle_tol:g} and {report.curvature_tol:g}): float64 "
+                "cannot hold this fillet at these coordinates; use a larger radius, or move the model nearer the origin"
+            )
 
 
 def fillet_face(
-    face: TopoDS_Face, radius: float, vertices: Iterable | None = None, *, transition: float = 0.5, same_sense: str = "nested"
+    face: TopoDS_Face,
+    radius: float,
+    vertices: Iterable | None = None,
+    *,
+    transition: float = 0.5,
+    same_sense: str = "nested",
+    shape: str = "walton-meek",
 ) -> TopoDS_Face:
     """Round the corners of a planar face (outer and inner wires) at ``vertices`` (None: every corner).
 
@@ -159,7 +211,8 @@ def fillet_face(
     points = None if vertices is None else list(vertices)
     outer = BRepTools.OuterWire_s(face)
     wires = [outer] + [w for w in _wires(face) if not w.IsSame(outer)]
-    rounded = [fillet_wire(w, radius, points, transition=transition, same_sense=same_sense, frame=frame)[0] for w in wires]
+    options = dict(transition=transition, same_sense=same_sense, shape=shape, frame=frame)
+    rounded = [fillet_wire(w, radius, points, **options)[0] for w in wires]
     maker = BRepBuilderAPI_MakeFace(BRep_Tool.Surface_s(face), rounded[0], True)
     for inner in rounded[1:]:
         maker.Add(inner)

@@ -15,6 +15,7 @@ towards Y.
 from __future__ import annotations
 
 import io
+import math
 import os
 import re
 import sys
@@ -24,8 +25,8 @@ from contextlib import contextmanager
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from OCP.BRep import BRep_Builder
-from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeEdge, BRepBuilderAPI_MakeVertex
+from OCP.BRep import BRep_Builder, BRep_Tool
+from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeEdge
 from OCP.Geom import (
     Geom_BezierCurve,
     Geom_BSplineCurve,
@@ -37,9 +38,10 @@ from OCP.gp import gp_Ax2, gp_Ax3, gp_Dir, gp_Pnt, gp_Vec
 from OCP.Precision import Precision
 from OCP.TColgp import TColgp_Array1OfPnt
 from OCP.TColStd import TColStd_Array1OfInteger, TColStd_Array1OfReal
-from OCP.TopoDS import TopoDS_Compound, TopoDS_Edge, TopoDS_Shape, TopoDS_Wire
+from OCP.TopoDS import TopoDS_Compound, TopoDS_Edge, TopoDS_Shape, TopoDS_Vertex, TopoDS_Wire
 
 from ..core.segments import Arc, Line, Segment
+from ..formats.joints import ROUNDING_ULPS
 from ..core.spiral import BezierSpiral
 
 __all__ = ["ReadError", "as_occ_shape", "captured_messages", "chain_wire", "nurbs_edge", "read_shape", "segment_edge", "segment_edges"]
@@ -163,31 +165,64 @@ def chain_wire(chain: Iterable[Segment], plane: gp_Ax3 | None = None) -> TopoDS_
     Consecutive edges share their vertex, and the wire is assembled directly
     (linear time: ``BRepBuilderAPI_MakeWire`` searches every vertex so far at
     each ``Add``, quadratic for long chains). A chain whose end meets its
-    start gives a closed wire.
+    start gives a closed wire. Ends meet when they are within OCCT's vertex
+    tolerance (1e-7) plus the rounding the G2 checker allows at their
+    coordinates (``ROUNDING_ULPS`` units in the last place), and each vertex
+    carries that tolerance (1e-7 for coordinates up to ~1e8).
 
     Raises:
-        ValueError: consecutive segments are further apart than OCCT's
-            vertex tolerance (1e-7), or there are none.
+        ValueError: consecutive segments do not meet, a segment too short
+            for OCCT to make an edge of, or no segments.
     """
     frame = _frame(plane)
-    spans = [_curve_span(s, frame) for s in chain]
+    segments = list(chain)
+    spans = [_curve_span(s, frame) for s in segments]
     if not spans:
         raise ValueError("chain_wire needs at least one segment")
     ends = [(curve.Value(first), curve.Value(last)) for curve, first, last in spans]
-    vertices = [BRepBuilderAPI_MakeVertex(ends[0][0]).Vertex()]
-    for i, ((_, end), (start, _)) in enumerate(zip(ends, ends[1:])):
-        if end.Distance(start) > Precision.Confusion_s():
-            raise ValueError(f"segment {i + 1} does not connect to segment {i}: gap {end.Distance(start):.3g}")
-        vertices.append(BRepBuilderAPI_MakeVertex(end).Vertex())
-    closed = ends[-1][1].Distance(ends[0][0]) <= Precision.Confusion_s()
-    vertices.append(vertices[0] if closed else BRepBuilderAPI_MakeVertex(ends[-1][1]).Vertex())
     builder = BRep_Builder()
+    vertices = [_vertex(builder, ends[0][0], ends[0][0])]
+    for i, ((_, end), (start, _)) in enumerate(zip(ends, ends[1:])):
+        if end.Distance(start) > _tolerance(end, start):
+            raise ValueError(f"segment {i + 1} does not connect to segment {i}: gap {end.Distance(start):.3g}")
+        vertices.append(_vertex(builder, end, start))
+    closed = ends[-1][1].Distance(ends[0][0]) <= _tolerance(ends[-1][1], ends[0][0])
+    if closed:
+        vertices[0] = _vertex(builder, ends[0][0], ends[-1][1])
+    vertices.append(vertices[0] if closed else _vertex(builder, ends[-1][1], ends[-1][1]))
     wire = TopoDS_Wire()
     builder.MakeWire(wire)
-    for (curve, first, last), v0, v1 in zip(spans, vertices, vertices[1:]):
-        builder.Add(wire, BRepBuilderAPI_MakeEdge(curve, v0, v1, first, last).Edge())
+    for i, ((curve, first, last), v0, v1) in enumerate(zip(spans, vertices, vertices[1:])):
+        maker = BRepBuilderAPI_MakeEdge(curve, v0, v1, first, last)
+        if not maker.IsDone():
+            short = segments[i].length <= 10.0 * BRep_Tool.Tolerance_s(v0)
+            raise ValueError(
+                f"segment {i} ({type(segments[i]).__name__}, length {segments[i].length:.3g}) cannot be an OCCT edge "
+                f"({maker.Error().name})"
+                + (
+                    f": OCCT merges points closer than {BRep_Tool.Tolerance_s(v0):.3g} model units, so its edges must be "
+                    "longer than that; scale the model up or use a smaller unit"
+                    if short
+                    else ""
+                )
+            )
+        builder.Add(wire, maker.Edge())
     wire.Closed(closed)
     return wire
+
+
+def _tolerance(a: gp_Pnt, b: gp_Pnt) -> float:
+    """How far apart two edge ends may be and share a vertex: OCCT's 1e-7 plus the rounding the
+    G2 checker allows at their coordinates (``ROUNDING_ULPS`` units in the last place)."""
+    magnitude = max(abs(a.X()), abs(a.Y()), abs(a.Z()), abs(b.X()), abs(b.Y()), abs(b.Z()))
+    return Precision.Confusion_s() + ROUNDING_ULPS * math.ulp(magnitude)
+
+
+def _vertex(builder: BRep_Builder, point: gp_Pnt, other: gp_Pnt) -> TopoDS_Vertex:
+    """The vertex at ``point`` shared with an edge end at ``other``, with that joint's tolerance."""
+    vertex = TopoDS_Vertex()
+    builder.MakeVertex(vertex, point, _tolerance(point, other))
+    return vertex
 
 
 def nurbs_edge(nurbs: Nurbs, plane: gp_Ax3 | None = None) -> TopoDS_Edge:

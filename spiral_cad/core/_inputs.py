@@ -2,7 +2,10 @@
 
 Only real numbers are accepted: bools, strings, bytes, complex numbers,
 mappings and sets are refused by name rather than read as numbers (a string
-``'12'`` is not the point (1, 2), a dict is not its keys).
+``'12'`` is not the point (1, 2), a dict is not its keys). Masked arrays are
+refused too: numpy drops the mask on conversion, so a masked value would be
+solved as whatever number lies under it. Messages show values as plain
+Python numbers (``shown``), never numpy reprs.
 """
 
 from __future__ import annotations
@@ -24,6 +27,29 @@ def _refused(value: Any) -> bool:
     return isinstance(value, (bool, np.bool_, str, bytes, complex, np.complexfloating, Mapping, Set)) or value is None
 
 
+def shown(value: Any) -> str:
+    """``repr`` of ``value`` with numpy scalars and arrays as plain Python values (for messages)."""
+    if isinstance(value, (np.generic, np.ndarray)) and not isinstance(value, np.ma.MaskedArray):
+        value = value.tolist()
+    elif isinstance(value, tuple):
+        return "(" + ", ".join(shown(v) for v in value) + ("," if len(value) == 1 else "") + ")"
+    elif isinstance(value, list):
+        return "[" + ", ".join(shown(v) for v in value) + "]"
+    return repr(value)
+
+
+def _refuse_masked(value: Any, name: str) -> None:
+    """ValueError naming ``name`` for a masked array (or a sequence holding one)."""
+    masked = isinstance(value, np.ma.MaskedArray) or (
+        isinstance(value, (list, tuple)) and any(isinstance(v, np.ma.MaskedArray) for v in value)
+    )
+    if masked:
+        raise ValueError(
+            f"{name} is a masked array: masked values have no geometry; fill them (np.ma.filled) or drop "
+            "those rows (np.ma.compress_rows) first"
+        )
+
+
 def as_float(value: Any, name: str) -> float:
     """``value`` as a finite float, else ValueError naming ``name``."""
     if type(value) is float or type(value) is int:  # the common case, checked cheaply
@@ -33,14 +59,15 @@ def as_float(value: Any, name: str) -> float:
             number = math.inf
         if math.isfinite(number):
             return number
+    _refuse_masked(value, name)
     if isinstance(value, np.ndarray) and value.ndim == 0 and value.dtype.kind in _REAL_KINDS:
         value = value[()]
     if _refused(value) or not isinstance(value, numbers.Real):
-        raise ValueError(f"{name} must be a real number; got {type(value).__name__} {value!r:.80}")
+        raise ValueError(f"{name} must be a real number; got {type(value).__name__} {shown(value):.80}")
     try:
         number = float(value)
     except OverflowError:
-        raise ValueError(f"{name} is too large for float64; got {value!r:.80}") from None
+        raise ValueError(f"{name} is too large for float64; got {shown(value):.80}") from None
     if not math.isfinite(number):
         raise ValueError(f"{name} must be finite; got {number}")
     return number
@@ -54,17 +81,18 @@ def as_xy(value: Any, name: str) -> tuple[float, float]:
         x, y = value.tolist()
         if math.isfinite(x) and math.isfinite(y):
             return x, y
+    _refuse_masked(value, name)
     if _refused(value):
-        raise ValueError(f"{name} must be a 2-D point or vector; got {type(value).__name__} {value!r:.80}")
+        raise ValueError(f"{name} must be a 2-D point or vector; got {type(value).__name__} {shown(value):.80}")
     try:
         items = list(value)
     except TypeError:
-        raise ValueError(f"{name} must be a 2-D point or vector; got {type(value).__name__} {value!r:.80}") from None
+        raise ValueError(f"{name} must be a 2-D point or vector; got {type(value).__name__} {shown(value):.80}") from None
     coords = [as_float(c, f"{name}[{i}]") for i, c in enumerate(items)]
     if len(coords) == 3 and coords[2] == 0.0:
         coords = coords[:2]
     if len(coords) != 2:
-        raise ValueError(f"{name} must have 2 coordinates; got {value!r:.80}")
+        raise ValueError(f"{name} must have 2 coordinates; got {shown(value):.80}")
     return coords[0], coords[1]
 
 
@@ -79,8 +107,9 @@ def as_unit(value: Any, name: str) -> tuple[float, float]:
 
 def as_real_array(value: Any, name: str) -> NDArray:
     """``value`` as a float64 array of real numbers (no bools, strings, complex or objects that are not numbers)."""
+    _refuse_masked(value, name)
     if _refused(value):
-        raise ValueError(f"{name} must be an array of real numbers; got {type(value).__name__} {value!r:.80}")
+        raise ValueError(f"{name} must be an array of real numbers; got {type(value).__name__} {shown(value):.80}")
     try:
         array = np.asarray(value)
     except ValueError as error:  # ragged nesting
@@ -89,7 +118,7 @@ def as_real_array(value: Any, name: str) -> NDArray:
         flat = array.ravel()
         bad = next((v for v in flat if _refused(v) or not isinstance(v, numbers.Real)), None)
         if bad is not None:
-            raise ValueError(f"{name} must hold real numbers only; got {type(bad).__name__} {bad!r:.80}")
+            raise ValueError(f"{name} must hold real numbers only; got {type(bad).__name__} {shown(bad):.80}")
         try:
             return array.astype(np.float64)
         except (OverflowError, ValueError):

@@ -192,6 +192,13 @@ def corner_factor(shape, sin_t, cos_t):
 
 
 @jit
+def corner_factor_batch(shape, sin_t, cos_t, out):
+    """``corner_factor`` over arrays of sin θ and cos θ, into ``out``."""
+    for i in range(sin_t.shape[0]):
+        out[i] = corner_factor(shape, sin_t[i], cos_t[i])
+
+
+@jit
 def corner_relation(shape, sin_t, cos_t, value):
     """K(θ)/value: a spiral pair's corner distance from its joint curvature, or the
     curvature from the distance (the relation is symmetric)."""
@@ -1017,21 +1024,3 @@ def circle_in_circle_batch(c0, r0, c1, r1, shape, out, status, theta, measure, p
     for i in prange(c0.shape[0]):
         row = circle_in_circle_row(c0[i, 0], c0[i, 1], r0[i], c1[i, 0], c1[i, 1], r1[i], shape, out[i])
         param[i] = _record(i, row, out, status, theta, measure)
-
-
-@_compile(parallel=True)
-def verify_corners_batch(out, corners, t_in, t_out, curvature, status, measure):
-    """``corner_residual`` for spiral pairs made elsewhere (e.g. G2CBS): rows
-    with status OK that fail become ``UNVERIFIED`` (NaN control points)."""
-    for i in prange(out.shape[0]):
-        if status[i] != OK:
-            continue
-        scale = frame_scale(1.0 / abs(curvature[i]))
-        inv = 1.0 / scale
-        res = corner_residual(
-            out[i], corners[i, 0], corners[i, 1], t_in[i, 0], t_in[i, 1], -t_out[i, 0], -t_out[i, 1], curvature[i] * scale, inv
-        )
-        if not res <= VERIFY_TOL:
-            status[i] = UNVERIFIED
-            measure[i] = res
-            fill_nan(out[i])

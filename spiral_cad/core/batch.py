@@ -135,9 +135,10 @@ def line_to_circle(
     failed rows with NaN.
 
     Raises:
-        ValueError: an input that is not an array of real numbers, of the
-            wrong shape or row count, a bad ``out`` or an unknown shape (the
-            message names it). No row's values raise: they become that row's status.
+        ValueError: an input that is not an array of real numbers (a masked
+            array included: numpy would drop its mask), of the wrong shape or
+            row count, a bad ``out`` or an unknown shape (the message names
+            it). No row's values raise: they become that row's status.
     """
     rows = _rows(point=(points, (2,)), direction=(directions, (2,)), center=(centers, (2,)), radius=(radii, ()))
     return _run("line_to_circle", K.line_to_circle_batch, 1, rows, out, shape)

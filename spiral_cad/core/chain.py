@@ -10,6 +10,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from ._inputs import as_float, as_real_array, as_xy
+from .errors import JointError
 from .segments import Arc, Join, Line, Segment, measure_join
 from .spiral import BezierSpiral
 from .transitions import Transition
@@ -33,7 +34,7 @@ def g2_mismatch(a: Segment, b: Segment, tolerance: float, units: str = "", index
     short, long = min(la, lb), max(la, lb)
     kappa = max(abs(a.end_curvature), abs(b.start_curvature), 1.0 / long)
     scale = np.array([short, 1.0, kappa])
-    floor = np.minimum(np.add(a.rounding_floor(True), b.rounding_floor(False)), ROUNDING_CAP * scale)
+    floor = np.minimum(np.add(rounding_floor(a, True), rounding_floor(b, False)), ROUNDING_CAP * scale)
     if j.gap > tolerance * short + floor[0] or j.angle > tolerance + floor[1] or j.curvature_jump > tolerance * kappa + floor[2]:
         return (
             f"joint {index} (between segments {index} and {index + 1}): gap {j.gap:.3g}, tangent angle "
@@ -41,6 +42,30 @@ def g2_mismatch(a: Segment, b: Segment, tolerance: float, units: str = "", index
             f"shorter segment, {short:.6g} {units}; curvature jump relative to {kappa:.6g} 1/{units})"
         )
     return None
+
+
+def rounding_floor(segment: Segment, at_end: bool) -> tuple[float, float, float]:
+    """``segment.rounding_floor(at_end)``, also where its own arithmetic leaves float64.
+
+    A floor is (gap, angle, curvature): a length, a pure number and an inverse
+    length. Where a segment's formula overflows or underflows (a spiral's
+    |leg|³ beyond 1e308 or below 1e-308), it is evaluated on a copy scaled
+    by a power of two (exact in float64) and scaled back; a copy that float64
+    cannot hold either means an unbounded floor (the cap then applies).
+    """
+    try:
+        return segment.rounding_floor(at_end)
+    except ArithmeticError:
+        pass
+    rebuild = getattr(type(segment), "from_control_points", None)  # spirals: the only floors that can raise
+    if rebuild is None:
+        return math.inf, math.inf, math.inf
+    exponent = math.frexp(segment.length)[1]
+    try:
+        gap, angle, curvature = rebuild(np.ldexp(segment.control_points, -exponent)).rounding_floor(at_end)
+    except (ArithmeticError, ValueError):
+        return math.inf, math.inf, math.inf
+    return math.ldexp(gap, exponent), angle, math.ldexp(curvature, -exponent)
 
 
 def join_tolerance(value: Any) -> float:
@@ -90,9 +115,9 @@ class Chain:
             travels with the chain into every file written from it.
 
     Raises:
-        ValueError: a joint exceeds the tolerance (the message names the joint
-            index and the three mismatches), no segments were given, or the
-            tolerance is not in (0, 1e-3].
+        ValueError: a joint exceeds the tolerance (a ``JointError`` naming the
+            joint index and the three mismatches), no segments were given, or
+            the tolerance is not in (0, 1e-3].
     """
 
     def __init__(self, segments: Iterable[Segment], tolerance: float = JOIN_TOLERANCE, units: str = DEFAULT_UNITS):
@@ -111,7 +136,7 @@ class Chain:
         for index, (a, b) in enumerate(zip(self._segments, self._segments[1:])):
             problem = g2_mismatch(a, b, self.tolerance, self.units, index)
             if problem:
-                raise ValueError(f"Chain is not G2 at {problem}")
+                raise JointError(f"Chain is not G2 at {problem}", index)
 
     @classmethod
     def join(
@@ -134,6 +159,12 @@ class Chain:
         Example:
             ``Chain.join([line_to_circle(...), circle_to_line(...)], start=a, end=b)``
             gives line → spiral → arc → spiral → line.
+
+        Raises:
+            ValueError: malformed parts, a ``start`` ahead of the first part's
+                start or an ``end`` behind the last part's end (the line would
+                fold back), or a joint that is not G2 (a ``JointError`` whose
+                ``part`` is the index of the part the joint belongs to).
         """
         if isinstance(parts, (Segment, Transition, str, bytes)) or not isinstance(parts, Sequence):
             raise ValueError(
@@ -149,15 +180,40 @@ class Chain:
                 raise ValueError("Chain.join needs parts, or both start and end for a straight chain")
             return cls([Line(as_xy(start, "start"), as_xy(end, "end"))], tolerance, units)
         segments: list[Segment] = []
+        owners: list[int] = []  # the part each segment comes from or follows
         if start is not None:
-            segments.extend(_bridge(np.array(as_xy(start, "start")), parts[0].start, parts[0].length, tolerance))
-        for previous, part in zip([None, *parts], parts):
+            first = np.array(as_xy(start, "start"))
+            bridge = _bridge(first, parts[0].start, parts[0].length, tolerance)
+            if bridge and float(np.dot(parts[0].start - first, parts[0].start_tangent)) < 0.0:
+                raise ValueError(
+                    f"start {tuple(first.tolist())} lies ahead of where parts[0] begins, "
+                    f"{tuple(parts[0].start.tolist())}: the line from it would run backwards"
+                )
+            segments.extend(bridge)
+        owners += [0] * len(segments)
+        for k, (previous, part) in enumerate(zip([None, *parts], parts)):
             if previous is not None:
-                segments.extend(_connector(previous, part, tolerance))
-            segments.extend(part.spirals if isinstance(part, Transition) else [part])
+                bridge = _connector(previous, part, tolerance)
+                segments.extend(bridge)
+                owners += [k - 1] * len(bridge)
+            own = part.spirals if isinstance(part, Transition) else [part]
+            segments.extend(own)
+            owners += [k] * len(own)
         if end is not None:
-            segments.extend(_bridge(parts[-1].end, np.array(as_xy(end, "end")), parts[-1].length, tolerance))
-        return cls(segments, tolerance, units)
+            last = np.array(as_xy(end, "end"))
+            bridge = _bridge(parts[-1].end, last, parts[-1].length, tolerance)
+            if bridge and float(np.dot(last - parts[-1].end, parts[-1].end_tangent)) < 0.0:
+                raise ValueError(
+                    f"end {tuple(last.tolist())} lies behind where parts[{len(parts) - 1}] ends, "
+                    f"{tuple(parts[-1].end.tolist())}: the line to it would run backwards"
+                )
+            segments.extend(bridge)
+        owners += [len(parts) - 1] * (len(segments) - len(owners))
+        try:
+            return cls(segments, tolerance, units)
+        except JointError as error:
+            part = owners[error.joint + 1] if owners[error.joint + 1] != owners[error.joint] else owners[error.joint]
+            raise JointError(f"{error} (at parts[{part}])", error.joint, part) from None
 
     # ------------------------------------------------------------- access
 

@@ -13,6 +13,20 @@ class NoSolutionError(ValueError):
     """
 
 
+class JointError(ValueError):
+    """A ``Chain`` joint that is not G2: ``joint`` is its index; ``part`` the index of the
+    ``Chain.join`` part it belongs to (None for a ``Chain`` built from segments).
+
+    Design tools catch it to name their PI, corner or circle (as a NoSolutionError:
+    their parts are consistent by construction, so only float64 can break a joint).
+    """
+
+    def __init__(self, message: str, joint: int, part: int | None = None):
+        super().__init__(message)
+        self.joint = joint
+        self.part = part
+
+
 class Status(IntEnum):
     """Outcome of one solver row (``spiral_cad.batch`` results carry these)."""
 

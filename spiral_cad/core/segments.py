@@ -124,12 +124,14 @@ class Line(Segment):
         self._a = np.array(as_xy(start, "start"))
         self._b = np.array(as_xy(end, "end"))
         if np.array_equal(self._a, self._b):
-            raise ValueError(f"Line needs distinct end points; both are {tuple(self._a)}")
+            raise ValueError(f"Line needs distinct end points; both are {tuple(self._a.tolist())}")
         if not math.isfinite(self.length):
-            raise ValueError(f"Line end points {tuple(self._a)} and {tuple(self._b)} are too far apart for float64")
+            raise ValueError(
+                f"Line end points {tuple(self._a.tolist())} and {tuple(self._b.tolist())} are too far apart for float64"
+            )
 
     def __repr__(self) -> str:
-        return f"Line({tuple(self._a)}, {tuple(self._b)})"
+        return f"Line({tuple(self._a.tolist())}, {tuple(self._b.tolist())})"
 
     def outline(self) -> list[tuple[float, float]]:
         return [self.ends[0][:2], self.ends[1][:2]]
@@ -235,7 +237,7 @@ class Arc(Segment):
         return cls((cx, cy), radius, a0, sweep)
 
     def __repr__(self) -> str:
-        return f"Arc(center={tuple(self._c)}, radius={self._r}, start_angle={self._a0}, sweep={self._sweep})"
+        return f"Arc(center={tuple(self._c.tolist())}, radius={self._r}, start_angle={self._a0}, sweep={self._sweep})"
 
     @property
     def center(self) -> NDArray:

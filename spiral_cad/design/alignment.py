@@ -19,22 +19,24 @@ from scipy.optimize import brentq
 
 from ..core.bezier import curvature_rate, peak_curvature_rate  # noqa: F401  (public here too)
 from ..core._inputs import as_float, as_points, as_real_array
-from ..core._kernels import WALTON_MEEK, shape_g1
+from ..core._kernels import shape_g1
+from ..core.factors import length_factor, search_range
+from ..core.shapes import SHAPE_CODES, TRANSITION_SHAPES, shape_code, shape_limits
 from ..core.chain import JOIN_TOLERANCE, Chain
 from ..core.units import DEFAULT_UNITS, length_unit, speed_unit
-from .criteria import CRITERIA_DIMENSIONS, THETA_RANGE, Criteria, CriteriaRow, RailCriteria, RoadCriteria, length_factor
+from .criteria import CRITERIA_DIMENSIONS, Criteria, CriteriaRow, RailCriteria, RoadCriteria
 from .tables import text_table, write_csv
-from ..core.errors import NoSolutionError
+from ..core.errors import JointError, NoSolutionError
 from ..core.transitions import Transition, line_to_circle
 
 #: |sin(deflection)| at or below this counts as a straight PI.
 COLLINEAR_TOL = 1e-12
-#: θ range searched when a spiral length is requested.
-_THETA_RANGE = (1e-7, math.pi / 2 * (1.0 - 1e-9))
+#: Smallest θ searched when a spiral length is requested.
+_THETA_MIN = 1e-7
 
 
-def theta_for_length(length: float, radius: float) -> float:
-    """The θ whose Theorem 3.1 spiral with end radius ``radius`` has arc length ``length``.
+def theta_for_length(length: float, radius: float, shape: str = "walton-meek") -> float:
+    """The θ whose spiral of ``shape`` with end radius ``radius`` has arc length ``length``.
 
     Length grows monotonically with θ for a fixed radius (and is
     proportional to the radius), so a bracketed 1-D root gives θ.
@@ -44,9 +46,10 @@ def theta_for_length(length: float, radius: float) -> float:
     """
 
     def excess(theta: float) -> float:
-        return float(length_factor(theta)) - length / radius
+        return float(length_factor(theta, shape)) - length / radius
 
-    lo, hi = _THETA_RANGE
+    largest = shape_limits(shape)["theta"]
+    lo, hi = _THETA_MIN, largest * (1.0 - 1e-9) if largest == math.pi / 2 else largest
     if not excess(lo) < 0.0 < excess(hi):
         raise NoSolutionError(
             f"spiral length {length:.6g} is outside the range a spiral onto radius {radius:.6g} "
@@ -98,16 +101,20 @@ class CurveData:
     entry: Transition
     exit: Transition
 
+    @property
+    def shape(self) -> str:
+        """The spiral shape of the curve's transitions."""
+        return self.entry.shape
+
     def row(self) -> dict[str, float]:
-        """The table row: lengths, chainages, angles in degrees, rates in 1/length²."""
-        return {
-            "pi": self.index,
+        """The table row (Python numbers): lengths, chainages, angles in degrees, rates in 1/length², and the spiral shape."""
+        values = {
             "x": self.pi[0],
             "y": self.pi[1],
-            "deflection_deg": math.degrees(self.deflection),
+            "deflection": math.degrees(self.deflection),
             "radius": self.radius,
-            "theta_in_deg": math.degrees(self.theta_in),
-            "theta_out_deg": math.degrees(self.theta_out),
+            "theta_in": math.degrees(self.theta_in),
+            "theta_out": math.degrees(self.theta_out),
             "spiral_in_length": self.spiral_in_length,
             "arc_length": self.arc_length,
             "spiral_out_length": self.spiral_out_length,
@@ -120,6 +127,7 @@ class CurveData:
             "peak_dk_ds_out": self.peak_rate_out,
             "mean_dk_ds_out": 1.0 / (self.radius * self.spiral_out_length),
         }
+        return {"pi": int(self.index), **{key: float(value) for key, value in values.items()}, "spiral_shape": self.shape}
 
 
 @dataclass(frozen=True)
@@ -132,6 +140,7 @@ class Alignment:
         start_station: chainage of the first PI.
         criteria: the design criteria the curves were chosen or checked by, if any.
         checks: one ``CriteriaRow`` per curve when there are criteria.
+        shape: the spiral shape of every transition (``"near-linear"`` or ``"walton-meek"``).
     """
 
     chain: Chain
@@ -139,6 +148,7 @@ class Alignment:
     start_station: float = 0.0
     criteria: Criteria | None = None
     checks: tuple[CriteriaRow, ...] = ()
+    shape: str = "near-linear"
 
     @classmethod
     def from_pis(
@@ -155,6 +165,7 @@ class Alignment:
         max_jerk: float | None = None,
         criteria: Criteria | None = None,
         strict: bool = False,
+        shape: str = "near-linear",
     ) -> Alignment:
         """Build tangent–spiral–arc–spiral–tangent at every interior PI.
 
@@ -179,6 +190,11 @@ class Alignment:
                 ``design_speed``/``max_jerk``, with every value settable).
             strict: raise when a given spiral or radius violates a criterion
                 (by default violations are listed in ``checks``).
+            shape: the spiral shape (``spiral_cad.core.shapes``): ``"near-linear"``
+                (default: curvature almost linear in arc length, so a spiral
+                meets a jerk limit at about the clothoid's length; spiral
+                angles up to 50°) or ``"walton-meek"`` (the 1996 spiral: 1.6–1.84×
+                longer for the same jerk; any angle below 90°).
 
         With criteria and neither ``spiral_angles`` nor ``spiral_lengths``,
         each spiral is the shortest that meets every criterion (its peak
@@ -213,7 +229,10 @@ class Alignment:
             if not r > 0.0:
                 raise ValueError(f"PI {j + 1}: radius must be positive; got {r}")
         units = length_unit(units)
+        shape_code(shape, TRANSITION_SHAPES)
         criteria = _criteria(design_speed, max_jerk, criteria)
+        if criteria is not None:
+            criteria.minimum_radius(units)  # a design speed outside the side friction table is named first
         origin = float(as_float(start_station, "start_station"))
         if spiral_angles is not None and spiral_lengths is not None:
             raise ValueError("give at most one of spiral_angles and spiral_lengths")
@@ -221,7 +240,7 @@ class Alignment:
         if spiral_angles is None and spiral_lengths is None:
             if criteria is None:
                 raise ValueError("give spiral_angles or spiral_lengths, or design criteria (design_speed) to choose them")
-            shortest, longest = criteria.choose(radius, units)
+            shortest, longest = criteria.choose(radius, units, shape)
             spec = np.stack([shortest, shortest], axis=1)
         else:
             shortest = longest = None
@@ -239,12 +258,12 @@ class Alignment:
                 raise ValueError(f"PI {i} at {pts[i].tolist()} {what}: no curve can be placed there")
             deflection = math.atan2(sin_d, cos_d)
             if shortest is not None:
-                _check_choice(i, r, deflection, shortest[j], longest[j], criteria, units)
+                _check_choice(i, r, deflection, shortest[j], longest[j], criteria, units, shape)
             if by_length:
                 for side, value in zip(("entry", "exit"), spec[j]):
                     if not value > 0.0:
                         raise ValueError(f"PI {i}: {side} spiral length must be positive; got {value}")
-                thetas = [_theta_at(value, r, i, side) for side, value in zip(("entry", "exit"), spec[j])]
+                thetas = [_theta_at(value, r, i, side, shape) for side, value in zip(("entry", "exit"), spec[j])]
             else:
                 thetas = list(spec[j])
                 for side, value in zip(("entry", "exit"), thetas):
@@ -258,14 +277,20 @@ class Alignment:
                     f"θ_in + θ_out = {math.degrees(theta_in):.6g}° + {math.degrees(theta_out):.6g}°: the circular arc "
                     f"would have negative sweep {math.degrees(sweep):.4g}°; use shorter spirals or a smaller radius"
                 )
-            solved.append(_curve(pts[i], t_in, t_out, deflection, r, theta_in, theta_out))
+            try:
+                solved.append(_curve(pts[i], t_in, t_out, deflection, r, theta_in, theta_out, shape))
+            except NoSolutionError as error:
+                raise NoSolutionError(f"PI {i}: {error}") from None
 
         _check_tangents(pts, lengths, directions, solved)
         parts: list[Transition] = [t for s in solved for t in s[:2]]
-        chain = Chain.join(parts, pts[0], pts[-1], tolerance, units)
+        try:
+            chain = Chain.join(parts, pts[0], pts[-1], tolerance, units)
+        except JointError as error:
+            raise NoSolutionError(f"PI {error.part // 2 + 1}: float64 cannot hold its curve G2 at these coordinates: {error}") from None
         curves = _curve_data(chain, pts, solved, radius, origin)
-        checks = () if criteria is None else _judge(curves, criteria, units, shortest, longest, strict)
-        return cls(chain, curves, origin, criteria, checks)
+        checks = () if criteria is None else _judge(curves, criteria, units, shortest, longest, strict, shape)
+        return cls(chain, curves, origin, criteria, checks, shape)
 
     # ------------------------------------------------------- table
 
@@ -330,6 +355,7 @@ class Alignment:
 #: Dimension of each stationing column (``L`` the design's length unit).
 STATION_DIMENSIONS = {
     **dict.fromkeys(["x", "y", "radius", "spiral_in_length", "arc_length", "spiral_out_length"], "L"),
+    **dict.fromkeys(["deflection", "theta_in", "theta_out"], "deg"),
     **dict.fromkeys(["TS", "SC", "CS", "ST"], "L"),
     **dict.fromkeys(["peak_dk_ds_in", "mean_dk_ds_in", "peak_dk_ds_out", "mean_dk_ds_out"], "1/L²"),
 }
@@ -350,12 +376,14 @@ def _criteria(design_speed: Any, max_jerk: Any, criteria: Any) -> Criteria | Non
     return RoadCriteria(design_speed) if max_jerk is None else RoadCriteria(design_speed, max_jerk)
 
 
-def _check_choice(i: int, r: float, deflection: float, shortest: float, longest: float, criteria: Criteria, units: str) -> None:
+def _check_choice(
+    i: int, r: float, deflection: float, shortest: float, longest: float, criteria: Criteria, units: str, shape: str
+) -> None:
     """Refuse, naming the PI and the numbers, when no spiral meets every criterion of curve ``i``."""
-    length = lambda theta: float(length_factor(theta) * r)  # noqa: E731
+    length = lambda theta: float(length_factor(theta, shape) * r)  # noqa: E731
     if math.isnan(shortest):
         raise NoSolutionError(
-            f"PI {i}: no spiral onto R = {r:.6g} {units} up to θ = {math.degrees(THETA_RANGE[1]):.0f}° meets the "
+            f"PI {i}: no spiral onto R = {r:.6g} {units} ({shape}, up to θ = {math.degrees(search_range(shape)[1]):.3g}°) meets the "
             f"criteria at {criteria.design_speed:g} {speed_unit(units)}; use a larger radius"
         )
     if shortest > longest * (1 + 1e-12):
@@ -371,17 +399,20 @@ def _check_choice(i: int, r: float, deflection: float, shortest: float, longest:
         )
 
 
-def _judge(curves: list[CurveData], criteria: Criteria, units: str, shortest, longest, strict: bool) -> tuple[CriteriaRow, ...]:
+def _judge(
+    curves: list[CurveData], criteria: Criteria, units: str, shortest, longest, strict: bool, shape: str
+) -> tuple[CriteriaRow, ...]:
     """The criteria row of every curve; with ``strict`` any violation raises."""
     radii = np.array([c.radius for c in curves])
     if shortest is None:
-        shortest, longest = criteria.choose(radii, units)
-    spirals_low, spirals_high = (length_factor(np.nan_to_num(t, nan=THETA_RANGE[1])) * radii for t in (shortest, longest))
+        shortest, longest = criteria.choose(radii, units, shape)
+    largest = search_range(shape)[1]
+    spirals_low, spirals_high = (length_factor(np.nan_to_num(t, nan=largest), shape) * radii for t in (shortest, longest))
     thetas = np.array([(c.theta_in, c.theta_out) for c in curves])
     lengths = np.array([(c.spiral_in_length, c.spiral_out_length) for c in curves])
     rates = np.array([(c.peak_rate_in, c.peak_rate_out) for c in curves])
     bounds = np.stack([spirals_low, spirals_high], axis=1)
-    rows = tuple(criteria.evaluate([c.index for c in curves], radii, thetas, units, bounds, lengths, rates))
+    rows = tuple(criteria.evaluate([c.index for c in curves], radii, thetas, units, bounds, lengths, rates, shape))
     broken = [f"PI {row.pi}: {'; '.join(row.violations)}" for row in rows if row.violations]
     if strict and broken:
         raise NoSolutionError("design criteria violated: " + " | ".join(broken))
@@ -415,24 +446,25 @@ def _sides(value: Any, count: int, name: str) -> NDArray:
     return array
 
 
-def _theta_at(length: float, radius: float, index: int, side: str) -> float:
+def _theta_at(length: float, radius: float, index: int, side: str, shape: str) -> float:
     try:
-        return theta_for_length(length, radius)
+        return theta_for_length(length, radius, shape)
     except NoSolutionError as error:
         raise NoSolutionError(f"PI {index}: {side} {error}") from None
 
 
-def _curve(pi: NDArray, t_in: NDArray, t_out: NDArray, deflection: float, r: float, theta_in: float, theta_out: float):
+def _curve(pi: NDArray, t_in: NDArray, t_out: NDArray, deflection: float, r: float, theta_in: float, theta_out: float, shape: str):
     """Entry and exit transitions at one PI, and the circle centre."""
     side = math.copysign(1.0, deflection)
     n_in = side * np.array([-t_in[1], t_in[0]])
     n_out = side * np.array([-t_out[1], t_out[0]])
     # Theorem 4.1: offset d = r·g1(θ) of the centre from each tangent.
-    d_in = r * shape_g1(WALTON_MEEK, math.sin(theta_in), math.cos(theta_in))
-    d_out = r * shape_g1(WALTON_MEEK, math.sin(theta_out), math.cos(theta_out))
+    code = SHAPE_CODES[shape]
+    d_in = r * shape_g1(code, math.sin(theta_in), math.cos(theta_in))
+    d_out = r * shape_g1(code, math.sin(theta_out), math.cos(theta_out))
     center = pi + np.linalg.solve(np.array([n_in, n_out]), np.array([d_in, d_out]))
-    entry = line_to_circle(pi, t_in, center, r)
-    exit_ = line_to_circle(pi, -t_out, center, r).reversed()
+    entry = line_to_circle(pi, t_in, center, r, shape=shape)
+    exit_ = line_to_circle(pi, -t_out, center, r, shape=shape).reversed()
     return entry, exit_, center, deflection
 
 
@@ -463,7 +495,8 @@ def _check_tangents(pts: NDArray, lengths: NDArray, directions: NDArray, solved)
 def _curve_data(chain: Chain, pts: NDArray, solved, radius: NDArray, origin: float) -> list[CurveData]:
     stations = chain.stations
     spirals = np.array([[s[0].spirals[0].control_points, s[1].spirals[0].control_points] for s in solved])
-    peaks = peak_curvature_rate(spirals.reshape(-1, 4, 2))[0] if len(spirals) else []
+    with np.errstate(over="ignore", divide="ignore", invalid="ignore"):  # 1/L² beyond float64 is inf
+        peaks = peak_curvature_rate(spirals.reshape(-1, 4, 2))[0] if len(spirals) else []
     where = {id(seg): k for k, seg in enumerate(chain.segments)}
     curves = []
     for j, (entry, exit_, center, deflection) in enumerate(solved):

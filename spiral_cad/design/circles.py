@@ -31,11 +31,12 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from ..core._inputs import as_float, as_xy
+from ..core._inputs import as_float, as_xy, shown
 from ..core.chain import Chain
 from ..core.units import DEFAULT_UNITS
-from ..core.errors import NoSolutionError
+from ..core.errors import JointError, NoSolutionError
 from ..core.segments import TAU, Circle
+from ..core.shapes import DEFAULT_SHAPE, TRANSITION_SHAPES, shape_code
 from ..core.transitions import Transition, circle_in_circle, circle_to_circle
 
 #: Belt sweeps within this of 2π count as 0 (coincident tangent points).
@@ -59,20 +60,25 @@ class CircleChain:
     transitions: list[Transition]
     sweeps: list[float]
 
+    @property
+    def shape(self) -> str:
+        """The spiral shape of the transitions."""
+        return self.transitions[0].shape
+
 
 def _as_circle(value: Any, index: int) -> Circle:
     if isinstance(value, Circle):
         center, radius = value.center, value.radius
     else:
         if isinstance(value, (str, bytes, dict)) or not isinstance(value, Iterable):
-            raise ValueError(f"circle {index} must be a Circle, (center, radius) or (x, y, radius); got {value!r:.80}")
+            raise ValueError(f"circle {index} must be a Circle, (center, radius) or (x, y, radius); got {shown(value):.80}")
         items = list(value)
         if len(items) == 3:
             center, radius = items[:2], items[2]
         elif len(items) == 2:
             center, radius = items
         else:
-            raise ValueError(f"circle {index} must be a Circle, (center, radius) or (x, y, radius); got {value!r}")
+            raise ValueError(f"circle {index} must be a Circle, (center, radius) or (x, y, radius); got {shown(value):.80}")
     center = as_xy(center, f"circle {index} center")
     radius = as_float(radius, f"circle {index} radius")
     if radius == 0.0:
@@ -110,7 +116,7 @@ def _reference(circle: Circle, other: Circle, contact: NDArray | None) -> NDArra
         return contact
     c, o = np.array(circle.center), np.array(other.center)
     away = (o - c) if abs(circle.radius) > abs(other.radius) else (c - o)
-    return c + abs(circle.radius) * away / np.hypot(*away)
+    return c + abs(circle.radius) * (away / np.hypot(*away))  # unit vector first: r·away may overflow
 
 
 def _sense_angle(circle: Circle, a: NDArray, b: NDArray) -> float:
@@ -121,7 +127,7 @@ def _sense_angle(circle: Circle, a: NDArray, b: NDArray) -> float:
     return math.pi - (math.pi - turn) % TAU
 
 
-def circle_chain(circles: Sequence[Any], units: str = DEFAULT_UNITS) -> CircleChain:
+def circle_chain(circles: Sequence[Any], units: str = DEFAULT_UNITS, shape: str = DEFAULT_SHAPE) -> CircleChain:
     """A G2 path round ``circles`` in order, with spiral transitions between them.
 
     Args:
@@ -129,6 +135,9 @@ def circle_chain(circles: Sequence[Any], units: str = DEFAULT_UNITS) -> CircleCh
             or ``(x, y, radius)``; the radius sign is the travel sense
             (positive counterclockwise).
         units: length unit of centres and radii (default mm).
+        shape: spiral shape of every transition: ``"walton-meek"`` (default,
+            the paper's geometry) or ``"near-linear"`` (curvature closer to
+            linear in arc length; C and S pairs reach less far apart circles).
 
     Each consecutive pair gets ``circle_in_circle`` when nested (same sense,
     one inside the other) and ``circle_to_circle`` otherwise (C for equal
@@ -143,19 +152,25 @@ def circle_chain(circles: Sequence[Any], units: str = DEFAULT_UNITS) -> CircleCh
     if isinstance(circles, (str, bytes, dict)) or not isinstance(circles, Iterable):
         raise ValueError(f"circles must be a list of circles; got {type(circles).__name__}")
     items = [_as_circle(c, i) for i, c in enumerate(circles)]
+    shape_code(shape, TRANSITION_SHAPES)
     if len(items) < 2:
         raise ValueError(f"circle_chain needs at least 2 circles; got {len(items)}")
     transitions = []
     for i, (a, b) in enumerate(zip(items, items[1:])):
         solve = circle_in_circle if _nested(a, b) else circle_to_circle
         try:
-            transitions.append(solve(a.center, a.radius, b.center, b.radius))
+            transitions.append(solve(a.center, a.radius, b.center, b.radius, shape=shape))
         except NoSolutionError as error:
             raise NoSolutionError(f"circles {i} and {i + 1}: {error}") from None
     sweeps = []
     for k in range(1, len(items) - 1):
         sweeps.append(_arc_sweep(items, transitions, k))
-    return CircleChain(Chain.join(transitions, units=units), items, transitions, sweeps)
+    try:
+        chain = Chain.join(transitions, units=units)
+    except JointError as error:
+        k = error.part
+        raise NoSolutionError(f"circles {k} and {k + 1}: float64 cannot hold the path G2 at these coordinates: {error}") from None
+    return CircleChain(chain, items, transitions, sweeps)
 
 
 def _arc_sweep(items: list[Circle], transitions: list[Transition], k: int) -> float:

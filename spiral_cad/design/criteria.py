@@ -37,20 +37,15 @@ ramps linearly along the spiral, and the cant deficiency I(s) = G·v²·κ(s)/g
 
 from __future__ import annotations
 
-import math
 from abc import ABC, abstractmethod
 from dataclasses import dataclass
-from functools import lru_cache
 from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
-from scipy.interpolate import CubicSpline
 
-from ..core import _kernels as K
-from ..core import batch
-from ..core._inputs import as_float
-from ..core.bezier import arc_length, curvature_rate, peak_curvature_rate
+from ..core._inputs import as_float, shown
+from ..core.factors import length_factor, peak_rate_factor, search_range, shift_factor, unit_spirals  # noqa: F401  (unit_spirals: public here too)
 from ..core.units import IMPERIAL, speed_unit, to_metres
 
 GRAVITY = 9.80665
@@ -64,70 +59,11 @@ SIDE_FRICTION_MPH = ((10, 0.38), (15, 0.32), (20, 0.27), (25, 0.23), (30, 0.20),
                      (45, 0.15), (50, 0.14), (55, 0.13), (60, 0.12), (65, 0.11), (70, 0.10), (75, 0.09),
                      (80, 0.08))  # fmt: skip
 
-#: Spiral angles searched for the shortest spiral (beyond ~80° the legs explode).
-THETA_RANGE = (1e-6, math.radians(80.0))
-
-
-def unit_spirals(theta: NDArray) -> NDArray:
-    """Control points (N, 4, 2) of Theorem 3.1 spirals of angles ``theta`` and end radius 1."""
-    theta = np.asarray(theta, dtype=float).ravel()
-    out = np.empty((len(theta), 4, 2))
-    K.unit_spirals_batch(np.sin(theta), np.cos(theta), K.WALTON_MEEK, out)
-    return out
-
-
-def shift_angle(shift: NDArray, radius: NDArray) -> NDArray:
-    """The θ whose spiral shifts its circle ``shift`` off the tangent (p = r(g1(θ) − 1), Theorem 4.1);
-    0 for a shift ≤ 0 (every spiral shifts its circle)."""
-    shift, radius = np.broadcast_arrays(np.asarray(shift, dtype=float), np.asarray(radius, dtype=float))
-    centres = np.stack([np.zeros(shift.size), (radius + np.maximum(shift, 0.0)).ravel()], axis=1)
-    theta = batch.line_to_circle([0.0, 0.0], [1.0, 0.0], centres, radius.ravel()).theta.reshape(shift.shape)
-    return np.where(shift > 0.0, theta, 0.0)
-
-
-@lru_cache(maxsize=1)
-def _interior_peak() -> tuple[float, CubicSpline]:
-    """Where the peak of |dκ/ds| leaves the spiral's start, and a spline of log F beyond it.
-
-    For small θ the unit spiral's (end radius 1) largest |dκ/ds| is at its
-    start u = 0, in closed form; from θ_k ≈ 27° on an interior maximum takes
-    over, smooth in θ, and is interpolated (cubic, ~1e-13 relative) from
-    2 049 measured spirals. The numbers reported for a design are measured on
-    its own spirals.
-    """
-    lo, hi = 0.2, 0.8
-    for _ in range(50):
-        mid = 0.5 * (lo + hi)
-        if peak_curvature_rate(unit_spirals([mid])[0])[1] > 1e-6:
-            hi = mid
-        else:
-            lo = mid
-    theta = np.linspace(hi, THETA_RANGE[1], 2049)
-    return hi, CubicSpline(theta, np.log(peak_curvature_rate(unit_spirals(theta))[0]))
-
-
-def peak_factor(theta: NDArray) -> NDArray:
-    """F(θ): the peak |dκ/ds| of unit spirals (end radius 1); a spiral onto radius r peaks at F/r².
-
-    Exact (at the spiral's start) below θ_k, interpolated above (see ``_interior_peak``).
-    """
-    theta = np.asarray(theta, dtype=float)
-    start = np.abs(curvature_rate(unit_spirals(theta), 0.0)).reshape(theta.shape)
-    switch, spline = _interior_peak()
-    return np.where(theta < switch, start, np.exp(spline(np.clip(theta, switch, THETA_RANGE[1]))))
-
-
-def length_factor(theta: NDArray) -> NDArray:
-    """ℓ(θ): the length of unit spirals (end radius 1); a spiral onto radius r is r·ℓ long."""
-    theta = np.asarray(theta, dtype=float)
-    return arc_length(unit_spirals(theta)).reshape(theta.shape)
-
-
-def _smallest_theta(ok, count: int) -> NDArray:
-    """Vectorised bisection: for each of ``count`` curves the smallest θ with ``ok(θ)`` true
-    (``ok`` is monotone: false below, true above); NaN where even the largest θ fails."""
-    lo = np.full(count, THETA_RANGE[0])
-    hi = np.full(count, THETA_RANGE[1])
+def _smallest_theta(ok, count: int, theta_range: tuple[float, float]) -> NDArray:
+    """Vectorised bisection: for each of ``count`` curves the smallest θ in ``theta_range`` with
+    ``ok(θ)`` true (``ok`` is monotone: false below, true above); NaN where even the largest θ fails."""
+    lo = np.full(count, theta_range[0])
+    hi = np.full(count, theta_range[1])
     feasible = ok(hi)
     done = ok(lo)
     for _ in range(64):  # in log θ: the bracket ends within 1e-15 relative
@@ -135,7 +71,7 @@ def _smallest_theta(ok, count: int) -> NDArray:
         good = ok(mid)
         hi = np.where(good, mid, hi)
         lo = np.where(good, lo, mid)
-    return np.where(done, THETA_RANGE[0], np.where(feasible, hi, np.nan))
+    return np.where(done, theta_range[0], np.where(feasible, hi, np.nan))
 
 
 @dataclass(frozen=True)
@@ -161,14 +97,15 @@ class CriteriaRow:
     violations: tuple[str, ...] = ()
     quantity: str = "peak lateral jerk"
     rate_unit: str = "m/s³"
+    shape: str = "near-linear"
 
     @property
     def ok(self) -> bool:
         return not self.violations
 
     def row(self) -> dict[str, Any]:
-        return {
-            "pi": self.pi,
+        """The table row: Python numbers, and the verdict as text."""
+        values = {
             "radius": self.radius,
             "R_min": self.minimum_radius,
             "L_in": self.spiral_lengths[0],
@@ -181,8 +118,10 @@ class CriteriaRow:
             f"{self.quantity.replace(' ', '_')}_out": self.peak_rates[1],
             "limit": self.limit,
             "banking": self.banking,
-            "verdict": "ok" if self.ok else "; ".join(self.violations),
         }
+        verdict = "ok" if self.ok else "; ".join(self.violations)
+        numbers = {key: float(value) for key, value in values.items()}
+        return {"pi": int(self.pi), **numbers, "spiral_shape": self.shape, "verdict": verdict}
 
 
 @dataclass(frozen=True)
@@ -195,43 +134,61 @@ class _Criteria(ABC):
         speed = as_float(self.design_speed, "design_speed")
         if not speed > 0:
             raise ValueError(f"design_speed must be positive; got {speed!r}")
+        object.__setattr__(self, "design_speed", speed)  # a plain float (not numpy) in tables and messages
+
+    def _set_floats(self, names: tuple[str, ...], positive: bool) -> None:
+        """Each field in ``names`` (None skipped) as a plain float, > 0 (``positive``) or ≥ 0, else ValueError."""
+        for name in names:
+            value = getattr(self, name)
+            if value is None:
+                continue
+            number = as_float(value, name)
+            if not (number > 0.0 if positive else number >= 0.0):
+                raise ValueError(f"{name} must be {'positive' if positive else '≥ 0'}; got {shown(value)}")
+            object.__setattr__(self, name, number)
 
     def speed(self, units: str) -> float:
         """The design speed in m/s (given in km/h for metric designs, mph for in/ft)."""
         return self.design_speed * (MPH if units in IMPERIAL else KMH)
 
     @abstractmethod
-    def _lower_ok(self, theta: NDArray, radius: NDArray, units: str) -> NDArray:
-        """Whether spirals θ onto ``radius`` meet every criterion that a longer spiral meets too."""
+    def _lower_ok(self, theta: NDArray, radius: NDArray, units: str, shape: str) -> NDArray:
+        """Whether spirals θ of ``shape`` onto ``radius`` meet every criterion that a longer spiral meets too."""
 
     @abstractmethod
-    def _upper_ok(self, theta: NDArray, radius: NDArray, units: str) -> NDArray:
-        """Whether spirals θ meet every criterion that a shorter spiral meets too."""
+    def _upper_ok(self, theta: NDArray, radius: NDArray, units: str, shape: str) -> NDArray:
+        """Whether spirals θ of ``shape`` meet every criterion that a shorter spiral meets too."""
 
     @abstractmethod
     def minimum_radius(self, units: str) -> float:
         """R_min in the design's unit."""
 
     @abstractmethod
-    def evaluate(self, pis, radii, thetas, units: str, bounds, lengths, peak_rates) -> list[CriteriaRow]:
+    def evaluate(self, pis, radii, thetas, units: str, bounds, lengths, peak_rates, shape: str) -> list[CriteriaRow]:
         """The criteria rows of curves at PIs ``pis`` (N,) onto ``radii`` (N,) with entry and exit
-        spiral angles ``thetas`` (N, 2), the length ``bounds`` (N, 2) the criteria allow, and the
+        spiral angles ``thetas`` (N, 2) of ``shape``, the length ``bounds`` (N, 2) the criteria allow, and the
         spirals' measured ``lengths`` (N, 2, design units) and ``peak_rates`` of dκ/ds (N, 2, 1/unit²)."""
 
-    def choose(self, radii: NDArray, units: str) -> tuple[NDArray, NDArray]:
-        """The shortest spiral angle meeting every lower bound, and the longest meeting
-        every upper bound, for each radius (NaN where none exists)."""
+    @np.errstate(over="ignore", divide="ignore", invalid="ignore")  # inf/NaN fail the bounds; no warnings
+    def choose(self, radii: NDArray, units: str, shape: str = "near-linear") -> tuple[NDArray, NDArray]:
+        """The shortest spiral angle of ``shape`` meeting every lower bound, and the longest
+        meeting every upper bound, for each radius (NaN where none exists).
+
+        Angles are searched in ``core.factors.search_range(shape)``, where a longer
+        spiral never has a higher peak dκ/ds."""
         radii = np.asarray(radii, dtype=float)
-        shortest = _smallest_theta(lambda t: self._lower_ok(t, radii, units), len(radii))
-        longest_fails = _smallest_theta(lambda t: ~self._upper_ok(t, radii, units), len(radii))
-        longest = np.where(np.isnan(longest_fails), THETA_RANGE[1], longest_fails)
+        theta_range = search_range(shape)
+        shortest = _smallest_theta(lambda t: self._lower_ok(t, radii, units, shape), len(radii), theta_range)
+        longest_fails = _smallest_theta(lambda t: ~self._upper_ok(t, radii, units, shape), len(radii), theta_range)
+        longest = np.where(np.isnan(longest_fails), theta_range[1], longest_fails)
         return shortest, longest
 
     @staticmethod
-    def _shifts(theta: NDArray, radius: NDArray) -> NDArray:
-        """The shift p = r·(g1(θ) − 1) of each spiral's circle (design units)."""
-        g1 = np.array([K.shape_g1(K.WALTON_MEEK, math.sin(t), math.cos(t)) for t in np.ravel(theta)]).reshape(np.shape(theta))
-        return radius * (g1 - 1.0)
+    def _shifts(theta: NDArray, radius: NDArray, shape: str) -> NDArray:
+        """The shift p = r·(g1(θ) − 1) of each spiral's circle off its tangent (design units; Theorem 4.1).
+
+        p grows with θ, so the shift bounds are bounds on θ."""
+        return radius * shift_factor(theta, shape)
 
 
 @dataclass(frozen=True)
@@ -255,13 +212,8 @@ class RoadCriteria(_Criteria):
 
     def __post_init__(self) -> None:
         super().__post_init__()
-        for name in ("max_jerk", "superelevation_max"):
-            if not as_float(getattr(self, name), name) > 0:
-                raise ValueError(f"{name} must be positive; got {getattr(self, name)!r}")
-        for name in ("side_friction", "shift_min", "shift_max"):
-            value = getattr(self, name)
-            if value is not None and not as_float(value, name) >= 0:
-                raise ValueError(f"{name} must be ≥ 0; got {value!r}")
+        self._set_floats(("max_jerk", "superelevation_max"), positive=True)
+        self._set_floats(("side_friction", "shift_min", "shift_max"), positive=False)
 
     def friction(self, units: str) -> float:
         """f: given, or AASHTO's table value at the design speed (linear between rows)."""
@@ -280,8 +232,8 @@ class RoadCriteria(_Criteria):
         """R_min in the design's unit."""
         e_f = self.superelevation_max + self.friction(units)
         if units in IMPERIAL:
-            return self.design_speed**2 / (15.0 * e_f) * 0.3048 / to_metres(units)
-        return self.design_speed**2 / (127.0 * e_f) / to_metres(units)
+            return self.design_speed * self.design_speed / (15.0 * e_f) * 0.3048 / to_metres(units)
+        return self.design_speed * self.design_speed / (127.0 * e_f) / to_metres(units)
 
     def superelevation(self, radius: float, units: str) -> float:
         """e = e_max·R_min/R, at most e_max (AASHTO's method 1)."""
@@ -293,35 +245,39 @@ class RoadCriteria(_Criteria):
         high = 1.0 / metres if self.shift_max is None else float(self.shift_max)
         return low, high
 
-    def _jerk(self, theta: NDArray, radius: NDArray, units: str) -> NDArray:
-        return self.speed(units) ** 3 * peak_factor(theta) / (radius * to_metres(units)) ** 2
+    def _jerk(self, theta: NDArray, radius: NDArray, units: str, shape: str) -> NDArray:
+        v = self.speed(units)  # v·v·v: inf, not OverflowError, for a design speed of 1e300
+        return v * v * v * peak_rate_factor(theta, shape) / (radius * to_metres(units)) ** 2
 
-    def _lower_ok(self, theta, radius, units):
+    def _lower_ok(self, theta, radius, units, shape):
         low = self.shifts(units)[0]
-        return (self._jerk(theta, radius, units) <= self.max_jerk) & (theta >= shift_angle(low, radius))
+        return (self._jerk(theta, radius, units, shape) <= self.max_jerk) & (self._shifts(theta, radius, shape) >= low)
 
-    def _upper_ok(self, theta, radius, units):
-        return theta <= shift_angle(self.shifts(units)[1], radius)
+    def _upper_ok(self, theta, radius, units, shape):
+        return self._shifts(theta, radius, shape) <= self.shifts(units)[1]
 
-    def evaluate(self, pis, radii, thetas, units: str, bounds, lengths, peak_rates) -> list[CriteriaRow]:
+    @np.errstate(over="ignore", divide="ignore", invalid="ignore")  # inf/NaN rates are violations (``not x <= limit``)
+    def evaluate(self, pis, radii, thetas, units: str, bounds, lengths, peak_rates, shape) -> list[CriteriaRow]:
         radii = np.asarray(radii, dtype=float)
-        shifts = self._shifts(np.asarray(thetas), radii[:, None])
-        jerks = self.speed(units) ** 3 * np.asarray(peak_rates) / to_metres(units) ** 2
+        shifts = self._shifts(np.asarray(thetas), radii[:, None], shape)
+        v = self.speed(units)
+        jerks = v * v * v * np.asarray(peak_rates) / to_metres(units) ** 2
         low, high = self.shifts(units)
         r_min = self.minimum_radius(units)
         rows = []
         for pi, radius, length, shift, jerk, bound in zip(pis, radii, lengths, shifts, jerks, bounds):
-            violations = [f"R = {radius:.6g} < R_min = {r_min:.6g}"] if radius < r_min * (1 - 1e-12) else []
+            violations = [f"R = {radius:.6g} < R_min = {r_min:.6g}"] if not radius >= r_min * (1 - 1e-12) else []
             for side, j, p in zip(("in", "out"), jerk, shift):
-                if j > self.max_jerk * (1 + 1e-9):
+                if not j <= self.max_jerk * (1 + 1e-9):
                     violations.append(f"{side}: peak jerk {j:.4g} m/s³ > C = {self.max_jerk:g}")
-                if p < low * (1 - 1e-9):
+                if not p >= low * (1 - 1e-9):
                     violations.append(f"{side}: shift p = {p:.4g} < p_min = {low:.4g}")
-                if p > high * (1 + 1e-9):
+                if not p <= high * (1 + 1e-9):
                     violations.append(f"{side}: shift p = {p:.4g} > p_max = {high:.4g}")
             e = self.superelevation(radius, units)
             rows.append(CriteriaRow(int(pi), float(radius), r_min, tuple(map(float, length)), tuple(map(float, bound)),
-                                    tuple(map(float, shift)), tuple(map(float, jerk)), self.max_jerk, e, e, tuple(violations)))  # fmt: skip
+                                    tuple(map(float, shift)), tuple(map(float, jerk)), self.max_jerk, e, e, tuple(violations),
+                                    shape=shape))  # fmt: skip
         return rows
 
 
@@ -339,20 +295,18 @@ class RailCriteria(_Criteria):
 
     def __post_init__(self) -> None:
         super().__post_init__()
-        for name in ("cant_max", "cant_deficiency_max", "cant_rate_max", "cant_deficiency_rate_max", "cant_gradient_max", "gauge"):
-            if not as_float(getattr(self, name), name) > 0:
-                raise ValueError(f"{name} must be positive; got {getattr(self, name)!r}")
-        if self.cant is not None and not as_float(self.cant, "cant") >= 0:
-            raise ValueError(f"cant must be ≥ 0 mm; got {self.cant!r}")
+        limits = ("cant_max", "cant_deficiency_max", "cant_rate_max", "cant_deficiency_rate_max", "cant_gradient_max", "gauge")
+        self._set_floats(limits, positive=True)
+        self._set_floats(("cant",), positive=False)
 
     def minimum_radius(self, units: str) -> float:
         """R_min = G·v²/(g·(D_max + I_max)), in the design's unit."""
-        metres = self.gauge * self.speed(units) ** 2 / (GRAVITY * (self.cant_max + self.cant_deficiency_max))
+        metres = self.gauge * self.speed(units) * self.speed(units) / (GRAVITY * (self.cant_max + self.cant_deficiency_max))
         return metres / to_metres(units)
 
     def equilibrium_cant(self, radius: NDArray, units: str) -> NDArray:
         """E = G·v²/(g·R) in mm."""
-        return self.gauge * self.speed(units) ** 2 / (GRAVITY * np.asarray(radius) * to_metres(units))
+        return self.gauge * self.speed(units) * self.speed(units) / (GRAVITY * np.asarray(radius) * to_metres(units))
 
     def applied_cant(self, radius: NDArray, units: str) -> NDArray:
         """D: the given cant, else min(E, cant_max), in mm."""
@@ -360,12 +314,12 @@ class RailCriteria(_Criteria):
             return np.full(np.shape(radius), float(self.cant))
         return np.minimum(self.equilibrium_cant(radius, units), self.cant_max)
 
-    def _rates(self, theta: NDArray, radius: NDArray, units: str, factors=None):
+    def _rates(self, theta: NDArray, radius: NDArray, units: str, shape: str, factors=None):
         """(cant rate, cant gradient, peak cant deficiency rate) of spirals θ onto radius, from
         their peak dκ/ds (1/m²) and length (m): the given ``factors``, else from F(θ), ℓ(θ)."""
         metres = np.asarray(radius) * to_metres(units)
         if factors is None:
-            peak, length = peak_factor(theta) / metres**2, length_factor(theta) * metres
+            peak, length = peak_rate_factor(theta, shape) / metres**2, length_factor(theta, shape) * metres
         else:
             peak, length = factors
         v = self.speed(units)
@@ -374,21 +328,22 @@ class RailCriteria(_Criteria):
         deficiency_rate = v * np.maximum(self.gauge * v * v / GRAVITY * peak - cant / length, cant / length)
         return v * cant / length, cant / length, deficiency_rate
 
-    def _lower_ok(self, theta, radius, units):
-        cant_rate, gradient, deficiency_rate = self._rates(theta, radius, units)
+    def _lower_ok(self, theta, radius, units, shape):
+        cant_rate, gradient, deficiency_rate = self._rates(theta, radius, units, shape)
         return (cant_rate <= self.cant_rate_max) & (gradient <= self.cant_gradient_max) & (deficiency_rate <= self.cant_deficiency_rate_max)
 
-    def _upper_ok(self, theta, radius, units):
+    def _upper_ok(self, theta, radius, units, shape):
         return np.ones(np.shape(theta), dtype=bool)
 
-    def evaluate(self, pis, radii, thetas, units: str, bounds, lengths, peak_rates) -> list[CriteriaRow]:
+    @np.errstate(over="ignore", divide="ignore", invalid="ignore")  # inf/NaN rates are violations (``not x <= limit``)
+    def evaluate(self, pis, radii, thetas, units: str, bounds, lengths, peak_rates, shape) -> list[CriteriaRow]:
         radii = np.asarray(radii, dtype=float)
         thetas = np.asarray(thetas)
         lengths = np.asarray(lengths)
-        shifts = self._shifts(thetas, radii[:, None])
+        shifts = self._shifts(thetas, radii[:, None], shape)
         metres = to_metres(units)
         factors = (np.asarray(peak_rates) / metres**2, lengths * metres)
-        cant_rates, gradients, deficiency_rates = self._rates(thetas, radii[:, None], units, factors)
+        cant_rates, gradients, deficiency_rates = self._rates(thetas, radii[:, None], units, shape, factors)
         cants = self.applied_cant(radii, units)
         deficiencies = self.equilibrium_cant(radii, units) - cants
         r_min = self.minimum_radius(units)
@@ -396,17 +351,17 @@ class RailCriteria(_Criteria):
                   ("cant deficiency rate", self.cant_deficiency_rate_max))  # fmt: skip
         rows = []
         for k, (pi, radius) in enumerate(zip(pis, radii)):
-            violations = [f"R = {radius:.6g} < R_min = {r_min:.6g}"] if radius < r_min * (1 - 1e-12) else []
-            if deficiencies[k] > self.cant_deficiency_max * (1 + 1e-9):
+            violations = [f"R = {radius:.6g} < R_min = {r_min:.6g}"] if not radius >= r_min * (1 - 1e-12) else []
+            if not deficiencies[k] <= self.cant_deficiency_max * (1 + 1e-9):
                 violations.append(f"cant deficiency {deficiencies[k]:.4g} mm > {self.cant_deficiency_max:g}")
             for j, side in enumerate(("in", "out")):
                 for values, (what, limit) in zip((cant_rates, gradients, deficiency_rates), limits):
-                    if values[k, j] > limit * (1 + 1e-9):
+                    if not values[k, j] <= limit * (1 + 1e-9):
                         violations.append(f"{side}: {what} {values[k, j]:.4g} > {limit:g}")
             rows.append(CriteriaRow(int(pi), float(radius), r_min, tuple(map(float, lengths[k])), tuple(map(float, bounds[k])),
                                     tuple(map(float, shifts[k])), tuple(map(float, deficiency_rates[k])),
                                     self.cant_deficiency_rate_max, float(cants[k]), float(cants[k]) / self.gauge,
-                                    tuple(violations), "peak cant deficiency rate", "mm/s"))  # fmt: skip
+                                    tuple(violations), "peak cant deficiency rate", "mm/s", shape))  # fmt: skip
         return rows
 
 

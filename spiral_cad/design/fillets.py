@@ -33,6 +33,7 @@ reach. Corners that are already tangent are left as they are.
 from __future__ import annotations
 
 import math
+import operator
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
 from typing import Any
@@ -41,10 +42,11 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ..core import _kernels as K
-from ..core._inputs import as_float, as_points
+from ..core._inputs import as_float, as_points, shown
 from ..core.chain import JOIN_TOLERANCE, Chain, g2_mismatch, join_tolerance
 from ..core.errors import NoSolutionError
 from ..core.segments import Arc, Circle, Line, Ray, Segment
+from ..core.shapes import DEFAULT_SHAPE, SHAPE_CODES, TRANSITION_SHAPES, shape_code, shape_limits
 from ..core.transitions import Transition, circle_in_circle, circle_to_circle, line_to_circle
 from ..core.units import DEFAULT_UNITS
 
@@ -89,6 +91,8 @@ class FilletedPath:
     corners: list[FilletCorner]
     closed: bool
     units: str = DEFAULT_UNITS
+    #: The vertex of the corner each segment belongs to (None: a trimmed original edge).
+    owners: tuple[int | None, ...] = ()
 
     @property
     def chain(self) -> Chain:
@@ -115,7 +119,32 @@ def _as_segments(path: Any) -> list[Segment]:
     points = as_points(path, "path")
     if points.ndim != 2 or len(points) < 2:
         raise ValueError(f"path must be lines and arcs, or (n ≥ 2, 2) points; got shape {points.shape}")
+    for i, (a, b) in enumerate(zip(points[:-1], points[1:])):
+        if np.array_equal(a, b):
+            raise ValueError(f"path points {i} and {i + 1} coincide at {tuple(a.tolist())}")
     return [Line(a, b) for a, b in zip(points[:-1], points[1:])]
+
+
+def _integer(value: Any) -> int | None:
+    """``value`` as an int when it is an integer (numpy integers too; not a bool, float or string), else None."""
+    if isinstance(value, (bool, np.bool_)):
+        return None
+    try:
+        return operator.index(value)
+    except TypeError:
+        return None
+
+
+def _vertex_indices(vertices: Any) -> list[int]:
+    """``vertices`` as sorted distinct ints; anything that is not an integer (1.5, '1', True) is refused by name."""
+    if isinstance(vertices, (str, bytes)) or not isinstance(vertices, Iterable):
+        raise ValueError(f"vertices must be a list of vertex indices; got {type(vertices).__name__} {shown(vertices):.80}")
+    items = list(vertices)
+    indices = [_integer(v) for v in items]
+    for i, (v, index) in enumerate(zip(items, indices)):
+        if index is None:
+            raise ValueError(f"vertices[{i}] must be a vertex index (an integer); got {type(v).__name__} {shown(v):.80}")
+    return sorted(set(indices))
 
 
 def _side_geometry(segment: Segment, at_end: bool) -> tuple[str, Any]:
@@ -126,21 +155,22 @@ def _side_geometry(segment: Segment, at_end: bool) -> tuple[str, Any]:
     return "arc", segment.circle
 
 
-def _offset_g1(theta: float) -> float:
-    return K.shape_g1(K.WALTON_MEEK, math.sin(theta), math.cos(theta))
+def _offset_g1(theta: float, shape: str) -> float:
+    return K.shape_g1(SHAPE_CODES[shape], math.sin(theta), math.cos(theta))
 
 
-def _center_distance(kind: str, theta: float, side_radius: float, r: float) -> float:
+def _center_distance(kind: str, theta: float, side_radius: float, r: float, shape: str) -> float:
     """Distance from an arc side's centre to the fillet circle's for transition angle θ."""
     a0, a1 = abs(side_radius), r
     s, c = math.sin(theta), math.cos(theta)
-    g1, g2 = K.shape_g1(K.WALTON_MEEK, s, c), K.shape_g2(K.WALTON_MEEK, s, c)
+    code = SHAPE_CODES[shape]
+    g1, g2 = K.shape_g1(code, s, c), K.shape_g2(code, s, c)
     if kind == "S":
         return (a0 + a1) * math.hypot(g1, g2)
     if kind == "C":
         return math.hypot((a0 + a1) * g2, (a1 - a0) * g1)
     big, small = max(a0, a1), min(a0, a1)
-    x, y = K.nested_center_offset(theta, big, small, K.WALTON_MEEK)[:2]
+    x, y = K.nested_center_offset(theta, big, small, code)[:2]
     return math.hypot(x, y)
 
 
@@ -148,11 +178,11 @@ def _arc_kind(circle: Circle, turn: float, same_sense: str) -> str:
     return same_sense if (circle.radius > 0) == (turn > 0) else "S"
 
 
-def _locus(kind: str, geometry: Any, theta: float, r: float, turn: float, same_sense: str):
+def _locus(kind: str, geometry: Any, theta: float, r: float, turn: float, same_sense: str, shape: str):
     """Where the fillet centre may lie for this side: ("line", point, direction) or ("circle", centre, distance)."""
     if kind == "line":
         (px, py), (tx, ty) = geometry.point, geometry.direction
-        offset = math.copysign(r * _offset_g1(theta), turn)
+        offset = math.copysign(r * _offset_g1(theta, shape), turn)
         return "line", np.array([px - ty * offset, py + tx * offset]), np.array([tx, ty])
     transition = _arc_kind(geometry, turn, same_sense)
     if transition == "nested" and abs(abs(geometry.radius) - r) <= 1e-12 * r:
@@ -160,11 +190,28 @@ def _locus(kind: str, geometry: Any, theta: float, r: float, turn: float, same_s
             f"the fillet radius equals the arc's ({r:.6g}): no single spiral joins equal nested circles; "
             "change the radius or use same_sense='C'"
         )
-    return "circle", np.array(geometry.center), _center_distance(transition, theta, geometry.radius, r)
+    return "circle", np.array(geometry.center), _center_distance(transition, theta, geometry.radius, r, shape)
 
 
 def _intersect(a, b, near: NDArray) -> NDArray | None:
-    """The intersection of two loci nearest ``near`` (None when they do not meet)."""
+    """The intersection of two loci nearest ``near`` (None when they do not meet).
+
+    Solved relative to ``near`` and scaled by a power of two (exact), so the
+    squares of distances neither overflow nor underflow at any magnitude.
+    """
+    offsets = [float(np.abs(point - near).max()) for _, point, _ in (a, b)]
+    size = max(offsets + [abs(distance) for kind, _, distance in (a, b) if kind == "circle"])
+    exponent = math.frexp(size)[1] if math.isfinite(size) else 0
+    local = [(kind, np.ldexp(point - near, -exponent), other if kind == "line" else math.ldexp(other, -exponent))
+             for kind, point, other in (a, b)]  # fmt: skip
+    root = _nearest_intersection(*local)
+    if root is None or not np.isfinite(root).all():
+        return None
+    return near + np.ldexp(root, exponent)
+
+
+def _nearest_intersection(a, b) -> NDArray | None:
+    """The intersection of two loci nearest the origin (None when they do not meet)."""
     if a[0] == "circle" and b[0] == "line":
         a, b = b, a
     if a[0] == "line" and b[0] == "line":
@@ -194,24 +241,24 @@ def _intersect(a, b, near: NDArray) -> NDArray | None:
         base = c0 + along * unit
         normal = np.array([-unit[1], unit[0]])
         roots = [base + h * normal, base - h * normal]
-    return min(roots, key=lambda x: float(np.hypot(*(x - near))))
+    return min(roots, key=lambda x: float(np.hypot(*x)))
 
 
-def _transition_onto(kind: str, geometry: Any, center: NDArray, r: float, same_sense: str) -> Transition:
+def _transition_onto(kind: str, geometry: Any, center: NDArray, r: float, same_sense: str, shape: str) -> Transition:
     """From the incoming side's geometry onto the fillet circle (center, r signed)."""
     if kind == "line":
-        return line_to_circle(geometry.point, geometry.direction, center, abs(r))
+        return line_to_circle(geometry.point, geometry.direction, center, abs(r), shape=shape)
     solve = circle_in_circle if _arc_kind(geometry, r, same_sense) == "nested" else circle_to_circle
-    return solve(geometry.center, geometry.radius, center, r)
+    return solve(geometry.center, geometry.radius, center, r, shape=shape)
 
 
-def _transition_off(kind: str, geometry: Any, center: NDArray, r: float, same_sense: str) -> Transition:
+def _transition_off(kind: str, geometry: Any, center: NDArray, r: float, same_sense: str, shape: str) -> Transition:
     """From the fillet circle (center, r signed) onto the outgoing side's geometry."""
     if kind == "line":
         (px, py), (tx, ty) = geometry.point, geometry.direction
-        return line_to_circle((px, py), (-tx, -ty), center, abs(r)).reversed()
+        return line_to_circle((px, py), (-tx, -ty), center, abs(r), shape=shape).reversed()
     solve = circle_in_circle if _arc_kind(geometry, r, same_sense) == "nested" else circle_to_circle
-    return solve(center, r, geometry.center, geometry.radius)
+    return solve(center, r, geometry.center, geometry.radius, shape=shape)
 
 
 def _signed_sweep(center: NDArray, radius: float, a: NDArray, b: NDArray) -> float:
@@ -221,18 +268,27 @@ def _signed_sweep(center: NDArray, radius: float, a: NDArray, b: NDArray) -> flo
     return math.pi - (math.pi - turn) % (2.0 * math.pi)
 
 
-def _round_corner(vertex: int, before: Segment, after: Segment, radius: float, transition: float, same_sense: str) -> FilletCorner:
+def _round_corner(
+    vertex: int, before: Segment, after: Segment, radius: float, transition: float, same_sense: str, shape: str
+) -> FilletCorner:
     (_, _, tx0, ty0, _), (x, y, tx1, ty1, _) = before.ends[1], after.ends[0]
     turn = math.atan2(tx0 * ty1 - ty0 * tx1, tx0 * tx1 + ty0 * ty1)
     where = f"corner {vertex} at ({x:.10g}, {y:.10g})"
     if abs(turn) > math.pi - 1e-9:
         raise NoSolutionError(f"{where}: the path folds straight back (turn {math.degrees(turn):.6g}°); no fillet exists")
     theta = transition * abs(turn) / 2.0
+    largest = shape_limits(shape)["theta"]
+    if not theta < largest or (theta == largest and shape == "near-linear"):
+        raise NoSolutionError(
+            f"{where}: its transitions turn {math.degrees(theta):.6g}° each (transition {transition:g} × half the "
+            f"{math.degrees(abs(turn)):.6g}° turn), beyond {math.degrees(largest):g}° for {shape} spirals; use a smaller "
+            "transition or shape='walton-meek'"
+        )
     kind_in, geometry_in = _side_geometry(before, at_end=True)
     kind_out, geometry_out = _side_geometry(after, at_end=False)
     try:
-        locus_in = _locus(kind_in, geometry_in, theta, radius, turn, same_sense)
-        locus_out = _locus(kind_out, geometry_out, theta, radius, turn, same_sense)
+        locus_in = _locus(kind_in, geometry_in, theta, radius, turn, same_sense, shape)
+        locus_out = _locus(kind_out, geometry_out, theta, radius, turn, same_sense, shape)
     except NoSolutionError as error:
         raise NoSolutionError(f"{where}: {error}") from None
     center = _intersect(locus_in, locus_out, np.array([x, y]))
@@ -243,8 +299,8 @@ def _round_corner(vertex: int, before: Segment, after: Segment, radius: float, t
             f"{kind_in} and {kind_out} sides' transition loci do not meet; use a smaller radius or transition"
         )
     try:
-        onto = _transition_onto(kind_in, geometry_in, center, signed, same_sense)
-        off = _transition_off(kind_out, geometry_out, center, signed, same_sense)
+        onto = _transition_onto(kind_in, geometry_in, center, signed, same_sense, shape)
+        off = _transition_off(kind_out, geometry_out, center, signed, same_sense, shape)
     except NoSolutionError as error:
         raise NoSolutionError(f"{where}: {error}") from None
     for t, side in ((onto, onto.end_circle), (off, off.start_circle)):
@@ -286,8 +342,8 @@ def _trim(segment: Segment, index: int, start: NDArray | None, end: NDArray | No
 def _parameter(segment: Segment, point: NDArray) -> float:
     """The parameter u of ``point`` (on the segment's line or circle)."""
     if isinstance(segment, Line):
-        a, b = segment.start, segment.end
-        return float(np.dot(point - a, b - a) / np.dot(b - a, b - a))
+        (ax, ay, tx, ty, _), length = segment.ends[0], segment.length  # unit tangent: no |b − a|² to overflow
+        return float((point[0] - ax) * tx + (point[1] - ay) * ty) / length
     c = segment.center
     angle = math.atan2(point[1] - c[1], point[0] - c[0]) - segment.start_angle
     travelled = (math.copysign(1.0, segment.radius) * angle) % (2.0 * math.pi)
@@ -304,6 +360,7 @@ def fillet_path(
     vertices: Iterable[int] | None = None,
     closed: bool | None = None,
     same_sense: str = "nested",
+    shape: str = DEFAULT_SHAPE,
     tolerance: float = JOIN_TOLERANCE,
     units: str = DEFAULT_UNITS,
 ) -> FilletedPath:
@@ -322,6 +379,9 @@ def fillet_path(
             meets its start).
         same_sense: for an arc that turns the same way as its corner,
             ``"nested"`` (one spiral, curvature monotone) or ``"C"``.
+        shape: spiral shape of the transitions: ``"walton-meek"`` (default)
+            or ``"near-linear"`` (curvature almost linear in arc length, like
+            a clothoid; transitions of up to 50° each).
         tolerance, units: of the resulting ``Chain``.
 
     Raises:
@@ -339,6 +399,7 @@ def fillet_path(
         raise ValueError(f"transition must lie in (0, 1]; got {transition!r}")
     if not isinstance(same_sense, str) or same_sense not in SAME_SENSE:
         raise ValueError(f"same_sense must be one of {', '.join(SAME_SENSE)}; got {same_sense!r}")
+    shape_code(shape, TRANSITION_SHAPES)
     size = max(s.length for s in segments)
     for i, (a, b) in enumerate(zip(segments, segments[1:])):
         gap = math.dist(a.ends[1][:2], b.ends[0][:2])
@@ -352,7 +413,7 @@ def fillet_path(
     if vertices is None:
         chosen = list(candidates)
     else:
-        chosen = sorted({int(v) for v in vertices})
+        chosen = _vertex_indices(vertices)
         unknown = [v for v in chosen if v not in pairs]
         if unknown:
             raise ValueError(f"vertices {unknown} are not corners of this path (corners: {list(candidates)})")
@@ -361,13 +422,17 @@ def fillet_path(
         before, after = pairs[v]
         (_, _, tx0, ty0, _), (_, _, tx1, ty1, _) = before.ends[1], after.ends[0]
         if abs(math.atan2(tx0 * ty1 - ty0 * tx1, tx0 * tx1 + ty0 * ty1)) > TANGENT_TOL:
-            corners.append(_round_corner(v, before, after, radius, transition, same_sense))
+            corners.append(_round_corner(v, before, after, radius, transition, same_sense, shape))
     tolerance = join_tolerance(tolerance)
-    return FilletedPath(tuple(_assemble(segments, corners, closed, tolerance)), corners, closed, units)
+    pieces, owners = _assemble(segments, corners, closed, tolerance)
+    return FilletedPath(tuple(pieces), corners, closed, units, tuple(owners))
 
 
-def _assemble(segments: list[Segment], corners: list[FilletCorner], closed: bool, tolerance: float) -> list[Segment]:
-    """Trimmed edges and each corner's transition – arc – transition, in travel order.
+def _assemble(
+    segments: list[Segment], corners: list[FilletCorner], closed: bool, tolerance: float
+) -> tuple[list[Segment], list[int | None]]:
+    """Trimmed edges and each corner's transition – arc – transition, in travel order, with the
+    corner each piece belongs to.
 
     A closed path's pieces start where edge 0 resumes after corner 0 and end
     with corner 0. Every joint that touches a rounded corner is checked G2;
@@ -406,38 +471,42 @@ def _assemble(segments: list[Segment], corners: list[FilletCorner], closed: bool
             problem = g2_mismatch(pieces[a], pieces[b], tolerance)
             if problem:
                 raise NoSolutionError(f"corner {vertex}: the fillet is not G2 at {problem}")
-    return pieces
+    return pieces, owners
 
 
 # ---------------------------------------------------------- shapes with continuous corners
 
 
-def _polygon(points: Sequence[tuple[float, float]], radius: float, transition: float, units: str) -> FilletedPath:
+def _polygon(points: Sequence[tuple[float, float]], radius: float, transition: float, units: str, shape: str) -> FilletedPath:
     closed_points = [*points, points[0]]
-    return fillet_path(closed_points, radius, transition=transition, closed=True, units=units)
+    return fillet_path(closed_points, radius, transition=transition, closed=True, units=units, shape=shape)
 
 
-def corner_distance(radius: float, turn: float, transition: float) -> float:
+def corner_distance(radius: float, turn: float, transition: float, shape: str = DEFAULT_SHAPE) -> float:
     """How far from a line–line corner of turn Δ its fillet starts: r·(g1(θ)·tan(Δ/2) + g2(θ)), θ = transition·Δ/2."""
     theta = transition * abs(turn) / 2.0
     s, c = math.sin(theta), math.cos(theta)
-    return radius * (K.shape_g1(K.WALTON_MEEK, s, c) * math.tan(abs(turn) / 2.0) + K.shape_g2(K.WALTON_MEEK, s, c))
+    code = SHAPE_CODES[shape]
+    return radius * (K.shape_g1(code, s, c) * math.tan(abs(turn) / 2.0) + K.shape_g2(code, s, c))
 
 
-def continuous_rectangle(width: float, height: float, radius: float, transition: float = 0.5, units: str = DEFAULT_UNITS) -> FilletedPath:
-    """A width × height rectangle centred on the origin, every corner a G2 fillet of ``radius``.
+def continuous_rectangle(
+    width: float, height: float, radius: float, transition: float = 0.5, units: str = DEFAULT_UNITS, shape: str = DEFAULT_SHAPE
+) -> FilletedPath:
+    """A width × height rectangle centred on the origin, every corner a G2 fillet of ``radius``
+    (spirals of ``shape``, as in ``fillet_path``).
 
     Raises:
         NoSolutionError: the corners do not fit (the message says how much is missing).
     """
     w, h = as_float(width, "width") / 2.0, as_float(height, "height") / 2.0
     if not (w > 0 and h > 0):
-        raise ValueError(f"width and height must be positive; got {width!r}, {height!r}")
-    return _polygon([(-w, -h), (w, -h), (w, h), (-w, h)], radius, transition, units)
+        raise ValueError(f"width and height must be positive; got {shown(width)}, {shown(height)}")
+    return _polygon([(-w, -h), (w, -h), (w, h), (-w, h)], radius, transition, units, shape)
 
 
 def continuous_polygon(radius: float, side_count: int, corner_radius: float, transition: float = 0.5,
-                       major_radius: bool = True, units: str = DEFAULT_UNITS) -> FilletedPath:  # fmt: skip
+                       major_radius: bool = True, units: str = DEFAULT_UNITS, shape: str = DEFAULT_SHAPE) -> FilletedPath:  # fmt: skip
     """A regular polygon centred on the origin (first vertex on +x), every corner a G2 fillet.
 
     Args:
@@ -445,16 +514,20 @@ def continuous_polygon(radius: float, side_count: int, corner_radius: float, tra
         side_count: number of sides (≥ 3).
         corner_radius: the fillet circle's radius at each corner.
     """
-    if isinstance(side_count, bool) or not isinstance(side_count, int) or side_count < 3:
-        raise ValueError(f"side_count must be an integer ≥ 3; got {side_count!r}")
+    count = _integer(side_count)
+    if count is None or count < 3:
+        raise ValueError(f"side_count must be an integer ≥ 3; got {shown(side_count)}")
+    side_count = count
     outer = as_float(radius, "radius") / (1.0 if major_radius else math.cos(math.pi / side_count))
     if not outer > 0:
         raise ValueError(f"radius must be positive; got {radius!r}")
     angles = [2.0 * math.pi * k / side_count for k in range(side_count)]
-    return _polygon([(outer * math.cos(a), outer * math.sin(a)) for a in angles], corner_radius, transition, units)
+    return _polygon([(outer * math.cos(a), outer * math.sin(a)) for a in angles], corner_radius, transition, units, shape)
 
 
-def continuous_slot(width: float, height: float, transition: float = 0.5, units: str = DEFAULT_UNITS) -> FilletedPath:
+def continuous_slot(
+    width: float, height: float, transition: float = 0.5, units: str = DEFAULT_UNITS, shape: str = DEFAULT_SHAPE
+) -> FilletedPath:
     """A slot of overall ``width`` × ``height`` whose ends are G2 all the way round.
 
     Each end is two 90° corners whose fillets meet in the middle of the end:
@@ -464,9 +537,10 @@ def continuous_slot(width: float, height: float, transition: float = 0.5, units:
     """
     w, h = as_float(width, "width"), as_float(height, "height")
     if not (w > h > 0):
-        raise ValueError(f"a slot needs width > height > 0; got width {width!r}, height {height!r}")
+        raise ValueError(f"a slot needs width > height > 0; got width {shown(width)}, height {shown(height)}")
     transition = as_float(transition, "transition")
     if not 0.0 < transition <= 1.0:
         raise ValueError(f"transition must lie in (0, 1]; got {transition!r}")
-    radius = 0.5 * h / corner_distance(1.0, math.pi / 2.0, transition)
-    return continuous_rectangle(w, h, radius, transition, units)
+    shape_code(shape, TRANSITION_SHAPES)
+    radius = 0.5 * h / corner_distance(1.0, math.pi / 2.0, transition, shape)
+    return continuous_rectangle(w, h, radius, transition, units, shape)

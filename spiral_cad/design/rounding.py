@@ -1,20 +1,23 @@
 """G2 corner rounding of polylines with pairs of Bézier spirals.
 
-Two spiral pairs are offered at each corner:
+Each corner gets a symmetric spiral pair (the ``line_to_line`` transition)
+of one of the corner shapes (``spiral_cad.core.shapes``):
 
-* ``"walton-meek"``: Theorem 4.4 of Walton & Meek (1996), two equal-leg
-  spirals (the ``line_to_line`` transition); peak curvature
-  ``(40/27) sin θ / (d cos² θ)``.
+* ``"walton-meek"``: Theorem 4.4 of Walton & Meek (1996), peak curvature
+  ``(40/27) sin θ / (d cos² θ)``;
+* ``"near-linear"``: curvature almost linear in arc length (deflections up
+  to 100°);
 * ``"g2cbs"``: the curvature-bounded pair of Yang & Sukkarieh (2010) with
-  unequal legs g/h = c2 = 2(√6 − 1)/5, the smallest ratio that keeps the
-  curvature monotone; peak curvature ``c4 sin θ / (d cos² θ)`` with
-  c4 ≈ 1.12249, i.e. about 24 % lower than Walton–Meek for the same corner
-  distance d (c4 / (40/27) ≈ 0.758).
+  leg ratio g/h = c2 = 2(√6 − 1)/5, the smallest that keeps the curvature
+  monotone; peak curvature ``c4 sin θ / (d cos² θ)`` with c4 ≈ 1.12249,
+  i.e. about 24 % lower than Walton–Meek for the same corner distance d
+  (c4 / (40/27) ≈ 0.758).
 
 Here θ is half the corner's deflection and d the distance from the corner to
-where each spiral leaves its leg. The array functions (``corner_legs``,
-``round_corners_batch``) handle millions of corners; ``round_corners`` builds
-a checked :class:`~spiral_cad.Chain` for one polyline.
+where each spiral leaves its leg: d = K(θ)/κ with κ the joint (peak)
+curvature and K the shape's corner factor. The array functions
+(``corner_legs``, ``round_corners_batch``) handle millions of corners;
+``round_corners`` builds a checked :class:`~spiral_cad.Chain` for one polyline.
 """
 
 from __future__ import annotations
@@ -29,73 +32,47 @@ from ..core import _kernels as K
 from ..core import batch
 from ..core._inputs import as_float, as_points, as_real_array
 from ..core.chain import JOIN_TOLERANCE, Chain
-from ..core.units import DEFAULT_UNITS
-from ..core.errors import NoSolutionError, Status
+from ..core.errors import JointError, NoSolutionError, Status
 from ..core.segments import Ray, Segment
+from ..core.shapes import CORNER_SHAPES, DEFAULT_SHAPE, SHAPE_CODES, shape_code
 from ..core.spiral import BezierSpiral
 from ..core.transitions import Transition
+from ..core.units import DEFAULT_UNITS
 
 #: Yang & Sukkarieh's leg ratio g/h: the smallest that keeps κ monotone.
-G2CBS_C2 = 2.0 * (math.sqrt(6.0) - 1.0) / 5.0
+G2CBS_C2 = K.G2CBS_RATIO
 #: Exact c1 = (c2 + 1)(c2 + 4) (the paper prints a rounded value that leaves a gap).
 G2CBS_C1 = (G2CBS_C2 + 1.0) * (G2CBS_C2 + 4.0)
 #: h = c3·d.
 G2CBS_C3 = (G2CBS_C2 + 4.0) / (G2CBS_C1 + 6.0)
-#: κmax = c4 sin β / (d cos² β).
+#: κmax = c4 sin β / (d cos² β): the G2CBS corner factor K(β) = c4·sin β/cos² β.
 G2CBS_C4 = (G2CBS_C2 + 4.0) ** 2 / (54.0 * G2CBS_C3)
-
-#: Peak-curvature factor of each method: κ = factor · sin θ / (d cos² θ).
-CORNER_FACTOR = {"walton-meek": 40.0 / 27.0, "g2cbs": G2CBS_C4}
-METHODS = tuple(CORNER_FACTOR)
 
 #: Relative |sin| below which three points count as collinear (passed through).
 COLLINEAR_TOL = 1e-12
 
 
-def corner_scale(theta_sin: ArrayLike, theta_cos: ArrayLike, value: ArrayLike, method: str) -> NDArray:
-    """``factor · sin θ / (value · cos² θ)`` of ``method``.
+def corner_scale(theta_sin: ArrayLike, theta_cos: ArrayLike, value: ArrayLike, shape: str) -> NDArray:
+    """``K(θ)/value`` of ``shape`` (``K`` its corner factor, ``spiral_cad.core._kernels.corner_factor``).
 
     The relation between the corner distance d and the peak (joint) curvature κ
     of a spiral pair is symmetric: pass κ to get d, or d to get κ.
     """
     sin_t, cos_t, value = np.broadcast_arrays(*(np.asarray(v, dtype=float) for v in (theta_sin, theta_cos, value)))
-    return CORNER_FACTOR[method] * sin_t / (value * cos_t * cos_t)
+    factor = np.empty(sin_t.size)
+    K.corner_factor_batch(SHAPE_CODES[shape], np.ravel(sin_t), np.ravel(cos_t), factor)
+    return factor.reshape(sin_t.shape) / value
 
 
-def g2cbs_control_points(corners: NDArray, t_in: NDArray, t_out: NDArray, distance: NDArray, theta_cos: NDArray) -> NDArray:
-    """Control points (N, 2, 4, 2) of Yang & Sukkarieh's spiral pairs, in travel order.
-
-    The first spiral leaves the incoming leg at ``corner − d·t_in`` with legs
-    g = c2·h, h = c3·d along ``t_in`` and k = 6h cos θ / (c2 + 4) along the
-    joint tangent ``unit(t_in + t_out)``; k = 6h² cos θ/(g + 4h) makes κ'(1) = 0
-    and d = g + h + k / cos θ puts the end on the corner's bisector, where the
-    mirrored second spiral meets it with equal curvature (G2). Peak curvature
-    (at the joint) is ``G2CBS_C4 · sin θ / (d cos² θ)``.
-
-    Args:
-        corners: (N, 2) corner points.
-        t_in, t_out: (N, 2) unit directions of the incoming and outgoing legs.
-        distance: (N,) corner-to-spiral-start distance d.
-        theta_cos: (N,) cos θ, θ = half the deflection.
-    """
-    d = distance[:, None]
-    h = G2CBS_C3 * d
-    g = G2CBS_C2 * h
-    k = 6.0 * h * theta_cos[:, None] / (G2CBS_C2 + 4.0)
-    joint = t_in + t_out
-    joint /= np.linalg.norm(joint, axis=1, keepdims=True)
-    out = np.empty((len(corners), 2, 4, 2))
-    first = out[:, 0]
-    first[:, 0] = corners - d * t_in
-    first[:, 1] = first[:, 0] + g * t_in
-    first[:, 2] = first[:, 1] + h * t_in
-    first[:, 3] = first[:, 2] + k * joint
-    second = out[:, 1]  # built from the far end, then read in travel order
-    second[:, 3] = corners + d * t_out
-    second[:, 2] = second[:, 3] - g * t_out
-    second[:, 1] = second[:, 2] - h * t_out
-    second[:, 0] = first[:, 3]  # the joint; the mirror image agrees to rounding
-    return out
+def corner_shape(shape: str, method: str | None) -> str:
+    """The corner shape from ``shape`` or from ``method`` (its former name), checked."""
+    if method is None:
+        shape_code(shape, CORNER_SHAPES)
+        return shape
+    if shape != DEFAULT_SHAPE and shape != method:
+        raise ValueError(f"give shape or method (its former name), not both; got shape={shape!r}, method={method!r}")
+    shape_code(method, CORNER_SHAPES, "method")
+    return method
 
 
 # ------------------------------------------------------------ array API
@@ -106,7 +83,7 @@ class CornerBatch:
     """Spiral pairs for N corners (one row per corner).
 
     Attributes:
-        method: ``"walton-meek"`` or ``"g2cbs"``.
+        shape: ``"walton-meek"``, ``"near-linear"`` or ``"g2cbs"``.
         control_points: (N, 2, 4, 2) the two spirals of each corner in travel
             order; NaN where ``status`` ≠ 0.
         theta: (N,) half the deflection (each spiral's turn), NaN when undefined.
@@ -120,7 +97,7 @@ class CornerBatch:
             off (relative); NaN elsewhere.
     """
 
-    method: str
+    shape: str
     control_points: NDArray
     theta: NDArray
     distance: NDArray
@@ -150,12 +127,17 @@ class CornerBatch:
                 f"{where}: curvature {self.requested[i]:.6g} needs the spirals to start "
                 f"{self.distance[i]:.6g} from the corner but only {self.available[i]:.6g} is available "
                 f"(each corner may use half of an interior leg); this corner needs curvature "
-                f"≥ {self.curvature[i]:.6g} ({self.method})"
+                f"≥ {self.curvature[i]:.6g} ({self.shape})"
             )
         if status is Status.CORNER_REVERSAL:
             return f"{where}: the path folds back (deflection ≥ 180°); no spiral pair exists"
         if status is Status.CORNER_STRAIGHT:
             return f"{where}: the legs are collinear, there is nothing to round"
+        if status is Status.OUTSIDE_SHAPE:
+            return (
+                f"{where}: deflection {2 * math.degrees(self.theta[i]):.6g}° is beyond what {self.shape} spiral pairs "
+                f"round ({2 * math.degrees(K.NEAR_LINEAR_MAX_THETA):g}° at most); use shape='walton-meek'"
+            )
         if status is Status.COINCIDENT:
             return f"{where}: a leg has zero length"
         if status is Status.UNVERIFIED:
@@ -168,7 +150,7 @@ class CornerBatch:
 
 
 def _half_deflection(p0: NDArray, corners: NDArray, p1: NDArray):
-    """Unit leg directions, leg lengths and sin/cos of half the deflection."""
+    """Leg lengths and sin/cos of half the deflection."""
     vin = corners - p0
     vout = p1 - corners
     lin = np.hypot(vin[:, 0], vin[:, 1])
@@ -180,7 +162,7 @@ def _half_deflection(p0: NDArray, corners: NDArray, p1: NDArray):
         joint /= np.hypot(joint[:, 0], joint[:, 1])[:, None]
     sin_t = np.abs(t_in[:, 0] * joint[:, 1] - t_in[:, 1] * joint[:, 0])
     cos_t = np.einsum("ij,ij->i", t_in, joint)
-    return t_in, t_out, lin, lout, sin_t, cos_t
+    return lin, lout, sin_t, cos_t
 
 
 def _requested(curvature: ArrayLike | None, max_curvature: ArrayLike | None, n: int) -> NDArray:
@@ -208,7 +190,8 @@ def round_corners_batch(
     *,
     curvature: ArrayLike | None = None,
     max_curvature: ArrayLike | None = None,
-    method: str = "walton-meek",
+    shape: str = DEFAULT_SHAPE,
+    method: str | None = None,
 ) -> CornerBatch:
     """Round N independent corners ``p0 → corner → p1`` with spiral pairs.
 
@@ -221,50 +204,36 @@ def round_corners_batch(
         curvature: joint curvature (scalar or (N,)); the pair peaks there.
         max_curvature: a bound κmax: each corner uses the smallest distance
             that respects it, i.e. its joint curvature equals κmax.
-        method: ``"walton-meek"`` (Theorem 4.4 via ``spiral_cad.batch``) or
-            ``"g2cbs"`` (Yang & Sukkarieh).
+        shape: ``"walton-meek"`` (Theorem 4.4), ``"near-linear"`` or
+            ``"g2cbs"`` (Yang & Sukkarieh); every pair is solved and verified
+            by ``spiral_cad.batch.line_to_line``.
+        method: the former name of ``shape``.
 
     With neither curvature given, each corner uses all of its shorter leg
     (Corollary 4.5: the lowest curvature that fits). Rows that fail carry a
     status (``CornerBatch.reason`` explains); the others are unaffected.
     """
-    if not isinstance(method, str) or method not in CORNER_FACTOR:
-        raise ValueError(f"method must be one of {METHODS}; got {method!r}")
+    shape = corner_shape(shape, method)
     arrays = np.broadcast_arrays(as_points(p0, "p0"), as_points(corners, "corners"), as_points(p1, "p1"))
     p0, corners, p1 = (np.ascontiguousarray(a.reshape(-1, 2)) for a in arrays)
     n = len(corners)
     k = _requested(curvature, max_curvature, n)
-    t_in, t_out, lin, lout, sin_t, cos_t = _half_deflection(p0, corners, p1)
+    lin, lout, sin_t, cos_t = _half_deflection(p0, corners, p1)
     available = np.minimum(lin, lout)
     fit = np.isnan(k)
     with np.errstate(invalid="ignore", divide="ignore"):
-        distance = np.where(fit, available, corner_scale(sin_t, cos_t, k, method))
-        needed = corner_scale(sin_t, cos_t, available, method)
-    if method == "walton-meek":
-        result = batch.line_to_line(p0, corners, p1, k)
-        control_points = np.stack(result.spirals, axis=1)
-        status = result.status.astype(np.int8)
-        residual = np.where(status == Status.UNVERIFIED, result.measure, np.nan)
-    else:
-        status = np.zeros(n, dtype=np.int8)
-        status[~(sin_t > 0.0)] = Status.CORNER_STRAIGHT
-        status[~(cos_t > 0.0)] = Status.CORNER_REVERSAL
-        status[(status == 0) & ~(distance <= available * (1.0 + 1e-12))] = Status.LEGS_TOO_SHORT
-        status[(lin == 0.0) | (lout == 0.0)] = Status.COINCIDENT
-        status[~np.isfinite(np.hstack([p0, corners, p1])).all(axis=1)] = Status.NOT_FINITE
-        control_points = np.full((n, 2, 4, 2), np.nan)
-        good = status == 0
-        control_points[good] = g2cbs_control_points(corners[good], t_in[good], t_out[good], np.minimum(distance[good], available[good]), cos_t[good])
-        with np.errstate(invalid="ignore", divide="ignore"):
-            peak_used = np.where(fit, needed, k)
-        residual = np.full(n, np.nan)
-        K.verify_corners_batch(control_points, corners, t_in, t_out, peak_used, status, residual)
+        distance = np.where(fit, available, corner_scale(sin_t, cos_t, k, shape))
+        needed = corner_scale(sin_t, cos_t, available, shape)
+    result = batch.line_to_line(p0, corners, p1, k, shape=shape)
+    control_points = np.stack(result.spirals, axis=1)
+    status = result.status.astype(np.int8)
+    residual = np.where(status == Status.UNVERIFIED, result.measure, np.nan)
     ok = status == 0
     theta = np.where(sin_t > 0.0, np.arctan2(sin_t, cos_t), np.nan)
     # Failed rows report what they would need: the distance asked for and the
     # curvature that would exactly fit the available legs.
     peak = np.where(ok, np.where(fit, needed, k), needed)
-    return CornerBatch(method, control_points, theta, distance, peak, available, status, corners, k, residual)
+    return CornerBatch(shape, control_points, theta, distance, peak, available, status, corners, k, residual)
 
 
 def corner_legs(points: ArrayLike) -> tuple[NDArray, NDArray, NDArray, NDArray]:
@@ -343,7 +312,12 @@ class RoundedPath:
 
     chain: Chain
     corners: list[RoundedCorner]
-    method: str
+    shape: str
+
+    @property
+    def method(self) -> str:
+        """The former name of ``shape``."""
+        return self.shape
 
     @property
     def max_curvature(self) -> float:
@@ -356,7 +330,8 @@ def round_corners(
     *,
     curvature: float | None = None,
     max_curvature: float | None = None,
-    method: str = "walton-meek",
+    shape: str = DEFAULT_SHAPE,
+    method: str | None = None,
     tolerance: float = JOIN_TOLERANCE,
     units: str = DEFAULT_UNITS,
 ) -> RoundedPath:
@@ -367,9 +342,11 @@ def round_corners(
         curvature: joint (peak) curvature of every corner's pair.
         max_curvature: bound κmax; each corner uses the smallest distance
             from the corner that respects it (so its peak equals κmax).
-        method: ``"walton-meek"`` (Theorem 4.4) or ``"g2cbs"`` (Yang &
-            Sukkarieh: about 24 % lower peak curvature for the same corner
-            distance).
+        shape: ``"walton-meek"`` (Theorem 4.4), ``"near-linear"`` (curvature
+            almost linear in arc length; deflections up to 100°) or ``"g2cbs"``
+            (Yang & Sukkarieh: about 24 % lower peak curvature for the same
+            corner distance).
+        method: the former name of ``shape``.
         tolerance: the chain's relative join tolerance (``Chain``).
         units: length unit of the points (default mm); curvatures are per unit.
 
@@ -388,19 +365,20 @@ def round_corners(
     for name, value in (("curvature", curvature), ("max_curvature", max_curvature)):
         if value is not None:
             as_float(value, name)
+    shape = corner_shape(shape, method)
     pts = as_points(points, "points")
     p0, corners, p1, index = corner_legs(pts)
     parts: list[Transition | Segment] = []
     rounded: list[RoundedCorner] = []
     if len(corners):
-        result = round_corners_batch(p0, corners, p1, curvature=curvature, max_curvature=max_curvature, method=method)
+        result = round_corners_batch(p0, corners, p1, curvature=curvature, max_curvature=max_curvature, shape=shape)
         for j in np.flatnonzero(~result.ok):
             message = result.reason(int(j), label=f"corner {index[j]}")
-            if result.status[j] in (Status.LEGS_TOO_SHORT, Status.CORNER_REVERSAL, Status.UNVERIFIED):
+            if result.status[j] in (Status.LEGS_TOO_SHORT, Status.CORNER_REVERSAL, Status.UNVERIFIED, Status.OUTSIDE_SHAPE):
                 raise NoSolutionError(message)
             raise ValueError(message)
         for j, cp in enumerate(result.control_points):
-            spirals = (BezierSpiral.from_control_points(cp[0]), BezierSpiral.from_control_points(cp[1]))
+            spirals = (BezierSpiral.from_control_points(cp[0], shape), BezierSpiral.from_control_points(cp[1], shape))
             corner = tuple(corners[j])
             parts.append(
                 Transition(
@@ -409,8 +387,13 @@ def round_corners(
                     float(result.theta[j]),
                     start_line=Ray(corner, tuple(corners[j] - p0[j])),
                     end_line=Ray(corner, tuple(p1[j] - corners[j])),
+                    shape=shape,
                 )
             )
             rounded.append(RoundedCorner(int(index[j]), float(result.theta[j]), float(result.distance[j]), float(result.curvature[j]), spirals))
-    return RoundedPath(Chain.join(parts, pts[0], pts[-1], tolerance, units), rounded, method)
+    try:
+        chain = Chain.join(parts, pts[0], pts[-1], tolerance, units)
+    except JointError as error:
+        raise NoSolutionError(f"corner {index[error.part]}: float64 cannot hold its spirals G2 at these coordinates: {error}") from None
+    return RoundedPath(chain, rounded, shape)
 

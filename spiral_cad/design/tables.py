@@ -1,16 +1,23 @@
 """Tables of design results (stationing, criteria): text for the terminal, CSV with the unit in every header.
 
 A column's dimension is a string in ``L`` (the design's length unit), e.g.
-``"L"``, ``"1/L²"``; the header becomes ``name [m]`` or ``name [1/m²]``.
-Columns without a dimension keep their name (angles say ``_deg`` in it).
+``"L"``, ``"1/L²"``, ``"deg"``; the header becomes ``name [m]``,
+``name [1/m²]`` or ``name [deg]``. Only ``TEXT_COLUMNS`` have none: ``pi``
+(the PI's index), ``spiral_shape`` and ``verdict`` (text). Every other cell is a plain
+decimal that ``float()`` reads: numbers of any type (numpy scalars too)
+are written as Python floats, at full precision in CSV.
 """
 
 from __future__ import annotations
 
 import csv
+import numbers
 from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import Any
+
+#: The columns without a unit: an index and two texts.
+TEXT_COLUMNS = ("pi", "spiral_shape", "verdict")
 
 
 def header(key: str, dimensions: Mapping[str, str], units: str) -> str:
@@ -19,15 +26,25 @@ def header(key: str, dimensions: Mapping[str, str], units: str) -> str:
     return f"{key} [{dimension.replace('L', units)}]" if dimension else key
 
 
+def cell(value: Any, digits: int | None = None) -> str:
+    """A table cell: integers as integers, other real numbers as Python floats (``repr``, or
+    ``digits`` significant digits), anything else as its text."""
+    if isinstance(value, numbers.Integral) and not isinstance(value, bool):
+        return str(int(value))
+    if isinstance(value, numbers.Real) and not isinstance(value, bool):
+        return repr(float(value)) if digits is None else f"{float(value):.{digits}g}"
+    return str(value)
+
+
 def write_csv(path: str | Path, rows: Sequence[Mapping[str, Any]], dimensions: Mapping[str, str], units: str) -> Path:
-    """Write ``rows`` as CSV: floats at full precision (``repr``), units in the headers."""
+    """Write ``rows`` as CSV: numbers at full precision (``repr`` of a Python float), units in the headers."""
     path = Path(path)
     keys = list(rows[0]) if rows else list(dimensions)
     with path.open("w", newline="", encoding="utf-8") as handle:
         writer = csv.writer(handle)
         writer.writerow([header(k, dimensions, units) for k in keys])
         for row in rows:
-            writer.writerow([repr(v) if isinstance(v, float) else v for v in (row[k] for k in keys)])
+            writer.writerow([cell(row[k]) for k in keys])
     return path
 
 
@@ -37,7 +54,7 @@ def text_table(rows: Sequence[Mapping[str, Any]], dimensions: Mapping[str, str],
         return ""
     keys = list(rows[0])
     head = [header(k, dimensions, units) for k in keys]
-    cells = [[f"{v:.{digits}g}" if isinstance(v, float) else str(v) for v in (row[k] for k in keys)] for row in rows]
+    cells = [[cell(row[k], digits) for k in keys] for row in rows]
     widths = [max(len(h), *(len(c[i]) for c in cells)) for i, h in enumerate(head)]
     lines = ["  ".join(h.rjust(w) for h, w in zip(head, widths))]
     lines += ["  ".join(c.rjust(w) for c, w in zip(row, widths)) for row in cells]

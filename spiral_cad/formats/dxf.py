@@ -2,7 +2,11 @@
 
 The header declares the unit twice, as readers differ in which they use:
 ``$INSUNITS`` (4 mm, 5 cm, 6 m, 7 km, 1 in, 2 ft) and ``$MEASUREMENT``
-(1 metric, 0 imperial, which Inkscape and LibreCAD use for scaling).
+(1 metric, 0 imperial, which Inkscape and LibreCAD use for scaling). The
+extents (``$EXTMIN``/``$EXTMAX``) are the drawing's bounding box and the
+limits (``$LIMMIN``/``$LIMMAX``) that box with a margin of 5 % of its
+diagonal, in the drawing's unit, so viewers open and print the whole
+drawing. The layer name follows DXF's rules (``formats.names.dxf_layer_name``).
 """
 
 from __future__ import annotations
@@ -11,15 +15,20 @@ import math
 import os
 from collections.abc import Sequence
 
+import numpy as np
+
 from ..core.chain import Chain
 from ..core.segments import Arc, Line, Segment
 from ..core.spiral import BezierSpiral
 from ..core.units import IMPERIAL
+from .names import dxf_layer_name
 
 #: ``$INSUNITS`` codes.
 INSUNITS = {"in": 1, "ft": 2, "mm": 4, "cm": 5, "m": 6, "km": 7}
 #: Knot vector of one cubic Bézier written as a B-spline.
 BEZIER_KNOTS = (0.0, 0.0, 0.0, 0.0, 1.0, 1.0, 1.0, 1.0)
+#: The limits' margin around the extents, a fraction of their diagonal.
+LIMITS_MARGIN = 0.05
 
 
 def _add(msp, seg: Segment, layer: str) -> None:
@@ -39,17 +48,56 @@ def _add(msp, seg: Segment, layer: str) -> None:
         raise ValueError(f"segment must be a Line, Arc or BezierSpiral; got {seg!r}")
 
 
+def _extreme_parameters(seg: Segment) -> list[float]:
+    """Where on ``seg`` (u in [0, 1]) x or y can be extreme: its ends, an arc's quadrant points
+    and the roots of a cubic's derivative."""
+    found = [0.0, 1.0]
+    if isinstance(seg, Arc):
+        turn = math.copysign(seg.sweep, seg.radius)
+        low, high = sorted((seg.start_angle, seg.start_angle + turn))
+        quarter = math.pi / 2
+        found += [(k * quarter - seg.start_angle) / turn for k in range(math.ceil(low / quarter), math.floor(high / quarter) + 1)]
+    elif isinstance(seg, BezierSpiral):
+        p = seg.control_points
+        a, b, c = p[1] - p[0], p[2] - p[1], p[3] - p[2]  # B'(t)/3 = a(1-t)² + 2b(1-t)t + ct²
+        for axis in range(2):
+            roots = np.roots([a[axis] - 2 * b[axis] + c[axis], 2 * (b[axis] - a[axis]), a[axis]])
+            found += [float(t.real) for t in roots if t.imag == 0 and 0 < t.real < 1]
+    return found
+
+
+def extents(chains: Sequence[Chain]) -> tuple[tuple[float, float], tuple[float, float]]:
+    """The drawing's exact bounding box ((xmin, ymin), (xmax, ymax))."""
+    points = np.vstack([seg.point(np.clip(_extreme_parameters(seg), 0.0, 1.0)) for chain in chains for seg in chain])
+    low, high = points.min(axis=0), points.max(axis=0)
+    return (float(low[0]), float(low[1])), (float(high[0]), float(high[1]))
+
+
+def _set_extents_and_limits(doc, msp, chains: Sequence[Chain]) -> None:
+    (x0, y0), (x1, y1) = extents(chains)
+    pad = LIMITS_MARGIN * math.hypot(x1 - x0, y1 - y0)
+    limits = (x0 - pad, y0 - pad), (x1 + pad, y1 + pad)
+    msp.reset_extents((x0, y0, 0.0), (x1, y1, 0.0))
+    msp.reset_limits(*limits)
+    doc.header["$EXTMIN"], doc.header["$EXTMAX"] = (x0, y0, 0.0), (x1, y1, 0.0)
+    doc.header["$LIMMIN"], doc.header["$LIMMAX"] = limits
+
+
 def write_dxf(chains: Sequence[Chain], path: str | os.PathLike, name: str, units: str) -> None:
-    """Write ``chains`` in travel order on layer ``name``; a full circle is an ARC from an angle to itself + 360°."""
+    """Write ``chains`` in travel order on the layer named after ``name``; a full circle is an ARC
+    from an angle to itself + 360°."""
     import ezdxf
 
     doc = ezdxf.new("R2010", setup=False)
     doc.header["$INSUNITS"] = INSUNITS[units]
     doc.header["$MEASUREMENT"] = 0 if units in IMPERIAL else 1
     doc.header["$LUNITS"] = 2  # decimal
-    doc.layers.add(name)
+    layer = dxf_layer_name(name)
+    if not doc.layers.has_entry(layer):  # "0" exists already
+        doc.layers.add(layer)
     msp = doc.modelspace()
     for chain in chains:
         for seg in chain:
-            _add(msp, seg, name)
+            _add(msp, seg, layer)
+    _set_extents_and_limits(doc, msp, chains)
     doc.saveas(os.fspath(path))

@@ -22,7 +22,8 @@ The length unit is declared in the representation context (an ``SI_UNIT``
 with its prefix for mm, cm, m, km; a ``CONVERSION_BASED_UNIT`` of 25.4 mm or
 304.8 mm for in and ft), so readers that convert (OCCT reads into mm by
 default) get the right size. Every real is the shortest decimal that reads
-back to the same double (at most 17 significant digits).
+back to the same double (at most 17 significant digits); every name an
+ISO 10303-21 string in pure ASCII (``spiral_cad.formats.names.step_string``).
 
 Needs no CAD kernel.
 """
@@ -39,6 +40,7 @@ from ..core.segments import Arc, Line, Segment, measure_join
 from ..core.spiral import BezierSpiral
 from ..core.units import MM_PER_UNIT
 from .decimals import shortest_decimal
+from .names import step_string
 
 #: STEP's name for each unit: an SI prefix of the metre, or a conversion-based unit.
 _SI_PREFIX = {"mm": ".MILLI.", "cm": ".CENTI.", "m": "$", "km": ".KILO."}
@@ -55,22 +57,6 @@ def real(value: float) -> str:
     if "." not in mantissa:
         mantissa += "."
     return f"{mantissa}E{exponent}" if exponent else mantissa
-
-
-def string(text: str) -> str:
-    """A STEP string literal: quotes and backslashes doubled, non-ASCII as \\X2\\ … \\X0\\."""
-    out = []
-    for ch in text:
-        if ch == "'":
-            out.append("''")
-        elif ch == "\\":
-            out.append("\\\\")
-        elif 32 <= ord(ch) < 127:
-            out.append(ch)
-        else:
-            code = ch.encode("utf-16-be").hex().upper()
-            out.append(f"\\X2\\{code}\\X0\\")
-    return "'" + "".join(out) + "'"
 
 
 class _Entities:
@@ -148,7 +134,7 @@ def _composite(data: _Entities, chain: Chain, label: str) -> str:
         last = i == len(chain) - 1
         code = (closing or ".DISCONTINUOUS.") if last else ".CONT_SAME_GRADIENT_SAME_CURVATURE."
         segments.append(data.add(f"COMPOSITE_CURVE_SEGMENT({code},.T.,{_curve(data, segment)})"))
-    return data.add(f"COMPOSITE_CURVE({string(label)},({','.join(segments)}),.F.)")
+    return data.add(f"COMPOSITE_CURVE({step_string(label)},({','.join(segments)}),.F.)")
 
 
 def _units(data: _Entities, units: str, uncertainty: float) -> str:
@@ -184,7 +170,7 @@ def step_text(chains: Sequence[Chain], name: str, units: str, originating_system
     context = data.add("APPLICATION_CONTEXT('core data for automotive mechanical design processes')")
     data.add(f"APPLICATION_PROTOCOL_DEFINITION('international standard','automotive_design',2000,{context})")
     product_context = data.add(f"PRODUCT_CONTEXT('',{context},'mechanical')")
-    product = data.add(f"PRODUCT({string(name)},{string(name)},'',({product_context}))")
+    product = data.add(f"PRODUCT({step_string(name)},{step_string(name)},'',({product_context}))")
     data.add(f"PRODUCT_RELATED_PRODUCT_CATEGORY('part',$,({product}))")
     formation = data.add(f"PRODUCT_DEFINITION_FORMATION('','',{product})")
     definition_context = data.add(f"PRODUCT_DEFINITION_CONTEXT('part definition',{context},'design')")
@@ -196,16 +182,16 @@ def step_text(chains: Sequence[Chain], name: str, units: str, originating_system
     )
     labels = [name] if len(chains) == 1 else [f"{name}-{i + 1}" for i in range(len(chains))]
     curves = [_composite(data, chain, label) for chain, label in zip(chains, labels)]
-    curve_set = data.add(f"GEOMETRIC_CURVE_SET({string(name)},({','.join(curves)}))")
+    curve_set = data.add(f"GEOMETRIC_CURVE_SET({step_string(name)},({','.join(curves)}))")
     representation = data.add(
-        f"GEOMETRICALLY_BOUNDED_WIREFRAME_SHAPE_REPRESENTATION({string(name)},({curve_set},{origin}),{representation_context})"
+        f"GEOMETRICALLY_BOUNDED_WIREFRAME_SHAPE_REPRESENTATION({step_string(name)},({curve_set},{origin}),{representation_context})"
     )
     data.add(f"SHAPE_DEFINITION_REPRESENTATION({shape},{representation})")
     header = [
         "ISO-10303-21;",
         "HEADER;",
-        f"FILE_DESCRIPTION(({string(f'{name}: exact G2 curves (lines, circles, cubic Bezier spirals)')}),'2;1');",
-        f"FILE_NAME({string(name)},'{when}',(''),(''),{string(originating_system)},{string(originating_system)},'');",
+        f"FILE_DESCRIPTION(({step_string(f'{name}: exact G2 curves (lines, circles, cubic Bezier spirals)')}),'2;1');",
+        f"FILE_NAME({step_string(name)},'{when}',(''),(''),{step_string(originating_system)},{step_string(originating_system)},'');",
         f"FILE_SCHEMA(('{SCHEMA}'));",
         "ENDSEC;",
         "DATA;",

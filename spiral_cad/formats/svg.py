@@ -3,8 +3,9 @@
 ``width``/``height`` carry a physical unit (mm for metric designs, in for
 in/ft) and the ``viewBox`` is in the chain's own units, so a viewer or an
 importer (Inkscape) shows the drawing at its real size and the path data
-keep the model coordinates. The design name is the ``id`` of the group and
-the ``title``; with several chains each path's id is ``NAME-k``.
+keep the model coordinates. The design name is the ``title`` and, as an
+XML name (``formats.names.xml_id``), the ``id`` of the group (``NAME-drawing``)
+and of the path; with several chains each path's id is ``NAME-k``.
 """
 
 from __future__ import annotations
@@ -21,6 +22,7 @@ from ..core.segments import Arc, Line, Segment
 from ..core.spiral import BezierSpiral
 from ..core.units import IMPERIAL, MM_PER_UNIT
 from .decimals import shortest_decimal
+from .names import xml_id
 
 
 def _num(value: float) -> str:
@@ -64,13 +66,13 @@ def svg_text(chains: Sequence[Chain], name: str, units: str, margin: float = 0.0
     x, y = lo[0] - pad, -hi[1] - pad
     width, height = hi[0] - lo[0] + 2 * pad, hi[1] - lo[1] + 2 * pad
     physical, per_unit = ("in", MM_PER_UNIT[units] / 25.4) if units in IMPERIAL else ("mm", MM_PER_UNIT[units])
-    ids = [name] if len(chains) == 1 else [f"{name}-{i + 1}" for i in range(len(chains))]
+    ids = [xml_id(name)] if len(chains) == 1 else [xml_id(f"{name}-{i + 1}") for i in range(len(chains))]
     lines = [
         '<?xml version="1.0" encoding="UTF-8"?>',
         f'<svg xmlns="http://www.w3.org/2000/svg" width="{_num(width * per_unit)}{physical}" '
         f'height="{_num(height * per_unit)}{physical}" viewBox="{_num(x)} {_num(y)} {_num(width)} {_num(height)}">',
         f"<title>{escape(name)} (units: {units})</title>",
-        f'<g id={quoteattr(name + "-drawing")} fill="none" stroke="black" stroke-width="{_num(0.004 * size)}" '
+        f'<g id={quoteattr(xml_id(name + "-drawing"))} fill="none" stroke="black" stroke-width="{_num(0.004 * size)}" '
         'stroke-linecap="round" stroke-linejoin="round">',
     ]
     lines += [f"<path id={quoteattr(i)} d={quoteattr(svg_path(chain))}/>" for i, chain in zip(ids, chains)]
