@@ -220,7 +220,7 @@ class _Lift:
             rows = np.flatnonzero(segment == k)
             seg = self.chain[int(k)]
             if isinstance(seg, Arc):
-                center, r = seg.center, abs(seg.radius)
+                center = seg.center
                 angle = np.arctan2(points[rows, :, 1] - center[1], points[rows, :, 0] - center[0])
                 turned = np.mod(math.copysign(1.0, seg.radius) * (angle - seg.start_angle), 2.0 * math.pi)
                 turned = np.where(turned > 0.5 * (seg.sweep + 2.0 * math.pi), turned - 2.0 * math.pi, turned)

@@ -397,6 +397,24 @@ class Profile:
         index, _ = self._locate(station)
         return 2.0 * self.coefficients[index, 2]
 
+    def records(self, start: float, end: float) -> NDArray:
+        """(m, 4) rows (s, a, b, c) of the pieces from station ``start`` to ``end``, with s and the
+        polynomials measured from ``start`` (OpenDRIVE's ``elevation`` records of a road starting there).
+
+        Raises:
+            ValueError: ``start`` or ``end`` outside the profile.
+        """
+        self._locate(np.array([start, end]))
+        first = int(np.clip(np.searchsorted(self.stations, start, side="right") - 1, 0, len(self.coefficients) - 1))
+        last = int(np.searchsorted(self.stations, end, side="left"))
+        coefficients = self.coefficients[first:max(last, first + 1)].copy()
+        starts = self.stations[first:first + len(coefficients)] - start
+        shift = -starts[0]  # re-centre the first piece on ``start``
+        a, b, c = coefficients[0]
+        coefficients[0] = (a + shift * (b + shift * c), b + 2.0 * shift * c, c)
+        starts[0] = 0.0
+        return np.column_stack([starts, coefficients])
+
     # ------------------------------------------------------------ table
 
     def rows(self) -> list[dict[str, Any]]:

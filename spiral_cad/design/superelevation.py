@@ -38,16 +38,24 @@ class Superelevation:
     """The roll angle φ(station) of an alignment as exact cubic pieces.
 
     Attributes:
-        stations: (m + 1,) piece boundaries (chainages) from the alignment's start to its end.
-        coefficients: (m, 4) φ = a + b·d + c·d² + e·d³ on each piece, d = station − its start (radians).
+        start: the alignment's start station.
+        local: (m + 1,) piece boundaries as arc length from the alignment's start (its
+            chain's own stations at TS, SC, CS and ST), ending at its length.
+        coefficients: (m, 4) φ = a + b·d + c·d² + e·d³ on each piece, d = distance from its start (radians).
         full: (m,) the roll angle of the curve a piece belongs to (0 on tangents), for ``share``.
         units: the alignment's length unit.
     """
 
-    stations: NDArray
+    start: float
+    local: NDArray
     coefficients: NDArray
     full: NDArray
     units: str
+
+    @property
+    def stations(self) -> NDArray:
+        """(m + 1,) piece boundaries as chainages."""
+        return self.start + self.local
 
     @classmethod
     def from_alignment(cls, alignment: Any, cross_slopes: ArrayLike | None = None) -> Superelevation:
@@ -76,25 +84,32 @@ class Superelevation:
         for curve, e in zip(curves, slopes.tolist()):
             if not (math.isfinite(e) and 0.0 <= e < 1.0):
                 raise ValueError(f"PI {curve.index}: the cross slope must lie in [0, 1); got {e!r}")
-        start, end = alignment.start_station, alignment.end_station
-        starts, coefficients, full = [start], [(0.0, 0.0, 0.0, 0.0)], [0.0]
-        for curve, e in zip(curves, slopes.tolist()):
-            roll = -math.copysign(1.0, curve.deflection) * (math.asin(e) if rail else math.atan(e))
-            for s0, s1, polynomial in (
-                (curve.ts, curve.sc, _ease(roll, curve.sc - curve.ts, rising=True)),
-                (curve.sc, curve.cs, (roll, 0.0, 0.0, 0.0)),
-                (curve.cs, curve.st, _ease(roll, curve.st - curve.cs, rising=False)),
-                (curve.st, None, (0.0, 0.0, 0.0, 0.0)),
-            ):
-                if s1 is not None and not s1 > s0:
-                    continue  # an empty piece (no arc between the spirals)
-                starts.append(s0)
-                coefficients.append(polynomial)
-                full.append(roll if s1 is not None else 0.0)
-        stations = np.array(starts + [end])
-        keep = np.diff(stations) > 0.0  # the first tangent is empty when the alignment starts on a curve
-        return cls(np.append(stations[:-1][keep], end), np.array(coefficients)[keep], np.array(full)[keep],
-                   alignment.chain.units)  # fmt: skip
+        chain = alignment.chain
+        stations = chain.stations
+        if not curves:
+            return cls(alignment.start_station, stations[[0, -1]], np.zeros((1, 4)), np.zeros(1), chain.units)
+        turn = np.array([math.copysign(1.0, c.deflection) for c in curves])
+        roll = -turn * (np.arcsin(slopes) if rail else np.arctan(slopes))
+        # TS, SC, CS, ST as the chain's own stations (ramps end exactly on segment ends)
+        wanted = np.array([(c.ts, c.sc, c.cs, c.st) for c in curves]) - alignment.start_station
+        index = np.clip(np.searchsorted(stations, wanted), 1, len(stations) - 1)
+        index -= np.abs(stations[index - 1] - wanted) <= np.abs(stations[index] - wanted)
+        ts, sc, cs, st = stations[index].T
+        entry, exit_ = sc - ts, st - cs
+        zero = np.zeros(len(curves))
+        pieces = np.stack([
+            np.stack([zero, zero, 3.0 * roll / entry**2, -2.0 * roll / entry**3], axis=1),  # cubic ease in
+            np.stack([roll, zero, zero, zero], axis=1),  # the circle
+            np.stack([roll, zero, -3.0 * roll / exit_**2, 2.0 * roll / exit_**3], axis=1),  # cubic ease out
+            np.zeros((len(curves), 4)),  # the tangent after
+        ], axis=1)  # fmt: skip
+        starts = np.concatenate([[0.0], np.stack([ts, sc, cs, st], axis=1).ravel()])
+        coefficients = np.concatenate([np.zeros((1, 4)), pieces.reshape(-1, 4)])
+        full = np.concatenate([[0.0], np.stack([roll, roll, roll, zero], axis=1).ravel()])
+        ends = np.append(starts, chain.length)
+        keep = np.diff(ends) > 0.0  # empty pieces: no arc between the spirals, no tangent between curves
+        return cls(alignment.start_station, np.append(starts[keep], chain.length), coefficients[keep], full[keep],
+                   chain.units)  # fmt: skip
 
     def _locate(self, station: ArrayLike) -> tuple[NDArray, NDArray]:
         s = as_real_array(station, "station")
@@ -131,12 +146,12 @@ class Superelevation:
         safe = np.where(full == 0.0, 1.0, full)
         return np.where(full == 0.0, 0.0, self.roll(station, derivative) / safe)
 
+    def records(self) -> NDArray:
+        """(m, 5) rows (s, a, b, c, d): each piece's cubic with s from the alignment's start
+        (OpenDRIVE's ``superelevation`` records)."""
+        return np.column_stack([self.local[:-1], self.coefficients])
+
     def ramp_ends(self) -> NDArray:
         """The stations where a ramp starts or ends (every interior piece boundary)."""
-        return self.stations[1:-1].copy()
+        return self.stations[1:-1]
 
-
-def _ease(roll: float, length: float, rising: bool) -> tuple[float, float, float, float]:
-    """The cubic ease from 0 to ``roll`` (or back) over ``length``, in powers of the distance from its start."""
-    c, e = 3.0 * roll / length**2, -2.0 * roll / length**3
-    return (0.0, 0.0, c, e) if rising else (roll, 0.0, -c, -e)

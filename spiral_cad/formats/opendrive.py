@@ -38,8 +38,9 @@ import math
 import os
 import xml.etree.ElementTree as ET
 from collections.abc import Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from datetime import datetime, timezone
+from xml.sax.saxutils import escape
 
 import numpy as np
 from numpy.typing import NDArray
@@ -95,156 +96,231 @@ class CrossSection:
             raise ValueError(f"rule must be 'RHT' or 'LHT'; got {self.rule!r}")
 
 
-@dataclass(frozen=True)
-class Banking:
-    """Superelevation of one curve: the cross slope ``e`` (m/m, ≥ 0) reached at SC and held to CS.
-
-    The stations are local ``s`` along the road (its start at 0), in the
-    chain's units; the slope ramps linearly from 0 at TS to e at SC and back
-    to 0 at ST, falling towards the curve's centre (``turn`` +1 left, −1 right).
-    """
-
-    ts: float
-    sc: float
-    cs: float
-    st: float
-    e: float
-    turn: float
-
-
 @dataclass
 class RoadToWrite:
-    """One road to write: its chain and what goes with it."""
+    """One road to write: its chain and what goes with it.
+
+    Attributes:
+        chain: the reference line.
+        name: the road's name.
+        start_station: the chainage of the chain's start (``userData``).
+        elevation: (m, 4) rows (s, a, b, c): z = a + b·d + c·d² from local s
+            (0 at the chain's start) on, in the chain's unit; None: level at 0.
+        superelevation: (m, 5) rows (s, a, b, c, d): the roll angle (radians)
+            as a cubic in the distance from s; None or all zero: none written.
+    """
 
     chain: Chain
     name: str
     start_station: float = 0.0
-    banking: list[Banking] = field(default_factory=list)
+    elevation: NDArray | None = None
+    superelevation: NDArray | None = None
 
 
-def _segment_record(segment: Segment, scale: float) -> tuple[tuple[float, float, float, float], str, dict[str, float]]:
-    """((x, y, hdg, length) in metres, element name, element attributes) of one segment."""
-    (x, y, tx, ty, _), _ = segment.ends
-    hdg = math.atan2(ty, tx)
-    if isinstance(segment, Line):
-        return (x * scale, y * scale, hdg, segment.length * scale), "line", {}
-    if isinstance(segment, Arc):
-        return (x * scale, y * scale, hdg, segment.length * scale), "arc", {"curvature": 1.0 / (segment.radius * scale)}
-    if isinstance(segment, BezierSpiral):
-        cp = segment.control_points * scale
-        local = (cp - cp[0]) @ np.array([[math.cos(hdg), -math.sin(hdg)], [math.sin(hdg), math.cos(hdg)]])
-        u, v = local[:, 0], local[:, 1]
-        coefficients = {
-            "aU": 0.0, "bU": 3.0 * u[1], "cU": 3.0 * (u[2] - 2.0 * u[1]), "dU": u[3] - 3.0 * u[2] + 3.0 * u[1],
-            "aV": 0.0, "bV": 0.0, "cV": 3.0 * (v[2] - 2.0 * v[1]), "dV": v[3] - 3.0 * v[2] + 3.0 * v[1],
-        }  # fmt: skip
-        return (cp[0, 0], cp[0, 1], hdg, bezier.arc_length(cp)), "paramPoly3", coefficients
-    raise ValueError(f"segment must be a Line, Arc or BezierSpiral; got {segment!r}")
+#: Kinds of planView records.
+LINE, ARC, SPIRAL = 0, 1, 2
 
 
-def _superelevation(road: RoadToWrite, scale: float) -> list[tuple[float, float, float]]:
-    """(s, a, b) records of the roll angle: linear ramps along the spirals, constant on the arcs.
+def plan_records(chain: Chain, scale: float) -> dict[str, NDArray]:
+    """The planView of ``chain`` in metres, as arrays (one pass over the segments, then vectorised).
 
-    OpenDRIVE's superelevation is the roll angle, positive when the road falls
-    to the right: a left-turning curve (centre on the left) falls to the left.
+    Keys: ``kind`` (LINE, ARC, SPIRAL), ``x``, ``y``, ``hdg``, ``length``,
+    ``s`` (the chain's station at the start of each geometry), ``curvature``
+    (arcs), ``poly`` (N, 5) the paramPoly3 coefficients bU, cU, dU, cV, dV of
+    the spirals in their own frame (aU = aV = bV = 0), ``box`` (west, south,
+    east, north) and ``total`` (the road's length).
     """
-    records = [(0.0, 0.0, 0.0)]
-    for bank in road.banking:
-        roll = -bank.turn * math.atan(bank.e)
-        ts, sc, cs, st = (scale * s for s in (bank.ts, bank.sc, bank.cs, bank.st))
-        if sc > ts:
-            records.append((ts, 0.0, roll / (sc - ts)))
-        records.append((sc, roll, 0.0))
-        if st > cs:
-            records.append((cs, roll, -roll / (st - cs)))
-        records.append((st, 0.0, 0.0))
-    kept: list[tuple[float, float, float]] = []
-    for record in records:  # a later record at the same s replaces the earlier one
-        if kept and record[0] <= kept[-1][0]:
-            kept[-1] = record
+    segments = chain.segments
+    count = len(segments)
+    kind = np.empty(count, dtype=np.int8)
+    frames = np.empty((count, 4))
+    length = np.empty(count)
+    radius = np.full(count, np.inf)
+    spirals: list[NDArray] = []
+    arcs: list[tuple[float, float, float, float, float]] = []
+    for k, segment in enumerate(segments):
+        frames[k] = segment.ends[0][:4]
+        if isinstance(segment, BezierSpiral):
+            kind[k] = SPIRAL
+            spirals.append(segment.control_points)
+        elif isinstance(segment, Arc):
+            kind[k] = ARC
+            radius[k] = segment.radius
+            length[k] = segment.length
+            (cx, cy), r = segment.center.tolist(), segment.radius
+            arcs.append((cx, cy, abs(r), segment.start_angle, math.copysign(segment.sweep, r)))
+        elif isinstance(segment, Line):
+            kind[k] = LINE
+            length[k] = segment.length
         else:
-            kept.append(record)
-    return kept
+            raise ValueError(f"segment {k} must be a Line, Arc or BezierSpiral; got {segment!r}")
+    hdg = np.arctan2(frames[:, 3], frames[:, 2])
+    spiral = kind == SPIRAL
+    poly = np.zeros((count, 5))
+    points = [frames[:, :2], np.array([s.ends[1][:2] for s in segments])]
+    if spirals:
+        cp = np.array(spirals)
+        length[spiral] = bezier.arc_length(cp)  # one batched quadrature
+        c, s = np.cos(hdg[spiral])[:, None], np.sin(hdg[spiral])[:, None]
+        delta = cp - cp[:, :1]
+        u = delta[..., 0] * c + delta[..., 1] * s  # the spiral in its own frame (start, heading)
+        v = delta[..., 1] * c - delta[..., 0] * s
+        poly[spiral] = np.stack([3.0 * u[:, 1], 3.0 * (u[:, 2] - 2.0 * u[:, 1]), u[:, 3] - 3.0 * u[:, 2] + 3.0 * u[:, 1],
+                                 3.0 * (v[:, 2] - 2.0 * v[:, 1]), v[:, 3] - 3.0 * v[:, 2] + 3.0 * v[:, 1]], axis=1) * scale  # fmt: skip
+        points.append(cp.reshape(-1, 2))  # the hull of the control points holds each spiral
+    if arcs:
+        points.append(_arc_extremes(np.array(arcs)))
+    box = np.vstack(points)
+    return {
+        "kind": kind, "x": frames[:, 0] * scale, "y": frames[:, 1] * scale, "hdg": hdg, "length": length * scale,
+        "s": chain.stations[:-1] * scale, "curvature": 1.0 / (radius * scale), "poly": poly,
+        "box": np.concatenate([box.min(axis=0), box.max(axis=0)]) * scale, "total": chain.length * scale,
+    }  # fmt: skip
 
 
-def _lanes(parent: ET.Element, section: CrossSection) -> None:
-    lanes = ET.SubElement(parent, "lanes")
-    lane_section = ET.SubElement(lanes, "laneSection", s="0.0")
+def _arc_extremes(arcs: NDArray) -> NDArray:
+    """The points of arcs (cx, cy, r, start angle, signed sweep) furthest along ±x and ±y that lie on them."""
+    cx, cy, r, a0, sweep = arcs.T
+    out = []
+    for angle in (0.0, 0.5 * math.pi, math.pi, 1.5 * math.pi):
+        turned = np.mod(np.sign(sweep) * (angle - a0), 2.0 * math.pi)
+        on = turned <= np.abs(sweep)
+        out.append(np.stack([cx + r * math.cos(angle), cy + r * math.sin(angle)], axis=1)[on])
+    return np.vstack(out) if out else np.empty((0, 2))
 
-    def lane(side: ET.Element, lane_id: int, kind: str, width: float, mark: str) -> None:
-        element = ET.SubElement(side, "lane", id=str(lane_id), type=kind, level="false")
-        ET.SubElement(element, "width", sOffset="0.0", a=number(width), b="0.0", c="0.0", d="0.0")
-        ET.SubElement(element, "roadMark", sOffset="0.0", type=mark, weight="standard", color="standard", width="0.12")
 
-    left = ET.SubElement(lane_section, "left")
+def decimals(values: NDArray) -> list[str]:
+    """Shortest round-trip decimals of an array (``number`` for many values at once)."""
+    values = np.asarray(values, dtype=float)
+    if not np.isfinite(values).all():
+        number(float(values[~np.isfinite(values)].ravel()[0]))  # raises, naming the value
+    return list(map(repr, (values + 0.0).ravel().tolist()))
+
+
+def _attribute(text: str) -> str:
+    """``text`` as a double-quoted XML attribute value."""
+    return '"' + escape(text, {'"': "&quot;", "\n": "&#10;", "\r": "&#13;", "\t": "&#9;"}) + '"'
+
+
+def _plan_view(plan: dict[str, NDArray]) -> list[str]:
+    """The ``<planView>`` lines of one road."""
+    s, x, y, hdg, length = (decimals(plan[key]) for key in ("s", "x", "y", "hdg", "length"))
+    kind = plan["kind"].tolist()
+    arcs = iter(decimals(plan["curvature"][plan["kind"] == ARC]))
+    polys = iter(zip(*(iter(decimals(plan["poly"][plan["kind"] == SPIRAL])),) * 5))
+    lines = ["    <planView>"]
+    for k in range(len(kind)):
+        lines.append(f'      <geometry s="{s[k]}" x="{x[k]}" y="{y[k]}" hdg="{hdg[k]}" length="{length[k]}">')
+        if kind[k] == LINE:
+            lines.append("        <line />")
+        elif kind[k] == ARC:
+            lines.append(f'        <arc curvature="{next(arcs)}" />')
+        else:
+            bu, cu, du, cv, dv = next(polys)
+            lines.append(f'        <paramPoly3 aU="0.0" bU="{bu}" cU="{cu}" dU="{du}" aV="0.0" bV="0.0" cV="{cv}" dV="{dv}" pRange="normalized" />')
+        lines.append("      </geometry>")
+    lines.append("    </planView>")
+    return lines
+
+
+def _polynomials(tag: str, element: str, rows: NDArray) -> list[str]:
+    """``<tag>`` holding one ``<element s a b c d>`` per row."""
+    cells = np.asarray(rows, dtype=float)
+    cells = np.hstack([cells, np.zeros((len(cells), 5 - cells.shape[1]))])
+    text = iter(decimals(cells))
+    lines = [f"    <{tag}>"]
+    for _ in range(len(cells)):
+        s, a, b, c, d = (next(text) for _ in range(5))
+        lines.append(f'      <{element} s="{s}" a="{a}" b="{b}" c="{c}" d="{d}" />')
+    return lines + [f"    </{tag}>"]
+
+
+def _scaled(rows: NDArray | None, scale: float, powers: tuple[int, ...]) -> NDArray | None:
+    """Polynomial rows (s, a, b, …) in the design's unit converted to metres: s·scale and each
+    coefficient times scale**power (a value is a length: 1; a roll angle: 0)."""
+    if rows is None:
+        return None
+    rows = np.asarray(rows, dtype=float)
+    return rows * (scale ** np.array((1, *powers), dtype=float))
+
+
+def _lanes(section: CrossSection) -> list[str]:
     kinds = [("driving", section.lane_width)] * section.driving_lanes
     if section.shoulder_width > 0:
         kinds.append(("shoulder", section.shoulder_width))
+
+    def lane(lane_id: int, kind: str, width: float, mark: str) -> list[str]:
+        return [
+            f'            <lane id="{lane_id}" type="{kind}" level="false">',
+            f'              <width sOffset="0.0" a="{number(width)}" b="0.0" c="0.0" d="0.0" />',
+            f'              <roadMark sOffset="0.0" type="{mark}" weight="standard" color="standard" width="0.12" />',
+            "            </lane>",
+        ]
+
+    def mark(k: int, kind: str) -> str:
+        return "solid" if k == section.driving_lanes else "broken" if kind == "driving" else "none"
+
+    lines = ["    <lanes>", '      <laneSection s="0.0">', "        <left>"]
     for k, (kind, width) in reversed(list(enumerate(kinds, 1))):
-        lane(left, k, kind, width, "solid" if k == section.driving_lanes else "broken" if kind == "driving" else "none")
-    center = ET.SubElement(lane_section, "center")
-    middle = ET.SubElement(center, "lane", id="0", type="none", level="false")
-    ET.SubElement(middle, "roadMark", sOffset="0.0", type="broken" if section.driving_lanes == 1 else "solid",
-                  weight="standard", color="standard", width="0.12")  # fmt: skip
-    right = ET.SubElement(lane_section, "right")
+        lines += lane(k, kind, width, mark(k, kind))
+    centre = "broken" if section.driving_lanes == 1 else "solid"
+    lines += ["        </left>", "        <center>", '          <lane id="0" type="none" level="false">',
+              f'            <roadMark sOffset="0.0" type="{centre}" weight="standard" color="standard" width="0.12" />',
+              "          </lane>", "        </center>", "        <right>"]  # fmt: skip
     for k, (kind, width) in enumerate(kinds, 1):
-        lane(right, -k, kind, width, "solid" if k == section.driving_lanes else "broken" if kind == "driving" else "none")
+        lines += lane(-k, kind, width, mark(k, kind))
+    return lines + ["        </right>", "      </laneSection>", "    </lanes>"]
 
 
-def opendrive_tree(
+def opendrive_text(
     roads: Sequence[RoadToWrite],
     name: str,
     units: str,
     originating_system: str,
     cross_section: CrossSection = CrossSection(),
     geo_reference: str | None = None,
-) -> ET.ElementTree:
-    """The OpenDRIVE document for ``roads`` (see the module docstring)."""
+) -> str:
+    """The OpenDRIVE document for ``roads`` as text (see the module docstring)."""
     scale = to_metres(units)
-    root = ET.Element("OpenDRIVE")
-    points = np.vstack([r.chain.sample(8) for r in roads]) * scale
-    (west, south), (east, north) = points.min(axis=0), points.max(axis=0)
-    header = ET.SubElement(
-        root, "header", revMajor=str(REV_MAJOR), revMinor=str(REV_MINOR), name=name, version="1",
-        date=datetime.now(timezone.utc).strftime("%Y-%m-%dT%H:%M:%S"), north=number(north), south=number(south),
-        east=number(east), west=number(west), vendor=originating_system,
-    )  # fmt: skip
+    plans = [plan_records(road.chain, scale) for road in roads]
+    boxes = np.array([plan["box"] for plan in plans])
+    west, south = boxes[:, :2].min(axis=0)
+    east, north = boxes[:, 2:].max(axis=0)
+    date = datetime.now(timezone.utc).strftime("%Y-%m-%dT%H:%M:%S")
+    lines = [
+        "<?xml version='1.0' encoding='utf-8'?>",
+        "<OpenDRIVE>",
+        f'  <header revMajor="{REV_MAJOR}" revMinor="{REV_MINOR}" name={_attribute(name)} version="1" date="{date}" '
+        f'north="{number(north)}" south="{number(south)}" east="{number(east)}" west="{number(west)}" '
+        f"vendor={_attribute(originating_system)}>",
+    ]
     if geo_reference:
-        ET.SubElement(header, "geoReference").text = geo_reference
+        lines.append(f"    <geoReference>{escape(geo_reference)}</geoReference>")
     note = f"design units: {units}; written in metres" + ("" if units == "m" else f" (× {number(scale)})")
-    ET.SubElement(header, "userData", code="spiral_cad:units", value=note)
-    for index, road in enumerate(roads, 1):
-        records = [_segment_record(seg, scale) for seg in road.chain]
-        length = sum(r[0][3] for r in records)
-        element = ET.SubElement(
-            root, "road", id=str(index), junction="-1", length=number(length), name=road.name, rule=cross_section.rule
-        )
-        plan = ET.SubElement(element, "planView")
-        s = 0.0
-        for (x, y, hdg, seg_length), kind, attributes in records:
-            geometry = ET.SubElement(plan, "geometry", s=number(s), x=number(x), y=number(y), hdg=number(hdg),
-                                     length=number(seg_length))  # fmt: skip
-            child = ET.SubElement(geometry, kind, {k: number(v) for k, v in attributes.items()})
-            if kind == "paramPoly3":
-                child.set("pRange", "normalized")
-            s += seg_length
-        elevation = ET.SubElement(element, "elevationProfile")
-        ET.SubElement(elevation, "elevation", s="0.0", a="0.0", b="0.0", c="0.0", d="0.0")
-        if road.banking:
-            lateral = ET.SubElement(element, "lateralProfile")
-            for s0, a, b in _superelevation(road, scale):
-                ET.SubElement(lateral, "superelevation", s=number(s0), a=number(a), b=number(b), c="0.0", d="0.0")
-        _lanes(element, cross_section)
-        ET.SubElement(element, "userData", code="spiral_cad:startStation", value=number(road.start_station * scale))
-    ET.indent(root)
-    return ET.ElementTree(root)
+    lines += [f'    <userData code="spiral_cad:units" value={_attribute(note)} />', "  </header>"]
+    lanes = _lanes(cross_section)
+    for index, (road, plan) in enumerate(zip(roads, plans), 1):
+        lines.append(f'  <road id="{index}" junction="-1" length="{number(plan["total"])}" name={_attribute(road.name)} '
+                     f'rule="{cross_section.rule}">')  # fmt: skip
+        lines += _plan_view(plan)
+        elevation = _scaled(road.elevation, scale, (1, 0, -1)) if road.elevation is not None else np.zeros((1, 4))
+        lines += _polynomials("elevationProfile", "elevation", elevation)
+        roll = _scaled(road.superelevation, scale, (0, -1, -2, -3))
+        if roll is not None and roll[:, 1:].any():
+            lines += _polynomials("lateralProfile", "superelevation", roll)
+        lines += lanes
+        lines.append(f'    <userData code="spiral_cad:startStation" value="{number(road.start_station * scale)}" />')
+        lines.append("  </road>")
+    lines.append("</OpenDRIVE>\n")
+    return "\n".join(lines)
 
 
 def write_opendrive(roads: Sequence[RoadToWrite], path: str | os.PathLike, name: str, units: str, originating_system: str,
                     cross_section: CrossSection = CrossSection(), geo_reference: str | None = None) -> None:  # fmt: skip
     """Write ``roads`` as one .xodr file (UTF-8, XML declaration)."""
-    tree = opendrive_tree(roads, name, units, originating_system, cross_section, geo_reference)
-    tree.write(os.fspath(path), encoding="utf-8", xml_declaration=True)
+    text = opendrive_text(roads, name, units, originating_system, cross_section, geo_reference)
+    with open(os.fspath(path), "w", encoding="utf-8", newline="\n") as handle:
+        handle.write(text)
 
 
 # ------------------------------------------------------------------ import
