@@ -33,7 +33,7 @@ profile = Profile.from_pvis(
 print(profile.table(6))
 
 # One 3.5 m lane each way with 1.5 m shoulders, 2.5 % crown on the tangents, 0.4 m of pavement.
-road = corridor(alignment, profile, CrossSection(lane_width=3.5, shoulder_width=1.5), depth=0.4)
+road = corridor(alignment, profile, CrossSection(lane_width=3.5, shoulder_width=1.5, crossfall=0.025, depth=0.4))
 print(road.describe())
 print(road.centerline.describe())
 export_step(road.solid, str(out / "road.step"))

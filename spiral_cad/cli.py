@@ -62,6 +62,7 @@ DEMO_DESIGN: dict = {
             "design_speed": 80,
             "max_jerk": 0.6,
             "start_station": 10000,
+            "profile": {"pvis": [[10000, 120], [10700, 132], [11500, 116], [12500, 121]]},
         },
         {
             "name": "circles",

@@ -23,8 +23,8 @@ def road():
 
 def test_the_corridor_is_a_valid_solid_with_the_volume_of_its_section(road, tmp_path):
     alignment, profile = road
-    section = CrossSection(driving_lanes=2, lane_width=3.5, shoulder_width=2.0)
-    built = corridor(alignment, profile, section, depth=0.3, tolerance=1e-6)
+    section = CrossSection(driving_lanes=2, lane_width=3.5, shoulder_width=2.0, depth=0.3)
+    built = corridor(alignment, profile, section, tolerance=1e-6)
     solid = built.solid
     assert solid.is_valid and BRepCheck_Analyzer(solid.wrapped).IsValid()
     # independent: the pavement is the top moved down by its depth, so every plan point carries 0.3 m,
@@ -50,8 +50,7 @@ def test_the_corridor_is_a_valid_solid_with_the_volume_of_its_section(road, tmp_
 
 def test_the_top_follows_profile_crossfall_and_banking(road):
     alignment, profile = road
-    built = corridor(alignment, profile, CrossSection(driving_lanes=1, lane_width=3.5, shoulder_width=0.0),
-                     crossfall=0.02, depth=0.25)  # fmt: skip
+    built = corridor(alignment, profile, CrossSection(driving_lanes=1, lane_width=3.5, shoulder_width=0.0, crossfall=0.02, depth=0.25))
     start = alignment.start_station
     # at the start (a tangent): centre on the profile, both edges 2 % below it, the pavement 0.25 m under the top
     section = built.roadway.section(0)
@@ -86,7 +85,9 @@ def test_the_centre_line_wire_is_the_plan_lifted(road):
 
 def test_corridor_errors(road):
     alignment, profile = road
-    with pytest.raises(ValueError, match="depth must be positive"):
-        corridor(alignment, profile, depth=-1)
+    with pytest.raises(ValueError, match="depth must be a finite number ≥ 0"):
+        corridor(alignment, profile, CrossSection(depth=-1))
+    with pytest.raises(ValueError, match="cross_section must be a CrossSection"):
+        corridor(alignment, profile, {"depth": 1})
     with pytest.raises(ValueError, match="the profile is in ft but the alignment in m"):
         corridor(alignment, Profile.from_pvis([(0, 0), (2000, 0)], units="ft"))

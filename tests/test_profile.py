@@ -49,7 +49,9 @@ def test_a_symmetric_curve_is_the_parabola_between_the_grades():
     assert 2 * c == pytest.approx(-0.06 / 200, rel=1e-9)
     assert curve.k == pytest.approx(200 / 6, rel=1e-12)
     assert profile.elevation(400.0) == pytest.approx(112 - 0.06 * 200 / 8, abs=1e-12)
-    assert curve.turning_point() == pytest.approx(400.0)
+    assert curve.extreme_point() == pytest.approx(400.0)
+    rising = Profile.from_pvis([(0, 100), (400, 112), (1000, 124.6)], curve_lengths=[200], units="m")
+    assert rising.curves[0].extreme_point() == 500.0  # a crest between rising grades: highest at its end
     assert profile.grade([300, 400, 500]) == pytest.approx([0.03, 0.0, -0.03], abs=1e-15)
 
 
@@ -117,13 +119,16 @@ def test_the_shortest_curves_meet_the_criteria_and_violations_are_listed(profile
 
 def test_profile_table_and_csv(profile, tmp_path):
     rows = profile.rows()
-    assert [r["pvi"] for r in rows] == [0, 1, 2, 3]
-    assert rows[1]["kind"] == "crest" and rows[2]["kind"] == "sag"
+    assert [r["pvi"] for r in rows] == [1, 2]
+    assert rows[0]["kind"] == "crest" and rows[1]["kind"] == "sag"
     assert all(type(v) in (int, float, str) for r in rows for v in r.values())
     path = profile.to_csv(tmp_path / "highway_profile.csv")
     head = path.read_text().splitlines()[0]
     assert "station [m]" in head and "K [m/%]" in head and "grade_in [%]" in head and "verdict" in head
     assert "K_min [m/%]" in profile.table()
+    from test_cli import assert_plain_csv
+
+    assert_plain_csv(path)
 
 
 @pytest.mark.parametrize(
@@ -137,6 +142,7 @@ def test_profile_table_and_csv(profile, tmp_path):
         (dict(points=[(0, 0), (100, 5), (200, 0)]), "give curve_lengths or k_values"),
         (dict(points=[(0, 0), (100, 5), (200, 0)], curve_lengths=[(1, 2, 3)]), r"PVI 1\) must be a length"),
         (dict(points=[(0, 0), (100, 5), (200, 0)], curve_lengths="12"), "must be a real number"),
+        (dict(points=[(0, 0), (100, 5), (200, 10)], curve_lengths=[5]), r"PVI 1 at station 100.0 lies on the grade of its neighbours \(5.0 %\)"),
     ],
 )
 def test_malformed_profiles_name_the_pvi(kwargs, message):

@@ -2,10 +2,10 @@
 
 ``centerline_wire`` turns a ``Centerline3D`` into one wire with one edge per
 plan segment (a rational cubic B-spline through its pieces; plan exact).
-``corridor`` sweeps a cross-section — lanes and shoulders of a
-``CrossSection``, the crown's crossfall, the superelevation and a pavement
-depth — along alignment and profile into a closed build123d ``Solid``: per
-plan segment one ruled B-spline face per lane and shoulder on top, one per
+``corridor`` sweeps a ``CrossSection`` — lanes and shoulders, the crown's
+crossfall on tangents and the pavement depth — with the superelevation
+along alignment and profile into a closed build123d ``Solid``: per plan
+segment one ruled B-spline face per lane and shoulder on top, one per
 side below, one vertical face at each outer edge, and a planar face at each
 end, sewn and checked (``BRepCheck_Analyzer``) before it is returned.
 """
@@ -109,8 +109,6 @@ def corridor(
     cross_section: CrossSection = CrossSection(),
     *,
     superelevation: Superelevation | None = None,
-    crossfall: float = 0.025,
-    depth: float | None = None,
     tolerance: float | None = None,
 ) -> Corridor:
     """Sweep ``cross_section`` along ``alignment`` and ``profile`` into a valid solid.
@@ -118,26 +116,25 @@ def corridor(
     Args:
         alignment: the horizontal ``Alignment``.
         profile: its ``Profile``.
-        cross_section: lanes and shoulders (widths in metres, converted to the
-            alignment's unit).
+        cross_section: lanes and shoulders, crossfall and pavement depth
+            (widths and depth in metres, converted to the alignment's unit).
         superelevation: the banking (default: from the alignment's criteria;
             level without them).
-        crossfall: the crown's cross slope on tangents (m/m).
-        depth: pavement thickness in the alignment's unit (default 0.5 m).
         tolerance: the largest distance of any edge from the exact road
             (default 1e-6 × the alignment's length).
 
     Raises:
-        ValueError: bad input (see ``roadway``), or a solid OCCT does not
-            find valid (never returned).
+        ValueError: bad input (see ``spiral_cad.design.roadway``), or a solid
+            OCCT does not find valid (never returned).
     """
     from build123d import Face, Solid
 
     units = alignment.chain.units
     metres = to_metres(units)
+    if not isinstance(cross_section, CrossSection):
+        raise ValueError(f"cross_section must be a CrossSection; got {type(cross_section).__name__}")
     offsets = section_offsets(cross_section) / metres
-    depth = 0.5 / metres if depth is None else depth
-    road = roadway(alignment, profile, offsets, superelevation, crossfall, depth, tolerance)
+    road = roadway(alignment, profile, offsets, superelevation, cross_section.crossfall, cross_section.depth / metres, tolerance)
     line = centerline_3d(alignment, profile, tolerance)
     roles = _lane_roles(cross_section)
     pieces: list[tuple[str, Any]] = []

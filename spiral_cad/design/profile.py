@@ -116,11 +116,10 @@ class ProfileCriteria:
 
     def minimum_length(self, difference: NDArray, units: str) -> NDArray:
         """The shortest curves for grade changes ``difference`` (A = g2 − g1 as fractions; negative:
-        crest): L = K_min·|A| (A in percent), at least ``appearance_length``; 0 where A = 0."""
+        crest): L = K_min·|A| (A in percent), at least ``appearance_length``."""
         difference = np.asarray(difference, dtype=float)
         k = np.where(difference < 0.0, self.minimum_k(True, units), self.minimum_k(False, units))
-        needed = np.maximum(k * 100.0 * np.abs(difference), self.appearance_length(units))
-        return np.where(difference == 0.0, 0.0, needed)
+        return np.maximum(k * 100.0 * np.abs(difference), self.appearance_length(units))
 
     def appearance_length(self, units: str) -> float:
         """The shortest curve for appearance: given, or 0.6·V m (3·V ft), in the design's unit."""
@@ -155,7 +154,7 @@ class VerticalCurve:
         index: the PVI's index.
         station, elevation: the PVI.
         grade_in, grade_out: the grades before and after.
-        length_in, length_out: BVC→PVI and PVI→EVC (equal for a symmetric curve; 0 for no curve).
+        length_in, length_out: BVC→PVI and PVI→EVC (equal for a symmetric curve).
     """
 
     index: int
@@ -177,7 +176,7 @@ class VerticalCurve:
 
     @property
     def kind(self) -> str:
-        return "crest" if self.difference < 0 else "sag" if self.difference > 0 else "none"
+        return "crest" if self.difference < 0 else "sag"
 
     @property
     def bvc(self) -> float:
@@ -190,31 +189,29 @@ class VerticalCurve:
     @property
     def middle_grade(self) -> float:
         """The grade below the PVI where the two parabolas of an asymmetric curve meet."""
-        if self.length == 0.0:
-            return self.grade_out
         return (self.grade_in * self.length_in + self.grade_out * self.length_out) / self.length
 
     @property
     def rates(self) -> tuple[float, float]:
         """d²z/ds² of the two parabolas (equal for a symmetric curve)."""
         g = self.middle_grade
-        return tuple((b - a) / length if length > 0 else 0.0 for a, b, length in
+        return tuple((b - a) / length for a, b, length in
                      ((self.grade_in, g, self.length_in), (g, self.grade_out, self.length_out)))  # fmt: skip
 
     @property
     def k(self) -> float:
-        """K = 1/(100·max|d²z/ds²|): length per percent of grade change (inf without curvature)."""
-        rate = max(abs(r) for r in self.rates)
-        return math.inf if rate == 0.0 else 1.0 / (100.0 * rate)
+        """K = 1/(100·max|d²z/ds²|): length per percent of grade change."""
+        return 1.0 / (100.0 * max(abs(r) for r in self.rates))
 
-    def turning_point(self) -> float | None:
-        """Station of the high (crest) or low (sag) point when it lies on the curve, else None."""
-        for (s0, z0, g0), rate, length in zip(self._starts(), self.rates, (self.length_in, self.length_out)):
-            if rate != 0.0:
-                x = -g0 / rate
-                if 0.0 <= x <= length:
-                    return s0 + x
-        return None
+    def extreme_point(self) -> float:
+        """Station of the curve's highest point (crest) or lowest (sag): where the grade is 0 on
+        it, else the end that is higher (crest) or lower (sag)."""
+        sign = 1.0 if self.kind == "crest" else -1.0
+        for (s0, _, g0), rate, length in zip(self._starts(), self.rates, (self.length_in, self.length_out)):
+            if 0.0 <= -g0 / rate <= length:
+                return s0 - g0 / rate
+        rising = sign * self.grade_out > 0.0  # no level point: the curve climbs (crest) or falls (sag) throughout
+        return self.evc if rising else self.bvc
 
     def _starts(self) -> tuple[tuple[float, float, float], tuple[float, float, float]]:
         """(station, elevation, grade) at the start of each parabola."""
@@ -329,6 +326,11 @@ class Profile:
         if curve_lengths is not None and k_values is not None:
             raise ValueError("give at most one of curve_lengths and k_values")
         differences = grades[1:] - grades[:-1]
+        for j in np.flatnonzero(differences == 0.0):
+            raise ValueError(
+                f"PVI {j + 1} at station {float(pvis[j + 1, 0])!r} lies on the grade of its neighbours "
+                f"({100 * float(grades[j])!r} %): no vertical curve can be placed there; remove it"
+            )
         if count == 0 and curve_lengths is None and k_values is None:
             halves = np.zeros((0, 2))  # one grade: nothing to choose
         elif curve_lengths is not None:
@@ -418,35 +420,24 @@ class Profile:
     # ------------------------------------------------------------ table
 
     def rows(self) -> list[dict[str, Any]]:
-        """One dict per PVI: station, elevation, grades (%), the curve (kind, lengths, K, BVC/EVC,
-        turning point) and, with criteria, SSD, K_min, L_min, the grade limit and the verdict."""
-        grades = self.grades * 100.0
-        by_pvi = {c.index: c for c in self.curves}
+        """One dict per vertical curve (interior PVI): station, elevation, grades in and out (%),
+        A (%), kind, lengths, K, BVC/EVC, the station of the curve's highest (crest) or lowest
+        (sag) point, and with criteria SSD, K_min, L_min, the grade limit and the verdict (of the
+        curve and its grades: the first row also judges the first grade)."""
         rows = []
-        for k, (station, elevation) in enumerate(self.pvis.tolist()):
-            curve = by_pvi.get(k)
+        for curve in self.curves:
             row: dict[str, Any] = {
-                "pvi": k,
-                "station": station,
-                "elevation": elevation,
-                "grade_in": float(grades[k - 1]) if k > 0 else "",
-                "grade_out": float(grades[k]) if k < len(grades) else "",
-            }
-            if curve is None:
-                row.update(dict.fromkeys(("A", "kind", "L_in", "L_out", "K", "BVC", "EVC", "turning_point"), ""))
-            else:
-                turning = curve.turning_point()
-                row.update({
-                    "A": 100.0 * curve.difference, "kind": curve.kind, "L_in": curve.length_in, "L_out": curve.length_out,
-                    "K": curve.k if math.isfinite(curve.k) else "", "BVC": curve.bvc, "EVC": curve.evc,
-                    "turning_point": "" if turning is None else turning,
-                })  # fmt: skip
+                "pvi": curve.index, "station": curve.station, "elevation": curve.elevation,
+                "grade_in": 100.0 * curve.grade_in, "grade_out": 100.0 * curve.grade_out, "A": 100.0 * curve.difference,
+                "kind": curve.kind, "L_in": curve.length_in, "L_out": curve.length_out, "K": curve.k,
+                "BVC": curve.bvc, "EVC": curve.evc, "extreme_point": curve.extreme_point(),
+            }  # fmt: skip
             if self.checks:
-                check = self.checks[k]
+                check = self.checks[curve.index]
+                violations = check.violations + (self.checks[0].violations if curve.index == 1 else ())
                 row.update({
-                    "SSD": check.sight_distance, "K_min": check.minimum_k if curve is not None else "",
-                    "L_min": check.minimum_length if curve is not None else "", "max_grade": 100.0 * check.max_grade,
-                    "verdict": "ok" if check.ok else "; ".join(check.violations),
+                    "SSD": check.sight_distance, "K_min": check.minimum_k, "L_min": check.minimum_length,
+                    "max_grade": 100.0 * check.max_grade, "verdict": "; ".join(violations) or "ok",
                 })  # fmt: skip
             rows.append(row)
         return rows
@@ -465,7 +456,7 @@ class Profile:
 
 #: Dimension of each profile-table column (``L`` the design's length unit).
 PROFILE_DIMENSIONS = {
-    **dict.fromkeys(["station", "elevation", "L_in", "L_out", "BVC", "EVC", "turning_point", "SSD", "L_min"], "L"),
+    **dict.fromkeys(["station", "elevation", "L_in", "L_out", "BVC", "EVC", "extreme_point", "SSD", "L_min"], "L"),
     **dict.fromkeys(["grade_in", "grade_out", "A", "max_grade"], "%"),
     **dict.fromkeys(["K", "K_min"], "L/%"),
 }
@@ -561,7 +552,7 @@ def _check_alignment(pvis: NDArray, curves: tuple[VerticalCurve, ...], alignment
     first, last = alignment.start_station, alignment.end_station
     slack = check_coverage(float(pvis[0, 0]), float(pvis[-1, 0]), alignment, units)
     for curve in curves:
-        if curve.length > 0.0 and (curve.bvc < first - slack or curve.evc > last + slack):
+        if curve.bvc < first - slack or curve.evc > last + slack:
             raise NoSolutionError(
                 f"PVI {curve.index}: its vertical curve ({curve.bvc:.6g} … {curve.evc:.6g} {units}) runs past the "
                 f"alignment's {'start' if curve.bvc < first - slack else 'end'} ({first:.6g} … {last:.6g})"
@@ -584,9 +575,6 @@ def _pieces(pvis: NDArray, grades: NDArray, curves: tuple[VerticalCurve, ...]) -
     grade_line(0, float(pvis[0, 0]))
     for curve in curves:
         k = curve.index
-        if curve.length == 0.0:
-            grade_line(k, curve.station)
-            continue
         parabolas = list(zip(curve._starts(), curve.rates))
         for (s0, z0, g0), rate in parabolas[:1] if curve.length_in == curve.length_out else parabolas:
             starts.append(s0)  # a symmetric curve is one parabola
@@ -609,7 +597,7 @@ def _judge(curves, grades: NDArray, criteria: ProfileCriteria, units: str, stric
         violations = []
         curve = by_pvi.get(k)
         k_min = length_min = 0.0
-        if curve is not None and curve.difference != 0.0:
+        if curve is not None:
             k_min = criteria.minimum_k(curve.kind == "crest", units)
             length_min = float(needed[k])
             if curve.k < k_min * (1 - 1e-9):

@@ -69,29 +69,38 @@ def number(value: float) -> str:
 
 @dataclass(frozen=True)
 class CrossSection:
-    """The lanes written to every road (metres; OpenDRIVE lane widths are always metres).
+    """A road's cross-section (metres; OpenDRIVE lane widths are always metres).
 
     Attributes:
         driving_lanes: driving lanes on each side of the reference line.
         lane_width: width of each driving lane.
         shoulder_width: width of the shoulder outside the driving lanes (0: none).
         rule: ``"RHT"`` (right-hand traffic) or ``"LHT"``.
+        crossfall: the crown's cross slope on tangents (m/m; both sides fall
+            outwards). The corridor solid has it; OpenDRIVE gets only the
+            superelevation, the roll of the whole road.
+        depth: the pavement's thickness under the surface (corridor solids).
     """
 
     driving_lanes: int = 1
     lane_width: float = 3.5
     shoulder_width: float = 2.5
     rule: str = "RHT"
+    crossfall: float = 0.025
+    depth: float = 0.5
 
     def __post_init__(self) -> None:
         if not (isinstance(self.driving_lanes, int) and self.driving_lanes >= 1):
             raise ValueError(f"driving_lanes must be a positive integer; got {self.driving_lanes!r}")
-        for name in ("lane_width", "shoulder_width"):
+        for name in ("lane_width", "shoulder_width", "crossfall", "depth"):
             value = getattr(self, name)
-            if not (isinstance(value, (int, float)) and math.isfinite(value) and value >= 0):
-                raise ValueError(f"{name} must be a finite width ≥ 0 (m); got {value!r}")
-        if not self.lane_width > 0:
-            raise ValueError(f"lane_width must be positive (m); got {self.lane_width!r}")
+            if isinstance(value, bool) or not (isinstance(value, (int, float)) and math.isfinite(value) and value >= 0):
+                raise ValueError(f"{name} must be a finite number ≥ 0; got {value!r}")
+        for name in ("lane_width", "depth"):
+            if not getattr(self, name) > 0:
+                raise ValueError(f"{name} must be positive (m); got {getattr(self, name)!r}")
+        if not self.crossfall < 1:
+            raise ValueError(f"crossfall must be below 1 (m/m); got {self.crossfall!r}")
         if self.rule not in ("RHT", "LHT"):
             raise ValueError(f"rule must be 'RHT' or 'LHT'; got {self.rule!r}")
 
