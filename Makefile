@@ -36,6 +36,7 @@ test: $(STAMP) $(TOOLS_STAMP)
 bench: $(STAMP)
 	$(BIN)/python benchmarks/bench_core.py --out benchmarks/results_core.md
 	$(BIN)/python benchmarks/bench_cad.py --out benchmarks/results_cad.md
+	$(BIN)/python benchmarks/bench_checker.py --out benchmarks/results_checker.md
 	$(BIN)/python benchmarks/bench_rounding.py --out benchmarks/results_rounding.md
 	$(BIN)/python benchmarks/bench_roads.py --out benchmarks/results_roads.md
 	$(BIN)/python benchmarks/bench_fillets.py --out benchmarks/results_fillets.md

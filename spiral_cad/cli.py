@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import argparse
 import math
+import os
 import signal
 import sys
 import threading
@@ -137,16 +138,42 @@ def _build(args: argparse.Namespace) -> int:
     return _write_design(args.design, Path(args.out), plots=not args.no_plots)
 
 
+#: Exit status of ``check`` when its output pipe closes early (``| head -1``): 128 + SIGPIPE,
+#: what a shell reports for a command a closed pipe stopped.
+CLOSED_PIPE = 141
+
+
 def _check(args: argparse.Namespace) -> int:
+    """``spiral-cad check``: 0 ok, 1 below ``--require``, 2 error, 141 when stdout closed early.
+
+    (Non-finite measures are graded "unmeasurable" on purpose; ``main`` keeps
+    numpy's warnings about them off the terminal.)
+    """
+    try:
+        status = _check_file(args)
+        sys.stdout.flush()
+    except BrokenPipeError:
+        try:  # the interpreter's last flush must not fail again
+            os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        except (OSError, ValueError, AttributeError):
+            pass
+        return CLOSED_PIPE
+    return status
+
+
+def _check_file(args: argparse.Namespace) -> int:
     if Path(args.file).suffix.lower() == ".xodr":
         if args.comb:
             print("error: --comb draws STEP/IGES edges; it does not apply to OpenDRIVE", file=sys.stderr)
             return 2
-        from .formats.joints import print_report
-        from .formats.opendrive import check_opendrive
+        from .formats.opendrive import check_opendrive, print_opendrive_report
 
         report = check_opendrive(args.file, gap_tol=args.gap_tol, angle_tol=args.angle_tol, curvature_tol=args.curvature_tol)
-        return print_report(report, args)
+        return print_opendrive_report(report, args)
+    for option in ("profiles", "links"):
+        if getattr(args, option):
+            print(f"error: --{option} judges OpenDRIVE files (.xodr) only", file=sys.stderr)
+            return 2
     if find_spec("OCP") is None:
         print(f"error: spiral-cad check reads STEP/IGES with OCCT, which comes with the CAD extra: {PIP_CAD}", file=sys.stderr)
         return 2
@@ -156,14 +183,29 @@ def _check(args: argparse.Namespace) -> int:
 
 
 def _add_check(sub: argparse._SubParsersAction) -> None:
-    check = sub.add_parser("check", help="report G0/G1/G2 continuity at every joint of a STEP, IGES or OpenDRIVE file")
+    check = sub.add_parser(
+        "check",
+        help="report G0/G1/G2 continuity at every joint of a STEP, IGES or OpenDRIVE file",
+        description="Report G0/G1/G2 continuity at every joint, in the unit the file declares. An OpenDRIVE file is "
+        "judged road by road (its planView, its elevation and superelevation in s) and link by link. Exit status: 0 ok, "
+        "1 below --require, --profiles or --links (or not --pieces pieces), 2 unreadable file or bad option, "
+        "141 output pipe closed early.",
+    )
     check.add_argument("file", help="a .step/.stp, .igs/.iges or .xodr file (OpenDRIVE: one piece per road)")
     check.add_argument(
-        "--require", choices=["G0", "G1", "G2"], help="exit 1 if any joint is below this level or the file is not in --pieces pieces"
-    )
-    check.add_argument("--pieces", type=int, help="how many separate paths the file should hold (default 1, with --require)")
+        "--require", choices=["G0", "G1", "G2"],
+        help="exit 1 if any joint (OpenDRIVE: of any road's planView) is below this level or the file is not in --pieces pieces",
+    )  # fmt: skip
+    check.add_argument("--pieces", type=int,
+                       help="how many separate paths the file should hold (default 1 with --require; OpenDRIVE: roads, "
+                            "judged only when given)")  # fmt: skip
+    check.add_argument("--profiles", choices=["C0", "C1", "C2"],
+                       help="OpenDRIVE: exit 1 if any road's elevation or superelevation is below this continuity in s")  # fmt: skip
+    check.add_argument("--links", choices=["G0", "G1", "G2"],
+                       help="OpenDRIVE: exit 1 if any link between roads (road links, junction connections) is below this level")  # fmt: skip
     check.add_argument("--snap", type=float, help="chain loose ends closer than this (model units; default 1%% of the model size)")
-    check.add_argument("--comb", metavar="OUT.step", help="also write the curvature comb of every edge as STEP (STEP/IGES input)")
+    check.add_argument("--comb", metavar="OUT.step",
+                       help="also write the curvature comb of every edge as STEP (STEP/IGES input; never the checked file)")  # fmt: skip
     check.add_argument("--gap-tol", type=float, default=1e-7, help="G0 gap, absolute model units (default 1e-7)")
     check.add_argument("--angle-tol", type=float, default=1e-7, help="G1 tangent angle, radians (default 1e-7)")
     check.add_argument("--curvature-tol", type=float, default=1e-6, help="G2 curvature jump, relative (default 1e-6)")
@@ -206,7 +248,7 @@ def _parser() -> argparse.ArgumentParser:
             "  spiral-cad demo --out out                  the built-in design: STEP, IGES, DXF, SVG, plots, CSV\n"
             "  spiral-cad build examples/design.json      your own design file (spiral-cad build --help for the format)\n"
             "  spiral-cad check out/highway.step --require G2   G0/G1/G2 at every joint; exit 1 below G2\n"
-            "  spiral-cad check out/highway.xodr --require G2   the same for every road of an OpenDRIVE file"
+            "  spiral-cad check out/highway.xodr --require G2 --profiles C1 --links G1   every road, profile and link of an OpenDRIVE map"
         ),
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )

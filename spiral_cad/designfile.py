@@ -603,7 +603,7 @@ def _write_design(b: Built, stage: Path, units: str, missing: list[str], plots: 
         from .export import export_iges
 
         export_iges(b.chain, stage / f"{b.name}.igs", name=b.name)
-        report = check_continuity(step, label=step.name, units=units)
+        report = check_continuity(step)  # as `spiral-cad check` reads it: the same numbers
         b.notes["continuity"] = f"{report.min_level} ({report.describe()})"
         (stage / f"{b.name}_continuity.txt").write_text(report.format_table() + "\n", encoding="utf-8")
         names += ["igs", "continuity.txt"]

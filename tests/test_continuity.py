@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+import os
 import re
 import subprocess
 import sys
@@ -393,3 +394,159 @@ def test_cli_script_runs(step_files):
     )
     assert done.returncode == 1
     assert "worst G1" in done.stdout
+
+
+# ------------------------------------------------------- NaN and scale
+
+
+def frame(point=(0.0, 0.0), tangent=(1.0, 0.0), curvature=(0.0, 0.0)):
+    return (point[0], point[1], 0.0, tangent[0], tangent[1], 0.0, curvature[0], curvature[1], 0.0)
+
+
+def test_nan_never_passes_and_is_its_own_level():
+    from spiral_cad.formats.joints import ContinuityReport, JointReport, WireReport, classify_joint
+
+    nan, inf = math.nan, math.inf
+    grade = lambda a, b: classify_joint(0, a, b, 1e-7, 1e-7, 1e-6, 0.1).level  # noqa: E731
+    assert grade(frame(), frame()) is G2
+    assert grade(frame(), frame(tangent=(nan, nan))) is Continuity.UNMEASURABLE  # a 0/0 tangent
+    assert grade(frame(), frame(point=(nan, 0.0))) is Continuity.UNMEASURABLE
+    assert grade(frame(), frame(curvature=(nan, 0.0))) is Continuity.UNMEASURABLE
+    assert grade(frame(curvature=(nan, 0.0)), frame()) is Continuity.UNMEASURABLE  # max() would drop a NaN here
+    assert grade(frame(), frame(curvature=(inf, 0.0))) is Continuity.UNMEASURABLE
+    # a measure that is decided before the NaN one keeps its verdict: a kink is G0 whatever its curvature
+    assert grade(frame(), frame(tangent=(0.0, 1.0), curvature=(nan, 0.0))) is G0
+    assert Continuity.UNMEASURABLE < NONE and str(Continuity.UNMEASURABLE) == "unmeasurable"
+    joint = JointReport(0, nan, nan, nan, Continuity.UNMEASURABLE)
+    broken = ContinuityReport((WireReport(0, 2, False, (joint,)),), 1e-7, 1e-7, 1e-6, 1.0)
+    assert all(not broken.passes(required) for required in ("none", "G0", "G1", "G2", 0, 3))
+    for bad in ("unmeasurable", -1, 4, True, 2.0):
+        with pytest.raises(ValueError, match="continuity level must be one of none, G0, G1, G2"):
+            Continuity.parse(bad)
+
+
+def test_model_size_names_the_coordinate_it_cannot_measure():
+    from spiral_cad.formats.joints import model_size
+
+    assert model_size([(0.0, 0.0, 0.0), (3e300, 4e300, 0.0)]) == pytest.approx(5e300)  # no overflow short of the range
+    with pytest.raises(ValueError, match=r"f.step: a point of the model is not finite: \(0.0, nan, 0.0\)"):
+        model_size([(0.0, 0.0, 0.0), (0.0, math.nan, 0.0)], "f.step")
+    with pytest.raises(ValueError, match=r"spans x = -1.7e\+308 to 1.7e\+308, wider than a float can measure"):
+        model_size([(-1.7e308, 0.0, 0.0), (1.7e308, 0.0, 0.0)])
+
+
+def test_curvature_is_measured_at_any_scale():
+    # |r'|⁴ overflows beyond 1e77: measured without it, a tangent arc at 1e80 is still only G1
+    s = 1e80
+    report = check_continuity([line((-2 * s, 0), (0, 0)), ccw_arc((0, s), s, -math.pi / 2, 0.0)], gap_tol=1e-12 * s)
+    (joint,) = report.joints
+    assert joint.level is G1 and joint.curvature_after * s == pytest.approx(1.0, rel=1e-12)
+
+
+def scaled_step(text: str, factor: float) -> str:
+    """A STEP text of lines and Bézier spirals with every length multiplied by ``factor``."""
+    def scale(match: re.Match) -> str:
+        return "%.17E" % (float(match.group(0)) * factor)
+
+    text = re.sub(r"(?<=CARTESIAN_POINT\('',\()[^)]*", lambda m: re.sub(r"[-0-9.E+]+", scale, m.group(0)), text)
+    return re.sub(r"(?<=PARAMETER_VALUE\()[-0-9.E+]+", scale, text)
+
+
+def test_a_file_at_1e300_is_measured_not_refused_for_its_snap(tmp_path, capsys):
+    chain = sc.design.round_corners([(0, 0), (10, 0), (10, 10), (20, 10)], units="m").chain
+    path = tmp_path / "huge.step"
+    sc.export.export_step(chain, path)
+    path.write_text(scaled_step(path.read_text(), 1e300))
+    status = main(["check", str(path), "--require", "G2"])
+    out, err = capsys.readouterr()
+    assert "snap" not in err and re.search(r"model size \d\.\d+e\+30\d m", out)
+    assert status == 1 and "FAIL" in out  # OCCT cannot trim lines this far out: never a false pass
+
+
+def test_reports_state_their_unit():
+    chain = sc.design.round_corners([(0, 0), (10, 0), (10, 10)], units="ft").chain
+    assert check_continuity(chain).units == "ft"
+    assert "gap 1e-07 ft" in check_continuity(chain).format_table()
+    assert "model size" in check_continuity(wire(line((0, 0), (1, 0)))).format_table()
+    assert "(model units)" in check_continuity(wire(line((0, 0), (1, 0)))).format_table()
+    assert check_continuity(wire(line((0, 0), (1, 0))), units="in").units == "in"
+    with pytest.raises(ValueError, match="units must be one of"):
+        check_continuity(wire(line((0, 0), (1, 0))), units="parsec")
+
+
+def test_the_demo_report_and_the_cli_print_the_same_numbers(tmp_path, capsys):
+    import json
+
+    design = tmp_path / "d.json"
+    design.write_text(json.dumps({"units": "m", "designs": [
+        {"name": "road", "type": "alignment", "pis": [[0, 0], [600, 120], [1150, -80]], "radii": [450], "spiral_angles_deg": 8},
+        {"name": "loop", "type": "circle_chain", "circles": [{"center": c, "radius": r} for c, r in
+                                                              [([0, 0], 60), ([29.85, 0], 30), ([150, -10], 40), ([150, 120], -35)]]},
+    ]}))  # fmt: skip
+    assert main(["build", str(design), "--out", str(tmp_path / "out"), "--no-plots"]) == 0
+    capsys.readouterr()
+    for name in ("road", "loop"):
+        assert main(["check", str(tmp_path / "out" / f"{name}.step")]) == 0
+        printed = capsys.readouterr().out
+        written = (tmp_path / "out" / f"{name}_continuity.txt").read_text()
+        assert printed == written and re.search(r"; model size \d+\.\d+ m\n", printed)  # metres, as declared
+
+
+# ------------------------------------------------------------------ comb
+
+
+def test_comb_refuses_to_overwrite_the_checked_file_by_any_name(step_files, tmp_path, capsys):
+    source = step_files["spiral"]
+    original = source.read_bytes()
+    (tmp_path / "link.step").symlink_to(source)
+    os.link(source, tmp_path / "hard.step")
+    (tmp_path / "folder.step").mkdir()
+    for comb, reason in ((str(source), "is the file being checked"), (str(tmp_path / "link.step"), "is the file being checked"),
+                         (str(tmp_path / "hard.step"), "is the file being checked"),
+                         (str(tmp_path / "." / source.name), "is the file being checked"),
+                         (str(tmp_path / "c.igs"), "give a .step or .stp file"), (str(tmp_path / "c"), "give a .step or .stp file"),
+                         (str(tmp_path / "folder.step"), "is a folder")):  # fmt: skip
+        assert main(["check", str(source), "--comb", comb]) == 2
+        err = capsys.readouterr().err
+        assert err.startswith("error: --comb") and reason in err, err
+    assert source.read_bytes() == original and not (tmp_path / "c.igs").exists()
+
+
+def test_comb_is_written_in_the_unit_of_the_checked_file(tmp_path, capsys):
+    chain = sc.design.round_corners([(0, 0), (10, 0), (10, 10)], units="m").chain
+    path, comb = tmp_path / "r.step", tmp_path / "comb.STP"
+    sc.export.export_step(chain, path)
+    assert main(["check", str(path), "--comb", str(comb), "--require", "G2"]) == 0
+    assert check_continuity(comb).units == "m"
+    assert check_continuity(comb).size == pytest.approx(check_continuity(path).size, rel=0.5)  # teeth stick out a little
+
+
+# -------------------------------------------------------- CLI manners
+
+
+def test_a_closed_pipe_ends_check_quietly_with_141(step_files):
+    script = Path(sys.executable).parent / "spiral-cad"
+    if not script.exists():
+        pytest.skip("spiral-cad script not installed next to this interpreter")
+    process = subprocess.Popen([str(script), "check", str(step_files["spiral"])], stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+    process.stdout.close()  # the reader of our output is gone before we print (`| head -0`)
+    err = process.stderr.read()
+    assert process.wait(timeout=120) == 141
+    assert err == b""
+
+
+def test_no_numpy_warning_reaches_the_terminal(tmp_path, capfd):
+    import warnings
+
+    kink = tmp_path / "kink.xodr"
+    kink.write_text(
+        '<?xml version="1.0"?><OpenDRIVE><header revMajor="1" revMinor="8"/><road id="1" junction="-1" length="20"><planView>'
+        '<geometry s="0" x="0" y="0" hdg="0" length="10"><line/></geometry>'
+        '<geometry s="10" x="10" y="0" hdg="0" length="10"><paramPoly3 aU="0" bU="0" cU="1" dU="0" aV="0" bV="0" cV="1" dV="0"/>'
+        "</geometry></planView></road></OpenDRIVE>"
+    )
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # any warning would be an exception here
+        assert main(["check", str(kink), "--require", "G0"]) == 1
+    out, err = capfd.readouterr()
+    assert err == "" and "worst joint unmeasurable" in out

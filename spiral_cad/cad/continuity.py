@@ -6,7 +6,8 @@ where the curvature is zero — exactly at a spiral's start. So the joint
 quantities are measured here from first and second derivatives.
 
 Measures and classification: ``spiral_cad.formats.joints`` (shared with the
-OpenDRIVE checker).
+OpenDRIVE checker). Files are read and measured in a child process
+(``spiral_cad.cad.readers``): only the measured numbers come back.
 
 Pieces: every wire is one piece, judged in wire order (with the closing
 joint of a closed wire). Edges that belong to no wire are chained by nearest
@@ -23,8 +24,8 @@ from __future__ import annotations
 import argparse
 import math
 import os
-import sys
-from dataclasses import dataclass
+from functools import partial
+from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -45,6 +46,8 @@ from OCP.TopoDS import (
 )
 from OCP.TopTools import TopTools_IndexedMapOfShape
 
+from ..core.chain import Chain
+from ..core.units import length_unit
 from ..formats.joints import (
     Continuity,
     ContinuityReport,
@@ -53,12 +56,13 @@ from ..formats.joints import (
     WireReport,
     check_tolerances,
     classify_pieces,
-    diagonal,
     distance,
     flip,
+    model_size,
     print_report,
 )
-from .occ import as_occ_shape, read_shape
+from .occ import as_occ_shape
+from .readers import STEP_SUFFIXES, read_file
 
 __all__ = ["Continuity", "ContinuityReport", "JointReport", "WireReport", "check_continuity", "curvature_comb"]
 
@@ -66,51 +70,61 @@ __all__ = ["Continuity", "ContinuityReport", "JointReport", "WireReport", "check
 #: chained into one piece (and their gap is then judged against ``gap_tol``).
 SNAP_FRACTION = 1e-2
 
-
-
-# --------------------------------------------------------------- input
+Point = tuple[float, float, float]
+#: What is measured of a shape: wires as (end frames of each edge, closed),
+#: the end frames of loose edges, and every edge's start, end and middle point.
+Measured = tuple[list[tuple[list[tuple[Frame, Frame]], bool]], list[tuple[Frame, Frame]], list[Point]]
 
 
 # ---------------------------------------------------- edge end frames
 
+
 def _frame(curve: BRepAdaptor_Curve, u: float, inward: float) -> Frame:
-    """Frame at parameter ``u`` in the curve's parameter direction; ``inward`` (±1) points into the edge."""
+    """Frame at parameter ``u`` in the curve's parameter direction; ``inward`` (±1) points into the edge.
+
+    The curvature vector is ``(r'' − (r''·t) t) / |r'|²`` with the unit
+    tangent ``t``: the same as ``((r' × r'') × r') / |r'|⁴``, but no product
+    of derivatives is formed, so no model within the float range overflows.
+    """
     p, d1, d2 = gp_Pnt(), gp_Vec(), gp_Vec()
     curve.D2(u, p, d1, d2)
     ax, ay, az = d1.X(), d1.Y(), d1.Z()
     bx, by, bz = d2.X(), d2.Y(), d2.Z()
-    n2 = ax * ax + ay * ay + az * az
-    if n2 <= 1e-24 * (bx * bx + by * by + bz * bz) or n2 == 0.0:
+    speed = math.hypot(ax, ay, az)
+    if not speed > 1e-12 * math.hypot(bx, by, bz):  # also r' = 0 and NaN
         return _singular_frame(curve, u, inward, p)
-    cx, cy, cz = ay * bz - az * by, az * bx - ax * bz, ax * by - ay * bx
-    q = 1.0 / (n2 * n2)
-    s = 1.0 / math.sqrt(n2)
+    tx, ty, tz = ax / speed, ay / speed, az / speed
+    along = bx * tx + by * ty + bz * tz
     return (
         p.X(), p.Y(), p.Z(),
-        ax * s, ay * s, az * s,
-        (cy * az - cz * ay) * q, (cz * ax - cx * az) * q, (cx * ay - cy * ax) * q,
+        tx, ty, tz,
+        (bx - along * tx) / speed / speed, (by - along * ty) / speed / speed, (bz - along * tz) / speed / speed,
     )  # fmt: skip
 
 
 def _singular_frame(curve: BRepAdaptor_Curve, u: float, inward: float, p: gp_Pnt) -> Frame:
     """Frame where r' = 0 (e.g. a Bézier with coincident end poles).
 
-    The tangent comes from higher derivatives (CLProps); the curvature
-    vector, which is unbounded there in general, is taken just inside.
+    The tangent comes from higher derivatives (CLProps), NaN if none defines
+    it; the curvature vector, which is unbounded there in general, is taken
+    just inside.
     """
     props = BRepLProp_CLProps(curve, u, 2, 0.0)
-    t = gp_Dir(1.0, 0.0, 0.0)
     if props.IsTangentDefined():
+        t = gp_Dir()
         props.Tangent(t)
+        tangent = (t.X(), t.Y(), t.Z())
+    else:
+        tangent = (math.nan, math.nan, math.nan)
     if inward:
         nudge = inward * 1e-9 * (curve.LastParameter() - curve.FirstParameter())
         k = _frame(curve, u + nudge, 0.0)[6:]
-    else:  # already nudged once: give up on the curvature
-        k = (0.0, 0.0, 0.0)
-    return (p.X(), p.Y(), p.Z(), t.X(), t.Y(), t.Z(), *k)
+    else:  # already nudged once: the curvature is not defined here
+        k = (math.nan, math.nan, math.nan)
+    return (p.X(), p.Y(), p.Z(), *tangent, *k)
 
 
-def _edge_ends(edge: TopoDS_Edge) -> tuple[Frame, Frame, tuple[float, float, float]]:
+def _edge_ends(edge: TopoDS_Edge) -> tuple[Frame, Frame, Point]:
     """(start frame, end frame, middle point) of ``edge`` in its travel sense."""
     curve = BRepAdaptor_Curve(edge)
     u0, u1 = curve.FirstParameter(), curve.LastParameter()
@@ -124,13 +138,6 @@ def _edge_ends(edge: TopoDS_Edge) -> tuple[Frame, Frame, tuple[float, float, flo
 
 
 # ----------------------------------------------------------- grouping
-
-
-@dataclass
-class _Group:
-    ends: list[tuple[Frame, Frame]]
-    closed: bool
-    loose: bool
 
 
 def _is_degenerated(edge: TopoDS_Edge) -> bool:
@@ -164,22 +171,26 @@ def _wire_edges(wire: TopoDS_Wire) -> tuple[list[TopoDS_Edge], bool]:
     return edges, (not v_first.IsNull()) and v_first.IsSame(v_last)
 
 
-def _collect(shape: TopoDS_Shape) -> tuple[list[_Group], list[tuple[Frame, Frame]], list[tuple[float, float, float]]]:
-    """Wire groups (evaluated), evaluated loose edges and all sample points."""
-    points: list[tuple[float, float, float]] = []
+def _measure(shape: TopoDS_Shape) -> Measured:
+    """Everything the checker needs of ``shape``, as plain numbers (see ``Measured``).
+
+    For a file this runs in the reader's child process (``read_file``): only
+    these numbers come back, so no curve of the file is evaluated here.
+    """
+    points: list[Point] = []
 
     def evaluate(edge: TopoDS_Edge) -> tuple[Frame, Frame]:
         start, end, middle = _edge_ends(edge)
         points.extend((start[:3], end[:3], middle))
         return start, end
 
-    groups = []
+    wires_found = []
     wires = TopTools_IndexedMapOfShape()
     TopExp.MapShapes_s(shape, TopAbs_WIRE, wires)
     for i in range(1, wires.Extent() + 1):
         edges, closed = _wire_edges(TopoDS.Wire_s(wires.FindKey(i)))
         if edges:
-            groups.append(_Group([evaluate(e) for e in edges], closed, False))
+            wires_found.append(([evaluate(e) for e in edges], closed))
     loose = TopTools_IndexedMapOfShape()
     explorer = TopExp_Explorer(shape, TopAbs_EDGE, TopAbs_WIRE)
     while explorer.More():
@@ -190,13 +201,19 @@ def _collect(shape: TopoDS_Shape) -> tuple[list[_Group], list[tuple[Frame, Frame
         edge = TopoDS.Edge_s(loose.FindKey(i))
         if not _is_degenerated(edge):
             loose_ends.append(evaluate(edge))
-    return groups, loose_ends, points
+    return wires_found, loose_ends, points
 
 
-def _chain_loose(ends: list[tuple[Frame, Frame]], snap: float, gap_tol: float) -> list[_Group]:
+def _chain_loose(ends: list[tuple[Frame, Frame]], snap: float, gap_tol: float, size: float) -> list[tuple[list[tuple[Frame, Frame]], bool]]:
     """Chain loose edges by nearest ends: each piece grows at both ends by the
-    unused edge end nearest to it, while that is within ``snap``."""
-    points = np.array([f[:3] for pair in ends for f in pair])  # edge k: start 2k, end 2k + 1
+    unused edge end nearest to it, while that is within ``snap``.
+
+    The search runs on coordinates divided by the model ``size``, so its
+    squared distances cannot overflow.
+    """
+    unit = size if size > 0.0 else 1.0
+    points = np.array([f[:3] for pair in ends for f in pair]) / unit  # edge k: start 2k, end 2k + 1
+    reach = snap / unit
     tree = cKDTree(points)
     used = np.zeros(len(ends), dtype=bool)
 
@@ -204,7 +221,7 @@ def _chain_loose(ends: list[tuple[Frame, Frame]], snap: float, gap_tol: float) -
         """Index (2k or 2k + 1) of the nearest end of an unused edge within ``snap``."""
         count = 8
         while True:
-            distances, found = tree.query(frame[:3], k=min(count, len(points)), distance_upper_bound=snap)
+            distances, found = tree.query(np.asarray(frame[:3]) / unit, k=min(count, len(points)), distance_upper_bound=reach)
             for d, i in zip(np.atleast_1d(distances), np.atleast_1d(found)):
                 if math.isfinite(d) and not used[i // 2]:
                     return int(i)
@@ -212,7 +229,7 @@ def _chain_loose(ends: list[tuple[Frame, Frame]], snap: float, gap_tol: float) -
                 return None
             count *= 4
 
-    groups: list[_Group] = []
+    pieces = []
     for first in range(len(ends)):
         if used[first]:
             continue
@@ -231,8 +248,8 @@ def _chain_loose(ends: list[tuple[Frame, Frame]], snap: float, gap_tol: float) -
                 else:  # joined before the piece: its end meets our start
                     piece.insert(0, (start, end) if not at_start else (flip(end), flip(start)))
         closed = len(piece) > 1 and distance(piece[-1][1], piece[0][0]) <= gap_tol
-        groups.append(_Group(piece, closed, True))
-    return groups
+        pieces.append((piece, closed))
+    return pieces
 
 
 # -------------------------------------------------------- measurement
@@ -245,7 +262,7 @@ def check_continuity(
     angle_tol: float = 1e-7,
     curvature_tol: float = 1e-6,
     snap: float | None = None,
-    units: str = "mm",
+    units: str | None = None,
     label: str | None = None,
 ) -> ContinuityReport:
     """Measure and classify every joint of every piece of a shape or STEP/IGES file.
@@ -254,40 +271,56 @@ def check_continuity(
     the closing joint of closed wires. Edges that belong to no wire are
     chained by nearest ends within ``snap`` (see the module docstring), so a
     small gap is reported as a G0 failure rather than splitting the path.
-    Degenerated edges (surface poles) are skipped. A file is read whole or
-    not at all (``spiral_cad.occ.read_shape``).
+    Degenerated edges (surface poles) are skipped.
+
+    A file is read in a child process, whole or not at all, every curve
+    accounted for (``spiral_cad.cad.readers``), in the unit it declares: the
+    report states that unit, and the demo's ``NAME_continuity.txt`` and
+    ``spiral-cad check`` print the same numbers for the same file.
 
     Args:
-        shape_or_path: ``TopoDS_Shape``, build123d/CadQuery shape, iterable of
-            shapes, or a .step/.stp/.igs/.iges path.
+        shape_or_path: ``TopoDS_Shape``, build123d/CadQuery shape, ``Chain``,
+            iterable of shapes, or a .step/.stp/.igs/.iges path.
         gap_tol: largest G0 gap, absolute model units.
         angle_tol: largest G1 tangent angle, radians.
         curvature_tol: largest G2 curvature jump relative to
             ``max(|K_a|, |K_b|, 1/size)``.
         snap: chaining distance for loose edges (model units); default
             ``SNAP_FRACTION · size``.
-        units: the unit a file is read in (the model units of the report).
+        units: for a file, the unit to read it in (None: the unit it
+            declares); for a shape, the unit its numbers are in, for the
+            report (None: a Chain's own unit, else "model units").
         label: name shown in the report (default: the file's name).
 
     Raises:
-        ValueError: an unreadable or incompletely read file (``ReadError``,
-            with the reader's reason), or a negative/non-finite tolerance.
+        ValueError: an unreadable or incompletely read file, or one the
+            reader crashed on (``ReadError``, with the reason), a point that
+            is not finite, or a negative/non-finite tolerance.
     """
     check_tolerances(gap_tol=gap_tol, angle_tol=angle_tol, curvature_tol=curvature_tol)
+    if snap is not None:
+        check_tolerances(snap=snap)
     if isinstance(shape_or_path, (str, os.PathLike)):
         source = os.path.basename(os.fspath(shape_or_path))
-        shape = read_shape(shape_or_path, units)
+        unit, measured = read_file(shape_or_path, units, _measure)
     else:
         source = type(shape_or_path).__name__
-        shape = as_occ_shape(shape_or_path)
-    groups, loose_ends, points = _collect(shape)
-    link = SNAP_FRACTION * diagonal(points) if snap is None else snap
-    check_tolerances(snap=link)
+        unit = length_unit(units) if units is not None else shape_or_path.units if isinstance(shape_or_path, Chain) else ""
+        measured = _measure(as_occ_shape(shape_or_path))
+    return _report(measured, unit, label or source, gap_tol, angle_tol, curvature_tol, snap)
+
+
+def _report(measured: Measured, unit: str, source: str, gap_tol: float, angle_tol: float, curvature_tol: float,
+            snap: float | None) -> ContinuityReport:  # fmt: skip
+    """Chain the loose edges and classify every joint."""
+    wires, loose_ends, points = measured
+    size = model_size(points, source)
+    link = SNAP_FRACTION * size if snap is None else snap
+    pieces = [("wire", ends, closed) for ends, closed in wires]
     if loose_ends:
-        groups += _chain_loose(loose_ends, link, gap_tol)
-    pieces = [("loose piece" if g.loose else "wire", g.ends, g.closed) for g in groups]
+        pieces += [("loose piece", ends, closed) for ends, closed in _chain_loose(loose_ends, link, gap_tol, size)]
     return classify_pieces(
-        pieces, points, gap_tol=gap_tol, angle_tol=angle_tol, curvature_tol=curvature_tol, snap=link, source=label or source
+        pieces, size, gap_tol=gap_tol, angle_tol=angle_tol, curvature_tol=curvature_tol, snap=link, source=source, units=unit
     )
 
 
@@ -295,23 +328,35 @@ def check_continuity(
 
 
 def main_check(args: argparse.Namespace) -> int:
-    """Run ``spiral-cad check``: the joint table; exit 0 ok, 1 below ``--require`` or the wrong
-    number of pieces, 2 unreadable (``error: …`` with the reader's reason)."""
-    try:
-        report = check_continuity(
-            args.file, gap_tol=args.gap_tol, angle_tol=args.angle_tol, curvature_tol=args.curvature_tol, snap=args.snap
-        )
-        if args.comb:
-            from ..export import export_step
+    """Run ``spiral-cad check`` on a STEP/IGES file: the joint table; exit 0 ok, 1 below
+    ``--require`` or the wrong number of pieces, 2 unreadable (``error: …`` with the reason).
 
-            export_step(curvature_comb(args.file), args.comb, name=f"{os.path.basename(args.file)} curvature comb")
-    except ValueError as exc:
-        print(f"error: {exc}", file=sys.stderr)
-        return 2
+    The table is ``check_continuity(file).format_table()``, as in the demo's
+    ``NAME_continuity.txt``: the same numbers for the same file.
+    """
+    comb = _comb_path(args.comb, args.file) if args.comb else None
+    report = check_continuity(args.file, gap_tol=args.gap_tol, angle_tol=args.angle_tol, curvature_tol=args.curvature_tol,
+                              snap=args.snap)  # fmt: skip
     if not report.wires:
-        print(f"error: {os.path.basename(args.file)!r} contains no edges to check", file=sys.stderr)
-        return 2
+        raise ValueError(f"{report.source!r} contains no edges to check")
+    if comb is not None:
+        from ..export import export_step
+
+        comb_shape = curvature_comb(args.file, units=report.units)  # in the unit the report is in
+        export_step(comb_shape, comb, name=f"{report.source} curvature comb", units=report.units)
     return print_report(report, args)
+
+
+def _comb_path(comb: str, checked: str) -> Path:
+    """The ``--comb`` file: a .step/.stp path that is not the file being checked (by any name)."""
+    path = Path(comb)
+    if path.suffix.lower() not in STEP_SUFFIXES:
+        raise ValueError(f"--comb {comb!r}: the comb is written as STEP; give a .step or .stp file")
+    if path.is_dir():
+        raise ValueError(f"--comb {comb!r} is a folder; give a .step or .stp file")
+    if path.exists() and Path(checked).exists() and os.path.samefile(path, checked):
+        raise ValueError(f"--comb {comb!r} is the file being checked; give another file")
+    return path
 
 
 # ------------------------------------------------------------------ comb
@@ -323,16 +368,29 @@ def curvature_comb(shape_or_path: Any, *, scale: float | None = None, per_edge: 
     A tooth runs from a point of the curve against its curvature vector
     (to the convex side), ``scale`` × |κ| long; by default the longest tooth
     is a fifth of the model size. Works for any wire or file the checker
-    reads, so a viewer (CQ-editor, FreeCAD) can show the comb beside the part.
+    reads (a file is read in ``units``, default mm as build123d reads it), so
+    a viewer (CQ-editor, FreeCAD) can show the comb beside the part.
 
     Returns:
         A ``TopoDS_Compound`` of line edges (teeth, then envelopes).
-    """
-    from OCP.BRep import BRep_Builder
-    from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeEdge
-    from OCP.TopoDS import TopoDS_Compound
 
-    shape = read_shape(shape_or_path, units) if isinstance(shape_or_path, (str, os.PathLike)) else as_occ_shape(shape_or_path)
+    Raises:
+        ValueError: no edges, ``per_edge`` not an integer ≥ 2, a bad
+            ``scale``, or an unreadable file.
+    """
+    if isinstance(per_edge, bool) or not isinstance(per_edge, int) or per_edge < 2:
+        raise ValueError(f"per_edge must be an integer ≥ 2; got {per_edge!r:.40}")
+    if scale is not None:
+        check_tolerances(scale=scale)
+    if isinstance(shape_or_path, (str, os.PathLike)):
+        _, samples = read_file(shape_or_path, units, partial(_comb_samples, per_edge=per_edge))
+    else:
+        samples = _comb_samples(as_occ_shape(shape_or_path), per_edge)
+    return _comb_compound(samples, scale)
+
+
+def _comb_samples(shape: TopoDS_Shape, per_edge: int) -> list[list[Frame]]:
+    """``per_edge`` frames along every non-degenerate edge (plain numbers: runs in the reader's child for files)."""
     samples = []
     explorer = TopExp_Explorer(shape, TopAbs_EDGE)
     while explorer.More():
@@ -340,24 +398,34 @@ def curvature_comb(shape_or_path: Any, *, scale: float | None = None, per_edge: 
         if not _is_degenerated(edge):
             curve = BRepAdaptor_Curve(edge)
             u0, u1 = curve.FirstParameter(), curve.LastParameter()
-            frames = [_frame(curve, u0 + (u1 - u0) * k / (per_edge - 1), 1.0 if k == 0 else -1.0) for k in range(per_edge)]
-            samples.append(np.array(frames))
+            samples.append([_frame(curve, u0 + (u1 - u0) * k / (per_edge - 1), 1.0 if k == 0 else -1.0) for k in range(per_edge)])
         explorer.Next()
+    return samples
+
+
+def _comb_compound(samples: list[list[Frame]], scale: float | None):
+    """Teeth and envelopes of the sampled frames as a compound of line edges (non-finite samples are left out)."""
+    from OCP.BRep import BRep_Builder
+    from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeEdge
+    from OCP.TopoDS import TopoDS_Compound
+
     if not samples:
         raise ValueError("the shape has no edges to comb")
-    everything = np.vstack(samples)
+    arrays = [np.array(frames, dtype=float).reshape(-1, 9) for frames in samples]
+    arrays = [a[np.isfinite(a).all(axis=1)] for a in arrays]
+    everything = np.vstack(arrays)
     if scale is None:
-        size = diagonal([tuple(p) for p in everything[:, :3]])
-        peak = float(np.linalg.norm(everything[:, 6:9], axis=1).max())
+        size = model_size([tuple(p) for p in everything[:, :3].tolist()])
+        peak = max((math.hypot(*k) for k in everything[:, 6:9].tolist()), default=0.0)
         scale = 0.2 * size / peak if peak > 0 else 0.0
     builder, compound = BRep_Builder(), TopoDS_Compound()
     builder.MakeCompound(compound)
 
     def line(a, b) -> None:
-        if np.linalg.norm(b - a) > 1e-12:
-            builder.Add(compound, BRepBuilderAPI_MakeEdge(gp_Pnt(*a), gp_Pnt(*b)).Edge())
+        if math.isfinite(math.hypot(*(b - a))) and math.hypot(*(b - a)) > 1e-12:
+            builder.Add(compound, BRepBuilderAPI_MakeEdge(gp_Pnt(*a.tolist()), gp_Pnt(*b.tolist())).Edge())
 
-    for frames in samples:
+    for frames in arrays:
         points, tips = frames[:, :3], frames[:, :3] - scale * frames[:, 6:9]
         for p, q in zip(points, tips):
             line(p, q)

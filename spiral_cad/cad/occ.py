@@ -22,7 +22,6 @@ import sys
 import tempfile
 from collections.abc import Iterable, Iterator
 from contextlib import contextmanager
-from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from OCP.BRep import BRep_Builder, BRep_Tool
@@ -43,6 +42,7 @@ from OCP.TopoDS import TopoDS_Compound, TopoDS_Edge, TopoDS_Shape, TopoDS_Vertex
 from ..core.segments import Arc, Line, Segment
 from ..formats.joints import ROUNDING_ULPS
 from ..core.spiral import BezierSpiral
+from .readers import ReadError, read_shape
 
 __all__ = ["ReadError", "as_occ_shape", "captured_messages", "chain_wire", "nurbs_edge", "read_shape", "segment_edge", "segment_edges"]
 
@@ -241,139 +241,9 @@ def nurbs_edge(nurbs: Nurbs, plane: gp_Ax3 | None = None) -> TopoDS_Edge:
     return BRepBuilderAPI_MakeEdge(curve).Edge()
 
 
-# ------------------------------------------------------------- file input
+# ------------------------------------------------------------- console
 
-STEP_SUFFIXES = (".step", ".stp")
-IGES_SUFFIXES = (".iges", ".igs")
-#: OCCT's names for the target unit of its readers.
-_READ_UNIT = {"mm": "MM", "cm": "CM", "m": "M", "km": "KM", "in": "INCH", "ft": "FT"}
 _ANSI = re.compile(r"\x1b\[[0-9;]*m")
-
-
-class ReadError(ValueError):
-    """A STEP/IGES file that the reader rejected or could not read whole; the message gives its reason."""
-
-
-def read_shape(path: str | os.PathLike, units: str = "mm") -> TopoDS_Shape:
-    """Read a STEP (.step/.stp) or IGES (.igs/.iges) file into one shape, in ``units``.
-
-    OCCT's readers convert from the unit the file declares to ``units``
-    (default mm, as FreeCAD and build123d read). A file is accepted only if
-    the reader read it whole: a syntax error, a truncated file (no end
-    section) or entities that failed to load raise ``ReadError`` with the
-    reader's own messages. Nothing the reader prints reaches the console.
-
-    Raises:
-        ReadError: the reader failed, or reported failed entities.
-        ValueError: unknown suffix, missing file or unknown ``units``.
-    """
-    from OCP.IFSelect import IFSelect_RetDone
-
-    from ..core.units import MM_PER_UNIT, length_unit
-
-    p = Path(path)
-    suffix = p.suffix.lower()
-    length_unit(units)
-    if suffix not in STEP_SUFFIXES + IGES_SUFFIXES:
-        raise ValueError(f"cannot read {p.name!r}: expected a .step/.stp or .igs/.iges file")
-    if not p.is_file():
-        raise ValueError(f"cannot read {str(p)!r}: no such file")
-    kind = "STEP" if suffix in STEP_SUFFIXES else "IGES"
-    if kind == "IGES":
-        _check_iges_sections(p)  # OCCT's IGES reader can crash on a truncated file
-    with captured_messages() as printed:
-        if kind == "STEP":
-            from OCP.STEPControl import STEPControl_Reader
-
-            reader = STEPControl_Reader()
-            status = reader.ReadFile(str(p))
-            reader.SetSystemLengthUnit(MM_PER_UNIT[units])
-            transfer = reader.TransferRoots
-        else:
-            from OCP.IGESControl import IGESControl_Controller, IGESControl_Reader
-            from OCP.Interface import Interface_Static
-
-            IGESControl_Controller.Init_s()
-            # The IGES reader takes its target unit from this session setting
-            # when it reads the file; it is restored at once.
-            previous = Interface_Static.CVal_s("xstep.cascade.unit")
-            Interface_Static.SetCVal_s("xstep.cascade.unit", _READ_UNIT[units])
-            try:
-                reader = IGESControl_Reader()
-                status = reader.ReadFile(str(p))
-            finally:
-                Interface_Static.SetCVal_s("xstep.cascade.unit", previous)
-            transfer = reader.TransferRoots
-
-        failures = _reader_failures(reader) if status == IFSelect_RetDone else []
-        if status == IFSelect_RetDone and not failures:
-            roots = reader.NbRootsForTransfer()
-            transferred = transfer()
-            if transferred < roots:
-                failures.append(f"only {transferred} of {roots} root entities could be transferred")
-    if status != IFSelect_RetDone or failures:
-        reasons = failures or _printed_reasons(printed) or [status.name]
-        more = f" (and {len(reasons) - 3} more)" if len(reasons) > 3 else ""
-        raise ReadError(f"cannot read {p.name!r}: the {kind} reader reports: " + "; ".join(reasons[:3]) + more)
-    shape = reader.OneShape()
-    if shape.IsNull():
-        raise ReadError(f"cannot read {p.name!r}: the {kind} reader found no transferable geometry")
-    return shape
-
-
-def _check_iges_sections(path: Path) -> None:
-    """Refuse an IGES file whose sections disagree with its terminate record (cut short or damaged).
-
-    Every IGES record carries its section letter in column 73 (S, G, D, P,
-    T); the single T record at the end counts the S, G, D and P records.
-    """
-    counts = {"S": 0, "G": 0, "D": 0, "P": 0, "T": 0}
-    last = ""
-    with open(path, "rb") as handle:
-        for raw in handle:
-            record = raw.rstrip(b"\r\n")
-            letter = chr(record[72]) if len(record) >= 73 else "?"
-            if letter in counts:
-                counts[letter] += 1
-                last = record.decode("ascii", "replace") if letter == "T" else last
-    if counts["T"] != 1:
-        raise ReadError(f"cannot read {path.name!r}: no IGES terminate section (the file is cut short or not IGES)")
-    declared = {}
-    for key, start in (("S", 0), ("G", 8), ("D", 16), ("P", 24)):
-        field = last[start : start + 8]
-        try:
-            declared[key] = int(field[1:])
-        except ValueError:
-            raise ReadError(f"cannot read {path.name!r}: damaged IGES terminate record {last[:32]!r}") from None
-    found = {key: counts[key] for key in declared}
-    if found != declared:
-        raise ReadError(
-            f"cannot read {path.name!r}: the IGES terminate record declares {declared} records per section, "
-            f"the file holds {found} (cut short or damaged)"
-        )
-
-
-def _reader_failures(reader: Any) -> list[str]:
-    """The reader's failure messages (and a missing end of file), de-duplicated, in order."""
-    found: list[str] = []
-    checks = reader.WS().ModelCheckList()
-    checks.Start()
-    while checks.More():
-        check = checks.Value()
-        texts = [check.CFail(i) for i in range(1, check.NbFails() + 1)]
-        texts += [w for w in (check.CWarning(i) for i in range(1, check.NbWarnings() + 1)) if "Terminate Section" in w]
-        for text in texts:
-            text = text.strip()
-            if text and text not in found:
-                found.append(text)
-        checks.Next()
-    return found
-
-
-def _printed_reasons(printed: list[str]) -> list[str]:
-    """Error lines the reader printed (its only report of a syntax error)."""
-    lines = [line.strip(" *") for line in printed if "ERR" in line or "rror" in line]
-    return [line for line in lines if line]
 
 
 @contextmanager

@@ -27,6 +27,16 @@ Classification:
   The floor ``1/size`` keeps joints between straight and almost-straight
   pieces from failing on rounding noise.
 * otherwise ``none`` (disconnected).
+* ``unmeasurable``: the measure that decides is not a finite number (NaN or
+  infinite: a tangent or curvature the element does not define, or an
+  overflow). Every comparison is written ``not (x <= tol)``, which is true
+  for NaN, so a NaN can never pass; this level is below ``none`` and fails
+  every requirement.
+
+All lengths are in the model's unit, which the report states. The measures
+are computed without squaring coordinates (``math.hypot``), so a model
+anywhere within the float range is measured; a model whose points are not
+finite, or span more than the float range, is refused (``model_size``).
 """
 
 from __future__ import annotations
@@ -46,28 +56,31 @@ ROUNDING_ULPS = 16
 
 
 class Continuity(IntEnum):
-    """Geometric continuity level of a joint; compares as none < G0 < G1 < G2."""
+    """Geometric continuity level of a joint; compares as unmeasurable < none < G0 < G1 < G2."""
 
+    UNMEASURABLE = -1
     NONE = 0
     G0 = 1
     G1 = 2
     G2 = 3
 
     def __str__(self) -> str:
-        return "none" if self is Continuity.NONE else self.name
+        return self.name.lower() if self < Continuity.G0 else self.name
 
     @classmethod
     def parse(cls, value: str | int | Continuity) -> Continuity:
-        """The level named ``"none"``, ``"G0"``, ``"G1"`` or ``"G2"`` (case-insensitive), or an int 0–3."""
+        """A required level: ``"none"``, ``"G0"``, ``"G1"`` or ``"G2"`` (case-insensitive), or an int 0–3.
+
+        ``unmeasurable`` is a result, never a requirement (it would pass a NaN).
+        """
         if isinstance(value, str):
             key = value.strip().upper()
             if key in ("NONE", "G0", "G1", "G2"):
                 return cls[key]
-            raise ValueError(f"continuity level must be one of none, G0, G1, G2; got {value!r}")
-        try:
+            raise ValueError(f"continuity level must be one of none, G0, G1, G2; got {value!r:.40}")
+        if isinstance(value, int) and not isinstance(value, bool) and 0 <= value <= 3:
             return cls(value)
-        except ValueError:
-            raise ValueError(f"continuity level must be one of none, G0, G1, G2 (0–3); got {value!r}") from None
+        raise ValueError(f"continuity level must be one of none, G0, G1, G2 (0–3); got {value!r:.40}")
 
 
 @dataclass(frozen=True)
@@ -108,6 +121,7 @@ class WireReport:
         joints: one report per joint.
         kind: ``"wire"``, ``"loose piece"`` (edges that belong to no wire,
             chained by nearest ends) or ``"road"`` (an OpenDRIVE planView).
+        name: what the file calls it, if anything (an OpenDRIVE road's id).
     """
 
     index: int
@@ -115,6 +129,7 @@ class WireReport:
     closed: bool
     joints: tuple[JointReport, ...]
     kind: str = "wire"
+    name: str = ""
 
     @property
     def loose(self) -> bool:
@@ -137,6 +152,8 @@ class ContinuityReport:
         snap: the distance within which loose ends were chained.
         source: file name or shape description, for the table heading.
         element: what a piece is made of (``"edge"``, or ``"geometry"`` for OpenDRIVE).
+        units: the unit of every length (a file's own unit; ``""``: not
+            known, shown as "model units").
     """
 
     wires: tuple[WireReport, ...]
@@ -147,6 +164,7 @@ class ContinuityReport:
     snap: float = 0.0
     source: str = ""
     element: str = "edge"
+    units: str = ""
 
     @property
     def joints(self) -> list[JointReport]:
@@ -180,17 +198,23 @@ class ContinuityReport:
         return " and ".join(parts) or f"no {_plural(self.element)}"
 
     def format_table(self) -> str:
-        """Readable text: what was found, then a heading per piece and one line per joint."""
-        snap = f"; loose ends snapped within {self.snap:.3g}" if self.snap else ""
+        """Readable text: what was found, then a heading per piece and one line per joint.
+
+        Lengths carry the report's unit (``gap 1e-07 m``, ``model size 2316.7 m``)
+        and curvatures its inverse, so the same file always prints the same numbers.
+        """
+        unit = f" {self.units}" if self.units else " (model units)"
+        snap = f"; loose ends snapped within {self.snap:.3g}{unit}" if self.snap else ""
         out = [
             f"{self.source or 'shape'}: {self.describe()}; worst joint {self.min_level}",
-            f"  tolerances: gap {self.gap_tol:g} (model units), angle {self.angle_tol:g} rad, "
-            f"curvature jump {self.curvature_tol:g} relative{snap}; model size {self.size:.6g}",
+            f"  tolerances: gap {self.gap_tol:g}{unit}, angle {self.angle_tol:g} rad, "
+            f"curvature jump {self.curvature_tol:g} relative{snap}; model size {self.size:.6g}{unit}",
         ]
         head = f"  {'joint':>5} {'gap':>10} {'angle rad':>10} {'κ before':>11} {'κ after':>11} {'|Δκ|':>10} {'Δκ rel':>9} level"
         for w in self.wires:
             out.append(
-                f"{w.kind} {w.index}: {_count(w.edge_count, self.element)}, {'closed' if w.closed else 'open'}, "
+                f"{w.kind} {w.index}{f' (id {w.name})' if w.name else ''}: {_count(w.edge_count, self.element)}, "
+                f"{'closed' if w.closed else 'open'}, "
                 f"{len(w.joints)} joint(s), worst {w.min_level}"
             )
             if w.joints:
@@ -223,40 +247,64 @@ def flip(f: Frame) -> Frame:
 
 
 def distance(a: Frame, b: Frame) -> float:
-    return math.sqrt((a[0] - b[0]) ** 2 + (a[1] - b[1]) ** 2 + (a[2] - b[2]) ** 2)
+    """Distance between the points of two frames (no overflow short of the float range)."""
+    return math.hypot(a[0] - b[0], a[1] - b[1], a[2] - b[2])
 
 
 def classify_joint(index: int, a: Frame, b: Frame, gap_tol: float, angle_tol: float, curvature_tol: float, floor: float) -> JointReport:
-    """Measure and classify the joint from end frame ``a`` to start frame ``b``."""
+    """Measure and classify the joint from end frame ``a`` to start frame ``b``.
+
+    Each measure is compared as ``not (x <= tol)``: a NaN never passes, and a
+    deciding measure that is not finite makes the joint ``unmeasurable``.
+    """
     gap = distance(a, b)
-    gap_tol += ROUNDING_ULPS * math.ulp(max(abs(v) for v in a[:3]))
+    gap_tol += ROUNDING_ULPS * math.ulp(max(abs(a[0]), abs(a[1]), abs(a[2])))
     cx, cy, cz = a[4] * b[5] - a[5] * b[4], a[5] * b[3] - a[3] * b[5], a[3] * b[4] - a[4] * b[3]
-    angle = math.atan2(math.sqrt(cx * cx + cy * cy + cz * cz), a[3] * b[3] + a[4] * b[4] + a[5] * b[5])
-    ka = math.sqrt(a[6] * a[6] + a[7] * a[7] + a[8] * a[8])
-    kb = math.sqrt(b[6] * b[6] + b[7] * b[7] + b[8] * b[8])
-    jump = math.sqrt((a[6] - b[6]) ** 2 + (a[7] - b[7]) ** 2 + (a[8] - b[8]) ** 2)
-    relative = jump / max(ka, kb, floor)
-    if gap > gap_tol:
-        level = Continuity.NONE
-    elif angle > angle_tol:
-        level = Continuity.G0
-    elif relative > curvature_tol:
-        level = Continuity.G1
-    else:
-        level = Continuity.G2
+    angle = math.atan2(math.hypot(cx, cy, cz), a[3] * b[3] + a[4] * b[4] + a[5] * b[5])
+    ka = math.hypot(a[6], a[7], a[8])
+    kb = math.hypot(b[6], b[7], b[8])
+    jump = math.hypot(a[6] - b[6], a[7] - b[7], a[8] - b[8])
+    # max() drops a NaN that is not its first argument: test finiteness first
+    relative = jump / max(ka, kb, floor) if math.isfinite(ka + kb + jump) else math.nan
+    level = Continuity.G2
+    for value, tolerance, failed in ((gap, gap_tol, Continuity.NONE), (angle, angle_tol, Continuity.G0),
+                                     (relative, curvature_tol, Continuity.G1)):  # fmt: skip
+        if not (value <= tolerance):
+            level = failed if math.isfinite(value) else Continuity.UNMEASURABLE
+            break
     return JointReport(index, gap, angle, jump, level, ka, kb, relative)
 
 
-def diagonal(points: Sequence[tuple[float, float, float]]) -> float:
+def model_size(points: Sequence[tuple[float, float, float]], source: str = "") -> float:
+    """The diagonal of the bounding box of ``points`` (0 for none).
+
+    Raises:
+        ValueError: a coordinate that is not a finite number, or a box wider
+            than the float range — naming the coordinate.
+    """
     if not points:
         return 0.0
-    xyz = np.array(points)
-    return float(np.linalg.norm(xyz.max(axis=0) - xyz.min(axis=0)))
+    where = f"{source}: " if source else ""
+    with np.errstate(all="ignore"):
+        xyz = np.asarray(points, dtype=float)
+        bad = ~np.isfinite(xyz)
+        if bad.any():
+            row = xyz[np.argmax(bad.any(axis=1))]
+            raise ValueError(f"{where}a point of the model is not finite: ({', '.join(repr(float(v)) for v in row)})")
+        low, high = xyz.min(axis=0), xyz.max(axis=0)
+        size = math.hypot(*(float(h) - float(lo) for lo, h in zip(low, high)))
+        axis = int(np.argmax(high - low > 1e307))
+    if not math.isfinite(size):
+        raise ValueError(
+            f"{where}the model spans {'xyz'[axis]} = {float(low[axis])!r} to {float(high[axis])!r}, "
+            "wider than a float can measure (±1.8e308)"
+        )
+    return size
 
 
 def classify_pieces(
-    pieces: Sequence[tuple[str, Sequence[tuple[Frame, Frame]], bool]],
-    points: Sequence[tuple[float, float, float]],
+    pieces: Sequence[tuple],
+    size: float,
     *,
     gap_tol: float,
     angle_tol: float,
@@ -264,20 +312,20 @@ def classify_pieces(
     snap: float = 0.0,
     source: str = "",
     element: str = "edge",
+    units: str = "",
 ) -> ContinuityReport:
-    """Classify every joint of ``pieces`` — (kind, element end frames in travel order, closed) —
-    with ``size`` taken from ``points`` (the elements' start, middle and end points)."""
-    size = diagonal(points)
+    """Classify every joint of ``pieces`` — (kind, element end frames in travel order, closed[, name]) —
+    in a model of ``size`` (``model_size`` of the elements' start, middle and end points)."""
     floor = 1.0 / size if size > 0.0 else 0.0
     wires = []
-    for w, (kind, ends, closed) in enumerate(pieces):
+    for w, (kind, ends, closed, *name) in enumerate(pieces):
         pairs = len(ends) if closed else len(ends) - 1
         joints = tuple(
             classify_joint(i, ends[i][1], ends[(i + 1) % len(ends)][0], gap_tol, angle_tol, curvature_tol, floor)
             for i in range(pairs)
         )
-        wires.append(WireReport(w, len(ends), closed, joints, kind))
-    return ContinuityReport(tuple(wires), gap_tol, angle_tol, curvature_tol, size, snap, source, element)
+        wires.append(WireReport(w, len(ends), closed, joints, kind, *name))
+    return ContinuityReport(tuple(wires), gap_tol, angle_tol, curvature_tol, size, snap, source, element, units)
 
 
 def check_tolerances(**tolerances: float) -> None:
@@ -298,7 +346,8 @@ def print_report(report: ContinuityReport, args: argparse.Namespace) -> int:
         print(f"FAIL: {report.describe()}: {report.pieces} separate pieces, expected {expected}{hint}")
         return 1
     if not report.passes(args.require, expected):
-        print(f"FAIL: worst joint is {report.min_level}, below the required {args.require}")
+        why = " (a measure that decides it is not a finite number)" if report.min_level is Continuity.UNMEASURABLE else ""
+        print(f"FAIL: worst joint is {report.min_level}{why}, below the required {args.require}")
         return 1
     print(f"OK: {report.describe()}, every joint at least {args.require}")
     return 0
