@@ -48,6 +48,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from ..core._inputs import as_float, as_points, as_real_array
 from ..core.errors import NoSolutionError
+from ..core.piecewise import inside, piece_at, piecewise_at, polynomial
 from ..core.units import DEFAULT_UNITS, IMPERIAL, length_unit, speed_unit, to_metres
 from .tables import text_table, write_csv
 
@@ -374,30 +375,21 @@ class Profile:
         """The grade of every tangent between consecutive PVIs (fractions)."""
         return np.diff(self.pvis[:, 1]) / np.diff(self.pvis[:, 0])
 
-    def _locate(self, station: ArrayLike) -> tuple[NDArray, NDArray]:
-        s = as_real_array(station, "station")
-        span = self.end - self.start
-        slack = 1e-12 * max(span, abs(self.start), abs(self.end))
-        outside = ~((s >= self.start - slack) & (s <= self.end + slack))
-        if outside.any():
-            raise ValueError(f"station {float(s[outside].ravel()[0])!r} is outside the profile ({self.start!r} … {self.end!r})")
-        index = np.clip(np.searchsorted(self.stations, s, side="right") - 1, 0, len(self.coefficients) - 1)
-        return index, s - self.stations[index]
+    def _at(self, station: ArrayLike, derivative: int) -> NDArray:
+        s = inside(station, self.start, self.end, "profile")
+        return piecewise_at(self.stations[:-1], self.coefficients, s, derivative)
 
     def elevation(self, station: ArrayLike) -> NDArray:
         """z at ``station`` (vectorised)."""
-        index, d = self._locate(station)
-        return self.coefficients[index, 0] + d * (self.coefficients[index, 1] + d * self.coefficients[index, 2])
+        return self._at(station, 0)
 
     def grade(self, station: ArrayLike) -> NDArray:
         """dz/ds at ``station`` (on a boundary: the grade of the piece that starts there)."""
-        index, d = self._locate(station)
-        return self.coefficients[index, 1] + 2.0 * d * self.coefficients[index, 2]
+        return self._at(station, 1)
 
     def grade_rate(self, station: ArrayLike) -> NDArray:
         """d²z/ds² at ``station``."""
-        index, _ = self._locate(station)
-        return 2.0 * self.coefficients[index, 2]
+        return self._at(station, 2)
 
     def records(self, start: float, end: float) -> NDArray:
         """(m, 4) rows (s, a, b, c) of the pieces from station ``start`` to ``end``, with s and the
@@ -406,14 +398,13 @@ class Profile:
         Raises:
             ValueError: ``start`` or ``end`` outside the profile.
         """
-        self._locate(np.array([start, end]))
-        first = int(np.clip(np.searchsorted(self.stations, start, side="right") - 1, 0, len(self.coefficients) - 1))
+        inside([start, end], self.start, self.end, "profile")
+        first = int(piece_at(self.stations[:-1], start)[0])
         last = int(np.searchsorted(self.stations, end, side="left"))
         coefficients = self.coefficients[first:max(last, first + 1)].copy()
         starts = self.stations[first:first + len(coefficients)] - start
-        shift = -starts[0]  # re-centre the first piece on ``start``
-        a, b, c = coefficients[0]
-        coefficients[0] = (a + shift * (b + shift * c), b + 2.0 * shift * c, c)
+        shift = -starts[0]  # re-centre the first piece on ``start``: its value, slope and curvature there
+        coefficients[0] = [polynomial(coefficients[0], shift, k) / (1.0, 1.0, 2.0)[k] for k in range(3)]
         starts[0] = 0.0
         return np.column_stack([starts, coefficients])
 

@@ -30,6 +30,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from ..core._inputs import as_real_array
+from ..core.piecewise import inside, piece_at, piecewise_at
 from .criteria import RailCriteria
 
 
@@ -111,28 +112,11 @@ class Superelevation:
         return cls(alignment.start_station, np.append(starts[keep], chain.length), coefficients[keep], full[keep],
                    chain.units)  # fmt: skip
 
-    def _locate(self, station: ArrayLike) -> tuple[NDArray, NDArray]:
-        s = as_real_array(station, "station")
-        first, last = float(self.stations[0]), float(self.stations[-1])
-        slack = 1e-12 * max(last - first, abs(first), abs(last))
-        outside = ~((s >= first - slack) & (s <= last + slack))
-        if outside.any():
-            raise ValueError(f"station {float(s[outside].ravel()[0])!r} is outside the alignment ({first!r} … {last!r})")
-        index = np.clip(np.searchsorted(self.stations, s, side="right") - 1, 0, len(self.coefficients) - 1)
-        return index, s - self.stations[index]
-
     def roll(self, station: ArrayLike, derivative: int = 0) -> NDArray:
         """φ (radians) or its ``derivative`` (1: dφ/ds, 2: d²φ/ds²) at ``station``; on a boundary,
         the piece that starts there."""
-        index, d = self._locate(station)
-        a, b, c, e = (self.coefficients[index, k] for k in range(4))
-        if derivative == 0:
-            return a + d * (b + d * (c + d * e))
-        if derivative == 1:
-            return b + d * (2.0 * c + 3.0 * d * e)
-        if derivative == 2:
-            return 2.0 * c + 6.0 * d * e
-        raise ValueError(f"derivative must be 0, 1 or 2; got {derivative!r}")
+        s = inside(station, float(self.stations[0]), float(self.stations[-1]), "alignment")
+        return piecewise_at(self.stations[:-1], self.coefficients, s, derivative)
 
     def cross_slope(self, station: ArrayLike) -> NDArray:
         """tan φ: the fall of the road across per unit width (positive falling to the right)."""
@@ -141,8 +125,8 @@ class Superelevation:
     def share(self, station: ArrayLike, derivative: int = 0) -> NDArray:
         """w = φ/φ_c ∈ [0, 1]: how much of its curve's banking the road has at ``station`` (0 on tangents),
         or its ``derivative`` in station."""
-        index, _ = self._locate(station)
-        full = self.full[index]
+        s = inside(station, float(self.stations[0]), float(self.stations[-1]), "alignment")
+        full = self.full[piece_at(self.stations[:-1], s)[0]]
         safe = np.where(full == 0.0, 1.0, full)
         return np.where(full == 0.0, 0.0, self.roll(station, derivative) / safe)
 
