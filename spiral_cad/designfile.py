@@ -101,7 +101,7 @@ MAX_DIGITS = 308
 #: Design files larger than this are refused before they are read.
 MAX_DESIGN_BYTES = 10_000_000
 #: The packages of the ``cad`` extra and what needs them.
-CAD_EXTRA = {"OCP": "IGES and the continuity check", "ezdxf": "DXF", "matplotlib": "plots"}
+CAD_EXTRA = {"OCP": "IGES, the 3-D STEP of roads and the continuity check", "ezdxf": "DXF", "matplotlib": "plots"}
 
 
 class DesignError(ValueError):

@@ -166,6 +166,19 @@ def test_overlapping_curves_and_curves_past_the_ends_are_refused(highway):
         Profile.from_pvis([(10000, 0), (end, 5)], units="ft", alignment=highway)
 
 
+@pytest.mark.parametrize(
+    "points, kwargs, message",
+    [
+        ([(0, 0), (1e300, 1), (2e300, 0)], dict(curve_lengths=[1e299]), "cannot be held in float64 at these numbers"),
+        ([(0, 1e308), (100, -1e308)], {}, "PVI 0 and PVI 1: the stations and elevations give a grade float64 cannot hold"),
+        ([(0, 0), (200, 10), (400, 0)], dict(design_speed=1e300, criteria=None), "PVI 1: its vertical curve would be longer"),
+    ],
+)
+def test_numbers_beyond_float64_are_refused_by_name(points, kwargs, message):
+    with pytest.raises(ValueError, match=message):
+        Profile.from_pvis(points, units="m", **kwargs)
+
+
 def test_profile_stations_are_checked(profile):
     with pytest.raises(ValueError, match="station 9000.0 is outside the profile"):
         profile.elevation(9000.0)

@@ -127,8 +127,6 @@ def corridor(
         ValueError: bad input (see ``spiral_cad.design.roadway``), or a solid
             OCCT does not find valid (never returned).
     """
-    from build123d import Face, Solid
-
     units = alignment.chain.units
     metres = to_metres(units)
     if not isinstance(cross_section, CrossSection):
@@ -136,7 +134,19 @@ def corridor(
     offsets = section_offsets(cross_section) / metres
     road = roadway(alignment, profile, offsets, superelevation, cross_section.crossfall, cross_section.depth / metres, tolerance)
     line = centerline_3d(alignment, profile, tolerance)
-    roles = _lane_roles(cross_section)
+    try:
+        solid, faces = _sewn_solid(road, _lane_roles(cross_section))
+    except Exception as error:  # OCCT's own exceptions (Standard_*) become ValueError; anything else is a bug
+        if not type(error).__module__.startswith("OCP"):
+            raise
+        raise ValueError(f"OCCT could not build the corridor ({type(error).__name__}: {error})") from None
+    return Corridor(solid, faces, road, line)
+
+
+def _sewn_solid(road: Roadway, roles: list[str]) -> tuple[Any, dict[str, list]]:
+    """The faces of the road per plan segment and its two ends, sewn into one checked solid, and the faces by role."""
+    from build123d import Face, Solid
+
     pieces: list[tuple[str, Any]] = []
     for k in np.unique(road.segment):
         rows = np.flatnonzero(road.segment == k)
@@ -172,7 +182,7 @@ def corridor(
     faces: dict[str, list] = {}
     for role, face in pieces:
         faces.setdefault(role, []).append(Face(sewing.Modified(face)))
-    return Corridor(result, faces, road, line)
+    return result, faces
 
 
 def section_offsets(cross_section: CrossSection) -> NDArray:

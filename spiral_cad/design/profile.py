@@ -315,13 +315,14 @@ class Profile:
         if not np.isfinite(pvis).all():
             k = int(np.flatnonzero(~np.isfinite(pvis).all(axis=1))[0])
             raise ValueError(f"PVI {k}: station and elevation must be finite; got {pvis[k].tolist()}")
-        steps = np.diff(pvis[:, 0])
-        for k, step in enumerate(steps):
+        with np.errstate(all="ignore"):
+            steps = np.diff(pvis[:, 0])
+            grades = np.diff(pvis[:, 1]) / steps
+        for k, step in enumerate(steps.tolist()):
             if not step > 0.0:
                 raise ValueError(f"PVI {k + 1}: station {float(pvis[k + 1, 0])!r} must be after PVI {k}'s station {float(pvis[k, 0])!r}")
-        grades = np.diff(pvis[:, 1]) / steps
-        if not np.isfinite(grades).all():
-            raise ValueError("PVI elevations and stations give a grade too large for float64")
+            if not math.isfinite(step) or not math.isfinite(grades[k]):
+                raise ValueError(f"PVI {k} and PVI {k + 1}: the stations and elevations give a grade float64 cannot hold")
         count = len(pvis) - 2
         criteria = _criteria(design_speed, criteria)
         if curve_lengths is not None and k_values is not None:
@@ -348,6 +349,9 @@ class Profile:
                 raise ValueError("give curve_lengths or k_values, or design criteria (design_speed) to choose them")
             full = criteria.minimum_length(differences, units)
             halves = np.stack([full / 2.0, full / 2.0], axis=1)
+        for j in np.flatnonzero(~np.isfinite(halves).all(axis=1)).tolist():
+            raise NoSolutionError(f"PVI {j + 1}: its vertical curve would be longer than float64 can hold "
+                                  f"(A = {100 * float(differences[j]):.4g} %)")  # fmt: skip
         curves = tuple(
             VerticalCurve(j + 1, float(pvis[j + 1, 0]), float(pvis[j + 1, 1]), float(grades[j]), float(grades[j + 1]),
                           float(halves[j, 0]), float(halves[j, 1]))
@@ -357,6 +361,7 @@ class Profile:
         if alignment is not None:
             _check_alignment(pvis, curves, alignment, units)
         stations, coefficients = _pieces(pvis, grades, curves)
+        _verify(stations, coefficients, pvis, units)
         checks = () if criteria is None else _judge(curves, grades, criteria, units, strict)
         return cls(pvis.copy(), curves, units, stations, coefficients, criteria, checks)
 
@@ -575,6 +580,24 @@ def _pieces(pvis: NDArray, grades: NDArray, curves: tuple[VerticalCurve, ...]) -
     coefficients = np.array(coefficients, dtype=float)
     keep = np.diff(stations) > 0.0  # a curve ending exactly where the next begins leaves an empty grade line
     return np.append(stations[:-1][keep], stations[-1]), coefficients[keep]
+
+
+def _verify(stations: NDArray, coefficients: NDArray, pvis: NDArray, units: str) -> None:
+    """The pieces as built must meet: value and grade continuous at every boundary (to 1e-9 of the
+    profile's own scale) and every number finite — else the numbers are beyond float64's reach."""
+    with np.errstate(all="ignore"):
+        span = float(pvis[-1, 0] - pvis[0, 0])
+        grade_scale = max(float(np.abs(coefficients[:, 1]).max()), 1e-300)
+        height_scale = max(float(np.abs(pvis[:, 1]).max()), span * grade_scale)
+        ends = np.diff(stations)[:-1]
+        jumps = [np.abs(polynomial(coefficients[:-1], ends, k) - coefficients[1:, k]) for k in (0, 1)]
+        bad = ~np.isfinite(coefficients).all(axis=1)[1:] | ~(jumps[0] <= 1e-9 * height_scale) | ~(jumps[1] <= 1e-9 * grade_scale)
+    if not np.isfinite(coefficients[0]).all() or bad.any():
+        where = float(stations[1 + int(np.argmax(bad))]) if bad.any() else float(stations[0])
+        raise NoSolutionError(
+            f"the profile cannot be held in float64 at these numbers: its pieces do not meet at station {where:.6g} "
+            f"{units} (elevations up to {height_scale:.3g}, grades up to {grade_scale:.3g})"
+        )
 
 
 def _judge(curves, grades: NDArray, criteria: ProfileCriteria, units: str, strict: bool) -> tuple[ProfileRow, ...]:
