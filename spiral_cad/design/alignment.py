@@ -18,7 +18,7 @@ from numpy.typing import ArrayLike, NDArray
 from scipy.optimize import brentq
 
 from ..core.bezier import curvature_rate, peak_curvature_rate  # noqa: F401  (public here too)
-from ..core._inputs import as_float, as_points, as_real_array
+from ..core._inputs import as_float, as_points, as_real_array, per_item
 from ..core._kernels import shape_g1
 from ..core.factors import length_factor, search_range
 from ..core.shapes import SHAPE_CODES, TRANSITION_SHAPES, shape_code, shape_limits
@@ -420,14 +420,7 @@ def _judge(
 
 
 def _per_pi(value: Any, count: int, name: str) -> NDArray:
-    array = as_real_array(value, name)
-    if array.ndim == 0:
-        array = np.full(count, float(array))
-    if array.shape != (count,):
-        raise ValueError(f"{name} needs one value or one per interior PI ({count}); got shape {array.shape}")
-    if not np.isfinite(array).all():
-        raise ValueError(f"{name} must be finite; got {array.tolist()}")
-    return array
+    return per_item(value, count, name, "interior PI")
 
 
 def _sides(value: Any, count: int, name: str) -> NDArray:

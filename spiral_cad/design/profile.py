@@ -46,7 +46,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from ..core._inputs import as_float, as_points, as_real_array
+from ..core._inputs import as_float, as_points, as_real_array, per_item
 from ..core.errors import NoSolutionError
 from ..core.piecewise import inside, piece_at, piecewise_at, polynomial
 from ..core.units import DEFAULT_UNITS, IMPERIAL, length_unit, speed_unit, to_metres
@@ -338,7 +338,7 @@ class Profile:
         elif curve_lengths is not None:
             halves = _curve_halves(curve_lengths, count)
         elif k_values is not None:
-            k = _per_pvi(k_values, count, "k_values")
+            k = per_item(k_values, count, "k_values", "interior PVI")
             for j, value in enumerate(k):
                 if not value > 0.0:
                     raise ValueError(f"PVI {j + 1}: K must be positive; got {value}")
@@ -466,17 +466,6 @@ def _criteria(design_speed: Any, criteria: Any) -> ProfileCriteria | None:
             raise ValueError(f"criteria must be a ProfileCriteria; got {type(criteria).__name__}")
         return criteria
     return None if design_speed is None else ProfileCriteria(as_float(design_speed, "design_speed"))
-
-
-def _per_pvi(value: Any, count: int, name: str) -> NDArray:
-    array = as_real_array(value, name)
-    if array.ndim == 0:
-        array = np.full(count, float(array))
-    if array.shape != (count,):
-        raise ValueError(f"{name} needs one value or one per interior PVI ({count}); got shape {array.shape}")
-    if not np.isfinite(array).all():
-        raise ValueError(f"{name} must be finite; got {array.tolist()}")
-    return array
 
 
 def _curve_halves(value: Any, count: int) -> NDArray:
