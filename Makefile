@@ -42,6 +42,7 @@ bench: $(STAMP)
 	$(BIN)/python benchmarks/bench_roads3d.py --out benchmarks/results_roads3d.md
 	$(BIN)/python benchmarks/bench_fillets.py --out benchmarks/results_fillets.md
 	$(BIN)/python benchmarks/bench_shapes.py --out benchmarks/results_shapes.md
+	$(BIN)/python benchmarks/bench_chains.py --out benchmarks/results_chains.md
 
 pictures: $(STAMP)
 	$(BIN)/python docs/make_pictures.py
