@@ -45,10 +45,9 @@ from xml.sax.saxutils import escape
 import numpy as np
 from numpy.typing import NDArray
 
-from ..core import bezier
 from ..core.chain import Chain
-from ..core.segments import Arc, Line
-from ..core.spiral import BezierSpiral
+from ..core.rows import ARC, LINE, SPIRAL
+from ..core.segments import row_frames
 from ..core.units import to_metres
 from .decimals import shortest_decimal
 from .opendrive_check import LinkReport, OpenDriveReport, ProfileReport, check_opendrive, print_opendrive_report
@@ -130,50 +129,32 @@ class RoadToWrite:
     superelevation: NDArray | None = None
 
 
-#: Kinds of planView records.
-LINE, ARC, SPIRAL = 0, 1, 2
-
-
 def plan_records(chain: Chain, scale: float) -> dict[str, NDArray]:
-    """The planView of ``chain`` in metres, as arrays (one pass over the segments, then vectorised).
+    """The planView of ``chain`` in metres, as arrays, from the chain's own rows (no segment objects).
 
-    Keys: ``kind`` (LINE, ARC, SPIRAL), ``x``, ``y``, ``hdg``, ``length``,
-    ``s`` (the chain's station at the start of each geometry), ``curvature``
-    (arcs), ``poly`` (N, 5) the paramPoly3 coefficients bU, cU, dU, cV, dV of
-    the spirals in their own frame (aU = aV = bV = 0), ``box`` (west, south,
-    east, north) and ``total`` (the road's length).
+    Keys: ``kind`` (``LINE``, ``ARC``, ``SPIRAL`` of ``spiral_cad.core.rows``),
+    ``x``, ``y``, ``hdg``, ``length``, ``s`` (the chain's station at the start
+    of each geometry), ``curvature`` (arcs), ``poly`` (N, 5) the paramPoly3
+    coefficients bU, cU, dU, cV, dV of the spirals in their own frame
+    (aU = aV = bV = 0), ``box`` (west, south, east, north) and ``total`` (the
+    road's length).
+
+    Raises:
+        ValueError: a chain in space (OpenDRIVE's planView is plane).
     """
-    segments = chain.segments
-    count = len(segments)
-    kind = np.empty(count, dtype=np.int8)
-    frames = np.empty((count, 4))
-    length = np.empty(count)
-    radius = np.full(count, np.inf)
-    spirals: list[NDArray] = []
-    arcs: list[tuple[float, float, float, float, float]] = []
-    for k, segment in enumerate(segments):
-        frames[k] = segment.ends[0][:4]
-        if isinstance(segment, BezierSpiral):
-            kind[k] = SPIRAL
-            spirals.append(segment.control_points)
-        elif isinstance(segment, Arc):
-            kind[k] = ARC
-            radius[k] = segment.radius
-            length[k] = segment.length
-            (cx, cy), r = segment.center.tolist(), segment.radius
-            arcs.append((cx, cy, abs(r), segment.start_angle, math.copysign(segment.sweep, r)))
-        elif isinstance(segment, Line):
-            kind[k] = LINE
-            length[k] = segment.length
-        else:
-            raise ValueError(f"segment {k} must be a Line, Arc or BezierSpiral; got {segment!r}")
-    hdg = np.arctan2(frames[:, 3], frames[:, 2])
-    spiral = kind == SPIRAL
-    poly = np.zeros((count, 5))
-    points = [frames[:, :2], np.array([s.ends[1][:2] for s in segments])]
-    if spirals:
-        cp = np.array(spirals)
-        length[spiral] = bezier.arc_length(cp)  # one batched quadrature
+    if chain.dim != 2:
+        raise ValueError("OpenDRIVE's planView holds plane chains; this chain lies in space")
+    rows = chain.rows
+    kind = np.array(rows.kind)
+    # writable copies: the compiled kernel the chain itself ran (read-only views would compile another)
+    frames, _, _ = row_frames(kind, np.array(rows.geometry), np.array(rows.params), rows.dim)
+    hdg = np.arctan2(frames[:, 0, 4], frames[:, 0, 3])
+    length = chain.lengths  # spirals measured once, by the chain (composite Gauss–Legendre)
+    spiral, arc = kind == SPIRAL, kind == ARC
+    poly = np.zeros((len(kind), 5))
+    points = [frames[:, 0, :2], frames[:, 1, :2]]
+    if spiral.any():
+        cp = rows.geometry[spiral, :, :2]
         c, s = np.cos(hdg[spiral])[:, None], np.sin(hdg[spiral])[:, None]
         delta = cp - cp[:, :1]
         u = delta[..., 0] * c + delta[..., 1] * s  # the spiral in its own frame (start, heading)
@@ -181,11 +162,13 @@ def plan_records(chain: Chain, scale: float) -> dict[str, NDArray]:
         poly[spiral] = np.stack([3.0 * u[:, 1], 3.0 * (u[:, 2] - 2.0 * u[:, 1]), u[:, 3] - 3.0 * u[:, 2] + 3.0 * u[:, 1],
                                  3.0 * (v[:, 2] - 2.0 * v[:, 1]), v[:, 3] - 3.0 * v[:, 2] + 3.0 * v[:, 1]], axis=1) * scale  # fmt: skip
         points.append(cp.reshape(-1, 2))  # the hull of the control points holds each spiral
-    if arcs:
-        points.append(_arc_extremes(np.array(arcs)))
+    radius = np.where(arc, rows.params[:, 0], np.inf)
+    if arc.any():
+        r, a0, sweep = rows.params[arc].T
+        points.append(_arc_extremes(np.column_stack([rows.geometry[arc, 0, :2], np.abs(r), a0, np.copysign(sweep, r)])))
     box = np.vstack(points)
     return {
-        "kind": kind, "x": frames[:, 0] * scale, "y": frames[:, 1] * scale, "hdg": hdg, "length": length * scale,
+        "kind": kind, "x": frames[:, 0, 0] * scale, "y": frames[:, 0, 1] * scale, "hdg": hdg, "length": length * scale,
         "s": chain.stations[:-1] * scale, "curvature": 1.0 / (radius * scale), "poly": poly,
         "box": np.concatenate([box.min(axis=0), box.max(axis=0)]) * scale, "total": chain.length * scale,
     }  # fmt: skip
