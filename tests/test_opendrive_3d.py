@@ -125,3 +125,13 @@ def test_feet_are_converted_in_elevation_and_superelevation(tmp_path):
     length = feet.curves[0].sc - feet.curves[0].ts
     assert ramp[3] == pytest.approx(3 * abs(polynomial_at(bank, ramp[0] + length * 0.3048)[0]) / (length * 0.3048) ** 2
                                     * np.sign(ramp[3]), rel=1e-9)  # fmt: skip
+
+
+def test_a_chain_in_space_is_refused_by_name(highway, tmp_path):
+    from spiral_cad.core.space import PlaneFrame
+
+    tilted = highway.chain.placed(PlaneFrame(normal=(0, 1, 1)))
+    assert tilted.dim == 3
+    with pytest.raises(ValueError, match="planView holds plane chains; this chain lies in space"):
+        export_opendrive(tilted, tmp_path / "space.xodr")
+    assert not (tmp_path / "space.xodr").exists()
