@@ -15,6 +15,7 @@ Needs no CAD kernel.
 
 from __future__ import annotations
 
+import gc
 import math
 import os
 from collections.abc import Sequence
@@ -495,6 +496,16 @@ def read_network(path: str | os.PathLike) -> Network:
             is not a road or junction with a contact point — naming the road
             id and the element.
     """
+    collecting = gc.isenabled()
+    gc.disable()  # one dict per element and no cycles: collections would only rescan them (3x the parse)
+    try:
+        return _read_network(path)
+    finally:
+        if collecting:
+            gc.enable()
+
+
+def _read_network(path: str | os.PathLike) -> Network:
     label = os.path.basename(os.fspath(path))
     if not os.path.isfile(path):
         raise ValueError(f"cannot read {label}: " + ("not a regular file" if os.path.exists(path) else "no such file"))
