@@ -39,6 +39,7 @@ from build123d import (
 from ..core.chain import Chain
 from ..core.shapes import DEFAULT_SHAPE
 from ..design.fillets import continuous_polygon, continuous_rectangle, continuous_slot
+from .corridor import Corridor, centerline_wire, corridor
 from .fillet import fillet_face, fillet_wire, planar_frame
 from .occ import chain_wire
 from ..core.segments import Segment
@@ -54,11 +55,14 @@ __all__ = [
     "ContinuousPolygon",
     "ContinuousRectangle",
     "ContinuousSlot",
+    "Corridor",
     "SpiralChain",
     "SpiralCircleInCircle",
     "SpiralCircleToCircle",
     "SpiralLineToCircle",
     "SpiralLineToLine",
+    "centerline_wire",
+    "corridor",
     "curvature_comb",
     "g2_fillet",
 ]

@@ -1,12 +1,14 @@
-"""Design tools built on the core: horizontal alignments, circle chains, corner rounding, G2 fillets.
+"""Design tools built on the core: horizontal and vertical alignments, superelevation, circle chains, corner rounding, G2 fillets.
 
 Pure numpy/numba: nothing here imports a CAD kernel.
 """
 
 from .alignment import Alignment, CurveData, curvature_rate, peak_curvature_rate
+from .centerline import Centerline3D, centerline_3d
 from .circles import CircleChain, circle_chain
 from .criteria import CriteriaRow, RailCriteria, RoadCriteria
 from .fillets import FilletCorner, FilletedPath, fillet_path
+from .profile import Profile, ProfileCriteria, VerticalCurve
 from .rounding import (
     CornerBatch,
     RoundedCorner,
@@ -15,19 +17,26 @@ from .rounding import (
     round_corners,
     round_corners_batch,
 )
+from .superelevation import Superelevation
 
 __all__ = [
     "Alignment",
+    "Centerline3D",
     "CircleChain",
     "CornerBatch",
     "CriteriaRow",
     "CurveData",
     "FilletCorner",
     "FilletedPath",
+    "Profile",
+    "ProfileCriteria",
     "RailCriteria",
     "RoadCriteria",
     "RoundedCorner",
     "RoundedPath",
+    "Superelevation",
+    "VerticalCurve",
+    "centerline_3d",
     "circle_chain",
     "corner_legs",
     "curvature_rate",
