@@ -39,6 +39,7 @@ bench: $(STAMP)
 	$(BIN)/python benchmarks/bench_checker.py --out benchmarks/results_checker.md
 	$(BIN)/python benchmarks/bench_rounding.py --out benchmarks/results_rounding.md
 	$(BIN)/python benchmarks/bench_roads.py --out benchmarks/results_roads.md
+	$(BIN)/python benchmarks/bench_roads3d.py --out benchmarks/results_roads3d.md
 	$(BIN)/python benchmarks/bench_fillets.py --out benchmarks/results_fillets.md
 	$(BIN)/python benchmarks/bench_shapes.py --out benchmarks/results_shapes.md
 	$(BIN)/python benchmarks/bench_chains.py --out benchmarks/results_chains.md

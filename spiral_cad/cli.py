@@ -63,6 +63,7 @@ DEMO_DESIGN: dict = {
             "design_speed": 80,
             "max_jerk": 0.6,
             "start_station": 10000,
+            "profile": {"pvis": [[10000, 120], [10700, 132], [11500, 116], [12500, 121]]},
         },
         {
             "name": "circles",
@@ -165,11 +166,14 @@ def _check_file(args: argparse.Namespace) -> int:
         if args.comb:
             print("error: --comb draws STEP/IGES edges; it does not apply to OpenDRIVE", file=sys.stderr)
             return 2
-        from .formats.joints import print_report
-        from .formats.opendrive import check_opendrive
+        from .formats.opendrive import check_opendrive, print_opendrive_report
 
         report = check_opendrive(args.file, gap_tol=args.gap_tol, angle_tol=args.angle_tol, curvature_tol=args.curvature_tol)
-        return print_report(report, args)
+        return print_opendrive_report(report, args)
+    for option in ("profiles", "links"):
+        if getattr(args, option):
+            print(f"error: --{option} judges OpenDRIVE files (.xodr) only", file=sys.stderr)
+            return 2
     if find_spec("OCP") is None:
         print(f"error: spiral-cad check reads STEP/IGES with OCCT, which comes with the CAD extra: {PIP_CAD}", file=sys.stderr)
         return 2
@@ -182,14 +186,23 @@ def _add_check(sub: argparse._SubParsersAction) -> None:
     check = sub.add_parser(
         "check",
         help="report G0/G1/G2 continuity at every joint of a STEP, IGES or OpenDRIVE file",
-        description="Report G0/G1/G2 continuity at every joint, in the unit the file declares. Exit status: 0 ok, "
-        "1 below --require (or not --pieces pieces), 2 unreadable file or bad option, 141 output pipe closed early.",
+        description="Report G0/G1/G2 continuity at every joint, in the unit the file declares. An OpenDRIVE file is "
+        "judged road by road (its planView, its elevation and superelevation in s) and link by link. Exit status: 0 ok, "
+        "1 below --require, --profiles or --links (or not --pieces pieces), 2 unreadable file or bad option, "
+        "141 output pipe closed early.",
     )
     check.add_argument("file", help="a .step/.stp, .igs/.iges or .xodr file (OpenDRIVE: one piece per road)")
     check.add_argument(
-        "--require", choices=["G0", "G1", "G2"], help="exit 1 if any joint is below this level or the file is not in --pieces pieces"
-    )
-    check.add_argument("--pieces", type=int, help="how many separate paths the file should hold (default 1, with --require)")
+        "--require", choices=["G0", "G1", "G2"],
+        help="exit 1 if any joint (OpenDRIVE: of any road's planView) is below this level or the file is not in --pieces pieces",
+    )  # fmt: skip
+    check.add_argument("--pieces", type=int,
+                       help="how many separate paths the file should hold (default 1 with --require; OpenDRIVE: roads, "
+                            "judged only when given)")  # fmt: skip
+    check.add_argument("--profiles", choices=["C0", "C1", "C2"],
+                       help="OpenDRIVE: exit 1 if any road's elevation or superelevation is below this continuity in s")  # fmt: skip
+    check.add_argument("--links", choices=["G0", "G1", "G2"],
+                       help="OpenDRIVE: exit 1 if any link between roads (road links, junction connections) is below this level")  # fmt: skip
     check.add_argument("--snap", type=float, help="chain loose ends closer than this (model units; default 1%% of the model size)")
     check.add_argument("--comb", metavar="OUT.step",
                        help="also write the curvature comb of every edge as STEP (STEP/IGES input; never the checked file)")  # fmt: skip
@@ -235,7 +248,7 @@ def _parser() -> argparse.ArgumentParser:
             "  spiral-cad demo --out out                  the built-in design: STEP, IGES, DXF, SVG, plots, CSV\n"
             "  spiral-cad build examples/design.json      your own design file (spiral-cad build --help for the format)\n"
             "  spiral-cad check out/highway.step --require G2   G0/G1/G2 at every joint; exit 1 below G2\n"
-            "  spiral-cad check out/highway.xodr --require G2   the same for every road of an OpenDRIVE file"
+            "  spiral-cad check out/highway.xodr --require G2 --profiles C1 --links G1   every road, profile and link of an OpenDRIVE map"
         ),
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )

@@ -60,8 +60,18 @@ FORMAT = """\
      "spiral_shape": "near-linear",      default; or "walton-meek" (the 1996 spiral, 1.6–1.8× longer
                                          for the same jerk)
      "cross_section": {"driving_lanes": 1, "lane_width": 3.5, "shoulder_width": 2.5,
-                       "rule": "RHT"},   OpenDRIVE lanes (m)
-     "geo_reference": "+proj=utm ..."},  OpenDRIVE geoReference (printable text, ≤ 10 000 characters)
+                       "rule": "RHT",    OpenDRIVE lanes (m)
+                       "crossfall": 0.025, "depth": 0.5},   crown (m/m) and pavement (m) of the corridor
+     "geo_reference": "+proj=utm ...",   OpenDRIVE geoReference (printable text, ≤ 10 000 characters)
+     "profile": {                        optional vertical alignment: NAME_profile.csv, elevation in
+                                         the .xodr, the 3-D centre line and corridor in NAME_3d.step
+       "pvis": [[station, elevation], ...],   ≥ 2, stations are the alignment's chainages
+                                         (start_station at its first PI); it must cover the alignment
+       "curve_lengths": [L | [Lin, Lout], ...]  or "k_values": [K, ...] (length per % of grade
+                                         change) or neither, with design_speed (road criteria): the
+                                         shortest curves that meet the stopping sight distance
+       "terrain": "rolling",             level | rolling | mountainous (the maximum grade)
+       "max_grade": 0.05, "min_curve_length": L}},  optional overrides (fraction; length)
     {"name": "oval", "type": "circle_chain",
      "circles": [{"center": [x, y], "radius": r}, ...],    signed radius = travel sense (+ ccw)
      "spiral_shape": "walton-meek" | "near-linear"},        default walton-meek
@@ -91,7 +101,7 @@ MAX_DIGITS = 308
 #: Design files larger than this are refused before they are read.
 MAX_DESIGN_BYTES = 10_000_000
 #: The packages of the ``cad`` extra and what needs them.
-CAD_EXTRA = {"OCP": "IGES and the continuity check", "ezdxf": "DXF", "matplotlib": "plots"}
+CAD_EXTRA = {"OCP": "IGES, the 3-D STEP of roads and the continuity check", "ezdxf": "DXF", "matplotlib": "plots"}
 
 
 class DesignError(ValueError):
@@ -280,7 +290,9 @@ def load(source: str | Path | dict) -> tuple[str, list[dict]]:
 #: Design-file keys of the criteria, by kind (values as the criteria classes take them).
 ROAD_KEYS = ("max_jerk", "superelevation_max", "side_friction", "shift_min", "shift_max")
 RAIL_KEYS = ("cant_max", "cant_deficiency_max", "cant_rate_max", "cant_deficiency_rate_max", "cant_gradient_max", "gauge", "cant")
-CROSS_SECTION_KEYS = {"driving_lanes": int, "lane_width": float, "shoulder_width": float, "rule": str}
+CROSS_SECTION_KEYS = {"driving_lanes": int, "lane_width": float, "shoulder_width": float, "rule": str, "crossfall": float,
+                      "depth": float}  # fmt: skip
+PROFILE_KEYS = ("pvis", "curve_lengths", "k_values", "terrain", "max_grade", "min_curve_length")
 
 
 def _design_criteria(d: dict, where: str):
@@ -337,7 +349,7 @@ def _alignment(d: dict, where: str, units: str) -> Built:
     from .design import Alignment
 
     optional = ("spiral_angles_deg", "spiral_lengths", "start_station", "design_speed", "criteria", "strict",
-                "cross_section", "geo_reference", "spiral_shape") + ROAD_KEYS + RAIL_KEYS  # fmt: skip
+                "cross_section", "geo_reference", "spiral_shape", "profile") + ROAD_KEYS + RAIL_KEYS  # fmt: skip
     _fields(d, where, ("pis", "radii"), optional)
     pis = _points(d["pis"], f"{where}.pis", 3)
     count = len(pis) - 2
@@ -371,7 +383,55 @@ def _alignment(d: dict, where: str, units: str) -> Built:
     shape = _shape(d, where, TRANSITION_SHAPES, "near-linear")
     alignment = Alignment.from_pis(pis, radii, start_station=start, units=units, criteria=criteria, strict=strict, shape=shape, **kw)
     notes = {"cross_section": _cross_section(d, where), "geo_reference": geo}
+    if "profile" in d:
+        notes["profile"] = _profile(d["profile"], f"{where}.profile", alignment, strict)
     return Built(d["name"], "alignment", alignment.chain, alignment, notes)
+
+
+def _profile(value: Any, where: str, alignment: Any, strict: bool):
+    """The vertical alignment of an alignment design (its stations are the alignment's chainages)."""
+    from .design import Profile, ProfileCriteria, RoadCriteria
+
+    if not isinstance(value, dict):
+        raise DesignError(f"{where}: must be an object with pvis and curve_lengths or k_values; got {value!r:.80}")
+    _fields(value, where, ("pvis",), PROFILE_KEYS[1:])
+    pvis = _points(value["pvis"], f"{where}.pvis", 2)
+    count = len(pvis) - 2
+    if "curve_lengths" in value and "k_values" in value:
+        raise DesignError(f"{where}: give at most one of curve_lengths and k_values")
+    kw: dict[str, Any] = {}
+    if "curve_lengths" in value:  # a number is a symmetric curve's whole length, a pair its halves
+        lengths = value["curve_lengths"]
+        if isinstance(lengths, list):
+            pairs = _pairs(lengths, f"{where}.curve_lengths", count, lambda v, w: _number(v, w, positive=True))
+            kw["curve_lengths"] = [pair if isinstance(item, list) else pair[0] for item, pair in zip(lengths, pairs)]
+        else:
+            kw["curve_lengths"] = _number(lengths, f"{where}.curve_lengths", positive=True)
+    elif "k_values" in value:
+        k = value["k_values"]
+        items = k if isinstance(k, list) else [k] * count
+        if len(items) != count:
+            raise DesignError(f"{where}.k_values: needs one K per interior PVI ({count}); got {len(items)}")
+        kw["k_values"] = [_number(v, f"{where}.k_values[{i}]", positive=True) for i, v in enumerate(items)]
+    limits = {k: _number(value[k], f"{where}.{k}", positive=k == "max_grade") for k in ("max_grade", "min_curve_length") if k in value}
+    terrain = value.get("terrain")
+    if terrain is not None:
+        from .design.profile import TERRAINS
+
+        limits["terrain"] = _choice(terrain, f"{where}.terrain", TERRAINS)
+    if isinstance(alignment.criteria, RoadCriteria):
+        try:
+            kw["criteria"] = ProfileCriteria(alignment.criteria.design_speed, **limits)
+        except ValueError as e:
+            raise DesignError(f"{where}: {e}") from None
+    elif limits:
+        raise DesignError(f"{where}: {', '.join(limits)} need road criteria (a design_speed with criteria \"road\")")
+    if count and "curve_lengths" not in kw and "k_values" not in kw and "criteria" not in kw:
+        raise DesignError(f"{where}: give curve_lengths or k_values (or a road design_speed to choose the curves)")
+    try:
+        return Profile.from_pvis(pvis, units=alignment.chain.units, strict=strict, alignment=alignment, **kw)
+    except (NoSolutionError, ValueError) as e:
+        raise DesignError(f"{where}: {e}") from None
 
 
 def _circle_chain(d: dict, where: str, units: str) -> Built:
@@ -525,13 +585,19 @@ def _write_design(b: Built, stage: Path, units: str, missing: list[str], plots: 
     if b.kind == "alignment":
         from .export import export_opendrive
 
+        profile = b.notes.get("profile")
         b.source.to_csv(stage / f"{b.name}_stations.csv")
         export_opendrive(b.source, stage / f"{b.name}.xodr", name=b.name, cross_section=b.notes["cross_section"],
-                         geo_reference=b.notes["geo_reference"])  # fmt: skip
+                         geo_reference=b.notes["geo_reference"], profile=profile)  # fmt: skip
         names += ["stations.csv", "xodr"]
         if b.source.checks:
             b.source.criteria_to_csv(stage / f"{b.name}_criteria.csv")
             names.append("criteria.csv")
+        if profile is not None:
+            profile.to_csv(stage / f"{b.name}_profile.csv")
+            names.append("profile.csv")
+            if "OCP" not in missing:
+                names += _road_3d(b, profile, stage, units)
     if "OCP" not in missing:
         from .cad.continuity import check_continuity
         from .export import export_iges
@@ -549,6 +615,26 @@ def _write_design(b: Built, stage: Path, units: str, missing: list[str], plots: 
     if plots and "matplotlib" not in missing:
         names += _plots(b, stage)
     return names
+
+
+def _road_3d(b: Built, profile: Any, stage: Path, units: str) -> list[str]:
+    """NAME_3d.step: the corridor solid and the 3-D centre line, their measured fit in the file's description."""
+    from build123d import Compound
+
+    from .cad.corridor import centerline_wire, corridor
+    from .export import originating_system
+    from .formats.step_occ import write_shape_step
+
+    road = corridor(b.source, profile, b.notes["cross_section"])
+    line = road.centerline
+    fit = (
+        f"{b.name} in 3-D: corridor solid and centre line (plan exact; z within {line.deviation:.3g} {units} of the "
+        f"profile, tolerance {line.tolerance:.3g} {units}; corridor edges within {road.roadway.deviation:.3g} {units})"
+    )
+    write_shape_step(Compound([road.solid, centerline_wire(line)]), stage / f"{b.name}_3d.step", b.name, units,
+                     originating_system(), description=fit)  # fmt: skip
+    b.notes["3d"] = f"{line.describe()}; {road.describe()}"
+    return ["3d.step"]
 
 
 def _plots(b: Built, stage: Path) -> list[str]:
@@ -583,13 +669,20 @@ def _interrupts_raise() -> Iterator[None]:
 
 
 def criteria_tables(built: list[Built]) -> str:
-    """The criteria table of every alignment designed with criteria, with its violations."""
+    """The criteria table of every alignment designed with criteria and the table of every profile,
+    with their violations."""
     parts = []
     for b in built:
         if b.kind == "alignment" and b.source.checks:
             broken = sum(1 for c in b.source.checks if not c.ok)
             verdict = "every curve meets the criteria" if not broken else f"{broken} curve(s) violate the criteria"
             parts.append(f"{b.name}: {b.source.criteria_table()}\n{b.name}: {verdict}")
+        profile = b.notes.get("profile")
+        if profile is not None:
+            broken = sum(1 for c in profile.checks if not c.ok)
+            verdict = "" if not profile.checks else (f"\n{b.name}: every PVI meets the profile criteria" if not broken
+                                                     else f"\n{b.name}: {broken} PVI(s) violate the profile criteria")  # fmt: skip
+            parts.append(f"{b.name} profile: {profile.table(6)}{verdict}")
     return "\n\n".join(parts)
 
 
@@ -607,4 +700,5 @@ def summary(built: list[Built], units: str) -> str:
             f"{b.name:14} {b.kind:30} {'+'.join(shapes):13} {len(b.chain):8d} {b.chain.length:12.3f} {peak:10.5f}  "
             f"{b.notes.get('continuity', '-')}"
         )
+    lines += [f"{b.name}: {b.notes['3d']}" for b in built if "3d" in b.notes]
     return "\n".join(lines)

@@ -26,7 +26,6 @@ post-processor (``spiral_cad.formats.samples``).
 
 from __future__ import annotations
 
-import math
 import os
 from collections.abc import Iterable
 from pathlib import Path
@@ -180,12 +179,16 @@ def export_opendrive(
     name: str | None = None,
     cross_section: CrossSection = CrossSection(),
     geo_reference: str | None = None,
+    profile: Any = None,
+    superelevation: Any = None,
 ) -> None:
     """Write ASAM OpenDRIVE 1.8: one road per alignment or chain, spirals as exact ``paramPoly3``.
 
     An ``Alignment`` brings its start station (as ``userData``) and, when it
     was designed with criteria, the superelevation of every curve (a
-    ``lateralProfile`` ramped along the spirals). See
+    ``lateralProfile`` of exact cubics, C1: ``spiral_cad.design.Superelevation``).
+    A ``Profile`` gives the ``elevationProfile`` (its parabolas and grades
+    exactly); without one the road is level at 0. See
     ``spiral_cad.formats.opendrive`` for the mapping; lengths are converted
     to metres, OpenDRIVE's unit.
 
@@ -197,13 +200,20 @@ def export_opendrive(
             lane each way and 2.5 m shoulders).
         geo_reference: a PROJ string (or WKT, up to 10 000 characters of
             printable text, newlines allowed) for the header's ``geoReference``.
+        profile: the ``Profile`` of an alignment, or one per item (None for
+            none); it must cover its alignment.
+        superelevation: a ``Superelevation`` (or one per item) instead of the
+            one the alignment's criteria give.
 
     Raises:
-        ValueError: an unsupported object, chains of different units, or a
-            name or ``geo_reference`` that is not printable text.
+        ValueError: an unsupported object, chains of different units, a
+            name or ``geo_reference`` that is not printable text, or a
+            profile or superelevation that does not fit its alignment.
     """
     from .design.alignment import Alignment
-    from .formats.opendrive import Banking, RoadToWrite, write_opendrive
+    from .design.centerline import check_profile
+    from .design.superelevation import Superelevation
+    from .formats.opendrive import RoadToWrite, write_opendrive
 
     items = list(obj) if isinstance(obj, (list, tuple)) else [obj]
     if not items or not all(isinstance(i, (Alignment, Chain)) for i in items):
@@ -211,17 +221,35 @@ def export_opendrive(
     label = _name(name, path)
     if geo_reference is not None:
         check_name(geo_reference, "geo_reference", limit=MAX_TEXT_LENGTH, multiline=True)
+    profiles = _per_item(profile, len(items), "profile")
+    bankings = _per_item(superelevation, len(items), "superelevation")
     roads = []
-    for k, item in enumerate(items):
+    for k, (item, its_profile, banking) in enumerate(zip(items, profiles, bankings)):
         road_name = label if len(items) == 1 else f"{label}-{k + 1}"
         if isinstance(item, Chain):
+            if its_profile is not None or banking is not None:
+                raise ValueError(f"item {k}: a profile or superelevation needs an Alignment (its stations), not a Chain")
             roads.append(RoadToWrite(item, road_name))
             continue
-        banking = [
-            Banking(c.ts - item.start_station, c.sc - item.start_station, c.cs - item.start_station,
-                    c.st - item.start_station, check.cross_slope, math.copysign(1.0, c.deflection))
-            for c, check in zip(item.curves, item.checks)
-        ]  # fmt: skip
-        roads.append(RoadToWrite(item.chain, road_name, item.start_station, banking))
+        elevation = None
+        if its_profile is not None:
+            check_profile(item, its_profile)
+            elevation = its_profile.records(item.start_station, item.end_station)
+        if banking is None:
+            banking = Superelevation.from_alignment(item)
+        elif not isinstance(banking, Superelevation):
+            raise ValueError(f"superelevation must be a Superelevation; got {type(banking).__name__}")
+        roads.append(RoadToWrite(item.chain, road_name, item.start_station, elevation, banking.records()))
     units = _units([r.chain for r in roads], None)
     write_opendrive(roads, path, label, units, originating_system(), cross_section, geo_reference)
+
+
+def _per_item(value: Any, count: int, name: str) -> list:
+    """One value per exported item: None, one object for a single item, or a list of ``count``."""
+    if isinstance(value, (list, tuple)):
+        if len(value) != count:
+            raise ValueError(f"{name} needs one entry per item ({count}); got {len(value)}")
+        return list(value)
+    if value is not None and count != 1:
+        raise ValueError(f"{name}: give a list with one entry per item ({count})")
+    return [value] * count

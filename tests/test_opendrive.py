@@ -246,6 +246,14 @@ def test_demo_writes_a_valid_highway_xodr(tmp_path):
     result = independent_check(tmp_path / "highway.xodr")
     assert result["schema"] == [] and all(issues == 0 for _, issues in result["checker"].values())
     assert "verdict" in (tmp_path / "highway_criteria.csv").read_text()
+    # the highway in 3-D: pyxodr's elevation is the designed profile (s along its 0.5 m polyline)
+    from spiral_cad.cli import DEMO_DESIGN
+    from spiral_cad.designfile import build
+
+    (highway, *_) = build(DEMO_DESIGN)[1]
+    ((distance, z),) = [np.array(v).T for v in result["elevation"].values()]
+    assert np.abs(z - highway.notes["profile"].elevation(highway.source.start_station + distance)).max() <= 1e-5
+    assert len(ET.parse(tmp_path / "highway.xodr").getroot().findall("road/lateralProfile/superelevation")) > 4
 
 
 # ------------------------------------------------------ hostile numbers

@@ -52,6 +52,7 @@ from ..core.chain import Chain
 from ..core.shapes import DEFAULT_SHAPE
 from ..design.rounding import fillet_polyline, round_corners
 from ..design.fillets import continuous_polygon, continuous_rectangle, continuous_slot
+from .corridor import Corridor, centerline_wire, corridor
 from .fillet import fillet_face, fillet_wire, planar_frame
 from .occ import chain_wire
 from ..core.segments import Segment
@@ -67,12 +68,15 @@ __all__ = [
     "ContinuousPolygon",
     "ContinuousRectangle",
     "ContinuousSlot",
+    "Corridor",
     "G2Polyline",
     "SpiralChain",
     "SpiralCircleInCircle",
     "SpiralCircleToCircle",
     "SpiralLineToCircle",
     "SpiralLineToLine",
+    "centerline_wire",
+    "corridor",
     "curvature_comb",
     "g2_fillet",
 ]

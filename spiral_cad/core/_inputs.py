@@ -146,3 +146,15 @@ def as_points(value: Any, name: str, shape: tuple[int, ...] = (2,)) -> NDArray:
     if array.shape[array.ndim - len(shape) :] != shape:
         raise ValueError(f"{name} must have trailing shape {shape}; got {array.shape}")
     return array
+
+
+def per_item(value: Any, count: int, name: str, item: str) -> NDArray:
+    """``value`` as ``count`` finite floats: one number for all, or one per ``item`` (named in the error)."""
+    array = as_real_array(value, name)
+    if array.ndim == 0:
+        array = np.full(count, float(array))
+    if array.shape != (count,):
+        raise ValueError(f"{name} needs one value or one per {item} ({count}); got shape {array.shape}")
+    if not np.isfinite(array).all():
+        raise ValueError(f"{name} must be finite; got {array.tolist()}")
+    return array

@@ -1,12 +1,14 @@
-"""Design tools built on the core: horizontal alignments, circle chains, corner rounding, G2 fillets.
+"""Design tools built on the core: horizontal and vertical alignments, superelevation, circle chains, corner rounding, G2 fillets.
 
 Pure numpy/numba: nothing here imports a CAD kernel.
 """
 
 from .alignment import Alignment, CurveData, curvature_rate, peak_curvature_rate
+from .centerline import Centerline3D, centerline_3d
 from .circles import CircleChain, circle_chain
 from .criteria import CriteriaRow, RailCriteria, RoadCriteria
 from .fillets import FilletCorner, FilletedPath, fillet_path
+from .profile import Profile, ProfileCriteria, VerticalCurve
 from .rounding import (
     CornerBatch,
     FilletedPolyline,
@@ -18,9 +20,11 @@ from .rounding import (
     round_corners,
     round_corners_batch,
 )
+from .superelevation import Superelevation
 
 __all__ = [
     "Alignment",
+    "Centerline3D",
     "CircleChain",
     "CornerBatch",
     "CriteriaRow",
@@ -28,11 +32,16 @@ __all__ = [
     "FilletCorner",
     "FilletedPath",
     "FilletedPolyline",
+    "Profile",
+    "ProfileCriteria",
     "RailCriteria",
     "RoadCriteria",
     "RoundedCorner",
     "RoundedPath",
     "SpaceFillet",
+    "Superelevation",
+    "VerticalCurve",
+    "centerline_3d",
     "circle_chain",
     "corner_legs",
     "curvature_rate",

@@ -20,7 +20,7 @@ from numpy.typing import ArrayLike, NDArray
 from ..core import _kernels as K
 from ..core import batch
 from ..core._chain_kernels import SPIRAL
-from ..core._inputs import as_float, as_points, as_real_array
+from ..core._inputs import as_float, as_points, as_real_array, per_item
 from ..core.bezier import curvature_rate, peak_curvature_rate  # noqa: F401  (public here too)
 from ..core.chain import JOIN_TOLERANCE, Chain, PartCircles, join_rows, join_tolerance
 from ..core.errors import JointError, NoSolutionError
@@ -342,6 +342,12 @@ class Alignment:
     def end_station(self) -> float:
         return self.start_station + self.chain.length
 
+    def centerline_3d(self, profile: Any, tolerance: float | None = None) -> Any:
+        """The 3-D centre line under ``profile`` (see ``spiral_cad.design.centerline``)."""
+        from .centerline import centerline_3d
+
+        return centerline_3d(self, profile, tolerance)
+
     def table(self, digits: int = 8) -> str:
         """The stationing table as aligned text (for printing), units in the headers."""
         units = self.chain.units
@@ -643,14 +649,7 @@ def _judge(
 
 
 def _per_pi(value: Any, count: int, name: str) -> NDArray:
-    array = as_real_array(value, name)
-    if array.ndim == 0:
-        array = np.full(count, float(array))
-    if array.shape != (count,):
-        raise ValueError(f"{name} needs one value or one per interior PI ({count}); got shape {array.shape}")
-    if not np.isfinite(array).all():
-        raise ValueError(f"{name} must be finite; got {array.tolist()}")
-    return array
+    return per_item(value, count, name, "interior PI")
 
 
 def _sides(value: Any, count: int, name: str) -> NDArray:

@@ -31,8 +31,11 @@ overridable): applied cant ≤ 160 mm, cant deficiency ≤ 130 mm, rate of
 change of cant ≤ 50 mm/s, rate of change of cant deficiency ≤ 55 mm/s, cant
 gradient ≤ 2.25 mm/m, rail-centre distance 1500 mm (standard gauge). The
 equilibrium cant is E = G·v²/(g·R); the applied cant D = min(E, cant_max)
-ramps linearly along the spiral, and the cant deficiency I(s) = G·v²·κ(s)/g
-− D(s) changes at v·|dI/ds|, peak taken on the real spiral.
+ramps along the spiral as a cubic ease (``superelevation``: C1 at both ends,
+steepest at mid-spiral with 1.5·D/L, where the cant rate and gradient are
+judged), and the cant deficiency I(s) = G·v²·κ(s)/g − D(s) changes at
+v·|dI/ds| ≤ v·max(G·v²/g·max dκ/ds, 1.5·D/L), the peak of dκ/ds taken on the
+real spiral.
 """
 
 from __future__ import annotations
@@ -49,6 +52,10 @@ from ..core.factors import length_factor, peak_rate_factor, search_range, shift_
 from ..core.units import IMPERIAL, speed_unit, to_metres
 
 GRAVITY = 9.80665
+#: The applied cant ramps along each spiral as the cubic ease D·(3t² − 2t³) of
+#: ``superelevation`` (C1 at both ends); its steepest slope, at mid-spiral, is
+#: 1.5× the mean D/L, and the rail rates are judged there.
+RAMP_PEAK_SLOPE = 1.5
 KMH = 1.0 / 3.6
 MPH = 0.44704
 
@@ -326,9 +333,10 @@ class RailCriteria(_Criteria):
             peak, length = factors
         v = self.speed(units)
         cant = self.applied_cant(radius, units)
-        # dI/ds = (G v²/g)·dκ/ds − D/L: largest at the peak of dκ/ds, or −D/L where dκ/ds = 0 (the spiral's end)
-        deficiency_rate = v * np.maximum(self.gauge * v * v / GRAVITY * peak - cant / length, cant / length)
-        return v * cant / length, cant / length, deficiency_rate
+        steepest = RAMP_PEAK_SLOPE * cant / length  # the cant's ramp at mid-spiral
+        # dI/ds = (G v²/g)·dκ/ds − dD/ds with both rates ≥ 0: at most the larger of the two peaks
+        deficiency_rate = v * np.maximum(self.gauge * v * v / GRAVITY * peak, steepest)
+        return v * steepest, steepest, deficiency_rate
 
     def _lower_ok(self, theta, radius, units, shape):
         cant_rate, gradient, deficiency_rate = self._rates(theta, radius, units, shape)

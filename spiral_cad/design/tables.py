@@ -3,7 +3,7 @@
 A column's dimension is a string in ``L`` (the design's length unit), e.g.
 ``"L"``, ``"1/L²"``, ``"deg"``; the header becomes ``name [m]``,
 ``name [1/m²]`` or ``name [deg]``. Only ``TEXT_COLUMNS`` have none: ``pi``
-(the PI's index), ``spiral_shape`` and ``verdict`` (text). Every other cell is a plain
+and ``pvi`` (indices), ``kind`` (crest or sag), ``spiral_shape`` and ``verdict`` (text). Every other cell is a plain
 decimal that ``float()`` reads: numbers of any type (numpy scalars too)
 are written as Python floats, at full precision in CSV.
 """
@@ -16,8 +16,8 @@ from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
-#: The columns without a unit: an index and two texts.
-TEXT_COLUMNS = ("pi", "spiral_shape", "verdict")
+#: The columns without a unit: indices and texts.
+TEXT_COLUMNS = ("pi", "pvi", "kind", "spiral_shape", "verdict")
 
 
 def header(key: str, dimensions: Mapping[str, str], units: str) -> str:

@@ -37,14 +37,19 @@ from .names import step_string
 _STEP_UNIT = {"mm": "MM", "cm": "CM", "m": "M", "km": "KM", "in": "INCH", "ft": "FT"}
 
 
-def write_shape_step(obj: Any, path: str | os.PathLike, name: str, units: str, originating_system: str) -> None:
-    """Write any OCP/build123d/CadQuery shape as STEP AP214 in ``units``.
+def write_shape_step(
+    obj: Any, path: str | os.PathLike, name: str, units: str, originating_system: str, description: str | None = None
+) -> None:
+    """Write any OCP/build123d/CadQuery shape as STEP AP214 in ``units`` (``description``: the
+    header's FILE_DESCRIPTION, printable ASCII without quotes or backslashes).
 
     Raises:
         ValueError: ``obj`` is not a shape.
         OSError: the transfer or the printing failed.
     """
     shape = as_occ_shape(obj)
+    if description is not None and not (description.isascii() and description.isprintable() and not set("'\\") & set(description)):
+        raise ValueError(f"a STEP description must be printable ASCII without quotes or backslashes; got {description!r:.80}")
     placeholder = f"SPIRALCADNAME{secrets.token_hex(12).upper()}"
     writer = STEPControl_Writer()
     Interface_Static.SetCVal_s("write.step.unit", _STEP_UNIT[units])
@@ -61,6 +66,8 @@ def write_shape_step(obj: Any, path: str | os.PathLike, name: str, units: str, o
     header.SetAuthorValue(1, TCollection_HAsciiString(""))
     header.SetOrganizationValue(1, TCollection_HAsciiString(""))
     header.SetAuthorisation(TCollection_HAsciiString(""))
+    if description is not None:
+        header.SetDescriptionValue(1, TCollection_HAsciiString(description))
     print_model(StepData_StepWriter(writer.Model()), StepAP214.Protocol_s(), path, "STEP")
     text = Path(path).read_bytes()
     # OCCT appends a per-session counter to the product name ("NAME 1", "NAME 2", …): drop it

@@ -4,6 +4,7 @@ Prints one JSON object:
   schema   — XSD 1.1 errors against the ASAM OpenDRIVE 1.8 schema shipped with asam-qc-opendrive
   checker  — the ASAM quality checker bundle: {checker id: [status, issue count]}
   roads    — pyxodr's reference line of every road, one list of [x, y] samples per geometry
+  elevation — pyxodr's elevation of every road: [distance along its sampled reference line, z] pairs
 """
 
 import json
@@ -39,15 +40,18 @@ def checker(path: str) -> dict[str, list]:
     return {c.checker_id: [str(c.status.value if hasattr(c.status, "value") else c.status), len(c.issues)] for c in bundle.checkers}
 
 
-def roads(path: str) -> dict[str, list]:
+def roads(path: str) -> tuple[dict[str, list], dict[str, list]]:
     network = RoadNetwork(path, resolution=0.5)
-    found = {}
+    found, heights = {}, {}
     for road in network.get_roads():
-        road.reference_line  # samples every geometry at parameters evenly spaced in [0, 1]
+        line = road.reference_line  # samples every geometry at parameters evenly spaced in [0, 1]
         found[road.id] = [np.asarray(c, dtype=float).tolist() for c in road.coordinates_sorted_by_distance]
-    return found
+        distance = np.append(0.0, np.cumsum(np.linalg.norm(np.diff(line, axis=0), axis=1)))
+        heights[road.id] = np.column_stack([distance, road.z_coordinates]).tolist()
+    return found, heights
 
 
 if __name__ == "__main__":
     target = sys.argv[1]
-    print(json.dumps({"schema": schema_errors(target), "checker": checker(target), "roads": roads(target)}))
+    lines, heights = roads(target)
+    print(json.dumps({"schema": schema_errors(target), "checker": checker(target), "roads": lines, "elevation": heights}))

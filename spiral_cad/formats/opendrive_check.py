@@ -1,0 +1,271 @@
+"""Checking OpenDRIVE maps road by road and link by link.
+
+Every road's planView joints (G0/G1/G2, the measures of every checker in
+``spiral_cad.formats.joints``), its ``elevation`` and ``superelevation`` in s
+(C0/C1/C2), and every link between road ends (road links, junction
+connections) measured as a joint. Public names: ``spiral_cad.formats.opendrive``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+from dataclasses import dataclass, fields
+
+import numpy as np
+from numpy.typing import NDArray
+
+from ..core.piecewise import polynomial
+from .joints import (
+    Continuity,
+    ContinuityReport,
+    JointReport,
+    check_tolerances,
+    classify_joint,
+    classify_pieces,
+    flip,
+    model_size,
+)
+from .opendrive_read import Network, Road, _label, read_network
+
+#: Continuity levels of a profile in s (elevation, superelevation).
+PROFILE_LEVELS = ("unmeasurable", "none", "C0", "C1", "C2")
+
+
+@dataclass(frozen=True)
+class ProfileReport:
+    """Continuity in s of one road's ``elevation`` or ``superelevation`` records.
+
+    Attributes:
+        road: the road's id.
+        kind: ``"elevation"`` or ``"superelevation"``.
+        records: how many records the road has.
+        level: the worst boundary's level: ``C2`` (value, slope and second
+            derivative continuous), ``C1``, ``C0``, ``none`` or ``unmeasurable``.
+        worst: (s, value jump, slope jump, second-derivative jump) at the worst boundary, if any.
+    """
+
+    road: str
+    kind: str
+    records: int
+    level: str
+    worst: tuple[float, float, float, float] | None = None
+
+    def describe(self) -> str:
+        if self.worst is None:
+            return f"{self.kind} {self.level} ({self.records} record{'s' if self.records != 1 else ''})"
+        s, j0, j1, j2 = self.worst
+        return f"{self.kind} {self.level} ({self.records} records; worst at s = {s:.6g}: jumps {j0:.2g}, {j1:.2g}, {j2:.2g})"
+
+
+@dataclass(frozen=True)
+class LinkReport:
+    """One link between two road ends (a road link or a junction connection), measured as a joint.
+
+    Attributes:
+        name: ``"road 1 end → road 2 start"``.
+        via: ``"road link"``, ``"junction J"`` or ``"direct junction J"``.
+        joint: gap, angle and curvature jump from the first road's end, travelling out of it,
+            into the second (a gap across the road of a direct junction is not counted: see ``offset``).
+        offset: a direct junction's lateral offset of the reference lines (lanes), metres.
+    """
+
+    name: str
+    via: str
+    joint: JointReport
+    offset: float = 0.0
+
+
+@dataclass(frozen=True)
+class OpenDriveReport(ContinuityReport):
+    """``check_opendrive``'s report: every road's planView (its pieces), its elevation and
+    superelevation in s, and every link between roads, with the number of junctions."""
+
+    profiles: tuple[ProfileReport, ...] = ()
+    links: tuple[LinkReport, ...] = ()
+    junctions: int = 0
+
+    @property
+    def link_level(self) -> Continuity:
+        """The worst link (G2 without links)."""
+        return min((link.joint.level for link in self.links), default=Continuity.G2)
+
+    @property
+    def profile_level(self) -> str:
+        """The worst elevation or superelevation level (C2 without records)."""
+        return min((p.level for p in self.profiles), key=PROFILE_LEVELS.index, default="C2")
+
+    def passes(self, required: str | int | Continuity, pieces: int | None = None) -> bool:
+        """Every road's planView reaches ``required`` (and, if given, the file holds ``pieces`` roads)."""
+        return (pieces is None or self.pieces == pieces) and self.min_level >= Continuity.parse(required)
+
+    def describe(self) -> str:
+        """``"5 roads (…), 4 links, 1 junction"``: the roads as the checker counts pieces, then links and junctions."""
+        parts = [super().describe()]
+        if self.links:
+            parts.append(f"{len(self.links)} link{'s' if len(self.links) != 1 else ''}")
+        if self.junctions:
+            parts.append(f"{self.junctions} junction{'s' if self.junctions != 1 else ''}")
+        return ", ".join(parts)
+
+    def format_table(self) -> str:
+        out = [super().format_table()]
+        if self.profiles:
+            out.append("elevation and superelevation in s (per road):")
+            out += [f"  road {p.road}: {p.describe()}" for p in self.profiles]
+        if self.links:
+            unit = f" {self.units}" if self.units else ""
+            out.append(f"links: {len(self.links)}, worst {self.link_level}")
+            out.append(f"  {'link':40} {'gap':>10} {'angle rad':>10} {'|Δκ|':>10} {'Δκ rel':>9} level")
+            for link in self.links:
+                j = link.joint
+                note = f"  ({link.via}; reference lines offset {link.offset:.6g}{unit} by lanes)" if link.offset else f"  ({link.via})"
+                out.append(f"  {link.name:40} {j.gap:10.3e} {j.angle:10.3e} {j.curvature_jump:10.3e} "
+                           f"{j.relative_curvature_jump:9.2e} {j.level}{note}")  # fmt: skip
+        return "\n".join(out)
+
+
+def check_opendrive(
+    path: str | os.PathLike, *, gap_tol: float = 1e-7, angle_tol: float = 1e-7, curvature_tol: float = 1e-6
+) -> OpenDriveReport:
+    """Every road's planView joints (G0/G1/G2), its elevation and superelevation in s (C0/C1/C2)
+    and every link between roads (G0/G1/G2), in metres.
+
+    Each road is one piece; the measures and tolerances are those of the
+    STEP/IGES checker (``spiral_cad.formats.joints``). A profile boundary is
+    C0 when the value jumps by at most ``gap_tol`` (elevation, m) or
+    ``angle_tol`` (roll angle, rad), C1 when the slope jumps by at most
+    ``angle_tol`` too, C2 when the second derivative jumps by at most
+    ``curvature_tol`` relative to max(|f''|, 1/size) (1/size² for the roll).
+    A link joins two road ends: a road's ``successor``/``predecessor`` with
+    its ``contactPoint`` (an end-to-end link reverses the second road) or a
+    junction's connection from its incoming road into the connecting road
+    (declared links are counted once). It is measured like a joint,
+    travelling out of the first road into the second; at a direct junction
+    the reference lines may be offset across the road by lanes, which is
+    reported as such rather than as a gap.
+
+    Raises:
+        ValueError: an unreadable file (see ``read_network``), a link to a
+            road or junction that is not in the file, or a bad tolerance.
+    """
+    check_tolerances(gap_tol=gap_tol, angle_tol=angle_tol, curvature_tol=curvature_tol)
+    network = read_network(path)
+    source = os.path.basename(os.fspath(path))
+    roads = network.roads
+    pieces = [("road", [(tuple(f[0]), tuple(f[1])) for f in road.plan.frames.tolist()], False, road.id) for road in roads]
+    size = model_size(np.vstack([road.plan.frames[:, :, :3].reshape(-1, 3) for road in roads]).tolist(), source)
+    planview = classify_pieces(pieces, size, gap_tol=gap_tol, angle_tol=angle_tol, curvature_tol=curvature_tol,
+                               source=source, element="geometry", units="m")  # fmt: skip
+    floor = 1.0 / size if size > 0.0 else 0.0
+    profiles = []
+    for road in roads:
+        for kind, records, tolerance, rate_floor in (("elevation", road.elevation, gap_tol, floor),
+                                                     ("superelevation", road.superelevation, angle_tol, floor * floor)):  # fmt: skip
+            if len(records):
+                profiles.append(_profile_report(road.id, kind, records, tolerance, angle_tol, curvature_tol, rate_floor))
+    links = _links(source, network, gap_tol, angle_tol, curvature_tol, floor)
+    return OpenDriveReport(**{f.name: getattr(planview, f.name) for f in fields(planview)}, profiles=tuple(profiles),
+                           links=tuple(links), junctions=len(network.junctions))  # fmt: skip
+
+
+def _profile_report(road: str, kind: str, records: NDArray, value_tol: float, slope_tol: float, relative_tol: float,
+                    floor: float) -> ProfileReport:  # fmt: skip
+    """The C-level of piecewise cubic records at each boundary: value, slope and second derivative of the
+    record before against the one starting there."""
+    if len(records) < 2:
+        return ProfileReport(road, kind, len(records), "C2")
+    s = records[1:, 0]
+    with np.errstate(all="ignore"):
+        x = s - records[:-1, 0]
+        before = [polynomial(records[:-1, 1:], x, k) for k in range(3)]  # each piece at the start of the next
+        after = [polynomial(records[1:, 1:], 0.0, k) for k in range(3)]
+        jumps = np.abs(np.stack(before) - np.stack(after))
+        scale = np.maximum(np.maximum(np.abs(before[2]), np.abs(after[2])), floor)
+        relative = jumps[2] / scale
+    levels = np.where(
+        ~np.isfinite(jumps).all(axis=0), 0,
+        np.where(~(jumps[0] <= value_tol), 1, np.where(~(jumps[1] <= slope_tol), 2, np.where(~(relative <= relative_tol), 3, 4))),
+    )  # fmt: skip
+    worst = int(np.argmin(levels))
+    return ProfileReport(road, kind, len(records), PROFILE_LEVELS[int(levels[worst])],
+                         (float(s[worst]), *(float(v) for v in jumps[:, worst])))  # fmt: skip
+
+
+def _links(source: str, network: Network, gap_tol: float, angle_tol: float, curvature_tol: float, floor: float) -> list[LinkReport]:
+    """Every declared link between two road ends, once, measured as a joint."""
+    roads = {road.id: road for road in network.roads}
+    junctions = {junction.id: junction for junction in network.junctions}
+    seen: set = set()
+    found: list[LinkReport] = []
+
+    def road(name: str, where: str) -> Road:
+        if _label(name) not in roads:
+            raise ValueError(f"{source}: {where} links to road {_label(name)}, which is not in the file")
+        return roads[_label(name)]
+
+    def add(a: Road, a_end: str, b: Road, b_end: str, via: str, direct: bool = False) -> None:
+        key = frozenset({(a.id, a_end), (b.id, b_end)})
+        if key in seen:
+            return
+        seen.add(key)
+        out = tuple(a.plan.frames[-1, 1].tolist()) if a_end == "end" else flip(tuple(a.plan.frames[0, 0].tolist()))
+        into = tuple(b.plan.frames[0, 0].tolist()) if b_end == "start" else flip(tuple(b.plan.frames[-1, 1].tolist()))
+        offset = 0.0
+        if direct:  # the reference lines may be offset across the road by lanes: only the gap along it counts
+            dx, dy = into[0] - out[0], into[1] - out[1]
+            offset = -dx * out[4] + dy * out[3]
+            into = (into[0] + offset * out[4], into[1] - offset * out[3], *into[2:])
+        joint = classify_joint(len(found), out, into, gap_tol, angle_tol, curvature_tol, floor)
+        found.append(LinkReport(f"road {a.id} {a_end} → road {b.id} {b_end}", via, joint, offset))
+
+    for r in network.roads:
+        for link in (r.predecessor, r.successor):
+            if link is not None and link.element_type == "junction" and _label(link.element_id) not in junctions:
+                raise ValueError(f"{source}: road {r.id} links to junction {_label(link.element_id)}, which is not in the file")
+    # junction connections first: they name the traffic's way, from the incoming road into the connecting one
+    for junction in network.junctions:
+        direct = junction.kind == "direct"
+        via = f"{'direct junction' if direct else 'junction'} {junction.id}"
+        for connection in junction.connections:
+            incoming = road(connection.incoming, f"junction {junction.id}, connection {connection.id}")
+            ends = [end for end, link in (("start", incoming.predecessor), ("end", incoming.successor))
+                    if link is not None and link.element_type == "junction" and _label(link.element_id) == junction.id]  # fmt: skip
+            if not ends:
+                raise ValueError(f"{source}: junction {junction.id}, connection {connection.id}: its incoming road "
+                                 f"{incoming.id} names the junction as neither predecessor nor successor")  # fmt: skip
+            target = road(connection.connecting, f"junction {junction.id}, connection {connection.id}")
+            add(incoming, ends[0], target, connection.contact_point, via, direct)
+    for r in network.roads:
+        for end, link in (("start", r.predecessor), ("end", r.successor)):
+            if link is not None and link.element_type == "road":
+                add(r, end, road(link.element_id, f"road {r.id} <{'predecessor' if end == 'start' else 'successor'}>"),
+                    link.contact_point, "road link")  # fmt: skip
+    return found
+
+
+def print_opendrive_report(report: OpenDriveReport, args: argparse.Namespace) -> int:
+    """Print ``report`` for ``spiral-cad check``: exit 1 when a road's planView is below ``--require``,
+    an elevation or superelevation below ``--profiles``, a link below ``--links``, or the file does
+    not hold ``--pieces`` roads; else 0."""
+    print(report.format_table())
+    failures = []
+    if args.pieces is not None and report.pieces != args.pieces:
+        failures.append(f"{report.pieces} roads, expected {args.pieces}")
+    if args.require and not report.passes(args.require):
+        why = " (a measure that decides it is not a finite number)" if report.min_level is Continuity.UNMEASURABLE else ""
+        failures.append(f"worst joint is {report.min_level}{why}, below the required {args.require}")
+    profiles = getattr(args, "profiles", None)
+    if profiles and PROFILE_LEVELS.index(report.profile_level) < PROFILE_LEVELS.index(profiles):
+        failures.append(f"worst elevation/superelevation is {report.profile_level}, below the required {profiles}")
+    links = getattr(args, "links", None)
+    if links and not report.link_level >= Continuity.parse(links):
+        failures.append(f"worst link is {report.link_level}, below the required {links}")
+    if failures:
+        print(f"FAIL: {'; '.join(failures)} ({report.describe()})")
+        return 1
+    demands = [f"every planView joint at least {args.require}"] if args.require else []
+    demands += [f"every profile at least {profiles}"] if profiles else []
+    demands += [f"every link at least {links}"] if links else []
+    print(f"OK: {report.describe()}" + (f", {', '.join(demands)}" if demands else ""))
+    return 0
