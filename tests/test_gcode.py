@@ -2,6 +2,7 @@
 
 import math
 import random
+import re
 from pathlib import Path
 
 import numpy as np
@@ -123,3 +124,90 @@ def test_huge_and_tiny_coordinates():
     assert math.isclose(big.points[-1][1], 1e300)
     tiny = parse_gcode("G21\nG1 X0.000001\nG1 Y0.000001\nG1 Z0.000001\n")
     assert round_toolpath(tiny, max_deviation=1e-8).chain.dim == 3
+
+
+# ------------------------------------------------------------ the command line and design files
+
+
+def csv_table(path):
+    lines = path.read_text().splitlines()
+    return lines[0], np.array([[float(v) for v in line.split(",")] for line in lines[1:]])
+
+
+def test_build_from_gcode_writes_step_and_samples_of_a_g2_path(tmp_path, capsys):
+    from spiral_cad.cli import main
+    from spiral_cad.continuity import check_continuity
+
+    out = tmp_path / "out"
+    assert main(["build", "--from-gcode", str(HERE / "pocket.nc"), "--max-deviation", "0.05", "--out", str(out)]) == 0
+    assert "pocket: rounded_polyline" in capsys.readouterr().out
+    assert {p.name for p in out.iterdir()} >= {"pocket.step", "pocket_samples.csv", "pocket.igs", "pocket.dxf"}
+    report = check_continuity(out / "pocket.step")
+    assert report.passes("G2") and report.pieces == 1 and report.units == "mm"
+    head, table = csv_table(out / "pocket_samples.csv")
+    assert head == "s [mm],x [mm],y [mm],z [mm],tx [1],ty [1],tz [1],curvature [1/mm]"
+    assert table[0, 1:4].tolist() == [5, 5, 10] and table[-1, 1:4].tolist() == [5, 10, 10]
+    assert table[:, 7].max() == pytest.approx(1 / 0.09, rel=1e-9)  # radius 0.09 mm at a 0.05 mm tolerance
+    # the same design as a design file, next to its program: the same samples
+    design = tmp_path / "design.json"
+    (tmp_path / "pocket.nc").write_bytes((HERE / "pocket.nc").read_bytes())
+    design.write_text('{"units": "mm", "designs": [{"name": "pocket", "type": "rounded_polyline", "gcode": "pocket.nc",'
+                      ' "max_deviation": 0.05, "samples": {"chord_tolerance": 0.005}}]}')  # fmt: skip
+    assert main(["build", str(design), "--out", str(tmp_path / "file")]) == 0
+    assert (tmp_path / "file" / "pocket_samples.csv").read_bytes() == (out / "pocket_samples.csv").read_bytes()
+
+
+def test_an_inch_program_is_converted_to_the_outputs_unit(tmp_path):
+    from spiral_cad.cli import main
+
+    assert main(["build", "--from-gcode", str(HERE / "helix_incremental.nc"), "--max-deviation", "1", "--sample-step", "5",
+                 "--out", str(tmp_path)]) == 0  # fmt: skip
+    _, table = csv_table(tmp_path / "helix_incremental_samples.csv")
+    assert table[0, 1:4].tolist() == [25.4, 0, 0]  # X1 inch, in mm
+    assert np.diff(table[:, 0]).max() <= 5.0
+
+
+@pytest.mark.parametrize(
+    "argv, message",
+    [
+        (["--from-gcode", "with_arcs.nc", "--max-deviation", "0.05"], r"with_arcs.nc line 5: G2 \(a clockwise arc\) is refused"),
+        (["--from-gcode", "pocket.nc"], r"--from-gcode needs --max-deviation"),
+        (["--from-gcode", ".", "--max-deviation", "1"], r"the G-code file is a folder"),
+        (["--from-gcode", "pocket.nc", "--max-deviation", "nan"], r"max_deviation: must be a finite number"),
+        (["--from-gcode", "pocket.nc", "--max-deviation", "1", "--sample-step", "1", "--chord-tolerance", "1"], r"not both"),
+        (["--from-gcode", "pocket.nc", "--max-deviation", "0.001", "--max-curvature", "1"], r"corner 2 \(line 9\) at \(5, 5, -1\): .*above max_curvature 1"),
+        (["design.json", "--max-deviation", "1"], r"--max-deviation: only with --from-gcode"),
+        ([], r"give a design file, or --from-gcode"),
+    ],
+)
+def test_build_from_gcode_refuses_by_name_and_writes_nothing(tmp_path, capsys, monkeypatch, argv, message):
+    from spiral_cad.cli import main
+
+    monkeypatch.chdir(HERE)
+    out = tmp_path / "out"
+    assert main(["build", *argv, "--out", str(out)]) == 2
+    err = capsys.readouterr().err
+    assert re.search(message, err) and "Traceback" not in err, err
+    assert not out.exists() or not any(out.iterdir())
+
+
+def test_design_files_take_3d_points_and_every_rounding_option(tmp_path):
+    from spiral_cad.designfile import DesignError, build
+
+    helix = [[40 * math.cos(0.9 * k), 40 * math.sin(0.9 * k), 9 * 0.9 * k] for k in range(8)]
+    for option in ({"max_deviation": 0.4}, {"max_curvature": 0.3}, {"spiral_lengths": [2.5] * 6}, {"curvature": 0.25},
+                   {"max_deviation": 0.4, "max_curvature": 2.0}):  # fmt: skip
+        _, (built,) = build({"units": "mm", "designs": [{"name": "h", "type": "rounded_polyline", "points": helix, **option}]})
+        assert built.chain.dim == 3
+    bad = [
+        ({"points": helix, "gcode": "x.nc"}, "give points or gcode"),
+        ({"points": [[0, 0], [1, 0, 0], [1, 1]]}, r"points\[1\]: must be a point like the first"),
+        ({"points": helix, "max_deviation": -1}, r"max_deviation: must be positive"),
+        ({"points": helix, "spiral_lengths": [1, 2]}, r"spiral_lengths needs one value or one per interior point"),
+        ({"points": helix, "samples": {"step": 1, "chord_tolerance": 1}}, r"samples: must be"),
+        ({"gcode": 12}, r"gcode: must be the path of a G-code file"),
+        ({"points": helix, "curvature": 1, "max_deviation": 1}, r"not both"),
+    ]
+    for fields, message in bad:
+        with pytest.raises(DesignError, match=message):
+            build({"units": "mm", "designs": [{"name": "h", "type": "rounded_polyline", **fields}]})

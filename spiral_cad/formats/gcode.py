@@ -44,6 +44,8 @@ from typing import TYPE_CHECKING
 import numpy as np
 from numpy.typing import NDArray
 
+from ..core.units import MM_PER_UNIT, length_unit
+
 if TYPE_CHECKING:
     from ..design.rounding import RoundedPath
 
@@ -81,6 +83,11 @@ class GcodePath:
 
     def __len__(self) -> int:
         return len(self.points)
+
+    def in_units(self, units: str) -> GcodePath:
+        """The same moves in ``units`` (mm, cm, m, km, in, ft): converted from the program's G20/G21."""
+        factor = MM_PER_UNIT[self.units] / MM_PER_UNIT[length_unit(units)]
+        return GcodePath(self.points * factor if factor != 1.0 else self.points, self.lines, self.rapid, units, self.source)
 
     def at_lines(self, message: str) -> str:
         """``message`` with every ``point i``/``corner i`` followed by the G-code line of that move."""
