@@ -13,6 +13,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from spiral_cad import BezierSpiral, NoSolutionError
+from test_chain3d import bezier_end  # the independent end frame (point, tangent, κN) of a cubic
 from spiral_cad.design import corner_legs, round_corners, round_corners_batch
 from spiral_cad.design.rounding import deviation_factor
 
@@ -29,16 +30,6 @@ def helix(count=14, radius=40.0, rise=9.0, step=0.9):
 def bezier(cp, u):
     u = np.asarray(u)[:, None]
     return (1 - u) ** 3 * cp[0] + 3 * u * (1 - u) ** 2 * cp[1] + 3 * u**2 * (1 - u) * cp[2] + u**3 * cp[3]
-
-
-def bezier_end(cp, at_end):
-    """Point, unit tangent and curvature vector κN at u = 0 or 1."""
-    if at_end:
-        p, d1, d2 = cp[3], 3 * (cp[3] - cp[2]), 6 * (cp[3] - 2 * cp[2] + cp[1])
-    else:
-        p, d1, d2 = cp[0], 3 * (cp[1] - cp[0]), 6 * (cp[2] - 2 * cp[1] + cp[0])
-    speed2 = d1 @ d1
-    return p, d1 / math.sqrt(speed2), np.cross(np.cross(d1, d2), d1) / speed2**2
 
 
 def curvature_along(cp, u=U):

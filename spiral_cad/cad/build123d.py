@@ -47,10 +47,9 @@ from OCP.GeomAbs import GeomAbs_CurveType
 from OCP.TopAbs import TopAbs_REVERSED
 from OCP.TopoDS import TopoDS
 
-from ..core._inputs import as_float
 from ..core.chain import Chain
 from ..core.shapes import DEFAULT_SHAPE
-from ..design.rounding import fillet_polyline, round_corners
+from ..design.rounding import curvature_bound, fillet_polyline, round_corners
 from ..design.fillets import continuous_polygon, continuous_rectangle, continuous_slot
 from .corridor import Corridor, centerline_wire, corridor
 from .fillet import fillet_face, fillet_wire, planar_frame
@@ -302,12 +301,7 @@ class G2Polyline(_ExactLineObject):
         mode: Mode = Mode.ADD,
     ):
         points = [tuple(Vector(p)) for p in flatten_sequence(*pts)]
-        curvature = None
-        if radius is not None:
-            radius = as_float(radius, "radius")
-            if not (radius > 0.0 and radius < float("inf")):
-                raise ValueError(f"radius must be positive and finite; got {radius!r}")
-            curvature = 1.0 / radius
+        curvature = curvature_bound(radius)
         path = round_corners(points, max_curvature=curvature, max_deviation=max_deviation, shape=shape)
         super().__init__(_wire(path.chain), mode=mode)
         self.rounded = path  # the numeric result (build123d's Shape owns the name "path")

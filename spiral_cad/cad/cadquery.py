@@ -46,9 +46,8 @@ from OCP.gp import gp_Ax3
 
 from ..core.chain import Chain
 from ..core.shapes import DEFAULT_SHAPE
-from ..core._inputs import as_float
 from ..design.fillets import continuous_polygon, continuous_rectangle, continuous_slot
-from ..design.rounding import round_corners
+from ..design.rounding import curvature_bound, round_corners
 from .fillet import fillet_face, fillet_wire
 from .occ import chain_wire, segment_edges
 from ..core.segments import Segment
@@ -229,12 +228,7 @@ def g2Polyline(
         ValueError: malformed points, a radius or deviation that is not positive.
         NoSolutionError: a corner that cannot be rounded as asked (named, with numbers).
     """
-    curvature = None
-    if radius is not None:
-        radius = as_float(radius, "radius")
-        if not (radius > 0.0 and radius < float("inf")):
-            raise ValueError(f"radius must be positive and finite; got {radius!r}")
-        curvature = 1.0 / radius
+    curvature = curvature_bound(radius)
     path = round_corners([tuple(cq.Vector(p).toTuple()) for p in points], max_curvature=curvature,
                          max_deviation=max_deviation, shape=shape)  # fmt: skip
     return _push_edges(self, path.chain.segments, True, forConstruction)

@@ -37,8 +37,8 @@ from numpy.typing import ArrayLike, NDArray
 
 from ..core import _kernels as K
 from ..core import batch
-from ..core._inputs import as_real_array
-from ..core.chain import JOIN_TOLERANCE, Chain, PartCircles, g2_mismatch, join_rows, join_tolerance
+from ..core._inputs import as_float, as_real_array
+from ..core.chain import JOIN_TOLERANCE, Chain, PartCircles, join_rows, join_tolerance
 from ..core.errors import JointError, NoSolutionError, Status
 from ..core.factors import length_factor
 from ..core.rows import SegmentRows
@@ -47,7 +47,7 @@ from ..core.segments import Line, Segment
 from ..core.space import PlaneFrame, corner_frames, norms, place, placed_pair_residuals
 from ..core.spiral import BezierSpiral
 from ..core.units import DEFAULT_UNITS, length_unit
-from .fillets import FilletCorner, _vertex_indices, fillet_path
+from .fillets import FilletCorner, _vertex_indices, fillet_path, first_broken_corner
 
 #: Yang & Sukkarieh's leg ratio g/h: the smallest that keeps κ monotone.
 G2CBS_C2 = K.G2CBS_RATIO
@@ -546,6 +546,20 @@ class RoundedPath:
         return max((c.deviation for c in self.corners), default=0.0)
 
 
+def curvature_bound(radius: float | None) -> float | None:
+    """``max_curvature`` from the smallest radius of curvature a path may have (None stays None).
+
+    Raises:
+        ValueError: a radius that is not positive and finite.
+    """
+    if radius is None:
+        return None
+    radius = as_float(radius, "radius")
+    if not (radius > 0.0 and radius < math.inf):
+        raise ValueError(f"radius must be positive and finite; got {radius!r}")
+    return 1.0 / radius
+
+
 def _at_corners(value: ArrayLike | None, name: str, interior: int, index: NDArray) -> ArrayLike | None:
     """A per-corner argument (one value, or one per interior point) at the corners kept by ``corner_legs``."""
     if value is None:
@@ -769,14 +783,7 @@ def fillet_polyline(
         if j in pieces and (closed or j < count - 1):
             segments += pieces[j]
             owners += [j] * len(pieces[j])
-    tolerance = join_tolerance(tolerance)
-    pairs = list(zip(range(len(segments) - 1), range(1, len(segments))))
-    if closed:
-        pairs.append((len(segments) - 1, 0))
-    for a, b in pairs:
-        vertex = owners[a] if owners[a] is not None else owners[b]
-        if vertex is not None:
-            problem = g2_mismatch(segments[a], segments[b], tolerance)
-            if problem:
-                raise NoSolutionError(f"corner {vertex}: float64 cannot hold its fillet G2 at these coordinates ({problem})")
+    broken = first_broken_corner(segments, owners, closed, join_tolerance(tolerance))
+    if broken:
+        raise NoSolutionError(f"corner {broken[0]}: float64 cannot hold its fillet G2 at these coordinates ({broken[1]})")
     return FilletedPolyline(tuple(segments), tuple(owners), fillets, closed, length_unit(units))
