@@ -417,8 +417,7 @@ def round_corners_batch(
     if values["max_deviation"] is not None:
         status[ok & too_fine] = Status.UNVERIFIED
         residual[ok & too_fine] = np.inf
-        if values["max_curvature"] is not None:
-            peak = np.where(ok & ~too_fine, np.where(fit, needed, k), peak)
+        if values["max_curvature"] is not None:  # both bounds: the pair within the deviation must respect κmax
             status[ok & ~(peak <= values["max_curvature"] * (1.0 + DEVIATION_MARGIN))] = Status.LEGS_TOO_SHORT
     if dim == 3:
         pairs = place(pairs, corners[:, None, None], x_dir[:, None, None], y_dir[:, None, None])
