@@ -459,8 +459,9 @@ def test_a_file_at_1e300_is_measured_not_refused_for_its_snap(tmp_path, capsys):
     path.write_text(scaled_step(path.read_text(), 1e300))
     status = main(["check", str(path), "--require", "G2"])
     out, err = capsys.readouterr()
-    assert "snap" not in err and re.search(r"model size \d\.\d+e\+30\d m", out)
-    assert status == 1 and "FAIL" in out  # OCCT cannot trim lines this far out: never a false pass
+    # OCCT cannot place vertices this far out (beyond its 2e100 "infinite"): never a false pass, never a word of snap
+    assert "snap" not in err and "OK" not in out
+    assert status == 2 and "root entities could be transferred" in err
 
 
 def test_reports_state_their_unit():
