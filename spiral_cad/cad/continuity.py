@@ -66,6 +66,7 @@ from ..formats.joints import (
     distance,
     flip,
     model_size,
+    norms,
     print_report,
 )
 from .occ import as_occ_shape
@@ -135,10 +136,10 @@ def _singular_frame(curve: BRepAdaptor_Curve, u: float, inward: float, p: gp_Pnt
 
 
 def _edge_rows(edges: list[TopoDS_Edge]) -> NDArray:
-    """One row per edge of what OCCT evaluates (``ROW`` floats: see ``_edge_frames``); the
-    frames, floors and lengths follow in one vectorised pass.
+    """One row of 25 floats per edge of what OCCT evaluates; ``_edge_frames`` turns them into
+    frames, floors and lengths in one vectorised pass.
 
-    Raw rows: point, first and second derivative at the curve's first and
+    A row: point, first and second derivative at the curve's first and
     last parameter (18), the middle point (3), the degree of a polynomial
     curve (0 for other curves), its end knot spans (NaN where the edge is
     trimmed inside the curve) and 1 for a reversed edge.
@@ -180,19 +181,19 @@ def _edge_frames(edges: list[TopoDS_Edge]) -> NDArray:
     its middle point."""
     raw = _edge_rows(edges)
     out = np.empty((len(raw), ROW))
-    lengths = _norm(raw[:, 18:21] - raw[:, 0:3]) + _norm(raw[:, 9:12] - raw[:, 18:21])
+    lengths = norms(raw[:, 18:21] - raw[:, 0:3]) + norms(raw[:, 9:12] - raw[:, 18:21])
     for end, (at, span) in enumerate(((0, 22), (9, 23))):
         p, d1, d2 = raw[:, at : at + 3], raw[:, at + 3 : at + 6], raw[:, at + 6 : at + 9]
         frame = out[:, end * FRAME : (end + 1) * FRAME]
         with np.errstate(all="ignore"):
-            speed = _norm(d1)[:, None]
+            speed = norms(d1)[:, None]
             tangent = d1 / speed
             along = np.einsum("ij,ij->i", d2, tangent)[:, None]
             frame[:, 0:3], frame[:, 3:6] = p, tangent
             frame[:, 6:9] = (d2 - along * tangent) / speed / speed
-            frame[:, 9] = _rounding_floor(p, d1, d2, raw[:, 21], raw[:, span], _norm(frame[:, 6:9]), inward=1 - 2 * end)
+            frame[:, 9] = _rounding_floor(p, d1, d2, raw[:, 21], raw[:, span], norms(frame[:, 6:9]), inward=1 - 2 * end)
         frame[:, 10] = lengths
-        singular = ~(speed[:, 0] > 1e-12 * _norm(d2))  # also r' = 0 and NaN
+        singular = ~(speed[:, 0] > 1e-12 * norms(d2))  # also r' = 0 and NaN
         for i in np.flatnonzero(singular):  # rare: the scalar path, from higher derivatives
             curve = BRepAdaptor_Curve(edges[i])
             u = curve.FirstParameter() if end == 0 else curve.LastParameter()
@@ -216,14 +217,10 @@ def _rounding_floor(p: NDArray, d1: NDArray, d2: NDArray, degree: NDArray, span:
         n = np.where(degree >= 2.0, degree, np.nan)
         first = d1 * (span / n)[:, None]
         second = first + inward * d2 * (span**2 / (n * (n - 1.0)))[:, None]
-        a, b = _norm(first), _norm(second)
+        a, b = norms(first), norms(second)
         delta = 4.0 * EPS * (np.abs(p).max(axis=1) + a + b)
         floor = curvature_rounding_floor(delta, a, b, curvature)
     return np.where(degree == 0.0, 0.0, floor)
-
-
-def _norm(v: NDArray) -> NDArray:
-    return np.hypot(np.hypot(v[:, 0], v[:, 1]), v[:, 2])
 
 
 # ----------------------------------------------------------- grouping

@@ -308,8 +308,8 @@ def curvature_rounding_floor(delta: NDArray, leg: NDArray, next_leg: NDArray, cu
         return 2.0 / 3.0 * delta * (leg + next_leg) / leg**3 + 3.0 * curvature * delta / leg
 
 
-def _norm(v: NDArray) -> NDArray:
-    """Row lengths without squaring (no overflow short of the float range)."""
+def norms(v: NDArray) -> NDArray:
+    """Lengths of the rows of an (n, 3) array, without squaring (no overflow short of the float range)."""
     return np.hypot(np.hypot(v[:, 0], v[:, 1]), v[:, 2])
 
 
@@ -326,11 +326,11 @@ def classify_joints(a: NDArray, b: NDArray, gap_tol: float, angle_tol: float, cu
     """
     a, b = np.asarray(a, dtype=float), np.asarray(b, dtype=float)
     with np.errstate(all="ignore"):
-        gap = _norm(a[:, :3] - b[:, :3])
+        gap = norms(a[:, :3] - b[:, :3])
         gap_bound = gap_tol + ROUNDING_ULPS * np.spacing(np.abs(a[:, :3]).max(axis=1))
-        angle = np.arctan2(_norm(np.cross(a[:, 3:6], b[:, 3:6])), np.einsum("ij,ij->i", a[:, 3:6], b[:, 3:6]))
-        ka, kb = _norm(a[:, 6:9]), _norm(b[:, 6:9])
-        jump = _norm(a[:, 6:9] - b[:, 6:9])
+        angle = np.arctan2(norms(np.cross(a[:, 3:6], b[:, 3:6])), np.einsum("ij,ij->i", a[:, 3:6], b[:, 3:6]))
+        ka, kb = norms(a[:, 6:9]), norms(b[:, 6:9])
+        jump = norms(a[:, 6:9] - b[:, 6:9])
         scale = np.maximum(np.maximum(ka, kb), floor)
         relative = np.where(np.isfinite(ka + kb + jump), jump / scale, np.nan)
         curvature_bound = np.full(len(a), curvature_tol)
