@@ -156,7 +156,8 @@ class Timing:
     """Where a check spent its time, in seconds.
 
     Attributes:
-        reading: the file's reader (with its checks that the file was read whole); 0 for a shape.
+        reading: the file's reader, with its checks that the file was read whole and the child
+            process round trip; 0 for a shape.
         measuring: evaluating every edge's end frames.
         classifying: chaining loose edges and classifying every joint.
         reader: who read the file (``"the STEP reader (OCCT)"``); empty for a shape.
