@@ -41,6 +41,7 @@ bench: $(STAMP)
 	$(BIN)/python benchmarks/bench_roads.py --out benchmarks/results_roads.md
 	$(BIN)/python benchmarks/bench_fillets.py --out benchmarks/results_fillets.md
 	$(BIN)/python benchmarks/bench_shapes.py --out benchmarks/results_shapes.md
+	$(BIN)/python benchmarks/bench_chains.py --out benchmarks/results_chains.md
 
 pictures: $(STAMP)
 	$(BIN)/python docs/make_pictures.py

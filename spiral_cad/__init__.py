@@ -7,6 +7,7 @@ scipy and numba; the CAD adapters import OCP when they are used.
 from .core.chain import Chain, Join
 from .core.errors import NoSolutionError, Status
 from .core.segments import Arc, Circle, Line, Segment
+from .core.space import PlaneFrame
 from .core.spiral import BezierSpiral
 from .core.transitions import (
     Transition,
@@ -24,6 +25,7 @@ __all__ = [
     "Join",
     "Line",
     "NoSolutionError",
+    "PlaneFrame",
     "Segment",
     "Status",
     "Transition",

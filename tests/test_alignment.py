@@ -179,3 +179,54 @@ def test_spec_errors():
         Alignment.from_pis(PIS, 300.0, spiral_angles=[0.1, (0.1, 2.0)])
     with pytest.raises(ValueError, match="PI 1: entry spiral length must be positive"):
         Alignment.from_pis(PIS, 300.0, spiral_lengths=[(-5.0, 10.0), 10.0])
+
+
+@pytest.mark.parametrize("shape", ["near-linear", "walton-meek"])
+@pytest.mark.parametrize("origin", [np.zeros(2), ORIGIN])
+def test_batch_built_curves_equal_the_scalar_solvers_bit_for_bit(shape, origin):
+    """Every PI is solved in one batch call per side; each curve is the scalar solution, exactly."""
+    from spiral_cad import line_to_circle
+
+    al = Alignment.from_pis(PIS + origin, [300.0, 400.0], spiral_angles=[(0.15, 0.35), (0.3, 0.1)], shape=shape)
+    for c in al.curves:
+        pi, center = np.array(c.pi), np.array(c.center)
+        t_in, t_out = (np.asarray(line.direction) for line in (c.entry.start_line, c.exit.end_line))
+        entry = line_to_circle(pi, t_in, center, c.radius, shape=shape)
+        exit_ = line_to_circle(pi, -t_out, center, c.radius, shape=shape).reversed()
+        assert np.array_equal(c.entry.spirals[0].control_points, entry.spirals[0].control_points)
+        assert np.array_equal(c.exit.spirals[0].control_points, exit_.spirals[0].control_points)
+        assert (c.entry.theta, c.exit.theta, c.entry.end_circle, c.exit.start_circle) == (entry.theta, exit_.theta, entry.end_circle, exit_.start_circle)
+        assert c.entry.spirals[0] is al.chain[al.chain.segments.index(c.entry.spirals[0])]  # the chain's own segments
+
+
+def test_curves_are_a_sequence_made_when_read():
+    al = Alignment.from_pis(PIS, [300.0, 400.0], spiral_angles=0.2)
+    curves = al.curves
+    assert len(curves) == 2 and curves[-1].index == 2 and [c.index for c in curves[:1]] == [1]
+    assert curves[0] is curves[0] and list(curves) == [curves[0], curves[1]] and curves == list(curves)
+    assert curves.lengths.shape == curves.thetas.shape == curves.peak_rates.shape == (2, 2)
+    with pytest.raises(IndexError):
+        curves[2]
+
+
+@pytest.mark.parametrize("shape", ["near-linear", "walton-meek"])
+def test_many_lengths_to_angles_at_once(shape):
+    from spiral_cad.design.alignment import thetas_for_lengths
+
+    thetas = np.array([1e-6, 0.01, 0.2, 0.6, 0.85] + ([1.3] if shape == "walton-meek" else []))
+    lengths = np.array([BezierSpiral((0, 0), (1, 0), t, 1 / 250.0, shape=shape).length for t in thetas])
+    found = thetas_for_lengths(lengths, 250.0, shape)
+    assert np.allclose(found, thetas, rtol=1e-12, atol=0)
+    assert all(theta_for_length(length, 250.0, shape) == pytest.approx(t, rel=1e-12) for length, t in zip(lengths, thetas))
+    assert np.isnan(thetas_for_lengths([1e-12, -1.0, np.inf], 250.0, shape)).all()
+
+
+def test_the_first_failing_pi_is_named_whatever_the_check():
+    """Checks run over all PIs at once; the error is the one the first failing PI raises."""
+    pis = [(0, 0), (1000, 0), (1600, 700), (2200, 700.0), (2800, 700), (3400, 900)]
+    with pytest.raises(ValueError, match=r"PI 3 at \[2200\.0, 700\.0\] .* collinear"):
+        Alignment.from_pis(pis, 300.0, spiral_angles=[0.1, 0.1, 0.1, 3.0])  # PI 4's bad angle comes later
+    with pytest.raises(ValueError, match=r"PI 2: exit spiral angle"):
+        Alignment.from_pis(PIS, 300.0, spiral_angles=[(0.1, 0.1), (0.1, 2.0)])
+    with pytest.raises(NoSolutionError, match=r"PI 1: deflection .* smaller than θ_in \+ θ_out"):
+        Alignment.from_pis(PIS, 300.0, spiral_angles=[(0.9, 0.9), (0.1, 2.0)])

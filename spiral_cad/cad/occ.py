@@ -7,9 +7,10 @@ than approximations. All edges run in travel order (their curve parameter
 increases along the path), which keeps wires, sweeps and exports free of
 orientation flips.
 
-A 2-D point (x, y) is placed at ``origin + x·X + y·Y`` of an optional
-``gp_Ax3`` (None: the global XY plane); counterclockwise arcs turn from X
-towards Y.
+A plane point (x, y) is placed at ``origin + x·X + y·Y`` of an optional
+``gp_Ax3`` (None: the global XY plane), a point in space (x, y, z) of a 3-D
+chain at ``origin + x·X + y·Y + z·(X × Y)``; counterclockwise plane arcs turn
+from X towards Y, arcs in space about their own normal.
 """
 
 from __future__ import annotations
@@ -39,9 +40,9 @@ from OCP.TColgp import TColgp_Array1OfPnt
 from OCP.TColStd import TColStd_Array1OfInteger, TColStd_Array1OfReal
 from OCP.TopoDS import TopoDS_Compound, TopoDS_Edge, TopoDS_Shape, TopoDS_Vertex, TopoDS_Wire
 
-from ..core.segments import Arc, Line, Segment
+from ..core._chain_kernels import ARC, LINE, SPIRAL
+from ..core.segments import Segment
 from ..formats.joints import ROUNDING_ULPS
-from ..core.spiral import BezierSpiral
 from .readers import ReadError, read_shape
 
 __all__ = ["ReadError", "as_occ_shape", "captured_messages", "chain_wire", "nurbs_edge", "read_shape", "segment_edge", "segment_edges"]
@@ -51,9 +52,13 @@ if TYPE_CHECKING:
 
 
 class _Frame:
-    """Maps plane coordinates to 3-D points; precomputed once per call, not per edge."""
+    """Maps chain coordinates to 3-D points; precomputed once per call, not per edge.
 
-    __slots__ = ("ox", "oy", "oz", "xx", "xy", "xz", "yx", "yy", "yz", "normal", "x_dir", "flat")
+    A chain's (x, y) — or (x, y, z) in space — lie at origin + x·X + y·Y + z·Z
+    of the frame, Z = X × Y (the global coordinates when there is no plane).
+    """
+
+    __slots__ = ("origin", "x", "y", "z", "flat")
 
     def __init__(self, plane: gp_Ax3 | None):
         if plane is None:
@@ -63,29 +68,37 @@ class _Frame:
                 raise ValueError(f"plane must be an OCP gp_Ax3 or None; got {plane!r}")
             loc, xd, yd = plane.Location(), plane.XDirection(), plane.YDirection()
             origin, x, y = (loc.X(), loc.Y(), loc.Z()), (xd.X(), xd.Y(), xd.Z()), (yd.X(), yd.Y(), yd.Z())
-        self.ox, self.oy, self.oz = origin
-        self.xx, self.xy, self.xz = x
-        self.yx, self.yy, self.yz = y
-        # The circle axis is X × Y (not the plane's main direction, which points
-        # the other way for a left-handed gp_Ax3) so "counterclockwise" always
-        # means turning from X towards Y.
-        self.normal = gp_Dir(x[1] * y[2] - x[2] * y[1], x[2] * y[0] - x[0] * y[2], x[0] * y[1] - x[1] * y[0])
-        self.x_dir = gp_Dir(*x)
+        self.origin, self.x, self.y = origin, x, y
+        # Z is X × Y (not the plane's main direction, which points the other way
+        # for a left-handed gp_Ax3) so "counterclockwise" always means turning from X towards Y.
+        self.z = (x[1] * y[2] - x[2] * y[1], x[2] * y[0] - x[0] * y[2], x[0] * y[1] - x[1] * y[0])
         self.flat = plane is None or (origin == (0.0, 0.0, 0.0) and x == (1.0, 0.0, 0.0) and y == (0.0, 1.0, 0.0))
 
-    def pnt(self, x: float, y: float) -> gp_Pnt:
-        if self.flat:
-            return gp_Pnt(x, y, 0.0)
-        return gp_Pnt(
-            self.ox + x * self.xx + y * self.yx,
-            self.oy + x * self.xy + y * self.yy,
-            self.oz + x * self.xz + y * self.yz,
+    def _map(self, coords: tuple[float, float, float], origin: tuple[float, float, float]) -> tuple[float, float, float]:
+        x, y, z = coords
+        (xx, xy, xz), (yx, yy, yz), (zx, zy, zz) = self.x, self.y, self.z
+        return (
+            origin[0] + x * xx + y * yx + z * zx,
+            origin[1] + x * xy + y * yy + z * zy,
+            origin[2] + x * xz + y * yz + z * zz,
         )
+
+    def pnt(self, x: float, y: float, z: float = 0.0) -> gp_Pnt:
+        """The point at chain coordinates (x, y) or (x, y, z)."""
+        if self.flat:
+            return gp_Pnt(x, y, z)
+        return gp_Pnt(*self._map((x, y, z), self.origin))
+
+    def dir(self, x: float, y: float, z: float = 0.0) -> gp_Dir:
+        """The direction of the chain vector (x, y[, z])."""
+        if self.flat:
+            return gp_Dir(x, y, z)
+        return gp_Dir(*self._map((x, y, z), (0.0, 0.0, 0.0)))
 
     def poles(self, points: list[list[float]]) -> TColgp_Array1OfPnt:
         array = TColgp_Array1OfPnt(1, len(points))
-        for i, (x, y) in enumerate(points, 1):
-            array.SetValue(i, self.pnt(x, y))
+        for i, p in enumerate(points, 1):
+            array.SetValue(i, self.pnt(*p))
         return array
 
 
@@ -101,40 +114,60 @@ def _frame(plane: gp_Ax3 | None) -> _Frame:
 CurveSpan = tuple[Geom_Curve, float, float]
 
 
-def _line_curve(line: Line, frame: _Frame) -> CurveSpan:
-    (ax, ay), (bx, by) = line._a.tolist(), line._b.tolist()
-    a, b = frame.pnt(ax, ay), frame.pnt(bx, by)
+# A segment as a row of a chain's arrays (``spiral_cad.core.rows``): kind, its
+# four points (x, y, z) and its arc numbers (signed radius, start angle, sweep).
+Row = tuple[int, list[list[float]], list[float]]
+
+
+def _line_curve(g: list[list[float]], p: list[float], frame: _Frame) -> CurveSpan:
+    a, b = frame.pnt(*g[0]), frame.pnt(*g[1])
     return Geom_Line(a, gp_Dir(gp_Vec(a, b))), 0.0, a.Distance(b)
 
 
-def _arc_curve(arc: Arc, frame: _Frame) -> CurveSpan:
-    cx, cy = arc.center.tolist()
-    radius, a0, sweep = arc.radius, arc.start_angle, arc.sweep
-    if radius > 0.0:
-        axis, first = frame.normal, a0
-    else:
-        # Clockwise travel: the circle's axis is flipped so its parameter still
-        # increases along the path; the point at plane angle a has parameter -a.
-        axis, first = frame.normal.Reversed(), -a0
-    circle = Geom_Circle(gp_Ax2(frame.pnt(cx, cy), axis, frame.x_dir), abs(radius))
+def _arc_curve(g: list[list[float]], p: list[float], frame: _Frame) -> CurveSpan:
+    """A ``Geom_Circle`` about the arc's normal e1 × e2 (flipped for clockwise travel, so the
+    parameter increases along the path: the point at polar angle a has parameter -a)."""
+    center, e1, e2 = g[0], g[1], g[2]
+    radius, a0, sweep = p
+    normal = frame.dir(e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2], e1[0] * e2[1] - e1[1] * e2[0])
+    axis, first = (normal, a0) if radius > 0.0 else (normal.Reversed(), -a0)
+    circle = Geom_Circle(gp_Ax2(frame.pnt(*center), axis, frame.dir(*e1)), abs(radius))
     return circle, first, first + sweep
 
 
-def _bezier_curve(spiral: BezierSpiral, frame: _Frame) -> CurveSpan:
-    return Geom_BezierCurve(frame.poles(spiral.control_points.tolist())), 0.0, 1.0
+def _bezier_curve(g: list[list[float]], p: list[float], frame: _Frame) -> CurveSpan:
+    return Geom_BezierCurve(frame.poles(g)), 0.0, 1.0
 
 
-_MAKERS = {Line: _line_curve, Arc: _arc_curve, BezierSpiral: _bezier_curve}
+_MAKERS = {LINE: _line_curve, ARC: _arc_curve, SPIRAL: _bezier_curve}
 
 
-def _curve_span(segment: Segment, frame: _Frame) -> CurveSpan:
-    """The exact curve of ``segment`` (subclasses included) and its travel-order range."""
-    maker = _MAKERS.get(type(segment))
-    if maker is None:
-        maker = next((m for kind, m in _MAKERS.items() if isinstance(segment, kind)), None)
-        if maker is None:
+def _rows(segments: Iterable[Segment]) -> tuple[Iterator[Row], list[str], list[float]]:
+    """The rows of ``segments`` (a ``Chain``'s own arrays, or each segment's row), their kind names and lengths.
+
+    Rows are made one at a time as they are used: a long chain's rows as nested
+    lists at once would keep the garbage collector busy.
+    """
+    from ..core.chain import Chain  # chain.py imports this module lazily in turn
+
+    if isinstance(segments, Chain):
+        rows = segments.rows
+        kinds = rows.kind.tolist()
+        names = [("Line", "Arc", "BezierSpiral")[k] for k in kinds]
+        made = ((k, g.tolist(), p.tolist()) for k, g, p in zip(kinds, rows.geometry, rows.params))
+        return made, names, segments.lengths.tolist()
+    items = list(segments)
+    for segment in items:
+        if not isinstance(segment, Segment):
             raise ValueError(f"segment must be a Line, Arc or BezierSpiral; got {segment!r}")
-    return maker(segment, frame)
+    made = ((k, g.tolist(), list(p)) for k, g, p in (segment._row() for segment in items))
+    return made, [type(s).__name__ for s in items], [s.length for s in items]
+
+
+def _curve_span(row: Row, frame: _Frame) -> CurveSpan:
+    """The exact curve of a segment row and its travel-order range."""
+    kind, g, p = row
+    return _MAKERS[kind](g, p, frame)
 
 
 def segment_edge(segment: Segment, plane: gp_Ax3 | None = None) -> TopoDS_Edge:
@@ -144,19 +177,21 @@ def segment_edge(segment: Segment, plane: gp_Ax3 | None = None) -> TopoDS_Edge:
         segment: a ``Line`` (edge on a ``Geom_Line``), ``Arc`` (on a
             ``Geom_Circle``) or ``BezierSpiral`` (``Geom_BezierCurve`` with
             its four control points).
-        plane: local frame of the 2-D coordinates; None is the XY plane.
+        plane: local frame of the coordinates (plane segments: its XY plane;
+            segments in space: its coordinate system); None is the global one.
 
     Raises:
         ValueError: an unsupported segment type or a ``plane`` that is not a
             ``gp_Ax3``.
     """
-    return BRepBuilderAPI_MakeEdge(*_curve_span(segment, _frame(plane))).Edge()
+    (row,) = _rows([segment])[0]
+    return BRepBuilderAPI_MakeEdge(*_curve_span(row, _frame(plane))).Edge()
 
 
 def segment_edges(segments: Iterable[Segment], plane: gp_Ax3 | None = None) -> list[TopoDS_Edge]:
-    """``segment_edge`` for many segments sharing one frame (a chain, a transition's spirals)."""
+    """``segment_edge`` for many segments sharing one frame (a ``Chain``: from its arrays, no segment objects)."""
     frame = _frame(plane)
-    return [BRepBuilderAPI_MakeEdge(*_curve_span(s, frame)).Edge() for s in segments]
+    return [BRepBuilderAPI_MakeEdge(*_curve_span(row, frame)).Edge() for row in _rows(segments)[0]]
 
 
 def chain_wire(chain: Iterable[Segment], plane: gp_Ax3 | None = None) -> TopoDS_Wire:
@@ -175,8 +210,8 @@ def chain_wire(chain: Iterable[Segment], plane: gp_Ax3 | None = None) -> TopoDS_
             for OCCT to make an edge of, or no segments.
     """
     frame = _frame(plane)
-    segments = list(chain)
-    spans = [_curve_span(s, frame) for s in segments]
+    rows, names, lengths = _rows(chain)
+    spans = [_curve_span(row, frame) for row in rows]
     if not spans:
         raise ValueError("chain_wire needs at least one segment")
     ends = [(curve.Value(first), curve.Value(last)) for curve, first, last in spans]
@@ -195,9 +230,9 @@ def chain_wire(chain: Iterable[Segment], plane: gp_Ax3 | None = None) -> TopoDS_
     for i, ((curve, first, last), v0, v1) in enumerate(zip(spans, vertices, vertices[1:])):
         maker = BRepBuilderAPI_MakeEdge(curve, v0, v1, first, last)
         if not maker.IsDone():
-            short = segments[i].length <= 10.0 * BRep_Tool.Tolerance_s(v0)
+            short = lengths[i] <= 10.0 * BRep_Tool.Tolerance_s(v0)
             raise ValueError(
-                f"segment {i} ({type(segments[i]).__name__}, length {segments[i].length:.3g}) cannot be an OCCT edge "
+                f"segment {i} ({names[i]}, length {lengths[i]:.3g}) cannot be an OCCT edge "
                 f"({maker.Error().name})"
                 + (
                     f": OCCT merges points closer than {BRep_Tool.Tolerance_s(v0):.3g} model units, so its edges must be "

@@ -81,19 +81,31 @@ def as_xy(value: Any, name: str) -> tuple[float, float]:
         x, y = value.tolist()
         if math.isfinite(x) and math.isfinite(y):
             return x, y
+    return as_point(value, name, plane_only=True)
+
+
+def as_point(value: Any, name: str, plane_only: bool = False) -> tuple[float, ...]:
+    """``value`` as a plane point (x, y) or a point in space (x, y, z), finite floats.
+
+    A 3-D point with z = 0 is the plane point (x, y), as for every plane input;
+    ``plane_only`` refuses the rest.
+    """
+    if not plane_only and ((type(value) is tuple and len(value) == 2) or (type(value) is np.ndarray and value.shape == (2,))):
+        return as_xy(value, name)  # the common case, checked cheaply
+    what = "a 2-D point or vector" if plane_only else "a 2-D or 3-D point"
     _refuse_masked(value, name)
     if _refused(value):
-        raise ValueError(f"{name} must be a 2-D point or vector; got {type(value).__name__} {shown(value):.80}")
+        raise ValueError(f"{name} must be {what}; got {type(value).__name__} {shown(value):.80}")
     try:
         items = list(value)
     except TypeError:
-        raise ValueError(f"{name} must be a 2-D point or vector; got {type(value).__name__} {shown(value):.80}") from None
-    coords = [as_float(c, f"{name}[{i}]") for i, c in enumerate(items)]
+        raise ValueError(f"{name} must be {what}; got {type(value).__name__} {shown(value):.80}") from None
+    coords = tuple(as_float(c, f"{name}[{i}]") for i, c in enumerate(items))
     if len(coords) == 3 and coords[2] == 0.0:
         coords = coords[:2]
-    if len(coords) != 2:
-        raise ValueError(f"{name} must have 2 coordinates; got {shown(value):.80}")
-    return coords[0], coords[1]
+    if len(coords) not in ((2,) if plane_only else (2, 3)):
+        raise ValueError(f"{name} must have {'2' if plane_only else '2 or 3'} coordinates; got {shown(value):.80}")
+    return coords
 
 
 def as_unit(value: Any, name: str) -> tuple[float, float]:

@@ -15,7 +15,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from . import _kernels as K
 from ._inputs import as_real_array
-from .errors import Status, describe
+from .errors import MALFORMED, NoSolutionError, Status, describe
 from .shapes import CORNER_SHAPES, DEFAULT_SHAPE, TRANSITION_SHAPES, shape_code
 
 __all__ = ["BatchResult", "circle_in_circle", "circle_to_circle", "line_to_circle", "line_to_line"]
@@ -53,6 +53,12 @@ class BatchResult:
 
     def __len__(self) -> int:
         return len(self.status)
+
+    def error(self, i: int) -> ValueError:
+        """The exception the scalar API raises for failed row ``i``: ``NoSolutionError``, or
+        ``ValueError`` for malformed input; its message is ``reason(i)``."""
+        message = self.reason(i)
+        return ValueError(message) if Status(int(self.status[i])) in MALFORMED else NoSolutionError(message)
 
     def reason(self, i: int) -> str:
         """Why row ``i`` failed (the scalar API's error message), or ``"ok"``."""

@@ -17,6 +17,8 @@ _GL_NODES, _GL_WEIGHTS = np.polynomial.legendre.leggauss(16)
 _PANELS = 4
 _U = ((np.arange(_PANELS)[:, None] + 0.5 * (_GL_NODES[None, :] + 1.0)) / _PANELS).ravel()
 _W = np.tile(_GL_WEIGHTS / (2.0 * _PANELS), _PANELS)
+#: Curves per block of a many-curve ``arc_length``.
+_BLOCK = 512
 
 
 def _power_coefficients(cp: NDArray, order: int = 0) -> NDArray:
@@ -41,15 +43,15 @@ def _power_coefficients(cp: NDArray, order: int = 0) -> NDArray:
 
 
 def _horner(coefficients: NDArray, u: ArrayLike) -> NDArray:
-    """Evaluate polynomials with 2-D coefficients (…, k, 2), lowest first, at ``u``.
+    """Evaluate polynomials with 2-D or 3-D coefficients (…, k, d), lowest first, at ``u``.
 
-    One curve (k, 2) gives ``u.shape + (2,)``; N curves (N, k, 2) broadcast
-    against ``u`` of shape (N, m) or (m,) and give (N, m, 2).
+    One curve (k, d) gives ``u.shape + (d,)``; N curves (N, k, d) broadcast
+    against ``u`` of shape (N, m) or (m,) and give (N, m, d).
     """
     u = np.asarray(u, dtype=float)
     if coefficients.ndim == 2:  # one curve: each coordinate on its own contiguous array (the fast path)
-        out = np.empty(u.shape + (2,))
-        for j in range(2):
+        out = np.empty(u.shape + coefficients.shape[-1:])
+        for j in range(coefficients.shape[-1]):
             acc = np.full(u.shape, coefficients[-1, j])
             for c in coefficients[-2::-1, j]:
                 acc *= u
@@ -116,10 +118,20 @@ def arc_length(cp: ArrayLike, u: ArrayLike = 1.0) -> NDArray | float:
     exact to ~1e-15 relative (checked against adaptive quadrature).
     """
     u = np.asarray(u, dtype=float)
-    coefficients = _power_coefficients(np.asarray(cp, dtype=float), 1)
+    cp = np.asarray(cp, dtype=float)
+    if cp.ndim == 3 and u.ndim == 0 and len(cp) > _BLOCK:  # blocks whose temporaries stay in cache (same bits)
+        return np.concatenate([arc_length(cp[i : i + _BLOCK], u) for i in range(0, len(cp), _BLOCK)])
+    coefficients = _power_coefficients(cp, 1)
     scale = _scale(coefficients)
-    speed = np.linalg.norm(_horner(coefficients / scale, u[..., None] * _U), axis=-1)
-    result = speed @ _W * u * scale
+    c = coefficients / scale
+    nodes = u[..., None] * _U
+    if c.ndim > 2:  # many curves: nodes broadcast against them
+        c = c[..., None, :, :]
+    squares = 0.0
+    for j in range(c.shape[-1]):  # |Q'|² one coordinate at a time (no (…, nodes, d) temporaries)
+        component = (c[..., 2, j] * nodes + c[..., 1, j]) * nodes + c[..., 0, j]
+        squares = squares + component * component
+    result = np.sqrt(squares) @ _W * u * scale
     return float(result) if result.ndim == 0 else result
 
 

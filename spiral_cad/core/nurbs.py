@@ -137,13 +137,16 @@ def chain_to_nurbs(chain) -> Nurbs:
 
     Raises:
         ValueError: no segments (segments themselves have positive length by
-            construction, so every knot span is non-empty).
+            construction, so every knot span is non-empty), or a segment in
+            space (``Nurbs`` is planar; 3-D chains reach CAD as exact edges).
     """
     points: list[NDArray] = []
     weights: list[NDArray] = []
     spans: list[float] = []
     owners: list[int] = []
     for index, segment in enumerate(chain):
+        if getattr(segment, "dim", 2) != 2:
+            raise ValueError(f"chain_to_nurbs takes plane segments; segment {index} is in space (use exact 3-D edges: to_edges/to_wire)")
         for cp, w, length in _pieces(segment):
             points.append(cp if not points else cp[1:])
             weights.append(w if not weights else w[1:])

@@ -12,7 +12,9 @@ from . import bezier
 from ._inputs import as_float, as_xy
 from ._kernels import spiral_row
 from .errors import Status, error_for
-from .segments import EPS, End, Segment, piece_range
+from ._chain_kernels import SPIRAL
+from .segments import EPS, PLANE_TOL, Segment, piece_range
+from .space import PlaneFrame
 from .shapes import DEFAULT_SHAPE, SHAPE_CODES, TRANSITION_SHAPES, shape_code
 
 
@@ -41,7 +43,10 @@ class BezierSpiral(Segment):
             (e.g. curvature 5e-324, or a tiny spiral at 1e12).
 
     Pieces (``piece``) and reversals (``reversed``) are exact Bézier curves
-    of the same shape; for them ``start_curvature`` need not be 0.
+    of the same shape; for them ``start_curvature`` need not be 0. A spiral
+    in space — ``placed`` in a ``PlaneFrame``, or ``from_control_points``
+    with (4, 3) points in one plane — is the same planar cubic; its curvature
+    is κ ≥ 0 and ``normal`` is the binormal it turns about.
     """
 
     def __init__(self, start: Any, direction: Any, theta: float, curvature: float, shape: str = DEFAULT_SHAPE):
@@ -56,6 +61,7 @@ class BezierSpiral(Segment):
             inputs = dict(start=(bx, by), direction=(dx, dy), theta=theta, curvature=curvature, shape=shape)
             raise error_for("BezierSpiral", status, measure, inputs)
         self._cp = out[0]
+        self._dim = 2
         self._length = None
         self._shape = shape
         self._cp.flags.writeable = False
@@ -68,36 +74,45 @@ class BezierSpiral(Segment):
         those of ``shape``; use the solvers or the constructor to make spirals.
 
         Args:
-            control_points: (4, 2) control points in travel order.
+            control_points: (4, 2) control points in travel order, or (4, 3) for
+                a spiral in space (z = 0 everywhere: a plane spiral). A spiral
+                in space is a planar cubic (``placed`` makes one from a plane spiral).
             shape: the shape the points were made with, if known (reported
                 by ``shape``; None: not stated).
 
         Raises:
-            ValueError: not a finite (4, 2) array, an end leg of zero
-                length (no end tangent: a degenerate spiral), or an unknown shape.
+            ValueError: not a finite (4, 2) or (4, 3) array, an end leg of zero
+                length (no end tangent: a degenerate spiral), control points in
+                space off one plane (beyond 1e-9 of the legs plus rounding), or
+                an unknown shape.
         """
         if shape is not None and shape not in SHAPE_CODES:
             shape_code(shape, tuple(SHAPE_CODES))
         cp = np.array(control_points, dtype=float)
-        if cp.shape != (4, 2):
-            raise ValueError(f"control_points must have shape (4, 2); got {cp.shape}")
+        if cp.shape not in ((4, 2), (4, 3)):
+            raise ValueError(f"control_points must have shape (4, 2) or (4, 3); got {cp.shape}")
         if not np.isfinite(cp).all():
             raise ValueError(f"control_points must be finite; got {cp.tolist()}")
+        if cp.shape[1] == 3 and not cp[:, 2].any():
+            cp = np.ascontiguousarray(cp[:, :2])
         for leg, (a, b) in (("first", (0, 1)), ("last", (2, 3))):
             if np.array_equal(cp[a], cp[b]) or not np.isfinite(cp[b] - cp[a]).all():
                 raise ValueError(
                     f"control_points make a degenerate spiral: the {leg} leg from {cp[a].tolist()} to "
                     f"{cp[b].tolist()} has no direction"
                 )
+        if cp.shape[1] == 3:
+            _check_planar(cp)
         return cls._wrap(cp, shape)
 
     @classmethod
-    def _wrap(cls, cp: NDArray, shape: str | None) -> BezierSpiral:
-        """Adopt a finite (4, 2) float64 array without copying or checks (solver output)."""
+    def _wrap(cls, cp: NDArray, shape: str | None, length: float | None = None) -> BezierSpiral:
+        """Adopt a finite (4, 2) or (4, 3) float64 array without copying or checks (solver output)."""
         spiral = object.__new__(cls)
         cp.flags.writeable = False
         spiral._cp = cp
-        spiral._length = None
+        spiral._dim = cp.shape[1]
+        spiral._length = length
         spiral._shape = shape
         return spiral
 
@@ -111,36 +126,37 @@ class BezierSpiral(Segment):
 
     @property
     def control_points(self) -> NDArray:
-        """(4, 2) float64 control points in travel order (read-only)."""
+        """(4, 2) float64 control points in travel order, (4, 3) in space (read-only)."""
         return self._cp
 
-    def outline(self) -> list[tuple[float, float]]:
-        return [tuple(p) for p in self._cp.tolist()]
+    def _row(self) -> tuple[int, NDArray, tuple[float, float, float]]:
+        geometry = np.zeros((4, 3))
+        geometry[:, : self._dim] = self._cp
+        return SPIRAL, geometry, (0.0, 0.0, 0.0)
 
-    def _end_frames(self) -> tuple[End, End]:
-        (x0, y0), (x1, y1), (x2, y2), (x3, y3) = self._cp.tolist()
-        legs = ((x1 - x0, y1 - y0), (x2 - x1, y2 - y1), (x3 - x2, y3 - y2))
-        scale = max(abs(v) for leg in legs for v in leg)  # keeps |leg|³ in range at any magnitude
-        (ax, ay), (bx, by), (cx, cy) = ((u / scale, v / scale) for u, v in legs)
-        la, lc = math.hypot(ax, ay), math.hypot(cx, cy)
-        k0 = 2.0 / 3.0 * (ax * by - ay * bx) / la**3 / scale
-        k1 = 2.0 / 3.0 * (bx * cy - by * cx) / lc**3 / scale
-        return (x0, y0, ax / la, ay / la, k0), (x3, y3, cx / lc, cy / lc, k1)
+    def outline(self) -> list[tuple[float, ...]]:
+        return [tuple(p) for p in self._cp.tolist()]
 
     @property
     def theta(self) -> float:
-        """Signed angle from the start tangent to the end tangent."""
-        (x0, y0), (x1, y1), (x2, y2), (x3, y3) = self._cp.tolist()
-        ax, ay, bx, by = x1 - x0, y1 - y0, x3 - x2, y3 - y2
-        return math.atan2(ax * by - ay * bx, ax * bx + ay * by)
+        """Angle from the start tangent to the end tangent: signed in the plane, ≥ 0 in space."""
+        return float(turn_angles(self._cp[None])[0])
 
-    @classmethod
-    def measure_lengths(cls, spirals) -> None:
-        """Measure the arc lengths of many spirals in one vectorised quadrature (each caches its own)."""
-        todo = [s for s in spirals if isinstance(s, cls) and s._length is None]
-        if todo:
-            for spiral, length in zip(todo, bezier.arc_length(np.stack([s._cp for s in todo])).tolist()):
-                spiral._length = length
+    @property
+    def normal(self) -> NDArray:
+        """Unit normal (3,) of the spiral's plane: (0, 0, 1) in the plane (curvature signed about it);
+        in space the binormal the spiral turns counterclockwise about.
+
+        Raises:
+            ValueError: a straight spiral in space (its legs span no plane).
+        """
+        if self._dim == 2:
+            return np.array([0.0, 0.0, 1.0])
+        n = _turn(self._cp)
+        size = math.hypot(*n.tolist())
+        if not size > 0.0:
+            raise ValueError("a straight spiral in space has no plane")
+        return n / size
 
     @property
     def length(self) -> float:
@@ -168,17 +184,19 @@ class BezierSpiral(Segment):
         return bezier.tangent(self._cp, u)
 
     def curvature(self, u: ArrayLike) -> NDArray | float:
-        return bezier.curvature(self._cp, u)[()]
+        if self._dim == 2:
+            return bezier.curvature(self._cp, u)[()]
+        return np.linalg.norm(self.curvature_vector(u), axis=-1)[()]
 
-    def rounding_floor(self, at_end: bool) -> tuple[float, float, float]:
-        """Rounding floor of the end frame: κ comes from differences of rounded
-        control points, (2/3)(a × b)/|a|³ with a the end leg and b the middle leg."""
-        (x0, y0), (x1, y1), (x2, y2), (x3, y3) = self._cp.tolist()
-        delta = 4.0 * EPS * max(abs(x0), abs(y0), abs(x1), abs(y1), abs(x2), abs(y2), abs(x3), abs(y3))
-        middle = math.hypot(x2 - x1, y2 - y1)
-        a, b = (math.hypot(x3 - x2, y3 - y2), middle) if at_end else (math.hypot(x1 - x0, y1 - y0), middle)
-        kappa = abs(self.end_curvature if at_end else self.start_curvature)
-        return delta, delta / a, 2.0 / 3.0 * delta * (a + b) / a**3 + 3.0 * kappa * delta / a
+    def curvature_vector(self, u: ArrayLike) -> NDArray:
+        """κN = ((Q' × Q'') × Q') / |Q'|⁴, on the control points scaled by a power of two (any magnitude)."""
+        scale = math.ldexp(1.0, math.frexp(float(np.abs(np.diff(self._cp, axis=0)).max()))[1])
+        cp = np.zeros((4, 3))
+        cp[:, : self._dim] = self._cp / scale
+        d1, d2 = (bezier.derivative(cp, u, order) for order in (1, 2))
+        speed2 = np.einsum("...i,...i->...", d1, d1)
+        k = np.cross(np.cross(d1, d2), d1) / (speed2 * speed2)[..., None] / scale
+        return k[..., : self._dim]
 
     def piece(self, t0: float, t1: float) -> BezierSpiral:
         """Exact sub-curve on [t0, t1] (de Casteljau) as a Bézier on [0, 1]."""
@@ -187,3 +205,50 @@ class BezierSpiral(Segment):
 
     def reversed(self) -> BezierSpiral:
         return BezierSpiral._wrap(self._cp[::-1].copy(), self._shape)
+
+    def placed(self, frame: PlaneFrame) -> BezierSpiral:
+        self._plane_only("placed")
+        return BezierSpiral._wrap(frame.point(self._cp), self._shape)
+
+
+def turn_angles(control_points: NDArray) -> NDArray:
+    """The turn from start to end tangent of N cubics (N, 4, 2 or 3): signed in the plane, ≥ 0 in space."""
+    a = control_points[:, 1] - control_points[:, 0]
+    c = control_points[:, 3] - control_points[:, 2]
+    size = np.maximum(np.abs(a).max(axis=1), np.abs(c).max(axis=1))
+    far = ~((size > 1e-100) & (size < 1e100))
+    if far.any():  # products of legs would leave float64: scale those rows by a power of two (exact)
+        scale = np.ldexp(1.0, np.frexp(size[far])[1])[:, None]
+        a[far], c[far] = a[far] / scale, c[far] / scale
+    if a.shape[1] == 2:
+        cross = a[:, 0] * c[:, 1] - a[:, 1] * c[:, 0]
+        dot = a[:, 0] * c[:, 0] + a[:, 1] * c[:, 1]
+    else:
+        cross = np.linalg.norm(np.cross(a, c), axis=1)
+        dot = np.einsum("ij,ij->i", a, c)
+    # math.atan2, not np.arctan2: the same bits on every machine (numpy may use SIMD variants).
+    return np.array([math.atan2(y, x) for y, x in zip(cross.tolist(), dot.tolist())])
+
+
+def _turn(cp: NDArray) -> NDArray:
+    """(a + b) × c of the legs a, b, c: along the binormal of a planar cubic that turns one way
+    (a × b vanishes where a spiral starts straight, so it is not used alone)."""
+    legs = np.diff(cp, axis=0)
+    legs /= math.ldexp(1.0, math.frexp(float(np.abs(legs).max()))[1])  # exact: no |leg|² overflow
+    return np.cross(legs[0] + legs[1], legs[2])
+
+
+def _check_planar(cp: NDArray) -> None:
+    """ValueError unless the (4, 3) control points lie in one plane (1e-9 of the legs plus rounding)."""
+    n = _turn(cp)
+    size = math.hypot(*n.tolist())
+    if not size > 0.0:
+        return  # collinear legs: a straight cubic lies in every plane through it
+    legs = np.diff(cp, axis=0)
+    off = float(np.abs(legs @ (n / size)).max())  # |leg · n̂|: no products of two legs
+    allowed = PLANE_TOL * float(np.linalg.norm(legs, axis=1).max()) + 8.0 * EPS * float(np.abs(cp).max())
+    if not off <= allowed:
+        raise ValueError(
+            f"control_points in space must lie in one plane (a spiral is planar): a leg leaves the plane of the others "
+            f"by {off:.3g} (allowed {allowed:.3g})"
+        )

@@ -9,25 +9,30 @@ result is one G2 :class:`~spiral_cad.Chain` plus a stationing table.
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
-from scipy.optimize import brentq
 
-from ..core.bezier import curvature_rate, peak_curvature_rate  # noqa: F401  (public here too)
+from ..core import _kernels as K
+from ..core import batch
+from ..core._chain_kernels import SPIRAL
 from ..core._inputs import as_float, as_points, as_real_array
-from ..core._kernels import shape_g1
-from ..core.factors import length_factor, search_range
+from ..core.bezier import curvature_rate, peak_curvature_rate  # noqa: F401  (public here too)
+from ..core.chain import JOIN_TOLERANCE, Chain, PartCircles, join_rows, join_tolerance
+from ..core.errors import JointError, NoSolutionError
+from ..core.factors import WALTON_MEEK_SEARCH_MAX, length_factor, peak_rate_factor, search_range
+from ..core.rows import SegmentRows
+from ..core.segments import Circle, Ray
 from ..core.shapes import SHAPE_CODES, TRANSITION_SHAPES, shape_code, shape_limits
-from ..core.chain import JOIN_TOLERANCE, Chain
+from ..core.spiral import turn_angles
+from ..core.transitions import Transition
 from ..core.units import DEFAULT_UNITS, length_unit, speed_unit
 from .criteria import CRITERIA_DIMENSIONS, Criteria, CriteriaRow, RailCriteria, RoadCriteria
 from .tables import text_table, write_csv
-from ..core.errors import JointError, NoSolutionError
-from ..core.transitions import Transition, line_to_circle
 
 #: |sin(deflection)| at or below this counts as a straight PI.
 COLLINEAR_TOL = 1e-12
@@ -39,23 +44,63 @@ def theta_for_length(length: float, radius: float, shape: str = "walton-meek") -
     """The θ whose spiral of ``shape`` with end radius ``radius`` has arc length ``length``.
 
     Length grows monotonically with θ for a fixed radius (and is
-    proportional to the radius), so a bracketed 1-D root gives θ.
+    proportional to the radius), so a bracketed 1-D root gives θ
+    (``thetas_for_lengths`` for many at once).
 
     Raises:
         NoSolutionError: ``length`` outside the reachable range.
     """
-
-    def excess(theta: float) -> float:
-        return float(length_factor(theta, shape)) - length / radius
-
-    largest = shape_limits(shape)["theta"]
-    lo, hi = _THETA_MIN, largest * (1.0 - 1e-9) if largest == math.pi / 2 else largest
-    if not excess(lo) < 0.0 < excess(hi):
+    theta = float(thetas_for_lengths([length], [radius], shape)[0])
+    if math.isnan(theta):
+        lo, hi = _length_bracket(shape)
+        low, high = (radius * float(length_factor(t, shape)) for t in (lo, hi))
         raise NoSolutionError(
             f"spiral length {length:.6g} is outside the range a spiral onto radius {radius:.6g} "
-            f"can have ({radius * (excess(lo) + length / radius):.3g} … {radius * (excess(hi) + length / radius):.3g})"
+            f"can have ({low:.3g} … {high:.3g})"
         )
-    return float(brentq(excess, lo, hi, xtol=1e-16, rtol=1e-15, maxiter=200))
+    return theta
+
+
+def _length_bracket(shape: str) -> tuple[float, float]:
+    """The θ range searched for a spiral length: from ``_THETA_MIN`` to the shape's largest angle."""
+    largest = shape_limits(shape)["theta"]
+    return _THETA_MIN, largest * (1.0 - 1e-9) if largest == math.pi / 2 else largest
+
+
+def thetas_for_lengths(lengths: ArrayLike, radii: ArrayLike, shape: str = "walton-meek") -> NDArray:
+    """``theta_for_length`` for arrays (broadcast): θ with ℓ(θ)·r = length, NaN where out of range.
+
+    Illinois regula falsi on the bracket of ``_length_bracket``, vectorised
+    over the rows still moving (ℓ(θ) is smooth and monotone: about eight
+    evaluations of ``length_factor`` per row), to |Δθ| ≤ 1e-16 + 1e-15·θ.
+    """
+    lengths, radii = np.broadcast_arrays(np.asarray(lengths, dtype=float), np.asarray(radii, dtype=float))
+    target = (lengths / radii).ravel()
+    lo_t, hi_t = _length_bracket(shape)
+    lo, hi = np.full(target.shape, lo_t), np.full(target.shape, hi_t)
+    with np.errstate(invalid="ignore"):
+        f_lo = length_factor(lo_t, shape) - target
+        f_hi = length_factor(hi_t, shape) - target
+        theta = np.full(target.shape, np.nan)
+        active = np.flatnonzero((f_lo < 0.0) & (f_hi > 0.0))
+        side = np.zeros(target.shape, dtype=np.int8)
+        for _ in range(200):
+            if not len(active):
+                break
+            a, b, fa, fb = lo[active], hi[active], f_lo[active], f_hi[active]
+            x = np.clip(b - fb * (b - a) / (fb - fa), a, b)
+            fx = length_factor(x, shape) - target[active]
+            below, above = fx < 0.0, fx > 0.0
+            # Illinois: halve the value at the end that stays, so both ends converge.
+            f_hi[active] = np.where(below, np.where(side[active] == -1, fb / 2.0, fb), np.where(above, fx, fb))
+            f_lo[active] = np.where(above, np.where(side[active] == 1, fa / 2.0, fa), np.where(below, fx, fa))
+            lo[active] = np.where(below, x, a)
+            hi[active] = np.where(above, x, b)
+            side[active] = np.where(below, -1, np.where(above, 1, 0))
+            done = (~below & ~above) | (hi[active] - lo[active] <= 1e-16 + 1e-15 * x)
+            theta[active[done]] = x[done]
+            active = active[~done]
+    return theta.reshape(lengths.shape)
 
 
 # -------------------------------------------------------- the model
@@ -136,7 +181,7 @@ class Alignment:
 
     Attributes:
         chain: the G2 chain (tangent–spiral–arc–spiral–tangent at every PI).
-        curves: one ``CurveData`` per interior PI.
+        curves: one ``CurveData`` per interior PI (a ``CurveList``: a sequence made when read).
         start_station: chainage of the first PI.
         criteria: the design criteria the curves were chosen or checked by, if any.
         checks: one ``CriteriaRow`` per curve when there are criteria.
@@ -144,7 +189,7 @@ class Alignment:
     """
 
     chain: Chain
-    curves: list[CurveData]
+    curves: Sequence[CurveData]
     start_station: float = 0.0
     criteria: Criteria | None = None
     checks: tuple[CriteriaRow, ...] = ()
@@ -240,55 +285,20 @@ class Alignment:
         if spiral_angles is None and spiral_lengths is None:
             if criteria is None:
                 raise ValueError("give spiral_angles or spiral_lengths, or design criteria (design_speed) to choose them")
-            shortest, longest = criteria.choose(radius, units, shape)
+            shortest, longest = _choose(criteria, radius, units, shape)
             spec = np.stack([shortest, shortest], axis=1)
         else:
             shortest = longest = None
             spec = _sides(spiral_lengths if by_length else spiral_angles, count, "spiral_lengths" if by_length else "spiral_angles")
 
-        solved = []
-        for j in range(count):
-            i = j + 1
-            r = radius[j]
-            t_in, t_out = directions[j], directions[j + 1]
-            sin_d = t_in[0] * t_out[1] - t_in[1] * t_out[0]
-            cos_d = float(np.dot(t_in, t_out))
-            if abs(sin_d) <= COLLINEAR_TOL:
-                what = "folds straight back" if cos_d < 0.0 else "is collinear with its neighbours (zero deflection)"
-                raise ValueError(f"PI {i} at {pts[i].tolist()} {what}: no curve can be placed there")
-            deflection = math.atan2(sin_d, cos_d)
-            if shortest is not None:
-                _check_choice(i, r, deflection, shortest[j], longest[j], criteria, units, shape)
-            if by_length:
-                for side, value in zip(("entry", "exit"), spec[j]):
-                    if not value > 0.0:
-                        raise ValueError(f"PI {i}: {side} spiral length must be positive; got {value}")
-                thetas = [_theta_at(value, r, i, side, shape) for side, value in zip(("entry", "exit"), spec[j])]
-            else:
-                thetas = list(spec[j])
-                for side, value in zip(("entry", "exit"), thetas):
-                    if not 0.0 < value < math.pi / 2:
-                        raise ValueError(f"PI {i}: {side} spiral angle must lie in (0, π/2); got {value}")
-            theta_in, theta_out = thetas
-            sweep = abs(deflection) - theta_in - theta_out
-            if sweep < -1e-12:
-                raise NoSolutionError(
-                    f"PI {i}: deflection {math.degrees(abs(deflection)):.6g}° is smaller than "
-                    f"θ_in + θ_out = {math.degrees(theta_in):.6g}° + {math.degrees(theta_out):.6g}°: the circular arc "
-                    f"would have negative sweep {math.degrees(sweep):.4g}°; use shorter spirals or a smaller radius"
-                )
-            try:
-                solved.append(_curve(pts[i], t_in, t_out, deflection, r, theta_in, theta_out, shape))
-            except NoSolutionError as error:
-                raise NoSolutionError(f"PI {i}: {error}") from None
-
+        solved = _solve_curves(pts, directions, radius, spec, by_length, shortest, longest, criteria, units, shape)
         _check_tangents(pts, lengths, directions, solved)
-        parts: list[Transition] = [t for s in solved for t in s[:2]]
+        tolerance = join_tolerance(tolerance)
         try:
-            chain = Chain.join(parts, pts[0], pts[-1], tolerance, units)
+            chain = join_rows(*_chain_rows(solved, shape), tuple(pts[0].tolist()), tuple(pts[-1].tolist()), tolerance, units)
         except JointError as error:
             raise NoSolutionError(f"PI {error.part // 2 + 1}: float64 cannot hold its curve G2 at these coordinates: {error}") from None
-        curves = _curve_data(chain, pts, solved, radius, origin)
+        curves = CurveList(chain, pts, solved, radius, origin, shape)
         checks = () if criteria is None else _judge(curves, criteria, units, shortest, longest, strict, shape)
         return cls(chain, curves, origin, criteria, checks, shape)
 
@@ -370,43 +380,262 @@ def _criteria(design_speed: Any, max_jerk: Any, criteria: Any) -> Criteria | Non
     return RoadCriteria(design_speed) if max_jerk is None else RoadCriteria(design_speed, max_jerk)
 
 
-def _check_choice(
-    i: int, r: float, deflection: float, shortest: float, longest: float, criteria: Criteria, units: str, shape: str
-) -> None:
-    """Refuse, naming the PI and the numbers, when no spiral meets every criterion of curve ``i``."""
-    length = lambda theta: float(length_factor(theta, shape) * r)  # noqa: E731
-    if math.isnan(shortest):
-        raise NoSolutionError(
-            f"PI {i}: no spiral onto R = {r:.6g} {units} ({shape}, up to θ = {math.degrees(search_range(shape)[1]):.3g}°) meets the "
-            f"criteria at {criteria.design_speed:g} {speed_unit(units)}; use a larger radius"
+class _FirstProblem:
+    """The error the PIs raise, in PI order and, within a PI, in the order the checks run."""
+
+    def __init__(self) -> None:
+        self.found: tuple[int, int, Any] | None = None
+
+    def flag(self, failing: NDArray, step: int, make) -> None:
+        """Record ``make(j)`` (an exception) for the first PI index j where ``failing`` holds."""
+        hit = np.flatnonzero(failing)
+        if len(hit) and (self.found is None or (int(hit[0]), step) < self.found[:2]):
+            self.found = (int(hit[0]), step, make)
+
+    def raise_first(self) -> None:
+        if self.found is not None:
+            j, _, make = self.found
+            raise make(j)
+
+
+@dataclass(frozen=True)
+class _Solved:
+    """Every PI's curve as arrays: deflection, centre, the spirals' θ and control points (N, 4, 2)
+    in travel order (the exit reversed), the entry/exit solvers' θ and the turn side."""
+
+    deflection: NDArray
+    center: NDArray
+    side: NDArray
+    radius: NDArray
+    entry: NDArray
+    exit: NDArray
+    theta: NDArray
+    directions: NDArray
+
+
+def _solve_curves(pts, directions, radius, spec, by_length, shortest, longest, criteria, units, shape) -> _Solved:
+    """Every PI's centre and spirals in two batch calls (entry and exit); the first failing check raises."""
+    count = len(radius)
+    t_in, t_out = directions[:-1], directions[1:]
+    sin_d = t_in[:, 0] * t_out[:, 1] - t_in[:, 1] * t_out[:, 0]
+    cos_d = t_in[:, 0] * t_out[:, 0] + t_in[:, 1] * t_out[:, 1]
+    deflection = np.array([math.atan2(y, x) for y, x in zip(sin_d.tolist(), cos_d.tolist())])
+    problem = _FirstProblem()
+
+    def straight(j: int) -> ValueError:
+        what = "folds straight back" if cos_d[j] < 0.0 else "is collinear with its neighbours (zero deflection)"
+        return ValueError(f"PI {j + 1} at {pts[j + 1].tolist()} {what}: no curve can be placed there")
+
+    problem.flag(np.abs(sin_d) <= COLLINEAR_TOL, 0, straight)
+    if shortest is not None:
+        _check_choices(problem, radius, deflection, shortest, longest, criteria, units, shape)
+    with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
+        if by_length:
+            for k, side_name in enumerate(("entry", "exit")):
+                problem.flag(~(spec[:, k] > 0.0), 1 + k, lambda j, k=k, n=side_name: ValueError(
+                    f"PI {j + 1}: {n} spiral length must be positive; got {spec[j, k]}"))  # fmt: skip
+            thetas = np.where(spec > 0.0, thetas_for_lengths(spec, radius[:, None], shape), np.nan)
+            for k, side_name in enumerate(("entry", "exit")):
+                problem.flag((spec[:, k] > 0.0) & np.isnan(thetas[:, k]), 3 + k, lambda j, k=k, n=side_name: _length_error(
+                    j, n, spec[j, k], radius[j], shape))  # fmt: skip
+        else:
+            thetas = spec
+            for k, side_name in enumerate(("entry", "exit")):
+                problem.flag(~((thetas[:, k] > 0.0) & (thetas[:, k] < math.pi / 2)), 1 + k, lambda j, k=k, n=side_name: ValueError(
+                    f"PI {j + 1}: {n} spiral angle must lie in (0, π/2); got {spec[j, k]}"))  # fmt: skip
+        sweep = np.abs(deflection) - thetas[:, 0] - thetas[:, 1]
+        problem.flag(sweep < -1e-12, 5, lambda j: NoSolutionError(
+            f"PI {j + 1}: deflection {math.degrees(abs(deflection[j])):.6g}° is smaller than "
+            f"θ_in + θ_out = {math.degrees(thetas[j, 0]):.6g}° + {math.degrees(thetas[j, 1]):.6g}°: the circular arc "
+            f"would have negative sweep {math.degrees(sweep[j]):.4g}°; use shorter spirals or a smaller radius"))  # fmt: skip
+        # Theorem 4.1: offset d = r·g1(θ) of the centre from each tangent.
+        side = np.copysign(1.0, deflection)
+        offsets = radius[:, None] * _g1(thetas, shape)
+        normals = side[:, None, None] * np.stack([np.stack([-t_in[:, 1], t_in[:, 0]], 1), np.stack([-t_out[:, 1], t_out[:, 0]], 1)], 1)
+        usable = np.isfinite(offsets).all(axis=1) & (np.abs(sin_d) > COLLINEAR_TOL)
+        center = np.full((count, 2), np.nan)
+        if usable.any():
+            center[usable] = pts[1:-1][usable] + np.linalg.solve(normals[usable], offsets[usable][..., None])[..., 0]
+    entry = batch.line_to_circle(pts[1:-1], t_in, center, radius, shape=shape)
+    exit_ = batch.line_to_circle(pts[1:-1], -t_out, center, radius, shape=shape)
+    for step, result in ((6, entry), (7, exit_)):
+        problem.flag(~result.ok, step, lambda j, result=result: _solver_error(j, result))
+    problem.raise_first()
+    spirals_out = exit_.spirals[0][:, ::-1]
+    return _Solved(deflection, center, side, radius, entry.spirals[0], spirals_out, np.stack([entry.theta, exit_.theta], 1), directions)
+
+
+def _g1(thetas: NDArray, shape: str) -> NDArray:
+    """g1(θ) of every spiral angle (math.sin/cos per value: the same bits as the scalar solvers)."""
+    flat = thetas.ravel().tolist()
+    sin_t = np.array([math.sin(t) for t in flat])
+    cos_t = np.array([math.cos(t) for t in flat])
+    e1 = np.empty(len(flat))
+    K.shape_offsets_batch(SHAPE_CODES[shape], sin_t, cos_t, e1, np.empty(len(flat)))
+    return (1.0 + sin_t * sin_t * e1).reshape(thetas.shape)
+
+
+def _solver_error(j: int, result: batch.BatchResult) -> ValueError:
+    error = result.error(j)
+    return NoSolutionError(f"PI {j + 1}: {error}") if isinstance(error, NoSolutionError) else error
+
+
+def _length_error(j: int, side: str, length: float, radius: float, shape: str) -> NoSolutionError:
+    try:
+        theta_for_length(length, radius, shape)
+    except NoSolutionError as error:
+        return NoSolutionError(f"PI {j + 1}: {side} {error}")
+    return NoSolutionError(f"PI {j + 1}: {side} spiral length {length:.6g} has no spiral angle")
+
+
+def _check_choices(problem: _FirstProblem, radius, deflection, shortest, longest, criteria: Criteria, units: str, shape: str) -> None:
+    """Flag, naming the PI and the numbers, the curves where no spiral meets every criterion."""
+    length = lambda theta, r: float(length_factor(theta, shape) * r)  # noqa: E731
+    speed = f"{criteria.design_speed:g} {speed_unit(units)}"
+    problem.flag(np.isnan(shortest), 0.1, lambda j: NoSolutionError(
+        f"PI {j + 1}: no spiral onto R = {radius[j]:.6g} {units} ({shape}, up to θ = {math.degrees(search_range(shape)[1]):.3g}°) "
+        f"meets the criteria at {speed}; use a larger radius"))  # fmt: skip
+    with np.errstate(invalid="ignore"):
+        conflict = shortest > longest * (1 + 1e-12)
+        narrow = ~conflict & (2.0 * shortest > np.abs(deflection))
+    problem.flag(conflict, 0.2, lambda j: NoSolutionError(
+        f"PI {j + 1}: the criteria conflict at R = {radius[j]:.6g} {units}: the rate limits need spirals of at least "
+        f"{length(shortest[j], radius[j]):.6g} {units} (θ ≥ {math.degrees(shortest[j]):.4g}°), the shift limit allows at most "
+        f"{length(longest[j], radius[j]):.6g} {units} (θ ≤ {math.degrees(longest[j]):.4g}°); use a larger radius or relax the limits"))  # fmt: skip
+    problem.flag(narrow, 0.3, lambda j: NoSolutionError(
+        f"PI {j + 1}: the shortest spirals that meet the criteria turn 2 × {math.degrees(shortest[j]):.4g}° but the "
+        f"deflection is only {math.degrees(abs(deflection[j])):.4g}°; use a larger radius"))  # fmt: skip
+
+
+def _check_tangents(pts: NDArray, lengths: NDArray, directions: NDArray, solved: _Solved) -> None:
+    """Each tangent must hold the ST of one curve before the TS of the next (§5)."""
+    inner = pts[1:-1]
+    back = np.concatenate([[0.0], np.einsum("ij,ij->i", inner - solved.entry[:, 0], directions[:-1])])
+    ahead = np.concatenate([np.einsum("ij,ij->i", solved.exit[:, 3] - inner, directions[1:]), [0.0]])
+    used = np.concatenate([[0.0], ahead[:-1]])  # ST of the curve before tangent k
+    used_next = np.concatenate([back[1:], [0.0]])  # TS of the curve after it
+    over = np.flatnonzero(used + used_next > lengths * (1.0 + 1e-12))
+    if not len(over):
+        return
+    k, last = int(over[0]), len(pts) - 1
+    used, used_next, length = float(used[k]), float(used_next[k]), float(lengths[k])
+    if k == 0:
+        where = f"the TS of PI 1 lies {used_next:.6g} before PI 1, beyond the start point PI 0"
+    elif k + 1 == last:
+        where = f"the ST of PI {k} lies {used:.6g} after PI {k}, beyond the end point PI {last}"
+    else:
+        where = (
+            f"the curves at PI {k} and PI {k + 1} overlap on their shared tangent: the ST of PI {k} is "
+            f"{used:.6g} after PI {k} and the TS of PI {k + 1} is {used_next:.6g} before PI {k + 1}"
         )
-    if shortest > longest * (1 + 1e-12):
-        raise NoSolutionError(
-            f"PI {i}: the criteria conflict at R = {r:.6g} {units}: the rate limits need spirals of at least "
-            f"{length(shortest):.6g} {units} (θ ≥ {math.degrees(shortest):.4g}°), the shift limit allows at most "
-            f"{length(longest):.6g} {units} (θ ≤ {math.degrees(longest):.4g}°); use a larger radius or relax the limits"
-        )
-    if 2.0 * shortest > abs(deflection):
-        raise NoSolutionError(
-            f"PI {i}: the shortest spirals that meet the criteria turn 2 × {math.degrees(shortest):.4g}° but the "
-            f"deflection is only {math.degrees(abs(deflection)):.4g}°; use a larger radius"
-        )
+    raise NoSolutionError(
+        f"{where}; together {used + used_next:.6g} > tangent length {length:.6g}. "
+        "Move the PIs apart, or reduce the radii or spiral lengths"
+    )
+
+
+def _chain_rows(solved: _Solved, shape: str) -> tuple[SegmentRows, NDArray, PartCircles]:
+    """The parts of the alignment's ``Chain.join``: entry and exit spiral of every PI, the entry
+    ending on the PI's circle (the arc between them follows from it)."""
+    count = len(solved.entry)
+    spirals = np.empty((2 * count, 4, 2))
+    spirals[0::2], spirals[1::2] = solved.entry, solved.exit
+    circles = PartCircles(2 * count)
+    circles.present[0::2] = True
+    circles.center[0::2, :2] = solved.center
+    circles.radius[0::2] = solved.side * solved.radius
+    return SegmentRows.spirals(spirals, shape), np.ones(2 * count, dtype=np.int64), circles
+
+
+class CurveList(Sequence):
+    """The curves of an alignment, one ``CurveData`` per interior PI, made when read (a long
+    alignment is built as arrays; its curve records cost nothing until a table asks for them).
+
+    Attributes (arrays over the curves): ``radius``, ``thetas`` (N, 2), ``lengths`` (N, 2),
+    ``peak_rates`` (N, 2) — what the criteria judge, measured on the chain's spirals.
+    """
+
+    def __init__(self, chain: Chain, pts: NDArray, solved: _Solved, radius: NDArray, origin: float, shape: str):
+        spiral_rows = np.flatnonzero(chain.rows.kind == SPIRAL)
+        self._chain, self._pts, self._solved, self._shape = chain, pts, solved, shape
+        self._first, self._last = spiral_rows[0::2], spiral_rows[1::2]
+        stations = origin + chain.stations
+        self._stations = np.stack([stations[self._first], stations[self._first + 1], stations[self._last], stations[self._last + 1]], 1)
+        self.radius = radius
+        self.lengths = np.stack([chain.lengths[self._first], chain.lengths[self._last]], 1)
+        self.thetas = np.abs(np.stack([turn_angles(solved.entry), turn_angles(solved.exit)], 1))
+        self.peak_rates = _peak_rates(self.thetas, radius, np.stack([solved.entry, solved.exit], 1), shape)
+        self._made: list[CurveData | None] = [None] * len(radius)
+
+    def __len__(self) -> int:
+        return len(self._made)
+
+    def __getitem__(self, index):
+        if isinstance(index, slice):
+            return [self[j] for j in range(*index.indices(len(self)))]
+        curve = self._made[index]
+        if curve is None:
+            curve = self._made[index] = self._curve(range(len(self))[index])
+        return curve
+
+    def __eq__(self, other: object) -> bool:
+        return list(self) == list(other) if isinstance(other, Sequence) else NotImplemented
+
+    def __repr__(self) -> str:
+        return f"CurveList({len(self)} curves)"
+
+    def _curve(self, j: int) -> CurveData:
+        solved, chain, shape = self._solved, self._chain, self._shape
+        i = j + 1
+        pi = tuple(self._pts[i].tolist())
+        center = tuple(solved.center[j].tolist())
+        circle = Circle(center, float(solved.side[j] * self.radius[j]))
+        t_in, t_out = (tuple(solved.directions[k].tolist()) for k in (j, j + 1))
+        entry = Transition("line-circle", [chain[int(self._first[j])]], float(solved.theta[j, 0]), end_circle=circle,
+                           start_line=Ray(pi, t_in), shape=shape)  # fmt: skip
+        exit_ = Transition("circle-line", [chain[int(self._last[j])]], float(solved.theta[j, 1]), start_circle=circle,
+                           end_line=Ray(pi, t_out), shape=shape)  # fmt: skip
+        ts, sc, cs, st = self._stations[j].tolist()
+        (theta_in, theta_out), (length_in, length_out), (rate_in, rate_out) = (a[j].tolist() for a in (self.thetas, self.lengths, self.peak_rates))
+        return CurveData(i, pi, float(solved.deflection[j]), float(self.radius[j]), center, theta_in, theta_out, length_in,
+                         length_out, float(self._stations[j, 2] - self._stations[j, 1]), ts, sc, cs, st, rate_in, rate_out,
+                         entry, exit_)  # fmt: skip
+
+
+def _peak_rates(thetas: NDArray, radius: NDArray, spirals: NDArray, shape: str) -> NDArray:
+    """Peak |dκ/ds| of every spiral (N, 2): F(θ)/R² (``factors.peak_rate_factor``) — the spirals are
+    full spirals of ``shape`` onto R — and measured (``peak_curvature_rate``) where F is not tabulated
+    (the 1996 spiral beyond 80°)."""
+    with np.errstate(over="ignore", divide="ignore", invalid="ignore"):  # 1/R² beyond float64 is inf
+        rates = peak_rate_factor(thetas, shape) / (radius * radius)[:, None]
+        if shape == "walton-meek":
+            measured = thetas > WALTON_MEEK_SEARCH_MAX
+            if measured.any():
+                rates[measured] = peak_curvature_rate(spirals[measured])[0]
+    return rates
+
+
+def _choose(criteria: Criteria, radii: NDArray, units: str, shape: str) -> tuple[NDArray, NDArray]:
+    """``criteria.choose`` once per distinct radius (a road has few), spread to every curve."""
+    unique, inverse = np.unique(radii, return_inverse=True)
+    shortest, longest = criteria.choose(unique, units, shape)
+    return shortest[inverse], longest[inverse]
 
 
 def _judge(
-    curves: list[CurveData], criteria: Criteria, units: str, shortest, longest, strict: bool, shape: str
+    curves: CurveList, criteria: Criteria, units: str, shortest, longest, strict: bool, shape: str
 ) -> tuple[CriteriaRow, ...]:
     """The criteria row of every curve; with ``strict`` any violation raises."""
-    radii = np.array([c.radius for c in curves])
+    radii = curves.radius
     if shortest is None:
-        shortest, longest = criteria.choose(radii, units, shape)
+        shortest, longest = _choose(criteria, radii, units, shape)
     largest = search_range(shape)[1]
-    spirals_low, spirals_high = (length_factor(np.nan_to_num(t, nan=largest), shape) * radii for t in (shortest, longest))
-    thetas = np.array([(c.theta_in, c.theta_out) for c in curves])
-    lengths = np.array([(c.spiral_in_length, c.spiral_out_length) for c in curves])
-    rates = np.array([(c.peak_rate_in, c.peak_rate_out) for c in curves])
-    bounds = np.stack([spirals_low, spirals_high], axis=1)
-    rows = tuple(criteria.evaluate([c.index for c in curves], radii, thetas, units, bounds, lengths, rates, shape))
+    # The length bounds: ℓ(θ)·R for each distinct (θ, R) (one quadrature for all).
+    both = np.stack([np.nan_to_num(shortest, nan=largest), np.nan_to_num(longest, nan=largest)], axis=1)
+    pairs, inverse = np.unique(both, axis=0, return_inverse=True)
+    bounds = (length_factor(pairs, shape)[inverse.ravel()]) * radii[:, None]
+    index = np.arange(1, len(radii) + 1)
+    rows = tuple(criteria.evaluate(index, radii, curves.thetas, units, bounds, curves.lengths, curves.peak_rates, shape))
     broken = [f"PI {row.pi}: {'; '.join(row.violations)}" for row in rows if row.violations]
     if strict and broken:
         raise NoSolutionError("design criteria violated: " + " | ".join(broken))
@@ -440,83 +669,3 @@ def _sides(value: Any, count: int, name: str) -> NDArray:
     return array
 
 
-def _theta_at(length: float, radius: float, index: int, side: str, shape: str) -> float:
-    try:
-        return theta_for_length(length, radius, shape)
-    except NoSolutionError as error:
-        raise NoSolutionError(f"PI {index}: {side} {error}") from None
-
-
-def _curve(pi: NDArray, t_in: NDArray, t_out: NDArray, deflection: float, r: float, theta_in: float, theta_out: float, shape: str):
-    """Entry and exit transitions at one PI, and the circle centre."""
-    side = math.copysign(1.0, deflection)
-    n_in = side * np.array([-t_in[1], t_in[0]])
-    n_out = side * np.array([-t_out[1], t_out[0]])
-    # Theorem 4.1: offset d = r·g1(θ) of the centre from each tangent.
-    code = SHAPE_CODES[shape]
-    d_in = r * shape_g1(code, math.sin(theta_in), math.cos(theta_in))
-    d_out = r * shape_g1(code, math.sin(theta_out), math.cos(theta_out))
-    center = pi + np.linalg.solve(np.array([n_in, n_out]), np.array([d_in, d_out]))
-    entry = line_to_circle(pi, t_in, center, r, shape=shape)
-    exit_ = line_to_circle(pi, -t_out, center, r, shape=shape).reversed()
-    return entry, exit_, center, deflection
-
-
-def _check_tangents(pts: NDArray, lengths: NDArray, directions: NDArray, solved) -> None:
-    """Each tangent must hold the ST of one curve before the TS of the next (§5)."""
-    back = [0.0] + [float(np.dot(pts[j + 1] - s[0].start, directions[j])) for j, s in enumerate(solved)]
-    ahead = [float(np.dot(s[1].end - pts[j + 1], directions[j + 1])) for j, s in enumerate(solved)] + [0.0]
-    last = len(pts) - 1
-    for k, length in enumerate(lengths):
-        used = ahead[k - 1] if k > 0 else 0.0
-        used_next = back[k + 1] if k + 1 < len(back) else 0.0
-        if used + used_next > length * (1.0 + 1e-12):
-            if k == 0:
-                where = f"the TS of PI 1 lies {used_next:.6g} before PI 1, beyond the start point PI 0"
-            elif k + 1 == last:
-                where = f"the ST of PI {k} lies {used:.6g} after PI {k}, beyond the end point PI {last}"
-            else:
-                where = (
-                    f"the curves at PI {k} and PI {k + 1} overlap on their shared tangent: the ST of PI {k} is "
-                    f"{used:.6g} after PI {k} and the TS of PI {k + 1} is {used_next:.6g} before PI {k + 1}"
-                )
-            raise NoSolutionError(
-                f"{where}; together {used + used_next:.6g} > tangent length {length:.6g}. "
-                "Move the PIs apart, or reduce the radii or spiral lengths"
-            )
-
-
-def _curve_data(chain: Chain, pts: NDArray, solved, radius: NDArray, origin: float) -> list[CurveData]:
-    stations = chain.stations
-    spirals = np.array([[s[0].spirals[0].control_points, s[1].spirals[0].control_points] for s in solved])
-    with np.errstate(over="ignore", divide="ignore", invalid="ignore"):  # 1/L² beyond float64 is inf
-        peaks = peak_curvature_rate(spirals.reshape(-1, 4, 2))[0] if len(spirals) else []
-    where = {id(seg): k for k, seg in enumerate(chain.segments)}
-    curves = []
-    for j, (entry, exit_, center, deflection) in enumerate(solved):
-        first, last = entry.spirals[0], exit_.spirals[0]
-        a, b = where[id(first)], where[id(last)]
-        ts, sc, cs, st = (origin + stations[k] for k in (a, a + 1, b, b + 1))
-        curves.append(
-            CurveData(
-                index=j + 1,
-                pi=(float(pts[j + 1][0]), float(pts[j + 1][1])),
-                deflection=deflection,
-                radius=float(radius[j]),
-                center=(float(center[0]), float(center[1])),
-                theta_in=abs(first.theta),
-                theta_out=abs(last.theta),
-                spiral_in_length=first.length,
-                spiral_out_length=last.length,
-                arc_length=float(cs - sc),
-                ts=float(ts),
-                sc=float(sc),
-                cs=float(cs),
-                st=float(st),
-                peak_rate_in=float(peaks[2 * j]),
-                peak_rate_out=float(peaks[2 * j + 1]),
-                entry=entry,
-                exit=exit_,
-            )
-        )
-    return curves

@@ -31,13 +31,15 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from ..core import batch
 from ..core._inputs import as_float, as_xy, shown
 from ..core.chain import Chain
-from ..core.units import DEFAULT_UNITS
 from ..core.errors import JointError, NoSolutionError
 from ..core.segments import TAU, Circle
 from ..core.shapes import DEFAULT_SHAPE, TRANSITION_SHAPES, shape_code
-from ..core.transitions import Transition, circle_in_circle, circle_to_circle
+from ..core.spiral import BezierSpiral
+from ..core.transitions import Transition
+from ..core.units import DEFAULT_UNITS
 
 #: Belt sweeps within this of 2π count as 0 (coincident tangent points).
 _FULL_TURN_TOL = 1e-9
@@ -155,13 +157,7 @@ def circle_chain(circles: Sequence[Any], units: str = DEFAULT_UNITS, shape: str 
     shape_code(shape, TRANSITION_SHAPES)
     if len(items) < 2:
         raise ValueError(f"circle_chain needs at least 2 circles; got {len(items)}")
-    transitions = []
-    for i, (a, b) in enumerate(zip(items, items[1:])):
-        solve = circle_in_circle if _nested(a, b) else circle_to_circle
-        try:
-            transitions.append(solve(a.center, a.radius, b.center, b.radius, shape=shape))
-        except NoSolutionError as error:
-            raise NoSolutionError(f"circles {i} and {i + 1}: {error}") from None
+    transitions = _transitions(items, shape)
     sweeps = []
     for k in range(1, len(items) - 1):
         sweeps.append(_arc_sweep(items, transitions, k))
@@ -171,6 +167,38 @@ def circle_chain(circles: Sequence[Any], units: str = DEFAULT_UNITS, shape: str 
         k = error.part
         raise NoSolutionError(f"circles {k} and {k + 1}: float64 cannot hold the path G2 at these coordinates: {error}") from None
     return CircleChain(chain, items, transitions, sweeps)
+
+
+def _transitions(items: list[Circle], shape: str) -> list[Transition]:
+    """The transition between each pair of consecutive circles: one batch call per case (nested
+    pairs, and C/S pairs); the first pair that has none raises, named."""
+    centers = np.array([c.center for c in items])
+    radii = np.array([c.radius for c in items])
+    nested = np.array([_nested(a, b) for a, b in zip(items, items[1:])], dtype=bool)
+    solved = {}
+    for case, solve, rows in (("nested", batch.circle_in_circle, np.flatnonzero(nested)), ("pair", batch.circle_to_circle, np.flatnonzero(~nested))):
+        if len(rows):
+            solved[case] = (rows, solve(centers[rows], radii[rows], centers[rows + 1], radii[rows + 1], shape=shape))
+    failed = [(int(rows[k]), result) for rows, result in solved.values() for k in np.flatnonzero(~result.ok)]
+    if failed:
+        i, result = min(failed, key=lambda f: f[0])
+        k = int(np.flatnonzero(solved["nested" if nested[i] else "pair"][0] == i)[0])
+        error = result.error(k)
+        if isinstance(error, NoSolutionError):
+            raise NoSolutionError(f"circles {i} and {i + 1}: {error}")
+        raise error
+    transitions: list[Transition | None] = [None] * len(nested)
+    for case, (rows, result) in solved.items():
+        pairs = zip(rows.tolist(), zip(*(s.tolist() for s in result.spirals)), result.theta.tolist())
+        for k, (i, spirals, theta) in enumerate(pairs):
+            a, b = items[i], items[i + 1]
+            if case == "nested":
+                kind, parameter = "circle-circle-nested", float(result.parameter[k])
+            else:
+                kind, parameter = ("S" if (a.radius > 0) != (b.radius > 0) else "C"), None
+            curves = [BezierSpiral._wrap(np.array(cp), shape) for cp in spirals]
+            transitions[i] = Transition(kind, curves, theta, a, b, parameter=parameter, shape=shape)
+    return transitions
 
 
 def _arc_sweep(items: list[Circle], transitions: list[Transition], k: int) -> float:

@@ -235,9 +235,10 @@ class RoadCriteria(_Criteria):
             return self.design_speed * self.design_speed / (15.0 * e_f) * 0.3048 / to_metres(units)
         return self.design_speed * self.design_speed / (127.0 * e_f) / to_metres(units)
 
-    def superelevation(self, radius: float, units: str) -> float:
-        """e = e_max·R_min/R, at most e_max (AASHTO's method 1)."""
-        return min(self.superelevation_max, self.superelevation_max * self.minimum_radius(units) / radius)
+    def superelevation(self, radius: float | NDArray, units: str) -> float | NDArray:
+        """e = e_max·R_min/R, at most e_max (AASHTO's method 1); one radius or an array of them."""
+        e = np.minimum(self.superelevation_max, self.superelevation_max * self.minimum_radius(units) / np.asarray(radius, dtype=float))
+        return float(e) if e.ndim == 0 else e
 
     def shifts(self, units: str) -> tuple[float, float]:
         metres = to_metres(units)
@@ -264,8 +265,10 @@ class RoadCriteria(_Criteria):
         jerks = v * v * v * np.asarray(peak_rates) / to_metres(units) ** 2
         low, high = self.shifts(units)
         r_min = self.minimum_radius(units)
+        banking = self.superelevation(radii, units).tolist()
         rows = []
-        for pi, radius, length, shift, jerk, bound in zip(pis, radii, lengths, shifts, jerks, bounds):
+        columns = (np.asarray(a, dtype=float).tolist() for a in (radii, lengths, shifts, jerks, bounds))  # plain floats: cheap rows
+        for pi, radius, length, shift, jerk, bound, e in zip(pis, *columns, banking):
             violations = [f"R = {radius:.6g} < R_min = {r_min:.6g}"] if not radius >= r_min * (1 - 1e-12) else []
             for side, j, p in zip(("in", "out"), jerk, shift):
                 if not j <= self.max_jerk * (1 + 1e-9):
@@ -274,7 +277,6 @@ class RoadCriteria(_Criteria):
                     violations.append(f"{side}: shift p = {p:.4g} < p_min = {low:.4g}")
                 if not p <= high * (1 + 1e-9):
                     violations.append(f"{side}: shift p = {p:.4g} > p_max = {high:.4g}")
-            e = self.superelevation(radius, units)
             rows.append(CriteriaRow(int(pi), float(radius), r_min, tuple(map(float, length)), tuple(map(float, bound)),
                                     tuple(map(float, shift)), tuple(map(float, jerk)), self.max_jerk, e, e, tuple(violations),
                                     shape=shape))  # fmt: skip

@@ -31,13 +31,12 @@ from numpy.typing import ArrayLike, NDArray
 from ..core import _kernels as K
 from ..core import batch
 from ..core._inputs import as_float, as_points, as_real_array
-from ..core.chain import JOIN_TOLERANCE, Chain
+from ..core.chain import JOIN_TOLERANCE, Chain, PartCircles, join_rows, join_tolerance
 from ..core.errors import JointError, NoSolutionError, Status
-from ..core.segments import Ray, Segment
+from ..core.rows import SegmentRows
 from ..core.shapes import CORNER_SHAPES, DEFAULT_SHAPE, SHAPE_CODES, shape_code
 from ..core.spiral import BezierSpiral
-from ..core.transitions import Transition
-from ..core.units import DEFAULT_UNITS
+from ..core.units import DEFAULT_UNITS, length_unit
 
 #: Yang & Sukkarieh's leg ratio g/h: the smallest that keeps κ monotone.
 G2CBS_C2 = K.G2CBS_RATIO
@@ -221,7 +220,7 @@ def round_corners_batch(
     lin, lout, sin_t, cos_t = _half_deflection(p0, corners, p1)
     available = np.minimum(lin, lout)
     fit = np.isnan(k)
-    with np.errstate(invalid="ignore", divide="ignore"):
+    with np.errstate(invalid="ignore", divide="ignore", over="ignore"):  # a tiny leg: the curvature it needs overflows
         distance = np.where(fit, available, corner_scale(sin_t, cos_t, k, shape))
         needed = corner_scale(sin_t, cos_t, available, shape)
     result = batch.line_to_line(p0, corners, p1, k, shape=shape)
@@ -368,8 +367,8 @@ def round_corners(
     shape = corner_shape(shape, method)
     pts = as_points(points, "points")
     p0, corners, p1, index = corner_legs(pts)
-    parts: list[Transition | Segment] = []
     rounded: list[RoundedCorner] = []
+    spirals = np.empty((0, 2, 4, 2))
     if len(corners):
         result = round_corners_batch(p0, corners, p1, curvature=curvature, max_curvature=max_curvature, shape=shape)
         for j in np.flatnonzero(~result.ok):
@@ -377,22 +376,17 @@ def round_corners(
             if result.status[j] in (Status.LEGS_TOO_SHORT, Status.CORNER_REVERSAL, Status.UNVERIFIED, Status.OUTSIDE_SHAPE):
                 raise NoSolutionError(message)
             raise ValueError(message)
-        for j, cp in enumerate(result.control_points):
-            spirals = (BezierSpiral.from_control_points(cp[0], shape), BezierSpiral.from_control_points(cp[1], shape))
-            corner = tuple(corners[j])
-            parts.append(
-                Transition(
-                    "line-line",
-                    list(spirals),
-                    float(result.theta[j]),
-                    start_line=Ray(corner, tuple(corners[j] - p0[j])),
-                    end_line=Ray(corner, tuple(p1[j] - corners[j])),
-                    shape=shape,
-                )
-            )
-            rounded.append(RoundedCorner(int(index[j]), float(result.theta[j]), float(result.distance[j]), float(result.curvature[j]), spirals))
+        spirals = result.control_points
+        numbers = zip(index.tolist(), result.theta.tolist(), result.distance.tolist(), result.curvature.tolist())
+        for cp, (i, theta, distance, peak) in zip(spirals, numbers):
+            pair = (BezierSpiral._wrap(cp[0], shape), BezierSpiral._wrap(cp[1], shape))
+            rounded.append(RoundedCorner(i, theta, distance, peak, pair))
+    # Each corner's pair is one part; the lines between them follow (``Chain.join`` on arrays).
+    rows = SegmentRows.spirals(spirals.reshape(-1, 4, 2), shape)
+    objects = [s for corner in rounded for s in corner.spirals]
     try:
-        chain = Chain.join(parts, pts[0], pts[-1], tolerance, units)
+        chain = join_rows(rows, np.full(len(rounded), 2), PartCircles(len(rounded)), tuple(pts[0].tolist()),
+                          tuple(pts[-1].tolist()), join_tolerance(tolerance), length_unit(units), objects)  # fmt: skip
     except JointError as error:
         raise NoSolutionError(f"corner {index[error.part]}: float64 cannot hold its spirals G2 at these coordinates: {error}") from None
     return RoundedPath(chain, rounded, shape)
