@@ -232,6 +232,28 @@ def test_step_edges_share_their_vertices_in_travel_order(tmp_path, name):
         assert_same_geometry(edge, seg, 1e-9, 1 / 25.4)
 
 
+def test_a_chain_in_space_is_written_as_exact_3d_edges_of_one_wire(tmp_path):
+    from test_chain3d import helix_chain
+
+    from spiral_cad.continuity import check_continuity
+
+    helix, _, _ = helix_chain()
+    normal = np.array([0.0, -1.0, 1.0])
+    arcs = Chain.join([Arc.in_space((1.0, 2.0, 3.0), normal, (6.0, 2.0, 3.0), 0.5),
+                       Arc.in_space((1.0, 2.0, 3.0), normal, (6.0, 2.0, 3.0), -0.8).reversed()])  # fmt: skip
+    for chain in (helix, arcs):
+        path = tmp_path / "space.step"
+        export_step(chain, path)
+        (edges,) = wires_of(read_shape(path, units="in"))
+        assert len(edges) == len(chain)
+        for edge, seg in zip(edges, chain):
+            curve, t0, t1 = travel_range(edge)
+            u = np.linspace(0.0, 1.0, 9)
+            got = np.array([vec(curve.Value(t0 + ui * (t1 - t0))) for ui in u]) * 25.4
+            assert np.abs(got - seg.point(u)).max() <= 1e-9 * chain.size
+        assert check_continuity(path).passes("G2")
+
+
 def test_iges_global_section_names_the_design_and_no_login(tmp_path):
     import getpass
 

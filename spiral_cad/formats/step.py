@@ -1,8 +1,8 @@
 """STEP (ISO 10303-21, AP214) for chains, written directly: exact curves, one wire per chain.
 
-Each chain becomes one ``CONNECTED_EDGE_SET`` of ``EDGE_CURVE`` entities in
-travel order; consecutive edges share their ``VERTEX_POINT`` (a closed chain
-ends on the vertex it starts from). The sets make one
+Each chain (in the plane or in space) becomes one ``CONNECTED_EDGE_SET`` of
+``EDGE_CURVE`` entities in travel order; consecutive edges share their
+``VERTEX_POINT`` (a closed chain ends on the vertex it starts from). The sets make one
 ``EDGE_BASED_WIREFRAME_MODEL`` of an ``EDGE_BASED_WIREFRAME_SHAPE_REPRESENTATION``:
 the shape of a ``PRODUCT`` named after the design. OCCT's reader, and so
 FreeCAD, turns each set into one connected ``TopoDS_Wire`` by adding its
@@ -22,7 +22,8 @@ curve in the same sense):
 
 * ``Line``: a ``LINE`` from the start point along the unit direction;
 * ``Arc``: a ``CIRCLE`` whose placement's x axis points at the arc's start,
-  its axis +Z for counterclockwise travel and −Z for clockwise;
+  its axis the arc's normal (+Z in the plane) for counterclockwise travel
+  and the opposite for clockwise;
 * ``BezierSpiral``: a ``B_SPLINE_CURVE_WITH_KNOTS`` of degree 3 with the
   spiral's four control points and knots (0, 1) of multiplicity 4
   (``PIECEWISE_BEZIER_KNOTS``): the same polynomial as the Bézier.
@@ -47,6 +48,9 @@ import math
 import os
 from collections.abc import Sequence
 from datetime import datetime, timezone
+
+import numpy as np
+from numpy.typing import NDArray
 
 from ..core.chain import Chain
 from ..core.segments import Arc, Line, Segment, measure_join
@@ -82,30 +86,32 @@ class _Entities:
         self.lines.append(text)
         return f"#{len(self.lines)}"
 
-    def point(self, x: float, y: float) -> str:
-        return self.add(f"CARTESIAN_POINT('',({real(x)},{real(y)},0.))")
+    def point(self, x: float, y: float, z: float = 0.0) -> str:
+        return self.add(f"CARTESIAN_POINT('',({real(x)},{real(y)},{real(z)}))")
 
     def direction(self, x: float, y: float, z: float = 0.0) -> str:
         return self.add(f"DIRECTION('',({real(x)},{real(y)},{real(z)}))")
 
 
+def _unit(vector: NDArray) -> list[float]:
+    return (vector / np.linalg.norm(vector)).tolist()
+
+
 def _line(data: _Entities, line: Line, start: str) -> str:
-    (ax, ay), (bx, by) = line.start.tolist(), line.end.tolist()
-    length = line.length
-    vector = data.add(f"VECTOR('',{data.direction((bx - ax) / length, (by - ay) / length)},1.)")
+    vector = data.add(f"VECTOR('',{data.direction(*_unit(line.end - line.start))},1.)")
     return data.add(f"LINE('',{start},{vector})")
 
 
 def _arc(data: _Entities, arc: Arc, start: str) -> str:
-    cx, cy = arc.center.tolist()
-    a0 = arc.start_angle
-    axis = data.direction(0.0, 0.0, 1.0 if arc.radius > 0 else -1.0)
-    placement = data.add(f"AXIS2_PLACEMENT_3D('',{data.point(cx, cy)},{axis},{data.direction(math.cos(a0), math.sin(a0))})")
+    """A circle about the arc's axis (its normal, reversed for clockwise travel) with its x axis at the start."""
+    axis = data.direction(*(math.copysign(1.0, arc.radius) * arc.normal).tolist())
+    reference = data.direction(*_unit(arc.start - arc.center))
+    placement = data.add(f"AXIS2_PLACEMENT_3D('',{data.point(*arc.center.tolist())},{axis},{reference})")
     return data.add(f"CIRCLE('',{placement},{real(abs(arc.radius))})")
 
 
 def _spiral(data: _Entities, spiral: BezierSpiral, start: str) -> str:
-    poles = ",".join([start] + [data.point(x, y) for x, y in spiral.control_points[1:].tolist()])
+    poles = ",".join([start] + [data.point(*p) for p in spiral.control_points[1:].tolist()])
     return data.add(f"B_SPLINE_CURVE_WITH_KNOTS('',3,({poles}),.UNSPECIFIED.,.F.,.F.,(4,4),(0.,1.),.PIECEWISE_BEZIER_KNOTS.)")
 
 
