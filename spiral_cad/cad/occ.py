@@ -16,7 +16,6 @@ from X towards Y, arcs in space about their own normal.
 from __future__ import annotations
 
 import io
-import math
 import os
 import re
 import sys
@@ -25,6 +24,8 @@ from collections.abc import Iterable, Iterator
 from contextlib import contextmanager
 from typing import TYPE_CHECKING, Any
 
+import numpy as np
+from numpy.typing import NDArray
 from OCP.BRep import BRep_Builder, BRep_Tool
 from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeEdge
 from OCP.Geom import (
@@ -34,14 +35,15 @@ from OCP.Geom import (
     Geom_Curve,
     Geom_Line,
 )
-from OCP.gp import gp_Ax2, gp_Ax3, gp_Dir, gp_Pnt, gp_Vec
+from OCP.gp import gp_Ax2, gp_Ax3, gp_Dir, gp_Pnt
 from OCP.Precision import Precision
 from OCP.TColgp import TColgp_Array1OfPnt
 from OCP.TColStd import TColStd_Array1OfInteger, TColStd_Array1OfReal
 from OCP.TopoDS import TopoDS_Compound, TopoDS_Edge, TopoDS_Shape, TopoDS_Vertex, TopoDS_Wire
 
 from ..core._chain_kernels import ARC, LINE, SPIRAL
-from ..core.segments import Segment
+from ..core.rows import SegmentRows
+from ..core.segments import Segment, row_frames
 from ..formats.joints import ROUNDING_ULPS
 from .readers import ReadError, read_shape
 
@@ -83,6 +85,12 @@ class _Frame:
             origin[2] + x * xz + y * yz + z * zz,
         )
 
+    def map(self, points: NDArray) -> NDArray:
+        """Chain coordinates (..., 3) as OCCT's, all at once (``pnt`` for many points)."""
+        if self.flat:
+            return points
+        return np.asarray(self.origin) + points @ np.array([self.x, self.y, self.z])
+
     def pnt(self, x: float, y: float, z: float = 0.0) -> gp_Pnt:
         """The point at chain coordinates (x, y) or (x, y, z)."""
         if self.flat:
@@ -114,60 +122,70 @@ def _frame(plane: gp_Ax3 | None) -> _Frame:
 CurveSpan = tuple[Geom_Curve, float, float]
 
 
-# A segment as a row of a chain's arrays (``spiral_cad.core.rows``): kind, its
-# four points (x, y, z) and its arc numbers (signed radius, start angle, sweep).
-Row = tuple[int, list[list[float]], list[float]]
+# A segment as one flat row of floats made from a chain's arrays (``spiral_cad.core.rows``):
+# its four points (x, y, z: 12), its arc numbers (signed radius, start angle, sweep: 3), and
+# what its curve needs besides: a line's unit direction and length, an arc's axis in the
+# travel sense and first parameter (4).
+Row = list[float]
 
 
-def _line_curve(g: list[list[float]], p: list[float], frame: _Frame) -> CurveSpan:
-    a, b = frame.pnt(*g[0]), frame.pnt(*g[1])
-    return Geom_Line(a, gp_Dir(gp_Vec(a, b))), 0.0, a.Distance(b)
+def _line_curve(r: Row, frame: _Frame) -> CurveSpan:
+    return Geom_Line(frame.pnt(r[0], r[1], r[2]), frame.dir(r[15], r[16], r[17])), 0.0, r[18]
 
 
-def _arc_curve(g: list[list[float]], p: list[float], frame: _Frame) -> CurveSpan:
-    """A ``Geom_Circle`` about the arc's normal e1 × e2 (flipped for clockwise travel, so the
-    parameter increases along the path: the point at polar angle a has parameter -a)."""
-    center, e1, e2 = g[0], g[1], g[2]
-    radius, a0, sweep = p
-    normal = frame.dir(e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2], e1[0] * e2[1] - e1[1] * e2[0])
-    axis, first = (normal, a0) if radius > 0.0 else (normal.Reversed(), -a0)
-    circle = Geom_Circle(gp_Ax2(frame.pnt(*center), axis, frame.dir(*e1)), abs(radius))
-    return circle, first, first + sweep
+def _arc_curve(r: Row, frame: _Frame) -> CurveSpan:
+    """A ``Geom_Circle`` about the arc's normal e1 × e2, flipped for clockwise travel so that the
+    parameter increases along the path (the point at polar angle a then has parameter -a)."""
+    axis = gp_Ax2(frame.pnt(r[0], r[1], r[2]), frame.dir(r[15], r[16], r[17]), frame.dir(r[3], r[4], r[5]))
+    return Geom_Circle(axis, abs(r[12])), r[18], r[18] + r[14]
 
 
-def _bezier_curve(g: list[list[float]], p: list[float], frame: _Frame) -> CurveSpan:
-    return Geom_BezierCurve(frame.poles(g)), 0.0, 1.0
+def _bezier_curve(r: Row, frame: _Frame) -> CurveSpan:
+    poles = TColgp_Array1OfPnt(1, 4)
+    for i in range(4):
+        poles.SetValue(i + 1, frame.pnt(r[3 * i], r[3 * i + 1], r[3 * i + 2]))
+    return Geom_BezierCurve(poles), 0.0, 1.0
 
 
 _MAKERS = {LINE: _line_curve, ARC: _arc_curve, SPIRAL: _bezier_curve}
 
 
-def _rows(segments: Iterable[Segment]) -> tuple[Iterator[Row], list[str], list[float]]:
-    """The rows of ``segments`` (a ``Chain``'s own arrays, or each segment's row), their kind names and lengths.
-
-    Rows are made one at a time as they are used: a long chain's rows as nested
-    lists at once would keep the garbage collector busy.
-    """
+def _segment_rows(segments: Any) -> SegmentRows:
+    """The rows of a ``Chain`` (its own arrays) or of any segments."""
     from ..core.chain import Chain  # chain.py imports this module lazily in turn
+    from ..core.rows import SegmentRows
 
     if isinstance(segments, Chain):
-        rows = segments.rows
-        kinds = rows.kind.tolist()
-        names = [("Line", "Arc", "BezierSpiral")[k] for k in kinds]
-        made = ((k, g.tolist(), p.tolist()) for k, g, p in zip(kinds, rows.geometry, rows.params))
-        return made, names, segments.lengths.tolist()
+        return segments.rows
     items = list(segments)
     for segment in items:
         if not isinstance(segment, Segment):
             raise ValueError(f"segment must be a Line, Arc or BezierSpiral; got {segment!r}")
-    made = ((k, g.tolist(), list(p)) for k, g, p in (segment._row() for segment in items))
-    return made, [type(s).__name__ for s in items], [s.length for s in items]
+    return SegmentRows.of_segments(items)
 
 
-def _curve_span(row: Row, frame: _Frame) -> CurveSpan:
-    """The exact curve of a segment row and its travel-order range."""
-    kind, g, p = row
-    return _MAKERS[kind](g, p, frame)
+def _rows(rows: SegmentRows) -> tuple[list[int], list[Row]]:
+    """The kinds and flat rows of ``rows``, made in one pass over the arrays (nested lists per
+    segment would cost more than the edges: the garbage collector walks every one)."""
+    kind, g, p = rows.kind, rows.geometry, rows.params
+    extra = np.zeros((len(kind), 4))
+    with np.errstate(all="ignore"):
+        line = kind == LINE
+        step = g[line, 1] - g[line, 0]
+        length = np.hypot(np.hypot(step[:, 0], step[:, 1]), step[:, 2])
+        extra[line, :3], extra[line, 3] = step / length[:, None], length
+        arc = kind == ARC
+        turn = np.where(p[arc, 0] > 0.0, 1.0, -1.0)
+        extra[arc, :3] = turn[:, None] * np.cross(g[arc, 1], g[arc, 2])
+        extra[arc, 3] = turn * p[arc, 1]
+    table = np.concatenate([g.reshape(len(kind), 12), p, extra], axis=1)
+    return kind.tolist(), table.tolist()
+
+
+def _curve_spans(rows: SegmentRows, frame: _Frame) -> list[CurveSpan]:
+    """The exact curve of every segment row and its travel-order range."""
+    kinds, table = _rows(rows)
+    return [_MAKERS[kind](row, frame) for kind, row in zip(kinds, table)]
 
 
 def segment_edge(segment: Segment, plane: gp_Ax3 | None = None) -> TopoDS_Edge:
@@ -184,14 +202,13 @@ def segment_edge(segment: Segment, plane: gp_Ax3 | None = None) -> TopoDS_Edge:
         ValueError: an unsupported segment type or a ``plane`` that is not a
             ``gp_Ax3``.
     """
-    (row,) = _rows([segment])[0]
-    return BRepBuilderAPI_MakeEdge(*_curve_span(row, _frame(plane))).Edge()
+    (span,) = _curve_spans(_segment_rows([segment]), _frame(plane))
+    return BRepBuilderAPI_MakeEdge(*span).Edge()
 
 
 def segment_edges(segments: Iterable[Segment], plane: gp_Ax3 | None = None) -> list[TopoDS_Edge]:
     """``segment_edge`` for many segments sharing one frame (a ``Chain``: from its arrays, no segment objects)."""
-    frame = _frame(plane)
-    return [BRepBuilderAPI_MakeEdge(*_curve_span(row, frame)).Edge() for row in _rows(segments)[0]]
+    return [BRepBuilderAPI_MakeEdge(*span).Edge() for span in _curve_spans(_segment_rows(segments), _frame(plane))]
 
 
 def chain_wire(chain: Iterable[Segment], plane: gp_Ax3 | None = None) -> TopoDS_Wire:
@@ -203,36 +220,43 @@ def chain_wire(chain: Iterable[Segment], plane: gp_Ax3 | None = None) -> TopoDS_
     start gives a closed wire. Ends meet when they are within OCCT's vertex
     tolerance (1e-7) plus the rounding the G2 checker allows at their
     coordinates (``ROUNDING_ULPS`` units in the last place), and each vertex
-    carries that tolerance (1e-7 for coordinates up to ~1e8).
+    carries that tolerance (1e-7 for coordinates up to ~1e8). The ends and
+    their gaps are computed for all joints at once from the segment rows.
 
     Raises:
         ValueError: consecutive segments do not meet, a segment too short
             for OCCT to make an edge of, or no segments.
     """
     frame = _frame(plane)
-    rows, names, lengths = _rows(chain)
-    spans = [_curve_span(row, frame) for row in rows]
-    if not spans:
+    rows = _segment_rows(chain)
+    if not len(rows):
         raise ValueError("chain_wire needs at least one segment")
-    ends = [(curve.Value(first), curve.Value(last)) for curve, first, last in spans]
+    spans = _curve_spans(rows, frame)
+    ends = frame.map(row_frames(rows.kind, rows.geometry, rows.params, rows.dim)[0][:, :, :3])  # (n, 2: start, end; xyz)
+    before, after = ends[:, 1], np.roll(ends[:, 0], -1, axis=0)  # joint i: end of segment i, start of the next
+    tolerance = Precision.Confusion_s() + ROUNDING_ULPS * np.spacing(np.maximum(np.abs(before), np.abs(after)).max(axis=1))
+    gap = np.hypot(np.hypot(*(before - after)[:, :2].T), (before - after)[:, 2])
+    apart = np.flatnonzero(~(gap[:-1] <= tolerance[:-1]))
+    if apart.size:
+        i = int(apart[0])
+        raise ValueError(f"segment {i + 1} does not connect to segment {i}: gap {gap[i]:.3g}")
+    closed = bool(gap[-1] <= tolerance[-1])
     builder = BRep_Builder()
-    vertices = [_vertex(builder, ends[0][0], ends[0][0])]
-    for i, ((_, end), (start, _)) in enumerate(zip(ends, ends[1:])):
-        if end.Distance(start) > _tolerance(end, start):
-            raise ValueError(f"segment {i + 1} does not connect to segment {i}: gap {end.Distance(start):.3g}")
-        vertices.append(_vertex(builder, end, start))
-    closed = ends[-1][1].Distance(ends[0][0]) <= _tolerance(ends[-1][1], ends[0][0])
-    if closed:
-        vertices[0] = _vertex(builder, ends[0][0], ends[-1][1])
-    vertices.append(vertices[0] if closed else _vertex(builder, ends[-1][1], ends[-1][1]))
+    points, tolerances = before.tolist(), tolerance.tolist()
+    first, last = ends[0, 0].tolist(), ends[-1, 1].tolist()
+    single = Precision.Confusion_s() + ROUNDING_ULPS * np.spacing(np.abs(ends[[0, -1], [0, 1]]).max(axis=1))
+    start = _vertex(builder, first, tolerances[-1] if closed else float(single[0]))
+    vertices = [start] + [_vertex(builder, p, t) for p, t in zip(points[:-1], tolerances[:-1])]
+    vertices.append(start if closed else _vertex(builder, last, float(single[1])))
     wire = TopoDS_Wire()
     builder.MakeWire(wire)
-    for i, ((curve, first, last), v0, v1) in enumerate(zip(spans, vertices, vertices[1:])):
-        maker = BRepBuilderAPI_MakeEdge(curve, v0, v1, first, last)
+    for i, ((curve, u0, u1), v0, v1) in enumerate(zip(spans, vertices, vertices[1:])):
+        maker = BRepBuilderAPI_MakeEdge(curve, v0, v1, u0, u1)
         if not maker.IsDone():
-            short = lengths[i] <= 10.0 * BRep_Tool.Tolerance_s(v0)
+            length, name = float(rows.lengths[i]), ("Line", "Arc", "BezierSpiral")[int(rows.kind[i])]
+            short = length <= 10.0 * BRep_Tool.Tolerance_s(v0)
             raise ValueError(
-                f"segment {i} ({names[i]}, length {lengths[i]:.3g}) cannot be an OCCT edge "
+                f"segment {i} ({name}, length {length:.3g}) cannot be an OCCT edge "
                 f"({maker.Error().name})"
                 + (
                     f": OCCT merges points closer than {BRep_Tool.Tolerance_s(v0):.3g} model units, so its edges must be "
@@ -246,17 +270,10 @@ def chain_wire(chain: Iterable[Segment], plane: gp_Ax3 | None = None) -> TopoDS_
     return wire
 
 
-def _tolerance(a: gp_Pnt, b: gp_Pnt) -> float:
-    """How far apart two edge ends may be and share a vertex: OCCT's 1e-7 plus the rounding the
-    G2 checker allows at their coordinates (``ROUNDING_ULPS`` units in the last place)."""
-    magnitude = max(abs(a.X()), abs(a.Y()), abs(a.Z()), abs(b.X()), abs(b.Y()), abs(b.Z()))
-    return Precision.Confusion_s() + ROUNDING_ULPS * math.ulp(magnitude)
-
-
-def _vertex(builder: BRep_Builder, point: gp_Pnt, other: gp_Pnt) -> TopoDS_Vertex:
-    """The vertex at ``point`` shared with an edge end at ``other``, with that joint's tolerance."""
+def _vertex(builder: BRep_Builder, point: list[float], tolerance: float) -> TopoDS_Vertex:
+    """A vertex at ``point`` (OCCT's coordinates) with ``tolerance``."""
     vertex = TopoDS_Vertex()
-    builder.MakeVertex(vertex, point, _tolerance(point, other))
+    builder.MakeVertex(vertex, gp_Pnt(*point), tolerance)
     return vertex
 
 
