@@ -44,7 +44,7 @@ from OCP.TopoDS import TopoDS_Compound, TopoDS_Edge, TopoDS_Shape, TopoDS_Vertex
 from ..core._chain_kernels import ARC, LINE, SPIRAL
 from ..core.rows import SegmentRows
 from ..core.segments import Segment, row_frames
-from ..formats.joints import ROUNDING_ULPS
+from ..formats.joints import ROUNDING_ULPS, norms
 from .readers import ReadError, read_shape
 
 __all__ = ["ReadError", "as_occ_shape", "captured_messages", "chain_wire", "nurbs_edge", "read_shape", "segment_edge", "segment_edges"]
@@ -87,9 +87,11 @@ class _Frame:
 
     def map(self, points: NDArray) -> NDArray:
         """Chain coordinates (..., 3) as OCCT's, all at once (``pnt`` for many points)."""
-        if self.flat:
-            return points
-        return np.asarray(self.origin) + points @ np.array([self.x, self.y, self.z])
+        return points if self.flat else np.asarray(self.origin) + self.turn(points)
+
+    def turn(self, vectors: NDArray) -> NDArray:
+        """Chain vectors (..., 3) as OCCT's (``dir`` for many vectors, unnormalised)."""
+        return vectors if self.flat else vectors @ np.array([self.x, self.y, self.z])
 
     def pnt(self, x: float, y: float, z: float = 0.0) -> gp_Pnt:
         """The point at chain coordinates (x, y) or (x, y, z)."""
@@ -129,21 +131,25 @@ CurveSpan = tuple[Geom_Curve, float, float]
 Row = list[float]
 
 
-def _line_curve(r: Row, frame: _Frame) -> CurveSpan:
-    return Geom_Line(frame.pnt(r[0], r[1], r[2]), frame.dir(r[15], r[16], r[17])), 0.0, r[18]
+# Each maker takes the row, its first point as a ``gp_Pnt`` (a line's or spiral's start, an
+# arc's centre) and a 4-pole array to fill (a Bézier copies its poles: one array serves all).
 
 
-def _arc_curve(r: Row, frame: _Frame) -> CurveSpan:
+def _line_curve(r: Row, first: gp_Pnt, poles: TColgp_Array1OfPnt) -> CurveSpan:
+    return Geom_Line(first, gp_Dir(r[15], r[16], r[17])), 0.0, r[18]
+
+
+def _arc_curve(r: Row, first: gp_Pnt, poles: TColgp_Array1OfPnt) -> CurveSpan:
     """A ``Geom_Circle`` about the arc's normal e1 × e2, flipped for clockwise travel so that the
     parameter increases along the path (the point at polar angle a then has parameter -a)."""
-    axis = gp_Ax2(frame.pnt(r[0], r[1], r[2]), frame.dir(r[15], r[16], r[17]), frame.dir(r[3], r[4], r[5]))
+    axis = gp_Ax2(first, gp_Dir(r[15], r[16], r[17]), gp_Dir(r[3], r[4], r[5]))
     return Geom_Circle(axis, abs(r[12])), r[18], r[18] + r[14]
 
 
-def _bezier_curve(r: Row, frame: _Frame) -> CurveSpan:
-    poles = TColgp_Array1OfPnt(1, 4)
-    for i in range(4):
-        poles.SetValue(i + 1, frame.pnt(r[3 * i], r[3 * i + 1], r[3 * i + 2]))
+def _bezier_curve(r: Row, first: gp_Pnt, poles: TColgp_Array1OfPnt) -> CurveSpan:
+    poles.SetValue(1, first)
+    for i in (1, 2, 3):
+        poles.SetValue(i + 1, gp_Pnt(r[3 * i], r[3 * i + 1], r[3 * i + 2]))
     return Geom_BezierCurve(poles), 0.0, 1.0
 
 
@@ -164,9 +170,10 @@ def _segment_rows(segments: Any) -> SegmentRows:
     return SegmentRows.of_segments(items)
 
 
-def _rows(rows: SegmentRows) -> tuple[list[int], list[Row]]:
-    """The kinds and flat rows of ``rows``, made in one pass over the arrays (nested lists per
-    segment would cost more than the edges: the garbage collector walks every one)."""
+def _rows(rows: SegmentRows, frame: _Frame) -> tuple[list[int], list[Row]]:
+    """The kinds and flat rows of ``rows`` in OCCT's coordinates (``frame``), made in one pass
+    over the arrays (nested lists per segment would cost more than the edges: the garbage
+    collector walks every one)."""
     kind, g, p = rows.kind, rows.geometry, rows.params
     extra = np.zeros((len(kind), 4))
     with np.errstate(all="ignore"):
@@ -178,14 +185,22 @@ def _rows(rows: SegmentRows) -> tuple[list[int], list[Row]]:
         turn = np.where(p[arc, 0] > 0.0, 1.0, -1.0)
         extra[arc, :3] = turn[:, None] * np.cross(g[arc, 1], g[arc, 2])
         extra[arc, 3] = turn * p[arc, 1]
+    if not frame.flat:  # points move and turn, directions (an arc's basis, the extras) only turn
+        arc_basis = frame.turn(g[arc, 1:3])
+        g = frame.map(g)
+        g[arc, 1:3] = arc_basis
+        extra[:, :3] = frame.turn(extra[:, :3])
     table = np.concatenate([g.reshape(len(kind), 12), p, extra], axis=1)
     return kind.tolist(), table.tolist()
 
 
-def _curve_spans(rows: SegmentRows, frame: _Frame) -> list[CurveSpan]:
-    """The exact curve of every segment row and its travel-order range."""
-    kinds, table = _rows(rows)
-    return [_MAKERS[kind](row, frame) for kind, row in zip(kinds, table)]
+def _curve_spans(rows: SegmentRows, frame: _Frame) -> tuple[list[CurveSpan], list[gp_Pnt]]:
+    """The exact curve of every segment row and its travel-order range, and each row's first
+    point (a line's or spiral's start: ``chain_wire`` puts its vertex there)."""
+    kinds, table = _rows(rows, frame)
+    firsts = [gp_Pnt(r[0], r[1], r[2]) for r in table]
+    poles = TColgp_Array1OfPnt(1, 4)
+    return [_MAKERS[kind](row, first, poles) for kind, row, first in zip(kinds, table, firsts)], firsts
 
 
 def segment_edge(segment: Segment, plane: gp_Ax3 | None = None) -> TopoDS_Edge:
@@ -202,13 +217,13 @@ def segment_edge(segment: Segment, plane: gp_Ax3 | None = None) -> TopoDS_Edge:
         ValueError: an unsupported segment type or a ``plane`` that is not a
             ``gp_Ax3``.
     """
-    (span,) = _curve_spans(_segment_rows([segment]), _frame(plane))
+    (span,), _ = _curve_spans(_segment_rows([segment]), _frame(plane))
     return BRepBuilderAPI_MakeEdge(*span).Edge()
 
 
 def segment_edges(segments: Iterable[Segment], plane: gp_Ax3 | None = None) -> list[TopoDS_Edge]:
     """``segment_edge`` for many segments sharing one frame (a ``Chain``: from its arrays, no segment objects)."""
-    return [BRepBuilderAPI_MakeEdge(*span).Edge() for span in _curve_spans(_segment_rows(segments), _frame(plane))]
+    return [BRepBuilderAPI_MakeEdge(*span).Edge() for span in _curve_spans(_segment_rows(segments), _frame(plane))[0]]
 
 
 def chain_wire(chain: Iterable[Segment], plane: gp_Ax3 | None = None) -> TopoDS_Wire:
@@ -231,28 +246,39 @@ def chain_wire(chain: Iterable[Segment], plane: gp_Ax3 | None = None) -> TopoDS_
     rows = _segment_rows(chain)
     if not len(rows):
         raise ValueError("chain_wire needs at least one segment")
-    spans = _curve_spans(rows, frame)
+    spans, firsts = _curve_spans(rows, frame)
     ends = frame.map(row_frames(rows.kind, rows.geometry, rows.params, rows.dim)[0][:, :, :3])  # (n, 2: start, end; xyz)
     before, after = ends[:, 1], np.roll(ends[:, 0], -1, axis=0)  # joint i: end of segment i, start of the next
     tolerance = Precision.Confusion_s() + ROUNDING_ULPS * np.spacing(np.maximum(np.abs(before), np.abs(after)).max(axis=1))
-    gap = np.hypot(np.hypot(*(before - after)[:, :2].T), (before - after)[:, 2])
+    gap = norms(before - after)
     apart = np.flatnonzero(~(gap[:-1] <= tolerance[:-1]))
     if apart.size:
         i = int(apart[0])
         raise ValueError(f"segment {i + 1} does not connect to segment {i}: gap {gap[i]:.3g}")
     closed = bool(gap[-1] <= tolerance[-1])
-    builder = BRep_Builder()
-    points, tolerances = before.tolist(), tolerance.tolist()
-    first, last = ends[0, 0].tolist(), ends[-1, 1].tolist()
+    # each vertex at its segment's start (the point a line or spiral starts from exactly), with
+    # the tolerance of the joint before it; the first with the closing joint's or its own
     single = Precision.Confusion_s() + ROUNDING_ULPS * np.spacing(np.abs(ends[[0, -1], [0, 1]]).max(axis=1))
-    start = _vertex(builder, first, tolerances[-1] if closed else float(single[0]))
-    vertices = [start] + [_vertex(builder, p, t) for p, t in zip(points[:-1], tolerances[:-1])]
-    vertices.append(start if closed else _vertex(builder, last, float(single[1])))
+    tolerances = np.roll(tolerance, 1)
+    tolerances[0] = tolerance[-1] if closed else single[0]
+    builder = BRep_Builder()
+    starts = [first if kind != ARC else gp_Pnt(*start) for kind, first, start in
+              zip(rows.kind.tolist(), firsts, ends[:, 0].tolist())]  # fmt: skip
+    if not closed:
+        starts.append(gp_Pnt(*ends[-1, 1].tolist()))
+    vertices = [TopoDS_Vertex() for _ in starts]
+    make_vertex, add = builder.MakeVertex, builder.Add
+    for vertex, point, vertex_tolerance in zip(vertices, starts, tolerances.tolist() + [float(single[1])]):
+        make_vertex(vertex, point, vertex_tolerance)
+    if closed:
+        vertices.append(vertices[0])
     wire = TopoDS_Wire()
     builder.MakeWire(wire)
     for i, ((curve, u0, u1), v0, v1) in enumerate(zip(spans, vertices, vertices[1:])):
         maker = BRepBuilderAPI_MakeEdge(curve, v0, v1, u0, u1)
-        if not maker.IsDone():
+        try:
+            add(wire, maker.Edge())
+        except Exception:  # OCCT's StdFail_NotDone: say why, below
             length, name = float(rows.lengths[i]), ("Line", "Arc", "BezierSpiral")[int(rows.kind[i])]
             short = length <= 10.0 * BRep_Tool.Tolerance_s(v0)
             raise ValueError(
@@ -264,17 +290,9 @@ def chain_wire(chain: Iterable[Segment], plane: gp_Ax3 | None = None) -> TopoDS_
                     if short
                     else ""
                 )
-            )
-        builder.Add(wire, maker.Edge())
+            ) from None
     wire.Closed(closed)
     return wire
-
-
-def _vertex(builder: BRep_Builder, point: list[float], tolerance: float) -> TopoDS_Vertex:
-    """A vertex at ``point`` (OCCT's coordinates) with ``tolerance``."""
-    vertex = TopoDS_Vertex()
-    builder.MakeVertex(vertex, gp_Pnt(*point), tolerance)
-    return vertex
 
 
 def nurbs_edge(nurbs: Nurbs, plane: gp_Ax3 | None = None) -> TopoDS_Edge:
