@@ -124,32 +124,33 @@ def _frame(plane: gp_Ax3 | None) -> _Frame:
 CurveSpan = tuple[Geom_Curve, float, float]
 
 
-# A segment as one flat row of floats made from a chain's arrays (``spiral_cad.core.rows``):
-# its four points (x, y, z: 12), its arc numbers (signed radius, start angle, sweep: 3), and
-# what its curve needs besides: a line's unit direction and length, an arc's axis in the
-# travel sense and first parameter (4).
-Row = list[float]
+# The segments as columns of floats made from a chain's arrays (``spiral_cad.core.rows``): the
+# four points of each (x, y, z: columns 0–11), its arc numbers (signed radius, start angle,
+# sweep: 12–14), and what its curve needs besides (15–18): a line's unit direction and length,
+# an arc's axis in the travel sense and first parameter. Columns, not a list per segment: a
+# long chain would otherwise hold one live list per segment, and the garbage collector walks them.
+Columns = list[list[float]]
+
+# Each maker takes the columns, the segment's index, its first point as a ``gp_Pnt`` (a line's or
+# spiral's start, an arc's centre) and a 4-pole array to fill (a Bézier copies its poles: one
+# array serves all).
 
 
-# Each maker takes the row, its first point as a ``gp_Pnt`` (a line's or spiral's start, an
-# arc's centre) and a 4-pole array to fill (a Bézier copies its poles: one array serves all).
+def _line_curve(c: Columns, i: int, first: gp_Pnt, poles: TColgp_Array1OfPnt) -> CurveSpan:
+    return Geom_Line(first, gp_Dir(c[15][i], c[16][i], c[17][i])), 0.0, c[18][i]
 
 
-def _line_curve(r: Row, first: gp_Pnt, poles: TColgp_Array1OfPnt) -> CurveSpan:
-    return Geom_Line(first, gp_Dir(r[15], r[16], r[17])), 0.0, r[18]
-
-
-def _arc_curve(r: Row, first: gp_Pnt, poles: TColgp_Array1OfPnt) -> CurveSpan:
+def _arc_curve(c: Columns, i: int, first: gp_Pnt, poles: TColgp_Array1OfPnt) -> CurveSpan:
     """A ``Geom_Circle`` about the arc's normal e1 × e2, flipped for clockwise travel so that the
     parameter increases along the path (the point at polar angle a then has parameter -a)."""
-    axis = gp_Ax2(first, gp_Dir(r[15], r[16], r[17]), gp_Dir(r[3], r[4], r[5]))
-    return Geom_Circle(axis, abs(r[12])), r[18], r[18] + r[14]
+    axis = gp_Ax2(first, gp_Dir(c[15][i], c[16][i], c[17][i]), gp_Dir(c[3][i], c[4][i], c[5][i]))
+    return Geom_Circle(axis, abs(c[12][i])), c[18][i], c[18][i] + c[14][i]
 
 
-def _bezier_curve(r: Row, first: gp_Pnt, poles: TColgp_Array1OfPnt) -> CurveSpan:
+def _bezier_curve(c: Columns, i: int, first: gp_Pnt, poles: TColgp_Array1OfPnt) -> CurveSpan:
     poles.SetValue(1, first)
-    for i in (1, 2, 3):
-        poles.SetValue(i + 1, gp_Pnt(r[3 * i], r[3 * i + 1], r[3 * i + 2]))
+    for k in (1, 2, 3):
+        poles.SetValue(k + 1, gp_Pnt(c[3 * k][i], c[3 * k + 1][i], c[3 * k + 2][i]))
     return Geom_BezierCurve(poles), 0.0, 1.0
 
 
@@ -170,10 +171,8 @@ def _segment_rows(segments: Any) -> SegmentRows:
     return SegmentRows.of_segments(items)
 
 
-def _rows(rows: SegmentRows, frame: _Frame) -> tuple[list[int], list[Row]]:
-    """The kinds and flat rows of ``rows`` in OCCT's coordinates (``frame``), made in one pass
-    over the arrays (nested lists per segment would cost more than the edges: the garbage
-    collector walks every one)."""
+def _columns(rows: SegmentRows, frame: _Frame) -> tuple[list[int], Columns]:
+    """The kinds and ``Columns`` of ``rows`` in OCCT's coordinates (``frame``), in one pass over the arrays."""
     kind, g, p = rows.kind, rows.geometry, rows.params
     extra = np.zeros((len(kind), 4))
     with np.errstate(all="ignore"):
@@ -191,16 +190,17 @@ def _rows(rows: SegmentRows, frame: _Frame) -> tuple[list[int], list[Row]]:
         g[arc, 1:3] = arc_basis
         extra[:, :3] = frame.turn(extra[:, :3])
     table = np.concatenate([g.reshape(len(kind), 12), p, extra], axis=1)
-    return kind.tolist(), table.tolist()
+    return kind.tolist(), table.T.tolist()
 
 
-def _curve_spans(rows: SegmentRows, frame: _Frame) -> tuple[list[CurveSpan], list[gp_Pnt]]:
-    """The exact curve of every segment row and its travel-order range, and each row's first
-    point (a line's or spiral's start: ``chain_wire`` puts its vertex there)."""
-    kinds, table = _rows(rows, frame)
-    firsts = [gp_Pnt(r[0], r[1], r[2]) for r in table]
+def _curves(rows: SegmentRows, frame: _Frame) -> tuple[Iterator[CurveSpan], list[gp_Pnt]]:
+    """The exact curve of every segment row with its travel-order range, made as they are used,
+    and each row's first point (a line's or spiral's start: ``chain_wire`` puts its vertex there)."""
+    kinds, columns = _columns(rows, frame)
+    firsts = [gp_Pnt(x, y, z) for x, y, z in zip(columns[0], columns[1], columns[2])]
     poles = TColgp_Array1OfPnt(1, 4)
-    return [_MAKERS[kind](row, first, poles) for kind, row, first in zip(kinds, table, firsts)], firsts
+    made = (_MAKERS[kind](columns, i, first, poles) for i, (kind, first) in enumerate(zip(kinds, firsts)))
+    return made, firsts
 
 
 def segment_edge(segment: Segment, plane: gp_Ax3 | None = None) -> TopoDS_Edge:
@@ -217,13 +217,13 @@ def segment_edge(segment: Segment, plane: gp_Ax3 | None = None) -> TopoDS_Edge:
         ValueError: an unsupported segment type or a ``plane`` that is not a
             ``gp_Ax3``.
     """
-    (span,), _ = _curve_spans(_segment_rows([segment]), _frame(plane))
+    (span,) = _curves(_segment_rows([segment]), _frame(plane))[0]
     return BRepBuilderAPI_MakeEdge(*span).Edge()
 
 
 def segment_edges(segments: Iterable[Segment], plane: gp_Ax3 | None = None) -> list[TopoDS_Edge]:
     """``segment_edge`` for many segments sharing one frame (a ``Chain``: from its arrays, no segment objects)."""
-    return [BRepBuilderAPI_MakeEdge(*span).Edge() for span in _curve_spans(_segment_rows(segments), _frame(plane))[0]]
+    return [BRepBuilderAPI_MakeEdge(*span).Edge() for span in _curves(_segment_rows(segments), _frame(plane))[0]]
 
 
 def chain_wire(chain: Iterable[Segment], plane: gp_Ax3 | None = None) -> TopoDS_Wire:
@@ -246,7 +246,7 @@ def chain_wire(chain: Iterable[Segment], plane: gp_Ax3 | None = None) -> TopoDS_
     rows = _segment_rows(chain)
     if not len(rows):
         raise ValueError("chain_wire needs at least one segment")
-    spans, firsts = _curve_spans(rows, frame)
+    curves, firsts = _curves(rows, frame)
     ends = frame.map(row_frames(rows.kind, rows.geometry, rows.params, rows.dim)[0][:, :, :3])  # (n, 2: start, end; xyz)
     before, after = ends[:, 1], np.roll(ends[:, 0], -1, axis=0)  # joint i: end of segment i, start of the next
     tolerance = Precision.Confusion_s() + ROUNDING_ULPS * np.spacing(np.maximum(np.abs(before), np.abs(after)).max(axis=1))
@@ -274,7 +274,7 @@ def chain_wire(chain: Iterable[Segment], plane: gp_Ax3 | None = None) -> TopoDS_
         vertices.append(vertices[0])
     wire = TopoDS_Wire()
     builder.MakeWire(wire)
-    for i, ((curve, u0, u1), v0, v1) in enumerate(zip(spans, vertices, vertices[1:])):
+    for i, ((curve, u0, u1), v0, v1) in enumerate(zip(curves, vertices, vertices[1:])):
         maker = BRepBuilderAPI_MakeEdge(curve, v0, v1, u0, u1)
         try:
             add(wire, maker.Edge())
