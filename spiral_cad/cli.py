@@ -239,6 +239,8 @@ def _add_check(sub: argparse._SubParsersAction) -> None:
     check.add_argument("--snap", type=float, help="chain loose ends closer than this (model units; default 1%% of the model size)")
     check.add_argument("--comb", metavar="OUT.step",
                        help="also write the curvature comb of every edge as STEP (STEP/IGES input; never the checked file)")  # fmt: skip
+    check.add_argument("--timing", action="store_true",
+                       help="also print where the check spent its time: the reader's share, and whether it limits the check")  # fmt: skip
     check.add_argument("--gap-tol", type=float, default=1e-7, help="G0 gap, absolute model units (default 1e-7)")
     check.add_argument("--angle-tol", type=float, default=1e-7, help="G1 tangent angle, radians (default 1e-7)")
     check.add_argument("--curvature-tol", type=float, default=1e-6, help="G2 curvature jump, relative (default 1e-6)")

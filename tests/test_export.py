@@ -200,7 +200,58 @@ def test_step_header_product_and_units_read_by_an_independent_parser(tmp_path):
     products = [i for i in step.data[0].instances.values() if getattr(i, "entity", None) and i.entity.name == "PRODUCT"]
     assert products and products[0].entity.params[0] == "Ramp 'B' — north"
     assert "CONVERSION_BASED_UNIT('FOOT'" in text and "LENGTH_MEASURE(304.8)" in text
-    assert text.count("COMPOSITE_CURVE(") == 1 and "CONT_SAME_GRADIENT_SAME_CURVATURE" in text
+    assert text.count("CONNECTED_EDGE_SET(") == 1 and text.count("EDGE_CURVE(") == len(chain)
+
+
+LOOPS = {
+    "halves": Chain([Arc((0, 0), 5, 0.0, math.pi), Arc((0, 0), 5, math.pi, math.pi)]),
+    "circle": Chain([Arc((3, 4), -5, 1.0, 2 * math.pi)]),
+}
+
+
+@pytest.mark.parametrize("name", ["mixed", "halves", "circle"])
+def test_step_edges_share_their_vertices_in_travel_order(tmp_path, name):
+    # one wire to any reader: each edge starts on the vertex the previous one ends on; a closed chain ends on its first
+    chain = LOOPS.get(name) or CHAINS[name]
+    path = tmp_path / f"{name}.step"
+    export_step(chain, path)
+    entities = {k: i.entity for k, i in p21.readfile(str(path)).data[0].instances.items() if hasattr(i, "entity")}
+    (edge_set,) = [e for e in entities.values() if e.name == "CONNECTED_EDGE_SET"]
+    edges = [entities[ref] for ref in edge_set.params[1]]
+    assert [e.name for e in edges] == ["EDGE_CURVE"] * len(chain) and all(e.params[4] == ".T." for e in edges)
+    ends = [(e.params[1], e.params[2]) for e in edges]
+    assert all(a[1] == b[0] for a, b in zip(ends, ends[1:]))
+    assert (ends[-1][1] == ends[0][0]) == (name in LOOPS)
+    starts = [entities[entities[start].params[1]].params[1] for start, _ in ends]
+    assert np.array_equal(np.array(starts)[:, :2], [s.start for s in chain])
+    (wire,) = wires_of(read_shape(path, units="in"))  # and OCCT reads one wire of the same edges, closed or not
+    assert len(wire) == len(chain)
+    first, last = TopExp.FirstVertex_s(TopoDS.Edge_s(wire[0]), True), TopExp.LastVertex_s(TopoDS.Edge_s(wire[-1]), True)
+    assert first.IsSame(last) == (name in LOOPS)
+    for edge, seg in zip(wire, chain):
+        assert_same_geometry(edge, seg, 1e-9, 1 / 25.4)
+
+
+def test_a_chain_in_space_is_written_as_exact_3d_edges_of_one_wire(tmp_path):
+    from test_chain3d import helix_chain
+
+    from spiral_cad.continuity import check_continuity
+
+    helix, _, _ = helix_chain()
+    normal = np.array([0.0, -1.0, 1.0])
+    arcs = Chain.join([Arc.in_space((1.0, 2.0, 3.0), normal, (6.0, 2.0, 3.0), 0.5),
+                       Arc.in_space((1.0, 2.0, 3.0), normal, (6.0, 2.0, 3.0), -0.8).reversed()])  # fmt: skip
+    for chain in (helix, arcs):
+        path = tmp_path / "space.step"
+        export_step(chain, path)
+        (edges,) = wires_of(read_shape(path, units="in"))
+        assert len(edges) == len(chain)
+        for edge, seg in zip(edges, chain):
+            curve, t0, t1 = travel_range(edge)
+            u = np.linspace(0.0, 1.0, 9)
+            got = np.array([vec(curve.Value(t0 + ui * (t1 - t0))) for ui in u]) * 25.4
+            assert np.abs(got - seg.point(u)).max() <= 1e-9 * chain.size
+        assert check_continuity(path).passes("G2")
 
 
 def test_iges_global_section_names_the_design_and_no_login(tmp_path):

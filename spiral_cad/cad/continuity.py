@@ -22,18 +22,22 @@ apart start a new piece. A report that finds more pieces than expected
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import math
 import os
+import time
 from functools import partial
 from pathlib import Path
 from typing import Any
 
 import numpy as np
+from numpy.typing import NDArray
 from scipy.spatial import cKDTree
 from OCP.BRep import BRep_Tool
 from OCP.BRepAdaptor import BRepAdaptor_Curve
 from OCP.BRepLProp import BRepLProp_CLProps
 from OCP.BRepTools import BRepTools_WireExplorer
+from OCP.Geom import Geom_BezierCurve, Geom_BSplineCurve
 from OCP.gp import gp_Dir, gp_Pnt, gp_Vec
 from OCP.TopAbs import TopAbs_EDGE, TopAbs_REVERSED, TopAbs_WIRE
 from OCP.TopExp import TopExp, TopExp_Explorer
@@ -47,18 +51,22 @@ from OCP.TopoDS import (
 from OCP.TopTools import TopTools_IndexedMapOfShape
 
 from ..core.chain import Chain
+from ..core.segments import EPS
 from ..core.units import length_unit
 from ..formats.joints import (
     Continuity,
     ContinuityReport,
     Frame,
     JointReport,
+    Timing,
     WireReport,
     check_tolerances,
     classify_pieces,
+    curvature_rounding_floor,
     distance,
     flip,
     model_size,
+    norms,
     print_report,
 )
 from .occ import as_occ_shape
@@ -70,10 +78,13 @@ __all__ = ["Continuity", "ContinuityReport", "JointReport", "WireReport", "check
 #: chained into one piece (and their gap is then judged against ``gap_tol``).
 SNAP_FRACTION = 1e-2
 
-Point = tuple[float, float, float]
-#: What is measured of a shape: wires as (end frames of each edge, closed),
-#: the end frames of loose edges, and every edge's start, end and middle point.
-Measured = tuple[list[tuple[list[tuple[Frame, Frame]], bool]], list[tuple[Frame, Frame]], list[Point]]
+#: Floats per measured edge: start and end frame (``FRAME`` each, travel sense), middle point.
+FRAME = 11
+ROW = 2 * FRAME + 3
+#: What is measured of a shape: each wire as (edge count, closed), the number of
+#: loose edges, and one row of ``ROW`` floats per edge (wires' edges in wire
+#: order, then the loose ones) as float64 bytes: plain data for ``marshal``.
+Measured = tuple[list[tuple[int, bool]], int, bytes]
 
 
 # ---------------------------------------------------- edge end frames
@@ -124,17 +135,92 @@ def _singular_frame(curve: BRepAdaptor_Curve, u: float, inward: float, p: gp_Pnt
     return (p.X(), p.Y(), p.Z(), *tangent, *k)
 
 
-def _edge_ends(edge: TopoDS_Edge) -> tuple[Frame, Frame, Point]:
-    """(start frame, end frame, middle point) of ``edge`` in its travel sense."""
-    curve = BRepAdaptor_Curve(edge)
-    u0, u1 = curve.FirstParameter(), curve.LastParameter()
-    first = _frame(curve, u0, 1.0)
-    last = _frame(curve, u1, -1.0)
-    mid = curve.Value(0.5 * (u0 + u1))
-    middle = (mid.X(), mid.Y(), mid.Z())
-    if edge.Orientation() == TopAbs_REVERSED:
-        return flip(last), flip(first), middle
-    return first, last, middle
+def _edge_rows(edges: list[TopoDS_Edge]) -> NDArray:
+    """One row of 25 floats per edge of what OCCT evaluates; ``_edge_frames`` turns them into
+    frames, floors and lengths in one vectorised pass.
+
+    A row: point, first and second derivative at the curve's first and
+    last parameter (18), the middle point (3), the degree of a polynomial
+    curve (0 for other curves), its end knot spans (NaN where the edge is
+    trimmed inside the curve) and 1 for a reversed edge.
+    """
+    p, d1, d2 = gp_Pnt(), gp_Vec(), gp_Vec()
+    rows = []
+    for edge in edges:
+        curve = BRep_Tool.Curve_s(edge, 0.0, 0.0)  # a transformed copy if the edge is located
+        u0, u1 = BRep_Tool.Range_s(edge)
+        curve.D2(u0, p, d1, d2)
+        start = p.Coord() + d1.Coord() + d2.Coord()
+        curve.D2(u1, p, d1, d2)
+        end = p.Coord() + d1.Coord() + d2.Coord()
+        rows.append(start + end + curve.Value(0.5 * (u0 + u1)).Coord() + _polynomial(curve, u0, u1)
+                    + (float(edge.Orientation() == TopAbs_REVERSED),))  # fmt: skip
+    return np.array(rows, dtype=float).reshape(len(rows), 25)
+
+
+def _polynomial(curve: Any, u0: float, u1: float) -> tuple[float, float, float]:
+    """(degree, knot span at u0, knot span at u1) of a Bézier or non-rational B-spline curve whose
+    ends the edge keeps (NaN spans where it does not); (0, NaN, NaN) for any other curve."""
+    if isinstance(curve, Geom_BezierCurve) and not curve.IsRational():
+        first, last, degree = curve.FirstParameter(), curve.LastParameter(), curve.Degree()
+        h0 = h1 = last - first
+    elif isinstance(curve, Geom_BSplineCurve) and not curve.IsRational():
+        first, last, degree = curve.FirstParameter(), curve.LastParameter(), curve.Degree()
+        h0 = h1 = last - first  # one span (a Bézier), else the spans at the ends:
+        if curve.NbKnots() > 2:
+            h0, h1 = curve.Knot(curve.FirstUKnotIndex() + 1) - first, last - curve.Knot(curve.LastUKnotIndex() - 1)
+    else:
+        return 0.0, math.nan, math.nan
+    return float(degree), h0 if u0 == first else math.nan, h1 if u1 == last else math.nan
+
+
+def _edge_frames(edges: list[TopoDS_Edge]) -> NDArray:
+    """Rows of ``ROW`` floats: start and end frame of each edge in its travel sense — point, unit
+    tangent, curvature vector ``(r'' − (r''·t) t) / |r'|²`` (no product of derivatives is formed,
+    so no model within the float range overflows), curvature rounding floor, edge length — then
+    its middle point."""
+    raw = _edge_rows(edges)
+    out = np.empty((len(raw), ROW))
+    lengths = norms(raw[:, 18:21] - raw[:, 0:3]) + norms(raw[:, 9:12] - raw[:, 18:21])
+    for end, (at, span) in enumerate(((0, 22), (9, 23))):
+        p, d1, d2 = raw[:, at : at + 3], raw[:, at + 3 : at + 6], raw[:, at + 6 : at + 9]
+        frame = out[:, end * FRAME : (end + 1) * FRAME]
+        with np.errstate(all="ignore"):
+            speed = norms(d1)[:, None]
+            tangent = d1 / speed
+            along = np.einsum("ij,ij->i", d2, tangent)[:, None]
+            frame[:, 0:3], frame[:, 3:6] = p, tangent
+            frame[:, 6:9] = (d2 - along * tangent) / speed / speed
+            frame[:, 9] = _rounding_floor(p, d1, d2, raw[:, 21], raw[:, span], norms(frame[:, 6:9]), inward=1 - 2 * end)
+        frame[:, 10] = lengths
+        singular = ~(speed[:, 0] > 1e-12 * norms(d2))  # also r' = 0 and NaN
+        for i in np.flatnonzero(singular):  # rare: the scalar path, from higher derivatives
+            curve = BRepAdaptor_Curve(edges[i])
+            u = curve.FirstParameter() if end == 0 else curve.LastParameter()
+            frame[i, :9], frame[i, 9] = _frame(curve, u, 1.0 - 2.0 * end), math.nan
+    out[:, 22:25] = raw[:, 18:21]
+    reverse = raw[:, 24] == 1.0
+    start, end = out[reverse, :FRAME].copy(), out[reverse, FRAME : 2 * FRAME].copy()
+    out[reverse, :FRAME], out[reverse, FRAME : 2 * FRAME] = end, start
+    out[reverse, 3:6] *= -1.0
+    out[reverse, FRAME + 3 : FRAME + 6] *= -1.0
+    return out
+
+
+def _rounding_floor(p: NDArray, d1: NDArray, d2: NDArray, degree: NDArray, span: NDArray, curvature: NDArray,
+                    inward: int) -> NDArray:  # fmt: skip
+    """The curvature rounding floor at one end of each polynomial curve (0 for other curves, NaN
+    where it is not known): its legs to the next two control points follow from the derivatives
+    there (a = h r' / n, b = |a ± h² r'' / (n (n − 1))| with h the end knot span, n the degree),
+    and its coordinates are at most |p| + a + b (``curvature_rounding_floor``)."""
+    with np.errstate(all="ignore"):
+        n = np.where(degree >= 2.0, degree, np.nan)
+        first = d1 * (span / n)[:, None]
+        second = first + inward * d2 * (span**2 / (n * (n - 1.0)))[:, None]
+        a, b = norms(first), norms(second)
+        delta = 4.0 * EPS * (np.abs(p).max(axis=1) + a + b)
+        floor = curvature_rounding_floor(delta, a, b, curvature)
+    return np.where(degree == 0.0, 0.0, floor)
 
 
 # ----------------------------------------------------------- grouping
@@ -155,14 +241,14 @@ def _wire_edges(wire: TopoDS_Wire) -> tuple[list[TopoDS_Edge], bool]:
     while explorer.More():
         edges.append(explorer.Current())
         explorer.Next()
-    stored = []
-    it = TopoDS_Iterator(wire)
-    while it.More():
-        if it.Value().ShapeType() == TopAbs_EDGE:
-            stored.append(TopoDS.Edge_s(it.Value()))
-        it.Next()
-    if len(edges) < len(stored):
-        edges = stored
+    if len(edges) < wire.NbChildren():
+        stored = []
+        it = TopoDS_Iterator(wire)
+        while it.More():
+            if it.Value().ShapeType() == TopAbs_EDGE:
+                stored.append(TopoDS.Edge_s(it.Value()))
+            it.Next()
+        edges = stored if len(edges) < len(stored) else edges
     edges = [e for e in edges if not _is_degenerated(e)]
     if not edges:
         return edges, False
@@ -172,36 +258,33 @@ def _wire_edges(wire: TopoDS_Wire) -> tuple[list[TopoDS_Edge], bool]:
 
 
 def _measure(shape: TopoDS_Shape) -> Measured:
-    """Everything the checker needs of ``shape``, as plain numbers (see ``Measured``).
+    """Everything the checker needs of ``shape``, as plain data (see ``Measured``).
 
     For a file this runs in the reader's child process (``read_file``): only
     these numbers come back, so no curve of the file is evaluated here.
     """
-    points: list[Point] = []
-
-    def evaluate(edge: TopoDS_Edge) -> tuple[Frame, Frame]:
-        start, end, middle = _edge_ends(edge)
-        points.extend((start[:3], end[:3], middle))
-        return start, end
-
-    wires_found = []
+    wires_found, edges = [], []
     wires = TopTools_IndexedMapOfShape()
     TopExp.MapShapes_s(shape, TopAbs_WIRE, wires)
     for i in range(1, wires.Extent() + 1):
-        edges, closed = _wire_edges(TopoDS.Wire_s(wires.FindKey(i)))
-        if edges:
-            wires_found.append(([evaluate(e) for e in edges], closed))
+        found, closed = _wire_edges(TopoDS.Wire_s(wires.FindKey(i)))
+        if found:
+            wires_found.append((len(found), closed))
+            edges += found
     loose = TopTools_IndexedMapOfShape()
     explorer = TopExp_Explorer(shape, TopAbs_EDGE, TopAbs_WIRE)
     while explorer.More():
         loose.Add(explorer.Current())
         explorer.Next()
-    loose_ends = []
-    for i in range(1, loose.Extent() + 1):
-        edge = TopoDS.Edge_s(loose.FindKey(i))
-        if not _is_degenerated(edge):
-            loose_ends.append(evaluate(edge))
-    return wires_found, loose_ends, points
+    loose_edges = [e for e in (TopoDS.Edge_s(loose.FindKey(i)) for i in range(1, loose.Extent() + 1)) if not _is_degenerated(e)]
+    return wires_found, len(loose_edges), _edge_frames(edges + loose_edges).tobytes()
+
+
+def _timed_measure(shape: TopoDS_Shape) -> tuple[Measured, float]:
+    """``_measure`` and the seconds it took (in the reader's child: the rest of its time is the reader's)."""
+    started = time.perf_counter()
+    measured = _measure(shape)
+    return measured, time.perf_counter() - started
 
 
 def _chain_loose(ends: list[tuple[Frame, Frame]], snap: float, gap_tol: float, size: float) -> list[tuple[list[tuple[Frame, Frame]], bool]]:
@@ -300,24 +383,34 @@ def check_continuity(
     check_tolerances(gap_tol=gap_tol, angle_tol=angle_tol, curvature_tol=curvature_tol)
     if snap is not None:
         check_tolerances(snap=snap)
+    started = time.perf_counter()
     if isinstance(shape_or_path, (str, os.PathLike)):
         source = os.path.basename(os.fspath(shape_or_path))
-        unit, measured = read_file(shape_or_path, units, _measure)
+        reader = "the STEP reader (OCCT)" if Path(shape_or_path).suffix.lower() in STEP_SUFFIXES else "the IGES reader (OCCT)"
+        unit, (measured, measuring) = read_file(shape_or_path, units, _timed_measure)
+        reading = time.perf_counter() - started - measuring
     else:
-        source = type(shape_or_path).__name__
+        source, reader, reading = type(shape_or_path).__name__, "", 0.0
         unit = length_unit(units) if units is not None else shape_or_path.units if isinstance(shape_or_path, Chain) else ""
-        measured = _measure(as_occ_shape(shape_or_path))
-    return _report(measured, unit, label or source, gap_tol, angle_tol, curvature_tol, snap)
+        measured, measuring = _timed_measure(as_occ_shape(shape_or_path))
+    classified = time.perf_counter()
+    report = _report(measured, unit, label or source, gap_tol, angle_tol, curvature_tol, snap)
+    timing = Timing(reading, measuring, time.perf_counter() - classified, reader)
+    return dataclasses.replace(report, timing=timing)
 
 
 def _report(measured: Measured, unit: str, source: str, gap_tol: float, angle_tol: float, curvature_tol: float,
             snap: float | None) -> ContinuityReport:  # fmt: skip
     """Chain the loose edges and classify every joint."""
-    wires, loose_ends, points = measured
-    size = model_size(points, source)
+    wires, loose, data = measured
+    rows = np.frombuffer(data, dtype=float).reshape(-1, ROW)
+    size = model_size(rows[:, [0, 1, 2, FRAME, FRAME + 1, FRAME + 2, 22, 23, 24]].reshape(-1, 3), source)
     link = SNAP_FRACTION * size if snap is None else snap
-    pieces = [("wire", ends, closed) for ends, closed in wires]
-    if loose_ends:
+    frames = rows[:, : 2 * FRAME].reshape(-1, 2, FRAME)
+    bounds = np.cumsum([0] + [count for count, _ in wires])
+    pieces: list[tuple] = [("wire", frames[i:j], closed) for i, j, (_, closed) in zip(bounds, bounds[1:], wires)]
+    if loose:
+        loose_ends = [(tuple(start), tuple(end)) for start, end in frames[bounds[-1] :].tolist()]
         pieces += [("loose piece", ends, closed) for ends, closed in _chain_loose(loose_ends, link, gap_tol, size)]
     return classify_pieces(
         pieces, size, gap_tol=gap_tol, angle_tol=angle_tol, curvature_tol=curvature_tol, snap=link, source=source, units=unit

@@ -16,7 +16,6 @@ from X towards Y, arcs in space about their own normal.
 from __future__ import annotations
 
 import io
-import math
 import os
 import re
 import sys
@@ -25,6 +24,8 @@ from collections.abc import Iterable, Iterator
 from contextlib import contextmanager
 from typing import TYPE_CHECKING, Any
 
+import numpy as np
+from numpy.typing import NDArray
 from OCP.BRep import BRep_Builder, BRep_Tool
 from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeEdge
 from OCP.Geom import (
@@ -34,15 +35,16 @@ from OCP.Geom import (
     Geom_Curve,
     Geom_Line,
 )
-from OCP.gp import gp_Ax2, gp_Ax3, gp_Dir, gp_Pnt, gp_Vec
+from OCP.gp import gp_Ax2, gp_Ax3, gp_Dir, gp_Pnt
 from OCP.Precision import Precision
 from OCP.TColgp import TColgp_Array1OfPnt
 from OCP.TColStd import TColStd_Array1OfInteger, TColStd_Array1OfReal
 from OCP.TopoDS import TopoDS_Compound, TopoDS_Edge, TopoDS_Shape, TopoDS_Vertex, TopoDS_Wire
 
 from ..core._chain_kernels import ARC, LINE, SPIRAL
-from ..core.segments import Segment
-from ..formats.joints import ROUNDING_ULPS
+from ..core.rows import SegmentRows
+from ..core.segments import Segment, row_frames
+from ..formats.joints import ROUNDING_ULPS, norms
 from .readers import ReadError, read_shape
 
 __all__ = ["ReadError", "as_occ_shape", "captured_messages", "chain_wire", "nurbs_edge", "read_shape", "segment_edge", "segment_edges"]
@@ -83,6 +85,14 @@ class _Frame:
             origin[2] + x * xz + y * yz + z * zz,
         )
 
+    def map(self, points: NDArray) -> NDArray:
+        """Chain coordinates (..., 3) as OCCT's, all at once (``pnt`` for many points)."""
+        return points if self.flat else np.asarray(self.origin) + self.turn(points)
+
+    def turn(self, vectors: NDArray) -> NDArray:
+        """Chain vectors (..., 3) as OCCT's (``dir`` for many vectors, unnormalised)."""
+        return vectors if self.flat else vectors @ np.array([self.x, self.y, self.z])
+
     def pnt(self, x: float, y: float, z: float = 0.0) -> gp_Pnt:
         """The point at chain coordinates (x, y) or (x, y, z)."""
         if self.flat:
@@ -114,60 +124,83 @@ def _frame(plane: gp_Ax3 | None) -> _Frame:
 CurveSpan = tuple[Geom_Curve, float, float]
 
 
-# A segment as a row of a chain's arrays (``spiral_cad.core.rows``): kind, its
-# four points (x, y, z) and its arc numbers (signed radius, start angle, sweep).
-Row = tuple[int, list[list[float]], list[float]]
+# The segments as columns of floats made from a chain's arrays (``spiral_cad.core.rows``): the
+# four points of each (x, y, z: columns 0–11), its arc numbers (signed radius, start angle,
+# sweep: 12–14), and what its curve needs besides (15–18): a line's unit direction and length,
+# an arc's axis in the travel sense and first parameter. Columns, not a list per segment: a
+# long chain would otherwise hold one live list per segment, and the garbage collector walks them.
+Columns = list[list[float]]
+
+# Each maker takes the columns, the segment's index, its first point as a ``gp_Pnt`` (a line's or
+# spiral's start, an arc's centre) and a 4-pole array to fill (a Bézier copies its poles: one
+# array serves all).
 
 
-def _line_curve(g: list[list[float]], p: list[float], frame: _Frame) -> CurveSpan:
-    a, b = frame.pnt(*g[0]), frame.pnt(*g[1])
-    return Geom_Line(a, gp_Dir(gp_Vec(a, b))), 0.0, a.Distance(b)
+def _line_curve(c: Columns, i: int, first: gp_Pnt, poles: TColgp_Array1OfPnt) -> CurveSpan:
+    return Geom_Line(first, gp_Dir(c[15][i], c[16][i], c[17][i])), 0.0, c[18][i]
 
 
-def _arc_curve(g: list[list[float]], p: list[float], frame: _Frame) -> CurveSpan:
-    """A ``Geom_Circle`` about the arc's normal e1 × e2 (flipped for clockwise travel, so the
-    parameter increases along the path: the point at polar angle a has parameter -a)."""
-    center, e1, e2 = g[0], g[1], g[2]
-    radius, a0, sweep = p
-    normal = frame.dir(e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2], e1[0] * e2[1] - e1[1] * e2[0])
-    axis, first = (normal, a0) if radius > 0.0 else (normal.Reversed(), -a0)
-    circle = Geom_Circle(gp_Ax2(frame.pnt(*center), axis, frame.dir(*e1)), abs(radius))
-    return circle, first, first + sweep
+def _arc_curve(c: Columns, i: int, first: gp_Pnt, poles: TColgp_Array1OfPnt) -> CurveSpan:
+    """A ``Geom_Circle`` about the arc's normal e1 × e2, flipped for clockwise travel so that the
+    parameter increases along the path (the point at polar angle a then has parameter -a)."""
+    axis = gp_Ax2(first, gp_Dir(c[15][i], c[16][i], c[17][i]), gp_Dir(c[3][i], c[4][i], c[5][i]))
+    return Geom_Circle(axis, abs(c[12][i])), c[18][i], c[18][i] + c[14][i]
 
 
-def _bezier_curve(g: list[list[float]], p: list[float], frame: _Frame) -> CurveSpan:
-    return Geom_BezierCurve(frame.poles(g)), 0.0, 1.0
+def _bezier_curve(c: Columns, i: int, first: gp_Pnt, poles: TColgp_Array1OfPnt) -> CurveSpan:
+    poles.SetValue(1, first)
+    for k in (1, 2, 3):
+        poles.SetValue(k + 1, gp_Pnt(c[3 * k][i], c[3 * k + 1][i], c[3 * k + 2][i]))
+    return Geom_BezierCurve(poles), 0.0, 1.0
 
 
 _MAKERS = {LINE: _line_curve, ARC: _arc_curve, SPIRAL: _bezier_curve}
 
 
-def _rows(segments: Iterable[Segment]) -> tuple[Iterator[Row], list[str], list[float]]:
-    """The rows of ``segments`` (a ``Chain``'s own arrays, or each segment's row), their kind names and lengths.
-
-    Rows are made one at a time as they are used: a long chain's rows as nested
-    lists at once would keep the garbage collector busy.
-    """
+def _segment_rows(segments: Any) -> SegmentRows:
+    """The rows of a ``Chain`` (its own arrays) or of any segments."""
     from ..core.chain import Chain  # chain.py imports this module lazily in turn
+    from ..core.rows import SegmentRows
 
     if isinstance(segments, Chain):
-        rows = segments.rows
-        kinds = rows.kind.tolist()
-        names = [("Line", "Arc", "BezierSpiral")[k] for k in kinds]
-        made = ((k, g.tolist(), p.tolist()) for k, g, p in zip(kinds, rows.geometry, rows.params))
-        return made, names, segments.lengths.tolist()
+        return segments.rows
     items = list(segments)
     for segment in items:
         if not isinstance(segment, Segment):
             raise ValueError(f"segment must be a Line, Arc or BezierSpiral; got {segment!r}")
-    made = ((k, g.tolist(), list(p)) for k, g, p in (segment._row() for segment in items))
-    return made, [type(s).__name__ for s in items], [s.length for s in items]
+    return SegmentRows.of_segments(items)
 
 
-def _curve_span(row: Row, frame: _Frame) -> CurveSpan:
-    """The exact curve of a segment row and its travel-order range."""
-    kind, g, p = row
-    return _MAKERS[kind](g, p, frame)
+def _columns(rows: SegmentRows, frame: _Frame) -> tuple[list[int], Columns]:
+    """The kinds and ``Columns`` of ``rows`` in OCCT's coordinates (``frame``), in one pass over the arrays."""
+    kind, g, p = rows.kind, rows.geometry, rows.params
+    extra = np.zeros((len(kind), 4))
+    with np.errstate(all="ignore"):
+        line = kind == LINE
+        step = g[line, 1] - g[line, 0]
+        length = np.hypot(np.hypot(step[:, 0], step[:, 1]), step[:, 2])
+        extra[line, :3], extra[line, 3] = step / length[:, None], length
+        arc = kind == ARC
+        turn = np.where(p[arc, 0] > 0.0, 1.0, -1.0)
+        extra[arc, :3] = turn[:, None] * np.cross(g[arc, 1], g[arc, 2])
+        extra[arc, 3] = turn * p[arc, 1]
+    if not frame.flat:  # points move and turn, directions (an arc's basis, the extras) only turn
+        arc_basis = frame.turn(g[arc, 1:3])
+        g = frame.map(g)
+        g[arc, 1:3] = arc_basis
+        extra[:, :3] = frame.turn(extra[:, :3])
+    table = np.concatenate([g.reshape(len(kind), 12), p, extra], axis=1)
+    return kind.tolist(), table.T.tolist()
+
+
+def _curves(rows: SegmentRows, frame: _Frame) -> tuple[Iterator[CurveSpan], list[gp_Pnt]]:
+    """The exact curve of every segment row with its travel-order range, made as they are used,
+    and each row's first point (a line's or spiral's start: ``chain_wire`` puts its vertex there)."""
+    kinds, columns = _columns(rows, frame)
+    firsts = [gp_Pnt(x, y, z) for x, y, z in zip(columns[0], columns[1], columns[2])]
+    poles = TColgp_Array1OfPnt(1, 4)
+    made = (_MAKERS[kind](columns, i, first, poles) for i, (kind, first) in enumerate(zip(kinds, firsts)))
+    return made, firsts
 
 
 def segment_edge(segment: Segment, plane: gp_Ax3 | None = None) -> TopoDS_Edge:
@@ -184,14 +217,13 @@ def segment_edge(segment: Segment, plane: gp_Ax3 | None = None) -> TopoDS_Edge:
         ValueError: an unsupported segment type or a ``plane`` that is not a
             ``gp_Ax3``.
     """
-    (row,) = _rows([segment])[0]
-    return BRepBuilderAPI_MakeEdge(*_curve_span(row, _frame(plane))).Edge()
+    (span,) = _curves(_segment_rows([segment]), _frame(plane))[0]
+    return BRepBuilderAPI_MakeEdge(*span).Edge()
 
 
 def segment_edges(segments: Iterable[Segment], plane: gp_Ax3 | None = None) -> list[TopoDS_Edge]:
     """``segment_edge`` for many segments sharing one frame (a ``Chain``: from its arrays, no segment objects)."""
-    frame = _frame(plane)
-    return [BRepBuilderAPI_MakeEdge(*_curve_span(row, frame)).Edge() for row in _rows(segments)[0]]
+    return [BRepBuilderAPI_MakeEdge(*span).Edge() for span in _curves(_segment_rows(segments), _frame(plane))[0]]
 
 
 def chain_wire(chain: Iterable[Segment], plane: gp_Ax3 | None = None) -> TopoDS_Wire:
@@ -203,36 +235,54 @@ def chain_wire(chain: Iterable[Segment], plane: gp_Ax3 | None = None) -> TopoDS_
     start gives a closed wire. Ends meet when they are within OCCT's vertex
     tolerance (1e-7) plus the rounding the G2 checker allows at their
     coordinates (``ROUNDING_ULPS`` units in the last place), and each vertex
-    carries that tolerance (1e-7 for coordinates up to ~1e8).
+    carries that tolerance (1e-7 for coordinates up to ~1e8). The ends and
+    their gaps are computed for all joints at once from the segment rows.
 
     Raises:
         ValueError: consecutive segments do not meet, a segment too short
             for OCCT to make an edge of, or no segments.
     """
     frame = _frame(plane)
-    rows, names, lengths = _rows(chain)
-    spans = [_curve_span(row, frame) for row in rows]
-    if not spans:
+    rows = _segment_rows(chain)
+    if not len(rows):
         raise ValueError("chain_wire needs at least one segment")
-    ends = [(curve.Value(first), curve.Value(last)) for curve, first, last in spans]
+    curves, firsts = _curves(rows, frame)
+    ends = frame.map(row_frames(rows.kind, rows.geometry, rows.params, rows.dim)[0][:, :, :3])  # (n, 2: start, end; xyz)
+    before, after = ends[:, 1], np.roll(ends[:, 0], -1, axis=0)  # joint i: end of segment i, start of the next
+    tolerance = Precision.Confusion_s() + ROUNDING_ULPS * np.spacing(np.maximum(np.abs(before), np.abs(after)).max(axis=1))
+    gap = norms(before - after)
+    apart = np.flatnonzero(~(gap[:-1] <= tolerance[:-1]))
+    if apart.size:
+        i = int(apart[0])
+        raise ValueError(f"segment {i + 1} does not connect to segment {i}: gap {gap[i]:.3g}")
+    closed = bool(gap[-1] <= tolerance[-1])
+    # each vertex at its segment's start (the point a line or spiral starts from exactly), with
+    # the tolerance of the joint before it; the first with the closing joint's or its own
+    single = Precision.Confusion_s() + ROUNDING_ULPS * np.spacing(np.abs(ends[[0, -1], [0, 1]]).max(axis=1))
+    tolerances = np.roll(tolerance, 1)
+    tolerances[0] = tolerance[-1] if closed else single[0]
     builder = BRep_Builder()
-    vertices = [_vertex(builder, ends[0][0], ends[0][0])]
-    for i, ((_, end), (start, _)) in enumerate(zip(ends, ends[1:])):
-        if end.Distance(start) > _tolerance(end, start):
-            raise ValueError(f"segment {i + 1} does not connect to segment {i}: gap {end.Distance(start):.3g}")
-        vertices.append(_vertex(builder, end, start))
-    closed = ends[-1][1].Distance(ends[0][0]) <= _tolerance(ends[-1][1], ends[0][0])
+    starts = [first if kind != ARC else gp_Pnt(*start) for kind, first, start in
+              zip(rows.kind.tolist(), firsts, ends[:, 0].tolist())]  # fmt: skip
+    if not closed:
+        starts.append(gp_Pnt(*ends[-1, 1].tolist()))
+    vertices = [TopoDS_Vertex() for _ in starts]
+    make_vertex, add = builder.MakeVertex, builder.Add
+    for vertex, point, vertex_tolerance in zip(vertices, starts, tolerances.tolist() + [float(single[1])]):
+        make_vertex(vertex, point, vertex_tolerance)
     if closed:
-        vertices[0] = _vertex(builder, ends[0][0], ends[-1][1])
-    vertices.append(vertices[0] if closed else _vertex(builder, ends[-1][1], ends[-1][1]))
+        vertices.append(vertices[0])
     wire = TopoDS_Wire()
     builder.MakeWire(wire)
-    for i, ((curve, first, last), v0, v1) in enumerate(zip(spans, vertices, vertices[1:])):
-        maker = BRepBuilderAPI_MakeEdge(curve, v0, v1, first, last)
-        if not maker.IsDone():
-            short = lengths[i] <= 10.0 * BRep_Tool.Tolerance_s(v0)
+    for i, ((curve, u0, u1), v0, v1) in enumerate(zip(curves, vertices, vertices[1:])):
+        maker = BRepBuilderAPI_MakeEdge(curve, v0, v1, u0, u1)
+        try:
+            add(wire, maker.Edge())
+        except Exception:  # OCCT's StdFail_NotDone: say why, below
+            length, name = float(rows.lengths[i]), ("Line", "Arc", "BezierSpiral")[int(rows.kind[i])]
+            short = length <= 10.0 * BRep_Tool.Tolerance_s(v0)
             raise ValueError(
-                f"segment {i} ({names[i]}, length {lengths[i]:.3g}) cannot be an OCCT edge "
+                f"segment {i} ({name}, length {length:.3g}) cannot be an OCCT edge "
                 f"({maker.Error().name})"
                 + (
                     f": OCCT merges points closer than {BRep_Tool.Tolerance_s(v0):.3g} model units, so its edges must be "
@@ -240,24 +290,9 @@ def chain_wire(chain: Iterable[Segment], plane: gp_Ax3 | None = None) -> TopoDS_
                     if short
                     else ""
                 )
-            )
-        builder.Add(wire, maker.Edge())
+            ) from None
     wire.Closed(closed)
     return wire
-
-
-def _tolerance(a: gp_Pnt, b: gp_Pnt) -> float:
-    """How far apart two edge ends may be and share a vertex: OCCT's 1e-7 plus the rounding the
-    G2 checker allows at their coordinates (``ROUNDING_ULPS`` units in the last place)."""
-    magnitude = max(abs(a.X()), abs(a.Y()), abs(a.Z()), abs(b.X()), abs(b.Y()), abs(b.Z()))
-    return Precision.Confusion_s() + ROUNDING_ULPS * math.ulp(magnitude)
-
-
-def _vertex(builder: BRep_Builder, point: gp_Pnt, other: gp_Pnt) -> TopoDS_Vertex:
-    """The vertex at ``point`` shared with an edge end at ``other``, with that joint's tolerance."""
-    vertex = TopoDS_Vertex()
-    builder.MakeVertex(vertex, point, _tolerance(point, other))
-    return vertex
 
 
 def nurbs_edge(nurbs: Nurbs, plane: gp_Ax3 | None = None) -> TopoDS_Edge:

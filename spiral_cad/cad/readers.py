@@ -16,12 +16,15 @@ A file is accepted only if it was read whole:
 * an IGES file's sections must agree with its terminate record (checked
   before OCCT sees it);
 * **every curve is accounted for**: the curve entities that must each become
-  an edge — every ``EDGE_CURVE``, every segment of a ``COMPOSITE_CURVE`` and
-  every other curve of a ``GEOMETRIC_(CURVE_)SET`` in STEP; every leaf of an
-  independent curve entity in IGES (the members of a composite curve 102,
-  and lines, arcs, conics, splines, offset curves) — are counted and compared
-  with the edges transferred. A file of 7 curves read as 6 edges is refused,
-  naming the curve that was dropped and why.
+  an edge — every ``EDGE_CURVE`` (of a ``CONNECTED_EDGE_SET`` or a face),
+  every segment of a ``COMPOSITE_CURVE`` and every other curve of a
+  ``GEOMETRIC_(CURVE_)SET`` in STEP; every leaf of an independent curve
+  entity in IGES (the members of a composite curve 102, and lines, arcs,
+  conics, splines, offset curves) — are counted and compared with the edges
+  transferred, and every edge must span a finite parameter range (OCCT
+  found its vertices on its curve). A file of 7 curves read as 6 edges is
+  refused, naming the curve that was dropped and why; so is a root the
+  reader could not transfer, with the curves it could not translate.
 
 Units: with ``units=None`` a file is read in the length unit it declares (a
 STEP ``GLOBAL_UNIT_ASSIGNED_CONTEXT``, the IGES global section) with no
@@ -181,6 +184,7 @@ def _read_whole(path: Path, kind: str, units: str | None) -> tuple[TopoDS_Shape,
             transferred = reader.TransferRoots()
             if transferred < roots:
                 failures.append(f"only {transferred} of {roots} root entities could be transferred")
+                failures += _culprits(kind, reader, curves, name)
     if status != IFSelect_RetDone or failures:
         reasons = failures or _printed_reasons(printed) or [status.name]
         more = f" (and {len(reasons) - 3} more)" if len(reasons) > 3 else ""
@@ -188,9 +192,9 @@ def _read_whole(path: Path, kind: str, units: str | None) -> tuple[TopoDS_Shape,
     shape = reader.OneShape()
     if shape.IsNull():
         raise ReadError(f"cannot read {path.name!r}: the {kind} reader found no transferable geometry")
-    edges = _edge_count(shape)
-    if edges < len(curves):
-        raise ReadError(_dropped(path, kind, reader, curves, edges))
+    edges, finite = _edge_count(shape)
+    if edges < len(curves) or not finite:
+        raise ReadError(_dropped(path, kind, reader, curves, edges, finite))
     return shape, unit
 
 
@@ -262,10 +266,11 @@ def _leaves(curve: Any, container: Any, position: int, parts: Callable[[Any], li
 
 def _step_curves(model: Any) -> list[tuple[Any, Any, int]]:
     """``(curve, container, position)`` of every curve the STEP reader must turn into an edge:
-    every ``EDGE_CURVE`` (its geometry), every leaf segment of a composite curve in a geometric
-    set, every other curve of a geometric set (each listed curve once, as OCCT transfers it)."""
+    every ``EDGE_CURVE`` (its geometry; its container the first ``CONNECTED_EDGE_SET`` that lists
+    it, else the edge itself), every leaf segment of a composite curve in a geometric set, every
+    other curve of a geometric set (each listed curve once, as OCCT transfers it)."""
     from OCP.StepGeom import StepGeom_CompositeCurve, StepGeom_Curve
-    from OCP.StepShape import StepShape_EdgeCurve, StepShape_GeometricSet
+    from OCP.StepShape import StepShape_ConnectedEdgeSet, StepShape_EdgeCurve, StepShape_GeometricSet
 
     def parts(curve: Any) -> list | None:
         if not isinstance(curve, StepGeom_CompositeCurve):
@@ -275,8 +280,15 @@ def _step_curves(model: Any) -> list[tuple[Any, Any, int]]:
 
     found: list[tuple[Any, Any, int]] = []
     listed: dict[int, Any] = {}  # a curve listed in two sets is transferred once (kept alive: ids stay unique)
+    places: dict[int, tuple[Any, Any, int]] = {}  # id(edge) → (edge kept alive: ids stay unique, its set, position)
+    for edge_set in _entities_of(model, StepShape_ConnectedEdgeSet):
+        edges = edge_set.CesEdges()
+        for k in range(1, (edges.Length() if edges is not None else 0) + 1):
+            edge = edges.Value(k)
+            places.setdefault(id(edge), (edge, edge_set, k))
     for entity in _entities_of(model, StepShape_EdgeCurve):
-        found.append((entity.EdgeGeometry(), entity, 0))
+        _, container, k = places.get(id(entity), (entity, entity, 0))
+        found.append((entity.EdgeGeometry(), container, k))
     for entity in _entities_of(model, StepShape_GeometricSet):
         for k in range(1, entity.NbElements() + 1):
             curve = entity.ElementsValue(k).Curve()
@@ -326,32 +338,53 @@ def _iges_curves(model: Any) -> list[tuple[Any, Any, int]]:
     return found
 
 
-def _edge_count(shape: TopoDS_Shape) -> int:
-    """Distinct edges of ``shape`` that are not degenerated (a surface's pole)."""
+def _edge_count(shape: TopoDS_Shape) -> tuple[int, bool]:
+    """Distinct edges of ``shape`` that are not degenerated (a surface's pole), and whether each
+    spans a finite parameter range (NaN where OCCT could not place a vertex on a non-finite curve)."""
     edges = TopTools_IndexedMapOfShape()
     TopExp.MapShapes_s(shape, TopAbs_EDGE, edges)
-    return sum(not BRep_Tool.Degenerated_s(TopoDS.Edge_s(edges.FindKey(i))) for i in range(1, edges.Extent() + 1))
+    count, finite = 0, True
+    for i in range(1, edges.Extent() + 1):
+        edge = TopoDS.Edge_s(edges.FindKey(i))
+        if not BRep_Tool.Degenerated_s(edge):
+            count += 1
+            first, last = BRep_Tool.Range_s(edge)
+            finite = finite and math.isfinite(first) and math.isfinite(last)
+    return count, finite
 
 
-def _dropped(path: Path, kind: str, reader: Any, curves: list[tuple[Any, Any, int]], edges: int) -> str:
-    """The message for a transfer that made fewer edges than the file has curves: which were dropped, and why."""
+def _dropped(path: Path, kind: str, reader: Any, curves: list[tuple[Any, Any, int]], edges: int, finite: bool) -> str:
+    """The message for a transfer that made fewer edges than the file has curves, or an edge
+    that is not finite: which curves, and why."""
     head = f"cannot read {path.name!r}: the {kind} reader made {edges} edges of the file's {len(curves)} curves"
     name = _namer(path, kind, reader)
-    if kind == "STEP":
-        culprits = [(curve, container, k, _step_curve_fault(curve)) for curve, container, k in curves]
-    else:
-        culprits = [(curve, container, k, _iges_curve_fault(reader.IGESModel(), curve)) for curve, container, k in curves]
-    named = [
-        f"{name(curve) if curve is not None else 'a missing curve'}"
-        + (f" ({'segment' if kind == 'STEP' else 'member'} {k} of {name(container)})" if k and container is not None else "")
-        + f": {fault}"
-        for curve, container, k, fault in culprits
-        if fault
-    ]
+    named = _culprits(kind, reader, curves, name)
     if not named:
         named = _reader_failures(reader.WS().TransferReader().LastCheckList(), name) or ["which one is not known"]
     more = f" (and {len(named) - 3} more)" if len(named) > 3 else ""
-    return f"{head}; not read: " + "; ".join(named[:3]) + more
+    return f"{head}{'' if finite else ', not all of them finite'}; not read: " + "; ".join(named[:3]) + more
+
+
+def _culprits(kind: str, reader: Any, curves: list[tuple[Any, Any, int]], name: Callable[[Any], str]) -> list[str]:
+    """Each curve that cannot become an edge on its own, named with its place and the reason."""
+    if kind == "STEP":
+        faults = [(curve, container, k, _step_curve_fault(curve)) for curve, container, k in curves]
+    else:
+        faults = [(curve, container, k, _iges_curve_fault(reader.IGESModel(), curve)) for curve, container, k in curves]
+    return [
+        f"{name(curve) if curve is not None else 'a missing curve'}"
+        + (f" ({_part_word(kind, container)} {k} of {name(container)})" if k and container is not None else "")
+        + f": {fault}"
+        for curve, container, k, fault in faults
+        if fault
+    ]
+
+
+def _part_word(kind: str, container: Any) -> str:
+    """What a numbered part of ``container`` is called: an edge of an edge set, a segment, an IGES member."""
+    if kind != "STEP":
+        return "member"
+    return "edge" if _class_name(container) == "ConnectedEdgeSet" else "segment"
 
 
 def _finite_fault(curve: Any) -> str:

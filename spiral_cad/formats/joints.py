@@ -25,7 +25,14 @@ Classification:
   with ``scale = max(|K_a|, |K_b|, 1/size)``, ``size`` being the diagonal of
   the bounding box of the checked elements' start, middle and end points.
   The floor ``1/size`` keeps joints between straight and almost-straight
-  pieces from failing on rounding noise.
+  pieces from failing on rounding noise. A CAD edge's frames also carry
+  what float64 rounding of its curve's stored coordinates can hide in its
+  end curvature (``curvature_rounding_floor``: a polynomial curve's
+  curvature comes from differences of nearby control points, so at survey
+  coordinates, ~3e6 m, a spiral's zero start curvature reads ~1e-13): the
+  bound widens by the two ends' floors, capped at ``ROUNDING_CAP`` (1e-6)
+  of the joint's own scale max(|K_a|, |K_b|, 1/longer edge) — as a
+  ``Chain`` judges its joints — so a real kink is caught at any coordinate.
 * otherwise ``none`` (disconnected).
 * ``unmeasurable``: the measure that decides is not a finite number (NaN or
   infinite: a tangent or curvature the element does not define, or an
@@ -48,8 +55,11 @@ from dataclasses import dataclass
 from enum import IntEnum
 
 import numpy as np
+from numpy.typing import NDArray
 
-__all__ = ["Continuity", "ContinuityReport", "Frame", "JointReport", "WireReport", "classify_pieces", "print_report"]
+from ..core.chain import ROUNDING_CAP
+
+__all__ = ["Continuity", "ContinuityReport", "Frame", "JointReport", "Timing", "WireReport", "classify_pieces", "print_report"]
 
 #: A gap of this many ulp of the joint's largest coordinate is float64 rounding, not a gap.
 ROUNDING_ULPS = 16
@@ -142,6 +152,36 @@ class WireReport:
 
 
 @dataclass(frozen=True)
+class Timing:
+    """Where a check spent its time, in seconds.
+
+    Attributes:
+        reading: the file's reader, with its checks that the file was read whole and the child
+            process round trip; 0 for a shape.
+        measuring: evaluating every edge's end frames.
+        classifying: chaining loose edges and classifying every joint.
+        reader: who read the file (``"the STEP reader (OCCT)"``); empty for a shape.
+    """
+
+    reading: float
+    measuring: float
+    classifying: float
+    reader: str = ""
+
+    def describe(self, joints: int) -> str:
+        """One line: the total, each part, the joints per second of ours, and which part limits the check."""
+        ours = self.measuring + self.classifying
+        total = self.reading + ours
+        rate = f"{joints / ours:,.0f} joints/s" if ours > 0.0 else "no time measured"
+        parts = f"measuring {self.measuring:.3g} s and classifying {self.classifying:.3g} s ({rate})"
+        if not self.reader:
+            return f"time {total:.3g} s: {parts}"
+        share = self.reading / total if total > 0.0 else 0.0
+        verdict = f"{self.reader} limits this check" if share >= 0.5 else "measuring and classifying limit this check"
+        return f"time {total:.3g} s: {self.reader} {self.reading:.3g} s ({share:.0%}), {parts}; {verdict}"
+
+
+@dataclass(frozen=True)
 class ContinuityReport:
     """Joint continuity of every piece (wire or chain of loose edges) of a shape.
 
@@ -154,6 +194,8 @@ class ContinuityReport:
         element: what a piece is made of (``"edge"``, or ``"geometry"`` for OpenDRIVE).
         units: the unit of every length (a file's own unit; ``""``: not
             known, shown as "model units").
+        timing: where the check spent its time (STEP/IGES files and shapes;
+            ``timing_line()``), or None.
     """
 
     wires: tuple[WireReport, ...]
@@ -165,6 +207,7 @@ class ContinuityReport:
     source: str = ""
     element: str = "edge"
     units: str = ""
+    timing: Timing | None = None
 
     @property
     def joints(self) -> list[JointReport]:
@@ -196,6 +239,11 @@ class ContinuityReport:
             else:
                 parts.append(f"{len(counts)} {kind}s ({', '.join(map(str, counts))} {_plural(self.element)})")
         return " and ".join(parts) or f"no {_plural(self.element)}"
+
+    def timing_line(self) -> str:
+        """Where the check spent its time (``spiral-cad check --timing``): the reader's share, and
+        whether the reader or our measuring and classifying limit it; empty without ``timing``."""
+        return self.timing.describe(len(self.joints)) if self.timing is not None else ""
 
     def format_table(self) -> str:
         """Readable text: what was found, then a heading per piece and one line per joint.
@@ -235,15 +283,16 @@ def _count(count: int, noun: str) -> str:
     return f"{count} {noun if count == 1 else _plural(noun)}"
 
 
-#: An end frame as 9 plain floats (cheaper than numpy for 3-vectors): point,
-#: unit tangent (travel sense) and curvature vector.
-Frame = tuple[float, float, float, float, float, float, float, float, float]
-
+#: An end frame as plain floats: point, unit tangent (travel sense) and curvature
+#: vector; a CAD edge's frame adds what float64 rounding of its curve's stored
+#: coordinates can hide in that curvature (1/model unit, ``curvature_rounding_floor``)
+#: and the edge's length (model units).
+Frame = tuple[float, ...]
 
 
 def flip(f: Frame) -> Frame:
     """The frame seen travelling the other way: the tangent flips, the curvature vector does not."""
-    return (f[0], f[1], f[2], -f[3], -f[4], -f[5], f[6], f[7], f[8])
+    return (f[0], f[1], f[2], -f[3], -f[4], -f[5], *f[6:])
 
 
 def distance(a: Frame, b: Frame) -> float:
@@ -251,42 +300,81 @@ def distance(a: Frame, b: Frame) -> float:
     return math.hypot(a[0] - b[0], a[1] - b[1], a[2] - b[2])
 
 
-def classify_joint(index: int, a: Frame, b: Frame, gap_tol: float, angle_tol: float, curvature_tol: float, floor: float) -> JointReport:
-    """Measure and classify the joint from end frame ``a`` to start frame ``b``.
+def curvature_rounding_floor(delta: NDArray, leg: NDArray, next_leg: NDArray, curvature: NDArray) -> NDArray:
+    """What rounding the coordinates of a polynomial curve's first three control points by
+    ``delta`` can change in its end curvature (the same bound as a chain's spirals,
+    ``BezierSpiral.rounding_floor``): κ = (2/3) |a × b| / |a|³ with ``leg`` |a| the end leg
+    and ``next_leg`` |b| the next one."""
+    with np.errstate(all="ignore"):
+        return 2.0 / 3.0 * delta * (leg + next_leg) / leg**3 + 3.0 * curvature * delta / leg
 
-    Each measure is compared as ``not (x <= tol)``: a NaN never passes, and a
-    deciding measure that is not finite makes the joint ``unmeasurable``.
+
+def norms(v: NDArray) -> NDArray:
+    """Lengths of the rows of an (n, 3) array, without squaring (no overflow short of the float range)."""
+    return np.hypot(np.hypot(v[:, 0], v[:, 1]), v[:, 2])
+
+
+def classify_joints(a: NDArray, b: NDArray, gap_tol: float, angle_tol: float, curvature_tol: float,
+                    floor: float) -> tuple[NDArray, ...]:  # fmt: skip
+    """Measure and classify the joints from end frames ``a`` to start frames ``b`` (rows of 9
+    floats, or 11 with each edge's curvature rounding floor and length).
+
+    Returns the arrays (gap, angle, curvature jump, level, |K_a|, |K_b|, relative jump). Each
+    measure is compared as ``not (x <= tol)``: a NaN never passes, and a deciding measure that is
+    not finite makes the joint ``unmeasurable``. Where the frames carry rounding floors the
+    curvature bound widens by their sum, capped at ``ROUNDING_CAP`` relative to the joint's own
+    scale max(|K_a|, |K_b|, 1/longer edge), as ``Chain`` judges its joints.
     """
-    gap = distance(a, b)
-    gap_tol += ROUNDING_ULPS * math.ulp(max(abs(a[0]), abs(a[1]), abs(a[2])))
-    cx, cy, cz = a[4] * b[5] - a[5] * b[4], a[5] * b[3] - a[3] * b[5], a[3] * b[4] - a[4] * b[3]
-    angle = math.atan2(math.hypot(cx, cy, cz), a[3] * b[3] + a[4] * b[4] + a[5] * b[5])
-    ka = math.hypot(a[6], a[7], a[8])
-    kb = math.hypot(b[6], b[7], b[8])
-    jump = math.hypot(a[6] - b[6], a[7] - b[7], a[8] - b[8])
-    # max() drops a NaN that is not its first argument: test finiteness first
-    relative = jump / max(ka, kb, floor) if math.isfinite(ka + kb + jump) else math.nan
-    level = Continuity.G2
-    for value, tolerance, failed in ((gap, gap_tol, Continuity.NONE), (angle, angle_tol, Continuity.G0),
-                                     (relative, curvature_tol, Continuity.G1)):  # fmt: skip
-        if not (value <= tolerance):
-            level = failed if math.isfinite(value) else Continuity.UNMEASURABLE
-            break
-    return JointReport(index, gap, angle, jump, level, ka, kb, relative)
+    a, b = np.asarray(a, dtype=float), np.asarray(b, dtype=float)
+    with np.errstate(all="ignore"):
+        gap = norms(a[:, :3] - b[:, :3])
+        gap_bound = gap_tol + ROUNDING_ULPS * np.spacing(np.abs(a[:, :3]).max(axis=1))
+        angle = np.arctan2(norms(np.cross(a[:, 3:6], b[:, 3:6])), np.einsum("ij,ij->i", a[:, 3:6], b[:, 3:6]))
+        ka, kb = norms(a[:, 6:9]), norms(b[:, 6:9])
+        jump = norms(a[:, 6:9] - b[:, 6:9])
+        scale = np.maximum(np.maximum(ka, kb), floor)
+        relative = np.where(np.isfinite(ka + kb + jump), jump / scale, np.nan)
+        curvature_bound = np.full(len(a), curvature_tol)
+        if a.shape[1] > 9 and b.shape[1] > 9:
+            cap = ROUNDING_CAP * np.maximum(np.maximum(ka, kb), 1.0 / np.maximum(a[:, 10], b[:, 10]))
+            allowance = np.minimum(a[:, 9] + b[:, 9], cap) / scale
+            curvature_bound += np.where(np.isfinite(allowance) & (allowance > 0.0), allowance, 0.0)
+    level = np.full(len(a), int(Continuity.G2))
+    decided = np.zeros(len(a), dtype=bool)
+    for value, bound, failed in ((gap, gap_bound, Continuity.NONE), (angle, angle_tol, Continuity.G0),
+                                 (relative, curvature_bound, Continuity.G1)):  # fmt: skip
+        fails = ~decided & ~(value <= bound)
+        level[fails] = np.where(np.isfinite(value[fails]), int(failed), int(Continuity.UNMEASURABLE))
+        decided |= fails
+    return gap, angle, jump, level, ka, kb, relative
 
 
-def model_size(points: Sequence[tuple[float, float, float]], source: str = "") -> float:
-    """The diagonal of the bounding box of ``points`` (0 for none).
+def classify_joint(index: int, a: Frame, b: Frame, gap_tol: float, angle_tol: float, curvature_tol: float, floor: float) -> JointReport:
+    """Measure and classify the joint from end frame ``a`` to start frame ``b`` (``classify_joints``)."""
+    return _joint_reports([index], classify_joints(np.array([a]), np.array([b]), gap_tol, angle_tol, curvature_tol, floor))[0]
+
+
+def _joint_reports(indices: Sequence[int], measures: tuple[NDArray, ...]) -> list[JointReport]:
+    gap, angle, jump, level, ka, kb, relative = (m.tolist() for m in measures)
+    levels = [Continuity(v) for v in range(-1, 4)]
+    return [
+        JointReport(i, g, an, j, levels[lv + 1], x, y, r)
+        for i, g, an, j, lv, x, y, r in zip(indices, gap, angle, jump, level, ka, kb, relative)
+    ]
+
+
+def model_size(points: Sequence[tuple[float, float, float]] | NDArray, source: str = "") -> float:
+    """The diagonal of the bounding box of ``points`` (a sequence or (n, 3) array; 0 for none).
 
     Raises:
         ValueError: a coordinate that is not a finite number, or a box wider
             than the float range — naming the coordinate.
     """
-    if not points:
+    if len(points) == 0:
         return 0.0
     where = f"{source}: " if source else ""
     with np.errstate(all="ignore"):
-        xyz = np.asarray(points, dtype=float)
+        xyz = np.asarray(points, dtype=float).reshape(-1, 3)
         bad = ~np.isfinite(xyz)
         if bad.any():
             row = xyz[np.argmax(bad.any(axis=1))]
@@ -320,10 +408,12 @@ def classify_pieces(
     wires = []
     for w, (kind, ends, closed, *name) in enumerate(pieces):
         pairs = len(ends) if closed else len(ends) - 1
-        joints = tuple(
-            classify_joint(i, ends[i][1], ends[(i + 1) % len(ends)][0], gap_tol, angle_tol, curvature_tol, floor)
-            for i in range(pairs)
-        )
+        joints: tuple[JointReport, ...] = ()
+        if pairs > 0:
+            frames = np.asarray(ends, dtype=float)  # (edges, 2: start and end, frame)
+            after = np.roll(frames[:, 0], -1, axis=0)[:pairs]
+            measures = classify_joints(frames[:pairs, 1], after, gap_tol, angle_tol, curvature_tol, floor)
+            joints = tuple(_joint_reports(range(pairs), measures))
         wires.append(WireReport(w, len(ends), closed, joints, kind, *name))
     return ContinuityReport(tuple(wires), gap_tol, angle_tol, curvature_tol, size, snap, source, element, units)
 
@@ -338,6 +428,8 @@ def check_tolerances(**tolerances: float) -> None:
 def print_report(report: ContinuityReport, args: argparse.Namespace) -> int:
     """Print ``report`` for ``spiral-cad check``; exit status 0 ok, 1 below ``--require`` or not ``--pieces`` pieces."""
     print(report.format_table())
+    if getattr(args, "timing", False) and report.timing is not None:
+        print(report.timing_line())
     if not args.require:
         return 0
     expected = 1 if args.pieces is None else args.pieces

@@ -1,22 +1,36 @@
 """STEP (ISO 10303-21, AP214) for chains, written directly: exact curves, one wire per chain.
 
-Each chain becomes one ``COMPOSITE_CURVE`` whose segments run in travel order
-and record the continuity at each joint (``CONT_SAME_GRADIENT_SAME_CURVATURE``
-between G2 segments, ``DISCONTINUOUS`` after the last one of an open chain).
-All composite curves sit in one ``GEOMETRIC_CURVE_SET`` of a
-``GEOMETRICALLY_BOUNDED_WIREFRAME_SHAPE_REPRESENTATION``: the shape of a
-``PRODUCT`` named after the design. OCCT's reader, and so FreeCAD, turns each
-composite curve into one connected ``TopoDS_Wire``.
+Each chain (in the plane or in space) becomes one ``CONNECTED_EDGE_SET`` of
+``EDGE_CURVE`` entities in travel order; consecutive edges share their
+``VERTEX_POINT`` (a closed chain ends on the vertex it starts from). The sets make one
+``EDGE_BASED_WIREFRAME_MODEL`` of an ``EDGE_BASED_WIREFRAME_SHAPE_REPRESENTATION``:
+the shape of a ``PRODUCT`` named after the design. OCCT's reader, and so
+FreeCAD, turns each set into one connected ``TopoDS_Wire`` by adding its
+edges in order, in time linear in the edge count.
 
-The curves:
+Why not a ``COMPOSITE_CURVE`` (this module's earlier form, which could carry
+G2 transition codes): OCCT translates a composite curve with
+``ShapeFix_Wire::FixReorder``, a greedy search over every remaining segment
+for each segment (``ShapeAnalysis_WireOrder``, quadratic), and then checks
+the order of every wire it read once more (``ShapeFix_Shape`` after the
+transfer, the same search). The edge-based form skips the first of the two;
+the second runs on every wire OCCT reads, whatever the form, and remains
+the cost of one wire of N edges over N loose edges (``benchmarks/bench_step.py``).
 
-* ``Line``: a ``TRIMMED_CURVE`` of a ``LINE`` (unit direction), parameters 0 … length;
-* ``Arc``: a ``TRIMMED_CURVE`` of a ``CIRCLE`` whose placement's x axis points
-  at the arc's start, its axis +Z for counterclockwise travel and −Z for
-  clockwise, parameters 0 … sweep (radians);
+The curves (each edge's geometry, bounded by its two vertices, edge and
+curve in the same sense):
+
+* ``Line``: a ``LINE`` from the start point along the unit direction;
+* ``Arc``: a ``CIRCLE`` whose placement's x axis points at the arc's start,
+  its axis the arc's normal (+Z in the plane) for counterclockwise travel
+  and the opposite for clockwise;
 * ``BezierSpiral``: a ``B_SPLINE_CURVE_WITH_KNOTS`` of degree 3 with the
   spiral's four control points and knots (0, 1) of multiplicity 4
   (``PIECEWISE_BEZIER_KNOTS``): the same polynomial as the Bézier.
+
+Each vertex is the next segment's start point (the point its curve starts
+from exactly); the chain's own join tolerance keeps the previous segment's
+end within rounding of it.
 
 The length unit is declared in the representation context (an ``SI_UNIT``
 with its prefix for mm, cm, m, km; a ``CONVERSION_BASED_UNIT`` of 25.4 mm or
@@ -34,6 +48,9 @@ import math
 import os
 from collections.abc import Sequence
 from datetime import datetime, timezone
+
+import numpy as np
+from numpy.typing import NDArray
 
 from ..core.chain import Chain
 from ..core.segments import Arc, Line, Segment, measure_join
@@ -69,72 +86,61 @@ class _Entities:
         self.lines.append(text)
         return f"#{len(self.lines)}"
 
-    def point(self, x: float, y: float) -> str:
-        return self.add(f"CARTESIAN_POINT('',({real(x)},{real(y)},0.))")
+    def point(self, x: float, y: float, z: float = 0.0) -> str:
+        return self.add(f"CARTESIAN_POINT('',({real(x)},{real(y)},{real(z)}))")
 
     def direction(self, x: float, y: float, z: float = 0.0) -> str:
         return self.add(f"DIRECTION('',({real(x)},{real(y)},{real(z)}))")
 
 
-def _line(data: _Entities, line: Line) -> str:
-    (ax, ay), (bx, by) = line.start.tolist(), line.end.tolist()
-    length = line.length
-    a, b = data.point(ax, ay), data.point(bx, by)
-    vector = data.add(f"VECTOR('',{data.direction((bx - ax) / length, (by - ay) / length)},1.)")
-    basis = data.add(f"LINE('',{a},{vector})")
-    return data.add(f"TRIMMED_CURVE('',{basis},(PARAMETER_VALUE(0.),{a}),(PARAMETER_VALUE({real(length)}),{b}),.T.,.PARAMETER.)")
+def _unit(vector: NDArray) -> list[float]:
+    return (vector / np.linalg.norm(vector)).tolist()
 
 
-def _arc(data: _Entities, arc: Arc) -> str:
-    cx, cy = arc.center.tolist()
-    a0 = arc.start_angle
-    axis = data.direction(0.0, 0.0, 1.0 if arc.radius > 0 else -1.0)
-    placement = data.add(f"AXIS2_PLACEMENT_3D('',{data.point(cx, cy)},{axis},{data.direction(math.cos(a0), math.sin(a0))})")
-    basis = data.add(f"CIRCLE('',{placement},{real(abs(arc.radius))})")
-    (sx, sy), (ex, ey) = arc.start.tolist(), arc.end.tolist()
-    start, end = data.point(sx, sy), data.point(ex, ey)
-    return data.add(
-        f"TRIMMED_CURVE('',{basis},(PARAMETER_VALUE(0.),{start}),(PARAMETER_VALUE({real(arc.sweep)}),{end}),.T.,.PARAMETER.)"
-    )
+def _line(data: _Entities, line: Line, start: str) -> str:
+    vector = data.add(f"VECTOR('',{data.direction(*_unit(line.end - line.start))},1.)")
+    return data.add(f"LINE('',{start},{vector})")
 
 
-def _spiral(data: _Entities, spiral: BezierSpiral) -> str:
-    poles = ",".join(data.point(x, y) for x, y in spiral.control_points.tolist())
+def _arc(data: _Entities, arc: Arc, start: str) -> str:
+    """A circle about the arc's axis (its normal, reversed for clockwise travel) with its x axis at the start."""
+    axis = data.direction(*(math.copysign(1.0, arc.radius) * arc.normal).tolist())
+    reference = data.direction(*_unit(arc.start - arc.center))
+    placement = data.add(f"AXIS2_PLACEMENT_3D('',{data.point(*arc.center.tolist())},{axis},{reference})")
+    return data.add(f"CIRCLE('',{placement},{real(abs(arc.radius))})")
+
+
+def _spiral(data: _Entities, spiral: BezierSpiral, start: str) -> str:
+    poles = ",".join([start] + [data.point(*p) for p in spiral.control_points[1:].tolist()])
     return data.add(f"B_SPLINE_CURVE_WITH_KNOTS('',3,({poles}),.UNSPECIFIED.,.F.,.F.,(4,4),(0.,1.),.PIECEWISE_BEZIER_KNOTS.)")
 
 
 _CURVES = {Line: _line, Arc: _arc, BezierSpiral: _spiral}
 
 
-def _curve(data: _Entities, segment: Segment) -> str:
+def _curve(data: _Entities, segment: Segment, start: str) -> str:
+    """The curve of ``segment``, starting at the point ``start`` (an entity already written)."""
     for kind, make in _CURVES.items():
         if isinstance(segment, kind):
-            return make(data, segment)
+            return make(data, segment, start)
     raise ValueError(f"segment must be a Line, Arc or BezierSpiral; got {segment!r}")
 
 
-def _closing_transition(chain: Chain) -> str | None:
-    """The transition code of a closed chain's closing joint (None when the chain is open)."""
-    join = measure_join(chain[-1], chain[0])
-    tol = chain.tolerance
-    if join.gap > tol * chain.size:
-        return None
-    if join.angle > tol:
-        return ".CONTINUOUS."
-    if join.curvature_jump * chain.size > tol:
-        return ".CONT_SAME_GRADIENT."
-    return ".CONT_SAME_GRADIENT_SAME_CURVATURE."
+def _closes(chain: Chain) -> bool:
+    """The chain ends where it starts (within its join tolerance): its last edge ends on its first vertex."""
+    return measure_join(chain[-1], chain[0]).gap <= chain.tolerance * chain.size
 
 
-def _composite(data: _Entities, chain: Chain, label: str) -> str:
-    """One COMPOSITE_CURVE in travel order; internal joints are G2 (the chain checked them)."""
-    closing = _closing_transition(chain) if len(chain) > 1 else None
-    segments = []
-    for i, segment in enumerate(chain):
-        last = i == len(chain) - 1
-        code = (closing or ".DISCONTINUOUS.") if last else ".CONT_SAME_GRADIENT_SAME_CURVATURE."
-        segments.append(data.add(f"COMPOSITE_CURVE_SEGMENT({code},.T.,{_curve(data, segment)})"))
-    return data.add(f"COMPOSITE_CURVE({step_string(label)},({','.join(segments)}),.F.)")
+def _edge_set(data: _Entities, chain: Chain, label: str) -> str:
+    """One CONNECTED_EDGE_SET: the chain's edges in travel order, consecutive edges sharing a vertex."""
+    starts = [data.point(*segment.start.tolist()) for segment in chain]
+    vertices = [data.add(f"VERTEX_POINT('',{point})") for point in starts]
+    last = vertices[0] if _closes(chain) else data.add(f"VERTEX_POINT('',{data.point(*chain[-1].end.tolist())})")
+    edges = [
+        data.add(f"EDGE_CURVE('',{v0},{v1},{_curve(data, segment, start)},.T.)")
+        for segment, start, v0, v1 in zip(chain, starts, vertices, vertices[1:] + [last])
+    ]
+    return data.add(f"CONNECTED_EDGE_SET({step_string(label)},({','.join(edges)}))")
 
 
 def _units(data: _Entities, units: str, uncertainty: float) -> str:
@@ -164,7 +170,7 @@ def _uncertainty(chains: Sequence[Chain], units: str) -> float:
 
 
 def step_text(chains: Sequence[Chain], name: str, units: str, originating_system: str, timestamp: datetime | None = None) -> str:
-    """The whole STEP file for ``chains`` (one product ``name``, one wire per chain)."""
+    """The whole STEP file for ``chains`` (one product ``name``, one connected edge set per chain)."""
     when = (timestamp or datetime.now(timezone.utc)).strftime("%Y-%m-%dT%H:%M:%S")
     data = _Entities()
     context = data.add("APPLICATION_CONTEXT('core data for automotive mechanical design processes')")
@@ -181,10 +187,10 @@ def step_text(chains: Sequence[Chain], name: str, units: str, originating_system
         f"AXIS2_PLACEMENT_3D('',{data.point(0.0, 0.0)},{data.direction(0.0, 0.0, 1.0)},{data.direction(1.0, 0.0)})"
     )
     labels = [name] if len(chains) == 1 else [f"{name}-{i + 1}" for i in range(len(chains))]
-    curves = [_composite(data, chain, label) for chain, label in zip(chains, labels)]
-    curve_set = data.add(f"GEOMETRIC_CURVE_SET({step_string(name)},({','.join(curves)}))")
+    sets = [_edge_set(data, chain, label) for chain, label in zip(chains, labels)]
+    model = data.add(f"EDGE_BASED_WIREFRAME_MODEL({step_string(name)},({','.join(sets)}))")
     representation = data.add(
-        f"GEOMETRICALLY_BOUNDED_WIREFRAME_SHAPE_REPRESENTATION({step_string(name)},({curve_set},{origin}),{representation_context})"
+        f"EDGE_BASED_WIREFRAME_SHAPE_REPRESENTATION({step_string(name)},({model},{origin}),{representation_context})"
     )
     data.add(f"SHAPE_DEFINITION_REPRESENTATION({shape},{representation})")
     header = [
