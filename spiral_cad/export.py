@@ -116,11 +116,11 @@ def export_step(obj: Any, path: PathLike, *, name: str | None = None, units: str
     """
     chains = _chains(obj)
     label, unit = _name(name, path), _units(chains, units)
-    if chains is not None and all(c.dim == 2 for c in chains):
+    if chains is not None:
         from .formats.step import write_step
 
         write_step(chains, path, label, unit, originating_system())
-    else:  # shapes, and chains in space: OCCT's writer, one exact wire per chain
+    else:
         from .formats.step_occ import write_shape_step
 
         write_shape_step(obj, path, label, unit, originating_system())

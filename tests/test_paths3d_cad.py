@@ -160,3 +160,24 @@ def test_samples_of_a_plane_chain_with_arcs_carry_signed_curvature(tmp_path):
             assert np.diff(table[:, 0]).max() <= 2.0
     assert export_samples(chain, tmp_path / "a.csv", step=2.0) == len(sample_path(chain, step=2.0))
     assert (tmp_path / "a.csv").read_text().splitlines()[0].startswith("s [m],x [m]")
+
+
+def test_the_checker_reports_where_a_path_in_space_changes_plane(tmp_path):
+    path = round_corners(RUN, max_deviation=2.0)
+    export_step(path.chain, tmp_path / "run.step")
+    report = check_continuity(tmp_path / "run.step")
+    assert report.passes("G2")
+    joints = report.wires[0].joints
+    # independently: the corners' planes, and the angle between consecutive ones
+    pts = np.array(RUN, dtype=float)
+    normals = [np.cross(b - a, c - b) / np.linalg.norm(np.cross(b - a, c - b)) for a, b, c in zip(pts, pts[1:], pts[2:])]
+    expected = [math.acos(min(1.0, abs(m @ n))) for m, n in zip(normals, normals[1:])]
+    # segments: line, pair, line, pair, line, pair, line: the twists show where each next pair begins (joints 3 and 6)
+    assert math.isnan(joints[0].plane_change)  # the path starts straight: no plane before it
+    assert [j.index for j in joints if j.plane_change > 1e-9] == [3, 6]
+    assert [joints[3].plane_change, joints[6].plane_change] == pytest.approx(expected, abs=1e-12)
+    assert all(j.plane_change <= 1e-12 for j in joints[1:] if j.index not in (3, 6))
+    text = report.format_table()
+    assert f"largest plane change {math.degrees(max(expected)):.4g}° at joint" in text and "plane°" in text
+    flat = round_corners([p[:2] for p in RUN], max_deviation=2.0).chain  # in the plane: no plane change anywhere
+    assert all(j.plane_change <= 1e-12 for j in check_continuity(flat).wires[0].joints[1:])
