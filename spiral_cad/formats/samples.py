@@ -43,8 +43,9 @@ COLUMNS = (("s", "L"), ("x", "L"), ("y", "L"), ("z", "L"), ("tx", "1"), ("ty", "
 MAX_SAMPLES = 20_000_000
 #: Points measured between two neighbouring samples when the chord tolerance is checked.
 CHORD_PROBES = 5
-#: A spiral's largest curvature is taken at this many parameters, raised by ``CURVATURE_MARGIN``.
-CURVATURE_PROBES = 17
+#: A spiral's largest curvature is taken at this many parameters, raised by ``CURVATURE_MARGIN`` (it sets the first
+#: spacing only: every chord is then measured).
+CURVATURE_PROBES = 5
 CURVATURE_MARGIN = 1.05
 #: Intervals measured at once (bounded temporaries).
 BLOCK = 1 << 17
@@ -73,6 +74,9 @@ class _Rows:
         # A power of two per row near its size: spiral derivatives are formed on exactly scaled copies (any magnitude).
         legs = np.abs(np.diff(self.cp, axis=1)).max(axis=(1, 2))
         self.scale = np.ldexp(1.0, np.frexp(np.where(legs > 0.0, legs, 1.0))[1])
+        # Power-basis coefficients of every row once (spirals: the point, and its derivatives scaled), gathered per sample.
+        scaled = self.cp / self.scale[:, None, None]
+        self.coefficients = [bezier._power_coefficients(self.cp)] + [bezier._power_coefficients(scaled, k) for k in (1, 2)]
 
     def points(self, owner: NDArray, u: NDArray) -> NDArray:
         out = np.empty((len(owner), self.dim))
@@ -84,8 +88,16 @@ class _Rows:
             elif kind == ARC:
                 out[pick] = self._arc(i, t)[0]
             else:
-                out[pick] = bezier.point(self.cp[i], t[:, None])[:, 0]
+                out[pick] = self._polynomial(0, i, t)
         return out
+
+    def _polynomial(self, order: int, i: NDArray, t: NDArray) -> NDArray:
+        """Derivative ``order`` (0: the point; 1, 2 on the scaled copies) of rows ``i`` at ``t``, by Horner."""
+        coefficients = self.coefficients[order]
+        acc = coefficients[i, -1]
+        for j in range(coefficients.shape[1] - 2, -1, -1):
+            acc = acc * t[:, None] + coefficients[i, j]
+        return acc
 
     def frames(self, owner: NDArray, u: NDArray, stations: bool = True) -> tuple[NDArray, NDArray, NDArray, NDArray]:
         """(s, points, unit tangents, curvature: signed in the plane, ≥ 0 in space); s is NaN
@@ -103,9 +115,8 @@ class _Rows:
                 points[pick], tangents[pick], kappa[pick] = self._arc(i, t)
                 s[pick] = self.stations[i] + t * self.lengths[i]
             else:
-                cp = self.cp[i] / self.scale[i, None, None]
-                points[pick] = bezier.point(self.cp[i], t[:, None])[:, 0]
-                d1, d2 = (bezier.derivative(cp, t[:, None], order)[:, 0] for order in (1, 2))
+                points[pick] = self._polynomial(0, i, t)
+                d1, d2 = self._polynomial(1, i, t), self._polynomial(2, i, t)
                 speed = np.linalg.norm(d1, axis=1)
                 tangents[pick] = d1 / speed[:, None]
                 # the multi-curve form of BezierSpiral.curvature: (Q' × Q'')/|Q'|³, signed in the plane
