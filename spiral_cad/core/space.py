@@ -45,19 +45,37 @@ def place(points: ArrayLike, origin: ArrayLike, x_dir: ArrayLike, y_dir: ArrayLi
     drop = (slice(None),) * split + (0,) * (len(lead) - split)  # the axes frames are constant along
     frames = [np.broadcast_to(f.reshape((1,) * (len(lead) + 1 - f.ndim) + f.shape)[drop], rows + (3,)).reshape(count, 3) for f in frames]
     flat = np.broadcast_to(p, lead + (2,)).reshape(count, inner, 2)
+    # Writeable C arrays: numba dispatches read-only views (what broadcast_to gives) in milliseconds, not microseconds.
+    frames = [np.require(f, np.float64, ["C", "W", "A"]) for f in frames]
+    flat = np.require(flat, np.float64, ["C", "W", "A"])
     out = np.empty((count, inner, 3))
-    _place_rows(flat, *frames, out)
+    (_place_rows_parallel if count * inner >= PARALLEL_FROM else _place_rows)(flat, *frames, out)
     return out.reshape(lead + (3,))
 
 
-@K._compile(parallel=True)
-def _place_rows(points, origin, x_dir, y_dir, out):
+#: Points from which ``place`` runs in parallel: waking the threads can cost milliseconds on a busy machine.
+PARALLEL_FROM = 100_000
+
+
+@K.jit
+def _place_row(points, origin, x_dir, y_dir, out, i):
     """out[i, k] = origin[i] + points[i, k, 0]·x_dir[i] + points[i, k, 1]·y_dir[i]."""
+    for k in range(points.shape[1]):
+        u, v = points[i, k, 0], points[i, k, 1]
+        for j in range(3):
+            out[i, k, j] = origin[i, j] + u * x_dir[i, j] + v * y_dir[i, j]
+
+
+@K.jit
+def _place_rows(points, origin, x_dir, y_dir, out):
+    for i in range(points.shape[0]):
+        _place_row(points, origin, x_dir, y_dir, out, i)
+
+
+@K._compile(parallel=True)
+def _place_rows_parallel(points, origin, x_dir, y_dir, out):
     for i in prange(points.shape[0]):
-        for k in range(points.shape[1]):
-            u, v = points[i, k, 0], points[i, k, 1]
-            for j in range(3):
-                out[i, k, j] = origin[i, j] + u * x_dir[i, j] + v * y_dir[i, j]
+        _place_row(points, origin, x_dir, y_dir, out, i)
 
 
 def norms(vectors: ArrayLike) -> NDArray:
@@ -102,8 +120,8 @@ def corner_frames(before: ArrayLike, corners: ArrayLike, after: ArrayLike) -> tu
     return x, y
 
 
-@K._compile(parallel=True)
-def placed_pair_residuals(pairs, corners, x_dir, y_dir, outgoing, peak, residual, deviation):
+def placed_pair_residuals(pairs: NDArray, corners: NDArray, x_dir: NDArray, y_dir: NDArray, outgoing: NDArray, peak: NDArray,
+                          residual: NDArray, deviation: NDArray) -> None:  # fmt: skip
     """Verify N corners' spiral pairs placed in space, measured on the placed control points.
 
     ``pairs`` (N, 2, 4, 3) were solved in the planes (``x_dir``, ``y_dir``)
@@ -117,26 +135,44 @@ def placed_pair_residuals(pairs, corners, x_dir, y_dir, outgoing, peak, residual
     receives the worst of these (NaN counted infinite), ``deviation`` (N,)
     the distance from each corner to its pair's joint.
     """
+    run = _pair_residuals_parallel if len(corners) * 8 >= PARALLEL_FROM else _pair_residuals
+    run(pairs, corners, x_dir, y_dir, outgoing, peak, residual, deviation)
+
+
+@K.jit
+def _pair_residual(pairs, corners, x_dir, y_dir, outgoing, peak, residual, deviation, i):
+    """Row ``i`` of ``placed_pair_residuals``."""
+    x, y = x_dir[i], y_dir[i]
+    nx, ny, nz = x[1] * y[2] - x[2] * y[1], x[2] * y[0] - x[0] * y[2], x[0] * y[1] - x[1] * y[0]
+    local = np.empty((2, 4, 2))
+    off = 0.0
+    for k in range(2):
+        for m in range(4):
+            dx, dy, dz = pairs[i, k, m, 0] - corners[i, 0], pairs[i, k, m, 1] - corners[i, 1], pairs[i, k, m, 2] - corners[i, 2]
+            local[k, m, 0] = dx * x[0] + dy * x[1] + dz * x[2]
+            local[k, m, 1] = dx * y[0] + dy * y[1] + dz * y[2]
+            off = K.worst(off, abs(dx * nx + dy * ny + dz * nz))
+    scale = K.frame_scale(max(abs(local[0, 0, 0]), abs(outgoing[i, 0]), abs(outgoing[i, 1])))
+    inv = 1.0 / scale
+    t1x, t1y = K.unit(-outgoing[i, 0], -outgoing[i, 1])  # along the outgoing leg, towards the corner
+    res = K.corner_residual(local, 0.0, 0.0, 1.0, 0.0, t1x, t1y, peak[i] * scale, inv)
+    leg = K.norm((local[0, 1, 0] - local[0, 0, 0]) * inv, (local[0, 1, 1] - local[0, 0, 1]) * inv)
+    length = min(leg, 1.0 / (peak[i] * scale))
+    residual[i] = K.worst(res, off * inv / length)
+    jx, jy, jz = (pairs[i, 0, 3, 0] - corners[i, 0]) * inv, (pairs[i, 0, 3, 1] - corners[i, 1]) * inv, (pairs[i, 0, 3, 2] - corners[i, 2]) * inv
+    deviation[i] = math.sqrt(jx * jx + jy * jy + jz * jz) * scale
+
+
+@K.jit
+def _pair_residuals(pairs, corners, x_dir, y_dir, outgoing, peak, residual, deviation):
+    for i in range(corners.shape[0]):
+        _pair_residual(pairs, corners, x_dir, y_dir, outgoing, peak, residual, deviation, i)
+
+
+@K._compile(parallel=True)
+def _pair_residuals_parallel(pairs, corners, x_dir, y_dir, outgoing, peak, residual, deviation):
     for i in prange(corners.shape[0]):
-        x, y = x_dir[i], y_dir[i]
-        nx, ny, nz = x[1] * y[2] - x[2] * y[1], x[2] * y[0] - x[0] * y[2], x[0] * y[1] - x[1] * y[0]
-        local = np.empty((2, 4, 2))
-        off = 0.0
-        for k in range(2):
-            for m in range(4):
-                dx, dy, dz = pairs[i, k, m, 0] - corners[i, 0], pairs[i, k, m, 1] - corners[i, 1], pairs[i, k, m, 2] - corners[i, 2]
-                local[k, m, 0] = dx * x[0] + dy * x[1] + dz * x[2]
-                local[k, m, 1] = dx * y[0] + dy * y[1] + dz * y[2]
-                off = K.worst(off, abs(dx * nx + dy * ny + dz * nz))
-        scale = K.frame_scale(max(abs(local[0, 0, 0]), abs(outgoing[i, 0]), abs(outgoing[i, 1])))
-        inv = 1.0 / scale
-        t1x, t1y = K.unit(-outgoing[i, 0], -outgoing[i, 1])  # along the outgoing leg, towards the corner
-        res = K.corner_residual(local, 0.0, 0.0, 1.0, 0.0, t1x, t1y, peak[i] * scale, inv)
-        leg = K.norm((local[0, 1, 0] - local[0, 0, 0]) * inv, (local[0, 1, 1] - local[0, 0, 1]) * inv)
-        length = min(leg, 1.0 / (peak[i] * scale))
-        residual[i] = K.worst(res, off * inv / length)
-        jx, jy, jz = (pairs[i, 0, 3, 0] - corners[i, 0]) * inv, (pairs[i, 0, 3, 1] - corners[i, 1]) * inv, (pairs[i, 0, 3, 2] - corners[i, 2]) * inv
-        deviation[i] = math.sqrt(jx * jx + jy * jy + jz * jz) * scale
+        _pair_residual(pairs, corners, x_dir, y_dir, outgoing, peak, residual, deviation, i)
 
 
 def _vector3(value: Any, name: str) -> NDArray:
