@@ -25,6 +25,7 @@ def main() -> None:
         tmp = Path(tmp)
         run("-m", "spiral_cad.cli", "demo", "--out", str(tmp / "demo"))
         run("examples/robot_path.py", str(tmp / "robot"))
+        run("examples/robot_path_3d.py", str(tmp / "robot3d"))
         run("examples/build123d_road.py", str(tmp / "road"))
         run("examples/cadquery_plugin.py", str(tmp / "cq" / "tube.step"))
         run("examples/continuous_corners.py", str(tmp / "corners"))
@@ -35,6 +36,7 @@ def main() -> None:
             "demo/fig6.png": "fig6.png",
             "demo/bezier_vs_clothoid.png": "bezier_vs_clothoid.png",
             "robot/robot_path.png": "robot_path.png",
+            "robot3d/robot_path_3d.png": "robot_path_3d.png",
             "road/road.svg": "road.svg",
             "corners/continuous_corners.png": "continuous_corners.png",
         }

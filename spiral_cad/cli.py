@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 import math
 import os
+import re
 import signal
 import sys
 import threading
@@ -134,8 +135,40 @@ def _paper_plots(folder: Path) -> None:
     plot_vs_clothoid(math.radians(8), 1.0, shapes=both).savefig(folder / "bezier_vs_clothoid.png", dpi=110, format="png")
 
 
+#: ``build`` options that describe a ``--from-gcode`` design (a design file states them per design).
+GCODE_OPTIONS = ("max_deviation", "max_curvature", "shape", "sample_step", "chord_tolerance", "name", "units")
+
+
 def _build(args: argparse.Namespace) -> int:
-    return _write_design(args.design, Path(args.out), plots=not args.no_plots)
+    if args.from_gcode is None:
+        given = [f"--{o.replace('_', '-')}" for o in GCODE_OPTIONS if getattr(args, o) is not None]
+        if args.design is None:
+            raise ValueError("give a design file, or --from-gcode FILE.nc")
+        if given:
+            raise ValueError(f"{', '.join(given)}: only with --from-gcode (a design file states these per design)")
+        return _write_design(args.design, Path(args.out), plots=not args.no_plots)
+    if args.design is not None:
+        raise ValueError("give a design file or --from-gcode, not both")
+    return _write_design(gcode_design(args), Path(args.out), plots=not args.no_plots)
+
+
+def gcode_design(args: argparse.Namespace) -> dict:
+    """The design of ``build --from-gcode``: one ``rounded_polyline`` of the program's moves, with samples."""
+    if args.max_deviation is None and args.max_curvature is None:
+        raise ValueError("--from-gcode needs --max-deviation (the tolerance at every corner) and/or --max-curvature")
+    if args.sample_step is not None and args.chord_tolerance is not None:
+        raise ValueError("give --sample-step or --chord-tolerance, not both")
+    stem = re.sub(r"[^A-Za-z0-9_-]", "_", Path(args.from_gcode).stem).lstrip("_-")[:64] or "toolpath"
+    design = {"name": args.name or stem, "type": "rounded_polyline", "gcode": args.from_gcode, "spiral_shape": args.shape or "walton-meek"}
+    for key in ("max_deviation", "max_curvature"):
+        if getattr(args, key) is not None:
+            design[key] = getattr(args, key)
+    if args.sample_step is not None:
+        design["samples"] = {"step": args.sample_step}
+    else:
+        default = args.max_deviation / 10.0 if args.max_deviation is not None else 0.001
+        design["samples"] = {"chord_tolerance": args.chord_tolerance if args.chord_tolerance is not None else default}
+    return {"units": args.units or "mm", "designs": [design]}
 
 
 #: Exit status of ``check`` when its output pipe closes early (``| head -1``): 128 + SIGPIPE,
@@ -249,6 +282,7 @@ def _parser() -> argparse.ArgumentParser:
             "examples:\n"
             "  spiral-cad demo --out out                  the built-in design: STEP, IGES, DXF, SVG, plots, CSV\n"
             "  spiral-cad build examples/design.json      your own design file (spiral-cad build --help for the format)\n"
+            "  spiral-cad build --from-gcode part.nc --max-deviation 0.01   a CNC program rounded G2: STEP and samples\n"
             "  spiral-cad check out/highway.step --require G2   G0/G1/G2 at every joint; exit 1 below G2\n"
             "  spiral-cad check out/highway.xodr --require G2 --profiles C1 --links G1   every road, profile and link of an OpenDRIVE map"
         ),
@@ -268,9 +302,23 @@ def _parser() -> argparse.ArgumentParser:
         description="Design file format:\n\n" + _design_format(),
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
-    build.add_argument("design", help="the design file (.json)")
+    build.add_argument("design", nargs="?", help="the design file (.json); or --from-gcode")
     build.add_argument("--out", default="out", help="output folder (default: out)")
     build.add_argument("--no-plots", action="store_true", help="skip the PNG plots (the slowest output for long chains)")
+    gcode = build.add_argument_group(
+        "G-code", "round the straight moves (G0/G1) of a CNC program G2 and write STEP, IGES, DXF, samples and the\n"
+        "continuity report (README: the G-code subset; arcs and other codes are refused by name and line)")  # fmt: skip
+    gcode.add_argument("--from-gcode", metavar="FILE.nc", help="the program to round (instead of a design file)")
+    gcode.add_argument("--max-deviation", type=float, help="the largest distance between a corner point and the path")
+    gcode.add_argument("--max-curvature", type=float, help="the curvature bound (1/unit)")
+    gcode.add_argument("--shape", choices=["walton-meek", "near-linear", "g2cbs"], help="spiral shape (default walton-meek)")
+    gcode.add_argument("--sample-step", type=float, help="samples at most this far apart along the path")
+    gcode.add_argument("--chord-tolerance", type=float,
+                       help="samples close enough that the path strays at most this far from their chords "
+                            "(default: a tenth of --max-deviation, else 0.001)")  # fmt: skip
+    gcode.add_argument("--units", choices=["mm", "cm", "m", "km", "in", "ft"],
+                       help="the unit of the outputs and of every length above (default mm; the program's G20/G21 is converted)")  # fmt: skip
+    gcode.add_argument("--name", help="the design's name (default: the program's file name)")
     build.set_defaults(run=_build)
     _add_check(sub)
     return parser

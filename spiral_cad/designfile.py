@@ -76,8 +76,15 @@ FORMAT = """\
      "circles": [{"center": [x, y], "radius": r}, ...],    signed radius = travel sense (+ ccw)
      "spiral_shape": "walton-meek" | "near-linear"},        default walton-meek
     {"name": "robot", "type": "rounded_polyline",
-     "points": [[x, y], ...],
-     "max_curvature": k  | "curvature": k  | neither (as large as fits),
+     "points": [[x, y] | [x, y, z], ...],   a polyline in the plane or in space (≥ 3 points), or
+     "gcode": "FILE.nc",                 the G0/G1 moves of a G-code program (a path relative to the
+                                         design file; G20/G21 converted to "units"; README: the subset)
+     "max_deviation": h,                 the largest distance between a corner point and the path,
+     "max_curvature": k,                 and/or the curvature bound (alone: every corner peaks at k),
+                                         or "curvature": k | "spiral_lengths": L | none (as large as
+                                         fits); each a number or one per interior point
+     "samples": {"step": s} | {"chord_tolerance": c},   optional NAME_samples.csv for a machine:
+                                         s, x, y, z, tangent and curvature along the path
      "spiral_shape": "walton-meek" | "near-linear" | "g2cbs"},   default walton-meek
                                          ("method" is its former name)
     {"name": "t", "type": "transition", "case": "line_to_circle" | "circle_to_circle" |
@@ -86,7 +93,8 @@ FORMAT = """\
   ]
 }
 Names: 1–64 characters of A–Z, a–z, 0–9, - and _ (they name the output files; no two may
-differ only in case). The file: UTF-8 JSON, a regular file of at most 10 MB."""
+differ only in case). The file: UTF-8 JSON, a regular file of at most 10 MB. A path in space
+gets STEP, IGES, DXF, samples and the continuity report (SVG and the plots are plane outputs)."""
 
 TRANSITION_ARGS = {
     "line_to_circle": ("point", "direction", "center", "radius"),
@@ -146,6 +154,26 @@ def _points(value: Any, where: str, minimum: int) -> list[tuple[float, float]]:
     if not isinstance(value, list) or len(value) < minimum:
         raise DesignError(f"{where}: must be a list of at least {minimum} points [x, y]; got {value!r:.80}")
     return [_point(p, f"{where}[{i}]") for i, p in enumerate(value)]
+
+
+def _points_in_space(value: Any, where: str, minimum: int) -> list[tuple[float, ...]]:
+    """At least ``minimum`` points, all [x, y] or all [x, y, z]."""
+    if not isinstance(value, list) or len(value) < minimum:
+        raise DesignError(f"{where}: must be a list of at least {minimum} points [x, y] or [x, y, z]; got {value!r:.80}")
+    size = len(value[0]) if isinstance(value[0], list) else 0
+    points = []
+    for i, p in enumerate(value):
+        if not isinstance(p, list) or len(p) not in (2, 3) or len(p) != size:
+            raise DesignError(f"{where}[{i}]: must be a point like the first, [x, y] or [x, y, z]; got {p!r:.80}")
+        points.append(tuple(_number(c, f"{where}[{i}][{j}]") for j, c in enumerate(p)))
+    return points
+
+
+def _numbers(value: Any, where: str) -> float | list[float]:
+    """A positive number, or a list of them."""
+    if isinstance(value, list):
+        return [_number(v, f"{where}[{i}]", positive=True) for i, v in enumerate(value)]
+    return _number(value, where, positive=True)
 
 
 def _pairs(value: Any, where: str, count: int, convert: Callable[[Any, str], float]) -> list[tuple[float, float]]:
@@ -454,19 +482,38 @@ def _circle_chain(d: dict, where: str, units: str) -> Built:
     return Built(d["name"], "circle_chain", result.chain, result)
 
 
+#: The per-corner options of a rounded polyline (``round_corners``'s keywords).
+ROUNDING_KEYS = ("curvature", "max_curvature", "max_deviation", "spiral_lengths")
+
+
 def _rounded(d: dict, where: str, units: str) -> Built:
     from .design import round_corners
 
-    _fields(d, where, ("points",), ("curvature", "max_curvature", "spiral_shape", "method"))
-    points = _points(d["points"], f"{where}.points", 3)
-    if "curvature" in d and "max_curvature" in d:
-        raise DesignError(f"{where}: give at most one of curvature and max_curvature")
-    kw = {k: _number(d[k], f"{where}.{k}", positive=True) for k in ("curvature", "max_curvature") if k in d}
+    _fields(d, where, (), ("points", "gcode", *ROUNDING_KEYS, "spiral_shape", "method", "samples"))
+    if ("points" in d) == ("gcode" in d):
+        raise DesignError(f"{where}: give points or gcode (one of them)")
+    kw = {k: _numbers(d[k], f"{where}.{k}") for k in ROUNDING_KEYS if k in d}
     if "method" in d and "spiral_shape" in d:
         raise DesignError(f"{where}: give spiral_shape or method (its former name), not both")
     shape = _choice(d["method"], f"{where}.method", CORNER_SHAPES) if "method" in d else _shape(d, where, CORNER_SHAPES)
-    result = round_corners(points, shape=shape, units=units, **kw)
-    return Built(d["name"], "rounded_polyline", result.chain, result)
+    samples = _samples(d["samples"], f"{where}.samples") if "samples" in d else None
+    if "gcode" in d:
+        from .formats.gcode import read_gcode, round_toolpath
+
+        program = d["gcode"]
+        if not isinstance(program, str) or not program or "\0" in program:
+            raise DesignError(f"{where}.gcode: must be the path of a G-code file; got {program!r:.80}")
+        result = round_toolpath(read_gcode(program).in_units(units), shape=shape, **kw)
+    else:
+        result = round_corners(_points_in_space(d["points"], f"{where}.points", 3), shape=shape, units=units, **kw)
+    return Built(d["name"], "rounded_polyline", result.chain, result, {"samples": samples})
+
+
+def _samples(value: Any, where: str) -> dict[str, float]:
+    if not isinstance(value, dict) or len(value) != 1 or not set(value) <= {"step", "chord_tolerance"}:
+        raise DesignError(f'{where}: must be {{"step": s}} or {{"chord_tolerance": c}}; got {value!r:.80}')
+    ((key, number),) = value.items()
+    return {key: _number(number, f"{where}.{key}", positive=True)}
 
 
 def _transition(d: dict, where: str, units: str) -> Built:
@@ -502,6 +549,10 @@ def build(source: str | Path | dict) -> tuple[str, list[Built]]:
             ``designs[i] (name)``.
     """
     units, designs = load(source)
+    if not isinstance(source, dict):  # a G-code program is found next to its design file
+        base = Path(source).parent
+        designs = [dict(d, gcode=str(base / d["gcode"])) if isinstance(d.get("gcode"), str) and d["gcode"] and "\0" not in d["gcode"]
+                   else d for d in designs]  # fmt: skip
     built = []
     for i, d in enumerate(designs):
         where = f"designs[{i}] ({d['name']})"
@@ -580,8 +631,16 @@ def _write_design(b: Built, stage: Path, units: str, missing: list[str], plots: 
 
     step = stage / f"{b.name}.step"
     export_step(b.chain, step, name=b.name)
-    export_svg(b.chain, stage / f"{b.name}.svg", name=b.name)
-    names = ["step", "svg"]
+    names = ["step"]
+    flat = b.chain.dim == 2  # SVG and the plots are plane outputs
+    if flat:
+        export_svg(b.chain, stage / f"{b.name}.svg", name=b.name)
+        names.append("svg")
+    if b.notes.get("samples"):
+        from .export import export_samples
+
+        export_samples(b.chain, stage / f"{b.name}_samples.csv", **b.notes["samples"])
+        names.append("samples.csv")
     if b.kind == "alignment":
         from .export import export_opendrive
 
@@ -612,7 +671,7 @@ def _write_design(b: Built, stage: Path, units: str, missing: list[str], plots: 
 
         export_dxf(b.chain, stage / f"{b.name}.dxf", name=b.name)
         names.append("dxf")
-    if plots and "matplotlib" not in missing:
+    if plots and flat and "matplotlib" not in missing:
         names += _plots(b, stage)
     return names
 

@@ -1,4 +1,4 @@
-"""Files from chains: STEP, IGES, DXF, SVG (and OpenDRIVE for alignments).
+"""Files from chains: STEP, IGES, DXF, SVG (and OpenDRIVE for alignments), and samples for machines.
 
 Every writer takes the chain's own length unit and declares it the way its
 readers expect, and takes a ``name`` (default: the file name's stem) that
@@ -18,6 +18,10 @@ SVG      one cubic ``C`` command (the Bézier itself)                  width/hei
 =======  ==========================================================  ==================================
 
 Each is exactly the same cubic; see README for what each round trip keeps.
+Chains in space go to STEP, IGES and DXF in 3-D (exact lines, circles about
+their normal and Bézier spirals with their four poles); SVG is a plane
+format. ``export_samples`` writes a path as points for a robot or CNC
+post-processor (``spiral_cad.formats.samples``).
 """
 
 from __future__ import annotations
@@ -34,7 +38,16 @@ from .formats.opendrive import CrossSection
 
 PathLike = str | os.PathLike
 
-__all__ = ["CrossSection", "export_dxf", "export_iges", "export_opendrive", "export_step", "export_svg", "originating_system"]
+__all__ = [
+    "CrossSection",
+    "export_dxf",
+    "export_iges",
+    "export_opendrive",
+    "export_samples",
+    "export_step",
+    "export_svg",
+    "originating_system",
+]
 
 
 def originating_system() -> str:
@@ -137,7 +150,26 @@ def export_svg(obj: Chain | Iterable[Chain], path: PathLike, *, name: str | None
     from .formats.svg import write_svg
 
     chains = _require_chains(obj)
+    if any(c.dim == 3 for c in chains):
+        raise ValueError("SVG is a plane format; this chain is in space (write STEP, IGES or DXF, which hold 3-D paths)")
     write_svg(chains, path, _name(name, path), _units(chains, None), margin)
+
+
+def export_samples(chain: Chain, path: PathLike, *, step: float | None = None, chord_tolerance: float | None = None) -> int:
+    """Write a path's samples as CSV for a robot or CNC post-processor: s, x, y, z, unit tangent and curvature
+    at most ``step`` apart, or close enough that the path strays at most ``chord_tolerance`` from the chord
+    between neighbours (measured), every segment's ends included; the unit in every header.
+
+    Returns:
+        The number of samples written.
+
+    Raises:
+        ValueError: not a Chain, neither or both of step and chord_tolerance, or too many samples.
+        OSError: the file could not be written.
+    """
+    from .formats.samples import write_samples
+
+    return write_samples(chain, path, step=step, chord_tolerance=chord_tolerance)
 
 
 def export_opendrive(

@@ -10,6 +10,8 @@ EXAMPLES = Path(__file__).resolve().parent.parent / "examples"
 OUTPUTS = {
     "build123d_road.py": ["road.step", "road_centreline.step", "road.svg"],
     "robot_path.py": ["robot_path.png", "robot_path.svg"],
+    "robot_path_3d.py": ["robot_path_3d.step", "robot_path_3d.csv", "robot_path_3d.png"],
+    "handrail.py": ["handrail.step", "handrail_path.step"],
     "fig6.py": ["fig6.png", "bezier_vs_clothoid.png"],
     "cadquery_plugin.py": ["cadquery_plugin.step"],
     "continuous_corners.py": ["slab.step", "continuous_corners.png"],

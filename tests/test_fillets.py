@@ -198,8 +198,10 @@ def test_continuous_sketch_objects_and_the_comb():
 def test_non_planar_and_non_arc_edges_are_refused():
     from spiral_cad.build123d import g2_fillet
 
-    with pytest.raises(ValueError, match="planar"):
-        g2_fillet(bd.Polyline((0, 0, 0), (10, 0, 0), (10, 10, 5), (0, 10, 0)), 1.0)
+    bent = bd.Wire([bd.Edge.make_line((0, 0, 0), (10, 0, 0)), bd.Edge.make_three_point_arc((10, 0, 0), (12, 0, 2), (10, 0, 4)),
+                    bd.Edge.make_line((10, 0, 4), (10, 5, 4))])  # fmt: skip
+    with pytest.raises(ValueError, match="planar"):  # in space only wires of lines are rounded (each corner in its plane)
+        g2_fillet(bent, 1.0)
     spline = bd.Wire([bd.Edge.make_line((0, 0), (10, 0)), bd.Edge.make_spline([(10, 0), (12, 5), (10, 10)])])
     with pytest.raises(ValueError, match="edge 1 is a BSPLINE curve"):
         g2_fillet(spline, 1.0)

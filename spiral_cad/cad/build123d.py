@@ -7,6 +7,11 @@ is placed on its workplane by build123d, exactly as for its own objects;
 outside a builder the result lies on ``Plane.XY``. Spirals become exact
 ``BEZIER`` edges, arcs ``CIRCLE`` and lines ``LINE`` edges, in travel order.
 
+``G2Polyline`` is build123d's ``Polyline`` with every corner rounded by a
+G2 spiral pair, in the plane or in space (robot and CNC paths, handrails,
+cable and pipe runs), and ``g2_fillet`` also rounds a 3-D wire of lines,
+each corner in the plane of its two edges.
+
 Example:
     >>> with BuildLine(Plane.XZ) as path:
     ...     SpiralChain(chain)
@@ -34,10 +39,17 @@ from build123d import (
     VectorLike,
     Vertex,
     Wire,
+    flatten_sequence,
 )
+from OCP.BRepAdaptor import BRepAdaptor_Curve
+from OCP.BRepTools import BRepTools_WireExplorer
+from OCP.GeomAbs import GeomAbs_CurveType
+from OCP.TopAbs import TopAbs_REVERSED
+from OCP.TopoDS import TopoDS
 
 from ..core.chain import Chain
 from ..core.shapes import DEFAULT_SHAPE
+from ..design.rounding import curvature_bound, fillet_polyline, round_corners
 from ..design.fillets import continuous_polygon, continuous_rectangle, continuous_slot
 from .corridor import Corridor, centerline_wire, corridor
 from .fillet import fillet_face, fillet_wire, planar_frame
@@ -56,6 +68,7 @@ __all__ = [
     "ContinuousRectangle",
     "ContinuousSlot",
     "Corridor",
+    "G2Polyline",
     "SpiralChain",
     "SpiralCircleInCircle",
     "SpiralCircleToCircle",
@@ -249,6 +262,51 @@ class SpiralChain(_ExactLineObject):
         self.chain = chain
 
 
+class G2Polyline(_ExactLineObject):
+    """Line Object: G2 Polyline
+
+    A polyline through ``pts`` whose corners are rounded by G2 spiral pairs
+    (``spiral_cad.design.round_corners``), in the plane or in space: each
+    pair lies in the plane of its corner's two edges, and between corners the
+    path runs straight along the polyline, so the whole wire is curvature
+    continuous. Edges: LINE between corners, two BEZIER per corner.
+
+    Args:
+        pts (VectorLike | Iterable[VectorLike]): sequence of three or more points
+        radius (float, optional): the smallest radius of curvature: every corner
+            reaches exactly 1/radius at its middle (the tightest that fits). Defaults to None
+        max_deviation (float, optional): the largest distance between a corner
+            point and the path (a CNC or robot tolerance): each corner gets the
+            largest pair within it; with ``radius`` too, its curvature must stay
+            below 1/radius. Defaults to None
+        shape (str, optional): "walton-meek", "near-linear" or "g2cbs". Defaults to "walton-meek"
+        mode (Mode, optional): combination mode. Defaults to Mode.ADD
+
+    With neither ``radius`` nor ``max_deviation`` each corner uses all of the
+    edges it may (half of a shared edge, all of an end edge). The numeric
+    result is kept as ``rounded`` (a ``RoundedPath``: chain, corners, deviations).
+
+    Raises:
+        ValueError: fewer than three points, repeated points, a polyline that
+            folds straight back, a radius or deviation that is not positive.
+        NoSolutionError: a corner that cannot be rounded as asked (named, with numbers).
+    """
+
+    def __init__(
+        self,
+        *pts: VectorLike | Iterable[VectorLike],
+        radius: float | None = None,
+        max_deviation: float | None = None,
+        shape: str = DEFAULT_SHAPE,
+        mode: Mode = Mode.ADD,
+    ):
+        points = [tuple(Vector(p)) for p in flatten_sequence(*pts)]
+        curvature = curvature_bound(radius)
+        path = round_corners(points, max_curvature=curvature, max_deviation=max_deviation, shape=shape)
+        super().__init__(_wire(path.chain), mode=mode)
+        self.rounded = path  # the numeric result (build123d's Shape owns the name "path")
+
+
 # ------------------------------------------------------------------ G2 fillets
 
 
@@ -321,7 +379,13 @@ def g2_fillet(
             f"{len(target.solids())} solid(s) and {len(target.shells())} shell(s): round one of its faces, or use "
             "build123d's fillet on its edges"
         )
-    if isinstance(target, Wire):
+    in_space = _lines_in_space(target) if isinstance(target, Wire) else None
+    if in_space is not None:
+        corners, closed = in_space
+        chosen = None if points is None else _corner_indices(corners, points)
+        rounded = fillet_polyline(corners, radius, vertices=chosen, closed=closed, **options)
+        result = Wire(chain_wire(rounded.segments))
+    elif isinstance(target, Wire):
         result = Wire(fillet_wire(target.wrapped, radius, points, **options)[0])
     elif isinstance(target, Face) and not isinstance(target, Sketch):
         result = Face(fillet_face(target.wrapped, radius, points, **options))
@@ -337,6 +401,45 @@ def g2_fillet(
     if in_builder:
         context._add_to_context(result, mode=Mode.REPLACE)
     return result
+
+
+def _lines_in_space(wire: Wire) -> tuple[list[tuple[float, float, float]], bool] | None:
+    """The vertices (in travel order) and closedness of a wire of lines that does not lie in one
+    plane; None for a planar wire or one with other edges (the planar fillet handles those)."""
+    try:
+        planar_frame(wire.wrapped)
+        return None
+    except ValueError:
+        pass
+    points = []
+    explorer = BRepTools_WireExplorer(wire.wrapped)
+    while explorer.More():
+        edge = TopoDS.Edge_s(explorer.Current())
+        curve = BRepAdaptor_Curve(edge)
+        if curve.GetType() != GeomAbs_CurveType.GeomAbs_Line:
+            return None
+        first, last = curve.FirstParameter(), curve.LastParameter()
+        start = curve.Value(last if edge.Orientation() == TopAbs_REVERSED else first)
+        points.append((start.X(), start.Y(), start.Z()))
+        end = curve.Value(first if edge.Orientation() == TopAbs_REVERSED else last)
+        explorer.Next()
+    if len(points) < 2:
+        return None
+    closed = wire.is_closed
+    if not closed:
+        points.append((end.X(), end.Y(), end.Z()))
+    return points, closed
+
+
+def _corner_indices(corners: list[tuple[float, float, float]], points: list[tuple[float, float, float]]) -> list[int]:
+    """Indices of the polyline vertices at the chosen build123d vertices (others are ignored, as in the plane)."""
+    size = max(max(abs(c) for c in p) for p in corners)
+    chosen = []
+    for point in points:
+        for i, corner in enumerate(corners):
+            if max(abs(a - b) for a, b in zip(point, corner)) <= 1e-7 * max(size, 1.0):
+                chosen.append(i)
+    return chosen
 
 
 def _refuse_loose_edges(target: Shape, parts: list[Shape]) -> None:

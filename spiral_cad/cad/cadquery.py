@@ -8,14 +8,17 @@ Importing this module adds these methods to ``cadquery.Workplane``:
 * ``spiralCircleInCircle(c0, r0, c1, r1)``
 * ``spiralTransition(transition)`` — an already solved ``Transition``
 * ``spiralChain(chain)`` — a whole ``spiral_cad.Chain`` as one wire
+* ``g2Polyline(points, radius=None, max_deviation=None)`` — a polyline (2-D or
+  3-D points) whose corners are G2 spiral pairs, as one pending wire
 * ``g2Fillet(radius, transition=0.5)`` — G2 fillets on every corner of the pending wires
 * ``continuousRect``, ``continuousPolygon``, ``continuousSlot2D`` — shapes with G2 corners
 
 and to ``cadquery.Sketch``: ``g2fillet(radius, transition=0.5)`` on the
 selected vertices (like ``Sketch.fillet``) and ``continuousRect``.
 
-All coordinates are 2-D and local to the workplane (``x`` along its
-``xDir``, ``y`` along ``zDir × xDir``); radii are signed by travel sense as
+All coordinates are local to the workplane (``x`` along its ``xDir``, ``y``
+along ``zDir × xDir``, and for ``g2Polyline`` and chains in space ``z`` along
+its normal); radii are signed by travel sense as
 in the core solvers. Lines become LINE edges, arcs true CIRCLE edges and
 spirals BEZIER edges with their exact control points (``spiral_cad.occ``).
 
@@ -44,6 +47,7 @@ from OCP.gp import gp_Ax3
 from ..core.chain import Chain
 from ..core.shapes import DEFAULT_SHAPE
 from ..design.fillets import continuous_polygon, continuous_rectangle, continuous_slot
+from ..design.rounding import curvature_bound, round_corners
 from .fillet import fillet_face, fillet_wire
 from .occ import chain_wire, segment_edges
 from ..core.segments import Segment
@@ -62,6 +66,7 @@ __all__ = [
     "continuousRect",
     "continuousSlot2D",
     "g2Fillet",
+    "g2Polyline",
     "plane_ax3",
     "spiralChain",
     "spiralCircleInCircle",
@@ -199,6 +204,36 @@ def spiralChain(self: W, chain: Chain, makeWire: bool = True, forConstruction: b
     return _push_edges(self, chain.segments, makeWire, forConstruction)
 
 
+def g2Polyline(
+    self: W,
+    points: Iterable[Any],
+    radius: float | None = None,
+    max_deviation: float | None = None,
+    shape: str = DEFAULT_SHAPE,
+    forConstruction: bool = False,
+) -> W:
+    """A polyline through ``points`` (2-D or 3-D, workplane-local) with every corner rounded by a
+    G2 spiral pair in the plane of its two edges (``spiral_cad.design.round_corners``), as one wire.
+
+    Args:
+        points: three or more points, like ``polyline``'s.
+        radius: the smallest radius of curvature: every corner reaches exactly 1/radius.
+        max_deviation: the largest distance between a corner point and the path
+            (each corner gets the largest pair within it; with ``radius`` its
+            curvature must also stay below 1/radius).
+        shape: "walton-meek", "near-linear" or "g2cbs".
+        forConstruction: do not queue the wire.
+
+    Raises:
+        ValueError: malformed points, a radius or deviation that is not positive.
+        NoSolutionError: a corner that cannot be rounded as asked (named, with numbers).
+    """
+    curvature = curvature_bound(radius)
+    path = round_corners([tuple(cq.Vector(p).toTuple()) for p in points], max_curvature=curvature,
+                         max_deviation=max_deviation, shape=shape)  # fmt: skip
+    return _push_edges(self, path.chain.segments, True, forConstruction)
+
+
 def g2Fillet(self: W, radius: float, transition: float = 0.5, same_sense: str = "nested", shape: str = DEFAULT_SHAPE) -> W:
     """Round every corner of the pending wires with G2 fillets (``spiral_cad.design.fillets``).
 
@@ -251,6 +286,7 @@ METHODS = (
     spiralLineToLine,
     spiralCircleInCircle,
     spiralChain,
+    g2Polyline,
     g2Fillet,
     continuousRect,
     continuousPolygon,

@@ -462,6 +462,15 @@ def _assemble(
             corner += off.spirals
             pieces += corner
             owners += [end_corner.vertex] * len(corner)
+    broken = first_broken_corner(pieces, owners, closed, tolerance)
+    if broken:
+        raise NoSolutionError(f"corner {broken[0]}: the fillet is not G2 at {broken[1]}")
+    return pieces, owners
+
+
+def first_broken_corner(pieces: Sequence[Segment], owners: Sequence[int | None], closed: bool, tolerance: float) -> tuple[int, str] | None:
+    """The first joint touching a rounded corner (``owners``: the corner of each piece, None for an
+    original edge) that is not G2, as (corner, why), or None; joints between original edges are not judged."""
     pairs = list(zip(range(len(pieces)), range(1, len(pieces))))
     if closed:
         pairs.append((len(pieces) - 1, 0))
@@ -470,8 +479,8 @@ def _assemble(
         if vertex is not None:
             problem = g2_mismatch(pieces[a], pieces[b], tolerance)
             if problem:
-                raise NoSolutionError(f"corner {vertex}: the fillet is not G2 at {problem}")
-    return pieces, owners
+                return vertex, problem
+    return None
 
 
 # ---------------------------------------------------------- shapes with continuous corners

@@ -1,4 +1,4 @@
-"""G2 corner rounding of polylines with pairs of Bézier spirals.
+"""G2 corner rounding of polylines, in the plane or in space, with pairs of Bézier spirals.
 
 Each corner gets a symmetric spiral pair (the ``line_to_line`` transition)
 of one of the corner shapes (``spiral_cad.core.shapes``):
@@ -15,7 +15,12 @@ of one of the corner shapes (``spiral_cad.core.shapes``):
 
 Here θ is half the corner's deflection and d the distance from the corner to
 where each spiral leaves its leg: d = K(θ)/κ with κ the joint (peak)
-curvature and K the shape's corner factor. The array functions
+curvature and K the shape's corner factor; the path passes h = D(θ)/κ from
+the corner (its deviation, ``deviation_factor``). A corner of a polyline in
+space lies in the plane of its two legs: it is solved in that plane
+(``spiral_cad.core.space.corner_frames``) by the same batch kernel as a plane
+corner and placed back; between corners the path is straight (κ = 0), so
+corners in different planes still join G2. The array functions
 (``corner_legs``, ``round_corners_batch``) handle millions of corners;
 ``round_corners`` builds a checked :class:`~spiral_cad.Chain` for one polyline.
 """
@@ -23,6 +28,8 @@ curvature and K the shape's corner factor. The array functions
 from __future__ import annotations
 
 import math
+import re
+from collections.abc import Iterable
 from dataclasses import dataclass
 
 import numpy as np
@@ -30,13 +37,17 @@ from numpy.typing import ArrayLike, NDArray
 
 from ..core import _kernels as K
 from ..core import batch
-from ..core._inputs import as_float, as_points, as_real_array
+from ..core._inputs import as_float, as_real_array
 from ..core.chain import JOIN_TOLERANCE, Chain, PartCircles, join_rows, join_tolerance
 from ..core.errors import JointError, NoSolutionError, Status
+from ..core.factors import length_factor
 from ..core.rows import SegmentRows
 from ..core.shapes import CORNER_SHAPES, DEFAULT_SHAPE, SHAPE_CODES, shape_code
+from ..core.segments import Line, Segment
+from ..core.space import PlaneFrame, corner_frames, norms, place, placed_pair_residuals
 from ..core.spiral import BezierSpiral
 from ..core.units import DEFAULT_UNITS, length_unit
+from .fillets import FilletCorner, _vertex_indices, fillet_path, first_broken_corner
 
 #: Yang & Sukkarieh's leg ratio g/h: the smallest that keeps κ monotone.
 G2CBS_C2 = K.G2CBS_RATIO
@@ -49,6 +60,12 @@ G2CBS_C4 = (G2CBS_C2 + 4.0) ** 2 / (54.0 * G2CBS_C3)
 
 #: Relative |sin| below which three points count as collinear (passed through).
 COLLINEAR_TOL = 1e-12
+#: A ``max_deviation`` pair is aimed this much (relative) inside its bound, and
+#: further by the rounding of the corner's coordinates (``ROUNDING_ULPS`` ulp of
+#: the largest), so that its measured deviation never exceeds the bound.
+DEVIATION_MARGIN = 1e-12
+ROUNDING_ULPS = 8.0
+EPS = float(np.finfo(float).eps)
 
 
 def corner_scale(theta_sin: ArrayLike, theta_cos: ArrayLike, value: ArrayLike, shape: str) -> NDArray:
@@ -63,6 +80,26 @@ def corner_scale(theta_sin: ArrayLike, theta_cos: ArrayLike, value: ArrayLike, s
     return factor.reshape(sin_t.shape) / value
 
 
+def deviation_factor(theta_sin: ArrayLike, theta_cos: ArrayLike, shape: str) -> NDArray:
+    """D(θ): a spiral pair of joint curvature κ passes D/κ from its corner point.
+
+    The pair is symmetric about the corner's bisector and meets on it, and
+    the distance to the corner falls all along the first spiral (tested by
+    dense sampling), so the joint is the path's nearest point to the corner.
+    The first spiral's end leg c runs from B2 on the incoming leg, at c/cos θ
+    from the corner, to the joint at angle θ to the leg; so the joint lies
+    h = c·tan θ from the corner. With c = γ(θ)·sin θ/κ (the shape's end leg
+    on the unit spiral), D = c_unit·tan θ, and the corner distance is
+    d = h·K(θ)/D(θ).
+    """
+    sin_t, cos_t = np.broadcast_arrays(np.asarray(theta_sin, dtype=float), np.asarray(theta_cos, dtype=float))
+    unit = np.empty((sin_t.size, 4, 2))
+    K.unit_spirals_batch(np.ascontiguousarray(sin_t.ravel()), np.ascontiguousarray(cos_t.ravel()), SHAPE_CODES[shape], unit)
+    end_leg = norms(unit[:, 3] - unit[:, 2]).reshape(sin_t.shape)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        return end_leg * sin_t / cos_t
+
+
 def corner_shape(shape: str, method: str | None) -> str:
     """The corner shape from ``shape`` or from ``method`` (its former name), checked."""
     if method is None:
@@ -74,26 +111,53 @@ def corner_shape(shape: str, method: str | None) -> str:
     return method
 
 
+def _sin_turn(u: NDArray, v: NDArray) -> NDArray:
+    """|u × v| of unit vectors (N, 2) or (N, 3): the sine of the turn between them."""
+    if u.shape[-1] == 2:
+        return np.abs(u[:, 0] * v[:, 1] - u[:, 1] * v[:, 0])
+    return norms(np.cross(u, v))
+
+
+def _coordinates(value: ArrayLike, name: str) -> NDArray:
+    """Points (..., 2) or (..., 3) as float64, refused by name otherwise."""
+    array = as_real_array(value, name)
+    if array.ndim == 0 or array.shape[-1] not in (2, 3):
+        raise ValueError(f"{name} must have 2 or 3 coordinates per point; got shape {array.shape}")
+    return array
+
+
+def _plane_if_flat(*arrays: NDArray) -> tuple[NDArray, ...]:
+    """Drop z when every z is 0: points whose z is 0 are plane points, as everywhere in the API."""
+    if arrays[0].shape[-1] == 3 and all(np.all(a[..., 2] == 0.0) for a in arrays):
+        return tuple(a[..., :2] for a in arrays)
+    return arrays
+
+
 # ------------------------------------------------------------ array API
 
 
 @dataclass(frozen=True)
 class CornerBatch:
-    """Spiral pairs for N corners (one row per corner).
+    """Spiral pairs for N corners (one row per corner), in the plane (d = 2) or in space (d = 3).
 
     Attributes:
         shape: ``"walton-meek"``, ``"near-linear"`` or ``"g2cbs"``.
-        control_points: (N, 2, 4, 2) the two spirals of each corner in travel
+        control_points: (N, 2, 4, d) the two spirals of each corner in travel
             order; NaN where ``status`` ≠ 0.
         theta: (N,) half the deflection (each spiral's turn), NaN when undefined.
         distance: (N,) corner-to-spiral-start distance used (or required).
         curvature: (N,) peak |κ| of the pair (at its joint), used or required.
         available: (N,) the longest distance the legs allow.
         status: (N,) ``spiral_cad.Status`` codes; 0 where rounded.
-        corners: (N, 2) the corner points.
-        requested: (N,) the curvature asked for (NaN: as large as fits).
-        residual: (N,) for ``UNVERIFIED`` rows, how far the pair's joins are
-            off (relative); NaN elsewhere.
+        corners: (N, d) the corner points.
+        requested: (N,) the joint curvature asked for (NaN: as large as fits).
+        residual: (N,) for ``UNVERIFIED`` rows, how far the pair is off
+            (relative); NaN elsewhere.
+        deviation: (N,) the distance from each corner to its path (to the
+            pair's joint), measured on the returned control points; NaN
+            where not rounded.
+        max_deviation, max_curvature, spiral_length: (N,) the bounds and
+            lengths asked for (NaN where not given).
     """
 
     shape: str
@@ -106,10 +170,19 @@ class CornerBatch:
     corners: NDArray
     requested: NDArray
     residual: NDArray
+    deviation: NDArray
+    max_deviation: NDArray
+    max_curvature: NDArray
+    spiral_length: NDArray
 
     @property
     def ok(self) -> NDArray:
         return self.status == Status.OK
+
+    @property
+    def dim(self) -> int:
+        """2 for plane corners, 3 for corners in space."""
+        return self.corners.shape[1]
 
     def __len__(self) -> int:
         return len(self.status)
@@ -118,16 +191,11 @@ class CornerBatch:
         """Why corner ``i`` could not be rounded (``"ok"`` if it was)."""
         status = Status(int(self.status[i]))
         name = label or f"corner {i}"
-        where = f"{name} at ({self.corners[i, 0]:.10g}, {self.corners[i, 1]:.10g})"
+        where = f"{name} at ({', '.join(f'{v:.10g}' for v in self.corners[i].tolist())})"
         if status is Status.OK:
             return "ok"
         if status is Status.LEGS_TOO_SHORT:
-            return (
-                f"{where}: curvature {self.requested[i]:.6g} needs the spirals to start "
-                f"{self.distance[i]:.6g} from the corner but only {self.available[i]:.6g} is available "
-                f"(each corner may use half of an interior leg); this corner needs curvature "
-                f"≥ {self.curvature[i]:.6g} ({self.shape})"
-            )
+            return f"{where}: {self._too_short(i)}"
         if status is Status.CORNER_REVERSAL:
             return f"{where}: the path folds back (deflection ≥ 180°); no spiral pair exists"
         if status is Status.CORNER_STRAIGHT:
@@ -140,16 +208,53 @@ class CornerBatch:
         if status is Status.COINCIDENT:
             return f"{where}: a leg has zero length"
         if status is Status.UNVERIFIED:
+            bound = self.max_deviation[i]
+            if bound == bound and not self.residual[i] < math.inf:
+                return (
+                    f"{where}: max_deviation {bound:.6g} is below what float64 resolves at these coordinates "
+                    f"({ROUNDING_ULPS:g} ulp of the largest is {ROUNDING_ULPS * EPS * np.abs(self.corners[i]).max():.3g}); "
+                    "use a larger max_deviation, or coordinates nearer the origin"
+                )
             return (
                 f"{where}: the spiral pair for curvature {self.curvature[i]:.6g} would start "
-                f"{self.distance[i]:.3g} from the corner, too small for float64 at these coordinates: its joins "
-                f"hold only to {self.residual[i]:.2g} (at most 1e-9 is returned); use a lower curvature"
+                f"{self.distance[i]:.3g} from the corner, too small for float64 at these coordinates: it "
+                f"holds only to {self.residual[i]:.2g} (at most 1e-9 is returned); use a lower curvature"
             )
+        if status is Status.NOT_FINITE:
+            return f"{where}: its points must be finite"
         return f"{where}: no spiral pair ({status.name})"
+
+    def _too_short(self, i: int) -> str:
+        """The reason of a ``LEGS_TOO_SHORT`` row, in the terms it was asked in."""
+        available = f"only {self.available[i]:.6g} is available (each corner may use half of an interior leg)"
+        largest = f"this corner needs curvature ≥ {self.curvature[i]:.6g} ({self.shape})"
+        length, bound, kmax = self.spiral_length[i], self.max_deviation[i], self.max_curvature[i]
+        if bound == bound and kmax == kmax and self.curvature[i] > kmax:
+            return (
+                f"within max_deviation {bound:.6g} and its legs the spiral pair may start at most "
+                f"{self.distance[i]:.6g} from the corner, which needs curvature {self.curvature[i]:.6g}, above "
+                f"max_curvature {kmax:.6g}; allow a larger deviation or curvature"
+            )
+        if self.distance[i] <= self.available[i]:  # the legs allow it: the plane solver could not hold the sizes
+            return (
+                f"float64 cannot round it at these magnitudes: the spirals would start {self.distance[i]:.6g} from the "
+                f"corner and the legs allow {self.available[i]:.6g}, but the legs differ in size by more than float64 "
+                "can hold in one corner; bring the points to a common scale"
+            )
+        if length == length:
+            longest = float(length_factor(self.theta[i], self.shape) / self.curvature[i])
+            return (
+                f"spirals {length:.6g} long need to start {self.distance[i]:.6g} from the corner but {available}; "
+                f"its spirals may be at most {longest:.6g} long ({self.shape})"
+            )
+        return (
+            f"curvature {self.requested[i]:.6g} needs the spirals to start {self.distance[i]:.6g} from the corner "
+            f"but {available}; {largest}"
+        )
 
 
 def _half_deflection(p0: NDArray, corners: NDArray, p1: NDArray):
-    """Leg lengths and sin/cos of half the deflection."""
+    """Leg lengths and sin/cos of half the deflection (plane points)."""
     vin = corners - p0
     vout = p1 - corners
     lin = np.hypot(vin[:, 0], vin[:, 1])
@@ -164,22 +269,60 @@ def _half_deflection(p0: NDArray, corners: NDArray, p1: NDArray):
     return lin, lout, sin_t, cos_t
 
 
-def _requested(curvature: ArrayLike | None, max_curvature: ArrayLike | None, n: int) -> NDArray:
-    if curvature is not None and max_curvature is not None:
-        raise ValueError("give curvature or max_curvature, not both")
-    value = curvature if curvature is not None else max_curvature
-    name = "curvature" if curvature is not None else "max_curvature"
+def _per_corner(value: ArrayLike | None, name: str, n: int) -> NDArray | None:
+    """One positive finite value, or one per corner, as (n,); None stays None."""
     if value is None:
-        return np.full(n, np.nan)
-    k = as_real_array(value, name)
-    if k.ndim > 1 or k.size not in (1, n):
-        raise ValueError(f"{name} needs one value or one per corner ({n}); got shape {k.shape}")
-    k = np.broadcast_to(k.reshape(-1), (n,))
-    bad = ~(np.isfinite(k) & (k > 0.0))
+        return None
+    v = as_real_array(value, name)
+    if v.ndim > 1 or v.size not in (1, n):
+        raise ValueError(f"{name} needs one value or one per corner ({n}); got shape {v.shape}")
+    v = np.broadcast_to(v.reshape(-1), (n,))
+    bad = ~(np.isfinite(v) & (v > 0.0))
     if bad.any():
         i = int(np.argmax(bad))
-        raise ValueError(f"{name} must be positive and finite; got {k[i]} (corner {i})")
-    return np.ascontiguousarray(k)
+        raise ValueError(f"{name} must be positive and finite; got {v[i]} (corner {i})")
+    return np.ascontiguousarray(v)
+
+
+def _exclusive(curvature, max_curvature, max_deviation, spiral_lengths) -> None:
+    """``curvature`` and ``spiral_lengths`` fix each pair; the two bounds may be combined."""
+    given = [name for name, v in (("curvature", curvature), ("spiral_lengths", spiral_lengths)) if v is not None]
+    bounds = [name for name, v in (("max_curvature", max_curvature), ("max_deviation", max_deviation)) if v is not None]
+    if len(given) > 1 or (given and bounds):
+        raise ValueError(f"give curvature, spiral_lengths or the bounds (max_curvature, max_deviation), not both; got {', '.join(given + bounds)}")
+
+
+def _corner_rows(p0: ArrayLike, corners: ArrayLike, p1: ArrayLike) -> tuple[NDArray, NDArray, NDArray]:
+    """The three point arrays as contiguous (N, d) rows: d = 3 when a z is not 0, else 2."""
+    named = (("p0", p0), ("corners", corners), ("p1", p1))
+    arrays = [_coordinates(v, name) for name, v in named]
+    dims = {a.shape[-1] for a in arrays}
+    if len(dims) > 1:
+        raise ValueError("p0, corners and p1 must all be 2-D or all 3-D points; got " + ", ".join(f"{n} {a.shape}" for (n, _), a in zip(named, arrays)))
+    try:
+        arrays = np.broadcast_arrays(*arrays)
+    except ValueError:
+        raise ValueError("p0, corners and p1 need N rows each (or one); got " + ", ".join(f"{n} {a.shape}" for (n, _), a in zip(named, arrays))) from None
+    d = arrays[0].shape[-1]
+    return _plane_if_flat(*(np.ascontiguousarray(a.reshape(-1, d)) for a in arrays))
+
+
+def _in_corner_planes(p0: NDArray, corners: NDArray, p1: NDArray) -> tuple[NDArray, NDArray, NDArray, NDArray]:
+    """Plane coordinates of corners in space: (p0, p1) local (N, 2) with the corner at the origin,
+    and each corner's frame (x_dir, y_dir) (N, 3).
+
+    p0 lies on the x axis; p1 at its distance along the turn (cos, sin) = (t_in·t_out,
+    |t_in × t_out|): legs that are collinear to the last bit stay exactly collinear.
+    """
+    x_dir, y_dir = corner_frames(p0, corners, p1)
+    local_p0 = np.zeros((len(corners), 2))
+    local_p0[:, 0] = -norms(corners - p0)
+    out = p1 - corners
+    length = norms(out)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        t_out = out / length[:, None]
+    turn = np.stack([np.einsum("ij,ij->i", x_dir, t_out), norms(np.cross(x_dir, t_out))], axis=1)
+    return local_p0, length[:, None] * turn, x_dir, y_dir
 
 
 def round_corners_batch(
@@ -189,83 +332,155 @@ def round_corners_batch(
     *,
     curvature: ArrayLike | None = None,
     max_curvature: ArrayLike | None = None,
+    max_deviation: ArrayLike | None = None,
+    spiral_lengths: ArrayLike | None = None,
     shape: str = DEFAULT_SHAPE,
     method: str | None = None,
 ) -> CornerBatch:
-    """Round N independent corners ``p0 → corner → p1`` with spiral pairs.
+    """Round N independent corners ``p0 → corner → p1`` with spiral pairs, in the plane or in space.
 
     The spirals of a corner must start between ``p0`` and the corner and end
     between the corner and ``p1``: pass the leg ends each corner may use (see
-    :func:`corner_legs` for polylines).
+    :func:`corner_legs` for polylines). A corner in space is solved in the
+    plane of its legs by the plane kernel (``spiral_cad.batch.line_to_line``),
+    placed back with ``spiral_cad.core.space.place`` and verified in space:
+    each spiral leaves its leg G2, the two meet G2 (curvature vector κN), at
+    the pair's curvature, else the row is ``UNVERIFIED``.
 
     Args:
-        p0, corners, p1: (N, 2) arrays (or broadcastable (2,)).
+        p0, corners, p1: (N, 2) or (N, 3) arrays (or broadcastable rows); 3-D
+            points whose z are all 0 are plane points.
         curvature: joint curvature (scalar or (N,)); the pair peaks there.
         max_curvature: a bound κmax: each corner uses the smallest distance
             that respects it, i.e. its joint curvature equals κmax.
+        max_deviation: the largest distance allowed between each corner point
+            and the path (the CNC or robot tolerance, scalar or (N,)): each
+            corner gets the largest pair that stays within it (and within its
+            legs); its deviation is measured (``deviation``) and never exceeds
+            the bound. With ``max_curvature`` as well, that pair's curvature
+            must respect κmax, else the row fails (``LEGS_TOO_SHORT``).
+        spiral_lengths: the arc length of each spiral (scalar or (N,)).
         shape: ``"walton-meek"`` (Theorem 4.4), ``"near-linear"`` or
-            ``"g2cbs"`` (Yang & Sukkarieh); every pair is solved and verified
-            by ``spiral_cad.batch.line_to_line``.
+            ``"g2cbs"`` (Yang & Sukkarieh).
         method: the former name of ``shape``.
 
-    With neither curvature given, each corner uses all of its shorter leg
-    (Corollary 4.5: the lowest curvature that fits). Rows that fail carry a
-    status (``CornerBatch.reason`` explains); the others are unaffected.
+    With none of curvature, spiral_lengths or max_* given, each corner uses
+    all of its shorter leg (Corollary 4.5: the lowest curvature that fits).
+    Rows that fail carry a status (``CornerBatch.reason`` explains); the
+    others are unaffected.
+
+    Raises:
+        ValueError: malformed arguments (shapes, signs, conflicting options).
     """
     shape = corner_shape(shape, method)
-    arrays = np.broadcast_arrays(as_points(p0, "p0"), as_points(corners, "corners"), as_points(p1, "p1"))
-    p0, corners, p1 = (np.ascontiguousarray(a.reshape(-1, 2)) for a in arrays)
-    n = len(corners)
-    k = _requested(curvature, max_curvature, n)
-    lin, lout, sin_t, cos_t = _half_deflection(p0, corners, p1)
+    _exclusive(curvature, max_curvature, max_deviation, spiral_lengths)
+    p0, corners, p1 = _corner_rows(p0, corners, p1)
+    n, dim = corners.shape
+    values = {name: _per_corner(v, name, n) for name, v in
+              (("curvature", curvature), ("max_curvature", max_curvature), ("max_deviation", max_deviation), ("spiral_lengths", spiral_lengths))}  # fmt: skip
+    if dim == 3:
+        local_p0, local_p1, x_dir, y_dir = _in_corner_planes(p0, corners, p1)
+        local_corners = np.zeros((n, 2))
+    else:
+        local_p0, local_corners, local_p1 = p0, corners, p1
+    lin, lout, sin_t, cos_t = _half_deflection(local_p0, local_corners, local_p1)
+    theta = np.where(sin_t > 0.0, np.arctan2(sin_t, cos_t), np.nan)
     available = np.minimum(lin, lout)
-    fit = np.isnan(k)
     with np.errstate(invalid="ignore", divide="ignore", over="ignore"):  # a tiny leg: the curvature it needs overflows
+        factor = corner_scale(sin_t, cos_t, 1.0, shape)
+        needed = factor / available
+        k = np.full(n, np.nan)
+        too_fine = np.zeros(n, dtype=bool)
+        if values["curvature"] is not None:
+            k = values["curvature"]
+        elif values["spiral_lengths"] is not None:
+            k = length_factor(np.nan_to_num(theta), shape) / values["spiral_lengths"]
+        elif values["max_deviation"] is not None:
+            # The largest pair within the bound, aimed inside it by the rounding of the coordinates.
+            size = np.abs(corners).max(axis=1)
+            target = values["max_deviation"] * (1.0 - DEVIATION_MARGIN) - ROUNDING_ULPS * EPS * size
+            too_fine = ~(target > 0.0)  # refused below, after the plane solve (as UNVERIFIED)
+            reach = target * factor / deviation_factor(sin_t, cos_t, shape)
+            k = np.where((reach < available) & ~too_fine, factor / reach, np.nan)
+        elif values["max_curvature"] is not None:
+            k = values["max_curvature"]
+        fit = np.isnan(k)
         distance = np.where(fit, available, corner_scale(sin_t, cos_t, k, shape))
-        needed = corner_scale(sin_t, cos_t, available, shape)
-    result = batch.line_to_line(p0, corners, p1, k, shape=shape)
-    control_points = np.stack(result.spirals, axis=1)
+    result = batch.line_to_line(local_p0, local_corners, local_p1, k, shape=shape)
+    pairs = np.stack(result.spirals, axis=1)
     status = result.status.astype(np.int8)
     residual = np.where(status == Status.UNVERIFIED, result.measure, np.nan)
-    ok = status == 0
-    theta = np.where(sin_t > 0.0, np.arctan2(sin_t, cos_t), np.nan)
+    ok = status == Status.OK
     # Failed rows report what they would need: the distance asked for and the
     # curvature that would exactly fit the available legs.
     peak = np.where(ok, np.where(fit, needed, k), needed)
-    return CornerBatch(shape, control_points, theta, distance, peak, available, status, corners, k, residual)
+    if values["max_deviation"] is not None:
+        status[ok & too_fine] = Status.UNVERIFIED
+        residual[ok & too_fine] = np.inf
+        if values["max_curvature"] is not None:  # both bounds: the pair within the deviation must respect κmax
+            status[ok & ~(peak <= values["max_curvature"] * (1.0 + DEVIATION_MARGIN))] = Status.LEGS_TOO_SHORT
+    if dim == 3:
+        pairs = place(pairs, corners[:, None, None], x_dir[:, None, None], y_dir[:, None, None])
+        off, deviation = np.empty(n), np.empty(n)
+        placed_pair_residuals(pairs, corners, x_dir, y_dir, local_p1, peak, off, deviation)
+        failed = (status == Status.OK) & ~(off <= K.VERIFY_TOL)
+        status[failed] = Status.UNVERIFIED
+        residual[failed] = off[failed]
+    else:
+        deviation = norms(pairs[:, 0, 3] - corners)
+    if values["max_deviation"] is not None:
+        over = (status == Status.OK) & ~(deviation <= values["max_deviation"])
+        status[over] = Status.UNVERIFIED
+        residual[over] = np.inf
+    ok = status == Status.OK
+    pairs[~ok] = np.nan
+    deviation[~ok] = np.nan
+    unset = np.full(n, np.nan)
+    given = {name: unset if v is None else v for name, v in values.items()}
+    return CornerBatch(shape, pairs, theta, distance, peak, available, status, corners, k, residual, deviation,
+                       given["max_deviation"], given["max_curvature"], given["spiral_lengths"])  # fmt: skip
+
+
+def _polyline(points: ArrayLike) -> NDArray:
+    """(n ≥ 3, d) polyline vertices: d = 3 when a z is not 0, else 2."""
+    pts = _coordinates(points, "points")
+    if pts.ndim != 2 or len(pts) < 3:
+        raise ValueError(f"points must be an (n ≥ 3, 2) or (n ≥ 3, 3) polyline; got shape {pts.shape}")
+    return _plane_if_flat(pts)[0]
 
 
 def corner_legs(points: ArrayLike) -> tuple[NDArray, NDArray, NDArray, NDArray]:
-    """The leg ends each interior corner of a polyline may use.
+    """The leg ends each interior corner of a polyline (in the plane or in space) may use.
 
     Interior segments are shared half-and-half between their two corners; the
     first and last segments belong wholly to their one corner, so spirals of
-    neighbouring corners never overlap. Collinear interior points (forward)
-    are dropped: they need no rounding.
+    neighbouring corners never overlap. Collinear interior points (forward,
+    |sin| of the turn ≤ 1e-12) are dropped: they need no rounding.
 
     Returns:
-        ``(p0, corners, p1, index)``: (M, 2) leg ends and corners, and the
+        ``(p0, corners, p1, index)``: (M, d) leg ends and corners, and the
         index of each corner in ``points``.
 
     Raises:
         ValueError: fewer than 3 points, non-finite or repeated consecutive
             points, or a polyline that folds straight back on itself.
     """
-    pts = as_points(points, "points")
-    if pts.ndim != 2 or len(pts) < 3:
-        raise ValueError(f"points must be an (n ≥ 3, 2) polyline; got shape {pts.shape}")
+    pts = _polyline(points)
     if not np.isfinite(pts).all():
         i = int(np.argmax(~np.isfinite(pts).all(axis=1)))
         raise ValueError(f"points must be finite; point {i} is {pts[i].tolist()}")
-    seg = np.diff(pts, axis=0)
-    length = np.hypot(seg[:, 0], seg[:, 1])
+    with np.errstate(over="ignore"):  # legs wider than float64: refused below by name
+        seg = np.diff(pts, axis=0)
+    length = norms(seg)
     if not (length > 0.0).all():
         i = int(np.argmax(~(length > 0.0)))
         raise ValueError(f"points {i} and {i + 1} coincide at {pts[i].tolist()}")
+    if not np.isfinite(length).all():
+        i = int(np.argmax(~np.isfinite(length)))
+        raise ValueError(f"points {i} and {i + 1} are too far apart for float64: {pts[i].tolist()} and {pts[i + 1].tolist()}")
     unit = seg / length[:, None]
-    cross = unit[:-1, 0] * unit[1:, 1] - unit[:-1, 1] * unit[1:, 0]
     dot = np.einsum("ij,ij->i", unit[:-1], unit[1:])
-    straight = np.abs(cross) <= COLLINEAR_TOL
+    straight = _sin_turn(unit[:-1], unit[1:]) <= COLLINEAR_TOL
     folds = straight & (dot < 0.0)
     if folds.any():
         i = int(np.argmax(folds)) + 1
@@ -273,7 +488,7 @@ def corner_legs(points: ArrayLike) -> tuple[NDArray, NDArray, NDArray, NDArray]:
     index = np.concatenate([[0], np.flatnonzero(~straight) + 1, [len(pts) - 1]])
     kept = pts[index]
     seg = np.diff(kept, axis=0)
-    length = np.hypot(seg[:, 0], seg[:, 1])
+    length = norms(seg)
     unit = seg / length[:, None]
     share = np.full(len(length), 0.5)
     share_in = share[:-1].copy()
@@ -296,13 +511,14 @@ def corner_legs(points: ArrayLike) -> tuple[NDArray, NDArray, NDArray, NDArray]:
 
 @dataclass(frozen=True)
 class RoundedCorner:
-    """One rounded corner: its index in the input points and its spiral pair."""
+    """One rounded corner: its index in the input points, its spiral pair and how far the path passes from it."""
 
     index: int
     theta: float
     distance: float
     curvature: float
     spirals: tuple[BezierSpiral, BezierSpiral]
+    deviation: float = math.nan
 
 
 @dataclass(frozen=True)
@@ -323,24 +539,68 @@ class RoundedPath:
         """Largest peak |κ| over the corners (0 for a straight polyline)."""
         return max((c.curvature for c in self.corners), default=0.0)
 
+    @property
+    def max_deviation(self) -> float:
+        """Largest distance between a corner point and the path, measured (0 for a straight polyline)."""
+        return max((c.deviation for c in self.corners), default=0.0)
+
+
+def curvature_bound(radius: float | None) -> float | None:
+    """``max_curvature`` from the smallest radius of curvature a path may have (None stays None).
+
+    Raises:
+        ValueError: a radius that is not positive and finite.
+    """
+    if radius is None:
+        return None
+    radius = as_float(radius, "radius")
+    if not (radius > 0.0 and radius < math.inf):
+        raise ValueError(f"radius must be positive and finite; got {radius!r}")
+    return 1.0 / radius
+
+
+def _at_corners(value: ArrayLike | None, name: str, interior: int, index: NDArray) -> ArrayLike | None:
+    """A per-corner argument (one value, or one per interior point) at the corners kept by ``corner_legs``."""
+    if value is None:
+        return None
+    v = as_real_array(value, name)
+    if v.ndim == 0 or v.size == 1:
+        return _per_corner(v, name, 1)
+    if v.ndim != 1 or v.size != interior:
+        raise ValueError(f"{name} needs one value or one per interior point ({interior}); got shape {v.shape}")
+    _per_corner(v, name, interior)
+    return v[index - 1]
+
 
 def round_corners(
     points: ArrayLike,
     *,
-    curvature: float | None = None,
-    max_curvature: float | None = None,
+    curvature: ArrayLike | None = None,
+    max_curvature: ArrayLike | None = None,
+    max_deviation: ArrayLike | None = None,
+    spiral_lengths: ArrayLike | None = None,
     shape: str = DEFAULT_SHAPE,
     method: str | None = None,
     tolerance: float = JOIN_TOLERANCE,
     units: str = DEFAULT_UNITS,
 ) -> RoundedPath:
-    """Round every corner of a polyline with a G2 spiral pair.
+    """Round every corner of a polyline, in the plane or in space, with a G2 spiral pair.
+
+    Each corner's pair lies in the plane of its two legs; between corners the
+    path runs straight along the polyline, so the whole path is G2 even when
+    every corner lies in another plane (a helix of lines).
 
     Args:
-        points: (n ≥ 3, 2) polyline vertices.
+        points: (n ≥ 3, 2) or (n ≥ 3, 3) polyline vertices (3-D points whose z
+            are all 0 make a plane path).
         curvature: joint (peak) curvature of every corner's pair.
         max_curvature: bound κmax; each corner uses the smallest distance
             from the corner that respects it (so its peak equals κmax).
+        max_deviation: the largest distance allowed between a corner point
+            and the path (a CNC or robot tolerance): each corner gets the
+            largest pair within it and its legs. With ``max_curvature`` too,
+            that pair's curvature must also respect κmax.
+        spiral_lengths: the arc length of each corner's spirals.
         shape: ``"walton-meek"`` (Theorem 4.4), ``"near-linear"`` (curvature
             almost linear in arc length; deflections up to 100°) or ``"g2cbs"``
             (Yang & Sukkarieh: about 24 % lower peak curvature for the same
@@ -349,40 +609,45 @@ def round_corners(
         tolerance: the chain's relative join tolerance (``Chain``).
         units: length unit of the points (default mm); curvatures are per unit.
 
-    With neither curvature given, each corner uses as much of its legs as it
-    may (Corollary 4.5): half of every interior segment, all of the first and
-    last. Collinear interior points are passed through.
+    Every value may be one number or one per interior point (n − 2; the value
+    of a collinear point is not used). With none given, each corner uses as
+    much of its legs as it may (Corollary 4.5): half of every interior
+    segment, all of the first and last. Collinear interior points are passed
+    through; a point where the polyline folds straight back is refused.
 
     Returns:
-        A :class:`RoundedPath`: chain from the first to the last point.
+        A :class:`RoundedPath`: chain from the first to the last point, and
+        per corner its pair, curvature and measured deviation.
 
     Raises:
-        NoSolutionError: a corner's legs are too short for the curvature
-            (the message names the corner index and the curvature it needs).
+        NoSolutionError: a corner that cannot be rounded as asked (the message
+            names the corner's point index and the numbers it needs).
         ValueError: malformed input.
     """
-    for name, value in (("curvature", curvature), ("max_curvature", max_curvature)):
-        if value is not None:
-            as_float(value, name)
     shape = corner_shape(shape, method)
-    pts = as_points(points, "points")
+    _exclusive(curvature, max_curvature, max_deviation, spiral_lengths)
+    pts = _polyline(points)
     p0, corners, p1, index = corner_legs(pts)
+    interior = len(pts) - 2
+    options = {name: _at_corners(v, name, interior, index) for name, v in
+               (("curvature", curvature), ("max_curvature", max_curvature), ("max_deviation", max_deviation), ("spiral_lengths", spiral_lengths))}  # fmt: skip
+    dim = pts.shape[1]
     rounded: list[RoundedCorner] = []
-    spirals = np.empty((0, 2, 4, 2))
+    spirals = np.empty((0, 2, 4, dim))
     if len(corners):
-        result = round_corners_batch(p0, corners, p1, curvature=curvature, max_curvature=max_curvature, shape=shape)
+        result = round_corners_batch(p0, corners, p1, shape=shape, **options)
         for j in np.flatnonzero(~result.ok):
             message = result.reason(int(j), label=f"corner {index[j]}")
             if result.status[j] in (Status.LEGS_TOO_SHORT, Status.CORNER_REVERSAL, Status.UNVERIFIED, Status.OUTSIDE_SHAPE):
                 raise NoSolutionError(message)
             raise ValueError(message)
         spirals = result.control_points
-        numbers = zip(index.tolist(), result.theta.tolist(), result.distance.tolist(), result.curvature.tolist())
-        for cp, (i, theta, distance, peak) in zip(spirals, numbers):
+        numbers = zip(index.tolist(), result.theta.tolist(), result.distance.tolist(), result.curvature.tolist(), result.deviation.tolist())
+        for cp, (i, theta, distance, peak, deviation) in zip(spirals, numbers):
             pair = (BezierSpiral._wrap(cp[0], shape), BezierSpiral._wrap(cp[1], shape))
-            rounded.append(RoundedCorner(i, theta, distance, peak, pair))
+            rounded.append(RoundedCorner(i, theta, distance, peak, pair, deviation))
     # Each corner's pair is one part; the lines between them follow (``Chain.join`` on arrays).
-    rows = SegmentRows.spirals(spirals.reshape(-1, 4, 2), shape)
+    rows = SegmentRows.spirals(spirals.reshape(-1, 4, dim), shape)
     objects = [s for corner in rounded for s in corner.spirals]
     try:
         chain = join_rows(rows, np.full(len(rounded), 2), PartCircles(len(rounded)), tuple(pts[0].tolist()),
@@ -391,3 +656,133 @@ def round_corners(
         raise NoSolutionError(f"corner {index[error.part]}: float64 cannot hold its spirals G2 at these coordinates: {error}") from None
     return RoundedPath(chain, rounded, shape)
 
+
+# ------------------------------------------------------------ fillets in space
+
+
+@dataclass(frozen=True)
+class SpaceFillet:
+    """One filleted corner of a polyline in space: its vertex, the plane of its two edges
+    (``frame``, origin at the vertex) and the fillet in that plane's coordinates."""
+
+    vertex: int
+    frame: PlaneFrame
+    fillet: FilletCorner
+
+
+@dataclass(frozen=True)
+class FilletedPolyline:
+    """A polyline in space with G2 fillets: its segments in travel order (closed when the polyline
+    was), the corner each segment belongs to (None: a trimmed edge) and the fillets."""
+
+    segments: tuple[Segment, ...]
+    owners: tuple[int | None, ...]
+    corners: list[SpaceFillet]
+    closed: bool
+    units: str = DEFAULT_UNITS
+
+    @property
+    def chain(self) -> Chain:
+        """The path as a ``Chain`` (every joint G2: every corner rounded).
+
+        Raises:
+            ValueError: a vertex left sharp, named as a joint.
+        """
+        return Chain(self.segments, units=self.units)
+
+
+_INNER_CORNER = re.compile(r"^corner 1( at \([^)]*\))?: ")
+
+
+def fillet_polyline(
+    points: ArrayLike,
+    radius: float,
+    *,
+    transition: float = 0.5,
+    vertices: Iterable[int] | None = None,
+    closed: bool = False,
+    same_sense: str = "nested",
+    shape: str = DEFAULT_SHAPE,
+    tolerance: float = JOIN_TOLERANCE,
+    units: str = DEFAULT_UNITS,
+) -> FilletedPolyline:
+    """G2 fillets at the corners of a polyline in space, each in the plane of its two edges.
+
+    Every chosen corner becomes transition → arc of ``radius`` → transition
+    exactly as a plane corner does (``spiral_cad.design.fillets.fillet_path``,
+    solved in the corner's plane and placed back): the same ``radius``,
+    ``transition`` and ``shape``. An edge between two rounded corners is
+    shared half-and-half (an edge with one rounded corner belongs wholly to it).
+
+    Args:
+        points: (n, 3) vertices (an (n, 2) polyline works too, in the XY plane).
+        radius: the fillet arc's radius, the smallest radius of curvature in each corner.
+        transition: the share of each corner's turn made by its spirals, in (0, 1].
+        vertices: the vertex indices to round (default every corner).
+        closed: the polyline closes (its last point joins its first; a repeated
+            first point at the end is dropped): vertex 0 is a corner too.
+        same_sense, shape, tolerance, units: as ``fillet_path``.
+
+    Raises:
+        ValueError: malformed input, a vertex index that is no corner.
+        NoSolutionError: a corner that cannot be rounded (named, with numbers).
+    """
+    pts = _polyline(points) if not closed else _coordinates(points, "points")
+    if closed and len(pts) > 1 and np.array_equal(pts[0], pts[-1]):
+        pts = pts[:-1]
+    if pts.ndim != 2 or len(pts) < 3:
+        raise ValueError(f"points must be an (n ≥ 3, 3) polyline; got shape {pts.shape}")
+    if not np.isfinite(pts).all():
+        i = int(np.argmax(~np.isfinite(pts).all(axis=1)))
+        raise ValueError(f"points must be finite; point {i} is {pts[i].tolist()}")
+    count = len(pts)
+    edges = count if closed else count - 1
+    ends = [(pts[i], pts[(i + 1) % count]) for i in range(edges)]
+    for i, (a, b) in enumerate(ends):
+        if np.array_equal(a, b):
+            raise ValueError(f"points {i} and {(i + 1) % count} coincide at {a.tolist()}")
+    candidates = list(range(count)) if closed else list(range(1, count - 1))
+    chosen = candidates if vertices is None else _vertex_indices(vertices)
+    unknown = [v for v in chosen if v not in candidates]
+    if unknown:
+        raise ValueError(f"vertices {unknown} are not corners of this polyline (corners: {candidates})")
+    rounded = {}
+    for v in chosen:
+        d_in, d_out = (ends[v - 1][1] - ends[v - 1][0]), (ends[v % edges][1] - ends[v % edges][0])
+        if _sin_turn(d_in[None] / norms(d_in), d_out[None] / norms(d_out))[0] > COLLINEAR_TOL:
+            rounded[v] = None  # a corner (straight vertices stay as they are)
+    pieces: dict[int, list[Segment]] = {}
+    fillets = []
+    for v in rounded:
+        before, after = pts[v - 1], pts[(v + 1) % count]
+        share_in = 0.5 if (v - 1) % count in rounded and (closed or v - 1 > 0) else 1.0
+        share_out = 0.5 if (v + 1) % count in rounded and (closed or v + 1 < count - 1) else 1.0
+        frame = PlaneFrame.of_corner(before, pts[v], after)
+        legs = frame.local([pts[v] + share_in * (before - pts[v]), pts[v] + share_out * (after - pts[v])])
+        try:
+            result = fillet_path([legs[0], (0.0, 0.0), legs[1]], radius, transition=transition, same_sense=same_sense,
+                                 shape=shape, tolerance=tolerance)  # fmt: skip
+        except ValueError as error:
+            where = f"corner {v} at ({', '.join(f'{c:.10g}' for c in pts[v].tolist())})"
+            message = _INNER_CORNER.sub("", str(error))  # the plane solve's own corner and edges are 1, 0 and 1
+            message = re.sub(r"edge ([01])\b", lambda m: f"edge {(v - 1) % count if m.group(1) == '0' else v}", message)
+            shared = " (each corner may use half of an edge it shares with another rounded corner)" if "edge" in message else ""
+            raise type(error)(f"{where}: {message}{shared}") from None
+        pieces[v] = [s.placed(frame) for s, owner in zip(result.segments, result.owners) if owner is not None]
+        fillets.append(SpaceFillet(v, frame, result.corners[0]))
+    segments: list[Segment] = []
+    owners: list[int | None] = []
+    for i, (a, b) in enumerate(ends):
+        start = pieces[i][-1].point(1.0) if i in pieces else a
+        j = (i + 1) % count
+        stop = pieces[j][0].point(0.0) if j in pieces else b
+        if not np.array_equal(start, stop):
+            segments.append(Line(start, stop))
+            owners.append(None)
+        if j in pieces and (closed or j < count - 1):
+            segments += pieces[j]
+            owners += [j] * len(pieces[j])
+    broken = first_broken_corner(segments, owners, closed, join_tolerance(tolerance))
+    if broken:
+        raise NoSolutionError(f"corner {broken[0]}: float64 cannot hold its fillet G2 at these coordinates ({broken[1]})")
+    return FilletedPolyline(tuple(segments), tuple(owners), fillets, closed, length_unit(units))

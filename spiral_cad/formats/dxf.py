@@ -1,5 +1,11 @@
 """DXF (R2010) through ezdxf: LINE, ARC and exact cubic SPLINE entities on a layer named after the design.
 
+Chains in space are written in 3-D: lines and spline control points with
+their z, and an arc in space as an ARC in its own object coordinate system
+(OCS): its ``extrusion`` is the arc's normal, turned so that the arc runs
+counterclockwise about it as DXF arcs do, its centre and angles in OCS
+coordinates (DXF's arbitrary axis algorithm, ``ezdxf.math.OCS``).
+
 The header declares the unit twice, as readers differ in which they use:
 ``$INSUNITS`` (4 mm, 5 cm, 6 m, 7 km, 1 in, 2 ft) and ``$MEASUREMENT``
 (1 metric, 0 imperial, which Inkscape and LibreCAD use for scaling). The
@@ -31,55 +37,80 @@ BEZIER_KNOTS = (0.0, 0.0, 0.0, 0.0, 1.0, 1.0, 1.0, 1.0)
 LIMITS_MARGIN = 0.05
 
 
+def _xyz(point) -> tuple[float, float, float]:
+    x, y, *z = point.tolist()
+    return x, y, (z[0] if z else 0.0)
+
+
 def _add(msp, seg: Segment, layer: str) -> None:
     attribs = {"layer": layer}
     if isinstance(seg, Line):
-        msp.add_line(tuple(seg.start), tuple(seg.end), dxfattribs=attribs)
-    elif isinstance(seg, Arc):
+        msp.add_line(_xyz(seg.start), _xyz(seg.end), dxfattribs=attribs)
+    elif isinstance(seg, Arc) and seg.dim == 2:
         # DXF arcs run counterclockwise: a clockwise arc is written from its end.
         a, b = math.degrees(seg.start_angle), math.degrees(seg.start_angle + math.copysign(seg.sweep, seg.radius))
         start, end = (a, b) if seg.radius > 0 else (b, a)
         msp.add_arc(tuple(seg.center), abs(seg.radius), start, end, dxfattribs=attribs)
+    elif isinstance(seg, Arc):
+        _add_arc_in_space(msp, seg, attribs)
     elif isinstance(seg, BezierSpiral):
-        points = [(*p, 0.0) for p in seg.control_points.tolist()]
+        points = [_xyz(p) for p in seg.control_points]
         spline = msp.add_open_spline(points, degree=3, knots=BEZIER_KNOTS, dxfattribs=attribs)
-        spline.dxf.flags |= spline.PLANAR
+        spline.dxf.flags |= spline.PLANAR  # every spiral lies in one plane
     else:
         raise ValueError(f"segment must be a Line, Arc or BezierSpiral; got {seg!r}")
 
 
+def _add_arc_in_space(msp, arc: Arc, attribs: dict) -> None:
+    """An ARC in the OCS whose extrusion is the arc's normal, turned for counterclockwise travel."""
+    from ezdxf.math import OCS
+
+    extrusion = tuple((math.copysign(1.0, arc.radius) * arc.normal).tolist())
+    ocs = OCS(extrusion)
+    center, start = ocs.from_wcs(_xyz(arc.center)), ocs.from_wcs(_xyz(arc.start))
+    a = math.degrees(math.atan2(start.y - center.y, start.x - center.x))
+    msp.add_arc((center.x, center.y, center.z), abs(arc.radius), a, a + math.degrees(arc.sweep),
+                dxfattribs={**attribs, "extrusion": extrusion})  # fmt: skip
+
+
 def _extreme_parameters(seg: Segment) -> list[float]:
-    """Where on ``seg`` (u in [0, 1]) x or y can be extreme: its ends, an arc's quadrant points
-    and the roots of a cubic's derivative."""
+    """Where on ``seg`` (u in [0, 1]) a coordinate can be extreme: its ends, the points of an arc
+    where it runs across an axis (its quadrant points in the plane) and the roots of a cubic's derivative."""
     found = [0.0, 1.0]
     if isinstance(seg, Arc):
-        turn = math.copysign(seg.sweep, seg.radius)
-        low, high = sorted((seg.start_angle, seg.start_angle + turn))
-        quarter = math.pi / 2
-        found += [(k * quarter - seg.start_angle) / turn for k in range(math.ceil(low / quarter), math.floor(high / quarter) + 1)]
+        (e1, e2), sense = seg.basis, math.copysign(1.0, seg.radius)
+        for axis in range(seg.dim):
+            # the axis coordinate is c + |r|·(cos a·e1 + sin a·e2): extreme where tan a = e2/e1
+            peak = math.atan2(e2[axis], e1[axis])
+            for angle in (peak, peak + math.pi):
+                u = (sense * (angle - seg.start_angle)) % (2.0 * math.pi) / seg.sweep
+                if 0.0 < u < 1.0:
+                    found.append(u)
     elif isinstance(seg, BezierSpiral):
         p = seg.control_points
         a, b, c = p[1] - p[0], p[2] - p[1], p[3] - p[2]  # B'(t)/3 = a(1-t)² + 2b(1-t)t + ct²
-        for axis in range(2):
+        for axis in range(seg.dim):
             roots = np.roots([a[axis] - 2 * b[axis] + c[axis], 2 * (b[axis] - a[axis]), a[axis]])
             found += [float(t.real) for t in roots if t.imag == 0 and 0 < t.real < 1]
     return found
 
 
-def extents(chains: Sequence[Chain]) -> tuple[tuple[float, float], tuple[float, float]]:
-    """The drawing's exact bounding box ((xmin, ymin), (xmax, ymax))."""
-    points = np.vstack([seg.point(np.clip(_extreme_parameters(seg), 0.0, 1.0)) for chain in chains for seg in chain])
+def extents(chains: Sequence[Chain]) -> tuple[tuple[float, float, float], tuple[float, float, float]]:
+    """The drawing's exact bounding box ((xmin, ymin, zmin), (xmax, ymax, zmax)); z is 0 in the plane."""
+    points = np.vstack([np.atleast_2d(seg.point(np.clip(_extreme_parameters(seg), 0.0, 1.0)))[:, :3] for chain in chains for seg in chain])
+    points = np.column_stack([points, np.zeros((len(points), 3 - points.shape[1]))])
     low, high = points.min(axis=0), points.max(axis=0)
-    return (float(low[0]), float(low[1])), (float(high[0]), float(high[1]))
+    return (float(low[0]), float(low[1]), float(low[2])), (float(high[0]), float(high[1]), float(high[2]))
 
 
 def _set_extents_and_limits(doc, msp, chains: Sequence[Chain]) -> None:
-    (x0, y0), (x1, y1) = extents(chains)
+    low, high = extents(chains)
+    (x0, y0, _), (x1, y1, _) = low, high
     pad = LIMITS_MARGIN * math.hypot(x1 - x0, y1 - y0)
     limits = (x0 - pad, y0 - pad), (x1 + pad, y1 + pad)
-    msp.reset_extents((x0, y0, 0.0), (x1, y1, 0.0))
+    msp.reset_extents(low, high)
     msp.reset_limits(*limits)
-    doc.header["$EXTMIN"], doc.header["$EXTMAX"] = (x0, y0, 0.0), (x1, y1, 0.0)
+    doc.header["$EXTMIN"], doc.header["$EXTMAX"] = low, high
     doc.header["$LIMMIN"], doc.header["$LIMMAX"] = limits
 
 

@@ -14,6 +14,16 @@ Measures at the joint from element *a* (its end) to element *b* (its start):
   ``K = κ·N = ((r' × r'') × r') / |r'|⁴`` (1/model unit). ``K`` is defined
   where κ = 0 (it is the zero vector) and does not depend on the direction
   of travel, so it works for 3-D wires and reversed edges alike.
+* **plane change** — the angle between the osculating planes (normal
+  T × K) on either side of the joint, in [0, π/2], so a user sees where a
+  path in space twists (0 everywhere in the plane). It does not grade the
+  joint: a G2 joint may change plane where κ = 0, and only there. Where an
+  end is straight (|K| ≤ ``curvature_tol``/size: a line, a spiral's start)
+  it has no osculating plane; the edge's other end lends its plane, and a
+  straight edge carries the last plane before it, so a twist between two
+  curved stretches is reported once, at the joint where the next one
+  begins. NaN where no plane is known before the joint (a path that starts
+  straight).
 
 Classification:
 
@@ -107,6 +117,9 @@ class JointReport:
         curvature_after: curvature magnitude at the start of the next edge.
         relative_curvature_jump: ``curvature_jump / max(|K_a|, |K_b|, 1/size)``,
             the value compared with ``curvature_tol``.
+        plane_change: angle between the osculating planes before and after
+            the joint (radians, [0, π/2]; see the module docstring), NaN when
+            no plane is known before it.
     """
 
     index: int
@@ -117,6 +130,7 @@ class JointReport:
     curvature_before: float = 0.0
     curvature_after: float = 0.0
     relative_curvature_jump: float = 0.0
+    plane_change: float = math.nan
 
 
 @dataclass(frozen=True)
@@ -240,6 +254,11 @@ class ContinuityReport:
                 parts.append(f"{len(counts)} {kind}s ({', '.join(map(str, counts))} {_plural(self.element)})")
         return " and ".join(parts) or f"no {_plural(self.element)}"
 
+    def largest_plane_change(self) -> tuple[float, int, int] | None:
+        """(angle in radians, piece, joint) where the path changes plane most, or None without a measured plane change."""
+        found = [(j.plane_change, w.index, j.index) for w in self.wires for j in w.joints if j.plane_change == j.plane_change]
+        return max(found, default=None)
+
     def timing_line(self) -> str:
         """Where the check spent its time (``spiral-cad check --timing``): the reader's share, and
         whether the reader or our measuring and classifying limit it; empty without ``timing``."""
@@ -258,7 +277,12 @@ class ContinuityReport:
             f"  tolerances: gap {self.gap_tol:g}{unit}, angle {self.angle_tol:g} rad, "
             f"curvature jump {self.curvature_tol:g} relative{snap}; model size {self.size:.6g}{unit}",
         ]
-        head = f"  {'joint':>5} {'gap':>10} {'angle rad':>10} {'κ before':>11} {'κ after':>11} {'|Δκ|':>10} {'Δκ rel':>9} level"
+        twist = self.largest_plane_change()
+        if twist is not None and twist[0] > 0.0:
+            out.append(f"  largest plane change {math.degrees(twist[0]):.4g}° at joint {twist[2]} of {self.wires[twist[1]].kind} "
+                       f"{twist[1]} (the angle between the osculating planes before and after a joint)")  # fmt: skip
+        head = (f"  {'joint':>5} {'gap':>10} {'angle rad':>10} {'κ before':>11} {'κ after':>11} {'|Δκ|':>10} {'Δκ rel':>9} "
+                f"{'plane°':>7} level")  # fmt: skip
         for w in self.wires:
             out.append(
                 f"{w.kind} {w.index}{f' (id {w.name})' if w.name else ''}: {_count(w.edge_count, self.element)}, "
@@ -268,9 +292,10 @@ class ContinuityReport:
             if w.joints:
                 out.append(head)
             for j in w.joints:
+                plane = f"{math.degrees(j.plane_change):7.3f}" if j.plane_change == j.plane_change else f"{'–':>7}"
                 out.append(
                     f"  {j.index:5d} {j.gap:10.3e} {j.angle:10.3e} {j.curvature_before:11.5g} {j.curvature_after:11.5g} "
-                    f"{j.curvature_jump:10.3e} {j.relative_curvature_jump:9.2e} {j.level}"
+                    f"{j.curvature_jump:10.3e} {j.relative_curvature_jump:9.2e} {plane} {j.level}"
                 )
         return "\n".join(out)
 
@@ -349,17 +374,51 @@ def classify_joints(a: NDArray, b: NDArray, gap_tol: float, angle_tol: float, cu
     return gap, angle, jump, level, ka, kb, relative
 
 
+def plane_changes(frames: NDArray, closed: bool, straight: float) -> NDArray:
+    """The plane change at each joint of one piece (radians; see the module docstring).
+
+    ``frames`` is (edges, 2, ≥ 9): every edge's start and end frame in travel
+    order; an end whose |K| ≤ ``straight`` has no osculating plane. Returns
+    one angle per joint (the closing joint last when ``closed``).
+    """
+    with np.errstate(all="ignore"):
+        tangent, k = frames[:, :, 3:6], frames[:, :, 6:9]
+        normal = np.cross(tangent, k)
+        length = np.sqrt(np.einsum("...i,...i->...", normal, normal))
+        curved = (np.sqrt(np.einsum("...i,...i->...", k, k)) > straight) & (length > 0.0)
+        normal = np.where(curved[..., None], normal / length[..., None], np.nan)
+        # an edge lends the plane of its other end to a straight end
+        lent = np.where(curved[..., None], normal, normal[:, ::-1])
+        sequence = lent.reshape(-1, 3)  # start, end, start, end, … in travel order
+        twice = np.concatenate([sequence, sequence]) if closed else sequence
+        known = np.flatnonzero(~np.isnan(twice[:, 0]))
+        last = np.full(len(twice), -1)
+        last[known] = known
+        last = np.maximum.accumulate(last)  # the last plane at or before each position
+        carried = np.where((last >= 0)[:, None], twice[np.maximum(last, 0)], np.nan)
+        if closed:
+            carried = carried[len(sequence) :]
+        edges = len(frames)
+        joints = edges if closed else edges - 1
+        before = carried[1 : 2 * joints : 2]  # the end of edge i, or what it carries
+        after = lent[(np.arange(joints) + 1) % edges, 0]  # the start of edge i + 1, from its own plane
+        after = np.where(np.isnan(after), before, after)  # a straight edge changes no plane
+        cross = np.cross(before, after)
+        return np.arctan2(np.sqrt(np.einsum("ij,ij->i", cross, cross)), np.abs(np.einsum("ij,ij->i", before, after)))
+
+
 def classify_joint(index: int, a: Frame, b: Frame, gap_tol: float, angle_tol: float, curvature_tol: float, floor: float) -> JointReport:
     """Measure and classify the joint from end frame ``a`` to start frame ``b`` (``classify_joints``)."""
     return _joint_reports([index], classify_joints(np.array([a]), np.array([b]), gap_tol, angle_tol, curvature_tol, floor))[0]
 
 
-def _joint_reports(indices: Sequence[int], measures: tuple[NDArray, ...]) -> list[JointReport]:
+def _joint_reports(indices: Sequence[int], measures: tuple[NDArray, ...], planes: NDArray | None = None) -> list[JointReport]:
     gap, angle, jump, level, ka, kb, relative = (m.tolist() for m in measures)
+    plane = [math.nan] * len(gap) if planes is None else planes.tolist()
     levels = [Continuity(v) for v in range(-1, 4)]
     return [
-        JointReport(i, g, an, j, levels[lv + 1], x, y, r)
-        for i, g, an, j, lv, x, y, r in zip(indices, gap, angle, jump, level, ka, kb, relative)
+        JointReport(i, g, an, j, levels[lv + 1], x, y, r, pc)
+        for i, g, an, j, lv, x, y, r, pc in zip(indices, gap, angle, jump, level, ka, kb, relative, plane)
     ]
 
 
@@ -413,7 +472,7 @@ def classify_pieces(
             frames = np.asarray(ends, dtype=float)  # (edges, 2: start and end, frame)
             after = np.roll(frames[:, 0], -1, axis=0)[:pairs]
             measures = classify_joints(frames[:pairs, 1], after, gap_tol, angle_tol, curvature_tol, floor)
-            joints = tuple(_joint_reports(range(pairs), measures))
+            joints = tuple(_joint_reports(range(pairs), measures, plane_changes(frames, closed, curvature_tol * floor)))
         wires.append(WireReport(w, len(ends), closed, joints, kind, *name))
     return ContinuityReport(tuple(wires), gap_tol, angle_tol, curvature_tol, size, snap, source, element, units)
 

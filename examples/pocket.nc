@@ -1,0 +1,22 @@
+%
+(square pocket ring, two depths; from a CAM post, with the usual preamble)
+N10 G21 G17 G40 G49 G80 G90 G94 (mm, absolute)
+N20 T1 M6
+N30 S12000 M3
+N40 G54
+N50 G0 X5. Y5. Z10.
+N60 G0 Z2.
+N70 G1 Z-1. F300.
+N80 X55. F1200.
+N90 Y45.
+N100 X5.
+N110 Y5.
+N120 G1 Z-2. F300.
+N130 X55. F1200.
+N140 Y45.
+N150 X5.
+N160 Y10.
+N170 G0 Z10.
+N180 M5
+N190 M30
+%
