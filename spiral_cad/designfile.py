@@ -632,8 +632,7 @@ def _write_design(b: Built, stage: Path, units: str, missing: list[str], plots: 
     step = stage / f"{b.name}.step"
     export_step(b.chain, step, name=b.name)
     names = ["step"]
-    flat = b.chain.dim == 2  # SVG and the plots are plane outputs
-    if flat:
+    if b.chain.dim == 2:  # SVG is a plane output (the plots draw a path in space as its plan)
         export_svg(b.chain, stage / f"{b.name}.svg", name=b.name)
         names.append("svg")
     if b.notes.get("samples"):
@@ -671,7 +670,7 @@ def _write_design(b: Built, stage: Path, units: str, missing: list[str], plots: 
 
         export_dxf(b.chain, stage / f"{b.name}.dxf", name=b.name)
         names.append("dxf")
-    if plots and flat and "matplotlib" not in missing:
+    if plots and "matplotlib" not in missing:
         names += _plots(b, stage)
     return names
 

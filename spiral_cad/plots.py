@@ -66,7 +66,8 @@ class Comb:
 
 
 def curvature_comb(chain: Chain, per_segment: int = 24, scale: float | None = None) -> Comb:
-    """Comb samples, ``per_segment`` per segment (ends included).
+    """Comb samples, ``per_segment`` per segment (ends included); in space the teeth
+    stand against the curvature vector κN, in the osculating plane.
 
     Args:
         chain: the path.
@@ -80,18 +81,24 @@ def curvature_comb(chain: Chain, per_segment: int = 24, scale: float | None = No
     for i, seg in enumerate(chain.segments):
         # Stations from the segment's own arc-length parametrisation.
         s = starts[i] + (bezier.arc_length(seg.control_points, u) if isinstance(seg, BezierSpiral) else u * seg.length)
-        t = seg.tangent(u)
         stations.append(s)
         points.append(seg.point(u))
-        normals.append(np.stack([-t[:, 1], t[:, 0]], axis=1))
-        kappa.append(np.broadcast_to(seg.curvature(u), u.shape))
+        k = np.broadcast_to(seg.curvature(u), u.shape)
+        if chain.dim == 2:  # the left normal: signed curvature times it is the curvature vector
+            t = seg.tangent(u)
+            normals.append(np.stack([-t[:, 1], t[:, 0]], axis=1))
+        else:  # in space the principal normal (κ ≥ 0); none on straight stretches
+            vector = seg.curvature_vector(u)
+            with np.errstate(invalid="ignore", divide="ignore"):
+                normals.append(np.nan_to_num(vector / k[:, None]))
+        kappa.append(k)
         owner.append(np.full(per_segment, i))
     kappa_all = np.concatenate(kappa)
     if scale is None:
         peak = float(np.abs(kappa_all).max())
         scale = 0.2 * chain.size / peak if peak > 0.0 else 0.0
     pts, nrm = np.vstack(points), np.vstack(normals)
-    tips = pts - scale * kappa_all[:, None] * nrm
+    tips = pts - scale * kappa_all[:, None] * nrm  # teeth on the convex side, against the curvature vector
     return Comb(np.concatenate(stations), pts, nrm, kappa_all, tips, np.concatenate(owner), float(scale))
 
 
@@ -111,7 +118,8 @@ def _samples(chain: Chain, per_segment: int | None, most: int) -> int:
 
 
 def plot_plan(chain: Chain, comb: bool = True, ax: Axes | None = None, per_segment: int | None = None) -> Figure:
-    """Plan view of ``chain``, coloured by segment type, with an optional curvature comb.
+    """Plan view of ``chain``, coloured by segment type, with an optional curvature comb
+    (a chain in space is drawn projected onto its XY plane, comb teeth included).
 
     Artists (one set per segment type; at most ``MAX_SAMPLES`` points unless
     ``per_segment`` is given, so long chains draw in seconds): a ``LineCollection`` of the segments (gid
@@ -125,21 +133,20 @@ def plot_plan(chain: Chain, comb: bool = True, ax: Axes | None = None, per_segme
     u = np.linspace(0.0, 1.0, per_segment)
     for kind, index in _by_kind(chain).items():
         color = SEGMENT_COLORS.get(kind, "k")
-        ax.add_collection(
-            LineCollection([chain.segments[i].point(u) for i in index], colors=color, linewidths=2.0, label=kind, gid=f"plan-{kind}")
-        )
+        plan = [chain.segments[i].point(u)[:, :2] for i in index]
+        ax.add_collection(LineCollection(plan, colors=color, linewidths=2.0, label=kind, gid=f"plan-{kind}"))
         if data is not None:
             rows = (index[:, None] * per_segment + np.arange(per_segment)).ravel()
-            teeth = np.stack([data.points[rows], data.tips[rows]], axis=1)
+            teeth = np.stack([data.points[rows, :2], data.tips[rows, :2]], axis=1)
             ax.add_collection(LineCollection(teeth, colors=color, linewidths=0.6, alpha=0.5, gid=f"comb-{kind}"))
-            envelopes = data.tips[rows].reshape(len(index), per_segment, 2)
+            envelopes = data.tips[rows, :2].reshape(len(index), per_segment, 2)
             ax.add_collection(LineCollection(envelopes, colors=color, linewidths=0.8, alpha=0.8, gid=f"envelope-{kind}"))
     ax.set_aspect("equal", adjustable="datalim")
     ax.autoscale_view()
     unit = f" ({chain.units})"
     ax.set_xlabel("x" + unit)
     ax.set_ylabel("y" + unit)
-    title = f"Plan: {len(chain)} segments, length {chain.length:.6g} {chain.units}"
+    title = f"{'Plan' if chain.dim == 2 else 'Plan (projected onto XY)'}: {len(chain)} segments, length {chain.length:.6g} {chain.units}"
     if data is not None:
         title += f" (comb: {data.scale:.3g} {chain.units}² per unit curvature)"
     ax.set_title(title)
@@ -149,8 +156,8 @@ def plot_plan(chain: Chain, comb: bool = True, ax: Axes | None = None, per_segme
 
 
 def plot_curvature(chain: Chain, ax: Axes | None = None, per_segment: int | None = None) -> Figure:
-    """Signed curvature against arc length: one ``LineCollection`` per segment type
-    (gid ``curvature-KIND``, one polyline per segment)."""
+    """Curvature against arc length (signed in the plane, κ ≥ 0 in space): one
+    ``LineCollection`` per segment type (gid ``curvature-KIND``, one polyline per segment)."""
     fig, ax = _axes(ax, figsize=(8, 4))
     per_segment = _samples(chain, per_segment, 64)
     data = curvature_comb(chain, per_segment, scale=0.0)
@@ -162,7 +169,7 @@ def plot_curvature(chain: Chain, ax: Axes | None = None, per_segment: int | None
     ax.autoscale_view()
     ax.axhline(0.0, color="0.6", lw=0.6)
     ax.set_xlabel(f"arc length s ({chain.units})")
-    ax.set_ylabel(f"curvature κ (1/{chain.units})")
+    ax.set_ylabel(f"curvature {'κ' if chain.dim == 2 else '|κ|'} (1/{chain.units})")
     ax.set_title("Curvature profile")
     ax.legend(loc="best", fontsize="small")
     ax.grid(True, alpha=0.3)

@@ -144,3 +144,21 @@ def test_jerk_length_plot_shows_the_bezier_needs_more_length(tmp_path):
     bezier, clothoid = right.lines
     assert np.all(bezier.get_ydata() > clothoid.get_ydata())
     assert saved(fig, tmp_path, "jerk.png")
+
+
+def test_chains_in_space_plot_as_a_plan_projection_and_a_curvature_magnitude(tmp_path):
+    path = round_corners([(0, 0, 0), (1, 0, 0), (1, 1, 1), (2, 1, 2)], max_curvature=5.0)
+    chain = path.chain
+    assert chain.dim == 3
+    comb = plots.curvature_comb(chain, per_segment=16)
+    inside = (comb.stations > 0) & (comb.stations < chain.length)
+    assert np.allclose(comb.curvature[inside], chain.curvature_at(comb.stations[inside]), rtol=1e-9, atol=1e-12)
+    vectors = chain.curvature_vector_at(comb.stations[inside])
+    teeth = (comb.tips - comb.points)[inside]
+    bent = comb.curvature[inside] > 1e-9
+    assert np.all(np.einsum("ij,ij->i", teeth[bent], vectors[bent]) < 0)  # against κN: on the convex side
+    assert np.allclose(np.linalg.norm(teeth, axis=1), comb.scale * comb.curvature[inside], rtol=1e-9, atol=1e-12)
+    fig = plots.plot_plan(chain)
+    assert "projected onto XY" in fig.axes[0].get_title() and saved(fig, tmp_path, "plan3d.png")
+    fig = plots.plot_curvature(chain)
+    assert "|κ|" in fig.axes[0].get_ylabel() and saved(fig, tmp_path, "curvature3d.png")
