@@ -1,14 +1,17 @@
 """Compiled kernels: every formula of the spiral and of its five transitions, once.
 
 Each ``*_row`` function solves one problem from plain floats and writes the
-control points into ``out`` (shape ``(k, 4, 2)``); it returns
-``(status, theta, measure, extra)``.  ``status`` is one of the codes below,
-``measure`` is the number that decides feasibility (reported in errors; for
-``UNVERIFIED`` the residual that failed) and ``extra`` is case specific (the
+control points into ``out[i]`` (``out`` of shape ``(N, k, 4, 2)``; NaN
+where it fails); it returns ``(status, theta, measure, extra)``. ``status``
+is one of the codes below, ``measure`` is the number that decides
+feasibility (reported in errors; for ``UNVERIFIED`` the residual that
+failed) and ``extra`` is case specific (the turn side of line → circle, the
 contact parameter ``t`` of the nested case). The batch kernels loop over
-rows; the scalar API calls the row functions.
+rows, with the row functions inlined; the scalar API calls the row
+functions with N = 1, so scalar and batch results agree bit for bit.
 
-Every row works in the same steps:
+Every row works in the same steps, in registers (nothing is written before
+the row is verified, and nothing is read back):
 
 1. check its inputs (finite, non-zero directions and radii);
 2. move to a normalised frame: translated to one input point and scaled by a
@@ -18,9 +21,10 @@ Every row works in the same steps:
    when the configuration turns right);
 4. map the control points back to world coordinates;
 5. verify what is returned: every contact and joint, measured from the world
-   control points, must hold to ``VERIFY_TOL`` (relative), else the row
-   fails with ``UNVERIFIED`` and the residual as its measure. Non-finite or
-   coinciding control points count as an infinite residual.
+   control points that are then written, must hold to ``VERIFY_TOL``
+   (relative), else the row fails with ``UNVERIFIED`` and the residual as
+   its measure. Non-finite or coinciding control points count as an
+   infinite residual. The checks need square roots and divisions only.
 
 Kernels use numpy's floating-point error model: a division by zero gives
 inf/NaN (caught by step 5) instead of raising, so no input can make a batch
@@ -31,12 +35,12 @@ from __future__ import annotations
 
 import math
 
-from numba import njit, prange
+from numba import njit
 
 from .errors import Status
 
 
-def _compile(parallel: bool = False):
+def _compile(inline: bool = False):
     """``njit`` with an on-disk cache where one can be written, else per process.
 
     Numba refuses to decorate a cached function when it finds no writable
@@ -45,7 +49,7 @@ def _compile(parallel: bool = False):
     """
 
     def wrap(function):
-        options = dict(nogil=True, error_model="numpy", parallel=parallel)
+        options = dict(nogil=True, error_model="numpy", inline="always" if inline else "never")
         try:
             return njit(cache=True, **options)(function)
         except RuntimeError:
@@ -55,6 +59,10 @@ def _compile(parallel: bool = False):
 
 
 jit = _compile()
+#: Row functions are inlined into the batch loops (where the output array
+#: then costs no reference counting per row) and compiled on their own for
+#: the scalar API.
+row_jit = _compile(inline=True)
 
 # Row status codes as compile-time ints (meanings: ``errors.Status``).
 OK = int(Status.OK)
@@ -150,27 +158,39 @@ def in_shape_domain(shape, cos_t):
 
 
 @jit
-def shape_offsets(shape, sin_t, cos_t):
-    """(e1, e2) with g1(θ) = 1 + sin²θ·e1 and g2(θ) = sin θ·e2.
+def leg_offsets(alpha, beta, gamma, cos_t):
+    """(e1, e2) of the spiral with leg factors (α, β, γ) at θ: g1(θ) = 1 + sin²θ·e1, g2(θ) = sin θ·e2.
 
     The end circle's centre is B0 + R·(g2·T + g1·N) (N the normal towards
     it): g1 − 1 is the circle's shift off the start line over R, and both
     are formed without cancellation as θ → 0.
     """
-    alpha, beta, gamma = leg_factors(shape, cos_t)
     return gamma - 1.0 / (1.0 + cos_t), alpha + beta + gamma * cos_t - 1.0
+
+
+@jit
+def shape_offsets(shape, sin_t, cos_t):
+    """(e1, e2) of ``leg_offsets`` for the shape's spiral of angle θ."""
+    alpha, beta, gamma = leg_factors(shape, cos_t)
+    return leg_offsets(alpha, beta, gamma, cos_t)
+
+
+@jit
+def centre_offset(sin_t, e1, e2):
+    """(g1, g2): the end circle's centre lies R·g1 off the start line and R·g2 along it."""
+    return 1.0 + sin_t * sin_t * e1, sin_t * e2
 
 
 @jit
 def shape_g1(shape, sin_t, cos_t):
     """g1(θ): the end circle's centre lies R·g1 off the start line (1996 spiral: (5 + 4cos²θ)/(9 cos θ))."""
-    return 1.0 + sin_t * sin_t * shape_offsets(shape, sin_t, cos_t)[0]
+    return centre_offset(sin_t, *shape_offsets(shape, sin_t, cos_t))[0]
 
 
 @jit
 def shape_g2(shape, sin_t, cos_t):
     """g2(θ): the end circle's centre lies R·g2 along the start line (1996 spiral: 25 tan θ/(27 cos θ) − (4/9) sin θ)."""
-    return sin_t * shape_offsets(shape, sin_t, cos_t)[1]
+    return centre_offset(sin_t, *shape_offsets(shape, sin_t, cos_t))[1]
 
 
 @jit
@@ -206,25 +226,20 @@ def corner_relation(shape, sin_t, cos_t, value):
 
 
 @jit
-def put_spiral(out, bx, by, tx, ty, nx, ny, sin_t, cos_t, radius, shape):
-    """Write the spiral's control points into ``out`` (4, 2).
+def spiral_points(bx, by, tx, ty, nx, ny, sin_t, cos_t, radius, alpha, beta, gamma):
+    """The spiral's control points (x0, y0, …, x3, y3) from its legs.
 
     Starts at (bx, by) along unit (tx, ty) and turns by |θ| towards the unit
-    normal (nx, ny), reaching radius ``radius`` at the end.
+    normal (nx, ny), reaching radius ``radius`` at the end; (α, β, γ) are the
+    shape's leg factors at θ (``leg_factors``).
     """
-    alpha, beta, gamma = leg_factors(shape, cos_t)
     size = radius * sin_t
     a = alpha * size
     b = a + beta * size
     c = gamma * size
-    out[0, 0] = bx
-    out[0, 1] = by
-    out[1, 0] = bx + a * tx
-    out[1, 1] = by + a * ty
-    out[2, 0] = bx + b * tx
-    out[2, 1] = by + b * ty
-    out[3, 0] = out[2, 0] + c * (cos_t * tx + sin_t * nx)
-    out[3, 1] = out[2, 1] + c * (cos_t * ty + sin_t * ny)
+    x2 = bx + b * tx
+    y2 = by + b * ty
+    return bx, by, bx + a * tx, by + a * ty, x2, y2, x2 + c * (cos_t * tx + sin_t * nx), y2 + c * (cos_t * ty + sin_t * ny)
 
 
 @jit
@@ -284,6 +299,85 @@ def unit(x, y):
     return x / n, y / n
 
 
+#: fdlibm's arctangent (s_atan.c): atan(t) = t − t·P(t²) for |t| < 7/16, else
+#: atan(c) + atan((t − c)/(1 + ct)) with c = 1/2, 1, 3/2, ∞, atan(c) in two parts.
+ATAN_HI = (0.4636476090008061, 0.7853981633974483, 0.982793723247329, 1.5707963267948966)
+ATAN_LO = (2.2698777452961687e-17, 3.061616997868383e-17, 1.3903311031230998e-17, 6.123233995736766e-17)
+ATAN_P = (3.33333333333329318027e-01, -1.99999999998764832476e-01, 1.42857142725034663711e-01,
+          -1.11111104054623557880e-01, 9.09088713343650656196e-02, -7.69187620504482999495e-02,
+          6.66107313738753120669e-02, -5.83357013379057348645e-02, 4.97687799461593236017e-02,
+          -3.65315727442169155270e-02, 1.62858201153657823623e-02)  # fmt: skip
+#: Veltkamp's splitter 2^27 + 1: a = hi + lo with 26-bit halves, so products of halves are exact.
+SPLIT = 134217729.0
+
+
+@jit
+def two_sum(a, b):
+    """a + b as s + e exactly (Knuth)."""
+    s = a + b
+    v = s - a
+    return s, (a - (s - v)) + (b - v)
+
+
+@jit
+def two_product_error(a, b, p):
+    """a·b − p exactly for p = fl(a·b) (Dekker; |a|, |b| below 2^996)."""
+    c = SPLIT * a
+    ah = c - (c - a)
+    al = a - ah
+    c = SPLIT * b
+    bh = c - (c - b)
+    bl = b - bh
+    return ((ah * bh - p) + ah * bl + al * bh) + al * bl
+
+
+@jit
+def angle(y, x):
+    """atan2(y, x) for 0 ≤ y ≤ 1 and 0 < x ≤ 1, the spiral angle θ from its sine and cosine.
+
+    fdlibm's arctangent of the reduced argument t = (n_hi + n_lo)/(d_hi + d_lo),
+    with t carried as two doubles (numerator and denominator formed exactly,
+    the quotient's remainder by Dekker's product), so the result is as
+    accurate as libm's ``atan2`` (about 0.5 ulp) at a third of its cost.
+    Scalar and batch results share it bit for bit.
+    """
+    n_lo = 0.0
+    d_lo = 0.0
+    if y < 0.4375 * x:
+        k = -1
+        n_hi = y
+        d_hi = x
+    elif y < 0.6875 * x:  # (t − 1/2)/(1 + t/2) = (2y − x)/(2x + y); 2y − x is exact
+        k = 0
+        n_hi = 2.0 * y - x
+        d_hi, d_lo = two_sum(2.0 * x, y)
+    elif y < 1.1875 * x:  # (t − 1)/(1 + t) = (y − x)/(y + x); y − x is exact
+        k = 1
+        n_hi = y - x
+        d_hi, d_lo = two_sum(y, x)
+    elif y < 2.4375 * x:  # (t − 3/2)/(1 + 3t/2) = (y − 3x/2)/(x + 3y/2)
+        k = 2
+        h, l = two_sum(x, 0.5 * x)  # 3x/2 exactly; y − h is exact
+        n_hi, n_lo = two_sum(y - h, -l)
+        h, l = two_sum(y, 0.5 * y)
+        d_hi, d_lo = two_sum(x, h)
+        d_lo += l
+    else:  # −1/t
+        k = 3
+        n_hi = -x
+        d_hi = y
+    t = n_hi / d_hi
+    t_lo = ((n_hi - t * d_hi - two_product_error(t, d_hi, t * d_hi)) + n_lo - t * d_lo) / d_hi
+    z = t * t
+    w = z * z
+    s1 = z * (ATAN_P[0] + w * (ATAN_P[2] + w * (ATAN_P[4] + w * (ATAN_P[6] + w * (ATAN_P[8] + w * ATAN_P[10])))))
+    s2 = w * (ATAN_P[1] + w * (ATAN_P[3] + w * (ATAN_P[5] + w * (ATAN_P[7] + w * ATAN_P[9]))))
+    small = t_lo - t * (s1 + s2)  # atan(t + t_lo) − t, to first order in t_lo
+    if k < 0:
+        return t + small
+    return ATAN_HI[k] + (t + (small + ATAN_LO[k]))
+
+
 @jit
 def finite(*values):
     for v in values:
@@ -301,156 +395,189 @@ def worst(a, b):
 
 
 @jit
-def reverse_in_place(cp):
-    """Reverse the order of the four control points ``cp``."""
-    for j in range(2):
-        a, b = cp[0, j], cp[1, j]
-        cp[0, j], cp[1, j] = cp[3, j], cp[2, j]
-        cp[3, j], cp[2, j] = a, b
+def to_world(x0, y0, x1, y1, x2, y2, x3, y3, ox, oy, scale, flip):
+    """Normalised points (x, flip·y) in world coordinates o + scale·(x, flip·y)."""
+    sy = scale * flip
+    return (ox + scale * x0, oy + sy * y0, ox + scale * x1, oy + sy * y1,
+            ox + scale * x2, oy + sy * y2, ox + scale * x3, oy + sy * y3)  # fmt: skip
+
+
+# Rows write their control points into ``out[i]`` of the (N, k, 4, 2) result
+# element by element: an array view per row would cost an atomic reference
+# count update that both threads contend for.
 
 
 @jit
-def place(out, ox, oy, scale, flip):
-    """Map normalised points (x, flip·y) back to world coordinates o + scale·(x, flip·y)."""
-    for i in range(out.shape[0]):
-        for k in range(4):
-            out[i, k, 0] = ox + scale * out[i, k, 0]
-            out[i, k, 1] = oy + scale * flip * out[i, k, 1]
+def store(out, i, k, x0, y0, x1, y1, x2, y2, x3, y3):
+    """Write four points into ``out[i, k]`` (4, 2)."""
+    out[i, k, 0, 0] = x0
+    out[i, k, 0, 1] = y0
+    out[i, k, 1, 0] = x1
+    out[i, k, 1, 1] = y1
+    out[i, k, 2, 0] = x2
+    out[i, k, 2, 1] = y2
+    out[i, k, 3, 0] = x3
+    out[i, k, 3, 1] = y3
 
 
 @jit
-def fill_nan(out):
-    for i in range(out.shape[0]):
-        for k in range(4):
-            out[i, k, 0] = NAN
-            out[i, k, 1] = NAN
+def fail(out, i, status, measure):
+    """A failed row: ``out[i]`` filled with NaN, θ NaN, the status and its measure."""
+    for k in range(out.shape[1]):
+        store(out, i, k, NAN, NAN, NAN, NAN, NAN, NAN, NAN, NAN)
+    return status, NAN, measure, NAN
 
 
 # ------------------------------------------- verification (world coordinates)
 # A contact or joint is measured like a chain's joint: gap / L, tangent angle
 # (radians) and curvature error × L, where L is the smaller of the spiral's
 # leg at that end and the radius there (so the curvature error is relative
-# to max(|κ|, 1/leg), as in the G2 checker); the residual is the largest. Differences of world
-# control points are multiplied by ``inv`` (a power of two, 1/scale of the
-# row) before they are squared, so nothing overflows or underflows; the
-# residuals are relative and do not depend on ``inv``.
+# to max(|κ|, 1/leg), as in the G2 checker); the residual is the largest.
+# Every check reads the world control points that are returned, as plain
+# numbers in registers (the points ``b0 … b3`` of a Bézier in the order it
+# is checked: a spiral read backwards is passed backwards). Differences of
+# world points are multiplied by ``inv`` (a power of two, 1/scale of the row)
+# before they are squared, so nothing overflows or underflows; the residuals
+# are relative and do not depend on ``inv``.
 
 
 @jit
-def _end_frame(cp, inv):
-    """At u = 1 of Bézier ``cp``: unit tangent, scaled signed curvature and the
-    scaled length of the last leg (NaN where the end is degenerate)."""
-    ax = (cp[2, 0] - cp[1, 0]) * inv
-    ay = (cp[2, 1] - cp[1, 1]) * inv
-    bx = (cp[3, 0] - cp[2, 0]) * inv
-    by = (cp[3, 1] - cp[2, 1]) * inv
+def end_leg(x1, y1, x2, y2, x3, y3, inv):
+    """At u = 1 of the Bézier ending b1, b2, b3: the last leg (bx, by) and its length,
+    scaled by ``inv``, and the scaled signed curvature (2/3)(a × b)/|b|³, a = b2 − b1."""
+    ax = (x2 - x1) * inv
+    ay = (y2 - y1) * inv
+    bx = (x3 - x2) * inv
+    by = (y3 - y2) * inv
     lb = norm(bx, by)
-    if not lb > 0.0:
-        return NAN, NAN, NAN, NAN
-    return bx / lb, by / lb, 2.0 / 3.0 * (ax * by - ay * bx) / (lb * lb * lb), lb
+    return bx, by, lb, 2.0 / 3.0 * (ax * by - ay * bx) / (lb * lb * lb)
 
 
 @jit
-def end_residual(cp, cx, cy, radius, inv):
-    """How far the end of Bézier ``cp`` is from joining circle (c, radius) G2.
+def end_residual(x1, y1, x2, y2, x3, y3, cx, cy, radius, inv):
+    """How far the end (b1, b2, b3) of a Bézier is from joining circle (c, radius) G2.
 
-    ``radius`` is signed by the travel sense of ``cp`` (positive:
+    ``radius`` is signed by the travel sense of the Bézier (positive:
     counterclockwise): the end must lie on the circle, run along it in that
     sense and have curvature 1/radius.
     """
-    tx, ty, kappa, leg = _end_frame(cp, inv)
-    ox = (cp[3, 0] - cx) * inv
-    oy = (cp[3, 1] - cy) * inv
-    scaled = radius * inv
-    # (dx, dy) is the radial direction times the travel sense, so the tangent
-    # must be rot90 of it in either sense.
-    dx = ox / scaled
-    dy = oy / scaled
+    bx, by, leg, kappa = end_leg(x1, y1, x2, y2, x3, y3, inv)
+    if not leg > 0.0:
+        return INF
+    curvature = 1.0 / (radius * inv)
+    # (dx, dy) = (b3 − c)/radius is the radial direction times the travel sense
+    # (divided before squaring: the radius may dwarf the legs), so the end
+    # leg b must be rot90 of it in either sense.
+    dx = (x3 - cx) * inv * curvature
+    dy = (y3 - cy) * inv * curvature
     distance = norm(dx, dy)
-    length = min(leg, abs(scaled))  # the smaller feature sets the scale
-    gap = abs(distance - 1.0) * abs(scaled) / length
-    angle = abs(tx * dx + ty * dy) / distance + (INF if dx * ty - dy * tx <= 0.0 else 0.0)
-    return worst(worst(gap, angle), abs(kappa - 1.0 / scaled) * length)
+    size = abs(radius * inv)
+    length = min(leg, size)  # the smaller feature sets the scale
+    gap = abs(distance - 1.0) * size / length
+    angle = abs(bx * dx + by * dy) / (leg * distance) + (INF if dx * by - dy * bx <= 0.0 else 0.0)
+    return worst(worst(gap, angle), abs(kappa - curvature) * length)
 
 
 @jit
-def line_residual(cp, px, py, tx, ty, inv):
-    """How far the start of spiral ``cp`` is from leaving the line through p along
-    unit t with zero curvature (gap, tangent angle, κ(0) × first leg)."""
-    ax = (cp[1, 0] - cp[0, 0]) * inv
-    ay = (cp[1, 1] - cp[0, 1]) * inv
-    bx = (cp[2, 0] - cp[1, 0]) * inv
-    by = (cp[2, 1] - cp[1, 1]) * inv
+def start_residual(x0, y0, x1, y1, x2, y2, tx, ty, inv):
+    """How far the start (b0, b1, b2) of a Bézier is from leaving along unit t with
+    zero curvature (tangent angle, κ(0) × first leg; b1 − b0 must point along t).
+    Also returns 1/|b1 − b0| (scaled)."""
+    ax = (x1 - x0) * inv
+    ay = (y1 - y0) * inv
+    bx = (x2 - x1) * inv
+    by = (y2 - y1) * inv
     la = norm(ax, ay)
     if not (la > 0.0 and tx * ax + ty * ay > 0.0):
-        return INF
-    distance = abs(tx * (cp[0, 1] - py) * inv - ty * (cp[0, 0] - px) * inv) / la
-    angle = abs(tx * ay - ty * ax) / la
-    kappa0 = abs(2.0 / 3.0 * (ax * by - ay * bx) / (la * la))  # κ(0) × first leg
-    return worst(worst(distance, angle), kappa0)
+        return INF, NAN
+    inv_la = 1.0 / la
+    angle = abs(tx * ay - ty * ax) * inv_la
+    kappa0 = abs(2.0 / 3.0 * (ax * by - ay * bx)) * (inv_la * inv_la)  # κ(0) × first leg
+    return worst(angle, kappa0), inv_la
 
 
 @jit
-def joint_residual(cp_a, cp_b, inv):
-    """How far two spirals that meet at their ends (u = 1 of both, travelled
-    towards each other) are from a G2 joint: gap, tangent angle, curvature jump × leg."""
-    tax, tay, ka, la = _end_frame(cp_a, inv)
-    tbx, tby, kb, lb = _end_frame(cp_b, inv)
+def line_residual(x0, y0, x1, y1, x2, y2, px, py, tx, ty, inv):
+    """How far the start (b0, b1, b2) of a spiral is from leaving the line through p
+    along unit t with zero curvature (gap / first leg, tangent angle, κ(0) × first leg)."""
+    res, inv_la = start_residual(x0, y0, x1, y1, x2, y2, tx, ty, inv)
+    distance = abs(tx * (y0 - py) * inv - ty * (x0 - px) * inv) * inv_la
+    return worst(distance, res)
+
+
+@jit
+def joint_residual(ax1, ay1, ax2, ay2, ax3, ay3, bx1, by1, bx2, by2, bx3, by3, inv):
+    """How far two spirals that meet at their ends (b3 of both, travelled towards
+    each other) are from a G2 joint: gap, tangent angle, curvature jump × leg.
+    Also returns the first spiral's scaled end curvature and end leg."""
+    ux, uy, la, ka = end_leg(ax1, ay1, ax2, ay2, ax3, ay3, inv)
+    vx, vy, lb, kb = end_leg(bx1, by1, bx2, by2, bx3, by3, inv)
     length = min(min(la, lb), 1.0 / abs(ka))
-    gap = norm((cp_a[3, 0] - cp_b[3, 0]) * inv, (cp_a[3, 1] - cp_b[3, 1]) * inv) / length
+    if not length > 0.0:
+        return INF, ka, la
+    gap = norm((ax3 - bx3) * inv, (ay3 - by3) * inv) / length
     # Travelling towards each other, the tangents are opposite and so are the signed curvatures.
-    angle = abs(tax * tby - tay * tbx) + (INF if tax * tbx + tay * tby >= 0.0 else 0.0)
-    return worst(worst(gap, angle), abs(ka + kb) * length)
+    angle = abs(ux * vy - uy * vx) / (la * lb) + (INF if ux * vx + uy * vy >= 0.0 else 0.0)
+    return worst(worst(gap, angle), abs(ka + kb) * length), ka, la
 
 
 # ---------------------------------------------------------- one spiral
 
 
 @jit
-def spiral_row(bx, by, dx, dy, theta, curvature, shape, out):
+def spiral_row(bx, by, dx, dy, theta, curvature, shape, out, i):
     """Theorem 3.1 (or the shape's own legs): the spiral from (bx, by) along d turning by θ to curvature c."""
     if not finite(bx, by, dx, dy, theta, curvature):
-        return NOT_FINITE, NAN, NAN, NAN
+        return fail(out, i, NOT_FINITE, NAN)
     tx, ty = unit(dx, dy)
     if tx == 0.0 and ty == 0.0:
-        return ZERO_DIRECTION, NAN, NAN, NAN
+        return fail(out, i, ZERO_DIRECTION, NAN)
     if not 0.0 < abs(theta) < math.pi / 2.0:
-        return BAD_ANGLE, NAN, NAN, NAN
+        return fail(out, i, BAD_ANGLE, NAN)
     if curvature == 0.0 or (curvature > 0.0) != (theta > 0.0):
-        return BAD_CURVATURE, NAN, NAN, NAN
+        return fail(out, i, BAD_CURVATURE, NAN)
     side = 1.0 if theta > 0.0 else -1.0
     sin_t = math.sin(abs(theta))
     cos_t = math.cos(theta)
     if not in_shape_domain(shape, cos_t):
-        return OUTSIDE_SHAPE, NAN, abs(theta), NAN
+        return fail(out, i, OUTSIDE_SHAPE, abs(theta))
     radius = 1.0 / abs(curvature)
+    alpha, beta, gamma = leg_factors(shape, cos_t)
     # The legs set the scale: the spiral's own size, not its end radius.
-    size = leg_factors(shape, cos_t)[1] * sin_t * radius
+    size = beta * sin_t * radius
     if not (size > 0.0 and size < INF):
-        return UNVERIFIED, NAN, INF, NAN
+        return fail(out, i, UNVERIFIED, INF)
     scale = frame_scale(size)
     inv = 1.0 / scale
     nx = -side * ty
     ny = side * tx
     local_radius = radius * inv
-    put_spiral(out[0], 0.0, 0.0, tx, ty, nx, ny, sin_t, cos_t, local_radius, shape)
-    place(out, bx, by, scale, 1.0)
+    x0, y0, x1, y1, x2, y2, x3, y3 = to_world(
+        *spiral_points(0.0, 0.0, tx, ty, nx, ny, sin_t, cos_t, local_radius, alpha, beta, gamma), bx, by, scale, 1.0
+    )
     # The end circle's centre B0 + r·(g2·T + g1·N).
-    g1 = shape_g1(shape, sin_t, cos_t) * local_radius
-    g2 = shape_g2(shape, sin_t, cos_t) * local_radius
+    g1, g2 = centre_offset(sin_t, *leg_offsets(alpha, beta, gamma, cos_t))
+    g1 *= local_radius
+    g2 *= local_radius
     cx = bx + scale * (g2 * tx + g1 * nx)
     cy = by + scale * (g2 * ty + g1 * ny)
-    res = worst(line_residual(out[0], bx, by, tx, ty, inv), end_residual(out[0], cx, cy, side * radius, inv))
+    res = worst(
+        line_residual(x0, y0, x1, y1, x2, y2, bx, by, tx, ty, inv),
+        end_residual(x1, y1, x2, y2, x3, y3, cx, cy, side * radius, inv),
+    )
     if not res <= VERIFY_TOL:
-        return UNVERIFIED, NAN, res, NAN
+        return fail(out, i, UNVERIFIED, res)
+    store(out, i, 0, x0, y0, x1, y1, x2, y2, x3, y3)
     return OK, theta, NAN, NAN
 
 
 @jit
 def unit_spirals_batch(sin_t, cos_t, shape, out):
     """Spirals of ``shape`` from the origin along +x, turning left by θ to end radius 1 (one per row)."""
+    rows = out.reshape((out.shape[0], 1, 4, 2))
     for i in range(sin_t.shape[0]):
-        put_spiral(out[i], 0.0, 0.0, 1.0, 0.0, 0.0, 1.0, sin_t[i], cos_t[i], 1.0, shape)
+        alpha, beta, gamma = leg_factors(shape, cos_t[i])
+        store(rows, i, 0, *spiral_points(0.0, 0.0, 1.0, 0.0, 0.0, 1.0, sin_t[i], cos_t[i], 1.0, alpha, beta, gamma))
 
 
 # ------------------------------------------------------------ 1-D roots
@@ -535,56 +662,66 @@ def _solve_offset(case, shape, target, a_hat):
 
 
 @jit
-def line_to_circle_row(px, py, dx, dy, cx, cy, r, shape, out):
-    """Theorem 4.1: spiral from the directed line (p, d) to circle (c, r > 0).
-
-    ``extra`` is the turn side: +1 left, −1 right.
-    """
-    if not finite(px, py, dx, dy, cx, cy, r):
-        return NOT_FINITE, NAN, NAN, NAN
-    tx, ty = unit(dx, dy)
-    if tx == 0.0 and ty == 0.0:
-        return ZERO_DIRECTION, NAN, NAN, NAN
-    if not r > 0.0:
-        return BAD_RADIUS, NAN, NAN, NAN
-    scale = frame_scale(r)
-    inv = 1.0 / scale
-    rs = r * inv
-    vx = (cx - px) * inv
-    vy = (cy - py) * inv
-    if not finite(vx, vy):
-        return UNVERIFIED, NAN, INF, NAN
-    d = tx * vy - ty * vx
-    side = 1.0 if d > 0.0 else -1.0
-    measure = abs(d) / rs
-    if not abs(d) > rs:
-        return CIRCLE_MEETS_LINE, NAN, measure, NAN
-    shift = (abs(d) - rs) / rs  # q = g1(θ) − 1
+def line_circle_angle(shape, shift, measure):
+    """(reached, sin θ, cos θ) of the spiral that shifts its circle by ``shift`` = g1(θ) − 1 > 0
+    (``measure`` = d/r = 1 + shift); ``reached`` is False beyond the shape's range."""
     if shape == WALTON_MEEK:
         # cos θ = 10 / (9ρ + √(81ρ² − 80)), with 1 − cos θ formed without cancellation.
         z = 81.0 * shift * (2.0 + shift)
         s = math.sqrt(1.0 + z)
         den = 9.0 * measure + s
         cos_t = 10.0 / den
-        sin_t = math.sqrt((9.0 * shift + z / (s + 1.0)) / den * (1.0 + cos_t))
-    elif shape == NEAR_LINEAR and shift < 1.0 / 27.0:
+        return True, math.sqrt((9.0 * shift + z / (s + 1.0)) / den * (1.0 + cos_t)), cos_t
+    if shape == NEAR_LINEAR and shift < 1.0 / 27.0:
         # Equal legs: 2cos²θ − 3cos θ + 1 + 3q = 0, so 1 − cos θ = 6q / (1 + √(1 − 24q)).
         versine = 6.0 * shift / (1.0 + math.sqrt(1.0 - 24.0 * shift))
-        cos_t = 1.0 - versine
-        sin_t = math.sqrt(versine * (2.0 - versine))
-    else:
-        w = _solve_offset(LINE_CASE, shape, shift, 0.0)
-        if not w > 0.0:
-            return OUTSIDE_SHAPE, NAN, measure, NAN
-        sin_t = math.sqrt(w)
-        cos_t = math.sqrt(1.0 - w)
-    a = vx * tx + vy * ty - rs * shape_g2(shape, sin_t, cos_t)
-    put_spiral(out[0], a * tx, a * ty, tx, ty, -side * ty, side * tx, sin_t, cos_t, rs, shape)
-    place(out, px, py, scale, 1.0)
-    res = worst(line_residual(out[0], px, py, tx, ty, inv), end_residual(out[0], cx, cy, side * r, inv))
+        return True, math.sqrt(versine * (2.0 - versine)), 1.0 - versine
+    w = _solve_offset(LINE_CASE, shape, shift, 0.0)
+    return w > 0.0, math.sqrt(w), math.sqrt(1.0 - w)
+
+
+@row_jit
+def line_to_circle_row(px, py, dx, dy, cx, cy, r, shape, out, i):
+    """Theorem 4.1: spiral from the directed line (p, d) to circle (c, r > 0).
+
+    ``extra`` is the turn side: +1 left, −1 right.
+    """
+    if not finite(px, py, dx, dy, cx, cy, r):
+        return fail(out, i, NOT_FINITE, NAN)
+    tx, ty = unit(dx, dy)
+    if tx == 0.0 and ty == 0.0:
+        return fail(out, i, ZERO_DIRECTION, NAN)
+    if not r > 0.0:
+        return fail(out, i, BAD_RADIUS, NAN)
+    scale = frame_scale(r)
+    inv = 1.0 / scale
+    rs = r * inv
+    vx = (cx - px) * inv
+    vy = (cy - py) * inv
+    if not finite(vx, vy):
+        return fail(out, i, UNVERIFIED, INF)
+    d = tx * vy - ty * vx
+    side = 1.0 if d > 0.0 else -1.0
+    measure = abs(d) / rs
+    if not abs(d) > rs:
+        return fail(out, i, CIRCLE_MEETS_LINE, measure)
+    reached, sin_t, cos_t = line_circle_angle(shape, (abs(d) - rs) / rs, measure)
+    if not reached:
+        return fail(out, i, OUTSIDE_SHAPE, measure)
+    alpha, beta, gamma = leg_factors(shape, cos_t)
+    g2 = centre_offset(sin_t, *leg_offsets(alpha, beta, gamma, cos_t))[1]
+    a = vx * tx + vy * ty - rs * g2  # B0 = p + a·T lies r·g2 before the centre's foot
+    x0, y0, x1, y1, x2, y2, x3, y3 = to_world(
+        *spiral_points(a * tx, a * ty, tx, ty, -side * ty, side * tx, sin_t, cos_t, rs, alpha, beta, gamma), px, py, scale, 1.0
+    )
+    res = worst(
+        line_residual(x0, y0, x1, y1, x2, y2, px, py, tx, ty, inv),
+        end_residual(x1, y1, x2, y2, x3, y3, cx, cy, side * r, inv),
+    )
     if not res <= VERIFY_TOL:
-        return UNVERIFIED, NAN, res, NAN
-    return OK, math.atan2(sin_t, cos_t), measure, side
+        return fail(out, i, UNVERIFIED, res)
+    store(out, i, 0, x0, y0, x1, y1, x2, y2, x3, y3)
+    return OK, angle(sin_t, cos_t), measure, side
 
 
 # ---------------------------------------------------- circle to circle
@@ -632,55 +769,15 @@ def _broken_back_w(a_hat, delta, one_minus_a):
 
 
 @jit
-def _two_spirals(out, ox, oy, tx, ty, r0, r1, sin_t, cos_t, s_shape, shape):
-    """Write Q0 (reversed) and Q1 leaving their common start of the C/S pair.
-
-    (ox, oy) is circle 1's centre relative to circle 0's; the common start is
-    B0 = C1 − r1·g2·T − r1·g1·N.  Q1 turns left towards N; Q0 leaves along −T
-    and turns towards +N (C) or −N (S).
-    """
-    nx = -ty
-    ny = tx
-    g1 = shape_g1(shape, sin_t, cos_t)
-    g2 = shape_g2(shape, sin_t, cos_t)
-    bx = ox - r1 * (g2 * tx + g1 * nx)
-    by = oy - r1 * (g2 * ty + g1 * ny)
-    side0 = -1.0 if s_shape else 1.0
-    put_spiral(out[1], bx, by, tx, ty, nx, ny, sin_t, cos_t, r1, shape)
-    put_spiral(out[0], bx, by, -tx, -ty, side0 * nx, side0 * ny, sin_t, cos_t, r0, shape)
-    reverse_in_place(out[0])
-
-
-@jit
-def circle_to_circle_row(c0x, c0y, r0, c1x, c1y, r1, shape, out):
-    """Theorems 4.2/4.3: from circle 0 to circle 1, radii signed by travel sense.
-
-    Same signs give a broken-back C, opposite signs an S.
-    """
-    if not finite(c0x, c0y, r0, c1x, c1y, r1):
-        return NOT_FINITE, NAN, NAN, NAN
-    if r0 == 0.0 or r1 == 0.0:
-        return BAD_RADIUS, NAN, NAN, NAN
-    if c0x == c1x and c0y == c1y:
-        return COINCIDENT, NAN, NAN, NAN
-    scale = frame_scale(max(abs(r0), abs(r1)))
-    inv = 1.0 / scale
-    dx = (c1x - c0x) * inv
-    dy = (c1y - c0y) * inv
-    a0 = abs(r0) * inv
-    a1 = abs(r1) * inv
-    dist = norm(dx, dy)
-    if not (dist < INF):
-        return UNVERIFIED, NAN, INF, NAN
-    s_shape = (r0 > 0.0) != (r1 > 0.0)
-    # Canonical frames: C with both counterclockwise, S with circle 1 counterclockwise.
-    flip = 1.0 if r1 > 0.0 else -1.0
-    dy = flip * dy
+def _pair_angle(s_shape, shape, dist, a0, a1):
+    """Theorems 4.2/4.3 in the normalised frame: (status, sin θ, cos θ, P, Q, measure)
+    for circles of radii a0, a1 > 0 whose centres lie ``dist`` apart. Circle 1's
+    centre lies at P·g2·T + Q·g1·rot90(T) from circle 0's (T the common start tangent)."""
     if s_shape:
         gap = a0 + a1
         measure = dist / gap
         if not dist > gap:
-            return CIRCLES_OVERLAP, NAN, measure, NAN
+            return CIRCLES_OVERLAP, NAN, NAN, NAN, NAN, measure
         eps = (dist - gap) / gap
         if shape == WALTON_MEEK:  # a quadratic in w = sin²θ
             gamma = -729.0 * eps * (2.0 + eps)
@@ -690,16 +787,14 @@ def circle_to_circle_row(c0x, c0y, r0, c1x, c1y, r1, shape, out):
         else:
             w = _solve_offset(S_CASE, shape, eps * (2.0 + eps), 0.0)
             if not w > 0.0:
-                return OUTSIDE_SHAPE, NAN, measure, NAN
-        sin_t = math.sqrt(w)
-        cos_t = math.sqrt(1.0 - w)
-        p = gap * shape_g2(shape, sin_t, cos_t)
-        q = gap * shape_g1(shape, sin_t, cos_t)
+                return OUTSIDE_SHAPE, NAN, NAN, NAN, NAN, measure
+        g_p = gap
+        g_q = gap
     else:
         gap = abs(a1 - a0)
         measure = dist / gap if gap > 0.0 else INF
         if not dist > gap:
-            return CIRCLES_ENCLOSED, NAN, measure, NAN
+            return CIRCLES_ENCLOSED, NAN, NAN, NAN, NAN, measure
         big = (a0 + a1) * (a0 + a1)
         delta = (dist - gap) * (dist + gap) / big
         if shape == WALTON_MEEK:  # a cubic in w = sin²θ
@@ -707,64 +802,101 @@ def circle_to_circle_row(c0x, c0y, r0, c1x, c1y, r1, shape, out):
         else:
             w = _solve_offset(C_CASE, shape, delta, gap * gap / big)
             if not w > 0.0:
-                return OUTSIDE_SHAPE, NAN, measure, NAN
-        sin_t = math.sqrt(w)
-        cos_t = math.sqrt(1.0 - w)
-        p = (a0 + a1) * shape_g2(shape, sin_t, cos_t)
-        q = (a1 - a0) * shape_g1(shape, sin_t, cos_t)
-    tx, ty = _frame_from_offset(dx, dy, p, q)
-    _two_spirals(out, dx, dy, tx, ty, a0, a1, sin_t, cos_t, s_shape, shape)
-    place(out, c0x, c0y, scale, flip)
-    # In world coordinates: Q0 leaves circle 0, Q1 reaches circle 1, and both
-    # leave their common start B0 along ∓T with zero curvature.
+                return OUTSIDE_SHAPE, NAN, NAN, NAN, NAN, measure
+        g_p = a0 + a1
+        g_q = a1 - a0
+    return OK, math.sqrt(w), math.sqrt(1.0 - w), g_p, g_q, measure
+
+
+@row_jit
+def circle_to_circle_row(c0x, c0y, r0, c1x, c1y, r1, shape, out, i):
+    """Theorems 4.2/4.3: from circle 0 to circle 1, radii signed by travel sense.
+
+    Same signs give a broken-back C, opposite signs an S. Q1 leaves the common
+    start B0 = C1 − r1·g2·T − r1·g1·N along T and turns left towards N; Q0
+    leaves it along −T, turning towards +N (C) or −N (S), and is returned
+    reversed (travel order: circle 0 → B0 → circle 1).
+    """
+    if not finite(c0x, c0y, r0, c1x, c1y, r1):
+        return fail(out, i, NOT_FINITE, NAN)
+    if r0 == 0.0 or r1 == 0.0:
+        return fail(out, i, BAD_RADIUS, NAN)
+    if c0x == c1x and c0y == c1y:
+        return fail(out, i, COINCIDENT, NAN)
+    scale = frame_scale(max(abs(r0), abs(r1)))
+    inv = 1.0 / scale
+    dx = (c1x - c0x) * inv
+    dy = (c1y - c0y) * inv
+    a0 = abs(r0) * inv
+    a1 = abs(r1) * inv
+    dist = norm(dx, dy)
+    if not (dist < INF):
+        return fail(out, i, UNVERIFIED, INF)
+    s_shape = (r0 > 0.0) != (r1 > 0.0)
+    # Canonical frames: C with both counterclockwise, S with circle 1 counterclockwise.
+    flip = 1.0 if r1 > 0.0 else -1.0
+    dy = flip * dy
+    status, sin_t, cos_t, big_p, big_q, measure = _pair_angle(s_shape, shape, dist, a0, a1)
+    if status != OK:
+        return fail(out, i, status, measure)
+    alpha, beta, gamma = leg_factors(shape, cos_t)
+    g1, g2 = centre_offset(sin_t, *leg_offsets(alpha, beta, gamma, cos_t))
+    tx, ty = _frame_from_offset(dx, dy, big_p * g2, big_q * g1)
+    nx = -ty
+    ny = tx
+    bx = dx - a1 * (g2 * tx + g1 * nx)
+    by = dy - a1 * (g2 * ty + g1 * ny)
+    side0 = -1.0 if s_shape else 1.0
+    # World points: Q1 = (s0, s1, s2, s3) and Q0 as built from B0 = s0, (s0, u1, u2, u3).
+    s0x, s0y, s1x, s1y, s2x, s2y, s3x, s3y = to_world(
+        *spiral_points(bx, by, tx, ty, nx, ny, sin_t, cos_t, a1, alpha, beta, gamma), c0x, c0y, scale, flip
+    )
+    _, _, u1x, u1y, u2x, u2y, u3x, u3y = to_world(
+        *spiral_points(bx, by, -tx, -ty, side0 * nx, side0 * ny, sin_t, cos_t, a0, alpha, beta, gamma), c0x, c0y, scale, flip
+    )
+    # Q0 leaves circle 0, Q1 reaches circle 1, and both leave B0 along ∓T with zero curvature.
     wtx = tx
     wty = flip * ty
-    res = worst(end_residual(out[0, ::-1], c0x, c0y, -r0, inv), end_residual(out[1], c1x, c1y, r1, inv))
-    res = worst(res, line_residual(out[1], out[1, 0, 0], out[1, 0, 1], wtx, wty, inv))
-    res = worst(res, line_residual(out[0, ::-1], out[1, 0, 0], out[1, 0, 1], -wtx, -wty, inv))
+    res = worst(
+        end_residual(u1x, u1y, u2x, u2y, u3x, u3y, c0x, c0y, -r0, inv),
+        end_residual(s1x, s1y, s2x, s2y, s3x, s3y, c1x, c1y, r1, inv),
+    )
+    res = worst(res, start_residual(s0x, s0y, s1x, s1y, s2x, s2y, wtx, wty, inv)[0])
+    res = worst(res, start_residual(s0x, s0y, u1x, u1y, u2x, u2y, -wtx, -wty, inv)[0])
     if not res <= VERIFY_TOL:
-        return UNVERIFIED, NAN, res, NAN
-    return OK, math.atan2(sin_t, cos_t), measure, NAN
+        return fail(out, i, UNVERIFIED, res)
+    store(out, i, 0, u3x, u3y, u2x, u2y, u1x, u1y, s0x, s0y)
+    store(out, i, 1, s0x, s0y, s1x, s1y, s2x, s2y, s3x, s3y)
+    return OK, angle(sin_t, cos_t), measure, NAN
 
 
 # -------------------------------------------------------- line to line
 
 
-@jit
-def corner_residual(out, px, py, t0x, t0y, t1x, t1y, joint_curvature, inv):
-    """Verification of a corner's spiral pair ``out`` (2, 4, 2) in travel order.
-
-    The first spiral must leave the line through corner p along t0, the second
-    (read backwards) the line through p along t1 (pointing at the corner);
-    they must share the osculating circle where they meet, with curvature
-    ``joint_curvature`` (magnitude, scaled by ``inv``).
-    """
-    second = out[1, ::-1]
-    res = worst(line_residual(out[0], px, py, t0x, t0y, inv), line_residual(second, px, py, t1x, t1y, inv))
-    res = worst(res, joint_residual(out[0], second, inv))
-    _, _, kappa, leg = _end_frame(out[0], inv)
-    return worst(res, abs(abs(kappa) - joint_curvature) * min(leg, 1.0 / joint_curvature))
-
-
-@jit
-def line_to_line_row(p0x, p0y, px, py, p1x, p1y, curvature, shape, out):
+@row_jit
+def line_to_line_row(p0x, p0y, px, py, p1x, p1y, curvature, shape, out, i):
     """Theorem 4.4: two spirals from line p0→p to line p→p1.
 
     ``curvature`` > 0 is the joint curvature magnitude; NaN applies Corollary
     4.5 (the larger spiral pair that fits the shorter leg).
+
+    Verification: the first spiral must leave the line through corner p along
+    t0, the second (read backwards) the line through p along t1 (pointing at
+    the corner); they must share the osculating circle where they meet, with
+    the joint curvature.
     """
     if not finite(p0x, p0y, px, py, p1x, p1y):
-        return NOT_FINITE, NAN, NAN, NAN
+        return fail(out, i, NOT_FINITE, NAN)
     if not (math.isnan(curvature) or (curvature > 0.0 and math.isfinite(curvature))):
-        return BAD_CURVATURE, NAN, NAN, NAN
+        return fail(out, i, BAD_CURVATURE, NAN)
     if (p0x == px and p0y == py) or (p1x == px and p1y == py):
-        return COINCIDENT, NAN, NAN, NAN
+        return fail(out, i, COINCIDENT, NAN)
     ux = px - p0x
     uy = py - p0y
     vx = px - p1x
     vy = py - p1y
     if not finite(ux, uy, vx, vy):
-        return UNVERIFIED, NAN, INF, NAN
+        return fail(out, i, UNVERIFIED, INF)
     scale = frame_scale(max(max(abs(ux), abs(uy)), max(abs(vx), abs(vy))))
     inv = 1.0 / scale
     ux *= inv
@@ -777,16 +909,16 @@ def line_to_line_row(p0x, p0y, px, py, p1x, p1y, curvature, shape, out):
     t1x, t1y = unit(vx, vy)
     bx, by = unit(t0x - t1x, t0y - t1y)
     if bx == 0.0 and by == 0.0:
-        return CORNER_REVERSAL, math.pi / 2.0, NAN, NAN
+        return fail(out, i, CORNER_REVERSAL, NAN)
     cross = t0x * by - t0y * bx
     sin_t = abs(cross)
     cos_t = t0x * bx + t0y * by
     if sin_t == 0.0:
-        return CORNER_STRAIGHT, 0.0, NAN, NAN
+        return fail(out, i, CORNER_STRAIGHT, NAN)
     if not cos_t > 0.0:
-        return CORNER_REVERSAL, math.pi / 2.0, NAN, NAN
+        return fail(out, i, CORNER_REVERSAL, NAN)
     if not in_shape_domain(shape, cos_t):
-        return OUTSIDE_SHAPE, math.atan2(sin_t, cos_t), math.atan2(sin_t, cos_t), NAN
+        return fail(out, i, OUTSIDE_SHAPE, angle(sin_t, cos_t))
     side = 1.0 if cross > 0.0 else -1.0
     shortest = min(l0, l1)
     if math.isnan(curvature):
@@ -795,17 +927,33 @@ def line_to_line_row(p0x, p0y, px, py, p1x, p1y, curvature, shape, out):
         a = corner_relation(shape, sin_t, cos_t, curvature * scale)
     measure = a / shortest
     if not measure <= 1.0 + 1e-12:
-        return LEGS_TOO_SHORT, math.atan2(sin_t, cos_t), measure, NAN
+        return fail(out, i, LEGS_TOO_SHORT, measure)
+    alpha, beta, gamma = leg_factors(shape, cos_t)
     joint = corner_relation(shape, sin_t, cos_t, a)
     radius = 1.0 / joint
-    put_spiral(out[0], -a * t0x, -a * t0y, t0x, t0y, -side * t0y, side * t0x, sin_t, cos_t, radius, shape)
-    put_spiral(out[1], -a * t1x, -a * t1y, t1x, t1y, side * t1y, -side * t1x, sin_t, cos_t, radius, shape)
-    reverse_in_place(out[1])
-    place(out, px, py, scale, 1.0)
-    res = corner_residual(out, px, py, t0x, t0y, t1x, t1y, joint, inv)
+    # Q0 from the first line, Q1 built from the second line (returned reversed).
+    q0 = to_world(
+        *spiral_points(-a * t0x, -a * t0y, t0x, t0y, -side * t0y, side * t0x, sin_t, cos_t, radius, alpha, beta, gamma),
+        px, py, scale, 1.0,
+    )  # fmt: skip
+    q1 = to_world(
+        *spiral_points(-a * t1x, -a * t1y, t1x, t1y, side * t1y, -side * t1x, sin_t, cos_t, radius, alpha, beta, gamma),
+        px, py, scale, 1.0,
+    )  # fmt: skip
+    x0, y0, x1, y1, x2, y2, x3, y3 = q0
+    v0x, v0y, v1x, v1y, v2x, v2y, v3x, v3y = q1
+    res = worst(
+        line_residual(x0, y0, x1, y1, x2, y2, px, py, t0x, t0y, inv),
+        line_residual(v0x, v0y, v1x, v1y, v2x, v2y, px, py, t1x, t1y, inv),
+    )
+    joint_res, kappa, leg = joint_residual(x1, y1, x2, y2, x3, y3, v1x, v1y, v2x, v2y, v3x, v3y, inv)
+    res = worst(res, joint_res)
+    res = worst(res, abs(abs(kappa) - joint) * min(leg, 1.0 / joint))
     if not res <= VERIFY_TOL:
-        return UNVERIFIED, NAN, res, NAN
-    return OK, math.atan2(sin_t, cos_t), measure, NAN
+        return fail(out, i, UNVERIFIED, res)
+    store(out, i, 0, x0, y0, x1, y1, x2, y2, x3, y3)
+    store(out, i, 1, v3x, v3y, v2x, v2y, v1x, v1y, v0x, v0y)
+    return OK, angle(sin_t, cos_t), measure, NAN
 
 
 # --------------------------------------------- circle inside circle
@@ -895,19 +1043,19 @@ def nested_center_offset(theta, r0, r1, shape):
 
 
 @jit
-def _nested_canonical(dx, dy, r0, r1, shape, out):
+def _nested_canonical(dx, dy, r0, r1, shape):
     """Fifth case, r0 > r1 > 0: the spiral piece [t, 1] from Ω0 to Ω1.
 
     Solves |C1 − C0|(θ) = D by Illinois regula falsi on θ between 0 and the
     family's largest angle, where the distance falls from r0 − r1 to the
-    band's lower end. Writes the piece relative to C0 and returns
-    (status, θ, D/(r0 − r1), t).
+    band's lower end. Returns (status, θ, D/(r0 − r1), t) and the piece's
+    control points relative to C0 (x0, y0, …, x3, y3).
     """
     dist = norm(dx, dy)
     ratio = dist / (r0 - r1)
     lower = nested_band_lower(r1 / r0, shape)
     if not (lower < ratio < 1.0):
-        return OUTSIDE_NESTED_BAND, NAN, ratio, NAN
+        return OUTSIDE_NESTED_BAND, NAN, ratio, NAN, NAN, NAN, NAN, NAN, NAN, NAN, NAN, NAN
     lo = 0.0
     hi = shape_max_theta(shape)
     f_lo = dist - (r0 - r1)  # dist − |C1 − C0|(θ), increasing in θ
@@ -923,41 +1071,32 @@ def _nested_canonical(dx, dy, r0, r1, shape, out):
         lo, f_lo, hi, f_hi, side = _illinois(lo, f_lo, hi, f_hi, side, theta, f)
     x, y, sigma, sin_t, cos_t, p0x, p0y, p1x, p1y, p2x, p2y = nested_center_offset(theta, r0, r1, shape)
     tx, ty = _frame_from_offset(dx, dy, x, y)
-    nx = -ty
-    ny = tx
-    out[0, 0] = p0x
-    out[0, 1] = p0y
-    out[1, 0] = p1x
-    out[1, 1] = p1y
-    out[2, 0] = p2x
-    out[2, 1] = p2y
-    out[3, 0] = 0.0
-    out[3, 1] = 0.0
     # Relative to C1 = B3 + r1·N1 with N1 = (−sin θ, cos θ), then to world axes relative to C0.
-    for k in range(4):
-        lx = out[k, 0] + r1 * sin_t
-        ly = out[k, 1] - r1 * cos_t
-        out[k, 0] = dx + lx * tx + ly * nx
-        out[k, 1] = dy + lx * ty + ly * ny
-    return OK, theta, ratio, 1.0 - sigma
+    sx = r1 * sin_t
+    sy = r1 * cos_t
+    return (OK, theta, ratio, 1.0 - sigma,
+            dx + (p0x + sx) * tx - (p0y - sy) * ty, dy + (p0x + sx) * ty + (p0y - sy) * tx,
+            dx + (p1x + sx) * tx - (p1y - sy) * ty, dy + (p1x + sx) * ty + (p1y - sy) * tx,
+            dx + (p2x + sx) * tx - (p2y - sy) * ty, dy + (p2x + sx) * ty + (p2y - sy) * tx,
+            dx + (0.0 + sx) * tx - (0.0 - sy) * ty, dy + (0.0 + sx) * ty + (0.0 - sy) * tx)  # fmt: skip
 
 
-@jit
-def circle_in_circle_row(c0x, c0y, r0, c1x, c1y, r1, shape, out):
+@row_jit
+def circle_in_circle_row(c0x, c0y, r0, c1x, c1y, r1, shape, out, i):
     """Fifth case: one spiral from circle 0 to the nested circle 1 (or out of it).
 
     Radii are signed by travel sense and must share the sign.
     """
     if not finite(c0x, c0y, r0, c1x, c1y, r1):
-        return NOT_FINITE, NAN, NAN, NAN
+        return fail(out, i, NOT_FINITE, NAN)
     if r0 == 0.0 or r1 == 0.0:
-        return BAD_RADIUS, NAN, NAN, NAN
+        return fail(out, i, BAD_RADIUS, NAN)
     if (r0 > 0.0) != (r1 > 0.0):
-        return SIGN_MISMATCH, NAN, NAN, NAN
+        return fail(out, i, SIGN_MISMATCH, NAN)
     if abs(r0) == abs(r1):
-        return EQUAL_RADII, NAN, NAN, NAN
+        return fail(out, i, EQUAL_RADII, NAN)
     if shape == G2CBS:
-        return OUTSIDE_SHAPE, NAN, NAN, NAN
+        return fail(out, i, OUTSIDE_SHAPE, NAN)
     inward = abs(r0) > abs(r1)
     # Outward travel is the reverse of inward travel with both senses flipped.
     big_r = r0 if inward else -r1
@@ -969,58 +1108,118 @@ def circle_in_circle_row(c0x, c0y, r0, c1x, c1y, r1, shape, out):
     dx = ((c1x - c0x) if inward else (c0x - c1x)) * inv
     dy = ((c1y - c0y) if inward else (c0y - c1y)) * inv
     if not finite(dx, dy):
-        return UNVERIFIED, NAN, INF, NAN
+        return fail(out, i, UNVERIFIED, INF)
     flip = 1.0 if big_r > 0.0 else -1.0
-    piece = out[0]
-    status, theta, ratio, t = _nested_canonical(dx, flip * dy, abs(big_r) * inv, abs(small_r) * inv, shape, piece)
+    status, theta, ratio, t, x0, y0, x1, y1, x2, y2, x3, y3 = _nested_canonical(
+        dx, flip * dy, abs(big_r) * inv, abs(small_r) * inv, shape
+    )
     if status != OK:
-        return status, NAN, ratio, NAN
+        return fail(out, i, status, ratio)
     if not inward:
-        reverse_in_place(piece)
-    place(out, ox, oy, scale, flip)
-    res = worst(end_residual(piece[::-1], c0x, c0y, -r0, inv), end_residual(piece, c1x, c1y, r1, inv))
+        x0, y0, x1, y1, x2, y2, x3, y3 = x3, y3, x2, y2, x1, y1, x0, y0
+    x0, y0, x1, y1, x2, y2, x3, y3 = to_world(x0, y0, x1, y1, x2, y2, x3, y3, ox, oy, scale, flip)
+    res = worst(
+        end_residual(x2, y2, x1, y1, x0, y0, c0x, c0y, -r0, inv),
+        end_residual(x1, y1, x2, y2, x3, y3, c1x, c1y, r1, inv),
+    )
     if not res <= VERIFY_TOL:
-        return UNVERIFIED, NAN, res, NAN
+        return fail(out, i, UNVERIFIED, res)
+    store(out, i, 0, x0, y0, x1, y1, x2, y2, x3, y3)
     return OK, theta, ratio, t
 
 
-# ------------------------------------------------------------ batches
+# ---------------------------------------------------- Bézier evaluation
+# One curve at many parameters (``spiral_cad.core.bezier``): numpy's
+# operations in numpy's order, so the values are those of the array formulas
+# bit for bit, but each in registers and written once. The loops vectorise;
+# a million parameters take about a millisecond, so they run in the calling
+# thread (starting threads would cost more than it saves).
 
 
 @jit
-def _record(i, result, out, status, theta, measure):
-    status[i] = result[0]
-    theta[i] = result[1]
-    measure[i] = result[2]
-    if result[0] != OK:
-        fill_nan(out[i])
-        theta[i] = NAN
-    return result[3]
+def polynomial_values(coefficients, u, out):
+    """``out[i, j]``: coordinate j of the polynomial at ``u[i]``, by Horner's rule.
+
+    ``coefficients`` (k, d), lowest first, with k ≤ 4 (a cubic Bézier and its
+    derivatives).
+    """
+    k = coefficients.shape[0]
+    for j in range(out.shape[1]):
+        c3 = coefficients[k - 1, j]
+        c2 = coefficients[k - 2, j] if k > 1 else 0.0
+        c1 = coefficients[k - 3, j] if k > 2 else 0.0
+        c0 = coefficients[k - 4, j] if k > 3 else 0.0
+        for i in range(u.shape[0]):
+            t = u[i]
+            acc = c3
+            if k > 1:
+                acc = acc * t + c2
+            if k > 2:
+                acc = acc * t + c1
+            if k > 3:
+                acc = acc * t + c0
+            out[i, j] = acc
 
 
-@_compile(parallel=True)
+@jit
+def plane_curvatures(first, second, scale, u, out):
+    """``out[i]``: signed curvature (Q' × Q'')/|Q'|³ at ``u[i]`` of a plane curve, from
+    the power coefficients of Q' (3, 2) and Q'' (2, 2) divided by ``scale``."""
+    for i in range(u.shape[0]):
+        t = u[i]
+        t2 = t * t
+        dx = first[2, 0] * t2 + first[1, 0] * t + first[0, 0]
+        dy = first[2, 1] * t2 + first[1, 1] * t + first[0, 1]
+        cross = dx * (second[1, 1] * t + second[0, 1]) - dy * (second[1, 0] * t + second[0, 0])
+        speed2 = dx * dx + dy * dy
+        out[i] = cross / (speed2 * math.sqrt(speed2) * scale)
+
+
+# ------------------------------------------------------------ batches
+# Each input has one row per problem or one row shared by all (``step`` 0):
+# shared rows are read in place, never copied. Every row writes its own slot
+# of ``out`` (control points, or NaN where it fails) and its status, θ and
+# measure, so a batch may be cut into ranges of rows run on several threads
+# (``spiral_cad.core.batch``; the kernels release the GIL).
+
+
+@jit
+def step(a):
+    """1 for an input with a row per problem, 0 for one row shared by all."""
+    return 1 if a.shape[0] > 1 else 0
+
+
+@jit
 def line_to_circle_batch(p, d, c, r, shape, out, status, theta, measure):
-    for i in prange(p.shape[0]):
-        row = line_to_circle_row(p[i, 0], p[i, 1], d[i, 0], d[i, 1], c[i, 0], c[i, 1], r[i], shape, out[i])
-        _record(i, row, out, status, theta, measure)
+    sp, sd, sc, sr = step(p), step(d), step(c), step(r)
+    for i in range(out.shape[0]):
+        ip, id_, ic, ir = i * sp, i * sd, i * sc, i * sr
+        row = line_to_circle_row(p[ip, 0], p[ip, 1], d[id_, 0], d[id_, 1], c[ic, 0], c[ic, 1], r[ir], shape, out, i)
+        status[i], theta[i], measure[i] = row[0], row[1], row[2]
 
 
-@_compile(parallel=True)
+@jit
 def circle_to_circle_batch(c0, r0, c1, r1, shape, out, status, theta, measure):
-    for i in prange(c0.shape[0]):
-        row = circle_to_circle_row(c0[i, 0], c0[i, 1], r0[i], c1[i, 0], c1[i, 1], r1[i], shape, out[i])
-        _record(i, row, out, status, theta, measure)
+    s0, sr0, s1, sr1 = step(c0), step(r0), step(c1), step(r1)
+    for i in range(out.shape[0]):
+        i0, j0, i1, j1 = i * s0, i * sr0, i * s1, i * sr1
+        row = circle_to_circle_row(c0[i0, 0], c0[i0, 1], r0[j0], c1[i1, 0], c1[i1, 1], r1[j1], shape, out, i)
+        status[i], theta[i], measure[i] = row[0], row[1], row[2]
 
 
-@_compile(parallel=True)
+@jit
 def line_to_line_batch(p0, p, p1, k, shape, out, status, theta, measure):
-    for i in prange(p0.shape[0]):
-        row = line_to_line_row(p0[i, 0], p0[i, 1], p[i, 0], p[i, 1], p1[i, 0], p1[i, 1], k[i], shape, out[i])
-        _record(i, row, out, status, theta, measure)
+    s0, sp, s1, sk = step(p0), step(p), step(p1), step(k)
+    for i in range(out.shape[0]):
+        i0, ip, i1, ik = i * s0, i * sp, i * s1, i * sk
+        row = line_to_line_row(p0[i0, 0], p0[i0, 1], p[ip, 0], p[ip, 1], p1[i1, 0], p1[i1, 1], k[ik], shape, out, i)
+        status[i], theta[i], measure[i] = row[0], row[1], row[2]
 
 
-@_compile(parallel=True)
+@jit
 def circle_in_circle_batch(c0, r0, c1, r1, shape, out, status, theta, measure, param):
-    for i in prange(c0.shape[0]):
-        row = circle_in_circle_row(c0[i, 0], c0[i, 1], r0[i], c1[i, 0], c1[i, 1], r1[i], shape, out[i])
-        param[i] = _record(i, row, out, status, theta, measure)
+    s0, sr0, s1, sr1 = step(c0), step(r0), step(c1), step(r1)
+    for i in range(out.shape[0]):
+        i0, j0, i1, j1 = i * s0, i * sr0, i * s1, i * sr1
+        row = circle_in_circle_row(c0[i0, 0], c0[i0, 1], r0[j0], c1[i1, 0], c1[i1, 1], r1[j1], shape, out, i)
+        status[i], theta[i], measure[i], param[i] = row

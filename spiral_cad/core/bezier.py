@@ -1,8 +1,10 @@
-"""Cubic Bézier evaluation over arrays of parameters (pure numpy functions).
+"""Cubic Bézier evaluation over arrays of parameters.
 
 Every function takes control points ``cp`` of shape (4, 2) and parameters
 ``u`` (a float or an array of any shape) and returns arrays whose leading
-shape is that of ``u``.
+shape is that of ``u``. One curve is evaluated by compiled loops
+(``spiral_cad.core._kernels``: each value in registers, written once), many
+curves by numpy broadcasting.
 """
 
 from __future__ import annotations
@@ -11,6 +13,8 @@ import math
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
+
+from . import _kernels as K
 
 #: Gauss–Legendre nodes used by :func:`arc_length` (per panel, 4 panels).
 _GL_NODES, _GL_WEIGHTS = np.polynomial.legendre.leggauss(16)
@@ -47,15 +51,11 @@ def _horner(coefficients: NDArray, u: ArrayLike) -> NDArray:
     against ``u`` of shape (N, m) or (m,) and give (N, m, 2).
     """
     u = np.asarray(u, dtype=float)
-    if coefficients.ndim == 2:  # one curve: each coordinate on its own contiguous array (the fast path)
-        out = np.empty(u.shape + (2,))
-        for j in range(2):
-            acc = np.full(u.shape, coefficients[-1, j])
-            for c in coefficients[-2::-1, j]:
-                acc *= u
-                acc += c
-            out[..., j] = acc
-        return out
+    if coefficients.ndim == 2:  # one curve: a compiled loop, each value in registers
+        flat = _parameters(u)
+        out = np.empty((flat.size, coefficients.shape[1]))
+        K.polynomial_values(np.ascontiguousarray(coefficients, dtype=float), flat, out)
+        return out.reshape(u.shape + coefficients.shape[1:])
     u = u[..., None]
     terms = coefficients[..., None, :, :]  # an axis for the samples
     acc = np.broadcast_to(terms[..., -1, :], np.broadcast_shapes(u.shape, terms[..., -1, :].shape)).copy()
@@ -63,6 +63,11 @@ def _horner(coefficients: NDArray, u: ArrayLike) -> NDArray:
         acc *= u
         acc += terms[..., j, :]
     return acc
+
+
+def _parameters(u: NDArray) -> NDArray:
+    """``u`` as a flat contiguous float64 array (the one type the kernels compile for)."""
+    return np.ascontiguousarray(u, dtype=float).reshape(-1)
 
 
 def point(cp: NDArray, u: ArrayLike) -> NDArray:
@@ -94,18 +99,10 @@ def curvature(cp: NDArray, u: ArrayLike) -> NDArray:
     u = np.asarray(u, dtype=float)
     first, second = _power_coefficients(cp, 1), _power_coefficients(cp, 2)
     scale = _scale(first)
-    (b0x, b0y), (b1x, b1y), (b2x, b2y) = (first / scale).tolist()
-    (c0x, c0y), (c1x, c1y) = (second / scale).tolist()
-    u2 = u * u
-    dx = b2x * u2 + b1x * u + b0x
-    dy = b2y * u2 + b1y * u + b0y
-    cross = dx * (c1y * u + c0y)
-    cross -= dy * (c1x * u + c0x)
-    dx *= dx
-    dy *= dy
-    dx += dy  # |Q'|²
-    cross /= dx * np.sqrt(dx) * scale
-    return cross
+    flat = _parameters(u)
+    out = np.empty(flat.size)
+    K.plane_curvatures(first / scale, second / scale, scale, flat, out)
+    return out.reshape(u.shape)
 
 
 def arc_length(cp: ArrayLike, u: ArrayLike = 1.0) -> NDArray | float:

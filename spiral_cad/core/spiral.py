@@ -50,12 +50,12 @@ class BezierSpiral(Segment):
         theta = as_float(theta, "theta")
         curvature = as_float(curvature, "curvature")
         code = shape_code(shape, TRANSITION_SHAPES)
-        out = np.empty((1, 4, 2))
-        status, _, measure, _ = spiral_row(bx, by, dx, dy, theta, curvature, code, out)
+        out = np.empty((1, 1, 4, 2))
+        status, _, measure, _ = spiral_row(bx, by, dx, dy, theta, curvature, code, out, 0)
         if status != Status.OK:
             inputs = dict(start=(bx, by), direction=(dx, dy), theta=theta, curvature=curvature, shape=shape)
             raise error_for("BezierSpiral", status, measure, inputs)
-        self._cp = out[0]
+        self._cp = out[0, 0]
         self._length = None
         self._shape = shape
         self._cp.flags.writeable = False

@@ -125,11 +125,11 @@ def _contact_piece(circle: Circle | None, line: Ray | None, point: NDArray, befo
 def _solve(case: str, row, count: int, args: tuple[float, ...], inputs: dict[str, Any], allowed=TRANSITION_SHAPES):
     shape = inputs["shape"]
     code = shape_code(shape, allowed)
-    out = np.empty((count, 4, 2))
-    status, theta, measure, extra = row(*args, code, out)
+    out = np.empty((1, count, 4, 2))
+    status, theta, measure, extra = row(*args, code, out, 0)
     if status != Status.OK:
         raise error_for(case, status, measure, inputs)
-    return [BezierSpiral._wrap(cp, shape) for cp in out], theta, extra
+    return [BezierSpiral._wrap(cp, shape) for cp in out[0]], theta, extra
 
 
 def line_to_circle(point: Any, direction: Any, center: Any, radius: float, shape: str = DEFAULT_SHAPE) -> Transition:
