@@ -35,6 +35,7 @@ from __future__ import annotations
 
 import math
 
+import numpy as np
 from numba import njit
 
 from .errors import Status
@@ -121,7 +122,7 @@ NEAR_LINEAR_MIN_COS = math.cos(NEAR_LINEAR_MAX_THETA)
 G2CBS_RATIO = 2.0 * (math.sqrt(6.0) - 1.0) / 5.0
 
 
-@jit
+@row_jit
 def boundary_ratio(shape, cos_t):
     """Leg ratio r = a/b of a member whose curvature peaks exactly at u = 1.
 
@@ -131,22 +132,17 @@ def boundary_ratio(shape, cos_t):
     (where it meets the equal-leg member) and follows the ratio that
     minimises the peak dκ/ds among these members (0.77 at 45°).
     """
-    if shape == WALTON_MEEK:
-        return 1.0
-    if shape == G2CBS:
-        return G2CBS_RATIO
-    return 1.8 * cos_t - 0.5
+    return 1.0 if shape == WALTON_MEEK else (G2CBS_RATIO if shape == G2CBS else 1.8 * cos_t - 0.5)
 
 
-@jit
+@row_jit
 def leg_factors(shape, cos_t):
     """(α, β, γ): the legs (a, b, c) of the spiral turning by θ onto radius R are R·sin θ·(α, β, γ)."""
-    if shape == NEAR_LINEAR and cos_t >= EQUAL_LEG_COS:
-        return 2.0 / 3.0, 2.0 / 3.0, 2.0 / 3.0
     r = boundary_ratio(shape, cos_t)
     k = r + 4.0
     beta = k * k / (54.0 * cos_t * cos_t)
-    return r * beta, beta, k / (9.0 * cos_t)
+    equal = shape == NEAR_LINEAR and cos_t >= EQUAL_LEG_COS  # selects, not branches: rows vectorise
+    return (2.0 / 3.0 if equal else r * beta), (2.0 / 3.0 if equal else beta), (2.0 / 3.0 if equal else k / (9.0 * cos_t))
 
 
 @jit
@@ -157,7 +153,7 @@ def in_shape_domain(shape, cos_t):
     return cos_t > 0.0
 
 
-@jit
+@row_jit
 def leg_offsets(alpha, beta, gamma, cos_t):
     """(e1, e2) of the spiral with leg factors (α, β, γ) at θ: g1(θ) = 1 + sin²θ·e1, g2(θ) = sin θ·e2.
 
@@ -175,7 +171,7 @@ def shape_offsets(shape, sin_t, cos_t):
     return leg_offsets(alpha, beta, gamma, cos_t)
 
 
-@jit
+@row_jit
 def centre_offset(sin_t, e1, e2):
     """(g1, g2): the end circle's centre lies R·g1 off the start line and R·g2 along it."""
     return 1.0 + sin_t * sin_t * e1, sin_t * e2
@@ -184,13 +180,15 @@ def centre_offset(sin_t, e1, e2):
 @jit
 def shape_g1(shape, sin_t, cos_t):
     """g1(θ): the end circle's centre lies R·g1 off the start line (1996 spiral: (5 + 4cos²θ)/(9 cos θ))."""
-    return centre_offset(sin_t, *shape_offsets(shape, sin_t, cos_t))[0]
+    e1, e2 = shape_offsets(shape, sin_t, cos_t)
+    return centre_offset(sin_t, e1, e2)[0]
 
 
 @jit
 def shape_g2(shape, sin_t, cos_t):
     """g2(θ): the end circle's centre lies R·g2 along the start line (1996 spiral: 25 tan θ/(27 cos θ) − (4/9) sin θ)."""
-    return centre_offset(sin_t, *shape_offsets(shape, sin_t, cos_t))[1]
+    e1, e2 = shape_offsets(shape, sin_t, cos_t)
+    return centre_offset(sin_t, e1, e2)[1]
 
 
 @jit
@@ -225,7 +223,7 @@ def corner_relation(shape, sin_t, cos_t, value):
     return corner_factor(shape, sin_t, cos_t) / value
 
 
-@jit
+@row_jit
 def spiral_points(bx, by, tx, ty, nx, ny, sin_t, cos_t, radius, alpha, beta, gamma):
     """The spiral's control points (x0, y0, …, x3, y3) from its legs.
 
@@ -240,6 +238,13 @@ def spiral_points(bx, by, tx, ty, nx, ny, sin_t, cos_t, radius, alpha, beta, gam
     x2 = bx + b * tx
     y2 = by + b * ty
     return bx, by, bx + a * tx, by + a * ty, x2, y2, x2 + c * (cos_t * tx + sin_t * nx), y2 + c * (cos_t * ty + sin_t * ny)
+
+
+@row_jit
+def spiral_in_world(bx, by, tx, ty, nx, ny, sin_t, cos_t, radius, alpha, beta, gamma, ox, oy, scale, flip):
+    """``spiral_points`` of a normalised frame in world coordinates (``to_world``)."""
+    x0, y0, x1, y1, x2, y2, x3, y3 = spiral_points(bx, by, tx, ty, nx, ny, sin_t, cos_t, radius, alpha, beta, gamma)
+    return to_world(x0, y0, x1, y1, x2, y2, x3, y3, ox, oy, scale, flip)
 
 
 @jit
@@ -260,7 +265,7 @@ def curvature_ratio(sigma, alpha, beta, gamma, sin_t, cos_t):
 # ------------------------------------------------- frames and numbers
 
 
-@jit
+@row_jit
 def norm(x, y):
     """√(x² + y²) for values of moderate size (normalised frames; ``math.hypot`` is slower)."""
     return math.sqrt(x * x + y * y)
@@ -272,6 +277,12 @@ def power_of_two_near(x):
     return math.ldexp(1.0, math.frexp(x)[1] - 1)
 
 
+@row_jit
+def ordinary(v):
+    """Whether a length lies where squares and cubes cannot overflow or underflow (1e-60 … 1e60)."""
+    return 1e-60 < v < 1e60
+
+
 @jit
 def frame_scale(length):
     """The normalising scale for a problem of natural size ``length`` > 0.
@@ -280,7 +291,7 @@ def frame_scale(length):
     lengths cannot overflow or underflow (1e-60 … 1e60), so ordinary inputs
     are solved without any rescaling at all.
     """
-    if 1e-60 < length < 1e60:
+    if ordinary(length):
         return 1.0
     return power_of_two_near(length)
 
@@ -291,10 +302,16 @@ def unit(x, y):
     big = max(abs(x), abs(y))
     if not (big > 0.0 and big < INF):
         return 0.0, 0.0
-    if not 1e-60 < big < 1e60:
+    if not ordinary(big):
         s = power_of_two_near(big)
         x /= s
         y /= s
+    return unit_ordinary(x, y)
+
+
+@row_jit
+def unit_ordinary(x, y):
+    """(x, y) / |(x, y)| for a vector of ordinary length (``unit`` rescales the others first)."""
     n = norm(x, y)
     return x / n, y / n
 
@@ -311,7 +328,7 @@ ATAN_P = (3.33333333333329318027e-01, -1.99999999998764832476e-01, 1.42857142725
 SPLIT = 134217729.0
 
 
-@jit
+@row_jit
 def two_sum(a, b):
     """a + b as s + e exactly (Knuth)."""
     s = a + b
@@ -319,7 +336,7 @@ def two_sum(a, b):
     return s, (a - (s - v)) + (b - v)
 
 
-@jit
+@row_jit
 def two_product_error(a, b, p):
     """a·b − p exactly for p = fl(a·b) (Dekker; |a|, |b| below 2^996)."""
     c = SPLIT * a
@@ -331,7 +348,7 @@ def two_product_error(a, b, p):
     return ((ah * bh - p) + ah * bl + al * bh) + al * bl
 
 
-@jit
+@row_jit
 def angle(y, x):
     """atan2(y, x) for 0 ≤ y ≤ 1 and 0 < x ≤ 1, the spiral angle θ from its sine and cosine.
 
@@ -341,31 +358,23 @@ def angle(y, x):
     accurate as libm's ``atan2`` (about 0.5 ulp) at a third of its cost.
     Scalar and batch results share it bit for bit.
     """
-    n_lo = 0.0
-    d_lo = 0.0
-    if y < 0.4375 * x:
-        k = -1
-        n_hi = y
-        d_hi = x
-    elif y < 0.6875 * x:  # (t − 1/2)/(1 + t/2) = (2y − x)/(2x + y); 2y − x is exact
-        k = 0
-        n_hi = 2.0 * y - x
-        d_hi, d_lo = two_sum(2.0 * x, y)
-    elif y < 1.1875 * x:  # (t − 1)/(1 + t) = (y − x)/(y + x); y − x is exact
-        k = 1
-        n_hi = y - x
-        d_hi, d_lo = two_sum(y, x)
-    elif y < 2.4375 * x:  # (t − 3/2)/(1 + 3t/2) = (y − 3x/2)/(x + 3y/2)
-        k = 2
-        h, l = two_sum(x, 0.5 * x)  # 3x/2 exactly; y − h is exact
-        n_hi, n_lo = two_sum(y - h, -l)
-        h, l = two_sum(y, 0.5 * y)
-        d_hi, d_lo = two_sum(x, h)
-        d_lo += l
-    else:  # −1/t
-        k = 3
-        n_hi = -x
-        d_hi = y
+    # Every reduction is formed and one selected (no branches: rows vectorise).
+    first = y < 0.4375 * x
+    k0 = y < 0.6875 * x  # (t − 1/2)/(1 + t/2) = (2y − x)/(2x + y); 2y − x is exact
+    k1 = y < 1.1875 * x  # (t − 1)/(1 + t) = (y − x)/(y + x); y − x is exact
+    k2 = y < 2.4375 * x  # (t − 3/2)/(1 + 3t/2) = (y − 3x/2)/(x + 3y/2); y − 3x/2 exact as y − h − l
+    d0, e0 = two_sum(2.0 * x, y)
+    d1, e1 = two_sum(y, x)
+    h, l = two_sum(x, 0.5 * x)
+    n2, f2 = two_sum(y - h, -l)
+    h, l = two_sum(y, 0.5 * y)
+    d2, e2 = two_sum(x, h)
+    n_hi = y if first else (2.0 * y - x if k0 else (y - x if k1 else (n2 if k2 else -x)))  # else −1/t
+    n_lo = f2 if (k2 and not k1) else 0.0
+    d_hi = x if first else (d0 if k0 else (d1 if k1 else (d2 if k2 else y)))
+    d_lo = 0.0 if first else (e0 if k0 else (e1 if k1 else (e2 + l if k2 else 0.0)))
+    hi = 0.0 if first else (ATAN_HI[0] if k0 else (ATAN_HI[1] if k1 else (ATAN_HI[2] if k2 else ATAN_HI[3])))
+    lo = 0.0 if first else (ATAN_LO[0] if k0 else (ATAN_LO[1] if k1 else (ATAN_LO[2] if k2 else ATAN_LO[3])))
     t = n_hi / d_hi
     t_lo = ((n_hi - t * d_hi - two_product_error(t, d_hi, t * d_hi)) + n_lo - t * d_lo) / d_hi
     z = t * t
@@ -373,9 +382,7 @@ def angle(y, x):
     s1 = z * (ATAN_P[0] + w * (ATAN_P[2] + w * (ATAN_P[4] + w * (ATAN_P[6] + w * (ATAN_P[8] + w * ATAN_P[10])))))
     s2 = w * (ATAN_P[1] + w * (ATAN_P[3] + w * (ATAN_P[5] + w * (ATAN_P[7] + w * ATAN_P[9]))))
     small = t_lo - t * (s1 + s2)  # atan(t + t_lo) − t, to first order in t_lo
-    if k < 0:
-        return t + small
-    return ATAN_HI[k] + (t + (small + ATAN_LO[k]))
+    return t + small if first else hi + (t + (small + lo))
 
 
 @jit
@@ -394,7 +401,7 @@ def worst(a, b):
     return a if a > b else b
 
 
-@jit
+@row_jit
 def to_world(x0, y0, x1, y1, x2, y2, x3, y3, ox, oy, scale, flip):
     """Normalised points (x, flip·y) in world coordinates o + scale·(x, flip·y)."""
     sy = scale * flip
@@ -521,6 +528,77 @@ def joint_residual(ax1, ay1, ax2, ay2, ax3, ay3, bx1, by1, bx2, by2, bx3, by3, i
     return worst(worst(gap, angle), abs(ka + kb) * length), ka, la
 
 
+# Most rows are far inside the tolerance, and for them a sufficient test
+# decides without square roots or divisions (the divider is what a row's
+# arithmetic waits for): each ratio residual ≤ tol is checked as
+# numerator ≤ tol × denominator, squared where the denominator is a length,
+# with a margin that covers the rounding of the exact residual. A row that
+# this test does not pass has its residuals computed exactly and is judged
+# on them, so no row is accepted that the residuals above would refuse.
+
+#: The tolerance of the sufficient tests (a 1e-12 relative margin below VERIFY_TOL).
+FIT = VERIFY_TOL * (1.0 - 1e-12)
+FIT2 = FIT * FIT
+
+
+@row_jit
+def moderate(v):
+    """Whether a squared length lies where the squared tests cannot overflow or underflow."""
+    return 1e-100 < v < 1e100
+
+
+@row_jit
+def start_fits(x0, y0, x1, y1, x2, y2, tx, ty, inv):
+    """Sufficient for ``start_residual`` ≤ VERIFY_TOL: |t × a| ≤ tol·|a| and
+    |(2/3) a × b| ≤ tol·|a|², a = b1 − b0 along t, b = b2 − b1."""
+    ax = (x1 - x0) * inv
+    ay = (y1 - y0) * inv
+    bx = (x2 - x1) * inv
+    by = (y2 - y1) * inv
+    aa = ax * ax + ay * ay
+    cross = tx * ay - ty * ax
+    curl = 2.0 / 3.0 * (ax * by - ay * bx)
+    return moderate(aa) & (tx * ax + ty * ay > 0.0) & (cross * cross <= FIT2 * aa) & (curl * curl <= FIT2 * (aa * aa))
+
+
+@row_jit
+def line_fits(x0, y0, x1, y1, x2, y2, px, py, tx, ty, inv):
+    """Sufficient for ``line_residual`` ≤ VERIFY_TOL: ``start_fits`` and |t × (b0 − p)| ≤ tol·|a|."""
+    ax = (x1 - x0) * inv
+    ay = (y1 - y0) * inv
+    gap = tx * (y0 - py) * inv - ty * (x0 - px) * inv
+    return start_fits(x0, y0, x1, y1, x2, y2, tx, ty, inv) & (gap * gap <= FIT2 * (ax * ax + ay * ay))
+
+
+@row_jit
+def end_fits(x1, y1, x2, y2, x3, y3, cx, cy, radius, inv):
+    """Sufficient for ``end_residual`` ≤ VERIFY_TOL, with o = b3 − c, b the end leg,
+    r = radius and L = min(|b|, |r|): |o·o − r²| ≤ tol·|r|·L (then ||o| − |r|| ≤ tol·L),
+    |b·o| ≤ tol·|b||o| with o × b of the sign of r, and |K·r − |b|³|·L ≤ tol·|b|³·|r|
+    for the end curvature κ = K/|b|³ (one square root, for |b|)."""
+    ax = (x2 - x1) * inv
+    ay = (y2 - y1) * inv
+    bx = (x3 - x2) * inv
+    by = (y3 - y2) * inv
+    ox = (x3 - cx) * inv
+    oy = (y3 - cy) * inv
+    rs = radius * inv
+    bb = bx * bx + by * by
+    oo = ox * ox + oy * oy
+    rr = rs * rs
+    leg = math.sqrt(bb)
+    length = min(leg, abs(rs))
+    off = oo - rr
+    dot = bx * ox + by * oy
+    cube = bb * leg
+    return (
+        moderate(bb) & moderate(oo) & moderate(rr) & ((ox * by - oy * bx) * rs > 0.0)
+        & (off * off <= FIT2 * rr * (length * length))
+        & (dot * dot <= FIT2 * (bb * oo))
+        & (abs(2.0 / 3.0 * (ax * by - ay * bx) * rs - cube) * length <= FIT * cube * abs(rs))
+    )
+
+
 # ---------------------------------------------------------- one spiral
 
 
@@ -552,21 +630,24 @@ def spiral_row(bx, by, dx, dy, theta, curvature, shape, out, i):
     nx = -side * ty
     ny = side * tx
     local_radius = radius * inv
-    x0, y0, x1, y1, x2, y2, x3, y3 = to_world(
-        *spiral_points(0.0, 0.0, tx, ty, nx, ny, sin_t, cos_t, local_radius, alpha, beta, gamma), bx, by, scale, 1.0
+    x0, y0, x1, y1, x2, y2, x3, y3 = spiral_in_world(
+        0.0, 0.0, tx, ty, nx, ny, sin_t, cos_t, local_radius, alpha, beta, gamma, bx, by, scale, 1.0
     )
     # The end circle's centre B0 + r·(g2·T + g1·N).
-    g1, g2 = centre_offset(sin_t, *leg_offsets(alpha, beta, gamma, cos_t))
+    e1, e2 = leg_offsets(alpha, beta, gamma, cos_t)
+    g1, g2 = centre_offset(sin_t, e1, e2)
     g1 *= local_radius
     g2 *= local_radius
     cx = bx + scale * (g2 * tx + g1 * nx)
     cy = by + scale * (g2 * ty + g1 * ny)
-    res = worst(
-        line_residual(x0, y0, x1, y1, x2, y2, bx, by, tx, ty, inv),
-        end_residual(x1, y1, x2, y2, x3, y3, cx, cy, side * radius, inv),
-    )
-    if not res <= VERIFY_TOL:
-        return fail(out, i, UNVERIFIED, res)
+    fits = line_fits(x0, y0, x1, y1, x2, y2, bx, by, tx, ty, inv)
+    if not (fits and end_fits(x1, y1, x2, y2, x3, y3, cx, cy, side * radius, inv)):
+        res = worst(
+            line_residual(x0, y0, x1, y1, x2, y2, bx, by, tx, ty, inv),
+            end_residual(x1, y1, x2, y2, x3, y3, cx, cy, side * radius, inv),
+        )
+        if not res <= VERIFY_TOL:
+            return fail(out, i, UNVERIFIED, res)
     store(out, i, 0, x0, y0, x1, y1, x2, y2, x3, y3)
     return OK, theta, NAN, NAN
 
@@ -577,7 +658,8 @@ def unit_spirals_batch(sin_t, cos_t, shape, out):
     rows = out.reshape((out.shape[0], 1, 4, 2))
     for i in range(sin_t.shape[0]):
         alpha, beta, gamma = leg_factors(shape, cos_t[i])
-        store(rows, i, 0, *spiral_points(0.0, 0.0, 1.0, 0.0, 0.0, 1.0, sin_t[i], cos_t[i], 1.0, alpha, beta, gamma))
+        x0, y0, x1, y1, x2, y2, x3, y3 = spiral_points(0.0, 0.0, 1.0, 0.0, 0.0, 1.0, sin_t[i], cos_t[i], 1.0, alpha, beta, gamma)
+        store(rows, i, 0, x0, y0, x1, y1, x2, y2, x3, y3)
 
 
 # ------------------------------------------------------------ 1-D roots
@@ -661,10 +743,11 @@ def _solve_offset(case, shape, target, a_hat):
 # ------------------------------------------------------ line to circle
 
 
-@jit
-def line_circle_angle(shape, shift, measure):
-    """(reached, sin θ, cos θ) of the spiral that shifts its circle by ``shift`` = g1(θ) − 1 > 0
-    (``measure`` = d/r = 1 + shift); ``reached`` is False beyond the shape's range."""
+@row_jit
+def line_circle_closed_form(shape, shift, measure):
+    """(found, sin θ, cos θ) of the spiral that shifts its circle by ``shift`` = g1(θ) − 1 > 0
+    (``measure`` = d/r = 1 + shift) where a closed form exists: the 1996 spiral,
+    and the near-linear equal-leg member (shift < 1/27)."""
     if shape == WALTON_MEEK:
         # cos θ = 10 / (9ρ + √(81ρ² − 80)), with 1 − cos θ formed without cancellation.
         z = 81.0 * shift * (2.0 + shift)
@@ -672,20 +755,55 @@ def line_circle_angle(shape, shift, measure):
         den = 9.0 * measure + s
         cos_t = 10.0 / den
         return True, math.sqrt((9.0 * shift + z / (s + 1.0)) / den * (1.0 + cos_t)), cos_t
-    if shape == NEAR_LINEAR and shift < 1.0 / 27.0:
-        # Equal legs: 2cos²θ − 3cos θ + 1 + 3q = 0, so 1 − cos θ = 6q / (1 + √(1 − 24q)).
-        versine = 6.0 * shift / (1.0 + math.sqrt(1.0 - 24.0 * shift))
-        return True, math.sqrt(versine * (2.0 - versine)), 1.0 - versine
-    w = _solve_offset(LINE_CASE, shape, shift, 0.0)
-    return w > 0.0, math.sqrt(w), math.sqrt(1.0 - w)
+    # Equal legs: 2cos²θ − 3cos θ + 1 + 3q = 0, so 1 − cos θ = 6q / (1 + √(1 − 24q)).
+    versine = 6.0 * shift / (1.0 + math.sqrt(1.0 - 24.0 * shift))
+    return shape == NEAR_LINEAR and shift < 1.0 / 27.0, math.sqrt(versine * (2.0 - versine)), 1.0 - versine
 
 
 @row_jit
-def line_to_circle_row(px, py, dx, dy, cx, cy, r, shape, out, i):
-    """Theorem 4.1: spiral from the directed line (p, d) to circle (c, r > 0).
+def line_circle_spiral(px, py, tx, ty, vx, vy, rs, sin_t, cos_t, side, shape, scale):
+    """Theorem 4.1's spiral in world coordinates: it leaves the line through p along
+    t and reaches radius ``rs`` (normalised) on the side ``side`` of the line, the
+    circle's centre at v from p (normalised)."""
+    alpha, beta, gamma = leg_factors(shape, cos_t)
+    e1, e2 = leg_offsets(alpha, beta, gamma, cos_t)
+    g2 = centre_offset(sin_t, e1, e2)[1]
+    a = vx * tx + vy * ty - rs * g2  # B0 = p + a·T lies r·g2 before the centre's foot
+    return spiral_in_world(
+        a * tx, a * ty, tx, ty, -side * ty, side * tx, sin_t, cos_t, rs, alpha, beta, gamma, px, py, scale, 1.0
+    )
 
-    ``extra`` is the turn side: +1 left, −1 right.
+
+@row_jit
+def line_to_circle_fast(px, py, dx, dy, cx, cy, r, shape):
+    """``line_to_circle_row`` in straight-line code for the ordinary row: every number
+    finite, the direction's and the radius's size within 1e-60 … 1e60 (a frame of
+    scale 1), the circle clear of the line, a closed-form angle and a verification
+    that the sufficient tests pass. Returns (ok, θ, measure, side, x0, y0, …, x3, y3);
+    where ``ok`` is False the row is left to ``line_to_circle_general``. The same
+    arithmetic as that path, so the two agree bit for bit; no branches, so the
+    batch runs it on vectors of rows.
     """
+    tx, ty = unit_ordinary(dx, dy)
+    vx = cx - px
+    vy = cy - py
+    d = tx * vy - ty * vx
+    side = 1.0 if d > 0.0 else -1.0
+    measure = abs(d) / r
+    found, sin_t, cos_t = line_circle_closed_form(shape, (abs(d) - r) / r, measure)
+    x0, y0, x1, y1, x2, y2, x3, y3 = line_circle_spiral(px, py, tx, ty, vx, vy, r, sin_t, cos_t, side, shape, 1.0)
+    ok = (
+        math.isfinite(px) & math.isfinite(py) & math.isfinite(cx) & math.isfinite(cy) & math.isfinite(vx) & math.isfinite(vy)
+        & ordinary(max(abs(dx), abs(dy))) & ordinary(r) & (abs(d) > r) & found
+        & line_fits(x0, y0, x1, y1, x2, y2, px, py, tx, ty, 1.0)
+        & end_fits(x1, y1, x2, y2, x3, y3, cx, cy, side * r, 1.0)
+    )  # fmt: skip
+    return ok, angle(sin_t, cos_t), measure, side, x0, y0, x1, y1, x2, y2, x3, y3
+
+
+@jit
+def line_to_circle_general(px, py, dx, dy, cx, cy, r, shape, out, i):
+    """``line_to_circle_row`` for any row: checks, scaled frames, every shape."""
     if not finite(px, py, dx, dy, cx, cy, r):
         return fail(out, i, NOT_FINITE, NAN)
     tx, ty = unit(dx, dy)
@@ -705,23 +823,38 @@ def line_to_circle_row(px, py, dx, dy, cx, cy, r, shape, out, i):
     measure = abs(d) / rs
     if not abs(d) > rs:
         return fail(out, i, CIRCLE_MEETS_LINE, measure)
-    reached, sin_t, cos_t = line_circle_angle(shape, (abs(d) - rs) / rs, measure)
-    if not reached:
-        return fail(out, i, OUTSIDE_SHAPE, measure)
-    alpha, beta, gamma = leg_factors(shape, cos_t)
-    g2 = centre_offset(sin_t, *leg_offsets(alpha, beta, gamma, cos_t))[1]
-    a = vx * tx + vy * ty - rs * g2  # B0 = p + a·T lies r·g2 before the centre's foot
-    x0, y0, x1, y1, x2, y2, x3, y3 = to_world(
-        *spiral_points(a * tx, a * ty, tx, ty, -side * ty, side * tx, sin_t, cos_t, rs, alpha, beta, gamma), px, py, scale, 1.0
-    )
-    res = worst(
-        line_residual(x0, y0, x1, y1, x2, y2, px, py, tx, ty, inv),
-        end_residual(x1, y1, x2, y2, x3, y3, cx, cy, side * r, inv),
-    )
-    if not res <= VERIFY_TOL:
-        return fail(out, i, UNVERIFIED, res)
+    shift = (abs(d) - rs) / rs
+    found, sin_t, cos_t = line_circle_closed_form(shape, shift, measure)
+    if not found:
+        w = _solve_offset(LINE_CASE, shape, shift, 0.0)
+        if not w > 0.0:
+            return fail(out, i, OUTSIDE_SHAPE, measure)
+        sin_t = math.sqrt(w)
+        cos_t = math.sqrt(1.0 - w)
+    x0, y0, x1, y1, x2, y2, x3, y3 = line_circle_spiral(px, py, tx, ty, vx, vy, rs, sin_t, cos_t, side, shape, scale)
+    fits = line_fits(x0, y0, x1, y1, x2, y2, px, py, tx, ty, inv)
+    if not (fits and end_fits(x1, y1, x2, y2, x3, y3, cx, cy, side * r, inv)):
+        res = worst(
+            line_residual(x0, y0, x1, y1, x2, y2, px, py, tx, ty, inv),
+            end_residual(x1, y1, x2, y2, x3, y3, cx, cy, side * r, inv),
+        )
+        if not res <= VERIFY_TOL:
+            return fail(out, i, UNVERIFIED, res)
     store(out, i, 0, x0, y0, x1, y1, x2, y2, x3, y3)
     return OK, angle(sin_t, cos_t), measure, side
+
+
+@jit
+def line_to_circle_row(px, py, dx, dy, cx, cy, r, shape, out, i):
+    """Theorem 4.1: spiral from the directed line (p, d) to circle (c, r > 0).
+
+    ``extra`` is the turn side: +1 left, −1 right.
+    """
+    ok, theta, measure, side, x0, y0, x1, y1, x2, y2, x3, y3 = line_to_circle_fast(px, py, dx, dy, cx, cy, r, shape)
+    if ok:
+        store(out, i, 0, x0, y0, x1, y1, x2, y2, x3, y3)
+        return OK, theta, measure, side
+    return line_to_circle_general(px, py, dx, dy, cx, cy, r, shape, out, i)
 
 
 # ---------------------------------------------------- circle to circle
@@ -840,7 +973,8 @@ def circle_to_circle_row(c0x, c0y, r0, c1x, c1y, r1, shape, out, i):
     if status != OK:
         return fail(out, i, status, measure)
     alpha, beta, gamma = leg_factors(shape, cos_t)
-    g1, g2 = centre_offset(sin_t, *leg_offsets(alpha, beta, gamma, cos_t))
+    e1, e2 = leg_offsets(alpha, beta, gamma, cos_t)
+    g1, g2 = centre_offset(sin_t, e1, e2)
     tx, ty = _frame_from_offset(dx, dy, big_p * g2, big_q * g1)
     nx = -ty
     ny = tx
@@ -848,23 +982,27 @@ def circle_to_circle_row(c0x, c0y, r0, c1x, c1y, r1, shape, out, i):
     by = dy - a1 * (g2 * ty + g1 * ny)
     side0 = -1.0 if s_shape else 1.0
     # World points: Q1 = (s0, s1, s2, s3) and Q0 as built from B0 = s0, (s0, u1, u2, u3).
-    s0x, s0y, s1x, s1y, s2x, s2y, s3x, s3y = to_world(
-        *spiral_points(bx, by, tx, ty, nx, ny, sin_t, cos_t, a1, alpha, beta, gamma), c0x, c0y, scale, flip
+    s0x, s0y, s1x, s1y, s2x, s2y, s3x, s3y = spiral_in_world(
+        bx, by, tx, ty, nx, ny, sin_t, cos_t, a1, alpha, beta, gamma, c0x, c0y, scale, flip
     )
-    _, _, u1x, u1y, u2x, u2y, u3x, u3y = to_world(
-        *spiral_points(bx, by, -tx, -ty, side0 * nx, side0 * ny, sin_t, cos_t, a0, alpha, beta, gamma), c0x, c0y, scale, flip
+    _, _, u1x, u1y, u2x, u2y, u3x, u3y = spiral_in_world(
+        bx, by, -tx, -ty, side0 * nx, side0 * ny, sin_t, cos_t, a0, alpha, beta, gamma, c0x, c0y, scale, flip
     )
     # Q0 leaves circle 0, Q1 reaches circle 1, and both leave B0 along ∓T with zero curvature.
     wtx = tx
     wty = flip * ty
-    res = worst(
-        end_residual(u1x, u1y, u2x, u2y, u3x, u3y, c0x, c0y, -r0, inv),
-        end_residual(s1x, s1y, s2x, s2y, s3x, s3y, c1x, c1y, r1, inv),
-    )
-    res = worst(res, start_residual(s0x, s0y, s1x, s1y, s2x, s2y, wtx, wty, inv)[0])
-    res = worst(res, start_residual(s0x, s0y, u1x, u1y, u2x, u2y, -wtx, -wty, inv)[0])
-    if not res <= VERIFY_TOL:
-        return fail(out, i, UNVERIFIED, res)
+    fits = end_fits(u1x, u1y, u2x, u2y, u3x, u3y, c0x, c0y, -r0, inv)
+    fits = fits and end_fits(s1x, s1y, s2x, s2y, s3x, s3y, c1x, c1y, r1, inv)
+    fits = fits and start_fits(s0x, s0y, s1x, s1y, s2x, s2y, wtx, wty, inv)
+    if not (fits and start_fits(s0x, s0y, u1x, u1y, u2x, u2y, -wtx, -wty, inv)):
+        res = worst(
+            end_residual(u1x, u1y, u2x, u2y, u3x, u3y, c0x, c0y, -r0, inv),
+            end_residual(s1x, s1y, s2x, s2y, s3x, s3y, c1x, c1y, r1, inv),
+        )
+        res = worst(res, start_residual(s0x, s0y, s1x, s1y, s2x, s2y, wtx, wty, inv)[0])
+        res = worst(res, start_residual(s0x, s0y, u1x, u1y, u2x, u2y, -wtx, -wty, inv)[0])
+        if not res <= VERIFY_TOL:
+            return fail(out, i, UNVERIFIED, res)
     store(out, i, 0, u3x, u3y, u2x, u2y, u1x, u1y, s0x, s0y)
     store(out, i, 1, s0x, s0y, s1x, s1y, s2x, s2y, s3x, s3y)
     return OK, angle(sin_t, cos_t), measure, NAN
@@ -932,12 +1070,12 @@ def line_to_line_row(p0x, p0y, px, py, p1x, p1y, curvature, shape, out, i):
     joint = corner_relation(shape, sin_t, cos_t, a)
     radius = 1.0 / joint
     # Q0 from the first line, Q1 built from the second line (returned reversed).
-    q0 = to_world(
-        *spiral_points(-a * t0x, -a * t0y, t0x, t0y, -side * t0y, side * t0x, sin_t, cos_t, radius, alpha, beta, gamma),
+    q0 = spiral_in_world(
+        -a * t0x, -a * t0y, t0x, t0y, -side * t0y, side * t0x, sin_t, cos_t, radius, alpha, beta, gamma,
         px, py, scale, 1.0,
     )  # fmt: skip
-    q1 = to_world(
-        *spiral_points(-a * t1x, -a * t1y, t1x, t1y, side * t1y, -side * t1x, sin_t, cos_t, radius, alpha, beta, gamma),
+    q1 = spiral_in_world(
+        -a * t1x, -a * t1y, t1x, t1y, side * t1y, -side * t1x, sin_t, cos_t, radius, alpha, beta, gamma,
         px, py, scale, 1.0,
     )  # fmt: skip
     x0, y0, x1, y1, x2, y2, x3, y3 = q0
@@ -1118,12 +1256,14 @@ def circle_in_circle_row(c0x, c0y, r0, c1x, c1y, r1, shape, out, i):
     if not inward:
         x0, y0, x1, y1, x2, y2, x3, y3 = x3, y3, x2, y2, x1, y1, x0, y0
     x0, y0, x1, y1, x2, y2, x3, y3 = to_world(x0, y0, x1, y1, x2, y2, x3, y3, ox, oy, scale, flip)
-    res = worst(
-        end_residual(x2, y2, x1, y1, x0, y0, c0x, c0y, -r0, inv),
-        end_residual(x1, y1, x2, y2, x3, y3, c1x, c1y, r1, inv),
-    )
-    if not res <= VERIFY_TOL:
-        return fail(out, i, UNVERIFIED, res)
+    fits = end_fits(x2, y2, x1, y1, x0, y0, c0x, c0y, -r0, inv)
+    if not (fits and end_fits(x1, y1, x2, y2, x3, y3, c1x, c1y, r1, inv)):
+        res = worst(
+            end_residual(x2, y2, x1, y1, x0, y0, c0x, c0y, -r0, inv),
+            end_residual(x1, y1, x2, y2, x3, y3, c1x, c1y, r1, inv),
+        )
+        if not res <= VERIFY_TOL:
+            return fail(out, i, UNVERIFIED, res)
     store(out, i, 0, x0, y0, x1, y1, x2, y2, x3, y3)
     return OK, theta, ratio, t
 
@@ -1189,13 +1329,45 @@ def step(a):
     return 1 if a.shape[0] > 1 else 0
 
 
+#: Rows per block of a batch: each block's inputs are gathered into columns,
+#: the ordinary rows solved on vectors of rows (``*_fast``), the others by the
+#: general row functions.
+BLOCK = 256
+
+
 @jit
 def line_to_circle_batch(p, d, c, r, shape, out, status, theta, measure):
     sp, sd, sc, sr = step(p), step(d), step(c), step(r)
-    for i in range(out.shape[0]):
-        ip, id_, ic, ir = i * sp, i * sd, i * sc, i * sr
-        row = line_to_circle_row(p[ip, 0], p[ip, 1], d[id_, 0], d[id_, 1], c[ic, 0], c[ic, 1], r[ir], shape, out, i)
-        status[i], theta[i], measure[i] = row[0], row[1], row[2]
+    cols = np.empty(7 * BLOCK)  # px, py, dx, dy, cx, cy, r of the block's rows
+    res = np.empty(12 * BLOCK)  # ok, θ, measure, x0 … y3
+    for start in range(0, out.shape[0], BLOCK):
+        m = min(BLOCK, out.shape[0] - start)
+        for k in range(m):
+            i = start + k
+            ip, id_, ic, ir = i * sp, i * sd, i * sc, i * sr
+            cols[k], cols[BLOCK + k], cols[2 * BLOCK + k], cols[3 * BLOCK + k] = p[ip, 0], p[ip, 1], d[id_, 0], d[id_, 1]
+            cols[4 * BLOCK + k], cols[5 * BLOCK + k], cols[6 * BLOCK + k] = c[ic, 0], c[ic, 1], r[ir]
+        for k in range(m):
+            row = line_to_circle_fast(
+                cols[k], cols[BLOCK + k], cols[2 * BLOCK + k], cols[3 * BLOCK + k],
+                cols[4 * BLOCK + k], cols[5 * BLOCK + k], cols[6 * BLOCK + k], shape,
+            )  # fmt: skip
+            ok, res[BLOCK + k], res[2 * BLOCK + k], _, x0, y0, x1, y1, x2, y2, x3, y3 = row
+            res[k] = 1.0 if ok else 0.0
+            res[4 * BLOCK + k], res[5 * BLOCK + k], res[6 * BLOCK + k], res[7 * BLOCK + k] = x0, y0, x1, y1
+            res[8 * BLOCK + k], res[9 * BLOCK + k], res[10 * BLOCK + k], res[11 * BLOCK + k] = x2, y2, x3, y3
+        for k in range(m):
+            i = start + k
+            if res[k] == 1.0:
+                store(out, i, 0, res[4 * BLOCK + k], res[5 * BLOCK + k], res[6 * BLOCK + k], res[7 * BLOCK + k],
+                      res[8 * BLOCK + k], res[9 * BLOCK + k], res[10 * BLOCK + k], res[11 * BLOCK + k])  # fmt: skip
+                status[i], theta[i], measure[i] = OK, res[BLOCK + k], res[2 * BLOCK + k]
+            else:
+                row = line_to_circle_general(
+                    cols[k], cols[BLOCK + k], cols[2 * BLOCK + k], cols[3 * BLOCK + k],
+                    cols[4 * BLOCK + k], cols[5 * BLOCK + k], cols[6 * BLOCK + k], shape, out, i,
+                )  # fmt: skip
+                status[i], theta[i], measure[i] = row[0], row[1], row[2]
 
 
 @jit
