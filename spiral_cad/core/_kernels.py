@@ -198,7 +198,7 @@ def shape_offsets_batch(shape, sin_t, cos_t, e1, e2):
         e1[i], e2[i] = shape_offsets(shape, sin_t[i], cos_t[i])
 
 
-@jit
+@row_jit
 def corner_factor(shape, sin_t, cos_t):
     """K(θ): a symmetric spiral pair at a corner of deflection 2θ starts K/κ from the
     corner, κ its joint curvature (1996 spiral: (40/27)·sin θ/cos²θ, Theorem 4.4).
@@ -216,7 +216,7 @@ def corner_factor_batch(shape, sin_t, cos_t, out):
         out[i] = corner_factor(shape, sin_t[i], cos_t[i])
 
 
-@jit
+@row_jit
 def corner_relation(shape, sin_t, cos_t, value):
     """K(θ)/value: a spiral pair's corner distance from its joint curvature, or the
     curvature from the distance (the relation is symmetric)."""
@@ -860,96 +860,166 @@ def line_to_circle_row(px, py, dx, dy, cx, cy, r, shape, out, i):
 # ---------------------------------------------------- circle to circle
 
 
+@row_jit
+def _frame_vector(dx, dy, p, q):
+    """A vector along T where (dx, dy) = p·T + q·rot90(T), up to scale."""
+    return p * dx + q * dy, p * dy - q * dx
+
+
 @jit
 def _frame_from_offset(dx, dy, p, q):
     """Unit T with (dx, dy) = p·T + q·rot90(T) (up to scale)."""
-    return unit(p * dx + q * dy, p * dy - q * dx)
+    fx, fy = _frame_vector(dx, dy, p, q)
+    return unit(fx, fy)
+
+
+@row_jit
+def _s_pair_w(eps, measure):
+    """w = sin²θ of the 1996 S pair, a quadratic in w; eps = D/(r0 + r1) − 1 = measure − 1."""
+    gamma = -729.0 * eps * (2.0 + eps)
+    beta = 1458.0 * measure * measure - 1208.0
+    alpha = 1104.0 - 729.0 * measure * measure
+    return -2.0 * gamma / (beta + math.sqrt(beta * beta - 4.0 * alpha * gamma))
+
+
+@row_jit
+def _broken_back_cubic(a_hat, delta, one_minus_a):
+    """Coefficients (c0 … c3) of the broken-back C equation in w = sin²θ, scaled by B:
+
+    f(w) = 9Â(1−w)(9−4w)² + w(13+12w)² − 729 D̂²(1−w)², with δ = D̂² − Â > 0,
+    so f(0) = −729δ < 0 < f(1) = 625.
+    """
+    d2 = delta + a_hat
+    return -729.0 * delta, 169.0 - 1377.0 * a_hat + 1458.0 * d2, 312.0 + 792.0 * a_hat - 729.0 * d2, 144.0 * one_minus_a
+
+
+@row_jit
+def _broken_back_step(c0, c1, c2, c3, w, lo, hi, done):
+    """One safeguarded Halley step for the root of the C cubic in the bracket [lo, hi]:
+    (w, lo, hi, done), left as it is once ``done`` (w the root found)."""
+    f = ((c3 * w + c2) * w + c1) * w + c0
+    below = f < 0.0
+    lo_new = w if below else lo
+    hi_new = hi if below else w
+    df = (3.0 * c3 * w + 2.0 * c2) * w + c1
+    ddf = 6.0 * c3 * w + 2.0 * c2
+    den = 2.0 * df * df - f * ddf
+    new = w - 2.0 * f * df / den if den != 0.0 else 0.5 * (lo_new + hi_new)  # Halley
+    new = new if lo_new < new < hi_new else 0.5 * (lo_new + hi_new)
+    root = f == 0.0  # w itself
+    converged = abs(new - w) <= 1e-15 * new or new == w
+    return (w if done or root else new), (lo if done else lo_new), (hi if done else hi_new), done or root or converged
+
+
+#: Halley steps the vectorised C rows take; a row that needs more is solved by the general row.
+FAST_HALLEY_STEPS = 6
 
 
 @jit
 def _broken_back_w(a_hat, delta, one_minus_a):
-    """Root w = sin²θ in (0, 1) of the broken-back C equation, scaled by B.
-
-    f(w) = 9Â(1−w)(9−4w)² + w(13+12w)² − 729 D̂²(1−w)², with δ = D̂² − Â > 0.
-    Safeguarded Halley iteration (~3 steps) on the bracket f(0) = −729δ < 0 < f(1) = 625.
-    """
-    d2 = delta + a_hat
-    c0 = -729.0 * delta
-    c1 = 169.0 - 1377.0 * a_hat + 1458.0 * d2
-    c2 = 312.0 + 792.0 * a_hat - 729.0 * d2
-    c3 = 144.0 * one_minus_a
-    lo = 0.0
-    hi = 1.0
-    w = -c0 / (625.0 - c0)
+    """Root w = sin²θ in (0, 1) of the broken-back C cubic (~3 Halley steps from the secant guess)."""
+    c0, c1, c2, c3 = _broken_back_cubic(a_hat, delta, one_minus_a)
+    w, lo, hi, done = -c0 / (625.0 - c0), 0.0, 1.0, False
     for _ in range(100):
-        f = ((c3 * w + c2) * w + c1) * w + c0
-        if f == 0.0:
-            return w
-        if f < 0.0:
-            lo = w
-        else:
-            hi = w
-        df = (3.0 * c3 * w + 2.0 * c2) * w + c1
-        ddf = 6.0 * c3 * w + 2.0 * c2
-        den = 2.0 * df * df - f * ddf
-        new = w - 2.0 * f * df / den if den != 0.0 else 0.5 * (lo + hi)  # Halley
-        if not (lo < new < hi):
-            new = 0.5 * (lo + hi)
-        if abs(new - w) <= 1e-15 * new or new == w:
-            return new
-        w = new
+        w, lo, hi, done = _broken_back_step(c0, c1, c2, c3, w, lo, hi, done)
+        if done:
+            break
     return w
 
 
-@jit
-def _pair_angle(s_shape, shape, dist, a0, a1):
-    """Theorems 4.2/4.3 in the normalised frame: (status, sin θ, cos θ, P, Q, measure)
-    for circles of radii a0, a1 > 0 whose centres lie ``dist`` apart. Circle 1's
-    centre lies at P·g2·T + Q·g1·rot90(T) from circle 0's (T the common start tangent)."""
-    if s_shape:
-        gap = a0 + a1
-        measure = dist / gap
-        if not dist > gap:
-            return CIRCLES_OVERLAP, NAN, NAN, NAN, NAN, measure
-        eps = (dist - gap) / gap
-        if shape == WALTON_MEEK:  # a quadratic in w = sin²θ
-            gamma = -729.0 * eps * (2.0 + eps)
-            beta = 1458.0 * measure * measure - 1208.0
-            alpha = 1104.0 - 729.0 * measure * measure
-            w = -2.0 * gamma / (beta + math.sqrt(beta * beta - 4.0 * alpha * gamma))
-        else:
-            w = _solve_offset(S_CASE, shape, eps * (2.0 + eps), 0.0)
-            if not w > 0.0:
-                return OUTSIDE_SHAPE, NAN, NAN, NAN, NAN, measure
-        g_p = gap
-        g_q = gap
-    else:
-        gap = abs(a1 - a0)
-        measure = dist / gap if gap > 0.0 else INF
-        if not dist > gap:
-            return CIRCLES_ENCLOSED, NAN, NAN, NAN, NAN, measure
-        big = (a0 + a1) * (a0 + a1)
-        delta = (dist - gap) * (dist + gap) / big
-        if shape == WALTON_MEEK:  # a cubic in w = sin²θ
-            w = _broken_back_w(gap * gap / big, delta, 4.0 * a0 * a1 / big)
-        else:
-            w = _solve_offset(C_CASE, shape, delta, gap * gap / big)
-            if not w > 0.0:
-                return OUTSIDE_SHAPE, NAN, NAN, NAN, NAN, measure
-        g_p = a0 + a1
-        g_q = a1 - a0
-    return OK, math.sqrt(w), math.sqrt(1.0 - w), g_p, g_q, measure
+@row_jit
+def _pair_gap(s_shape, dist, a0, a1):
+    """(gap, D/gap): the centres must lie more than ``gap`` apart (r0 + r1 for an S,
+    |r1 − r0| for a C)."""
+    gap = a0 + a1 if s_shape else abs(a1 - a0)
+    return gap, (dist / gap if gap > 0.0 else INF)
 
 
 @row_jit
-def circle_to_circle_row(c0x, c0y, r0, c1x, c1y, r1, shape, out, i):
-    """Theorems 4.2/4.3: from circle 0 to circle 1, radii signed by travel sense.
+def _pair_spirals(dx, dy, tx, ty, a0, a1, sin_t, cos_t, shape, s_shape, ox, oy, scale, flip):
+    """The C/S pair in world coordinates: Q1 = (s0, s1, s2, s3) and Q0 as built from
+    their common start B0 = s0 = C1 − r1·g2·T − r1·g1·N, (s0, u1, u2, u3): Q1 turns
+    left towards N, Q0 leaves along −T towards +N (C) or −N (S). Returns s0 … s3, u1 … u3."""
+    alpha, beta, gamma = leg_factors(shape, cos_t)
+    e1, e2 = leg_offsets(alpha, beta, gamma, cos_t)
+    g1, g2 = centre_offset(sin_t, e1, e2)
+    nx = -ty
+    ny = tx
+    bx = dx - a1 * (g2 * tx + g1 * nx)
+    by = dy - a1 * (g2 * ty + g1 * ny)
+    side0 = -1.0 if s_shape else 1.0
+    s0x, s0y, s1x, s1y, s2x, s2y, s3x, s3y = spiral_in_world(
+        bx, by, tx, ty, nx, ny, sin_t, cos_t, a1, alpha, beta, gamma, ox, oy, scale, flip
+    )
+    _, _, u1x, u1y, u2x, u2y, u3x, u3y = spiral_in_world(
+        bx, by, -tx, -ty, side0 * nx, side0 * ny, sin_t, cos_t, a0, alpha, beta, gamma, ox, oy, scale, flip
+    )
+    return s0x, s0y, s1x, s1y, s2x, s2y, s3x, s3y, u1x, u1y, u2x, u2y, u3x, u3y
 
-    Same signs give a broken-back C, opposite signs an S. Q1 leaves the common
-    start B0 = C1 − r1·g2·T − r1·g1·N along T and turns left towards N; Q0
-    leaves it along −T, turning towards +N (C) or −N (S), and is returned
-    reversed (travel order: circle 0 → B0 → circle 1).
-    """
+
+@row_jit
+def _pair_frame(dx, dy, a0, a1, sin_t, cos_t, gap_p, gap_q, shape):
+    """The vector along the common start tangent T: circle 1's centre lies at
+    P·g2·T + Q·g1·rot90(T) from circle 0's (P, Q = ``gap_p``, ``gap_q``)."""
+    alpha, beta, gamma = leg_factors(shape, cos_t)
+    e1, e2 = leg_offsets(alpha, beta, gamma, cos_t)
+    g1, g2 = centre_offset(sin_t, e1, e2)
+    return _frame_vector(dx, dy, gap_p * g2, gap_q * g1)
+
+
+@row_jit
+def _pair_fits(s0x, s0y, s1x, s1y, s2x, s2y, s3x, s3y, u1x, u1y, u2x, u2y, u3x, u3y, wtx, wty, c0x, c0y, r0, c1x, c1y, r1, inv):
+    """Sufficient tests (``*_fits``) of the pair: Q0 leaves circle 0, Q1 reaches circle 1,
+    and both leave B0 = s0 along ∓T (world T = (wtx, wty)) with zero curvature."""
+    return (
+        end_fits(u1x, u1y, u2x, u2y, u3x, u3y, c0x, c0y, -r0, inv) & end_fits(s1x, s1y, s2x, s2y, s3x, s3y, c1x, c1y, r1, inv)
+        & start_fits(s0x, s0y, s1x, s1y, s2x, s2y, wtx, wty, inv) & start_fits(s0x, s0y, u1x, u1y, u2x, u2y, -wtx, -wty, inv)
+    )  # fmt: skip
+
+
+@row_jit
+def circle_to_circle_fast(c0x, c0y, r0, c1x, c1y, r1, shape):
+    """``circle_to_circle_row`` in straight-line code for the ordinary row (see
+    ``line_to_circle_fast``): finite input, radii within 1e-60 … 1e60, the 1996
+    spiral, a C solved within ``FAST_HALLEY_STEPS``. Returns (ok, θ, measure,
+    s0 … s3, u1 … u3)."""
+    dx = c1x - c0x
+    dy = c1y - c0y
+    a0 = abs(r0)
+    a1 = abs(r1)
+    dist = norm(dx, dy)
+    s_shape = (r0 > 0.0) != (r1 > 0.0)
+    flip = 1.0 if r1 > 0.0 else -1.0
+    dy = flip * dy
+    gap, measure = _pair_gap(s_shape, dist, a0, a1)
+    # Both cases are solved and one is taken (no branches: rows vectorise).
+    w_s = _s_pair_w((dist - gap) / gap, measure)
+    big = (a0 + a1) * (a0 + a1)
+    c0, c1, c2, c3 = _broken_back_cubic(gap * gap / big, (dist - gap) * (dist + gap) / big, 4.0 * a0 * a1 / big)
+    w, lo, hi, done = -c0 / (625.0 - c0), 0.0, 1.0, False
+    for _ in range(FAST_HALLEY_STEPS):
+        w, lo, hi, done = _broken_back_step(c0, c1, c2, c3, w, lo, hi, done)
+    w = w_s if s_shape else w
+    sin_t = math.sqrt(w)
+    cos_t = math.sqrt(1.0 - w)
+    fx, fy = _pair_frame(dx, dy, a0, a1, sin_t, cos_t, gap if s_shape else a0 + a1, gap if s_shape else a1 - a0, shape)
+    tx, ty = unit_ordinary(fx, fy)
+    s0x, s0y, s1x, s1y, s2x, s2y, s3x, s3y, u1x, u1y, u2x, u2y, u3x, u3y = _pair_spirals(
+        dx, dy, tx, ty, a0, a1, sin_t, cos_t, shape, s_shape, c0x, c0y, 1.0, flip
+    )
+    ok = (
+        math.isfinite(c0x) & math.isfinite(c0y) & math.isfinite(c1x) & math.isfinite(c1y) & math.isfinite(dist)
+        & (r0 != 0.0) & (r1 != 0.0) & ordinary(max(a0, a1)) & (dist > gap) & (shape == WALTON_MEEK) & (s_shape or done)
+        & ordinary(max(abs(fx), abs(fy)))
+        & _pair_fits(s0x, s0y, s1x, s1y, s2x, s2y, s3x, s3y, u1x, u1y, u2x, u2y, u3x, u3y, tx, flip * ty,
+                     c0x, c0y, r0, c1x, c1y, r1, 1.0)
+    )  # fmt: skip
+    return ok, angle(sin_t, cos_t), measure, s0x, s0y, s1x, s1y, s2x, s2y, s3x, s3y, u1x, u1y, u2x, u2y, u3x, u3y
+
+
+@jit
+def circle_to_circle_general(c0x, c0y, r0, c1x, c1y, r1, shape, out, i):
+    """``circle_to_circle_row`` for any row: checks, scaled frames, every shape."""
     if not finite(c0x, c0y, r0, c1x, c1y, r1):
         return fail(out, i, NOT_FINITE, NAN)
     if r0 == 0.0 or r1 == 0.0:
@@ -969,32 +1039,31 @@ def circle_to_circle_row(c0x, c0y, r0, c1x, c1y, r1, shape, out, i):
     # Canonical frames: C with both counterclockwise, S with circle 1 counterclockwise.
     flip = 1.0 if r1 > 0.0 else -1.0
     dy = flip * dy
-    status, sin_t, cos_t, big_p, big_q, measure = _pair_angle(s_shape, shape, dist, a0, a1)
-    if status != OK:
-        return fail(out, i, status, measure)
-    alpha, beta, gamma = leg_factors(shape, cos_t)
-    e1, e2 = leg_offsets(alpha, beta, gamma, cos_t)
-    g1, g2 = centre_offset(sin_t, e1, e2)
-    tx, ty = _frame_from_offset(dx, dy, big_p * g2, big_q * g1)
-    nx = -ty
-    ny = tx
-    bx = dx - a1 * (g2 * tx + g1 * nx)
-    by = dy - a1 * (g2 * ty + g1 * ny)
-    side0 = -1.0 if s_shape else 1.0
-    # World points: Q1 = (s0, s1, s2, s3) and Q0 as built from B0 = s0, (s0, u1, u2, u3).
-    s0x, s0y, s1x, s1y, s2x, s2y, s3x, s3y = spiral_in_world(
-        bx, by, tx, ty, nx, ny, sin_t, cos_t, a1, alpha, beta, gamma, c0x, c0y, scale, flip
+    gap, measure = _pair_gap(s_shape, dist, a0, a1)
+    if not dist > gap:
+        return fail(out, i, CIRCLES_OVERLAP if s_shape else CIRCLES_ENCLOSED, measure)
+    if s_shape:
+        eps = (dist - gap) / gap
+        w = _s_pair_w(eps, measure) if shape == WALTON_MEEK else _solve_offset(S_CASE, shape, eps * (2.0 + eps), 0.0)
+    else:
+        big = (a0 + a1) * (a0 + a1)
+        delta = (dist - gap) * (dist + gap) / big
+        if shape == WALTON_MEEK:  # a cubic in w = sin²θ
+            w = _broken_back_w(gap * gap / big, delta, 4.0 * a0 * a1 / big)
+        else:
+            w = _solve_offset(C_CASE, shape, delta, gap * gap / big)
+    if shape != WALTON_MEEK and not w > 0.0:
+        return fail(out, i, OUTSIDE_SHAPE, measure)
+    sin_t = math.sqrt(w)
+    cos_t = math.sqrt(1.0 - w)
+    fx, fy = _pair_frame(dx, dy, a0, a1, sin_t, cos_t, gap if s_shape else a0 + a1, gap if s_shape else a1 - a0, shape)
+    tx, ty = unit(fx, fy)
+    s0x, s0y, s1x, s1y, s2x, s2y, s3x, s3y, u1x, u1y, u2x, u2y, u3x, u3y = _pair_spirals(
+        dx, dy, tx, ty, a0, a1, sin_t, cos_t, shape, s_shape, c0x, c0y, scale, flip
     )
-    _, _, u1x, u1y, u2x, u2y, u3x, u3y = spiral_in_world(
-        bx, by, -tx, -ty, side0 * nx, side0 * ny, sin_t, cos_t, a0, alpha, beta, gamma, c0x, c0y, scale, flip
-    )
-    # Q0 leaves circle 0, Q1 reaches circle 1, and both leave B0 along ∓T with zero curvature.
     wtx = tx
     wty = flip * ty
-    fits = end_fits(u1x, u1y, u2x, u2y, u3x, u3y, c0x, c0y, -r0, inv)
-    fits = fits and end_fits(s1x, s1y, s2x, s2y, s3x, s3y, c1x, c1y, r1, inv)
-    fits = fits and start_fits(s0x, s0y, s1x, s1y, s2x, s2y, wtx, wty, inv)
-    if not (fits and start_fits(s0x, s0y, u1x, u1y, u2x, u2y, -wtx, -wty, inv)):
+    if not _pair_fits(s0x, s0y, s1x, s1y, s2x, s2y, s3x, s3y, u1x, u1y, u2x, u2y, u3x, u3y, wtx, wty, c0x, c0y, r0, c1x, c1y, r1, inv):
         res = worst(
             end_residual(u1x, u1y, u2x, u2y, u3x, u3y, c0x, c0y, -r0, inv),
             end_residual(s1x, s1y, s2x, s2y, s3x, s3y, c1x, c1y, r1, inv),
@@ -1008,21 +1077,127 @@ def circle_to_circle_row(c0x, c0y, r0, c1x, c1y, r1, shape, out, i):
     return OK, angle(sin_t, cos_t), measure, NAN
 
 
+@jit
+def circle_to_circle_row(c0x, c0y, r0, c1x, c1y, r1, shape, out, i):
+    """Theorems 4.2/4.3: from circle 0 to circle 1, radii signed by travel sense.
+
+    Same signs give a broken-back C, opposite signs an S; the pair is
+    returned in travel order (circle 0 → B0 → circle 1).
+    """
+    row = circle_to_circle_fast(c0x, c0y, r0, c1x, c1y, r1, shape)
+    if row[0]:
+        _, theta, measure, s0x, s0y, s1x, s1y, s2x, s2y, s3x, s3y, u1x, u1y, u2x, u2y, u3x, u3y = row
+        store(out, i, 0, u3x, u3y, u2x, u2y, u1x, u1y, s0x, s0y)
+        store(out, i, 1, s0x, s0y, s1x, s1y, s2x, s2y, s3x, s3y)
+        return OK, theta, measure, NAN
+    return circle_to_circle_general(c0x, c0y, r0, c1x, c1y, r1, shape, out, i)
+
+
 # -------------------------------------------------------- line to line
 
 
 @row_jit
-def line_to_line_row(p0x, p0y, px, py, p1x, p1y, curvature, shape, out, i):
-    """Theorem 4.4: two spirals from line p0→p to line p→p1.
+def joint_fits(ax1, ay1, ax2, ay2, ax3, ay3, bx1, by1, bx2, by2, bx3, by3, joint, inv):
+    """Sufficient for ``joint_residual`` ≤ VERIFY_TOL and for the first spiral's end
+    curvature to be ``joint`` (a corner's check): with end legs u, v, κ = K/|u|³ and
+    L = min(|u|, |v|, 1/|κa|): |b3a − b3b| ≤ tol·L, |u × v| ≤ tol·|u||v| with u·v < 0,
+    |Ka·|v|³ + Kb·|u|³|·L ≤ tol·|u|³|v|³ and |(|Ka| − joint·|u|³)|·min(|u|·joint, 1) ≤
+    tol·|u|³·joint. Two square roots and one division."""
+    ux = (ax3 - ax2) * inv
+    uy = (ay3 - ay2) * inv
+    vx = (bx3 - bx2) * inv
+    vy = (by3 - by2) * inv
+    uu = ux * ux + uy * uy
+    vv = vx * vx + vy * vy
+    la = math.sqrt(uu)
+    lb = math.sqrt(vv)
+    ka = 2.0 / 3.0 * ((ax2 - ax1) * inv * uy - (ay2 - ay1) * inv * ux)  # κ·|u|³
+    kb = 2.0 / 3.0 * ((bx2 - bx1) * inv * vy - (by2 - by1) * inv * vx)
+    cube_a = uu * la
+    cube_b = vv * lb
+    length = min(min(la, lb), cube_a / abs(ka))
+    gx = (ax3 - bx3) * inv
+    gy = (ay3 - by3) * inv
+    cross = ux * vy - uy * vx
+    return (
+        moderate(uu) & moderate(vv) & (ux * vx + uy * vy < 0.0)
+        & (gx * gx + gy * gy <= FIT2 * (length * length))
+        & (cross * cross <= FIT2 * (uu * vv))
+        & (abs(ka * cube_b + kb * cube_a) * length <= FIT * (cube_a * cube_b))
+        & (abs(abs(ka) - joint * cube_a) * min(la * joint, 1.0) <= FIT * cube_a * joint)
+    )  # fmt: skip
 
-    ``curvature`` > 0 is the joint curvature magnitude; NaN applies Corollary
-    4.5 (the larger spiral pair that fits the shorter leg).
 
-    Verification: the first spiral must leave the line through corner p along
-    t0, the second (read backwards) the line through p along t1 (pointing at
-    the corner); they must share the osculating circle where they meet, with
-    the joint curvature.
-    """
+@row_jit
+def _corner_pair(px, py, t0x, t0y, t1x, t1y, a, sin_t, cos_t, side, shape, scale):
+    """Theorem 4.4's pair, its starts ``a`` before the corner p along each line: the
+    joint curvature (normalised) and Q0 (from the first line) and Q1 (built from the
+    second line, travelled backwards) in world coordinates."""
+    alpha, beta, gamma = leg_factors(shape, cos_t)
+    joint = corner_relation(shape, sin_t, cos_t, a)
+    radius = 1.0 / joint
+    x0, y0, x1, y1, x2, y2, x3, y3 = spiral_in_world(
+        -a * t0x, -a * t0y, t0x, t0y, -side * t0y, side * t0x, sin_t, cos_t, radius, alpha, beta, gamma, px, py, scale, 1.0
+    )
+    v0x, v0y, v1x, v1y, v2x, v2y, v3x, v3y = spiral_in_world(
+        -a * t1x, -a * t1y, t1x, t1y, side * t1y, -side * t1x, sin_t, cos_t, radius, alpha, beta, gamma, px, py, scale, 1.0
+    )
+    return joint, x0, y0, x1, y1, x2, y2, x3, y3, v0x, v0y, v1x, v1y, v2x, v2y, v3x, v3y
+
+
+@row_jit
+def _corner_turn(t0x, t0y, bx, by):
+    """(cross, sin θ, cos θ) of the corner from the first leg's direction and the unit bisector."""
+    cross = t0x * by - t0y * bx
+    return cross, abs(cross), t0x * bx + t0y * by
+
+
+@row_jit
+def _corner_start(shape, sin_t, cos_t, shortest, curvature, scale):
+    """How far before the corner the pair starts: the shorter leg (curvature NaN,
+    Corollary 4.5) or K(θ)/κ."""
+    return shortest if math.isnan(curvature) else corner_relation(shape, sin_t, cos_t, curvature * scale)
+
+
+@row_jit
+def line_to_line_fast(p0x, p0y, px, py, p1x, p1y, curvature, shape):
+    """``line_to_line_row`` in straight-line code for the ordinary row (see
+    ``line_to_circle_fast``): legs and their difference of ordinary size, a turn
+    inside the shape's range, legs long enough. Returns (ok, θ, measure, Q0, Q1 as built)."""
+    ux = px - p0x
+    uy = py - p0y
+    vx = px - p1x
+    vy = py - p1y
+    l0 = norm(ux, uy)
+    l1 = norm(vx, vy)
+    t0x, t0y = unit_ordinary(ux, uy)
+    t1x, t1y = unit_ordinary(vx, vy)
+    bx, by = unit_ordinary(t0x - t1x, t0y - t1y)
+    cross, sin_t, cos_t = _corner_turn(t0x, t0y, bx, by)
+    side = 1.0 if cross > 0.0 else -1.0
+    shortest = min(l0, l1)
+    a = _corner_start(shape, sin_t, cos_t, shortest, curvature, 1.0)
+    measure = a / shortest
+    joint, x0, y0, x1, y1, x2, y2, x3, y3, v0x, v0y, v1x, v1y, v2x, v2y, v3x, v3y = _corner_pair(
+        px, py, t0x, t0y, t1x, t1y, a, sin_t, cos_t, side, shape, 1.0
+    )
+    ok = (
+        math.isfinite(p0x) & math.isfinite(p0y) & math.isfinite(px) & math.isfinite(py) & math.isfinite(p1x)
+        & math.isfinite(p1y) & (math.isnan(curvature) | ((curvature > 0.0) & (curvature < INF)))
+        & ordinary(max(abs(ux), abs(uy))) & ordinary(max(abs(vx), abs(vy)))
+        & ordinary(max(max(abs(ux), abs(uy)), max(abs(vx), abs(vy))))
+        & ordinary(max(abs(t0x - t1x), abs(t0y - t1y))) & (sin_t > 0.0) & (cos_t > 0.0) & in_shape_domain(shape, cos_t)
+        & (measure <= 1.0 + 1e-12)
+        & line_fits(x0, y0, x1, y1, x2, y2, px, py, t0x, t0y, 1.0)
+        & line_fits(v0x, v0y, v1x, v1y, v2x, v2y, px, py, t1x, t1y, 1.0)
+        & joint_fits(x1, y1, x2, y2, x3, y3, v1x, v1y, v2x, v2y, v3x, v3y, joint, 1.0)
+    )  # fmt: skip
+    return ok, angle(sin_t, cos_t), measure, x0, y0, x1, y1, x2, y2, x3, y3, v0x, v0y, v1x, v1y, v2x, v2y, v3x, v3y
+
+
+@jit
+def line_to_line_general(p0x, p0y, px, py, p1x, p1y, curvature, shape, out, i):
+    """``line_to_line_row`` for any row: checks, scaled frames, every shape."""
     if not finite(p0x, p0y, px, py, p1x, p1y):
         return fail(out, i, NOT_FINITE, NAN)
     if not (math.isnan(curvature) or (curvature > 0.0 and math.isfinite(curvature))):
@@ -1048,9 +1223,7 @@ def line_to_line_row(p0x, p0y, px, py, p1x, p1y, curvature, shape, out, i):
     bx, by = unit(t0x - t1x, t0y - t1y)
     if bx == 0.0 and by == 0.0:
         return fail(out, i, CORNER_REVERSAL, NAN)
-    cross = t0x * by - t0y * bx
-    sin_t = abs(cross)
-    cos_t = t0x * bx + t0y * by
+    cross, sin_t, cos_t = _corner_turn(t0x, t0y, bx, by)
     if sin_t == 0.0:
         return fail(out, i, CORNER_STRAIGHT, NAN)
     if not cos_t > 0.0:
@@ -1059,39 +1232,49 @@ def line_to_line_row(p0x, p0y, px, py, p1x, p1y, curvature, shape, out, i):
         return fail(out, i, OUTSIDE_SHAPE, angle(sin_t, cos_t))
     side = 1.0 if cross > 0.0 else -1.0
     shortest = min(l0, l1)
-    if math.isnan(curvature):
-        a = shortest
-    else:
-        a = corner_relation(shape, sin_t, cos_t, curvature * scale)
+    a = _corner_start(shape, sin_t, cos_t, shortest, curvature, scale)
     measure = a / shortest
     if not measure <= 1.0 + 1e-12:
         return fail(out, i, LEGS_TOO_SHORT, measure)
-    alpha, beta, gamma = leg_factors(shape, cos_t)
-    joint = corner_relation(shape, sin_t, cos_t, a)
-    radius = 1.0 / joint
-    # Q0 from the first line, Q1 built from the second line (returned reversed).
-    q0 = spiral_in_world(
-        -a * t0x, -a * t0y, t0x, t0y, -side * t0y, side * t0x, sin_t, cos_t, radius, alpha, beta, gamma,
-        px, py, scale, 1.0,
-    )  # fmt: skip
-    q1 = spiral_in_world(
-        -a * t1x, -a * t1y, t1x, t1y, side * t1y, -side * t1x, sin_t, cos_t, radius, alpha, beta, gamma,
-        px, py, scale, 1.0,
-    )  # fmt: skip
-    x0, y0, x1, y1, x2, y2, x3, y3 = q0
-    v0x, v0y, v1x, v1y, v2x, v2y, v3x, v3y = q1
-    res = worst(
-        line_residual(x0, y0, x1, y1, x2, y2, px, py, t0x, t0y, inv),
-        line_residual(v0x, v0y, v1x, v1y, v2x, v2y, px, py, t1x, t1y, inv),
+    joint, x0, y0, x1, y1, x2, y2, x3, y3, v0x, v0y, v1x, v1y, v2x, v2y, v3x, v3y = _corner_pair(
+        px, py, t0x, t0y, t1x, t1y, a, sin_t, cos_t, side, shape, scale
     )
-    joint_res, kappa, leg = joint_residual(x1, y1, x2, y2, x3, y3, v1x, v1y, v2x, v2y, v3x, v3y, inv)
-    res = worst(res, joint_res)
-    res = worst(res, abs(abs(kappa) - joint) * min(leg, 1.0 / joint))
-    if not res <= VERIFY_TOL:
-        return fail(out, i, UNVERIFIED, res)
+    fits = line_fits(x0, y0, x1, y1, x2, y2, px, py, t0x, t0y, inv)
+    fits = fits and line_fits(v0x, v0y, v1x, v1y, v2x, v2y, px, py, t1x, t1y, inv)
+    if not (fits and joint_fits(x1, y1, x2, y2, x3, y3, v1x, v1y, v2x, v2y, v3x, v3y, joint, inv)):
+        res = worst(
+            line_residual(x0, y0, x1, y1, x2, y2, px, py, t0x, t0y, inv),
+            line_residual(v0x, v0y, v1x, v1y, v2x, v2y, px, py, t1x, t1y, inv),
+        )
+        joint_res, kappa, leg = joint_residual(x1, y1, x2, y2, x3, y3, v1x, v1y, v2x, v2y, v3x, v3y, inv)
+        res = worst(res, joint_res)
+        res = worst(res, abs(abs(kappa) - joint) * min(leg, 1.0 / joint))
+        if not res <= VERIFY_TOL:
+            return fail(out, i, UNVERIFIED, res)
     store(out, i, 0, x0, y0, x1, y1, x2, y2, x3, y3)
     store(out, i, 1, v3x, v3y, v2x, v2y, v1x, v1y, v0x, v0y)
     return OK, angle(sin_t, cos_t), measure, NAN
+
+
+@jit
+def line_to_line_row(p0x, p0y, px, py, p1x, p1y, curvature, shape, out, i):
+    """Theorem 4.4: two spirals from line p0→p to line p→p1.
+
+    ``curvature`` > 0 is the joint curvature magnitude; NaN applies Corollary
+    4.5 (the larger spiral pair that fits the shorter leg).
+
+    Verification: the first spiral must leave the line through corner p along
+    t0, the second (read backwards) the line through p along t1 (pointing at
+    the corner); they must share the osculating circle where they meet, with
+    the joint curvature.
+    """
+    row = line_to_line_fast(p0x, p0y, px, py, p1x, p1y, curvature, shape)
+    if row[0]:
+        _, theta, measure, x0, y0, x1, y1, x2, y2, x3, y3, v0x, v0y, v1x, v1y, v2x, v2y, v3x, v3y = row
+        store(out, i, 0, x0, y0, x1, y1, x2, y2, x3, y3)
+        store(out, i, 1, v3x, v3y, v2x, v2y, v1x, v1y, v0x, v0y)
+        return OK, theta, measure, NAN
+    return line_to_line_general(p0x, p0y, px, py, p1x, p1y, curvature, shape, out, i)
 
 
 # --------------------------------------------- circle inside circle
@@ -1373,19 +1556,80 @@ def line_to_circle_batch(p, d, c, r, shape, out, status, theta, measure):
 @jit
 def circle_to_circle_batch(c0, r0, c1, r1, shape, out, status, theta, measure):
     s0, sr0, s1, sr1 = step(c0), step(r0), step(c1), step(r1)
-    for i in range(out.shape[0]):
-        i0, j0, i1, j1 = i * s0, i * sr0, i * s1, i * sr1
-        row = circle_to_circle_row(c0[i0, 0], c0[i0, 1], r0[j0], c1[i1, 0], c1[i1, 1], r1[j1], shape, out, i)
-        status[i], theta[i], measure[i] = row[0], row[1], row[2]
+    cols = np.empty(6 * BLOCK)  # c0x, c0y, r0, c1x, c1y, r1 of the block's rows
+    res = np.empty(17 * BLOCK)  # ok, θ, measure, s0 … s3, u1 … u3
+    for start in range(0, out.shape[0], BLOCK):
+        m = min(BLOCK, out.shape[0] - start)
+        for k in range(m):
+            i = start + k
+            i0, j0, i1, j1 = i * s0, i * sr0, i * s1, i * sr1
+            cols[k], cols[BLOCK + k], cols[2 * BLOCK + k] = c0[i0, 0], c0[i0, 1], r0[j0]
+            cols[3 * BLOCK + k], cols[4 * BLOCK + k], cols[5 * BLOCK + k] = c1[i1, 0], c1[i1, 1], r1[j1]
+        for k in range(m):
+            row = circle_to_circle_fast(
+                cols[k], cols[BLOCK + k], cols[2 * BLOCK + k], cols[3 * BLOCK + k], cols[4 * BLOCK + k], cols[5 * BLOCK + k], shape
+            )
+            res[k] = 1.0 if row[0] else 0.0
+            res[BLOCK + k], res[2 * BLOCK + k] = row[1], row[2]
+            _, _, _, s0x, s0y, s1x, s1y, s2x, s2y, s3x, s3y, u1x, u1y, u2x, u2y, u3x, u3y = row
+            res[3 * BLOCK + k], res[4 * BLOCK + k], res[5 * BLOCK + k], res[6 * BLOCK + k] = s0x, s0y, s1x, s1y
+            res[7 * BLOCK + k], res[8 * BLOCK + k], res[9 * BLOCK + k], res[10 * BLOCK + k] = s2x, s2y, s3x, s3y
+            res[11 * BLOCK + k], res[12 * BLOCK + k], res[13 * BLOCK + k] = u1x, u1y, u2x
+            res[14 * BLOCK + k], res[15 * BLOCK + k], res[16 * BLOCK + k] = u2y, u3x, u3y
+        for k in range(m):
+            i = start + k
+            if res[k] == 1.0:
+                s0x, s0y = res[3 * BLOCK + k], res[4 * BLOCK + k]
+                store(out, i, 0, res[15 * BLOCK + k], res[16 * BLOCK + k], res[13 * BLOCK + k], res[14 * BLOCK + k],
+                      res[11 * BLOCK + k], res[12 * BLOCK + k], s0x, s0y)  # fmt: skip
+                store(out, i, 1, s0x, s0y, res[5 * BLOCK + k], res[6 * BLOCK + k], res[7 * BLOCK + k], res[8 * BLOCK + k],
+                      res[9 * BLOCK + k], res[10 * BLOCK + k])  # fmt: skip
+                status[i], theta[i], measure[i] = OK, res[BLOCK + k], res[2 * BLOCK + k]
+            else:
+                row = circle_to_circle_general(
+                    cols[k], cols[BLOCK + k], cols[2 * BLOCK + k], cols[3 * BLOCK + k], cols[4 * BLOCK + k], cols[5 * BLOCK + k],
+                    shape, out, i,
+                )  # fmt: skip
+                status[i], theta[i], measure[i] = row[0], row[1], row[2]
 
 
 @jit
 def line_to_line_batch(p0, p, p1, k, shape, out, status, theta, measure):
     s0, sp, s1, sk = step(p0), step(p), step(p1), step(k)
-    for i in range(out.shape[0]):
-        i0, ip, i1, ik = i * s0, i * sp, i * s1, i * sk
-        row = line_to_line_row(p0[i0, 0], p0[i0, 1], p[ip, 0], p[ip, 1], p1[i1, 0], p1[i1, 1], k[ik], shape, out, i)
-        status[i], theta[i], measure[i] = row[0], row[1], row[2]
+    cols = np.empty(7 * BLOCK)  # p0x, p0y, px, py, p1x, p1y, curvature of the block's rows
+    res = np.empty(19 * BLOCK)  # ok, θ, measure, Q0, Q1 as built
+    for start in range(0, out.shape[0], BLOCK):
+        m = min(BLOCK, out.shape[0] - start)
+        for j in range(m):
+            i = start + j
+            i0, ip, i1, ik = i * s0, i * sp, i * s1, i * sk
+            cols[j], cols[BLOCK + j], cols[2 * BLOCK + j], cols[3 * BLOCK + j] = p0[i0, 0], p0[i0, 1], p[ip, 0], p[ip, 1]
+            cols[4 * BLOCK + j], cols[5 * BLOCK + j], cols[6 * BLOCK + j] = p1[i1, 0], p1[i1, 1], k[ik]
+        for j in range(m):
+            row = line_to_line_fast(
+                cols[j], cols[BLOCK + j], cols[2 * BLOCK + j], cols[3 * BLOCK + j],
+                cols[4 * BLOCK + j], cols[5 * BLOCK + j], cols[6 * BLOCK + j], shape,
+            )  # fmt: skip
+            ok, res[BLOCK + j], res[2 * BLOCK + j], x0, y0, x1, y1, x2, y2, x3, y3, v0x, v0y, v1x, v1y, v2x, v2y, v3x, v3y = row
+            res[j] = 1.0 if ok else 0.0
+            res[3 * BLOCK + j], res[4 * BLOCK + j], res[5 * BLOCK + j], res[6 * BLOCK + j] = x0, y0, x1, y1
+            res[7 * BLOCK + j], res[8 * BLOCK + j], res[9 * BLOCK + j], res[10 * BLOCK + j] = x2, y2, x3, y3
+            res[11 * BLOCK + j], res[12 * BLOCK + j], res[13 * BLOCK + j], res[14 * BLOCK + j] = v3x, v3y, v2x, v2y
+            res[15 * BLOCK + j], res[16 * BLOCK + j], res[17 * BLOCK + j], res[18 * BLOCK + j] = v1x, v1y, v0x, v0y
+        for j in range(m):
+            i = start + j
+            if res[j] == 1.0:
+                store(out, i, 0, res[3 * BLOCK + j], res[4 * BLOCK + j], res[5 * BLOCK + j], res[6 * BLOCK + j],
+                      res[7 * BLOCK + j], res[8 * BLOCK + j], res[9 * BLOCK + j], res[10 * BLOCK + j])  # fmt: skip
+                store(out, i, 1, res[11 * BLOCK + j], res[12 * BLOCK + j], res[13 * BLOCK + j], res[14 * BLOCK + j],
+                      res[15 * BLOCK + j], res[16 * BLOCK + j], res[17 * BLOCK + j], res[18 * BLOCK + j])  # fmt: skip
+                status[i], theta[i], measure[i] = OK, res[BLOCK + j], res[2 * BLOCK + j]
+            else:
+                row = line_to_line_general(
+                    cols[j], cols[BLOCK + j], cols[2 * BLOCK + j], cols[3 * BLOCK + j],
+                    cols[4 * BLOCK + j], cols[5 * BLOCK + j], cols[6 * BLOCK + j], shape, out, i,
+                )  # fmt: skip
+                status[i], theta[i], measure[i] = row[0], row[1], row[2]
 
 
 @jit
