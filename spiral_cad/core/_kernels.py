@@ -743,11 +743,63 @@ def _solve_offset(case, shape, target, a_hat):
 # ------------------------------------------------------ line to circle
 
 
+def _near_linear_line_cubic() -> tuple[float, float, float, float]:
+    """Taylor coefficients (F0, F1, F2, F3) about c0 = 5/6 of the near-linear
+    continuation's shift equation (``_near_linear_line_step``) without its q terms.
+
+    With r = 1.8c − 0.5 the shift g1 − 1 = (1 − c²)·(1.8c + 3.5)/(9c) − (1 − c), so
+    9c·(g1 − 1 − q) = −1.8c³ + 5.5c² + (1.8 − 9)c + 3.5 − 9qc. Expanded about c0
+    (exactly, from the float constants the legs use) the terms stay small where
+    the root lies, so the root keeps the accuracy of the 1996 spiral's closed form.
+    """
+    from fractions import Fraction
+
+    a, c0 = Fraction(1.8), Fraction(EQUAL_LEG_COS)
+    value = ((-a * c0 + Fraction(5.5)) * c0 + (a - 9)) * c0 + Fraction(3.5)
+    slope = (-3 * a * c0 + 11) * c0 + (a - 9)
+    return float(value), float(slope), float(-3 * a * c0 + Fraction(5.5)), float(-a)
+
+
+NL_LINE_F0, NL_LINE_F1, NL_LINE_F2, NL_LINE_F3 = _near_linear_line_cubic()
+
+
 @row_jit
-def line_circle_closed_form(shape, shift, measure):
+def _near_linear_line_step(q9, x, lo, hi, done):
+    """One safeguarded Newton step for cos θ = 5/6 + x of the near-linear continuation
+    (33.56° ≤ θ ≤ 50°) that shifts its circle by q = q9/9: the root of
+    F = 9c·(g1(θ) − 1 − q), a cubic in x that falls with x (``_near_linear_line_cubic``),
+    in the bracket [lo, hi]. Returns (x, lo, hi, done), left as it is once done."""
+    f = ((NL_LINE_F3 * x + NL_LINE_F2) * x + (NL_LINE_F1 - q9)) * x + (NL_LINE_F0 - q9 * EQUAL_LEG_COS)
+    above = f > 0.0  # the root lies at a larger x
+    lo_new = x if above else lo
+    hi_new = hi if above else x
+    new = x - f / ((3.0 * NL_LINE_F3 * x + 2.0 * NL_LINE_F2) * x + (NL_LINE_F1 - q9))
+    new = new if lo_new < new < hi_new else 0.5 * (lo_new + hi_new)
+    root = f == 0.0
+    converged = abs(new - x) <= 2e-16
+    return (x if done or root else new), (lo if done else lo_new), (hi if done else hi_new), done or root or converged
+
+
+#: Newton steps the vectorised near-linear rows take (from the secant of the bracket, about 4 suffice).
+FAST_NEWTON_STEPS = 6
+
+
+@row_jit
+def _near_linear_line_start(q9):
+    """The bracket [cos 50° − 5/6, 0] of x = cos θ − 5/6 on the near-linear continuation,
+    its secant point and whether the shift is within reach (F > 0 at 50°)."""
+    lo = NEAR_LINEAR_MIN_COS - EQUAL_LEG_COS
+    f_lo = ((NL_LINE_F3 * lo + NL_LINE_F2) * lo + (NL_LINE_F1 - q9)) * lo + (NL_LINE_F0 - q9 * EQUAL_LEG_COS)
+    f_hi = NL_LINE_F0 - q9 * EQUAL_LEG_COS
+    return f_lo > 0.0, _secant(lo, f_lo, 0.0, f_hi), lo, 0.0
+
+
+@row_jit
+def line_circle_angle_fast(shape, shift, measure):
     """(found, sin θ, cos θ) of the spiral that shifts its circle by ``shift`` = g1(θ) − 1 > 0
-    (``measure`` = d/r = 1 + shift) where a closed form exists: the 1996 spiral,
-    and the near-linear equal-leg member (shift < 1/27)."""
+    (``measure`` = d/r = 1 + shift) in straight-line code: the 1996 spiral's closed
+    form, the near-linear equal-leg closed form (shift < 1/27) or, beyond it,
+    ``FAST_NEWTON_STEPS`` Newton steps (``found`` False if they do not settle)."""
     if shape == WALTON_MEEK:
         # cos θ = 10 / (9ρ + √(81ρ² − 80)), with 1 − cos θ formed without cancellation.
         z = 81.0 * shift * (2.0 + shift)
@@ -757,7 +809,35 @@ def line_circle_closed_form(shape, shift, measure):
         return True, math.sqrt((9.0 * shift + z / (s + 1.0)) / den * (1.0 + cos_t)), cos_t
     # Equal legs: 2cos²θ − 3cos θ + 1 + 3q = 0, so 1 − cos θ = 6q / (1 + √(1 − 24q)).
     versine = 6.0 * shift / (1.0 + math.sqrt(1.0 - 24.0 * shift))
-    return shape == NEAR_LINEAR and shift < 1.0 / 27.0, math.sqrt(versine * (2.0 - versine)), 1.0 - versine
+    q9 = 9.0 * shift
+    reach, x, lo, hi = _near_linear_line_start(q9)
+    done = False
+    for _ in range(FAST_NEWTON_STEPS):
+        x, lo, hi, done = _near_linear_line_step(q9, x, lo, hi, done)
+    c = EQUAL_LEG_COS + x
+    equal = shift < 1.0 / 27.0
+    found = shape == NEAR_LINEAR and (equal or (reach and done))
+    return found, (math.sqrt(versine * (2.0 - versine)) if equal else math.sqrt((1.0 - c) * (1.0 + c))), (1.0 - versine if equal else c)
+
+
+@jit
+def line_circle_angle(shape, shift, measure):
+    """``line_circle_angle_fast`` for any row: (found, sin θ, cos θ); ``found`` False
+    beyond the shape's reach."""
+    found, sin_t, cos_t = line_circle_angle_fast(shape, shift, measure)
+    if found or shape != NEAR_LINEAR:
+        return found, sin_t, cos_t
+    q9 = 9.0 * shift
+    reach, x, lo, hi = _near_linear_line_start(q9)
+    if not reach:
+        return False, NAN, NAN
+    done = False
+    for _ in range(100):
+        x, lo, hi, done = _near_linear_line_step(q9, x, lo, hi, done)
+        if done:
+            break
+    c = EQUAL_LEG_COS + x
+    return True, math.sqrt((1.0 - c) * (1.0 + c)), c
 
 
 @row_jit
@@ -778,7 +858,7 @@ def line_circle_spiral(px, py, tx, ty, vx, vy, rs, sin_t, cos_t, side, shape, sc
 def line_to_circle_fast(px, py, dx, dy, cx, cy, r, shape):
     """``line_to_circle_row`` in straight-line code for the ordinary row: every number
     finite, the direction's and the radius's size within 1e-60 … 1e60 (a frame of
-    scale 1), the circle clear of the line, a closed-form angle and a verification
+    scale 1), the circle clear of the line, an angle the shape reaches and a verification
     that the sufficient tests pass. Returns (ok, θ, measure, side, x0, y0, …, x3, y3);
     where ``ok`` is False the row is left to ``line_to_circle_general``. The same
     arithmetic as that path, so the two agree bit for bit; no branches, so the
@@ -790,7 +870,7 @@ def line_to_circle_fast(px, py, dx, dy, cx, cy, r, shape):
     d = tx * vy - ty * vx
     side = 1.0 if d > 0.0 else -1.0
     measure = abs(d) / r
-    found, sin_t, cos_t = line_circle_closed_form(shape, (abs(d) - r) / r, measure)
+    found, sin_t, cos_t = line_circle_angle_fast(shape, (abs(d) - r) / r, measure)
     x0, y0, x1, y1, x2, y2, x3, y3 = line_circle_spiral(px, py, tx, ty, vx, vy, r, sin_t, cos_t, side, shape, 1.0)
     ok = (
         math.isfinite(px) & math.isfinite(py) & math.isfinite(cx) & math.isfinite(cy) & math.isfinite(vx) & math.isfinite(vy)
@@ -823,14 +903,9 @@ def line_to_circle_general(px, py, dx, dy, cx, cy, r, shape, out, i):
     measure = abs(d) / rs
     if not abs(d) > rs:
         return fail(out, i, CIRCLE_MEETS_LINE, measure)
-    shift = (abs(d) - rs) / rs
-    found, sin_t, cos_t = line_circle_closed_form(shape, shift, measure)
+    found, sin_t, cos_t = line_circle_angle(shape, (abs(d) - rs) / rs, measure)
     if not found:
-        w = _solve_offset(LINE_CASE, shape, shift, 0.0)
-        if not w > 0.0:
-            return fail(out, i, OUTSIDE_SHAPE, measure)
-        sin_t = math.sqrt(w)
-        cos_t = math.sqrt(1.0 - w)
+        return fail(out, i, OUTSIDE_SHAPE, measure)
     x0, y0, x1, y1, x2, y2, x3, y3 = line_circle_spiral(px, py, tx, ty, vx, vy, rs, sin_t, cos_t, side, shape, scale)
     fits = line_fits(x0, y0, x1, y1, x2, y2, px, py, tx, ty, inv)
     if not (fits and end_fits(x1, y1, x2, y2, x3, y3, cx, cy, side * r, inv)):
@@ -1085,7 +1160,7 @@ def circle_to_circle_row(c0x, c0y, r0, c1x, c1y, r1, shape, out, i):
     returned in travel order (circle 0 → B0 → circle 1).
     """
     row = circle_to_circle_fast(c0x, c0y, r0, c1x, c1y, r1, shape)
-    if row[0]:
+    if shape == WALTON_MEEK and row[0]:
         _, theta, measure, s0x, s0y, s1x, s1y, s2x, s2y, s3x, s3y, u1x, u1y, u2x, u2y, u3x, u3y = row
         store(out, i, 0, u3x, u3y, u2x, u2y, u1x, u1y, s0x, s0y)
         store(out, i, 1, s0x, s0y, s1x, s1y, s2x, s2y, s3x, s3y)
@@ -1565,7 +1640,7 @@ def circle_to_circle_batch(c0, r0, c1, r1, shape, out, status, theta, measure):
             i0, j0, i1, j1 = i * s0, i * sr0, i * s1, i * sr1
             cols[k], cols[BLOCK + k], cols[2 * BLOCK + k] = c0[i0, 0], c0[i0, 1], r0[j0]
             cols[3 * BLOCK + k], cols[4 * BLOCK + k], cols[5 * BLOCK + k] = c1[i1, 0], c1[i1, 1], r1[j1]
-        for k in range(m):
+        for k in range(m if shape == WALTON_MEEK else 0):  # other shapes need the general row's root search
             row = circle_to_circle_fast(
                 cols[k], cols[BLOCK + k], cols[2 * BLOCK + k], cols[3 * BLOCK + k], cols[4 * BLOCK + k], cols[5 * BLOCK + k], shape
             )
@@ -1578,7 +1653,7 @@ def circle_to_circle_batch(c0, r0, c1, r1, shape, out, status, theta, measure):
             res[14 * BLOCK + k], res[15 * BLOCK + k], res[16 * BLOCK + k] = u2y, u3x, u3y
         for k in range(m):
             i = start + k
-            if res[k] == 1.0:
+            if shape == WALTON_MEEK and res[k] == 1.0:
                 s0x, s0y = res[3 * BLOCK + k], res[4 * BLOCK + k]
                 store(out, i, 0, res[15 * BLOCK + k], res[16 * BLOCK + k], res[13 * BLOCK + k], res[14 * BLOCK + k],
                       res[11 * BLOCK + k], res[12 * BLOCK + k], s0x, s0y)  # fmt: skip
