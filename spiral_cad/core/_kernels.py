@@ -688,8 +688,7 @@ def _illinois(lo, f_lo, hi, f_hi, side, x, f):
     return lo, f_lo, x, f, 1
 
 
-# Which centre-offset equation ``_offset_measure`` evaluates.
-LINE_CASE = 0
+# Which circle-pair equation ``_offset_measure`` evaluates.
 S_CASE = 1
 C_CASE = 2
 
@@ -704,16 +703,13 @@ def shape_max_w(shape):
 
 @jit
 def _offset_measure(case, shape, w, a_hat):
-    """The left-hand side of a transition's equation in w = sin²θ, increasing from 0.
+    """The left-hand side of a circle pair's equation in w = sin²θ, increasing from 0.
 
-    Line → circle: g1 − 1 = w·e1 (the shift over R). S: g1² + g2² − 1.
-    C: Â·(g1² − 1) + g2² with Â = (r1 − r0)²/(r1 + r0)².
+    S: g1² + g2² − 1. C: Â·(g1² − 1) + g2² with Â = (r1 − r0)²/(r1 + r0)².
     """
     sin_t = math.sqrt(w)
     cos_t = math.sqrt(1.0 - w)
     e1, e2 = shape_offsets(shape, sin_t, cos_t)
-    if case == LINE_CASE:
-        return w * e1
     g1_squared_less_one = e1 * (2.0 + w * e1)
     if case == S_CASE:
         return w * (g1_squared_less_one + e2 * e2)
