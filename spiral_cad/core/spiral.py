@@ -58,7 +58,7 @@ class BezierSpiral(Segment):
         self._cp = out[0, 0]
         self._length = None
         self._shape = shape
-        self._cp.flags.writeable = False
+        self._cp.setflags(write=False)
 
     @classmethod
     def from_control_points(cls, control_points: ArrayLike, shape: str | None = None) -> BezierSpiral:
@@ -95,7 +95,7 @@ class BezierSpiral(Segment):
     def _wrap(cls, cp: NDArray, shape: str | None) -> BezierSpiral:
         """Adopt a finite (4, 2) float64 array without copying or checks (solver output)."""
         spiral = object.__new__(cls)
-        cp.flags.writeable = False
+        cp.setflags(write=False)
         spiral._cp = cp
         spiral._length = None
         spiral._shape = shape
