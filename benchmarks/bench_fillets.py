@@ -65,7 +65,8 @@ def main() -> None:
         print(" | ".join(rows[-1]), flush=True)
     note = f"Single runs; fillet_2d grows as N^{exponent:.2f} (fitted to {', '.join(map(str, sizes))} corners)."
     report = Report("G2 fillets at scale", note)
-    report.section("g2_fillet against build123d's fillet_2d", table(["corners", "g2_fillet (ours), s", "fillet_2d (peer), s", "peer / ours"], rows))
+    header = ["corners", "g2_fillet (ours), s", "fillet_2d (peer), s", "peer / ours"]
+    report.section("g2_fillet against build123d's fillet_2d", table(header, rows))
     report.finish(args)
 
 

@@ -28,7 +28,8 @@ def scripts(only: list[str] | None = None) -> list[Path]:
     if only:
         unknown = set(only) - {path.stem.removeprefix("bench_") for path in found}
         if unknown:
-            raise SystemExit(f"no benchmark named {', '.join(sorted(unknown))}; have {', '.join(p.stem for p in found)}")
+            names = ", ".join(path.stem for path in found)
+            raise SystemExit(f"no benchmark named {', '.join(sorted(unknown))}; have {names}")
         found = [path for path in found if path.stem.removeprefix("bench_") in only]
     return found
 
@@ -37,7 +38,7 @@ def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--quick", action="store_true", help="every script at its smallest sizes (a smoke test)")
     parser.add_argument("--only", nargs="+", metavar="NAME", help="run only bench_NAME.py for these NAMEs")
-    parser.add_argument("--out-dir", type=Path, help="where results_NAME.md go (default: benchmarks/, or a temporary folder with --quick)")
+    parser.add_argument("--out-dir", type=Path, help="for results_NAME.md (default benchmarks/; --quick: a temporary folder)")
     args = parser.parse_args()
     with tempfile.TemporaryDirectory() as scratch:
         out_dir = args.out_dir or (Path(scratch) if args.quick else HERE)
@@ -45,12 +46,14 @@ def main() -> int:
         summary = []
         for script in scripts(args.only):
             name = script.stem.removeprefix("bench_")
-            command = [sys.executable, str(script), *(["--quick"] if args.quick else []), "--out", str(out_dir / f"results_{name}.md")]
+            out = out_dir / f"results_{name}.md"
+            command = [sys.executable, str(script), *(["--quick"] if args.quick else []), "--out", str(out)]
             print(f"\n=== {script.name} ===", flush=True)
             started = time.perf_counter()
             code = subprocess.run(command, cwd=HERE).returncode
             summary.append((script.name, code, time.perf_counter() - started))
-    print("\n" + "\n".join(f"{name:24} {'ok' if code == 0 else f'FAILED ({code})':12} {seconds:8.1f} s" for name, code, seconds in summary))
+    for name, code, seconds in summary:
+        print(f"{name:24} {'ok' if code == 0 else f'FAILED ({code})':12} {seconds:8.1f} s")
     return sum(code != 0 for _, code, _ in summary)
 
 

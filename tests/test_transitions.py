@@ -310,4 +310,5 @@ def test_two_number_points_are_checked_item_by_item(point, message):
     """Tuples and lists of two floats take a short path; anything else in them is named as before."""
     with pytest.raises(ValueError, match=message):
         line_to_circle(point, (1, 0), (0, 105), 100)
-    assert line_to_circle([0, 0.0], [1, 0], (0, 105), 100).spirals[0].start.tolist() == line_to_circle((0, 0), (1, 0), (0, 105), 100).spirals[0].start.tolist()
+    as_list = line_to_circle([0, 0.0], [1, 0], (0, 105), 100).spirals[0].control_points
+    assert np.array_equal(as_list, line_to_circle((0, 0), (1, 0), (0, 105), 100).spirals[0].control_points)
