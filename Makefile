@@ -33,16 +33,10 @@ demo: $(STAMP)
 test: $(STAMP) $(TOOLS_STAMP)
 	SPIRAL_CAD_XODR_TOOLS=$(abspath $(TOOLS))/bin/python $(BIN)/python -m pytest -q
 
+# Every benchmarks/bench_*.py, each in its own process, writing benchmarks/results_*.md
+# (the convention a script follows: benchmarks/timing.py).
 bench: $(STAMP)
-	$(BIN)/python benchmarks/bench_core.py --out benchmarks/results_core.md
-	$(BIN)/python benchmarks/bench_cad.py --out benchmarks/results_cad.md
-	$(BIN)/python benchmarks/bench_checker.py --out benchmarks/results_checker.md
-	$(BIN)/python benchmarks/bench_rounding.py --out benchmarks/results_rounding.md
-	$(BIN)/python benchmarks/bench_roads.py --out benchmarks/results_roads.md
-	$(BIN)/python benchmarks/bench_roads3d.py --out benchmarks/results_roads3d.md
-	$(BIN)/python benchmarks/bench_fillets.py --out benchmarks/results_fillets.md
-	$(BIN)/python benchmarks/bench_shapes.py --out benchmarks/results_shapes.md
-	$(BIN)/python benchmarks/bench_chains.py --out benchmarks/results_chains.md
+	$(BIN)/python benchmarks/run_all.py
 
 pictures: $(STAMP)
 	$(BIN)/python docs/make_pictures.py

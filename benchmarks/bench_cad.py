@@ -1,28 +1,28 @@
-"""CAD layer: a 10,000-segment chain → OCCT wire → STEP, against raw OCP calls.
+"""CAD layer: a long chain → OCCT wire → STEP → read back and checked, each against raw OCP in the same runs.
 
-Run: ``.venv/bin/python benchmarks/bench_cad.py [--segments N] [--repeat R] [--out FILE]``.
-The peer builds the very same edges (Geom_Line, Geom_Circle, Geom_BezierCurve)
-from plain float lists with direct OCP calls, in the same run; the ratio is
-ours / raw (goal ≤ 1.2). Also reports the G2 checker's throughput.
+Run: ``.venv/bin/python benchmarks/bench_cad.py [--quick] [--segments N] [--rounds R] [--out FILE]``
+(the harness and its conventions: ``timing.py``). The peer builds the very
+same edges (Geom_Line, Geom_Circle, Geom_BezierCurve) from plain float lists
+with direct OCP calls and writes them with OCCT's own STEP writer; OCCT then
+reads both files. The growth of every job is fitted over a range of chain
+lengths (exponent 1: linear).
 """
 
 from __future__ import annotations
 
-import argparse
 import os
 import tempfile
-import time
 
 from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeEdge, BRepBuilderAPI_MakeWire
 from OCP.Geom import Geom_BezierCurve
 from OCP.gp import gp_Ax2, gp_Circ, gp_Dir, gp_Pnt
 from OCP.TColgp import TColgp_Array1OfPnt
-from timing import machine, median_time, write_markdown
+from timing import Report, arguments, compare, growth_exponent, table
 
 from spiral_cad import Arc, Chain, Line, circle_to_circle
 from spiral_cad.continuity import check_continuity
 from spiral_cad.export import export_step
-from spiral_cad.occ import chain_wire
+from spiral_cad.occ import chain_wire, read_shape
 
 
 def snake(segments: int) -> Chain:
@@ -76,48 +76,8 @@ def raw_ocp_wire(rows: list[tuple]):
     return wire.Wire()
 
 
-def main() -> None:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--segments", type=int, default=10_000)
-    parser.add_argument("--repeat", type=int, default=5)
-    parser.add_argument("--out", help="also write the table to this markdown file")
-    args = parser.parse_args()
-    t0 = time.perf_counter()
-    chain = snake(args.segments)
-    build_chain = time.perf_counter() - t0
-    rows = plain_description(chain)
-    print(f"chain of {len(chain):,} segments built and G2-checked in {build_chain:.2f} s", flush=True)
-    with tempfile.TemporaryDirectory() as tmp:
-        ours_path, raw_path = os.path.join(tmp, "ours.step"), os.path.join(tmp, "raw.step")
-        t_ours_wire = median_time(lambda: chain_wire(chain), args.repeat)
-        t_raw_edges = median_time(lambda: raw_ocp_edges(rows), args.repeat)
-        t_raw_wire = median_time(lambda: raw_ocp_wire(rows), args.repeat)
-        t_ours = median_time(lambda: export_step(chain, ours_path), args.repeat)
-        t_raw = median_time(lambda: _write_step(raw_ocp_wire(rows), raw_path), args.repeat)
-        wire = chain_wire(chain)
-        t_check = median_time(lambda: check_continuity(wire), args.repeat)
-        report = check_continuity(wire)
-    joints = len(chain) - 1
-    ms = lambda t: f"{t * 1e3:,.1f} ms"  # noqa: E731
-    table = [
-        ("segments", f"{len(chain):,}", "line, arc and spiral edges"),
-        ("ours: chain → OCCT wire", ms(t_ours_wire), "edges share vertices, wire assembled directly"),
-        ("raw OCP: the same edges only", ms(t_raw_edges), "MakeEdge per segment, no wire"),
-        ("ratio ours (whole wire) / raw edges", f"{t_ours_wire / t_raw_edges:.2f}×", "goal ≤ 1.2"),
-        ("raw OCP: edges + BRepBuilderAPI_MakeWire", ms(t_raw_wire), "the usual way; Add is linear in the wire size"),
-        ("ours: chain → wire → STEP file", ms(t_ours), "17 significant digits"),
-        ("raw OCP: edges → MakeWire → STEP file", ms(t_raw), "STEPControl_Writer defaults"),
-        ("ratio ours / raw (wire + STEP)", f"{t_ours / t_raw:.2f}×", "goal ≤ 1.2"),
-        ("G2 checker", f"{joints / t_check:,.0f} joints/s", f"{joints:,} joints, min level {report.min_level}"),
-    ]
-    for name, value, note in table:
-        print(f"  {name:38} {value:>18}  {note}")
-    print(f"machine: {machine()}")
-    if args.out:
-        write_markdown(args.out, "CAD benchmark", f"Median of {args.repeat} runs.", ("measurement", "value", "note"), table)
-
-
-def _write_step(shape, path: str) -> None:
+def write_occt_step(shape, path: str) -> None:
+    """OCCT's own STEP writer with its defaults."""
     from OCP.IFSelect import IFSelect_RetDone
     from OCP.STEPControl import STEPControl_AsIs, STEPControl_Writer
 
@@ -125,6 +85,55 @@ def _write_step(shape, path: str) -> None:
     writer.Transfer(shape, STEPControl_AsIs)
     if writer.Write(path) != IFSelect_RetDone:
         raise RuntimeError(f"could not write {path}")
+
+
+def measure(report: Report, segments: int, rounds: int, folder: str) -> dict[str, float]:
+    """Every job at one chain length; returns the medians (seconds) for the growth fit."""
+    chain = snake(segments)
+    rows = plain_description(chain)
+    ours_path, occt_path = os.path.join(folder, "ours.step"), os.path.join(folder, "occt.step")
+    export_step(chain, ours_path)
+    write_occt_step(raw_ocp_wire(rows), occt_path)
+    wire = chain_wire(chain)
+    t = compare({
+        "wire": lambda: chain_wire(chain),
+        "edges": lambda: raw_ocp_edges(rows),
+        "step": lambda: export_step(chain, ours_path),
+        "occt step": lambda: write_occt_step(wire, occt_path),
+        "read ours": lambda: read_shape(ours_path),
+        "read occt": lambda: read_shape(occt_path),
+        "check wire": lambda: check_continuity(wire),
+        "check file": lambda: check_continuity(ours_path),
+    }, rounds)  # fmt: skip
+    ms = {name: timing.median * 1e3 for name, timing in t.items()}
+    n = f"{len(chain):,} segments"
+    report.add(f"chain → OCCT wire ({n})", ms["wire"], "ms", t["wire"], f"raw OCP edges only {ms['edges']:,.0f} ms",
+               t["edges"].median / t["wire"].median, "≤ 1.1× raw edges")  # fmt: skip
+    report.add(f"chain → STEP file, written directly ({n})", ms["step"], "ms", t["step"],
+               f"OCCT's writer, wire given {ms['occt step']:,.0f} ms", t["occt step"].median / t["step"].median)  # fmt: skip
+    report.add(f"OCCT reads our STEP ({n})", ms["read ours"], "ms", t["read ours"],
+               f"OCCT reads its own {ms['read occt']:,.0f} ms", t["read occt"].median / t["read ours"].median,
+               "≤ 1.2× OCCT's own")  # fmt: skip
+    joints = len(chain) - 1
+    report.add(f"G2 checker on the wire ({joints:,} joints)", joints / t["check wire"].median, "joints/s", t["check wire"])
+    report.add(f"G2 checker on our STEP file ({joints:,} joints)", joints / t["check file"].median, "joints/s",
+               t["check file"], f"of it, OCCT's read {ms['read ours']:,.0f} ms",
+               t["read ours"].median / t["check file"].median)  # fmt: skip
+    return {name: timing.median for name, timing in t.items()}
+
+
+def main() -> None:
+    args = arguments(__doc__, segments=([1_000, 4_000, 10_000], [30, 60]), rounds=(3, 1))
+    report = Report("CAD benchmark", f"Medians of {args.rounds} alternating rounds per chain length.")
+    with tempfile.TemporaryDirectory() as folder:
+        sizes = sorted(args.segments)
+        medians = [measure(report, size, args.rounds, folder) for size in sizes]
+    if len(sizes) > 1:
+        names = {"wire": "chain → wire", "edges": "raw OCP edges", "step": "our STEP", "occt step": "OCCT's STEP writer",
+                 "read ours": "OCCT reads ours", "read occt": "OCCT reads its own", "check file": "checker on our file"}  # fmt: skip
+        rows = [(label, f"{growth_exponent(sizes, [m[name] for m in medians]):.2f}") for name, label in names.items()]
+        report.section(f"Growth over {sizes[0]:,} … {sizes[-1]:,} segments (time ∝ N^k; 1 is linear)", table(("job", "k"), rows))
+    report.finish(args)
 
 
 if __name__ == "__main__":

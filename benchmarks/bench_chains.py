@@ -30,7 +30,7 @@ import time
 from pathlib import Path
 
 import numpy as np
-from timing import machine, write_markdown
+from timing import growth_exponent, machine, write_markdown
 
 ROOT = Path(__file__).resolve().parent.parent
 CHAIN_SIZES = (1_000, 10_000, 40_000)
@@ -126,11 +126,6 @@ def baseline_source(ref: str, folder: Path) -> Path:
     return folder
 
 
-def exponent(sizes: list[int], times: list[float]) -> float:
-    """The growth exponent k of time ∝ size^k (least squares in log-log)."""
-    return float(np.polyfit(np.log(sizes), np.log(times), 1)[0])
-
-
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--baseline", default="main", help="git ref of the version to compare with ('' for none)")
@@ -185,10 +180,10 @@ def main() -> None:
         sizes = chain_sizes if job in ("chain", "join") else pi_sizes
         for name, _ in workers:
             times = [statistics.median(results[(job, n, name)]) for n in sizes if (job, n, name) in results]
-            if len(times) == len(sizes):
+            if len(times) == len(sizes) >= 3:
                 # Over every size, and over the largest three (where a fixed cost no longer hides the growth).
-                notes.append(f"{labels[job]} ({name}): growth exponent {exponent(list(sizes), times):.2f} over "
-                             f"{sizes[0]:,}…{sizes[-1]:,}, {exponent(list(sizes[-3:]), times[-3:]):.2f} over {sizes[-3]:,}…{sizes[-1]:,}")  # fmt: skip
+                notes.append(f"{labels[job]} ({name}): growth exponent {growth_exponent(list(sizes), times):.2f} over "
+                             f"{sizes[0]:,}…{sizes[-1]:,}, {growth_exponent(list(sizes[-3:]), times[-3:]):.2f} over {sizes[-3]:,}…{sizes[-1]:,}")  # fmt: skip
     for job, goal in GOALS.items():
         if (job, 10_000, "ours") in results:
             t = statistics.median(results[(job, 10_000, "ours")])

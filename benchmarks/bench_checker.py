@@ -1,6 +1,6 @@
 """G2 checker on files: the price of reading in a child process, against OCCT reading in-process.
 
-Run: ``.venv/bin/python benchmarks/bench_checker.py [--repeat R] [--out FILE]``.
+Run: ``.venv/bin/python benchmarks/bench_checker.py [--quick] [--repeat R] [--edges N] [--out FILE]``.
 
 The peer reads the same file with OCCT's reader in the calling process
 (``ReadFile`` + ``TransferRoots``) and measures it with the same code, as
@@ -13,14 +13,12 @@ per file (one fork) and about 1.2× on a 10 000-edge file.
 
 from __future__ import annotations
 
-import argparse
 import tempfile
-import time
 from collections.abc import Callable
 from pathlib import Path
 
 from bench_cad import snake
-from timing import machine, write_markdown
+from timing import arguments, compare, machine, write_markdown
 
 from spiral_cad.cad.continuity import _measure, _report, check_continuity
 from spiral_cad.cad.occ import captured_messages
@@ -46,41 +44,29 @@ def in_process_check(path: Path) -> None:
     _report(_measure(reader.OneShape()), "", path.name, 1e-7, 1e-7, 1e-6, None)
 
 
-def fastest(runs: dict[str, Callable[[], object]], repeat: int) -> dict[str, float]:
-    """The fastest of ``repeat`` runs of each, interleaved, after one warm-up each (on a shared
-    machine the minimum is the stable figure: others' load only ever adds)."""
-    for run in runs.values():
-        run()
-    best = dict.fromkeys(runs, float("inf"))
-    for _ in range(repeat):
-        for name, run in runs.items():
-            started = time.perf_counter()
-            run()
-            best[name] = min(best[name], time.perf_counter() - started)
-    return best
+def medians(runs: dict[str, Callable[[], object]], repeat: int) -> dict[str, float]:
+    """The median of ``repeat`` runs of each, taking them in turn (``timing.compare``)."""
+    return {name: timing.median for name, timing in compare(runs, repeat).items()}
 
 
 def main() -> None:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--repeat", type=int, default=6, help="timed runs per large file (20× that per small file)")
-    parser.add_argument("--out", help="also write the table to this markdown file")
-    args = parser.parse_args()
+    args = arguments(__doc__, repeat=(6, 1), edges=(10_000, 200))
     rows = []
     with tempfile.TemporaryDirectory() as folder:
         files = []
         highway = Alignment.from_pis([[0, 0], [600, 120], [1150, -80], [1700, 260], [2300, 200]], [450, 400, 600],
                                      units="m", design_speed=80).chain  # fmt: skip
-        big = snake(10_000)
+        big = snake(args.edges)
         for name, chain in (("highway (demo, 13 edges)", highway), (f"snake ({len(big):,} edges)", big)):
             for suffix, write in (("step", export_step), ("igs", export_iges)):
                 path = Path(folder) / f"{name.split()[0]}.{suffix}"
                 write(chain, path)
                 files.append((f"{name} .{suffix}", path))
-        empty = fastest({"empty": lambda: run_isolated(int, what="nothing", subject="-")}, 20 * args.repeat)["empty"]
+        empty = medians({"empty": lambda: run_isolated(int, what="nothing", subject="-")}, 20 * args.repeat)["empty"]
         rows.append(("child process round trip (empty task)", "", f"{empty * 1000:.1f} ms", ""))
         for label, path in files:
             repeat = args.repeat if "snake" in label else 20 * args.repeat
-            best = fastest({"peer": lambda: in_process_check(path), "ours": lambda: check_continuity(path),
+            best = medians({"peer": lambda: in_process_check(path), "ours": lambda: check_continuity(path),
                             "shape": lambda: read_shape(path)}, repeat)  # fmt: skip
             peer, ours = best["peer"], best["ours"]
             rows.append((f"check {label}", f"{peer * 1000:,.1f} ms", f"{ours * 1000:,.1f} ms (+{(ours - peer) * 1000:,.1f} ms)",
@@ -94,7 +80,7 @@ def main() -> None:
     print(machine())
     if args.out:
         write_markdown(args.out, "Checker on files: readers in a child process",
-                       f"Fastest of {args.repeat} interleaved runs (20× that for the small files); peer and ours in the same run.",
+                       f"Medians of {args.repeat} interleaved runs (20× that for the small files); peer and ours in the same run.",
                        header, rows)  # fmt: skip
 
 

@@ -1,6 +1,7 @@
 """G2 fillets at scale: every corner of an N-corner polygon rounded into a face, against build123d's fillet_2d.
 
-Run: ``.venv/bin/python benchmarks/bench_fillets.py [--corners N ...] [--peer-corners N ...] [--out FILE]``.
+Run: ``.venv/bin/python benchmarks/bench_fillets.py [--quick] [--corners N ...] [--peer-corners N ...] [--out FILE]``
+(the harness and its conventions: ``timing.py``).
 
 The polygon is a zigzag round a circle (alternating radii, every corner
 turning about 77°), filleted with radius 5 % of its shortest side. Ours is
@@ -15,14 +16,14 @@ fillet_2d at 10 000 corners.
 
 from __future__ import annotations
 
-import argparse
 import math
 import time
 
 import build123d as bd
 import numpy as np
-from timing import machine, write_markdown
+from timing import Report, arguments, table
 
+from spiral_cad import NoSolutionError
 from spiral_cad.build123d import g2_fillet
 
 
@@ -43,13 +44,9 @@ def timed(fn) -> tuple[float, object]:
 
 
 def main() -> None:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--corners", type=int, nargs="+", default=[1000, 10_000])
-    parser.add_argument("--peer-corners", type=int, nargs="+", default=[100, 200, 400])
-    parser.add_argument("--out", help="also write the table to this markdown file")
-    args = parser.parse_args()
+    args = arguments(__doc__, corners=([1000, 10_000], [40]), peer_corners=([100, 200, 400], [10, 20]))
     rows, peer = [], {}
-    for n in sorted(set(args.peer_corners)):
+    for n in sorted(set(args.peer_corners)):  # single runs: the peer takes minutes at these sizes
         face, radius = zigzag_face(n)
         seconds, theirs = timed(lambda: face.fillet_2d(radius, face.vertices()))
         assert theirs.is_valid
@@ -62,19 +59,20 @@ def main() -> None:
     exponent, scale = np.polyfit(np.log(sizes), np.log([peer[n] for n in sizes]), 1)
     for n in args.corners:
         face, radius = zigzag_face(n)
-        ours, mine = timed(lambda: g2_fillet(face, radius))
-        assert mine.is_valid and len(mine.edges()) == 4 * n
         estimate = math.exp(scale) * n**exponent
-        rows.append([f"{n:,}", f"{ours:.3f}", f"est. {estimate:,.0f}", f"est. {estimate / ours:,.0f}×"])
+        try:
+            ours, mine = timed(lambda: g2_fillet(face, radius))
+        except NoSolutionError as refusal:  # the one rule: a refusal is an answer, and the table says so
+            rows.append([f"{n:,}", f"refused: {str(refusal).split(':', 2)[1].strip()}", f"est. {estimate:,.0f}", "—"])
+        else:
+            assert mine.is_valid and len(mine.edges()) == 4 * n
+            rows.append([f"{n:,}", f"{ours:.3f}", f"est. {estimate:,.0f}", f"est. {estimate / ours:,.0f}×"])
         print(" | ".join(rows[-1]), flush=True)
-    header = ["corners", "g2_fillet (ours), s", "fillet_2d (peer), s", "peer / ours"]
     note = f"Single runs; fillet_2d grows as N^{exponent:.2f} (fitted to {', '.join(map(str, sizes))} corners)."
-    print("| " + " | ".join(header) + " |")
-    for row in rows:
-        print("| " + " | ".join(row) + " |")
-    print(f"{note} machine: {machine()}")
-    if args.out:
-        write_markdown(args.out, "G2 fillets at scale", note, header, rows)
+    report = Report("G2 fillets at scale", note)
+    header = ["corners", "g2_fillet (ours), s", "fillet_2d (peer), s", "peer / ours"]
+    report.section("g2_fillet against build123d's fillet_2d", table(header, rows))
+    report.finish(args)
 
 
 if __name__ == "__main__":

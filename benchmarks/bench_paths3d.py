@@ -176,7 +176,7 @@ def main() -> None:
     head = ["job", "size", "time (s)", "rate / detail", "peer in the same run", "note"]
     with tempfile.TemporaryDirectory() as folder:
         rows = rounding_rows(sizes, repeat) + gcode_rows(sizes, Path(folder)) + sweep_rows(sizes)
-    lines = [f"machine: {machine()}; medians of {repeat} runs (G-code and sweep: one run each)", "",
+    lines = [f"Machine: {machine()}; medians of {repeat} runs (G-code and sweep: one run each)", "",
              "| " + " | ".join(head) + " |", "|" + "---|" * len(head)]  # fmt: skip
     lines += ["| " + " | ".join(row) + " |" for row in rows]
     print("\n".join(lines))

@@ -30,7 +30,10 @@ def main() -> None:
     parser.add_argument("--pis", type=int, nargs="+", default=[250, 1000, 4000])
     parser.add_argument("--repeat", type=int, default=3)
     parser.add_argument("--out", help="also write the table to this markdown file")
+    parser.add_argument("--quick", action="store_true", help="smallest sizes: a smoke test (timing.py)")
     args = parser.parse_args()
+    if args.quick:
+        args.pis, args.repeat = [4], 1
     rows = []
     folder = Path(tempfile.mkdtemp())
     for count in args.pis:

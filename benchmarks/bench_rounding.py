@@ -1,17 +1,16 @@
-"""Corner rounding throughput: 1,000,000 corners of a random polyline.
+"""Corner rounding throughput: every corner of a long random polyline, against leg sharing alone.
 
-Run: ``.venv/bin/python benchmarks/bench_rounding.py [--corners N] [--repeat R]``.
-Times ``corner_legs`` (leg sharing along the polyline) plus
-``round_corners_batch`` for both spiral pairs and prints a markdown table of
-medians over ``repeat`` runs. Goal: 1 M corners in ≤ 1 s.
+Run: ``.venv/bin/python benchmarks/bench_rounding.py [--quick] [--corners N] [--rounds R] [--out FILE]``
+(the harness and its conventions: ``timing.py``). Times ``corner_legs`` (leg
+sharing along the polyline) and ``round_corners_batch`` for each spiral pair,
+all in the same alternating rounds; the peer is ``corner_legs`` alone (the
+work any rounding must do first). Goal: 1 M corners in ≤ 1 s, legs included.
 """
 
 from __future__ import annotations
 
-import argparse
-
 import numpy as np
-from timing import machine, median_time
+from timing import Report, arguments, compare, per_second
 
 from spiral_cad.design import corner_legs, round_corners_batch
 
@@ -27,44 +26,29 @@ def random_polyline(corners: int, rng: np.random.Generator) -> np.ndarray:
 
 
 def main() -> None:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--corners", type=int, default=1_000_000)
-    parser.add_argument("--repeat", type=int, default=5)
-    parser.add_argument("--out", help="also write the table to this markdown file")
-    args = parser.parse_args()
-    lines: list[str] = []
-
-    def emit(line: str = "") -> None:
-        print(line, flush=True)
-        lines.append(line)
-
-    points = random_polyline(args.corners, np.random.default_rng(1))
-    emit(f"machine: {machine()}")
-    emit(f"{args.corners:,} corners, median of {args.repeat} runs\n")
-    emit("| case | time (s) | corners/s | 1 M corners ≤ 1 s |")
-    emit("|---|---:|---:|:---:|")
-    legs_time = median_time(lambda: corner_legs(points), args.repeat)
+    args = arguments(__doc__, corners=(1_000_000, 2_000), rounds=(5, 1))
+    n = args.corners
+    points = random_polyline(n, np.random.default_rng(1))
     p0, corners, p1, _ = corner_legs(points)
-    cases = [
-        ("corner_legs (leg sharing) only", lambda: corner_legs(points), None),
-        ("walton-meek, largest fit", lambda: round_corners_batch(p0, corners, p1), "walton-meek"),
-        ("walton-meek, κmax = 2", lambda: round_corners_batch(p0, corners, p1, max_curvature=2.0), "walton-meek"),
-        ("g2cbs, largest fit", lambda: round_corners_batch(p0, corners, p1, method="g2cbs"), "g2cbs"),
-        ("g2cbs, κmax = 2", lambda: round_corners_batch(p0, corners, p1, max_curvature=2.0, method="g2cbs"), "g2cbs"),
-    ]
-    for name, fn, method in cases:
-        t = legs_time if method is None else median_time(fn, args.repeat)
-        total = t if method is None else t + legs_time  # polyline → spirals, end to end
-        label = name if method is None else f"{name} (+ legs)"
-        per_million = total * 1e6 / args.corners
-        goal = "yes" if per_million <= 1.0 else "no"
-        emit(f"| {label} | {total:.3f} | {args.corners / total:,.0f} | {goal} |")
+    jobs = {
+        "legs": lambda: corner_legs(points),
+        "walton-meek, largest fit": lambda: round_corners_batch(p0, corners, p1),
+        "walton-meek, κmax = 2": lambda: round_corners_batch(p0, corners, p1, max_curvature=2.0),
+        "near-linear, largest fit": lambda: round_corners_batch(p0, corners, p1, shape="near-linear"),
+        "g2cbs, largest fit": lambda: round_corners_batch(p0, corners, p1, shape="g2cbs"),
+        "g2cbs, κmax = 2": lambda: round_corners_batch(p0, corners, p1, max_curvature=2.0, shape="g2cbs"),
+    }
+    t = compare(jobs, args.rounds)
+    report = Report("Corner rounding benchmark", f"{n:,} corners of a random polyline; medians of {args.rounds} alternating rounds.")
+    legs = t.pop("legs")
+    report.add("corner_legs (leg sharing) alone", per_second(n, legs), "M corners/s", legs)
+    for name, timing in t.items():
+        total = timing.median + legs.median  # polyline → spirals, end to end
+        report.add(f"{name} (+ legs)", n / total / 1e6, "M corners/s", timing, f"legs alone {legs.median * 1e3:,.1f} ms",
+                   legs.median / total, "1 M corners ≤ 1 s" if total * 1e6 / n <= 1.0 else "1 M corners ≤ 1 s: missed")  # fmt: skip
     result = round_corners_batch(p0, corners, p1, max_curvature=2.0)
-    emit(f"\nκmax = 2: {result.ok.sum():,} corners rounded, {(~result.ok).sum():,} report legs too short")
-
-    if args.out:
-        with open(args.out, "w", encoding="utf-8") as fh:
-            fh.write("# Corner rounding benchmark\n\n" + "\n".join(lines) + "\n")
+    report.section("κmax = 2", f"{int(result.ok.sum()):,} corners rounded, {int((~result.ok).sum()):,} report legs too short.")
+    report.finish(args)
 
 
 if __name__ == "__main__":

@@ -1,6 +1,6 @@
 """Spiral shapes side by side: the jerk-limited design table and peak/mean dκ/ds by spiral angle.
 
-Run: ``.venv/bin/python benchmarks/bench_shapes.py [--out FILE]``.
+Run: ``.venv/bin/python benchmarks/bench_shapes.py [--quick] [--samples N] [--out FILE]`` (conventions: ``timing.py``).
 
 1. Design speed V, radius R and jerk limit C → the spiral length L and the
    circle's shift p of the clothoid rule (L = v³/(R·C), p ≈ L²/(24R)), of the
@@ -13,11 +13,10 @@ Run: ``.venv/bin/python benchmarks/bench_shapes.py [--out FILE]``.
 
 from __future__ import annotations
 
-import argparse
 import math
 
 import numpy as np
-from timing import machine
+from timing import Report, arguments, table
 
 from spiral_cad import BezierSpiral
 from spiral_cad.core.factors import length_factor, shift_factor
@@ -28,9 +27,9 @@ DESIGNS = ((60, 120, 0.9), (80, 250, 0.6), (100, 500, 0.5), (100, 700, 0.5), (12
 ANGLES = (2, 5, 8, 15, 30, 45, 60)
 
 
-def design_rows() -> list[list[str]]:
+def design_rows(designs=DESIGNS) -> list[list[str]]:
     rows = []
-    for speed, radius, jerk in DESIGNS:
+    for speed, radius, jerk in designs:
         v = speed / 3.6
         clothoid = v**3 / (radius * jerk)
         row = [f"{speed}", f"{radius}", f"{jerk}", f"{clothoid:.2f}, {clothoid**2 / (24 * radius):.3f}"]
@@ -45,48 +44,37 @@ def design_rows() -> list[list[str]]:
     return rows
 
 
-def ratio(theta: float, shape: str) -> float:
+def ratio(theta: float, shape: str, samples: int) -> float:
     """max dκ/ds · L / κ_end, sampled densely along the spiral."""
     spiral = BezierSpiral((0.0, 0.0), (1.0, 0.0), theta, 1.0, shape=shape)
-    u = np.linspace(0.0, 1.0, 400_001)
+    u = np.linspace(0.0, 1.0, samples)
     points = spiral.point(u)
     s = np.concatenate([[0.0], np.cumsum(np.hypot(*np.diff(points, axis=0).T))])
     kappa = spiral.curvature(u)
     return float(np.max(np.diff(kappa) / np.diff(s)) * s[-1] / kappa[-1])
 
 
-def angle_rows() -> list[list[str]]:
+def angle_rows(samples: int, angles=ANGLES) -> list[list[str]]:
     rows = []
-    for degrees in ANGLES:
+    for degrees in angles:
         cells = [f"{degrees}°"]
         for shape in SHAPES:
             fits = shape != "near-linear" or degrees <= 50
-            cells.append(f"{ratio(math.radians(degrees), shape):.4f}" if fits else "— (near-linear ends at 50°)")
+            cells.append(f"{ratio(math.radians(degrees), shape, samples):.4f}" if fits else "— (near-linear ends at 50°)")
         rows.append(cells)
     return rows
 
 
-def table(header: list[str], rows: list[list[str]]) -> str:
-    lines = ["| " + " | ".join(header) + " |", "|" + "---|" * len(header)]
-    return "\n".join(lines + ["| " + " | ".join(row) + " |" for row in rows])
-
-
 def main() -> None:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--out", help="also write the tables to this markdown file")
-    args = parser.parse_args()
-    designs = table(["V km/h", "R m", "C m/s³", "clothoid L, p (m)", "1996 spiral L, p (m)", "near-linear L, p (m)"], design_rows())
-    angles = table(["θ", "1996 spiral", "near-linear"], angle_rows())
-    text = (
-        "## Spiral length at a jerk limit\n\nThe shortest spiral whose peak lateral jerk v³·max dκ/ds equals C "
-        "(the clothoid's is constant). Road criteria also ask 0.2 m ≤ p ≤ 1.0 m.\n\n" + designs +
-        "\n\n## Peak over mean dκ/ds by spiral angle\n\nMeasured on the spirals (4·10⁵ samples): the clothoid's is 1.\n\n" + angles
-    )  # fmt: skip
-    print(text)
-    print(f"\nmachine: {machine()}")
-    if args.out:
-        with open(args.out, "w", encoding="utf-8") as handle:
-            handle.write(f"# Spiral shapes\n\nMachine: {machine()}.\n\n{text}\n")
+    args = arguments(__doc__, samples=(400_001, 2_001))
+    designs, angles = (DESIGNS[2:3], ANGLES[:2]) if args.quick else (DESIGNS, ANGLES)
+    report = Report("Spiral shapes")
+    header = ["V km/h", "R m", "C m/s³", "clothoid L, p (m)", "1996 spiral L, p (m)", "near-linear L, p (m)"]
+    report.section("Spiral length at a jerk limit", "The shortest spiral whose peak lateral jerk v³·max dκ/ds equals C "
+                   "(the clothoid's is constant). Road criteria also ask 0.2 m ≤ p ≤ 1.0 m.\n\n" + table(header, design_rows(designs)))
+    report.section("Peak over mean dκ/ds by spiral angle", f"Measured on the spirals ({args.samples:,} samples): the clothoid's is 1.\n\n"
+                   + table(["θ", "1996 spiral", "near-linear"], angle_rows(args.samples, angles)))  # fmt: skip
+    report.finish(args)
 
 
 if __name__ == "__main__":

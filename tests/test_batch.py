@@ -131,3 +131,69 @@ def test_batch_theta_matches_the_scalar_theta():
     res = batch.line_to_circle((0, 0), (1, 0), centers, 1.0)
     scalar = [sc.line_to_circle((0, 0), (1, 0), c, 1.0).theta for c in centers.tolist()]
     np.testing.assert_allclose(res.theta, scalar, rtol=4e-16, atol=0)
+
+
+# ------------------------------------------------ the vectorised rows and threads
+
+
+def _ordinary_rows(n):
+    """Random rows of each case, most of them within the near-linear spirals' reach too."""
+    r = np.random.default_rng(11)
+    p, angle = r.normal(size=(n, 2)) * 3, r.uniform(-np.pi, np.pi, n)
+    t = np.stack([np.cos(angle), np.sin(angle)], 1)
+    radii, side = r.uniform(0.2, 3, n), r.choice([-1.0, 1.0], n)
+    c = p + r.normal(size=n)[:, None] * t + (side * radii * r.uniform(1.0005, 1.12, n))[:, None] * t[:, ::-1] * [-1, 1]
+    c0, r0, r1 = r.normal(size=(n, 2)) * 5, r.uniform(0.2, 3, n), r.uniform(0.2, 3, n)
+    s_shape = r.random(n) < 0.5
+    reach = np.where(s_shape, (r0 + r1) * r.uniform(1.01, 1.4, n), np.abs(r1 - r0) + (r0 + r1) * r.uniform(0.05, 0.8, n))
+    c1 = c0 + reach[:, None] * t
+    r1 = np.where(s_shape, -r1, r1)
+    corner = r.normal(size=(n, 2)) * 3
+    p0, p1 = corner + r.normal(size=(n, 2)) * 5, corner + r.normal(size=(n, 2)) * 5
+    k = np.where(r.random(n) < 0.5, np.nan, r.uniform(0.05, 3, n))
+    return (p, t * r.uniform(0.1, 10, n)[:, None], c, radii), (c0, r0, c1, r1), (p0, corner, p1, k)
+
+
+@pytest.mark.parametrize("shape", ["walton-meek", "near-linear"])
+def test_vectorised_rows_are_the_general_rows_bit_for_bit(shape):
+    """Rows the blocks solve on vectors of rows (``*_fast``) get exactly what the general
+    row function (checks, scaled frames, exact residuals) gives them."""
+    from spiral_cad.core import _kernels as K
+
+    code = {"walton-meek": K.WALTON_MEEK, "near-linear": K.NEAR_LINEAR}[shape]
+    lc, cc, ll = _ordinary_rows(300)
+    cases = [(batch.line_to_circle(*lc, shape=shape), K.line_to_circle_general, np.column_stack([lc[0], lc[1], lc[2], lc[3]])),
+             (batch.circle_to_circle(*cc, shape=shape), K.circle_to_circle_general,
+              np.column_stack([cc[0], cc[1], cc[2], cc[3]])),
+             (batch.line_to_line(*ll, shape=shape), K.line_to_line_general, np.column_stack(ll[:3] + (ll[3],)))]  # fmt: skip
+    for result, general, rows in cases:
+        assert result.ok.sum() > 100
+        for i, row in enumerate(rows.tolist()):
+            out = np.empty((1, len(result.spirals), 4, 2))
+            status, theta, _, _ = general(*row, code, out, 0)
+            assert status == result.status[i]
+            if status == Status.OK:
+                assert theta == result.theta[i]
+                assert np.array_equal(out[0], np.stack([s[i] for s in result.spirals]))
+
+
+def test_batches_split_over_threads_give_the_bits_of_one_call():
+    from spiral_cad.core import _kernels as K
+    from spiral_cad.core._threads import ROWS_PER_THREAD
+
+    n = 2 * ROWS_PER_THREAD + 17
+    r = np.random.default_rng(5)
+    p, d, c, radii = r.normal(size=(n, 2)), r.normal(size=(n, 2)), r.normal(size=(n, 2)) * 4, r.uniform(0.2, 3, n)
+    split = batch.line_to_circle(p, d, c, radii)
+    out, status, theta, measure = np.empty((n, 1, 4, 2)), np.empty(n, np.int8), np.empty(n), np.empty(n)
+    K.line_to_circle_batch(p, d, c, radii, K.WALTON_MEEK, out, status, theta, measure)
+    assert np.array_equal(split.spirals[0], out[:, 0], equal_nan=True)
+    assert np.array_equal(split.status, status) and np.array_equal(split.theta, theta, equal_nan=True)
+
+
+def test_shared_input_rows_are_read_in_place_not_copied():
+    centers = np.tile([0.0, 105.0], (5, 1))
+    res = batch.line_to_circle([0.0, 0.0], [1.0, 0.0], centers, 100.0)
+    assert res.ok.all() and res.inputs["point"].shape == (5, 2) and res.inputs["radius"].shape == (5,)
+    assert res.inputs["point"].strides[0] == 0  # one stored row, shown as five
+    assert np.array_equal(res.spirals[0][0], res.spirals[0][4])

@@ -414,3 +414,21 @@ def test_design_files_name_the_spiral_shape():
     t = one({"name": "t", "type": "transition", "case": "line_to_circle", "point": [0, 0], "direction": [1, 0],
              "center": [0, 105], "radius": 100, "spiral_shape": "near-linear"})  # fmt: skip
     assert t.source.shape == "near-linear"
+
+
+def test_line_to_circle_beyond_the_equal_legs_solves_the_shift_to_a_few_ulp():
+    """Past 33.56° the angle is a root (Newton on the shift cubic in cos θ); it must match
+    the exact root of g1(θ) − 1 = q as closely as the closed forms do."""
+    import mpmath as mp
+
+    mp.mp.dps = 40
+
+    def shift(c):  # the continuation member: r = 1.8c − 0.5, γ = (r + 4)/(9c)
+        gamma = (mp.mpf(1.8) * c + mp.mpf(3.5)) / (9 * c)
+        return (1 - c * c) * (gamma - 1 / (1 + c))
+
+    for q in np.linspace(1 / 27 + 1e-6, 0.115, 25).tolist():
+        t = sc.line_to_circle((0, 0), (1, 0), (0, 1 + q), 1.0, shape="near-linear")
+        assert t.theta > math.acos(5 / 6)
+        exact = mp.acos(mp.findroot(lambda c: shift(c) - (mp.mpf(1 + q) - 1), mp.mpf(math.cos(t.theta))))
+        assert abs(t.theta - exact) <= 4 * math.ulp(t.theta)

@@ -158,3 +158,16 @@ def test_from_control_points_validates_shape():
         BezierSpiral.from_control_points(np.zeros((3, 2)))
     with pytest.raises(ValueError, match="finite"):
         BezierSpiral.from_control_points([[0, 0], [1, 0], [2, 0], [math.nan, 1]])
+
+
+def test_evaluation_keeps_the_parameter_shape_and_matches_the_bernstein_form():
+    s = BezierSpiral((3, -2), (1, 0.5), 0.9, 0.2)
+    cp = s.control_points
+    u = np.random.default_rng(0).random((7, 5))
+    v = 1 - u
+    bernstein = sum(w[..., None] * p for w, p in zip((v**3, 3 * u * v * v, 3 * u * u * v, u**3), cp))
+    assert s.point(u).shape == (7, 5, 2) and np.allclose(s.point(u), bernstein, rtol=0, atol=1e-13)
+    assert s.point(0.5).shape == (2,) and s.point([]).shape == (0, 2)
+    assert isinstance(s.curvature(0.5), float) and s.curvature(u).shape == (7, 5)
+    assert s.curvature([0.0, 1.0]) == pytest.approx([0.0, 0.2], abs=1e-15)
+    assert np.isnan(s.point([np.nan])).all() and np.isnan(s.curvature([np.nan])).all()

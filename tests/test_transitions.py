@@ -279,3 +279,36 @@ def test_theta_near_half_pi_is_verified_or_refused():
         assert j.gap <= 1e-9 and j.angle <= 1e-9 and j.curvature_jump <= 1e-9
     with pytest.raises(NoSolutionError, match="reproduces its contacts only to"):
         line_to_circle((0, 0), (1, 0), (0, 1e6), 1.0)
+
+
+def test_spiral_angle_is_atan2_of_its_sine_and_cosine_to_an_ulp():
+    """θ comes from the kernels' arctangent (shared by scalar and batch rows): within
+    0.7 ulp of the exact atan2 over the whole quadrant, as libm's own."""
+    import mpmath as mp
+
+    from spiral_cad.core._kernels import angle
+
+    mp.mp.dps = 40
+    rng = np.random.default_rng(3)
+    thetas = np.concatenate([rng.uniform(0, math.pi / 2, 3000), 10.0 ** rng.uniform(-300, -1, 300),
+                             math.pi / 2 - 10.0 ** rng.uniform(-15, -1, 300),
+                             (np.arctan([0.4375, 0.6875, 1.1875, 2.4375]) + rng.uniform(-1e-9, 1e-9, (100, 4))).ravel()])  # fmt: skip
+    for t in thetas.ravel().tolist():
+        y, x = math.sin(t), math.cos(t)
+        exact = mp.atan2(y, x)
+        assert abs(mp.mpf(angle(y, x)) - exact) <= 0.7 * math.ulp(float(exact))
+    assert angle(0.0, 1.0) == 0.0 and angle(1.0, 0.0) == math.pi / 2 and math.isnan(angle(math.nan, 1.0))
+
+
+@pytest.mark.parametrize(
+    "point, message",
+    [([True, 0.0], r"point\[0\] must be a real number"), ((0.0, math.inf), r"point\[1\] must be finite"),
+     ([0, 10**400], r"point\[1\] is too large"), ((1.5, "2"), r"point\[1\] must be a real number"),
+     ([0.0, 0.0, 1.0], "point must have 2 coordinates")],  # fmt: skip
+)
+def test_two_number_points_are_checked_item_by_item(point, message):
+    """Tuples and lists of two floats take a short path; anything else in them is named as before."""
+    with pytest.raises(ValueError, match=message):
+        line_to_circle(point, (1, 0), (0, 105), 100)
+    as_list = line_to_circle([0, 0.0], [1, 0], (0, 105), 100).spirals[0].control_points
+    assert np.array_equal(as_list, line_to_circle((0, 0), (1, 0), (0, 105), 100).spirals[0].control_points)

@@ -75,9 +75,19 @@ def as_float(value: Any, name: str) -> float:
 
 def as_xy(value: Any, name: str) -> tuple[float, float]:
     """``value`` (a 2-sequence, or a 3-vector with z = 0) as two finite floats."""
-    if type(value) is tuple and len(value) == 2:  # the common cases, checked cheaply
-        return as_float(value[0], f"{name}[0]"), as_float(value[1], f"{name}[1]")
-    if type(value) is np.ndarray and value.shape == (2,) and value.dtype == np.float64:
+    if (type(value) is tuple or type(value) is list) and len(value) == 2:  # the common cases, checked cheaply
+        x, y = value
+        if type(x) is float and type(y) is float and math.isfinite(x) and math.isfinite(y):
+            return x, y
+        if (type(x) is float or type(x) is int) and (type(y) is float or type(y) is int):
+            try:
+                x, y = float(x), float(y)
+            except OverflowError:  # an int beyond float64: named below
+                pass
+            else:
+                if math.isfinite(x) and math.isfinite(y):
+                    return x, y
+    elif type(value) is np.ndarray and value.shape == (2,) and value.dtype == np.float64:
         x, y = value.tolist()
         if math.isfinite(x) and math.isfinite(y):
             return x, y

@@ -1,7 +1,7 @@
 """Vectorised transition solvers: N problems per call, one status per row.
 
 Each function broadcasts its inputs to N rows, runs the compiled row kernel
-that the scalar API uses (in parallel over rows) and returns a
+that the scalar API uses (large batches split over threads) and returns a
 :class:`BatchResult`. A row that is infeasible or malformed gets a non-zero
 ``status`` and NaN control points; the other rows are unaffected.
 """
@@ -15,11 +15,11 @@ from numpy.typing import ArrayLike, NDArray
 
 from . import _kernels as K
 from ._inputs import as_real_array
+from ._threads import run_split
 from .errors import MALFORMED, NoSolutionError, Status, describe
 from .shapes import CORNER_SHAPES, DEFAULT_SHAPE, TRANSITION_SHAPES, shape_code
 
 __all__ = ["BatchResult", "circle_in_circle", "circle_to_circle", "line_to_circle", "line_to_line"]
-
 
 @dataclass(frozen=True)
 class BatchResult:
@@ -71,20 +71,24 @@ class BatchResult:
         return describe(self.case, int(self.status[i]), float(self.measure[i]), row)
 
 
-def _rows(**arrays: tuple[ArrayLike, tuple[int, ...]]) -> dict[str, NDArray]:
-    """Named inputs (value, trailing shape) as C-contiguous float64 arrays of N rows.
+def _rows(**arrays: tuple[ArrayLike, tuple[int, ...]]) -> tuple[dict[str, NDArray], int]:
+    """Named inputs (value, trailing shape) as C-contiguous float64 arrays, and the row count N.
 
-    Each input has N rows or is one row broadcast to all; a mismatch names
-    both arguments. The arrays handed to the kernels always have the same
-    type (contiguous, writeable, float64), so each kernel compiles once.
+    Each input has N rows or is one row shared by all; a mismatch names both
+    arguments. A shared row is handed to the kernels as one row (they read it
+    for every problem), so broadcasting copies nothing. The arrays handed to
+    the kernels always have the same type (contiguous, writeable, float64),
+    so each kernel compiles once.
     """
     parsed = {}
+    counts = {}
     for name, (value, trailing) in arrays.items():
         a = as_real_array(value, name)
         if a.shape[a.ndim - len(trailing) :] != trailing or not len(trailing) <= a.ndim <= len(trailing) + 1:
             raise ValueError(f"{name} must have shape (N, {', '.join(map(str, trailing))}) or {trailing}; got {a.shape}")
-        parsed[name] = a
-    counts = {name: len(a) for name, a in parsed.items() if a.ndim > len(arrays[name][1])}
+        if a.ndim > len(trailing):
+            counts[name] = len(a)
+        parsed[name] = a if a.ndim > len(trailing) else a[None]
     n = max(counts.values(), default=1)
     for name, count in counts.items():
         if count not in (1, n):
@@ -92,10 +96,9 @@ def _rows(**arrays: tuple[ArrayLike, tuple[int, ...]]) -> dict[str, NDArray]:
             raise ValueError(f"{name} has {count} rows but {longest} has {n}; each input needs N rows or one")
     rows = {}
     for name, a in parsed.items():
-        a = np.broadcast_to(a, (n,) + arrays[name][1])
         ready = a.flags.c_contiguous and a.flags.writeable and a.flags.aligned and a.dtype == np.float64
         rows[name] = a if ready else np.array(a, dtype=np.float64, order="C")
-    return rows
+    return rows, n
 
 
 def _output(out: NDArray | None, n: int, spirals: int) -> NDArray:
@@ -110,17 +113,19 @@ def _output(out: NDArray | None, n: int, spirals: int) -> NDArray:
     return out
 
 
-def _run(case: str, kernel, spirals: int, rows: dict[str, NDArray], out: NDArray | None, shape: str, extra: bool = False) -> BatchResult:
-    n = len(next(iter(rows.values())))
+def _run(case: str, kernel, spirals: int, inputs: tuple[dict[str, NDArray], int], out: NDArray | None, shape: str,
+         extra: bool = False) -> BatchResult:  # fmt: skip
+    rows, n = inputs
     out = _output(out, n, spirals)
     status = np.empty(n, dtype=np.int8)
     theta = np.empty(n)
     measure = np.empty(n)
     parameter = np.empty(n) if extra else None
     code = shape_code(shape, CORNER_SHAPES if case == "line_to_line" else TRANSITION_SHAPES)
-    args = (*rows.values(), code, out, status, theta, measure) + ((parameter,) if extra else ())
-    kernel(*args)
-    return BatchResult(case, tuple(out[:, k] for k in range(spirals)), theta, status, measure, parameter, rows, shape)
+    outputs = [out, status, theta, measure] + ([parameter] if extra else [])
+    run_split(kernel, [*rows.values(), code, *outputs], n)
+    shown = {name: np.broadcast_to(a, (n,) + a.shape[1:]) for name, a in rows.items()}  # N rows each, as views
+    return BatchResult(case, tuple(out[:, k] for k in range(spirals)), theta, status, measure, parameter, shown, shape)
 
 
 def line_to_circle(

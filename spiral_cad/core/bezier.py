@@ -1,8 +1,10 @@
-"""Cubic Bézier evaluation over arrays of parameters (pure numpy functions).
+"""Cubic Bézier evaluation over arrays of parameters.
 
 Every function takes control points ``cp`` of shape (4, 2) and parameters
 ``u`` (a float or an array of any shape) and returns arrays whose leading
-shape is that of ``u``.
+shape is that of ``u``. One curve is evaluated by compiled loops
+(``spiral_cad.core._kernels``: each value in registers, written once), many
+curves by numpy broadcasting.
 """
 
 from __future__ import annotations
@@ -12,13 +14,13 @@ import math
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from . import _kernels as K
+
 #: Gauss–Legendre nodes used by :func:`arc_length` (per panel, 4 panels).
 _GL_NODES, _GL_WEIGHTS = np.polynomial.legendre.leggauss(16)
 _PANELS = 4
 _U = ((np.arange(_PANELS)[:, None] + 0.5 * (_GL_NODES[None, :] + 1.0)) / _PANELS).ravel()
 _W = np.tile(_GL_WEIGHTS / (2.0 * _PANELS), _PANELS)
-#: Curves per block of a many-curve ``arc_length``.
-_BLOCK = 512
 
 
 def _power_coefficients(cp: NDArray, order: int = 0) -> NDArray:
@@ -43,21 +45,17 @@ def _power_coefficients(cp: NDArray, order: int = 0) -> NDArray:
 
 
 def _horner(coefficients: NDArray, u: ArrayLike) -> NDArray:
-    """Evaluate polynomials with 2-D or 3-D coefficients (…, k, d), lowest first, at ``u``.
+    """Evaluate polynomials with 2-D coefficients (…, k, 2), lowest first, at ``u``.
 
-    One curve (k, d) gives ``u.shape + (d,)``; N curves (N, k, d) broadcast
-    against ``u`` of shape (N, m) or (m,) and give (N, m, d).
+    One curve (k, 2) gives ``u.shape + (2,)``; N curves (N, k, 2) broadcast
+    against ``u`` of shape (N, m) or (m,) and give (N, m, 2).
     """
     u = np.asarray(u, dtype=float)
-    if coefficients.ndim == 2:  # one curve: each coordinate on its own contiguous array (the fast path)
-        out = np.empty(u.shape + coefficients.shape[-1:])
-        for j in range(coefficients.shape[-1]):
-            acc = np.full(u.shape, coefficients[-1, j])
-            for c in coefficients[-2::-1, j]:
-                acc *= u
-                acc += c
-            out[..., j] = acc
-        return out
+    if coefficients.ndim == 2:  # one curve: a compiled loop, each value in registers
+        flat = _parameters(u)
+        out = np.empty((flat.size, coefficients.shape[1]))
+        K.polynomial_values(np.ascontiguousarray(coefficients, dtype=float), flat, out)
+        return out.reshape(u.shape + coefficients.shape[1:])
     u = u[..., None]
     terms = coefficients[..., None, :, :]  # an axis for the samples
     acc = np.broadcast_to(terms[..., -1, :], np.broadcast_shapes(u.shape, terms[..., -1, :].shape)).copy()
@@ -65,6 +63,11 @@ def _horner(coefficients: NDArray, u: ArrayLike) -> NDArray:
         acc *= u
         acc += terms[..., j, :]
     return acc
+
+
+def _parameters(u: NDArray) -> NDArray:
+    """``u`` as a flat contiguous float64 array (the one type the kernels compile for)."""
+    return np.ascontiguousarray(u, dtype=float).reshape(-1)
 
 
 def point(cp: NDArray, u: ArrayLike) -> NDArray:
@@ -96,18 +99,10 @@ def curvature(cp: NDArray, u: ArrayLike) -> NDArray:
     u = np.asarray(u, dtype=float)
     first, second = _power_coefficients(cp, 1), _power_coefficients(cp, 2)
     scale = _scale(first)
-    (b0x, b0y), (b1x, b1y), (b2x, b2y) = (first / scale).tolist()
-    (c0x, c0y), (c1x, c1y) = (second / scale).tolist()
-    u2 = u * u
-    dx = b2x * u2 + b1x * u + b0x
-    dy = b2y * u2 + b1y * u + b0y
-    cross = dx * (c1y * u + c0y)
-    cross -= dy * (c1x * u + c0x)
-    dx *= dx
-    dy *= dy
-    dx += dy  # |Q'|²
-    cross /= dx * np.sqrt(dx) * scale
-    return cross
+    flat = _parameters(u)
+    out = np.empty(flat.size)
+    K.plane_curvatures(first / scale, second / scale, scale, flat, out)
+    return out.reshape(u.shape)
 
 
 def arc_length(cp: ArrayLike, u: ArrayLike = 1.0) -> NDArray | float:
@@ -118,20 +113,10 @@ def arc_length(cp: ArrayLike, u: ArrayLike = 1.0) -> NDArray | float:
     exact to ~1e-15 relative (checked against adaptive quadrature).
     """
     u = np.asarray(u, dtype=float)
-    cp = np.asarray(cp, dtype=float)
-    if cp.ndim == 3 and u.ndim == 0 and len(cp) > _BLOCK:  # blocks whose temporaries stay in cache (same bits)
-        return np.concatenate([arc_length(cp[i : i + _BLOCK], u) for i in range(0, len(cp), _BLOCK)])
-    coefficients = _power_coefficients(cp, 1)
+    coefficients = _power_coefficients(np.asarray(cp, dtype=float), 1)
     scale = _scale(coefficients)
-    c = coefficients / scale
-    nodes = u[..., None] * _U
-    if c.ndim > 2:  # many curves: nodes broadcast against them
-        c = c[..., None, :, :]
-    squares = 0.0
-    for j in range(c.shape[-1]):  # |Q'|² one coordinate at a time (no (…, nodes, d) temporaries)
-        component = (c[..., 2, j] * nodes + c[..., 1, j]) * nodes + c[..., 0, j]
-        squares = squares + component * component
-    result = np.sqrt(squares) @ _W * u * scale
+    speed = np.linalg.norm(_horner(coefficients / scale, u[..., None] * _U), axis=-1)
+    result = speed @ _W * u * scale
     return float(result) if result.ndim == 0 else result
 
 

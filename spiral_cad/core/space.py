@@ -16,11 +16,11 @@ from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
-from numba import prange
 from numpy.typing import ArrayLike, NDArray
 
 from . import _kernels as K
 from ._inputs import as_float, as_real_array
+from ._threads import run_split
 
 #: Legs whose |sin(turn)| is at most this span no plane.
 COLLINEAR_TOL = 1e-12
@@ -49,12 +49,12 @@ def place(points: ArrayLike, origin: ArrayLike, x_dir: ArrayLike, y_dir: ArrayLi
     frames = [np.require(f, np.float64, ["C", "W", "A"]) for f in frames]
     flat = np.require(flat, np.float64, ["C", "W", "A"])
     out = np.empty((count, inner, 3))
-    (_place_rows_parallel if count * inner >= PARALLEL_FROM else _place_rows)(flat, *frames, out)
+    run_split(_place_rows, [flat, *frames, out], count, max(1, POINTS_PER_THREAD // max(inner, 1)))
     return out.reshape(lead + (3,))
 
 
-#: Points from which ``place`` runs in parallel: waking the threads can cost milliseconds on a busy machine.
-PARALLEL_FROM = 100_000
+#: Points per thread from which ``place`` and the pair check split over threads.
+POINTS_PER_THREAD = 100_000
 
 
 @K.jit
@@ -69,12 +69,6 @@ def _place_row(points, origin, x_dir, y_dir, out, i):
 @K.jit
 def _place_rows(points, origin, x_dir, y_dir, out):
     for i in range(points.shape[0]):
-        _place_row(points, origin, x_dir, y_dir, out, i)
-
-
-@K._compile(parallel=True)
-def _place_rows_parallel(points, origin, x_dir, y_dir, out):
-    for i in prange(points.shape[0]):
         _place_row(points, origin, x_dir, y_dir, out, i)
 
 
@@ -135,8 +129,8 @@ def placed_pair_residuals(pairs: NDArray, corners: NDArray, x_dir: NDArray, y_di
     receives the worst of these (NaN counted infinite), ``deviation`` (N,)
     the distance from each corner to its pair's joint.
     """
-    run = _pair_residuals_parallel if len(corners) * 8 >= PARALLEL_FROM else _pair_residuals
-    run(pairs, corners, x_dir, y_dir, outgoing, peak, residual, deviation)
+    args = [pairs, corners, x_dir, y_dir, outgoing, peak, residual, deviation]
+    run_split(_pair_residuals, args, len(corners), POINTS_PER_THREAD // 8)
 
 
 @K.jit
@@ -168,11 +162,6 @@ def _pair_residuals(pairs, corners, x_dir, y_dir, outgoing, peak, residual, devi
     for i in range(corners.shape[0]):
         _pair_residual(pairs, corners, x_dir, y_dir, outgoing, peak, residual, deviation, i)
 
-
-@K._compile(parallel=True)
-def _pair_residuals_parallel(pairs, corners, x_dir, y_dir, outgoing, peak, residual, deviation):
-    for i in prange(corners.shape[0]):
-        _pair_residual(pairs, corners, x_dir, y_dir, outgoing, peak, residual, deviation, i)
 
 
 def _vector3(value: Any, name: str) -> NDArray:

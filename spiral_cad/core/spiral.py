@@ -55,16 +55,16 @@ class BezierSpiral(Segment):
         theta = as_float(theta, "theta")
         curvature = as_float(curvature, "curvature")
         code = shape_code(shape, TRANSITION_SHAPES)
-        out = np.empty((1, 4, 2))
-        status, _, measure, _ = spiral_row(bx, by, dx, dy, theta, curvature, code, out)
+        out = np.empty((1, 1, 4, 2))
+        status, _, measure, _ = spiral_row(bx, by, dx, dy, theta, curvature, code, out, 0)
         if status != Status.OK:
             inputs = dict(start=(bx, by), direction=(dx, dy), theta=theta, curvature=curvature, shape=shape)
             raise error_for("BezierSpiral", status, measure, inputs)
-        self._cp = out[0]
+        self._cp = out[0, 0]
         self._dim = 2
         self._length = None
         self._shape = shape
-        self._cp.flags.writeable = False
+        self._cp.setflags(write=False)
 
     @classmethod
     def from_control_points(cls, control_points: ArrayLike, shape: str | None = None) -> BezierSpiral:
@@ -109,7 +109,7 @@ class BezierSpiral(Segment):
     def _wrap(cls, cp: NDArray, shape: str | None, length: float | None = None) -> BezierSpiral:
         """Adopt a finite (4, 2) or (4, 3) float64 array without copying or checks (solver output)."""
         spiral = object.__new__(cls)
-        cp.flags.writeable = False
+        cp.setflags(write=False)
         spiral._cp = cp
         spiral._dim = cp.shape[1]
         spiral._length = length

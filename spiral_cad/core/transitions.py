@@ -18,9 +18,9 @@ from numpy.typing import NDArray
 
 from . import _kernels as K
 from ._inputs import as_float, as_xy
-from .errors import Status, error_for
+from .errors import error_for
 from .segments import Arc, Circle, Join, Line, Ray, Segment, measure_join
-from .shapes import CORNER_SHAPES, DEFAULT_SHAPE, TRANSITION_SHAPES, shape_code
+from .shapes import CORNER_SHAPES, DEFAULT_SHAPE, shape_code
 from .spiral import BezierSpiral
 
 
@@ -51,6 +51,19 @@ class Transition:
     start_line: Ray | None = None
     end_line: Ray | None = None
     shape: str = DEFAULT_SHAPE
+
+    @classmethod
+    def _solved(cls, kind: str, spirals: list[BezierSpiral], theta: float, shape: str, start_circle: Circle | None = None,
+                end_circle: Circle | None = None, parameter: float | None = None, start_line: Ray | None = None,
+                end_line: Ray | None = None) -> Transition:  # fmt: skip
+        """A solver's result, its fields set directly: the frozen dataclass's ``__init__``
+        sets each through ``object.__setattr__`` (a fifth of a scalar solve)."""
+        transition = object.__new__(cls)
+        object.__setattr__(transition, "__dict__", {
+            "kind": kind, "spirals": spirals, "theta": theta, "start_circle": start_circle, "end_circle": end_circle,
+            "parameter": parameter, "start_line": start_line, "end_line": end_line, "shape": shape,
+        })  # fmt: skip
+        return transition
 
     @property
     def start(self) -> NDArray:
@@ -122,14 +135,10 @@ def _contact_piece(circle: Circle | None, line: Ray | None, point: NDArray, befo
     return Line(foot - step, foot) if before else Line(foot, foot + step)
 
 
-def _solve(case: str, row, count: int, args: tuple[float, ...], inputs: dict[str, Any], allowed=TRANSITION_SHAPES):
-    shape = inputs["shape"]
-    code = shape_code(shape, allowed)
-    out = np.empty((count, 4, 2))
-    status, theta, measure, extra = row(*args, code, out)
-    if status != Status.OK:
-        raise error_for(case, status, measure, inputs)
-    return [BezierSpiral._wrap(cp, shape) for cp in out], theta, extra
+def _spirals(out: NDArray, shape: str) -> list[BezierSpiral]:
+    """The solved row ``out`` (1, k, 4, 2), k = 1 or 2, as spirals (read-only views)."""
+    first = BezierSpiral._wrap(out[0, 0], shape)
+    return [first] if out.shape[1] == 1 else [first, BezierSpiral._wrap(out[0, 1], shape)]
 
 
 def line_to_circle(point: Any, direction: Any, center: Any, radius: float, shape: str = DEFAULT_SHAPE) -> Transition:
@@ -156,17 +165,29 @@ def line_to_circle(point: Any, direction: Any, center: Any, radius: float, shape
     dx, dy = as_xy(direction, "direction")
     cx, cy = as_xy(center, "center")
     r = as_float(radius, "radius")
-    inputs = dict(point=(px, py), direction=(dx, dy), center=(cx, cy), radius=r, shape=shape)
-    spirals, theta, side = _solve("line_to_circle", K.line_to_circle_row, 1, (px, py, dx, dy, cx, cy, r), inputs)
-    sense = side * r
-    line = Ray((px, py), (dx, dy))
-    return Transition("line-circle", spirals, theta, end_circle=Circle((cx, cy), sense), start_line=line, shape=shape)
+    out = np.empty((1, 1, 4, 2))
+    status, theta, measure, side = K.line_to_circle_row(px, py, dx, dy, cx, cy, r, shape_code(shape), out, 0)
+    if status:
+        inputs = dict(point=(px, py), direction=(dx, dy), center=(cx, cy), radius=r, shape=shape)
+        raise error_for("line_to_circle", status, measure, inputs)
+    circle, line = Circle((cx, cy), side * r), Ray((px, py), (dx, dy))
+    return Transition._solved("line-circle", _spirals(out, shape), theta, shape, end_circle=circle, start_line=line)
 
 
-def _two_circles(center0: Any, radius0: Any, center1: Any, radius1: Any, shape: str) -> dict[str, Any]:
-    """The two circles' arguments coerced and named, in argument order."""
-    return dict(center0=as_xy(center0, "center0"), radius0=as_float(radius0, "radius0"),
-                center1=as_xy(center1, "center1"), radius1=as_float(radius1, "radius1"), shape=shape)  # fmt: skip
+def _two_circles(case: str, center0: Any, radius0: Any, center1: Any, radius1: Any, shape: str) -> tuple:
+    """Coerce the two circles' arguments (in argument order), solve ``case``'s row and
+    raise its error if it fails: (c0, r0, c1, r1, out, θ, extra)."""
+    c0 = as_xy(center0, "center0")
+    r0 = as_float(radius0, "radius0")
+    c1 = as_xy(center1, "center1")
+    r1 = as_float(radius1, "radius1")
+    row, spirals = (K.circle_to_circle_row, 2) if case == "circle_to_circle" else (K.circle_in_circle_row, 1)
+    out = np.empty((1, spirals, 4, 2))
+    status, theta, measure, extra = row(c0[0], c0[1], r0, c1[0], c1[1], r1, shape_code(shape), out, 0)
+    if status:
+        inputs = dict(center0=c0, radius0=r0, center1=c1, radius1=r1, shape=shape)
+        raise error_for(case, status, measure, inputs)
+    return c0, r0, c1, r1, out, theta, extra
 
 
 def circle_to_circle(center0: Any, radius0: float, center1: Any, radius1: float, shape: str = DEFAULT_SHAPE) -> Transition:
@@ -187,11 +208,9 @@ def circle_to_circle(center0: Any, radius0: float, center1: Any, radius1: float,
             circles that touch or overlap, or circles beyond the shape's reach.
         ValueError: malformed input (zero radius, coincident centres, …).
     """
-    inputs = _two_circles(center0, radius0, center1, radius1, shape)
-    c0, r0, c1, r1 = (inputs[k] for k in ("center0", "radius0", "center1", "radius1"))
-    spirals, theta, _ = _solve("circle_to_circle", K.circle_to_circle_row, 2, (*c0, r0, *c1, r1), inputs)
+    c0, r0, c1, r1, out, theta, _ = _two_circles("circle_to_circle", center0, radius0, center1, radius1, shape)
     kind = "S" if (r0 > 0) != (r1 > 0) else "C"
-    return Transition(kind, spirals, theta, Circle(c0, r0), Circle(c1, r1), shape=shape)
+    return Transition._solved(kind, _spirals(out, shape), theta, shape, Circle(c0, r0), Circle(c1, r1))
 
 
 def line_to_line(p0: Any, corner: Any, p1: Any, curvature: float | None = None, shape: str = DEFAULT_SHAPE) -> Transition:
@@ -218,10 +237,14 @@ def line_to_line(p0: Any, corner: Any, p1: Any, curvature: float | None = None, 
     p = as_xy(corner, "corner")
     b = as_xy(p1, "p1")
     k = math.nan if curvature is None else as_float(curvature, "curvature")
-    inputs = dict(p0=a, corner=p, p1=b, curvature=curvature, shape=shape)
-    spirals, theta, _ = _solve("line_to_line", K.line_to_line_row, 2, (*a, *p, *b, k), inputs, CORNER_SHAPES)
+    out = np.empty((1, 2, 4, 2))
+    code = shape_code(shape, CORNER_SHAPES)
+    status, theta, measure, _ = K.line_to_line_row(a[0], a[1], p[0], p[1], b[0], b[1], k, code, out, 0)
+    if status:
+        inputs = dict(p0=a, corner=p, p1=b, curvature=curvature, shape=shape)
+        raise error_for("line_to_line", status, measure, inputs)
     start, end = Ray(p, (p[0] - a[0], p[1] - a[1])), Ray(p, (b[0] - p[0], b[1] - p[1]))
-    return Transition("line-line", spirals, theta, start_line=start, end_line=end, shape=shape)
+    return Transition._solved("line-line", _spirals(out, shape), theta, shape, start_line=start, end_line=end)
 
 
 def circle_in_circle(center0: Any, radius0: float, center1: Any, radius1: float, shape: str = DEFAULT_SHAPE) -> Transition:
@@ -238,7 +261,6 @@ def circle_in_circle(center0: Any, radius0: float, center1: Any, radius1: float,
         NoSolutionError: centre distance outside the band, or equal radii.
         ValueError: malformed input or radii of different signs.
     """
-    inputs = _two_circles(center0, radius0, center1, radius1, shape)
-    c0, r0, c1, r1 = (inputs[k] for k in ("center0", "radius0", "center1", "radius1"))
-    spirals, theta, t = _solve("circle_in_circle", K.circle_in_circle_row, 1, (*c0, r0, *c1, r1), inputs)
-    return Transition("circle-circle-nested", spirals, theta, Circle(c0, r0), Circle(c1, r1), parameter=t, shape=shape)
+    c0, r0, c1, r1, out, theta, t = _two_circles("circle_in_circle", center0, radius0, center1, radius1, shape)
+    circles = Circle(c0, r0), Circle(c1, r1)
+    return Transition._solved("circle-circle-nested", _spirals(out, shape), theta, shape, *circles, parameter=t)

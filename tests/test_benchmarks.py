@@ -1,0 +1,35 @@
+"""The benchmarks run: every ``benchmarks/bench_*.py`` in quick mode writes its table.
+
+A smoke test only: the numbers of a quick run mean nothing and are never
+checked (speed goals live in the benchmarks' own tables).
+"""
+
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+BENCH = Path(__file__).resolve().parents[1] / "benchmarks"
+SCRIPTS = sorted(BENCH.glob("bench_*.py"))
+
+
+@pytest.mark.parametrize("script", SCRIPTS, ids=lambda path: path.stem)
+def test_benchmark_runs_quick_and_writes_its_table(script, tmp_path):
+    out = tmp_path / "results.md"
+    done = subprocess.run([sys.executable, str(script), "--quick", "--out", str(out)], cwd=BENCH,
+                          capture_output=True, text=True, timeout=600)  # fmt: skip
+    assert done.returncode == 0, done.stderr[-3000:]
+    text = out.read_text(encoding="utf-8")
+    assert text.startswith("# ") and "Machine:" in text
+    assert "\n| " in text and "|---|" in text  # at least one table
+
+
+def test_run_all_runs_the_named_scripts_and_counts_failures(tmp_path):
+    done = subprocess.run([sys.executable, str(BENCH / "run_all.py"), "--quick", "--only", "shapes", "--out-dir", str(tmp_path)],
+                          cwd=BENCH, capture_output=True, text=True, timeout=600)  # fmt: skip
+    assert done.returncode == 0, done.stdout[-3000:] + done.stderr[-3000:]
+    assert [path.name for path in tmp_path.iterdir()] == ["results_shapes.md"]
+    unknown = subprocess.run([sys.executable, str(BENCH / "run_all.py"), "--quick", "--only", "nonexistent"],
+                             cwd=BENCH, capture_output=True, text=True, timeout=60)  # fmt: skip
+    assert unknown.returncode != 0 and "no benchmark named nonexistent" in unknown.stderr
