@@ -513,6 +513,13 @@ def line_residual(x0, y0, x1, y1, x2, y2, px, py, tx, ty, inv):
 
 
 @jit
+def opposite_angle(ux, uy, lu, vx, vy, lv):
+    """The tangent angle between u and −v (sine), given their lengths; infinite
+    unless they point apart (two spirals' legs at the point they share)."""
+    return abs(ux * vy - uy * vx) / (lu * lv) + (INF if ux * vx + uy * vy >= 0.0 else 0.0)
+
+
+@jit
 def joint_residual(ax1, ay1, ax2, ay2, ax3, ay3, bx1, by1, bx2, by2, bx3, by3, inv):
     """How far two spirals that meet at their ends (b3 of both, travelled towards
     each other) are from a G2 joint: gap, tangent angle, curvature jump × leg.
@@ -524,7 +531,7 @@ def joint_residual(ax1, ay1, ax2, ay2, ax3, ay3, bx1, by1, bx2, by2, bx3, by3, i
         return INF, ka, la
     gap = norm((ax3 - bx3) * inv, (ay3 - by3) * inv) / length
     # Travelling towards each other, the tangents are opposite and so are the signed curvatures.
-    angle = abs(ux * vy - uy * vx) / (la * lb) + (INF if ux * vx + uy * vy >= 0.0 else 0.0)
+    angle = opposite_angle(ux, uy, la, vx, vy, lb)
     return worst(worst(gap, angle), abs(ka + kb) * length), ka, la
 
 
@@ -568,6 +575,15 @@ def line_fits(x0, y0, x1, y1, x2, y2, px, py, tx, ty, inv):
     ay = (y1 - y0) * inv
     gap = tx * (y0 - py) * inv - ty * (x0 - px) * inv
     return start_fits(x0, y0, x1, y1, x2, y2, tx, ty, inv) & (gap * gap <= FIT2 * (ax * ax + ay * ay))
+
+
+@row_jit
+def opposite_fits(ux, uy, vx, vy):
+    """Sufficient for ``opposite_angle`` ≤ VERIFY_TOL: u·v < 0 and |u × v| ≤ tol·|u||v|."""
+    uu = ux * ux + uy * uy
+    vv = vx * vx + vy * vy
+    cross = ux * vy - uy * vx
+    return moderate(uu) & moderate(vv) & (ux * vx + uy * vy < 0.0) & (cross * cross <= FIT2 * (uu * vv))
 
 
 @row_jit
@@ -1041,10 +1057,13 @@ def _pair_frame(dx, dy, a0, a1, sin_t, cos_t, gap_p, gap_q, shape):
 @row_jit
 def _pair_fits(s0x, s0y, s1x, s1y, s2x, s2y, s3x, s3y, u1x, u1y, u2x, u2y, u3x, u3y, wtx, wty, c0x, c0y, r0, c1x, c1y, r1, inv):
     """Sufficient tests (``*_fits``) of the pair: Q0 leaves circle 0, Q1 reaches circle 1,
-    and both leave B0 = s0 along ∓T (world T = (wtx, wty)) with zero curvature."""
+    both leave B0 = s0 along ∓T (world T = (wtx, wty)) with zero curvature, and
+    their first legs are opposite there (each within the tolerance of T is not
+    enough: the angle between them could be twice it)."""
     return (
         end_fits(u1x, u1y, u2x, u2y, u3x, u3y, c0x, c0y, -r0, inv) & end_fits(s1x, s1y, s2x, s2y, s3x, s3y, c1x, c1y, r1, inv)
         & start_fits(s0x, s0y, s1x, s1y, s2x, s2y, wtx, wty, inv) & start_fits(s0x, s0y, u1x, u1y, u2x, u2y, -wtx, -wty, inv)
+        & opposite_fits((s1x - s0x) * inv, (s1y - s0y) * inv, (u1x - s0x) * inv, (u1y - s0y) * inv)
     )  # fmt: skip
 
 
@@ -1141,6 +1160,8 @@ def circle_to_circle_general(c0x, c0y, r0, c1x, c1y, r1, shape, out, i):
         )
         res = worst(res, start_residual(s0x, s0y, s1x, s1y, s2x, s2y, wtx, wty, inv)[0])
         res = worst(res, start_residual(s0x, s0y, u1x, u1y, u2x, u2y, -wtx, -wty, inv)[0])
+        ax, ay, bx, by = (s1x - s0x) * inv, (s1y - s0y) * inv, (u1x - s0x) * inv, (u1y - s0y) * inv
+        res = worst(res, opposite_angle(ax, ay, norm(ax, ay), bx, by, norm(bx, by)))
         if not res <= VERIFY_TOL:
             return fail(out, i, UNVERIFIED, res)
     store(out, i, 0, u3x, u3y, u2x, u2y, u1x, u1y, s0x, s0y)
