@@ -11,9 +11,10 @@ Jobs (a zigzag of 1 km tangents, R = 800 m, as in ``bench_roads.py``):
   criteria (80 km/h), with the growth exponent of each fitted over the sizes.
 
 Each job runs in two worker processes, ours and the baseline (the package as
-it is at git ``REF``, default ``main``, exported with ``git archive`` into a
-temporary folder), alternating run by run; the table gives medians, the
-baseline/ours ratio and the goals (``Alignment.from_pis`` ≥ 100 k segments/s:
+it is at git ``REF``, exported with ``git archive`` into a temporary folder;
+by default the package before its chains were array-backed, when git can
+find it; none in ``--quick``), alternating run by run; the table gives
+medians, the baseline/ours ratio and the goals (``Alignment.from_pis`` ≥ 100 k segments/s:
 10 000 PIs in ≤ 0.4 s with given angles, ≤ 0.6 s with criteria).
 """
 
@@ -126,9 +127,19 @@ def baseline_source(ref: str, folder: Path) -> Path:
     return folder
 
 
+#: The package before array-backed chains (the first parent of their merge).
+BEFORE_CHAINS = "0a2f552^1"
+
+
+def resolvable(ref: str) -> bool:
+    """Whether git knows ``ref`` here (a clone may be shallow, or no clone at all)."""
+    return subprocess.run(["git", "-C", str(ROOT), "rev-parse", "--verify", "--quiet", ref + "^{commit}"],
+                          capture_output=True).returncode == 0  # fmt: skip
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--baseline", default="main", help="git ref of the version to compare with ('' for none)")
+    parser.add_argument("--baseline", help=f"git ref of the version to compare with ('' for none; default {BEFORE_CHAINS})")
     parser.add_argument("--repeat", type=int, default=7)
     parser.add_argument("--quick", action="store_true", help="small sizes, one run (checks that the script works)")
     parser.add_argument("--out", help="also write the table to this markdown file")
@@ -137,6 +148,11 @@ def main() -> None:
     if args.worker:
         worker()
         return
+    if args.baseline is None:
+        args.baseline = "" if args.quick else BEFORE_CHAINS
+    if args.baseline and not resolvable(args.baseline):
+        print(f"note: git cannot find {args.baseline!r} here; measuring without a baseline")
+        args.baseline = ""
     chain_sizes, pi_sizes, repeat = ((200, 1_000), (20, 60, 200), 1) if args.quick else (CHAIN_SIZES, PI_SIZES, args.repeat)
     with tempfile.TemporaryDirectory() as scratch:
         ours = Worker(None, str(ROOT))
