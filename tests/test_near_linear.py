@@ -434,3 +434,18 @@ def test_line_to_circle_beyond_the_equal_legs_solves_the_shift_to_a_few_ulp():
         assert t.theta > math.acos(5 / 6)
         exact = mp.acos(mp.findroot(lambda c: shift(c) - (mp.mpf(1 + q) - 1), mp.mpf(math.cos(t.theta))))
         assert abs(t.theta - exact) <= 4 * math.ulp(t.theta)
+
+
+@pytest.mark.parametrize("shape", ["walton-meek", "near-linear"])
+def test_peak_rate_factor_is_the_measured_peak_and_its_branch_ends_where_the_peak_moves(shape):
+    from spiral_cad.core import factors
+    from spiral_cad.core.bezier import peak_curvature_rate
+
+    low, high = factors.search_range(shape)
+    theta = np.random.default_rng(3).uniform(low, high, 64)
+    measured = peak_curvature_rate(factors.unit_spirals(theta, shape))[0]
+    assert np.max(np.abs(factors.peak_rate_factor(theta, shape) / measured - 1.0)) < 1e-9
+    start, stop, _ = factors._interior_branch(shape)
+    switch, inside_before = (start, False) if shape == "walton-meek" else (stop, True)
+    sides = peak_curvature_rate(factors.unit_spirals(np.array([switch - 1e-9, switch + 1e-9]), shape))[1] > 1e-6
+    assert list(sides) == [inside_before, not inside_before]
