@@ -23,6 +23,7 @@ from collections.abc import Sequence
 
 import numpy as np
 
+from ..core._chain_kernels import ARC, LINE, SPIRAL
 from ..core.chain import Chain
 from ..core.segments import Arc, Line, Segment
 from ..core.spiral import BezierSpiral
@@ -73,33 +74,53 @@ def _add_arc_in_space(msp, arc: Arc, attribs: dict) -> None:
                 dxfattribs={**attribs, "extrusion": extrusion})  # fmt: skip
 
 
-def _extreme_parameters(seg: Segment) -> list[float]:
-    """Where on ``seg`` (u in [0, 1]) a coordinate can be extreme: its ends, the points of an arc
-    where it runs across an axis (its quadrant points in the plane) and the roots of a cubic's derivative."""
-    found = [0.0, 1.0]
-    if isinstance(seg, Arc):
-        (e1, e2), sense = seg.basis, math.copysign(1.0, seg.radius)
-        for axis in range(seg.dim):
-            # the axis coordinate is c + |r|·(cos a·e1 + sin a·e2): extreme where tan a = e2/e1
-            peak = math.atan2(e2[axis], e1[axis])
-            for angle in (peak, peak + math.pi):
-                u = (sense * (angle - seg.start_angle)) % (2.0 * math.pi) / seg.sweep
-                if 0.0 < u < 1.0:
-                    found.append(u)
-    elif isinstance(seg, BezierSpiral):
-        p = seg.control_points
-        a, b, c = p[1] - p[0], p[2] - p[1], p[3] - p[2]  # B'(t)/3 = a(1-t)² + 2b(1-t)t + ct²
-        for axis in range(seg.dim):
-            roots = np.roots([a[axis] - 2 * b[axis] + c[axis], 2 * (b[axis] - a[axis]), a[axis]])
-            found += [float(t.real) for t in roots if t.imag == 0 and 0 < t.real < 1]
+def _arc_extreme_parameters(arc: Arc) -> list[float]:
+    """Where inside an arc (u in (0, 1)) a coordinate can be extreme: where it runs across an axis."""
+    found = []
+    (e1, e2), sense = arc.basis, math.copysign(1.0, arc.radius)
+    for axis in range(arc.dim):
+        # the axis coordinate is c + |r|·(cos a·e1 + sin a·e2): extreme where tan a = e2/e1
+        peak = math.atan2(e2[axis], e1[axis])
+        for angle in (peak, peak + math.pi):
+            u = (sense * (angle - arc.start_angle)) % (2.0 * math.pi) / arc.sweep
+            if 0.0 < u < 1.0:
+                found.append(u)
     return found
 
 
+def _cubic_extreme_points(cp: np.ndarray) -> np.ndarray:
+    """Points of N cubic Béziers (N, 4, 3) where a coordinate can be extreme inside (0, 1):
+    the roots of B'(t)/3 = a(1−t)² + 2b(1−t)t + ct² per axis, (N, 6, 3) (an end where a root is not inside)."""
+    a, b, c = cp[:, 1] - cp[:, 0], cp[:, 2] - cp[:, 1], cp[:, 3] - cp[:, 2]
+    qa, qb, qc = a - 2.0 * b + c, 2.0 * (b - a), a  # qa·t² + qb·t + qc, per curve and axis
+    with np.errstate(divide="ignore", invalid="ignore"):
+        root = np.sqrt(qb * qb - 4.0 * qa * qc)  # NaN where the roots are complex
+        q = -0.5 * (qb + np.copysign(root, qb))  # the stable pair: q/qa and qc/q
+        t = np.stack([np.where(qa != 0.0, q / qa, -qc / qb), qc / q], axis=1).reshape(len(cp), 6)
+    t = np.where((t > 0.0) & (t < 1.0), t, 0.0)[..., None]
+    s = 1.0 - t
+    return (s**3 * cp[:, None, 0] + 3.0 * s * s * t * cp[:, None, 1] + 3.0 * s * t * t * cp[:, None, 2]
+            + t**3 * cp[:, None, 3])  # fmt: skip
+
+
 def extents(chains: Sequence[Chain]) -> tuple[tuple[float, float, float], tuple[float, float, float]]:
-    """The drawing's exact bounding box ((xmin, ymin, zmin), (xmax, ymax, zmax)); z is 0 in the plane."""
-    points = np.vstack([np.atleast_2d(seg.point(np.clip(_extreme_parameters(seg), 0.0, 1.0)))[:, :3] for chain in chains for seg in chain])
-    points = np.column_stack([points, np.zeros((len(points), 3 - points.shape[1]))])
-    low, high = points.min(axis=0), points.max(axis=0)
+    """The drawing's exact bounding box ((xmin, ymin, zmin), (xmax, ymax, zmax)); z is 0 in the plane.
+
+    From the rows of every chain: line ends, spiral ends and interior extremes
+    (all spirals at once), and each arc's ends and axis crossings."""
+    points = []
+    for chain in chains:
+        rows = chain.rows
+        lines, spirals = rows.geometry[rows.kind == LINE], rows.geometry[rows.kind == SPIRAL]
+        points += [lines[:, :2].reshape(-1, 3), spirals[:, [0, 3]].reshape(-1, 3)]
+        if len(spirals):
+            points.append(_cubic_extreme_points(spirals).reshape(-1, 3))
+        for i in np.flatnonzero(rows.kind == ARC).tolist():
+            arc = chain[i]
+            found = np.atleast_2d(arc.point(np.array([0.0, 1.0, *_arc_extreme_parameters(arc)])))
+            points.append(np.column_stack([found, np.zeros((len(found), 3 - found.shape[1]))]))
+    everything = np.vstack(points)
+    low, high = everything.min(axis=0), everything.max(axis=0)
     return (float(low[0]), float(low[1]), float(low[2])), (float(high[0]), float(high[1]), float(high[2]))
 
 
