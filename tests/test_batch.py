@@ -126,6 +126,14 @@ def test_out_buffer_is_filled_in_place_and_checked():
         batch.line_to_circle((0, 0), (1, 0), centers, 1.0, out=np.zeros((2, 2, 4, 2)))
 
 
+def test_an_out_buffer_that_overlaps_an_input_is_refused_by_name():
+    buf = np.zeros((300, 1, 4, 2))
+    centers = buf.reshape(-1, 2)[:300]  # the rows would be overwritten while they are read
+    centers[:] = np.c_[np.linspace(-1, 1, 300), np.full(300, 1.5)]
+    with pytest.raises(ValueError, match="overlaps center"):
+        batch.line_to_circle((0, 0), (1, 0), centers, 1.0, out=buf)
+
+
 def test_batch_theta_matches_the_scalar_theta():
     centers = np.stack([np.linspace(-3, 3, 50), np.linspace(1.2, 40, 50)], axis=1)
     res = batch.line_to_circle((0, 0), (1, 0), centers, 1.0)

@@ -132,6 +132,41 @@ def test_circle_to_circle_returns_verified_geometry_or_refuses(log_scale, dx, dy
     assert_on_circle(t.spirals[-1].control_points, centre, r1, True)
 
 
+def assert_leaves_line(cp, point, direction, tol=1e-9):
+    """The spiral starts on the line (point, direction) along it: gap / first leg and tangent angle."""
+    p = [[mp.mpf(float(v)) for v in row] for row in cp]
+    d = [mp.mpf(float(v)) for v in direction]
+    d_len = mp.sqrt(d[0] ** 2 + d[1] ** 2)
+    a = [p[1][k] - p[0][k] for k in range(2)]
+    leg = mp.sqrt(a[0] ** 2 + a[1] ** 2)
+    off = [p[0][k] - mp.mpf(float(point[k])) for k in range(2)]
+    assert abs(d[0] * off[1] - d[1] * off[0]) / d_len / leg <= tol
+    assert abs(d[0] * a[1] - d[1] * a[0]) / d_len / leg <= tol and d[0] * a[0] + d[1] * a[1] > 0
+
+
+@pytest.mark.parametrize("shape", ["walton-meek", "near-linear"])
+@pytest.mark.parametrize("case", ["tiny turn", "far from the line's point"])
+def test_rows_float64_cannot_resolve_are_refused_not_passed(case, shape):
+    # Tiny turns (legs ~1e-7 of the radius) and lines given by a point 1e4…1e8 away: the gap
+    # to the circle or to the line cancels large terms, and their rounding alone reaches 1e-9.
+    rng = np.random.default_rng(11)
+    n = 600
+    angle = rng.uniform(0, 2 * np.pi, n)
+    d = np.c_[np.cos(angle), np.sin(angle)]
+    normal = np.c_[-d[:, 1], d[:, 0]]
+    if case == "tiny turn":
+        p = rng.uniform(-1, 1, (n, 2))
+        c = p + rng.uniform(-1, 1, (n, 1)) * d + (1 + 10 ** rng.uniform(-18, -12, n))[:, None] * normal
+    else:
+        p = np.zeros((n, 2))
+        c = 10 ** rng.uniform(4, 8, (n, 1)) * d + 1.05 * normal
+    res = batch.line_to_circle(p, d, c, 1.0, shape=shape)
+    for i in np.flatnonzero(res.ok).tolist():
+        assert_leaves_line(res.spirals[0][i], p[i], d[i])
+        assert_on_circle(res.spirals[0][i], c[i], 1.0, True)
+    assert res.ok.any() and (res.status[~res.ok] == Status.UNVERIFIED).any()  # both verdicts exercised
+
+
 # ------------------------------------------------------------------ batches
 
 
@@ -244,3 +279,20 @@ def test_round_corners_refuses_a_curvature_float64_cannot_hold():
 def test_non_real_and_malformed_input_is_refused_by_name(call, message):
     with pytest.raises(ValueError, match=message):
         call()
+
+
+def test_a_corner_in_space_whose_legs_tilt_off_its_plane_is_refused_or_g2():
+    # In plane and off it, each part of the joint angle was within 1e-9, their sum 1.1e-9.
+    points = np.array([[-775.5831054160924, -812.2974304480725, 1875.4182928908224],
+                       [-775.5859132617687, -812.297853187196, 1875.4170295860029],
+                       [-775.5863482726035, -812.2992942464253, 1875.415649761706],
+                       [-775.591179005107, -812.2994049310744, 1875.416555656958]])  # fmt: skip
+    try:
+        path = round_corners(points, max_deviation=0.0006972261259975527)
+    except sc.NoSolutionError as error:
+        assert "corner 1" in str(error)
+        return
+    segments = list(path.chain)
+    for a, b in zip(segments, segments[1:]):
+        ta, tb = a.tangent(1.0), b.tangent(0.0)
+        assert np.linalg.norm(np.cross(ta, tb)) <= 1e-9

@@ -91,6 +91,13 @@ OUTSIDE_SHAPE = int(Status.OUTSIDE_SHAPE)
 #: achieved on well-conditioned input is ~1e-15.
 VERIFY_TOL = 1e-9
 
+#: A bound on the relative rounding of the few float64 operations behind one measure
+#: (five units of rounding: a difference, a product, a square root, the unit vector). Two measures cancel large terms: a spiral's end against its circle
+#: (||b3 − c| − r| of a leg L ≪ r) and its start against the line's point p far away
+#: (|t × (b0 − p)|); their rounding, ROUNDING × r / L and ROUNDING × |b0 − p| / L,
+#: is added to the measure, so a row float64 cannot resolve is refused, never passed.
+ROUNDING = 5.0 * 2.0**-53
+
 NAN = math.nan
 INF = math.inf
 
@@ -461,12 +468,14 @@ def end_leg(x1, y1, x2, y2, x3, y3, inv):
 
 
 @jit
-def end_residual(x1, y1, x2, y2, x3, y3, cx, cy, radius, inv):
+def end_residual(x1, y1, x2, y2, x3, y3, cx, cy, radius, inv, rounding=ROUNDING):
     """How far the end (b1, b2, b3) of a Bézier is from joining circle (c, radius) G2.
 
     ``radius`` is signed by the travel sense of the Bézier (positive:
     counterclockwise): the end must lie on the circle, run along it in that
-    sense and have curvature 1/radius.
+    sense and have curvature 1/radius. ``rounding`` (ROUNDING for a given
+    circle) bounds the relative rounding of |b3 − c|; 0 where the centre is the
+    spiral's own, derived from the same closed form (``spiral_row``).
     """
     bx, by, leg, kappa = end_leg(x1, y1, x2, y2, x3, y3, inv)
     if not leg > 0.0:
@@ -480,7 +489,7 @@ def end_residual(x1, y1, x2, y2, x3, y3, cx, cy, radius, inv):
     distance = norm(dx, dy)
     size = abs(radius * inv)
     length = min(leg, size)  # the smaller feature sets the scale
-    gap = abs(distance - 1.0) * size / length
+    gap = (abs(distance - 1.0) + rounding) * size / length
     angle = abs(bx * dx + by * dy) / (leg * distance) + (INF if dx * by - dy * bx <= 0.0 else 0.0)
     return worst(worst(gap, angle), abs(kappa - curvature) * length)
 
@@ -508,7 +517,9 @@ def line_residual(x0, y0, x1, y1, x2, y2, px, py, tx, ty, inv):
     """How far the start (b0, b1, b2) of a spiral is from leaving the line through p
     along unit t with zero curvature (gap / first leg, tangent angle, κ(0) × first leg)."""
     res, inv_la = start_residual(x0, y0, x1, y1, x2, y2, tx, ty, inv)
-    distance = abs(tx * (y0 - py) * inv - ty * (x0 - px) * inv) * inv_la
+    dx = (x0 - px) * inv
+    dy = (y0 - py) * inv
+    distance = (abs(tx * dy - ty * dx) + ROUNDING * (abs(dx) + abs(dy))) * inv_la
     return worst(distance, res)
 
 
@@ -570,10 +581,13 @@ def start_fits(x0, y0, x1, y1, x2, y2, tx, ty, inv):
 
 @row_jit
 def line_fits(x0, y0, x1, y1, x2, y2, px, py, tx, ty, inv):
-    """Sufficient for ``line_residual`` ≤ VERIFY_TOL: ``start_fits`` and |t × (b0 − p)| ≤ tol·|a|."""
+    """Sufficient for ``line_residual`` ≤ VERIFY_TOL: ``start_fits`` and |t × (b0 − p)| plus its
+    rounding ≤ tol·|a|."""
     ax = (x1 - x0) * inv
     ay = (y1 - y0) * inv
-    gap = tx * (y0 - py) * inv - ty * (x0 - px) * inv
+    dx = (x0 - px) * inv
+    dy = (y0 - py) * inv
+    gap = abs(tx * dy - ty * dx) + ROUNDING * (abs(dx) + abs(dy))
     return start_fits(x0, y0, x1, y1, x2, y2, tx, ty, inv) & (gap * gap <= FIT2 * (ax * ax + ay * ay))
 
 
@@ -587,9 +601,9 @@ def opposite_fits(ux, uy, vx, vy):
 
 
 @row_jit
-def end_fits(x1, y1, x2, y2, x3, y3, cx, cy, radius, inv):
+def end_fits(x1, y1, x2, y2, x3, y3, cx, cy, radius, inv, rounding=ROUNDING):
     """Sufficient for ``end_residual`` ≤ VERIFY_TOL, with o = b3 − c, b the end leg,
-    r = radius and L = min(|b|, |r|): |o·o − r²| ≤ tol·|r|·L (then ||o| − |r|| ≤ tol·L),
+    r = radius and L = min(|b|, |r|): |o·o − r²| plus its rounding ≤ tol·|r|·L (then ||o| − |r|| ≤ tol·L),
     |b·o| ≤ tol·|b||o| with o × b of the sign of r, and |K·r − |b|³|·L ≤ tol·|b|³·|r|
     for the end curvature κ = K/|b|³ (one square root, for |b|)."""
     ax = (x2 - x1) * inv
@@ -609,7 +623,7 @@ def end_fits(x1, y1, x2, y2, x3, y3, cx, cy, radius, inv):
     cube = bb * leg
     return (
         moderate(bb) & moderate(oo) & moderate(rr) & ((ox * by - oy * bx) * rs > 0.0)
-        & (off * off <= FIT2 * rr * (length * length))
+        & (abs(off) + rounding * (oo + rr) <= FIT * abs(rs) * length)
         & (dot * dot <= FIT2 * (bb * oo))
         & (abs(2.0 / 3.0 * (ax * by - ay * bx) * rs - cube) * length <= FIT * cube * abs(rs))
     )
@@ -657,10 +671,11 @@ def spiral_row(bx, by, dx, dy, theta, curvature, shape, out, i):
     cx = bx + scale * (g2 * tx + g1 * nx)
     cy = by + scale * (g2 * ty + g1 * ny)
     fits = line_fits(x0, y0, x1, y1, x2, y2, bx, by, tx, ty, inv)
-    if not (fits and end_fits(x1, y1, x2, y2, x3, y3, cx, cy, side * radius, inv)):
+    # The centre is the spiral's own (not given): its check carries no rounding of a far circle.
+    if not (fits and end_fits(x1, y1, x2, y2, x3, y3, cx, cy, side * radius, inv, 0.0)):
         res = worst(
             line_residual(x0, y0, x1, y1, x2, y2, bx, by, tx, ty, inv),
-            end_residual(x1, y1, x2, y2, x3, y3, cx, cy, side * radius, inv),
+            end_residual(x1, y1, x2, y2, x3, y3, cx, cy, side * radius, inv, 0.0),
         )
         if not res <= VERIFY_TOL:
             return fail(out, i, UNVERIFIED, res)

@@ -101,7 +101,7 @@ def _rows(**arrays: tuple[ArrayLike, tuple[int, ...]]) -> tuple[dict[str, NDArra
     return rows, n
 
 
-def _output(out: NDArray | None, n: int, spirals: int) -> NDArray:
+def _output(out: NDArray | None, n: int, spirals: int, rows: dict[str, NDArray]) -> NDArray:
     """The (N, k, 4, 2) control-point buffer: ``out`` if given (checked), else new."""
     shape = (n, spirals, 4, 2)
     if out is None:
@@ -110,13 +110,16 @@ def _output(out: NDArray | None, n: int, spirals: int) -> NDArray:
         raise ValueError(f"out must be a numpy array of shape {shape}; got {type(out).__name__}")
     if out.shape != shape or out.dtype != np.float64 or not out.flags.c_contiguous or not out.flags.writeable:
         raise ValueError(f"out must be a writeable C-contiguous float64 array of shape {shape}; got {out.dtype} {out.shape}")
+    for name, values in rows.items():  # rows are read in place while out is written
+        if np.may_share_memory(out, values) and np.shares_memory(out, values):
+            raise ValueError(f"out must not share memory with an input; it overlaps {name}")
     return out
 
 
 def _run(case: str, kernel, spirals: int, inputs: tuple[dict[str, NDArray], int], out: NDArray | None, shape: str,
          extra: bool = False) -> BatchResult:  # fmt: skip
     rows, n = inputs
-    out = _output(out, n, spirals)
+    out = _output(out, n, spirals, rows)
     status = np.empty(n, dtype=np.int8)
     theta = np.empty(n)
     measure = np.empty(n)

@@ -123,7 +123,7 @@ def placed_pair_residuals(pairs: NDArray, corners: NDArray, x_dir: NDArray, y_di
     outgoing leg along ``outgoing`` (N, 2, plane coordinates), joint curvature
     ``peak`` (N,). Each placed point's offset from its corner is split into
     plane coordinates and its distance off the plane; the pair must lie in
-    the plane (distance / L) and round the corner G2 in it (the plane
+    the plane (distance / L, added to the in-plane residual) and round the corner G2 in it (the plane
     kernel's own ``corner_residual``: gap / L, tangent angle, curvature error
     × L, L the smaller of the spiral's leg and the radius). ``residual`` (N,)
     receives the worst of these (NaN counted infinite), ``deviation`` (N,)
@@ -152,7 +152,8 @@ def _pair_residual(pairs, corners, x_dir, y_dir, outgoing, peak, residual, devia
     res = K.corner_residual(local, 0.0, 0.0, 1.0, 0.0, t1x, t1y, peak[i] * scale, inv)
     leg = K.norm((local[0, 1, 0] - local[0, 0, 0]) * inv, (local[0, 1, 1] - local[0, 0, 1]) * inv)
     length = min(leg, 1.0 / (peak[i] * scale))
-    residual[i] = K.worst(res, off * inv / length)
+    # Off the plane, each leg may tilt by up to 2 × off / L beside its in-plane angle: the sum bounds the angle in space.
+    residual[i] = K.worst(res + 2.0 * off * inv / length, res)
     jx, jy, jz = (pairs[i, 0, 3, 0] - corners[i, 0]) * inv, (pairs[i, 0, 3, 1] - corners[i, 1]) * inv, (pairs[i, 0, 3, 2] - corners[i, 2]) * inv
     deviation[i] = math.sqrt(jx * jx + jy * jy + jz * jz) * scale
 
