@@ -171,30 +171,17 @@ def gcode_design(args: argparse.Namespace) -> dict:
     return {"units": args.units or "mm", "designs": [design]}
 
 
-#: Exit status of ``check`` when its output pipe closes early (``| head -1``): 128 + SIGPIPE,
-#: what a shell reports for a command a closed pipe stopped.
+#: Exit status when the output pipe closes early (``| head -1``): 128 + SIGPIPE, what a
+#: shell reports for a command a closed pipe stopped (a build then changes nothing).
 CLOSED_PIPE = 141
 
 
 def _check(args: argparse.Namespace) -> int:
-    """``spiral-cad check``: 0 ok, 1 below ``--require``, 2 error, 141 when stdout closed early.
+    """``spiral-cad check``: 0 ok, 1 below ``--require``, 2 error.
 
     (Non-finite measures are graded "unmeasurable" on purpose; ``main`` keeps
     numpy's warnings about them off the terminal.)
     """
-    try:
-        status = _check_file(args)
-        sys.stdout.flush()
-    except BrokenPipeError:
-        try:  # the interpreter's last flush must not fail again
-            os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
-        except (OSError, ValueError, AttributeError):
-            pass
-        return CLOSED_PIPE
-    return status
-
-
-def _check_file(args: argparse.Namespace) -> int:
     if Path(args.file).suffix.lower() == ".xodr":
         if args.comb:
             print("error: --comb draws STEP/IGES edges; it does not apply to OpenDRIVE", file=sys.stderr)
@@ -325,7 +312,8 @@ def _parser() -> argparse.ArgumentParser:
 
 
 def main(argv: Sequence[str] | None = None) -> int:
-    """Run the command line; returns the exit status (0 ok, 1 check failed, 2 error, 130 interrupted).
+    """Run the command line; returns the exit status (0 ok, 1 check failed, 2 error, 130 interrupted,
+    141 output pipe closed early).
 
     Every error is printed as one ``error: …`` line on stderr, never as a
     traceback; Ctrl-C at any moment gives ``error: interrupted`` and 130;
@@ -335,7 +323,15 @@ def main(argv: Sequence[str] | None = None) -> int:
         warnings.simplefilter("ignore")
         try:
             args = _parser().parse_args(argv)
-            return args.run(args)
+            status = args.run(args)
+            sys.stdout.flush()
+            return status
+        except BrokenPipeError:
+            try:  # the interpreter's last flush must not fail again
+                os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+            except (OSError, ValueError, AttributeError):
+                pass
+            return CLOSED_PIPE
         except KeyboardInterrupt as interrupt:
             print(f"error: interrupted{f'; {interrupt}' if str(interrupt) else ''}", file=sys.stderr)
             return 130

@@ -626,12 +626,32 @@ def write(
 
 
 def _write_design(b: Built, stage: Path, units: str, missing: list[str], plots: bool) -> list[str]:
-    """Write one design's files into ``stage``; returns what follows the name of each file written."""
-    from .export import export_step, export_svg
+    """Write one design's files into ``stage``; returns what follows the name of each file written.
+
+    The STEP file goes first: OCCT reads it for the continuity report in its
+    own process while the other files are written.
+    """
+    from .export import export_step
 
     step = stage / f"{b.name}.step"
     export_step(b.chain, step, name=b.name)
-    names = ["step"]
+    if "OCP" in missing:
+        return ["step"] + _write_others(b, stage, units, missing, plots)
+    from .cad.continuity import checking
+
+    with checking(step) as continuity:  # as `spiral-cad check` reads it: the same numbers
+        names = ["step"] + _write_others(b, stage, units, missing, plots)
+        report = continuity()
+    b.notes["continuity"] = f"{report.min_level} ({report.describe()})"
+    (stage / f"{b.name}_continuity.txt").write_text(report.format_table() + "\n", encoding="utf-8")
+    return names + ["continuity.txt"]
+
+
+def _write_others(b: Built, stage: Path, units: str, missing: list[str], plots: bool) -> list[str]:
+    """Every file of a design but its STEP and continuity report."""
+    from .export import export_svg
+
+    names = []
     if b.chain.dim == 2:  # SVG is a plane output (the plots draw a path in space as its plan)
         export_svg(b.chain, stage / f"{b.name}.svg", name=b.name)
         names.append("svg")
@@ -657,14 +677,10 @@ def _write_design(b: Built, stage: Path, units: str, missing: list[str], plots: 
             if "OCP" not in missing:
                 names += _road_3d(b, profile, stage, units)
     if "OCP" not in missing:
-        from .cad.continuity import check_continuity
         from .export import export_iges
 
         export_iges(b.chain, stage / f"{b.name}.igs", name=b.name)
-        report = check_continuity(step)  # as `spiral-cad check` reads it: the same numbers
-        b.notes["continuity"] = f"{report.min_level} ({report.describe()})"
-        (stage / f"{b.name}_continuity.txt").write_text(report.format_table() + "\n", encoding="utf-8")
-        names += ["igs", "continuity.txt"]
+        names.append("igs")
     if "ezdxf" not in missing:
         from .export import export_dxf
 

@@ -159,6 +159,19 @@ def test_ctrl_c_at_any_moment_is_one_line_and_130(tmp_path, moment):
     assert [p.name for p in out.iterdir()] == ["rail.step"] and (out / "rail.step").read_text() == "from before"
 
 
+def test_a_build_whose_output_pipe_closes_ends_with_141_and_changes_nothing(tmp_path):
+    script = Path(sys.executable).parent / "spiral-cad"
+    if not script.exists():
+        pytest.skip("spiral-cad script not installed next to this interpreter")
+    out = tmp_path / "out"
+    process = subprocess.Popen([str(script), "build", str(EXAMPLES / "design.json"), "--out", str(out), "--no-plots"],
+                               stdout=subprocess.PIPE, stderr=subprocess.PIPE)  # fmt: skip
+    process.stdout.close()  # `| head -0`: the build's first line finds no reader
+    err = process.stderr.read()
+    assert process.wait(timeout=300) == 141 and err == b""
+    assert not out.exists()
+
+
 def test_an_interrupt_a_library_turned_into_another_exception_is_still_an_interrupt(tmp_path, capsys, monkeypatch):
     """OCP's modules turn Ctrl-C during their import into ImportError('initialization failed')."""
     import os

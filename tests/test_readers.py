@@ -104,6 +104,20 @@ def test_every_way_a_task_can_fail_is_a_value_error(task, message):
         sandbox.run_isolated(task, what="the test task", subject="x")
 
 
+def test_a_started_child_works_while_the_caller_does_and_one_not_waited_for_is_stopped():
+    started = time.monotonic()
+    with sandbox.Isolated(lambda: time.sleep(0.5) or 7, what="the test task", subject="x") as child:
+        time.sleep(0.5)  # the caller's own work, at the same time
+        assert child.result() == 7 and child.result() == 7
+    assert time.monotonic() - started < 0.9
+    with sandbox.Isolated(time.sleep, 60, what="the test task", subject="x") as child:
+        pid = child._pid
+    with pytest.raises(ChildProcessError):  # stopped and reaped when the block ended
+        os.waitpid(pid, 0)
+    with pytest.raises(ValueError, match=r"failed on 'x' \(stopped before its result\)"):
+        child.result()
+
+
 def test_no_process_to_spare_is_a_value_error(monkeypatch):
     import errno
 

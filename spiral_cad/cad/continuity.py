@@ -22,10 +22,12 @@ apart start a new piece. A report that finds more pieces than expected
 from __future__ import annotations
 
 import argparse
+import contextlib
 import dataclasses
 import math
 import os
 import time
+from collections.abc import Callable, Iterator
 from functools import partial
 from pathlib import Path
 from typing import Any
@@ -70,7 +72,7 @@ from ..formats.joints import (
     print_report,
 )
 from .occ import as_occ_shape
-from .readers import STEP_SUFFIXES, read_file
+from .readers import STEP_SUFFIXES, finish_reading, read_file, start_reading
 
 __all__ = ["Continuity", "ContinuityReport", "JointReport", "WireReport", "check_continuity", "curvature_comb"]
 
@@ -380,23 +382,49 @@ def check_continuity(
             reader crashed on (``ReadError``, with the reason), a point that
             is not finite, or a negative/non-finite tolerance.
     """
+    tolerances = dict(gap_tol=gap_tol, angle_tol=angle_tol, curvature_tol=curvature_tol, snap=snap)
+    if isinstance(shape_or_path, (str, os.PathLike)):
+        with checking(shape_or_path, units=units, label=label, **tolerances) as report:
+            return report()
+    _check_options(**tolerances)
+    unit = length_unit(units) if units is not None else shape_or_path.units if isinstance(shape_or_path, Chain) else ""
+    measured, measuring = _timed_measure(as_occ_shape(shape_or_path))
+    return _timed_report(measured, unit, label or type(shape_or_path).__name__, tolerances, Timing(0.0, measuring, 0.0, ""))
+
+
+@contextlib.contextmanager
+def checking(path: str | os.PathLike, *, gap_tol: float = 1e-7, angle_tol: float = 1e-7, curvature_tol: float = 1e-6,
+             snap: float | None = None, units: str | None = None,
+             label: str | None = None) -> Iterator[Callable[[], ContinuityReport]]:  # fmt: skip
+    """``check_continuity(path, ...)`` started: OCCT reads the file in its child process while
+    the caller goes on; the function yielded waits for the report (leaving the block
+    without asking for it stops the child). Arguments and errors as ``check_continuity``."""
+    tolerances = dict(gap_tol=gap_tol, angle_tol=angle_tol, curvature_tol=curvature_tol, snap=snap)
+    _check_options(**tolerances)
+    source = os.path.basename(os.fspath(path))
+    reader = "the STEP reader (OCCT)" if Path(path).suffix.lower() in STEP_SUFFIXES else "the IGES reader (OCCT)"
+    started = time.perf_counter()
+
+    def report() -> ContinuityReport:
+        unit, (measured, measuring) = finish_reading(child)
+        timing = Timing(time.perf_counter() - started - measuring, measuring, 0.0, reader)
+        return _timed_report(measured, unit, label or source, tolerances, timing)
+
+    with start_reading(path, units, _timed_measure) as child:
+        yield report
+
+
+def _check_options(gap_tol: float, angle_tol: float, curvature_tol: float, snap: float | None) -> None:
     check_tolerances(gap_tol=gap_tol, angle_tol=angle_tol, curvature_tol=curvature_tol)
     if snap is not None:
         check_tolerances(snap=snap)
-    started = time.perf_counter()
-    if isinstance(shape_or_path, (str, os.PathLike)):
-        source = os.path.basename(os.fspath(shape_or_path))
-        reader = "the STEP reader (OCCT)" if Path(shape_or_path).suffix.lower() in STEP_SUFFIXES else "the IGES reader (OCCT)"
-        unit, (measured, measuring) = read_file(shape_or_path, units, _timed_measure)
-        reading = time.perf_counter() - started - measuring
-    else:
-        source, reader, reading = type(shape_or_path).__name__, "", 0.0
-        unit = length_unit(units) if units is not None else shape_or_path.units if isinstance(shape_or_path, Chain) else ""
-        measured, measuring = _timed_measure(as_occ_shape(shape_or_path))
+
+
+def _timed_report(measured: Measured, unit: str, source: str, tolerances: dict, timing: Timing) -> ContinuityReport:
+    """The report of what was measured, with the time its classification took added to ``timing``."""
     classified = time.perf_counter()
-    report = _report(measured, unit, label or source, gap_tol, angle_tol, curvature_tol, snap)
-    timing = Timing(reading, measuring, time.perf_counter() - classified, reader)
-    return dataclasses.replace(report, timing=timing)
+    report = _report(measured, unit, source, **tolerances)
+    return dataclasses.replace(report, timing=dataclasses.replace(timing, classifying=time.perf_counter() - classified))
 
 
 def _report(measured: Measured, unit: str, source: str, gap_tol: float, angle_tol: float, curvature_tol: float,

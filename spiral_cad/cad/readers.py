@@ -53,7 +53,7 @@ from OCP.TopoDS import TopoDS, TopoDS_Shape
 from OCP.TopTools import TopTools_IndexedMapOfShape
 
 from ..core.units import MM_PER_UNIT, length_unit
-from .sandbox import run_isolated
+from .sandbox import Isolated
 
 __all__ = ["IGES_SUFFIXES", "STEP_SUFFIXES", "ReadError", "read_file", "read_shape"]
 
@@ -117,6 +117,16 @@ def read_file(path: str | os.PathLike, units: str | None, extract: Callable[[Top
     Raises:
         ReadError, ValueError: as ``read_shape``.
     """
+    with start_reading(path, units, extract) as child:
+        return finish_reading(child)
+
+
+def start_reading(path: str | os.PathLike, units: str | None, extract: Callable[[TopoDS_Shape], Any]) -> Isolated:
+    """``read_file`` started: the child reads while the caller goes on; ``finish_reading`` waits.
+
+    Raises:
+        ValueError: a path that is not a readable STEP/IGES file (checked here, before the child starts).
+    """
     p = Path(path)
     suffix = p.suffix.lower()
     if units is not None:
@@ -129,8 +139,13 @@ def read_file(path: str | os.PathLike, units: str | None, extract: Callable[[Top
     if kind == "IGES":
         _check_iges_sections(p)
     _load_readers()
+    return Isolated(_read_and_extract, p, kind, units, extract, what=f"the {kind} reader", subject=p.name)
+
+
+def finish_reading(child: Isolated) -> tuple[str, Any]:
+    """The ``(unit, extract(shape))`` of a ``start_reading`` child, once it is there."""
     try:
-        return run_isolated(_read_and_extract, p, kind, units, extract, what=f"the {kind} reader", subject=p.name)
+        return child.result()
     except ValueError as error:  # the child's ReadError, or the reader's crash, timeout, exhaustion
         raise ReadError(str(error)) from None
 

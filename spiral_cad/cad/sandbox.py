@@ -28,7 +28,7 @@ import warnings
 from collections.abc import Callable
 from typing import Any
 
-__all__ = ["MEMORY_LIMIT", "TIME_LIMIT", "run_isolated"]
+__all__ = ["MEMORY_LIMIT", "TIME_LIMIT", "Isolated", "run_isolated"]
 
 #: Seconds a reader may take before it is stopped.
 TIME_LIMIT = 120.0
@@ -68,42 +68,93 @@ def run_isolated(task: Callable[..., Any], *args: Any, what: str, subject: str) 
             120 s; stopped)``, ``(out of memory: more than 4 GiB)`` or
             ``(<exception type>: <message>)``.
     """
-    if not hasattr(os, "fork"):
-        return task(*args)
-    memory = _memory_limit()
-    read_fd, write_fd = os.pipe()
-    for stream in (sys.stdout, sys.stderr):  # else the child inherits unwritten output
-        try:
-            stream.flush()
-        except (OSError, ValueError):
-            pass
-    failed = f"{what} failed on {subject!r}"
-    with warnings.catch_warnings():
-        # Python ≥ 3.12 warns about forking with threads running (numpy's BLAS
-        # pool): the child only runs ``task`` and leaves with os._exit.
-        warnings.simplefilter("ignore", DeprecationWarning)
-        try:
-            pid = os.fork()
-        except OSError as error:  # no process to spare
+    with Isolated(task, *args, what=what, subject=subject) as child:
+        return child.result()
+
+
+class Isolated:
+    """``task(*args)`` started in a child process; ``result()`` waits for it (as ``run_isolated``).
+
+    Between the start and ``result()`` the caller may do other work (the
+    build writes its other files while OCCT reads the STEP). Used as a
+    context manager, a child whose result was never asked for is stopped.
+    """
+
+    def __init__(self, task: Callable[..., Any], *args: Any, what: str, subject: str) -> None:
+        self._failed = f"{what} failed on {subject!r}"
+        self._pid: int | None = None
+        self._outcome: tuple[bool, Any] | None = None
+        if not hasattr(os, "fork"):  # the task runs here and now
+            try:
+                self._outcome = (True, task(*args))
+            except ValueError as error:
+                self._outcome = (False, error)
+            return
+        self._memory = _memory_limit()
+        read_fd, write_fd = os.pipe()
+        for stream in (sys.stdout, sys.stderr):  # else the child inherits unwritten output
+            try:
+                stream.flush()
+            except (OSError, ValueError):
+                pass
+        with warnings.catch_warnings():
+            # Python ≥ 3.12 warns about forking with threads running (numpy's BLAS
+            # pool): the child only runs ``task`` and leaves with os._exit.
+            warnings.simplefilter("ignore", DeprecationWarning)
+            try:
+                pid = os.fork()
+            except OSError as error:  # no process to spare
+                os.close(read_fd)
+                os.close(write_fd)
+                self._outcome = (False, ValueError(f"{self._failed} (no process could be started for it: {error.strerror})"))
+                return
+        if pid == 0:  # the child: never returns
             os.close(read_fd)
-            os.close(write_fd)
-            raise ValueError(f"{failed} (no process could be started for it: {error.strerror})") from None
-    if pid == 0:  # the child: never returns
-        os.close(read_fd)
-        _child(task, args, write_fd, memory)
-    os.close(write_fd)
-    status = None
-    try:
-        payload = _receive(read_fd, time.monotonic() + TIME_LIMIT)
-        if payload is not None:
-            _, status = os.waitpid(pid, 0)
-    finally:
-        os.close(read_fd)
-        if status is None:  # timed out or interrupted: the child goes too
-            os.kill(pid, signal.SIGKILL)
-            os.waitpid(pid, 0)
+            _child(task, args, write_fd, self._memory)
+        os.close(write_fd)
+        self._pid, self._fd = pid, read_fd
+
+    def __enter__(self) -> Isolated:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.stop()
+
+    def stop(self) -> None:
+        """Stop the child if it still runs (its result is not wanted)."""
+        if self._pid is not None:
+            os.close(self._fd)
+            os.kill(self._pid, signal.SIGKILL)
+            os.waitpid(self._pid, 0)
+            self._pid = None
+
+    def result(self) -> Any:
+        """The task's result, once it is there (at most ``TIME_LIMIT`` s from now); raises as ``run_isolated``."""
+        if self._pid is not None:
+            pid, self._pid = self._pid, None
+            status = None
+            try:
+                payload = _receive(self._fd, time.monotonic() + TIME_LIMIT)
+                if payload is not None:
+                    _, status = os.waitpid(pid, 0)
+            finally:
+                os.close(self._fd)
+                if status is None:  # timed out or interrupted: the child goes too
+                    os.kill(pid, signal.SIGKILL)
+                    os.waitpid(pid, 0)
+            self._outcome = _outcome(payload, status, self._failed, self._memory)
+        if self._outcome is None:
+            raise ValueError(f"{self._failed} (stopped before its result)")
+        ok, value = self._outcome
+        if ok:
+            return value
+        raise value
+
+
+def _outcome(payload: bytes | None, status: int | None, failed: str, memory: int) -> tuple[bool, Any]:
+    """(True, result) or (False, the ValueError to raise) from what a child sent and how it ended."""
     if payload is None:
-        raise ValueError(f"{failed} (no result within {TIME_LIMIT:g} s; stopped)")
+        return False, ValueError(f"{failed} (no result within {TIME_LIMIT:g} s; stopped)")
     if os.WIFSIGNALED(status):
         number = os.WTERMSIG(status)
         try:
@@ -111,18 +162,18 @@ def run_isolated(task: Callable[..., Any], *args: Any, what: str, subject: str) 
         except ValueError:
             name = ""
         killed = " (the system stops a process that runs out of memory this way)" if number == signal.SIGKILL else ""
-        raise ValueError(f"{failed} (signal {number}{name}){killed}")
+        return False, ValueError(f"{failed} (signal {number}{name}){killed}")
     try:
         kind, value = marshal.loads(payload)
     except (EOFError, ValueError, TypeError):
-        raise ValueError(f"{failed} (it exited with status {os.waitstatus_to_exitcode(status)} and no result)") from None
+        return False, ValueError(f"{failed} (it exited with status {os.waitstatus_to_exitcode(status)} and no result)")
     if kind == "ok":
-        return value
+        return True, value
     if kind == "ValueError":
-        raise ValueError(value)
+        return False, ValueError(value)
     if kind == "MemoryError":
-        raise ValueError(f"{failed} (out of memory: more than {_gib(memory)})")
-    raise ValueError(f"{failed} ({value})")
+        return False, ValueError(f"{failed} (out of memory: more than {_gib(memory)})")
+    return False, ValueError(f"{failed} ({value})")
 
 
 def _receive(fd: int, deadline: float) -> bytes | None:
