@@ -281,6 +281,11 @@ class Chain:
     def end(self) -> NDArray:
         return self._frames[-1, 1, : self.dim].copy()
 
+    @property
+    def segment_ends(self) -> NDArray:
+        """The start and end point of every segment, (n, 2, dim) (a copy)."""
+        return self._frames[:, :, : self.dim].copy()
+
     def joins(self) -> list[Join]:
         """Mismatches at every internal joint, in order (``Join``)."""
         return [Join(i, gap, angle, jump) for i, (gap, angle, jump) in enumerate(self._joints[:, :3].tolist())]

@@ -29,6 +29,9 @@ def header(key: str, dimensions: Mapping[str, str], units: str) -> str:
 def cell(value: Any, digits: int | None = None) -> str:
     """A table cell: integers as integers, other real numbers as Python floats (``repr``, or
     ``digits`` significant digits), anything else as its text."""
+    kind = type(value)
+    if kind is float or kind is int:  # the common cells, without the abstract type checks below
+        return str(value) if kind is int else repr(value) if digits is None else f"{value:.{digits}g}"
     if isinstance(value, numbers.Integral) and not isinstance(value, bool):
         return str(int(value))
     if isinstance(value, numbers.Real) and not isinstance(value, bool):

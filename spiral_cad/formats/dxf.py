@@ -23,7 +23,7 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from ..core._chain_kernels import ARC, LINE, SPIRAL
+from ..core._chain_kernels import ARC, SPIRAL
 from ..core.chain import Chain
 from ..core.segments import Arc, Line, Segment
 from ..core.spiral import BezierSpiral
@@ -106,19 +106,22 @@ def _cubic_extreme_points(cp: np.ndarray) -> np.ndarray:
 def extents(chains: Sequence[Chain]) -> tuple[tuple[float, float, float], tuple[float, float, float]]:
     """The drawing's exact bounding box ((xmin, ymin, zmin), (xmax, ymax, zmax)); z is 0 in the plane.
 
-    From the rows of every chain: line ends, spiral ends and interior extremes
-    (all spirals at once), and each arc's ends and axis crossings."""
+    From the rows of every chain: every segment's ends, the spirals' interior
+    extremes (all spirals at once) and each arc's axis crossings."""
     points = []
     for chain in chains:
         rows = chain.rows
-        lines, spirals = rows.geometry[rows.kind == LINE], rows.geometry[rows.kind == SPIRAL]
-        points += [lines[:, :2].reshape(-1, 3), spirals[:, [0, 3]].reshape(-1, 3)]
+        ends = chain.segment_ends.reshape(-1, chain.dim)
+        points.append(np.column_stack([ends, np.zeros((len(ends), 3 - chain.dim))]))
+        spirals = rows.geometry[rows.kind == SPIRAL]
         if len(spirals):
             points.append(_cubic_extreme_points(spirals).reshape(-1, 3))
         for i in np.flatnonzero(rows.kind == ARC).tolist():
             arc = chain[i]
-            found = np.atleast_2d(arc.point(np.array([0.0, 1.0, *_arc_extreme_parameters(arc)])))
-            points.append(np.column_stack([found, np.zeros((len(found), 3 - found.shape[1]))]))
+            inside = _arc_extreme_parameters(arc)
+            if inside:
+                found = np.atleast_2d(arc.point(np.array(inside)))
+                points.append(np.column_stack([found, np.zeros((len(found), 3 - found.shape[1]))]))
     everything = np.vstack(points)
     low, high = everything.min(axis=0), everything.max(axis=0)
     return (float(low[0]), float(low[1]), float(low[2])), (float(high[0]), float(high[1]), float(high[2]))

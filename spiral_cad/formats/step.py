@@ -165,7 +165,7 @@ def _units(data: _Entities, units: str, uncertainty: float) -> str:
 
 def _uncertainty(chains: Sequence[Chain], units: str) -> float:
     """1e-7 mm in the file's unit, but at least what float64 can resolve at the largest coordinate."""
-    largest = max(float(abs(p).max()) for c in chains for s in c for p in (s.start, s.end))
+    largest = max(float(np.abs(c.segment_ends).max()) for c in chains)
     return max(1e-7 / MM_PER_UNIT[units], 16.0 * math.ulp(largest))
 
 
