@@ -54,7 +54,8 @@ from .tables import text_table, write_csv
 
 FOOT = 0.3048
 
-#: AASHTO Green Book, rural arterials: maximum grade (%) by design speed for level, rolling and mountainous terrain.
+#: AASHTO Green Book, rural arterials: maximum grade (%) by design speed for level, rolling and mountainous terrain
+#: (level and rolling as TxDOT's Roadway Design Manual, Table 4-11, reproduces the US customary table).
 MAX_GRADE_KMH = ((60, 5, 6, 8), (70, 5, 6, 7), (80, 4, 5, 7), (90, 4, 5, 6), (100, 3, 4, 6), (110, 3, 4, 5),
                  (120, 3, 4, 5), (130, 3, 4, 5))  # fmt: skip
 MAX_GRADE_MPH = ((40, 5, 6, 8), (45, 5, 6, 7), (50, 4, 5, 7), (55, 4, 5, 6), (60, 3, 4, 6), (65, 3, 4, 5),
