@@ -57,6 +57,13 @@ def test_arcs_are_refused_by_name_with_their_line():
         ("G21\nG1 Xnan\n", r"line 2: 'Xnan' is not a G-code word"),
         ("G21\nG1 X1\n", r"has 1 move\(s\)"),
         ("", r"has 0 move\(s\)"),
+        ("G21 G90\nG1 X1\x0bY1\nG1 X2 Y2\n", r"line 2: control character '\\x0b'"),  # not a line break
+        ("G21 G90\nG1 X1\u2028Y1\nG1 X2 Y2\n", r"line 2: control character"),
+        ("G21\nG1 X1 Y1\nG1 X\u0663 Y5\n", r"line 3: 'X\u0663 Y5' is not a G-code word"),  # an Arabic-Indic 3
+        ("G21\nG1 X\uff11\uff12\n", r"line 2: .* is not a G-code word"),  # full-width digits
+        ("G21\nG1 X1 (a(b)c)\n", r"line 2: a comment is not closed \(or is nested\)"),
+        ("G21\nG1 X1 )\n", r"line 2: a comment is not closed"),
+        ("G21\nG1 X1" + " F1" * 30_000 + "\n", r"line 2: the line has 90,005 characters; at most 65,536"),
     ],
 )
 def test_everything_outside_the_subset_is_refused_by_name(text, match):
@@ -69,7 +76,26 @@ def test_comments_blank_lines_and_program_end():
     assert path.points.tolist() == [[1, 0, 0], [1, 1, 0]] and path.lines.tolist() == [4, 6]
 
 
+def test_many_comments_on_one_line_are_read_in_one_pass():
+    # One pass over the line: 20 000 comments take milliseconds (each once cost a copy of the rest).
+    path = parse_gcode("G21 G90\nG1 X1 " + "(a)" * 20_000 + "\nG1 X2 Y1 ; done (\r\nG1 X3 Y1\rG1 X3 Y2\n")
+    assert path.points.tolist() == [[1, 0, 0], [2, 1, 0], [3, 1, 0], [3, 2, 0]] and path.lines.tolist() == [2, 3, 4, 5]
+
+
+def test_a_file_name_with_control_characters_is_shown_quoted(tmp_path):
+    odd = tmp_path / "evil\x1b[31mRED\nline.nc"
+    odd.write_text("G1 X1\n", encoding="utf-8")
+    with pytest.raises(ValueError) as error:
+        read_gcode(odd)
+    assert "\x1b" not in str(error.value) and "\n" not in str(error.value) and "\\x1b[31mRED\\nline.nc" in str(error.value)
+
+
 def test_files_that_are_not_programs(tmp_path):
+    secret = tmp_path / "passwd"
+    secret.write_text("root:x:0:0:root:/root:/bin/sh\n", encoding="utf-8")
+    with pytest.raises(ValueError, match="passwd: not a G-code file name") as error:
+        read_gcode(secret)  # a design file naming any file: neither read nor quoted
+    assert "root" not in str(error.value)
     with pytest.raises(ValueError, match="is a folder"):
         read_gcode(tmp_path)
     with pytest.raises(ValueError, match="is missing"):

@@ -323,6 +323,27 @@ def test_roadway_errors(highway, profile):
         (dict(offsets=[3.0], crossfall=1.5), "crossfall must lie in"),
         (dict(offsets=[3.0], depth=0), "depth must be positive"),
         (dict(offsets=[3.0], tolerance=-1), "tolerance must be positive"),
+        (dict(offsets=[-460.0, 3.0]), r"PI 1: the cross-section reaches 460 m to the right, towards the curve's centre 450 m away"),
+        (dict(offsets=[400.0]), r"PI 2: the cross-section reaches 400 m to the left, towards the curve's centre 400 m away"),
     ]:
         with pytest.raises(ValueError, match=message):
             roadway(highway, profile, **kwargs)
+
+
+def test_grades_equal_to_the_last_ulp_make_a_straight_curve_not_a_crash():
+    profile = Profile.from_pvis([[0, 0], [100, 1], [200, 2.0000000000000004]], k_values=50)
+    row = profile.rows()[0]
+    assert row["BVC"] <= row["extreme_point"] <= row["EVC"]
+    assert profile.elevation([50.0, 150.0]).tolist() == pytest.approx([0.5, 1.5])
+
+
+@pytest.mark.parametrize(
+    "make, message",
+    [
+        (lambda: ProfileCriteria(np.float64(-3)), "design_speed must be positive; got -3.0$"),
+        (lambda: ProfileCriteria(80, max_grade=np.float64(-1)), "max_grade must be positive; got -1.0$"),
+    ],
+)
+def test_messages_show_plain_numbers(make, message):
+    with pytest.raises(ValueError, match=message):
+        make()

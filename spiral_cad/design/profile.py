@@ -46,7 +46,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from ..core._inputs import as_float, as_points, as_real_array, per_item
+from ..core._inputs import as_float, as_points, as_real_array, per_item, shown
 from ..core.errors import NoSolutionError
 from ..core.piecewise import inside, piece_at, piecewise_at, polynomial
 from ..core.units import DEFAULT_UNITS, IMPERIAL, length_unit, speed_unit, to_metres
@@ -87,13 +87,13 @@ class ProfileCriteria:
     def __post_init__(self) -> None:
         for name in ("design_speed", "reaction_time"):
             if not as_float(getattr(self, name), name) > 0:
-                raise ValueError(f"{name} must be positive; got {getattr(self, name)!r}")
+                raise ValueError(f"{name} must be positive; got {shown(getattr(self, name))}")
         for name in ("deceleration", "max_grade"):
             value = getattr(self, name)
             if value is not None and not as_float(value, name) > 0:
-                raise ValueError(f"{name} must be positive; got {value!r}")
+                raise ValueError(f"{name} must be positive; got {shown(value)}")
         if self.min_curve_length is not None and not as_float(self.min_curve_length, "min_curve_length") >= 0:
-            raise ValueError(f"min_curve_length must be ≥ 0; got {self.min_curve_length!r}")
+            raise ValueError(f"min_curve_length must be ≥ 0; got {shown(self.min_curve_length)}")
         if self.terrain not in TERRAINS:
             raise ValueError(f"terrain must be one of {', '.join(TERRAINS)}; got {self.terrain!r:.80}")
 
@@ -210,7 +210,7 @@ class VerticalCurve:
         it, else the end that is higher (crest) or lower (sag)."""
         sign = 1.0 if self.kind == "crest" else -1.0
         for (s0, _, g0), rate, length in zip(self._starts(), self.rates, (self.length_in, self.length_out)):
-            if 0.0 <= -g0 / rate <= length:
+            if rate != 0.0 and 0.0 <= -g0 / rate <= length:  # rate 0: a straight piece (grades equal to the last ulp)
                 return s0 - g0 / rate
         rising = sign * self.grade_out > 0.0  # no level point: the curve climbs (crest) or falls (sag) throughout
         return self.evc if rising else self.bvc
@@ -488,9 +488,9 @@ def _curve_halves(value: Any, count: int) -> NDArray:
                 raise ValueError(f"curve_lengths[{j}] (PVI {j + 1}) must be a length or an (L_in, L_out) pair; got shape {entry.shape}")
     for j, (before, after) in enumerate(halves.tolist()):
         if not (math.isfinite(before) and math.isfinite(after)):
-            raise ValueError(f"PVI {j + 1}: curve lengths must be finite; got {before + after!r}")
+            raise ValueError(f"PVI {j + 1}: curve lengths must be finite; got {shown(before + after)}")
         if not (before > 0.0 and after > 0.0):
-            raise ValueError(f"PVI {j + 1}: curve lengths must be positive; got L_in = {before!r}, L_out = {after!r}")
+            raise ValueError(f"PVI {j + 1}: curve lengths must be positive; got L_in = {shown(before)}, L_out = {shown(after)}")
     return halves
 
 

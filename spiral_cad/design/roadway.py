@@ -31,7 +31,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from ..core._inputs import as_float, as_real_array
+from ..core._inputs import as_float, as_real_array, shown
 from .centerline import FIT_SAMPLES, REPORT_SAMPLES, check_profile, float_floor, refine
 from .profile import Profile
 from .superelevation import Superelevation
@@ -79,6 +79,20 @@ class Roadway:
         return np.vstack([top, below])
 
 
+def _check_inside_curves(alignment: Any, offsets: NDArray) -> None:
+    """Refuse a cross-section that reaches a curve's centre: its inner edges would fold back."""
+    units = alignment.chain.units
+    for curve in alignment.curves:
+        side = "left" if curve.deflection > 0.0 else "right"
+        inner = float(offsets.max()) if curve.deflection > 0.0 else float(-offsets.min())  # towards the centre
+        if inner >= curve.radius:
+            raise ValueError(
+                f"PI {curve.index}: the cross-section reaches {inner:g} {units} to the {side}, towards the curve's "
+                f"centre {curve.radius:g} {units} away: its inner edge would fold back on itself (every offset must "
+                f"stay within each curve's radius)"
+            )
+
+
 def roadway(
     alignment: Any,
     profile: Profile,
@@ -102,8 +116,9 @@ def roadway(
             units; default 1e-6 × the alignment's length).
 
     Raises:
-        ValueError: bad offsets, crossfall, depth or tolerance; a profile that
-            does not fit the alignment; a tolerance out of float64's reach.
+        ValueError: bad offsets, crossfall, depth or tolerance; offsets that reach
+            a curve's centre; a profile that does not fit the alignment; a
+            tolerance out of float64's reach.
     """
     chain = alignment.chain
     check_profile(alignment, profile)
@@ -113,15 +128,16 @@ def roadway(
     offsets = np.unique(np.append(offsets, 0.0))[::-1]
     if len(offsets) < 2:
         raise ValueError("offsets must reach off the centre line on at least one side")
+    _check_inside_curves(alignment, offsets)
     crossfall = as_float(crossfall, "crossfall")
     if not 0.0 <= crossfall < 1.0:
-        raise ValueError(f"crossfall must lie in [0, 1); got {crossfall!r}")
+        raise ValueError(f"crossfall must lie in [0, 1); got {shown(crossfall)}")
     depth = as_float(depth, "depth")
     if not depth > 0.0:
-        raise ValueError(f"depth must be positive; got {depth!r}")
+        raise ValueError(f"depth must be positive; got {shown(depth)}")
     tolerance = 1e-6 * chain.length if tolerance is None else as_float(tolerance, "tolerance")
     if not tolerance > 0.0:
-        raise ValueError(f"tolerance must be positive; got {tolerance!r}")
+        raise ValueError(f"tolerance must be positive; got {shown(tolerance)}")
     if superelevation is None:
         superelevation = Superelevation.from_alignment(alignment)
     sweep = _Sweep(alignment, profile, superelevation, offsets, crossfall)

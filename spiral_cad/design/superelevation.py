@@ -29,7 +29,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from ..core._inputs import as_real_array
+from ..core._inputs import as_real_array, shown
 from ..core.piecewise import inside, piece_at, piecewise_at
 from .criteria import RailCriteria
 
@@ -84,7 +84,7 @@ class Superelevation:
                 raise ValueError(f"cross_slopes needs one value per curve ({len(curves)}); got shape {slopes.shape}")
         for curve, e in zip(curves, slopes.tolist()):
             if not (math.isfinite(e) and 0.0 <= e < 1.0):
-                raise ValueError(f"PI {curve.index}: the cross slope must lie in [0, 1); got {e!r}")
+                raise ValueError(f"PI {curve.index}: the cross slope must lie in [0, 1); got {shown(e)}")
         chain = alignment.chain
         stations = chain.stations
         if not curves:

@@ -2,8 +2,9 @@
 
 What is read (anything else is refused with its line number and the word):
 
-* words are a letter and a decimal number (``X-1.5``, ``x .5``, ``G01``;
-  no exponents), upper or lower case, spaces allowed between and inside;
+* words are a letter and a decimal number of ASCII digits (``X-1.5``,
+  ``x .5``, ``G01``; no exponents), upper or lower case, spaces allowed
+  between words, after the letter and after a sign;
 * ``G0``/``G00`` (rapid) and ``G1``/``G01`` (feed) straight moves with
   ``X``, ``Y``, ``Z``; the motion mode is modal (a line of coordinates alone
   moves as the last G0/G1 did); an axis a move does not name keeps its value,
@@ -27,7 +28,10 @@ straight moves, or linearise the arcs first), every other G and M code
 other words (``A``, ``B``, ``C``, ``I``, ``J``, ``K``, ``R``, ``P``, …), two
 motion codes on one line, coordinates with no motion mode in effect, numbers
 that are not finite, text that is not a word (``X1e3``, ``X--1``), an
-unclosed comment, control characters, and bytes that are not UTF-8.
+unclosed comment, control characters (line breaks are ``\n``, ``\r\n`` or
+``\r``; a vertical tab, form feed or Unicode line separator is refused, not
+read as a line break), lines longer than 65 536 characters, and bytes that
+are not UTF-8.
 
 A move that ends where it started is not a point of the path (it would be a
 corner of no length); the path's first point is where the first move ends.
@@ -51,6 +55,9 @@ if TYPE_CHECKING:
 
 #: Files larger than this are refused before reading (a full disk or a wrong file, not a program).
 MAX_BYTES = 1 << 30
+#: What a G-code program's file name ends in (a design file cannot make the build read, and
+#: quote in its error, any other file).
+SUFFIXES = (".nc", ".ngc", ".gcode", ".gc", ".g", ".tap", ".cnc", ".mpt", ".mpf")
 #: Codes that keep a state the path does not depend on.
 NEUTRAL_G = {17: "XY plane", 40: "no cutter compensation", 49: "no tool length offset", 54: "work offset 1",
              80: "no canned cycle", 94: "feed per minute"}  # fmt: skip
@@ -59,8 +66,13 @@ END_M = {2, 30}
 ARCS = {2: "G2 (a clockwise arc)", 3: "G3 (a counterclockwise arc)"}
 IGNORED_WORDS = set("FSTN")
 
-_WORD = re.compile(r"\s*([A-Za-z])\s*([+-]?\s*(?:\d+\.?\d*|\.\d+))")
-_CONTROL = re.compile(r"[\x00-\x08\x0b-\x1f\x7f]")
+#: Lines longer than this are refused before their words are read (memory grows with a line's words).
+MAX_LINE = 1 << 16
+
+_WORD = re.compile(r"\s*([A-Za-z])\s*([+-]?\s*(?:\d+\.?\d*|\.\d+))", re.ASCII)
+_CONTROL = re.compile("[\x00-\x08\x0b-\x1f\x7f-\x9f\u2028\u2029]")
+#: A whole comment, or a parenthesis or semicolon that starts or ends none.
+_COMMENT = re.compile(r"\([^()]*\)|[;()]")
 
 
 @dataclass(frozen=True)
@@ -118,19 +130,22 @@ class _Reader:
 
     def words(self, number: int, text: str) -> list[tuple[str, float, str]]:
         """(letter, value, as written) of every word of one line, comments removed."""
-        if _CONTROL.search(text):
-            raise self.error(number, f"control character {_CONTROL.search(text).group(0)!r} in the line")
-        kept = []
-        while text:  # comments, left to right: ( … ) or ; to the end of the line
-            cut = min((i for i in (text.find("("), text.find(";"), text.find(")")) if i >= 0), default=len(text))
-            kept.append(text[:cut])
-            if cut == len(text) or text[cut] == ";":
+        if len(text) > MAX_LINE:
+            raise self.error(number, f"the line has {len(text):,} characters; at most {MAX_LINE:,} are read")
+        control = _CONTROL.search(text)
+        if control:
+            raise self.error(number, f"control character {control.group(0)!r} in the line")
+        kept, at = [], 0
+        for comment in _COMMENT.finditer(text):  # left to right, in one pass: ( … ) or ; to the end of the line
+            kept.append(text[at : comment.start()])
+            at = comment.end()
+            if comment.group(0) == ";":
+                at = len(text)
                 break
-            close = text.find(")", cut)
-            if text[cut] == ")" or close < 0 or "(" in text[cut + 1 : close]:
+            if len(comment.group(0)) == 1:  # "(" with no ")" before the next "(", or a ")" with no "("
                 raise self.error(number, "a comment is not closed (or is nested): comments are ( … ) on one line")
             kept.append(" ")
-            text = text[close + 1 :]
+        kept.append(text[at:])
         text = "".join(kept)
         found, at = [], 0
         stripped = text.rstrip()
@@ -212,7 +227,8 @@ def parse_gcode(text: str, source: str = "G-code") -> GcodePath:
             a program with fewer than two moves.
     """
     reader = _Reader(source)
-    for number, line in enumerate(text.splitlines(), 1):
+    lines = text.replace("\r\n", "\n").replace("\r", "\n").split("\n")  # not splitlines: it breaks at \v, \f, …
+    for number, line in enumerate(lines, 1):
         reader.read_line(number, line)
     if len(reader.points) < 2:
         raise ValueError(f"{source}: the program has {len(reader.points)} move(s) to a new position; a path needs at least two")
@@ -220,18 +236,23 @@ def parse_gcode(text: str, source: str = "G-code") -> GcodePath:
 
 
 def read_gcode(path: str | os.PathLike) -> GcodePath:
-    """Read the straight moves of a G-code file (``.nc``, ``.gcode``, ``.ngc``, …).
+    """Read the straight moves of a G-code file (named ``*.nc``, ``.ngc``, ``.gcode``, ``.gc``, ``.g``,
+    ``.tap``, ``.cnc``, ``.mpt`` or ``.mpf``).
 
     Raises:
-        ValueError: not a regular file (a folder, a device), larger than 1 GiB,
-            not UTF-8 text, or outside the subset (named with the line).
+        ValueError: another file name, not a regular file (a folder, a device),
+            larger than 1 GiB, not UTF-8 text, or outside the subset (named with the line).
         OSError: the file could not be read.
     """
     name = os.fspath(path)
     label = os.path.basename(name) or name
+    if not label.isprintable():  # a file name is shown in messages: never raw control characters
+        label = repr(label)
     if not os.path.isfile(name):
         what = "a folder" if os.path.isdir(name) else "not a regular file" if os.path.exists(name) else "missing"
         raise ValueError(f"{label}: the G-code file is {what}")
+    if not name.lower().endswith(SUFFIXES):
+        raise ValueError(f"{label}: not a G-code file name (expected one ending in {', '.join(SUFFIXES)})")
     if os.path.getsize(name) > MAX_BYTES:
         raise ValueError(f"{label}: larger than {MAX_BYTES >> 30} GiB; not read")
     data = open(name, "rb").read()

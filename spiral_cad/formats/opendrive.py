@@ -45,6 +45,7 @@ from xml.sax.saxutils import escape
 import numpy as np
 from numpy.typing import NDArray
 
+from ..core._inputs import shown
 from ..core.chain import Chain
 from ..core.rows import ARC, LINE, SPIRAL
 from ..core.segments import row_frames
@@ -94,16 +95,16 @@ class CrossSection:
 
     def __post_init__(self) -> None:
         if not (isinstance(self.driving_lanes, int) and self.driving_lanes >= 1):
-            raise ValueError(f"driving_lanes must be a positive integer; got {self.driving_lanes!r}")
+            raise ValueError(f"driving_lanes must be a positive integer; got {shown(self.driving_lanes)}")
         for name in ("lane_width", "shoulder_width", "crossfall", "depth"):
             value = getattr(self, name)
             if isinstance(value, bool) or not (isinstance(value, (int, float)) and math.isfinite(value) and value >= 0):
-                raise ValueError(f"{name} must be a finite number ≥ 0; got {value!r}")
+                raise ValueError(f"{name} must be a finite number ≥ 0; got {shown(value)}")
         for name in ("lane_width", "depth"):
             if not getattr(self, name) > 0:
-                raise ValueError(f"{name} must be positive (m); got {getattr(self, name)!r}")
+                raise ValueError(f"{name} must be positive (m); got {shown(getattr(self, name))}")
         if not self.crossfall < 1:
-            raise ValueError(f"crossfall must be below 1 (m/m); got {self.crossfall!r}")
+            raise ValueError(f"crossfall must be below 1 (m/m); got {shown(self.crossfall)}")
         if self.rule not in ("RHT", "LHT"):
             raise ValueError(f"rule must be 'RHT' or 'LHT'; got {self.rule!r}")
 
