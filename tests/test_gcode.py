@@ -237,3 +237,11 @@ def test_design_files_take_3d_points_and_every_rounding_option(tmp_path):
     for fields, message in bad:
         with pytest.raises(DesignError, match=message):
             build({"units": "mm", "designs": [{"name": "h", "type": "rounded_polyline", **fields}]})
+
+
+def test_bytes_and_a_second_unit_are_value_errors():
+    with pytest.raises(ValueError, match="text must be the program as str; got bytes"):
+        parse_gcode(b"G21\nG1 X1\n")
+    path = parse_gcode("G21\nG1 X1\nG1 X1 Y1\nG1 X2 Y1\n")
+    with pytest.raises(ValueError, match="units: the program's own"):
+        round_toolpath(path, units="m", max_deviation=0.1)

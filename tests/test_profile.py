@@ -347,3 +347,20 @@ def test_grades_equal_to_the_last_ulp_make_a_straight_curve_not_a_crash():
 def test_messages_show_plain_numbers(make, message):
     with pytest.raises(ValueError, match=message):
         make()
+
+
+@pytest.mark.parametrize(
+    "make, message",
+    [
+        (lambda: Profile.from_pvis([[0, 0], [100, 1], [200, 0]], 50, alignment="x"), "alignment must be an Alignment; got str"),
+        (lambda: Profile.from_pvis([[0, 0], [100, 1], [200, 0]], 50, strict="no"), "strict must be True or False; got 'no'"),
+    ],
+)
+def test_arguments_of_the_wrong_kind_are_value_errors(make, message):
+    with pytest.raises(ValueError, match=message):
+        make()
+
+
+def test_a_superelevation_of_the_wrong_kind_is_named(highway, profile):
+    with pytest.raises(ValueError, match="superelevation must be a Superelevation; got str"):
+        roadway(highway, profile, [3.0], superelevation="x")

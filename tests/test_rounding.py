@@ -180,3 +180,9 @@ def test_malformed_input():
         round_corners(ZIGZAG, curvature=1.0, max_curvature=2.0)
     with pytest.raises(ValueError, match="max_curvature must be positive"):
         round_corners(ZIGZAG, max_curvature=-1.0)
+
+
+def test_a_bad_per_corner_value_names_the_corner_as_geometry_errors_do():
+    points = [[0, 0], [10, 0], [10, 10], [20, 10], [20, 20]]  # corners 1, 2, 3: the interior points
+    with pytest.raises(ValueError, match=r"max_deviation must be positive and finite; got nan \(corner 2\)"):
+        round_corners(points, max_deviation=[0.1, float("nan"), 0.1])

@@ -50,6 +50,7 @@ from ..core._inputs import as_float, as_points, as_real_array, per_item, shown
 from ..core.errors import NoSolutionError
 from ..core.piecewise import inside, piece_at, piecewise_at, polynomial
 from ..core.units import DEFAULT_UNITS, IMPERIAL, length_unit, speed_unit, to_metres
+from .alignment import Alignment
 from .tables import text_table, write_csv
 
 FOOT = 0.3048
@@ -304,6 +305,10 @@ class Profile:
                 alignment, or (``strict``) violated criteria — naming the PVIs
                 and the numbers.
         """
+        if alignment is not None and not isinstance(alignment, Alignment):
+            raise ValueError(f"alignment must be an Alignment; got {type(alignment).__name__}")
+        if not isinstance(strict, bool):
+            raise ValueError(f"strict must be True or False; got {shown(strict):.80}")
         if alignment is not None:
             own = alignment.chain.units
             if units not in (DEFAULT_UNITS, own):

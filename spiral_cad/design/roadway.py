@@ -140,6 +140,8 @@ def roadway(
         raise ValueError(f"tolerance must be positive; got {shown(tolerance)}")
     if superelevation is None:
         superelevation = Superelevation.from_alignment(alignment)
+    elif not isinstance(superelevation, Superelevation):
+        raise ValueError(f"superelevation must be a Superelevation; got {type(superelevation).__name__}")
     sweep = _Sweep(alignment, profile, superelevation, offsets, crossfall)
     floor = float_floor(chain.sample(2), profile.pvis[:, 1], offsets)
     if tolerance < floor:

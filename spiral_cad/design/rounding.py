@@ -269,8 +269,10 @@ def _half_deflection(p0: NDArray, corners: NDArray, p1: NDArray):
     return lin, lout, sin_t, cos_t
 
 
-def _per_corner(value: ArrayLike | None, name: str, n: int) -> NDArray | None:
-    """One positive finite value, or one per corner, as (n,); None stays None."""
+def _per_corner(value: ArrayLike | None, name: str, n: int, first: int = 0) -> NDArray | None:
+    """One positive finite value, or one per corner, as (n,); None stays None. Errors name
+    the corner by its number, ``first`` for the first value (a polyline's corners are its
+    interior points, numbered from 1)."""
     if value is None:
         return None
     v = as_real_array(value, name)
@@ -280,7 +282,7 @@ def _per_corner(value: ArrayLike | None, name: str, n: int) -> NDArray | None:
     bad = ~(np.isfinite(v) & (v > 0.0))
     if bad.any():
         i = int(np.argmax(bad))
-        raise ValueError(f"{name} must be positive and finite; got {v[i]} (corner {i})")
+        raise ValueError(f"{name} must be positive and finite; got {v[i]} (corner {i + first})")
     return np.ascontiguousarray(v)
 
 
@@ -568,7 +570,7 @@ def _at_corners(value: ArrayLike | None, name: str, interior: int, index: NDArra
         return _per_corner(v, name, 1)
     if v.ndim != 1 or v.size != interior:
         raise ValueError(f"{name} needs one value or one per interior point ({interior}); got shape {v.shape}")
-    _per_corner(v, name, interior)
+    _per_corner(v, name, interior, first=1)
     return v[index - 1]
 
 

@@ -226,6 +226,8 @@ def parse_gcode(text: str, source: str = "G-code") -> GcodePath:
         ValueError: anything outside the subset, naming ``source``, the line and the word;
             a program with fewer than two moves.
     """
+    if not isinstance(text, str):
+        raise ValueError(f"text must be the program as str; got {type(text).__name__} (decode bytes first, or use read_gcode)")
     reader = _Reader(source)
     lines = text.replace("\r\n", "\n").replace("\r", "\n").split("\n")  # not splitlines: it breaks at \v, \f, …
     for number, line in enumerate(lines, 1):
@@ -274,6 +276,8 @@ def round_toolpath(path: GcodePath, **options) -> RoundedPath:
     """
     from ..design.rounding import round_corners
 
+    if "units" in options:
+        raise ValueError("units: the program's own (G20/G21); convert the path with GcodePath.in_units first")
     try:
         return round_corners(path.points, units=path.units, **options)
     except ValueError as error:
