@@ -447,3 +447,14 @@ def test_svg_draws_one_named_path_per_chain(tmp_path):
     export_svg([CHAINS["S"], CHAINS["mixed"]], path, name="pair")
     ids = [p.get("id") for p in ET.parse(path).getroot().findall(".//{http://www.w3.org/2000/svg}path")]
     assert ids == ["pair-1", "pair-2"]
+
+
+@pytest.mark.parametrize("scale", [1e155, 1e-200])
+def test_step_directions_of_huge_and_tiny_paths_are_unit_vectors(tmp_path, scale):
+    from spiral_cad.design import round_corners
+
+    chain = round_corners(np.array([[0, 0, 0], [1, 0, 0], [1, 1, 1]]) * scale, units="m").chain
+    export_step(chain, tmp_path / "p.step")
+    directions = re.findall(r"DIRECTION\('',\(([^)]*)\)\)", (tmp_path / "p.step").read_text())
+    vectors = np.array([[float(v) for v in d.split(",")] for d in directions])
+    assert len(vectors) >= 3 and np.allclose(np.linalg.norm(vectors, axis=1), 1.0, rtol=1e-15)

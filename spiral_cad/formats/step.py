@@ -94,7 +94,9 @@ class _Entities:
 
 
 def _unit(vector: NDArray) -> list[float]:
-    return (vector / np.linalg.norm(vector)).tolist()
+    """The direction of ``vector``, scaled first: its squares overflow at 1e155 and vanish at 1e-160."""
+    scaled = vector / np.abs(vector).max()
+    return (scaled / np.linalg.norm(scaled)).tolist()
 
 
 def _line(data: _Entities, line: Line, start: str) -> str:
