@@ -158,6 +158,10 @@ def gcode_design(args: argparse.Namespace) -> dict:
         raise ValueError("--from-gcode needs --max-deviation (the tolerance at every corner) and/or --max-curvature")
     if args.sample_step is not None and args.chord_tolerance is not None:
         raise ValueError("give --sample-step or --chord-tolerance, not both")
+    for key in ("max_deviation", "max_curvature", "sample_step", "chord_tolerance"):
+        value = getattr(args, key)
+        if value is not None and not 0.0 < value < math.inf:
+            raise ValueError(f"--{key.replace('_', '-')} must be a positive finite number; got {value}")
     stem = re.sub(r"[^A-Za-z0-9_-]", "_", Path(args.from_gcode).stem).lstrip("_-")[:64] or "toolpath"
     design = {"name": args.name or stem, "type": "rounded_polyline", "gcode": args.from_gcode, "spiral_shape": args.shape or "walton-meek"}
     for key in ("max_deviation", "max_curvature"):
@@ -166,7 +170,7 @@ def gcode_design(args: argparse.Namespace) -> dict:
     if args.sample_step is not None:
         design["samples"] = {"step": args.sample_step}
     else:
-        default = args.max_deviation / 10.0 if args.max_deviation is not None else 0.001
+        default = (args.max_deviation / 10.0 or args.max_deviation) if args.max_deviation is not None else 0.001
         design["samples"] = {"chord_tolerance": args.chord_tolerance if args.chord_tolerance is not None else default}
     return {"units": args.units or "mm", "designs": [design]}
 
