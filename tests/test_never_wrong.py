@@ -250,8 +250,12 @@ def test_degenerate_spiral_is_refused_and_cannot_hide_a_kink():
 def test_round_corners_refuses_a_curvature_float64_cannot_hold():
     points = [(0, 0), (1.0, 0.1), (1.4, 0.9), (2.4, 1.0)]
     for method in ("walton-meek", "g2cbs"):
-        with pytest.raises(sc.NoSolutionError, match=r"corner 1 .*float64"):
+        with pytest.raises(sc.NoSolutionError, match=r"corner 1 .*float64 at these coordinates: .*use a lower curvature$"):
             round_corners(points, max_curvature=1e15, method=method)
+    with pytest.raises(sc.NoSolutionError, match=r"would start .*e-301 from the corner.* cannot be told apart; use a lower curvature$"):
+        round_corners(points, max_curvature=1e300)
+    with pytest.raises(sc.NoSolutionError, match=r"float64 at these coordinates: .*; use a larger max_deviation$"):
+        round_corners(points, max_deviation=1e-12)
 
 
 # ----------------------------------------------------------- input coercion

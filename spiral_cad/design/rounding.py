@@ -215,10 +215,12 @@ class CornerBatch:
                     f"({ROUNDING_ULPS:g} ulp of the largest is {ROUNDING_ULPS * EPS * np.abs(self.corners[i]).max():.3g}); "
                     "use a larger max_deviation, or coordinates nearer the origin"
                 )
+            held = (f"it holds only to {self.residual[i]:.2g} (at most 1e-9 is returned)" if self.residual[i] < math.inf
+                    else "its control points cannot be told apart")  # fmt: skip
+            advice = "a larger max_deviation" if bound == bound else "a lower curvature"
             return (
-                f"{where}: the spiral pair for curvature {self.curvature[i]:.6g} would start "
-                f"{self.distance[i]:.3g} from the corner, too small for float64 at these coordinates: it "
-                f"holds only to {self.residual[i]:.2g} (at most 1e-9 is returned); use a lower curvature"
+                f"{where}: the spiral pair would start {self.distance[i]:.3g} from the corner, too small for "
+                f"float64 at these coordinates: {held}; use {advice}"
             )
         if status is Status.NOT_FINITE:
             return f"{where}: its points must be finite"
