@@ -62,6 +62,8 @@ def test_arcs_are_refused_by_name_with_their_line():
         ("G21\nG1 X1 Y1\nG1 X\u0663 Y5\n", r"line 3: 'X\u0663 Y5' is not a G-code word"),  # an Arabic-Indic 3
         ("G21\nG1 X\uff11\uff12\n", r"line 2: .* is not a G-code word"),  # full-width digits
         ("G21\nG1 X1 (a(b)c)\n", r"line 2: a comment is not closed \(or is nested\)"),
+        ("G21\nG0.00000000000000000000005 X1\n", r"line 2: G0.000000000000000000… is not in the supported subset"),
+        ("G21\nG" + "9" * 300 + "\n", r"line 2: G99999999999999999999… is not in the supported subset \(G0"),
         ("G21\nG1 X1 )\n", r"line 2: a comment is not closed"),
         ("G21\nG1 X1" + " F1" * 30_000 + "\n", r"line 2: the line has 90,005 characters; at most 65,536"),
     ],

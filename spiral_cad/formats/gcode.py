@@ -71,6 +71,8 @@ MAX_LINE = 1 << 16
 
 _WORD = re.compile(r"\s*([A-Za-z])\s*([+-]?\s*(?:\d+\.?\d*|\.\d+))", re.ASCII)
 _CONTROL = re.compile("[\x00-\x08\x0b-\x1f\x7f-\x9f\u2028\u2029]")
+#: A G or M code as written: an integer, perhaps with a point and zeros (G01, G1.0).
+_INTEGER = re.compile(r"[+-]?[0-9]+(?:\.0*)?")
 #: A whole comment, or a parenthesis or semicolon that starts or ends none.
 _COMMENT = re.compile(r"\([^()]*\)|[;()]")
 
@@ -158,7 +160,8 @@ class _Reader:
             value = float(written)
             if not math.isfinite(value):
                 raise self.error(number, f"{letter}{written[:20]}… is not a finite number")
-            found.append((letter, value, f"{letter}{written}"))
+            shown = f"{letter}{written}" if len(written) <= 20 else f"{letter}{written[:20]}…"  # for messages
+            found.append((letter, value, shown))
             at = match.end()
         return found
 
@@ -170,7 +173,7 @@ class _Reader:
         motion: list[int] = []
         target: dict[int, float] = {}
         for letter, value, written in words:
-            code = int(value) if value == int(value) else None
+            code = int(value) if _INTEGER.fullmatch(written[1:]) else None  # G0.0…05 is no G0
             if letter == "G":
                 if code in (0, 1):
                     motion.append(code)
