@@ -54,7 +54,7 @@ def main() -> None:
                     f"Medians of {args.repeat} runs, each a fresh process; with and without plots taking turns.")  # fmt: skip
     with tempfile.TemporaryDirectory() as scratch:
         folder = Path(scratch)
-        floor = Timing(tuple(run(["build", "--help"], folder)[0] for _ in range(max(3, args.repeat))))
+        floor = Timing(tuple(run(["build", "--help"], folder)[0] for _ in range(args.repeat if args.quick else max(3, args.repeat))))
         report.add("command start (`spiral-cad build --help`)", floor.median, "s", floor)
         medians: dict[str, list[float]] = {"no plots": [], "plots": []}
         for count in args.pis:

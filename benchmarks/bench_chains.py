@@ -30,7 +30,6 @@ import tempfile
 import time
 from pathlib import Path
 
-import numpy as np
 from timing import growth_exponent, machine, write_markdown
 
 ROOT = Path(__file__).resolve().parent.parent

@@ -12,6 +12,11 @@ import pytest
 
 BENCH = Path(__file__).resolve().parents[1] / "benchmarks"
 SCRIPTS = sorted(BENCH.glob("bench_*.py"))
+#: What a script's quick table must say beside its numbers (every job ran; the solids it built are valid).
+EXPECTED = {
+    "bench_paths3d": ("3-D batch", "G-code", "valid True", "per-corner"),
+    "bench_roads3d": ("corridor", "valid", "growth exponent"),
+}
 
 
 @pytest.mark.parametrize("script", SCRIPTS, ids=lambda path: path.stem)
@@ -23,6 +28,7 @@ def test_benchmark_runs_quick_and_writes_its_table(script, tmp_path):
     text = out.read_text(encoding="utf-8")
     assert text.startswith("# ") and "Machine:" in text
     assert "\n| " in text and "|---|" in text  # at least one table
+    assert all(words in text for words in EXPECTED.get(script.stem, ())) and "INVALID" not in text
 
 
 def test_run_all_runs_the_named_scripts_and_counts_failures(tmp_path):

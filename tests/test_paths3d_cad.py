@@ -181,18 +181,3 @@ def test_the_checker_reports_where_a_path_in_space_changes_plane(tmp_path):
     assert f"largest plane change {math.degrees(max(expected)):.4g}° at joint" in text and "plane°" in text
     flat = round_corners([p[:2] for p in RUN], max_deviation=2.0).chain  # in the plane: no plane change anywhere
     assert all(j.plane_change <= 1e-12 for j in check_continuity(flat).wires[0].joints[1:])
-
-
-def test_the_paths3d_benchmark_runs_quick(tmp_path):
-    """bench_paths3d --quick --out: every job runs and writes its row (timings are not judged here)."""
-    import subprocess
-    import sys
-    from pathlib import Path
-
-    bench = Path(__file__).resolve().parent.parent / "benchmarks" / "bench_paths3d.py"
-    out = tmp_path / "results.md"
-    run = subprocess.run([sys.executable, str(bench), "--quick", "--out", str(out)], capture_output=True, text=True,
-                         timeout=600, cwd=bench.parent)  # fmt: skip
-    assert run.returncode == 0, run.stderr[-2000:]
-    text = out.read_text()
-    assert "3-D batch" in text and "G-code" in text and "valid True" in text and "per-corner" in text

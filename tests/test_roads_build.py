@@ -89,15 +89,3 @@ def test_curve_lengths_in_a_design_file_are_whole_lengths_or_halves():
     (built,) = build(design(curve_lengths=[120, [50, 70]]))[1]
     first, second = built.notes["profile"].curves
     assert (first.length_in, first.length_out, second.length_in, second.length_out) == (60, 60, 50, 70)
-
-
-def test_the_3d_benchmark_runs_quick():
-    """bench_roads3d --quick: every job runs and prints its row (timings are not judged here)."""
-    import subprocess
-    import sys
-    from pathlib import Path
-
-    bench = Path(__file__).resolve().parent.parent / "benchmarks" / "bench_roads3d.py"
-    run = subprocess.run([sys.executable, str(bench), "--quick"], capture_output=True, text=True, timeout=300, cwd=bench.parent)
-    assert run.returncode == 0, run.stderr[-2000:]
-    assert "corridor" in run.stdout and "valid" in run.stdout and "INVALID" not in run.stdout and "growth exponent" in run.stdout
