@@ -15,6 +15,7 @@ as it was.
 
 from __future__ import annotations
 
+import contextlib
 import json
 import math
 import os
@@ -26,6 +27,7 @@ import time
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from dataclasses import dataclass, field
+from functools import partial
 from importlib.util import find_spec
 from pathlib import Path
 from typing import Any
@@ -635,19 +637,31 @@ def write(
 def _write_design(b: Built, stage: Path, units: str, missing: list[str], plots: bool) -> list[str]:
     """Write one design's files into ``stage``; returns what follows the name of each file written.
 
-    The STEP file goes first: OCCT reads it for the continuity report in its
-    own process while the other files are written.
+    The STEP file goes first; then two child processes work beside this one:
+    OCCT reads the STEP for the continuity report, and the DXF is written
+    (ezdxf's objects are the slowest of the files), while the rest are written here.
     """
-    from .export import export_step
+    from .cad.sandbox import Isolated
+    from .export import export_dxf, export_step
 
     step = stage / f"{b.name}.step"
     export_step(b.chain, step, name=b.name)
-    if "OCP" in missing:
-        return ["step"] + _write_others(b, stage, units, missing, plots)
-    from .cad.continuity import checking
+    with contextlib.ExitStack() as children:
+        continuity = None
+        if "OCP" not in missing:
+            from .cad.continuity import checking
 
-    with checking(step) as continuity:  # as `spiral-cad check` reads it: the same numbers
+            continuity = children.enter_context(checking(step))  # as `spiral-cad check` reads it: the same numbers
+        dxf = None
+        if "ezdxf" not in missing:
+            dxf = children.enter_context(Isolated(partial(export_dxf, name=b.name), b.chain, stage / f"{b.name}.dxf",
+                                                  what="the DXF writer", subject=f"{b.name}.dxf"))  # fmt: skip
         names = ["step"] + _write_others(b, stage, units, missing, plots)
+        if dxf is not None:
+            dxf.result()
+            names.append("dxf")
+        if continuity is None:
+            return names
         report = continuity()
     b.notes["continuity"] = f"{report.min_level} ({report.describe()})"
     (stage / f"{b.name}_continuity.txt").write_text(report.format_table() + "\n", encoding="utf-8")
@@ -655,7 +669,7 @@ def _write_design(b: Built, stage: Path, units: str, missing: list[str], plots: 
 
 
 def _write_others(b: Built, stage: Path, units: str, missing: list[str], plots: bool) -> list[str]:
-    """Every file of a design but its STEP and continuity report."""
+    """Every file of a design but its STEP, DXF and continuity report."""
     from .export import export_svg
 
     names = []
@@ -688,11 +702,6 @@ def _write_others(b: Built, stage: Path, units: str, missing: list[str], plots: 
 
         export_iges(b.chain, stage / f"{b.name}.igs", name=b.name)
         names.append("igs")
-    if "ezdxf" not in missing:
-        from .export import export_dxf
-
-        export_dxf(b.chain, stage / f"{b.name}.dxf", name=b.name)
-        names.append("dxf")
     if plots and "matplotlib" not in missing:
         names += _plots(b, stage)
     return names
