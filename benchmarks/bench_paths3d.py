@@ -23,14 +23,13 @@ Jobs, each with a peer measured in the same run:
 
 from __future__ import annotations
 
-import argparse
 import math
 import tempfile
 import time
 from pathlib import Path
 
 import numpy as np
-from timing import machine, median_time
+from timing import arguments, machine, median_time
 
 SIZES = {"corners": 1_000_000, "moves": 100_000, "handrail": 1_000, "scalar": 2_000}
 QUICK = {"corners": 20_000, "moves": 2_000, "handrail": 30, "scalar": 200}
@@ -167,12 +166,8 @@ def sweep_rows(sizes: dict) -> list[list[str]]:
 
 
 def main() -> None:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--repeat", type=int, default=5)
-    parser.add_argument("--quick", action="store_true", help="small sizes, one run (checks that the script works)")
-    parser.add_argument("--out", help="also write the tables to this markdown file")
-    args = parser.parse_args()
-    sizes, repeat = (QUICK, 1) if args.quick else (SIZES, args.repeat)
+    args = arguments(__doc__, repeat=(5, 1))
+    sizes, repeat = (QUICK if args.quick else SIZES), args.repeat
     head = ["job", "size", "time (s)", "rate / detail", "peer in the same run", "note"]
     with tempfile.TemporaryDirectory() as folder:
         rows = rounding_rows(sizes, repeat) + gcode_rows(sizes, Path(folder)) + sweep_rows(sizes)

@@ -10,11 +10,10 @@ built from given spiral angles (no criteria), measured in the same run.
 
 from __future__ import annotations
 
-import argparse
 import tempfile
 from pathlib import Path
 
-from timing import machine, median_time, write_markdown
+from timing import arguments, machine, median_time, write_markdown
 
 from spiral_cad.design import Alignment
 from spiral_cad.export import export_opendrive
@@ -26,14 +25,7 @@ def zigzag(count: int) -> list[list[float]]:
 
 
 def main() -> None:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--pis", type=int, nargs="+", default=[250, 1000, 4000])
-    parser.add_argument("--repeat", type=int, default=3)
-    parser.add_argument("--out", help="also write the table to this markdown file")
-    parser.add_argument("--quick", action="store_true", help="smallest sizes: a smoke test (timing.py)")
-    args = parser.parse_args()
-    if args.quick:
-        args.pis, args.repeat = [4], 1
+    args = arguments(__doc__, pis=([250, 1000, 4000], [4]), repeat=(3, 1))
     rows = []
     folder = Path(tempfile.mkdtemp())
     for count in args.pis:

@@ -19,14 +19,13 @@ measured in the same run:
 
 from __future__ import annotations
 
-import argparse
 import gc
 import tempfile
 import xml.etree.ElementTree as ET
 from pathlib import Path
 
 import numpy as np
-from timing import machine, median_time, write_markdown
+from timing import arguments, machine, median_time, write_markdown
 
 from spiral_cad.design import Alignment, Profile
 from spiral_cad.export import export_opendrive
@@ -130,12 +129,8 @@ def _without_gc(job):
 
 
 def main() -> None:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--repeat", type=int, default=3)
-    parser.add_argument("--quick", action="store_true", help="small sizes, one run (a smoke test, no timings to trust)")
-    parser.add_argument("--out", help="also write the table to this markdown file")
-    args = parser.parse_args()
-    repeat = 1 if args.quick else args.repeat
+    args = arguments(__doc__, repeat=(3, 1))
+    repeat = args.repeat
     rows = profile_rows(repeat)
     rows += corridor_rows(repeat, 1.0 if args.quick else 10.0)
     rows += opendrive_rows(repeat, [10, 100] if args.quick else [100, 1000, 10000])

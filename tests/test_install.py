@@ -190,3 +190,22 @@ def test_the_cad_extra_s_two_ocp_distributions_install_one_ocp_the_vtk_build():
     import_both = "import cadquery, build123d, OCP.IVtkVTK; print(OCP.IVtkVTK.IVtkVTK_ShapeData.__name__)"
     done = subprocess.run([sys.executable, "-c", import_both], capture_output=True, text=True, cwd="/")
     assert done.returncode == 0 and done.stdout.strip() == "IVtkVTK_ShapeData", done.stderr[-2000:]
+
+
+def test_the_numeric_core_names_no_cad_kernel_not_even_inside_a_function():
+    import ast
+    from pathlib import Path
+
+    core = Path(__file__).resolve().parent.parent / "spiral_cad" / "core"
+    cad = ("OCP", "build123d", "cadquery", "spiral_cad.cad")
+    found = []
+    for path in sorted(core.glob("*.py")):
+        for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+            if isinstance(node, ast.Import):
+                names = [alias.name for alias in node.names]
+            elif isinstance(node, ast.ImportFrom):
+                names = ["." * node.level + (node.module or "")]
+            else:
+                continue
+            found += [f"{path.name}: {name}" for name in names if name.split(".")[0] in cad[:3] or name.startswith(("spiral_cad.cad", "..cad"))]
+    assert found == []

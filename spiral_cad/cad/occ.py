@@ -226,6 +226,35 @@ def segment_edges(segments: Iterable[Segment], plane: gp_Ax3 | None = None) -> l
     return [BRepBuilderAPI_MakeEdge(*span).Edge() for span in _curves(_segment_rows(segments), _frame(plane))[0]]
 
 
+def chain_edges(chain: Iterable[Segment], plane: Any = None) -> list:
+    """``Chain.to_edges``: the exact build123d edges (LINE, CIRCLE, BEZIER) in travel order.
+
+    Args:
+        plane: a build123d ``Plane``: the coordinate system of the chain's
+            coordinates (x, y[, z]) (None: the global one, ``Plane.XY``).
+    """
+    from build123d import Edge
+
+    return [Edge(e) for e in segment_edges(chain, _ax3(plane))]
+
+
+def chain_to_wire(chain: Iterable[Segment], plane: Any = None) -> Any:
+    """``Chain.to_wire``: the chain as one build123d ``Wire`` in ``plane``'s coordinates (None: ``Plane.XY``)."""
+    from build123d import Wire
+
+    return Wire(chain_wire(chain, _ax3(plane)))
+
+
+def _ax3(plane: Any) -> gp_Ax3 | None:
+    """A build123d ``Plane`` (or None) as the OCP ``gp_Ax3`` the edge makers take."""
+    if plane is None:
+        return None
+    to_gp_ax3 = getattr(plane, "to_gp_ax3", None)
+    if to_gp_ax3 is None:
+        raise ValueError(f"plane must be a build123d Plane or None; got {plane!r}")
+    return to_gp_ax3()
+
+
 def chain_wire(chain: Iterable[Segment], plane: gp_Ax3 | None = None) -> TopoDS_Wire:
     """One wire of the exact edges of ``chain`` (a ``Chain`` or any segments in travel order).
 

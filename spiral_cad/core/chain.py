@@ -351,28 +351,8 @@ class Chain:
         pts = [seg.point(u) for seg in self.segments]
         return np.vstack(pts + [self.end[None]])
 
-    # ------------------------------------------- CAD (imported when used)
-
-    def to_edges(self, plane: Any = None) -> list:
-        """The exact build123d edges (LINE, CIRCLE, BEZIER) in travel order.
-
-        Args:
-            plane: a build123d ``Plane``: the coordinate system of the chain's
-                coordinates (x, y[, z]) (None: the global one, ``Plane.XY``).
-        """
-        from build123d import Edge
-
-        from ..cad.occ import segment_edges
-
-        return [Edge(e) for e in segment_edges(self, _ax3(plane))]
-
-    def to_wire(self, plane: Any = None) -> Any:
-        """The chain as one build123d ``Wire`` in ``plane``'s coordinates (None: ``Plane.XY``)."""
-        from build123d import Wire
-
-        from ..cad.occ import chain_wire
-
-        return Wire(chain_wire(self, _ax3(plane)))
+    # ``to_edges`` and ``to_wire`` (exact build123d edges and wire) are CAD adapters:
+    # ``spiral_cad.cad.occ`` defines them and the package attaches them here.
 
     def to_nurbs(self) -> Any:
         """The whole chain as one exact rational cubic B-spline (``spiral_cad.nurbs.Nurbs``).
@@ -385,16 +365,6 @@ class Chain:
         from .nurbs import chain_to_nurbs
 
         return chain_to_nurbs(self.segments)
-
-
-def _ax3(plane: Any) -> Any:
-    """A build123d ``Plane`` (or None) as the OCP ``gp_Ax3`` the edge makers take."""
-    if plane is None:
-        return None
-    to_gp_ax3 = getattr(plane, "to_gp_ax3", None)
-    if to_gp_ax3 is None:
-        raise ValueError(f"plane must be a build123d Plane or None; got {plane!r}")
-    return to_gp_ax3()
 
 
 def _size(rows: SegmentRows, frames: NDArray) -> float:
