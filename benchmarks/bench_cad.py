@@ -20,9 +20,10 @@ from OCP.TColgp import TColgp_Array1OfPnt
 from timing import Report, arguments, compare, growth_exponent, table
 
 from spiral_cad import Arc, Chain, Line, circle_to_circle
-from spiral_cad.continuity import check_continuity
-from spiral_cad.export import export_step
-from spiral_cad.occ import chain_wire, read_shape
+from spiral_cad.cad.continuity import check_continuity
+from spiral_cad.cad.export import export_step
+from spiral_cad.cad.occ import chain_wire
+from spiral_cad.cad.readers import read_shape
 
 
 def snake(segments: int) -> Chain:

@@ -15,7 +15,7 @@ from scipy.special import fresnel
 from timing import Report, arguments, compare, growth_exponent, latencies, per_second, table
 
 import spiral_cad as sc
-from spiral_cad import batch
+from spiral_cad.core import batch
 from spiral_cad.core import _kernels as K
 
 

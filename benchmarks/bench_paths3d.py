@@ -117,8 +117,8 @@ def rounding_rows(sizes: dict, repeat: int) -> list[list[str]]:
 def gcode_rows(sizes: dict, folder: Path) -> list[list[str]]:
     from build123d import Polyline
 
-    from spiral_cad.export import export_samples, export_step
-    from spiral_cad.formats.gcode import read_gcode, round_toolpath
+    from spiral_cad.cad.export import export_samples, export_step
+    from spiral_cad.io.gcode import read_gcode, round_toolpath
 
     program = folder / "finish.nc"
     program.write_text(gcode_program(sizes["moves"], np.random.default_rng(2)))

@@ -16,8 +16,8 @@ from pathlib import Path
 from timing import arguments, machine, median_time, write_markdown
 
 from spiral_cad.design import Alignment
-from spiral_cad.export import export_opendrive
-from spiral_cad.formats.opendrive import check_opendrive, read_opendrive
+from spiral_cad.cad.export import export_opendrive
+from spiral_cad.io.opendrive import check_opendrive, read_opendrive
 
 
 def zigzag(count: int) -> list[list[float]]:
@@ -40,7 +40,7 @@ def main() -> None:
         import matplotlib
 
         matplotlib.use("Agg")
-        from spiral_cad.plots import plot_plan
+        from spiral_cad.app.plots import plot_plan
 
         plot = median_time(lambda: plot_plan(alignment.chain).savefig(folder / "plan.png", dpi=110), 1)
         per_k = 1000.0 / count

@@ -28,8 +28,8 @@ import numpy as np
 from timing import arguments, machine, median_time, write_markdown
 
 from spiral_cad.design import Alignment, Profile
-from spiral_cad.export import export_opendrive
-from spiral_cad.formats.opendrive import read_opendrive
+from spiral_cad.cad.export import export_opendrive
+from spiral_cad.io.opendrive import read_opendrive
 
 
 def zigzag_alignment(count: int, spacing: float = 1000.0, offset: float = 250.0, speed: float = 80.0) -> Alignment:
@@ -67,8 +67,8 @@ def profile_rows(repeat: int) -> list[list[str]]:
 def corridor_rows(repeat: int, length_km: float) -> list[list[str]]:
     from build123d import Plane, Polygon, sweep
 
-    from spiral_cad.build123d import corridor
-    from spiral_cad.export import CrossSection
+    from spiral_cad.build123d import chain_to_wire, corridor
+    from spiral_cad.cad.export import CrossSection
 
     count = max(1, round(length_km))  # a curve every kilometre
     alignment = zigzag_alignment(count, offset=150.0, speed=100.0)
@@ -77,7 +77,7 @@ def corridor_rows(repeat: int, length_km: float) -> list[list[str]]:
     road = corridor(alignment, profile, section)
     ours = median_time(lambda: corridor(alignment, profile, section), repeat, warm_up=False)
     faces = len(road.solid.faces())
-    wire = alignment.chain.to_wire()
+    wire = chain_to_wire(alignment.chain)
     start, tangent = wire @ 0, wire % 0
     half = 2 * 3.5 + 2.5
 

@@ -17,7 +17,7 @@ For zigzag alignments of N PIs (near-linear spirals, 4 N + 1 edges, as
   ``report.timing``: the reader's part (the child's read, curve accounting
   and round trip) and ours (measuring every edge, classifying every joint),
   as joints per second;
-* **to_wire**: ``chain.to_wire()`` against the peer ``raw_ocp_edges`` of
+* **to_wire**: ``chain_to_wire(chain)`` against the peer ``raw_ocp_edges`` of
   ``bench_cad.py`` (the same exact edges made with direct OCP calls from
   plain numbers, no wire), run back to back: the ratio is the median of the
   per-pair ratios (a shared machine's load hits both alike).
@@ -39,12 +39,14 @@ import numpy as np
 from bench_cad import plain_description, raw_ocp_edges
 from timing import machine, write_markdown
 
+from spiral_cad.build123d import chain_to_wire
 from spiral_cad.cad.continuity import check_continuity
-from spiral_cad.cad.occ import chain_wire, captured_messages
+from spiral_cad.cad.occ import chain_wire
+from spiral_cad.cad.console import captured_messages
 from spiral_cad.design import Alignment
-from spiral_cad.formats.joints import ContinuityReport
-from spiral_cad.export import export_step
-from spiral_cad.formats.step_occ import write_shape_step
+from spiral_cad.check.joints import ContinuityReport
+from spiral_cad.cad.export import export_step
+from spiral_cad.cad.step_occ import write_shape_step
 
 
 def zigzag(count: int) -> list[list[float]]:
@@ -126,7 +128,7 @@ def main() -> None:
     results = []
     for chain in chains:  # first, in a process that has read no large file (OCCT's reads leave its heap fragmented)
         rows = plain_description(chain)
-        pairs = timed({"to_wire": lambda: chain.to_wire(), "raw edges": lambda: raw_ocp_edges(rows)}, args.pairs)
+        pairs = timed({"to_wire": lambda: chain_to_wire(chain), "raw edges": lambda: raw_ocp_edges(rows)}, args.pairs)
         results.append(medians(pairs))
         results[-1]["to_wire / raw"] = statistics.median(a / b for a, b in zip(pairs["to_wire"], pairs["raw edges"]))
     for count, chain, t in zip(args.pis, chains, results):

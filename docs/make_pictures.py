@@ -23,7 +23,7 @@ def main() -> None:
     IMAGES.mkdir(parents=True, exist_ok=True)
     with tempfile.TemporaryDirectory() as tmp:
         tmp = Path(tmp)
-        run("-m", "spiral_cad.cli", "demo", "--out", str(tmp / "demo"))
+        run("-m", "spiral_cad.app.cli", "demo", "--out", str(tmp / "demo"))
         run("examples/robot_path.py", str(tmp / "robot"))
         run("examples/robot_path_3d.py", str(tmp / "robot3d"))
         run("examples/build123d_road.py", str(tmp / "road"))
@@ -42,7 +42,7 @@ def main() -> None:
         }
         for source, target in picks.items():
             shutil.copy(tmp / source, IMAGES / target)
-        from spiral_cad.plots import plot_jerk_length
+        from spiral_cad.app.plots import plot_jerk_length
 
         plot_jerk_length(shapes=("walton-meek", "near-linear")).savefig(IMAGES / "jerk_length.png", dpi=100)
         tube = cq.importers.importStep(str(tmp / "cq" / "tube.step"))

@@ -13,7 +13,7 @@ from build123d import ExportSVG, LineType, export_step, scale
 
 from spiral_cad.build123d import centerline_wire, corridor
 from spiral_cad.design import Alignment, Profile
-from spiral_cad.export import CrossSection
+from spiral_cad.cad.export import CrossSection
 
 out = Path(sys.argv[1] if len(sys.argv) > 1 else "out")
 out.mkdir(parents=True, exist_ok=True)

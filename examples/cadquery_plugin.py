@@ -18,7 +18,7 @@ import cadquery as cq
 
 import spiral_cad as sc
 import spiral_cad.cadquery  # noqa: F401  (registers the Workplane methods)
-from spiral_cad.continuity import check_continuity
+from spiral_cad.cad.continuity import check_continuity
 
 RADIUS = 10.0  # bend radius
 CENTER = (40.0, 10.5)  # bend centre: the straights are y = 0 and y = 21

@@ -15,7 +15,7 @@ from pathlib import Path
 from build123d import BuildLine, BuildPart, BuildSketch, Circle, Plane, export_step, sweep
 
 from spiral_cad.build123d import G2Polyline
-from spiral_cad.continuity import check_continuity
+from spiral_cad.cad.continuity import check_continuity
 
 out = Path(sys.argv[1] if len(sys.argv) > 1 else "out")
 out.mkdir(parents=True, exist_ok=True)

@@ -1,4 +1,560 @@
-"""Public name of ``spiral_cad.cad.build123d`` (see there)."""
+"""build123d line objects for G2 spiral transitions and whole chains.
 
-from .cad.build123d import *  # noqa: F403
-from .cad.build123d import __all__  # noqa: F401
+Each object is a ``BaseLineObject`` (a ``Wire``, like build123d's
+``Polyline``) because a transition or chain has several edges. Points are
+taken in the local coordinates of the active ``BuildLine`` and the result
+is placed on its workplane by build123d, exactly as for its own objects;
+outside a builder the result lies on ``Plane.XY``. Spirals become exact
+``BEZIER`` edges, arcs ``CIRCLE`` and lines ``LINE`` edges, in travel order.
+
+``G2Polyline`` is build123d's ``Polyline`` with every corner rounded by a
+G2 spiral pair, in the plane or in space (robot and CNC paths, handrails,
+cable and pipe runs), and ``g2_fillet`` also rounds a 3-D wire of lines,
+each corner in the plane of its two edges.
+
+Example:
+    >>> with BuildLine(Plane.XZ) as path:
+    ...     SpiralChain(chain)
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable
+
+from build123d import (
+    Edge,
+    Plane,
+    Align,
+    BaseLineObject,
+    BaseSketchObject,
+    Builder,
+    BuildLine,
+    BuildSketch,
+    Compound,
+    Curve,
+    Face,
+    Mode,
+    Sketch,
+    Shape,
+    SkipClean,
+    Vector,
+    VectorLike,
+    Vertex,
+    Wire,
+    flatten_sequence,
+)
+from OCP.BRepAdaptor import BRepAdaptor_Curve
+from OCP.BRepTools import BRepTools_WireExplorer
+from OCP.GeomAbs import GeomAbs_CurveType
+from OCP.TopAbs import TopAbs_REVERSED
+from OCP.TopoDS import TopoDS
+
+from .core.chain import Chain
+from .core.shapes import DEFAULT_SHAPE
+from .design.rounding import curvature_bound, fillet_polyline, round_corners
+from .design.fillets import continuous_polygon, continuous_rectangle, continuous_slot
+from .cad.corridor import Corridor, centerline_wire, corridor
+from .cad.fillet import fillet_face, fillet_wire, planar_frame
+from .cad.occ import chain_wire, plane_ax3, segment_edges
+from .core.segments import Segment
+from .core.transitions import Transition, circle_in_circle, circle_to_circle, line_to_circle, line_to_line
+
+__all__ = [
+    "chain_edges",
+    "chain_to_wire",
+    "ContinuousPolygon",
+    "ContinuousRectangle",
+    "ContinuousSlot",
+    "Corridor",
+    "G2Polyline",
+    "SpiralChain",
+    "SpiralCircleInCircle",
+    "SpiralCircleToCircle",
+    "SpiralLineToCircle",
+    "SpiralLineToLine",
+    "centerline_wire",
+    "corridor",
+    "curvature_comb",
+    "g2_fillet",
+]
+
+
+def chain_edges(chain: Iterable[Segment], plane: Plane | None = None) -> list[Edge]:
+    """The exact build123d edges (LINE, CIRCLE, BEZIER) in travel order.
+
+    Args:
+        plane: a build123d ``Plane``: the coordinate system of the chain's
+            coordinates (x, y[, z]) (None: the global one, ``Plane.XY``).
+    """
+    return [Edge(e) for e in segment_edges(chain, plane_ax3(plane))]
+
+
+def chain_to_wire(chain: Iterable[Segment], plane: Plane | None = None) -> Wire:
+    """The chain as one build123d ``Wire`` in ``plane``'s coordinates (None: ``Plane.XY``)."""
+    return Wire(chain_wire(chain, plane_ax3(plane)))
+
+
+def _xy(value: VectorLike, name: str) -> tuple[float, float]:
+    """A build123d point in the local plane as (x, y); a non-zero z is an error, not projected away."""
+    vector = Vector(value)
+    if vector.Z != 0.0:
+        raise ValueError(f"{name} must lie in the line's plane (z = 0); got {tuple(vector)}")
+    return vector.X, vector.Y
+
+
+def _wire(segments: Iterable[Segment]) -> Wire:
+    return Wire(chain_wire(segments))
+
+
+class _ExactLineObject(BaseLineObject):
+    """A line object whose edges reach the builder unmerged.
+
+    ``BuildLine`` fuses new edges into its line and then "cleans" it with
+    ``ShapeUpgrade_UnifySameDomain``, which concatenates tangent-continuous
+    Bézier edges into one B-spline. Publishing inside build123d's
+    ``SkipClean`` keeps each spiral its own exact BEZIER edge. (Later objects
+    added to the same builder clean the whole line again unless the builder
+    itself runs inside ``with SkipClean():``.)
+    """
+
+    _applies_to = [BuildLine._tag]
+
+    def _publish_to_context(self, object_scope) -> None:
+        previous = SkipClean.clean  # restored as found, so an enclosing SkipClean stays in force
+        SkipClean.clean = False
+        try:
+            super()._publish_to_context(object_scope)
+        finally:
+            SkipClean.clean = previous
+
+
+class _TransitionObject(_ExactLineObject):
+    """Common base: the spirals of one solved transition, with the solution kept as ``transition``."""
+
+    def __init__(self, transition: Transition, mode: Mode):
+        super().__init__(_wire(transition.spirals), mode=mode)
+        self.transition = transition
+
+
+class SpiralLineToCircle(_TransitionObject):
+    """Line Object: Spiral Line To Circle
+
+    The G2 Bézier spiral from a directed line onto a circle (Walton–Meek
+    Theorem 4.1). Travel follows ``direction`` and turns toward the circle.
+
+    Args:
+        point (VectorLike): a point of the line
+        direction (VectorLike): travel direction of the line
+        center (VectorLike): circle centre, off the line
+        radius (float): circle radius (> 0, smaller than the centre's distance to the line)
+        shape (str, optional): spiral shape, "walton-meek" or "near-linear". Defaults to "walton-meek"
+        mode (Mode, optional): combination mode. Defaults to Mode.ADD
+
+    Raises:
+        NoSolutionError: the circle touches or crosses the line.
+    """
+
+    def __init__(
+        self,
+        point: VectorLike,
+        direction: VectorLike,
+        center: VectorLike,
+        radius: float,
+        shape: str = DEFAULT_SHAPE,
+        mode: Mode = Mode.ADD,
+    ):
+        transition = line_to_circle(_xy(point, "point"), _xy(direction, "direction"), _xy(center, "center"), radius, shape)
+        super().__init__(transition, mode)
+
+
+class _CirclePairObject(_TransitionObject):
+    """A transition between two circles given by centres and signed radii (``_solve``: the subclass's solver)."""
+
+    def __init__(
+        self,
+        center0: VectorLike,
+        radius0: float,
+        center1: VectorLike,
+        radius1: float,
+        shape: str = DEFAULT_SHAPE,
+        mode: Mode = Mode.ADD,
+    ):
+        transition = self._solve(_xy(center0, "center0"), radius0, _xy(center1, "center1"), radius1, shape)
+        super().__init__(transition, mode)
+
+
+class SpiralCircleToCircle(_CirclePairObject):
+    """Line Object: Spiral Circle To Circle
+
+    Two G2 spirals from circle 0 to circle 1: a C when the signed radii
+    share their sign, an S otherwise (positive radius: counterclockwise).
+
+    Args:
+        center0 (VectorLike): centre of the circle left
+        radius0 (float): its signed radius
+        center1 (VectorLike): centre of the circle reached
+        radius1 (float): its signed radius
+        shape (str, optional): spiral shape, "walton-meek" or "near-linear". Defaults to "walton-meek"
+        mode (Mode, optional): combination mode. Defaults to Mode.ADD
+
+    Raises:
+        NoSolutionError: the circles admit no such transition.
+    """
+
+    _solve = staticmethod(circle_to_circle)
+
+
+class SpiralLineToLine(_TransitionObject):
+    """Line Object: Spiral Line To Line
+
+    Two G2 spirals rounding the corner between the lines p0→corner and
+    corner→p1.
+
+    Args:
+        p0 (VectorLike): a point on the incoming line
+        corner (VectorLike): the lines' intersection
+        p1 (VectorLike): a point on the outgoing line
+        curvature (float, optional): curvature at the joint; None takes the
+            largest spirals that fit between p0 and p1. Defaults to None
+        shape (str, optional): "walton-meek", "near-linear" or "g2cbs". Defaults to "walton-meek"
+        mode (Mode, optional): combination mode. Defaults to Mode.ADD
+
+    Raises:
+        NoSolutionError: collinear legs or a curvature too small to fit.
+    """
+
+    def __init__(
+        self,
+        p0: VectorLike,
+        corner: VectorLike,
+        p1: VectorLike,
+        curvature: float | None = None,
+        shape: str = DEFAULT_SHAPE,
+        mode: Mode = Mode.ADD,
+    ):
+        transition = line_to_line(_xy(p0, "p0"), _xy(corner, "corner"), _xy(p1, "p1"), curvature, shape)
+        super().__init__(transition, mode)
+
+
+class SpiralCircleInCircle(_CirclePairObject):
+    """Line Object: Spiral Circle In Circle
+
+    One G2 spiral between two nested circles (either way: in or out).
+
+    Args:
+        center0 (VectorLike): centre of the circle left
+        radius0 (float): its signed radius
+        center1 (VectorLike): centre of the circle reached
+        radius1 (float): its signed radius (same sign as radius0)
+        shape (str, optional): spiral shape, "walton-meek" or "near-linear". Defaults to "walton-meek"
+        mode (Mode, optional): combination mode. Defaults to Mode.ADD
+
+    Raises:
+        NoSolutionError: the circles lie outside the thin band where a
+            single spiral exists.
+    """
+
+    _solve = staticmethod(circle_in_circle)
+
+
+class SpiralChain(_ExactLineObject):
+    """Line Object: Spiral Chain
+
+    Every segment of a G2 ``Chain``: lines as LINE, arcs as CIRCLE and
+    spirals as BEZIER edges, joined into one wire in travel order.
+
+    Args:
+        chain (Chain): the chain, in the builder's local coordinates
+        mode (Mode, optional): combination mode. Defaults to Mode.ADD
+    """
+
+    def __init__(self, chain: Chain, mode: Mode = Mode.ADD):
+        if not isinstance(chain, Chain):
+            raise ValueError(f"chain must be a spiral_cad.Chain; got {chain!r}")
+        super().__init__(_wire(chain), mode=mode)
+        self.chain = chain
+
+
+class G2Polyline(_ExactLineObject):
+    """Line Object: G2 Polyline
+
+    A polyline through ``pts`` whose corners are rounded by G2 spiral pairs
+    (``spiral_cad.design.round_corners``), in the plane or in space: each
+    pair lies in the plane of its corner's two edges, and between corners the
+    path runs straight along the polyline, so the whole wire is curvature
+    continuous. Edges: LINE between corners, two BEZIER per corner.
+
+    Args:
+        pts (VectorLike | Iterable[VectorLike]): sequence of three or more points
+        radius (float, optional): the smallest radius of curvature: every corner
+            reaches exactly 1/radius at its middle (the tightest that fits). Defaults to None
+        max_deviation (float, optional): the largest distance between a corner
+            point and the path (a CNC or robot tolerance): each corner gets the
+            largest pair within it; with ``radius`` too, its curvature must stay
+            below 1/radius. Defaults to None
+        shape (str, optional): "walton-meek", "near-linear" or "g2cbs". Defaults to "walton-meek"
+        mode (Mode, optional): combination mode. Defaults to Mode.ADD
+
+    With neither ``radius`` nor ``max_deviation`` each corner uses all of the
+    edges it may (half of a shared edge, all of an end edge). The numeric
+    result is kept as ``rounded`` (a ``RoundedPath``: chain, corners, deviations).
+
+    Raises:
+        ValueError: fewer than three points, repeated points, a polyline that
+            folds straight back, a radius or deviation that is not positive.
+        NoSolutionError: a corner that cannot be rounded as asked (named, with numbers).
+    """
+
+    def __init__(
+        self,
+        *pts: VectorLike | Iterable[VectorLike],
+        radius: float | None = None,
+        max_deviation: float | None = None,
+        shape: str = DEFAULT_SHAPE,
+        mode: Mode = Mode.ADD,
+    ):
+        points = [tuple(Vector(p)) for p in flatten_sequence(*pts)]
+        curvature = curvature_bound(radius)
+        path = round_corners(points, max_curvature=curvature, max_deviation=max_deviation, shape=shape)
+        super().__init__(_wire(path.chain), mode=mode)
+        self.rounded = path  # the numeric result (build123d's Shape owns the name "path")
+
+
+# ------------------------------------------------------------------ G2 fillets
+
+
+def _points(vertices) -> list[tuple[float, float, float]] | None:
+    if vertices is None:
+        return None
+    items = [vertices] if isinstance(vertices, Vertex) else list(vertices)
+    for item in items:
+        if not isinstance(item, Vertex):
+            raise ValueError(f"vertices must be build123d Vertex objects; got {type(item).__name__}")
+    return [tuple(Vector(v)) for v in items]
+
+
+def g2_fillet(
+    target: Wire | Face | Sketch | Curve | Vertex | Iterable[Vertex],
+    radius: float,
+    vertices: Iterable[Vertex] | None = None,
+    transition: float = 0.5,
+    same_sense: str = "nested",
+    shape: str = DEFAULT_SHAPE,
+) -> Wire | Face | Sketch | Curve:
+    """Operation: G2 Fillet
+
+    Round corners with curvature-continuous fillets ("continuous corners"):
+    each corner becomes transition → arc of ``radius`` → transition, joined G2
+    on both sides (``spiral_cad.design.fillets``), with exact LINE, CIRCLE and
+    BEZIER edges and a G2 closing joint.
+
+    Used like build123d's ``fillet``: given a planar ``Wire``, ``Face``,
+    ``Sketch`` or ``Curve`` (on any plane) it returns the same kind with the
+    chosen corners (default: all) rounded, every wire and every face of it;
+    inside ``BuildSketch``/``BuildLine``, given vertices (e.g.
+    ``sketch.vertices()``), it rounds those vertices of the builder's object
+    and replaces it (``Mode.REPLACE``).
+
+    Args:
+        target: the shape to round, or the vertices to round in a builder.
+        radius (float): the smallest radius of curvature in each corner.
+        vertices (Iterable[Vertex], optional): corners to round; default all.
+        transition (float, optional): share of each corner's turn made by the
+            transitions, in (0, 1]; 1 gives a spiral pair with no arc. Defaults to 0.5
+        same_sense (str, optional): ``"nested"`` or ``"C"`` for an arc that
+            turns the same way as its corner. Defaults to "nested"
+        shape (str, optional): spiral shape of the transitions, "walton-meek" or
+            "near-linear" (curvature almost linear in arc length). Defaults to "walton-meek"
+
+    Raises:
+        ValueError: a solid or shell (round one of its faces, or use build123d's
+            ``fillet`` on its edges), non-planar input, edges other than lines
+            and arcs, or edges that belong to no wire or face.
+        NoSolutionError: a corner that cannot be rounded (named, with numbers).
+    """
+    context = Builder._get_context("g2_fillet")
+    in_builder = isinstance(target, Vertex) or (
+        isinstance(target, Iterable) and not isinstance(target, (Shape, str, bytes))
+    )
+    if in_builder:
+        _points(target)  # only vertices select corners of a builder's object
+        if context is None or context._obj is None:
+            raise ValueError("g2_fillet of vertices needs a BuildSketch or BuildLine with an object")
+        vertices, target = target, context._obj
+    points = _points(vertices)
+    options = dict(transition=transition, same_sense=same_sense, shape=shape)
+    if not isinstance(target, Shape):
+        raise ValueError(f"g2_fillet rounds a Wire, Face, Sketch or Curve; got {type(target).__name__}")
+    solids = target.solids() or target.shells()
+    if solids or getattr(target, "_dim", None) == 3:
+        raise ValueError(
+            f"g2_fillet rounds planar wires, faces and sketches; got a {type(target).__name__} with "
+            f"{len(target.solids())} solid(s) and {len(target.shells())} shell(s): round one of its faces, or use "
+            "build123d's fillet on its edges"
+        )
+    in_space = _lines_in_space(target) if isinstance(target, Wire) else None
+    if in_space is not None:
+        corners, closed = in_space
+        chosen = None if points is None else _corner_indices(corners, points)
+        rounded = fillet_polyline(corners, radius, vertices=chosen, closed=closed, **options)
+        result = Wire(chain_wire(rounded.segments))
+    elif isinstance(target, Wire):
+        result = Wire(fillet_wire(target.wrapped, radius, points, **options)[0])
+    elif isinstance(target, Face) and not isinstance(target, Sketch):
+        result = Face(fillet_face(target.wrapped, radius, points, **options))
+    else:
+        faces, wires = target.faces(), [] if target.faces() else target.wires()
+        _refuse_loose_edges(target, faces or wires)
+        if faces:
+            result = Sketch(Compound([Face(fillet_face(f.wrapped, radius, points, **options)) for f in faces]).wrapped)
+        else:  # one plane for all the wires (a straight wire alone has none; here it passes through)
+            frame = planar_frame(target.wrapped)
+            rounded = [fillet_wire(w.wrapped, radius, points, frame=frame, **options)[0] for w in wires]
+            result = Curve(Compound([Wire(w) for w in rounded]).wrapped)
+    if in_builder:
+        context._add_to_context(result, mode=Mode.REPLACE)
+    return result
+
+
+def _lines_in_space(wire: Wire) -> tuple[list[tuple[float, float, float]], bool] | None:
+    """The vertices (in travel order) and closedness of a wire of lines that does not lie in one
+    plane; None for a planar wire or one with other edges (the planar fillet handles those)."""
+    try:
+        planar_frame(wire.wrapped)
+        return None
+    except ValueError:
+        pass
+    points = []
+    explorer = BRepTools_WireExplorer(wire.wrapped)
+    while explorer.More():
+        edge = TopoDS.Edge_s(explorer.Current())
+        curve = BRepAdaptor_Curve(edge)
+        if curve.GetType() != GeomAbs_CurveType.GeomAbs_Line:
+            return None
+        first, last = curve.FirstParameter(), curve.LastParameter()
+        start = curve.Value(last if edge.Orientation() == TopAbs_REVERSED else first)
+        points.append((start.X(), start.Y(), start.Z()))
+        end = curve.Value(first if edge.Orientation() == TopAbs_REVERSED else last)
+        explorer.Next()
+    if len(points) < 2:
+        return None
+    closed = wire.is_closed
+    if not closed:
+        points.append((end.X(), end.Y(), end.Z()))
+    return points, closed
+
+
+def _corner_indices(corners: list[tuple[float, float, float]], points: list[tuple[float, float, float]]) -> list[int]:
+    """Indices of the polyline vertices at the chosen build123d vertices (others are ignored, as in the plane)."""
+    size = max(max(abs(c) for c in p) for p in corners)
+    chosen = []
+    for point in points:
+        for i, corner in enumerate(corners):
+            if max(abs(a - b) for a, b in zip(point, corner)) <= 1e-7 * max(size, 1.0):
+                chosen.append(i)
+    return chosen
+
+
+def _refuse_loose_edges(target: Shape, parts: list[Shape]) -> None:
+    """ValueError unless every edge of ``target`` belongs to one of ``parts`` (its faces or its wires)."""
+    held = sum(len(p.edges()) for p in parts)
+    edges = len(target.edges())
+    if not parts or held < edges:
+        what = "faces" if parts and isinstance(parts[0], Face) else "wires"
+        raise ValueError(
+            f"g2_fillet rounds whole wires and faces; this {type(target).__name__} has {edges - held} of its "
+            f"{edges} edge(s) outside its {what}"
+        )
+
+
+class _ContinuousSketch(BaseSketchObject):
+    """A face bounded by a closed chain with continuous corners (``spiral_cad.design.fillets``)."""
+
+    _applies_to = [BuildSketch._tag]
+
+    def __init__(self, path, rotation: float, align, mode: Mode):
+        self.filleted = path  # the chain and the corners (build123d's Shape owns the name "path")
+        super().__init__(Face(chain_to_wire(path.chain)), rotation, align, mode)
+
+
+class ContinuousRectangle(_ContinuousSketch):
+    """Sketch Object: Continuous Rectangle
+
+    A rectangle whose corners are G2 ("continuous corners"): spiral → arc of
+    ``radius`` → spiral, curvature continuous everywhere.
+
+    Args:
+        width (float): rectangle width
+        height (float): rectangle height
+        radius (float): the smallest radius of curvature of each corner
+        transition (float, optional): share of each corner's turn made by the spirals, in (0, 1]. Defaults to 0.5
+        shape (str, optional): spiral shape, "walton-meek" or "near-linear". Defaults to "walton-meek"
+        rotation (float, optional): angle to rotate object. Defaults to 0
+        align (Align | tuple[Align, Align], optional): align MIN, CENTER, or MAX of object.
+            Defaults to (Align.CENTER, Align.CENTER)
+        mode (Mode, optional): combination mode. Defaults to Mode.ADD
+    """
+
+    def __init__(self, width: float, height: float, radius: float, transition: float = 0.5, rotation: float = 0,
+                 align: Align | tuple[Align, Align] | None = (Align.CENTER, Align.CENTER), shape: str = DEFAULT_SHAPE,
+                 mode: Mode = Mode.ADD):  # fmt: skip
+        super().__init__(continuous_rectangle(width, height, radius, transition, shape=shape), rotation, align, mode)
+
+
+class ContinuousPolygon(_ContinuousSketch):
+    """Sketch Object: Continuous Polygon
+
+    A regular polygon whose corners are G2 fillets.
+
+    Args:
+        radius (float): construction radius
+        side_count (int): number of sides
+        corner_radius (float): the smallest radius of curvature of each corner
+        transition (float, optional): share of each corner's turn made by the spirals. Defaults to 0.5
+        shape (str, optional): spiral shape, "walton-meek" or "near-linear". Defaults to "walton-meek"
+        major_radius (bool, optional): radius is the circumscribed (True) or inscribed circle's. Defaults to True
+        rotation (float, optional): angle to rotate object. Defaults to 0
+        align (Align | tuple[Align, Align], optional): align MIN, CENTER, or MAX of object. Defaults to None
+        mode (Mode, optional): combination mode. Defaults to Mode.ADD
+    """
+
+    def __init__(self, radius: float, side_count: int, corner_radius: float, transition: float = 0.5,
+                 major_radius: bool = True, rotation: float = 0, align: Align | tuple[Align, Align] | None = None,
+                 shape: str = DEFAULT_SHAPE, mode: Mode = Mode.ADD):  # fmt: skip
+        path = continuous_polygon(radius, side_count, corner_radius, transition, major_radius, shape=shape)
+        super().__init__(path, rotation, align, mode)
+
+
+class ContinuousSlot(_ContinuousSketch):
+    """Sketch Object: Continuous Slot
+
+    A slot of overall ``width`` and ``height`` whose ends are curvature
+    continuous all the way round (each end: two G2 corners meeting in its middle).
+
+    Args:
+        width (float): overall width of slot
+        height (float): overall height (the width of the ends)
+        transition (float, optional): share of each 90° corner made by the spirals. Defaults to 0.5
+        shape (str, optional): spiral shape, "walton-meek" or "near-linear". Defaults to "walton-meek"
+        rotation (float, optional): angle to rotate object. Defaults to 0
+        align (Align | tuple[Align, Align], optional): align MIN, CENTER, or MAX of object.
+            Defaults to (Align.CENTER, Align.CENTER)
+        mode (Mode, optional): combination mode. Defaults to Mode.ADD
+    """
+
+    def __init__(self, width: float, height: float, transition: float = 0.5, rotation: float = 0,
+                 align: Align | tuple[Align, Align] | None = (Align.CENTER, Align.CENTER), shape: str = DEFAULT_SHAPE,
+                 mode: Mode = Mode.ADD):  # fmt: skip
+        super().__init__(continuous_slot(width, height, transition, shape=shape), rotation, align, mode)
+
+
+def curvature_comb(shape_or_chain, scale: float | None = None, per_edge: int = 24) -> Compound:
+    """The curvature comb (teeth and envelope) of a chain, wire, face or part as a build123d ``Compound`` of edges.
+
+    Show it beside the part (CQ-editor, ``show``) to see where the curvature
+    jumps: a circular fillet's comb steps from nothing to 1/r, a G2 corner's
+    ramps.
+    """
+    from .cad.continuity import curvature_comb as comb
+
+    return Compound(comb(shape_or_chain, scale=scale, per_edge=per_edge))

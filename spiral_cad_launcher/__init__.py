@@ -1,9 +1,9 @@
 """The ``spiral-cad`` command's entry point: Ctrl-C is handled from its first instant.
 
 Importing ``spiral_cad`` (numpy, scipy, numba) takes about half a second,
-and an interrupt then would end in a traceback, before ``spiral_cad.cli``
+and an interrupt then would end in a traceback, before ``spiral_cad.app.cli``
 could handle it. This package imports nothing heavy: it installs the
-handling, then runs ``spiral_cad.cli.main``.
+handling, then runs ``spiral_cad.app.cli.main``.
 """
 
 import signal
@@ -12,7 +12,7 @@ import warnings
 
 
 def main() -> int:
-    """Run ``spiral_cad.cli.main``; an interrupt while it is imported gives ``error: interrupted`` and 130."""
+    """Run ``spiral_cad.app.cli.main``; an interrupt while it is imported gives ``error: interrupted`` and 130."""
     received: list[int] = []
 
     def interrupt(signum, frame):
@@ -22,7 +22,7 @@ def main() -> int:
     signal.signal(signal.SIGINT, interrupt)
     warnings.simplefilter("ignore")
     try:
-        from spiral_cad.cli import main as run
+        from spiral_cad.app.cli import main as run
 
         status = run()
     except BaseException as error:

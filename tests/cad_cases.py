@@ -6,16 +6,7 @@ import math
 
 import numpy as np
 
-from spiral_cad import (
-    Arc,
-    Chain,
-    Circle,
-    Line,
-    circle_in_circle,
-    circle_to_circle,
-    line_to_circle,
-    line_to_line,
-)
+from spiral_cad import Arc, Chain, Circle, Line, circle_in_circle, circle_to_circle, line_to_circle, line_to_line
 
 
 def arc_on(circle: Circle, point, sweep: float, before: bool = False) -> Arc:

@@ -6,7 +6,8 @@ import numpy as np
 import pytest
 
 import spiral_cad as sc
-from spiral_cad import Status, batch
+from spiral_cad import Status
+from spiral_cad.core import batch
 from spiral_cad.core.errors import MALFORMED
 
 rng = np.random.default_rng(7)

@@ -19,17 +19,9 @@ from build123d import (
 )
 from cad_cases import transition_chains
 
-from spiral_cad import (
-    Arc,
-    BezierSpiral,
-    Chain,
-    Line,
-    circle_in_circle,
-    circle_to_circle,
-    line_to_circle,
-    line_to_line,
-)
+from spiral_cad import Arc, BezierSpiral, Chain, Line, circle_in_circle, circle_to_circle, line_to_circle, line_to_line
 from spiral_cad.build123d import (
+    chain_edges,
     SpiralChain,
     SpiralCircleInCircle,
     SpiralCircleToCircle,
@@ -128,7 +120,7 @@ def test_enclosing_skip_clean_stays_in_force():
 @pytest.mark.parametrize("plane_name", sorted(PLANES))
 def test_chain_to_edges_and_to_wire_on_a_plane(plane_name):
     chain, plane = CHAINS["S"], PLANES[plane_name]
-    edges = chain.to_edges(plane)
+    edges = chain_edges(chain, plane)
     wire = chain.to_wire(plane)
     assert [e.geom_type for e in edges] == [GEOM[type(s)] for s in chain]
     assert [e.geom_type for e in wire.edges()] == [GEOM[type(s)] for s in chain]

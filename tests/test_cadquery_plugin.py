@@ -11,7 +11,7 @@ cq = pytest.importorskip("cadquery")
 
 import spiral_cad as sc  # noqa: E402
 import spiral_cad.cadquery as plugin  # noqa: E402
-from spiral_cad.continuity import Continuity, check_continuity  # noqa: E402
+from spiral_cad.cad.continuity import Continuity, check_continuity  # noqa: E402
 
 R, CX, H = 1.0, 3.0, 2.1  # racetrack: arcs of radius R about (±CX, H/2), straights on y = 0 and y = H
 

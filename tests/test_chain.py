@@ -5,15 +5,7 @@ import math
 import numpy as np
 import pytest
 
-from spiral_cad import (
-    Arc,
-    BezierSpiral,
-    Chain,
-    Line,
-    circle_to_circle,
-    line_to_circle,
-    line_to_line,
-)
+from spiral_cad import Arc, BezierSpiral, Chain, Line, circle_to_circle, line_to_circle, line_to_line
 
 
 def road():

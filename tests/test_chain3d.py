@@ -293,11 +293,12 @@ def test_a_chain_in_space_reaches_occt_as_exact_edges_and_checks_g2():
     from OCP.BRepAdaptor import BRepAdaptor_Curve
     from OCP.GeomAbs import GeomAbs_BezierCurve, GeomAbs_Circle, GeomAbs_Line
 
-    from spiral_cad.continuity import check_continuity
+    from spiral_cad.build123d import chain_edges, chain_to_wire
+    from spiral_cad.cad.continuity import check_continuity
 
     chain, _, _ = helix_chain()
     arc = Arc.in_space(chain.end, (0.3, 0.2, 1.0), chain.end + (10.0, 0.0, -3.0), 1.0)
-    wire = chain.to_wire()
+    wire = chain_to_wire(chain)
     edges = wire.edges()
     assert len(edges) == len(chain)
     kinds = [BRepAdaptor_Curve(e.wrapped).GetType() for e in edges]
@@ -308,13 +309,13 @@ def test_a_chain_in_space_reaches_occt_as_exact_edges_and_checks_g2():
             assert np.allclose((p.X, p.Y, p.Z), segment.point(segment.parameter_at(u * segment.length)), atol=1e-9 * chain.size)
     report = check_continuity(wire)
     assert report.passes("G2"), report.format_table()
-    (edge,) = Chain([arc]).to_edges()
+    (edge,) = chain_edges(Chain([arc]))
     assert BRepAdaptor_Curve(edge.wrapped).GetType() == GeomAbs_Circle
     for u in (0.0, 0.5, 1.0):
         p = edge.position_at(u)
         assert np.allclose((p.X, p.Y, p.Z), arc.point(u), atol=1e-12 * abs(arc.radius))
     clockwise = Arc.in_space((0, 0, 0), (1, 1, 1), (1, -1, 0), -2.0)
-    (edge,) = Chain([clockwise]).to_edges()
+    (edge,) = chain_edges(Chain([clockwise]))
     p = edge.position_at(0.5)
     assert np.allclose((p.X, p.Y, p.Z), clockwise.point(0.5), atol=1e-12)
 

@@ -9,8 +9,8 @@ from pathlib import Path
 
 import pytest
 
-from spiral_cad.cli import DEMO_DESIGN, main
-from spiral_cad.continuity import check_continuity
+from spiral_cad.app.cli import DEMO_DESIGN, main
+from spiral_cad.cad.continuity import check_continuity
 from spiral_cad.design import circle_chain
 
 EXAMPLES = Path(__file__).resolve().parent.parent / "examples"
@@ -107,7 +107,7 @@ def test_malformed_json_names_the_line(tmp_path, capsys):
 
 
 def test_help_lists_the_commands():
-    run = subprocess.run([sys.executable, "-m", "spiral_cad.cli", "--help"], capture_output=True, text=True)
+    run = subprocess.run([sys.executable, "-m", "spiral_cad.app.cli", "--help"], capture_output=True, text=True)
     assert run.returncode == 0
     for word in ("demo", "build", "check"):
         assert word in run.stdout
@@ -182,7 +182,7 @@ def test_an_interrupt_a_library_turned_into_another_exception_is_still_an_interr
     import signal
     import time
 
-    from spiral_cad import designfile
+    from spiral_cad.app import designfile
 
     def import_interrupted(*args, **kwargs):
         try:
@@ -200,7 +200,7 @@ def test_an_interrupt_a_library_turned_into_another_exception_is_still_an_interr
 def test_warnings_never_reach_the_terminal(tmp_path, capsys, monkeypatch, recwarn):
     import warnings
 
-    from spiral_cad import designfile
+    from spiral_cad.app import designfile
 
     summary = designfile.summary
 

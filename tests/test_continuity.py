@@ -34,9 +34,9 @@ from OCP.TopoDS import TopoDS, TopoDS_Wire  # noqa: E402
 
 import spiral_cad as sc  # noqa: E402
 import spiral_cad.design  # noqa: E402,F401
-import spiral_cad.export  # noqa: E402,F401
-from spiral_cad.cli import main  # noqa: E402
-from spiral_cad.continuity import Continuity, check_continuity  # noqa: E402
+import spiral_cad.cad.export  # noqa: E402,F401
+from spiral_cad.app.cli import main  # noqa: E402
+from spiral_cad.cad.continuity import Continuity, check_continuity  # noqa: E402
 
 G0, G1, G2, NONE = Continuity.G0, Continuity.G1, Continuity.G2, Continuity.NONE
 
@@ -356,7 +356,7 @@ def test_a_g2_highway_at_survey_coordinates_is_g2_and_a_real_kink_there_is_caugh
 
 
 def test_the_rounding_floor_is_capped_so_a_segment_too_small_for_its_coordinates_hides_no_kink(monkeypatch):
-    import spiral_cad.formats.joints as joints
+    import spiral_cad.check.joints as joints
 
     # a 1 mm spiral at 3e6 m whose start curvature (~1e-3 1/m) is below what rounding can hide there
     x = y = 3e6
@@ -462,7 +462,7 @@ def frame(point=(0.0, 0.0), tangent=(1.0, 0.0), curvature=(0.0, 0.0)):
 
 
 def test_nan_never_passes_and_is_its_own_level():
-    from spiral_cad.formats.joints import ContinuityReport, JointReport, WireReport, classify_joint
+    from spiral_cad.check.joints import ContinuityReport, JointReport, WireReport, classify_joint
 
     nan, inf = math.nan, math.inf
     grade = lambda a, b: classify_joint(0, a, b, 1e-7, 1e-7, 1e-6, 0.1).level  # noqa: E731
@@ -484,7 +484,7 @@ def test_nan_never_passes_and_is_its_own_level():
 
 
 def test_model_size_names_the_coordinate_it_cannot_measure():
-    from spiral_cad.formats.joints import model_size
+    from spiral_cad.check.joints import model_size
 
     assert model_size([(0.0, 0.0, 0.0), (3e300, 4e300, 0.0)]) == pytest.approx(5e300)  # no overflow short of the range
     with pytest.raises(ValueError, match=r"f.step: a point of the model is not finite: \(0.0, nan, 0.0\)"):

@@ -8,9 +8,9 @@ pytest.importorskip("OCP")
 from OCP.BRepCheck import BRepCheck_Analyzer  # noqa: E402
 
 from spiral_cad.build123d import centerline_wire, corridor  # noqa: E402
-from spiral_cad.cad.occ import read_shape  # noqa: E402
-from spiral_cad.design import Alignment, Profile  # noqa: E402
-from spiral_cad.export import CrossSection, export_step  # noqa: E402
+from spiral_cad.cad.readers import read_shape  # noqa: E402
+from spiral_cad.design import Alignment, Profile, centerline_3d  # noqa: E402
+from spiral_cad.cad.export import CrossSection, export_step  # noqa: E402
 
 
 @pytest.fixture(scope="module")
@@ -68,7 +68,7 @@ def test_the_top_follows_profile_crossfall_and_banking(road):
 
 def test_the_centre_line_wire_is_the_plan_lifted(road):
     alignment, profile = road
-    line = alignment.centerline_3d(profile, tolerance=1e-8)
+    line = centerline_3d(alignment, profile, tolerance=1e-8)
     wire = centerline_wire(line)
     edges = wire.edges()
     assert len(edges) == len(alignment.chain)

@@ -12,7 +12,7 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from spiral_cad.cli import main
+from spiral_cad.app.cli import main
 
 DESIGN = {"units": "m", "designs": [{"name": "t", "type": "transition", "case": "line_to_circle",
                                       "point": [0, 0], "direction": [1, 0], "center": [0, 105], "radius": 100}]}
@@ -115,7 +115,7 @@ def test_an_interrupted_build_leaves_nothing_behind(tmp_path):
     out.mkdir()
     (out / "old.txt").write_text("from before")
     process = subprocess.Popen(
-        [sys.executable, "-m", "spiral_cad.cli", "build", str(design), "--out", str(out)],
+        [sys.executable, "-m", "spiral_cad.app.cli", "build", str(design), "--out", str(out)],
         stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
     )
     for line in process.stdout:  # wait until the writing has begun
@@ -130,7 +130,7 @@ def test_an_interrupted_build_leaves_nothing_behind(tmp_path):
 
 
 def test_a_killed_builds_staging_folder_is_removed_by_the_next_build_only_if_it_is_ours(tmp_path, capsys):
-    from spiral_cad.staging import MARKER, _marker_text
+    from spiral_cad.io.staging import MARKER, _marker_text
 
     out = tmp_path / "out"
     stale = out / ".spiral-cad-build-999999999-abc"
@@ -157,7 +157,7 @@ def test_units_of_a_design_reach_every_file(tmp_path, capsys, units, factor):
     from OCP.TopExp import TopExp_Explorer
     from OCP.TopoDS import TopoDS
 
-    from spiral_cad.occ import read_shape
+    from spiral_cad.cad.readers import read_shape
 
     design = {"units": units, "designs": [{"name": "road", "type": "alignment", "pis": [[0, 0], [600, 120], [1150, -80],
                                            [1700, 260]], "radii": [450, 400], "spiral_angles_deg": 8}]}
@@ -165,7 +165,7 @@ def test_units_of_a_design_reach_every_file(tmp_path, capsys, units, factor):
     path.write_text(json.dumps(design))
     out = tmp_path / "out"
     assert main(["build", str(path), "--out", str(out), "--no-plots"]) == 0
-    from spiral_cad.designfile import build
+    from spiral_cad.app.designfile import build
 
     chain = build(design)[1][0].chain
     for suffix in ("step", "igs"):
@@ -250,7 +250,7 @@ def test_names_differing_only_in_case_are_refused(tmp_path, capsys):
 
 @pytest.mark.parametrize("kind", ["device", "folder", "too large", "fifo"])
 def test_design_files_that_are_not_regular_or_too_large_are_refused_before_reading(tmp_path, kind):
-    from spiral_cad.designfile import MAX_DESIGN_BYTES
+    from spiral_cad.app.designfile import MAX_DESIGN_BYTES
 
     path = {"device": Path("/dev/zero"), "folder": tmp_path}.get(kind, tmp_path / "design.json")
     if kind == "too large":
@@ -261,7 +261,7 @@ def test_design_files_that_are_not_regular_or_too_large_are_refused_before_readi
     if not path.exists():
         pytest.skip(f"no {path} here")
     started = time.perf_counter()
-    done = subprocess.run([sys.executable, "-m", "spiral_cad.cli", "build", str(path), "--out", str(tmp_path / "out")],
+    done = subprocess.run([sys.executable, "-m", "spiral_cad.app.cli", "build", str(path), "--out", str(tmp_path / "out")],
                           capture_output=True, text=True, timeout=120)  # fmt: skip
     expected = {"device": "is not a regular file (a device, pipe or socket)", "folder": "is a folder, not a file",
                 "too large": f"has {MAX_DESIGN_BYTES + 1} bytes; at most {MAX_DESIGN_BYTES} are read",
@@ -313,7 +313,7 @@ BYTE_FLIPS = st.just([]) | st.just([]) | st.lists(st.tuples(st.integers(0, 10_00
 @given(st.lists(EDITS, max_size=2), BYTE_FLIPS)
 def test_mutated_example_designs_build_or_fail_with_a_design_error(tmp_path, edits, flips):
     """The design loader's one rule, through the API: files, or a ValueError (exit 2) — nothing else."""
-    from spiral_cad.designfile import build, write
+    from spiral_cad.app.designfile import build, write
 
     raw = bytearray(json.dumps(edited(EXAMPLE_DATA, edits)).encode())
     for position, byte in flips:

@@ -28,9 +28,9 @@ from OCP.TopoDS import TopoDS
 
 from spiral_cad import Arc, BezierSpiral, Chain, Line
 from spiral_cad.core.units import MM_PER_UNIT, UNITS
-from spiral_cad.export import export_dxf, export_iges, export_step, export_svg, originating_system
-from spiral_cad.formats.dxf import BEZIER_KNOTS, INSUNITS
-from spiral_cad.occ import read_shape
+from spiral_cad.cad.export import export_dxf, export_iges, export_step, export_svg, originating_system
+from spiral_cad.io.dxf import BEZIER_KNOTS, INSUNITS
+from spiral_cad.cad.readers import read_shape
 
 CHAINS = transition_chains()
 WRITERS = {"step": export_step, "igs": export_iges}
@@ -167,8 +167,8 @@ def test_files_declare_their_unit_so_readers_convert_to_the_right_size(tmp_path,
 
 
 def test_demo_highway_in_metres_reads_back_in_millimetres(tmp_path):
-    from spiral_cad.cli import DEMO_DESIGN
-    from spiral_cad.designfile import build
+    from spiral_cad.app.cli import DEMO_DESIGN
+    from spiral_cad.app.designfile import build
 
     chain = build(DEMO_DESIGN)[1][0].chain
     assert chain.units == "m" and 2398 < chain.length < 2399
@@ -235,7 +235,7 @@ def test_step_edges_share_their_vertices_in_travel_order(tmp_path, name):
 def test_a_chain_in_space_is_written_as_exact_3d_edges_of_one_wire(tmp_path):
     from test_chain3d import helix_chain
 
-    from spiral_cad.continuity import check_continuity
+    from spiral_cad.cad.continuity import check_continuity
 
     helix, _, _ = helix_chain()
     normal = np.array([0.0, -1.0, 1.0])

@@ -148,8 +148,8 @@ bd = pytest.importorskip("build123d")
 
 def test_g2_fillet_on_sketches_faces_and_wires_with_exact_edges(tmp_path):
     from spiral_cad.build123d import g2_fillet
-    from spiral_cad.continuity import check_continuity
-    from spiral_cad.export import export_step
+    from spiral_cad.cad.continuity import check_continuity
+    from spiral_cad.cad.export import export_step
 
     face = g2_fillet(bd.Rectangle(60, 30), 5.0)
     assert [e.geom_type.name for e in face.edges()][:4] == ["LINE", "BEZIER", "CIRCLE", "BEZIER"]
@@ -170,7 +170,7 @@ def test_g2_fillet_on_sketches_faces_and_wires_with_exact_edges(tmp_path):
 @pytest.mark.parametrize("plane", ["XY", "XZ", "YZ"])
 def test_g2_fillet_in_build_sketch_on_any_plane(plane):
     from spiral_cad.build123d import g2_fillet
-    from spiral_cad.continuity import check_continuity
+    from spiral_cad.cad.continuity import check_continuity
 
     with bd.BuildSketch(getattr(bd.Plane, plane)) as sketch:
         bd.Rectangle(40, 20)
@@ -186,7 +186,7 @@ def test_g2_fillet_in_build_sketch_on_any_plane(plane):
 
 def test_continuous_sketch_objects_and_the_comb():
     from spiral_cad.build123d import ContinuousPolygon, ContinuousRectangle, ContinuousSlot, curvature_comb
-    from spiral_cad.continuity import check_continuity
+    from spiral_cad.cad.continuity import check_continuity
 
     for shape in (ContinuousRectangle(60, 30, 6), ContinuousPolygon(20, 6, 4), ContinuousSlot(50, 12)):
         assert shape.is_valid and check_continuity(shape).passes("G2")
@@ -210,7 +210,7 @@ def test_non_planar_and_non_arc_edges_are_refused():
 def test_cadquery_sketch_and_workplane():
     cq = pytest.importorskip("cadquery")
     import spiral_cad.cadquery  # noqa: F401
-    from spiral_cad.continuity import check_continuity
+    from spiral_cad.cad.continuity import check_continuity
 
     sketch = cq.Sketch().rect(40, 20).vertices().g2fillet(4.0)
     assert check_continuity(sketch._faces).passes("G2")

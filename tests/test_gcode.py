@@ -8,7 +8,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from spiral_cad.formats.gcode import parse_gcode, read_gcode, round_toolpath
+from spiral_cad.io.gcode import parse_gcode, read_gcode, round_toolpath
 
 HERE = Path(__file__).parent / "gcode"
 
@@ -163,8 +163,8 @@ def csv_table(path):
 
 
 def test_build_from_gcode_writes_step_and_samples_of_a_g2_path(tmp_path, capsys):
-    from spiral_cad.cli import main
-    from spiral_cad.continuity import check_continuity
+    from spiral_cad.app.cli import main
+    from spiral_cad.cad.continuity import check_continuity
 
     out = tmp_path / "out"
     assert main(["build", "--from-gcode", str(HERE / "pocket.nc"), "--max-deviation", "0.05", "--out", str(out)]) == 0
@@ -186,7 +186,7 @@ def test_build_from_gcode_writes_step_and_samples_of_a_g2_path(tmp_path, capsys)
 
 
 def test_an_inch_program_is_converted_to_the_outputs_unit(tmp_path):
-    from spiral_cad.cli import main
+    from spiral_cad.app.cli import main
 
     assert main(["build", "--from-gcode", str(HERE / "helix_incremental.nc"), "--max-deviation", "1", "--sample-step", "5",
                  "--out", str(tmp_path)]) == 0  # fmt: skip
@@ -212,7 +212,7 @@ def test_an_inch_program_is_converted_to_the_outputs_unit(tmp_path):
     ],
 )
 def test_build_from_gcode_refuses_by_name_and_writes_nothing(tmp_path, capsys, monkeypatch, argv, message):
-    from spiral_cad.cli import main
+    from spiral_cad.app.cli import main
 
     monkeypatch.chdir(HERE)
     out = tmp_path / "out"
@@ -223,7 +223,7 @@ def test_build_from_gcode_refuses_by_name_and_writes_nothing(tmp_path, capsys, m
 
 
 def test_design_files_take_3d_points_and_every_rounding_option(tmp_path):
-    from spiral_cad.designfile import DesignError, build
+    from spiral_cad.app.designfile import DesignError, build
 
     helix = [[40 * math.cos(0.9 * k), 40 * math.sin(0.9 * k), 9 * 0.9 * k] for k in range(8)]
     for option in ({"max_deviation": 0.4}, {"max_curvature": 0.3}, {"spiral_lengths": [2.5] * 6}, {"curvature": 0.25},

@@ -20,10 +20,10 @@ from cad_cases import transition_chains
 from ezdxf.lldxf.validator import is_valid_layer_name
 
 from spiral_cad import Chain
-from spiral_cad.export import export_dxf, export_iges, export_opendrive, export_step, export_svg
-from spiral_cad.formats.names import MAX_NAME_LENGTH, check_name, dxf_layer_name, iges_text, step_string
-from spiral_cad.formats.opendrive import read_opendrive
-from spiral_cad.occ import read_shape
+from spiral_cad.cad.export import export_dxf, export_iges, export_opendrive, export_step, export_svg
+from spiral_cad.io.names import MAX_NAME_LENGTH, check_name, dxf_layer_name, iges_text, step_string
+from spiral_cad.io.opendrive import read_opendrive
+from spiral_cad.cad.readers import read_shape
 
 CHAIN = Chain(transition_chains()["S"].segments, units="m")
 WRITERS = {"step": export_step, "igs": export_iges, "dxf": export_dxf, "svg": export_svg, "xodr": export_opendrive}
@@ -65,7 +65,7 @@ def iges_names(path) -> tuple[str, list[str]]:
     from OCP.TDocStd import TDocStd_Document
     from OCP.XCAFDoc import XCAFDoc_DocumentTool
 
-    from spiral_cad.cad.occ import captured_messages
+    from spiral_cad.cad.console import captured_messages
 
     with captured_messages():
         document = TDocStd_Document(TCollection_ExtendedString("XmlXCAF"))
@@ -154,7 +154,7 @@ def test_enormous_names_and_file_names_never_crash_the_iges_writer(tmp_path):
 import sys
 sys.path.insert(0, {str(tmp_path.parent)!r})
 from spiral_cad import Chain, line_to_circle
-from spiral_cad.export import export_iges
+from spiral_cad.cad.export import export_iges
 chain = Chain(line_to_circle((0, 0), (1, 0), (0, 1.05), 1.0).spirals, units="mm")
 for name, path in (("x" * 1300, {str(tmp_path / 'a.igs')!r}), ("x", {str(tmp_path)!r} + "/" + "y" * 1300 + ".igs")):
     try:

@@ -15,7 +15,7 @@ from hypothesis import strategies as st
 from test_never_wrong import assert_meet_g2, assert_on_circle
 
 import spiral_cad as sc
-from spiral_cad import batch
+from spiral_cad.core import batch
 
 SHAPES = ("walton-meek", "near-linear")
 EQUAL_LEG_LIMIT = math.acos(5.0 / 6.0)  # 33.557°: where the equal-leg member stops being monotone
@@ -346,7 +346,7 @@ def test_cad_objects_take_the_shape():
 
     import spiral_cad.cadquery  # noqa: F401  (registers the Workplane methods)
     from spiral_cad.build123d import ContinuousRectangle, SpiralLineToCircle, g2_fillet
-    from spiral_cad.continuity import check_continuity
+    from spiral_cad.cad.continuity import check_continuity
 
     face = g2_fillet(Rectangle(60, 30), radius=5, transition=0.5, shape="near-linear")
     assert check_continuity(face.faces()[0].outer_wire()).passes("G2")
@@ -370,14 +370,14 @@ def test_the_100_kmh_design_file_builds_end_to_end(tmp_path):
     import sys
 
     from spiral_cad.design import Alignment, RoadCriteria
-    from spiral_cad.formats.opendrive import read_opendrive
+    from spiral_cad.io.opendrive import read_opendrive
 
     pis = [[0, 0], [900, 150], [1900, -120], [2900, 60]]
     design = {"units": "m", "designs": [{"name": "autobahn", "type": "alignment", "pis": pis, "radii": [500, 700],
                                          "design_speed": 100, "max_jerk": 0.5, "strict": True}]}  # fmt: skip
     path = tmp_path / "design.json"
     path.write_text(json.dumps(design))
-    done = subprocess.run([sys.executable, "-m", "spiral_cad.cli", "build", str(path), "--out", str(tmp_path / "out"), "--no-plots"],
+    done = subprocess.run([sys.executable, "-m", "spiral_cad.app.cli", "build", str(path), "--out", str(tmp_path / "out"), "--no-plots"],
                           capture_output=True, text=True, timeout=300)  # fmt: skip
     assert done.returncode == 0, done.stderr
     with open(tmp_path / "out" / "autobahn_criteria.csv", newline="") as handle:
@@ -398,7 +398,7 @@ def test_the_100_kmh_design_file_builds_end_to_end(tmp_path):
 
 
 def test_design_files_name_the_spiral_shape():
-    from spiral_cad.designfile import DesignError, build
+    from spiral_cad.app.designfile import DesignError, build
 
     def one(design):
         return build({"units": "m", "designs": [design]})[1][0]

@@ -10,7 +10,7 @@ from cad_cases import transition_chains
 from scipy.interpolate import BSpline
 
 from spiral_cad import Arc, Chain, Line
-from spiral_cad.nurbs import Nurbs, chain_to_nurbs
+from spiral_cad.core.nurbs import Nurbs, chain_to_nurbs
 
 CHAINS = transition_chains()
 
@@ -79,7 +79,7 @@ def test_occt_edge_evaluates_to_the_same_points(name):
     from OCP.BRepAdaptor import BRepAdaptor_Curve
     from OCP.GeomAbs import GeomAbs_CurveType
 
-    from spiral_cad.occ import nurbs_edge
+    from spiral_cad.cad.occ import nurbs_edge
 
     chain = CHAINS[name]
     nurbs = chain.to_nurbs()
@@ -113,5 +113,5 @@ def test_invalid_nurbs_and_chains_are_rejected():
 
 
 def test_module_is_pure_numpy():
-    code = "import sys, spiral_cad.nurbs, spiral_cad; sys.exit('OCP' in sys.modules or 'build123d' in sys.modules)"
+    code = "import sys, spiral_cad.core.nurbs, spiral_cad; sys.exit('OCP' in sys.modules or 'build123d' in sys.modules)"
     assert subprocess.run([sys.executable, "-c", code]).returncode == 0

@@ -18,7 +18,7 @@ from OCP.GeomAbs import GeomAbs_CurveType
 from OCP.gp import gp_Ax3, gp_Dir, gp_Pnt, gp_Vec
 
 from spiral_cad import Arc, BezierSpiral, Chain, Line, line_to_circle
-from spiral_cad.occ import chain_wire, segment_edge, segment_edges
+from spiral_cad.cad.occ import chain_wire, segment_edge, segment_edges
 
 EXPECTED_TYPE = {
     Line: GeomAbs_CurveType.GeomAbs_Line,

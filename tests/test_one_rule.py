@@ -4,7 +4,7 @@ and offsets up to 1e12 times the feature size.
 
 "Verified" means: the result passes the check its own layer applies (a ``Chain`` re-checks
 every joint, a ``FilletedPath`` every joint it made, a CAD shape is graded by
-``spiral_cad.continuity``), and it starts and ends where it was asked to. Every refusal
+``spiral_cad.cad.continuity``), and it starts and ends where it was asked to. Every refusal
 shows plain numbers (no numpy reprs).
 """
 
@@ -299,7 +299,7 @@ def TILTED(bd):
 def test_g2_fillet_returns_what_the_checker_grades_g2_or_refuses(log_scale, offset, points, log_radius, transition, kind, plane):
     bd = pytest.importorskip("build123d")
     from spiral_cad.build123d import g2_fillet
-    from spiral_cad.continuity import check_continuity
+    from spiral_cad.cad.continuity import check_continuity
 
     scale = 10.0**log_scale
     try:  # the input itself must exist in OCCT (it refuses coordinates past ~1e100 and edges below 1e-7)
@@ -328,7 +328,7 @@ def test_g2_fillet_returns_what_the_checker_grades_g2_or_refuses(log_scale, offs
 def test_g2_fillet_of_the_issue():
     bd = pytest.importorskip("build123d")
     from spiral_cad.build123d import g2_fillet
-    from spiral_cad.continuity import check_continuity
+    from spiral_cad.cad.continuity import check_continuity
 
     with pytest.raises(sc.NoSolutionError, match=r"corner \d: a \w+ of the fillet is \S+ long; OCCT merges points closer than 1e-07"):
         g2_fillet(bd.Rectangle(2e-6, 1e-6), 1e-7)  # was StdFail_NotDone
@@ -372,7 +372,7 @@ MASKED = np.ma.masked_array([[0.0, 0.0], [5.0, 5.0]], mask=[[False, False], [Tru
 )
 def test_masked_input_is_refused_by_name(call, name):
     """numpy drops a mask when it converts: the masked value would be solved as the number under it."""
-    import spiral_cad.batch  # noqa: F401  (sc.batch)
+    import spiral_cad.core.batch  # noqa: F401  (sc.batch)
 
     with pytest.raises(ValueError, match=rf"{name} is a masked array: masked values have no geometry"):
         call()

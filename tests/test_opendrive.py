@@ -12,10 +12,10 @@ import pytest
 
 import spiral_cad as sc
 from spiral_cad import Arc, BezierSpiral
-from spiral_cad.cli import main
+from spiral_cad.app.cli import main
 from spiral_cad.design import Alignment, round_corners
-from spiral_cad.export import CrossSection, export_opendrive
-from spiral_cad.formats.opendrive import check_opendrive, read_opendrive
+from spiral_cad.cad.export import CrossSection, export_opendrive
+from spiral_cad.io.opendrive import check_opendrive, read_opendrive
 
 REPO = Path(__file__).resolve().parent.parent
 PIS = [[0, 0], [600, 120], [1150, -80], [1700, 260], [2300, 200]]
@@ -247,8 +247,8 @@ def test_demo_writes_a_valid_highway_xodr(tmp_path):
     assert result["schema"] == [] and all(issues == 0 for _, issues in result["checker"].values())
     assert "verdict" in (tmp_path / "highway_criteria.csv").read_text()
     # the highway in 3-D: pyxodr's elevation is the designed profile (s along its 0.5 m polyline)
-    from spiral_cad.cli import DEMO_DESIGN
-    from spiral_cad.designfile import build
+    from spiral_cad.app.cli import DEMO_DESIGN
+    from spiral_cad.app.designfile import build
 
     (highway, *_) = build(DEMO_DESIGN)[1]
     ((distance, z),) = [np.array(v).T for v in result["elevation"].values()]
@@ -383,7 +383,7 @@ def test_any_file_reads_as_verified_chains_or_a_value_error(text):
     import warnings
 
     from spiral_cad import Chain
-    from spiral_cad.formats.joints import Continuity
+    from spiral_cad.check.joints import Continuity
 
     with tempfile.TemporaryDirectory() as folder:
         path = Path(folder) / "any.xodr"

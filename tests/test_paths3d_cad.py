@@ -11,9 +11,9 @@ from build123d import BuildLine, BuildPart, BuildSketch, Circle, GeomType, Plane
 
 from spiral_cad import NoSolutionError
 from spiral_cad.build123d import G2Polyline, g2_fillet
-from spiral_cad.continuity import check_continuity
+from spiral_cad.cad.continuity import check_continuity
 from spiral_cad.design import fillet_polyline, round_corners
-from spiral_cad.export import export_dxf, export_iges, export_samples, export_step, export_svg
+from spiral_cad.cad.export import export_dxf, export_iges, export_samples, export_step, export_svg
 
 RUN = [(0, 0, 0), (100, 0, 0), (100, 80, 30), (0, 80, 60), (0, 0, 90)]
 
@@ -147,7 +147,7 @@ def test_samples_for_machines(tmp_path):
 
 def test_samples_of_a_plane_chain_with_arcs_carry_signed_curvature(tmp_path):
     from spiral_cad.design import Alignment
-    from spiral_cad.formats.samples import sample_path
+    from spiral_cad.io.samples import sample_path
 
     chain = Alignment.from_pis([(0, 0), (300, 60), (560, -40), (820, 90)], radii=[220, 260], spiral_angles=0.12, units="m").chain
     for options in ({"step": 2.0}, {"chord_tolerance": 0.001}):

@@ -6,7 +6,8 @@ import numpy as np
 import pytest
 from matplotlib.figure import Figure
 
-from spiral_cad import BezierSpiral, plots
+from spiral_cad import BezierSpiral
+from spiral_cad.app import plots
 from spiral_cad.design import Alignment, round_corners
 
 PNG = b"\x89PNG\r\n\x1a\n"

@@ -238,7 +238,7 @@ def arc_length_to(segment, u):
 
 
 def test_the_3d_centre_line_is_within_its_tolerance_sampled_densely(highway, profile):
-    line = highway.centerline_3d(profile, tolerance=1e-7)
+    line = centerline_3d(highway, profile, tolerance=1e-7)
     assert line.deviation <= 1e-7 and line.tolerance == 1e-7
     t = np.linspace(0, 1, 41)
     points = line.point(t)

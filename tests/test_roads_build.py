@@ -5,8 +5,8 @@ import xml.etree.ElementTree as ET
 
 import pytest
 
-from spiral_cad.cli import DEMO_DESIGN, main
-from spiral_cad.designfile import DesignError, build
+from spiral_cad.app.cli import DEMO_DESIGN, main
+from spiral_cad.app.designfile import DesignError, build
 
 ROAD = {
     "name": "road", "type": "alignment", "pis": [[0, 0], [220, 10], [430, 120]], "radii": 200, "design_speed": 60,
@@ -38,7 +38,7 @@ def test_build_writes_the_profile_table_the_3d_step_and_the_xodr(tmp_path, capsy
     assert "road in 3-D: corridor solid and centre line (plan exact; z within" in step
     from build123d import Shape
 
-    from spiral_cad.cad.occ import read_shape
+    from spiral_cad.cad.readers import read_shape
 
     shape = Shape.cast(read_shape(out / "road_3d.step", units="m"))
     (solid,) = shape.solids()

@@ -7,8 +7,8 @@ import stat
 
 import pytest
 
-from spiral_cad import staging
-from spiral_cad.staging import MARKER, OutputError, Staging, remove_stale
+from spiral_cad.io import staging
+from spiral_cad.io.staging import MARKER, OutputError, Staging, remove_stale
 
 OLD = {"a.step": "old a", "b.svg": "old b", "c.csv": "old c"}
 

@@ -5,7 +5,7 @@ OCCT's own tools do not answer this question: ``GeomLProp``/``BRepLProp``
 where the curvature is zero — exactly at a spiral's start. So the joint
 quantities are measured here from first and second derivatives.
 
-Measures and classification: ``spiral_cad.formats.joints`` (shared with the
+Measures and classification: ``spiral_cad.check.joints`` (shared with the
 OpenDRIVE checker). Files are read and measured in a child process
 (``spiral_cad.cad.readers``): only the measured numbers come back.
 
@@ -55,7 +55,7 @@ from OCP.TopTools import TopTools_IndexedMapOfShape
 from ..core.chain import Chain
 from ..core.segments import EPS
 from ..core.units import length_unit
-from ..formats.joints import (
+from ..check.joints import (
     Continuity,
     ContinuityReport,
     Frame,
@@ -461,7 +461,7 @@ def main_check(args: argparse.Namespace) -> int:
     if not report.wires:
         raise ValueError(f"{report.source!r} contains no edges to check")
     if comb is not None:
-        from ..export import export_step
+        from .export import export_step
 
         comb_shape = curvature_comb(args.file, units=report.units)  # in the unit the report is in
         export_step(comb_shape, comb, name=f"{report.source} curvature comb", units=report.units)

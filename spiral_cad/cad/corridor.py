@@ -41,7 +41,7 @@ from ..design.centerline import Centerline3D, centerline_3d
 from ..design.profile import Profile
 from ..design.roadway import Roadway, roadway
 from ..design.superelevation import Superelevation
-from ..formats.opendrive import CrossSection
+from ..io.opendrive import CrossSection
 
 
 @dataclass(frozen=True)

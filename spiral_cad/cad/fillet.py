@@ -25,7 +25,7 @@ from OCP.TopExp import TopExp_Explorer
 from OCP.TopoDS import TopoDS, TopoDS_Face, TopoDS_Wire
 
 from ..core.errors import NoSolutionError
-from ..formats.joints import Continuity
+from ..check.joints import Continuity
 from ..core.segments import Arc, Line, Segment
 from ..design.fillets import FilletedPath, fillet_path
 from .occ import chain_wire
@@ -171,7 +171,7 @@ def fillet_wire(
 
 
 def _verify(wire: TopoDS_Wire, result: FilletedPath) -> None:
-    """NoSolutionError unless the G2 checker (``spiral_cad.continuity``, default tolerances) grades
+    """NoSolutionError unless the G2 checker (``spiral_cad.cad.continuity``, default tolerances) grades
     every joint of every rounded corner G2 in the built wire: float64 rounding of 3-D coordinates
     may break what held in the plane (a tiny fillet far from the origin or on a tilted plane)."""
     from .continuity import check_continuity  # late: the checker imports the edge makers of this layer

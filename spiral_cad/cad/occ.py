@@ -44,10 +44,10 @@ from OCP.TopoDS import TopoDS_Compound, TopoDS_Edge, TopoDS_Shape, TopoDS_Vertex
 from ..core._chain_kernels import ARC, LINE, SPIRAL
 from ..core.rows import SegmentRows
 from ..core.segments import Segment, row_frames
-from ..formats.joints import ROUNDING_ULPS, norms
-from .readers import ReadError, read_shape
+from ..check.joints import ROUNDING_ULPS, norms
+from .readers import read_shape
 
-__all__ = ["ReadError", "as_occ_shape", "captured_messages", "chain_wire", "nurbs_edge", "read_shape", "segment_edge", "segment_edges"]
+__all__ = ["as_occ_shape", "chain_wire", "nurbs_edge", "plane_ax3", "print_model", "segment_edge", "segment_edges"]
 
 if TYPE_CHECKING:
     from ..core.nurbs import Nurbs
@@ -226,26 +226,7 @@ def segment_edges(segments: Iterable[Segment], plane: gp_Ax3 | None = None) -> l
     return [BRepBuilderAPI_MakeEdge(*span).Edge() for span in _curves(_segment_rows(segments), _frame(plane))[0]]
 
 
-def chain_edges(chain: Iterable[Segment], plane: Any = None) -> list:
-    """``Chain.to_edges``: the exact build123d edges (LINE, CIRCLE, BEZIER) in travel order.
-
-    Args:
-        plane: a build123d ``Plane``: the coordinate system of the chain's
-            coordinates (x, y[, z]) (None: the global one, ``Plane.XY``).
-    """
-    from build123d import Edge
-
-    return [Edge(e) for e in segment_edges(chain, _ax3(plane))]
-
-
-def chain_to_wire(chain: Iterable[Segment], plane: Any = None) -> Any:
-    """``Chain.to_wire``: the chain as one build123d ``Wire`` in ``plane``'s coordinates (None: ``Plane.XY``)."""
-    from build123d import Wire
-
-    return Wire(chain_wire(chain, _ax3(plane)))
-
-
-def _ax3(plane: Any) -> gp_Ax3 | None:
+def plane_ax3(plane: Any) -> gp_Ax3 | None:
     """A build123d ``Plane`` (or None) as the OCP ``gp_Ax3`` the edge makers take."""
     if plane is None:
         return None
@@ -341,35 +322,6 @@ def nurbs_edge(nurbs: Nurbs, plane: gp_Ax3 | None = None) -> TopoDS_Edge:
 
 
 # ------------------------------------------------------------- console
-
-_ANSI = re.compile(r"\x1b\[[0-9;]*m")
-
-
-@contextmanager
-def captured_messages() -> Iterator[list[str]]:
-    """Capture everything OCCT prints (its messenger writes to the process's stdout and stderr).
-
-    Yields a list that holds the printed lines, ANSI colour codes removed,
-    once the block ends; nothing reaches the console.
-    """
-    lines: list[str] = []
-    for stream in (sys.stdout, sys.stderr):
-        stream.flush()
-    saved = [os.dup(1), os.dup(2)]
-    with tempfile.TemporaryFile() as sink:
-        os.dup2(sink.fileno(), 1)
-        os.dup2(sink.fileno(), 2)
-        try:
-            yield lines
-        finally:
-            os.dup2(saved[0], 1)
-            os.dup2(saved[1], 2)
-            for fd in saved:
-                os.close(fd)
-            sink.seek(0)
-            text = _ANSI.sub("", sink.read().decode("utf-8", "replace"))
-            lines.extend(line for line in text.splitlines() if line.strip())
-
 
 def print_model(printer: Any, protocol: Any, path: str | os.PathLike, kind: str) -> None:
     """Print an OCCT model (``printer``: its STEP or IGES writer) to ``path`` with 17 significant digits.

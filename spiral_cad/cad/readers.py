@@ -53,6 +53,7 @@ from OCP.TopoDS import TopoDS, TopoDS_Shape
 from OCP.TopTools import TopTools_IndexedMapOfShape
 
 from ..core.units import MM_PER_UNIT, length_unit
+from .console import captured_messages
 from .sandbox import Isolated
 
 __all__ = ["IGES_SUFFIXES", "STEP_SUFFIXES", "ReadError", "read_file", "read_shape"]
@@ -173,7 +174,6 @@ def _read_whole(path: Path, kind: str, units: str | None) -> tuple[TopoDS_Shape,
     """Read ``path`` with OCCT, check that it was read whole; (shape, unit read in)."""
     from OCP.IFSelect import IFSelect_RetDone
 
-    from .occ import captured_messages
 
     with captured_messages() as printed:
         if kind == "STEP":

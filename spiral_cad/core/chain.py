@@ -351,17 +351,14 @@ class Chain:
         pts = [seg.point(u) for seg in self.segments]
         return np.vstack(pts + [self.end[None]])
 
-    # ``to_edges`` and ``to_wire`` (exact build123d edges and wire) are CAD adapters:
-    # ``spiral_cad.cad.occ`` defines them and the package attaches them here.
-
     def to_nurbs(self) -> Any:
-        """The whole chain as one exact rational cubic B-spline (``spiral_cad.nurbs.Nurbs``).
+        """The whole chain as one exact rational cubic B-spline (``spiral_cad.core.nurbs.Nurbs``).
 
         Raises:
             ValueError: a chain in space (``Nurbs`` is planar).
         """
         if self.dim != 2:
-            raise ValueError("to_nurbs takes a plane chain; this chain is in space (use to_edges/to_wire for exact 3-D edges)")
+            raise ValueError("to_nurbs takes a plane chain; this chain is in space (use spiral_cad.build123d.chain_edges/chain_to_wire for exact 3-D edges)")
         from .nurbs import chain_to_nurbs
 
         return chain_to_nurbs(self.segments)

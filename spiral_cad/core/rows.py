@@ -63,7 +63,7 @@ class SegmentRows:
 
     @classmethod
     def spirals(cls, control_points: ArrayLike, shape: str | None = None) -> SegmentRows:
-        """Rows of spirals from (n, 4, 2) or (n, 4, 3) control points (solver output, e.g. ``spiral_cad.batch``
+        """Rows of spirals from (n, 4, 2) or (n, 4, 3) control points (solver output, e.g. ``spiral_cad.core.batch``
         rows placed by ``space.place``: no checks)."""
         cp = np.asarray(control_points, dtype=float)
         rows = cls.empty(len(cp), cp.shape[2])

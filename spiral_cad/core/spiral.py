@@ -11,7 +11,8 @@ from numpy.typing import ArrayLike, NDArray
 from . import bezier
 from ._inputs import as_float, as_xy
 from ._kernels import spiral_row
-from .errors import Status, error_for
+from .errors import Status
+from .messages import error_for
 from ._chain_kernels import SPIRAL
 from .segments import EPS, PLANE_TOL, Segment, piece_range
 from .space import PlaneFrame

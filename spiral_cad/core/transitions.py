@@ -3,7 +3,7 @@
 Each solver returns a :class:`Transition` whose ``spirals`` read in travel
 order, made with the spiral ``shape`` asked for (``spiral_cad.core.shapes``:
 ``"walton-meek"`` by default, or ``"near-linear"``). The work is done by the
-row kernels that ``spiral_cad.batch`` runs over arrays, so scalar and batch
+row kernels that ``spiral_cad.core.batch`` runs over arrays, so scalar and batch
 results agree bit for bit.
 """
 
@@ -18,7 +18,7 @@ from numpy.typing import NDArray
 
 from . import _kernels as K
 from ._inputs import as_float, as_xy
-from .errors import error_for
+from .messages import error_for
 from .segments import Arc, Circle, Join, Line, Ray, Segment, measure_join
 from .shapes import CORNER_SHAPES, DEFAULT_SHAPE, shape_code
 from .spiral import BezierSpiral

@@ -2,7 +2,7 @@
 
 The API default is millimetres, as in build123d and CadQuery; design files
 name their unit (``"units": "m"``). Each writer declares the unit the way its
-readers expect (see ``spiral_cad.export``); nothing is rescaled on the way.
+readers expect (see ``spiral_cad.cad.export``); nothing is rescaled on the way.
 """
 
 from __future__ import annotations

@@ -342,12 +342,6 @@ class Alignment:
     def end_station(self) -> float:
         return self.start_station + self.chain.length
 
-    def centerline_3d(self, profile: Any, tolerance: float | None = None) -> Any:
-        """The 3-D centre line under ``profile`` (see ``spiral_cad.design.centerline``)."""
-        from .centerline import centerline_3d
-
-        return centerline_3d(self, profile, tolerance)
-
     def table(self, digits: int = 8) -> str:
         """The stationing table as aligned text (for printing), units in the headers."""
         units = self.chain.units

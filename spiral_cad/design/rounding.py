@@ -346,7 +346,7 @@ def round_corners_batch(
     The spirals of a corner must start between ``p0`` and the corner and end
     between the corner and ``p1``: pass the leg ends each corner may use (see
     :func:`corner_legs` for polylines). A corner in space is solved in the
-    plane of its legs by the plane kernel (``spiral_cad.batch.line_to_line``),
+    plane of its legs by the plane kernel (``spiral_cad.core.batch.line_to_line``),
     placed back with ``spiral_cad.core.space.place`` and verified in space:
     each spiral leaves its leg G2, the two meet G2 (curvature vector κN), at
     the pair's curvature, else the row is ``UNVERIFIED``.

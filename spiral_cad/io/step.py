@@ -37,7 +37,7 @@ with its prefix for mm, cm, m, km; a ``CONVERSION_BASED_UNIT`` of 25.4 mm or
 304.8 mm for in and ft), so readers that convert (OCCT reads into mm by
 default) get the right size. Every real is the shortest decimal that reads
 back to the same double (at most 17 significant digits); every name an
-ISO 10303-21 string in pure ASCII (``spiral_cad.formats.names.step_string``).
+ISO 10303-21 string in pure ASCII (``spiral_cad.io.names.step_string``).
 
 Needs no CAD kernel.
 """

@@ -9,7 +9,7 @@ organisation. Reals are printed with 17 significant digits.
 OCCT's writer would print a name's non-ASCII characters as raw UTF-8 and a
 quote before ``)`` in a form its own reader cannot parse, so it is given a
 random ASCII placeholder that is then replaced by the name encoded as
-ISO 10303-21 requires (``spiral_cad.formats.names.step_string``); the
+ISO 10303-21 requires (``spiral_cad.io.names.step_string``); the
 product is named exactly ``name`` (OCCT would append a counter).
 """
 
@@ -29,9 +29,10 @@ from OCP.STEPControl import STEPControl_AsIs, STEPControl_Writer
 from OCP.StepData import StepData_StepWriter
 from OCP.TCollection import TCollection_HAsciiString
 
-from ..cad.occ import as_occ_shape, captured_messages, print_model
+from .occ import as_occ_shape, print_model
+from .console import captured_messages
 from ..core.units import MM_PER_UNIT
-from .names import step_string
+from ..io.names import step_string
 
 #: OCCT's names for ``write.step.unit``.
 _STEP_UNIT = {"mm": "MM", "cm": "CM", "m": "M", "km": "KM", "in": "INCH", "ft": "FT"}

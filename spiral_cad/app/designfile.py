@@ -6,7 +6,7 @@ sequence is either a valid design or a ``DesignError`` naming the field and
 the value: the file must be a regular file of at most ``MAX_DESIGN_BYTES``
 (checked before it is read), it is decoded, parsed and every field checked
 before anything is built, and every design is built before anything is
-written. Output is all or nothing (``spiral_cad.staging``): files are
+written. Output is all or nothing (``spiral_cad.io.staging``): files are
 written into a staging folder inside the output folder and moved into place
 only when all of them were written and every destination was checked; a
 failure or an interrupt (Ctrl-C, SIGTERM, SIGHUP) leaves the output folder
@@ -32,13 +32,13 @@ from importlib.util import find_spec
 from pathlib import Path
 from typing import Any
 
-from .core.chain import Chain
-from .core.errors import NoSolutionError
-from .core.shapes import CORNER_SHAPES, DEFAULT_SHAPE, TRANSITION_SHAPES
-from .core.spiral import BezierSpiral
-from .core.units import UNITS
-from .formats.names import MAX_TEXT_LENGTH, check_name
-from .staging import Staging
+from ..core.chain import Chain
+from ..core.errors import NoSolutionError
+from ..core.shapes import CORNER_SHAPES, DEFAULT_SHAPE, TRANSITION_SHAPES
+from ..core.spiral import BezierSpiral
+from ..core.units import UNITS
+from ..io.names import MAX_TEXT_LENGTH, check_name
+from ..io.staging import Staging
 
 FORMAT = """\
 {
@@ -334,7 +334,7 @@ PROFILE_KEYS = ("pvis", "curve_lengths", "k_values", "terrain", "max_grade", "mi
 
 def _design_criteria(d: dict, where: str):
     """The RoadCriteria / RailCriteria of an alignment design, or None."""
-    from .design import RailCriteria, RoadCriteria
+    from ..design import RailCriteria, RoadCriteria
 
     kind = _choice(d.get("criteria", "road"), f"{where}.criteria", ("road", "rail"))
     own, other = (ROAD_KEYS, RAIL_KEYS) if kind == "road" else (RAIL_KEYS, ROAD_KEYS)
@@ -354,7 +354,7 @@ def _design_criteria(d: dict, where: str):
 
 
 def _cross_section(d: dict, where: str):
-    from .formats.opendrive import CrossSection
+    from ..io.opendrive import CrossSection
 
     value = d.get("cross_section", {})
     if not isinstance(value, dict) or set(value) - set(CROSS_SECTION_KEYS):
@@ -383,7 +383,7 @@ def _shape(d: dict, where: str, choices: tuple[str, ...], default: str = DEFAULT
 
 
 def _alignment(d: dict, where: str, units: str) -> Built:
-    from .design import Alignment
+    from ..design import Alignment
 
     optional = ("spiral_angles_deg", "spiral_lengths", "start_station", "design_speed", "criteria", "strict",
                 "cross_section", "geo_reference", "spiral_shape", "profile") + ROAD_KEYS + RAIL_KEYS  # fmt: skip
@@ -427,7 +427,7 @@ def _alignment(d: dict, where: str, units: str) -> Built:
 
 def _profile(value: Any, where: str, alignment: Any, strict: bool):
     """The vertical alignment of an alignment design (its stations are the alignment's chainages)."""
-    from .design import Profile, ProfileCriteria, RoadCriteria
+    from ..design import Profile, ProfileCriteria, RoadCriteria
 
     if not isinstance(value, dict):
         raise DesignError(f"{where}: must be an object with pvis and curve_lengths or k_values; got {value!r:.80}")
@@ -453,7 +453,7 @@ def _profile(value: Any, where: str, alignment: Any, strict: bool):
     limits = {k: _number(value[k], f"{where}.{k}", positive=k == "max_grade") for k in ("max_grade", "min_curve_length") if k in value}
     terrain = value.get("terrain")
     if terrain is not None:
-        from .design.profile import TERRAINS
+        from ..design.profile import TERRAINS
 
         limits["terrain"] = _choice(terrain, f"{where}.terrain", TERRAINS)
     if isinstance(alignment.criteria, RoadCriteria):
@@ -472,7 +472,7 @@ def _profile(value: Any, where: str, alignment: Any, strict: bool):
 
 
 def _circle_chain(d: dict, where: str, units: str) -> Built:
-    from .design import circle_chain
+    from ..design import circle_chain
 
     _fields(d, where, ("circles",), ("spiral_shape",))
     circles = d["circles"]
@@ -496,7 +496,7 @@ ROUNDING_KEYS = ("curvature", "max_curvature", "max_deviation", "spiral_lengths"
 
 
 def _rounded(d: dict, where: str, units: str) -> Built:
-    from .design import round_corners
+    from ..design import round_corners
 
     _fields(d, where, (), ("points", "gcode", *ROUNDING_KEYS, "spiral_shape", "method", "samples"))
     if ("points" in d) == ("gcode" in d):
@@ -507,7 +507,7 @@ def _rounded(d: dict, where: str, units: str) -> Built:
     shape = _choice(d["method"], f"{where}.method", CORNER_SHAPES) if "method" in d else _shape(d, where, CORNER_SHAPES)
     samples = _samples(d["samples"], f"{where}.samples") if "samples" in d else None
     if "gcode" in d:
-        from .formats.gcode import read_gcode, round_toolpath
+        from ..io.gcode import read_gcode, round_toolpath
 
         program = d["gcode"]
         if not isinstance(program, str) or not program or "\0" in program:
@@ -526,7 +526,7 @@ def _samples(value: Any, where: str) -> dict[str, float]:
 
 
 def _transition(d: dict, where: str, units: str) -> Built:
-    from .core import transitions
+    from ..core import transitions
 
     case = _choice(d.get("case"), f"{where}.case", tuple(TRANSITION_ARGS))
     names = TRANSITION_ARGS[case]
@@ -641,15 +641,15 @@ def _write_design(b: Built, stage: Path, units: str, missing: list[str], plots: 
     OCCT reads the STEP for the continuity report, and the DXF is written
     (ezdxf's objects are the slowest of the files), while the rest are written here.
     """
-    from .cad.sandbox import Isolated
-    from .export import export_dxf, export_step
+    from ..cad.sandbox import Isolated
+    from ..cad.export import export_dxf, export_step
 
     step = stage / f"{b.name}.step"
     export_step(b.chain, step, name=b.name)
     with contextlib.ExitStack() as children:
         continuity = None
         if "OCP" not in missing:
-            from .cad.continuity import checking
+            from ..cad.continuity import checking
 
             continuity = children.enter_context(checking(step))  # as `spiral-cad check` reads it: the same numbers
         dxf = None
@@ -670,19 +670,19 @@ def _write_design(b: Built, stage: Path, units: str, missing: list[str], plots: 
 
 def _write_others(b: Built, stage: Path, units: str, missing: list[str], plots: bool) -> list[str]:
     """Every file of a design but its STEP, DXF and continuity report."""
-    from .export import export_svg
+    from ..cad.export import export_svg
 
     names = []
     if b.chain.dim == 2:  # SVG is a plane output (the plots draw a path in space as its plan)
         export_svg(b.chain, stage / f"{b.name}.svg", name=b.name)
         names.append("svg")
     if b.notes.get("samples"):
-        from .export import export_samples
+        from ..cad.export import export_samples
 
         export_samples(b.chain, stage / f"{b.name}_samples.csv", **b.notes["samples"])
         names.append("samples.csv")
     if b.kind == "alignment":
-        from .export import export_opendrive
+        from ..cad.export import export_opendrive
 
         profile = b.notes.get("profile")
         b.source.to_csv(stage / f"{b.name}_stations.csv")
@@ -698,7 +698,7 @@ def _write_others(b: Built, stage: Path, units: str, missing: list[str], plots: 
             if "OCP" not in missing:
                 names += _road_3d(b, profile, stage, units)
     if "OCP" not in missing:
-        from .export import export_iges
+        from ..cad.export import export_iges
 
         export_iges(b.chain, stage / f"{b.name}.igs", name=b.name)
         names.append("igs")
@@ -711,9 +711,9 @@ def _road_3d(b: Built, profile: Any, stage: Path, units: str) -> list[str]:
     """NAME_3d.step: the corridor solid and the 3-D centre line, their measured fit in the file's description."""
     from build123d import Compound
 
-    from .cad.corridor import centerline_wire, corridor
-    from .export import originating_system
-    from .formats.step_occ import write_shape_step
+    from ..cad.corridor import centerline_wire, corridor
+    from ..cad.export import originating_system
+    from ..cad.step_occ import write_shape_step
 
     road = corridor(b.source, profile, b.notes["cross_section"])
     line = road.centerline

@@ -1,6 +1,6 @@
 """ASAM OpenDRIVE 1.8: exact export of roads in 3-D; reading and checking (their public names).
 
-Export (``write_opendrive``, public as ``spiral_cad.export.export_opendrive``):
+Export (``write_opendrive``, public as ``spiral_cad.cad.export.export_opendrive``):
 every chain becomes one ``<road>`` whose ``planView`` holds its segments in
 travel order:
 
@@ -52,7 +52,18 @@ from ..core.segments import row_frames
 from ..core.units import to_metres
 from .decimals import shortest_decimal
 from .opendrive_check import LinkReport, OpenDriveReport, ProfileReport, check_opendrive, print_opendrive_report
-from .opendrive_read import Connection, Geometry, Junction, Link, Network, Plan, Road, read_network, read_opendrive, records_at
+from .opendrive_read import (
+    Connection,
+    Geometry,
+    Junction,
+    Link,
+    Network,
+    Plan,
+    Road,
+    read_network,
+    read_opendrive,
+    records_at,
+)
 
 __all__ = [
     "Connection", "CrossSection", "Geometry", "Junction", "Link", "LinkReport", "Network", "OpenDriveReport", "Plan",

@@ -9,7 +9,7 @@ left empty. The top entity (the composite curve of a chain, the group of a
 list of chains) carries the name as its entity label (8 characters) and as
 a name property (entity 406 form 15), which OCCT-based importers such as
 FreeCAD show; the curves of a group are named ``NAME-k``. IGES text is
-7-bit ASCII: names pass through ``spiral_cad.formats.names.iges_text`` (and
+7-bit ASCII: names pass through ``spiral_cad.io.names.iges_text`` (and
 the file name is cut to 255 characters).
 """
 
@@ -25,9 +25,10 @@ from OCP.IGESSelect import IGESSelect_WorkLibrary
 from OCP.Interface import Interface_Static
 from OCP.TCollection import TCollection_HAsciiString
 
-from ..cad.occ import as_occ_shape, captured_messages, print_model
+from .occ import as_occ_shape, print_model
+from .console import captured_messages
 from ..core.units import MM_PER_UNIT
-from .names import MAX_NAME_LENGTH, iges_text
+from ..io.names import MAX_NAME_LENGTH, iges_text
 
 #: IGES unit names as OCCT's writer takes them.
 _IGES_UNIT = {"mm": "MM", "cm": "CM", "m": "M", "km": "KM", "in": "IN", "ft": "FT"}

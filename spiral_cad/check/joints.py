@@ -1,7 +1,7 @@
 """Joint measures and their G0/G1/G2 classification, shared by every checker.
 
-The STEP/IGES checker (``spiral_cad.continuity``, through OCCT) and the
-OpenDRIVE checker (``spiral_cad.formats.opendrive``) both reduce a file to
+The STEP/IGES checker (``spiral_cad.cad.continuity``, through OCCT) and the
+OpenDRIVE checker (``spiral_cad.io.opendrive``) both reduce a file to
 pieces (wires, chains of loose edges, roads) of elements in travel order,
 each element given by its two end frames; this module measures and
 classifies the joints between them.

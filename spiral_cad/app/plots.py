@@ -18,11 +18,11 @@ from matplotlib.figure import Figure
 from numpy.typing import NDArray
 from scipy.special import fresnel
 
-from .core import bezier
-from .core.chain import Chain
-from .core.factors import length_factor, peak_rate_factor, search_range
-from .core.shapes import shape_limits
-from .core.spiral import BezierSpiral
+from ..core import bezier
+from ..core.chain import Chain
+from ..core.factors import length_factor, peak_rate_factor, search_range
+from ..core.shapes import shape_limits
+from ..core.spiral import BezierSpiral
 
 #: Colour per segment type (plan, comb and curvature plots).
 SEGMENT_COLORS = {"Line": "0.35", "Arc": "tab:blue", "BezierSpiral": "tab:red"}
@@ -306,7 +306,7 @@ def plot_jerk_length(
     lengths against the radius at ``design_speed`` (km/h) and ``max_jerk``
     (m/s³), metric units, one line per shape in ``shapes``.
     """
-    from .design.criteria import RoadCriteria
+    from ..design.criteria import RoadCriteria
 
     fig, (left, right) = _axes_pair(ax)
     radii = np.linspace(150.0, 3000.0, 120)

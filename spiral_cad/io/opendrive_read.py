@@ -8,7 +8,7 @@ arcs, clothoid spirals (Fresnel integrals from scipy), ``paramPoly3`` in both
 ``pRange`` and the deprecated ``poly3`` (its parameter range by a batched
 Gauss–Legendre Newton on its arc length). ``Geometry`` objects are made
 only when a road's ``geometries`` are asked for. Public names:
-``spiral_cad.formats.opendrive``.
+``spiral_cad.io.opendrive``.
 
 Needs no CAD kernel.
 """
@@ -31,7 +31,7 @@ from ..core.chain import Chain
 from ..core.piecewise import piecewise_at
 from ..core.segments import Arc, Line, Segment
 from ..core.spiral import BezierSpiral
-from .joints import Frame
+from ..check.joints import Frame
 
 #: Shape elements of a planView geometry and their numeric attributes.
 _KINDS = {

@@ -5,7 +5,7 @@ readers expect, and takes a ``name`` (default: the file name's stem) that
 becomes the STEP product, the IGES product id and entity name, the DXF
 layer and the SVG id and title. A name is 1 to 255 characters of printable
 text (no control characters); each format escapes or replaces what it cannot
-hold (``spiral_cad.formats.names``). The originating system is
+hold (``spiral_cad.io.names``). The originating system is
 ``spiral_cad <version>``. How each format stores a spiral:
 
 =======  ==========================================================  ==================================
@@ -21,7 +21,7 @@ Each is exactly the same cubic; see README for what each round trip keeps.
 Chains in space go to STEP, IGES and DXF in 3-D (exact lines, circles about
 their normal and Bézier spirals with their four poles); SVG is a plane
 format. ``export_samples`` writes a path as points for a robot or CNC
-post-processor (``spiral_cad.formats.samples``).
+post-processor (``spiral_cad.io.samples``).
 """
 
 from __future__ import annotations
@@ -31,10 +31,10 @@ from collections.abc import Iterable
 from pathlib import Path
 from typing import Any
 
-from .core.chain import Chain
-from .core.units import DEFAULT_UNITS, length_unit
-from .formats.names import MAX_TEXT_LENGTH, check_name
-from .formats.opendrive import CrossSection
+from ..core.chain import Chain
+from ..core.units import DEFAULT_UNITS, length_unit
+from ..io.names import MAX_TEXT_LENGTH, check_name
+from ..io.opendrive import CrossSection
 
 PathLike = str | os.PathLike
 
@@ -52,7 +52,7 @@ __all__ = [
 
 def originating_system() -> str:
     """``spiral_cad <version>``: the originating system written into every file."""
-    from . import __version__
+    from .. import __version__
 
     return f"spiral_cad {__version__}"
 
@@ -97,7 +97,7 @@ def _units(chains: list[Chain] | None, units: str | None) -> str:
 def export_step(obj: Any, path: PathLike, *, name: str | None = None, units: str | None = None) -> None:
     """Write STEP (AP214).
 
-    Chains are written directly (``spiral_cad.formats.step``): one connected
+    Chains are written directly (``spiral_cad.io.step``): one connected
     wire per chain, exact lines, circles and Bézier spirals, in the chain's
     unit. Any other shape (build123d, CadQuery, OCP) goes through OCCT's
     writer, declared in ``units`` (default mm, build123d's convention) and
@@ -117,11 +117,11 @@ def export_step(obj: Any, path: PathLike, *, name: str | None = None, units: str
     chains = _chains(obj)
     label, unit = _name(name, path), _units(chains, units)
     if chains is not None:
-        from .formats.step import write_step
+        from ..io.step import write_step
 
         write_step(chains, path, label, unit, originating_system())
     else:
-        from .formats.step_occ import write_shape_step
+        from .step_occ import write_shape_step
 
         write_shape_step(obj, path, label, unit, originating_system())
 
@@ -131,7 +131,7 @@ def export_iges(obj: Any, path: PathLike, *, name: str | None = None, units: str
 
     Args and errors as :func:`export_step`.
     """
-    from .formats.iges import write_iges
+    from .iges import write_iges
 
     chains = _chains(obj)
     write_iges(obj, path, _name(name, path), _units(chains, units), originating_system())
@@ -139,7 +139,7 @@ def export_iges(obj: Any, path: PathLike, *, name: str | None = None, units: str
 
 def export_dxf(obj: Chain | Iterable[Chain], path: PathLike, *, name: str | None = None) -> None:
     """Write chains as DXF R2010 (LINE, ARC, exact SPLINE) on layer ``name``, in the chains' unit; needs ezdxf."""
-    from .formats.dxf import write_dxf
+    from ..io.dxf import write_dxf
 
     chains = _require_chains(obj)
     write_dxf(chains, path, _name(name, path), _units(chains, None))
@@ -147,7 +147,7 @@ def export_dxf(obj: Chain | Iterable[Chain], path: PathLike, *, name: str | None
 
 def export_svg(obj: Chain | Iterable[Chain], path: PathLike, *, name: str | None = None, margin: float = 0.05) -> None:
     """Write chains as SVG at true size (one path per chain; ``margin`` a fraction of the drawing's size)."""
-    from .formats.svg import write_svg
+    from ..io.svg import write_svg
 
     chains = _require_chains(obj)
     if any(c.dim == 3 for c in chains):
@@ -167,7 +167,7 @@ def export_samples(chain: Chain, path: PathLike, *, step: float | None = None, c
         ValueError: not a Chain, neither or both of step and chord_tolerance, or too many samples.
         OSError: the file could not be written.
     """
-    from .formats.samples import write_samples
+    from ..io.samples import write_samples
 
     return write_samples(chain, path, step=step, chord_tolerance=chord_tolerance)
 
@@ -189,7 +189,7 @@ def export_opendrive(
     ``lateralProfile`` of exact cubics, C1: ``spiral_cad.design.Superelevation``).
     A ``Profile`` gives the ``elevationProfile`` (its parabolas and grades
     exactly); without one the road is level at 0. See
-    ``spiral_cad.formats.opendrive`` for the mapping; lengths are converted
+    ``spiral_cad.io.opendrive`` for the mapping; lengths are converted
     to metres, OpenDRIVE's unit.
 
     Args:
@@ -210,10 +210,10 @@ def export_opendrive(
             name or ``geo_reference`` that is not printable text, or a
             profile or superelevation that does not fit its alignment.
     """
-    from .design.alignment import Alignment
-    from .design.centerline import check_profile
-    from .design.superelevation import Superelevation
-    from .formats.opendrive import RoadToWrite, write_opendrive
+    from ..design.alignment import Alignment
+    from ..design.centerline import check_profile
+    from ..design.superelevation import Superelevation
+    from ..io.opendrive import RoadToWrite, write_opendrive
 
     items = list(obj) if isinstance(obj, (list, tuple)) else [obj]
     if not items or not all(isinstance(i, (Alignment, Chain)) for i in items):

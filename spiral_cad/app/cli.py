@@ -16,8 +16,8 @@ from contextlib import contextmanager
 from importlib.util import find_spec
 from pathlib import Path
 
-from . import circle_in_circle, circle_to_circle, line_to_circle, line_to_line
-from .core.transitions import Transition
+from .. import circle_in_circle, circle_to_circle, line_to_circle, line_to_line
+from ..core.transitions import Transition
 
 
 def core_examples() -> list[tuple[str, Transition]]:
@@ -190,7 +190,7 @@ def _check(args: argparse.Namespace) -> int:
         if args.comb:
             print("error: --comb draws STEP/IGES edges; it does not apply to OpenDRIVE", file=sys.stderr)
             return 2
-        from .formats.opendrive import check_opendrive, print_opendrive_report
+        from ..io.opendrive import check_opendrive, print_opendrive_report
 
         report = check_opendrive(args.file, gap_tol=args.gap_tol, angle_tol=args.angle_tol, curvature_tol=args.curvature_tol)
         return print_opendrive_report(report, args)
@@ -201,7 +201,7 @@ def _check(args: argparse.Namespace) -> int:
     if find_spec("OCP") is None:
         print(f"error: spiral-cad check reads STEP/IGES with OCCT, which comes with the CAD extra: {PIP_CAD}", file=sys.stderr)
         return 2
-    from .cad.continuity import main_check  # imports OCP, so only when used
+    from ..cad.continuity import main_check  # imports OCP, so only when used
 
     return main_check(args)
 

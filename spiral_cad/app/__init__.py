@@ -1,0 +1,1 @@
+"""The application layer: design files, the ``spiral-cad`` command and its plots."""
