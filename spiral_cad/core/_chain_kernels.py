@@ -23,7 +23,10 @@ from __future__ import annotations
 
 import math
 
-from ._kernels import jit
+from ._jit import Kernels
+
+KERNELS = Kernels(globals())
+jit = KERNELS.jit
 
 LINE, ARC, SPIRAL = 0, 1, 2
 TAU = 2.0 * math.pi
@@ -223,3 +226,6 @@ def connectors(a, b, scale, circle, center, radius, basis, flat, tolerance, kind
                 geometry[i, 1, j], geometry[i, 2, j] = basis[i, 0, j], basis[i, 1, j]
             params[i, 0], params[i, 1] = radius[i], angles[0]
             params[i, 2] = math.copysign(1.0, radius[i]) * (angles[1] - angles[0]) % TAU  # Python's float %
+
+
+KERNELS.seal()

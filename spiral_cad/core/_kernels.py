@@ -36,34 +36,17 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit
 
+from ._jit import Kernels
 from .errors import Status
 
 
-def _compile(inline: bool = False):
-    """``njit`` with an on-disk cache where one can be written, else per process.
-
-    Numba refuses to decorate a cached function when it finds no writable
-    cache location (a read-only install without a writable home): then the
-    kernels compile in memory at first use instead.
-    """
-
-    def wrap(function):
-        options = dict(nogil=True, error_model="numpy", inline="always" if inline else "never")
-        try:
-            return njit(cache=True, **options)(function)
-        except RuntimeError:
-            return njit(cache=False, **options)(function)
-
-    return wrap
-
-
-jit = _compile()
+KERNELS = Kernels(globals())
+jit = KERNELS.jit
 #: Row functions are inlined into the batch loops (where the output array
 #: then costs no reference counting per row) and compiled on their own for
 #: the scalar API.
-row_jit = _compile(inline=True)
+row_jit = KERNELS.row_jit
 
 # Row status codes as compile-time ints (meanings: ``errors.Status``).
 OK = int(Status.OK)
@@ -1769,3 +1752,6 @@ def circle_in_circle_batch(c0, r0, c1, r1, shape, out, status, theta, measure, p
         i0, j0, i1, j1 = i * s0, i * sr0, i * s1, i * sr1
         row = circle_in_circle_row(c0[i0, 0], c0[i0, 1], r0[j0], c1[i1, 0], c1[i1, 1], r1[j1], shape, out, i)
         status[i], theta[i], measure[i], param[i] = row
+
+
+KERNELS.seal()

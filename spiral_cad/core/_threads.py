@@ -12,7 +12,6 @@ from __future__ import annotations
 import threading
 from typing import Any
 
-import numba
 import numpy as np
 
 #: Rows per thread from which a batch of transition rows is split (about a millisecond of work).
@@ -22,7 +21,9 @@ ROWS_PER_THREAD = 16_384
 def thread_count(n: int, rows_per_thread: int = ROWS_PER_THREAD) -> int:
     """How many threads share n rows: one per ``rows_per_thread`` rows, at most
     ``NUMBA_NUM_THREADS`` (the cores, unless the environment says otherwise)."""
-    return max(1, min(numba.config.NUMBA_NUM_THREADS, n // rows_per_thread))
+    from numba import config  # the batch that asks has compiled kernels: numba is loaded
+
+    return max(1, min(config.NUMBA_NUM_THREADS, n // rows_per_thread))
 
 
 def run_split(kernel: Any, args: list[Any], n: int, rows_per_thread: int = ROWS_PER_THREAD) -> None:

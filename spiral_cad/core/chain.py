@@ -15,7 +15,8 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from ._chain_kernels import ARC, LINE, SPIRAL, connectors
+from . import _chain_kernels as CK
+from ._chain_kernels import ARC, LINE, SPIRAL
 from ._inputs import as_float, as_point, as_real_array
 from .errors import JointError
 from .rows import SegmentRows
@@ -477,7 +478,7 @@ def join_rows(
     present[inner], center[inner], radius[inner], basis[inner] = (x[:-1] for x in (circles.present, circles.center, circles.radius, circles.basis))
     bridge = SegmentRows.empty(gaps, dim)
     kind = np.empty(gaps, dtype=np.int8)
-    connectors(a, b, scale, present, center, radius, basis, dim == 2, tolerance, kind, bridge.geometry, bridge.params)
+    CK.connectors(a, b, scale, present, center, radius, basis, dim == 2, tolerance, kind, bridge.geometry, bridge.params)
     bridge.kind[:] = np.maximum(kind, 0)
     bridge_frames, bridge_floors, bridge_lengths = bridge.measure()
     _check_connectors(bridge, kind, bridge_lengths, a, b, dim, head, tail, begins, ends, count)

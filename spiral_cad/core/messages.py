@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import math
 
-from ._kernels import nested_band_lower
+from . import _kernels as K
 from .errors import MALFORMED, NoSolutionError, Status
 from .shapes import SHAPE_CODES, shape_limits
 
@@ -81,7 +81,7 @@ def describe(case: str, status: int, measure: float, inputs: dict[str, object]) 
         q = small / big
         return (
             f"circle_in_circle: a single {shape} spiral exists only for "
-            f"{nested_band_lower(q, SHAPE_CODES[shape]):.5f} ≤ D/(r0 − r1) < 1 at r1/r0 = {q:.2f}; "
+            f"{K.KERNELS.python.nested_band_lower(q, SHAPE_CODES[shape]):.5f} ≤ D/(r0 − r1) < 1 at r1/r0 = {q:.2f}; "
             f"here D/(r0 − r1) = {measure:.5f}"
         )
     if status is Status.OUTSIDE_SHAPE:

@@ -1,0 +1,184 @@
+"""Kernels compiled by numba when first needed, and the same kernels as plain Python meanwhile.
+
+A kernel module declares its functions with ``jit`` / ``row_jit`` from its own
+``Kernels`` and ends with ``seal()``. Its functions then leave the module's
+namespace: the first access to any of them (``K.name``) imports numba and
+makes every kernel of the module a compiled dispatcher (each compiles, or is
+loaded from numba's on-disk cache, at its first call). Until then nothing
+imports numba, so ``import spiral_cad`` costs numpy alone.
+
+``Kernels.python`` is the same source run by CPython: each function a copy
+whose globals hold the other copies. The scalar API uses it while the kernels
+are not compiled in this process (a first call answers in microseconds rather
+than waiting seconds for a compiler), then compiles them once a process has
+made ``SCALAR_CALLS_BEFORE_COMPILING`` scalar calls. One source, one formula:
+the two differ only in who executes it.
+"""
+
+from __future__ import annotations
+
+import math
+import threading
+from collections.abc import Callable
+from types import FunctionType, SimpleNamespace
+from typing import Any
+
+import numpy as np
+
+#: Scalar calls a process makes through the plain-Python kernels before it compiles them (a loop, not a REPL).
+SCALAR_CALLS_BEFORE_COMPILING = 200
+
+_LOCK = threading.RLock()
+
+
+class Kernels:
+    """The kernel functions of one module: plain Python until compiled.
+
+    Args:
+        namespace: the module's ``globals()``.
+    """
+
+    def __init__(self, namespace: dict[str, Any]) -> None:
+        self.namespace = namespace
+        self.functions: dict[str, tuple[FunctionType, bool]] = {}
+        self.compiled = False
+        self.scalar_calls = 0
+        self._python: SimpleNamespace | None = None
+
+    def jit(self, function: FunctionType) -> FunctionType:
+        """Declare a kernel (compiled on its own, called from other kernels)."""
+        self.functions[function.__name__] = (function, False)
+        return function
+
+    def row_jit(self, function: FunctionType) -> FunctionType:
+        """Declare a kernel that is inlined into the kernels calling it (one solver row)."""
+        self.functions[function.__name__] = (function, True)
+        return function
+
+    def seal(self) -> None:
+        """Take the kernels out of the module's namespace: the first access compiles them all."""
+        for name in self.functions:
+            del self.namespace[name]
+        module = self.namespace["__name__"]
+
+        def module_getattr(name: str) -> Any:
+            if name in self.functions:
+                self.compile()
+                return self.namespace[name]
+            raise AttributeError(f"module {module!r} has no attribute {name!r}")
+
+        self.namespace["__getattr__"] = module_getattr
+
+    def compile(self) -> None:
+        """Make every kernel a numba dispatcher, cached on disk where a cache can be written.
+
+        Numba refuses to decorate a cached function when it finds no writable
+        cache location (a read-only install without a writable home): the
+        kernels then compile in memory at first use.
+        """
+        with _LOCK:
+            if self.compiled:
+                return
+            from numba import njit
+
+            for name, (function, inline) in self.functions.items():
+                options: dict[str, Any] = dict(nogil=True, error_model="numpy", inline="always" if inline else "never")
+                try:
+                    self.namespace[name] = njit(cache=True, **options)(function)
+                except RuntimeError:
+                    self.namespace[name] = njit(cache=False, **options)(function)
+            self.compiled = True
+
+    @property
+    def python(self) -> SimpleNamespace:
+        """The kernels as plain Python functions calling each other (nothing compiled)."""
+        if self._python is None:
+            with _LOCK:
+                scope = {k: v for k, v in self.namespace.items() if k not in self.functions}
+                scope["math"] = _FLOAT_MATH
+                for name, (function, _) in self.functions.items():
+                    scope[name] = FunctionType(function.__code__, scope, name, function.__defaults__, function.__closure__)
+                self._python = SimpleNamespace(**{name: scope[name] for name in self.functions})
+        return self._python
+
+    def for_scalar_call(self) -> Any:
+        """The kernels a scalar call should use: compiled ones once this process has them, else plain Python.
+
+        A process that keeps making scalar calls compiles them after
+        ``SCALAR_CALLS_BEFORE_COMPILING`` calls (once; numba's cache makes
+        that cheap in the next process).
+        """
+        if not self.compiled:
+            self.scalar_calls += 1
+            if self.scalar_calls <= SCALAR_CALLS_BEFORE_COMPILING:
+                return _Python(self)
+            self.compile()
+        return _Compiled(self.namespace)
+
+
+def _float_semantics(name: str) -> Callable[..., Any]:
+    """``math.name`` with the kernels' floating-point model: a domain error gives NaN, an overflow
+    what numpy's function of that name gives (±inf), and the result is a numpy float, so that a
+    later division by zero gives inf rather than raising."""
+    function = getattr(math, name)
+    fallback = getattr(np, name, None)
+
+    def kernel_math(*args: Any) -> Any:
+        try:
+            return np.float64(function(*args))
+        except ValueError:
+            return np.float64(math.nan)
+        except OverflowError:
+            if fallback is None:
+                raise
+            return np.float64(fallback(*args))
+
+    return kernel_math
+
+
+#: ``math`` as the plain-Python kernels see it (numba's math functions follow numpy's float model).
+_FLOAT_MATH = SimpleNamespace(
+    **{
+        **{name: getattr(math, name) for name in dir(math) if not name.startswith("_")},
+        **{name: _float_semantics(name) for name in ("sqrt", "log", "log2", "log10", "log1p", "acos", "asin", "atan2", "exp",
+                                                      "expm1", "ldexp", "pow", "cosh", "sinh", "hypot", "fmod", "atanh", "acosh")},
+    }
+)
+
+
+class _Python:
+    """The plain-Python kernels, called with numpy floats (whose division by zero gives inf, as in
+    the kernels, rather than raising); a kernel that still raises runs compiled instead."""
+
+    __slots__ = ("_kernels",)
+
+    def __init__(self, kernels: Kernels) -> None:
+        self._kernels = kernels
+
+    def __getattr__(self, name: str) -> Callable[..., Any]:
+        kernels = self._kernels
+        function: Callable[..., Any] = getattr(kernels.python, name)
+
+        def guarded(*args: Any) -> Any:
+            floats = tuple(np.float64(a) if type(a) is float else a for a in args)
+            try:
+                with np.errstate(all="ignore"):
+                    return function(*floats)
+            except (ArithmeticError, ValueError):
+                kernels.compile()
+                return kernels.namespace[name](*args)
+
+        return guarded
+
+
+class _Compiled:
+    """Attribute access to a compiled module's kernels (its namespace, read directly)."""
+
+    __slots__ = ("_namespace",)
+
+    def __init__(self, namespace: dict[str, Any]) -> None:
+        self._namespace = namespace
+
+    def __getattr__(self, name: str) -> Callable[..., Any]:
+        function: Callable[..., Any] = self._namespace[name]
+        return function
