@@ -49,7 +49,8 @@ assert CornerShape.__args__ == CORNER_SHAPES  # noqa: S101
 
 def _error(message: str, *at: str | int, sep: str = ": ") -> PydanticCustomError:
     """A validation error whose message is shown as is, ``at`` the path below the failing field."""
-    return PydanticCustomError("design", message.replace("{", "{{").replace("}", "}}"), {"at": at, "sep": sep})
+    # the text goes in last, so no placeholder inside it (a value quoted as "{at}") is filled in
+    return PydanticCustomError("design", "{message}", {"at": at, "sep": sep, "message": message})
 
 
 def _shown(value: Any) -> str:
@@ -637,6 +638,7 @@ def _type(node: dict[str, Any]) -> str:
         size = (node.get("minItems"), node.get("maxItems"))
         count = ("" if size == (None, None) else f"{size[0]}" if size[0] == size[1]
                  else f"{size[0] or 0}–{size[1]}" if size[1] is not None else f"≥ {size[0]}")  # fmt: skip
+        inner = f"({inner})" if " or " in inner else inner
         return f"list{f' ({count})' if count else ''} of {inner}"
     if kind == "string" and "pattern" in node:
         limits.append(f"matching `{node['pattern']}`")
@@ -661,7 +663,8 @@ def _section(title: str, node: dict[str, Any]) -> list[str]:
     required = set(node.get("required", ()))
     lines += ["| field | type | required / default | description |", "|---|---|---|---|"]
     for key, field in node.get("properties", {}).items():
-        need = "required" if key in required else "default `" + json.dumps(field["default"]) + "`" if "default" in field else "optional"
+        default = field.get("default")
+        need = "required" if key in required else "optional" if default is None else f"default `{json.dumps(default)}`"
         text = field.get("description", "").replace("|", "\\|").replace("\n", " ")
         lines.append(f"| `{key}` | {_type(field)} | {need} | {text} |")
     return lines + [""]
@@ -681,6 +684,9 @@ def schema_markdown() -> str:
         "",
     ]
     lines += _section("DesignFile", schema)
+    kinds = {"description": "Each design is told apart by its `type` (a transition also by its `case`).",
+             **schema["properties"]["designs"]["items"]}  # fmt: skip
+    lines += _section("Design", kinds)
     for name, node in schema.get("$defs", {}).items():
         lines += _section(name, node)
     return "\n".join(lines).rstrip() + "\n"
