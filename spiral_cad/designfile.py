@@ -49,7 +49,7 @@ from .design_schema import (
 from .design_schema import Profile as ProfileDesign
 from .staging import Staging
 
-__all__ = ["MAX_PIS", "MAX_PVIS", "NAME", "DesignError", "Built", "build", "load", "write"]
+__all__ = ["MAX_PIS", "MAX_PVIS", "NAME", "Built", "DesignError", "build", "load", "write"]
 
 #: JSON integers longer than this are refused (they cannot be lengths in float64 anyway).
 MAX_DIGITS = 308
