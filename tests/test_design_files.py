@@ -421,3 +421,16 @@ def test_a_missing_program_is_named_as_given(shared):
     (shared / "gone.nc").symlink_to(shared / "nowhere.nc")
     with pytest.raises(DesignError, match=r"^designs\[0\] \(cnc\): gone.nc: the G-code file is missing$"):
         build(gcode_design(shared, "gone.nc"))
+
+
+def test_built_designs_are_typed_by_kind():
+    from spiral_cad.designfile import BuiltAlignment, BuiltCircleChain, BuiltRounded, BuiltTransition, build, summary
+
+    units, built = build(EXAMPLE)
+    assert units == "m"
+    assert [type(b) for b in built] == [BuiltAlignment, BuiltCircleChain, BuiltRounded, BuiltTransition]
+    rail, loop, cnc, ramp = built
+    assert rail.kind == "alignment" and rail.profile is None and rail.cross_section.driving_lanes == 1
+    assert ramp.kind == f"transition ({ramp.source.kind})" and cnc.samples is None
+    assert rail.notes == {"cross_section": rail.cross_section}  # the dict view older callers read
+    assert summary(built, units).count("\n") == len(built) + 1
