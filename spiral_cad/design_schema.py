@@ -40,8 +40,6 @@ NAME = re.compile(r"[A-Za-z0-9][A-Za-z0-9_-]{0,63}")
 #: 20 s and 1 GB for 10 000 PIs; a corridor about 0.2 GB per 1 000 PVIs), so a file cannot ask for 30 GB.
 MAX_PIS = 20_000
 MAX_PVIS = 2_000
-#: Where the JSON Schema of design files says it lives (files may name it in ``"$schema"``).
-SCHEMA_ID = "https://spiral-cad.invalid/design-file.schema.json"
 
 Units = Literal[UNITS]  # the tuples of the library, so the two cannot drift apart
 TransitionShape = Literal[TRANSITION_SHAPES]
@@ -489,7 +487,7 @@ class DesignFile(_Model):
     writes every design's STEP, SVG (plane paths), IGES, DXF, plots and continuity report."""
 
     model_config = ConfigDict(extra="forbid", title="spiral-cad design file",
-                              json_schema_extra={"$id": SCHEMA_ID, "$schema": "https://json-schema.org/draft/2020-12/schema"})  # fmt: skip
+                              json_schema_extra={"$schema": "https://json-schema.org/draft/2020-12/schema"})  # fmt: skip
 
     schema_uri: str | None = Field(None, alias="$schema", description="The schema's address; accepted and ignored.")
     units: Units = Field(description="The unit of every length in the file (required).")

@@ -97,7 +97,7 @@ def test_more_problems_are_counted():
 
 def test_a_schema_address_is_accepted_and_ignored():
     plain = validate(one())
-    named = validate({"$schema": "https://spiral-cad.invalid/design-file.schema.json", **one()})
+    named = validate({"$schema": "./design-file.schema.json", **one()})
     assert named.designs == plain.designs and named.units == plain.units
     with pytest.raises(ValueError, match=r"\$schema: must be a string; got 3"):
         validate({"$schema": 3, **one()})
