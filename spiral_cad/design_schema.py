@@ -28,9 +28,8 @@ from pydantic import (
     ValidationError,
     model_validator,
 )
-from pydantic_core import PydanticCustomError
+from pydantic_core import ErrorDetails, PydanticCustomError
 
-from .core.shapes import CORNER_SHAPES, TRANSITION_SHAPES
 from .core.units import UNITS
 from .formats.names import MAX_TEXT_LENGTH, check_name
 
@@ -41,9 +40,10 @@ NAME = re.compile(r"[A-Za-z0-9][A-Za-z0-9_-]{0,63}")
 MAX_PIS = 20_000
 MAX_PVIS = 2_000
 
-Units = Literal[UNITS]  # the tuples of the library, so the two cannot drift apart
-TransitionShape = Literal[TRANSITION_SHAPES]
-CornerShape = Literal[CORNER_SHAPES]
+#: The library's choices (UNITS, TRANSITION_SHAPES, CORNER_SHAPES; a test keeps them in step).
+Units = Literal["mm", "cm", "m", "km", "in", "ft"]
+TransitionShape = Literal["walton-meek", "near-linear"]
+CornerShape = Literal["walton-meek", "near-linear", "g2cbs"]
 Terrain = Literal["level", "rolling", "mountainous"]
 
 
@@ -376,7 +376,8 @@ class Samples(_Model):
 
     def options(self) -> dict[str, float]:
         """The keyword of ``export_samples``."""
-        return {"step": self.step} if self.step is not None else {"chord_tolerance": self.chord_tolerance}
+        key = "step" if self.step is not None else "chord_tolerance"
+        return {key: getattr(self, key)}
 
 
 #: The per-corner options of a rounded polyline (``round_corners``'s keywords).
@@ -428,7 +429,6 @@ class RoundedPolylineDesign(_Model):
 class _Transition(_Model):
     name: Name = Field(description="Names the output files (see alignment).")
     type: Literal["transition"]
-    spiral_shape: TransitionShape = Field("walton-meek", description="walton-meek or near-linear.")
 
     def arguments(self) -> dict[str, Any]:
         """The transition function's keyword arguments."""
@@ -443,6 +443,7 @@ class LineToCircle(_Transition):
     direction: Point = Field(description="The line's direction of travel.")
     center: Point = Field(description="The circle's centre.")
     radius: Number = Field(description="The circle's radius.")
+    spiral_shape: TransitionShape = Field("walton-meek", description="walton-meek or near-linear.")
 
 
 class CircleToCircle(_Transition):
@@ -453,6 +454,7 @@ class CircleToCircle(_Transition):
     radius0: Number = Field(description="The first circle's signed radius.")
     center1: Point = Field(description="The second circle's centre.")
     radius1: Number = Field(description="The second circle's signed radius.")
+    spiral_shape: TransitionShape = Field("walton-meek", description="walton-meek or near-linear.")
 
 
 class CircleInCircle(_Transition):
@@ -463,6 +465,7 @@ class CircleInCircle(_Transition):
     radius0: Number = Field(description="The outer circle's radius.")
     center1: Point = Field(description="The inner circle's centre.")
     radius1: Number = Field(description="The inner circle's radius.")
+    spiral_shape: TransitionShape = Field("walton-meek", description="walton-meek or near-linear.")
 
 
 class LineToLine(_Transition):
@@ -538,7 +541,7 @@ def _choices(expected: str) -> str:
     return ", ".join(re.findall(r"'([^']*)'", expected))
 
 
-def _line(error: dict, data: Any, errors: list[dict]) -> str:
+def _line(error: ErrorDetails, data: Any, errors: list[ErrorDetails]) -> str:
     """One error as ``path: message``."""
     kind, loc, value, ctx = error["type"], tuple(error["loc"]), error.get("input"), error.get("ctx") or {}
     if kind == "design":

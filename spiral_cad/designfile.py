@@ -291,13 +291,13 @@ def _circle_chain(d: CircleChainDesign, where: str, units: str, base: Path | Non
 def _rounded(d: RoundedPolylineDesign, where: str, units: str, base: Path | None) -> BuiltRounded:
     from .design import round_corners
 
-    if d.gcode is not None:
+    if d.points is not None:  # the model holds points or gcode
+        result = round_corners(d.points, shape=d.shape, units=units, **d.rounding())
+    else:
         from .formats.gcode import read_gcode, round_toolpath
 
-        program = _own_file(d.gcode, base, f"{where}.gcode")
+        program = _own_file(str(d.gcode), base, f"{where}.gcode")
         result = round_toolpath(read_gcode(program).in_units(units), shape=d.shape, **d.rounding())
-    else:
-        result = round_corners(d.points, shape=d.shape, units=units, **d.rounding())
     samples = None if d.samples is None else d.samples.options()
     return BuiltRounded(name=d.name, chain=result.chain, source=result, samples=samples)
 

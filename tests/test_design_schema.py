@@ -146,3 +146,15 @@ def test_models_are_typed():
     assert rounded.samples.options() == {"step": 0.5}
     assert transition.arguments() == {"point": (0.0, 0.0), "direction": (1.0, 0.0), "center": (0.0, 105.0), "radius": 100.0}
     assert isinstance(design, DesignFile)
+
+
+def test_the_choices_are_the_librarys():
+    from typing import get_args
+
+    from spiral_cad.core.shapes import CORNER_SHAPES, TRANSITION_SHAPES
+    from spiral_cad.core.units import UNITS
+    from spiral_cad.design.profile import TERRAINS
+    from spiral_cad.design_schema import CornerShape, Terrain, TransitionShape, Units
+
+    assert get_args(Units) == UNITS and get_args(Terrain) == TERRAINS
+    assert get_args(TransitionShape) == TRANSITION_SHAPES and get_args(CornerShape) == CORNER_SHAPES
