@@ -385,7 +385,9 @@ ROUNDING_KEYS = ("curvature", "max_curvature", "max_deviation", "spiral_lengths"
 
 
 class RoundedPolylineDesign(_Model):
-    """A polyline in the plane or in space, or a G-code program's straight moves, with every corner rounded G2."""
+    """A polyline in the plane or in space, or a G-code program's straight moves (README: the subset), with
+    every corner rounded G2. A path in space gets STEP, IGES, DXF, samples and the continuity report (SVG and
+    the plots are plane outputs)."""
 
     name: Name = Field(description="Names the output files (see alignment).")
     type: Literal["rounded_polyline"]
