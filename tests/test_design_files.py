@@ -344,3 +344,93 @@ def test_messages_and_reprs_show_plain_numbers():
         texts.append(str(error.value))
     assert texts[3] == "Line needs distinct end points; both are (0.0, 0.0)"
     assert not [t for t in texts if "np." in t or "float64(" in t], texts
+
+
+# ------------------------------------------- files a design may read
+
+POCKET = Path(__file__).resolve().parent.parent / "examples" / "pocket.nc"
+
+
+def gcode_design(folder: Path, program: str) -> Path:
+    """A design file in ``folder`` that rounds the G-code program ``program``."""
+    path = folder / "design.json"
+    path.write_text(json.dumps({"units": "mm", "designs": [{"name": "cnc", "type": "rounded_polyline",
+                                                            "gcode": program, "max_deviation": 0.5}]}))  # fmt: skip
+    return path
+
+
+@pytest.fixture
+def shared(tmp_path) -> Path:
+    """A design folder inside ``tmp_path``, beside a program and a secret outside it."""
+    folder = tmp_path / "designs"
+    (folder / "programs").mkdir(parents=True)
+    (tmp_path / "router.nc").write_bytes(POCKET.read_bytes())
+    (tmp_path / "secret-target.nc").write_bytes(POCKET.read_bytes())
+    return folder
+
+
+@pytest.mark.parametrize("program", ["../router.nc", "programs/../../router.nc", "..\\router.nc"])
+def test_a_design_cannot_climb_out_of_its_folder(shared, program):
+    from spiral_cad.designfile import DesignError, build
+
+    with pytest.raises(DesignError) as error:
+        build(gcode_design(shared, program))
+    assert str(error.value) == (f"designs[0] (cnc).gcode: {program!r} climbs out with '..'; a design file reads only "
+                                "files in its own folder")  # fmt: skip
+
+
+def test_a_design_cannot_read_an_absolute_path(shared):
+    from spiral_cad.designfile import DesignError, build
+
+    program = str(shared.parent / "router.nc")
+    with pytest.raises(DesignError, match=r"^designs\[0\] \(cnc\)\.gcode: .* is an absolute path; a design file reads only"):
+        build(gcode_design(shared, program))
+
+
+def test_a_link_out_of_the_folder_is_refused_by_its_own_name(shared, capsys):
+    link = shared / "programs" / "part.nc"
+    link.symlink_to(shared.parent / "secret-target.nc")
+    design = gcode_design(shared, "programs/part.nc")
+    assert main(["build", str(design), "--out", str(shared / "out"), "--no-plots"]) == 2
+    err = capsys.readouterr().err
+    assert err == ("error: designs[0] (cnc).gcode: 'programs/part.nc' is a link leading outside the design file's "
+                   "folder; a design file reads only files in its own folder\n")  # fmt: skip
+    assert "secret" not in err and not (shared / "out").exists()
+
+
+def test_a_folder_link_out_of_the_folder_is_refused(shared):
+    from spiral_cad.designfile import DesignError, build
+
+    (shared / "elsewhere").symlink_to(shared.parent)
+    with pytest.raises(DesignError, match=r"'elsewhere/router.nc' is a link leading outside"):
+        build(gcode_design(shared, "elsewhere/router.nc"))
+
+
+def test_programs_in_the_folder_and_below_it_are_read_also_through_links(shared):
+    from spiral_cad.designfile import build
+
+    (shared / "programs" / "pocket.nc").write_bytes(POCKET.read_bytes())
+    (shared / "same.nc").symlink_to(shared / "programs" / "pocket.nc")
+    lengths = [build(gcode_design(shared, program))[1][0].chain.length for program in ("programs/pocket.nc", "same.nc")]
+    assert lengths[0] == lengths[1] > 0
+
+
+def test_a_missing_program_is_named_as_given(shared):
+    from spiral_cad.designfile import DesignError, build
+
+    (shared / "gone.nc").symlink_to(shared / "nowhere.nc")
+    with pytest.raises(DesignError, match=r"^designs\[0\] \(cnc\): gone.nc: the G-code file is missing$"):
+        build(gcode_design(shared, "gone.nc"))
+
+
+def test_built_designs_are_typed_by_kind():
+    from spiral_cad.designfile import BuiltAlignment, BuiltCircleChain, BuiltRounded, BuiltTransition, build, summary
+
+    units, built = build(EXAMPLE)
+    assert units == "m"
+    assert [type(b) for b in built] == [BuiltAlignment, BuiltCircleChain, BuiltRounded, BuiltTransition]
+    rail, loop, cnc, ramp = built
+    assert rail.kind == "alignment" and rail.profile is None and rail.cross_section.driving_lanes == 1
+    assert ramp.kind == f"transition ({ramp.source.kind})" and cnc.samples is None
+    assert rail.notes == {"cross_section": rail.cross_section}  # the dict view older callers read
+    assert summary(built, units).count("\n") == len(built) + 1

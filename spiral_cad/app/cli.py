@@ -1,4 +1,4 @@
-"""Command line: ``spiral-cad demo | build | check``."""
+"""Command line: ``spiral-cad demo | build | check | schema``."""
 
 from __future__ import annotations
 
@@ -238,10 +238,12 @@ def _add_check(sub: argparse._SubParsersAction) -> None:
     check.set_defaults(run=_check)
 
 
-def _design_format() -> str:
-    from .designfile import FORMAT
+def _schema(args: argparse.Namespace) -> int:
+    """``spiral-cad schema``: the JSON Schema of design files, the one description of the format."""
+    from .schema import schema_text
 
-    return FORMAT
+    print(schema_text())
+    return 0
 
 
 @contextmanager
@@ -272,7 +274,7 @@ def _parser() -> argparse.ArgumentParser:
         epilog=(
             "examples:\n"
             "  spiral-cad demo --out out                  the built-in design: STEP, IGES, DXF, SVG, plots, CSV\n"
-            "  spiral-cad build examples/design.json      your own design file (spiral-cad build --help for the format)\n"
+            "  spiral-cad build examples/design.json      your own design file (spiral-cad schema prints the format)\n"
             "  spiral-cad build --from-gcode part.nc --max-deviation 0.01   a CNC program rounded G2: STEP and samples\n"
             "  spiral-cad check out/highway.step --require G2   G0/G1/G2 at every joint; exit 1 below G2\n"
             "  spiral-cad check out/highway.xodr --require G2 --profiles C1 --links G1   every road, profile and link of an OpenDRIVE map"
@@ -290,8 +292,8 @@ def _parser() -> argparse.ArgumentParser:
     build = sub.add_parser(
         "build",
         help="build a JSON design file and write STEP, IGES, DXF, SVG, plots, tables and a continuity report",
-        description="Design file format:\n\n" + _design_format(),
-        formatter_class=argparse.RawDescriptionHelpFormatter,
+        description="Build a JSON design file (spiral-cad schema prints its JSON Schema, the format's reference) "
+        "or a G-code program.",
     )
     build.add_argument("design", nargs="?", help="the design file (.json); or --from-gcode")
     build.add_argument("--out", default="out", help="output folder (default: out)")
@@ -312,6 +314,8 @@ def _parser() -> argparse.ArgumentParser:
     gcode.add_argument("--name", help="the design's name (default: the program's file name)")
     build.set_defaults(run=_build)
     _add_check(sub)
+    schema = sub.add_parser("schema", help="print the JSON Schema of design files (the format of build)")
+    schema.set_defaults(run=_schema)
     return parser
 
 

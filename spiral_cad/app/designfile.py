@@ -1,16 +1,18 @@
 """JSON design files: validation, building and writing every output.
 
 A design file holds ``units`` and a list of ``designs``; each design has a
-``name``, a ``type`` and the fields of that type (see ``FORMAT``). Any byte
-sequence is either a valid design or a ``DesignError`` naming the field and
-the value: the file must be a regular file of at most ``MAX_DESIGN_BYTES``
-(checked before it is read), it is decoded, parsed and every field checked
-before anything is built, and every design is built before anything is
-written. Output is all or nothing (``spiral_cad.io.staging``): files are
-written into a staging folder inside the output folder and moved into place
-only when all of them were written and every destination was checked; a
-failure or an interrupt (Ctrl-C, SIGTERM, SIGHUP) leaves the output folder
-as it was.
+``name``, a ``type`` and the fields of that type, as the models of
+``spiral_cad.app.schema`` describe them (``spiral-cad schema`` prints the
+JSON Schema). Any byte sequence is either a valid design or a ``DesignError``
+naming the field and the value: the file must be a regular file of at most
+``MAX_DESIGN_BYTES`` (checked before it is read), it is decoded, parsed and
+every field checked before anything is built, and every design is built
+before anything is written. A design reads files (a G-code program) only
+from its own folder. Output is all or nothing (``spiral_cad.io.staging``):
+files are written into a staging folder inside the output folder and moved
+into place only when all of them were written and every destination was
+checked; a failure or an interrupt (Ctrl-C, SIGTERM, SIGHUP) leaves the
+output folder as it was.
 """
 
 from __future__ import annotations
@@ -19,102 +21,40 @@ import contextlib
 import json
 import math
 import os
-import re
 import signal
 import stat
 import threading
 import time
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from functools import partial
 from importlib.util import find_spec
-from pathlib import Path
+from pathlib import Path, PurePosixPath, PureWindowsPath
 from typing import Any
 
 from ..core.chain import Chain
 from ..core.errors import NoSolutionError
-from ..core.shapes import CORNER_SHAPES, DEFAULT_SHAPE, TRANSITION_SHAPES
 from ..core.spiral import BezierSpiral
-from ..core.units import UNITS
-from ..io.names import MAX_TEXT_LENGTH, check_name
+from .schema import (
+    MAX_PIS,
+    MAX_PVIS,
+    NAME,
+    AlignmentDesign,
+    CircleChainDesign,
+    DesignFile,
+    RoundedPolylineDesign,
+    validate,
+)
+from .schema import Profile as ProfileDesign
 from ..io.staging import Staging
 
-FORMAT = """\
-{
-  "units": "m",                          required: mm, cm, m, km, in or ft (every length below)
-  "designs": [
-    {"name": "highway", "type": "alignment",
-     "pis": [[x, y], ...],               ≥ 3 points of intersection, in travel order
-     "radii": [r, ...],                  one positive radius per interior PI (or one number)
-     "spiral_angles_deg": [θ | [θin, θout], ...]   or "spiral_lengths": [L | [Lin, Lout], ...]
-                                         or neither, with "design_speed": the shortest spirals
-                                         that meet every criterion
-     "start_station": 0,                 optional chainage of the first PI
-     "design_speed": V,                  optional: km/h (metric units) or mph (in, ft)
-     "criteria": "road" | "rail",        default road; road keys: "max_jerk" (m/s³, 0.6),
-                                         "superelevation_max" (0.08), "side_friction",
-                                         "shift_min", "shift_max"; rail keys (mm, mm/s, mm/m):
-                                         "cant_max", "cant_deficiency_max", "cant_rate_max",
-                                         "cant_deficiency_rate_max", "cant_gradient_max",
-                                         "gauge", "cant"
-     "strict": false,                    true: a violated criterion is an error
-     "spiral_shape": "near-linear",      default; or "walton-meek" (the 1996 spiral, 1.6–1.8× longer
-                                         for the same jerk)
-     "cross_section": {"driving_lanes": 1, "lane_width": 3.5, "shoulder_width": 2.5,
-                       "rule": "RHT",    OpenDRIVE lanes (m)
-                       "crossfall": 0.025, "depth": 0.5},   crown (m/m) and pavement (m) of the corridor
-     "geo_reference": "+proj=utm ...",   OpenDRIVE geoReference (printable text, ≤ 10 000 characters)
-     "profile": {                        optional vertical alignment: NAME_profile.csv, elevation in
-                                         the .xodr, the 3-D centre line and corridor in NAME_3d.step
-       "pvis": [[station, elevation], ...],   ≥ 2, stations are the alignment's chainages
-                                         (start_station at its first PI); it must cover the alignment
-       "curve_lengths": [L | [Lin, Lout], ...]  or "k_values": [K, ...] (length per % of grade
-                                         change) or neither, with design_speed (road criteria): the
-                                         shortest curves that meet the stopping sight distance
-       "terrain": "rolling",             level | rolling | mountainous (the maximum grade)
-       "max_grade": 0.05, "min_curve_length": L}},  optional overrides (fraction; length)
-    {"name": "oval", "type": "circle_chain",
-     "circles": [{"center": [x, y], "radius": r}, ...],    signed radius = travel sense (+ ccw)
-     "spiral_shape": "walton-meek" | "near-linear"},        default walton-meek
-    {"name": "robot", "type": "rounded_polyline",
-     "points": [[x, y] | [x, y, z], ...],   a polyline in the plane or in space (≥ 3 points), or
-     "gcode": "FILE.nc",                 the G0/G1 moves of a G-code program (a path relative to the
-                                         design file; G20/G21 converted to "units"; README: the subset)
-     "max_deviation": h,                 the largest distance between a corner point and the path,
-     "max_curvature": k,                 and/or the curvature bound (alone: every corner peaks at k),
-                                         or "curvature": k | "spiral_lengths": L | none (as large as
-                                         fits); each a number or one per interior point
-     "samples": {"step": s} | {"chord_tolerance": c},   optional NAME_samples.csv for a machine:
-                                         s, x, y, z, tangent and curvature along the path
-     "spiral_shape": "walton-meek" | "near-linear" | "g2cbs"},   default walton-meek
-                                         ("method" is its former name)
-    {"name": "t", "type": "transition", "case": "line_to_circle" | "circle_to_circle" |
-     "line_to_line" | "circle_in_circle", ...that function's arguments by name...,
-     "spiral_shape": "walton-meek" | "near-linear"}          default walton-meek
-  ]
-}
-Names: 1–64 characters of A–Z, a–z, 0–9, - and _ (they name the output files; no two may
-differ only in case). The file: UTF-8 JSON, a regular file of at most 10 MB; at most 20 000 PIs
-per alignment and 2 000 PVIs per profile. A path in space
-gets STEP, IGES, DXF, samples and the continuity report (SVG and the plots are plane outputs)."""
+__all__ = ["MAX_PIS", "MAX_PVIS", "NAME", "Built", "DesignError", "build", "load", "write"]
 
-TRANSITION_ARGS = {
-    "line_to_circle": ("point", "direction", "center", "radius"),
-    "circle_to_circle": ("center0", "radius0", "center1", "radius1"),
-    "line_to_line": ("p0", "corner", "p1", "curvature"),
-    "circle_in_circle": ("center0", "radius0", "center1", "radius1"),
-}
-OPTIONAL = {"curvature"}
-NAME = re.compile(r"[A-Za-z0-9][A-Za-z0-9_-]{0,63}")
 #: JSON integers longer than this are refused (they cannot be lengths in float64 anyway).
 MAX_DIGITS = 308
 #: Design files larger than this are refused before they are read.
 MAX_DESIGN_BYTES = 10_000_000
-#: PIs of one alignment and PVIs of one profile: a design's time and memory grow with them (about
-#: 20 s and 1 GB for 10 000 PIs; a corridor about 0.2 GB per 1 000 PVIs), so a file cannot ask for 30 GB.
-MAX_PIS = 20_000
-MAX_PVIS = 2_000
 #: The packages of the ``cad`` extra and what needs them.
 CAD_EXTRA = {"OCP": "IGES, the 3-D STEP of roads and the continuity check", "ezdxf": "DXF", "matplotlib": "plots"}
 
@@ -123,107 +63,76 @@ class DesignError(ValueError):
     """A design file is malformed or infeasible; the message names the field and value."""
 
 
-@dataclass
+@dataclass(kw_only=True)
 class Built:
-    """One built design: its chain and the object that made it (for tables)."""
+    """One built design: its chain and the object that made it (for tables).
+
+    ``continuity`` and ``road_3d`` are filled in by ``write``: the checked
+    continuity of the STEP file and the fit of a road's 3-D file.
+    """
 
     name: str
-    kind: str
     chain: Chain
-    source: Any = None
-    notes: dict[str, Any] = field(default_factory=dict)
+    source: Any
+    continuity: str | None = None
+    road_3d: str | None = None
+
+    @property
+    def kind(self) -> str:
+        """What the design is, as the summary shows it."""
+        raise NotImplementedError
+
+    @property
+    def notes(self) -> dict[str, Any]:
+        """The typed fields as the dict older callers read (``notes["profile"]``, ``notes["continuity"]``)."""
+        names = {"road_3d": "3d"}
+        skip = {"name", "chain", "source"}
+        return {names.get(k, k): v for k, v in vars(self).items() if k not in skip and v is not None}
 
 
-# ------------------------------------------------------------ validation
+@dataclass(kw_only=True)
+class BuiltAlignment(Built):
+    """An alignment (``source``: the ``Alignment``), with its road's cross-section and its optional profile."""
+
+    cross_section: Any
+    geo_reference: str | None = None
+    profile: Any = None
+
+    @property
+    def kind(self) -> str:
+        return "alignment"
 
 
-def _number(value: Any, where: str, positive: bool = False) -> float:
-    if isinstance(value, bool) or not isinstance(value, (int, float)):
-        raise DesignError(f"{where}: must be a finite number; got {value!r:.80}")
-    try:
-        number = float(value)
-    except OverflowError:
-        raise DesignError(f"{where}: must be a finite number; got an integer of {len(str(value))} digits") from None
-    if not math.isfinite(number):
-        raise DesignError(f"{where}: must be a finite number; got {value!r:.80}")
-    if positive and not number > 0:
-        raise DesignError(f"{where}: must be positive; got {value!r:.80}")
-    return number
+@dataclass(kw_only=True)
+class BuiltCircleChain(Built):
+    """A circle chain (``source``: the ``CircleChain``)."""
+
+    @property
+    def kind(self) -> str:
+        return "circle_chain"
 
 
-def _point(value: Any, where: str) -> tuple[float, float]:
-    if not isinstance(value, list) or len(value) != 2:
-        raise DesignError(f"{where}: must be a point [x, y]; got {value!r:.80}")
-    return _number(value[0], f"{where}[0]"), _number(value[1], f"{where}[1]")
+@dataclass(kw_only=True)
+class BuiltRounded(Built):
+    """A rounded polyline or toolpath (``source``: the ``RoundedPath``), with its optional samples."""
+
+    samples: dict[str, float] | None = None
+
+    @property
+    def kind(self) -> str:
+        return "rounded_polyline"
 
 
-def _points(value: Any, where: str, minimum: int, maximum: int) -> list[tuple[float, float]]:
-    if not isinstance(value, list) or len(value) < minimum:
-        raise DesignError(f"{where}: must be a list of at least {minimum} points [x, y]; got {value!r:.80}")
-    if len(value) > maximum:
-        raise DesignError(f"{where}: {len(value):,} points; at most {maximum:,} per design (split a longer road into designs)")
-    return [_point(p, f"{where}[{i}]") for i, p in enumerate(value)]
+@dataclass(kw_only=True)
+class BuiltTransition(Built):
+    """One transition (``source``: the ``Transition``)."""
+
+    @property
+    def kind(self) -> str:
+        return f"transition ({self.source.kind})"
 
 
-def _points_in_space(value: Any, where: str, minimum: int) -> list[tuple[float, ...]]:
-    """At least ``minimum`` points, all [x, y] or all [x, y, z]."""
-    if not isinstance(value, list) or len(value) < minimum:
-        raise DesignError(f"{where}: must be a list of at least {minimum} points [x, y] or [x, y, z]; got {value!r:.80}")
-    size = len(value[0]) if isinstance(value[0], list) else 0
-    points = []
-    for i, p in enumerate(value):
-        if not isinstance(p, list) or len(p) not in (2, 3) or len(p) != size:
-            raise DesignError(f"{where}[{i}]: must be a point like the first, [x, y] or [x, y, z]; got {p!r:.80}")
-        points.append(tuple(_number(c, f"{where}[{i}][{j}]") for j, c in enumerate(p)))
-    return points
-
-
-def _numbers(value: Any, where: str) -> float | list[float]:
-    """A positive number, or a list of them."""
-    if isinstance(value, list):
-        return [_number(v, f"{where}[{i}]", positive=True) for i, v in enumerate(value)]
-    return _number(value, where, positive=True)
-
-
-def _pairs(value: Any, where: str, count: int, convert: Callable[[Any, str], float]) -> list[tuple[float, float]]:
-    """One number for all, or a list of numbers / [in, out] pairs, one per interior PI."""
-    if not isinstance(value, list):
-        v = convert(value, where)
-        return [(v, v)] * count
-    if len(value) != count:
-        raise DesignError(f"{where}: needs one entry per interior PI ({count}); got {len(value)}")
-    out = []
-    for i, item in enumerate(value):
-        if isinstance(item, list):
-            if len(item) != 2:
-                raise DesignError(f"{where}[{i}]: must be a number or [in, out]; got {item!r:.80}")
-            out.append((convert(item[0], f"{where}[{i}][0]"), convert(item[1], f"{where}[{i}][1]")))
-        else:
-            v = convert(item, f"{where}[{i}]")
-            out.append((v, v))
-    return out
-
-
-def _degrees(value: Any, where: str) -> float:
-    v = _number(value, where)
-    if not 0 < v < 90:
-        raise DesignError(f"{where}: spiral angles are in degrees and must lie in (0, 90); got {value!r:.80}")
-    return math.radians(v)
-
-
-def _fields(design: dict, where: str, required: tuple[str, ...], optional: tuple[str, ...] = ()) -> None:
-    missing = [k for k in required if k not in design]
-    if missing:
-        raise DesignError(f"{where}: missing field(s) {', '.join(missing)}")
-    unknown = sorted(set(design) - set(required) - set(optional) - {"name", "type"})
-    if unknown:
-        raise DesignError(f"{where}: unknown field(s) {', '.join(unknown)}")
-
-
-def _choice(value: Any, where: str, choices) -> str:
-    if not isinstance(value, str) or value not in choices:
-        raise DesignError(f"{where}: must be one of {', '.join(choices)}; got {value!r:.80}")
-    return value
+# ------------------------------------------------------------ reading
 
 
 def _json_integer(text: str) -> int:
@@ -290,172 +199,73 @@ def _parse(source: str | Path) -> Any:
         raise DesignError(f"{label}: {e}") from None
 
 
-def load(source: str | Path | dict) -> tuple[str, list[dict]]:
-    """Parse and check the top level of a design (a JSON file path or a dict): (units, designs)."""
+def load(source: str | Path | dict) -> DesignFile:
+    """Parse and check a design (a JSON file path or a dict): every field, before anything is built.
+
+    Raises:
+        DesignError: the file cannot be read or parsed, or the first malformed
+            field, named by its JSON path and value.
+    """
     data = source if isinstance(source, dict) else _parse(source)
-    if not isinstance(data, dict):
-        raise DesignError(f"the design must be a JSON object with 'units' and 'designs'; got {type(data).__name__}")
-    unknown = sorted(set(data) - {"units", "designs"})
-    if unknown:
-        raise DesignError(f"unknown top-level field(s) {', '.join(map(repr, unknown))}")
-    if "units" not in data:
-        raise DesignError(f"units: required, one of {', '.join(UNITS)}")
-    units = _choice(data["units"], "units", UNITS)
-    designs = data.get("designs")
-    if not isinstance(designs, list) or not designs:
-        raise DesignError("designs: must be a non-empty list of designs")
-    names = set()
-    for i, d in enumerate(designs):
-        if not isinstance(d, dict):
-            raise DesignError(f"designs[{i}]: must be an object; got {d!r:.80}")
-        name = d.get("name")
-        if not isinstance(name, str) or not NAME.fullmatch(name):
-            raise DesignError(
-                f"designs[{i}].name: must be 1–64 characters of A–Z, a–z, 0–9, - and _ (starting with a letter or "
-                f"digit); got {name!r:.80}"
-            )
-        if name.casefold() in names:
-            raise DesignError(f"designs[{i}].name: {name!r} is used twice (names may not differ only in case: they name files)")
-        names.add(name.casefold())
-        _choice(d.get("type"), f"designs[{i}].type", tuple(BUILDERS))
-    return units, designs
+    try:
+        return validate(data)
+    except ValueError as e:
+        raise DesignError(str(e)) from None
 
 
 # ------------------------------------------------------------- building
 
 
-#: Design-file keys of the criteria, by kind (values as the criteria classes take them).
-ROAD_KEYS = ("max_jerk", "superelevation_max", "side_friction", "shift_min", "shift_max")
-RAIL_KEYS = ("cant_max", "cant_deficiency_max", "cant_rate_max", "cant_deficiency_rate_max", "cant_gradient_max", "gauge", "cant")
-CROSS_SECTION_KEYS = {"driving_lanes": int, "lane_width": float, "shoulder_width": float, "rule": str, "crossfall": float,
-                      "depth": float}  # fmt: skip
-PROFILE_KEYS = ("pvis", "curve_lengths", "k_values", "terrain", "max_grade", "min_curve_length")
-
-
-def _design_criteria(d: dict, where: str):
+def _criteria(d: AlignmentDesign, where: str):
     """The RoadCriteria / RailCriteria of an alignment design, or None."""
     from ..design import RailCriteria, RoadCriteria
 
-    kind = _choice(d.get("criteria", "road"), f"{where}.criteria", ("road", "rail"))
-    own, other = (ROAD_KEYS, RAIL_KEYS) if kind == "road" else (RAIL_KEYS, ROAD_KEYS)
-    stray = [k for k in other if k in d]
-    if stray:
-        raise DesignError(f"{where}: {', '.join(stray)} belong(s) to {'rail' if kind == 'road' else 'road'} criteria, not {kind}")
-    given = {k: _number(d[k], f"{where}.{k}") for k in own if k in d}
-    if "design_speed" not in d:
-        if given or "criteria" in d or "strict" in d:
-            raise DesignError(f"{where}: design criteria need design_speed")
+    if d.design_speed is None:
         return None
-    speed = _number(d["design_speed"], f"{where}.design_speed", positive=True)
     try:
-        return (RoadCriteria if kind == "road" else RailCriteria)(speed, **given)
+        return (RailCriteria if d.criteria == "rail" else RoadCriteria)(d.design_speed, **d.criteria_values())
     except ValueError as e:
         raise DesignError(f"{where}: {e}") from None
 
 
-def _cross_section(d: dict, where: str):
+def _pairs(value: float | list, count: int) -> list[tuple[float, float]]:
+    """One number for all, or per interior PI a number or an (in, out) pair: (in, out) pairs."""
+    items = value if isinstance(value, list) else [value] * count
+    return [tuple(item) if isinstance(item, tuple) else (item, item) for item in items]
+
+
+def _alignment(d: AlignmentDesign, where: str, units: str, base: Path | None) -> BuiltAlignment:
+    from ..design import Alignment
     from ..io.opendrive import CrossSection
 
-    value = d.get("cross_section", {})
-    if not isinstance(value, dict) or set(value) - set(CROSS_SECTION_KEYS):
-        raise DesignError(f"{where}.cross_section: must be an object with {', '.join(CROSS_SECTION_KEYS)}; got {value!r:.80}")
-    fields = {}
-    for key, kind in CROSS_SECTION_KEYS.items():
-        if key in value:
-            item = value[key]
-            if kind is str:
-                fields[key] = _choice(item, f"{where}.cross_section.{key}", ("RHT", "LHT"))
-            elif kind is int:
-                if isinstance(item, bool) or not isinstance(item, int) or not 1 <= item <= 10:
-                    raise DesignError(f"{where}.cross_section.{key}: must be an integer from 1 to 10; got {item!r:.80}")
-                fields[key] = item
-            else:
-                fields[key] = _number(item, f"{where}.cross_section.{key}")
+    count = len(d.pis) - 2
+    kw: dict[str, Any] = {}
+    if d.spiral_angles_deg is not None:
+        kw["spiral_angles"] = [(math.radians(a), math.radians(b)) for a, b in _pairs(d.spiral_angles_deg, count)]
+    elif d.spiral_lengths is not None:
+        kw["spiral_lengths"] = _pairs(d.spiral_lengths, count)
+    alignment = Alignment.from_pis(d.pis, d.radii, start_station=d.start_station, units=units, criteria=_criteria(d, where),
+                                   strict=d.strict, shape=d.spiral_shape, **kw)  # fmt: skip
     try:
-        return CrossSection(**fields)
+        cross_section = CrossSection(**d.cross_section.model_dump())
     except ValueError as e:
         raise DesignError(f"{where}.cross_section: {e}") from None
+    profile = None if d.profile is None else _profile(d.profile, f"{where}.profile", alignment, d.strict)
+    return BuiltAlignment(name=d.name, chain=alignment.chain, source=alignment, cross_section=cross_section,
+                          geo_reference=d.geo_reference, profile=profile)  # fmt: skip
 
 
-def _shape(d: dict, where: str, choices: tuple[str, ...], default: str = DEFAULT_SHAPE) -> str:
-    """The design's ``spiral_shape`` (one of ``choices``), or ``default``."""
-    return _choice(d.get("spiral_shape", default), f"{where}.spiral_shape", choices)
-
-
-def _alignment(d: dict, where: str, units: str) -> Built:
-    from ..design import Alignment
-
-    optional = ("spiral_angles_deg", "spiral_lengths", "start_station", "design_speed", "criteria", "strict",
-                "cross_section", "geo_reference", "spiral_shape", "profile") + ROAD_KEYS + RAIL_KEYS  # fmt: skip
-    _fields(d, where, ("pis", "radii"), optional)
-    pis = _points(d["pis"], f"{where}.pis", 3, MAX_PIS)
-    count = len(pis) - 2
-    radii = d["radii"]
-    if isinstance(radii, list):
-        if len(radii) != count:
-            raise DesignError(f"{where}.radii: needs one radius per interior PI ({count}); got {len(radii)}")
-        radii = [_number(r, f"{where}.radii[{i}]", positive=True) for i, r in enumerate(radii)]
-    else:
-        radii = _number(radii, f"{where}.radii", positive=True)
-    criteria = _design_criteria(d, where)
-    if "spiral_angles_deg" in d and "spiral_lengths" in d:
-        raise DesignError(f"{where}: give at most one of spiral_angles_deg and spiral_lengths")
-    if criteria is None and "spiral_angles_deg" not in d and "spiral_lengths" not in d:
-        raise DesignError(f"{where}: give spiral_angles_deg, spiral_lengths or design_speed (to choose the spirals)")
-    kw = {}
-    if "spiral_angles_deg" in d:
-        kw["spiral_angles"] = _pairs(d["spiral_angles_deg"], f"{where}.spiral_angles_deg", count, _degrees)
-    elif "spiral_lengths" in d:
-        kw["spiral_lengths"] = _pairs(d["spiral_lengths"], f"{where}.spiral_lengths", count, lambda v, w: _number(v, w, positive=True))
-    strict = d.get("strict", False)
-    if not isinstance(strict, bool):
-        raise DesignError(f"{where}.strict: must be true or false; got {strict!r:.80}")
-    geo = d.get("geo_reference")
-    if geo is not None:
-        try:
-            check_name(geo, f"{where}.geo_reference", limit=MAX_TEXT_LENGTH, multiline=True)
-        except ValueError as e:
-            raise DesignError(f"{e} (a PROJ string or WKT)") from None
-    start = _number(d.get("start_station", 0.0), f"{where}.start_station")
-    shape = _shape(d, where, TRANSITION_SHAPES, "near-linear")
-    alignment = Alignment.from_pis(pis, radii, start_station=start, units=units, criteria=criteria, strict=strict, shape=shape, **kw)
-    notes = {"cross_section": _cross_section(d, where), "geo_reference": geo}
-    if "profile" in d:
-        notes["profile"] = _profile(d["profile"], f"{where}.profile", alignment, strict)
-    return Built(d["name"], "alignment", alignment.chain, alignment, notes)
-
-
-def _profile(value: Any, where: str, alignment: Any, strict: bool):
+def _profile(p: ProfileDesign, where: str, alignment: Any, strict: bool):
     """The vertical alignment of an alignment design (its stations are the alignment's chainages)."""
     from ..design import Profile, ProfileCriteria, RoadCriteria
 
-    if not isinstance(value, dict):
-        raise DesignError(f"{where}: must be an object with pvis and curve_lengths or k_values; got {value!r:.80}")
-    _fields(value, where, ("pvis",), PROFILE_KEYS[1:])
-    pvis = _points(value["pvis"], f"{where}.pvis", 2, MAX_PVIS)
-    count = len(pvis) - 2
-    if "curve_lengths" in value and "k_values" in value:
-        raise DesignError(f"{where}: give at most one of curve_lengths and k_values")
+    count = len(p.pvis) - 2
     kw: dict[str, Any] = {}
-    if "curve_lengths" in value:  # a number is a symmetric curve's whole length, a pair its halves
-        lengths = value["curve_lengths"]
-        if isinstance(lengths, list):
-            pairs = _pairs(lengths, f"{where}.curve_lengths", count, lambda v, w: _number(v, w, positive=True))
-            kw["curve_lengths"] = [pair if isinstance(item, list) else pair[0] for item, pair in zip(lengths, pairs)]
-        else:
-            kw["curve_lengths"] = _number(lengths, f"{where}.curve_lengths", positive=True)
-    elif "k_values" in value:
-        k = value["k_values"]
-        items = k if isinstance(k, list) else [k] * count
-        if len(items) != count:
-            raise DesignError(f"{where}.k_values: needs one K per interior PVI ({count}); got {len(items)}")
-        kw["k_values"] = [_number(v, f"{where}.k_values[{i}]", positive=True) for i, v in enumerate(items)]
-    limits = {k: _number(value[k], f"{where}.{k}", positive=k == "max_grade") for k in ("max_grade", "min_curve_length") if k in value}
-    terrain = value.get("terrain")
-    if terrain is not None:
-        from ..design.profile import TERRAINS
-
-        limits["terrain"] = _choice(terrain, f"{where}.terrain", TERRAINS)
+    if p.curve_lengths is not None:  # a number is a symmetric curve's whole length, a pair its halves
+        kw["curve_lengths"] = p.curve_lengths
+    elif p.k_values is not None:
+        kw["k_values"] = p.k_values if isinstance(p.k_values, list) else [p.k_values] * count
+    limits = {k: getattr(p, k) for k in ("max_grade", "min_curve_length", "terrain") if getattr(p, k) is not None}
     if isinstance(alignment.criteria, RoadCriteria):
         try:
             kw["criteria"] = ProfileCriteria(alignment.criteria.design_speed, **limits)
@@ -466,83 +276,66 @@ def _profile(value: Any, where: str, alignment: Any, strict: bool):
     if count and "curve_lengths" not in kw and "k_values" not in kw and "criteria" not in kw:
         raise DesignError(f"{where}: give curve_lengths or k_values (or a road design_speed to choose the curves)")
     try:
-        return Profile.from_pvis(pvis, units=alignment.chain.units, strict=strict, alignment=alignment, **kw)
+        return Profile.from_pvis(p.pvis, units=alignment.chain.units, strict=strict, alignment=alignment, **kw)
     except (NoSolutionError, ValueError) as e:
         raise DesignError(f"{where}: {e}") from None
 
 
-def _circle_chain(d: dict, where: str, units: str) -> Built:
+def _circle_chain(d: CircleChainDesign, where: str, units: str, base: Path | None) -> BuiltCircleChain:
     from ..design import circle_chain
 
-    _fields(d, where, ("circles",), ("spiral_shape",))
-    circles = d["circles"]
-    if not isinstance(circles, list) or len(circles) < 2:
-        raise DesignError(f"{where}.circles: must be a list of at least 2 circles; got {circles!r:.80}")
-    parsed = []
-    for i, c in enumerate(circles):
-        w = f"{where}.circles[{i}]"
-        if not isinstance(c, dict) or set(c) != {"center", "radius"}:
-            raise DesignError(f'{w}: must be {{"center": [x, y], "radius": r}}; got {c!r:.80}')
-        radius = _number(c["radius"], f"{w}.radius")
-        if radius == 0:
-            raise DesignError(f"{w}.radius: must be non-zero (its sign is the travel sense); got 0")
-        parsed.append((_point(c["center"], f"{w}.center"), radius))
-    result = circle_chain(parsed, units=units, shape=_shape(d, where, TRANSITION_SHAPES))
-    return Built(d["name"], "circle_chain", result.chain, result)
+    result = circle_chain([(c.center, c.radius) for c in d.circles], units=units, shape=d.spiral_shape)
+    return BuiltCircleChain(name=d.name, chain=result.chain, source=result)
 
 
-#: The per-corner options of a rounded polyline (``round_corners``'s keywords).
-ROUNDING_KEYS = ("curvature", "max_curvature", "max_deviation", "spiral_lengths")
-
-
-def _rounded(d: dict, where: str, units: str) -> Built:
+def _rounded(d: RoundedPolylineDesign, where: str, units: str, base: Path | None) -> BuiltRounded:
     from ..design import round_corners
 
-    _fields(d, where, (), ("points", "gcode", *ROUNDING_KEYS, "spiral_shape", "method", "samples"))
-    if ("points" in d) == ("gcode" in d):
-        raise DesignError(f"{where}: give points or gcode (one of them)")
-    kw = {k: _numbers(d[k], f"{where}.{k}") for k in ROUNDING_KEYS if k in d}
-    if "method" in d and "spiral_shape" in d:
-        raise DesignError(f"{where}: give spiral_shape or method (its former name), not both")
-    shape = _choice(d["method"], f"{where}.method", CORNER_SHAPES) if "method" in d else _shape(d, where, CORNER_SHAPES)
-    samples = _samples(d["samples"], f"{where}.samples") if "samples" in d else None
-    if "gcode" in d:
+    if d.points is not None:  # the model holds points or gcode
+        result = round_corners(d.points, shape=d.shape, units=units, **d.rounding())
+    else:
         from ..io.gcode import read_gcode, round_toolpath
 
-        program = d["gcode"]
-        if not isinstance(program, str) or not program or "\0" in program:
-            raise DesignError(f"{where}.gcode: must be the path of a G-code file; got {program!r:.80}")
-        result = round_toolpath(read_gcode(program).in_units(units), shape=shape, **kw)
-    else:
-        result = round_corners(_points_in_space(d["points"], f"{where}.points", 3), shape=shape, units=units, **kw)
-    return Built(d["name"], "rounded_polyline", result.chain, result, {"samples": samples})
+        program = _own_file(str(d.gcode), base, f"{where}.gcode")
+        result = round_toolpath(read_gcode(program).in_units(units), shape=d.shape, **d.rounding())
+    samples = None if d.samples is None else d.samples.options()
+    return BuiltRounded(name=d.name, chain=result.chain, source=result, samples=samples)
 
 
-def _samples(value: Any, where: str) -> dict[str, float]:
-    if not isinstance(value, dict) or len(value) != 1 or not set(value) <= {"step", "chord_tolerance"}:
-        raise DesignError(f'{where}: must be {{"step": s}} or {{"chord_tolerance": c}}; got {value!r:.80}')
-    ((key, number),) = value.items()
-    return {key: _number(number, f"{where}.{key}", positive=True)}
+def _own_file(given: str, base: Path | None, where: str) -> Path:
+    """The file ``given`` by a design whose file is in ``base``: only a file in that folder (or below it).
+
+    A design file may be shared; what it reads must not reach beyond its folder,
+    so an absolute path, a ``..`` and a link leading outside are refused by the
+    name given (never the link's target). A design given as a dict (the API)
+    has no folder: its paths are the caller's.
+    """
+    if base is None:
+        return Path(given)
+    shown = f"{given!r:.200}"
+    if any(p.is_absolute() or p.drive or p.root for p in (PurePosixPath(given), PureWindowsPath(given))):
+        raise DesignError(f"{where}: {shown} is an absolute path; a design file reads only files in its own folder")
+    if any(".." in p.parts for p in (PurePosixPath(given), PureWindowsPath(given))):
+        raise DesignError(f"{where}: {shown} climbs out with '..'; a design file reads only files in its own folder")
+    path = base / given
+    try:
+        inside = path.resolve().is_relative_to(base.resolve())
+    except (OSError, RuntimeError):  # a loop of links
+        raise DesignError(f"{where}: {shown} is a link that cannot be followed (a loop)") from None
+    if not inside:
+        raise DesignError(f"{where}: {shown} is a link leading outside the design file's folder; "
+                          "a design file reads only files in its own folder")  # fmt: skip
+    return path
 
 
-def _transition(d: dict, where: str, units: str) -> Built:
+def _transition(d: Any, where: str, units: str, base: Path | None) -> BuiltTransition:
     from ..core import transitions
 
-    case = _choice(d.get("case"), f"{where}.case", tuple(TRANSITION_ARGS))
-    names = TRANSITION_ARGS[case]
-    optional = tuple(n for n in names if n in OPTIONAL) + ("spiral_shape",)
-    _fields(d, where, tuple(n for n in names if n not in OPTIONAL) + ("case",), optional)
-    args = {}
-    for n in names:
-        if n in d:
-            value = d[n]
-            args[n] = _point(value, f"{where}.{n}") if isinstance(value, list) else _number(value, f"{where}.{n}")
-    shapes = CORNER_SHAPES if case == "line_to_line" else TRANSITION_SHAPES
-    t = getattr(transitions, case)(**args, shape=_shape(d, where, shapes))
-    return Built(d["name"], f"transition ({t.kind})", Chain(t.spirals, units=units), t)
+    t = getattr(transitions, d.case)(**d.arguments(), shape=d.spiral_shape)
+    return BuiltTransition(name=d.name, chain=Chain(t.spirals, units=units), source=t)
 
 
-BUILDERS: dict[str, Callable[[dict, str, str], Built]] = {
+BUILDERS: dict[str, Callable[[Any, str, str, Path | None], Built]] = {
     "alignment": _alignment,
     "circle_chain": _circle_chain,
     "rounded_polyline": _rounded,
@@ -553,25 +346,25 @@ BUILDERS: dict[str, Callable[[dict, str, str], Built]] = {
 def build(source: str | Path | dict) -> tuple[str, list[Built]]:
     """Validate and build every design of ``source``: (units, built designs).
 
+    A G-code program named by a design file is read from the design file's
+    folder (a dict's from the working folder).
+
     Raises:
         DesignError: the first malformed field or infeasible design, named as
-            ``designs[i] (name)``.
+            ``designs[i] (name)``, or a file outside the design file's folder.
     """
-    units, designs = load(source)
-    if not isinstance(source, dict):  # a G-code program is found next to its design file
-        base = Path(source).parent
-        designs = [dict(d, gcode=str(base / d["gcode"])) if isinstance(d.get("gcode"), str) and d["gcode"] and "\0" not in d["gcode"]
-                   else d for d in designs]  # fmt: skip
+    design_file = load(source)
+    base = None if isinstance(source, dict) else Path(source).parent
     built = []
-    for i, d in enumerate(designs):
-        where = f"designs[{i}] ({d['name']})"
+    for i, d in enumerate(design_file.designs):
+        where = f"designs[{i}] ({d.name})"
         try:
-            built.append(BUILDERS[d["type"]](d, where, units))
+            built.append(BUILDERS[d.type](d, where, design_file.units, base))
         except DesignError:
             raise
         except (NoSolutionError, ValueError) as e:
             raise DesignError(f"{where}: {e}") from None
-    return units, built
+    return design_file.units, built
 
 
 # -------------------------------------------------------------- writing
@@ -663,7 +456,7 @@ def _write_design(b: Built, stage: Path, units: str, missing: list[str], plots: 
         if continuity is None:
             return names
         report = continuity()
-    b.notes["continuity"] = f"{report.min_level} ({report.describe()})"
+    b.continuity = f"{report.min_level} ({report.describe()})"
     (stage / f"{b.name}_continuity.txt").write_text(report.format_table() + "\n", encoding="utf-8")
     return names + ["continuity.txt"]
 
@@ -676,18 +469,18 @@ def _write_others(b: Built, stage: Path, units: str, missing: list[str], plots: 
     if b.chain.dim == 2:  # SVG is a plane output (the plots draw a path in space as its plan)
         export_svg(b.chain, stage / f"{b.name}.svg", name=b.name)
         names.append("svg")
-    if b.notes.get("samples"):
+    if isinstance(b, BuiltRounded) and b.samples:
         from ..cad.export import export_samples
 
-        export_samples(b.chain, stage / f"{b.name}_samples.csv", **b.notes["samples"])
+        export_samples(b.chain, stage / f"{b.name}_samples.csv", **b.samples)
         names.append("samples.csv")
-    if b.kind == "alignment":
+    if isinstance(b, BuiltAlignment):
         from ..cad.export import export_opendrive
 
-        profile = b.notes.get("profile")
+        profile = b.profile
         b.source.to_csv(stage / f"{b.name}_stations.csv")
-        export_opendrive(b.source, stage / f"{b.name}.xodr", name=b.name, cross_section=b.notes["cross_section"],
-                         geo_reference=b.notes["geo_reference"], profile=profile)  # fmt: skip
+        export_opendrive(b.source, stage / f"{b.name}.xodr", name=b.name, cross_section=b.cross_section,
+                         geo_reference=b.geo_reference, profile=profile)  # fmt: skip
         names += ["stations.csv", "xodr"]
         if b.source.checks:
             b.source.criteria_to_csv(stage / f"{b.name}_criteria.csv")
@@ -707,7 +500,7 @@ def _write_others(b: Built, stage: Path, units: str, missing: list[str], plots: 
     return names
 
 
-def _road_3d(b: Built, profile: Any, stage: Path, units: str) -> list[str]:
+def _road_3d(b: BuiltAlignment, profile: Any, stage: Path, units: str) -> list[str]:
     """NAME_3d.step: the corridor solid and the 3-D centre line, their measured fit in the file's description."""
     from build123d import Compound
 
@@ -715,7 +508,7 @@ def _road_3d(b: Built, profile: Any, stage: Path, units: str) -> list[str]:
     from ..cad.export import originating_system
     from ..cad.step_occ import write_shape_step
 
-    road = corridor(b.source, profile, b.notes["cross_section"])
+    road = corridor(b.source, profile, b.cross_section)
     line = road.centerline
     fit = (
         f"{b.name} in 3-D: corridor solid and centre line (plan exact; z within {line.deviation:.3g} {units} of the "
@@ -723,7 +516,7 @@ def _road_3d(b: Built, profile: Any, stage: Path, units: str) -> list[str]:
     )
     write_shape_step(Compound([road.solid, centerline_wire(line)]), stage / f"{b.name}_3d.step", b.name, units,
                      originating_system(), description=fit)  # fmt: skip
-    b.notes["3d"] = f"{line.describe()}; {road.describe()}"
+    b.road_3d = f"{line.describe()}; {road.describe()}"
     return ["3d.step"]
 
 
@@ -771,11 +564,13 @@ def criteria_tables(built: list[Built]) -> str:
     with their violations."""
     parts = []
     for b in built:
-        if b.kind == "alignment" and b.source.checks:
+        if not isinstance(b, BuiltAlignment):
+            continue
+        if b.source.checks:
             broken = sum(1 for c in b.source.checks if not c.ok)
             verdict = "every curve meets the criteria" if not broken else f"{broken} curve(s) violate the criteria"
             parts.append(f"{b.name}: {b.source.criteria_table()}\n{b.name}: {verdict}")
-        profile = b.notes.get("profile")
+        profile = b.profile
         if profile is not None:
             broken = sum(1 for c in profile.checks if not c.ok)
             verdict = "" if not profile.checks else (f"\n{b.name}: every PVI meets the profile criteria" if not broken
@@ -796,7 +591,7 @@ def summary(built: list[Built], units: str) -> str:
         shapes = sorted({seg.shape or "not stated" for seg in b.chain if isinstance(seg, BezierSpiral)}) or ["-"]
         lines.append(
             f"{b.name:14} {b.kind:30} {'+'.join(shapes):13} {len(b.chain):8d} {b.chain.length:12.3f} {peak:10.5f}  "
-            f"{b.notes.get('continuity', '-')}"
+            f"{b.continuity or '-'}"
         )
-    lines += [f"{b.name}: {b.notes['3d']}" for b in built if "3d" in b.notes]
+    lines += [f"{b.name}: {b.road_3d}" for b in built if b.road_3d]
     return "\n".join(lines)
