@@ -371,7 +371,7 @@ def shared(tmp_path) -> Path:
 
 @pytest.mark.parametrize("program", ["../router.nc", "programs/../../router.nc", "..\\router.nc"])
 def test_a_design_cannot_climb_out_of_its_folder(shared, program):
-    from spiral_cad.designfile import DesignError, build
+    from spiral_cad.app.designfile import DesignError, build
 
     with pytest.raises(DesignError) as error:
         build(gcode_design(shared, program))
@@ -380,7 +380,7 @@ def test_a_design_cannot_climb_out_of_its_folder(shared, program):
 
 
 def test_a_design_cannot_read_an_absolute_path(shared):
-    from spiral_cad.designfile import DesignError, build
+    from spiral_cad.app.designfile import DesignError, build
 
     program = str(shared.parent / "router.nc")
     with pytest.raises(DesignError, match=r"^designs\[0\] \(cnc\)\.gcode: .* is an absolute path; a design file reads only"):
@@ -399,7 +399,7 @@ def test_a_link_out_of_the_folder_is_refused_by_its_own_name(shared, capsys):
 
 
 def test_a_folder_link_out_of_the_folder_is_refused(shared):
-    from spiral_cad.designfile import DesignError, build
+    from spiral_cad.app.designfile import DesignError, build
 
     (shared / "elsewhere").symlink_to(shared.parent)
     with pytest.raises(DesignError, match=r"'elsewhere/router.nc' is a link leading outside"):
@@ -407,7 +407,7 @@ def test_a_folder_link_out_of_the_folder_is_refused(shared):
 
 
 def test_programs_in_the_folder_and_below_it_are_read_also_through_links(shared):
-    from spiral_cad.designfile import build
+    from spiral_cad.app.designfile import build
 
     (shared / "programs" / "pocket.nc").write_bytes(POCKET.read_bytes())
     (shared / "same.nc").symlink_to(shared / "programs" / "pocket.nc")
@@ -416,7 +416,7 @@ def test_programs_in_the_folder_and_below_it_are_read_also_through_links(shared)
 
 
 def test_a_missing_program_is_named_as_given(shared):
-    from spiral_cad.designfile import DesignError, build
+    from spiral_cad.app.designfile import DesignError, build
 
     (shared / "gone.nc").symlink_to(shared / "nowhere.nc")
     with pytest.raises(DesignError, match=r"^designs\[0\] \(cnc\): gone.nc: the G-code file is missing$"):
@@ -424,7 +424,14 @@ def test_a_missing_program_is_named_as_given(shared):
 
 
 def test_built_designs_are_typed_by_kind():
-    from spiral_cad.designfile import BuiltAlignment, BuiltCircleChain, BuiltRounded, BuiltTransition, build, summary
+    from spiral_cad.app.designfile import (
+        BuiltAlignment,
+        BuiltCircleChain,
+        BuiltRounded,
+        BuiltTransition,
+        build,
+        summary,
+    )
 
     units, built = build(EXAMPLE)
     assert units == "m"

@@ -5,8 +5,8 @@ from pathlib import Path
 
 import pytest
 
-from spiral_cad.cli import main
-from spiral_cad.design_schema import DesignFile, json_schema, schema_markdown, validate
+from spiral_cad.app.cli import main
+from spiral_cad.app.schema import DesignFile, json_schema, schema_markdown, validate
 
 ROOT = Path(__file__).resolve().parent.parent
 EXAMPLES = sorted((ROOT / "examples").rglob("*.json"))
@@ -154,7 +154,7 @@ def test_the_choices_are_the_librarys():
     from spiral_cad.core.shapes import CORNER_SHAPES, TRANSITION_SHAPES
     from spiral_cad.core.units import UNITS
     from spiral_cad.design.profile import TERRAINS
-    from spiral_cad.design_schema import CornerShape, Terrain, TransitionShape, Units
+    from spiral_cad.app.schema import CornerShape, Terrain, TransitionShape, Units
 
     assert get_args(Units) == UNITS and get_args(Terrain) == TERRAINS
     assert get_args(TransitionShape) == TRANSITION_SHAPES and get_args(CornerShape) == CORNER_SHAPES
