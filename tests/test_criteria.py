@@ -9,7 +9,8 @@ from spiral_cad import NoSolutionError
 import spiral_cad as sc
 from spiral_cad.core.bezier import curvature_rate, peak_curvature_rate
 from spiral_cad.design import Alignment, RailCriteria, RoadCriteria
-from spiral_cad.design.criteria import SIDE_FRICTION_KMH, unit_spirals
+from spiral_cad.core.factors import unit_spirals
+from spiral_cad.design.criteria import SIDE_FRICTION_KMH
 
 PIS = [[0, 0], [600, 120], [1150, -80], [1700, 260], [2300, 200]]
 

@@ -17,11 +17,7 @@ from __future__ import annotations
 
 import io
 import os
-import re
-import sys
-import tempfile
 from collections.abc import Iterable, Iterator
-from contextlib import contextmanager
 from typing import TYPE_CHECKING, Any
 
 import numpy as np

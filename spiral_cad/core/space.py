@@ -21,9 +21,9 @@ from numpy.typing import ArrayLike, NDArray
 from . import _kernels as K
 from ._inputs import as_float, as_real_array
 from ._threads import run_split
+from .units import COLLINEAR_TOL
 
 #: Legs whose |sin(turn)| is at most this span no plane.
-COLLINEAR_TOL = 1e-12
 
 
 def place(points: ArrayLike, origin: ArrayLike, x_dir: ArrayLike, y_dir: ArrayLike) -> NDArray:

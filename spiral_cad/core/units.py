@@ -1,4 +1,5 @@
-"""Length units: every chain's numbers are in one of these, and every file says which.
+"""Length units (every chain's numbers are in one of these, and every file says which) and the
+shared tolerances.
 
 The API default is millimetres, as in build123d and CadQuery; design files
 name their unit (``"units": "m"``). Each writer declares the unit the way its
@@ -15,6 +16,10 @@ UNITS = tuple(MM_PER_UNIT)
 DEFAULT_UNITS = "mm"
 #: Units of US customary designs (speeds in mph, the US forms of road formulas).
 IMPERIAL = frozenset({"in", "ft"})
+#: Metres per international foot.
+FOOT = MM_PER_UNIT["ft"] / 1000.0
+#: |sin| of a turn below which two directions count as one line (before any deviation is measured).
+COLLINEAR_TOL = 1e-12
 
 
 def length_unit(value: Any, name: str = "units") -> str:

@@ -3,7 +3,8 @@
 Pure numpy/numba: nothing here imports a CAD kernel.
 """
 
-from .alignment import Alignment, CurveData, curvature_rate, peak_curvature_rate
+from ..core.bezier import curvature_rate, peak_curvature_rate
+from .alignment import Alignment, CurveData
 from .centerline import Centerline3D, centerline_3d
 from .circles import CircleChain, circle_chain
 from .criteria import CriteriaRow, RailCriteria, RoadCriteria

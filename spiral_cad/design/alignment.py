@@ -21,7 +21,7 @@ from ..core import _kernels as K
 from ..core import batch
 from ..core._chain_kernels import SPIRAL
 from ..core._inputs import as_float, as_points, as_real_array, per_item
-from ..core.bezier import curvature_rate, peak_curvature_rate  # noqa: F401  (public here too)
+from ..core.bezier import peak_curvature_rate
 from ..core.chain import JOIN_TOLERANCE, Chain, PartCircles, join_rows, join_tolerance
 from ..core.errors import JointError, NoSolutionError
 from ..core.factors import WALTON_MEEK_SEARCH_MAX, length_factor, peak_rate_factor, search_range
@@ -30,12 +30,11 @@ from ..core.segments import Circle, Ray
 from ..core.shapes import SHAPE_CODES, TRANSITION_SHAPES, shape_code, shape_limits
 from ..core.spiral import turn_angles
 from ..core.transitions import Transition
-from ..core.units import DEFAULT_UNITS, length_unit, speed_unit
+from ..core.units import COLLINEAR_TOL, DEFAULT_UNITS, length_unit, speed_unit
 from .criteria import CRITERIA_DIMENSIONS, Criteria, CriteriaRow, RailCriteria, RoadCriteria
 from .tables import text_table, write_csv
 
 #: |sin(deflection)| at or below this counts as a straight PI.
-COLLINEAR_TOL = 1e-12
 #: Smallest θ searched when a spiral length is requested.
 _THETA_MIN = 1e-7
 

@@ -48,8 +48,8 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ..core._inputs import as_float, shown
-from ..core.factors import length_factor, peak_rate_factor, search_range, shift_factor, unit_spirals  # noqa: F401  (unit_spirals: public here too)
-from ..core.units import IMPERIAL, speed_unit, to_metres
+from ..core.factors import length_factor, peak_rate_factor, search_range, shift_factor
+from ..core.units import FOOT, IMPERIAL, speed_unit, to_metres
 
 GRAVITY = 9.80665
 #: The applied cant ramps along each spiral as the cubic ease D·(3t² − 2t³) of
@@ -239,7 +239,7 @@ class RoadCriteria(_Criteria):
         """R_min in the design's unit."""
         e_f = self.superelevation_max + self.friction(units)
         if units in IMPERIAL:
-            return self.design_speed * self.design_speed / (15.0 * e_f) * 0.3048 / to_metres(units)
+            return self.design_speed * self.design_speed / (15.0 * e_f) * FOOT / to_metres(units)
         return self.design_speed * self.design_speed / (127.0 * e_f) / to_metres(units)
 
     def superelevation(self, radius: float | NDArray, units: str) -> float | NDArray:

@@ -49,11 +49,10 @@ from numpy.typing import ArrayLike, NDArray
 from ..core._inputs import as_float, as_points, as_real_array, per_item, shown
 from ..core.errors import NoSolutionError
 from ..core.piecewise import inside, piece_at, piecewise_at, polynomial
-from ..core.units import DEFAULT_UNITS, IMPERIAL, length_unit, speed_unit, to_metres
+from ..core.units import DEFAULT_UNITS, FOOT, IMPERIAL, length_unit, speed_unit, to_metres
 from .alignment import Alignment
 from .tables import text_table, write_csv
 
-FOOT = 0.3048
 
 #: AASHTO Green Book, rural arterials: maximum grade (%) by design speed for level, rolling and mountainous terrain
 #: (level and rolling as TxDOT's Roadway Design Manual, Table 4-11, reproduces the US customary table).
