@@ -8,7 +8,7 @@ STAMP  := $(VENV)/.installed
 TOOLS       := .venv-tools
 TOOLS_STAMP := $(TOOLS)/.installed
 
-.PHONY: setup demo test bench pictures clean
+.PHONY: setup demo test check lint bench pictures clean
 
 $(STAMP): requirements.lock pyproject.toml
 	test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
@@ -16,6 +16,8 @@ $(STAMP): requirements.lock pyproject.toml
 	$(BIN)/python -m pip install -q -r requirements.lock
 	$(BIN)/python -m pip install -q --no-deps -e .
 	$(BIN)/python -m pip check
+	# compile the kernels once now (numba's on-disk cache), so a first demo or build does not wait for them
+	$(BIN)/spiral-cad demo --out $(VENV)/first-demo > /dev/null
 	touch $(STAMP)
 
 $(TOOLS_STAMP): tools/xodr-tools.lock
@@ -30,8 +32,20 @@ setup: $(STAMP)
 demo: $(STAMP)
 	$(BIN)/spiral-cad demo --out out
 
-test: $(STAMP) $(TOOLS_STAMP)
+# Everything CI runs: lint, then every test.
+test: $(STAMP) $(TOOLS_STAMP) lint
 	SPIRAL_CAD_XODR_TOOLS=$(abspath $(TOOLS))/bin/python $(BIN)/python -m pytest -q
+
+# The fast tier while working: no slow, install or subprocess-heavy tests.
+check: $(STAMP)
+	$(BIN)/python -m pytest -q -m "not slow and not install"
+
+# ruff (lint and format), mypy (strict for the numeric core), import-linter (layers point one way).
+lint: $(STAMP)
+	$(BIN)/ruff check spiral_cad spiral_cad_launcher tests benchmarks examples docs
+	$(BIN)/ruff format --check spiral_cad spiral_cad_launcher tests benchmarks examples docs
+	$(BIN)/mypy
+	$(BIN)/lint-imports
 
 # Every benchmarks/bench_*.py, each in its own process, writing benchmarks/results_*.md
 # (the convention a script follows: benchmarks/timing.py).
