@@ -6,18 +6,16 @@ import argparse
 import math
 import os
 import re
-import signal
 import sys
-import threading
 import time
 import warnings
-from collections.abc import Callable, Iterator, Sequence
-from contextlib import contextmanager
+from collections.abc import Callable, Sequence
 from importlib.util import find_spec
 from pathlib import Path
 
 from .. import circle_in_circle, circle_to_circle, line_to_circle, line_to_line
 from ..core.transitions import Transition
+from ..io.signals import signals_handled
 
 
 def core_examples() -> list[tuple[str, Transition]]:
@@ -246,27 +244,6 @@ def _schema(args: argparse.Namespace) -> int:
     return 0
 
 
-@contextmanager
-def _interrupt_watch() -> Iterator[list[int]]:
-    """Ctrl-C raises KeyboardInterrupt as usual and is also recorded in the yielded list, so an
-    interrupt that a library turned into another exception (OCP's "ImportError: initialization
-    failed" during a long import) is still reported as an interrupt."""
-    received: list[int] = []
-    if threading.current_thread() is not threading.main_thread():
-        yield received
-        return
-
-    def interrupt(signum, frame):
-        received.append(signum)
-        raise KeyboardInterrupt
-
-    previous = signal.signal(signal.SIGINT, interrupt)
-    try:
-        yield received
-    finally:
-        signal.signal(signal.SIGINT, previous)
-
-
 def _parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(
         prog="spiral-cad",
@@ -327,7 +304,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     traceback; Ctrl-C at any moment gives ``error: interrupted`` and 130;
     Python warnings are not shown (what matters is an error or in the report).
     """
-    with _interrupt_watch() as interrupted, warnings.catch_warnings():
+    with signals_handled(("SIGINT",), interrupt=True) as interrupted, warnings.catch_warnings():
         warnings.simplefilter("ignore")
         try:
             args = _parser().parse_args(argv)

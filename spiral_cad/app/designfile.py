@@ -21,9 +21,7 @@ import contextlib
 import json
 import math
 import os
-import signal
 import stat
-import threading
 import time
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
@@ -36,6 +34,8 @@ from typing import Any
 from ..core.chain import Chain
 from ..core.errors import NoSolutionError
 from ..core.spiral import BezierSpiral
+from ..io.signals import signals_handled
+from ..io.staging import Staging
 from .schema import (
     MAX_PIS,
     MAX_PVIS,
@@ -47,7 +47,6 @@ from .schema import (
     validate,
 )
 from .schema import Profile as ProfileDesign
-from ..io.staging import Staging
 
 __all__ = ["MAX_PIS", "MAX_PVIS", "NAME", "Built", "DesignError", "build", "load", "write"]
 
@@ -434,8 +433,8 @@ def _write_design(b: Built, stage: Path, units: str, missing: list[str], plots: 
     OCCT reads the STEP for the continuity report, and the DXF is written
     (ezdxf's objects are the slowest of the files), while the rest are written here.
     """
-    from ..cad.sandbox import Isolated
     from ..cad.export import export_dxf, export_step
+    from ..cad.sandbox import Isolated
 
     step = stage / f"{b.name}.step"
     export_step(b.chain, step, name=b.name)
@@ -537,26 +536,13 @@ def _interrupts_raise() -> Iterator[None]:
     """Turn SIGTERM and SIGHUP into KeyboardInterrupt while files are written, so cleanup runs
     (also when a library turned the interrupt into another exception: OCP's "ImportError:
     initialization failed" during a long import)."""
-    if threading.current_thread() is not threading.main_thread():
-        yield
-        return
-    received: list[int] = []
-
-    def interrupt(signum, frame):
-        received.append(signum)
-        raise KeyboardInterrupt
-
-    names = [s for s in ("SIGTERM", "SIGHUP") if hasattr(signal, s)]
-    previous = {name: signal.signal(getattr(signal, name), interrupt) for name in names}
-    try:
-        yield
-    except Exception:
-        if received:
-            raise KeyboardInterrupt from None
-        raise
-    finally:
-        for name, handler in previous.items():
-            signal.signal(getattr(signal, name), handler)
+    with signals_handled(("SIGTERM", "SIGHUP"), interrupt=True) as received:
+        try:
+            yield
+        except Exception:
+            if received:
+                raise KeyboardInterrupt from None
+            raise
 
 
 def criteria_tables(built: list[Built]) -> str:

@@ -23,14 +23,12 @@ from __future__ import annotations
 import os
 import re
 import shutil
-import signal
 import stat
 import tempfile
-import threading
-from collections.abc import Iterator
-from contextlib import contextmanager
 from pathlib import Path
 from types import TracebackType
+
+from .signals import signals_handled
 
 PREFIX = ".spiral-cad-build-"
 MARKER = ".spiral-cad-staging"
@@ -125,25 +123,6 @@ def _alive(pid: int) -> bool:
     return True
 
 
-@contextmanager
-def interrupts_deferred() -> Iterator[list[int]]:
-    """Within the block, SIGINT, SIGTERM and SIGHUP are only recorded (in the yielded list).
-
-    Outside the main thread signals cannot arrive there, and nothing changes.
-    """
-    received: list[int] = []
-    if threading.current_thread() is not threading.main_thread():
-        yield received
-        return
-    names = [name for name in ("SIGINT", "SIGTERM", "SIGHUP") if hasattr(signal, name)]
-    previous = {name: signal.signal(getattr(signal, name), lambda signum, frame: received.append(signum)) for name in names}
-    try:
-        yield received
-    finally:
-        for name, handler in previous.items():
-            signal.signal(getattr(signal, name), handler)
-
-
 class Staging:
     """A staging folder in ``out`` whose files ``commit`` moves into ``out`` all together (see the module)."""
 
@@ -210,7 +189,7 @@ class Staging:
         backups = self.folder / BACKUP
         backups.mkdir()
         moved: list[tuple[Path, bool, bool]] = []  # (destination, backed up, new file in place)
-        with interrupts_deferred() as received:
+        with signals_handled(("SIGINT", "SIGTERM", "SIGHUP"), interrupt=False) as received:
             try:
                 for source, target in zip(staged, targets):
                     if received:
