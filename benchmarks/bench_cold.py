@@ -1,0 +1,71 @@
+"""Cold and warm first calls: ``import spiral_cad`` plus one scalar transition, in fresh processes.
+
+Run: ``.venv/bin/python benchmarks/bench_cold.py [--quick] [--rounds N] [--out FILE]`` (conventions: ``timing.py``).
+
+Each measurement is a new Python process (so nothing is imported yet):
+
+* **cold**: an empty kernel cache (``NUMBA_CACHE_DIR`` a new empty folder):
+  the scalar API runs the kernels as plain Python and never waits for a compiler;
+* **warm**: the same, after the kernels were compiled into that cache by a
+  process that made enough scalar calls to compile them;
+* **compiled first call**: the time a process that does compile its kernels
+  pays (a batch call with an empty cache) — what the first call cost before;
+* peers in the same runs: ``import numpy`` alone (the floor any numpy package
+  pays) and ``import numba`` alone.
+
+Goal: import plus the first scalar call in ≤ 2 s with an empty cache.
+"""
+
+from __future__ import annotations
+
+import statistics
+import subprocess
+import sys
+import tempfile
+import time
+
+from timing import Report, Timing, arguments
+
+FIRST_CALL = "import spiral_cad; spiral_cad.line_to_circle((0, 0), (1, 0), (10, 5), 3)"
+COMPILE_ALL = (
+    "import spiral_cad; from spiral_cad.core._jit import SCALAR_CALLS_BEFORE_COMPILING as n\n"
+    "for _ in range(n + 2): spiral_cad.line_to_circle((0, 0), (1, 0), (10, 5), 3)"
+)
+BATCH_CALL = "import numpy as np, spiral_cad; spiral_cad.batch.line_to_circle(np.zeros((4, 2)), [[1, 0]] * 4, [[10, 5]] * 4, [3] * 4)"
+
+
+def process_time(code: str, cache: str) -> float:
+    """Wall time of a new interpreter running ``code`` with numba's cache in ``cache``."""
+    env = {"NUMBA_CACHE_DIR": cache, "PATH": "/usr/bin:/bin"}
+    started = time.perf_counter()
+    subprocess.run([sys.executable, "-c", code], check=True, env=env, capture_output=True)
+    return time.perf_counter() - started
+
+
+def main() -> None:
+    args = arguments(__doc__, rounds=(7, 1))
+    runs: dict[str, list[float]] = {name: [] for name in ("cold", "warm", "compiled", "numpy", "numba")}
+    for _ in range(args.rounds):
+        with tempfile.TemporaryDirectory() as cold, tempfile.TemporaryDirectory() as warm, tempfile.TemporaryDirectory() as fresh:
+            runs["cold"].append(process_time(FIRST_CALL, cold))
+            process_time(COMPILE_ALL, warm)
+            runs["warm"].append(process_time(FIRST_CALL, warm))
+            runs["compiled"].append(process_time(BATCH_CALL, fresh))
+            runs["numpy"].append(process_time("import numpy", cold))
+            runs["numba"].append(process_time("import numba", cold))
+    timings = {name: Timing(tuple(values)) for name, values in runs.items()}
+    report = Report("Cold start", note=f"{args.rounds} fresh processes per row, taken in turn; medians.")
+    floor = timings["numpy"].median
+    report.add("import + first scalar call, empty kernel cache", timings["cold"].median, "s", timings["cold"],
+               "a first call that compiles", timings["compiled"].median / timings["cold"].median, "≤ 2 s")  # fmt: skip
+    report.add("import + first scalar call, warm kernel cache", timings["warm"].median, "s", timings["warm"])
+    report.add("import + first batch call, empty cache (compiles)", timings["compiled"].median, "s", timings["compiled"])
+    report.add("import numba alone", timings["numba"].median, "s", timings["numba"])
+    report.add("import numpy alone", floor, "s", timings["numpy"])
+    report.section("Every run (s)", "\n".join(f"- {name}: {', '.join(f'{v:.2f}' for v in values)} (median {statistics.median(values):.2f})"
+                                              for name, values in runs.items()))  # fmt: skip
+    report.finish(args)
+
+
+if __name__ == "__main__":
+    main()
