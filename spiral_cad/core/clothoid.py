@@ -112,8 +112,8 @@ def clothoid_method(length: ArrayLike, k0: ArrayLike, rate: ArrayLike) -> NDArra
                 np.where(panels <= MAX_PANELS, QUADRATURE, np.where(condition <= _LAST_RESORT, FRESNEL, NONE)),
             ),
         )
-        bad = ~(np.isfinite(length) & np.isfinite(k0) & np.isfinite(rate) & np.isfinite(turn))
-    method = np.where(bad & (method != FRESNEL), NONE, method)
+        bad = ~(np.isfinite(length) & np.isfinite(k0) & np.isfinite(rate))
+    method = np.where(bad, NONE, method)  # an arc whose turn overflows is evaluated: its points are NaN
     return method.astype(int)
 
 
