@@ -98,23 +98,18 @@ def clothoid_method(length: ArrayLike, k0: ArrayLike, rate: ArrayLike) -> NDArra
     Returns:
         An integer array of the broadcast shape (see the module docstring for the criterion).
     """
-    length, k0, rate = np.broadcast_arrays(*(np.asarray(v, dtype=float) for v in (length, k0, rate)))
+    length, k0, rate = (np.asarray(v, dtype=float) for v in (length, k0, rate))
     with np.errstate(all="ignore"):
         turn = _turn(length, k0, rate)
-        condition = _fresnel_condition(length, k0, rate)
-        panels = np.ceil(turn / PANEL_TURN)
-        method = np.where(
-            rate == 0.0,
-            ARC,
-            np.where(
-                (turn > FRESNEL_TURN) & (condition <= FRESNEL_CONDITION),
-                FRESNEL,
-                np.where(panels <= MAX_PANELS, QUADRATURE, np.where(condition <= _LAST_RESORT, FRESNEL, NONE)),
-            ),
-        )
-        bad = ~(np.isfinite(length) & np.isfinite(k0) & np.isfinite(rate))
-    method = np.where(bad, NONE, method)  # an arc whose turn overflows is evaluated: its points are NaN
-    return method.astype(int)
+        method = np.where(rate == 0.0, ARC, QUADRATURE)
+        large = (turn > FRESNEL_TURN) & (rate != 0.0)  # only these may take Fresnel: its criterion is skipped for the rest
+        if large.any():
+            condition = _fresnel_condition(length, k0, rate)
+            panels = np.ceil(turn / PANEL_TURN)
+            fallback = np.where(panels <= MAX_PANELS, QUADRATURE, np.where(condition <= _LAST_RESORT, FRESNEL, NONE))
+            method = np.where(large, np.where(condition <= FRESNEL_CONDITION, FRESNEL, fallback), method)
+        bad = ~np.isfinite(length + k0 + rate)  # inf − inf is NaN: any non-finite input
+    return np.where(bad, NONE, method)  # an arc whose turn overflows is evaluated: its points are NaN
 
 
 def clothoid_points(s: ArrayLike, k0: ArrayLike, rate: ArrayLike, method: ArrayLike | None = None) -> NDArray:
@@ -125,14 +120,15 @@ def clothoid_points(s: ArrayLike, k0: ArrayLike, rate: ArrayLike, method: ArrayL
     to the method for length ``s`` itself. Points of ``NONE`` pieces are NaN.
     """
     s, k0, rate = np.broadcast_arrays(*(np.asarray(v, dtype=float) for v in (s, k0, rate)))
-    if method is None:
-        method = clothoid_method(s, k0, rate)
-    method = np.broadcast_to(np.asarray(method), s.shape)
-    points = np.full(s.shape + (2,), np.nan)
-    for code, evaluate in ((ARC, _arc), (QUADRATURE, _quadrature), (FRESNEL, _fresnel)):
-        chosen = method == code
-        if chosen.any():
-            with np.errstate(all="ignore"):
+    method = np.broadcast_to(clothoid_method(s, k0, rate) if method is None else np.asarray(method), s.shape)
+    with np.errstate(all="ignore"):
+        for code, evaluate in ((ARC, _arc), (QUADRATURE, _quadrature), (FRESNEL, _fresnel)):
+            if (method == code).all():  # one method for all: no gathering
+                return evaluate(s.ravel(), k0.ravel(), rate.ravel()).reshape(s.shape + (2,))
+        points = np.full(s.shape + (2,), np.nan)
+        for code, evaluate in ((ARC, _arc), (QUADRATURE, _quadrature), (FRESNEL, _fresnel)):
+            chosen = method == code
+            if chosen.any():
                 points[chosen] = evaluate(s[chosen], k0[chosen], rate[chosen])
     return points
 
@@ -146,6 +142,7 @@ def clothoid_frames(
     y0: ArrayLike = 0.0,
     hdg: ArrayLike = 0.0,
     length: ArrayLike | None = None,
+    method: ArrayLike | None = None,
 ) -> tuple[NDArray, NDArray, NDArray]:
     """Points, headings and curvatures of clothoids at arc lengths ``s``.
 
@@ -162,19 +159,26 @@ def clothoid_frames(
         length: the pieces' lengths, which choose the method (see
             ``clothoid_method``) so that all points of a piece agree; by
             default each point's own ``s``.
+        method: the pieces' methods, if already known (``clothoid_method``
+            of their lengths); overrides ``length``.
 
     Returns:
         (points (..., 2), headings (...), curvatures (...)); points of a piece
         that cannot be evaluated (``NONE``: its heading overflows) are NaN.
     """
-    s, k0, rate, x0, y0, hdg = np.broadcast_arrays(*(np.asarray(v, dtype=float) for v in (s, k0, rate, x0, y0, hdg)))
-    method = None if length is None else clothoid_method(np.broadcast_to(np.asarray(length, dtype=float), s.shape), k0, rate)
-    local = clothoid_points(s, k0, rate, method)
+    s, k0, rate = (np.asarray(v, dtype=float) for v in (s, k0, rate))
+    if method is None and length is not None:
+        method = clothoid_method(length, k0, rate)
+    points = clothoid_points(s, k0, rate, method)
     with np.errstate(all="ignore"):
-        heading = hdg + s * (k0 + 0.5 * rate * s)
+        heading = s * (k0 + 0.5 * rate * s)
         curvature = k0 + rate * s
-        c, n = np.cos(hdg), np.sin(hdg)
-        points = np.stack([x0 + c * local[..., 0] - n * local[..., 1], y0 + n * local[..., 0] + c * local[..., 1]], axis=-1)
+        if not (np.ndim(x0) == np.ndim(y0) == np.ndim(hdg) == 0 and x0 == y0 == hdg == 0.0):  # placed
+            x0, y0, hdg = (np.asarray(v, dtype=float) for v in (x0, y0, hdg))
+            c, n = np.cos(hdg), np.sin(hdg)
+            x, y = points[..., 0], points[..., 1]
+            points = np.stack([x0 + c * x - n * y, y0 + n * x + c * y], axis=-1)
+            heading = hdg + heading
     return points, heading, curvature
 
 
@@ -194,6 +198,10 @@ def _quadrature(s: NDArray, k0: NDArray, rate: NDArray) -> NDArray:
     [0, s] in equal panels turning by at most ``PANEL_TURN`` each (1-d arrays; ragged panel counts
     are flattened into one array)."""
     panels = np.maximum(np.ceil(_turn(s, k0, rate) / PANEL_TURN), 1.0).astype(np.int64)
+    if len(s) and panels.max() == 1:  # one panel each: no flattening
+        t = s[:, None] * _U
+        theta = t * (k0[:, None] + 0.5 * rate[:, None] * t)
+        return np.stack([np.cos(theta) @ _HALF_W * s, np.sin(theta) @ _HALF_W * s], axis=-1)
     owner = np.repeat(np.arange(len(s)), panels)
     first = np.cumsum(panels) - panels
     index = np.arange(len(owner)) - first[owner]  # each panel's number within its point

@@ -199,7 +199,7 @@ def _clothoid(s: NDArray, k0: NDArray, rate: NDArray, length: NDArray):
     with κ = k0 + rate·s ((n, 1) each), by ``spiral_cad.core.clothoid`` (closed-form lines and arcs,
     quadrature or well-conditioned Fresnel integrals for clothoids, chosen per piece by its length)."""
     method = clothoid_method(length, k0, rate)
-    points, heading, curvature = clothoid_frames(s, k0, rate, length=length)
+    points, heading, curvature = clothoid_frames(s, k0, rate, method=method)
     with np.errstate(all="ignore"):
         tangents = np.stack([np.cos(heading), np.sin(heading)], axis=-1)
     flag = np.broadcast_to(np.where(method == NONE, np.nan, 0.0), s.shape)
