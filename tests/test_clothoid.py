@@ -204,3 +204,25 @@ def test_esmini_roads_of_nearly_constant_curvature_have_no_phantom_gaps(tmp_path
             (end,), _, _ = g.local([1.0])
             k0_, length_ = float(k0), float(length)
             assert np.abs(end - exact(length_, k0_, (float(k1) - k0_) / length_)).max() <= 1e-14 * length_
+
+
+def test_a_nearly_straight_arc_is_read_without_cancellation(tmp_path):
+    # y = (1 − cos κL)/κ lost 2 % of a 5e-8 m offset at κ = 1e-7; 2 sin²(κL/2)/κ keeps every digit
+    k, length = 1e-7, 1.0
+    path = tmp_path / "arc.xodr"
+    path.write_text(HEADER.format(f'<road id="1" junction="-1" length="1"><planView><geometry s="0" x="0" y="0" hdg="0" '
+                                  f'length="{length!r}"><arc curvature="{k!r}"/></geometry></planView></road>'))  # fmt: skip
+    (road,) = read_opendrive(path)
+    (end,), _, _ = road.geometries[0].local([1.0])
+    assert np.abs(end - exact(length, k, 0.0)).max() <= 1e-16
+
+
+def test_a_spiral_whose_heading_holds_no_angle_is_refused_by_name(tmp_path, capsys):
+    # 2e16 rad with φ = k0²/(2c) = 5e15: neither quadrature (1e16 panels) nor Fresnel can place it
+    path = tmp_path / "wound.xodr"
+    path.write_text(HEADER.format('<road id="9" junction="-1" length="1e6"><planView><geometry s="0" x="0" y="0" hdg="0" '
+                                  'length="1e6"><spiral curvStart="1e10" curvEnd="2e10"/></geometry></planView></road>'))  # fmt: skip
+    with pytest.raises(ValueError, match=r"road 9, planView geometry 0 <spiral>: cannot be evaluated .*curvStart=10000000000.0"):
+        read_opendrive(path)
+    assert main(["check", str(path)]) == 2
+    assert capsys.readouterr().err.startswith("error: ")

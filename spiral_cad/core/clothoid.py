@@ -164,7 +164,7 @@ def clothoid_frames(
 
     Returns:
         (points (..., 2), headings (...), curvatures (...)); points of a piece
-        that cannot be evaluated (``NONE``: its heading overflows) are NaN.
+        that cannot be evaluated (``NONE``: its heading overflows or holds no angle) are NaN.
     """
     s, k0, rate = (np.asarray(v, dtype=float) for v in (s, k0, rate))
     if method is None and length is not None:

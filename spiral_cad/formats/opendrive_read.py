@@ -195,7 +195,7 @@ def _local_frames(kind: str, values: NDArray, length: NDArray, top: NDArray, t: 
 
 def _clothoid(s: NDArray, k0: NDArray, rate: NDArray, length: NDArray):
     """Local points, tangents, curvature and an evaluability flag (0, or NaN where the clothoid
-    cannot be evaluated: its heading overflows) at arc lengths ``s`` (n, m) of curves of ``length``
+    cannot be evaluated: its heading overflows or holds no angle) at arc lengths ``s`` (n, m) of curves of ``length``
     with κ = k0 + rate·s ((n, 1) each), by ``spiral_cad.core.clothoid`` (closed-form lines and arcs,
     quadrature or well-conditioned Fresnel integrals for clothoids, chosen per piece by its length)."""
     method = clothoid_method(length, k0, rate)
@@ -611,7 +611,7 @@ def _plan(road_id: str, record: dict) -> Plan:
             j, problem = problems[0]
             numbers = ", ".join([f"{k}={float(own[k][j])!r}" for k in ("x", "y", "hdg", "length")]
                                 + [f"{k}={v!r}" for k, v in zip(_KINDS[kind], values[j].tolist())])  # fmt: skip
-            raise ValueError(f"{where(rows[j])} <{kind}>: " + (f"cannot be evaluated (its heading overflows; {numbers})"
+            raise ValueError(f"{where(rows[j])} <{kind}>: " + (f"cannot be evaluated (its heading overflows or is too large to hold an angle; {numbers})"
                              if problem is None else f"{problem} ({numbers})"))  # fmt: skip
         frames[rows] = evaluated
         by_kind[kind] = (rows, values, ranges)
