@@ -25,13 +25,15 @@ BOUND = 1e-13
 TURN = 64.0
 
 
-def exact(s: float, k0: float, rate: float) -> np.ndarray:
-    """∫₀ˢ (cos θ, sin θ), θ = k0·t + rate·t²/2, by mpmath at 50 digits (the floats taken exactly)."""
+def exact(s: float, k0: float, rate: float, method: str = "tanh-sinh") -> np.ndarray:
+    """∫₀ˢ (cos θ, sin θ), θ = k0·t + rate·t²/2, by mpmath at 50 digits (the floats taken exactly),
+    on sub-intervals turning by about 1 rad (3 rad for mpmath's adaptive Gauss–Legendre)."""
     with mpmath.workdps(50):
         s_, k_, c_ = mpmath.mpf(s), mpmath.mpf(k0), mpmath.mpf(rate)
         turn = max(abs(k0), abs(k0 + rate * s)) * abs(s)
-        points = mpmath.linspace(0, s_, int(turn) + 2)
-        z = mpmath.quad(lambda t: mpmath.expj(t * (k_ + c_ * t / 2)), points)
+        points = mpmath.linspace(0, s_, int(turn / (1.0 if method == "tanh-sinh" else 3.0)) + 2)
+        z, estimate = mpmath.quad(lambda t: mpmath.expj(t * (k_ + c_ * t / 2)), points, method=method, error=True)
+        assert estimate <= 1e-30 * max(abs(s), 1e-300)
         return np.array([float(z.real), float(z.imag)])
 
 
@@ -73,6 +75,29 @@ def test_every_rate_to_1e_13_of_the_length_against_mpmath():
     check()
     assert len(ran) >= 100  # the examples actually ran, not only passed
     assert {ARC, QUADRATURE} <= methods
+
+
+def test_large_turns_to_1e_13_of_the_length_against_mpmath():
+    """Pieces turning by 33 to 1000 rad, where Fresnel is used when well conditioned."""
+    ran, methods = [], set()
+
+    @settings(max_examples=40, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+    @given(k0=st.one_of(st.just(0.0), magnitudes(-6, 1)), rate=magnitudes(-16, 3), turn=st.floats(33.0, 1000.0))
+    def check(k0, rate, turn):
+        low, high = 0.0, 1e4  # the length turning by ``turn``: max |κ|·L grows with L
+        for _ in range(200):
+            middle = 0.5 * (low + high)
+            low, high = (middle, high) if max(abs(k0), abs(k0 + rate * middle)) * middle < turn else (low, middle)
+        length = high
+        method = int(clothoid_method(length, k0, rate))
+        reference = exact(length, k0, rate, "gauss-legendre")
+        assert np.hypot(*(clothoid_points(length, k0, rate) - reference)) <= BOUND * length, (k0, rate, length, method)
+        ran.append(1)
+        methods.add(method)
+
+    check()
+    assert len(ran) >= 35
+    assert {QUADRATURE, FRESNEL} <= methods
 
 
 @pytest.mark.parametrize(
