@@ -17,7 +17,15 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from spiral_cad.cli import main
-from spiral_cad.core.clothoid import ARC, FRESNEL, NONE, QUADRATURE, clothoid_frames, clothoid_method, clothoid_points
+from spiral_cad.core.clothoid import (
+    ARC,
+    FRESNEL,
+    NONE,
+    QUADRATURE,
+    clothoid_frames,
+    clothoid_method,
+    clothoid_points,
+)
 from spiral_cad.formats.opendrive import check_opendrive, read_opendrive
 
 BOUND = 1e-13
