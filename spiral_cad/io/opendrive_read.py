@@ -4,7 +4,7 @@
 needs; converts and checks every numeric attribute over all elements at once
 (a bad one is named by road, element and attribute); and evaluates the
 start, middle and end of every geometry kind by kind, all at once — lines,
-arcs, clothoid spirals (Fresnel integrals from scipy), ``paramPoly3`` in both
+arcs, clothoid spirals (``spiral_cad.core.clothoid``: exact at every rate), ``paramPoly3`` in both
 ``pRange`` and the deprecated ``poly3`` (its parameter range by a batched
 Gauss–Legendre Newton on its arc length). ``Geometry`` objects are made
 only when a road's ``geometries`` are asked for. Public names:
@@ -25,9 +25,9 @@ from xml.parsers import expat
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
-from scipy.special import fresnel
 
 from ..core.chain import Chain
+from ..core.clothoid import NONE, clothoid_frames, clothoid_method
 from ..core.piecewise import piecewise_at
 from ..core.segments import Arc, Line, Segment
 from ..core.spiral import BezierSpiral
@@ -184,7 +184,7 @@ def _local_frames(kind: str, values: NDArray, length: NDArray, top: NDArray, t: 
         zero = np.zeros((len(values), 1))
         k0 = zero if kind == "line" else values[:, :1]
         rate = zero if kind != "spiral" else (values[:, 1:2] - values[:, :1]) / length[:, None]
-        return _clothoid(p, k0, rate)
+        return _clothoid(p, k0, rate, length[:, None])
     if kind == "paramPoly3":
         u, v = (values[:, 4 * k : 4 * k + 4] for k in range(2))
     else:
@@ -193,32 +193,21 @@ def _local_frames(kind: str, values: NDArray, length: NDArray, top: NDArray, t: 
     return _parametric(u, v, p)
 
 
-def _clothoid(s: NDArray, k0: NDArray, rate: NDArray):
-    """Local points, tangents, curvature and the phase of the heading's square (0 for lines and
-    arcs; not finite: the clothoid cannot be evaluated) at arc lengths ``s`` (n, m) of curves with
-    κ = k0 + rate·s ((n, 1) each): lines and arcs in closed form, clothoids by Fresnel integrals
-    after completing the square of the heading k0·s + rate·s²/2."""
+def _clothoid(s: NDArray, k0: NDArray, rate: NDArray, length: NDArray):
+    """Local points, tangents, curvature and an evaluability flag (0, or NaN where the clothoid
+    cannot be evaluated: its heading overflows or holds no angle) at arc lengths ``s`` (n, m) of curves of ``length``
+    with κ = k0 + rate·s ((n, 1) each), by ``spiral_cad.core.clothoid`` (closed-form lines and arcs,
+    quadrature or well-conditioned Fresnel integrals for clothoids, chosen per piece by its length)."""
+    method = clothoid_method(length, k0, rate)
+    points, heading, curvature = clothoid_frames(s, k0, rate, method=method)
     with np.errstate(all="ignore"):
-        heading = k0 * s + 0.5 * rate * s * s
         tangents = np.stack([np.cos(heading), np.sin(heading)], axis=-1)
-        curvature = k0 + rate * s
-        arc = np.stack([np.where(k0 == 0.0, s, np.sin(k0 * s) / k0), np.where(k0 == 0.0, 0.0, (1.0 - np.cos(k0 * s)) / k0)], axis=-1)
-        safe = np.where(rate == 0.0, 1.0, rate)
-        sign = np.sign(safe)
-        a = np.sqrt(math.pi / np.abs(safe))
-        phase = k0 * k0 / (2.0 * safe)  # heading = (rate/2)(s + k0/rate)² − phase
-        S, C = fresnel((s + k0 / safe) / a)
-        S0, C0 = fresnel((k0 / safe) / a)
-        dC, dS = C - C0, S - S0
-        spiral = np.stack([a * (np.cos(phase) * dC + sign * np.sin(phase) * dS),
-                           a * (sign * np.cos(phase) * dS - np.sin(phase) * dC)], axis=-1)  # fmt: skip
-        points = np.where((rate == 0.0)[..., None], arc, spiral)
-        phase = np.broadcast_to(np.where(rate == 0.0, 0.0, phase), s.shape)  # a clothoid's phase must be finite
-    return points, tangents, curvature, phase
+    flag = np.broadcast_to(np.where(method == NONE, np.nan, 0.0), s.shape)
+    return points, tangents, curvature, flag
 
 
 def _parametric(u: NDArray, v: NDArray, p: NDArray):
-    """Points, unit tangents, curvature and a zero phase (see ``_clothoid``) of the parametric
+    """Points, unit tangents, curvature and a zero flag (see ``_clothoid``) of the parametric
     cubics (u(p), v(p)), coefficients (n, 4) each, at parameters ``p`` (n, m)."""
     (x, x1, x2), (y, y1, y2) = _cubic(u, p), _cubic(v, p)
     with np.errstate(all="ignore"):  # speed 0 (bU = bV = 0): no tangent, NaN
@@ -622,7 +611,7 @@ def _plan(road_id: str, record: dict) -> Plan:
             j, problem = problems[0]
             numbers = ", ".join([f"{k}={float(own[k][j])!r}" for k in ("x", "y", "hdg", "length")]
                                 + [f"{k}={v!r}" for k, v in zip(_KINDS[kind], values[j].tolist())])  # fmt: skip
-            raise ValueError(f"{where(rows[j])} <{kind}>: " + (f"cannot be evaluated (its heading overflows; {numbers})"
+            raise ValueError(f"{where(rows[j])} <{kind}>: " + (f"cannot be evaluated (its heading overflows or is too large to hold an angle; {numbers})"
                              if problem is None else f"{problem} ({numbers})"))  # fmt: skip
         frames[rows] = evaluated
         by_kind[kind] = (rows, values, ranges)
@@ -631,7 +620,7 @@ def _plan(road_id: str, record: dict) -> Plan:
 
 def _world_frames(kind: str, values: NDArray, head: dict[str, NDArray], ranges: list[str]) -> tuple[NDArray, list]:
     """(m, 3, 9) start, end and middle frames of m geometries of one kind, and the problems: (j, None)
-    where a clothoid's phase or a poly3's end is not finite, (j, text) where a point is not finite."""
+    where a clothoid cannot be evaluated or a poly3's end is not finite, (j, text) where a point is not finite."""
     length = head["length"]
     with np.errstate(all="ignore"):
         top = _parameter_end(kind, values, length, ranges)
