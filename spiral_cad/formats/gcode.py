@@ -42,7 +42,10 @@ from __future__ import annotations
 import math
 import os
 import re
+import sys
+import time
 from dataclasses import dataclass
+from collections.abc import Callable
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -58,21 +61,67 @@ MAX_BYTES = 1 << 30
 #: What a G-code program's file name ends in (a design file cannot make the build read, and
 #: quote in its error, any other file).
 SUFFIXES = (".nc", ".ngc", ".gcode", ".gc", ".g", ".tap", ".cnc", ".mpt", ".mpf")
-#: Codes that keep a state the path does not depend on.
-NEUTRAL_G = {17: "XY plane", 40: "no cutter compensation", 49: "no tool length offset", 54: "work offset 1",
-             80: "no canned cycle", 94: "feed per minute"}  # fmt: skip
-NEUTRAL_M = {3, 4, 5, 6, 7, 8, 9}
+#: LinuxCNC's modal groups of G codes (the code times ten: G90.1 is 901); two codes of one group on
+#: one line are an error, as in LinuxCNC ("Two g codes used from same modal group").
+G_GROUPS: dict[int, tuple[int, str]] = {
+    **{c: (1, "motion") for c in (0, 10, 20, 30, 330, 331, 382, 383, 384, 385, 50, 51, 52, 53, 62, 730, 760, 800,
+                                  810, 820, 830, 840, 850, 860, 870, 880, 890)},
+    **{c: (2, "plane") for c in (170, 171, 180, 181, 190, 191)},
+    **{c: (3, "distance mode") for c in (900, 910)},
+    **{c: (4, "arc centre mode") for c in (901, 911)},
+    **{c: (5, "feed rate mode") for c in (930, 940, 950)},
+    **{c: (6, "units") for c in (200, 210)},
+    **{c: (7, "cutter compensation") for c in (400, 410, 411, 420, 421)},
+    **{c: (8, "tool length offset") for c in (430, 431, 432, 490)},
+    **{c: (10, "canned cycle return") for c in (980, 990)},
+    **{c: (12, "work offset") for c in (540, 550, 560, 570, 580, 590, 591, 592, 593)},
+    **{c: (13, "path control") for c in (610, 611, 640)},
+    **{c: (14, "spindle speed mode") for c in (960, 970)},
+    **{c: (15, "lathe diameter mode") for c in (70, 80)},
+    **{c: (0, "non-modal") for c in (40, 100, 280, 281, 300, 301, 520, 530, 920, 921, 922, 923)},
+}  # fmt: skip
+#: Codes that keep a state the straight path does not depend on (feeds, stops, exact-stop modes, …).
+NEUTRAL_G = {40, 170, 400, 490, 540, 550, 560, 570, 580, 590, 591, 592, 593, 610, 611, 640, 80, 930, 940, 950,
+             960, 970, 980, 990}  # fmt: skip
+#: Codes refused by name, with why (each would move the tool somewhere the program's words do not say).
+REFUSED_G = {
+    **{c: "a canned cycle (have the CAM expand cycles into G0/G1 moves, or use interpreter='rs274')"
+       for c in (730, 760, 810, 820, 830, 840, 850, 860, 870, 880, 890)},
+    280: "a move to the machine's home position (G28), which the program does not state",
+    300: "a move to the machine's second home position (G30), which the program does not state",
+    281: "setting the home position (G28.1)", 301: "setting the second home position (G30.1)",
+    100: "setting work offsets or tool data (G10): the offsets would change the path",
+    520: "a local coordinate offset (G52)", 530: "a move in machine coordinates (G53)",
+    920: "a coordinate offset (G92)", 921: "a coordinate offset reset (G92.1)", 922: "a coordinate offset reset (G92.2)",
+    923: "a coordinate offset restore (G92.3)",
+    410: "cutter radius compensation (G41): the tool centre's path is not the programmed one",
+    411: "cutter radius compensation (G41.1)", 420: "cutter radius compensation (G42): the tool centre's path is not the programmed one",
+    421: "cutter radius compensation (G42.1)",
+    430: "a tool length offset (G43) from a tool table", 431: "a dynamic tool length offset (G43.1)",
+    432: "an added tool length offset (G43.2)",
+    330: "spindle-synchronised motion (G33)", 331: "rigid tapping (G33.1)",
+    382: "probing (G38.2)", 383: "probing (G38.3)", 384: "probing (G38.4)", 385: "probing (G38.5)",
+    62: "a NURBS curve (G6.2)", 50: "a cubic spline (G5)", 51: "a quadratic spline (G5.1)", 52: "a NURBS block (G5.2)", 53: "a NURBS block end (G5.3)",
+    171: "the UV plane (G17.1)", 181: "the WU plane (G18.1)", 191: "the VW plane (G19.1)",
+    70: "lathe diameter mode (G7): X would be a diameter",
+}  # fmt: skip
+#: LinuxCNC's modal groups of M codes that matter for a line's words (M7 and M8 may share a line).
+M_GROUPS = {0: 4, 1: 4, 2: 4, 30: 4, 60: 4, 3: 7, 4: 7, 5: 7, 6: 6, 7: 8, 8: 8, 9: 8, 48: 9, 49: 9, 50: 9, 51: 9,
+            52: 9, 53: 9}  # fmt: skip
 END_M = {2, 30}
-ARCS = {2: "G2 (a clockwise arc)", 3: "G3 (a counterclockwise arc)"}
-IGNORED_WORDS = set("FSTN")
+#: Words that do not move the tool: feed, spindle speed, tool, line number, dwell/G64 P and Q, G96 D.
+IGNORED_WORDS = set("FSTNPQD")
+PLANES = {170: (0, 1, 2), 180: (2, 0, 1), 190: (1, 2, 0)}  # (first, second, normal axis) as LinuxCNC's ARC_FEED
 
 #: Lines longer than this are refused before their words are read (memory grows with a line's words).
 MAX_LINE = 1 << 16
 
 _WORD = re.compile(r"\s*([A-Za-z])\s*([+-]?\s*(?:\d+\.?\d*|\.\d+))", re.ASCII)
+#: Where a line goes beyond plain words: a parameter, an expression, a named parameter (``#<x>``).
+_FULL_NGC = re.compile(r"\s*(?:[A-Za-z]\s*)?[#\[<]")
 _CONTROL = re.compile("[\x00-\x08\x0b-\x1f\x7f-\x9f\u2028\u2029]")
-#: A G or M code as written: an integer, perhaps with a point and zeros (G01, G1.0).
-_INTEGER = re.compile(r"[+-]?[0-9]+(?:\.0*)?")
+#: A G or M code as written: an integer, perhaps with one decimal and zeros (G01, G1.0, G90.1).
+_CODE = re.compile(r"[0-9]{1,4}(?:\.[0-9]?0*)?")
 #: A whole comment, or a parenthesis or semicolon that starts or ends none.
 _COMMENT = re.compile(r"\([^()]*\)|[;()]")
 
@@ -87,6 +136,7 @@ class GcodePath:
         rapid: (n,) True where the move was a rapid (G0).
         units: ``"mm"`` (G21) or ``"in"`` (G20).
         source: the file's name, for messages.
+        notes: what was read but does not move the tool and is worth telling (tool changes).
     """
 
     points: NDArray
@@ -94,6 +144,7 @@ class GcodePath:
     rapid: NDArray
     units: str
     source: str = "G-code"
+    notes: tuple[str, ...] = ()
 
     def __len__(self) -> int:
         return len(self.points)
@@ -101,7 +152,7 @@ class GcodePath:
     def in_units(self, units: str) -> GcodePath:
         """The same moves in ``units`` (mm, cm, m, km, in, ft): converted from the program's G20/G21."""
         factor = MM_PER_UNIT[self.units] / MM_PER_UNIT[length_unit(units)]
-        return GcodePath(self.points * factor if factor != 1.0 else self.points, self.lines, self.rapid, units, self.source)
+        return GcodePath(self.points * factor if factor != 1.0 else self.points, self.lines, self.rapid, units, self.source, self.notes)
 
     def at_lines(self, message: str) -> str:
         """``message`` with every ``point i``/``corner i`` followed by the G-code line of that move."""
@@ -116,15 +167,24 @@ class GcodePath:
 class _Reader:
     """The interpreter's state while lines are read."""
 
-    def __init__(self, source: str):
+    def __init__(self, source: str, arc_tolerance: float | None = None, progress: Callable[[int], None] | None = None):
         self.source = source
+        self.arc_tolerance = arc_tolerance
+        self.progress = progress
         self.position = [0.0, 0.0, 0.0]
         self.absolute = True
+        self.absolute_centre = False  # G91.1, LinuxCNC's default: I, J, K are offsets from the start
+        self.plane = 170
         self.motion: int | None = None
+        self.cancelled = False
         self.units: str | None = None
         self.points: list[tuple[float, float, float]] = []
         self.lines: list[int] = []
         self.rapid: list[bool] = []
+        self.notes: list[str] = []
+        self.opened: int | None = None  # the line of an opening %
+        self.any_words = False
+        self.end_at: int | None = None
         self.ended = False
 
     def error(self, number: int, text: str) -> ValueError:
@@ -155,6 +215,8 @@ class _Reader:
             match = _WORD.match(stripped, at)
             if match is None:
                 bad = stripped[at:].strip()[:20]
+                if _FULL_NGC.match(stripped, at) or found and found[-1][0] == "O":
+                    raise self.error(number, f"{bad!r}: parameters, expressions and O-words are not read by the built-in reader; use interpreter='rs274' (--interpreter rs274), LinuxCNC's own")
                 raise self.error(number, f"{bad!r} is not a G-code word (a letter and a decimal number, no exponents)")
             letter, written = match.group(1).upper(), match.group(2).replace(" ", "")
             value = float(written)
@@ -167,80 +229,225 @@ class _Reader:
 
     def read_line(self, number: int, text: str) -> None:
         stripped = text.strip()
-        if not stripped or stripped == "%" or self.ended:
+        if self.ended or not stripped:
             return
+        if stripped == "%":  # LinuxCNC: a first line % opens the program, the next % ends it
+            if self.opened is None and not self.points and not self.any_words:
+                self.opened = number
+            else:
+                self.ended = True
+            return
+        if stripped[0] == "/":  # block delete: LinuxCNC's switch is off by default, so the line runs
+            text = text.replace("/", " ", 1)
         words = self.words(number, text)
-        motion: list[int] = []
+        if words:
+            self.any_words = True
+        groups: dict[int, str] = {}
+        motion: int | None = None
         target: dict[int, float] = {}
+        centre: dict[str, float] = {}
         for letter, value, written in words:
-            code = int(value) if _INTEGER.fullmatch(written[1:]) else None  # G0.0…05 is no G0
+            if letter in "GM":
+                code = round(value * 10) if _CODE.fullmatch(written[1:]) else None
+                if letter == "M":
+                    code = code // 10 if code is not None and code % 10 == 0 else None
             if letter == "G":
-                if code in (0, 1):
-                    motion.append(code)
-                elif code in ARCS:
-                    raise self.error(number, f"{ARCS[code]} is refused: only straight moves (G0, G1) are read; have the CAM write straight moves, or linearise the arcs first")
-                elif code in (90, 91):
-                    self.absolute = code == 90
-                elif code in (20, 21):
-                    units = "in" if code == 20 else "mm"
+                if code not in G_GROUPS:
+                    raise self.error(number, f"{written} is not a LinuxCNC G code this reader knows")
+                group, name = G_GROUPS[code]
+                if group and group in groups:
+                    raise self.error(number, f"{groups[group]} and {written} are both in modal group {group} ({name}); LinuxCNC allows one per line")
+                groups[group] = written
+                if code in REFUSED_G:
+                    raise self.error(number, f"{written} is refused: {REFUSED_G[code]}")
+                if group == 1:
+                    motion = code
+                elif code in (900, 910):
+                    self.absolute = code == 900
+                elif code in (901, 911):
+                    self.absolute_centre = code == 901
+                elif code in (200, 210):
+                    units = "in" if code == 200 else "mm"
                     if self.points and units != self.units:
                         raise self.error(number, f"{written} changes the unit after the first move; one unit per program")
                     self.units = units
-                elif code not in NEUTRAL_G:
-                    raise self.error(number, f"{written} is not in the supported subset (G0, G1, G17, G20, G21, G40, G49, G54, G80, G90, G91, G94)")
+                elif code in PLANES:
+                    self.plane = code
+                elif code == 40 or code in NEUTRAL_G:
+                    pass
             elif letter == "M":
+                if code not in M_GROUPS:
+                    raise self.error(number, f"{written} is not in the supported subset (M0, M1, M2, M30, M60 stops and ends; M3–M9 spindle, tool change, coolant; M48–M53 overrides)")
+                group = M_GROUPS[code]
+                if group in groups and not {groups[group].upper(), written.upper()} <= {"M7", "M8", "M07", "M08"}:
+                    raise self.error(number, f"{groups[group]} and {written} are both in M modal group {group}; LinuxCNC allows one per line")
+                groups[group] = written
                 if code in END_M:
-                    self.ended = True
-                elif code not in NEUTRAL_M:
-                    raise self.error(number, f"{written} is not in the supported subset (M2, M30 end the program; M3–M9 are ignored)")
+                    self.end_at = number
+                elif code == 6:
+                    self.notes.append(f"line {number}: {written} tool change (no move)")
             elif letter in "XYZ":
                 axis = "XYZ".index(letter)
                 if axis in target:
                     raise self.error(number, f"{letter} is given twice")
                 target[axis] = value
+            elif letter in "IJKR":
+                if letter in centre:
+                    raise self.error(number, f"{letter} is given twice")
+                centre[letter] = value
+            elif letter == "O":
+                raise self.error(number, f"{written}: O-words (subroutines, loops, conditions) are not read by the built-in reader; use interpreter='rs274' (--interpreter rs274), LinuxCNC's own")
             elif letter not in IGNORED_WORDS:
-                raise self.error(number, f"the word {written} is not in the supported subset (X, Y, Z, F, S, T, N besides G and M codes)")
-        if len(motion) > 1:
-            raise self.error(number, "two motion codes (G0/G1) on one line")
-        if motion:
-            self.motion = motion[0]
-        if not target:
-            return
-        if self.motion is None:
-            raise self.error(number, "coordinates with no motion mode in effect (G0 or G1)")
-        if self.units is None:
-            raise self.error(number, "the program sets no unit before its first move: add G21 (mm) or G20 (inch)")
-        moved = list(self.position)
-        for axis, value in target.items():
-            moved[axis] = value if self.absolute else moved[axis] + value
-        if not all(math.isfinite(v) for v in moved):
-            raise self.error(number, "the move's position is beyond the float range")
+                raise self.error(number, f"the word {written} is not in the supported subset (X, Y, Z, I, J, K, R, F, S, T, N, P, Q, D besides G and M codes)")
+        if motion is not None:
+            self.motion = None if motion == 800 else motion
+        if target:
+            if self.motion is None:
+                reason = "after G80 (motion cancelled)" if motion == 800 or self.cancelled else "with no motion mode in effect (G0, G1, G2, G3)"
+                raise self.error(number, f"coordinates {reason}; LinuxCNC: cannot use axis values without a G code that uses them")
+            if self.units is None:
+                raise self.error(number, "the program sets no unit before its first move: add G21 (mm) or G20 (inch)")
+            moved = list(self.position)
+            for axis, value in target.items():
+                moved[axis] = value if self.absolute else moved[axis] + value
+            if not all(math.isfinite(v) for v in moved):
+                raise self.error(number, "the move's position is beyond the float range")
+            if self.motion in (20, 30):
+                self.arc(number, moved, centre)
+            else:
+                if centre:
+                    raise self.error(number, f"{', '.join(centre)} with a straight move: only arcs (G2, G3) take I, J, K, R")
+                self.add(number, moved)
+            self.position = moved
+        elif centre:
+            raise self.error(number, f"{', '.join(centre)} with no axis word: LinuxCNC needs an end point for an arc")
+        if motion == 800:
+            self.cancelled = True
+        if self.end_at is not None:
+            self.ended = True
+
+    def add(self, number: int, moved: list[float]) -> None:
         if moved != self.position or not self.points:
             self.points.append((moved[0], moved[1], moved[2]))
             self.lines.append(number)
             self.rapid.append(self.motion == 0)
-        self.position = moved
+        if self.progress is not None:
+            self.progress(len(self.points))
+
+    def arc(self, number: int, end: list[float], centre: dict[str, float]) -> None:
+        """An arc (G2 clockwise, G3 counterclockwise) in the plane, as chords within ``arc_tolerance``."""
+        name = "G2 (a clockwise arc)" if self.motion == 20 else "G3 (a counterclockwise arc)"
+        if self.arc_tolerance is None:
+            raise self.error(number, f"{name} is refused: only straight moves (G0, G1) are read unless arc_tolerance is given (arcs become chords within it); have the CAM write straight moves, or linearise the arcs first")
+        first, second, normal = PLANES[self.plane]
+        offsets = {170: "IJ", 180: "KI", 190: "JK"}[self.plane]
+        start = self.position
+        a0, b0, a1, b1 = start[first], start[second], end[first], end[second]
+        if "R" in centre:
+            if set(centre) - {"R"}:
+                raise self.error(number, f"{name}: R with {', '.join(set(centre) - {'R'})}; give R or the centre offsets, not both")
+            radius = centre["R"]
+            chord = math.hypot(a1 - a0, b1 - b0)
+            if chord == 0.0 or abs(radius) < chord / 2 * (1 - 1e-12):
+                raise self.error(number, f"{name}: R{radius:g} cannot join points {chord:g} apart")
+            half = math.sqrt(max(radius * radius - chord * chord / 4, 0.0))
+            # LinuxCNC: R > 0 takes the shorter arc, R < 0 the longer; the centre is left of the chord for the shorter G3 arc
+            side = (1 if self.motion == 30 else -1) * (1 if radius > 0 else -1)
+            ca = (a0 + a1) / 2 - side * half * (b1 - b0) / chord
+            cb = (b0 + b1) / 2 + side * half * (a1 - a0) / chord
+        else:
+            if set(centre) - set(offsets) or not centre:
+                raise self.error(number, f"{name} in the {'XY' if self.plane == 170 else 'XZ' if self.plane == 180 else 'YZ'} plane takes {offsets[0]} and {offsets[1]}; got {', '.join(centre) or 'none'}")
+            i, j = centre.get(offsets[0], 0.0), centre.get(offsets[1], 0.0)
+            ca, cb = (i, j) if self.absolute_centre else (a0 + i, b0 + j)
+        r0, r1 = math.hypot(a0 - ca, b0 - cb), math.hypot(a1 - ca, b1 - cb)
+        if r0 == 0.0 or abs(r0 - r1) > max(1e-6 * r0, 1e-9 * max(abs(ca), abs(cb), 1.0)) and abs(r0 - r1) > 0.002 * (25.4 if self.units == "mm" else 1.0) / 25.4:
+            raise self.error(number, f"{name}: the start is {r0:g} from the centre and the end {r1:g}; LinuxCNC refuses radii that differ")
+        t0, t1 = math.atan2(b0 - cb, a0 - ca), math.atan2(b1 - cb, a1 - ca)
+        sweep = t1 - t0
+        if self.motion == 30:
+            sweep = sweep if sweep > 0 else sweep + 2 * math.pi
+        else:
+            sweep = sweep if sweep < 0 else sweep - 2 * math.pi
+        radius = (r0 + r1) / 2
+        step = 2 * math.acos(max(1 - self.arc_tolerance / radius, -1.0)) if self.arc_tolerance < radius else math.pi / 2
+        count = max(2, math.ceil(abs(sweep) / min(step, math.pi / 2)))
+        for k in range(1, count + 1):
+            f = k / count
+            t = t0 + sweep * f
+            point = list(end)
+            if k < count:
+                point[first] = ca + radius * math.cos(t)
+                point[second] = cb + radius * math.sin(t)
+                point[normal] = start[normal] + (end[normal] - start[normal]) * f
+            self.add(number, point)
+            self.position = point
 
 
-def parse_gcode(text: str, source: str = "G-code") -> GcodePath:
-    """The straight moves of G-code ``text`` (see the module docstring).
+class Progress:
+    """Progress lines on stderr for a job that has run longer than ``after`` seconds, at most one every ``every``."""
+
+    def __init__(self, what: str, total: int | None = None, after: float = 3.0, every: float = 2.0):
+        self.what, self.total, self.every = what, total, every
+        self.started = time.monotonic()
+        self.next = self.started + after
+        self.shown = False
+
+    def __call__(self, done: int) -> None:
+        now = time.monotonic()
+        if now < self.next:
+            return
+        self.next = now + self.every
+        self.shown = True
+        of = f" of {self.total:,}" if self.total else ""
+        print(f"{self.what}: {done:,}{of} ({now - self.started:.0f} s)", file=sys.stderr, flush=True)
+
+    def done(self, count: int) -> None:
+        if self.shown:
+            print(f"{self.what}: {count:,} done in {time.monotonic() - self.started:.1f} s", file=sys.stderr, flush=True)
+
+
+def parse_gcode(text: str, source: str = "G-code", *, arc_tolerance: float | None = None, interpreter: str = "builtin") -> GcodePath:
+    """The moves of G-code ``text`` (see the module docstring).
+
+    Args:
+        text: the program.
+        source: its name, for messages.
+        arc_tolerance: when given (in the program's unit), arcs G2/G3 are read as chords at most this
+            far from the arc; when None, arcs are refused by name.
+        interpreter: ``"builtin"`` (this module's reader) or ``"rs274"`` (LinuxCNC's own interpreter,
+            for parameters, expressions and O-word subroutines; see ``spiral_cad.formats.rs274``).
 
     Raises:
         ValueError: anything outside the subset, naming ``source``, the line and the word;
-            a program with fewer than two moves.
+            a program with fewer than two moves; rs274 asked for but not installed.
     """
     if not isinstance(text, str):
         raise ValueError(f"text must be the program as str; got {type(text).__name__} (decode bytes first, or use read_gcode)")
-    reader = _Reader(source)
+    if arc_tolerance is not None and not 0.0 < arc_tolerance < math.inf:
+        raise ValueError(f"arc_tolerance must be a positive finite length; got {arc_tolerance}")
+    if interpreter == "rs274":
+        from .rs274 import run_rs274
+
+        return run_rs274(text, source, arc_tolerance=arc_tolerance)
+    if interpreter != "builtin":
+        raise ValueError(f"interpreter must be 'builtin' or 'rs274'; got {interpreter!r}")
     lines = text.replace("\r\n", "\n").replace("\r", "\n").split("\n")  # not splitlines: it breaks at \v, \f, …
+    progress = Progress(f"reading {source}", len(lines))
+    reader = _Reader(source, arc_tolerance)
     for number, line in enumerate(lines, 1):
         reader.read_line(number, line)
+        if not number & 0x3FFF:
+            progress(number)
+    progress.done(len(lines))
+    if reader.opened is not None and not reader.ended:
+        raise ValueError(f"{source}: the program opens with % (line {reader.opened}) but has no closing % or M2/M30; LinuxCNC refuses it (file ended with no percent sign)")
     if len(reader.points) < 2:
         raise ValueError(f"{source}: the program has {len(reader.points)} move(s) to a new position; a path needs at least two")
-    return GcodePath(np.array(reader.points), np.array(reader.lines), np.array(reader.rapid), reader.units, source)
+    return GcodePath(np.array(reader.points), np.array(reader.lines), np.array(reader.rapid), reader.units, source, tuple(reader.notes))
 
 
-def read_gcode(path: str | os.PathLike) -> GcodePath:
+def read_gcode(path: str | os.PathLike, *, arc_tolerance: float | None = None, interpreter: str = "builtin") -> GcodePath:
     """Read the straight moves of a G-code file (named ``*.nc``, ``.ngc``, ``.gcode``, ``.gc``, ``.g``,
     ``.tap``, ``.cnc``, ``.mpt`` or ``.mpf``).
 
@@ -266,7 +473,7 @@ def read_gcode(path: str | os.PathLike) -> GcodePath:
     except UnicodeDecodeError as error:
         line = data[: error.start].count(b"\n") + 1
         raise ValueError(f"{label} line {line}: byte {data[error.start]:#04x} is not UTF-8 text") from None
-    return parse_gcode(text, label)
+    return parse_gcode(text, label, arc_tolerance=arc_tolerance, interpreter=interpreter)
 
 
 def round_toolpath(path: GcodePath, **options) -> RoundedPath:
