@@ -97,3 +97,17 @@ def test_absolute_arc_centres_and_the_xz_plane():
     absolute = parse_gcode("G21 F1\nG1 X10 Z0\nG90.1 G18 G3 X0 Z10 I0 K0\n", arc_tolerance=0.01)
     assert np.allclose(relative.points, absolute.points)
     assert np.allclose(np.hypot(relative.points[:, 0], relative.points[:, 2]), 10.0) and np.all(relative.points[:, 1] == 0)
+
+
+def test_full_turns_and_radii_that_differ():
+    once = parse_gcode("G21 F1\nG1 X10\nG3 X10 Y0 I-10 J0\n", arc_tolerance=0.01)
+    twice = parse_gcode("G21 F1\nG1 X10\nG3 X10 Y0 I-10 J0 P2 Z-4\n", arc_tolerance=0.01)
+    def swept(path):  # the angle turned about the centre (0, 0), unwrapped
+        return np.unwrap(np.arctan2(path.points[:, 1], path.points[:, 0]))[-1]
+
+    assert swept(once) == pytest.approx(2 * math.pi) and swept(twice) == pytest.approx(4 * math.pi)
+    assert twice.points[-1].tolist() == [10, 0, -4] and np.allclose(np.hypot(*twice.points[:, :2].T), 10)
+    with pytest.raises(ValueError, match=r"line 3: G3 .*: the start is 10 from the centre and the end 11"):
+        parse_gcode("G21 F1\nG1 X10\nG3 X-11 Y0 I-10 J0\n", arc_tolerance=0.01)
+    with pytest.raises(ValueError, match=r"line 3: G2 .*: R1 cannot join points 4 apart"):
+        parse_gcode("G21 F1\nG1 X10\nG2 X14 R1\n", arc_tolerance=0.01)

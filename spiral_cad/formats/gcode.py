@@ -246,6 +246,7 @@ class _Reader:
         motion: int | None = None
         target: dict[int, float] = {}
         centre: dict[str, float] = {}
+        turn_count: float | None = None  # P with G2/G3: the number of turns
         for letter, value, written in words:
             if letter in "GM":
                 code = round(value * 10) if _CODE.fullmatch(written[1:]) else None
@@ -295,6 +296,8 @@ class _Reader:
                 if letter in centre:
                     raise self.error(number, f"{letter} is given twice")
                 centre[letter] = value
+            elif letter == "P":
+                turn_count = value
             elif letter == "O":
                 raise self.error(number, f"{written}: O-words (subroutines, loops, conditions) are not read by the built-in reader; use interpreter='rs274' (--interpreter rs274), LinuxCNC's own")
             elif letter not in IGNORED_WORDS:
@@ -313,7 +316,7 @@ class _Reader:
             if not all(math.isfinite(v) for v in moved):
                 raise self.error(number, "the move's position is beyond the float range")
             if self.motion in (20, 30):
-                self.arc(number, moved, centre)
+                self.arc(number, moved, centre, turn_count)
             else:
                 if centre:
                     raise self.error(number, f"{', '.join(centre)} with a straight move: only arcs (G2, G3) take I, J, K, R")
@@ -334,7 +337,7 @@ class _Reader:
         if self.progress is not None:
             self.progress(len(self.points))
 
-    def arc(self, number: int, end: list[float], centre: dict[str, float]) -> None:
+    def arc(self, number: int, end: list[float], centre: dict[str, float], turn_count: float | None) -> None:
         """An arc (G2 clockwise, G3 counterclockwise) in the plane, as chords within ``arc_tolerance``."""
         name = "G2 (a clockwise arc)" if self.motion == 20 else "G3 (a counterclockwise arc)"
         if self.arc_tolerance is None:
@@ -361,27 +364,55 @@ class _Reader:
             i, j = centre.get(offsets[0], 0.0), centre.get(offsets[1], 0.0)
             ca, cb = (i, j) if self.absolute_centre else (a0 + i, b0 + j)
         r0, r1 = math.hypot(a0 - ca, b0 - cb), math.hypot(a1 - ca, b1 - cb)
-        if r0 == 0.0 or abs(r0 - r1) > max(1e-6 * r0, 1e-9 * max(abs(ca), abs(cb), 1.0)) and abs(r0 - r1) > 0.002 * (25.4 if self.units == "mm" else 1.0) / 25.4:
-            raise self.error(number, f"{name}: the start is {r0:g} from the centre and the end {r1:g}; LinuxCNC refuses radii that differ")
-        t0, t1 = math.atan2(b0 - cb, a0 - ca), math.atan2(b1 - cb, a1 - ca)
-        sweep = t1 - t0
-        if self.motion == 30:
-            sweep = sweep if sweep > 0 else sweep + 2 * math.pi
-        else:
-            sweep = sweep if sweep < 0 else sweep - 2 * math.pi
-        radius = (r0 + r1) / 2
-        step = 2 * math.acos(max(1 - self.arc_tolerance / radius, -1.0)) if self.arc_tolerance < radius else math.pi / 2
-        count = max(2, math.ceil(abs(sweep) / min(step, math.pi / 2)))
-        for k in range(1, count + 1):
-            f = k / count
-            t = t0 + sweep * f
-            point = list(end)
-            if k < count:
-                point[first] = ca + radius * math.cos(t)
-                point[second] = cb + radius * math.sin(t)
-                point[normal] = start[normal] + (end[normal] - start[normal]) * f
+        # LinuxCNC's tolerances (interp_internal.hh): a zero radius, and radii that differ by more than
+        # 100 × CENTER_ARC_RADIUS_TOLERANCE, or by 0.1 % and more than that tolerance
+        inch = 1.0 if self.units == "in" else 25.4
+        error = abs(r0 - r1)
+        if min(r0, r1) < 0.00005 * inch:
+            raise self.error(number, f"{name}: a zero-radius arc (the start is {r0:g} from the centre, the end {r1:g})")
+        if error > 100 * 0.002 * math.sqrt(2) * inch or error > 0.001 * max(r0, r1) and error > 0.002 * math.sqrt(2) * inch:
+            raise self.error(number, f"{name}: the start is {r0:g} from the centre and the end {r1:g}; LinuxCNC refuses radii that differ this much")
+        turns = 1
+        if turn_count is not None:
+            if turn_count != int(turn_count) or turn_count < 1:
+                raise self.error(number, f"{name}: P{turn_count:g} must be a whole number of turns, at least 1")
+            turns = int(turn_count)
+        for point in arc_points(start, end, self.plane, ca, cb, turns if self.motion == 30 else -turns, self.arc_tolerance):
             self.add(number, point)
             self.position = point
+
+
+def arc_points(start: list[float], end: list[float], plane: int, ca: float, cb: float, rotation: int,
+               tolerance: float) -> list[list[float]]:
+    """The chords of an arc (helical along the plane's normal) from ``start`` to ``end`` about the centre
+    (``ca``, ``cb``) in ``plane`` (170 XY, 180 ZX, 190 YZ): ends of chords at most ``tolerance`` from the arc.
+
+    ``rotation`` is LinuxCNC's (ARC_FEED): positive counterclockwise, negative clockwise, and
+    ``abs(rotation) - 1`` more full turns; the last point is ``end`` exactly.
+    """
+    first, second, normal = PLANES[plane]
+    a0, b0, a1, b1 = start[first], start[second], end[first], end[second]
+    t0, t1 = math.atan2(b0 - cb, a0 - ca), math.atan2(b1 - cb, a1 - ca)
+    sweep = t1 - t0
+    if rotation > 0:
+        sweep = (sweep if sweep > 0 else sweep + 2 * math.pi) + 2 * math.pi * (rotation - 1)
+    else:
+        sweep = (sweep if sweep < 0 else sweep - 2 * math.pi) - 2 * math.pi * (-rotation - 1)
+    radius = (math.hypot(a0 - ca, b0 - cb) + math.hypot(a1 - ca, b1 - cb)) / 2
+    # a chord of angle step is at most radius·(1 − cos(step/2)) from its arc
+    step = 2 * math.acos(1 - tolerance / radius) if tolerance < radius else math.pi / 2
+    count = max(2, math.ceil(abs(sweep) / min(step, math.pi / 2)))
+    points = []
+    for k in range(1, count):
+        f = k / count
+        t = t0 + sweep * f
+        point = list(end)
+        point[first] = ca + radius * math.cos(t)
+        point[second] = cb + radius * math.sin(t)
+        point[normal] = start[normal] + (end[normal] - start[normal]) * f
+        points.append(point)
+    points.append(list(end))
+    return points
 
 
 class Progress:
