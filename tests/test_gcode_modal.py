@@ -111,3 +111,26 @@ def test_full_turns_and_radii_that_differ():
         parse_gcode("G21 F1\nG1 X10\nG3 X-11 Y0 I-10 J0\n", arc_tolerance=0.01)
     with pytest.raises(ValueError, match=r"line 3: G2 .*: R1 cannot join points 4 apart"):
         parse_gcode("G21 F1\nG1 X10\nG2 X14 R1\n", arc_tolerance=0.01)
+
+
+def sliver_program(leftover: float) -> str:
+    """Two right-angle corners whose roundings leave ``leftover`` of straight line between them (0.5 mm tolerance)."""
+    from spiral_cad.formats.gcode import round_toolpath
+
+    def text(side: float) -> str:
+        return f"G21 G90\nG1 X0 Y0\nG1 X10 Y0\nG1 X10 Y{side:.17g}\nG1 X20 Y{side:.17g}\n"
+
+    between = float(round_toolpath(parse_gcode(text(10.0)), max_deviation=0.5).chain.lengths[3])
+    return text(10.0 - between + leftover)
+
+
+def test_a_sliver_names_the_gcode_line_of_its_move():
+    from spiral_cad.formats.gcode import round_toolpath, segment_lines
+
+    path = parse_gcode(sliver_program(4e-8), "sliver.nc")
+    with pytest.raises(ValueError, match=r"sliver.nc line 4: the rounded path's segment 3 \(Line, length 4e-08 mm\) is shorter than OCCT's 1e-07"):
+        round_toolpath(path, max_deviation=0.5)
+    fine = round_toolpath(parse_gcode(sliver_program(1e-6)), max_deviation=0.5)
+    assert segment_lines(fine, path).tolist() == [3, 3, 3, 4, 4, 4, 5]  # straight pieces: their move; spirals: the corner's
+    pytest.importorskip("OCP")
+    fine.chain.to_wire()  # OCCT takes a leftover line of 1e-6

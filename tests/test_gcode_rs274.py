@@ -129,3 +129,18 @@ def test_read_gcode_takes_the_interpreter(tmp_path):
     file.write_text("G20 F1\n#100=0.5\nG1 X#100\nG1 Y[#100*3]\nM2\n", encoding="utf-8")
     path = read_gcode(file, interpreter="rs274")
     assert path.units == "in" and path.points.tolist() == [[0.5, 0, 0], [0.5, 1.5, 0]] and path.source == "p.ngc"
+
+
+@needs_rs274
+def test_build_from_gcode_with_the_rs274_interpreter(tmp_path, capsys):
+    from spiral_cad.cli import main
+
+    program = tmp_path / "loop.ngc"
+    program.write_text("G21 G90 F100\n#100=0\no1 while [#100 LT 4]\nG1 X[#100*10] Y[#100 MOD 2 * 10]\n#100=[#100+1]\no1 endwhile\nG2 X30 Y0 I0 J-5\nM2\n",
+                       encoding="utf-8")  # fmt: skip
+    out = tmp_path / "out"
+    argv = ["build", "--from-gcode", str(program), "--max-deviation", "0.05", "--no-plots", "--out", str(out)]
+    assert main([*argv, "--interpreter", "rs274", "--arc-tolerance", "0.01"]) == 0
+    assert (out / "loop_samples.csv").exists()
+    assert main([*argv, "--interpreter", "builtin"]) == 2
+    assert "parameters, expressions and O-words are not read by the built-in reader" in capsys.readouterr().err

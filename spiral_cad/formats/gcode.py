@@ -45,7 +45,9 @@ import re
 import sys
 import time
 from dataclasses import dataclass
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
+from contextvars import ContextVar
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -415,6 +417,21 @@ def arc_points(start: list[float], end: list[float], plane: int, ca: float, cb: 
     return points
 
 
+#: How ``read_gcode`` reads when its caller does not say (set by ``reading_options``).
+_DEFAULTS: ContextVar[tuple[str, float | None]] = ContextVar("gcode_reading", default=("builtin", None))
+
+
+@contextmanager
+def reading_options(interpreter: str = "builtin", arc_tolerance: float | None = None) -> Iterator[None]:
+    """Within the block, ``read_gcode`` calls that do not name them use this interpreter and arc
+    tolerance (how ``build --from-gcode --interpreter rs274`` reaches the design file's reader)."""
+    token = _DEFAULTS.set((interpreter, arc_tolerance))
+    try:
+        yield
+    finally:
+        _DEFAULTS.reset(token)
+
+
 class Progress:
     """Progress lines on stderr for a job that has run longer than ``after`` seconds, at most one every ``every``."""
 
@@ -478,7 +495,7 @@ def parse_gcode(text: str, source: str = "G-code", *, arc_tolerance: float | Non
     return GcodePath(np.array(reader.points), np.array(reader.lines), np.array(reader.rapid), reader.units, source, tuple(reader.notes))
 
 
-def read_gcode(path: str | os.PathLike, *, arc_tolerance: float | None = None, interpreter: str = "builtin") -> GcodePath:
+def read_gcode(path: str | os.PathLike, *, arc_tolerance: float | None = None, interpreter: str | None = None) -> GcodePath:
     """Read the straight moves of a G-code file (named ``*.nc``, ``.ngc``, ``.gcode``, ``.gc``, ``.g``,
     ``.tap``, ``.cnc``, ``.mpt`` or ``.mpf``).
 
@@ -504,7 +521,36 @@ def read_gcode(path: str | os.PathLike, *, arc_tolerance: float | None = None, i
     except UnicodeDecodeError as error:
         line = data[: error.start].count(b"\n") + 1
         raise ValueError(f"{label} line {line}: byte {data[error.start]:#04x} is not UTF-8 text") from None
+    if interpreter is None:  # neither given: what reading_options set (the built-in reader, arcs refused)
+        interpreter, default_tolerance = _DEFAULTS.get()
+        arc_tolerance = default_tolerance if arc_tolerance is None else arc_tolerance
     return parse_gcode(text, label, arc_tolerance=arc_tolerance, interpreter=interpreter)
+
+
+#: OCCT's Precision::Confusion (model units): two points closer than this are one point, so no edge is shorter.
+OCCT_CONFUSION = 1e-7
+
+
+def segment_lines(rounded: RoundedPath, path: GcodePath) -> NDArray:
+    """The G-code line of every segment of ``rounded.chain`` (rounded from ``path``): a corner's
+    spirals take the line of the move that ends at the corner, a straight piece the line of its move."""
+    kind = np.asarray(rounded.chain.rows.kind)
+    corner_of = np.cumsum(kind != 0) - 1  # the spiral's number along the chain
+    index = np.array([c.index for c in rounded.corners], dtype=np.int64)
+    lines = np.empty(len(kind), dtype=np.int64)
+    spiral = kind != 0
+    if spiral.sum() == 2 * len(index):  # two spirals a corner, in order
+        lines[spiral] = path.lines[index[corner_of[spiral] // 2]]
+        # a straight piece runs from the previous corner to the next point: the move that ends there
+        after = np.searchsorted(np.flatnonzero(spiral), np.flatnonzero(~spiral))  # spirals before each straight piece
+        ahead = after // 2  # the corner the straight piece leads to (len(index) past the last corner)
+        ends = np.where(ahead < len(index), index[np.minimum(ahead, len(index) - 1)] if len(index) else 0, len(path) - 1)
+        lines[~spiral] = path.lines[ends]
+    else:  # another layout: the line of the nearest point to each segment's middle
+        middles = np.asarray(rounded.chain.segment_ends).mean(axis=1)
+        for i, middle in enumerate(middles):
+            lines[i] = path.lines[int(np.argmin(np.linalg.norm(path.points - middle, axis=1)))]
+    return lines
 
 
 def round_toolpath(path: GcodePath, **options) -> RoundedPath:
@@ -519,7 +565,22 @@ def round_toolpath(path: GcodePath, **options) -> RoundedPath:
 
     if "units" in options:
         raise ValueError("units: the program's own (G20/G21); convert the path with GcodePath.in_units first")
+    progress = Progress(f"rounding {path.source}: {len(path):,} points")
     try:
-        return round_corners(path.points, units=path.units, **options)
+        rounded = round_corners(path.points, units=path.units, **options)
     except ValueError as error:
         raise type(error)(f"{path.source}: {path.at_lines(str(error))}") from None
+    progress.shown = time.monotonic() - progress.started > 3.0  # say how long a long rounding took
+    progress.done(len(path))
+    lengths = np.asarray(rounded.chain.lengths)
+    short = np.flatnonzero(lengths <= OCCT_CONFUSION)
+    if short.size:
+        i = int(short[0])
+        kind = ("Line", "Arc", "BezierSpiral")[int(np.asarray(rounded.chain.rows.kind)[i])]
+        line = int(segment_lines(rounded, path)[i])
+        raise ValueError(
+            f"{path.source} line {line}: the rounded path's segment {i} ({kind}, length {lengths[i]:.3g} {path.units}) is shorter "
+            f"than OCCT's {OCCT_CONFUSION:g} and cannot be an OCCT edge ({short.size} such segment(s)); "
+            "change the tolerance slightly, or move the corner's points"
+        )
+    return rounded
