@@ -151,7 +151,9 @@ def test_huge_and_tiny_coordinates():
     big = parse_gcode("G21\nG1 X1e0\n".replace("X1e0", "X" + "1" + "0" * 300) + "G1 Y" + "1" + "0" * 300 + "\n")
     assert math.isclose(big.points[-1][1], 1e300)
     tiny = parse_gcode("G21\nG1 X0.000001\nG1 Y0.000001\nG1 Z0.000001\n")
-    assert round_toolpath(tiny, max_deviation=1e-8).chain.dim == 3
+    assert round_toolpath(tiny, max_deviation=1e-8, for_occt=False).chain.dim == 3
+    with pytest.raises(ValueError, match=r"line 3: the rounded path's segment 1 \(BezierSpiral, length .* mm\) is shorter than OCCT's 1e-07"):
+        round_toolpath(tiny, max_deviation=1e-8)  # legs of 1e-6 mm: no STEP edge can be that short
 
 
 # ------------------------------------------------------------ the command line and design files

@@ -553,10 +553,12 @@ def segment_lines(rounded: RoundedPath, path: GcodePath) -> NDArray:
     return lines
 
 
-def round_toolpath(path: GcodePath, **options) -> RoundedPath:
+def round_toolpath(path: GcodePath, *, for_occt: bool = True, **options) -> RoundedPath:
     """The G2 rounding of a toolpath's polyline (``spiral_cad.design.round_corners`` with ``options``:
     ``max_deviation``, ``max_curvature``, ``shape``, …) in the program's unit; an error names the
-    G-code line of the corner or point it is about.
+    G-code line of the corner or point it is about. With ``for_occt`` (the default), a segment
+    shorter than OCCT's point tolerance (1e-7 model units, so never a STEP edge) is refused here,
+    naming the G-code line of its move (``segment_lines``), rather than later by OCCT by index only.
 
     Raises:
         ValueError, NoSolutionError: as ``round_corners``, with the line.
@@ -573,14 +575,14 @@ def round_toolpath(path: GcodePath, **options) -> RoundedPath:
     progress.shown = time.monotonic() - progress.started > 3.0  # say how long a long rounding took
     progress.done(len(path))
     lengths = np.asarray(rounded.chain.lengths)
-    short = np.flatnonzero(lengths <= OCCT_CONFUSION)
-    if short.size:
+    short = np.flatnonzero(lengths <= OCCT_CONFUSION) if for_occt else ()
+    if len(short):
         i = int(short[0])
         kind = ("Line", "Arc", "BezierSpiral")[int(np.asarray(rounded.chain.rows.kind)[i])]
         line = int(segment_lines(rounded, path)[i])
         raise ValueError(
             f"{path.source} line {line}: the rounded path's segment {i} ({kind}, length {lengths[i]:.3g} {path.units}) is shorter "
-            f"than OCCT's {OCCT_CONFUSION:g} and cannot be an OCCT edge ({short.size} such segment(s)); "
+            f"than OCCT's {OCCT_CONFUSION:g} and cannot be an OCCT edge ({len(short)} such segment(s)); "
             "change the tolerance slightly, or move the corner's points"
         )
     return rounded
