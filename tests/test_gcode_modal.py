@@ -134,3 +134,38 @@ def test_a_sliver_names_the_gcode_line_of_its_move():
     assert segment_lines(fine, path).tolist() == [3, 3, 3, 4, 4, 4, 5]  # straight pieces: their move; spirals: the corner's
     pytest.importorskip("OCP")
     fine.chain.to_wire()  # OCCT takes a leftover line of 1e-6
+
+
+def test_arrays_round_as_the_chain_does_and_name_lines():
+    from spiral_cad.formats.gcode import round_toolpath, round_toolpath_arrays
+
+    text = "G21 G90 F1\nG1 X0 Y0 Z0\n" + "".join(f"G1 X{(i % 2) * 10 + i * 0.1:.4f} Y{i * 2:.4f} Z{-0.1 * i:.4f}\n" for i in range(1, 40))
+    path = parse_gcode(text, "zigzag.nc")
+    arrays = round_toolpath_arrays(path, max_deviation=0.05)
+    chain = round_toolpath(path, max_deviation=0.05)
+    assert arrays.index.tolist() == [c.index for c in chain.corners] and arrays.lines.tolist() == (arrays.index + 2).tolist()
+    expected = np.array([[s.control_points for s in c.spirals] for c in chain.corners])
+    assert np.array_equal(arrays.control_points, expected)
+    assert np.allclose(arrays.deviation, 0.05) and np.array_equal(arrays.curvature, [c.curvature for c in chain.corners])
+    with pytest.raises(ValueError, match=r"zigzag.nc: corner 1 \(line 3\) at \(10.1, 2, -0.1\): curvature 0.5 needs .* \(38 corners fail\)"):
+        round_toolpath_arrays(path, max_curvature=0.5)
+    with pytest.raises(ValueError, match=r"max_deviation must be one positive finite number here"):
+        round_toolpath_arrays(path, max_deviation=[0.1])
+
+
+def test_long_jobs_say_they_are_still_running(capsys):
+    import time
+
+    from spiral_cad.formats.gcode import Progress, ticking
+
+    with ticking("rounding x.nc", after=0.05, every=0.05):
+        time.sleep(0.3)
+    progress = Progress("reading x.nc", 10, after=0.0, every=0.0)
+    progress(5)
+    progress.done(10)
+    err = capsys.readouterr().err
+    assert "rounding x.nc: still running (0 s)" in err and "rounding x.nc: done in 0.3 s" in err
+    assert "reading x.nc: 5 of 10 (0 s)" in err and "reading x.nc: 10 done in" in err
+    with ticking("quick", after=5.0):
+        pass
+    assert capsys.readouterr().err == ""  # a quick job says nothing

@@ -455,6 +455,32 @@ class Progress:
             print(f"{self.what}: {count:,} done in {time.monotonic() - self.started:.1f} s", file=sys.stderr, flush=True)
 
 
+@contextmanager
+def ticking(what: str, after: float = 3.0, every: float = 5.0) -> Iterator[None]:
+    """While the block runs longer than ``after`` seconds, a line on stderr every ``every`` seconds
+    saying it still runs (for one long call that cannot count its own progress), and its time at the end."""
+    import threading
+
+    stop = threading.Event()
+    started = time.monotonic()
+
+    def tick() -> None:
+        wait = after
+        while not stop.wait(wait):
+            print(f"{what}: still running ({time.monotonic() - started:.0f} s)", file=sys.stderr, flush=True)
+            wait = every
+
+    thread = threading.Thread(target=tick, daemon=True)
+    thread.start()
+    try:
+        yield
+    finally:
+        stop.set()
+        thread.join()
+        if time.monotonic() - started > after:
+            print(f"{what}: done in {time.monotonic() - started:.1f} s", file=sys.stderr, flush=True)
+
+
 def parse_gcode(text: str, source: str = "G-code", *, arc_tolerance: float | None = None, interpreter: str = "builtin") -> GcodePath:
     """The moves of G-code ``text`` (see the module docstring).
 
@@ -567,13 +593,11 @@ def round_toolpath(path: GcodePath, *, for_occt: bool = True, **options) -> Roun
 
     if "units" in options:
         raise ValueError("units: the program's own (G20/G21); convert the path with GcodePath.in_units first")
-    progress = Progress(f"rounding {path.source}: {len(path):,} points")
     try:
-        rounded = round_corners(path.points, units=path.units, **options)
+        with ticking(f"rounding {path.source} ({len(path):,} points)"):
+            rounded = round_corners(path.points, units=path.units, **options)
     except ValueError as error:
         raise type(error)(f"{path.source}: {path.at_lines(str(error))}") from None
-    progress.shown = time.monotonic() - progress.started > 3.0  # say how long a long rounding took
-    progress.done(len(path))
     lengths = np.asarray(rounded.chain.lengths)
     short = np.flatnonzero(lengths <= OCCT_CONFUSION) if for_occt else ()
     if len(short):
@@ -586,3 +610,72 @@ def round_toolpath(path: GcodePath, *, for_occt: bool = True, **options) -> Roun
             "change the tolerance slightly, or move the corner's points"
         )
     return rounded
+
+
+@dataclass(frozen=True)
+class ToolpathCorners:
+    """The G2 rounding of a toolpath as arrays, one row per rounded corner (no object per move).
+
+    Between corners the path runs straight along the program's moves, so the corners and
+    ``points`` are the whole path; ``round_toolpath`` builds the same spirals as a ``Chain``
+    (for STEP, IGES, samples), at far higher cost in time and memory on long programs.
+
+    Attributes:
+        index: (k,) the point of ``path.points`` each corner is at.
+        lines: (k,) the G-code line of each corner (the move that ends there).
+        control_points: (k, 2, 4, 3) the corner's two Bézier spirals in travel order.
+        curvature: (k,) the pair's peak |κ| (1/unit).
+        deviation: (k,) the distance from the corner point to the path (unit).
+        units: the program's unit.
+        shape: the spiral shape.
+    """
+
+    index: NDArray
+    lines: NDArray
+    control_points: NDArray
+    curvature: NDArray
+    deviation: NDArray
+    units: str
+    shape: str
+
+    def __len__(self) -> int:
+        return len(self.index)
+
+
+def round_toolpath_arrays(path: GcodePath, *, shape: str = "walton-meek", max_deviation: float | None = None,
+                          max_curvature: float | None = None, curvature: float | None = None,
+                          spiral_lengths: float | None = None) -> ToolpathCorners:
+    """Round every corner of a toolpath G2 as ``round_toolpath`` does, into arrays (one value per
+    option for every corner): what a program of millions of moves needs.
+
+    Raises:
+        NoSolutionError: a corner that cannot be rounded as asked (its point, G-code line and numbers).
+        ValueError: malformed options or points (two moves to one point are one point: never here).
+    """
+    from ..core.errors import NoSolutionError, Status
+    from ..design.rounding import corner_legs, round_corners_batch
+
+    options = {"max_deviation": max_deviation, "max_curvature": max_curvature, "curvature": curvature,
+               "spiral_lengths": spiral_lengths}  # fmt: skip
+    for name, value in options.items():
+        if value is not None and not (isinstance(value, (int, float)) and 0.0 < value < math.inf):
+            raise ValueError(f"{name} must be one positive finite number here; got {value!r:.40}")
+    given = {name: value for name, value in options.items() if value is not None}
+    with ticking(f"rounding {path.source} ({len(path):,} points)"):
+        try:
+            p0, corners, p1, index = corner_legs(path.points)
+        except ValueError as error:
+            raise ValueError(f"{path.source}: {path.at_lines(str(error))}") from None
+        result = round_corners_batch(p0, corners, p1, shape=shape, **given)
+    bad = np.flatnonzero(~result.ok)
+    if bad.size:
+        j = int(bad[0])
+        message = result.reason(j, label=f"corner {index[j]} (line {int(path.lines[index[j]])})")
+        refused = NoSolutionError if result.status[j] in (Status.LEGS_TOO_SHORT, Status.CORNER_REVERSAL, Status.UNVERIFIED,
+                                                           Status.OUTSIDE_SHAPE) else ValueError  # fmt: skip
+        raise refused(f"{path.source}: {message}" + (f" ({bad.size:,} corners fail)" if bad.size > 1 else ""))
+    control = result.control_points
+    if control.shape[-1] == 2:  # a flat program is rounded in its plane: back to x, y, z
+        control = np.concatenate([control, np.full(control.shape[:-1] + (1,), path.points[0, 2])], axis=-1)
+    return ToolpathCorners(index, path.lines[index], control, result.curvature, result.deviation, path.units, shape)
+
