@@ -1,40 +1,54 @@
-"""G-code in: the straight moves of a CNC program as a polyline, in a small, documented subset.
+"""G-code in: the moves of a CNC program as a polyline, read as LinuxCNC reads RS274/NGC.
 
-What is read (anything else is refused with its line number and the word):
+Two readers (``interpreter=``): the built-in one below, and ``"rs274"``, LinuxCNC's own
+interpreter run as a program (full NGC: parameters, expressions, O-word subroutines and
+loops, canned cycles; see ``spiral_cad.formats.rs274``).
 
-* words are a letter and a decimal number of ASCII digits (``X-1.5``,
-  ``x .5``, ``G01``; no exponents), upper or lower case, spaces allowed
-  between words, after the letter and after a sign;
-* ``G0``/``G00`` (rapid) and ``G1``/``G01`` (feed) straight moves with
-  ``X``, ``Y``, ``Z``; the motion mode is modal (a line of coordinates alone
-  moves as the last G0/G1 did); an axis a move does not name keeps its value,
-  and every axis starts at 0;
-* ``G90`` absolute and ``G91`` incremental coordinates (absolute at the start);
-* ``G20`` inch and ``G21`` mm: one of them must come before the first move
-  (a CNC path in the wrong unit is worse than none), and the unit may not
-  change after it;
-* states that do not change the path are accepted and ignored: ``G17``
-  (XY plane), ``G40`` (no cutter compensation), ``G49`` (no tool length
-  offset), ``G54`` (the first work offset: coordinates are read as written),
-  ``G80`` (no canned cycle), ``G94`` (feed per minute), ``F``, ``S``, ``T``,
-  ``N`` (line numbers), ``M3``–``M9`` (spindle, tool change, coolant); ``M2``
-  and ``M30`` end the program (nothing after them is read);
-* comments ``( … )`` and ``; …`` to the end of the line, blank lines and
-  ``%`` lines.
+What the built-in reader reads (anything else is refused with its line number and the word):
 
-Refused by name, with the line: arcs ``G2``/``G3`` (have the CAM output
-straight moves, or linearise the arcs first), every other G and M code
-(``G28`` homing, ``G81`` drilling cycles, ``G55``–``G59`` work offsets, …),
-other words (``A``, ``B``, ``C``, ``I``, ``J``, ``K``, ``R``, ``P``, …), two
-motion codes on one line, coordinates with no motion mode in effect, numbers
-that are not finite, text that is not a word (``X1e3``, ``X--1``), an
-unclosed comment, control characters (line breaks are ``\n``, ``\r\n`` or
-``\r``; a vertical tab, form feed or Unicode line separator is refused, not
-read as a line break), lines longer than 65 536 characters, and bytes that
-are not UTF-8.
+* words are a letter and a decimal number of ASCII digits (``X-1.5``, ``x .5``, ``G01``;
+  no exponents), upper or lower case, spaces allowed between words, after the letter and
+  after a sign; ``N`` line numbers; a leading ``/`` (block delete; LinuxCNC's switch is off,
+  so the line runs);
+* ``G0`` (rapid) and ``G1`` (feed) straight moves with ``X``, ``Y``, ``Z``, modal as in
+  LinuxCNC (a line of coordinates alone moves as the last motion code did); an axis a move
+  does not name keeps its value, and every axis starts at 0;
+* arcs ``G2``/``G3`` (``I``, ``J``, ``K`` offsets or centre under ``G90.1``, or ``R``; ``P``
+  full turns; helical with the plane's normal axis) in the ``G17``/``G18``/``G19`` plane, as
+  chords within ``arc_tolerance`` when it is given (refused by name otherwise), with
+  LinuxCNC's tolerance on radii that differ;
+* ``G90``/``G91`` absolute/incremental coordinates, ``G90.1``/``G91.1`` arc centres;
+* ``G20`` inch and ``G21`` mm: one of them must come before the first move (a CNC path in
+  the wrong unit is worse than none), and the unit may not change after it;
+* states that do not change the path: ``G40``, ``G49``, ``G54``–``G59.3`` (work offsets: a
+  program that does not set them with G10, which is refused, is read in their common frame),
+  ``G61``, ``G61.1``, ``G64`` (``P``, ``Q``), ``G80`` (motion cancelled: coordinates after it
+  are refused, as LinuxCNC does), ``G93``–``G95``, ``G96``/``G97`` (``D``), ``G98``/``G99``,
+  ``G8``, ``G4`` dwell (``P``); ``F``, ``S``, ``T``; ``M0``, ``M1``, ``M60`` (pauses),
+  ``M3``–``M5``, ``M7``–``M9``, ``M6`` (tool change: kept as a note, no move), ``M48``–``M53``;
+  ``M2`` and ``M30`` end the program;
+* ``%``: a first line ``%`` opens the program and the next ``%`` ends it (nothing after it is
+  read, as LinuxCNC); a program opened with ``%`` must close it or end with M2/M30;
+* comments ``( … )`` and ``; …`` to the end of the line, blank lines.
 
-A move that ends where it started is not a point of the path (it would be a
-corner of no length); the path's first point is where the first move ends.
+LinuxCNC's modal rules: two codes of one modal group on a line (``G90 G91``, ``G20 G21``,
+``G0 G1``, ``M3 M5``) are refused, naming the line, both words and the group.
+
+Refused by name, with the line: canned cycles ``G73``–``G89`` (use ``interpreter="rs274"``,
+which expands them), ``G28``/``G30`` (moves to a home position the program does not state),
+``G10``, ``G52``, ``G53``, ``G92`` (offsets), cutter compensation ``G41``/``G42``, tool length
+offsets ``G43``, ``G33``, probing ``G38``, splines and NURBS ``G5``–``G6.2``, ``G7``,
+parameters (``#``), expressions (``[``) and O-words (use ``interpreter="rs274"``), other words
+(``A``, ``B``, ``C``, ``U``, ``V``, ``W``, ``L``, ``H``, ``E``, …), numbers that are not finite,
+text that is not a word (``X1e3``, ``X--1``), an unclosed comment, control characters (line
+breaks are ``\n``, ``\r\n`` or ``\r``; a vertical tab, form feed or Unicode line separator is
+refused, not read as a line break), lines longer than 65 536 characters, and bytes that are
+not UTF-8. LinuxCNC also refuses a program with neither M2/M30 nor ``%``; this reader takes the
+end of the file as its end.
+
+A move that ends where it started is not a point of the path (it would be a corner of no
+length); the path's first point is where the first move ends. Long reads and roundings say
+on stderr that they are still running.
 """
 
 from __future__ import annotations
