@@ -47,12 +47,18 @@ def peak_mb() -> float:
 
 def child(job: str, moves: int) -> None:
     """One job in this process; prints its seconds and peak memory as JSON."""
-    from spiral_cad.formats.gcode import read_gcode, round_toolpath, round_toolpath_arrays
-
-    from spiral_cad.formats.gcode import parse_gcode
+    from spiral_cad.formats.gcode import (
+        parse_gcode,
+        read_gcode,
+        round_toolpath,
+        round_toolpath_arrays,
+    )
 
     warm = parse_gcode(program(50))  # compile the kernels first (one warm-up, as compare does)
-    round_toolpath(warm, max_deviation=MAX_DEVIATION, for_occt=False) if job == "chain" else round_toolpath_arrays(warm, max_deviation=MAX_DEVIATION)
+    if job == "chain":
+        round_toolpath(warm, max_deviation=MAX_DEVIATION, for_occt=False)
+    else:
+        round_toolpath_arrays(warm, max_deviation=MAX_DEVIATION)
     with tempfile.TemporaryDirectory() as folder:
         file = os.path.join(folder, f"pocket{moves}.nc")
         with open(file, "w", encoding="ascii") as handle:
@@ -75,7 +81,7 @@ def child(job: str, moves: int) -> None:
 
 
 def run(job: str, moves: int) -> dict:
-    done = subprocess.run([sys.executable, __file__, "--child", job, str(moves)], capture_output=True, text=True)
+    done = subprocess.run([sys.executable, __file__, "--child", job, str(moves)], capture_output=True, text=True, check=False)
     if done.returncode != 0:
         raise SystemExit(f"{job} {moves}: {done.stderr[-2000:]}")
     return json.loads(done.stdout.strip().splitlines()[-1])

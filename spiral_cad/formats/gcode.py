@@ -58,10 +58,10 @@ import os
 import re
 import sys
 import time
-from dataclasses import dataclass
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from contextvars import ContextVar
+from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -358,7 +358,7 @@ class _Reader:
         name = "G2 (a clockwise arc)" if self.motion == 20 else "G3 (a counterclockwise arc)"
         if self.arc_tolerance is None:
             raise self.error(number, f"{name} is refused: only straight moves (G0, G1) are read unless arc_tolerance is given (arcs become chords within it); have the CAM write straight moves, or linearise the arcs first")
-        first, second, normal = PLANES[self.plane]
+        first, second, _ = PLANES[self.plane]
         offsets = {170: "IJ", 180: "KI", 190: "JK"}[self.plane]
         start = self.position
         a0, b0, a1, b1 = start[first], start[second], end[first], end[second]

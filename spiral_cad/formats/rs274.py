@@ -93,7 +93,7 @@ def run_rs274(text: str, source: str = "G-code", *, arc_tolerance: float | None 
         output = os.path.join(folder, "canon.txt")
         with open(program, "w", encoding="utf-8") as file:
             file.write(numbered(text))
-        done = subprocess.run([executable, "-g", program, output], cwd=folder, stdin=subprocess.DEVNULL,
+        done = subprocess.run([executable, "-g", program, output], check=False, cwd=folder, stdin=subprocess.DEVNULL,
                               stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True, errors="replace")  # fmt: skip
         messages = [m for m in done.stderr.splitlines() if m.strip() and m.strip() != "executing"]
         if done.returncode != 0 or messages:
