@@ -210,6 +210,9 @@ def test_an_inch_program_is_converted_to_the_outputs_unit(tmp_path):
         (["--from-gcode", "pocket.nc", "--max-deviation", "1", "--sample-step", "1", "--chord-tolerance", "1"], r"not both"),
         (["--from-gcode", "pocket.nc", "--max-deviation", "0.001", "--max-curvature", "1"], r"corner 2 \(line 9\) at \(5, 5, -1\): .*above max_curvature 1"),
         (["design.json", "--max-deviation", "1"], r"--max-deviation: only with --from-gcode"),
+        (["design.json", "--interpreter", "rs274"], r"--interpreter: only with --from-gcode"),
+        (["--from-gcode", "with_arcs.nc", "--max-deviation", "0.05"], r"with_arcs.nc line 5: G2 \(a clockwise arc\) is refused"),
+        (["--from-gcode", "with_arcs.nc", "--max-deviation", "0.05", "--arc-tolerance", "0"], r"arc_tolerance must be a positive finite length; got 0.0"),
         ([], r"give a design file, or --from-gcode"),
     ],
 )

@@ -169,3 +169,18 @@ def test_long_jobs_say_they_are_still_running(capsys):
     with ticking("quick", after=5.0):
         pass
     assert capsys.readouterr().err == ""  # a quick job says nothing
+
+
+def test_build_from_gcode_reads_arcs_with_an_arc_tolerance(tmp_path):
+    from pathlib import Path
+
+    from spiral_cad.cli import main
+
+    program = Path(__file__).parent / "gcode" / "with_arcs.nc"
+    out = tmp_path / "out"
+    argv = ["build", "--from-gcode", str(program), "--max-deviation", "0.05", "--arc-tolerance", "0.005", "--no-plots", "--out", str(out)]
+    assert main(argv) == 0
+    table = np.loadtxt(out / "with_arcs_samples.csv", delimiter=",", skiprows=1)
+    # G2 from (20, 0) to (30, 10) about (20, 10) is clockwise: three quarters of a circle, by (10, 10) and (20, 20)
+    on_arc = (table[:, 1] < 19.0) & (table[:, 2] > 1.0)
+    assert on_arc.any() and np.abs(np.hypot(table[on_arc, 1] - 20, table[on_arc, 2] - 10) - 10).max() < 0.06
