@@ -144,3 +144,18 @@ def test_build_from_gcode_with_the_rs274_interpreter(tmp_path, capsys):
     assert (out / "loop_samples.csv").exists()
     assert main([*argv, "--interpreter", "builtin"]) == 2
     assert "parameters, expressions and O-words are not read by the built-in reader" in capsys.readouterr().err
+
+
+@needs_rs274
+def test_a_program_that_never_ends_is_stopped():
+    endless = "G21 F100\n#100=0\no1 while [1]\nG1 X[#100 MOD 2]\n#100=[#100+1]\no1 endwhile\nM2\n"
+    with pytest.raises(ValueError, match=r"endless.ngc: rs274 was still running after 2 s \(a loop that never ends\?\); stopped"):
+        rs274.run_rs274(endless, "endless.ngc", timeout=2)
+
+
+@needs_rs274
+def test_a_program_that_prints_without_end_is_stopped_by_size(monkeypatch):
+    monkeypatch.setattr(rs274, "MAX_OUTPUT", 1 << 20)
+    endless = "G21 F100\n#100=0\no1 while [1]\nG1 X[#100 MOD 2]\n#100=[#100+1]\no1 endwhile\nM2\n"
+    with pytest.raises(ValueError, match=r"rs274 printed more than 1 MB of moves"):
+        rs274.run_rs274(endless, "endless.ngc", timeout=60)

@@ -39,10 +39,11 @@ import re
 import shutil
 import subprocess
 import tempfile
+import time
 
 import numpy as np
 
-from .gcode import GcodePath, Progress, arc_points
+from .gcode import GcodePath, Progress, arc_points, ticking
 
 #: The Debian package that has ``rs274``.
 PACKAGE = "linuxcnc-uspace"
@@ -77,13 +78,20 @@ def numbered(text: str) -> str:
     return "\n".join(out)
 
 
-def run_rs274(text: str, source: str = "G-code", *, arc_tolerance: float | None = None) -> GcodePath:
+#: The most canonical output read (bytes): a program's moves, not a loop's.
+MAX_OUTPUT = 4 << 30
+#: How long rs274 may run (seconds) before the program is taken for one that never ends (an O-word loop).
+TIMEOUT = 600.0
+
+
+def run_rs274(text: str, source: str = "G-code", *, arc_tolerance: float | None = None, timeout: float | None = None) -> GcodePath:
     """The moves of G-code ``text`` as LinuxCNC's interpreter ``rs274`` executes them.
 
     Raises:
         ValueError: rs274 is not installed (naming the package), rs274 refused the program
             (its message and the line's text), a call that is not a straight move or an arc,
-            an arc without ``arc_tolerance``, fewer than two moves.
+            an arc without ``arc_tolerance``, fewer than two moves, or rs274 still running after
+            ``timeout`` seconds (default ``TIMEOUT``).
     """
     executable = rs274_executable()
     if executable is None:
@@ -93,13 +101,30 @@ def run_rs274(text: str, source: str = "G-code", *, arc_tolerance: float | None 
         output = os.path.join(folder, "canon.txt")
         with open(program, "w", encoding="utf-8") as file:
             file.write(numbered(text))
-        done = subprocess.run([executable, "-g", program, output], check=False, cwd=folder, stdin=subprocess.DEVNULL,
-                              stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True, errors="replace")  # fmt: skip
-        messages = [m for m in done.stderr.splitlines() if m.strip() and m.strip() != "executing"]
-        if done.returncode != 0 or messages:
+        limit = TIMEOUT if timeout is None else timeout
+        with ticking(f"rs274 reading {source}"), open(os.path.join(folder, "errors.txt"), "w+") as errors:
+            process = subprocess.Popen([executable, "-g", program, output], cwd=folder, stdin=subprocess.DEVNULL,
+                                       stdout=subprocess.DEVNULL, stderr=errors)  # fmt: skip
+            started = time.monotonic()
+            try:
+                while process.poll() is None:  # a loop that never ends would fill the disk: watch time and size
+                    time.sleep(0.05)
+                    if time.monotonic() - started > limit:
+                        raise ValueError(f"{source}: rs274 was still running after {limit:g} s (a loop that never ends?); stopped")
+                    if os.path.exists(output) and os.path.getsize(output) > MAX_OUTPUT:
+                        raise ValueError(f"{source}: rs274 printed more than {MAX_OUTPUT / 1e6:,.0f} MB of moves (a loop that never ends?); stopped")
+            finally:
+                if process.poll() is None:
+                    process.kill()
+                    process.wait()
+            errors.seek(0)
+            stderr = errors.read()
+        returncode = process.returncode
+        messages = [m for m in stderr.splitlines() if m.strip() and m.strip() != "executing"]
+        if returncode != 0 or messages:
             where = _N_WORD.match(messages[1]) if len(messages) > 1 else None
             line = f" line {where.group(0).strip(' /Nn')}" if where else ""
-            said = messages[0] if messages else f"exit status {done.returncode}"
+            said = messages[0] if messages else f"exit status {returncode}"
             raise ValueError(f"{source}{line}: rs274 refused the program: {said}")
         with open(output, encoding="utf-8", errors="replace") as file:
             return _moves(file, source, arc_tolerance)
