@@ -8,7 +8,7 @@ STAMP  := $(VENV)/.installed
 TOOLS       := .venv-tools
 TOOLS_STAMP := $(TOOLS)/.installed
 
-.PHONY: setup demo test check lint bench pictures clean
+.PHONY: setup demo test check lint bench pictures clean rs274
 
 $(STAMP): requirements.lock pyproject.toml
 	test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
@@ -33,7 +33,7 @@ demo: $(STAMP)
 	$(BIN)/spiral-cad demo --out out
 
 # Everything CI runs: lint, then every test.
-test: $(STAMP) $(TOOLS_STAMP) lint
+test: $(STAMP) $(TOOLS_STAMP) rs274 lint
 	SPIRAL_CAD_XODR_TOOLS=$(abspath $(TOOLS))/bin/python $(BIN)/python -m pytest -q
 
 # The fast tier while working: no slow, install or subprocess-heavy tests.
@@ -46,6 +46,14 @@ lint: $(STAMP)
 	$(BIN)/ruff format --check spiral_cad spiral_cad_launcher tests benchmarks examples docs
 	$(BIN)/mypy
 	$(BIN)/lint-imports
+
+# LinuxCNC's standalone G-code interpreter rs274 (Debian package linuxcnc-uspace) for the tests of
+# --interpreter rs274: installed when we are root on Debian; otherwise those tests skip, saying why.
+APT_RS274 := DEBIAN_FRONTEND=noninteractive apt-get install -y -q --no-install-recommends linuxcnc-uspace >/dev/null
+rs274:
+	@command -v rs274 >/dev/null || { [ "$$(id -u)" = 0 ] && command -v apt-get >/dev/null && \
+	  { $(APT_RS274) || { apt-get update -q >/dev/null && $(APT_RS274); }; }; } || \
+	  echo "note: LinuxCNC's rs274 (Debian package linuxcnc-uspace) could not be installed; its tests will skip"
 
 # Every benchmarks/bench_*.py, each in its own process, writing benchmarks/results_*.md
 # (the convention a script follows: benchmarks/timing.py).

@@ -134,7 +134,8 @@ def _paper_plots(folder: Path) -> None:
 
 
 #: ``build`` options that describe a ``--from-gcode`` design (a design file states them per design).
-GCODE_OPTIONS = ("max_deviation", "max_curvature", "shape", "sample_step", "chord_tolerance", "name", "units")
+GCODE_OPTIONS = ("max_deviation", "max_curvature", "shape", "sample_step", "chord_tolerance", "name", "units", "interpreter",
+                 "arc_tolerance")
 
 
 def _build(args: argparse.Namespace) -> int:
@@ -147,7 +148,10 @@ def _build(args: argparse.Namespace) -> int:
         return _write_design(args.design, Path(args.out), plots=not args.no_plots)
     if args.design is not None:
         raise ValueError("give a design file or --from-gcode, not both")
-    return _write_design(gcode_design(args), Path(args.out), plots=not args.no_plots)
+    from ..io.gcode import reading_options
+
+    with reading_options(args.interpreter or "builtin", args.arc_tolerance):
+        return _write_design(gcode_design(args), Path(args.out), plots=not args.no_plots)
 
 
 def gcode_design(args: argparse.Namespace) -> dict:
@@ -289,6 +293,10 @@ def _parser() -> argparse.ArgumentParser:
     gcode.add_argument("--units", choices=["mm", "cm", "m", "km", "in", "ft"],
                        help="the unit of the outputs and of every length above (default mm; the program's G20/G21 is converted)")  # fmt: skip
     gcode.add_argument("--name", help="the design's name (default: the program's file name)")
+    gcode.add_argument("--interpreter", choices=["builtin", "rs274"],
+                       help="builtin (default: straight moves and arcs, no parameters) or rs274 (LinuxCNC's own, full NGC; "
+                            "Debian package linuxcnc-uspace)")
+    gcode.add_argument("--arc-tolerance", type=float, help="read arcs G2/G3 as chords at most this far from the arc (default: arcs refused)")
     build.set_defaults(run=_build)
     _add_check(sub)
     schema = sub.add_parser("schema", help="print the JSON Schema of design files (the format of build)")

@@ -1,40 +1,54 @@
-"""G-code in: the straight moves of a CNC program as a polyline, in a small, documented subset.
+"""G-code in: the moves of a CNC program as a polyline, read as LinuxCNC reads RS274/NGC.
 
-What is read (anything else is refused with its line number and the word):
+Two readers (``interpreter=``): the built-in one below, and ``"rs274"``, LinuxCNC's own
+interpreter run as a program (full NGC: parameters, expressions, O-word subroutines and
+loops, canned cycles; see ``spiral_cad.io.rs274``).
 
-* words are a letter and a decimal number of ASCII digits (``X-1.5``,
-  ``x .5``, ``G01``; no exponents), upper or lower case, spaces allowed
-  between words, after the letter and after a sign;
-* ``G0``/``G00`` (rapid) and ``G1``/``G01`` (feed) straight moves with
-  ``X``, ``Y``, ``Z``; the motion mode is modal (a line of coordinates alone
-  moves as the last G0/G1 did); an axis a move does not name keeps its value,
-  and every axis starts at 0;
-* ``G90`` absolute and ``G91`` incremental coordinates (absolute at the start);
-* ``G20`` inch and ``G21`` mm: one of them must come before the first move
-  (a CNC path in the wrong unit is worse than none), and the unit may not
-  change after it;
-* states that do not change the path are accepted and ignored: ``G17``
-  (XY plane), ``G40`` (no cutter compensation), ``G49`` (no tool length
-  offset), ``G54`` (the first work offset: coordinates are read as written),
-  ``G80`` (no canned cycle), ``G94`` (feed per minute), ``F``, ``S``, ``T``,
-  ``N`` (line numbers), ``M3``–``M9`` (spindle, tool change, coolant); ``M2``
-  and ``M30`` end the program (nothing after them is read);
-* comments ``( … )`` and ``; …`` to the end of the line, blank lines and
-  ``%`` lines.
+What the built-in reader reads (anything else is refused with its line number and the word):
 
-Refused by name, with the line: arcs ``G2``/``G3`` (have the CAM output
-straight moves, or linearise the arcs first), every other G and M code
-(``G28`` homing, ``G81`` drilling cycles, ``G55``–``G59`` work offsets, …),
-other words (``A``, ``B``, ``C``, ``I``, ``J``, ``K``, ``R``, ``P``, …), two
-motion codes on one line, coordinates with no motion mode in effect, numbers
-that are not finite, text that is not a word (``X1e3``, ``X--1``), an
-unclosed comment, control characters (line breaks are ``\n``, ``\r\n`` or
-``\r``; a vertical tab, form feed or Unicode line separator is refused, not
-read as a line break), lines longer than 65 536 characters, and bytes that
-are not UTF-8.
+* words are a letter and a decimal number of ASCII digits (``X-1.5``, ``x .5``, ``G01``;
+  no exponents), upper or lower case, spaces allowed between words, after the letter and
+  after a sign; ``N`` line numbers; a leading ``/`` (block delete; LinuxCNC's switch is off,
+  so the line runs);
+* ``G0`` (rapid) and ``G1`` (feed) straight moves with ``X``, ``Y``, ``Z``, modal as in
+  LinuxCNC (a line of coordinates alone moves as the last motion code did); an axis a move
+  does not name keeps its value, and every axis starts at 0;
+* arcs ``G2``/``G3`` (``I``, ``J``, ``K`` offsets or centre under ``G90.1``, or ``R``; ``P``
+  full turns; helical with the plane's normal axis) in the ``G17``/``G18``/``G19`` plane, as
+  chords within ``arc_tolerance`` when it is given (refused by name otherwise), with
+  LinuxCNC's tolerance on radii that differ;
+* ``G90``/``G91`` absolute/incremental coordinates, ``G90.1``/``G91.1`` arc centres;
+* ``G20`` inch and ``G21`` mm: one of them must come before the first move (a CNC path in
+  the wrong unit is worse than none), and the unit may not change after it;
+* states that do not change the path: ``G40``, ``G49``, ``G54``–``G59.3`` (work offsets: a
+  program that does not set them with G10, which is refused, is read in their common frame),
+  ``G61``, ``G61.1``, ``G64`` (``P``, ``Q``), ``G80`` (motion cancelled: coordinates after it
+  are refused, as LinuxCNC does), ``G93``–``G95``, ``G96``/``G97`` (``D``), ``G98``/``G99``,
+  ``G8``, ``G4`` dwell (``P``); ``F``, ``S``, ``T``; ``M0``, ``M1``, ``M60`` (pauses),
+  ``M3``–``M5``, ``M7``–``M9``, ``M6`` (tool change: kept as a note, no move), ``M48``–``M53``;
+  ``M2`` and ``M30`` end the program;
+* ``%``: a first line ``%`` opens the program and the next ``%`` ends it (nothing after it is
+  read, as LinuxCNC); a program opened with ``%`` must close it or end with M2/M30;
+* comments ``( … )`` and ``; …`` to the end of the line, blank lines.
 
-A move that ends where it started is not a point of the path (it would be a
-corner of no length); the path's first point is where the first move ends.
+LinuxCNC's modal rules: two codes of one modal group on a line (``G90 G91``, ``G20 G21``,
+``G0 G1``, ``M3 M5``) are refused, naming the line, both words and the group.
+
+Refused by name, with the line: canned cycles ``G73``–``G89`` (use ``interpreter="rs274"``,
+which expands them), ``G28``/``G30`` (moves to a home position the program does not state),
+``G10``, ``G52``, ``G53``, ``G92`` (offsets), cutter compensation ``G41``/``G42``, tool length
+offsets ``G43``, ``G33``, probing ``G38``, splines and NURBS ``G5``–``G6.2``, ``G7``,
+parameters (``#``), expressions (``[``) and O-words (use ``interpreter="rs274"``), other words
+(``A``, ``B``, ``C``, ``U``, ``V``, ``W``, ``L``, ``H``, ``E``, …), numbers that are not finite,
+text that is not a word (``X1e3``, ``X--1``), an unclosed comment, control characters (line
+breaks are ``\n``, ``\r\n`` or ``\r``; a vertical tab, form feed or Unicode line separator is
+refused, not read as a line break), lines longer than 65 536 characters, and bytes that are
+not UTF-8. LinuxCNC also refuses a program with neither M2/M30 nor ``%``; this reader takes the
+end of the file as its end.
+
+A move that ends where it started is not a point of the path (it would be a corner of no
+length); the path's first point is where the first move ends. Long reads and roundings say
+on stderr that they are still running.
 """
 
 from __future__ import annotations
@@ -42,6 +56,11 @@ from __future__ import annotations
 import math
 import os
 import re
+import sys
+import time
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
+from contextvars import ContextVar
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
@@ -58,21 +77,67 @@ MAX_BYTES = 1 << 30
 #: What a G-code program's file name ends in (a design file cannot make the build read, and
 #: quote in its error, any other file).
 SUFFIXES = (".nc", ".ngc", ".gcode", ".gc", ".g", ".tap", ".cnc", ".mpt", ".mpf")
-#: Codes that keep a state the path does not depend on.
-NEUTRAL_G = {17: "XY plane", 40: "no cutter compensation", 49: "no tool length offset", 54: "work offset 1",
-             80: "no canned cycle", 94: "feed per minute"}  # fmt: skip
-NEUTRAL_M = {3, 4, 5, 6, 7, 8, 9}
+#: LinuxCNC's modal groups of G codes (the code times ten: G90.1 is 901); two codes of one group on
+#: one line are an error, as in LinuxCNC ("Two g codes used from same modal group").
+G_GROUPS: dict[int, tuple[int, str]] = {
+    **{c: (1, "motion") for c in (0, 10, 20, 30, 330, 331, 382, 383, 384, 385, 50, 51, 52, 53, 62, 730, 760, 800,
+                                  810, 820, 830, 840, 850, 860, 870, 880, 890)},
+    **{c: (2, "plane") for c in (170, 171, 180, 181, 190, 191)},
+    **{c: (3, "distance mode") for c in (900, 910)},
+    **{c: (4, "arc centre mode") for c in (901, 911)},
+    **{c: (5, "feed rate mode") for c in (930, 940, 950)},
+    **{c: (6, "units") for c in (200, 210)},
+    **{c: (7, "cutter compensation") for c in (400, 410, 411, 420, 421)},
+    **{c: (8, "tool length offset") for c in (430, 431, 432, 490)},
+    **{c: (10, "canned cycle return") for c in (980, 990)},
+    **{c: (12, "work offset") for c in (540, 550, 560, 570, 580, 590, 591, 592, 593)},
+    **{c: (13, "path control") for c in (610, 611, 640)},
+    **{c: (14, "spindle speed mode") for c in (960, 970)},
+    **{c: (15, "lathe diameter mode") for c in (70, 80)},
+    **{c: (0, "non-modal") for c in (40, 100, 280, 281, 300, 301, 520, 530, 920, 921, 922, 923)},
+}  # fmt: skip
+#: Codes that keep a state the straight path does not depend on (feeds, stops, exact-stop modes, …).
+NEUTRAL_G = {40, 170, 400, 490, 540, 550, 560, 570, 580, 590, 591, 592, 593, 610, 611, 640, 80, 930, 940, 950,
+             960, 970, 980, 990}  # fmt: skip
+#: Codes refused by name, with why (each would move the tool somewhere the program's words do not say).
+REFUSED_G = {
+    **{c: "a canned cycle (have the CAM expand cycles into G0/G1 moves, or use interpreter='rs274')"
+       for c in (730, 760, 810, 820, 830, 840, 850, 860, 870, 880, 890)},
+    280: "a move to the machine's home position (G28), which the program does not state",
+    300: "a move to the machine's second home position (G30), which the program does not state",
+    281: "setting the home position (G28.1)", 301: "setting the second home position (G30.1)",
+    100: "setting work offsets or tool data (G10): the offsets would change the path",
+    520: "a local coordinate offset (G52)", 530: "a move in machine coordinates (G53)",
+    920: "a coordinate offset (G92)", 921: "a coordinate offset reset (G92.1)", 922: "a coordinate offset reset (G92.2)",
+    923: "a coordinate offset restore (G92.3)",
+    410: "cutter radius compensation (G41): the tool centre's path is not the programmed one",
+    411: "cutter radius compensation (G41.1)", 420: "cutter radius compensation (G42): the tool centre's path is not the programmed one",
+    421: "cutter radius compensation (G42.1)",
+    430: "a tool length offset (G43) from a tool table", 431: "a dynamic tool length offset (G43.1)",
+    432: "an added tool length offset (G43.2)",
+    330: "spindle-synchronised motion (G33)", 331: "rigid tapping (G33.1)",
+    382: "probing (G38.2)", 383: "probing (G38.3)", 384: "probing (G38.4)", 385: "probing (G38.5)",
+    62: "a NURBS curve (G6.2)", 50: "a cubic spline (G5)", 51: "a quadratic spline (G5.1)", 52: "a NURBS block (G5.2)", 53: "a NURBS block end (G5.3)",
+    171: "the UV plane (G17.1)", 181: "the WU plane (G18.1)", 191: "the VW plane (G19.1)",
+    70: "lathe diameter mode (G7): X would be a diameter",
+}  # fmt: skip
+#: LinuxCNC's modal groups of M codes that matter for a line's words (M7 and M8 may share a line).
+M_GROUPS = {0: 4, 1: 4, 2: 4, 30: 4, 60: 4, 3: 7, 4: 7, 5: 7, 6: 6, 7: 8, 8: 8, 9: 8, 48: 9, 49: 9, 50: 9, 51: 9,
+            52: 9, 53: 9}  # fmt: skip
 END_M = {2, 30}
-ARCS = {2: "G2 (a clockwise arc)", 3: "G3 (a counterclockwise arc)"}
-IGNORED_WORDS = set("FSTN")
+#: Words that do not move the tool: feed, spindle speed, tool, line number, dwell/G64 P and Q, G96 D.
+IGNORED_WORDS = set("FSTNPQD")
+PLANES = {170: (0, 1, 2), 180: (2, 0, 1), 190: (1, 2, 0)}  # (first, second, normal axis) as LinuxCNC's ARC_FEED
 
 #: Lines longer than this are refused before their words are read (memory grows with a line's words).
 MAX_LINE = 1 << 16
 
 _WORD = re.compile(r"\s*([A-Za-z])\s*([+-]?\s*(?:\d+\.?\d*|\.\d+))", re.ASCII)
+#: Where a line goes beyond plain words: a parameter, an expression, a named parameter (``#<x>``).
+_FULL_NGC = re.compile(r"\s*(?:[A-Za-z]\s*)?[#\[<]")
 _CONTROL = re.compile("[\x00-\x08\x0b-\x1f\x7f-\x9f\u2028\u2029]")
-#: A G or M code as written: an integer, perhaps with a point and zeros (G01, G1.0).
-_INTEGER = re.compile(r"[+-]?[0-9]+(?:\.0*)?")
+#: A G or M code as written: an integer, perhaps with one decimal and zeros (G01, G1.0, G90.1).
+_CODE = re.compile(r"[0-9]{1,4}(?:\.[0-9]?0*)?")
 #: A whole comment, or a parenthesis or semicolon that starts or ends none.
 _COMMENT = re.compile(r"\([^()]*\)|[;()]")
 
@@ -87,6 +152,7 @@ class GcodePath:
         rapid: (n,) True where the move was a rapid (G0).
         units: ``"mm"`` (G21) or ``"in"`` (G20).
         source: the file's name, for messages.
+        notes: what was read but does not move the tool and is worth telling (tool changes).
     """
 
     points: NDArray
@@ -94,6 +160,7 @@ class GcodePath:
     rapid: NDArray
     units: str
     source: str = "G-code"
+    notes: tuple[str, ...] = ()
 
     def __len__(self) -> int:
         return len(self.points)
@@ -101,7 +168,7 @@ class GcodePath:
     def in_units(self, units: str) -> GcodePath:
         """The same moves in ``units`` (mm, cm, m, km, in, ft): converted from the program's G20/G21."""
         factor = MM_PER_UNIT[self.units] / MM_PER_UNIT[length_unit(units)]
-        return GcodePath(self.points * factor if factor != 1.0 else self.points, self.lines, self.rapid, units, self.source)
+        return GcodePath(self.points * factor if factor != 1.0 else self.points, self.lines, self.rapid, units, self.source, self.notes)
 
     def at_lines(self, message: str) -> str:
         """``message`` with every ``point i``/``corner i`` followed by the G-code line of that move."""
@@ -116,15 +183,24 @@ class GcodePath:
 class _Reader:
     """The interpreter's state while lines are read."""
 
-    def __init__(self, source: str):
+    def __init__(self, source: str, arc_tolerance: float | None = None, progress: Callable[[int], None] | None = None):
         self.source = source
+        self.arc_tolerance = arc_tolerance
+        self.progress = progress
         self.position = [0.0, 0.0, 0.0]
         self.absolute = True
+        self.absolute_centre = False  # G91.1, LinuxCNC's default: I, J, K are offsets from the start
+        self.plane = 170
         self.motion: int | None = None
+        self.cancelled = False
         self.units: str | None = None
         self.points: list[tuple[float, float, float]] = []
         self.lines: list[int] = []
         self.rapid: list[bool] = []
+        self.notes: list[str] = []
+        self.opened: int | None = None  # the line of an opening %
+        self.any_words = False
+        self.end_at: int | None = None
         self.ended = False
 
     def error(self, number: int, text: str) -> ValueError:
@@ -155,6 +231,8 @@ class _Reader:
             match = _WORD.match(stripped, at)
             if match is None:
                 bad = stripped[at:].strip()[:20]
+                if _FULL_NGC.match(stripped, at) or found and found[-1][0] == "O":
+                    raise self.error(number, f"{bad!r}: parameters, expressions and O-words are not read by the built-in reader; use interpreter='rs274' (--interpreter rs274), LinuxCNC's own")
                 raise self.error(number, f"{bad!r} is not a G-code word (a letter and a decimal number, no exponents)")
             letter, written = match.group(1).upper(), match.group(2).replace(" ", "")
             value = float(written)
@@ -167,80 +245,297 @@ class _Reader:
 
     def read_line(self, number: int, text: str) -> None:
         stripped = text.strip()
-        if not stripped or stripped == "%" or self.ended:
+        if self.ended or not stripped:
             return
+        if stripped == "%":  # LinuxCNC: a first line % opens the program, the next % ends it
+            if self.opened is None and not self.points and not self.any_words:
+                self.opened = number
+            else:
+                self.ended = True
+            return
+        if stripped[0] == "/":  # block delete: LinuxCNC's switch is off by default, so the line runs
+            text = text.replace("/", " ", 1)
         words = self.words(number, text)
-        motion: list[int] = []
+        if words:
+            self.any_words = True
+        groups: dict[int, str] = {}
+        motion: int | None = None
         target: dict[int, float] = {}
+        centre: dict[str, float] = {}
+        turn_count: float | None = None  # P with G2/G3: the number of turns
         for letter, value, written in words:
-            code = int(value) if _INTEGER.fullmatch(written[1:]) else None  # G0.0…05 is no G0
+            if letter in "GM":
+                code = round(value * 10) if _CODE.fullmatch(written[1:]) else None
+                if letter == "M":
+                    code = code // 10 if code is not None and code % 10 == 0 else None
             if letter == "G":
-                if code in (0, 1):
-                    motion.append(code)
-                elif code in ARCS:
-                    raise self.error(number, f"{ARCS[code]} is refused: only straight moves (G0, G1) are read; have the CAM write straight moves, or linearise the arcs first")
-                elif code in (90, 91):
-                    self.absolute = code == 90
-                elif code in (20, 21):
-                    units = "in" if code == 20 else "mm"
+                if code not in G_GROUPS:
+                    raise self.error(number, f"{written} is not a LinuxCNC G code this reader knows")
+                group, name = G_GROUPS[code]
+                if group and group in groups:
+                    raise self.error(number, f"{groups[group]} and {written} are both in modal group {group} ({name}); LinuxCNC allows one per line")
+                groups[group] = written
+                if code in REFUSED_G:
+                    raise self.error(number, f"{written} is refused: {REFUSED_G[code]}")
+                if group == 1:
+                    motion = code
+                elif code in (900, 910):
+                    self.absolute = code == 900
+                elif code in (901, 911):
+                    self.absolute_centre = code == 901
+                elif code in (200, 210):
+                    units = "in" if code == 200 else "mm"
                     if self.points and units != self.units:
                         raise self.error(number, f"{written} changes the unit after the first move; one unit per program")
                     self.units = units
-                elif code not in NEUTRAL_G:
-                    raise self.error(number, f"{written} is not in the supported subset (G0, G1, G17, G20, G21, G40, G49, G54, G80, G90, G91, G94)")
+                elif code in PLANES:
+                    self.plane = code
+                elif code == 40 or code in NEUTRAL_G:
+                    pass
             elif letter == "M":
+                if code not in M_GROUPS:
+                    raise self.error(number, f"{written} is not in the supported subset (M0, M1, M2, M30, M60 stops and ends; M3–M9 spindle, tool change, coolant; M48–M53 overrides)")
+                group = M_GROUPS[code]
+                if group in groups and not {groups[group].upper(), written.upper()} <= {"M7", "M8", "M07", "M08"}:
+                    raise self.error(number, f"{groups[group]} and {written} are both in M modal group {group}; LinuxCNC allows one per line")
+                groups[group] = written
                 if code in END_M:
-                    self.ended = True
-                elif code not in NEUTRAL_M:
-                    raise self.error(number, f"{written} is not in the supported subset (M2, M30 end the program; M3–M9 are ignored)")
+                    self.end_at = number
+                elif code == 6:
+                    self.notes.append(f"line {number}: {written} tool change (no move)")
             elif letter in "XYZ":
                 axis = "XYZ".index(letter)
                 if axis in target:
                     raise self.error(number, f"{letter} is given twice")
                 target[axis] = value
+            elif letter in "IJKR":
+                if letter in centre:
+                    raise self.error(number, f"{letter} is given twice")
+                centre[letter] = value
+            elif letter == "P":
+                turn_count = value
+            elif letter == "O":
+                raise self.error(number, f"{written}: O-words (subroutines, loops, conditions) are not read by the built-in reader; use interpreter='rs274' (--interpreter rs274), LinuxCNC's own")
             elif letter not in IGNORED_WORDS:
-                raise self.error(number, f"the word {written} is not in the supported subset (X, Y, Z, F, S, T, N besides G and M codes)")
-        if len(motion) > 1:
-            raise self.error(number, "two motion codes (G0/G1) on one line")
-        if motion:
-            self.motion = motion[0]
-        if not target:
-            return
-        if self.motion is None:
-            raise self.error(number, "coordinates with no motion mode in effect (G0 or G1)")
-        if self.units is None:
-            raise self.error(number, "the program sets no unit before its first move: add G21 (mm) or G20 (inch)")
-        moved = list(self.position)
-        for axis, value in target.items():
-            moved[axis] = value if self.absolute else moved[axis] + value
-        if not all(math.isfinite(v) for v in moved):
-            raise self.error(number, "the move's position is beyond the float range")
+                raise self.error(number, f"the word {written} is not in the supported subset (X, Y, Z, I, J, K, R, F, S, T, N, P, Q, D besides G and M codes)")
+        if motion is not None:
+            self.motion = None if motion == 800 else motion
+        if target:
+            if self.motion is None:
+                reason = "after G80 (motion cancelled)" if motion == 800 or self.cancelled else "with no motion mode in effect (G0, G1, G2, G3)"
+                raise self.error(number, f"coordinates {reason}; LinuxCNC: cannot use axis values without a G code that uses them")
+            if self.units is None:
+                raise self.error(number, "the program sets no unit before its first move: add G21 (mm) or G20 (inch)")
+            moved = list(self.position)
+            for axis, value in target.items():
+                moved[axis] = value if self.absolute else moved[axis] + value
+            if not all(math.isfinite(v) for v in moved):
+                raise self.error(number, "the move's position is beyond the float range")
+            if self.motion in (20, 30):
+                self.arc(number, moved, centre, turn_count)
+            else:
+                if centre:
+                    raise self.error(number, f"{', '.join(centre)} with a straight move: only arcs (G2, G3) take I, J, K, R")
+                self.add(number, moved)
+            self.position = moved
+        elif centre:
+            raise self.error(number, f"{', '.join(centre)} with no axis word: LinuxCNC needs an end point for an arc")
+        if motion == 800:
+            self.cancelled = True
+        if self.end_at is not None:
+            self.ended = True
+
+    def add(self, number: int, moved: list[float]) -> None:
         if moved != self.position or not self.points:
             self.points.append((moved[0], moved[1], moved[2]))
             self.lines.append(number)
             self.rapid.append(self.motion == 0)
-        self.position = moved
+        if self.progress is not None:
+            self.progress(len(self.points))
+
+    def arc(self, number: int, end: list[float], centre: dict[str, float], turn_count: float | None) -> None:
+        """An arc (G2 clockwise, G3 counterclockwise) in the plane, as chords within ``arc_tolerance``."""
+        name = "G2 (a clockwise arc)" if self.motion == 20 else "G3 (a counterclockwise arc)"
+        if self.arc_tolerance is None:
+            raise self.error(number, f"{name} is refused: only straight moves (G0, G1) are read unless arc_tolerance is given (arcs become chords within it); have the CAM write straight moves, or linearise the arcs first")
+        first, second, _ = PLANES[self.plane]
+        offsets = {170: "IJ", 180: "KI", 190: "JK"}[self.plane]
+        start = self.position
+        a0, b0, a1, b1 = start[first], start[second], end[first], end[second]
+        if "R" in centre:
+            if set(centre) - {"R"}:
+                raise self.error(number, f"{name}: R with {', '.join(set(centre) - {'R'})}; give R or the centre offsets, not both")
+            radius = centre["R"]
+            chord = math.hypot(a1 - a0, b1 - b0)
+            if chord == 0.0 or abs(radius) < chord / 2 * (1 - 1e-12):
+                raise self.error(number, f"{name}: R{radius:g} cannot join points {chord:g} apart")
+            half = math.sqrt(max(radius * radius - chord * chord / 4, 0.0))
+            # LinuxCNC: R > 0 takes the shorter arc, R < 0 the longer; the centre is left of the chord for the shorter G3 arc
+            side = (1 if self.motion == 30 else -1) * (1 if radius > 0 else -1)
+            ca = (a0 + a1) / 2 - side * half * (b1 - b0) / chord
+            cb = (b0 + b1) / 2 + side * half * (a1 - a0) / chord
+        else:
+            if set(centre) - set(offsets) or not centre:
+                raise self.error(number, f"{name} in the {'XY' if self.plane == 170 else 'XZ' if self.plane == 180 else 'YZ'} plane takes {offsets[0]} and {offsets[1]}; got {', '.join(centre) or 'none'}")
+            i, j = centre.get(offsets[0], 0.0), centre.get(offsets[1], 0.0)
+            ca, cb = (i, j) if self.absolute_centre else (a0 + i, b0 + j)
+        r0, r1 = math.hypot(a0 - ca, b0 - cb), math.hypot(a1 - ca, b1 - cb)
+        # LinuxCNC's tolerances (interp_internal.hh): a zero radius, and radii that differ by more than
+        # 100 × CENTER_ARC_RADIUS_TOLERANCE, or by 0.1 % and more than that tolerance
+        inch = 1.0 if self.units == "in" else 25.4
+        error = abs(r0 - r1)
+        if min(r0, r1) < 0.00005 * inch:
+            raise self.error(number, f"{name}: a zero-radius arc (the start is {r0:g} from the centre, the end {r1:g})")
+        if error > 100 * 0.002 * math.sqrt(2) * inch or error > 0.001 * max(r0, r1) and error > 0.002 * math.sqrt(2) * inch:
+            raise self.error(number, f"{name}: the start is {r0:g} from the centre and the end {r1:g}; LinuxCNC refuses radii that differ this much")
+        turns = 1
+        if turn_count is not None:
+            if turn_count != int(turn_count) or turn_count < 1:
+                raise self.error(number, f"{name}: P{turn_count:g} must be a whole number of turns, at least 1")
+            turns = int(turn_count)
+        for point in arc_points(start, end, self.plane, ca, cb, turns if self.motion == 30 else -turns, self.arc_tolerance):
+            self.add(number, point)
+            self.position = point
 
 
-def parse_gcode(text: str, source: str = "G-code") -> GcodePath:
-    """The straight moves of G-code ``text`` (see the module docstring).
+def arc_points(start: list[float], end: list[float], plane: int, ca: float, cb: float, rotation: int,
+               tolerance: float) -> list[list[float]]:
+    """The chords of an arc (helical along the plane's normal) from ``start`` to ``end`` about the centre
+    (``ca``, ``cb``) in ``plane`` (170 XY, 180 ZX, 190 YZ): ends of chords at most ``tolerance`` from the arc.
+
+    ``rotation`` is LinuxCNC's (ARC_FEED): positive counterclockwise, negative clockwise, and
+    ``abs(rotation) - 1`` more full turns; the last point is ``end`` exactly.
+    """
+    first, second, normal = PLANES[plane]
+    a0, b0, a1, b1 = start[first], start[second], end[first], end[second]
+    t0, t1 = math.atan2(b0 - cb, a0 - ca), math.atan2(b1 - cb, a1 - ca)
+    sweep = t1 - t0
+    if rotation > 0:
+        sweep = (sweep if sweep > 0 else sweep + 2 * math.pi) + 2 * math.pi * (rotation - 1)
+    else:
+        sweep = (sweep if sweep < 0 else sweep - 2 * math.pi) - 2 * math.pi * (-rotation - 1)
+    radius = (math.hypot(a0 - ca, b0 - cb) + math.hypot(a1 - ca, b1 - cb)) / 2
+    # a chord of angle step is at most radius·(1 − cos(step/2)) from its arc
+    step = 2 * math.acos(1 - tolerance / radius) if tolerance < radius else math.pi / 2
+    count = max(2, math.ceil(abs(sweep) / min(step, math.pi / 2)))
+    points = []
+    for k in range(1, count):
+        f = k / count
+        t = t0 + sweep * f
+        point = list(end)
+        point[first] = ca + radius * math.cos(t)
+        point[second] = cb + radius * math.sin(t)
+        point[normal] = start[normal] + (end[normal] - start[normal]) * f
+        points.append(point)
+    points.append(list(end))
+    return points
+
+
+#: How ``read_gcode`` reads when its caller does not say (set by ``reading_options``).
+_DEFAULTS: ContextVar[tuple[str, float | None]] = ContextVar("gcode_reading", default=("builtin", None))
+
+
+@contextmanager
+def reading_options(interpreter: str = "builtin", arc_tolerance: float | None = None) -> Iterator[None]:
+    """Within the block, ``read_gcode`` calls that do not name them use this interpreter and arc
+    tolerance (how ``build --from-gcode --interpreter rs274`` reaches the design file's reader)."""
+    token = _DEFAULTS.set((interpreter, arc_tolerance))
+    try:
+        yield
+    finally:
+        _DEFAULTS.reset(token)
+
+
+class Progress:
+    """Progress lines on stderr for a job that has run longer than ``after`` seconds, at most one every ``every``."""
+
+    def __init__(self, what: str, total: int | None = None, after: float = 3.0, every: float = 2.0):
+        self.what, self.total, self.every = what, total, every
+        self.started = time.monotonic()
+        self.next = self.started + after
+        self.shown = False
+
+    def __call__(self, done: int) -> None:
+        now = time.monotonic()
+        if now < self.next:
+            return
+        self.next = now + self.every
+        self.shown = True
+        of = f" of {self.total:,}" if self.total else ""
+        print(f"{self.what}: {done:,}{of} ({now - self.started:.0f} s)", file=sys.stderr, flush=True)
+
+    def done(self, count: int) -> None:
+        if self.shown:
+            print(f"{self.what}: {count:,} done in {time.monotonic() - self.started:.1f} s", file=sys.stderr, flush=True)
+
+
+@contextmanager
+def ticking(what: str, after: float = 3.0, every: float = 5.0) -> Iterator[None]:
+    """While the block runs longer than ``after`` seconds, a line on stderr every ``every`` seconds
+    saying it still runs (for one long call that cannot count its own progress), and its time at the end."""
+    import threading
+
+    stop = threading.Event()
+    started = time.monotonic()
+
+    def tick() -> None:
+        wait = after
+        while not stop.wait(wait):
+            print(f"{what}: still running ({time.monotonic() - started:.0f} s)", file=sys.stderr, flush=True)
+            wait = every
+
+    thread = threading.Thread(target=tick, daemon=True)
+    thread.start()
+    try:
+        yield
+    finally:
+        stop.set()
+        thread.join()
+        if time.monotonic() - started > after:
+            print(f"{what}: done in {time.monotonic() - started:.1f} s", file=sys.stderr, flush=True)
+
+
+def parse_gcode(text: str, source: str = "G-code", *, arc_tolerance: float | None = None, interpreter: str = "builtin") -> GcodePath:
+    """The moves of G-code ``text`` (see the module docstring).
+
+    Args:
+        text: the program.
+        source: its name, for messages.
+        arc_tolerance: when given (in the program's unit), arcs G2/G3 are read as chords at most this
+            far from the arc; when None, arcs are refused by name.
+        interpreter: ``"builtin"`` (this module's reader) or ``"rs274"`` (LinuxCNC's own interpreter,
+            for parameters, expressions and O-word subroutines; see ``spiral_cad.io.rs274``).
 
     Raises:
         ValueError: anything outside the subset, naming ``source``, the line and the word;
-            a program with fewer than two moves.
+            a program with fewer than two moves; rs274 asked for but not installed.
     """
     if not isinstance(text, str):
         raise ValueError(f"text must be the program as str; got {type(text).__name__} (decode bytes first, or use read_gcode)")
-    reader = _Reader(source)
+    if arc_tolerance is not None and not 0.0 < arc_tolerance < math.inf:
+        raise ValueError(f"arc_tolerance must be a positive finite length; got {arc_tolerance}")
+    if interpreter == "rs274":
+        from .rs274 import run_rs274
+
+        return run_rs274(text, source, arc_tolerance=arc_tolerance)
+    if interpreter != "builtin":
+        raise ValueError(f"interpreter must be 'builtin' or 'rs274'; got {interpreter!r}")
     lines = text.replace("\r\n", "\n").replace("\r", "\n").split("\n")  # not splitlines: it breaks at \v, \f, …
+    progress = Progress(f"reading {source}", len(lines))
+    reader = _Reader(source, arc_tolerance)
     for number, line in enumerate(lines, 1):
         reader.read_line(number, line)
+        if not number & 0x3FFF:
+            progress(number)
+    progress.done(len(lines))
+    if reader.opened is not None and not reader.ended:
+        raise ValueError(f"{source}: the program opens with % (line {reader.opened}) but has no closing % or M2/M30; LinuxCNC refuses it (file ended with no percent sign)")
     if len(reader.points) < 2:
         raise ValueError(f"{source}: the program has {len(reader.points)} move(s) to a new position; a path needs at least two")
-    return GcodePath(np.array(reader.points), np.array(reader.lines), np.array(reader.rapid), reader.units, source)
+    return GcodePath(np.array(reader.points), np.array(reader.lines), np.array(reader.rapid), reader.units, source, tuple(reader.notes))
 
 
-def read_gcode(path: str | os.PathLike) -> GcodePath:
+def read_gcode(path: str | os.PathLike, *, arc_tolerance: float | None = None, interpreter: str | None = None) -> GcodePath:
     """Read the straight moves of a G-code file (named ``*.nc``, ``.ngc``, ``.gcode``, ``.gc``, ``.g``,
     ``.tap``, ``.cnc``, ``.mpt`` or ``.mpf``).
 
@@ -266,13 +561,44 @@ def read_gcode(path: str | os.PathLike) -> GcodePath:
     except UnicodeDecodeError as error:
         line = data[: error.start].count(b"\n") + 1
         raise ValueError(f"{label} line {line}: byte {data[error.start]:#04x} is not UTF-8 text") from None
-    return parse_gcode(text, label)
+    if interpreter is None:  # neither given: what reading_options set (the built-in reader, arcs refused)
+        interpreter, default_tolerance = _DEFAULTS.get()
+        arc_tolerance = default_tolerance if arc_tolerance is None else arc_tolerance
+    return parse_gcode(text, label, arc_tolerance=arc_tolerance, interpreter=interpreter)
 
 
-def round_toolpath(path: GcodePath, **options) -> RoundedPath:
+#: OCCT's Precision::Confusion (model units): two points closer than this are one point, so no edge is shorter.
+OCCT_CONFUSION = 1e-7
+
+
+def segment_lines(rounded: RoundedPath, path: GcodePath) -> NDArray:
+    """The G-code line of every segment of ``rounded.chain`` (rounded from ``path``): a corner's
+    spirals take the line of the move that ends at the corner, a straight piece the line of its move."""
+    kind = np.asarray(rounded.chain.rows.kind)
+    corner_of = np.cumsum(kind != 0) - 1  # the spiral's number along the chain
+    index = np.array([c.index for c in rounded.corners], dtype=np.int64)
+    lines = np.empty(len(kind), dtype=np.int64)
+    spiral = kind != 0
+    if spiral.sum() == 2 * len(index):  # two spirals a corner, in order
+        lines[spiral] = path.lines[index[corner_of[spiral] // 2]]
+        # a straight piece runs from the previous corner to the next point: the move that ends there
+        after = np.searchsorted(np.flatnonzero(spiral), np.flatnonzero(~spiral))  # spirals before each straight piece
+        ahead = after // 2  # the corner the straight piece leads to (len(index) past the last corner)
+        ends = np.where(ahead < len(index), index[np.minimum(ahead, len(index) - 1)] if len(index) else 0, len(path) - 1)
+        lines[~spiral] = path.lines[ends]
+    else:  # another layout: the line of the nearest point to each segment's middle
+        middles = np.asarray(rounded.chain.segment_ends).mean(axis=1)
+        for i, middle in enumerate(middles):
+            lines[i] = path.lines[int(np.argmin(np.linalg.norm(path.points - middle, axis=1)))]
+    return lines
+
+
+def round_toolpath(path: GcodePath, *, for_occt: bool = True, **options) -> RoundedPath:
     """The G2 rounding of a toolpath's polyline (``spiral_cad.design.round_corners`` with ``options``:
     ``max_deviation``, ``max_curvature``, ``shape``, …) in the program's unit; an error names the
-    G-code line of the corner or point it is about.
+    G-code line of the corner or point it is about. With ``for_occt`` (the default), a segment
+    shorter than OCCT's point tolerance (1e-7 model units, so never a STEP edge) is refused here,
+    naming the G-code line of its move (``segment_lines``), rather than later by OCCT by index only.
 
     Raises:
         ValueError, NoSolutionError: as ``round_corners``, with the line.
@@ -282,6 +608,88 @@ def round_toolpath(path: GcodePath, **options) -> RoundedPath:
     if "units" in options:
         raise ValueError("units: the program's own (G20/G21); convert the path with GcodePath.in_units first")
     try:
-        return round_corners(path.points, units=path.units, **options)
+        with ticking(f"rounding {path.source} ({len(path):,} points)"):
+            rounded = round_corners(path.points, units=path.units, **options)
     except ValueError as error:
         raise type(error)(f"{path.source}: {path.at_lines(str(error))}") from None
+    lengths = np.asarray(rounded.chain.lengths)
+    short = np.flatnonzero(lengths <= OCCT_CONFUSION) if for_occt else ()
+    if len(short):
+        i = int(short[0])
+        kind = ("Line", "Arc", "BezierSpiral")[int(np.asarray(rounded.chain.rows.kind)[i])]
+        line = int(segment_lines(rounded, path)[i])
+        raise ValueError(
+            f"{path.source} line {line}: the rounded path's segment {i} ({kind}, length {lengths[i]:.3g} {path.units}) is shorter "
+            f"than OCCT's {OCCT_CONFUSION:g} and cannot be an OCCT edge ({len(short)} such segment(s)); "
+            "change the tolerance slightly, or move the corner's points"
+        )
+    return rounded
+
+
+@dataclass(frozen=True)
+class ToolpathCorners:
+    """The G2 rounding of a toolpath as arrays, one row per rounded corner (no object per move).
+
+    Between corners the path runs straight along the program's moves, so the corners and
+    ``points`` are the whole path; ``round_toolpath`` builds the same spirals as a ``Chain``
+    (for STEP, IGES, samples), at far higher cost in time and memory on long programs.
+
+    Attributes:
+        index: (k,) the point of ``path.points`` each corner is at.
+        lines: (k,) the G-code line of each corner (the move that ends there).
+        control_points: (k, 2, 4, 3) the corner's two Bézier spirals in travel order.
+        curvature: (k,) the pair's peak |κ| (1/unit).
+        deviation: (k,) the distance from the corner point to the path (unit).
+        units: the program's unit.
+        shape: the spiral shape.
+    """
+
+    index: NDArray
+    lines: NDArray
+    control_points: NDArray
+    curvature: NDArray
+    deviation: NDArray
+    units: str
+    shape: str
+
+    def __len__(self) -> int:
+        return len(self.index)
+
+
+def round_toolpath_arrays(path: GcodePath, *, shape: str = "walton-meek", max_deviation: float | None = None,
+                          max_curvature: float | None = None, curvature: float | None = None,
+                          spiral_lengths: float | None = None) -> ToolpathCorners:
+    """Round every corner of a toolpath G2 as ``round_toolpath`` does, into arrays (one value per
+    option for every corner): what a program of millions of moves needs.
+
+    Raises:
+        NoSolutionError: a corner that cannot be rounded as asked (its point, G-code line and numbers).
+        ValueError: malformed options or points (two moves to one point are one point: never here).
+    """
+    from ..core.errors import NoSolutionError, Status
+    from ..design.rounding import corner_legs, round_corners_batch
+
+    options = {"max_deviation": max_deviation, "max_curvature": max_curvature, "curvature": curvature,
+               "spiral_lengths": spiral_lengths}  # fmt: skip
+    for name, value in options.items():
+        if value is not None and not (isinstance(value, (int, float)) and 0.0 < value < math.inf):
+            raise ValueError(f"{name} must be one positive finite number here; got {value!r:.40}")
+    given = {name: value for name, value in options.items() if value is not None}
+    with ticking(f"rounding {path.source} ({len(path):,} points)"):
+        try:
+            p0, corners, p1, index = corner_legs(path.points)
+        except ValueError as error:
+            raise ValueError(f"{path.source}: {path.at_lines(str(error))}") from None
+        result = round_corners_batch(p0, corners, p1, shape=shape, **given)
+    bad = np.flatnonzero(~result.ok)
+    if bad.size:
+        j = int(bad[0])
+        message = result.reason(j, label=f"corner {index[j]} (line {int(path.lines[index[j]])})")
+        refused = NoSolutionError if result.status[j] in (Status.LEGS_TOO_SHORT, Status.CORNER_REVERSAL, Status.UNVERIFIED,
+                                                           Status.OUTSIDE_SHAPE) else ValueError  # fmt: skip
+        raise refused(f"{path.source}: {message}" + (f" ({bad.size:,} corners fail)" if bad.size > 1 else ""))
+    control = result.control_points
+    if control.shape[-1] == 2:  # a flat program is rounded in its plane: back to x, y, z
+        control = np.concatenate([control, np.full(control.shape[:-1] + (1,), path.points[0, 2])], axis=-1)
+    return ToolpathCorners(index, path.lines[index], control, result.curvature, result.deviation, path.units, shape)
+

@@ -1,0 +1,120 @@
+"""Large G-code programs: reading, and rounding as a Chain (``round_toolpath``) or as arrays.
+
+Run: ``.venv/bin/python benchmarks/bench_gcode.py [--quick] [--sizes N ...] [--chain-max N] [--out FILE]``
+(the harness and its conventions: ``timing.py``). Each size is a generated pocketing
+program (a zigzag of G1 moves with jittered ends, layer after layer, 4 decimals in mm),
+written to a file; after a warm-up on 50 moves (the kernels compile), every job runs in a child process of its own, so its peak memory
+(the child's maximum resident set, imports included) is its own. Jobs: ``read_gcode``
+alone; ``read_gcode`` + ``round_toolpath`` (spirals as objects in a ``Chain``, what
+``build --from-gcode`` writes STEP from), up to ``--chain-max`` moves; ``read_gcode`` +
+``round_toolpath_arrays`` (the same spirals as arrays). One run per job (a minute-long
+job on a shared machine: the spread is not measured); the peer of the arrays is the
+Chain at the same size. Goals: 100 000 moves read and rounded in ≤ 60 s and ≤ 1.5 GB;
+1 M moves rounded in ≤ 20 s and ≤ 3 GB.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import resource
+import subprocess
+import sys
+import tempfile
+import time
+
+import numpy as np
+from timing import Report, Timing, arguments
+
+MAX_DEVIATION = 0.01  # mm at every corner
+
+
+def program(moves: int) -> str:
+    """A pocketing program of ``moves`` G1 moves: rows 20 mm long, 0.5 mm apart, 200 rows a layer, 0.1 mm deeper each."""
+    rng = np.random.default_rng(7)
+    rows = (moves + 1) // 2
+    row = np.repeat(np.arange(rows), 2)[:moves]
+    x = np.tile([0.0, 20.0, 20.0, 0.0], rows // 2 + 1)[:moves] + rng.uniform(-0.2, 0.2, moves)
+    y = (row % 200) * 0.5
+    z = -1.0 - (row // 200) * 0.1
+    body = "\n".join(f"X{a:.4f} Y{b:.4f} Z{c:.4f}" for a, b, c in zip(x.tolist(), y.tolist(), z.tolist()))
+    return f"%\n(pocket, {moves} moves)\nG21 G90 G17 G40 G49 G80\nT1 M6\nS12000 M3\nG0 X0 Y0 Z5\nG1 Z-1 F800\n{body}\nG0 Z5\nM30\n%\n"
+
+
+def peak_mb() -> float:
+    return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0
+
+
+def child(job: str, moves: int) -> None:
+    """One job in this process; prints its seconds and peak memory as JSON."""
+    from spiral_cad.io.gcode import parse_gcode, read_gcode, round_toolpath, round_toolpath_arrays
+
+    warm = parse_gcode(program(50))  # compile the kernels first (one warm-up, as compare does)
+    if job == "chain":
+        round_toolpath(warm, max_deviation=MAX_DEVIATION, for_occt=False)
+    else:
+        round_toolpath_arrays(warm, max_deviation=MAX_DEVIATION)
+    with tempfile.TemporaryDirectory() as folder:
+        file = os.path.join(folder, f"pocket{moves}.nc")
+        with open(file, "w", encoding="ascii") as handle:
+            handle.write(program(moves))
+        before = peak_mb()
+        started = time.perf_counter()
+        path = read_gcode(file)
+        read = time.perf_counter() - started
+        rounded = 0.0
+        if job != "read":
+            started = time.perf_counter()
+            if job == "chain":
+                result = round_toolpath(path, max_deviation=MAX_DEVIATION, for_occt=False)
+                corners = len(result.corners)
+            else:
+                corners = len(round_toolpath_arrays(path, max_deviation=MAX_DEVIATION))
+            rounded = time.perf_counter() - started
+            assert corners > 0.9 * moves, corners
+    print(json.dumps({"read": read, "round": rounded, "peak_mb": peak_mb(), "before_mb": before, "moves": len(path)}))
+
+
+def run(job: str, moves: int) -> dict:
+    done = subprocess.run([sys.executable, __file__, "--child", job, str(moves)], capture_output=True, text=True, check=False)
+    if done.returncode != 0:
+        raise SystemExit(f"{job} {moves}: {done.stderr[-2000:]}")
+    return json.loads(done.stdout.strip().splitlines()[-1])
+
+
+def main() -> None:
+    if len(sys.argv) == 4 and sys.argv[1] == "--child":
+        child(sys.argv[2], int(sys.argv[3]))
+        return
+    args = arguments(__doc__, sizes=([10_000, 100_000, 1_000_000], [300, 2_000]), chain_max=(100_000, 2_000))
+    report = Report("G-code benchmark", f"Generated pocketing programs, max_deviation {MAX_DEVIATION} mm; one run per job, "
+                                        "each in its own process (peak = that process's maximum resident set).")  # fmt: skip
+    rows = []
+    for moves in args.sizes:
+        read = run("read", moves)
+        report.add(f"read_gcode, {moves:,} moves", read["read"], "s", Timing((read["read"],)), goal=f"peak {read['peak_mb']:,.0f} MB")
+        arrays = run("arrays", moves)
+        chain = run("chain", moves) if moves <= args.chain_max else None
+        total = chain["read"] + chain["round"] if chain else float("nan")
+        if chain:
+            goal = ""
+            if moves == 100_000:
+                ok = total <= 60 and chain["peak_mb"] <= 1536
+                goal = f"read + round ≤ 60 s, ≤ 1.5 GB: {'met' if ok else 'missed'}"
+            report.add(f"read + round_toolpath (Chain), {moves:,} moves", total, "s", Timing((total,)), goal=goal)
+        goal = ""
+        if moves == 1_000_000:
+            ok = arrays["round"] <= 20 and arrays["peak_mb"] <= 3072
+            goal = f"rounded ≤ 20 s, ≤ 3 GB: {'met' if ok else 'missed'}"
+        report.add(f"round_toolpath_arrays, {moves:,} moves", arrays["round"], "s", Timing((arrays["round"],)),
+                   f"Chain {chain['round']:.2f} s" if chain else "", chain["round"] / arrays["round"] if chain else None, goal)  # fmt: skip
+        rows.append(f"| {moves:,} | {read['read']:.2f} s, {read['peak_mb']:,.0f} MB | "
+                    + (f"{chain['round']:.2f} s, {chain['peak_mb']:,.0f} MB" if chain else "not run (above --chain-max)")
+                    + f" | {arrays['round']:.2f} s, {arrays['peak_mb']:,.0f} MB |")  # fmt: skip
+    report.section("Peak memory per job (process maximum, imports and the program's text included)",
+                   "| moves | read_gcode | round_toolpath (Chain) | round_toolpath_arrays |\n|---|---|---|---|\n" + "\n".join(rows))
+    report.finish(args)
+
+
+if __name__ == "__main__":
+    main()
