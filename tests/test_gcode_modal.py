@@ -156,7 +156,7 @@ def test_arrays_round_as_the_chain_does_and_name_lines():
 def test_long_jobs_say_they_are_still_running(capsys):
     import time
 
-    from spiral_cad.io.gcode import Progress, ticking
+    from spiral_cad.io.progress import Progress, ticking
 
     with ticking("rounding x.nc", after=0.05, every=0.05):
         time.sleep(0.3)

@@ -56,8 +56,6 @@ from __future__ import annotations
 import math
 import os
 import re
-import sys
-import time
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from contextvars import ContextVar
@@ -67,7 +65,8 @@ from typing import TYPE_CHECKING
 import numpy as np
 from numpy.typing import NDArray
 
-from ..core.units import MM_PER_UNIT, length_unit
+from .progress import Progress, ticking
+from .toolpath import PLANES, GcodePath, arc_points
 
 if TYPE_CHECKING:
     from ..design.rounding import RoundedPath
@@ -127,7 +126,6 @@ M_GROUPS = {0: 4, 1: 4, 2: 4, 30: 4, 60: 4, 3: 7, 4: 7, 5: 7, 6: 6, 7: 8, 8: 8, 
 END_M = {2, 30}
 #: Words that do not move the tool: feed, spindle speed, tool, line number, dwell/G64 P and Q, G96 D.
 IGNORED_WORDS = set("FSTNPQD")
-PLANES = {170: (0, 1, 2), 180: (2, 0, 1), 190: (1, 2, 0)}  # (first, second, normal axis) as LinuxCNC's ARC_FEED
 
 #: Lines longer than this are refused before their words are read (memory grows with a line's words).
 MAX_LINE = 1 << 16
@@ -140,44 +138,6 @@ _CONTROL = re.compile("[\x00-\x08\x0b-\x1f\x7f-\x9f\u2028\u2029]")
 _CODE = re.compile(r"[0-9]{1,4}(?:\.[0-9]?0*)?")
 #: A whole comment, or a parenthesis or semicolon that starts or ends none.
 _COMMENT = re.compile(r"\([^()]*\)|[;()]")
-
-
-@dataclass(frozen=True)
-class GcodePath:
-    """The straight moves of a G-code program.
-
-    Attributes:
-        points: (n, 3) where each move ends, in the program's unit.
-        lines: (n,) the line (1-based) of each move.
-        rapid: (n,) True where the move was a rapid (G0).
-        units: ``"mm"`` (G21) or ``"in"`` (G20).
-        source: the file's name, for messages.
-        notes: what was read but does not move the tool and is worth telling (tool changes).
-    """
-
-    points: NDArray
-    lines: NDArray
-    rapid: NDArray
-    units: str
-    source: str = "G-code"
-    notes: tuple[str, ...] = ()
-
-    def __len__(self) -> int:
-        return len(self.points)
-
-    def in_units(self, units: str) -> GcodePath:
-        """The same moves in ``units`` (mm, cm, m, km, in, ft): converted from the program's G20/G21."""
-        factor = MM_PER_UNIT[self.units] / MM_PER_UNIT[length_unit(units)]
-        return GcodePath(self.points * factor if factor != 1.0 else self.points, self.lines, self.rapid, units, self.source, self.notes)
-
-    def at_lines(self, message: str) -> str:
-        """``message`` with every ``point i``/``corner i`` followed by the G-code line of that move."""
-
-        def line(match: re.Match) -> str:
-            i = int(match.group(2))
-            return f"{match.group(0)} (line {int(self.lines[i])})" if 0 <= i < len(self.lines) else match.group(0)
-
-        return re.sub(r"\b(points?|corner) (\d+)\b", line, message)
 
 
 class _Reader:
@@ -398,39 +358,6 @@ class _Reader:
             self.position = point
 
 
-def arc_points(start: list[float], end: list[float], plane: int, ca: float, cb: float, rotation: int,
-               tolerance: float) -> list[list[float]]:
-    """The chords of an arc (helical along the plane's normal) from ``start`` to ``end`` about the centre
-    (``ca``, ``cb``) in ``plane`` (170 XY, 180 ZX, 190 YZ): ends of chords at most ``tolerance`` from the arc.
-
-    ``rotation`` is LinuxCNC's (ARC_FEED): positive counterclockwise, negative clockwise, and
-    ``abs(rotation) - 1`` more full turns; the last point is ``end`` exactly.
-    """
-    first, second, normal = PLANES[plane]
-    a0, b0, a1, b1 = start[first], start[second], end[first], end[second]
-    t0, t1 = math.atan2(b0 - cb, a0 - ca), math.atan2(b1 - cb, a1 - ca)
-    sweep = t1 - t0
-    if rotation > 0:
-        sweep = (sweep if sweep > 0 else sweep + 2 * math.pi) + 2 * math.pi * (rotation - 1)
-    else:
-        sweep = (sweep if sweep < 0 else sweep - 2 * math.pi) - 2 * math.pi * (-rotation - 1)
-    radius = (math.hypot(a0 - ca, b0 - cb) + math.hypot(a1 - ca, b1 - cb)) / 2
-    # a chord of angle step is at most radius·(1 − cos(step/2)) from its arc
-    step = 2 * math.acos(1 - tolerance / radius) if tolerance < radius else math.pi / 2
-    count = max(2, math.ceil(abs(sweep) / min(step, math.pi / 2)))
-    points = []
-    for k in range(1, count):
-        f = k / count
-        t = t0 + sweep * f
-        point = list(end)
-        point[first] = ca + radius * math.cos(t)
-        point[second] = cb + radius * math.sin(t)
-        point[normal] = start[normal] + (end[normal] - start[normal]) * f
-        points.append(point)
-    points.append(list(end))
-    return points
-
-
 #: How ``read_gcode`` reads when its caller does not say (set by ``reading_options``).
 _DEFAULTS: ContextVar[tuple[str, float | None]] = ContextVar("gcode_reading", default=("builtin", None))
 
@@ -444,55 +371,6 @@ def reading_options(interpreter: str = "builtin", arc_tolerance: float | None = 
         yield
     finally:
         _DEFAULTS.reset(token)
-
-
-class Progress:
-    """Progress lines on stderr for a job that has run longer than ``after`` seconds, at most one every ``every``."""
-
-    def __init__(self, what: str, total: int | None = None, after: float = 3.0, every: float = 2.0):
-        self.what, self.total, self.every = what, total, every
-        self.started = time.monotonic()
-        self.next = self.started + after
-        self.shown = False
-
-    def __call__(self, done: int) -> None:
-        now = time.monotonic()
-        if now < self.next:
-            return
-        self.next = now + self.every
-        self.shown = True
-        of = f" of {self.total:,}" if self.total else ""
-        print(f"{self.what}: {done:,}{of} ({now - self.started:.0f} s)", file=sys.stderr, flush=True)
-
-    def done(self, count: int) -> None:
-        if self.shown:
-            print(f"{self.what}: {count:,} done in {time.monotonic() - self.started:.1f} s", file=sys.stderr, flush=True)
-
-
-@contextmanager
-def ticking(what: str, after: float = 3.0, every: float = 5.0) -> Iterator[None]:
-    """While the block runs longer than ``after`` seconds, a line on stderr every ``every`` seconds
-    saying it still runs (for one long call that cannot count its own progress), and its time at the end."""
-    import threading
-
-    stop = threading.Event()
-    started = time.monotonic()
-
-    def tick() -> None:
-        wait = after
-        while not stop.wait(wait):
-            print(f"{what}: still running ({time.monotonic() - started:.0f} s)", file=sys.stderr, flush=True)
-            wait = every
-
-    thread = threading.Thread(target=tick, daemon=True)
-    thread.start()
-    try:
-        yield
-    finally:
-        stop.set()
-        thread.join()
-        if time.monotonic() - started > after:
-            print(f"{what}: done in {time.monotonic() - started:.1f} s", file=sys.stderr, flush=True)
 
 
 def parse_gcode(text: str, source: str = "G-code", *, arc_tolerance: float | None = None, interpreter: str = "builtin") -> GcodePath:

@@ -15,7 +15,6 @@ from dataclasses import dataclass, fields
 import numpy as np
 from numpy.typing import NDArray
 
-from ..core.piecewise import polynomial
 from ..check.joints import (
     Continuity,
     ContinuityReport,
@@ -26,6 +25,7 @@ from ..check.joints import (
     flip,
     model_size,
 )
+from ..core.piecewise import polynomial
 from .opendrive_read import Network, Road, _label, read_network
 
 #: Continuity levels of a profile in s (elevation, superelevation).

@@ -26,12 +26,12 @@ from xml.parsers import expat
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from ..check.joints import Frame
 from ..core.chain import Chain
 from ..core.clothoid import NONE, clothoid_frames, clothoid_method
 from ..core.piecewise import piecewise_at
 from ..core.segments import Arc, Line, Segment
 from ..core.spiral import BezierSpiral
-from ..check.joints import Frame
 
 #: Shape elements of a planView geometry and their numeric attributes.
 _KINDS = {

@@ -43,7 +43,8 @@ import time
 
 import numpy as np
 
-from .gcode import GcodePath, Progress, arc_points, ticking
+from .progress import Progress, ticking
+from .toolpath import GcodePath, arc_points
 
 #: The Debian package that has ``rs274``.
 PACKAGE = "linuxcnc-uspace"
