@@ -23,9 +23,11 @@ from .joints import (
     check_tolerances,
     classify_joint,
     classify_pieces,
+    Frame,
     flip,
     model_size,
 )
+from .opendrive_lanes import lane_frame, lane_links, read_lanes
 from .opendrive_read import Network, Road, _label, read_network
 
 #: Continuity levels of a profile in s (elevation, superelevation).
@@ -68,12 +70,15 @@ class LinkReport:
         joint: gap, angle and curvature jump from the first road's end, travelling out of it,
             into the second (a gap across the road of a direct junction is not counted: see ``offset``).
         offset: a direct junction's lateral offset of the reference lines (lanes), metres.
+        lanes: (lane of the first road, lane of the second) when the link joins lane centres
+            (a junction connection's ``laneLink``), else None (the reference lines).
     """
 
     name: str
     via: str
     joint: JointReport
     offset: float = 0.0
+    lanes: tuple[int, int] | None = None
 
 
 @dataclass(frozen=True)
@@ -164,7 +169,7 @@ def check_opendrive(
                                                      ("superelevation", road.superelevation, angle_tol, floor * floor)):  # fmt: skip
             if len(records):
                 profiles.append(_profile_report(road.id, kind, records, tolerance, angle_tol, curvature_tol, rate_floor))
-    links = _links(source, network, gap_tol, angle_tol, curvature_tol, floor)
+    links = _links(source, path, network, gap_tol, angle_tol, curvature_tol, floor)
     return OpenDriveReport(**{f.name: getattr(planview, f.name) for f in fields(planview)}, profiles=tuple(profiles),
                            links=tuple(links), junctions=len(network.junctions))  # fmt: skip
 
@@ -192,10 +197,15 @@ def _profile_report(road: str, kind: str, records: NDArray, value_tol: float, sl
                          (float(s[worst]), *(float(v) for v in jumps[:, worst])))  # fmt: skip
 
 
-def _links(source: str, network: Network, gap_tol: float, angle_tol: float, curvature_tol: float, floor: float) -> list[LinkReport]:
-    """Every declared link between two road ends, once, measured as a joint."""
+def _links(source: str, path: str | os.PathLike, network: Network, gap_tol: float, angle_tol: float, curvature_tol: float,
+           floor: float) -> list[LinkReport]:  # fmt: skip
+    """Every declared link between two road ends, once, measured as a joint: junction connections
+    lane by lane where they give lane links, road links (and connections without lane links)
+    between the reference lines."""
     roads = {road.id: road for road in network.roads}
     junctions = {junction.id: junction for junction in network.junctions}
+    lanes = read_lanes(path) if any(j.connections for j in network.junctions) else None
+    in_junctions = {r.id for r in network.roads if r.junction not in ("-1", "")}
     seen: set = set()
     found: list[LinkReport] = []
 
@@ -204,13 +214,16 @@ def _links(source: str, network: Network, gap_tol: float, angle_tol: float, curv
             raise ValueError(f"{source}: {where} links to road {_label(name)}, which is not in the file")
         return roads[_label(name)]
 
+    def end_frame(r: Road, end: str) -> Frame:
+        return tuple(r.plan.frames[0, 0].tolist()) if end == "start" else tuple(r.plan.frames[-1, 1].tolist())
+
     def add(a: Road, a_end: str, b: Road, b_end: str, via: str, direct: bool = False) -> None:
         key = frozenset({(a.id, a_end), (b.id, b_end)})
         if key in seen:
             return
         seen.add(key)
-        out = tuple(a.plan.frames[-1, 1].tolist()) if a_end == "end" else flip(tuple(a.plan.frames[0, 0].tolist()))
-        into = tuple(b.plan.frames[0, 0].tolist()) if b_end == "start" else flip(tuple(b.plan.frames[-1, 1].tolist()))
+        out = end_frame(a, a_end) if a_end == "end" else flip(end_frame(a, a_end))
+        into = end_frame(b, b_end) if b_end == "start" else flip(end_frame(b, b_end))
         offset = 0.0
         if direct:  # the reference lines may be offset across the road by lanes: only the gap along it counts
             dx, dy = into[0] - out[0], into[1] - out[1]
@@ -218,6 +231,41 @@ def _links(source: str, network: Network, gap_tol: float, angle_tol: float, curv
             into = (into[0] + offset * out[4], into[1] - offset * out[3], *into[2:])
         joint = classify_joint(len(found), out, into, gap_tol, angle_tol, curvature_tol, floor)
         found.append(LinkReport(f"road {a.id} {a_end} → road {b.id} {b_end}", via, joint, offset))
+
+    def add_lanes(a: Road, a_end: str, b: Road, b_end: str, via: str, pairs: tuple[tuple[int, int], ...], where: str) -> None:
+        """One link per lane link: the centre of the incoming road's lane into the connecting road's."""
+        assert lanes is not None
+        for road_ in (a, b):
+            if road_.id not in lanes.roads:
+                raise ValueError(f"{source}: {where}: road {road_.id} has no <lanes>")
+        for lane_a, lane_b in pairs:
+            key = frozenset({(a.id, a_end, lane_a), (b.id, b_end, lane_b)})
+            if key in seen:
+                continue
+            seen.add(key)
+            out = lane_frame(a, lanes.roads[a.id], lane_a, a_end, f"{source}: {where}")
+            into = lane_frame(b, lanes.roads[b.id], lane_b, b_end, f"{source}: {where}")
+            out = out if a_end == "end" else flip(out)
+            into = into if b_end == "start" else flip(into)
+            joint = classify_joint(len(found), out, into, gap_tol, angle_tol, curvature_tol, floor)
+            found.append(LinkReport(f"road {a.id} {a_end} lane {lane_a} → road {b.id} {b_end} lane {lane_b}", via, joint,
+                                    lanes=(lane_a, lane_b)))  # fmt: skip
+
+    def incoming_end(incoming: Road, target: Road, contact: str, junction: str, where: str) -> str:
+        """The end of the incoming road in the junction: the one it names the junction at; if both,
+        the one the connecting road's own link names, else the one nearer the connecting road's end."""
+        ends = [end for end, link in (("start", incoming.predecessor), ("end", incoming.successor))
+                if link is not None and link.element_type == "junction" and _label(link.element_id) == junction]  # fmt: skip
+        if not ends:
+            raise ValueError(f"{source}: {where}: its incoming road {incoming.id} names the junction as neither "
+                             "predecessor nor successor")  # fmt: skip
+        if len(ends) == 1:
+            return ends[0]
+        back = target.predecessor if contact == "start" else target.successor
+        if back is not None and back.element_type == "road" and _label(back.element_id) == incoming.id and back.contact_point:
+            return back.contact_point
+        there = np.array(end_frame(target, contact)[:3])
+        return min(ends, key=lambda end: float(np.linalg.norm(np.array(end_frame(incoming, end)[:3]) - there)))
 
     for r in network.roads:
         for link in (r.predecessor, r.successor):
@@ -228,19 +276,31 @@ def _links(source: str, network: Network, gap_tol: float, angle_tol: float, curv
         direct = junction.kind == "direct"
         via = f"{'direct junction' if direct else 'junction'} {junction.id}"
         for connection in junction.connections:
-            incoming = road(connection.incoming, f"junction {junction.id}, connection {connection.id}")
-            ends = [end for end, link in (("start", incoming.predecessor), ("end", incoming.successor))
-                    if link is not None and link.element_type == "junction" and _label(link.element_id) == junction.id]  # fmt: skip
-            if not ends:
-                raise ValueError(f"{source}: junction {junction.id}, connection {connection.id}: its incoming road "
-                                 f"{incoming.id} names the junction as neither predecessor nor successor")  # fmt: skip
-            target = road(connection.connecting, f"junction {junction.id}, connection {connection.id}")
-            add(incoming, ends[0], target, connection.contact_point, via, direct)
+            where = f"junction {junction.id}, connection {connection.id}"
+            incoming = road(connection.incoming, where)
+            target = road(connection.connecting, where)
+            end = incoming_end(incoming, target, connection.contact_point, junction.id, where)
+            pairs = lanes.links.get((junction.id, connection.id), ()) if lanes is not None else ()
+            if pairs:
+                add_lanes(incoming, end, target, connection.contact_point, via, pairs, where)
+                seen.add(frozenset({(incoming.id, end), (target.id, connection.contact_point)}))  # judged by its lanes
+            else:
+                add(incoming, end, target, connection.contact_point, via, direct)
     for r in network.roads:
         for end, link in (("start", r.predecessor), ("end", r.successor)):
-            if link is not None and link.element_type == "road":
-                add(r, end, road(link.element_id, f"road {r.id} <{'predecessor' if end == 'start' else 'successor'}>"),
-                    link.contact_point, "road link")  # fmt: skip
+            if link is None or link.element_type != "road":
+                continue
+            where = f"road {r.id} <{'predecessor' if end == 'start' else 'successor'}>"
+            other = road(link.element_id, where)
+            # inside a junction the reference lines are meant to be apart: follow the lanes' own links
+            pairs = lane_links(lanes.roads[r.id], end) if lanes is not None and r.id in lanes.roads else []
+            if pairs and (r.id in in_junctions or other.id in in_junctions):
+                if frozenset({(r.id, end), (other.id, link.contact_point)}) in seen:
+                    continue
+                add_lanes(r, end, other, link.contact_point, "road link", tuple(pairs), where)
+                seen.add(frozenset({(r.id, end), (other.id, link.contact_point)}))
+            else:
+                add(r, end, other, link.contact_point, "road link")
     return found
 
 
