@@ -1,0 +1,121 @@
+"""OpenDRIVE links judged at the right road ends and lane by lane (lane centres through junctions)."""
+
+import math
+
+import pytest
+
+from spiral_cad.cli import main
+from spiral_cad.formats.opendrive import check_opendrive
+from spiral_cad.formats.opendrive_lanes import read_lanes
+
+HEADER = '<?xml version="1.0"?>\n<OpenDRIVE><header revMajor="1" revMinor="6"/>{}</OpenDRIVE>'
+R = 100.0
+
+
+def circle_map() -> str:
+    """A circle of radius 100 split into a 300° road 1 and a 60° connecting road 10 in junction 5:
+    both ends of road 1 are in the junction; every joint is exactly G2."""
+    big, small = R * math.radians(300), R * math.radians(60)
+    return HEADER.format(f"""
+<road id="1" junction="-1" length="{big!r}">
+  <link><predecessor elementType="junction" elementId="5"/><successor elementType="junction" elementId="5"/></link>
+  <planView><geometry s="0" x="0" y="{-R!r}" hdg="0" length="{big!r}"><arc curvature="{1 / R!r}"/></geometry></planView>
+</road>
+<road id="10" junction="5" length="{small!r}">
+  <link><predecessor elementType="road" elementId="1" contactPoint="end"/><successor elementType="road" elementId="1" contactPoint="start"/></link>
+  <planView><geometry s="0" x="{R * math.cos(math.radians(210))!r}" y="{R * math.sin(math.radians(210))!r}" hdg="{math.radians(300)!r}" length="{small!r}"><arc curvature="{1 / R!r}"/></geometry></planView>
+</road>
+<junction id="5"><connection id="0" incomingRoad="1" connectingRoad="10" contactPoint="start"/>
+  <connection id="1" incomingRoad="1" connectingRoad="10" contactPoint="end"/></junction>
+""")
+
+
+def test_the_incoming_roads_end_is_the_one_in_the_junction(tmp_path):
+    path = tmp_path / "circle.xodr"
+    path.write_text(circle_map())
+    report = check_opendrive(path)
+    names = {link.name: link for link in report.links}
+    assert set(names) == {"road 1 end → road 10 start", "road 1 start → road 10 end"}
+    for link in report.links:
+        assert str(link.joint.level) == "G2" and link.joint.gap < 1e-9
+    assert main(["check", str(path), "--links", "G2"]) == 0
+
+
+def lane_junction(width_b: float = 0.0, offset: float = 1.75) -> str:
+    """Road 1 (x 0…50) and road 2 (x 70…120), two lanes of 3.5 m each side, their reference lines on
+    y = 0, meet in junction 9; connecting road 3 runs straight from x 50 to 70 with its reference
+    line on y = −``offset`` and a laneOffset of +``offset``, so its lanes lie exactly over the roads'
+    lanes although the reference lines are apart. Road 3's lane −1 may widen (``width_b``)."""
+    lanes = """<lanes>{offset}<laneSection s="0">
+    <left><lane id="1" type="driving"><link><predecessor id="1"/><successor id="1"/></link><width sOffset="0" a="3.5" b="0" c="0" d="0"/></lane></left>
+    <center><lane id="0" type="none"/></center>
+    <right><lane id="-1" type="driving"><link><predecessor id="-1"/><successor id="-1"/></link><width sOffset="0" a="3.5" b="{b}" c="0" d="0"/></lane></right>
+  </laneSection></lanes>"""
+    plain = lanes.format(offset="", b="0")
+    shifted = lanes.format(offset=f'<laneOffset s="0" a="{offset!r}" b="0" c="0" d="0"/>', b=repr(width_b))
+    return HEADER.format(f"""
+<road id="1" junction="-1" length="50"><link><successor elementType="junction" elementId="9"/></link>
+  <planView><geometry s="0" x="0" y="0" hdg="0" length="50"><line/></geometry></planView>{plain}</road>
+<road id="2" junction="-1" length="50"><link><predecessor elementType="junction" elementId="9"/></link>
+  <planView><geometry s="0" x="70" y="0" hdg="0" length="50"><line/></geometry></planView>{plain}</road>
+<road id="3" junction="9" length="20">
+  <link><predecessor elementType="road" elementId="1" contactPoint="end"/><successor elementType="road" elementId="2" contactPoint="start"/></link>
+  <planView><geometry s="0" x="50" y="{-offset!r}" hdg="0" length="20"><line/></geometry></planView>{shifted}</road>
+<junction id="9"><connection id="0" incomingRoad="1" connectingRoad="3" contactPoint="start">
+  <laneLink from="1" to="1"/><laneLink from="-1" to="-1"/></connection></junction>
+""")
+
+
+def test_a_junction_offset_by_lane_offset_is_judged_lane_by_lane(tmp_path):
+    path = tmp_path / "offset.xodr"
+    path.write_text(lane_junction())
+    report = check_opendrive(path)
+    names = {link.name: link for link in report.links}
+    assert set(names) == {"road 1 end lane 1 → road 3 start lane 1", "road 1 end lane -1 → road 3 start lane -1",
+                          "road 3 end lane -1 → road 2 start lane -1", "road 3 end lane 1 → road 2 start lane 1"}  # fmt: skip
+    for link in report.links:
+        assert str(link.joint.level) == "G2" and link.joint.gap < 1e-12, link.name
+    assert names["road 1 end lane -1 → road 3 start lane -1"].lanes == (-1, -1)
+    assert main(["check", str(path), "--links", "G2"]) == 0
+
+
+def test_a_lane_that_does_not_line_up_is_a_gap_of_the_right_size(tmp_path):
+    path = tmp_path / "off.xodr"
+    # road 3's reference line 1.75 below, its laneOffset only 1.5: its lanes lie 0.25 low
+    path.write_text(lane_junction(offset=1.75).replace('a="1.75" b="0"', 'a="1.5" b="0"'))
+    links = {link.name: link.joint for link in check_opendrive(path).links}
+    assert links["road 1 end lane 1 → road 3 start lane 1"].gap == pytest.approx(0.25)
+    assert str(links["road 1 end lane 1 → road 3 start lane 1"].level) == "none"
+    assert main(["check", str(path), "--links", "G0"]) == 1
+
+
+def test_a_widening_lane_turns_its_centre_and_the_angle_is_half_the_width_rate(tmp_path):
+    # lane −1 of road 3 widens by 0.02 per metre: its centre heads away at atan(0.01) from road 1's lane
+    path = tmp_path / "widen.xodr"
+    path.write_text(lane_junction(width_b=0.02))
+    links = {link.name: link.joint for link in check_opendrive(path).links}
+    joint = links["road 1 end lane -1 → road 3 start lane -1"]
+    assert joint.gap < 1e-12 and joint.angle == pytest.approx(math.atan(0.01), rel=1e-12)
+    assert str(links["road 1 end lane 1 → road 3 start lane 1"].level) == "G2"
+
+
+def test_lane_centre_curvature_on_an_arc_is_the_offset_circles(tmp_path):
+    # a road on a circle of radius 100 with 3.5 m lanes: lane 1's centre is the circle of radius 98.25
+    from spiral_cad.formats.opendrive import read_network
+    from spiral_cad.formats.opendrive_lanes import lane_frame
+
+    path = tmp_path / "arc.xodr"
+    path.write_text(lane_junction().replace('<line/></geometry></planView><lanes><laneOffset', '<arc curvature="0.01"/></geometry></planView><lanes><laneOffset'))
+    network = read_network(path)
+    road = next(r for r in network.roads if r.id == "3")
+    frame = lane_frame(road, read_lanes(path).roads["3"], 1, "end", "test")
+    t = 1.75 + 1.75  # laneOffset + half the lane
+    assert math.hypot(frame[6], frame[7]) == pytest.approx(0.01 / (1 - 0.01 * t), rel=1e-12)
+
+
+def test_a_lane_link_to_a_missing_lane_is_named(tmp_path):
+    path = tmp_path / "bad.xodr"
+    path.write_text(lane_junction().replace('<laneLink from="-1" to="-1"/>', '<laneLink from="-1" to="-3"/>'))
+    with pytest.raises(ValueError, match=r"junction 9, connection 0: road 3 has no lane -3 at its start \(lanes \[-1, 1\]\)"):
+        check_opendrive(path)
+    assert main(["check", str(path), "--links", "G0"]) == 2
