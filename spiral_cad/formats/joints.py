@@ -146,6 +146,9 @@ class WireReport:
         kind: ``"wire"``, ``"loose piece"`` (edges that belong to no wire,
             chained by nearest ends) or ``"road"`` (an OpenDRIVE planView).
         name: what the file calls it, if anything (an OpenDRIVE road's id).
+        reverses: its last edge ends where the first starts but arrives going back the way the
+            first leaves (a path that returns along its start, as a program often does): it is
+            judged as an open path, two ends and no closing joint (``closed`` is then False).
     """
 
     index: int
@@ -154,6 +157,7 @@ class WireReport:
     joints: tuple[JointReport, ...]
     kind: str = "wire"
     name: str = ""
+    reverses: bool = False
 
     @property
     def loose(self) -> bool:
@@ -286,7 +290,7 @@ class ContinuityReport:
         for w in self.wires:
             out.append(
                 f"{w.kind} {w.index}{f' (id {w.name})' if w.name else ''}: {_count(w.edge_count, self.element)}, "
-                f"{'closed' if w.closed else 'open'}, "
+                f"{'closed' if w.closed else 'open (its ends meet, reversing: no closing joint)' if w.reverses else 'open'}, "
                 f"{len(w.joints)} joint(s), worst {w.min_level}"
             )
             if w.joints:
@@ -466,6 +470,8 @@ def classify_pieces(
     floor = 1.0 / size if size > 0.0 else 0.0
     wires = []
     for w, (kind, ends, closed, *name) in enumerate(pieces):
+        reverses = bool(closed) and len(ends) > 1 and _reversal(ends[-1][1], ends[0][0], gap_tol, angle_tol)
+        closed = closed and not reverses
         pairs = len(ends) if closed else len(ends) - 1
         joints: tuple[JointReport, ...] = ()
         if pairs > 0:
@@ -473,8 +479,17 @@ def classify_pieces(
             after = np.roll(frames[:, 0], -1, axis=0)[:pairs]
             measures = classify_joints(frames[:pairs, 1], after, gap_tol, angle_tol, curvature_tol, floor)
             joints = tuple(_joint_reports(range(pairs), measures, plane_changes(frames, closed, curvature_tol * floor)))
-        wires.append(WireReport(w, len(ends), closed, joints, kind, *name))
+        wires.append(WireReport(w, len(ends), closed, joints, kind, *name, reverses=reverses))
     return ContinuityReport(tuple(wires), gap_tol, angle_tol, curvature_tol, size, snap, source, element, units)
+
+
+def _reversal(a: Frame, b: Frame, gap_tol: float, angle_tol: float) -> bool:
+    """The end frame ``a`` meets the start frame ``b`` (within ``gap_tol``) heading the opposite way (within
+    ``angle_tol`` of π): a path that comes back along its start, not a loop through its closing point."""
+    ta, tb = np.asarray(a[3:6], dtype=float), np.asarray(b[3:6], dtype=float)
+    with np.errstate(all="ignore"):
+        angle = math.atan2(float(np.linalg.norm(np.cross(ta, tb))), float(ta @ tb))
+    return distance(a, b) <= gap_tol and math.pi - angle <= angle_tol
 
 
 def check_tolerances(**tolerances: float) -> None:
