@@ -3,7 +3,9 @@
 Every road's planView joints (G0/G1/G2, the measures of every checker in
 ``spiral_cad.formats.joints``), its ``elevation`` and ``superelevation`` in s
 (C0/C1/C2), and every link between road ends (road links, junction
-connections) measured as a joint. Public names: ``spiral_cad.formats.opendrive``.
+connections) measured as a joint — through a junction lane centre to lane
+centre, what a driver follows (``spiral_cad.formats.opendrive_lanes``).
+Public names: ``spiral_cad.formats.opendrive``.
 """
 
 from __future__ import annotations
@@ -65,7 +67,8 @@ class LinkReport:
     """One link between two road ends (a road link or a junction connection), measured as a joint.
 
     Attributes:
-        name: ``"road 1 end → road 2 start"``.
+        name: ``"road 1 end → road 2 start"``, or ``"road 1 end lane -1 → road 2 start lane -1"``
+            for a lane link.
         via: ``"road link"``, ``"junction J"`` or ``"direct junction J"``.
         joint: gap, angle and curvature jump from the first road's end, travelling out of it,
             into the second (a gap across the road of a direct junction is not counted: see ``offset``).
@@ -124,7 +127,8 @@ class OpenDriveReport(ContinuityReport):
             out.append(f"  {'link':40} {'gap':>10} {'angle rad':>10} {'|Δκ|':>10} {'Δκ rel':>9} level")
             for link in self.links:
                 j = link.joint
-                note = f"  ({link.via}; reference lines offset {link.offset:.6g}{unit} by lanes)" if link.offset else f"  ({link.via})"
+                note = (f"  ({link.via}; reference lines offset {link.offset:.6g}{unit} by lanes)" if link.offset
+                        else f"  ({link.via}; lane centres)" if link.lanes else f"  ({link.via})")  # fmt: skip
                 out.append(f"  {link.name:40} {j.gap:10.3e} {j.angle:10.3e} {j.curvature_jump:10.3e} "
                            f"{j.relative_curvature_jump:9.2e} {j.level}{note}")  # fmt: skip
         return "\n".join(out)
@@ -144,15 +148,29 @@ def check_opendrive(
     ``curvature_tol`` relative to max(|f''|, 1/size) (1/size² for the roll).
     A link joins two road ends: a road's ``successor``/``predecessor`` with
     its ``contactPoint`` (an end-to-end link reverses the second road) or a
-    junction's connection from its incoming road into the connecting road
+    junction's connection from its incoming road — at the end that road
+    names the junction at; if both, the end the connecting road's own link
+    names, else the nearer — into the connecting road at its ``contactPoint``
     (declared links are counted once). It is measured like a joint,
-    travelling out of the first road into the second; at a direct junction
-    the reference lines may be offset across the road by lanes, which is
-    reported as such rather than as a gap.
+    travelling out of the first road into the second.
+
+    In a junction the reference lines are meant to be apart (``laneOffset``,
+    lanes on one side only), so a connection with ``laneLink`` elements is
+    judged per lane link, and a road link to or from a road of a junction
+    per lane ``<link>``: the lane centres (reference line + laneOffset +
+    inner widths + half the lane's, in the first lane section at a road's
+    start and the last at its end, raised by elevation and tilted by
+    superelevation) in 3-D, their tangents and their curvature vectors in
+    closed form (see ``opendrive_lanes``). Other road links, and
+    connections without lane links, join the reference lines; at a direct
+    junction without lane links the reference lines may be offset across
+    the road, which is reported as such rather than as a gap.
 
     Raises:
         ValueError: an unreadable file (see ``read_network``), a link to a
-            road or junction that is not in the file, or a bad tolerance.
+            road or junction that is not in the file, a lane link to a lane
+            the road does not have at that end (or given by ``<border>``), a
+            road in a lane-linked connection without ``<lanes>``, or a bad tolerance.
     """
     check_tolerances(gap_tol=gap_tol, angle_tol=angle_tol, curvature_tol=curvature_tol)
     network = read_network(path)
@@ -293,8 +311,15 @@ def _links(source: str, path: str | os.PathLike, network: Network, gap_tol: floa
             where = f"road {r.id} <{'predecessor' if end == 'start' else 'successor'}>"
             other = road(link.element_id, where)
             # inside a junction the reference lines are meant to be apart: follow the lanes' own links
-            pairs = lane_links(lanes.roads[r.id], end) if lanes is not None and r.id in lanes.roads else []
-            if pairs and (r.id in in_junctions or other.id in in_junctions):
+            # (this road's at this end, else the other road's, if its link there names this road's end)
+            pairs = []
+            if lanes is not None and (r.id in in_junctions or other.id in in_junctions):
+                pairs = lane_links(lanes.roads[r.id], end) if r.id in lanes.roads else []
+                back = other.predecessor if link.contact_point == "start" else other.successor
+                if not pairs and other.id in lanes.roads and back is not None and back.element_type == "road" \
+                        and _label(back.element_id) == r.id and back.contact_point == end:
+                    pairs = [(b, a) for a, b in lane_links(lanes.roads[other.id], link.contact_point)]
+            if pairs:
                 if frozenset({(r.id, end), (other.id, link.contact_point)}) in seen:
                     continue
                 add_lanes(r, end, other, link.contact_point, "road link", tuple(pairs), where)
