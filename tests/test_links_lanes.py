@@ -2,6 +2,7 @@
 
 import math
 
+import numpy as np
 import pytest
 
 from spiral_cad.cli import main
@@ -119,3 +120,47 @@ def test_a_lane_link_to_a_missing_lane_is_named(tmp_path):
     with pytest.raises(ValueError, match=r"junction 9, connection 0: road 3 has no lane -3 at its start \(lanes \[-1, 1\]\)"):
         check_opendrive(path)
     assert main(["check", str(path), "--links", "G0"]) == 2
+
+
+DATA = __import__("pathlib").Path(__file__).parent / "data"
+
+
+def test_a_real_lane_offset_junction_lines_up_lane_by_lane_but_not_by_reference_lines(capsys):
+    # esmini's lane_offset_intersection (trimmed): road 7 opens a turn lane (laneOffset and lane −1's width
+    # grow as the same cubic), so at its end the reference line lies 3.5 m beside connecting road 13's
+    from spiral_cad.formats.opendrive import read_network
+
+    path = DATA / "esmini_lane_offset_junction.xodr"
+    roads = {r.id: r for r in read_network(path).roads}
+    reference_gap = math.dist(roads["7"].plan.frames[-1, 1, :2], roads["13"].plan.frames[0, 0, :2])
+    assert reference_gap == pytest.approx(3.5, abs=1e-5)
+    links = {link.name: link.joint for link in check_opendrive(path).links}
+    assert set(links) == {"road 1 end lane -2 → road 9 start lane -1", "road 7 end lane -1 → road 13 start lane -1",
+                          "road 9 end lane -1 → road 7 end lane 1", "road 13 end lane -1 → road 1 end lane 1"}  # fmt: skip
+    assert max(joint.gap for joint in links.values()) < 1e-5  # the file's own rounding: micrometres
+    assert max(joint.angle for joint in links.values()) < 1e-7
+    assert main(["check", str(path), "--links", "G1", "--gap-tol", "1e-5"]) == 0
+    assert "road 1 end lane -2 → road 9 start lane -1" in capsys.readouterr().out
+
+
+def test_a_lane_centre_on_a_straight_road_follows_its_offset_polynomial():
+    # road 1 is a straight line; lane −1's centre lies at t(s) = laneOffset(s) − width(s)/2, a graph over the
+    # line: heading atan(t'), curvature t''/(1 + t'²)^1.5 — both from the file's numbers, written out here
+    from spiral_cad.formats.opendrive import read_network
+    from spiral_cad.formats.opendrive_lanes import lane_frame
+
+    path = DATA / "esmini_lane_offset_junction.xodr"
+    road = next(r for r in read_network(path).roads if r.id == "1")
+    offset = np.polynomial.Polynomial([0.0, 0.0, 0.01311473410248621, -0.0003089963334634307])
+    width = np.polynomial.Polynomial([0.0, 0.0, 0.01311473410248621, -0.00030899633346343077])
+    t = offset - width / 2
+    s, hdg = 28.295339204595706, 2.603087685674666
+    frame = lane_frame(road, read_lanes(path).roads["1"], -1, "end", "test")
+    slope, bend = t.deriv()(s), t.deriv(2)(s)
+    heading = hdg + math.atan(slope)
+    assert frame[3:5] == pytest.approx((math.cos(heading), math.sin(heading)), abs=1e-14)
+    assert math.hypot(*frame[6:8]) == pytest.approx(abs(bend) / (1 + slope**2) ** 1.5, rel=1e-12)
+    start = (5.696453094482422, -5.444994926452637)
+    normal = (-math.sin(hdg), math.cos(hdg))
+    expected = (start[0] + s * math.cos(hdg) + t(s) * normal[0], start[1] + s * math.sin(hdg) + t(s) * normal[1])
+    assert frame[:2] == pytest.approx(expected, abs=1e-12)
