@@ -164,3 +164,32 @@ def test_a_lane_centre_on_a_straight_road_follows_its_offset_polynomial():
     normal = (-math.sin(hdg), math.cos(hdg))
     expected = (start[0] + s * math.cos(hdg) + t(s) * normal[0], start[1] + s * math.sin(hdg) + t(s) * normal[1])
     assert frame[:2] == pytest.approx(expected, abs=1e-12)
+
+
+def with_profiles(text: str, road: str, profiles: str) -> str:
+    """``text`` with ``profiles`` (elevationProfile/lateralProfile elements) after road ``road``'s planView."""
+    head, tail = text.split(f'<road id="{road}"', 1)
+    before, after = tail.split("</planView>", 1)
+    return f'{head}<road id="{road}"{before}</planView>{profiles}{after}'
+
+
+def test_lane_links_are_judged_with_elevation(tmp_path):
+    # road 1 climbs at 2 % to z = 1 at its end; road 3 goes on from z = 1 at 2 % (G2) or at 5 % (a kink)
+    base = with_profiles(lane_junction(offset=0.0), "1", '<elevationProfile><elevation s="0" a="0" b="0.02" c="0" d="0"/></elevationProfile>')
+    path = tmp_path / "climb.xodr"
+    for grade, level, angle in ((0.02, "G2", 0.0), (0.05, "G0", math.atan(0.05) - math.atan(0.02))):
+        path.write_text(with_profiles(base, "3", f'<elevationProfile><elevation s="0" a="1" b="{grade}" c="0" d="0"/></elevationProfile>'))
+        joint = {link.name: link.joint for link in check_opendrive(path).links}["road 1 end lane 1 → road 3 start lane 1"]
+        assert str(joint.level) == level and joint.gap < 1e-12 and joint.angle == pytest.approx(angle, abs=1e-12)
+
+
+def test_lane_links_are_judged_with_superelevation(tmp_path):
+    # both roads rolled by 0.05 rad about one reference line: lane 1's centre meets; road 3 rolled 0.08: it
+    # sits t·(sin 0.08 − sin 0.05) higher and t·(cos 0.05 − cos 0.08) nearer the reference line
+    roll = '<lateralProfile><superelevation s="0" a="{}" b="0" c="0" d="0"/></lateralProfile>'
+    path = tmp_path / "roll.xodr"
+    for other, gap in ((0.05, 0.0), (0.08, 1.75 * math.hypot(math.sin(0.08) - math.sin(0.05), math.cos(0.08) - math.cos(0.05)))):
+        path.write_text(with_profiles(with_profiles(lane_junction(offset=0.0), "1", roll.format(0.05)), "3", roll.format(other)))
+        joint = {link.name: link.joint for link in check_opendrive(path).links}["road 1 end lane 1 → road 3 start lane 1"]
+        assert joint.gap == pytest.approx(gap, abs=1e-12)
+        assert str(joint.level) == ("G2" if gap == 0.0 else "none")
