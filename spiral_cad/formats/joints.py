@@ -479,7 +479,7 @@ def classify_pieces(
             after = np.roll(frames[:, 0], -1, axis=0)[:pairs]
             measures = classify_joints(frames[:pairs, 1], after, gap_tol, angle_tol, curvature_tol, floor)
             joints = tuple(_joint_reports(range(pairs), measures, plane_changes(frames, closed, curvature_tol * floor)))
-        wires.append(WireReport(w, len(ends), closed, joints, kind, *name, reverses=reverses))
+        wires.append(WireReport(w, len(ends), closed, joints, kind, name[0] if name else "", reverses=reverses))
     return ContinuityReport(tuple(wires), gap_tol, angle_tol, curvature_tol, size, snap, source, element, units)
 
 

@@ -21,11 +21,11 @@ from ..core.piecewise import polynomial
 from .joints import (
     Continuity,
     ContinuityReport,
+    Frame,
     JointReport,
     check_tolerances,
     classify_joint,
     classify_pieces,
-    Frame,
     flip,
     model_size,
 )
@@ -74,7 +74,8 @@ class LinkReport:
             into the second (a gap across the road of a direct junction is not counted: see ``offset``).
         offset: a direct junction's lateral offset of the reference lines (lanes), metres.
         lanes: (lane of the first road, lane of the second) when the link joins lane centres
-            (a junction connection's ``laneLink``), else None (the reference lines).
+            (a junction connection's ``laneLink``, or a lane's ``<link>`` at a junction road's end),
+            else None (the reference lines).
     """
 
     name: str
@@ -310,22 +311,23 @@ def _links(source: str, path: str | os.PathLike, network: Network, gap_tol: floa
                 continue
             where = f"road {r.id} <{'predecessor' if end == 'start' else 'successor'}>"
             other = road(link.element_id, where)
+            contact = link.contact_point or ""  # read_network refuses a road link without start or end
             # inside a junction the reference lines are meant to be apart: follow the lanes' own links
             # (this road's at this end, else the other road's, if its link there names this road's end)
-            pairs = []
+            lane_pairs: list[tuple[int, int]] = []
             if lanes is not None and (r.id in in_junctions or other.id in in_junctions):
-                pairs = lane_links(lanes.roads[r.id], end) if r.id in lanes.roads else []
-                back = other.predecessor if link.contact_point == "start" else other.successor
-                if not pairs and other.id in lanes.roads and back is not None and back.element_type == "road" \
+                lane_pairs = lane_links(lanes.roads[r.id], end) if r.id in lanes.roads else []
+                back = other.predecessor if contact == "start" else other.successor
+                if not lane_pairs and other.id in lanes.roads and back is not None and back.element_type == "road" \
                         and _label(back.element_id) == r.id and back.contact_point == end:
-                    pairs = [(b, a) for a, b in lane_links(lanes.roads[other.id], link.contact_point)]
-            if pairs:
-                if frozenset({(r.id, end), (other.id, link.contact_point)}) in seen:
+                    lane_pairs = [(b, a) for a, b in lane_links(lanes.roads[other.id], contact)]
+            if lane_pairs:
+                if frozenset({(r.id, end), (other.id, contact)}) in seen:
                     continue
-                add_lanes(r, end, other, link.contact_point, "road link", tuple(pairs), where)
-                seen.add(frozenset({(r.id, end), (other.id, link.contact_point)}))
+                add_lanes(r, end, other, contact, "road link", tuple(lane_pairs), where)
+                seen.add(frozenset({(r.id, end), (other.id, contact)}))
             else:
-                add(r, end, other, link.contact_point, "road link")
+                add(r, end, other, contact, "road link")
     return found
 
 
