@@ -193,3 +193,54 @@ def test_lane_links_are_judged_with_superelevation(tmp_path):
         joint = {link.name: link.joint for link in check_opendrive(path).links}["road 1 end lane 1 → road 3 start lane 1"]
         assert joint.gap == pytest.approx(gap, abs=1e-12)
         assert str(joint.level) == ("G2" if gap == 0.0 else "none")
+
+
+def test_lane_centre_curvature_on_a_spiral_with_a_growing_lane_matches_a_sampled_curve(tmp_path):
+    # the closed form (κ, κ', t, t', t'') against the lane centre sampled at 9 stations before the road's end and
+    # differentiated by a polynomial fit: a clothoid reference line and a lane whose width is a cubic
+    from spiral_cad.formats.opendrive import read_network
+    from spiral_cad.formats.opendrive_lanes import lane_frame
+
+    length, k0, k1 = 40.0, 0.002, 0.03
+    width = np.polynomial.Polynomial([3.0, 0.02, 4e-4, -5e-6])
+    offset = np.polynomial.Polynomial([0.3, -0.01, 2e-4, 0.0])
+    path = tmp_path / "spiral.xodr"
+    path.write_text(HEADER.format(f"""
+<road id="1" junction="-1" length="{length!r}">
+  <planView><geometry s="0" x="3" y="-2" hdg="0.4" length="{length!r}"><spiral curvStart="{k0!r}" curvEnd="{k1!r}"/></geometry></planView>
+  <lanes><laneOffset s="0" a="{float(offset.coef[0])!r}" b="{float(offset.coef[1])!r}" c="{float(offset.coef[2])!r}" d="{float(offset.coef[3])!r}"/>
+    <laneSection s="0"><center><lane id="0"/></center><right><lane id="-1" type="driving">
+      <width sOffset="0" a="{float(width.coef[0])!r}" b="{float(width.coef[1])!r}" c="{float(width.coef[2])!r}" d="{float(width.coef[3])!r}"/></lane></right></laneSection></lanes>
+</road>"""))
+    (road,) = read_network(path).roads
+    (geometry,) = road.geometries
+    frame = lane_frame(road, read_lanes(path).roads["1"], -1, "end", "test")
+    s = length - np.linspace(0.0, 4.0, 9)
+    points, tangents, _ = geometry.evaluate(s / length)
+    t = offset(s) - width(s) / 2
+    centre = points + t[:, None] * np.column_stack([-tangents[:, 1], tangents[:, 0]])
+    fit = [np.polynomial.Polynomial.fit(s - length, centre[:, k], 8).convert() for k in range(2)]
+    d1 = np.array([f.deriv()(0.0) for f in fit])
+    d2 = np.array([f.deriv(2)(0.0) for f in fit])
+    curvature = (d1[0] * d2[1] - d1[1] * d2[0]) / np.linalg.norm(d1) ** 3
+    assert frame[:2] == pytest.approx(centre[0], abs=1e-12)
+    assert frame[3:5] == pytest.approx(d1 / np.linalg.norm(d1), abs=1e-9)
+    normal = (-frame[4], frame[3])
+    assert frame[6] * normal[0] + frame[7] * normal[1] == pytest.approx(curvature, rel=1e-6)
+
+
+@pytest.mark.parametrize("kind", ["paramPoly3", "poly3", "spiral"])
+def test_the_curvature_rate_at_a_road_end_matches_a_difference_of_curvatures(kind):
+    # dκ/ds at the end of each planView kind whose curvature varies, against (κ(1) − κ(1 − h)) / chord
+    from spiral_cad.formats.opendrive_lanes import _curvature_rate
+    from spiral_cad.formats.opendrive_read import Geometry
+
+    params = {"paramPoly3": {"aU": 0.0, "bU": 30.0, "cU": -2.0, "dU": 0.5, "aV": 0.0, "bV": 0.0, "cV": 3.0, "dV": -0.8,
+                             "pRange": "normalized"},
+              "poly3": {"a": 0.0, "b": 0.1, "c": 0.004, "d": -0.0002},
+              "spiral": {"curvStart": 0.001, "curvEnd": 0.02}}[kind]  # fmt: skip
+    geometry = Geometry("1", 0, 0.0, 1.0, 2.0, 0.3, 30.0, kind, params)
+    h = 1e-6
+    points, _, curvature = geometry.evaluate([1.0 - h, 1.0])
+    rate = (curvature[1] - curvature[0]) / math.dist(points[0], points[1])
+    assert _curvature_rate(geometry, 1.0) == pytest.approx(rate, rel=1e-4)
