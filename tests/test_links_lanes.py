@@ -244,3 +244,30 @@ def test_the_curvature_rate_at_a_road_end_matches_a_difference_of_curvatures(kin
     points, _, curvature = geometry.evaluate([1.0 - h, 1.0])
     rate = (curvature[1] - curvature[0]) / math.dist(points[0], points[1])
     assert _curvature_rate(geometry, 1.0) == pytest.approx(rate, rel=1e-4)
+
+
+@pytest.mark.parametrize(
+    "change, message",
+    [
+        (('<width sOffset="0" a="3.5" b="0"', '<width sOffset="0" a="wide" b="0"'), r"road 1, lane 1 <width>: a must be a finite number; got 'wide'"),
+        (('<lane id="-1" type="driving">', '<lane id="minus one" type="driving">'), r"road 1, laneSection 0 <lane>: id must be an integer lane id"),
+        (('<laneLink from="1" to="1"/>', '<laneLink from="1"/>'), r"junction 9, connection 0 <laneLink>: to must be an integer lane id; got None"),
+        (('<laneOffset s="0" a="1.75"', '<laneOffset s="inf" a="1.75"'), r"road 3, laneOffset 0: s must be a finite number; got 'inf'"),
+        (('<width sOffset="0" a="3.5" b="0" c="0" d="0"/></lane></left>', '<border sOffset="0" a="3.5" b="0" c="0" d="0"/></lane></left>'),
+         r"road 1, lane 1 is given by <border>, which is not supported; give <width>"),
+    ],
+)
+def test_bad_lanes_are_named(tmp_path, change, message):
+    path = tmp_path / "bad.xodr"
+    path.write_text(lane_junction().replace(*change, 1))
+    with pytest.raises(ValueError, match=message):
+        check_opendrive(path)
+
+
+def test_lane_elements_out_of_place_are_ignored(tmp_path):
+    # a width outside a lane section and a laneLink outside a connection are not lanes: the links are as before
+    text = lane_junction().replace("<lanes>", '<lanes><userData><x><lane id="5"><width sOffset="0" a="x"/></lane></x></userData>', 1)
+    text = text.replace('<junction id="9">', '<junction id="9"><userData><laneLink from="a" to="b"/></userData>')
+    path = tmp_path / "odd.xodr"
+    path.write_text(text)
+    assert all(str(link.joint.level) == "G2" for link in check_opendrive(path).links)

@@ -120,7 +120,7 @@ def read_lanes(path: str | os.PathLike) -> Lanes:
             state["connection"] = attributes.get("id", str(state["count"]))
             state["count"] += 1
             links[(state["junction"], state["connection"])] = ()
-        elif depth == 4 and tag == "laneLink" and stack[1] == "junction":
+        elif depth == 4 and tag == "laneLink" and stack[1] == "junction" and stack[2] == "connection":
             where = f"{label}: junction {state['junction']}, connection {state['connection']} <laneLink>"
             key = (state["junction"], state["connection"])
             links[key] += ((_integer(attributes.get("from"), where, "from"), _integer(attributes.get("to"), where, "to")),)
@@ -138,10 +138,10 @@ def read_lanes(path: str | os.PathLike) -> Lanes:
             state["lane"] = lane
             state["sections"][-1][1][lane] = ([], 0)
             state["lane_links"][(len(state["sections"]) - 1, lane)] = {}
-        elif depth == 8 and tag in ("predecessor", "successor") and stack[6] == "link" and stack[5] == "lane":
+        elif depth == 8 and tag in ("predecessor", "successor") and stack[6] == "link" and stack[5] == "lane" and stack[3] == "laneSection":
             where = f"{label}: road {state['road']}, lane {state['lane']} <{tag}>"
             state["lane_links"][(len(state["sections"]) - 1, state["lane"])][tag] = _integer(attributes.get("id"), where, "id")
-        elif depth == 7 and tag in ("width", "border") and stack[5] == "lane":
+        elif depth == 7 and tag in ("width", "border") and stack[5] == "lane" and stack[3] == "laneSection":
             widths, borders = state["sections"][-1][1][state["lane"]]
             if tag == "border":
                 state["sections"][-1][1][state["lane"]] = (widths, borders + 1)
