@@ -634,3 +634,14 @@ def test_a_program_that_ends_where_it_started_builds_and_checks_g2(tmp_path, cap
     assert "open (its ends meet, reversing: no closing joint), 9 joint(s), worst G2" in capsys.readouterr().out
     (w,) = check_continuity(out / "back.step").wires
     assert w.reverses and not w.closed and w.min_level is Continuity.G2
+
+
+def test_a_smooth_loop_whose_ends_are_two_vertices_is_still_a_loop():
+    # two half circles whose end points coincide but are separate vertices: the seam is judged (G2), as
+    # in a wire that shares them; the same with a corner at the seam stays an open path
+    halves = [ccw_arc((0, 0), 1.0, 0.0, math.pi), ccw_arc((0, 0), 1.0, math.pi, 2 * math.pi)]
+    (w,) = check_continuity(loose_wire(*halves)).wires
+    assert w.closed and len(w.joints) == 2 and w.min_level is G2
+    corner = [line((0, 0), (1, 0)), line((1, 0), (1, 1)), line((1, 1), (0, 0))]
+    (w,) = check_continuity(loose_wire(*corner)).wires
+    assert not w.closed and len(w.joints) == 2

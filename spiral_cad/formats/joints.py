@@ -140,8 +140,9 @@ class WireReport:
     Attributes:
         index: position in the report.
         edge_count: non-degenerate edges in the piece.
-        closed: the last edge ends where the first starts (shared vertex or
-            within ``gap_tol``); the closing joint is then reported last.
+        closed: the last edge ends where the first starts (a shared vertex,
+            or within ``gap_tol`` going on smoothly) and does not come back
+            along it (see ``reverses``); the closing joint is then reported last.
         joints: one report per joint.
         kind: ``"wire"``, ``"loose piece"`` (edges that belong to no wire,
             chained by nearest ends) or ``"road"`` (an OpenDRIVE planView).
@@ -483,13 +484,26 @@ def classify_pieces(
     return ContinuityReport(tuple(wires), gap_tol, angle_tol, curvature_tol, size, snap, source, element, units)
 
 
+def _closing_angle(a: Frame, b: Frame) -> float:
+    """The angle between the unit tangents of frames ``a`` and ``b`` (radians, [0, π]; atan2 keeps it exact near π)."""
+    ta, tb = np.asarray(a[3:6], dtype=float), np.asarray(b[3:6], dtype=float)
+    with np.errstate(all="ignore"):
+        return math.atan2(float(np.linalg.norm(np.cross(ta, tb))), float(ta @ tb))
+
+
 def _reversal(a: Frame, b: Frame, gap_tol: float, angle_tol: float) -> bool:
     """The end frame ``a`` meets the start frame ``b`` (within ``gap_tol``) heading the opposite way (within
     ``angle_tol`` of π): a path that comes back along its start, not a loop through its closing point."""
-    ta, tb = np.asarray(a[3:6], dtype=float), np.asarray(b[3:6], dtype=float)
-    with np.errstate(all="ignore"):
-        angle = math.atan2(float(np.linalg.norm(np.cross(ta, tb))), float(ta @ tb))
-    return distance(a, b) <= gap_tol and math.pi - angle <= angle_tol
+    return distance(a, b) <= gap_tol and math.pi - _closing_angle(a, b) <= angle_tol
+
+
+def closes_smoothly(ends: Sequence[tuple[Frame, Frame]] | NDArray, gap_tol: float, angle_tol: float) -> bool:
+    """The last element ends where the first starts (within ``gap_tol``) going on the same way (within
+    ``angle_tol``): a path whose end points are not one vertex but which is a loop all the same."""
+    if not len(ends):
+        return False
+    a, b = ends[-1][1], ends[0][0]
+    return distance(a, b) <= gap_tol and _closing_angle(a, b) <= angle_tol
 
 
 def check_tolerances(**tolerances: float) -> None:
