@@ -125,12 +125,12 @@ class OpenDriveReport(ContinuityReport):
         if self.links:
             unit = f" {self.units}" if self.units else ""
             out.append(f"links: {len(self.links)}, worst {self.link_level}")
-            out.append(f"  {'link':40} {'gap':>10} {'angle rad':>10} {'|Δκ|':>10} {'Δκ rel':>9} level")
+            out.append(f"  {'link':46} {'gap':>10} {'angle rad':>10} {'|Δκ|':>10} {'Δκ rel':>9} level")
             for link in self.links:
                 j = link.joint
                 note = (f"  ({link.via}; reference lines offset {link.offset:.6g}{unit} by lanes)" if link.offset
                         else f"  ({link.via}; lane centres)" if link.lanes else f"  ({link.via})")  # fmt: skip
-                out.append(f"  {link.name:40} {j.gap:10.3e} {j.angle:10.3e} {j.curvature_jump:10.3e} "
+                out.append(f"  {link.name:46} {j.gap:10.3e} {j.angle:10.3e} {j.curvature_jump:10.3e} "
                            f"{j.relative_curvature_jump:9.2e} {j.level}{note}")  # fmt: skip
         return "\n".join(out)
 
