@@ -609,3 +609,39 @@ def test_no_numpy_warning_reaches_the_terminal(tmp_path, capfd):
         assert main(["check", str(kink), "--require", "G0"]) == 1
     out, err = capfd.readouterr()
     assert err == "" and "worst joint unmeasurable" in out
+
+
+def test_a_wire_that_returns_along_its_start_is_an_open_path_but_a_corner_loop_stays_closed():
+    # out along y = 0, up, and back down to the start along y = 0 the other way: the last edge
+    # reverses the first at the shared point, so there is no closing joint to judge
+    edges = [line((0, 0), (4, 0)), line((4, 0), (4, 3)), line((4, 3), (2, 0)), line((2, 0), (0, 0))]
+    (w,) = check_continuity(wire(*edges)).wires
+    assert not w.closed and w.reverses and len(w.joints) == 3
+    assert "open (its ends meet, reversing: no closing joint)" in check_continuity(wire(*edges)).format_table()
+    # a square meets its start at a right angle: a closed loop whose closing joint is a corner
+    square = [line((0, 0), (1, 0)), line((1, 0), (1, 1)), line((1, 1), (0, 1)), line((0, 1), (0, 0))]
+    (w,) = check_continuity(wire(*square)).wires
+    assert w.closed and not w.reverses and len(w.joints) == 4
+
+
+def test_a_program_that_ends_where_it_started_builds_and_checks_g2(tmp_path, capsys):
+    program = tmp_path / "back.nc"
+    program.write_text("G21 G90\nG1 X0 Y0\nG1 X40 Y0\nG1 X40 Y30\nG1 X20 Y0\nG1 X0 Y0\n")  # back along its first move
+    out = tmp_path / "out"
+    assert main(["build", "--from-gcode", str(program), "--max-deviation", "2", "--out", str(out), "--no-plots"]) == 0
+    assert "G2 (1 wire of 10 edges)" in capsys.readouterr().out  # the build's own report of its STEP
+    assert main(["check", str(out / "back.step"), "--require", "G2"]) == 0
+    assert "open (its ends meet, reversing: no closing joint), 9 joint(s), worst G2" in capsys.readouterr().out
+    (w,) = check_continuity(out / "back.step").wires
+    assert w.reverses and not w.closed and w.min_level is Continuity.G2
+
+
+def test_a_smooth_loop_whose_ends_are_two_vertices_is_still_a_loop():
+    # two half circles whose end points coincide but are separate vertices: the seam is judged (G2), as
+    # in a wire that shares them; the same with a corner at the seam stays an open path
+    halves = [ccw_arc((0, 0), 1.0, 0.0, math.pi), ccw_arc((0, 0), 1.0, math.pi, 2 * math.pi)]
+    (w,) = check_continuity(loose_wire(*halves)).wires
+    assert w.closed and len(w.joints) == 2 and w.min_level is G2
+    corner = [line((0, 0), (1, 0)), line((1, 0), (1, 1)), line((1, 1), (0, 0))]
+    (w,) = check_continuity(loose_wire(*corner)).wires
+    assert not w.closed and len(w.joints) == 2

@@ -64,6 +64,7 @@ from ..check.joints import (
     WireReport,
     check_tolerances,
     classify_pieces,
+    closes_smoothly,
     curvature_rounding_floor,
     distance,
     flip,
@@ -436,7 +437,9 @@ def _report(measured: Measured, unit: str, source: str, gap_tol: float, angle_to
     link = SNAP_FRACTION * size if snap is None else snap
     frames = rows[:, : 2 * FRAME].reshape(-1, 2, FRAME)
     bounds = np.cumsum([0] + [count for count, _ in wires])
-    pieces: list[tuple] = [("wire", frames[i:j], closed) for i, j, (_, closed) in zip(bounds, bounds[1:], wires)]
+    # a wire whose ends are two vertices at one point is a loop when it goes on smoothly there
+    pieces: list[tuple] = [("wire", frames[i:j], closed or closes_smoothly(frames[i:j], gap_tol, angle_tol))
+                           for i, j, (_, closed) in zip(bounds, bounds[1:], wires)]  # fmt: skip
     if loose:
         loose_ends = [(tuple(start), tuple(end)) for start, end in frames[bounds[-1] :].tolist()]
         pieces += [("loose piece", ends, closed) for ends, closed in _chain_loose(loose_ends, link, gap_tol, size)]

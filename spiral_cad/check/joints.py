@@ -140,12 +140,16 @@ class WireReport:
     Attributes:
         index: position in the report.
         edge_count: non-degenerate edges in the piece.
-        closed: the last edge ends where the first starts (shared vertex or
-            within ``gap_tol``); the closing joint is then reported last.
+        closed: the last edge ends where the first starts (a shared vertex,
+            or within ``gap_tol`` going on smoothly) and does not come back
+            along it (see ``reverses``); the closing joint is then reported last.
         joints: one report per joint.
         kind: ``"wire"``, ``"loose piece"`` (edges that belong to no wire,
             chained by nearest ends) or ``"road"`` (an OpenDRIVE planView).
         name: what the file calls it, if anything (an OpenDRIVE road's id).
+        reverses: its last edge ends where the first starts but arrives going back the way the
+            first leaves (a path that returns along its start, as a program often does): it is
+            judged as an open path, two ends and no closing joint (``closed`` is then False).
     """
 
     index: int
@@ -154,6 +158,7 @@ class WireReport:
     joints: tuple[JointReport, ...]
     kind: str = "wire"
     name: str = ""
+    reverses: bool = False
 
     @property
     def loose(self) -> bool:
@@ -286,7 +291,7 @@ class ContinuityReport:
         for w in self.wires:
             out.append(
                 f"{w.kind} {w.index}{f' (id {w.name})' if w.name else ''}: {_count(w.edge_count, self.element)}, "
-                f"{'closed' if w.closed else 'open'}, "
+                f"{'closed' if w.closed else 'open (its ends meet, reversing: no closing joint)' if w.reverses else 'open'}, "
                 f"{len(w.joints)} joint(s), worst {w.min_level}"
             )
             if w.joints:
@@ -466,6 +471,8 @@ def classify_pieces(
     floor = 1.0 / size if size > 0.0 else 0.0
     wires = []
     for w, (kind, ends, closed, *name) in enumerate(pieces):
+        reverses = bool(closed) and len(ends) > 1 and _reversal(ends[-1][1], ends[0][0], gap_tol, angle_tol)
+        closed = closed and not reverses
         pairs = len(ends) if closed else len(ends) - 1
         joints: tuple[JointReport, ...] = ()
         if pairs > 0:
@@ -473,8 +480,30 @@ def classify_pieces(
             after = np.roll(frames[:, 0], -1, axis=0)[:pairs]
             measures = classify_joints(frames[:pairs, 1], after, gap_tol, angle_tol, curvature_tol, floor)
             joints = tuple(_joint_reports(range(pairs), measures, plane_changes(frames, closed, curvature_tol * floor)))
-        wires.append(WireReport(w, len(ends), closed, joints, kind, *name))
+        wires.append(WireReport(w, len(ends), closed, joints, kind, name[0] if name else "", reverses=reverses))
     return ContinuityReport(tuple(wires), gap_tol, angle_tol, curvature_tol, size, snap, source, element, units)
+
+
+def _closing_angle(a: Frame, b: Frame) -> float:
+    """The angle between the unit tangents of frames ``a`` and ``b`` (radians, [0, π]; atan2 keeps it exact near π)."""
+    ta, tb = np.asarray(a[3:6], dtype=float), np.asarray(b[3:6], dtype=float)
+    with np.errstate(all="ignore"):
+        return math.atan2(float(np.linalg.norm(np.cross(ta, tb))), float(ta @ tb))
+
+
+def _reversal(a: Frame, b: Frame, gap_tol: float, angle_tol: float) -> bool:
+    """The end frame ``a`` meets the start frame ``b`` (within ``gap_tol``) heading the opposite way (within
+    ``angle_tol`` of π): a path that comes back along its start, not a loop through its closing point."""
+    return distance(a, b) <= gap_tol and math.pi - _closing_angle(a, b) <= angle_tol
+
+
+def closes_smoothly(ends: Sequence[tuple[Frame, Frame]] | NDArray, gap_tol: float, angle_tol: float) -> bool:
+    """The last element ends where the first starts (within ``gap_tol``) going on the same way (within
+    ``angle_tol``): a path whose end points are not one vertex but which is a loop all the same."""
+    if not len(ends):
+        return False
+    a, b = ends[-1][1], ends[0][0]
+    return distance(a, b) <= gap_tol and _closing_angle(a, b) <= angle_tol
 
 
 def check_tolerances(**tolerances: float) -> None:
