@@ -97,8 +97,8 @@ class Centerline3D:
         if not len(self.g1_stations):
             return "G2 at every joint"
         where = ", ".join(f"{s:.6g}" for s in self.g1_stations)
-        return (f"G2 at every joint but G1 at stations {where} {self.units} (vertical curve ends BVC/EVC, "
-                "where the parabola's second derivative jumps)")  # fmt: skip
+        return (f"G2 at every joint but G1 at stations {where} {self.units} (vertical curve ends BVC and EVC, "
+                "where the second derivative of the profile jumps)")  # fmt: skip
 
 
 def centerline_3d(alignment: Any, profile: Profile, tolerance: float | None = None) -> Centerline3D:

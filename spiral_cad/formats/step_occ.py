@@ -20,7 +20,7 @@ every file holds ONE ``PRODUCT`` whose ``SHAPE_REPRESENTATION`` lists all its
 items. **Wires stay wires.** OCCT writes wires and loose edges only as a
 ``GEOMETRIC_CURVE_SET`` of loose trimmed curves (readers get loose edges and
 lose the order); so the solids, shells and faces go through OCCT and every
-wire is written here as a ``CONNECTED_EDGE_SET`` of ``EDGE_CURVE``\ s in
+wire is written here as a ``CONNECTED_EDGE_SET`` of ``EDGE_CURVE`` entities in
 wire order, consecutive edges sharing their vertex (as
 ``spiral_cad.formats.step`` writes chains), in one
 ``EDGE_BASED_WIREFRAME_MODEL`` added to that same representation, in the
@@ -169,10 +169,10 @@ def _edge_bspline(edge: TopoDS_Edge) -> Geom_BSplineCurve:
         raise ValueError("an edge without a 3-D curve cannot be written as STEP")
     spline = GeomConvert.CurveToBSplineCurve_s(Geom_TrimmedCurve(curve, first, last))
     if spline.FirstParameter() != first or spline.LastParameter() != last:
-        spline = Geom_BSplineCurve.DownCast(spline.Copy())
+        spline = spline.Copy()  # (OCP hands back the B-spline itself)
         spline.Segment(first, last)
     if edge.Orientation() == TopAbs_REVERSED:
-        spline = Geom_BSplineCurve.DownCast(spline.Reversed())
+        spline = spline.Reversed()
     return spline
 
 
