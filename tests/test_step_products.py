@@ -196,3 +196,50 @@ def test_freecad_imports_the_road_with_import_insert(road, road_file):
     objects, solids, edges = map(int, run.stdout.split()[-3:])
     assert objects == 1 and solids == 1
     assert edges >= len(road[0].chain)
+
+
+def _read(path, unit_mm=1.0):
+    reader = STEPControl_Reader()
+    assert reader.ReadFile(str(path)) == IFSelect_ReturnStatus.IFSelect_RetDone
+    reader.SetSystemLengthUnit(unit_mm)
+    reader.TransferRoots()
+    return reader.OneShape()
+
+
+def test_mixed_shapes_closed_and_reversed_wires_stay_one_product(tmp_path):
+    from build123d import Box, Compound, Edge, Rectangle, Wire
+
+    box = Box(10, 20, 30).solids()[0]
+    closed = Rectangle(40, 20).wire()  # closed: its last edge ends on its first vertex
+    spline = Edge.make_spline([(0, 0, 50), (10, 5, 55), (20, 0, 60), (30, -5, 58)])
+    bent = Wire([Edge.make_line((-20, 0, 50), (0, 0, 50)), spline])
+    reversed_edge = Edge.make_line((0, 0, 0), (5, 5, 5)).reversed()  # a loose edge, travelled backwards
+    shape = Compound([box, closed, bent, reversed_edge, box.faces()[0].translate((100, 0, 0))])
+    path = tmp_path / "mixed.step"
+    export_step(shape, path, units="mm")
+    text = path.read_text()
+    assert text.count("PRODUCT(") == 1 and text.count("CONNECTED_EDGE_SET(") == 3
+    read = _read(path)
+    assert _count(read, TopAbs_SOLID) == 1 and _count(read, TopAbs_WIRE, TopAbs_FACE) == 3
+    from build123d import Shape
+
+    loose = Shape.cast(read).wires()  # (the box's face wires lie in faces: only ours are wires of the compound)
+    loose = [w for w in loose if not any(w.is_same(f) for face in Shape.cast(read).faces() for f in face.wires())]
+    assert sorted(w.length for w in loose) == pytest.approx(sorted([closed.length, bent.length, reversed_edge.length]), rel=1e-12)
+    # the reversed loose edge starts where the edge starts, not where its curve does
+    (single,) = [w for w in loose if len(w.edges()) == 1]
+    assert (single.position_at(0) - reversed_edge.position_at(0)).length < 1e-9
+    # the closed rectangle reads back closed; the bent wire keeps its order
+    (rectangle,) = [w for w in loose if len(w.edges()) == 4]
+    (two,) = [w for w in loose if len(w.edges()) == 2]
+    assert rectangle.is_closed and not two.is_closed
+    assert (two.position_at(0) - bent.position_at(0)).length < 1e-9 and (two.position_at(1) - bent.position_at(1)).length < 1e-9
+
+
+def test_shapes_step_can_not_hold_nothing_or_loose_vertices(tmp_path):
+    from build123d import Compound, Vertex
+
+    with pytest.raises(ValueError, match="empty"):
+        export_step(Compound([]), tmp_path / "empty.step")
+    with pytest.raises(ValueError, match="loose vertices"):
+        export_step(Compound([Vertex(1, 2, 3)]), tmp_path / "vertex.step")

@@ -62,19 +62,23 @@ _STEP_UNIT = {"mm": "MM", "cm": "CM", "m": "M", "km": "KM", "in": "INCH", "ft": 
 
 
 def write_shape_step(
-    obj: Any, path: str | os.PathLike, name: str, units: str, originating_system: str, description: str | None = None
+    obj: Any, path: str | os.PathLike, name: str, units: str, originating_system: str, description: str | None = None,
+    *, occt_wires: bool = False,
 ) -> None:
-    """Write any OCP/build123d/CadQuery shape as STEP AP214 in ``units`` (``description``: the
-    header's FILE_DESCRIPTION, printable ASCII without quotes or backslashes).
+    """Write any OCP/build123d/CadQuery shape as STEP AP214 in ``units``, as one product (``description``:
+    the header's FILE_DESCRIPTION, printable ASCII without quotes or backslashes).
+
+    ``occt_wires=True`` leaves wires and edges to OCCT too (loose trimmed curves: what OCCT's own
+    writer makes of them, for comparison in benchmarks).
 
     Raises:
-        ValueError: ``obj`` is not a shape.
+        ValueError: ``obj`` is not a shape, holds nothing or loose vertices.
         OSError: the transfer or the printing failed.
     """
     shape = as_occ_shape(obj)
     if description is not None and not (description.isascii() and description.isprintable() and not set("'\\") & set(description)):
         raise ValueError(f"a STEP description must be printable ASCII without quotes or backslashes; got {description!r:.80}")
-    solids, wires = _split(shape)
+    solids, wires = (shape, []) if occt_wires else _split(shape)
     placeholder = f"SPIRALCADNAME{secrets.token_hex(12).upper()}"
     writer = STEPControl_Writer()  # (its controller registers the write.step.* parameters set below)
     Interface_Static.SetIVal_s("write.step.assembly", 0)  # one product, never an assembly of its members
