@@ -24,7 +24,7 @@ from OCP.Geom import Geom_BSplineCurve  # noqa: E402
 from OCP.gp import gp_Pnt, gp_Vec  # noqa: E402
 from OCP.IFSelect import IFSelect_ReturnStatus  # noqa: E402
 from OCP.STEPCAFControl import STEPCAFControl_Reader  # noqa: E402
-from OCP.STEPControl import STEPControl_Reader  # noqa: E402
+from OCP.STEPControl import STEPControl_Reader, STEPControl_Writer  # noqa: E402
 from OCP.TCollection import TCollection_ExtendedString  # noqa: E402
 from OCP.TDF import TDF_LabelSequence  # noqa: E402
 from OCP.TDocStd import TDocStd_Document  # noqa: E402
@@ -216,7 +216,12 @@ def test_mixed_shapes_closed_and_reversed_wires_stay_one_product(tmp_path):
     reversed_edge = Edge.make_line((0, 0, 0), (5, 5, 5)).reversed()  # a loose edge, travelled backwards
     shape = Compound([box, closed, bent, reversed_edge, box.faces()[0].translate((100, 0, 0))])
     path = tmp_path / "mixed.step"
+    from OCP.Interface import Interface_Static
+
+    STEPControl_Writer()  # registers OCCT's write.step.* parameters (default: assemblies Auto)
+    before = Interface_Static.IVal_s("write.step.assembly")
     export_step(shape, path, units="mm")
+    assert Interface_Static.IVal_s("write.step.assembly") == before  # other writers keep their assemblies
     text = path.read_text()
     assert text.count("PRODUCT(") == 1 and text.count("CONNECTED_EDGE_SET(") == 3
     read = _read(path)

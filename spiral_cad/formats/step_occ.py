@@ -80,14 +80,18 @@ def write_shape_step(
         raise ValueError(f"a STEP description must be printable ASCII without quotes or backslashes; got {description!r:.80}")
     solids, wires = (shape, []) if occt_wires else _split(shape)
     placeholder = f"SPIRALCADNAME{secrets.token_hex(12).upper()}"
-    writer = STEPControl_Writer()  # (its controller registers the write.step.* parameters set below)
+    STEPControl_Writer()  # registers the write.step.* parameters (a new model reads them when made)
+    assembly = Interface_Static.IVal_s("write.step.assembly")
     Interface_Static.SetIVal_s("write.step.assembly", 0)  # one product, never an assembly of its members
     Interface_Static.SetCVal_s("write.step.unit", _STEP_UNIT[units])
     Interface_Static.SetCVal_s("write.step.product.name", placeholder)
-    writer = STEPControl_Writer()
-    writer.Model().SetLocalLengthUnit(MM_PER_UNIT[units])  # the shape is in the file unit: no rescaling
-    with captured_messages():
-        status = writer.Transfer(solids, STEPControl_AsIs)
+    try:
+        writer = STEPControl_Writer()
+        writer.Model().SetLocalLengthUnit(MM_PER_UNIT[units])  # the shape is in the file unit: no rescaling
+        with captured_messages():
+            status = writer.Transfer(solids, STEPControl_AsIs)
+    finally:  # other writers in this process (build123d's, CadQuery's) keep their own setting
+        Interface_Static.SetIVal_s("write.step.assembly", assembly)
     if status != IFSelect_ReturnStatus.IFSelect_RetDone:
         raise OSError(f"STEP transfer failed for {name!r}")
     header = APIHeaderSection_MakeHeader(writer.Model())
