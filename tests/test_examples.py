@@ -34,8 +34,8 @@ def test_the_road_example_writes_metres(tmp_path):
     pytest.importorskip("OCP")
     from OCP.Bnd import Bnd_Box
     from OCP.BRepBndLib import BRepBndLib
-    from OCP.GProp import GProp_GProps
     from OCP.BRepGProp import BRepGProp
+    from OCP.GProp import GProp_GProps
     from OCP.STEPControl import STEPControl_Reader
 
     run = subprocess.run([sys.executable, str(EXAMPLES / "build123d_road.py"), str(tmp_path)], capture_output=True,
