@@ -134,7 +134,7 @@ def main() -> None:
     for count, chain, t in zip(args.pis, chains, results):
         ours, theirs = folder / f"ours_{count}.step", folder / f"occt_{count}.step"
         export_step(chain, ours)
-        write_shape_step(chain_wire(chain), theirs, "occt", "m", "bench_step")
+        write_shape_step(chain_wire(chain), theirs, "occt", "m", "bench_step", occt_wires=True)
         wire = one_wire(occt_read(ours))
         t |= medians(timed({
             "ours": lambda: occt_read(ours),

@@ -2,18 +2,22 @@
 
 Run: ``python examples/build123d_road.py [OUT_DIR]`` (default ./out). Writes
 ``road.step`` (the corridor solid), ``road_centreline.step`` (the 3-D centre
-line) and ``road.svg`` (a hidden-line view of the solid, heights ×8), and prints the
+line, one G2 wire) and ``road.svg`` (a hidden-line view of the solid, heights ×8), and prints the
 stationing and profile tables, the corridor and the centre line's fit.
+
+The design is in metres and so are the STEP files: they are written through
+``spiral_cad.cad.export.export_step`` in the alignment's unit (build123d's own
+``export_step`` declares millimetres, which would make the road an 820 mm toy).
 """
 
 import sys
 from pathlib import Path
 
-from build123d import ExportSVG, LineType, export_step, scale
+from build123d import ExportSVG, LineType, scale
 
 from spiral_cad.build123d import centerline_wire, corridor
 from spiral_cad.design import Alignment, Profile
-from spiral_cad.cad.export import CrossSection
+from spiral_cad.cad.export import CrossSection, export_step
 
 out = Path(sys.argv[1] if len(sys.argv) > 1 else "out")
 out.mkdir(parents=True, exist_ok=True)
@@ -36,8 +40,9 @@ print(profile.table(6))
 road = corridor(alignment, profile, CrossSection(lane_width=3.5, shoulder_width=1.5, crossfall=0.025, depth=0.4))
 print(road.describe())
 print(road.centerline.describe())
-export_step(road.solid, str(out / "road.step"))
-export_step(centerline_wire(road.centerline), str(out / "road_centreline.step"))
+units = alignment.chain.units  # the design's unit, declared in the files (nothing is rescaled)
+export_step(road.solid, out / "road.step", units=units)
+export_step(centerline_wire(road.centerline), out / "road_centreline.step", units=units)
 
 # The view exaggerates heights 8× so that the crest and the sag show.
 view = scale(road.solid, by=(1, 1, 8)).project_to_viewport((410, -700, 800), viewport_up=(0, 0, 1), look_at=(410, 20, 420))

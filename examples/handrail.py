@@ -12,10 +12,11 @@ line's exact LINE and BEZIER edges) and prints the G2 check of the path.
 import sys
 from pathlib import Path
 
-from build123d import BuildLine, BuildPart, BuildSketch, Circle, Plane, export_step, sweep
+from build123d import BuildLine, BuildPart, BuildSketch, Circle, Plane, sweep
 
 from spiral_cad.build123d import G2Polyline
 from spiral_cad.cad.continuity import check_continuity
+from spiral_cad.cad.export import export_step
 
 out = Path(sys.argv[1] if len(sys.argv) > 1 else "out")
 out.mkdir(parents=True, exist_ok=True)
@@ -40,8 +41,8 @@ with BuildPart() as handrail:
 
 solid = handrail.part
 assert solid.is_valid, "the swept rail is not a valid solid"
-export_step(solid, str(out / "handrail.step"))
-export_step(path, str(out / "handrail_path.step"))
+export_step(solid, out / "handrail.step", units="mm")  # the design's unit; one product, the path one wire
+export_step(path, out / "handrail_path.step", units="mm")
 report = check_continuity(out / "handrail_path.step")
 assert report.passes("G2"), report.describe()
 rounded = line.rounded

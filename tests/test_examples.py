@@ -27,3 +27,36 @@ def test_example_runs(script, tmp_path):
     assert run.returncode == 0, run.stdout[-2000:] + run.stderr[-2000:]
     for name in OUTPUTS[script]:
         assert (tmp_path / name).stat().st_size > 0, name
+
+
+def test_the_road_example_writes_metres(tmp_path):
+    """road.step holds the design in metres: OCCT reading it into millimetres finds a road of about 900 m, not 0.9 m."""
+    pytest.importorskip("OCP")
+    from OCP.Bnd import Bnd_Box
+    from OCP.BRepBndLib import BRepBndLib
+    from OCP.BRepGProp import BRepGProp
+    from OCP.GProp import GProp_GProps
+    from OCP.STEPControl import STEPControl_Reader
+
+    run = subprocess.run([sys.executable, str(EXAMPLES / "build123d_road.py"), str(tmp_path)], capture_output=True,
+                         text=True, timeout=300)  # fmt: skip
+    assert run.returncode == 0, run.stdout[-2000:] + run.stderr[-2000:]
+    for name in ("road.step", "road_centreline.step"):
+        reader = STEPControl_Reader()
+        reader.ReadFile(str(tmp_path / name))
+        reader.SetSystemLengthUnit(1.0)  # millimetres
+        reader.TransferRoots()
+        box = Bnd_Box()
+        BRepBndLib.Add_s(reader.OneShape(), box)
+        x0, y0, _, x1, y1, _ = box.Get()
+        assert 820e3 <= x1 - x0 <= 830e3 and 100e3 <= y1 - y0 <= 220e3, (name, x1 - x0, y1 - y0)
+    # the centre line's 3-D length in mm: longer than its plan's chord, shorter than the polyline of its PIs
+    props = GProp_GProps()
+    reader = STEPControl_Reader()
+    reader.ReadFile(str(tmp_path / "road_centreline.step"))
+    reader.SetSystemLengthUnit(1.0)
+    reader.TransferRoots()
+    BRepGProp.LinearProperties_s(reader.OneShape(), props)
+    chord = (820**2 + 90**2) ** 0.5 * 1e3
+    pis = sum(((bx - ax) ** 2 + (by - ay) ** 2) ** 0.5 for (ax, ay), (bx, by) in zip([(0, 0), (300, 60), (560, -40)], [(300, 60), (560, -40), (820, 90)]))
+    assert chord < props.Mass() < pis * 1e3 * 1.01

@@ -36,6 +36,13 @@ def test_build_writes_the_profile_table_the_3d_step_and_the_xodr(tmp_path, capsy
     assert len(elevations) == 5 and float(elevations[0].get("a")) == 10.0
     step = (out / "road_3d.step").read_text()
     assert "road in 3-D: corridor solid and centre line (plan exact; z within" in step
+    # one product (FreeCAD 0.20's Import.insert crashed on the assembly OCCT made of solid + curves), the centre
+    # line one wire, and the description names the joints that are only G1 and why
+    assert step.count("PRODUCT(") == 1 and "NEXT_ASSEMBLY_USAGE_OCCURRENCE" not in step
+    assert step.count("CONNECTED_EDGE_SET(") == 1 and "GEOMETRIC_CURVE_SET" not in step
+    header = " ".join(step.split("FILE_NAME")[0].split())
+    assert "centre line one wire, G2 at every joint but G1 at stations" in header
+    assert "(vertical curve ends BVC and EVC, where the second derivative of the profile jumps)" in header
     from build123d import Shape
 
     from spiral_cad.cad.readers import read_shape

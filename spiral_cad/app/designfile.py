@@ -511,7 +511,8 @@ def _road_3d(b: BuiltAlignment, profile: Any, stage: Path, units: str) -> list[s
     line = road.centerline
     fit = (
         f"{b.name} in 3-D: corridor solid and centre line (plan exact; z within {line.deviation:.3g} {units} of the "
-        f"profile, tolerance {line.tolerance:.3g} {units}; corridor edges within {road.roadway.deviation:.3g} {units})"
+        f"profile, tolerance {line.tolerance:.3g} {units}; corridor edges within {road.roadway.deviation:.3g} {units}); "
+        f"centre line one wire, {line.continuity()}"
     )
     write_shape_step(Compound([road.solid, centerline_wire(line)]), stage / f"{b.name}_3d.step", b.name, units,
                      originating_system(), description=fit)  # fmt: skip

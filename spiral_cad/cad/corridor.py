@@ -212,7 +212,7 @@ def _knots(spans: NDArray, degree: int) -> tuple[TColStd_Array1OfReal, TColStd_A
 
 
 def _chained(pieces: NDArray) -> NDArray:
-    """(3n + 1, d) poles of n cubic Bézier pieces (n, 4, d) that share their ends (the earlier piece's end is kept)."""
+    """(pn + 1, d) poles of n Bézier pieces (n, p + 1, d) of degree p that share their ends (the earlier piece's end is kept)."""
     return np.concatenate([pieces[0], *[p[1:] for p in pieces[1:]]])
 
 
@@ -221,13 +221,14 @@ def _bspline_curve(pieces: NDArray, weights: NDArray, spans: NDArray) -> Geom_BS
     array = TColgp_Array1OfPnt(1, len(poles))
     for i, (x, y, z) in enumerate(poles.tolist(), 1):
         array.SetValue(i, gp_Pnt(x, y, z))
-    knots, mults = _knots(spans, 3)
+    degree = pieces.shape[1] - 1
+    knots, mults = _knots(spans, degree)
     if np.all(weights == 1.0):
-        return Geom_BSplineCurve(array, knots, mults, 3)
+        return Geom_BSplineCurve(array, knots, mults, degree)
     w = TColStd_Array1OfReal(1, len(poles))
     for i, value in enumerate(_chained(weights[..., None])[:, 0].tolist(), 1):
         w.SetValue(i, value)
-    return Geom_BSplineCurve(array, w, knots, mults, 3)
+    return Geom_BSplineCurve(array, w, knots, mults, degree)
 
 
 def _ruled(first: NDArray, second: NDArray, spans: NDArray) -> Any:

@@ -99,9 +99,13 @@ def export_step(obj: Any, path: PathLike, *, name: str | None = None, units: str
 
     Chains are written directly (``spiral_cad.io.step``): one connected
     wire per chain, exact lines, circles and Bézier spirals, in the chain's
-    unit. Any other shape (build123d, CadQuery, OCP) goes through OCCT's
-    writer, declared in ``units`` (default mm, build123d's convention) and
-    printed with 17 significant digits.
+    unit. Any other shape (build123d, CadQuery, OCP) is declared in ``units``
+    (default mm, build123d's convention; give the design's unit, e.g.
+    ``units="m"`` for a road) and written as ONE product: its solids, shells
+    and faces through OCCT's writer (17 significant digits), its wires as
+    connected edge sets of their exact B-splines, in wire order
+    (``spiral_cad.cad.step_occ``), so FreeCAD and OCCT read one part
+    with real wires.
 
     Args:
         obj: a Chain, a list of Chains, or a build123d/CadQuery/OCP shape.

@@ -1,22 +1,28 @@
 """The 3-D centre line of a road: its plan (an alignment) lifted by its profile.
 
 The curve is (x(u), y(u), z(s(u))): the alignment's own segments in plan and
-the profile's elevation at their arc length s. It is built as rational cubic
-Bézier pieces, one or more per plan segment, whose plan projection **is the
-segment itself** (the same Bézier, line or rational arc, split exactly at
-the piece ends), so the plan stays exactly the G2 alignment. Only z can
-differ from the truth, and only where it has to:
+the profile's elevation at their arc length s. It is built as rational
+Bézier pieces of degree 5, one or more per plan segment, whose plan
+projection **is the segment itself** (the same Bézier, line or rational arc,
+split exactly at the piece ends and raised to degree 5 without change), so
+the plan stays exactly the G2 alignment. Only z can differ from the truth,
+and only where it has to:
 
 * on a line, s is proportional to the curve parameter and z(s) is a
   parabola or a grade line, so z(s(u)) is a polynomial of degree ≤ 2 and
   the piece is **exact**; the same holds wherever the profile is level;
 * on arcs and spirals under a grade or a vertical curve z(s(u)) is not a
-  polynomial: each piece takes the exact z and dz/ds at its ends (so the
-  curve is exactly G1 in 3-D, and C1 in z like the profile itself) and is
-  split until the distance to (x(u), y(u), z(s(u))), sampled on every
-  piece, is within the tolerance (default 1e-6 × the alignment's length).
+  polynomial: each piece takes the exact z, dz/ds and d²z/ds² at its ends
+  (a quintic Hermite in the homogeneous height) and is split until the
+  distance to (x(u), y(u), z(s(u))), sampled on every piece, is within the
+  tolerance (default 1e-6 × the alignment's length).
 
-Pieces also end at every profile break (BVC, EVC), where z'' jumps. The
+Point, tangent and d²r/ds² (s the plan length) are therefore those of the
+exact road at every piece end, so the 3-D curvature vector is continuous —
+the curve is **G2** — wherever the plan is G2 and the profile C2. Pieces
+also end at every profile break (BVC, EVC): there the parabola's z'' jumps
+(the profile itself is only C1), and so does the 3-D curvature: those
+joints are **G1**, as the road is (``Centerline3D.g1_stations``). The
 measured worst distance is ``Centerline3D.deviation``; nothing is returned
 without it being within ``tolerance``.
 """
@@ -24,7 +30,7 @@ without it being within ``tolerance``.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
@@ -36,7 +42,7 @@ from ..core.nurbs import MAX_ARC_PIECE, _pieces
 from ..core.segments import Arc, Line
 from .profile import Profile, check_coverage
 
-#: Samples per piece while refining, and for the reported deviation.
+#: Samples per piece while refining (the roadway), and for the reported deviation (which the centre line also refines on).
 FIT_SAMPLES, REPORT_SAMPLES = 16, 64
 #: Halvings of one piece, and pieces in all, before a tolerance counts as out of reach.
 MAX_SPLITS, MAX_PIECES = 40, 200_000
@@ -44,11 +50,11 @@ MAX_SPLITS, MAX_PIECES = 40, 200_000
 
 @dataclass(frozen=True)
 class Centerline3D:
-    """A road's 3-D centre line as rational cubic Bézier pieces (see the module docstring).
+    """A road's 3-D centre line as rational quintic Bézier pieces (see the module docstring).
 
     Attributes:
-        control_points: (n, 4, 3) control points of the pieces in travel order.
-        weights: (n, 4) their weights (1 except on arcs).
+        control_points: (n, 6, 3) control points of the pieces in travel order.
+        weights: (n, 6) their weights (1 except on arcs).
         segment: (n,) the plan segment each piece lies on.
         parameters: (n, 2) the piece's range of that segment's parameter u.
         stations: (n + 1,) chainage at each piece end.
@@ -56,6 +62,8 @@ class Centerline3D:
         tolerance: the largest distance allowed from (x(u), y(u), z(s(u))).
         deviation: the largest distance measured (``REPORT_SAMPLES`` per piece).
         units: the length unit.
+        g1_stations: the piece ends where the 3-D curvature jumps: the BVCs and EVCs inside the
+            road, where the profile's z'' jumps (every other joint is G2).
     """
 
     control_points: NDArray
@@ -67,6 +75,7 @@ class Centerline3D:
     tolerance: float
     deviation: float
     units: str
+    g1_stations: NDArray = field(default_factory=lambda: np.empty(0))
 
     def __len__(self) -> int:
         return len(self.control_points)
@@ -82,6 +91,14 @@ class Centerline3D:
             f"3-D centre line: {len(self)} pieces ({exact} exact, {len(self) - exact} with z fitted); "
             f"deviation {self.deviation:.2g} {self.units} (tolerance {self.tolerance:.2g} {self.units}); plan exact"
         )
+
+    def continuity(self) -> str:
+        """One line (printable ASCII) naming the joints that are G1 and why; every other is G2."""
+        if not len(self.g1_stations):
+            return "G2 at every joint"
+        where = ", ".join(f"{s:.6g}" for s in self.g1_stations)
+        return (f"G2 at every joint but G1 at stations {where} {self.units} (vertical curve ends BVC and EVC, "
+                "where the second derivative of the profile jumps)")  # fmt: skip
 
 
 def centerline_3d(alignment: Any, profile: Profile, tolerance: float | None = None) -> Centerline3D:
@@ -115,7 +132,7 @@ def centerline_3d(alignment: Any, profile: Profile, tolerance: float | None = No
         middle = 0.5 * (u0 + u1)
         return (k, u0, middle), (k, middle, u1)
 
-    done = refine(lift.initial_pieces(), lambda pieces: lift.deviation(pieces, FIT_SAMPLES), halves, tolerance,
+    done = refine(lift.initial_pieces(), lambda pieces: lift.deviation(pieces, REPORT_SAMPLES), halves, tolerance,
                   lambda piece: f"the 3-D centre line near station {lift.station(np.array([piece[0]]), np.array([piece[1]]))[0]:.6g}")  # fmt: skip
     return lift.assemble(sorted(done), tolerance)
 
@@ -191,7 +208,8 @@ class _Lift:
         return out + self.start
 
     def control(self, pieces: list[tuple[int, float, float]]) -> tuple[NDArray, NDArray]:
-        """(n, 4, 3) control points and (n, 4) weights: the exact plan piece and Hermite z."""
+        """(n, 6, 3) control points and (n, 6) weights: the exact plan piece raised to degree 5 and a
+        quintic Hermite z taking the profile's z, dz/ds and d²z/ds² at both ends (so pieces meet G2)."""
         plan, weights = [], []
         for k, u0, u1 in pieces:
             segment = self.chain[k]
@@ -199,13 +217,39 @@ class _Lift:
             ((points, w, _),) = _pieces(part)
             plan.append(points)
             weights.append(w)
-        plan, weights = np.array(plan), np.array(weights)
+        homogeneous = _raise_degree(np.concatenate([np.array(plan) * np.array(weights)[..., None],
+                                                    np.array(weights)[..., None]], axis=2), 2)  # fmt: skip
+        weights = homogeneous[..., 2]
+        plan = homogeneous[..., :2] / weights[..., None]
         segment = np.array([p[0] for p in pieces])
         ends = self.station(np.repeat(segment, 2), np.array([(p[1], p[2]) for p in pieces]).ravel()).reshape(-1, 2)
         z = self.profile.elevation(ends)
         g = self.profile.grade(ends)
-        legs = np.linalg.norm(plan[:, [1, 3]] - plan[:, [0, 2]], axis=-1)  # |Q1 − Q0|, |Q3 − Q2|
-        heights = np.stack([z[:, 0], z[:, 0] + g[:, 0] * legs[:, 0], z[:, 1] - g[:, 1] * legs[:, 1], z[:, 1]], axis=1)
+        # d²z/ds² of the profile piece the whole piece lies in (pieces end at every BVC and EVC)
+        which = np.clip(np.searchsorted(self.profile.stations, ends.mean(axis=1), "right") - 1, 0,
+                        len(self.profile.coefficients) - 1)  # fmt: skip
+        bend = 2.0 * self.profile.coefficients[which, 2]
+        heights = np.empty(weights.shape)
+        for end, (i0, i1, i2, sign) in enumerate(((0, 1, 2, 1.0), (5, 4, 3, -1.0))):
+            # plan derivatives in t at this end (rational: X = A / W), then s_t = |X'|, s_tt = X'·X'' / |X'|
+            a = homogeneous[:, [i0, i1, i2], :2]
+            w = weights[:, [i0, i1, i2]]
+            x = a[:, 0] / w[:, :1]
+            a1, w1 = 5.0 * sign * (a[:, 1] - a[:, 0]), 5.0 * sign * (w[:, 1] - w[:, 0])
+            a2, w2 = 20.0 * (a[:, 2] - 2.0 * a[:, 1] + a[:, 0]), 20.0 * (w[:, 2] - 2.0 * w[:, 1] + w[:, 0])
+            x1 = (a1 - x * w1[:, None]) / w[:, :1]
+            x2 = (a2 - 2.0 * x1 * w1[:, None] - x * w2[:, None]) / w[:, :1]
+            s_t = np.linalg.norm(x1, axis=1)
+            s_tt = np.einsum("ij,ij->i", x1, x2) / s_t
+            z_t = g[:, end] * s_t
+            z_tt = bend * s_t**2 + g[:, end] * s_tt
+            # the homogeneous height above this end, Z = (z − z_end) W (0 here: a level piece stays exactly
+            # level), its derivatives, then the three Bézier ordinates from this end
+            h1 = z_t * w[:, 0]
+            h2 = z_tt * w[:, 0] + 2.0 * z_t * w1
+            c1 = sign * h1 / 5.0
+            c2 = h2 / 20.0 + 2.0 * c1
+            heights[:, i0], heights[:, i1], heights[:, i2] = z[:, end], z[:, end] + c1 / w[:, 1], z[:, end] + c2 / w[:, 2]
         return np.concatenate([plan, heights[..., None]], axis=2), weights
 
     def exact_points(self, pieces, t: NDArray, points: NDArray) -> NDArray:
@@ -255,12 +299,27 @@ class _Lift:
             for a, b in ends
         ])  # fmt: skip
         lines = np.array([isinstance(self.chain[int(k)], Line) for k in segment])
+        # interior profile breaks where z'' (twice the quadratic coefficient) changes
+        jumps = self.profile.stations[1:-1][np.diff(self.profile.coefficients[:, 2]) != 0.0]
+        inside = (jumps > stations[0]) & (jumps < stations[-1])
         return Centerline3D(cp, w, segment, u, stations, lines | level, float(tolerance), float(deviation.max()),
-                            self.chain.units)  # fmt: skip
+                            self.chain.units, jumps[inside])  # fmt: skip
+
+
+def _raise_degree(points: NDArray, times: int) -> NDArray:
+    """(n, p + times, d) control points of n Bézier curves (n, p, d) of one degree raised ``times`` times (the same curves)."""
+    for _ in range(times):
+        degree = points.shape[1]  # the raised degree n + 1
+        i = np.arange(degree + 1)[None, :, None] / degree
+        padded = np.pad(points, ((0, 0), (1, 1), (0, 0)))
+        points = i * padded[:, :-1] + (1.0 - i) * padded[:, 1:]
+    return points
 
 
 def _rational_points(cp: NDArray, weights: NDArray, t: NDArray) -> NDArray:
-    """(n, m, 3) points of n rational cubic Béziers at m parameters ``t``."""
-    b = np.stack([(1 - t) ** 3, 3 * t * (1 - t) ** 2, 3 * t * t * (1 - t), t**3], axis=1)  # (m, 4)
+    """(n, m, 3) points of n rational Béziers (any one degree) at m parameters ``t``."""
+    degree = cp.shape[1] - 1
+    i = np.arange(degree + 1)
+    b = np.array([math.comb(degree, k) for k in i]) * t[:, None] ** i * (1 - t[:, None]) ** (degree - i)  # (m, p + 1)
     homogeneous = np.einsum("mj,nj,njd->nmd", b, weights, cp)
     return homogeneous / (b @ weights.T).T[..., None]
