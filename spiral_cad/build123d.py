@@ -22,8 +22,6 @@ from __future__ import annotations
 from collections.abc import Iterable
 
 from build123d import (
-    Edge,
-    Plane,
     Align,
     BaseLineObject,
     BaseSketchObject,
@@ -32,10 +30,12 @@ from build123d import (
     BuildSketch,
     Compound,
     Curve,
+    Edge,
     Face,
     Mode,
-    Sketch,
+    Plane,
     Shape,
+    Sketch,
     SkipClean,
     Vector,
     VectorLike,
@@ -49,15 +49,15 @@ from OCP.GeomAbs import GeomAbs_CurveType
 from OCP.TopAbs import TopAbs_REVERSED
 from OCP.TopoDS import TopoDS
 
-from .core.chain import Chain
-from .core.shapes import DEFAULT_SHAPE
-from .design.rounding import curvature_bound, fillet_polyline, round_corners
-from .design.fillets import continuous_polygon, continuous_rectangle, continuous_slot
 from .cad.corridor import Corridor, centerline_wire, corridor
 from .cad.fillet import fillet_face, fillet_wire, planar_frame
 from .cad.occ import chain_wire, plane_ax3, segment_edges
+from .core.chain import Chain
 from .core.segments import Segment
+from .core.shapes import DEFAULT_SHAPE
 from .core.transitions import Transition, circle_in_circle, circle_to_circle, line_to_circle, line_to_line
+from .design.fillets import continuous_polygon, continuous_rectangle, continuous_slot
+from .design.rounding import curvature_bound, fillet_polyline, round_corners
 
 __all__ = [
     "chain_edges",

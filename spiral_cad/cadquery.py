@@ -44,14 +44,14 @@ from typing import Any, TypeVar
 import cadquery as cq
 from OCP.gp import gp_Ax3
 
-from .core.chain import Chain
-from .core.shapes import DEFAULT_SHAPE
-from .design.fillets import continuous_polygon, continuous_rectangle, continuous_slot
-from .design.rounding import curvature_bound, round_corners
 from .cad.fillet import fillet_face, fillet_wire
 from .cad.occ import chain_wire, segment_edges
+from .core.chain import Chain
 from .core.segments import Segment
+from .core.shapes import DEFAULT_SHAPE
 from .core.transitions import Transition, circle_in_circle, circle_to_circle, line_to_circle, line_to_line
+from .design.fillets import continuous_polygon, continuous_rectangle, continuous_slot
+from .design.rounding import curvature_bound, round_corners
 
 __all__ = [
     "METHODS",

@@ -14,7 +14,9 @@ from importlib.util import find_spec
 from pathlib import Path
 
 from .. import circle_in_circle, circle_to_circle, line_to_circle, line_to_line
+from ..check.joints import Continuity, ContinuityReport
 from ..core.transitions import Transition
+from ..io.opendrive_check import PROFILE_LEVELS, OpenDriveReport
 from ..io.signals import signals_handled
 
 
@@ -192,10 +194,10 @@ def _check(args: argparse.Namespace) -> int:
         if args.comb:
             print("error: --comb draws STEP/IGES edges; it does not apply to OpenDRIVE", file=sys.stderr)
             return 2
-        from ..io.opendrive import check_opendrive, print_opendrive_report
+        from ..io.opendrive import check_opendrive
 
         report = check_opendrive(args.file, gap_tol=args.gap_tol, angle_tol=args.angle_tol, curvature_tol=args.curvature_tol)
-        return print_opendrive_report(report, args)
+        return _print_opendrive_report(report, args)
     for option in ("profiles", "links"):
         if getattr(args, option):
             print(f"error: --{option} judges OpenDRIVE files (.xodr) only", file=sys.stderr)
@@ -203,9 +205,87 @@ def _check(args: argparse.Namespace) -> int:
     if find_spec("OCP") is None:
         print(f"error: spiral-cad check reads STEP/IGES with OCCT, which comes with the CAD extra: {PIP_CAD}", file=sys.stderr)
         return 2
-    from ..cad.continuity import main_check  # imports OCP, so only when used
+    return _check_shape_file(args)
 
-    return main_check(args)
+
+def _check_shape_file(args: argparse.Namespace) -> int:
+    """Run ``spiral-cad check`` on a STEP/IGES file: the joint table; exit 0 ok, 1 below
+    ``--require`` or the wrong number of pieces, 2 unreadable (``error: …`` with the reason).
+
+    The table is ``check_continuity(file).format_table()``, as in the demo's
+    ``NAME_continuity.txt``: the same numbers for the same file.
+    """
+    from ..cad.continuity import check_continuity, curvature_comb  # import OCP, so only when used
+    from ..cad.export import export_step
+
+    comb = _comb_path(args.comb, args.file) if args.comb else None
+    report = check_continuity(args.file, gap_tol=args.gap_tol, angle_tol=args.angle_tol, curvature_tol=args.curvature_tol,
+                              snap=args.snap)  # fmt: skip
+    if not report.wires:
+        raise ValueError(f"{report.source!r} contains no edges to check")
+    if comb is not None:
+        comb_shape = curvature_comb(args.file, units=report.units)  # in the unit the report is in
+        export_step(comb_shape, comb, name=f"{report.source} curvature comb", units=report.units)
+    return _print_report(report, args)
+
+
+def _comb_path(comb: str, checked: str) -> Path:
+    """The ``--comb`` file: a .step/.stp path that is not the file being checked (by any name)."""
+    path = Path(comb)
+    if path.suffix.lower() not in (".step", ".stp"):
+        raise ValueError(f"--comb {comb!r}: the comb is written as STEP; give a .step or .stp file")
+    if path.is_dir():
+        raise ValueError(f"--comb {comb!r} is a folder; give a .step or .stp file")
+    if path.exists() and Path(checked).exists() and os.path.samefile(path, checked):
+        raise ValueError(f"--comb {comb!r} is the file being checked; give another file")
+    return path
+
+
+def _print_report(report: ContinuityReport, args: argparse.Namespace) -> int:
+    """Print ``report`` for ``spiral-cad check``; exit status 0 ok, 1 below ``--require`` or not ``--pieces`` pieces."""
+    print(report.format_table())
+    if getattr(args, "timing", False) and report.timing is not None:
+        print(report.timing_line())
+    if not args.require:
+        return 0
+    expected = 1 if args.pieces is None else args.pieces
+    if report.pieces != expected:
+        hint = "" if args.pieces is not None else " (pass --pieces N if the file holds N separate paths)"
+        print(f"FAIL: {report.describe()}: {report.pieces} separate pieces, expected {expected}{hint}")
+        return 1
+    if not report.passes(args.require, expected):
+        why = " (a measure that decides it is not a finite number)" if report.min_level is Continuity.UNMEASURABLE else ""
+        print(f"FAIL: worst joint is {report.min_level}{why}, below the required {args.require}")
+        return 1
+    print(f"OK: {report.describe()}, every joint at least {args.require}")
+    return 0
+
+
+def _print_opendrive_report(report: OpenDriveReport, args: argparse.Namespace) -> int:
+    """Print ``report`` for ``spiral-cad check``: exit 1 when a road's planView is below ``--require``,
+    an elevation or superelevation below ``--profiles``, a link below ``--links``, or the file does
+    not hold ``--pieces`` roads; else 0."""
+    print(report.format_table())
+    failures = []
+    if args.pieces is not None and report.pieces != args.pieces:
+        failures.append(f"{report.pieces} roads, expected {args.pieces}")
+    if args.require and not report.passes(args.require):
+        why = " (a measure that decides it is not a finite number)" if report.min_level is Continuity.UNMEASURABLE else ""
+        failures.append(f"worst joint is {report.min_level}{why}, below the required {args.require}")
+    profiles = getattr(args, "profiles", None)
+    if profiles and PROFILE_LEVELS.index(report.profile_level) < PROFILE_LEVELS.index(profiles):
+        failures.append(f"worst elevation/superelevation is {report.profile_level}, below the required {profiles}")
+    links = getattr(args, "links", None)
+    if links and not report.link_level >= Continuity.parse(links):
+        failures.append(f"worst link is {report.link_level}, below the required {links}")
+    if failures:
+        print(f"FAIL: {'; '.join(failures)} ({report.describe()})")
+        return 1
+    demands = [f"every planView joint at least {args.require}"] if args.require else []
+    demands += [f"every profile at least {profiles}"] if profiles else []
+    demands += [f"every link at least {links}"] if links else []
+    print(f"OK: {report.describe()}" + (f", {', '.join(demands)}" if demands else ""))
+    return 0
 
 
 def _add_check(sub: argparse._SubParsersAction) -> None:

@@ -21,7 +21,6 @@ apart start a new piece. A report that finds more pieces than expected
 
 from __future__ import annotations
 
-import argparse
 import contextlib
 import dataclasses
 import math
@@ -34,7 +33,6 @@ from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
-from scipy.spatial import cKDTree
 from OCP.BRep import BRep_Tool
 from OCP.BRepAdaptor import BRepAdaptor_Curve
 from OCP.BRepLProp import BRepLProp_CLProps
@@ -51,10 +49,8 @@ from OCP.TopoDS import (
     TopoDS_Wire,
 )
 from OCP.TopTools import TopTools_IndexedMapOfShape
+from scipy.spatial import cKDTree
 
-from ..core.chain import Chain
-from ..core.segments import EPS
-from ..core.units import length_unit
 from ..check.joints import (
     Continuity,
     ContinuityReport,
@@ -70,8 +66,10 @@ from ..check.joints import (
     flip,
     model_size,
     norms,
-    print_report,
 )
+from ..core.chain import Chain
+from ..core.segments import EPS
+from ..core.units import length_unit
 from .occ import as_occ_shape
 from .readers import STEP_SUFFIXES, finish_reading, read_file, start_reading
 
@@ -446,41 +444,6 @@ def _report(measured: Measured, unit: str, source: str, gap_tol: float, angle_to
     return classify_pieces(
         pieces, size, gap_tol=gap_tol, angle_tol=angle_tol, curvature_tol=curvature_tol, snap=link, source=source, units=unit
     )
-
-
-# ------------------------------------------------------------------ CLI
-
-
-def main_check(args: argparse.Namespace) -> int:
-    """Run ``spiral-cad check`` on a STEP/IGES file: the joint table; exit 0 ok, 1 below
-    ``--require`` or the wrong number of pieces, 2 unreadable (``error: …`` with the reason).
-
-    The table is ``check_continuity(file).format_table()``, as in the demo's
-    ``NAME_continuity.txt``: the same numbers for the same file.
-    """
-    comb = _comb_path(args.comb, args.file) if args.comb else None
-    report = check_continuity(args.file, gap_tol=args.gap_tol, angle_tol=args.angle_tol, curvature_tol=args.curvature_tol,
-                              snap=args.snap)  # fmt: skip
-    if not report.wires:
-        raise ValueError(f"{report.source!r} contains no edges to check")
-    if comb is not None:
-        from .export import export_step
-
-        comb_shape = curvature_comb(args.file, units=report.units)  # in the unit the report is in
-        export_step(comb_shape, comb, name=f"{report.source} curvature comb", units=report.units)
-    return print_report(report, args)
-
-
-def _comb_path(comb: str, checked: str) -> Path:
-    """The ``--comb`` file: a .step/.stp path that is not the file being checked (by any name)."""
-    path = Path(comb)
-    if path.suffix.lower() not in STEP_SUFFIXES:
-        raise ValueError(f"--comb {comb!r}: the comb is written as STEP; give a .step or .stp file")
-    if path.is_dir():
-        raise ValueError(f"--comb {comb!r} is a folder; give a .step or .stp file")
-    if path.exists() and Path(checked).exists() and os.path.samefile(path, checked):
-        raise ValueError(f"--comb {comb!r} is the file being checked; give another file")
-    return path
 
 
 # ------------------------------------------------------------------ comb

@@ -24,8 +24,8 @@ from OCP.TopAbs import TopAbs_REVERSED, TopAbs_WIRE
 from OCP.TopExp import TopExp_Explorer
 from OCP.TopoDS import TopoDS, TopoDS_Face, TopoDS_Wire
 
-from ..core.errors import NoSolutionError
 from ..check.joints import Continuity
+from ..core.errors import NoSolutionError
 from ..core.segments import Arc, Line, Segment
 from ..design.fillets import FilletedPath, fillet_path
 from .occ import chain_wire

@@ -25,10 +25,10 @@ from OCP.IGESSelect import IGESSelect_WorkLibrary
 from OCP.Interface import Interface_Static
 from OCP.TCollection import TCollection_HAsciiString
 
-from .occ import as_occ_shape, print_model
-from .console import captured_messages
 from ..core.units import MM_PER_UNIT
 from ..io.names import MAX_NAME_LENGTH, iges_text
+from .console import captured_messages
+from .occ import as_occ_shape, print_model
 
 #: IGES unit names as OCCT's writer takes them.
 _IGES_UNIT = {"mm": "MM", "cm": "CM", "m": "M", "km": "KM", "in": "IN", "ft": "FT"}

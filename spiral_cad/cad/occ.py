@@ -37,10 +37,10 @@ from OCP.TColgp import TColgp_Array1OfPnt
 from OCP.TColStd import TColStd_Array1OfInteger, TColStd_Array1OfReal
 from OCP.TopoDS import TopoDS_Compound, TopoDS_Edge, TopoDS_Shape, TopoDS_Vertex, TopoDS_Wire
 
+from ..check.joints import ROUNDING_ULPS, norms
 from ..core._chain_kernels import ARC, LINE, SPIRAL
 from ..core.rows import SegmentRows
 from ..core.segments import Segment, row_frames
-from ..check.joints import ROUNDING_ULPS, norms
 from .readers import read_shape
 
 __all__ = ["as_occ_shape", "chain_wire", "nurbs_edge", "plane_ax3", "print_model", "segment_edge", "segment_edges"]

@@ -58,7 +58,6 @@ finite, or span more than the float range, is refused (``model_size``).
 
 from __future__ import annotations
 
-import argparse
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass
@@ -69,7 +68,7 @@ from numpy.typing import NDArray
 
 from ..core.chain import ROUNDING_CAP
 
-__all__ = ["Continuity", "ContinuityReport", "Frame", "JointReport", "Timing", "WireReport", "classify_pieces", "print_report"]
+__all__ = ["Continuity", "ContinuityReport", "Frame", "JointReport", "Timing", "WireReport", "classify_pieces"]
 
 #: A gap of this many ulp of the joint's largest coordinate is float64 rounding, not a gap.
 ROUNDING_ULPS = 16
@@ -511,23 +510,3 @@ def check_tolerances(**tolerances: float) -> None:
     for name, value in tolerances.items():
         if not (isinstance(value, (int, float)) and not isinstance(value, bool) and math.isfinite(value) and value >= 0.0):
             raise ValueError(f"{name} must be finite and ≥ 0; got {value!r}")
-
-
-def print_report(report: ContinuityReport, args: argparse.Namespace) -> int:
-    """Print ``report`` for ``spiral-cad check``; exit status 0 ok, 1 below ``--require`` or not ``--pieces`` pieces."""
-    print(report.format_table())
-    if getattr(args, "timing", False) and report.timing is not None:
-        print(report.timing_line())
-    if not args.require:
-        return 0
-    expected = 1 if args.pieces is None else args.pieces
-    if report.pieces != expected:
-        hint = "" if args.pieces is not None else " (pass --pieces N if the file holds N separate paths)"
-        print(f"FAIL: {report.describe()}: {report.pieces} separate pieces, expected {expected}{hint}")
-        return 1
-    if not report.passes(args.require, expected):
-        why = " (a measure that decides it is not a finite number)" if report.min_level is Continuity.UNMEASURABLE else ""
-        print(f"FAIL: worst joint is {report.min_level}{why}, below the required {args.require}")
-        return 1
-    print(f"OK: {report.describe()}, every joint at least {args.require}")
-    return 0

@@ -40,7 +40,6 @@ import numpy as np
 from ._jit import Kernels
 from .errors import Status
 
-
 KERNELS = Kernels(globals())
 jit = KERNELS.jit
 #: Row functions are inlined into the batch loops (where the output array

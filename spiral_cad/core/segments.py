@@ -27,7 +27,6 @@ from . import _chain_kernels as CK
 from ._inputs import as_float, as_point, as_xy
 from .space import PlaneFrame
 
-
 TAU = 2.0 * math.pi
 EPS = float(np.finfo(float).eps)
 #: Largest |n · e| (cosine) between a space arc's normal and its start direction.

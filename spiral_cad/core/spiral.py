@@ -8,15 +8,15 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from . import bezier
-from ._inputs import as_float, as_xy
 from . import _kernels as K
+from . import bezier
+from ._chain_kernels import SPIRAL
+from ._inputs import as_float, as_xy
 from .errors import Status
 from .messages import error_for
-from ._chain_kernels import SPIRAL
 from .segments import EPS, PLANE_TOL, Segment, piece_range
-from .space import PlaneFrame
 from .shapes import DEFAULT_SHAPE, SHAPE_CODES, TRANSITION_SHAPES, shape_code
+from .space import PlaneFrame
 
 
 class BezierSpiral(Segment):

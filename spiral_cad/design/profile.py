@@ -53,7 +53,6 @@ from ..core.units import DEFAULT_UNITS, FOOT, IMPERIAL, length_unit, speed_unit,
 from .alignment import Alignment
 from .tables import text_table, write_csv
 
-
 #: AASHTO Green Book, rural arterials: maximum grade (%) by design speed for level, rolling and mountainous terrain
 #: (level and rolling as TxDOT's Roadway Design Manual, Table 4-11, reproduces the US customary table).
 MAX_GRADE_KMH = ((60, 5, 6, 8), (70, 5, 6, 7), (80, 4, 5, 7), (90, 4, 5, 6), (100, 3, 4, 6), (110, 3, 4, 5),

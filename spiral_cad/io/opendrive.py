@@ -51,7 +51,7 @@ from ..core.rows import ARC, LINE, SPIRAL
 from ..core.segments import row_frames
 from ..core.units import to_metres
 from .decimals import shortest_decimal
-from .opendrive_check import LinkReport, OpenDriveReport, ProfileReport, check_opendrive, print_opendrive_report
+from .opendrive_check import LinkReport, OpenDriveReport, ProfileReport, check_opendrive
 from .opendrive_read import (
     Connection,
     Geometry,
@@ -67,7 +67,7 @@ from .opendrive_read import (
 
 __all__ = [
     "Connection", "CrossSection", "Geometry", "Junction", "Link", "LinkReport", "Network", "OpenDriveReport", "Plan",
-    "ProfileReport", "Road", "RoadToWrite", "check_opendrive", "print_opendrive_report", "read_network", "read_opendrive",
+    "ProfileReport", "Road", "RoadToWrite", "check_opendrive", "read_network", "read_opendrive",
     "records_at", "write_opendrive",
 ]  # fmt: skip
 

@@ -10,14 +10,12 @@ Public names: ``spiral_cad.io.opendrive``.
 
 from __future__ import annotations
 
-import argparse
 import os
 from dataclasses import dataclass, fields
 
 import numpy as np
 from numpy.typing import NDArray
 
-from ..core.piecewise import polynomial
 from ..check.joints import (
     Continuity,
     ContinuityReport,
@@ -29,6 +27,7 @@ from ..check.joints import (
     flip,
     model_size,
 )
+from ..core.piecewise import polynomial
 from .opendrive_lanes import lane_frame, lane_links, read_lanes
 from .opendrive_read import Network, Road, _label, read_network
 
@@ -329,30 +328,3 @@ def _links(source: str, path: str | os.PathLike, network: Network, gap_tol: floa
             else:
                 add(r, end, other, contact, "road link")
     return found
-
-
-def print_opendrive_report(report: OpenDriveReport, args: argparse.Namespace) -> int:
-    """Print ``report`` for ``spiral-cad check``: exit 1 when a road's planView is below ``--require``,
-    an elevation or superelevation below ``--profiles``, a link below ``--links``, or the file does
-    not hold ``--pieces`` roads; else 0."""
-    print(report.format_table())
-    failures = []
-    if args.pieces is not None and report.pieces != args.pieces:
-        failures.append(f"{report.pieces} roads, expected {args.pieces}")
-    if args.require and not report.passes(args.require):
-        why = " (a measure that decides it is not a finite number)" if report.min_level is Continuity.UNMEASURABLE else ""
-        failures.append(f"worst joint is {report.min_level}{why}, below the required {args.require}")
-    profiles = getattr(args, "profiles", None)
-    if profiles and PROFILE_LEVELS.index(report.profile_level) < PROFILE_LEVELS.index(profiles):
-        failures.append(f"worst elevation/superelevation is {report.profile_level}, below the required {profiles}")
-    links = getattr(args, "links", None)
-    if links and not report.link_level >= Continuity.parse(links):
-        failures.append(f"worst link is {report.link_level}, below the required {links}")
-    if failures:
-        print(f"FAIL: {'; '.join(failures)} ({report.describe()})")
-        return 1
-    demands = [f"every planView joint at least {args.require}"] if args.require else []
-    demands += [f"every profile at least {profiles}"] if profiles else []
-    demands += [f"every link at least {links}"] if links else []
-    print(f"OK: {report.describe()}" + (f", {', '.join(demands)}" if demands else ""))
-    return 0
