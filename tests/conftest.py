@@ -2,7 +2,9 @@
 ``outcome``, the tally of property tests whose examples may be refused."""
 
 import os
+import re
 from collections import Counter
+from pathlib import Path
 
 import pytest
 from hypothesis import HealthCheck, event, settings
@@ -58,3 +60,32 @@ def outcome():
         assert outcomes.tally["built"] >= max(3, outcomes.minimum_built * total), (
             f"only {outcomes.tally['built']} of {total} examples were built: the property was hardly tested"
         )
+
+
+#: Tests of more than a few seconds on a quiet 2-core machine (``make check`` leaves them out), by
+#: module or by ``module::test`` name.
+SLOW = {
+    "test_install.py",
+    "test_fuzz_readers.py",
+    "test_examples.py",
+    "test_benchmarks.py",
+}
+_CAD = re.compile(r"^\s*(?:from|import) (?:build123d|cadquery|OCP)\b|importorskip\([\"'](?:build123d|cadquery|OCP)", re.M)
+_SUBPROCESS = re.compile(r"\bsubprocess\b|sys\.executable")
+
+
+def pytest_collection_modifyitems(config, items):
+    """Markers by what a test module needs: ``cad`` (imports OCP, build123d or CadQuery, or lives in
+    tests/cad), ``subprocess`` (runs a program), ``install`` (tests/app/test_install.py), ``slow`` (``SLOW``)."""
+    texts: dict[Path, str] = {}
+    for item in items:
+        path = Path(item.fspath)
+        text = texts.setdefault(path, path.read_text(encoding="utf-8"))
+        if path.parent.name == "cad" or _CAD.search(text):
+            item.add_marker(pytest.mark.cad)
+        if _SUBPROCESS.search(text):
+            item.add_marker(pytest.mark.subprocess)
+        if path.name == "test_install.py":
+            item.add_marker(pytest.mark.install)
+        if path.name in SLOW or f"{path.name}::{item.originalname}" in SLOW:
+            item.add_marker(pytest.mark.slow)

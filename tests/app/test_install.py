@@ -24,7 +24,7 @@ from pathlib import Path
 
 import pytest
 
-REPO = Path(__file__).resolve().parent.parent
+REPO = Path(__file__).resolve().parents[2]
 
 
 def _open_to_everyone(folder: Path) -> bool:
@@ -196,7 +196,7 @@ def test_the_numeric_core_names_no_cad_kernel_not_even_inside_a_function():
     import ast
     from pathlib import Path
 
-    core = Path(__file__).resolve().parent.parent / "spiral_cad" / "core"
+    core = Path(__file__).resolve().parents[2] / "spiral_cad" / "core"
     cad = ("OCP", "build123d", "cadquery", "spiral_cad.cad")
     found = []
     for path in sorted(core.glob("*.py")):

@@ -10,7 +10,7 @@ import pytest
 
 from spiral_cad.io.gcode import parse_gcode, read_gcode, round_toolpath
 
-HERE = Path(__file__).parent / "gcode"
+HERE = Path(__file__).resolve().parents[1] / "gcode"
 
 
 def test_a_pocket_program_with_the_usual_preamble():

@@ -10,7 +10,7 @@ from pathlib import Path
 
 import pytest
 
-BENCH = Path(__file__).resolve().parents[1] / "benchmarks"
+BENCH = Path(__file__).resolve().parents[2] / "benchmarks"
 SCRIPTS = sorted(BENCH.glob("bench_*.py"))
 #: What a script's quick table must say beside its numbers (every job ran; the solids it built are valid).
 EXPECTED = {

@@ -17,7 +17,7 @@ from spiral_cad.design import Alignment, round_corners
 from spiral_cad.cad.export import CrossSection, export_opendrive
 from spiral_cad.io.opendrive import check_opendrive, read_opendrive
 
-REPO = Path(__file__).resolve().parent.parent
+REPO = Path(__file__).resolve().parents[2]
 PIS = [[0, 0], [600, 120], [1150, -80], [1700, 260], [2300, 200]]
 
 

@@ -8,7 +8,7 @@ import pytest
 from spiral_cad.app.cli import main
 from spiral_cad.app.schema import DesignFile, json_schema, schema_markdown, validate
 
-ROOT = Path(__file__).resolve().parent.parent
+ROOT = Path(__file__).resolve().parents[2]
 EXAMPLES = sorted((ROOT / "examples").rglob("*.json"))
 ROAD = {"name": "road", "type": "alignment", "pis": [[0, 0], [600, 120], [1150, -80], [1700, 260]],
         "radii": [450, 400], "spiral_angles_deg": 8}  # fmt: skip

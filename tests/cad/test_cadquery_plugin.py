@@ -133,7 +133,7 @@ def test_example_script_runs_from_plain_python(tmp_path):
     import sys
     from pathlib import Path
 
-    script = Path(__file__).resolve().parents[1] / "examples" / "cadquery_plugin.py"
+    script = Path(__file__).resolve().parents[2] / "examples" / "cadquery_plugin.py"
     target = tmp_path / "tube.step"
     done = subprocess.run([sys.executable, str(script), str(target)], capture_output=True, text=True, timeout=300)
     assert done.returncode == 0, done.stderr

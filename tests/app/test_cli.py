@@ -13,7 +13,7 @@ from spiral_cad.app.cli import DEMO_DESIGN, main
 from spiral_cad.cad.continuity import check_continuity
 from spiral_cad.design import circle_chain
 
-EXAMPLES = Path(__file__).resolve().parent.parent / "examples"
+EXAMPLES = Path(__file__).resolve().parents[2] / "examples"
 
 
 def assert_plain_csv(path: Path) -> None:

@@ -178,7 +178,7 @@ def test_build_from_gcode_reads_arcs_with_an_arc_tolerance(tmp_path):
 
     from spiral_cad.app.cli import main
 
-    program = Path(__file__).parent / "gcode" / "with_arcs.nc"
+    program = Path(__file__).resolve().parents[1] / "gcode" / "with_arcs.nc"
     out = tmp_path / "out"
     argv = ["build", "--from-gcode", str(program), "--max-deviation", "0.05", "--arc-tolerance", "0.005", "--no-plots", "--out", str(out)]
     assert main(argv) == 0

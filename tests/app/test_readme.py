@@ -20,7 +20,7 @@ from pathlib import Path
 
 import pytest
 
-README = Path(__file__).resolve().parent.parent / "README.md"
+README = Path(__file__).resolve().parents[2] / "README.md"
 SKIP = re.compile(r"<!-- readme: skip \((?P<reason>[^()]+)\) -->")
 FENCE = re.compile(r"^(?P<indent> *)```(?P<info>[^`]*)$")
 

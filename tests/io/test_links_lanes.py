@@ -122,7 +122,7 @@ def test_a_lane_link_to_a_missing_lane_is_named(tmp_path):
     assert main(["check", str(path), "--links", "G0"]) == 2
 
 
-DATA = __import__("pathlib").Path(__file__).parent / "data"
+DATA = __import__("pathlib").Path(__file__).resolve().parents[1] / "data"
 
 
 def test_a_real_lane_offset_junction_lines_up_lane_by_lane_but_not_by_reference_lines(capsys):

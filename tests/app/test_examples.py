@@ -6,7 +6,7 @@ from pathlib import Path
 
 import pytest
 
-EXAMPLES = Path(__file__).resolve().parent.parent / "examples"
+EXAMPLES = Path(__file__).resolve().parents[2] / "examples"
 OUTPUTS = {
     "build123d_road.py": ["road.step", "road_centreline.step", "road.svg"],
     "robot_path.py": ["robot_path.png", "robot_path.svg"],

@@ -209,7 +209,7 @@ def _rail():
 
 # --------------------------------------------------- all-or-nothing output
 
-EXAMPLE = Path(__file__).resolve().parent.parent / "examples" / "design.json"
+EXAMPLE = Path(__file__).resolve().parents[2] / "examples" / "design.json"
 EXAMPLE_FILES = [f"{name}{suffix}" for name in ("rail", "loop", "cnc", "ramp")
                  for suffix in (".step", ".svg", ".igs", "_continuity.txt", ".dxf")] + ["rail_stations.csv", "rail.xodr"]
 
@@ -348,7 +348,7 @@ def test_messages_and_reprs_show_plain_numbers():
 
 # ------------------------------------------- files a design may read
 
-POCKET = Path(__file__).resolve().parent.parent / "examples" / "pocket.nc"
+POCKET = Path(__file__).resolve().parents[2] / "examples" / "pocket.nc"
 
 
 def gcode_design(folder: Path, program: str) -> Path:
