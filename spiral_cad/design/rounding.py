@@ -38,12 +38,12 @@ from numpy.typing import ArrayLike, NDArray
 from ..core import _kernels as K
 from ..core import batch
 from ..core._inputs import as_float, as_real_array
-from ..core.chain import JOIN_TOLERANCE, Chain, PartCircles, join_rows, join_tolerance
+from ..core.chain import JOIN_TOLERANCE, ROUNDING_CAP, Chain, PartCircles, join_rows, join_tolerance
 from ..core.errors import JointError, NoSolutionError, Status
 from ..core.factors import length_factor
 from ..core.rows import SegmentRows
 from ..core.shapes import CORNER_SHAPES, DEFAULT_SHAPE, SHAPE_CODES, shape_code
-from ..core.segments import Line, Segment
+from ..core.segments import Line, Segment, curvature_scales, joint_table
 from ..core.space import PlaneFrame, corner_frames, norms, place, placed_pair_residuals
 from ..core.spiral import BezierSpiral
 from ..core.units import DEFAULT_UNITS, length_unit
@@ -58,7 +58,8 @@ G2CBS_C3 = (G2CBS_C2 + 4.0) / (G2CBS_C1 + 6.0)
 #: κmax = c4 sin β / (d cos² β): the G2CBS corner factor K(β) = c4·sin β/cos² β.
 G2CBS_C4 = (G2CBS_C2 + 4.0) ** 2 / (54.0 * G2CBS_C3)
 
-#: Relative |sin| below which three points count as collinear (passed through).
+#: Relative |sin| below which two unit directions count as parallel; kept for callers. Points
+#: of a polyline are judged by their distance instead (``straight_points``), never by angle alone.
 COLLINEAR_TOL = 1e-12
 #: A ``max_deviation`` pair is aimed this much (relative) inside its bound, and
 #: further by the rounding of the corner's coordinates (``ROUNDING_ULPS`` ulp of
@@ -116,6 +117,28 @@ def _sin_turn(u: NDArray, v: NDArray) -> NDArray:
     if u.shape[-1] == 2:
         return np.abs(u[:, 0] * v[:, 1] - u[:, 1] * v[:, 0])
     return norms(np.cross(u, v))
+
+
+def straight_points(before: NDArray, corner: NDArray, after: NDArray) -> tuple[NDArray, NDArray]:
+    """Which corners (N, d) are no corners: ``(straight, folds)``, each (N,) bool.
+
+    A corner is straight when it lies within what float64 resolves at its coordinates
+    (``ROUNDING_ULPS`` ulp of the largest) of the chord ``before`` → ``after``: dropping it
+    moves the path by no more than rounding. The turn's angle alone never decides: a point
+    0.4 off a line between points 1e12 apart turns by 1e-12 rad but is a real corner.
+    It folds when the path turns back and the shorter leg lies that close to the other's line.
+    """
+    vin, vout = corner - before, after - corner
+    lin, lout = norms(vin), norms(vout)
+    with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
+        sin_t = _sin_turn(vin / lin[:, None], vout / lout[:, None])
+        chord = norms(after - before)
+        resolution = ROUNDING_ULPS * EPS * np.maximum(np.abs(np.stack([before, corner, after])).max(axis=(0, 2)), 1e-300)
+        ahead = np.einsum("ij,ij->i", vin, vout) > 0.0
+        # The corner's distance from the chord (the path's deviation if it were dropped).
+        straight = ahead & (lin * (lout / chord) * sin_t <= resolution)
+        folds = ~ahead & (np.minimum(lin, lout) * sin_t <= resolution)
+    return straight, folds
 
 
 def _coordinates(value: ArrayLike, name: str) -> NDArray:
@@ -340,6 +363,7 @@ def round_corners_batch(
     spiral_lengths: ArrayLike | None = None,
     shape: str = DEFAULT_SHAPE,
     method: str | None = None,
+    tolerance: float = JOIN_TOLERANCE,
 ) -> CornerBatch:
     """Round N independent corners ``p0 → corner → p1`` with spiral pairs, in the plane or in space.
 
@@ -367,6 +391,9 @@ def round_corners_batch(
         shape: ``"walton-meek"`` (Theorem 4.4), ``"near-linear"`` or
             ``"g2cbs"`` (Yang & Sukkarieh).
         method: the former name of ``shape``.
+        tolerance: the relative join tolerance of the chains the corners will be
+            part of: each corner's joints must pass ``Chain``'s joint test with it
+            (else ``UNVERIFIED``), so ``round_corners`` refuses exactly what this refuses.
 
     With none of curvature, spiral_lengths or max_* given, each corner uses
     all of its shorter leg (Corollary 4.5: the lowest curvature that fits).
@@ -432,6 +459,9 @@ def round_corners_batch(
         residual[failed] = off[failed]
     else:
         deviation = norms(pairs[:, 0, 3] - corners)
+    joined = _joints_hold(pairs, p0, corners, p1, status == Status.OK, shape, tolerance)
+    status[~joined] = Status.UNVERIFIED
+    residual[~joined] = np.inf
     if values["max_deviation"] is not None:
         over = (status == Status.OK) & ~(deviation <= values["max_deviation"])
         status[over] = Status.UNVERIFIED
@@ -443,6 +473,43 @@ def round_corners_batch(
     given = {name: unset if v is None else v for name, v in values.items()}
     return CornerBatch(shape, pairs, theta, distance, peak, available, status, corners, k, residual, deviation,
                        given["max_deviation"], given["max_curvature"], given["spiral_lengths"])  # fmt: skip
+
+
+def _joints_hold(pairs: NDArray, p0: NDArray, corners: NDArray, p1: NDArray, ok: NDArray, shape: str, tolerance: float) -> NDArray:
+    """Whether each OK corner's three joints (line → spiral → spiral → line) pass the ``Chain``'s own
+    joint test (``joint_table``), so that a corner the batch returns is one a chain accepts.
+
+    The lines are taken as long as a polyline's segment can be around the corner (twice its
+    leg): the longest line gives the strictest test, so no chain around the corner refuses it.
+    """
+    held = np.ones(len(ok), dtype=bool)
+    rows_ok = np.flatnonzero(ok)
+    if not len(rows_ok):
+        return held
+    cp = pairs[rows_ok]
+    m, dim = len(rows_ok), cp.shape[-1]
+    frames, floors, lengths = SegmentRows.spirals(cp.reshape(-1, 4, dim), shape).measure()
+    frames, floors, lengths = frames.reshape(m, 2, 2, 9), floors.reshape(m, 2, 2, 3), lengths.reshape(m, 2)
+    own = curvature_scales(frames.reshape(-1, 2, 9)).reshape(m, 2).max(axis=1)
+    line_frames = np.zeros((2, m, 9))
+    line_floors = np.zeros((2, m, 3))
+    line_lengths = np.empty((2, m))
+    for side, (leg_end, at) in enumerate(((p0[rows_ok], frames[:, 0, 0]), (p1[rows_ok], frames[:, 1, 1]))):
+        line_frames[side, :, :6] = at[:, :6]  # the line runs along the spiral's end tangent, κ = 0
+        line_lengths[side] = 2.0 * norms(corners[rows_ok] - leg_end)
+        gap = 4.0 * EPS * np.abs(np.concatenate([corners[rows_ok], leg_end], axis=1)).max(axis=1)
+        line_floors[side, :, 0], line_floors[side, :, 1] = gap, gap / line_lengths[side]
+    ends = np.concatenate([line_frames[0], frames[:, 0, 1], frames[:, 1, 1]])
+    end_floors = np.concatenate([line_floors[0], floors[:, 0, 1], floors[:, 1, 1]])
+    end_lengths = np.concatenate([line_lengths[0], lengths[:, 0], lengths[:, 1]])
+    starts = np.concatenate([frames[:, 0, 0], frames[:, 1, 0], line_frames[1]])
+    start_floors = np.concatenate([floors[:, 0, 0], floors[:, 1, 0], line_floors[1]])
+    start_lengths = np.concatenate([lengths[:, 0], lengths[:, 1], line_lengths[1]])
+    with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
+        table, _ = joint_table(ends, end_floors, end_lengths, starts, start_floors, start_lengths, np.tile(own, 3),
+                               join_tolerance(tolerance), ROUNDING_CAP)  # fmt: skip
+    held[rows_ok] = ~(table[:, 5].reshape(3, m) != 0.0).any(axis=0)
+    return held
 
 
 def _polyline(points: ArrayLike) -> NDArray:
@@ -458,8 +525,9 @@ def corner_legs(points: ArrayLike) -> tuple[NDArray, NDArray, NDArray, NDArray]:
 
     Interior segments are shared half-and-half between their two corners; the
     first and last segments belong wholly to their one corner, so spirals of
-    neighbouring corners never overlap. Collinear interior points (forward,
-    |sin| of the turn ≤ 1e-12) are dropped: they need no rounding.
+    neighbouring corners never overlap. Collinear interior points (forward, within
+    float64's resolution of the chord of their neighbours: ``straight_points``)
+    are dropped: they need no rounding.
 
     Returns:
         ``(p0, corners, p1, index)``: (M, d) leg ends and corners, and the
@@ -482,10 +550,7 @@ def corner_legs(points: ArrayLike) -> tuple[NDArray, NDArray, NDArray, NDArray]:
     if not np.isfinite(length).all():
         i = int(np.argmax(~np.isfinite(length)))
         raise ValueError(f"points {i} and {i + 1} are too far apart for float64: {pts[i].tolist()} and {pts[i + 1].tolist()}")
-    unit = seg / length[:, None]
-    dot = np.einsum("ij,ij->i", unit[:-1], unit[1:])
-    straight = _sin_turn(unit[:-1], unit[1:]) <= COLLINEAR_TOL
-    folds = straight & (dot < 0.0)
+    straight, folds = straight_points(pts[:-2], pts[1:-1], pts[2:])
     if folds.any():
         i = int(np.argmax(folds)) + 1
         raise ValueError(f"the polyline folds straight back at point {i} {pts[i].tolist()}")
@@ -639,7 +704,7 @@ def round_corners(
     rounded: list[RoundedCorner] = []
     spirals = np.empty((0, 2, 4, dim))
     if len(corners):
-        result = round_corners_batch(p0, corners, p1, shape=shape, **options)
+        result = round_corners_batch(p0, corners, p1, shape=shape, tolerance=tolerance, **options)
         for j in np.flatnonzero(~result.ok):
             message = result.reason(int(j), label=f"corner {index[j]}")
             if result.status[j] in (Status.LEGS_TOO_SHORT, Status.CORNER_REVERSAL, Status.UNVERIFIED, Status.OUTSIDE_SHAPE):
@@ -752,8 +817,8 @@ def fillet_polyline(
         raise ValueError(f"vertices {unknown} are not corners of this polyline (corners: {candidates})")
     rounded = {}
     for v in chosen:
-        d_in, d_out = (ends[v - 1][1] - ends[v - 1][0]), (ends[v % edges][1] - ends[v % edges][0])
-        if _sin_turn(d_in[None] / norms(d_in), d_out[None] / norms(d_out))[0] > COLLINEAR_TOL:
+        before, after = ends[v - 1][0], ends[v % edges][1]
+        if not straight_points(before[None], pts[v][None], after[None])[0][0]:
             rounded[v] = None  # a corner (straight vertices stay as they are)
     pieces: dict[int, list[Segment]] = {}
     fillets = []
