@@ -148,3 +148,27 @@ def test_the_property_test_built_most_of_its_examples():
     if BUILT["count"] == 0:
         pytest.skip("the property test did not run in this session")
     assert BUILT["count"] >= 30
+
+
+@pytest.mark.parametrize("bound", [1e-3, 0.1, 10.0, None])
+def test_a_near_reversal_says_what_would_help(bound):
+    """179.9°: no max_deviation helps (the turn, not the size, is the limit): the message says so and
+    what does help; the advice works (the tip split by a short flat rounds)."""
+    turn = math.radians(179.9)
+    points = [[0.0, 0.0], [100.0, 0.0], [100.0 + 100.0 * math.cos(turn), 100.0 * math.sin(turn)]]
+    with pytest.raises(NoSolutionError) as info:
+        round_corners(points, max_deviation=bound)
+    message = str(info.value)
+    assert message.startswith("corner 1 at (100, 0): deflection 179.9° is too close to a reversal")
+    assert "larger max_deviation" not in message and "lower curvature" not in message
+    assert "at most 179.6" in message and "two corners" in message
+    flat = [points[0], [100.0, 0.0], [100.0, 0.5 * points[2][1] + 0.05], points[2]]
+    assert len(round_corners(flat, max_deviation=bound).corners) == 2
+
+
+def test_a_corner_limited_by_its_size_still_advises_a_larger_bound():
+    turn = math.radians(179.0)
+    points = [[0.0, 0.0], [100.0, 0.0], [100.0 + 100.0 * math.cos(turn), 100.0 * math.sin(turn)]]
+    with pytest.raises(NoSolutionError, match="use a larger max_deviation"):
+        round_corners(points, max_deviation=1e-3)
+    assert round_corners(points, max_deviation=0.1).max_deviation <= 0.1

@@ -232,6 +232,16 @@ class CornerBatch:
             return f"{where}: a leg has zero length"
         if status is Status.UNVERIFIED:
             bound = self.max_deviation[i]
+            steepest = _steepest_deflection(self.shape) if self.theta[i] == self.theta[i] else math.nan
+            if 2.0 * self.theta[i] > steepest:
+                # Scale-free: the same turn fails with unit legs at the origin, so no size or tolerance helps.
+                return (
+                    f"{where}: deflection {2 * math.degrees(self.theta[i]):.6g}° is too close to a reversal for a "
+                    f"{self.shape} spiral pair: its peak curvature is {float(corner_scale(math.sin(self.theta[i]), math.cos(self.theta[i]), 1.0, self.shape)):.3g} "
+                    f"/ d (d its distance from the corner), beyond what float64 holds to 1e-9 at any size or max_deviation "
+                    f"(at most {math.degrees(steepest):.6g}° holds); replace the corner by two corners that each turn "
+                    "about half as much (e.g. a short flat across its tip), each rounded by its own pair"
+                )
             if bound == bound and not self.residual[i] < math.inf:
                 return (
                     f"{where}: max_deviation {bound:.6g} is below what float64 resolves at these coordinates "
@@ -276,6 +286,29 @@ class CornerBatch:
             f"curvature {self.requested[i]:.6g} needs the spirals to start {self.distance[i]:.6g} from the corner "
             f"but {available}; {largest}"
         )
+
+
+_STEEPEST: dict[str, float] = {}
+
+
+def _steepest_deflection(shape: str) -> float:
+    """The largest deflection (radians) whose ``shape`` spiral pair float64 holds (to
+    ``VERIFY_TOL``) for a corner with unit legs at the origin: beyond it a corner is too
+    close to a reversal at any size. Bisected once per shape on the plane kernel."""
+    if shape not in _STEEPEST:
+        def holds(deflection: float) -> bool:
+            end = (math.cos(deflection), math.sin(deflection))
+            return bool(batch.line_to_line([(-1.0, 0.0)], [(0.0, 0.0)], [end], shape=shape).status[0] == Status.OK)
+
+        lo, hi = math.radians(90.0), math.pi
+        if not holds(lo):
+            _STEEPEST[shape] = math.nan
+            return math.nan
+        for _ in range(60):
+            mid = 0.5 * (lo + hi)
+            lo, hi = (mid, hi) if holds(mid) else (lo, mid)
+        _STEEPEST[shape] = lo
+    return _STEEPEST[shape]
 
 
 def _half_deflection(p0: NDArray, corners: NDArray, p1: NDArray):
