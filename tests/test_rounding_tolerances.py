@@ -30,9 +30,10 @@ def _path_distance(chain, point: np.ndarray) -> float:
             t = float(np.clip(np.dot(point - a, b - a) / np.dot(b - a, b - a), 0.0, 1.0))
             best = min(best, float(np.linalg.norm(a + t * (b - a) - point)))
             continue
+        if min(np.linalg.norm(a - point), np.linalg.norm(b - point)) > best + seg.length:
+            continue  # no point of this segment can be nearer
         u = np.linspace(0.0, 1.0, 2001)
-        xy = np.array([seg.point(float(t)) for t in u])
-        d = np.linalg.norm(xy - point, axis=1)
+        d = np.linalg.norm(np.asarray(seg.point(u)) - point, axis=1)
         k = int(np.argmin(d))
         lo, hi = u[max(k - 1, 0)], u[min(k + 1, len(u) - 1)]
         for _ in range(80):  # ternary search: the distance is unimodal near its minimum
@@ -172,3 +173,73 @@ def test_a_corner_limited_by_its_size_still_advises_a_larger_bound():
     with pytest.raises(NoSolutionError, match="use a larger max_deviation"):
         round_corners(points, max_deviation=1e-3)
     assert round_corners(points, max_deviation=0.1).max_deviation <= 0.1
+
+
+def _linearised_arc(count: int, radius: float, centre=(123.4, 56.7)) -> np.ndarray:
+    """A half circle as ``count`` points (the tangent lines of a CAM program), with a lead-in and lead-out."""
+    t = np.linspace(0.0, math.pi, count)
+    arc = np.c_[radius * np.cos(t) + centre[0], radius * np.sin(t) + centre[1]]
+    return np.vstack([arc[0] - (0.0, 20.0), arc, arc[-1] - (0.0, 20.0)])
+
+
+def _bound_reaching(points: np.ndarray, share: float) -> float:
+    """The max_deviation whose pairs reach ``share`` of half a chord of ``_linearised_arc``."""
+    from spiral_cad.design.rounding import corner_scale, deviation_factor
+
+    chord = float(np.linalg.norm(points[2] - points[1]))
+    a, b = points[2] - points[1], points[3] - points[2]
+    half = 0.5 * math.atan2(abs(a[0] * b[1] - a[1] * b[0]), float(a @ b))
+    reach = float(corner_scale(math.sin(half), math.cos(half), 1.0, "walton-meek") / deviation_factor(math.sin(half), math.cos(half), "walton-meek"))
+    return 0.5 * chord * share / reach
+
+
+def _lines(path) -> list[float]:
+    return [s.length for s in path.chain if type(s).__name__ == "Line"]
+
+
+@pytest.mark.parametrize("share", [1.0 - 2e-8, 1.0 - 1e-7, 1.0 - 3e-7])
+def test_no_sliver_line_is_left_between_corners_under_a_deviation_bound(share):
+    points = _linearised_arc(40, 25.4)
+    bound = _bound_reaching(points, share)
+    path = round_corners(points, max_deviation=bound)
+    assert len(path.corners) == len(points) - 2
+    assert min(_lines(path)) >= 1e-6  # every line is a real edge (OCCT: 1e-7 mm)
+    assert path.max_deviation <= bound
+    assert all(_path_distance(path.chain, points[c.index]) <= bound for c in path.corners[::7])
+
+
+def test_no_sliver_line_is_left_under_a_curvature_bound():
+    """Pairs at κmax that stop 2e-8 short of each other grow to meet: a lower curvature, no line."""
+    from spiral_cad.design.rounding import corner_scale
+
+    points = _linearised_arc(40, 25.4)
+    chord = float(np.linalg.norm(points[2] - points[1]))
+    a, b = points[2] - points[1], points[3] - points[2]
+    half = 0.5 * math.atan2(abs(a[0] * b[1] - a[1] * b[0]), float(a @ b))
+    kmax = float(corner_scale(math.sin(half), math.cos(half), 0.5 * chord * (1.0 - 2e-8), "walton-meek"))
+    path = round_corners(points, max_curvature=kmax)
+    assert all(length >= 1e-6 for length in _lines(path))
+    assert path.max_curvature <= kmax * (1.0 + 1e-12)
+
+
+def test_a_sliver_the_pairs_cannot_avoid_is_refused_naming_its_corner():
+    """With the curvature fixed the corners cannot move: the refusal carries the corner's point index."""
+    from spiral_cad.design.rounding import corner_scale
+
+    points = _linearised_arc(40, 25.4)
+    chord = float(np.linalg.norm(points[2] - points[1]))
+    a, b = points[2] - points[1], points[3] - points[2]
+    half = 0.5 * math.atan2(abs(a[0] * b[1] - a[1] * b[0]), float(a @ b))
+    k = float(corner_scale(math.sin(half), math.cos(half), 0.5 * chord * (1.0 - 2e-8), "walton-meek"))
+    with pytest.raises(NoSolutionError, match=r"^corner \d+: the line it leaves .* too short for a CAD edge") as info:
+        round_corners(points, curvature=k)
+    assert isinstance(info.value.corner, int) and 1 <= info.value.corner <= len(points) - 2
+    assert str(info.value).startswith(f"corner {info.value.corner}:")
+
+
+def test_every_refusal_carries_its_corner():
+    turn = math.radians(179.9)
+    points = [[0.0, 0.0], [5.0, 5.0], [100.0, 5.0], [100.0 + 100.0 * math.cos(turn), 5.0 + 100.0 * math.sin(turn)]]
+    with pytest.raises(NoSolutionError) as info:
+        round_corners(points, max_deviation=0.1)
+    assert info.value.corner == 2

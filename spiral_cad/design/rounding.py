@@ -46,7 +46,7 @@ from ..core.shapes import CORNER_SHAPES, DEFAULT_SHAPE, SHAPE_CODES, shape_code
 from ..core.segments import Line, Segment, curvature_scales, joint_table
 from ..core.space import PlaneFrame, corner_frames, norms, place, placed_pair_residuals
 from ..core.spiral import BezierSpiral
-from ..core.units import DEFAULT_UNITS, length_unit
+from ..core.units import DEFAULT_UNITS, MM_PER_UNIT, length_unit
 from .fillets import FilletCorner, _vertex_indices, fillet_path, first_broken_corner
 
 #: Yang & Sukkarieh's leg ratio g/h: the smallest that keeps κ monotone.
@@ -738,11 +738,8 @@ def round_corners(
     spirals = np.empty((0, 2, 4, dim))
     if len(corners):
         result = round_corners_batch(p0, corners, p1, shape=shape, tolerance=tolerance, **options)
-        for j in np.flatnonzero(~result.ok):
-            message = result.reason(int(j), label=f"corner {index[j]}")
-            if result.status[j] in (Status.LEGS_TOO_SHORT, Status.CORNER_REVERSAL, Status.UNVERIFIED, Status.OUTSIDE_SHAPE):
-                raise NoSolutionError(message)
-            raise ValueError(message)
+        _raise_first_failure(result, index)
+        result = _without_slivers(result, pts, p0, corners, p1, index, options, tolerance, length_unit(units))
         spirals = result.control_points
         numbers = zip(index.tolist(), result.theta.tolist(), result.distance.tolist(), result.curvature.tolist(), result.deviation.tolist())
         for cp, (i, theta, distance, peak, deviation) in zip(spirals, numbers):
@@ -755,8 +752,109 @@ def round_corners(
         chain = join_rows(rows, np.full(len(rounded), 2), PartCircles(len(rounded)), tuple(pts[0].tolist()),
                           tuple(pts[-1].tolist()), join_tolerance(tolerance), length_unit(units), objects)  # fmt: skip
     except JointError as error:
-        raise NoSolutionError(f"corner {index[error.part]}: float64 cannot hold its spirals G2 at these coordinates: {error}") from None
+        raise _refusal(f"corner {index[error.part]}: float64 cannot hold its spirals G2 at these coordinates: {error}", int(index[error.part])) from None
     return RoundedPath(chain, rounded, shape)
+
+
+#: The shortest line left between rounded corners, in mm: ten times OCCT's Precision::Confusion
+#: (1e-7 mm), below which a line cannot become an edge of a wire.
+MIN_EDGE_MM = 1e-6
+
+
+def _refusal(message: str, corner: int, kind: type[ValueError] = NoSolutionError) -> ValueError:
+    """The error of a polyline's corner: ``corner`` (its point index) is kept on it as an attribute,
+    so a reader of the polyline's source (e.g. G-code) can name where the point came from."""
+    error = kind(message)
+    error.corner = corner  # type: ignore[attr-defined]
+    return error
+
+
+def _raise_first_failure(result: CornerBatch, index: NDArray) -> None:
+    """Raise the first corner ``result`` could not round, named by its point index."""
+    for j in np.flatnonzero(~result.ok):
+        message = result.reason(int(j), label=f"corner {index[j]}")
+        refused = result.status[j] in (Status.LEGS_TOO_SHORT, Status.CORNER_REVERSAL, Status.UNVERIFIED, Status.OUTSIDE_SHAPE)
+        raise _refusal(message, int(index[j]), NoSolutionError if refused else ValueError)
+
+
+def _without_slivers(result: CornerBatch, pts: NDArray, p0: NDArray, corners: NDArray, p1: NDArray, index: NDArray,
+                     options: dict, tolerance: float, units: str) -> CornerBatch:  # fmt: skip
+    """``result`` with no line shorter than ``MIN_EDGE_MM`` left between corners (or before the first,
+    after the last): such a sliver cannot become a CAD edge.
+
+    The corners beside a sliver are re-solved with a fixed curvature: under ``max_deviation`` they
+    move back from it (a smaller pair: a smaller deviation) until the line is a real edge; under
+    ``max_curvature`` alone they grow to meet across it (a lower curvature). Either keeps every bound;
+    where neither applies (``curvature`` or ``spiral_lengths`` fix the pairs) or the bound would be
+    broken, the corner is refused, named.
+    """
+    n = len(result)
+    min_edge = MIN_EDGE_MM / MM_PER_UNIT[units]
+    # Each gap's line runs along the polyline: before corner 0, between corners, after the last.
+    heading = np.concatenate([corners[:1] - p0[:1], corners[1:] - corners[:-1], p1[-1:] - corners[-1:]])
+    heading /= norms(heading)[:, None]
+
+    def lines(batch: CornerBatch) -> tuple[NDArray, NDArray]:
+        """The signed length of every line (negative: the pairs overlap) and which are slivers."""
+        starts, ends = batch.control_points[:, 0, 0], batch.control_points[:, 1, 3]
+        step = np.concatenate([starts[:1] - pts[0], starts[1:] - ends[:-1], pts[-1:] - ends[-1:]])
+        signed = np.einsum("ij,ij->i", step, heading)
+        # Gaps the chain closes without a line (within its join tolerance) are no slivers.
+        beside = np.concatenate([batch.distance[:1], np.maximum(batch.distance[:-1], batch.distance[1:]), batch.distance[-1:]])
+        resolution = ROUNDING_ULPS * EPS * np.abs(pts).max()
+        closed = norms(step) <= np.maximum(tolerance * beside, resolution)
+        return signed, ~closed & (signed < min_edge)
+
+    gaps, sliver = lines(result)
+    if not sliver.any():
+        return result
+    bound, kmax = (None if options[name] is None else np.broadcast_to(np.asarray(options[name], dtype=float).ravel(), (n,))
+                   for name in ("max_deviation", "max_curvature"))  # fmt: skip
+    bounded = bound is not None
+    distance = result.distance.copy()
+    for g in np.flatnonzero(sliver).tolist():
+        pair = [j for j in (g - 1, g) if 0 <= j < n]  # the corners before and after gap g
+        if bounded:  # step back: each corner by its share of what the line lacks
+            for j in pair:
+                distance[j] = min(distance[j], result.distance[j] - 1.01 * (min_edge - gaps[g]) / len(pair))
+        elif kmax is not None and gaps[g] > 0.0:
+            for j in pair:  # grow to meet: the gap's share of each corner
+                distance[j] = max(distance[j], result.distance[j] + gaps[g] / len(pair))
+        else:
+            j = pair[0]
+            raise _refusal(
+                f"corner {index[j]}: the line it leaves {'after' if j < g else 'before'} it would be {gaps[g]:.3g} long, "
+                f"too short for a CAD edge ({min_edge:.3g} {units} at least); give max_deviation or max_curvature "
+                "so the corners may move, or move the point", int(index[j]))  # fmt: skip
+    changed = np.flatnonzero(distance != result.distance)
+    s, c = np.sin(result.theta[changed]), np.cos(result.theta[changed])
+    k = corner_scale(s, c, distance[changed], result.shape)
+    fixed = round_corners_batch(p0[changed], corners[changed], p1[changed], curvature=k, shape=result.shape, tolerance=tolerance)
+    for m, j in enumerate(changed.tolist()):
+        why = None
+        if not fixed.ok[m]:
+            why = fixed.reason(m, label=f"corner {index[j]}")
+        elif bounded and not fixed.deviation[m] <= bound[j]:
+            why = f"corner {index[j]}: closing a sliver line beside it would take it {fixed.deviation[m]:.6g} from the path"
+        elif kmax is not None and not fixed.curvature[m] <= kmax[j] * (1.0 + DEVIATION_MARGIN):
+            why = (f"corner {index[j]}: making the sliver line beside it a real edge needs curvature "
+                   f"{fixed.curvature[m]:.6g}, above max_curvature {kmax[j]:.6g}; allow a larger curvature or deviation")
+        if why is not None:
+            raise _refusal(why, int(index[j]))
+    arrays = {name: getattr(result, name).copy() for name in ("control_points", "distance", "curvature", "deviation")}
+    for name, array in arrays.items():
+        array[changed] = getattr(fixed, name)
+    mended = CornerBatch(result.shape, arrays["control_points"], result.theta, arrays["distance"], arrays["curvature"],
+                       result.available, result.status, result.corners, result.requested, result.residual,
+                       arrays["deviation"], result.max_deviation, result.max_curvature, result.spiral_length)  # fmt: skip
+    gaps, sliver = lines(mended)
+    if sliver.any():  # a corner moved into its other neighbour's way (or sits between two slivers)
+        g = int(np.argmax(sliver))
+        j = g - 1 if g > 0 else 0
+        raise _refusal(f"corner {index[j]}: the line it leaves {'after' if j < g else 'before'} it would be {gaps[g]:.3g} long, "
+                       f"too short for a CAD edge ({min_edge:.3g} {units} at least), and moving the corners beside it "
+                       "would break their bounds; move the point or change the bounds", int(index[j]))  # fmt: skip
+    return mended
 
 
 # ------------------------------------------------------------ fillets in space
