@@ -759,6 +759,8 @@ def round_corners(
 #: The shortest line left between rounded corners, in mm: ten times OCCT's Precision::Confusion
 #: (1e-7 mm), below which a line cannot become an edge of a wire.
 MIN_EDGE_MM = 1e-6
+#: ... and at most this share of the corner distance beside it (a path too small for CAD edges keeps its lines).
+SLIVER_SHARE = 1e-3
 
 
 def _refusal(message: str, corner: int, kind: type[ValueError] = NoSolutionError) -> ValueError:
@@ -803,7 +805,8 @@ def _without_slivers(result: CornerBatch, pts: NDArray, p0: NDArray, corners: ND
         beside = np.concatenate([batch.distance[:1], np.maximum(batch.distance[:-1], batch.distance[1:]), batch.distance[-1:]])
         resolution = ROUNDING_ULPS * EPS * np.abs(pts).max()
         closed = norms(step) <= np.maximum(tolerance * beside, resolution)
-        return signed, ~closed & (signed < min_edge)
+        # A path too small for CAD edges altogether keeps its lines: a sliver is small beside its corners too.
+        return signed, ~closed & (signed < np.minimum(min_edge, SLIVER_SHARE * beside))
 
     gaps, sliver = lines(result)
     if not sliver.any():
@@ -814,9 +817,10 @@ def _without_slivers(result: CornerBatch, pts: NDArray, p0: NDArray, corners: ND
     distance = result.distance.copy()
     for g in np.flatnonzero(sliver).tolist():
         pair = [j for j in (g - 1, g) if 0 <= j < n]  # the corners before and after gap g
+        edge = min(min_edge, SLIVER_SHARE * max(result.distance[j] for j in pair))
         if bounded:  # step back: each corner by its share of what the line lacks
             for j in pair:
-                distance[j] = min(distance[j], result.distance[j] - 1.01 * (min_edge - gaps[g]) / len(pair))
+                distance[j] = min(distance[j], result.distance[j] - 1.01 * (edge - gaps[g]) / len(pair))
         elif kmax is not None and gaps[g] > 0.0:
             for j in pair:  # grow to meet: the gap's share of each corner
                 distance[j] = max(distance[j], result.distance[j] + gaps[g] / len(pair))
