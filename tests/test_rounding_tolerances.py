@@ -243,3 +243,15 @@ def test_every_refusal_carries_its_corner():
     with pytest.raises(NoSolutionError) as info:
         round_corners(points, max_deviation=0.1)
     assert info.value.corner == 2
+
+
+def test_the_rounded_linearised_arc_is_a_valid_occt_wire_edge_for_segment():
+    """OCCT judges: every segment of the rounded path becomes an edge of a valid wire."""
+    pytest.importorskip("OCP")
+    from OCP.BRepCheck import BRepCheck_Analyzer
+
+    points = _linearised_arc(40, 25.4)
+    path = round_corners(points, max_deviation=_bound_reaching(points, 1.0 - 2e-8))
+    wire = path.chain.to_wire()
+    assert BRepCheck_Analyzer(wire.wrapped).IsValid()
+    assert len(wire.edges()) == len(path.chain)
