@@ -167,10 +167,17 @@ def test_a_near_reversal_says_what_would_help(bound):
     assert len(round_corners(flat, max_deviation=bound).corners) == 2
 
 
-def test_a_corner_limited_by_its_size_still_advises_a_larger_bound():
+def test_a_steep_corner_near_the_limit_rounds_at_a_micrometre():
     turn = math.radians(179.0)
     points = [[0.0, 0.0], [100.0, 0.0], [100.0 + 100.0 * math.cos(turn), 100.0 * math.sin(turn)]]
-    with pytest.raises(NoSolutionError, match="use a larger max_deviation"):
+    assert round_corners(points, max_deviation=1e-3).max_deviation <= 1e-3
+
+
+def test_a_corner_limited_by_its_size_advises_a_larger_bound_and_that_helps():
+    """1 µm at 1 km from the origin: float64 holds its spirals only to ~1e-7, and a larger bound helps."""
+    turn = math.radians(120.0)
+    points = [[1e6, 1e6], [1e6 + 100.0, 1e6], [1e6 + 100.0 + 100.0 * math.cos(turn), 1e6 + 100.0 * math.sin(turn)]]
+    with pytest.raises(NoSolutionError, match=r"^corner 1 at .*: the spiral pair would start .* holds only to .*; use a larger max_deviation$"):
         round_corners(points, max_deviation=1e-3)
     assert round_corners(points, max_deviation=0.1).max_deviation <= 0.1
 

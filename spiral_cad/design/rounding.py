@@ -474,6 +474,20 @@ def round_corners_batch(
     pairs = np.stack(result.spirals, axis=1)
     status = result.status.astype(np.int8)
     residual = np.where(status == Status.UNVERIFIED, result.measure, np.nan)
+    if dim == 2:
+        # The kernel verifies world control points to 1e-9 with no allowance for their rounding; a
+        # small pair far from the origin can miss that by its last bits alone. Such a pair is solved
+        # about its corner (where float64 holds it), placed by translation, and judged below as
+        # the chain judges it (``_joints_hold``: with the rounding floors of its stored points).
+        again = np.flatnonzero(status == Status.UNVERIFIED)
+        if len(again):
+            origin = corners[again]
+            local = batch.line_to_line(p0[again] - origin, np.zeros_like(origin), p1[again] - origin, k[again], shape=shape)
+            held = local.status == Status.OK
+            rows = again[held]
+            pairs[rows] = np.stack(local.spirals, axis=1)[held] + origin[held][:, None, None]
+            status[rows] = Status.OK
+            residual[rows] = np.nan
     ok = status == Status.OK
     # Failed rows report what they would need: the distance asked for and the
     # curvature that would exactly fit the available legs.
@@ -492,9 +506,9 @@ def round_corners_batch(
         residual[failed] = off[failed]
     else:
         deviation = norms(pairs[:, 0, 3] - corners)
-    joined = _joints_hold(pairs, p0, corners, p1, status == Status.OK, shape, tolerance)
+    joined, off = _joints_hold(pairs, p0, corners, p1, status == Status.OK, shape, tolerance)
     status[~joined] = Status.UNVERIFIED
-    residual[~joined] = np.inf
+    residual[~joined] = off[~joined]
     if values["max_deviation"] is not None:
         over = (status == Status.OK) & ~(deviation <= values["max_deviation"])
         status[over] = Status.UNVERIFIED
@@ -508,17 +522,18 @@ def round_corners_batch(
                        given["max_deviation"], given["max_curvature"], given["spiral_lengths"])  # fmt: skip
 
 
-def _joints_hold(pairs: NDArray, p0: NDArray, corners: NDArray, p1: NDArray, ok: NDArray, shape: str, tolerance: float) -> NDArray:
+def _joints_hold(pairs: NDArray, p0: NDArray, corners: NDArray, p1: NDArray, ok: NDArray, shape: str, tolerance: float) -> tuple[NDArray, NDArray]:
     """Whether each OK corner's three joints (line → spiral → spiral → line) pass the ``Chain``'s own
     joint test (``joint_table``), so that a corner the batch returns is one a chain accepts.
 
     The lines are taken as long as a polyline's segment can be around the corner (twice its
     leg): the longest line gives the strictest test, so no chain around the corner refuses it.
+    Returns whether each row holds and, for the rows judged, its largest relative mismatch.
     """
     held = np.ones(len(ok), dtype=bool)
     rows_ok = np.flatnonzero(ok)
     if not len(rows_ok):
-        return held
+        return held, np.full(len(ok), np.nan)
     cp = pairs[rows_ok]
     m, dim = len(rows_ok), cp.shape[-1]
     frames, floors, lengths = SegmentRows.spirals(cp.reshape(-1, 4, dim), shape).measure()
@@ -528,8 +543,10 @@ def _joints_hold(pairs: NDArray, p0: NDArray, corners: NDArray, p1: NDArray, ok:
     line_floors = np.zeros((2, m, 3))
     line_lengths = np.empty((2, m))
     for side, (leg_end, at) in enumerate(((p0[rows_ok], frames[:, 0, 0]), (p1[rows_ok], frames[:, 1, 1]))):
-        line_frames[side, :, :6] = at[:, :6]  # the line runs along the spiral's end tangent, κ = 0
-        line_lengths[side] = 2.0 * norms(corners[rows_ok] - leg_end)
+        leg = corners[rows_ok] - leg_end
+        line_lengths[side] = 2.0 * norms(leg)
+        line_frames[side, :, :3] = at[:, :3]  # the line meets the spiral, along its leg, κ = 0
+        line_frames[side, :, 3 : 3 + dim] = (leg if side == 0 else -leg) / (0.5 * line_lengths[side])[:, None]
         gap = 4.0 * EPS * np.abs(np.concatenate([corners[rows_ok], leg_end], axis=1)).max(axis=1)
         line_floors[side, :, 0], line_floors[side, :, 1] = gap, gap / line_lengths[side]
     ends = np.concatenate([line_frames[0], frames[:, 0, 1], frames[:, 1, 1]])
@@ -542,7 +559,11 @@ def _joints_hold(pairs: NDArray, p0: NDArray, corners: NDArray, p1: NDArray, ok:
         table, _ = joint_table(ends, end_floors, end_lengths, starts, start_floors, start_lengths, np.tile(own, 3),
                                join_tolerance(tolerance), ROUNDING_CAP)  # fmt: skip
     held[rows_ok] = ~(table[:, 5].reshape(3, m) != 0.0).any(axis=0)
-    return held
+    with np.errstate(invalid="ignore", divide="ignore"):
+        relative = np.maximum(np.maximum(table[:, 0] / table[:, 3], table[:, 1]), table[:, 2] / table[:, 4])
+    off = np.full(len(ok), np.nan)
+    off[rows_ok] = np.nan_to_num(relative.reshape(3, m), nan=np.inf).max(axis=0)
+    return held, off
 
 
 def _polyline(points: ArrayLike) -> NDArray:
