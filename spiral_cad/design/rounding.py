@@ -43,7 +43,7 @@ from ..core.errors import JointError, NoSolutionError, Status
 from ..core.factors import length_factor
 from ..core.rows import SegmentRows
 from ..core.shapes import CORNER_SHAPES, DEFAULT_SHAPE, SHAPE_CODES, shape_code
-from ..core.segments import Line, Segment, curvature_scales, joint_table
+from ..core.segments import Line, Segment, curvature_scales, joint_table, row_frames
 from ..core.space import PlaneFrame, corner_frames, norms, place, placed_pair_residuals
 from ..core.spiral import BezierSpiral
 from ..core.units import DEFAULT_UNITS, MM_PER_UNIT, length_unit
@@ -536,8 +536,15 @@ def _joints_hold(pairs: NDArray, p0: NDArray, corners: NDArray, p1: NDArray, ok:
         return held, np.full(len(ok), np.nan)
     cp = pairs[rows_ok]
     m, dim = len(rows_ok), cp.shape[-1]
-    frames, floors, lengths = SegmentRows.spirals(cp.reshape(-1, 4, dim), shape).measure()
-    frames, floors, lengths = frames.reshape(m, 2, 2, 9), floors.reshape(m, 2, 2, 3), lengths.reshape(m, 2)
+    rows = SegmentRows.spirals(cp.reshape(-1, 4, dim), shape)
+    frames, floors, _ = row_frames(rows.kind, rows.geometry, rows.params, dim)
+    frames, floors = frames.reshape(m, 2, 2, 9), floors.reshape(m, 2, 2, 3)
+    # Bounds of each spiral's length instead of its quadrature (the chain's): the chord below, the
+    # control polygon above; the joint between the two spirals is judged with the shorter taken
+    # as the chord and the longer as the polygon, so it is never judged more leniently than the chain judges it.
+    chord = norms(cp[:, :, 3] - cp[:, :, 0])
+    polygon = norms(np.diff(cp, axis=2)).sum(axis=2)
+    lengths = np.stack([chord[:, 0], polygon[:, 1]], axis=1)
     own = curvature_scales(frames.reshape(-1, 2, 9)).reshape(m, 2).max(axis=1)
     line_frames = np.zeros((2, m, 9))
     line_floors = np.zeros((2, m, 3))
