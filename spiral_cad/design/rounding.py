@@ -35,6 +35,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from ..core import _chain_kernels as CK
 from ..core import _kernels as K
 from ..core import batch
 from ..core._inputs import as_float, as_real_array
@@ -43,7 +44,7 @@ from ..core.errors import JointError, NoSolutionError, Status
 from ..core.factors import length_factor
 from ..core.rows import SegmentRows
 from ..core.shapes import CORNER_SHAPES, DEFAULT_SHAPE, SHAPE_CODES, shape_code
-from ..core.segments import Line, Segment, curvature_scales, joint_table, row_frames
+from ..core.segments import Line, Segment
 from ..core.space import PlaneFrame, corner_frames, norms, place, placed_pair_residuals
 from ..core.spiral import BezierSpiral
 from ..core.units import DEFAULT_UNITS, MM_PER_UNIT, length_unit
@@ -522,54 +523,96 @@ def round_corners_batch(
                        given["max_deviation"], given["max_curvature"], given["spiral_lengths"])  # fmt: skip
 
 
+@K.jit
+def _pair_joints(cp, ok, t_in, t_out, line_in, line_out, tolerance, cap, held, off):  # pragma: no cover - compiled
+    """``_joints_hold`` per row: the spirals' end frames and floors (``_chain_kernels._spiral``), the
+    legs' lines, and the three joints judged by ``_chain_kernels.joint_measures``."""
+    dim = cp.shape[3]
+    g = np.zeros((4, 3))
+    frames = np.zeros((2, 2, 9))
+    floors = np.zeros((2, 2, 3))
+    ends, starts = np.zeros((3, 9)), np.zeros((3, 9))
+    end_floors, start_floors = np.zeros((3, 3)), np.zeros((3, 3))
+    end_lengths, start_lengths = np.zeros(3), np.zeros(3)
+    own = np.zeros(3)
+    out = np.zeros((3, 6))
+    chord, polygon = np.zeros(2), np.zeros(2)
+    for i in range(cp.shape[0]):
+        if not ok[i]:
+            continue
+        polygon[0] = polygon[1] = 0.0
+        big = 0.0
+        for s in range(2):
+            for r in range(4):
+                for j in range(dim):
+                    g[r, j] = cp[i, s, r, j]
+                    big = max(big, abs(g[r, j]))
+            CK._spiral(g, frames[s], floors[s])
+            # hypot: lengths of any magnitude, no square under- or overflows.
+            chord[s] = math.hypot(math.hypot(g[3, 0] - g[0, 0], g[3, 1] - g[0, 1]), g[3, 2] - g[0, 2])
+            for r in range(3):
+                polygon[s] += math.hypot(math.hypot(g[r + 1, 0] - g[r, 0], g[r + 1, 1] - g[r, 1]), g[r + 1, 2] - g[r, 2])
+        peak = 0.0
+        for s in range(2):
+            for e in range(2):
+                peak = max(peak, CK.norm3(frames[s, e, 6], frames[s, e, 7], frames[s, e, 8]))
+        gap = 4.0 * EPS * big
+        for k in range(3):
+            own[k] = peak
+            for j in range(9):
+                ends[k, j] = 0.0
+                starts[k, j] = 0.0
+            for j in range(3):
+                end_floors[k, j] = 0.0
+                start_floors[k, j] = 0.0
+        # line in → spiral 0; spiral 0 → spiral 1 (chord below, polygon above the quadrature); spiral 1 → line out.
+        for j in range(3):
+            ends[0, j] = frames[0, 0, j]
+            starts[2, j] = frames[1, 1, j]
+        for j in range(dim):
+            ends[0, 3 + j] = t_in[i, j]
+            starts[2, 3 + j] = t_out[i, j]
+        end_floors[0, 0], end_floors[0, 1] = gap, gap / line_in[i]
+        start_floors[2, 0], start_floors[2, 1] = gap, gap / line_out[i]
+        end_lengths[0], start_lengths[2] = line_in[i], line_out[i]
+        for j in range(9):
+            starts[0, j] = frames[0, 0, j]
+            ends[1, j] = frames[0, 1, j]
+            starts[1, j] = frames[1, 0, j]
+            ends[2, j] = frames[1, 1, j]
+        for j in range(3):
+            start_floors[0, j] = floors[0, 0, j]
+            end_floors[1, j] = floors[0, 1, j]
+            start_floors[1, j] = floors[1, 0, j]
+            end_floors[2, j] = floors[1, 1, j]
+        start_lengths[0], end_lengths[1], start_lengths[1], end_lengths[2] = chord[0], chord[0], polygon[1], polygon[1]
+        first = CK.joint_measures(ends, end_floors, end_lengths, starts, start_floors, start_lengths, own, tolerance, cap, out)
+        held[i] = first < 0
+        worst = 0.0
+        for k in range(3):
+            worst = max(worst, out[k, 0] / out[k, 3], out[k, 1], out[k, 2] / out[k, 4])
+        off[i] = worst if worst == worst else math.inf
+
+
 def _joints_hold(pairs: NDArray, p0: NDArray, corners: NDArray, p1: NDArray, ok: NDArray, shape: str, tolerance: float) -> tuple[NDArray, NDArray]:
     """Whether each OK corner's three joints (line → spiral → spiral → line) pass the ``Chain``'s own
-    joint test (``joint_table``), so that a corner the batch returns is one a chain accepts.
+    joint test (``joint_table``'s kernel), so that a corner the batch returns is one a chain accepts.
 
-    The lines are taken as long as a polyline's segment can be around the corner (twice its
-    leg): the longest line gives the strictest test, so no chain around the corner refuses it.
-    Returns whether each row holds and, for the rows judged, its largest relative mismatch.
+    The lines run along the legs and are taken as long as a polyline's segment can be around the
+    corner (twice its leg); each spiral's length is bounded by its chord (below) and control polygon
+    (above) instead of its quadrature, the shorter taken below and the longer above: the test is
+    never more lenient than the chain's. Returns whether each row holds and, for the rows judged,
+    its largest relative mismatch (NaN elsewhere).
     """
-    held = np.ones(len(ok), dtype=bool)
-    rows_ok = np.flatnonzero(ok)
-    if not len(rows_ok):
-        return held, np.full(len(ok), np.nan)
-    cp = pairs[rows_ok]
-    m, dim = len(rows_ok), cp.shape[-1]
-    rows = SegmentRows.spirals(cp.reshape(-1, 4, dim), shape)
-    frames, floors, _ = row_frames(rows.kind, rows.geometry, rows.params, dim)
-    frames, floors = frames.reshape(m, 2, 2, 9), floors.reshape(m, 2, 2, 3)
-    # Bounds of each spiral's length instead of its quadrature (the chain's): the chord below, the
-    # control polygon above; the joint between the two spirals is judged with the shorter taken
-    # as the chord and the longer as the polygon, so it is never judged more leniently than the chain judges it.
-    chord = norms(cp[:, :, 3] - cp[:, :, 0])
-    polygon = norms(np.diff(cp, axis=2)).sum(axis=2)
-    lengths = np.stack([chord[:, 0], polygon[:, 1]], axis=1)
-    own = curvature_scales(frames.reshape(-1, 2, 9)).reshape(m, 2).max(axis=1)
-    line_frames = np.zeros((2, m, 9))
-    line_floors = np.zeros((2, m, 3))
-    line_lengths = np.empty((2, m))
-    for side, (leg_end, at) in enumerate(((p0[rows_ok], frames[:, 0, 0]), (p1[rows_ok], frames[:, 1, 1]))):
-        leg = corners[rows_ok] - leg_end
-        line_lengths[side] = 2.0 * norms(leg)
-        line_frames[side, :, :3] = at[:, :3]  # the line meets the spiral, along its leg, κ = 0
-        line_frames[side, :, 3 : 3 + dim] = (leg if side == 0 else -leg) / (0.5 * line_lengths[side])[:, None]
-        gap = 4.0 * EPS * np.abs(np.concatenate([corners[rows_ok], leg_end], axis=1)).max(axis=1)
-        line_floors[side, :, 0], line_floors[side, :, 1] = gap, gap / line_lengths[side]
-    ends = np.concatenate([line_frames[0], frames[:, 0, 1], frames[:, 1, 1]])
-    end_floors = np.concatenate([line_floors[0], floors[:, 0, 1], floors[:, 1, 1]])
-    end_lengths = np.concatenate([line_lengths[0], lengths[:, 0], lengths[:, 1]])
-    starts = np.concatenate([frames[:, 0, 0], frames[:, 1, 0], line_frames[1]])
-    start_floors = np.concatenate([floors[:, 0, 0], floors[:, 1, 0], line_floors[1]])
-    start_lengths = np.concatenate([lengths[:, 0], lengths[:, 1], line_lengths[1]])
-    with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
-        table, _ = joint_table(ends, end_floors, end_lengths, starts, start_floors, start_lengths, np.tile(own, 3),
-                               join_tolerance(tolerance), ROUNDING_CAP)  # fmt: skip
-    held[rows_ok] = ~(table[:, 5].reshape(3, m) != 0.0).any(axis=0)
-    with np.errstate(invalid="ignore", divide="ignore"):
-        relative = np.maximum(np.maximum(table[:, 0] / table[:, 3], table[:, 1]), table[:, 2] / table[:, 4])
+    del shape  # the frames come from the control points alone
+    held = np.ones(len(ok), dtype=np.bool_)
     off = np.full(len(ok), np.nan)
-    off[rows_ok] = np.nan_to_num(relative.reshape(3, m), nan=np.inf).max(axis=0)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        leg_in, leg_out = corners - p0, p1 - corners
+        len_in, len_out = norms(leg_in), norms(leg_out)
+        t_in, t_out = leg_in / len_in[:, None], leg_out / len_out[:, None]
+    _pair_joints(np.ascontiguousarray(pairs), np.ascontiguousarray(ok, dtype=np.bool_), np.ascontiguousarray(t_in), np.ascontiguousarray(t_out), 2.0 * len_in,
+                 2.0 * len_out, join_tolerance(tolerance), ROUNDING_CAP, held, off)  # fmt: skip
     return held, off
 
 
