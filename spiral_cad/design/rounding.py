@@ -134,7 +134,8 @@ def straight_points(before: NDArray, corner: NDArray, after: NDArray) -> tuple[N
     with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
         sin_t = _sin_turn(vin / lin[:, None], vout / lout[:, None])
         chord = norms(after - before)
-        resolution = ROUNDING_ULPS * EPS * np.maximum(np.abs(np.stack([before, corner, after])).max(axis=(0, 2)), 1e-300)
+        size = np.maximum(np.maximum(np.abs(before).max(axis=1), np.abs(corner).max(axis=1)), np.abs(after).max(axis=1))
+        resolution = ROUNDING_ULPS * EPS * size
         ahead = np.einsum("ij,ij->i", vin, vout) > 0.0
         # The corner's distance from the chord (the path's deviation if it were dropped).
         straight = ahead & (lin * (lout / chord) * sin_t <= resolution)
