@@ -114,7 +114,7 @@ def test_a_router_bed_rounds_at_a_hundredth():
 BUILT = {"count": 0}
 
 
-@settings(max_examples=60, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@settings(max_examples=100, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @given(
     size=st.sampled_from([1.0, 1e2, 1e4, 1e6]),
     bound=st.sampled_from([1e-3, 1e-2, 1e-1, 1.0]),
