@@ -154,14 +154,16 @@ def _capped(floor, cap):
 
 
 @jit
-def joint_measures(end, floor_end, length_a, start, floor_start, length_b, tolerance, cap, out):
+def joint_measures(end, floor_end, length_a, start, floor_start, length_b, own, tolerance, cap, out):
     """Measure and judge m joints: from frames ``end`` (m, 9) of the segments before to ``start``
     (m, 9) of the segments after, with their rounding floors (m, 3) and lengths (m,).
 
+    ``own`` (m,) is the joint's own curvature scale: the largest |κ| either
+    segment reaches at any of its ends (0 between lines; a spiral's peak).
     ``out`` (m, 6) receives gap, tangent angle, curvature jump |Δω|, the shorter
-    length, the curvature scale max(|κ_a|, |κ_b|, 1/L_long) and 1.0 where the
-    joint fails (``spiral_cad.core.chain.Chain`` states the rule). Returns the
-    index of the first failing joint, or -1.
+    length, the curvature scale max(|κ_a|, |κ_b|, own, 1/L_long) and 1.0 where
+    the joint fails (``spiral_cad.core.chain.Chain`` states the rule). Returns
+    the index of the first failing joint, or -1.
     """
     first = -1
     for i in range(len(out)):
@@ -173,10 +175,13 @@ def joint_measures(end, floor_end, length_a, start, floor_start, length_b, toler
         jump = norm3(b[6] - a[6], b[7] - a[7], b[8] - a[8])
         la, lb = length_a[i], length_b[i]
         short, long = min(la, lb), max(la, lb)
-        kappa = max(norm3(a[6], a[7], a[8]), norm3(b[6], b[7], b[8]), 1.0 / long)
+        at_joint = max(norm3(a[6], a[7], a[8]), norm3(b[6], b[7], b[8]), 1.0 / long)
+        kappa = max(at_joint, own[i])
         g_floor = _capped(floor_end[i, 0] + floor_start[i, 0], cap * short)
         a_floor = _capped(floor_end[i, 1] + floor_start[i, 1], cap)
-        k_floor = _capped(floor_end[i, 2] + floor_start[i, 2], cap * kappa)
+        # The rounding allowance stays capped on the joint's curvatures: a spiral's peak widens
+        # the tolerance, never what its rounding may hide.
+        k_floor = _capped(floor_end[i, 2] + floor_start[i, 2], cap * at_joint)
         bad = gap > tolerance * short + g_floor or angle > tolerance + a_floor or jump > tolerance * kappa + k_floor
         out[i, 0], out[i, 1], out[i, 2], out[i, 3], out[i, 4] = gap, angle, jump, short, kappa
         out[i, 5] = 1.0 if bad else 0.0

@@ -20,7 +20,7 @@ from ._chain_kernels import ARC, LINE, SPIRAL
 from ._inputs import as_float, as_point, as_real_array
 from .errors import JointError
 from .rows import SegmentRows
-from .segments import _XY_BASIS, Arc, Join, Line, Segment, joint_table, lifted
+from .segments import _XY_BASIS, Arc, Join, Line, Segment, curvature_scales, joint_table, lifted
 from .space import PlaneFrame
 from .spiral import BezierSpiral
 from .transitions import Transition
@@ -54,8 +54,9 @@ def g2_mismatch(a: Segment, b: Segment, tolerance: float, units: str = "", index
     if a.dim != b.dim:
         a, b = (s if s.dim == 3 else s.placed(PlaneFrame()) for s in (a, b))
     (frames_a, floors_a), (frames_b, floors_b) = a._ends, b._ends
+    own = curvature_scales(np.stack([frames_a, frames_b])).max()
     out, first = joint_table(frames_a[1:], floors_a[1:], np.array([a.length]), frames_b[:1], floors_b[:1],
-                             np.array([b.length]), tolerance, ROUNDING_CAP)  # fmt: skip
+                             np.array([b.length]), own, tolerance, ROUNDING_CAP)  # fmt: skip
     return None if first < 0 else _problem(index, out[0], tolerance, units)
 
 
@@ -96,8 +97,12 @@ class Chain:
 
     * gap ≤ tol · L_short,
     * tangent angle ≤ tol (radians),
-    * |Δκ| ≤ tol · max(|κ_before|, |κ_after|, 1/L_long),
+    * |Δκ| ≤ tol · max(|κ_before|, |κ_after|, κ_own, 1/L_long),
 
+    κ_own being the largest |κ| either segment reaches at its ends (a spiral's
+    peak): a spiral leaving a long line is judged on its own curvature, not on
+    the line's length, so float64 residue of its start curvature (~1e-12 of its
+    peak) never fails a joint that the spiral's construction holds.
     where tol is ``tolerance`` (default 1e-9). Each bound is widened by what
     float64 rounding of the stored coordinates can hide at that joint
     (``Segment.rounding_floor``), so survey coordinates (~1e6) and tiny
@@ -166,8 +171,9 @@ class Chain:
         if not math.isfinite(self.size):
             raise ValueError("Chain extent overflows float64")
         f, lengths = self._frames, self._lengths
+        own = curvature_scales(f)
         self._joints, first = joint_table(f[:-1, 1], floors[:-1, 1], lengths[:-1], f[1:, 0], floors[1:, 0], lengths[1:],
-                                          tolerance, ROUNDING_CAP)  # fmt: skip
+                                          np.maximum(own[:-1], own[1:]), tolerance, ROUNDING_CAP)  # fmt: skip
         if first >= 0:
             raise JointError(f"Chain is not G2 at {_problem(first, self._joints[first], tolerance, units)}", first)
 

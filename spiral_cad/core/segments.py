@@ -514,14 +514,22 @@ class Join:
     curvature_jump: float
 
 
+def curvature_scales(frames: NDArray) -> NDArray:
+    """Each segment's own curvature scale from its end frames (n, 2, 9): the larger |κ| of its two ends
+    (0 for a line, 1/r for an arc, the peak of a monotone-curvature spiral)."""
+    return np.sqrt(np.max(np.einsum("nej,nej->ne", frames[:, :, 6:9], frames[:, :, 6:9]), axis=1))
+
+
 def joint_table(
     end: NDArray, end_floor: NDArray, end_length: NDArray, start: NDArray, start_floor: NDArray, start_length: NDArray,
-    tolerance: float, cap: float,
+    own: NDArray, tolerance: float, cap: float,
 ) -> tuple[NDArray, int]:  # fmt: skip
     """Measure and judge m joints in one pass (``_chain_kernels.joint_measures``): (m, 6) rows of gap,
-    angle, curvature jump, shorter length, curvature scale and failure flag, and the first failing joint (-1: none)."""
+    angle, curvature jump, shorter length, curvature scale and failure flag, and the first failing joint (-1: none).
+    ``own`` (m,): the larger ``curvature_scales`` of each joint's two segments."""
     out = np.empty((len(end), 6))
-    first = CK.joint_measures(end, end_floor, end_length, start, start_floor, start_length, tolerance, cap, out)
+    own = np.ascontiguousarray(np.broadcast_to(np.asarray(own, dtype=float), (len(end),)))
+    first = CK.joint_measures(end, end_floor, end_length, start, start_floor, start_length, own, tolerance, cap, out)
     return out, int(first)
 
 
@@ -531,6 +539,6 @@ def measure_join(a: Segment, b: Segment, index: int = 0) -> Join:
         a, b = (s if s.dim == 3 else s.placed(PlaneFrame()) for s in (a, b))
     (frames_a, floors_a), (frames_b, floors_b) = a._ends, b._ends
     one = np.ones(1)
-    out, _ = joint_table(frames_a[1:], floors_a[1:], one, frames_b[:1], floors_b[:1], one, 1.0, 0.0)
+    out, _ = joint_table(frames_a[1:], floors_a[1:], one, frames_b[:1], floors_b[:1], one, 0.0, 1.0, 0.0)
     gap, angle, jump = out[0, :3].tolist()
     return Join(index, gap, angle, jump)

@@ -35,10 +35,11 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from ..core import _chain_kernels as CK
 from ..core import _kernels as K
 from ..core import batch
 from ..core._inputs import as_float, as_real_array
-from ..core.chain import JOIN_TOLERANCE, Chain, PartCircles, join_rows, join_tolerance
+from ..core.chain import JOIN_TOLERANCE, ROUNDING_CAP, Chain, PartCircles, join_rows, join_tolerance
 from ..core.errors import JointError, NoSolutionError, Status
 from ..core.factors import length_factor
 from ..core.rows import SegmentRows
@@ -46,7 +47,7 @@ from ..core.segments import Line, Segment
 from ..core.shapes import CORNER_SHAPES, DEFAULT_SHAPE, SHAPE_CODES, shape_code
 from ..core.space import PlaneFrame, corner_frames, norms, place, placed_pair_residuals
 from ..core.spiral import BezierSpiral
-from ..core.units import DEFAULT_UNITS, length_unit
+from ..core.units import DEFAULT_UNITS, MM_PER_UNIT, length_unit
 from .fillets import FilletCorner, _vertex_indices, fillet_path, first_broken_corner
 
 #: Yang & Sukkarieh's leg ratio g/h: the smallest that keeps κ monotone.
@@ -58,7 +59,8 @@ G2CBS_C3 = (G2CBS_C2 + 4.0) / (G2CBS_C1 + 6.0)
 #: κmax = c4 sin β / (d cos² β): the G2CBS corner factor K(β) = c4·sin β/cos² β.
 G2CBS_C4 = (G2CBS_C2 + 4.0) ** 2 / (54.0 * G2CBS_C3)
 
-#: Relative |sin| below which three points count as collinear (passed through).
+#: Relative |sin| below which two unit directions count as parallel; kept for callers. Points
+#: of a polyline are judged by their distance instead (``straight_points``), never by angle alone.
 COLLINEAR_TOL = 1e-12
 #: A ``max_deviation`` pair is aimed this much (relative) inside its bound, and
 #: further by the rounding of the corner's coordinates (``ROUNDING_ULPS`` ulp of
@@ -116,6 +118,29 @@ def _sin_turn(u: NDArray, v: NDArray) -> NDArray:
     if u.shape[-1] == 2:
         return np.abs(u[:, 0] * v[:, 1] - u[:, 1] * v[:, 0])
     return norms(np.cross(u, v))
+
+
+def straight_points(before: NDArray, corner: NDArray, after: NDArray) -> tuple[NDArray, NDArray]:
+    """Which corners (N, d) are no corners: ``(straight, folds)``, each (N,) bool.
+
+    A corner is straight when it lies within what float64 resolves at its coordinates
+    (``ROUNDING_ULPS`` ulp of the largest) of the chord ``before`` → ``after``: dropping it
+    moves the path by no more than rounding. The turn's angle alone never decides: a point
+    0.4 off a line between points 1e12 apart turns by 1e-12 rad but is a real corner.
+    It folds when the path turns back and the shorter leg lies that close to the other's line.
+    """
+    vin, vout = corner - before, after - corner
+    lin, lout = norms(vin), norms(vout)
+    with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
+        sin_t = _sin_turn(vin / lin[:, None], vout / lout[:, None])
+        chord = norms(after - before)
+        size = np.maximum(np.maximum(np.abs(before).max(axis=1), np.abs(corner).max(axis=1)), np.abs(after).max(axis=1))
+        resolution = ROUNDING_ULPS * EPS * size
+        ahead = np.einsum("ij,ij->i", vin, vout) > 0.0
+        # The corner's distance from the chord (the path's deviation if it were dropped).
+        straight = ahead & (lin * (lout / chord) * sin_t <= resolution)
+        folds = ~ahead & (np.minimum(lin, lout) * sin_t <= resolution)
+    return straight, folds
 
 
 def _coordinates(value: ArrayLike, name: str) -> NDArray:
@@ -209,6 +234,16 @@ class CornerBatch:
             return f"{where}: a leg has zero length"
         if status is Status.UNVERIFIED:
             bound = self.max_deviation[i]
+            steepest = _steepest_deflection(self.shape) if self.theta[i] == self.theta[i] else math.nan
+            if 2.0 * self.theta[i] > steepest:
+                # Scale-free: the same turn fails with unit legs at the origin, so no size or tolerance helps.
+                return (
+                    f"{where}: deflection {2 * math.degrees(self.theta[i]):.6g}° is too close to a reversal for a "
+                    f"{self.shape} spiral pair: its peak curvature is {float(corner_scale(math.sin(self.theta[i]), math.cos(self.theta[i]), 1.0, self.shape)):.3g} "
+                    f"/ d (d its distance from the corner), beyond what float64 holds to 1e-9 at any size or max_deviation "
+                    f"(at most {math.degrees(steepest):.6g}° holds); replace the corner by two corners that each turn "
+                    "about half as much (e.g. a short flat across its tip), each rounded by its own pair"
+                )
             if bound == bound and not self.residual[i] < math.inf:
                 return (
                     f"{where}: max_deviation {bound:.6g} is below what float64 resolves at these coordinates "
@@ -253,6 +288,29 @@ class CornerBatch:
             f"curvature {self.requested[i]:.6g} needs the spirals to start {self.distance[i]:.6g} from the corner "
             f"but {available}; {largest}"
         )
+
+
+_STEEPEST: dict[str, float] = {}
+
+
+def _steepest_deflection(shape: str) -> float:
+    """The largest deflection (radians) whose ``shape`` spiral pair float64 holds (to
+    ``VERIFY_TOL``) for a corner with unit legs at the origin: beyond it a corner is too
+    close to a reversal at any size. Bisected once per shape on the plane kernel."""
+    if shape not in _STEEPEST:
+        def holds(deflection: float) -> bool:
+            end = (math.cos(deflection), math.sin(deflection))
+            return bool(batch.line_to_line([(-1.0, 0.0)], [(0.0, 0.0)], [end], shape=shape).status[0] == Status.OK)
+
+        lo, hi = math.radians(90.0), math.pi
+        if not holds(lo):
+            _STEEPEST[shape] = math.nan
+            return math.nan
+        for _ in range(60):
+            mid = 0.5 * (lo + hi)
+            lo, hi = (mid, hi) if holds(mid) else (lo, mid)
+        _STEEPEST[shape] = lo
+    return _STEEPEST[shape]
 
 
 def _half_deflection(p0: NDArray, corners: NDArray, p1: NDArray):
@@ -340,6 +398,7 @@ def round_corners_batch(
     spiral_lengths: ArrayLike | None = None,
     shape: str = DEFAULT_SHAPE,
     method: str | None = None,
+    tolerance: float = JOIN_TOLERANCE,
 ) -> CornerBatch:
     """Round N independent corners ``p0 → corner → p1`` with spiral pairs, in the plane or in space.
 
@@ -367,6 +426,9 @@ def round_corners_batch(
         shape: ``"walton-meek"`` (Theorem 4.4), ``"near-linear"`` or
             ``"g2cbs"`` (Yang & Sukkarieh).
         method: the former name of ``shape``.
+        tolerance: the relative join tolerance of the chains the corners will be
+            part of: each corner's joints must pass ``Chain``'s joint test with it
+            (else ``UNVERIFIED``), so ``round_corners`` refuses exactly what this refuses.
 
     With none of curvature, spiral_lengths or max_* given, each corner uses
     all of its shorter leg (Corollary 4.5: the lowest curvature that fits).
@@ -414,6 +476,20 @@ def round_corners_batch(
     pairs = np.stack(result.spirals, axis=1)
     status = result.status.astype(np.int8)
     residual = np.where(status == Status.UNVERIFIED, result.measure, np.nan)
+    if dim == 2:
+        # The kernel verifies world control points to 1e-9 with no allowance for their rounding; a
+        # small pair far from the origin can miss that by its last bits alone. Such a pair is solved
+        # about its corner (where float64 holds it), placed by translation, and judged below as
+        # the chain judges it (``_joints_hold``: with the rounding floors of its stored points).
+        again = np.flatnonzero(status == Status.UNVERIFIED)
+        if len(again):
+            origin = corners[again]
+            local = batch.line_to_line(p0[again] - origin, np.zeros_like(origin), p1[again] - origin, k[again], shape=shape)
+            held = local.status == Status.OK
+            rows = again[held]
+            pairs[rows] = np.stack(local.spirals, axis=1)[held] + origin[held][:, None, None]
+            status[rows] = Status.OK
+            residual[rows] = np.nan
     ok = status == Status.OK
     # Failed rows report what they would need: the distance asked for and the
     # curvature that would exactly fit the available legs.
@@ -432,6 +508,9 @@ def round_corners_batch(
         residual[failed] = off[failed]
     else:
         deviation = norms(pairs[:, 0, 3] - corners)
+    joined, off = _joints_hold(pairs, p0, corners, p1, status == Status.OK, shape, tolerance)
+    status[~joined] = Status.UNVERIFIED
+    residual[~joined] = off[~joined]
     if values["max_deviation"] is not None:
         over = (status == Status.OK) & ~(deviation <= values["max_deviation"])
         status[over] = Status.UNVERIFIED
@@ -443,6 +522,99 @@ def round_corners_batch(
     given = {name: unset if v is None else v for name, v in values.items()}
     return CornerBatch(shape, pairs, theta, distance, peak, available, status, corners, k, residual, deviation,
                        given["max_deviation"], given["max_curvature"], given["spiral_lengths"])  # fmt: skip
+
+
+@K.jit
+def _pair_joints(cp, ok, t_in, t_out, line_in, line_out, tolerance, cap, held, off):  # pragma: no cover - compiled
+    """``_joints_hold`` per row: the spirals' end frames and floors (``_chain_kernels._spiral``), the
+    legs' lines, and the three joints judged by ``_chain_kernels.joint_measures``."""
+    dim = cp.shape[3]
+    g = np.zeros((4, 3))
+    frames = np.zeros((2, 2, 9))
+    floors = np.zeros((2, 2, 3))
+    ends, starts = np.zeros((3, 9)), np.zeros((3, 9))
+    end_floors, start_floors = np.zeros((3, 3)), np.zeros((3, 3))
+    end_lengths, start_lengths = np.zeros(3), np.zeros(3)
+    own = np.zeros(3)
+    out = np.zeros((3, 6))
+    chord, polygon = np.zeros(2), np.zeros(2)
+    for i in range(cp.shape[0]):
+        if not ok[i]:
+            continue
+        polygon[0] = polygon[1] = 0.0
+        big = 0.0
+        for s in range(2):
+            for r in range(4):
+                for j in range(dim):
+                    g[r, j] = cp[i, s, r, j]
+                    big = max(big, abs(g[r, j]))
+            CK._spiral(g, frames[s], floors[s])
+            # hypot: lengths of any magnitude, no square under- or overflows.
+            chord[s] = math.hypot(math.hypot(g[3, 0] - g[0, 0], g[3, 1] - g[0, 1]), g[3, 2] - g[0, 2])
+            for r in range(3):
+                polygon[s] += math.hypot(math.hypot(g[r + 1, 0] - g[r, 0], g[r + 1, 1] - g[r, 1]), g[r + 1, 2] - g[r, 2])
+        peak = 0.0
+        for s in range(2):
+            for e in range(2):
+                peak = max(peak, CK.norm3(frames[s, e, 6], frames[s, e, 7], frames[s, e, 8]))
+        gap = 4.0 * EPS * big
+        for k in range(3):
+            own[k] = peak
+            for j in range(9):
+                ends[k, j] = 0.0
+                starts[k, j] = 0.0
+            for j in range(3):
+                end_floors[k, j] = 0.0
+                start_floors[k, j] = 0.0
+        # line in → spiral 0; spiral 0 → spiral 1 (chord below, polygon above the quadrature); spiral 1 → line out.
+        for j in range(3):
+            ends[0, j] = frames[0, 0, j]
+            starts[2, j] = frames[1, 1, j]
+        for j in range(dim):
+            ends[0, 3 + j] = t_in[i, j]
+            starts[2, 3 + j] = t_out[i, j]
+        end_floors[0, 0], end_floors[0, 1] = gap, gap / line_in[i]
+        start_floors[2, 0], start_floors[2, 1] = gap, gap / line_out[i]
+        end_lengths[0], start_lengths[2] = line_in[i], line_out[i]
+        for j in range(9):
+            starts[0, j] = frames[0, 0, j]
+            ends[1, j] = frames[0, 1, j]
+            starts[1, j] = frames[1, 0, j]
+            ends[2, j] = frames[1, 1, j]
+        for j in range(3):
+            start_floors[0, j] = floors[0, 0, j]
+            end_floors[1, j] = floors[0, 1, j]
+            start_floors[1, j] = floors[1, 0, j]
+            end_floors[2, j] = floors[1, 1, j]
+        start_lengths[0], end_lengths[1], start_lengths[1], end_lengths[2] = chord[0], chord[0], polygon[1], polygon[1]
+        first = CK.joint_measures(ends, end_floors, end_lengths, starts, start_floors, start_lengths, own, tolerance, cap, out)
+        held[i] = first < 0
+        worst = 0.0
+        for k in range(3):
+            worst = max(worst, out[k, 0] / out[k, 3], out[k, 1], out[k, 2] / out[k, 4])
+        off[i] = worst if worst == worst else math.inf
+
+
+def _joints_hold(pairs: NDArray, p0: NDArray, corners: NDArray, p1: NDArray, ok: NDArray, shape: str, tolerance: float) -> tuple[NDArray, NDArray]:
+    """Whether each OK corner's three joints (line → spiral → spiral → line) pass the ``Chain``'s own
+    joint test (``joint_table``'s kernel), so that a corner the batch returns is one a chain accepts.
+
+    The lines run along the legs and are taken as long as a polyline's segment can be around the
+    corner (twice its leg); each spiral's length is bounded by its chord (below) and control polygon
+    (above) instead of its quadrature, the shorter taken below and the longer above: the test is
+    never more lenient than the chain's. Returns whether each row holds and, for the rows judged,
+    its largest relative mismatch (NaN elsewhere).
+    """
+    del shape  # the frames come from the control points alone
+    held = np.ones(len(ok), dtype=np.bool_)
+    off = np.full(len(ok), np.nan)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        leg_in, leg_out = corners - p0, p1 - corners
+        len_in, len_out = norms(leg_in), norms(leg_out)
+        t_in, t_out = leg_in / len_in[:, None], leg_out / len_out[:, None]
+    _pair_joints(np.ascontiguousarray(pairs), np.ascontiguousarray(ok, dtype=np.bool_), np.ascontiguousarray(t_in), np.ascontiguousarray(t_out), 2.0 * len_in,
+                 2.0 * len_out, join_tolerance(tolerance), ROUNDING_CAP, held, off)  # fmt: skip
+    return held, off
 
 
 def _polyline(points: ArrayLike) -> NDArray:
@@ -458,8 +630,9 @@ def corner_legs(points: ArrayLike) -> tuple[NDArray, NDArray, NDArray, NDArray]:
 
     Interior segments are shared half-and-half between their two corners; the
     first and last segments belong wholly to their one corner, so spirals of
-    neighbouring corners never overlap. Collinear interior points (forward,
-    |sin| of the turn ≤ 1e-12) are dropped: they need no rounding.
+    neighbouring corners never overlap. Collinear interior points (forward, within
+    float64's resolution of the chord of their neighbours: ``straight_points``)
+    are dropped: they need no rounding.
 
     Returns:
         ``(p0, corners, p1, index)``: (M, d) leg ends and corners, and the
@@ -482,10 +655,7 @@ def corner_legs(points: ArrayLike) -> tuple[NDArray, NDArray, NDArray, NDArray]:
     if not np.isfinite(length).all():
         i = int(np.argmax(~np.isfinite(length)))
         raise ValueError(f"points {i} and {i + 1} are too far apart for float64: {pts[i].tolist()} and {pts[i + 1].tolist()}")
-    unit = seg / length[:, None]
-    dot = np.einsum("ij,ij->i", unit[:-1], unit[1:])
-    straight = _sin_turn(unit[:-1], unit[1:]) <= COLLINEAR_TOL
-    folds = straight & (dot < 0.0)
+    straight, folds = straight_points(pts[:-2], pts[1:-1], pts[2:])
     if folds.any():
         i = int(np.argmax(folds)) + 1
         raise ValueError(f"the polyline folds straight back at point {i} {pts[i].tolist()}")
@@ -639,12 +809,9 @@ def round_corners(
     rounded: list[RoundedCorner] = []
     spirals = np.empty((0, 2, 4, dim))
     if len(corners):
-        result = round_corners_batch(p0, corners, p1, shape=shape, **options)
-        for j in np.flatnonzero(~result.ok):
-            message = result.reason(int(j), label=f"corner {index[j]}")
-            if result.status[j] in (Status.LEGS_TOO_SHORT, Status.CORNER_REVERSAL, Status.UNVERIFIED, Status.OUTSIDE_SHAPE):
-                raise NoSolutionError(message)
-            raise ValueError(message)
+        result = round_corners_batch(p0, corners, p1, shape=shape, tolerance=tolerance, **options)
+        _raise_first_failure(result, index)
+        result = _without_slivers(result, pts, p0, corners, p1, index, options, tolerance, length_unit(units))
         spirals = result.control_points
         numbers = zip(index.tolist(), result.theta.tolist(), result.distance.tolist(), result.curvature.tolist(), result.deviation.tolist())
         for cp, (i, theta, distance, peak, deviation) in zip(spirals, numbers):
@@ -657,8 +824,113 @@ def round_corners(
         chain = join_rows(rows, np.full(len(rounded), 2), PartCircles(len(rounded)), tuple(pts[0].tolist()),
                           tuple(pts[-1].tolist()), join_tolerance(tolerance), length_unit(units), objects)  # fmt: skip
     except JointError as error:
-        raise NoSolutionError(f"corner {index[error.part]}: float64 cannot hold its spirals G2 at these coordinates: {error}") from None
+        raise _refusal(f"corner {index[error.part]}: float64 cannot hold its spirals G2 at these coordinates: {error}", int(index[error.part])) from None
     return RoundedPath(chain, rounded, shape)
+
+
+#: The shortest line left between rounded corners, in mm: ten times OCCT's Precision::Confusion
+#: (1e-7 mm), below which a line cannot become an edge of a wire.
+MIN_EDGE_MM = 1e-6
+#: ... and at most this share of the corner distance beside it (a path too small for CAD edges keeps its lines).
+SLIVER_SHARE = 1e-3
+
+
+def _refusal(message: str, corner: int, kind: type[ValueError] = NoSolutionError) -> ValueError:
+    """The error of a polyline's corner: ``corner`` (its point index) is kept on it as an attribute,
+    so a reader of the polyline's source (e.g. G-code) can name where the point came from."""
+    error = kind(message)
+    error.corner = corner  # type: ignore[attr-defined]
+    return error
+
+
+def _raise_first_failure(result: CornerBatch, index: NDArray) -> None:
+    """Raise the first corner ``result`` could not round, named by its point index."""
+    for j in np.flatnonzero(~result.ok):
+        message = result.reason(int(j), label=f"corner {index[j]}")
+        refused = result.status[j] in (Status.LEGS_TOO_SHORT, Status.CORNER_REVERSAL, Status.UNVERIFIED, Status.OUTSIDE_SHAPE)
+        raise _refusal(message, int(index[j]), NoSolutionError if refused else ValueError)
+
+
+def _without_slivers(result: CornerBatch, pts: NDArray, p0: NDArray, corners: NDArray, p1: NDArray, index: NDArray,
+                     options: dict, tolerance: float, units: str) -> CornerBatch:  # fmt: skip
+    """``result`` with no line shorter than ``MIN_EDGE_MM`` left between corners (or before the first,
+    after the last): such a sliver cannot become a CAD edge.
+
+    The corners beside a sliver are re-solved with a fixed curvature: under ``max_deviation`` they
+    move back from it (a smaller pair: a smaller deviation) until the line is a real edge; under
+    ``max_curvature`` alone they grow to meet across it (a lower curvature). Either keeps every bound;
+    where neither applies (``curvature`` or ``spiral_lengths`` fix the pairs) or the bound would be
+    broken, the corner is refused, named.
+    """
+    n = len(result)
+    min_edge = MIN_EDGE_MM / MM_PER_UNIT[units]
+    # Each gap's line runs along the polyline: before corner 0, between corners, after the last.
+    heading = np.concatenate([corners[:1] - p0[:1], corners[1:] - corners[:-1], p1[-1:] - corners[-1:]])
+    heading /= norms(heading)[:, None]
+
+    def lines(batch: CornerBatch) -> tuple[NDArray, NDArray]:
+        """The signed length of every line (negative: the pairs overlap) and which are slivers."""
+        starts, ends = batch.control_points[:, 0, 0], batch.control_points[:, 1, 3]
+        step = np.concatenate([starts[:1] - pts[0], starts[1:] - ends[:-1], pts[-1:] - ends[-1:]])
+        signed = np.einsum("ij,ij->i", step, heading)
+        # Gaps the chain closes without a line (within its join tolerance) are no slivers.
+        beside = np.concatenate([batch.distance[:1], np.maximum(batch.distance[:-1], batch.distance[1:]), batch.distance[-1:]])
+        resolution = ROUNDING_ULPS * EPS * np.abs(pts).max()
+        closed = norms(step) <= np.maximum(tolerance * beside, resolution)
+        # A path too small for CAD edges altogether keeps its lines: a sliver is small beside its corners too.
+        return signed, ~closed & (signed < np.minimum(min_edge, SLIVER_SHARE * beside))
+
+    gaps, sliver = lines(result)
+    if not sliver.any():
+        return result
+    bound, kmax = (None if options[name] is None else np.broadcast_to(np.asarray(options[name], dtype=float).ravel(), (n,))
+                   for name in ("max_deviation", "max_curvature"))  # fmt: skip
+    bounded = bound is not None
+    distance = result.distance.copy()
+    for g in np.flatnonzero(sliver).tolist():
+        pair = [j for j in (g - 1, g) if 0 <= j < n]  # the corners before and after gap g
+        edge = min(min_edge, SLIVER_SHARE * max(result.distance[j] for j in pair))
+        if bounded:  # step back: each corner by its share of what the line lacks
+            for j in pair:
+                distance[j] = min(distance[j], result.distance[j] - 1.01 * (edge - gaps[g]) / len(pair))
+        elif kmax is not None and gaps[g] > 0.0:
+            for j in pair:  # grow to meet: the gap's share of each corner
+                distance[j] = max(distance[j], result.distance[j] + gaps[g] / len(pair))
+        else:
+            j = pair[0]
+            raise _refusal(
+                f"corner {index[j]}: the line it leaves {'after' if j < g else 'before'} it would be {gaps[g]:.3g} long, "
+                f"too short for a CAD edge ({min_edge:.3g} {units} at least); give max_deviation or max_curvature "
+                "so the corners may move, or move the point", int(index[j]))  # fmt: skip
+    changed = np.flatnonzero(distance != result.distance)
+    s, c = np.sin(result.theta[changed]), np.cos(result.theta[changed])
+    k = corner_scale(s, c, distance[changed], result.shape)
+    fixed = round_corners_batch(p0[changed], corners[changed], p1[changed], curvature=k, shape=result.shape, tolerance=tolerance)
+    for m, j in enumerate(changed.tolist()):
+        why = None
+        if not fixed.ok[m]:
+            why = fixed.reason(m, label=f"corner {index[j]}")
+        elif bounded and not fixed.deviation[m] <= bound[j]:
+            why = f"corner {index[j]}: closing a sliver line beside it would take it {fixed.deviation[m]:.6g} from the path"
+        elif kmax is not None and not fixed.curvature[m] <= kmax[j] * (1.0 + DEVIATION_MARGIN):
+            why = (f"corner {index[j]}: making the sliver line beside it a real edge needs curvature "
+                   f"{fixed.curvature[m]:.6g}, above max_curvature {kmax[j]:.6g}; allow a larger curvature or deviation")
+        if why is not None:
+            raise _refusal(why, int(index[j]))
+    arrays = {name: getattr(result, name).copy() for name in ("control_points", "distance", "curvature", "deviation")}
+    for name, array in arrays.items():
+        array[changed] = getattr(fixed, name)
+    mended = CornerBatch(result.shape, arrays["control_points"], result.theta, arrays["distance"], arrays["curvature"],
+                       result.available, result.status, result.corners, result.requested, result.residual,
+                       arrays["deviation"], result.max_deviation, result.max_curvature, result.spiral_length)  # fmt: skip
+    gaps, sliver = lines(mended)
+    if sliver.any():  # a corner moved into its other neighbour's way (or sits between two slivers)
+        g = int(np.argmax(sliver))
+        j = g - 1 if g > 0 else 0
+        raise _refusal(f"corner {index[j]}: the line it leaves {'after' if j < g else 'before'} it would be {gaps[g]:.3g} long, "
+                       f"too short for a CAD edge ({min_edge:.3g} {units} at least), and moving the corners beside it "
+                       "would break their bounds; move the point or change the bounds", int(index[j]))  # fmt: skip
+    return mended
 
 
 # ------------------------------------------------------------ fillets in space
@@ -752,8 +1024,8 @@ def fillet_polyline(
         raise ValueError(f"vertices {unknown} are not corners of this polyline (corners: {candidates})")
     rounded = {}
     for v in chosen:
-        d_in, d_out = (ends[v - 1][1] - ends[v - 1][0]), (ends[v % edges][1] - ends[v % edges][0])
-        if _sin_turn(d_in[None] / norms(d_in), d_out[None] / norms(d_out))[0] > COLLINEAR_TOL:
+        before, after = ends[v - 1][0], ends[v % edges][1]
+        if not straight_points(before[None], pts[v][None], after[None])[0][0]:
             rounded[v] = None  # a corner (straight vertices stay as they are)
     pieces: dict[int, list[Segment]] = {}
     fillets = []
