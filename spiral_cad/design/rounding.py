@@ -59,9 +59,6 @@ G2CBS_C3 = (G2CBS_C2 + 4.0) / (G2CBS_C1 + 6.0)
 #: κmax = c4 sin β / (d cos² β): the G2CBS corner factor K(β) = c4·sin β/cos² β.
 G2CBS_C4 = (G2CBS_C2 + 4.0) ** 2 / (54.0 * G2CBS_C3)
 
-#: Relative |sin| below which two unit directions count as parallel; kept for callers. Points
-#: of a polyline are judged by their distance instead (``straight_points``), never by angle alone.
-COLLINEAR_TOL = 1e-12
 #: A ``max_deviation`` pair is aimed this much (relative) inside its bound, and
 #: further by the rounding of the corner's coordinates (``ROUNDING_ULPS`` ulp of
 #: the largest), so that its measured deviation never exceeds the bound.
