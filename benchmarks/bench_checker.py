@@ -20,12 +20,12 @@ from pathlib import Path
 from bench_cad import snake
 from timing import arguments, compare, machine, write_markdown
 
-from spiral_cad.cad.continuity import _measure, _report, check_continuity
 from spiral_cad.cad.console import captured_messages
+from spiral_cad.cad.continuity import _measure, _report, check_continuity
+from spiral_cad.cad.export import export_iges, export_step
 from spiral_cad.cad.readers import read_shape
 from spiral_cad.cad.sandbox import run_isolated
 from spiral_cad.design import Alignment
-from spiral_cad.cad.export import export_iges, export_step
 
 
 def in_process_check(path: Path) -> None:

@@ -15,8 +15,8 @@ from scipy.special import fresnel
 from timing import Report, arguments, compare, growth_exponent, latencies, per_second, table
 
 import spiral_cad as sc
-from spiral_cad.core import batch
 from spiral_cad.core import _kernels as K
+from spiral_cad.core import batch
 
 
 def line_circle_problems(n: int, rng: np.random.Generator, near: bool = False):

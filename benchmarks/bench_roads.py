@@ -18,8 +18,8 @@ from pathlib import Path
 
 from timing import arguments, machine, median_time, write_markdown
 
-from spiral_cad.design import Alignment
 from spiral_cad.cad.export import export_opendrive
+from spiral_cad.design import Alignment
 from spiral_cad.io.opendrive import check_opendrive, read_network, read_opendrive
 
 

@@ -27,8 +27,8 @@ from pathlib import Path
 import numpy as np
 from timing import arguments, machine, median_time, write_markdown
 
-from spiral_cad.design import Alignment, Profile
 from spiral_cad.cad.export import export_opendrive
+from spiral_cad.design import Alignment, Profile
 from spiral_cad.io.opendrive import read_opendrive
 
 

@@ -40,13 +40,13 @@ from bench_cad import plain_description, raw_ocp_edges
 from timing import machine, write_markdown
 
 from spiral_cad.build123d import chain_to_wire
-from spiral_cad.cad.continuity import check_continuity
-from spiral_cad.cad.occ import chain_wire
 from spiral_cad.cad.console import captured_messages
-from spiral_cad.design import Alignment
-from spiral_cad.check.joints import ContinuityReport
+from spiral_cad.cad.continuity import check_continuity
 from spiral_cad.cad.export import export_step
+from spiral_cad.cad.occ import chain_wire
 from spiral_cad.cad.step_occ import write_shape_step
+from spiral_cad.check.joints import ContinuityReport
+from spiral_cad.design import Alignment
 
 
 def zigzag(count: int) -> list[list[float]]:

@@ -16,8 +16,8 @@ from pathlib import Path
 from build123d import ExportSVG, LineType, scale
 
 from spiral_cad.build123d import centerline_wire, corridor
-from spiral_cad.design import Alignment, Profile
 from spiral_cad.cad.export import CrossSection, export_step
+from spiral_cad.design import Alignment, Profile
 
 out = Path(sys.argv[1] if len(sys.argv) > 1 else "out")
 out.mkdir(parents=True, exist_ok=True)

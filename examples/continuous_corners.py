@@ -30,8 +30,8 @@ from OCP.GCPnts import GCPnts_AbscissaPoint
 
 from spiral_cad.build123d import ContinuousRectangle, curvature_comb, g2_fillet
 from spiral_cad.cad.continuity import check_continuity
-from spiral_cad.design.fillets import corner_distance
 from spiral_cad.cad.export import export_step
+from spiral_cad.design.fillets import corner_distance
 
 out = Path(sys.argv[1] if len(sys.argv) > 1 else "out")
 out.mkdir(parents=True, exist_ok=True)

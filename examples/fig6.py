@@ -13,8 +13,8 @@ import sys
 from pathlib import Path
 
 from spiral_cad import BezierSpiral
-from spiral_cad.design import peak_curvature_rate
 from spiral_cad.app.plots import plot_fig6_shapes, plot_vs_clothoid
+from spiral_cad.design import peak_curvature_rate
 
 out = Path(sys.argv[1] if len(sys.argv) > 1 else "out")
 out.mkdir(parents=True, exist_ok=True)

@@ -16,9 +16,9 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt
 import numpy as np
 
-from spiral_cad.design import round_corners
-from spiral_cad.cad.export import export_svg
 from spiral_cad.app.plots import plot_curvature, plot_plan
+from spiral_cad.cad.export import export_svg
+from spiral_cad.design import round_corners
 
 out = Path(sys.argv[1] if len(sys.argv) > 1 else "out")
 out.mkdir(parents=True, exist_ok=True)

@@ -23,8 +23,8 @@ import matplotlib.pyplot as plt
 import numpy as np
 
 from spiral_cad.cad.continuity import check_continuity
-from spiral_cad.design import round_corners
 from spiral_cad.cad.export import export_samples, export_step
+from spiral_cad.design import round_corners
 
 out = Path(sys.argv[1] if len(sys.argv) > 1 else "out")
 out.mkdir(parents=True, exist_ok=True)

@@ -205,7 +205,7 @@ def test_warnings_never_reach_the_terminal(tmp_path, capsys, monkeypatch, recwar
     summary = designfile.summary
 
     def noisy_summary(*args):
-        warnings.warn("overflow encountered in multiply", RuntimeWarning)
+        warnings.warn("overflow encountered in multiply", RuntimeWarning, stacklevel=2)
         return summary(*args)
 
     monkeypatch.setattr(designfile, "summary", noisy_summary)

@@ -151,10 +151,10 @@ def test_models_are_typed():
 def test_the_choices_are_the_librarys():
     from typing import get_args
 
+    from spiral_cad.app.schema import CornerShape, Terrain, TransitionShape, Units
     from spiral_cad.core.shapes import CORNER_SHAPES, TRANSITION_SHAPES
     from spiral_cad.core.units import UNITS
     from spiral_cad.design.profile import TERRAINS
-    from spiral_cad.app.schema import CornerShape, Terrain, TransitionShape, Units
 
     assert get_args(Units) == UNITS and get_args(Terrain) == TERRAINS
     assert get_args(TransitionShape) == TRANSITION_SHAPES and get_args(CornerShape) == CORNER_SHAPES

@@ -21,12 +21,12 @@ from cad_cases import transition_chains
 
 from spiral_cad import Arc, BezierSpiral, Chain, Line, circle_in_circle, circle_to_circle, line_to_circle, line_to_line
 from spiral_cad.build123d import (
-    chain_edges,
     SpiralChain,
     SpiralCircleInCircle,
     SpiralCircleToCircle,
     SpiralLineToCircle,
     SpiralLineToLine,
+    chain_edges,
 )
 
 CHAINS = transition_chains()

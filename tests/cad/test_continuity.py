@@ -33,8 +33,8 @@ from OCP.TopAbs import TopAbs_REVERSED  # noqa: E402
 from OCP.TopoDS import TopoDS, TopoDS_Wire  # noqa: E402
 
 import spiral_cad as sc  # noqa: E402
-import spiral_cad.design  # noqa: E402,F401
 import spiral_cad.cad.export  # noqa: E402,F401
+import spiral_cad.design  # noqa: E402,F401
 from spiral_cad.app.cli import main  # noqa: E402
 from spiral_cad.cad.continuity import Continuity, check_continuity  # noqa: E402
 
@@ -326,7 +326,7 @@ def test_survey_coordinates_are_not_failed_on_their_last_bit():
     assert levels(report) == [G2]
 
 
-def survey_highway() -> "sc.Chain":
+def survey_highway() -> sc.Chain:
     """A G2 highway at survey coordinates (~3e6 m): 20 PIs 100 km apart, R 300 m."""
     pis = [[3e6 - 1e6 + 1e5 * k, 3e6 + 2.5e4 * (k % 2)] for k in range(22)]
     return sc.design.Alignment.from_pis(pis, 300.0, spiral_angles=0.08, units="m").chain

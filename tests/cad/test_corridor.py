@@ -8,9 +8,9 @@ pytest.importorskip("OCP")
 from OCP.BRepCheck import BRepCheck_Analyzer  # noqa: E402
 
 from spiral_cad.build123d import centerline_wire, corridor  # noqa: E402
+from spiral_cad.cad.export import CrossSection, export_step  # noqa: E402
 from spiral_cad.cad.readers import read_shape  # noqa: E402
 from spiral_cad.design import Alignment, Profile, centerline_3d  # noqa: E402
-from spiral_cad.cad.export import CrossSection, export_step  # noqa: E402
 
 
 @pytest.fixture(scope="module")

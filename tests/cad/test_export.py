@@ -18,19 +18,19 @@ p21 = pytest.importorskip("steputils.p21")
 
 from cad_cases import curvature_vector, transition_chains
 from OCP.BRepAdaptor import BRepAdaptor_Curve
-from OCP.GCPnts import GCPnts_AbscissaPoint
 from OCP.BRepLProp import BRepLProp_CLProps
 from OCP.BRepTools import BRepTools_WireExplorer
+from OCP.GCPnts import GCPnts_AbscissaPoint
 from OCP.GeomAbs import GeomAbs_CurveType
 from OCP.TopAbs import TopAbs_EDGE, TopAbs_REVERSED, TopAbs_WIRE
 from OCP.TopExp import TopExp, TopExp_Explorer
 from OCP.TopoDS import TopoDS
 
 from spiral_cad import Arc, BezierSpiral, Chain, Line
-from spiral_cad.core.units import MM_PER_UNIT, UNITS
 from spiral_cad.cad.export import export_dxf, export_iges, export_step, export_svg, originating_system
-from spiral_cad.io.dxf import BEZIER_KNOTS, INSUNITS
 from spiral_cad.cad.readers import read_shape
+from spiral_cad.core.units import MM_PER_UNIT, UNITS
+from spiral_cad.io.dxf import BEZIER_KNOTS, INSUNITS
 
 CHAINS = transition_chains()
 WRITERS = {"step": export_step, "igs": export_iges}

@@ -12,8 +12,8 @@ from build123d import BuildLine, BuildPart, BuildSketch, Circle, GeomType, Plane
 from spiral_cad import NoSolutionError
 from spiral_cad.build123d import G2Polyline, g2_fillet
 from spiral_cad.cad.continuity import check_continuity
-from spiral_cad.design import fillet_polyline, round_corners
 from spiral_cad.cad.export import export_dxf, export_iges, export_samples, export_step, export_svg
+from spiral_cad.design import fillet_polyline, round_corners
 
 RUN = [(0, 0, 0), (100, 0, 0), (100, 80, 30), (0, 80, 60), (0, 0, 90)]
 

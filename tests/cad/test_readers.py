@@ -14,12 +14,12 @@ import pytest
 
 pytest.importorskip("OCP")
 
-from spiral_cad.cad import sandbox  # noqa: E402
-from spiral_cad.cad.readers import ReadError, read_file, read_shape  # noqa: E402
 from spiral_cad.app.cli import main  # noqa: E402
+from spiral_cad.cad import sandbox  # noqa: E402
 from spiral_cad.cad.continuity import check_continuity  # noqa: E402
-from spiral_cad.design import circle_chain  # noqa: E402
 from spiral_cad.cad.export import export_iges, export_step  # noqa: E402
+from spiral_cad.cad.readers import ReadError, read_file, read_shape  # noqa: E402
+from spiral_cad.design import circle_chain  # noqa: E402
 
 CIRCLES = [((0, 0), 60), ((29.85, 0), 30), ((150, -10), 40), ((150, 120), -35)]  # the demo's: spiral … spiral, 7 edges
 

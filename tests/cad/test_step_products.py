@@ -34,8 +34,8 @@ from OCP.TopoDS import TopoDS  # noqa: E402
 from OCP.XCAFDoc import XCAFDoc_DocumentTool  # noqa: E402
 
 from spiral_cad.build123d import centerline_wire, corridor  # noqa: E402
-from spiral_cad.design import Alignment, Profile  # noqa: E402
 from spiral_cad.cad.export import CrossSection, export_step  # noqa: E402
+from spiral_cad.design import Alignment, Profile  # noqa: E402
 
 
 @pytest.fixture(scope="module")

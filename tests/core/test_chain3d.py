@@ -101,7 +101,7 @@ def test_a_helix_of_lines_and_placed_spiral_pairs_is_g2_by_the_curvature_vector(
     assert_g2_by_curvature_vector(chain)
     # Every corner in its own plane: its spirals lie in the plane of its legs.
     normals = []
-    for (spirals, frame), (before, corner, after) in zip(pairs, zip(pts, pts[1:], pts[2:])):
+    for (spirals, _frame), (before, corner, after) in zip(pairs, zip(pts, pts[1:], pts[2:])):
         n = np.cross(corner - before, after - corner)
         n /= np.linalg.norm(n)
         normals.append(n)

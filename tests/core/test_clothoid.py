@@ -225,7 +225,7 @@ def test_esmini_roads_of_nearly_constant_curvature_have_no_phantom_gaps(tmp_path
     assert all(str(j.level) == "G2" for j in report.joints)
     # and every end is mpmath's
     for road, (_, geometries) in zip(read_opendrive(path), ESMINI):
-        for g, (s, x, y, hdg, length, k0, k1) in zip(road.geometries, geometries):
+        for g, (_s, _x, _y, _hdg, length, k0, k1) in zip(road.geometries, geometries):
             (end,), _, _ = g.local([1.0])
             k0_, length_ = float(k0), float(length)
             assert np.abs(end - exact(length_, k0_, (float(k1) - k0_) / length_)).max() <= 1e-14 * length_

@@ -14,8 +14,8 @@ from hypothesis import strategies as st
 
 import spiral_cad as sc
 from spiral_cad import Status
-from spiral_cad.core import batch
 from spiral_cad.core import _kernels as K
+from spiral_cad.core import batch
 from spiral_cad.design import Alignment, circle_chain, round_corners
 
 mp.mp.dps = 40

@@ -5,11 +5,11 @@ import math
 import numpy as np
 import pytest
 
-from spiral_cad import NoSolutionError
 import spiral_cad as sc
+from spiral_cad import NoSolutionError
 from spiral_cad.core.bezier import curvature_rate, peak_curvature_rate
-from spiral_cad.design import Alignment, RailCriteria, RoadCriteria
 from spiral_cad.core.factors import unit_spirals
+from spiral_cad.design import Alignment, RailCriteria, RoadCriteria
 from spiral_cad.design.criteria import SIDE_FRICTION_KMH
 
 PIS = [[0, 0], [600, 120], [1150, -80], [1700, 260], [2300, 200]]

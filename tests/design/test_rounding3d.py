@@ -11,9 +11,9 @@ import numpy as np
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
+from test_chain3d import bezier_end  # the independent end frame (point, tangent, κN) of a cubic
 
 from spiral_cad import BezierSpiral, NoSolutionError
-from test_chain3d import bezier_end  # the independent end frame (point, tangent, κN) of a cubic
 from spiral_cad.design import corner_legs, round_corners, round_corners_batch
 from spiral_cad.design.rounding import deviation_factor
 

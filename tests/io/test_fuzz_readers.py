@@ -32,8 +32,8 @@ HANG = 120.0
 
 def demo_files(folder: Path) -> list[Path]:
     """The demo's circle chain written as STEP and IGES (the demo's writers, its smallest design)."""
-    from spiral_cad.design import circle_chain
     from spiral_cad.cad.export import export_iges, export_step
+    from spiral_cad.design import circle_chain
 
     chain = circle_chain([((0, 0), 60), ((29.85, 0), 30), ((150, -10), 40), ((150, 120), -35)], units="m").chain
     paths = [folder / "circles.step", folder / "circles.igs"]
@@ -59,8 +59,8 @@ def check_in_child(path: Path) -> tuple[str, str, str]:
 
     outcome is ``"exit N"``, ``"signal N"`` or ``"hang"``.
     """
-    from spiral_cad.app.cli import main  # imported here once, not in every child
     import spiral_cad.cad.continuity  # noqa: F401  (what `check` imports for STEP/IGES)
+    from spiral_cad.app.cli import main  # imported here once, not in every child
 
     out_file, err_file = path.with_suffix(".out"), path.with_suffix(".err")
     pid = os.fork()

@@ -21,9 +21,9 @@ from ezdxf.lldxf.validator import is_valid_layer_name
 
 from spiral_cad import Chain
 from spiral_cad.cad.export import export_dxf, export_iges, export_opendrive, export_step, export_svg
+from spiral_cad.cad.readers import read_shape
 from spiral_cad.io.names import MAX_NAME_LENGTH, check_name, dxf_layer_name, iges_text, step_string
 from spiral_cad.io.opendrive import read_opendrive
-from spiral_cad.cad.readers import read_shape
 
 CHAIN = Chain(transition_chains()["S"].segments, units="m")
 WRITERS = {"step": export_step, "igs": export_iges, "dxf": export_dxf, "svg": export_svg, "xodr": export_opendrive}

@@ -13,8 +13,8 @@ import pytest
 import spiral_cad as sc
 from spiral_cad import Arc, BezierSpiral
 from spiral_cad.app.cli import main
-from spiral_cad.design import Alignment, round_corners
 from spiral_cad.cad.export import CrossSection, export_opendrive
+from spiral_cad.design import Alignment, round_corners
 from spiral_cad.io.opendrive import check_opendrive, read_opendrive
 
 REPO = Path(__file__).resolve().parents[2]

@@ -7,8 +7,8 @@ import numpy as np
 import pytest
 from test_opendrive import independent_check
 
-from spiral_cad.design import Alignment, Profile, Superelevation
 from spiral_cad.cad.export import export_opendrive
+from spiral_cad.design import Alignment, Profile, Superelevation
 
 PIS = [[0, 0], [600, 120], [1150, -80], [1700, 260], [2300, 200]]
 

@@ -6,8 +6,8 @@ import numpy as np
 import pytest
 
 from spiral_cad.app.cli import main
-from spiral_cad.design import Alignment, Profile
 from spiral_cad.cad.export import export_opendrive
+from spiral_cad.design import Alignment, Profile
 from spiral_cad.io.opendrive import check_opendrive, read_network, read_opendrive
 
 HEADER = '<?xml version="1.0"?>\n<OpenDRIVE><header revMajor="1" revMinor="8"/>{}</OpenDRIVE>'
