@@ -308,7 +308,8 @@ def _add_check(sub: argparse._SubParsersAction) -> None:
     check.add_argument("--profiles", choices=["C0", "C1", "C2"],
                        help="OpenDRIVE: exit 1 if any road's elevation or superelevation is below this continuity in s")  # fmt: skip
     check.add_argument("--links", choices=["G0", "G1", "G2"],
-                       help="OpenDRIVE: exit 1 if any link between roads (road links, junction connections) is below this level")  # fmt: skip
+                       help="OpenDRIVE: exit 1 if any link between roads is below this level (junction connections lane centre to "
+                       "lane centre, as a driver follows them; road links reference line to reference line)")  # fmt: skip
     check.add_argument("--snap", type=float, help="chain loose ends closer than this (model units; default 1%% of the model size)")
     check.add_argument("--comb", metavar="OUT.step",
                        help="also write the curvature comb of every edge as STEP (STEP/IGES input; never the checked file)")  # fmt: skip
