@@ -239,5 +239,5 @@ def test_the_site_opens_in_a_browser(site, tmp_path, path, title, text):
     assert 'class="md-nav' in dom and "Getting started" in dom and "Tutorials" in dom
     assert text in dom
     assert server.failed == [], f"requests not answered: {server.failed}"
-    errors = [line for line in console.splitlines() if re.search(r"error|uncaught|failed", line, re.I)]
-    assert errors == [], console
+    # Chromium logs every console message at one level; the site logs none, so any line is a fault.
+    assert console == "", console
