@@ -241,3 +241,32 @@ def test_the_site_opens_in_a_browser(site, tmp_path, path, title, text):
     assert server.failed == [], f"requests not answered: {server.failed}"
     # Chromium logs every console message at one level; the site logs none, so any line is a fault.
     assert console == "", console
+
+
+def _hooks():
+    pytest.importorskip("mkdocs", reason="the documentation toolchain is not installed here (make docs installs it)")
+    spec = importlib.util.spec_from_file_location("docs_hooks", DOCS / "hooks.py")
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+def test_the_design_file_page_comes_from_the_schema_when_the_package_renders_it(monkeypatch):
+    hooks = _hooks()
+    import types
+
+    fake = types.ModuleType("spiral_cad.app.designfile")
+    fake.schema_markdown = lambda: "# Design files\n\nrendered from the schema\n"
+    monkeypatch.setitem(sys.modules, "spiral_cad.app.designfile", fake)
+    assert hooks._schema_markdown() == "# Design files\n\nrendered from the schema\n"
+    monkeypatch.setitem(sys.modules, "spiral_cad.app.designfile", types.ModuleType("spiral_cad.app.designfile"))
+    monkeypatch.setitem(sys.modules, "spiral_cad.designfile", types.ModuleType("spiral_cad.designfile"))
+    assert hooks._schema_markdown() is None  # then the page says `spiral-cad schema` prints the format
+    assert "spiral-cad schema" in hooks.FALLBACK_DESIGN_FILES
+
+
+def test_the_results_page_gathers_every_benchmark_table():
+    text = _hooks()._results_markdown()
+    for path in (ROOT / "benchmarks").glob("results_*.md"):
+        title = path.read_text(encoding="utf-8").splitlines()[0].lstrip("# ")
+        assert f"## {title}" in text, path.name
