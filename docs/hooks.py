@@ -43,7 +43,7 @@ complete example.
 
 def _schema_markdown() -> str | None:
     """The design-file reference the package renders from its schema, if it can."""
-    for module in ("spiral_cad.app.designfile", "spiral_cad.designfile"):
+    for module in ("spiral_cad.app.designfile", "spiral_cad.app.schema", "spiral_cad.designfile"):
         try:
             render = getattr(importlib.import_module(module), "schema_markdown", None)
         except ImportError:

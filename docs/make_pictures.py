@@ -22,7 +22,7 @@ def run(*args: str) -> None:
 def first_curve() -> None:
     """The picture of Getting started's first curve, made by the same calls as the page."""
     import spiral_cad as sc
-    from spiral_cad.plots import plot_plan
+    from spiral_cad.app.plots import plot_plan
 
     enter = sc.line_to_circle((0, 0), (1, 0), (100, 60), 50.0)
     leave = sc.line_to_circle((300, 150), (-1, -1), (100, 60), 50.0).reversed()
@@ -57,9 +57,7 @@ def main() -> None:
 
         plot_jerk_length(shapes=("walton-meek", "near-linear")).savefig(IMAGES / "jerk_length.png", dpi=100)
         tube = cq.importers.importStep(str(tmp / "cq" / "tube.step"))
-        cq.exporters.export(
-            tube, str(IMAGES / "cadquery_tube.svg"), opt={"projectionDir": (0.4, -1.0, 0.5), "showHidden": False}
-        )
+        cq.exporters.export(tube, str(IMAGES / "cadquery_tube.svg"), opt={"projectionDir": (0.4, -1.0, 0.5), "showHidden": False})
         first_curve()
     for path in sorted(IMAGES.iterdir()):
         print(path.relative_to(ROOT))

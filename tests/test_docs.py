@@ -94,13 +94,21 @@ def test_every_block_is_valid_python(page):
 
 @pytest.mark.slow
 @pytest.mark.subprocess
+@pytest.mark.cad
 @pytest.mark.parametrize("page", PAGES_WITH_CODE, ids=rel)
 def test_every_block_runs(page, tmp_path):
     blocks = python_blocks(page.read_text(encoding="utf-8"), rel(page))
     runnable = [[b.first_line, b.code] for b in blocks if b.skip_reason is None]
     env = {**os.environ, "MPLBACKEND": "Agg", "PYTHONPATH": os.pathsep.join([str(ROOT), os.environ.get("PYTHONPATH", "")])}
-    done = subprocess.run([sys.executable, "-c", RUNNER], input=json.dumps([str(page), runnable]),
-                          capture_output=True, text=True, cwd=tmp_path, env=env, timeout=900)
+    done = subprocess.run(
+        [sys.executable, "-c", RUNNER],
+        input=json.dumps([str(page), runnable]),
+        capture_output=True,
+        text=True,
+        cwd=tmp_path,
+        env=env,
+        timeout=900,
+    )
     if done.returncode != 0:
         pytest.fail(done.stderr[-4000:], pytrace=False)
 
@@ -150,16 +158,32 @@ def test_every_page_is_in_the_navigation_and_every_image_exists():
 def test_the_mathematics_cites_the_paper_and_the_api_pages_render_the_faces():
     math = (DOCS / "math" / "index.md").read_text(encoding="utf-8")
     assert "Walton" in math and "1996" in math
-    for face in ("spiral_cad", "spiral_cad.design", "spiral_cad.build123d", "spiral_cad.cadquery",
-                 "spiral_cad.check", "spiral_cad.io", "spiral_cad.cad", "spiral_cad.app"):
+    for face in (
+        "spiral_cad",
+        "spiral_cad.design",
+        "spiral_cad.build123d",
+        "spiral_cad.cadquery",
+        "spiral_cad.check",
+        "spiral_cad.io",
+        "spiral_cad.cad",
+        "spiral_cad.app",
+    ):
         name = "spiral_cad" if face == "spiral_cad" else face.split(".")[1]
         assert f"::: {face}\n" in (DOCS / "api" / f"{name}.md").read_text(encoding="utf-8")
 
 
 # --- the built site, opened in a browser -------------------------------------------------------
 
-CHROMIUM_FLAGS = ["--headless", "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
-                  "--disable-background-networking", "--disable-component-update", "--disable-sync"]
+CHROMIUM_FLAGS = [
+    "--headless",
+    "--no-sandbox",
+    "--disable-gpu",
+    "--disable-quic",
+    "--no-first-run",
+    "--disable-background-networking",
+    "--disable-component-update",
+    "--disable-sync",
+]
 
 
 def _chromium() -> str:
@@ -177,15 +201,19 @@ def site(tmp_path_factory) -> Path:
     except ImportError:
         pytest.skip("the documentation toolchain is not installed here (make docs installs requirements-docs.lock)")
     out = tmp_path_factory.mktemp("site")
-    env = {**os.environ, "PYTHONPATH": os.pathsep.join([str(ROOT), os.environ.get("PYTHONPATH", "")]),
-           "NO_MKDOCS_2_WARNING": "1"}
+    env = {**os.environ, "PYTHONPATH": os.pathsep.join([str(ROOT), os.environ.get("PYTHONPATH", "")]), "NO_MKDOCS_2_WARNING": "1"}
     # API pages of faces this checkout does not have yet are left out, as the hook documents.
-    missing = [name for name in ("check", "io", "cad", "app")
-               if importlib.util.find_spec(f"spiral_cad.{name}") is None]
+    missing = [name for name in ("check", "io", "cad", "app") if importlib.util.find_spec(f"spiral_cad.{name}") is None]
     if missing:
         env["SPIRAL_CAD_DOCS_SKIP_API"] = ",".join(missing)
-    done = subprocess.run([sys.executable, "-m", "mkdocs", "build", "--strict", "--site-dir", str(out)],
-                          cwd=ROOT, env=env, capture_output=True, text=True, timeout=900)
+    done = subprocess.run(
+        [sys.executable, "-m", "mkdocs", "build", "--strict", "--site-dir", str(out)],
+        cwd=ROOT,
+        env=env,
+        capture_output=True,
+        text=True,
+        timeout=900,
+    )
     assert done.returncode == 0, done.stderr[-4000:]
     return out
 
@@ -214,9 +242,21 @@ def _serve(root: Path) -> _Server:
 
 def _open(url: str, tmp_path: Path) -> tuple[str, str]:
     """The DOM Chromium built for ``url`` and the console lines it logged."""
-    done = subprocess.run([_chromium(), *CHROMIUM_FLAGS, f"--user-data-dir={tmp_path / 'profile'}",
-                           "--enable-logging=stderr", "--v=0", "--virtual-time-budget=8000", "--dump-dom", url],
-                          capture_output=True, text=True, timeout=180)
+    done = subprocess.run(
+        [
+            _chromium(),
+            *CHROMIUM_FLAGS,
+            f"--user-data-dir={tmp_path / 'profile'}",
+            "--enable-logging=stderr",
+            "--v=0",
+            "--virtual-time-budget=8000",
+            "--dump-dom",
+            url,
+        ],
+        capture_output=True,
+        text=True,
+        timeout=180,
+    )
     assert done.returncode == 0, done.stderr[-3000:]
     console = [line for line in done.stderr.splitlines() if "CONSOLE" in line]
     return done.stdout, "\n".join(console)
@@ -224,11 +264,14 @@ def _open(url: str, tmp_path: Path) -> tuple[str, str]:
 
 @pytest.mark.slow
 @pytest.mark.subprocess
-@pytest.mark.parametrize(("path", "title", "text"), [
-    ("index.html", "spiral_cad", "cubic Bézier spiral"),
-    ("api/design.html", "spiral_cad.design", "Alignment"),
-    ("math/index.html", "The Walton–Meek spiral", "mjx-container"),
-])
+@pytest.mark.parametrize(
+    ("path", "title", "text"),
+    [
+        ("index.html", "spiral_cad", "cubic Bézier spiral"),
+        ("api/design.html", "spiral_cad.design", "Alignment"),
+        ("math/index.html", "The Walton–Meek spiral", "mjx-container"),
+    ],
+)
 def test_the_site_opens_in_a_browser(site, tmp_path, path, title, text):
     server = _serve(site)
     try:

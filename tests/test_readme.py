@@ -82,8 +82,15 @@ def test_every_block_is_valid_python(block):
 def test_every_block_runs(tmp_path):
     runnable = [[b.first_line, b.code] for b in BLOCKS if b.skip_reason is None]
     env = {**os.environ, "MPLBACKEND": "Agg"}
-    done = subprocess.run([sys.executable, "-c", RUNNER], input=json.dumps([str(README), runnable]),
-                          capture_output=True, text=True, cwd=tmp_path, env=env, timeout=600)
+    done = subprocess.run(
+        [sys.executable, "-c", RUNNER],
+        input=json.dumps([str(README), runnable]),
+        capture_output=True,
+        text=True,
+        cwd=tmp_path,
+        env=env,
+        timeout=600,
+    )
     if done.returncode != 0:
         pytest.fail(done.stderr[-4000:], pytrace=False)
 
