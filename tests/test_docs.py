@@ -303,7 +303,8 @@ def test_the_design_file_page_comes_from_the_schema_when_the_package_renders_it(
     monkeypatch.setitem(sys.modules, "spiral_cad.app.designfile", fake)
     assert hooks._schema_markdown() == "# Design files\n\nrendered from the schema\n"
     monkeypatch.setitem(sys.modules, "spiral_cad.app.designfile", types.ModuleType("spiral_cad.app.designfile"))
-    monkeypatch.setitem(sys.modules, "spiral_cad.designfile", types.ModuleType("spiral_cad.designfile"))
+    for module in ("spiral_cad.app.schema", "spiral_cad.designfile"):
+        monkeypatch.setitem(sys.modules, module, types.ModuleType(module))
     assert hooks._schema_markdown() is None  # then the page says `spiral-cad schema` prints the format
     assert "spiral-cad schema" in hooks.FALLBACK_DESIGN_FILES
 
