@@ -68,6 +68,19 @@ rs274:
 bench: $(STAMP)
 	$(BIN)/python benchmarks/run_all.py
 
+# The documentation site into site/: the pinned mkdocs toolchain on top of the
+# package's own set (shared packages keep requirements.lock's versions).
+DOCS_STAMP := $(VENV)/.docs-installed
+
+$(DOCS_STAMP): $(STAMP) requirements-docs.lock
+	$(BIN)/python -m pip install -q -r requirements-docs.lock -c requirements.lock
+	$(BIN)/python -m pip check
+	touch $(DOCS_STAMP)
+
+.PHONY: docs
+docs: $(DOCS_STAMP)
+	NO_MKDOCS_2_WARNING=1 $(BIN)/python -m mkdocs build --strict
+
 pictures: $(STAMP)
 	$(BIN)/python docs/make_pictures.py
 

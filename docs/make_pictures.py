@@ -1,4 +1,4 @@
-"""Regenerate the README pictures in docs/images from the project's own outputs.
+"""Regenerate the pictures of the README and the documentation site in docs/images from the project's own outputs.
 
 Run: ``make pictures`` (or ``.venv/bin/python docs/make_pictures.py``).
 """
@@ -17,6 +17,17 @@ IMAGES = ROOT / "docs" / "images"
 
 def run(*args: str) -> None:
     subprocess.run([sys.executable, *args], check=True, cwd=ROOT, stdout=subprocess.DEVNULL)
+
+
+def first_curve() -> None:
+    """The picture of Getting started's first curve, made by the same calls as the page."""
+    import spiral_cad as sc
+    from spiral_cad.app.plots import plot_plan
+
+    enter = sc.line_to_circle((0, 0), (1, 0), (100, 60), 50.0)
+    leave = sc.line_to_circle((300, 150), (-1, -1), (100, 60), 50.0).reversed()
+    chain = sc.Chain.join([enter, leave], start=(-20, 0), end=(400, 250), units="mm")
+    plot_plan(chain, comb=True).savefig(IMAGES / "first_curve.png")
 
 
 def main() -> None:
@@ -46,9 +57,8 @@ def main() -> None:
 
         plot_jerk_length(shapes=("walton-meek", "near-linear")).savefig(IMAGES / "jerk_length.png", dpi=100)
         tube = cq.importers.importStep(str(tmp / "cq" / "tube.step"))
-        cq.exporters.export(
-            tube, str(IMAGES / "cadquery_tube.svg"), opt={"projectionDir": (0.4, -1.0, 0.5), "showHidden": False}
-        )
+        cq.exporters.export(tube, str(IMAGES / "cadquery_tube.svg"), opt={"projectionDir": (0.4, -1.0, 0.5), "showHidden": False})
+        first_curve()
     for path in sorted(IMAGES.iterdir()):
         print(path.relative_to(ROOT))
 

@@ -1,0 +1,316 @@
+"""The documentation site: every Python block of its pages runs, every name it gives exists, and it builds and opens.
+
+Each page's ``python`` blocks run top to bottom in one fresh namespace (a
+page is read like one Python session), in a subprocess whose working folder
+is a temporary one. A block that cannot run by design is preceded by the line
+``<!-- docs: skip (the reason) -->``; it is still compiled.
+
+The site test builds with ``mkdocs build --strict`` (the toolchain of
+``requirements-docs.lock``, which ``make docs`` installs) and opens pages in
+headless Chromium served over HTTP: the title, the navigation, every request
+answered and no error on the console.
+"""
+
+from __future__ import annotations
+
+import ast
+import http.server
+import importlib
+import importlib.util
+import json
+import os
+import re
+import shutil
+import subprocess
+import sys
+import threading
+from dataclasses import dataclass
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[2]
+DOCS = ROOT / "docs"
+SKIP = re.compile(r"<!-- docs: skip \((?P<reason>[^()]+)\) -->")
+FENCE = re.compile(r"^(?P<indent> *)```(?P<info>[^`]*)$")
+PAGES = sorted(DOCS.rglob("*.md"))
+
+# Runs the blocks given on stdin as [first line, code] pairs; tracebacks show the page's own line numbers.
+RUNNER = """
+import json, sys
+page, blocks = json.load(sys.stdin)
+namespace = {"__name__": "__main__"}
+for first_line, code in blocks:
+    exec(compile("\\n" * (first_line - 1) + code, page, "exec"), namespace)
+"""
+
+
+@dataclass(frozen=True)
+class Block:
+    first_line: int  # 1-based line of the block's first code line
+    code: str
+    skip_reason: str | None
+
+
+def python_blocks(text: str, name: str = "page") -> list[Block]:
+    """The fenced ``python`` blocks of a Markdown text, with the skip marker that precedes each, if any."""
+    lines = text.splitlines()
+    blocks, i = [], 0
+    while i < len(lines):
+        opening = FENCE.match(lines[i])
+        if opening is None:
+            i += 1
+            continue
+        end = next((j for j in range(i + 1, len(lines)) if lines[j].strip() == "```"), None)
+        assert end is not None, f"{name}:{i + 1}: a code block is never closed"
+        if opening["info"].strip() == "python":
+            before = next((line for line in reversed(lines[:i]) if line.strip()), "")
+            marker = SKIP.fullmatch(before.strip())
+            indent = len(opening["indent"])
+            code = "\n".join(line[indent:] for line in lines[i + 1 : end]) + "\n"
+            blocks.append(Block(i + 2, code, marker["reason"] if marker else None))
+        i = end + 1
+    return blocks
+
+
+def rel(page: Path) -> str:
+    return str(page.relative_to(ROOT))
+
+
+PAGES_WITH_CODE = [p for p in PAGES if python_blocks(p.read_text(encoding="utf-8"), rel(p))]
+
+
+def test_the_extractor_finds_blocks_markers_and_line_numbers():
+    text = "# t\n\n```python\nx = 1\n```\n\n<!-- docs: skip (needs a GUI) -->\n```python\nshow(x)\n```\n```sh\nls\n```\n"
+    assert python_blocks(text) == [Block(4, "x = 1\n", None), Block(9, "show(x)\n", "needs a GUI")]
+    assert len(PAGES_WITH_CODE) >= 8, "the tutorials lost their Python blocks?"
+
+
+@pytest.mark.parametrize("page", PAGES, ids=rel)
+def test_every_block_is_valid_python(page):
+    for block in python_blocks(page.read_text(encoding="utf-8"), rel(page)):
+        ast.parse(block.code, filename=f"{rel(page)}:{block.first_line}")
+
+
+@pytest.mark.slow
+@pytest.mark.subprocess
+@pytest.mark.cad
+@pytest.mark.parametrize("page", PAGES_WITH_CODE, ids=rel)
+def test_every_block_runs(page, tmp_path):
+    blocks = python_blocks(page.read_text(encoding="utf-8"), rel(page))
+    runnable = [[b.first_line, b.code] for b in blocks if b.skip_reason is None]
+    env = {**os.environ, "MPLBACKEND": "Agg", "PYTHONPATH": os.pathsep.join([str(ROOT), os.environ.get("PYTHONPATH", "")])}
+    done = subprocess.run(
+        [sys.executable, "-c", RUNNER],
+        input=json.dumps([str(page), runnable]),
+        capture_output=True,
+        text=True,
+        cwd=tmp_path,
+        env=env,
+        timeout=900,
+    )
+    if done.returncode != 0:
+        pytest.fail(done.stderr[-4000:], pytrace=False)
+
+
+def _dotted_names() -> list[tuple[str, str]]:
+    found = set()
+    for page in PAGES:
+        for dotted in re.findall(r"`(spiral_cad(?:\.\w+)+)", page.read_text(encoding="utf-8")):
+            found.add((rel(page), dotted))
+    return sorted(found)
+
+
+# The layer packages the API pages document; the prose names them only as packages.
+FUTURE_FACES = {"spiral_cad.check", "spiral_cad.io", "spiral_cad.app"}
+
+
+@pytest.mark.parametrize(("page", "dotted"), _dotted_names(), ids=lambda x: x)
+def test_every_dotted_name_in_the_text_exists(page, dotted):
+    """Names the prose gives in full (`spiral_cad.design.fillet_path`) import as written."""
+    parts = dotted.split(".")
+    for split in range(len(parts), 0, -1):  # the longest importable module, then attributes
+        try:
+            found = importlib.import_module(".".join(parts[:split]))
+        except ModuleNotFoundError:
+            continue
+        for attribute in parts[split:]:
+            if f"{found.__name__}.{attribute}" in FUTURE_FACES:
+                pytest.skip(f"{dotted}: a layer package of the restructured layout")
+            assert hasattr(found, attribute), f"{page}: {dotted}: {'.'.join(parts[:split])} has no {attribute}"
+            found = getattr(found, attribute)
+        return
+    pytest.fail(f"{page}: {dotted}: no such module")
+
+
+def test_every_page_is_in_the_navigation_and_every_image_exists():
+    config = (ROOT / "mkdocs.yml").read_text(encoding="utf-8")
+    in_nav = set(re.findall(r":\s+(\S+\.md)\s*$", config, flags=re.M))
+    generated = {"reference/design-files.md", "benchmarks/results.md"}
+    on_disk = {str(p.relative_to(DOCS)) for p in PAGES}
+    assert on_disk - in_nav == set(), "pages missing from the nav"
+    assert in_nav - on_disk - generated == set(), "nav entries without a page"
+    for page in PAGES:
+        for target in re.findall(r"!\[[^\]]*\]\(([^)]+)\)", page.read_text(encoding="utf-8")):
+            assert (page.parent / target).resolve().is_file(), f"{rel(page)}: no image {target}"
+
+
+def test_the_mathematics_cites_the_paper_and_the_api_pages_render_the_faces():
+    math = (DOCS / "math" / "index.md").read_text(encoding="utf-8")
+    assert "Walton" in math and "1996" in math
+    for face in (
+        "spiral_cad",
+        "spiral_cad.design",
+        "spiral_cad.build123d",
+        "spiral_cad.cadquery",
+        "spiral_cad.check",
+        "spiral_cad.io",
+        "spiral_cad.cad",
+        "spiral_cad.app",
+    ):
+        name = "spiral_cad" if face == "spiral_cad" else face.split(".")[1]
+        assert f"::: {face}\n" in (DOCS / "api" / f"{name}.md").read_text(encoding="utf-8")
+
+
+# --- the built site, opened in a browser -------------------------------------------------------
+
+CHROMIUM_FLAGS = [
+    "--headless",
+    "--no-sandbox",
+    "--disable-gpu",
+    "--disable-quic",
+    "--no-first-run",
+    "--disable-background-networking",
+    "--disable-component-update",
+    "--disable-sync",
+]
+
+
+def _chromium() -> str:
+    for name in ("chromium", "chromium-browser", "google-chrome"):
+        if found := shutil.which(name):
+            return found
+    pytest.skip("headless Chromium is not installed (Debian: apt-get install chromium)")
+
+
+@pytest.fixture(scope="module")
+def site(tmp_path_factory) -> Path:
+    try:
+        import mkdocs  # noqa: F401
+        import mkdocstrings  # noqa: F401
+    except ImportError:
+        pytest.skip("the documentation toolchain is not installed here (make docs installs requirements-docs.lock)")
+    out = tmp_path_factory.mktemp("site")
+    env = {**os.environ, "PYTHONPATH": os.pathsep.join([str(ROOT), os.environ.get("PYTHONPATH", "")]), "NO_MKDOCS_2_WARNING": "1"}
+    # API pages of faces this checkout does not have yet are left out, as the hook documents.
+    missing = [name for name in ("check", "io", "cad", "app") if importlib.util.find_spec(f"spiral_cad.{name}") is None]
+    if missing:
+        env["SPIRAL_CAD_DOCS_SKIP_API"] = ",".join(missing)
+    done = subprocess.run(
+        [sys.executable, "-m", "mkdocs", "build", "--strict", "--site-dir", str(out)],
+        cwd=ROOT,
+        env=env,
+        capture_output=True,
+        text=True,
+        timeout=900,
+    )
+    assert done.returncode == 0, done.stderr[-4000:]
+    return out
+
+
+class _Server(http.server.ThreadingHTTPServer):
+    failed: list[str]
+
+
+def _serve(root: Path) -> _Server:
+    class Handler(http.server.SimpleHTTPRequestHandler):
+        def __init__(self, *args, **kwargs):
+            super().__init__(*args, directory=str(root), **kwargs)
+
+        def log_request(self, code="-", size="-"):
+            if str(code) not in ("200", "304"):
+                self.server.failed.append(f"{code} {self.path}")
+
+        def log_message(self, *args):
+            pass
+
+    server = _Server(("127.0.0.1", 0), Handler)
+    server.failed = []
+    threading.Thread(target=server.serve_forever, daemon=True).start()
+    return server
+
+
+def _open(url: str, tmp_path: Path) -> tuple[str, str]:
+    """The DOM Chromium built for ``url`` and the console lines it logged."""
+    done = subprocess.run(
+        [
+            _chromium(),
+            *CHROMIUM_FLAGS,
+            f"--user-data-dir={tmp_path / 'profile'}",
+            "--enable-logging=stderr",
+            "--v=0",
+            "--virtual-time-budget=8000",
+            "--dump-dom",
+            url,
+        ],
+        capture_output=True,
+        text=True,
+        timeout=180,
+    )
+    assert done.returncode == 0, done.stderr[-3000:]
+    console = [line for line in done.stderr.splitlines() if "CONSOLE" in line]
+    return done.stdout, "\n".join(console)
+
+
+@pytest.mark.slow
+@pytest.mark.subprocess
+@pytest.mark.parametrize(
+    ("path", "title", "text"),
+    [
+        ("index.html", "spiral_cad", "cubic Bézier spiral"),
+        ("api/design.html", "spiral_cad.design", "Alignment"),
+        ("math/index.html", "The Walton–Meek spiral", "mjx-container"),
+    ],
+)
+def test_the_site_opens_in_a_browser(site, tmp_path, path, title, text):
+    server = _serve(site)
+    try:
+        dom, console = _open(f"http://127.0.0.1:{server.server_address[1]}/{path}", tmp_path)
+    finally:
+        server.shutdown()
+    assert re.search(r"<title>[^<]*" + re.escape(title), dom), dom[:2000]
+    assert 'class="md-nav' in dom and "Getting started" in dom and "Tutorials" in dom
+    assert text in dom
+    assert server.failed == [], f"requests not answered: {server.failed}"
+    # Chromium logs every console message at one level; the site logs none, so any line is a fault.
+    assert console == "", console
+
+
+def _hooks():
+    pytest.importorskip("mkdocs", reason="the documentation toolchain is not installed here (make docs installs it)")
+    spec = importlib.util.spec_from_file_location("docs_hooks", DOCS / "hooks.py")
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+def test_the_design_file_page_comes_from_the_schema_when_the_package_renders_it(monkeypatch):
+    hooks = _hooks()
+    import types
+
+    fake = types.ModuleType("spiral_cad.app.designfile")
+    fake.schema_markdown = lambda: "# Design files\n\nrendered from the schema\n"
+    monkeypatch.setitem(sys.modules, "spiral_cad.app.designfile", fake)
+    assert hooks._schema_markdown() == "# Design files\n\nrendered from the schema\n"
+    monkeypatch.setitem(sys.modules, "spiral_cad.app.designfile", types.ModuleType("spiral_cad.app.designfile"))
+    for module in ("spiral_cad.app.schema", "spiral_cad.designfile"):
+        monkeypatch.setitem(sys.modules, module, types.ModuleType(module))
+    assert hooks._schema_markdown() is None  # then the page says `spiral-cad schema` prints the format
+    assert "spiral-cad schema" in hooks.FALLBACK_DESIGN_FILES
+
+
+def test_the_results_page_gathers_every_benchmark_table():
+    text = _hooks()._results_markdown()
+    for path in (ROOT / "benchmarks").glob("results_*.md"):
+        title = path.read_text(encoding="utf-8").splitlines()[0].lstrip("# ")
+        assert f"## {title}" in text, path.name
