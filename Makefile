@@ -8,7 +8,7 @@ STAMP  := $(VENV)/.installed
 TOOLS       := .venv-tools
 TOOLS_STAMP := $(TOOLS)/.installed
 
-.PHONY: setup demo test check lint bench pictures clean rs274 freecad
+.PHONY: setup demo test check lint bench pictures clean rs274 freecad chromium
 
 $(STAMP): requirements.lock pyproject.toml
 	test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
@@ -40,8 +40,17 @@ freecad:
 	       && apt-get update -q >/dev/null && DEBIAN_FRONTEND=noninteractive apt-get install -y -q --no-install-recommends freecad-python3 >/dev/null; } \
 	  || echo "FreeCAD not installed (apt-get install freecad-python3): its STEP import tests are skipped"
 
-# Everything CI runs: lint, then every test.
-test: $(STAMP) $(TOOLS_STAMP) rs274 freecad lint
+# Headless Chromium opens the built site in tests/app/test_docs.py. Installed from the distribution when
+# apt-get can (root, Debian); otherwise those tests skip, naming why. Never fatal.
+chromium:
+	-@command -v chromium >/dev/null \
+	  || { command -v apt-get >/dev/null && [ "$$(id -u)" = 0 ] \
+	       && { DEBIAN_FRONTEND=noninteractive apt-get install -y -q --no-install-recommends chromium >/dev/null \
+	            || { apt-get update -q >/dev/null && DEBIAN_FRONTEND=noninteractive apt-get install -y -q --no-install-recommends chromium >/dev/null; }; }; } \
+	  || echo "Chromium not installed (apt-get install chromium): the rendered-site tests are skipped"
+
+# Everything CI runs: lint, the documentation site (--strict), then every test.
+test: $(STAMP) $(TOOLS_STAMP) rs274 freecad chromium lint docs
 	SPIRAL_CAD_XODR_TOOLS=$(abspath $(TOOLS))/bin/python $(BIN)/python -m pytest -q
 
 # The fast tier while working: no slow, install or subprocess-heavy tests.
@@ -85,4 +94,4 @@ pictures: $(STAMP)
 	$(BIN)/python docs/make_pictures.py
 
 clean:
-	rm -rf $(VENV) $(TOOLS) out build .pytest_cache .hypothesis
+	rm -rf $(VENV) $(TOOLS) out build site .pytest_cache .hypothesis
