@@ -16,6 +16,7 @@ from pathlib import Path
 from .. import circle_in_circle, circle_to_circle, line_to_circle, line_to_line
 from ..check.joints import Continuity, ContinuityReport
 from ..core.transitions import Transition
+from ..design.tables import fixed_columns
 from ..io.opendrive_check import PROFILE_LEVELS, OpenDriveReport
 from ..io.signals import signals_handled
 
@@ -39,17 +40,14 @@ def core_examples() -> list[tuple[str, Transition]]:
 
 def transition_table(rows: Sequence[tuple[str, Transition]]) -> str:
     """Table of the shape, θ, end curvatures and the worst join residuals per transition."""
-    head = f"{'case':30} {'shape':12} {'θ°':>9} {'κ start':>10} {'κ end':>10} {'gap/len':>9} {'angle':>9} {'Δκ·len':>9}"
-    lines = [head, "-" * len(head)]
+    columns = [("case", "30"), ("shape", "12"), ("θ°", "9.4f"), ("κ start", "10.5f"), ("κ end", "10.5f"),
+               ("gap/len", "9.1e"), ("angle", "9.1e"), ("Δκ·len", "9.1e")]  # fmt: skip
+    values = []
     for name, t in rows:
-        joins = t.joins()
-        size = t.length
-        lines.append(
-            f"{name:30} {t.shape:12} {math.degrees(t.theta):9.4f} {t.spirals[0].start_curvature:10.5f} "
-            f"{t.spirals[-1].end_curvature:10.5f} {max(j.gap for j in joins) / size:9.1e} "
-            f"{max(j.angle for j in joins):9.1e} {max(j.curvature_jump for j in joins) * size:9.1e}"
-        )
-    return "\n".join(lines)
+        joins, size = t.joins(), t.length
+        values.append((name, t.shape, math.degrees(t.theta), t.spirals[0].start_curvature, t.spirals[-1].end_curvature,
+                       max(j.gap for j in joins) / size, max(j.angle for j in joins), max(j.curvature_jump for j in joins) * size))  # fmt: skip
+    return "\n".join(fixed_columns(columns, values))
 
 
 #: The built-in default design of ``spiral-cad demo`` (the JSON format of ``build``).

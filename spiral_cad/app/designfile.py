@@ -34,6 +34,7 @@ from typing import Any
 from ..core.chain import Chain
 from ..core.errors import NoSolutionError
 from ..core.spiral import BezierSpiral
+from ..design.tables import fixed_columns
 from ..io.signals import signals_handled
 from ..io.staging import Staging
 from .schema import (
@@ -568,17 +569,13 @@ def criteria_tables(built: list[Built]) -> str:
 
 def summary(built: list[Built], units: str) -> str:
     """One line per design: kind, spiral shape, segments, length, peak |κ| and the checked continuity."""
-    head = (
-        f"{'design':14} {'kind':30} {'spiral shape':13} {'segments':>8} {'length ' + units:>12} {'max |κ|':>10}  "
-        "continuity (of the STEP file)"
-    )
-    lines = [head, "-" * len(head)]
+    columns = [("design", "14"), ("kind", "30"), ("spiral shape", "13"), ("segments", "8d"), (f"length {units}", "12.3f"),
+               ("max |κ|", "10.5f"), (" continuity (of the STEP file)", "")]  # fmt: skip
+    rows = []
     for b in built:
         peak = max(max(abs(seg.start_curvature), abs(seg.end_curvature)) for seg in b.chain)  # spirals are monotone
         shapes = sorted({seg.shape or "not stated" for seg in b.chain if isinstance(seg, BezierSpiral)}) or ["-"]
-        lines.append(
-            f"{b.name:14} {b.kind:30} {'+'.join(shapes):13} {len(b.chain):8d} {b.chain.length:12.3f} {peak:10.5f}  "
-            f"{b.continuity or '-'}"
-        )
+        rows.append((b.name, b.kind, "+".join(shapes), len(b.chain), b.chain.length, peak, f" {b.continuity or '-'}"))
+    lines = fixed_columns(columns, rows)
     lines += [f"{b.name}: {b.road_3d}" for b in built if b.road_3d]
     return "\n".join(lines)

@@ -12,7 +12,8 @@ from __future__ import annotations
 
 import csv
 import numbers
-from collections.abc import Mapping, Sequence
+import re
+from collections.abc import Iterable, Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
@@ -62,3 +63,21 @@ def text_table(rows: Sequence[Mapping[str, Any]], dimensions: Mapping[str, str],
     lines = ["  ".join(h.rjust(w) for h, w in zip(head, widths))]
     lines += ["  ".join(c.rjust(w) for c, w in zip(row, widths)) for row in cells]
     return "\n".join(lines)
+
+
+def fixed_columns(columns: Sequence[tuple[str, str]], rows: Iterable[Sequence[Any]], rule: bool = True) -> list[str]:
+    """Lines of a fixed-width text table: a header, a rule of dashes under it, one line per row.
+
+    Args:
+        columns: (title, format spec) per column, e.g. ``("θ°", "9.4f")``, ``("case", "30")``;
+            a title is aligned as its values are (text left, numbers right) and as wide.
+            A column whose spec is ``""`` (the last, free text) has no width.
+        rows: the values, one sequence per row.
+        rule: a line of dashes under the header.
+    """
+    widths = [re.match(r"[<>^]?(\d*)", spec).group(1) for _, spec in columns]
+    numeric = [spec[-1:] in ("f", "e", "g", "d", "%") for _, spec in columns]
+    head = " ".join(f"{title:{'>' if number else '<'}{width}}" for (title, _), width, number in zip(columns, widths, numeric))
+    lines = [head.rstrip()] + (["-" * len(head.rstrip())] if rule else [])
+    lines += [" ".join(format(value, spec) for value, (_, spec) in zip(row, columns)) for row in rows]
+    return lines
