@@ -441,3 +441,18 @@ def test_built_designs_are_typed_by_kind():
     assert ramp.kind == f"transition ({ramp.source.kind})" and cnc.samples is None
     assert rail.notes == {"cross_section": rail.cross_section}  # the dict view older callers read
     assert summary(built, units).count("\n") == len(built) + 1
+
+
+def test_a_chain_too_long_for_occts_reread_is_reported_by_its_own_joint_checks(tmp_path, monkeypatch, capsys):
+    pytest.importorskip("OCP")
+    from spiral_cad.app import designfile
+
+    (tmp_path / "pocket.nc").write_bytes(POCKET.read_bytes())
+    design = {"units": "mm", "designs": [{"name": "pocket", "type": "rounded_polyline", "gcode": "pocket.nc", "max_deviation": 0.05}]}
+    (tmp_path / "pocket.json").write_text(json.dumps(design))
+    monkeypatch.setattr(designfile, "REREAD_EDGES", 3)
+    assert main(["build", str(tmp_path / "pocket.json"), "--out", str(tmp_path / "out"), "--no-plots"]) == 0
+    out = capsys.readouterr().out
+    assert "G2 by the chain's own joint checks" in out and "skipped above 3" in out
+    assert not (tmp_path / "out" / "pocket_continuity.txt").exists()
+    assert (tmp_path / "out" / "pocket.step").is_file()
