@@ -39,16 +39,16 @@ class BatchResult:
     """
 
     case: str
-    spirals: tuple[NDArray, ...]
-    theta: NDArray
-    status: NDArray
-    measure: NDArray
-    parameter: NDArray | None
-    inputs: dict[str, NDArray]
+    spirals: tuple[NDArray[np.float64], ...]
+    theta: NDArray[np.float64]
+    status: NDArray[np.int8]
+    measure: NDArray[np.float64]
+    parameter: NDArray[np.float64] | None
+    inputs: dict[str, NDArray[np.float64]]
     shape: str = DEFAULT_SHAPE
 
     @property
-    def ok(self) -> NDArray:
+    def ok(self) -> NDArray[np.float64]:
         """Boolean mask of solved rows."""
         return self.status == Status.OK
 
@@ -72,7 +72,7 @@ class BatchResult:
         return describe(self.case, int(self.status[i]), float(self.measure[i]), row)
 
 
-def _rows(**arrays: tuple[ArrayLike, tuple[int, ...]]) -> tuple[dict[str, NDArray], int]:
+def _rows(**arrays: tuple[ArrayLike, tuple[int, ...]]) -> tuple[dict[str, NDArray[np.float64]], int]:
     """Named inputs (value, trailing shape) as C-contiguous float64 arrays, and the row count N.
 
     Each input has N rows or is one row shared by all; a mismatch names both
@@ -102,7 +102,7 @@ def _rows(**arrays: tuple[ArrayLike, tuple[int, ...]]) -> tuple[dict[str, NDArra
     return rows, n
 
 
-def _output(out: NDArray | None, n: int, spirals: int, rows: dict[str, NDArray]) -> NDArray:
+def _output(out: NDArray[np.float64] | None, n: int, spirals: int, rows: dict[str, NDArray[np.float64]]) -> NDArray[np.float64]:
     """The (N, k, 4, 2) control-point buffer: ``out`` if given (checked), else new."""
     shape = (n, spirals, 4, 2)
     if out is None:
@@ -117,7 +117,7 @@ def _output(out: NDArray | None, n: int, spirals: int, rows: dict[str, NDArray])
     return out
 
 
-def _run(case: str, kernel, spirals: int, inputs: tuple[dict[str, NDArray], int], out: NDArray | None, shape: str,
+def _run(case: str, kernel, spirals: int, inputs: tuple[dict[str, NDArray[np.float64]], int], out: NDArray[np.float64] | None, shape: str,
          extra: bool = False) -> BatchResult:  # fmt: skip
     rows, n = inputs
     out = _output(out, n, spirals, rows)
@@ -137,7 +137,7 @@ def line_to_circle(
     directions: ArrayLike,
     centers: ArrayLike,
     radii: ArrayLike,
-    out: NDArray | None = None,
+    out: NDArray[np.float64] | None = None,
     shape: str = DEFAULT_SHAPE,
 ) -> BatchResult:
     """Theorem 4.1 for N rows: points, directions, centers (N, 2); radii (N,) > 0.
@@ -164,7 +164,7 @@ def circle_to_circle(
     radii0: ArrayLike,
     centers1: ArrayLike,
     radii1: ArrayLike,
-    out: NDArray | None = None,
+    out: NDArray[np.float64] | None = None,
     shape: str = DEFAULT_SHAPE,
 ) -> BatchResult:
     """Theorems 4.2/4.3 for N rows (signed travel-sense radii: C or S per row)."""
@@ -177,7 +177,7 @@ def line_to_line(
     corners: ArrayLike,
     p1: ArrayLike,
     curvatures: ArrayLike | None = None,
-    out: NDArray | None = None,
+    out: NDArray[np.float64] | None = None,
     shape: str = DEFAULT_SHAPE,
 ) -> BatchResult:
     """Theorem 4.4 for N corners; ``curvatures`` NaN (or None) applies Corollary 4.5.
@@ -192,7 +192,7 @@ def circle_in_circle(
     radii0: ArrayLike,
     centers1: ArrayLike,
     radii1: ArrayLike,
-    out: NDArray | None = None,
+    out: NDArray[np.float64] | None = None,
     shape: str = DEFAULT_SHAPE,
 ) -> BatchResult:
     """The fifth case for N rows (nested circles, same-sign radii)."""

@@ -39,7 +39,7 @@ ROUNDING_CAP = 1e-6
 _KIND_NAMES = ("Line", "Arc", "BezierSpiral")
 
 
-def _problem(index: int, measures: NDArray, tolerance: float, units: str) -> str:
+def _problem(index: int, measures: NDArray[np.float64], tolerance: float, units: str) -> str:
     """The message of a joint that fails (``measures``: its row of ``joint_table``)."""
     gap, angle, jump, short, kappa = measures[:5].tolist()
     return (
@@ -137,7 +137,7 @@ class Chain:
 
     @classmethod
     def _of_rows(
-        cls, rows: SegmentRows, tolerance: float, units: str, measured=None, objects=None, owners: NDArray | None = None
+        cls, rows: SegmentRows, tolerance: float, units: str, measured=None, objects=None, owners: NDArray[np.int64] | None = None
     ) -> Chain:
         """A checked chain of ``rows`` (tolerance and units already checked). With ``owners`` (the
         ``Chain.join`` part of every row) a failing joint raises a ``JointError`` naming its part."""
@@ -256,7 +256,7 @@ class Chain:
         return float(self._stations[-1])
 
     @property
-    def lengths(self) -> NDArray:
+    def lengths(self) -> NDArray[np.float64]:
         """Arc length of each segment (n,)."""
         return self._lengths.copy()
 
@@ -270,20 +270,20 @@ class Chain:
         return SegmentRows(*views[:4], rows.dim, views[4])
 
     @property
-    def stations(self) -> NDArray:
+    def stations(self) -> NDArray[np.float64]:
         """Arc length at the start of each segment, plus the total (len + 1)."""
         return self._stations.copy()
 
     @property
-    def start(self) -> NDArray:
+    def start(self) -> NDArray[np.float64]:
         return self._frames[0, 0, : self.dim].copy()
 
     @property
-    def end(self) -> NDArray:
+    def end(self) -> NDArray[np.float64]:
         return self._frames[-1, 1, : self.dim].copy()
 
     @property
-    def segment_ends(self) -> NDArray:
+    def segment_ends(self) -> NDArray[np.float64]:
         """The start and end point of every segment, (n, 2, dim) (a copy)."""
         return self._frames[:, :, : self.dim].copy()
 
@@ -308,7 +308,7 @@ class Chain:
 
     # --------------------------------------------------- station queries
 
-    def _locate(self, s: ArrayLike) -> tuple[NDArray, NDArray]:
+    def _locate(self, s: ArrayLike) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
         s = as_real_array(s, "stations")
         if not np.all((s >= -1e-12 * self.length) & (s <= self.length * (1 + 1e-12))):
             bad = s[~((s >= -1e-12 * self.length) & (s <= self.length * (1 + 1e-12)))].ravel()[0]
@@ -316,7 +316,7 @@ class Chain:
         index = np.clip(np.searchsorted(self._stations, s, side="right") - 1, 0, len(self) - 1)
         return index, s - self._stations[index]
 
-    def _at(self, s: ArrayLike, method: str, width: tuple[int, ...]) -> NDArray:
+    def _at(self, s: ArrayLike, method: str, width: tuple[int, ...]) -> NDArray[np.float64]:
         index, local = self._locate(s)
         flat_index, flat_local = index.ravel(), local.ravel()
         out = np.empty(flat_index.shape + width)
@@ -330,23 +330,23 @@ class Chain:
                 out[group] = getattr(seg, method)(seg.parameter_at(flat_local[group]))
         return out.reshape(index.shape + width)
 
-    def point_at(self, s: ArrayLike) -> NDArray:
+    def point_at(self, s: ArrayLike) -> NDArray[np.float64]:
         """Points at stations ``s`` (arc length from the start), shape ``s.shape + (dim,)``."""
         return self._at(s, "point", (self.dim,))
 
-    def tangent_at(self, s: ArrayLike) -> NDArray:
+    def tangent_at(self, s: ArrayLike) -> NDArray[np.float64]:
         """Unit tangents at stations ``s``."""
         return self._at(s, "tangent", (self.dim,))
 
-    def curvature_at(self, s: ArrayLike) -> NDArray:
+    def curvature_at(self, s: ArrayLike) -> NDArray[np.float64]:
         """Curvature at stations ``s``: signed in the plane, κ ≥ 0 in space."""
         return self._at(s, "curvature", ())
 
-    def curvature_vector_at(self, s: ArrayLike) -> NDArray:
+    def curvature_vector_at(self, s: ArrayLike) -> NDArray[np.float64]:
         """Curvature vectors κN at stations ``s``, shape ``s.shape + (dim,)``."""
         return self._at(s, "curvature_vector", (self.dim,))
 
-    def sample(self, per_segment: int = 32) -> NDArray:
+    def sample(self, per_segment: int = 32) -> NDArray[np.float64]:
         """Points along the chain, ``per_segment`` per segment plus the end (for plots)."""
         u = np.linspace(0.0, 1.0, per_segment, endpoint=False)
         pts = [seg.point(u) for seg in self.segments]
@@ -365,7 +365,7 @@ class Chain:
         return chain_to_nurbs(self.segments)
 
 
-def _size(rows: SegmentRows, frames: NDArray) -> float:
+def _size(rows: SegmentRows, frames: NDArray[np.float64]) -> float:
     """The diagonal of the box around every segment's outline (``Segment.outline``), in one pass."""
     kind, g, p = rows.kind, rows.geometry, rows.params
     arc = kind == ARC
@@ -420,7 +420,7 @@ class PartCircles:
 
 def join_rows(
     rows: SegmentRows,
-    counts: NDArray,
+    counts: NDArray[np.float64],
     circles: PartCircles,
     start: tuple[float, ...] | None,
     end: tuple[float, ...] | None,
@@ -530,7 +530,7 @@ def _check_connectors(bridge, kind, lengths, a, b, dim, head, tail, begins, ends
             _fold(b[i], ends[-1], dim, "end", count)
 
 
-def _fold(point: NDArray, frame: NDArray, dim: int, which: str, count: int) -> None:
+def _fold(point: NDArray[np.float64], frame: NDArray[np.float64], dim: int, which: str, count: int) -> None:
     """A start line must not run against the first part's start tangent (an end line: its end tangent)."""
     if which == "start":
         if float(np.dot(frame[:3] - point, frame[3:6])) < 0.0:

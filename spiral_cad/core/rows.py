@@ -44,12 +44,12 @@ class SegmentRows:
         lengths: (n,) known arc lengths, NaN where not yet measured (spirals).
     """
 
-    kind: NDArray
-    geometry: NDArray
-    params: NDArray
-    shapes: NDArray
+    kind: NDArray[np.int8]
+    geometry: NDArray[np.float64]
+    params: NDArray[np.float64]
+    shapes: NDArray[np.int8]
     dim: int
-    lengths: NDArray
+    lengths: NDArray[np.float64]
 
     def __len__(self) -> int:
         return len(self.kind)
@@ -121,13 +121,13 @@ class SegmentRows:
         return cls(*(np.concatenate([getattr(p, name) for p in parts]) for name in ("kind", "geometry", "params", "shapes")),
                    max(p.dim for p in parts), np.concatenate([p.lengths for p in parts]))  # fmt: skip
 
-    def take(self, index: NDArray) -> SegmentRows:
+    def take(self, index: NDArray[np.intp]) -> SegmentRows:
         """The rows at ``index`` (in that order)."""
         return SegmentRows(self.kind[index], self.geometry[index], self.params[index], self.shapes[index], self.dim, self.lengths[index])
 
     # ------------------------------------------------------- measuring
 
-    def measure(self) -> tuple[NDArray, NDArray, NDArray]:
+    def measure(self) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
         """End frames (n, 2, 9), rounding floors (n, 2, 3) and lengths (n,) of every row in one pass;
         spiral lengths not yet known by one vectorised quadrature (``bezier.arc_length``)."""
         frames, floors, lengths = row_frames(self.kind, self.geometry, self.params, self.dim)

@@ -26,7 +26,7 @@ from .units import COLLINEAR_TOL
 #: Legs whose |sin(turn)| is at most this span no plane.
 
 
-def place(points: ArrayLike, origin: ArrayLike, x_dir: ArrayLike, y_dir: ArrayLike) -> NDArray:
+def place(points: ArrayLike, origin: ArrayLike, x_dir: ArrayLike, y_dir: ArrayLike) -> NDArray[np.float64]:
     """Plane points (..., 2) in space: origin + x·x_dir + y·y_dir, shape (..., 3).
 
     ``origin``, ``x_dir`` and ``y_dir`` are (..., 3) and broadcast against the
@@ -72,7 +72,7 @@ def _place_rows(points, origin, x_dir, y_dir, out):
         _place_row(points, origin, x_dir, y_dir, out, i)
 
 
-def norms(vectors: ArrayLike) -> NDArray:
+def norms(vectors: ArrayLike) -> NDArray[np.float64]:
     """|v| of (..., 2) or (..., 3) vectors without overflow or underflow (``math.hypot`` per row)."""
     v = np.asarray(vectors, dtype=float)
     if v.shape[-1] == 2:
@@ -85,7 +85,7 @@ def norms(vectors: ArrayLike) -> NDArray:
     return length
 
 
-def corner_frames(before: ArrayLike, corners: ArrayLike, after: ArrayLike) -> tuple[NDArray, NDArray]:
+def corner_frames(before: ArrayLike, corners: ArrayLike, after: ArrayLike) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     """The planes of N corners before → corner → after, points (N, 3): unit x_dir (N, 3) along the
     incoming leg and unit y_dir (N, 3) perpendicular to it, towards the outgoing leg.
 
@@ -114,8 +114,8 @@ def corner_frames(before: ArrayLike, corners: ArrayLike, after: ArrayLike) -> tu
     return x, y
 
 
-def placed_pair_residuals(pairs: NDArray, corners: NDArray, x_dir: NDArray, y_dir: NDArray, outgoing: NDArray, peak: NDArray,
-                          residual: NDArray, deviation: NDArray) -> None:  # fmt: skip
+def placed_pair_residuals(pairs: NDArray[np.float64], corners: NDArray[np.float64], x_dir: NDArray[np.float64], y_dir: NDArray[np.float64], outgoing: NDArray[np.float64], peak: NDArray[np.float64],
+                          residual: NDArray[np.float64], deviation: NDArray[np.float64]) -> None:  # fmt: skip
     """Verify N corners' spiral pairs placed in space, measured on the placed control points.
 
     ``pairs`` (N, 2, 4, 3) were solved in the planes (``x_dir``, ``y_dir``)
@@ -165,7 +165,7 @@ def _pair_residuals(pairs, corners, x_dir, y_dir, outgoing, peak, residual, devi
 
 
 
-def _vector3(value: Any, name: str) -> NDArray:
+def _vector3(value: Any, name: str) -> NDArray[np.float64]:
     v = as_real_array(value, name)
     if v.shape not in ((2,), (3,)):
         raise ValueError(f"{name} must have 2 or 3 coordinates; got shape {v.shape}")
@@ -174,7 +174,7 @@ def _vector3(value: Any, name: str) -> NDArray:
     return out
 
 
-def _unit(v: NDArray, name: str) -> NDArray:
+def _unit(v: NDArray[np.float64], name: str) -> NDArray[np.float64]:
     length = math.hypot(*v.tolist())
     if not length > 0.0 or not math.isfinite(length):
         raise ValueError(f"{name} must be a non-zero finite vector; got {tuple(v.tolist())}")
@@ -229,19 +229,19 @@ class PlaneFrame:
         return cls(p, x, np.cross(x, y))
 
     @property
-    def basis(self) -> NDArray:
+    def basis(self) -> NDArray[np.float64]:
         """(2, 3): x_dir and y_dir."""
         return np.array([self.x_dir, self.y_dir])
 
-    def point(self, xy: ArrayLike) -> NDArray:
+    def point(self, xy: ArrayLike) -> NDArray[np.float64]:
         """Plane points (..., 2) in space (..., 3)."""
         return place(xy, self.origin, self.x_dir, self.y_dir)
 
-    def vector(self, xy: ArrayLike) -> NDArray:
+    def vector(self, xy: ArrayLike) -> NDArray[np.float64]:
         """Plane vectors (..., 2) in space (..., 3) (directions: no origin)."""
         return place(xy, (0.0, 0.0, 0.0), self.x_dir, self.y_dir)
 
-    def local(self, xyz: ArrayLike) -> NDArray:
+    def local(self, xyz: ArrayLike) -> NDArray[np.float64]:
         """Plane coordinates (..., 2) of points (..., 3): their projection onto the plane."""
         d = np.asarray(xyz, dtype=float) - self.origin
         return np.stack([d @ self.x_dir, d @ self.y_dir], axis=-1)

@@ -107,7 +107,7 @@ class BezierSpiral(Segment):
         return cls._wrap(cp, shape)
 
     @classmethod
-    def _wrap(cls, cp: NDArray, shape: str | None, length: float | None = None) -> BezierSpiral:
+    def _wrap(cls, cp: NDArray[np.float64], shape: str | None, length: float | None = None) -> BezierSpiral:
         """Adopt a finite (4, 2) or (4, 3) float64 array without copying or checks (solver output)."""
         spiral = object.__new__(cls)
         cp.setflags(write=False)
@@ -126,11 +126,11 @@ class BezierSpiral(Segment):
         return self._shape
 
     @property
-    def control_points(self) -> NDArray:
+    def control_points(self) -> NDArray[np.float64]:
         """(4, 2) float64 control points in travel order, (4, 3) in space (read-only)."""
         return self._cp
 
-    def _row(self) -> tuple[int, NDArray, tuple[float, float, float]]:
+    def _row(self) -> tuple[int, NDArray[np.float64], tuple[float, float, float]]:
         geometry = np.zeros((4, 3))
         geometry[:, : self._dim] = self._cp
         return SPIRAL, geometry, (0.0, 0.0, 0.0)
@@ -144,7 +144,7 @@ class BezierSpiral(Segment):
         return float(turn_angles(self._cp[None])[0])
 
     @property
-    def normal(self) -> NDArray:
+    def normal(self) -> NDArray[np.float64]:
         """Unit normal (3,) of the spiral's plane: (0, 0, 1) in the plane (curvature signed about it);
         in space the binormal the spiral turns counterclockwise about.
 
@@ -166,7 +166,7 @@ class BezierSpiral(Segment):
             self._length = bezier.arc_length(self._cp)
         return self._length
 
-    def parameter_at(self, s: ArrayLike) -> NDArray:
+    def parameter_at(self, s: ArrayLike) -> NDArray[np.float64]:
         """Parameters u with arc length ``s`` from the start (Newton, to 1e-14·length)."""
         s = np.asarray(s, dtype=float)
         total = self.length
@@ -178,18 +178,18 @@ class BezierSpiral(Segment):
                 break
         return u
 
-    def point(self, u: ArrayLike) -> NDArray:
+    def point(self, u: ArrayLike) -> NDArray[np.float64]:
         return bezier.point(self._cp, u)
 
-    def tangent(self, u: ArrayLike) -> NDArray:
+    def tangent(self, u: ArrayLike) -> NDArray[np.float64]:
         return bezier.tangent(self._cp, u)
 
-    def curvature(self, u: ArrayLike) -> NDArray | float:
+    def curvature(self, u: ArrayLike) -> NDArray[np.float64] | float:
         if self._dim == 2:
             return bezier.curvature(self._cp, u)[()]
         return np.linalg.norm(self.curvature_vector(u), axis=-1)[()]
 
-    def curvature_vector(self, u: ArrayLike) -> NDArray:
+    def curvature_vector(self, u: ArrayLike) -> NDArray[np.float64]:
         """κN = ((Q' × Q'') × Q') / |Q'|⁴, on the control points scaled by a power of two (any magnitude)."""
         scale = math.ldexp(1.0, math.frexp(float(np.abs(np.diff(self._cp, axis=0)).max()))[1])
         cp = np.zeros((4, 3))
@@ -212,7 +212,7 @@ class BezierSpiral(Segment):
         return BezierSpiral._wrap(frame.point(self._cp), self._shape)
 
 
-def turn_angles(control_points: NDArray) -> NDArray:
+def turn_angles(control_points: NDArray[np.float64]) -> NDArray[np.float64]:
     """The turn from start to end tangent of N cubics (N, 4, 2 or 3): signed in the plane, ≥ 0 in space."""
     a = control_points[:, 1] - control_points[:, 0]
     c = control_points[:, 3] - control_points[:, 2]
@@ -231,7 +231,7 @@ def turn_angles(control_points: NDArray) -> NDArray:
     return np.array([math.atan2(y, x) for y, x in zip(cross.tolist(), dot.tolist())])
 
 
-def _turn(cp: NDArray) -> NDArray:
+def _turn(cp: NDArray[np.float64]) -> NDArray[np.float64]:
     """(a + b) × c of the legs a, b, c: along the binormal of a planar cubic that turns one way
     (a × b vanishes where a spiral starts straight, so it is not used alone)."""
     legs = np.diff(cp, axis=0)
@@ -239,7 +239,7 @@ def _turn(cp: NDArray) -> NDArray:
     return np.cross(legs[0] + legs[1], legs[2])
 
 
-def _check_planar(cp: NDArray) -> None:
+def _check_planar(cp: NDArray[np.float64]) -> None:
     """ValueError unless the (4, 3) control points lie in one plane (1e-9 of the legs plus rounding)."""
     n = _turn(cp)
     size = math.hypot(*n.tolist())

@@ -66,25 +66,25 @@ class Transition:
         return transition
 
     @property
-    def start(self) -> NDArray:
+    def start(self) -> NDArray[np.float64]:
         """Contact point where the transition leaves the first line/circle."""
         return self.spirals[0].start
 
     @property
-    def start_tangent(self) -> NDArray:
+    def start_tangent(self) -> NDArray[np.float64]:
         return self.spirals[0].start_tangent
 
     @property
-    def end(self) -> NDArray:
+    def end(self) -> NDArray[np.float64]:
         """Contact point where the transition reaches the last line/circle."""
         return self.spirals[-1].end
 
     @property
-    def end_tangent(self) -> NDArray:
+    def end_tangent(self) -> NDArray[np.float64]:
         return self.spirals[-1].end_tangent
 
     @property
-    def joint(self) -> NDArray | None:
+    def joint(self) -> NDArray[np.float64] | None:
         """Where two spirals meet (two-spiral cases), else None."""
         return self.spirals[0].end if len(self.spirals) == 2 else None
 
@@ -118,7 +118,7 @@ class Transition:
         return [measure_join(a, b, i) for i, (a, b) in enumerate(zip(chain, chain[1:]))]
 
 
-def _contact_piece(circle: Circle | None, line: Ray | None, point: NDArray, before: bool, size: float) -> Segment:
+def _contact_piece(circle: Circle | None, line: Ray | None, point: NDArray[np.float64], before: bool, size: float) -> Segment:
     """A short piece of the given circle/line ending (``before``) or starting at the foot of ``point``.
 
     A line piece is ``size`` long (the transition's length), so it stays
@@ -135,7 +135,7 @@ def _contact_piece(circle: Circle | None, line: Ray | None, point: NDArray, befo
     return Line(foot - step, foot) if before else Line(foot, foot + step)
 
 
-def _spirals(out: NDArray, shape: str) -> list[BezierSpiral]:
+def _spirals(out: NDArray[np.float64], shape: str) -> list[BezierSpiral]:
     """The solved row ``out`` (1, k, 4, 2), k = 1 or 2, as spirals (read-only views)."""
     first = BezierSpiral._wrap(out[0, 0], shape)
     return [first] if out.shape[1] == 1 else [first, BezierSpiral._wrap(out[0, 1], shape)]
