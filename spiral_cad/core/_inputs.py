@@ -13,7 +13,7 @@ from __future__ import annotations
 import math
 import numbers
 from collections.abc import Mapping, Set
-from typing import Any
+from typing import Any, cast
 
 import numpy as np
 from numpy.typing import NDArray
@@ -91,7 +91,7 @@ def as_xy(value: Any, name: str) -> tuple[float, float]:
         x, y = value.tolist()
         if math.isfinite(x) and math.isfinite(y):
             return x, y
-    return as_point(value, name, plane_only=True)
+    return cast(tuple[float, float], as_point(value, name, plane_only=True))  # plane_only: two coordinates
 
 
 def as_point(value: Any, name: str, plane_only: bool = False) -> tuple[float, ...]:

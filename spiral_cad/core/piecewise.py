@@ -29,7 +29,7 @@ def polynomial(coefficients: NDArray[np.float64], x: NDArray[np.float64], deriva
     return result
 
 
-def piece_at(starts: NDArray[np.float64], s: ArrayLike) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+def piece_at(starts: NDArray[np.float64], s: ArrayLike) -> tuple[NDArray[np.intp], NDArray[np.float64]]:
     """(index of the piece, distance from its start) for every ``s`` given the pieces' ``starts``."""
     s = np.asarray(s, dtype=float)
     index = np.clip(np.searchsorted(starts, s, side="right") - 1, 0, len(starts) - 1)
