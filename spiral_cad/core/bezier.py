@@ -10,6 +10,7 @@ curves by numpy broadcasting.
 from __future__ import annotations
 
 import math
+from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -34,7 +35,7 @@ def _power_coefficients(cp: NDArray[np.float64], order: int = 0) -> NDArray[np.f
     d2 = d1[..., 1:, :] - d1[..., :-1, :]  # Δ²P0, Δ²P1
     d3 = d2[..., 1, :] - d2[..., 0, :]
     if order == 0:
-        terms = (cp[..., 0, :], 3.0 * d1[..., 0, :], 3.0 * d2[..., 0, :], d3)
+        terms: tuple[NDArray[np.float64], ...] = (cp[..., 0, :], 3.0 * d1[..., 0, :], 3.0 * d2[..., 0, :], d3)
     elif order == 1:
         terms = (3.0 * d1[..., 0, :], 6.0 * d2[..., 0, :], 3.0 * d3)
     elif order == 2:
@@ -91,7 +92,8 @@ def tangent(cp: NDArray[np.float64], u: ArrayLike) -> NDArray[np.float64]:
     """Unit tangents Q'(u)/|Q'(u)|."""
     coefficients = _power_coefficients(cp, 1)
     d = _horner(coefficients / _scale(coefficients), u)
-    return d / np.linalg.norm(d, axis=-1, keepdims=True)
+    unit: NDArray[np.float64] = d / np.linalg.norm(d, axis=-1, keepdims=True)
+    return unit
 
 
 def curvature(cp: NDArray[np.float64], u: ArrayLike) -> NDArray[np.float64]:
@@ -127,11 +129,13 @@ def split(cp: NDArray[np.float64], t0: float, t1: float) -> NDArray[np.float64]:
         pts = cp
         for s in (a, b, c):
             pts = (1.0 - s) * pts[:-1] + s * pts[1:]
-        return pts[0]
+        point: NDArray[np.float64] = pts[0]  # the blossom: one point (2,)
+        return point
 
-    return np.array(
+    points: NDArray[np.float64] = np.array(
         [blossom(t0, t0, t0), blossom(t0, t0, t1), blossom(t0, t1, t1), blossom(t1, t1, t1)]
     )
+    return points
 
 
 def curvature_rate(cp: ArrayLike, u: ArrayLike) -> NDArray[np.float64]:
@@ -151,10 +155,11 @@ def curvature_rate(cp: ArrayLike, u: ArrayLike) -> NDArray[np.float64]:
     cross13 = d1[..., 0] * d3[..., 1] - d1[..., 1] * d3[..., 0]
     speed2 = d1[..., 0] ** 2 + d1[..., 1] ** 2
     dot12 = d1[..., 0] * d2[..., 0] + d1[..., 1] * d2[..., 1]
-    return (cross13 * speed2 - 3.0 * cross12 * dot12) / speed2**3 / (scale * scale)
+    rate: NDArray[np.float64] = (cross13 * speed2 - 3.0 * cross12 * dot12) / speed2**3 / (scale * scale)
+    return rate
 
 
-def peak_curvature_rate(cp: ArrayLike, samples: int = 257) -> tuple:
+def peak_curvature_rate(cp: ArrayLike, samples: int = 257) -> tuple[Any, Any]:
     """The largest |dκ/ds| of one curve (cp (4, 2)) or of N curves (cp (N, 4, 2)), and the u where it occurs.
 
     A grid of ``samples`` parameters finds each peak's neighbourhood, then a

@@ -21,6 +21,7 @@ from __future__ import annotations
 
 import math
 from functools import lru_cache
+from typing import cast
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -49,7 +50,8 @@ def unit_spirals(theta: ArrayLike, shape: str = "walton-meek") -> NDArray[np.flo
 def length_factor(theta: ArrayLike, shape: str = "walton-meek") -> NDArray[np.float64]:
     """ℓ(θ): the length of unit spirals; a spiral onto radius r is r·ℓ long."""
     theta = np.asarray(theta, dtype=float)
-    return arc_length(unit_spirals(theta, shape)).reshape(theta.shape)
+    lengths = cast("NDArray[np.float64]", arc_length(unit_spirals(theta, shape)))  # N curves: an array
+    return lengths.reshape(theta.shape)
 
 
 def shift_factor(theta: ArrayLike, shape: str = "walton-meek") -> NDArray[np.float64]:
@@ -58,7 +60,8 @@ def shift_factor(theta: ArrayLike, shape: str = "walton-meek") -> NDArray[np.flo
     flat = theta.ravel()
     e1 = np.empty(flat.shape)
     K.shape_offsets_batch(SHAPE_CODES[shape], np.sin(flat), np.cos(flat), e1, np.empty(flat.shape))
-    return (np.sin(flat) ** 2 * e1).reshape(theta.shape)
+    factor: NDArray[np.float64] = (np.sin(flat) ** 2 * e1).reshape(theta.shape)
+    return factor
 
 
 def shift_angle(shift: ArrayLike, radius: ArrayLike, shape: str = "walton-meek") -> NDArray[np.float64]:
@@ -76,7 +79,8 @@ def _start_rate(theta: NDArray[np.float64], shape: str) -> NDArray[np.float64]:
     legs = np.diff(unit_spirals(theta, shape), axis=1)
     a = np.hypot(legs[:, 0, 0], legs[:, 0, 1])
     c = np.hypot(legs[:, 2, 0], legs[:, 2, 1])
-    return (2.0 / 9.0 * c * np.sin(theta.ravel()) / a**3).reshape(theta.shape)
+    rate: NDArray[np.float64] = (2.0 / 9.0 * c * np.sin(theta.ravel()) / a**3).reshape(theta.shape)
+    return rate
 
 
 def _equal_leg_peak(theta: NDArray[np.float64]) -> NDArray[np.float64]:
@@ -87,7 +91,8 @@ def _equal_leg_peak(theta: NDArray[np.float64]) -> NDArray[np.float64]:
         f = 5.0 - 16.0 * m + 16.0 * k * m - 60.0 * k * m * m + 80.0 * k * m**3
         m -= f / (-16.0 + 16.0 * k - 120.0 * k * m + 240.0 * k * m * m)
     base = 1.0 - 4.0 * k * m * (1.0 - m)
-    return (1.0 + 8.0 * k * m - 20.0 * k * m * m) / (2.0 * np.sin(theta) * base**3)
+    peak: NDArray[np.float64] = (1.0 + 8.0 * k * m - 20.0 * k * m * m) / (2.0 * np.sin(theta) * base**3)
+    return peak
 
 
 def _peak_switch(lo: float, hi: float, shape: str, inside_at_hi: bool) -> tuple[float, float]:
