@@ -8,7 +8,9 @@ that the scalar API uses (large batches split over threads) and returns a
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -48,9 +50,10 @@ class BatchResult:
     shape: str = DEFAULT_SHAPE
 
     @property
-    def ok(self) -> NDArray[np.float64]:
+    def ok(self) -> NDArray[np.bool_]:
         """Boolean mask of solved rows."""
-        return self.status == Status.OK
+        solved: NDArray[np.bool_] = self.status == Status.OK
+        return solved
 
     def __len__(self) -> int:
         return len(self.status)
@@ -65,7 +68,7 @@ class BatchResult:
         """Why row ``i`` failed (the scalar API's error message), or ``"ok"``."""
         if self.status[i] == Status.OK:
             return "ok"
-        row = {k: tuple(v[i].tolist()) if v.ndim > 1 else float(v[i]) for k, v in self.inputs.items()}
+        row: dict[str, Any] = {k: tuple(v[i].tolist()) if v.ndim > 1 else float(v[i]) for k, v in self.inputs.items()}
         if self.case == "line_to_line" and np.isnan(row["curvature"]):
             row["curvature"] = None
         row["shape"] = self.shape
@@ -93,7 +96,7 @@ def _rows(**arrays: tuple[ArrayLike, tuple[int, ...]]) -> tuple[dict[str, NDArra
     n = max(counts.values(), default=1)
     for name, count in counts.items():
         if count not in (1, n):
-            longest = max(counts, key=counts.get)
+            longest = max(counts, key=counts.__getitem__)
             raise ValueError(f"{name} has {count} rows but {longest} has {n}; each input needs N rows or one")
     rows = {}
     for name, a in parsed.items():
@@ -117,7 +120,7 @@ def _output(out: NDArray[np.float64] | None, n: int, spirals: int, rows: dict[st
     return out
 
 
-def _run(case: str, kernel, spirals: int, inputs: tuple[dict[str, NDArray[np.float64]], int], out: NDArray[np.float64] | None, shape: str,
+def _run(case: str, kernel: Callable[..., None], spirals: int, inputs: tuple[dict[str, NDArray[np.float64]], int], out: NDArray[np.float64] | None, shape: str,
          extra: bool = False) -> BatchResult:  # fmt: skip
     rows, n = inputs
     out = _output(out, n, spirals, rows)
