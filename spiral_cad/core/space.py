@@ -58,7 +58,14 @@ POINTS_PER_THREAD = 100_000
 
 
 @K.jit
-def _place_row(points, origin, x_dir, y_dir, out, i):
+def _place_row(
+    points: NDArray[np.float64],
+    origin: NDArray[np.float64],
+    x_dir: NDArray[np.float64],
+    y_dir: NDArray[np.float64],
+    out: NDArray[np.float64],
+    i: int,
+) -> None:
     """out[i, k] = origin[i] + points[i, k, 0]·x_dir[i] + points[i, k, 1]·y_dir[i]."""
     for k in range(points.shape[1]):
         u, v = points[i, k, 0], points[i, k, 1]
@@ -67,7 +74,13 @@ def _place_row(points, origin, x_dir, y_dir, out, i):
 
 
 @K.jit
-def _place_rows(points, origin, x_dir, y_dir, out):
+def _place_rows(
+    points: NDArray[np.float64],
+    origin: NDArray[np.float64],
+    x_dir: NDArray[np.float64],
+    y_dir: NDArray[np.float64],
+    out: NDArray[np.float64],
+) -> None:
     for i in range(points.shape[0]):
         _place_row(points, origin, x_dir, y_dir, out, i)
 
@@ -76,9 +89,10 @@ def norms(vectors: ArrayLike) -> NDArray[np.float64]:
     """|v| of (..., 2) or (..., 3) vectors without overflow or underflow (``math.hypot`` per row)."""
     v = np.asarray(vectors, dtype=float)
     if v.shape[-1] == 2:
-        return np.hypot(v[..., 0], v[..., 1])
+        plane: NDArray[np.float64] = np.hypot(v[..., 0], v[..., 1])
+        return plane
     with np.errstate(over="ignore", under="ignore"):
-        length = np.sqrt(np.einsum("...i,...i->...", v, v))  # 6x faster than hypot, within an ulp or two
+        length: NDArray[np.float64] = np.sqrt(np.einsum("...i,...i->...", v, v))  # 6x faster than hypot, within an ulp or two
     unsafe = ~((length > 1e-150) & (length < 1e150))  # squares that may have overflowed or underflowed
     if unsafe.any():
         length[unsafe] = np.hypot(np.hypot(v[unsafe][..., 0], v[unsafe][..., 1]), v[unsafe][..., 2])
@@ -114,7 +128,8 @@ def corner_frames(before: ArrayLike, corners: ArrayLike, after: ArrayLike) -> tu
     return x, y
 
 
-def placed_pair_residuals(pairs: NDArray[np.float64], corners: NDArray[np.float64], x_dir: NDArray[np.float64], y_dir: NDArray[np.float64], outgoing: NDArray[np.float64], peak: NDArray[np.float64],
+def placed_pair_residuals(pairs: NDArray[np.float64], corners: NDArray[np.float64], x_dir: NDArray[np.float64],
+                          y_dir: NDArray[np.float64], outgoing: NDArray[np.float64], peak: NDArray[np.float64],
                           residual: NDArray[np.float64], deviation: NDArray[np.float64]) -> None:  # fmt: skip
     """Verify N corners' spiral pairs placed in space, measured on the placed control points.
 
@@ -134,7 +149,17 @@ def placed_pair_residuals(pairs: NDArray[np.float64], corners: NDArray[np.float6
 
 
 @K.jit
-def _pair_residual(pairs, corners, x_dir, y_dir, outgoing, peak, residual, deviation, i):
+def _pair_residual(
+    pairs: NDArray[np.float64],
+    corners: NDArray[np.float64],
+    x_dir: NDArray[np.float64],
+    y_dir: NDArray[np.float64],
+    outgoing: NDArray[np.float64],
+    peak: NDArray[np.float64],
+    residual: NDArray[np.float64],
+    deviation: NDArray[np.float64],
+    i: int,
+) -> None:
     """Row ``i`` of ``placed_pair_residuals``."""
     x, y = x_dir[i], y_dir[i]
     nx, ny, nz = x[1] * y[2] - x[2] * y[1], x[2] * y[0] - x[0] * y[2], x[0] * y[1] - x[1] * y[0]
@@ -159,7 +184,16 @@ def _pair_residual(pairs, corners, x_dir, y_dir, outgoing, peak, residual, devia
 
 
 @K.jit
-def _pair_residuals(pairs, corners, x_dir, y_dir, outgoing, peak, residual, deviation):
+def _pair_residuals(
+    pairs: NDArray[np.float64],
+    corners: NDArray[np.float64],
+    x_dir: NDArray[np.float64],
+    y_dir: NDArray[np.float64],
+    outgoing: NDArray[np.float64],
+    peak: NDArray[np.float64],
+    residual: NDArray[np.float64],
+    deviation: NDArray[np.float64],
+) -> None:
     for i in range(corners.shape[0]):
         _pair_residual(pairs, corners, x_dir, y_dir, outgoing, peak, residual, deviation, i)
 
