@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 import math
-from typing import Any
+from typing import Any, cast
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -50,7 +50,7 @@ class BezierSpiral(Segment):
     is κ ≥ 0 and ``normal`` is the binormal it turns about.
     """
 
-    def __init__(self, start: Any, direction: Any, theta: float, curvature: float, shape: str = DEFAULT_SHAPE):
+    def __init__(self, start: Any, direction: Any, theta: float, curvature: float, shape: str = DEFAULT_SHAPE) -> None:
         bx, by = as_xy(start, "start")
         dx, dy = as_xy(direction, "direction")
         theta = as_float(theta, "theta")
@@ -61,10 +61,10 @@ class BezierSpiral(Segment):
         if status != Status.OK:
             inputs = dict(start=(bx, by), direction=(dx, dy), theta=theta, curvature=curvature, shape=shape)
             raise error_for("BezierSpiral", status, measure, inputs)
-        self._cp = out[0, 0]
-        self._dim = 2
-        self._length = None
-        self._shape = shape
+        self._cp: NDArray[np.float64] = out[0, 0]
+        self._dim: int = 2
+        self._length: float | None = None
+        self._shape: str | None = shape
         self._cp.setflags(write=False)
 
     @classmethod
@@ -94,7 +94,8 @@ class BezierSpiral(Segment):
             raise ValueError(f"control_points must have shape (4, 2) or (4, 3); got {cp.shape}")
         if not np.isfinite(cp).all():
             raise ValueError(f"control_points must be finite; got {cp.tolist()}")
-        if cp.shape[1] == 3 and not cp[:, 2].any():
+        dim: int = cp.shape[1]  # as an int: mypy would narrow cp.shape to the first shape allowed above
+        if dim == 3 and not cp[:, 2].any():
             cp = np.ascontiguousarray(cp[:, :2])
         for leg, (a, b) in (("first", (0, 1)), ("last", (2, 3))):
             if np.array_equal(cp[a], cp[b]) or not np.isfinite(cp[b] - cp[a]).all():
@@ -163,7 +164,7 @@ class BezierSpiral(Segment):
     def length(self) -> float:
         """Arc length by composite Gauss–Legendre (≤ 1e-14 relative for |θ| ≤ 80°)."""
         if self._length is None:  # immutable curve: integrate once
-            self._length = bezier.arc_length(self._cp)
+            self._length = cast(float, bezier.arc_length(self._cp))  # one curve: a float
         return self._length
 
     def parameter_at(self, s: ArrayLike) -> NDArray[np.float64]:
@@ -187,7 +188,8 @@ class BezierSpiral(Segment):
     def curvature(self, u: ArrayLike) -> NDArray[np.float64] | float:
         if self._dim == 2:
             return bezier.curvature(self._cp, u)[()]
-        return np.linalg.norm(self.curvature_vector(u), axis=-1)[()]
+        kappa: NDArray[np.float64] | float = np.linalg.norm(self.curvature_vector(u), axis=-1)[()]
+        return kappa
 
     def curvature_vector(self, u: ArrayLike) -> NDArray[np.float64]:
         """κN = ((Q' × Q'') × Q') / |Q'|⁴, on the control points scaled by a power of two (any magnitude)."""
@@ -197,7 +199,8 @@ class BezierSpiral(Segment):
         d1, d2 = (bezier.derivative(cp, u, order) for order in (1, 2))
         speed2 = np.einsum("...i,...i->...", d1, d1)
         k = np.cross(np.cross(d1, d2), d1) / (speed2 * speed2)[..., None] / scale
-        return k[..., : self._dim]
+        vector: NDArray[np.float64] = k[..., : self._dim]
+        return vector
 
     def piece(self, t0: float, t1: float) -> BezierSpiral:
         """Exact sub-curve on [t0, t1] (de Casteljau) as a Bézier on [0, 1]."""
