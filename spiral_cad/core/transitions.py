@@ -129,10 +129,11 @@ def _contact_piece(circle: Circle | None, line: Ray | None, point: NDArray[np.fl
         angle = math.atan2(point[1] - cy, point[0] - cx)
         step = 1e-3 * math.copysign(1.0, circle.radius)
         return Arc(circle.center, circle.radius, angle - step if before else angle, 1e-3)
+    assert line is not None  # every contact is a circle or a line
     (px, py), direction = line.point, np.asarray(line.direction) / math.hypot(*line.direction)
     foot = np.array([px, py]) + np.dot(point - (px, py), direction) * direction
-    step = size * direction
-    return Line(foot - step, foot) if before else Line(foot, foot + step)
+    leg = size * direction
+    return Line(foot - leg, foot) if before else Line(foot, foot + leg)
 
 
 def _spirals(out: NDArray[np.float64], shape: str) -> list[BezierSpiral]:
@@ -174,7 +175,9 @@ def line_to_circle(point: Any, direction: Any, center: Any, radius: float, shape
     return Transition._solved("line-circle", _spirals(out, shape), theta, shape, end_circle=circle, start_line=line)
 
 
-def _two_circles(case: str, center0: Any, radius0: Any, center1: Any, radius1: Any, shape: str) -> tuple:
+def _two_circles(
+    case: str, center0: Any, radius0: Any, center1: Any, radius1: Any, shape: str
+) -> tuple[tuple[float, float], float, tuple[float, float], float, NDArray[np.float64], float, float]:
     """Coerce the two circles' arguments (in argument order), solve ``case``'s row and
     raise its error if it fails: (c0, r0, c1, r1, out, θ, extra)."""
     c0 = as_xy(center0, "center0")
