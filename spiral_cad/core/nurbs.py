@@ -16,6 +16,7 @@ runs from 0 to about the chain length.
 from __future__ import annotations
 
 import math
+from collections.abc import Iterable
 from dataclasses import dataclass
 
 import numpy as np
@@ -45,7 +46,7 @@ class Nurbs:
 
     degree: int
     knots: NDArray[np.float64]
-    multiplicities: NDArray[np.float64]
+    multiplicities: NDArray[np.int64]
     weights: NDArray[np.float64]
     control_points: NDArray[np.float64]
     segment_index: tuple[int, ...] = ()
@@ -92,7 +93,8 @@ class Nurbs:
                 alpha = ((flat - left) / (right - left))[:, None]
                 d[:, j] = (1.0 - alpha) * d[:, j - 1] + alpha * d[:, j]
         result = d[:, p, :2] / d[:, p, 2:]
-        return result.reshape(t.shape + (2,))
+        points: NDArray[np.float64] = result.reshape(t.shape + (2,))
+        return points
 
 
 def _arc_pieces(arc: Arc) -> list[tuple[NDArray[np.float64], NDArray[np.float64], float]]:
@@ -129,7 +131,7 @@ def _pieces(segment: Segment) -> list[tuple[NDArray[np.float64], NDArray[np.floa
     raise ValueError(f"segment must be a Line, Arc or BezierSpiral; got {segment!r}")
 
 
-def chain_to_nurbs(chain) -> Nurbs:
+def chain_to_nurbs(chain: Iterable[Segment]) -> Nurbs:
     """The exact rational cubic B-spline of a chain (or any segments in travel order).
 
     Each joint shares the end point of the piece before it; the chain's own
