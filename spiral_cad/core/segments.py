@@ -43,7 +43,9 @@ def lifted(point: tuple[float, ...], dim: int) -> tuple[float, ...]:
     return point + (0.0,) * (dim - len(point))
 
 
-def row_frames(kind: NDArray[np.int8], geometry: NDArray[np.float64], params: NDArray[np.float64], dim: int) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
+def row_frames(
+    kind: NDArray[np.int8], geometry: NDArray[np.float64], params: NDArray[np.float64], dim: int
+) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
     """End frames (n, 2, 9), rounding floors (n, 2, 3) and lengths (n,; NaN for spirals) of segment rows.
 
     The layout of rows and frames is described in ``spiral_cad.core._chain_kernels``.
@@ -470,7 +472,8 @@ class Arc(Segment):
         """Plane-basis coordinates as points of the segment's space."""
         if self._basis is None:
             return np.stack([x, y], axis=-1)
-        return x[..., None] * self._basis[0] + y[..., None] * self._basis[1]
+        points: NDArray[np.float64] = x[..., None] * self._basis[0] + y[..., None] * self._basis[1]
+        return points
 
     def point(self, u: ArrayLike) -> NDArray[np.float64]:
         a = self._angle(u)
@@ -516,7 +519,8 @@ class Join:
 
 
 def joint_table(
-    end: NDArray[np.float64], end_floor: NDArray[np.float64], end_length: NDArray[np.float64], start: NDArray[np.float64], start_floor: NDArray[np.float64], start_length: NDArray[np.float64],
+    end: NDArray[np.float64], end_floor: NDArray[np.float64], end_length: NDArray[np.float64],
+    start: NDArray[np.float64], start_floor: NDArray[np.float64], start_length: NDArray[np.float64],
     tolerance: float, cap: float,
 ) -> tuple[NDArray[np.float64], int]:  # fmt: skip
     """Measure and judge m joints in one pass (``_chain_kernels.joint_measures``): (m, 6) rows of gap,
