@@ -132,9 +132,7 @@ def split(cp: NDArray[np.float64], t0: float, t1: float) -> NDArray[np.float64]:
         point: NDArray[np.float64] = pts[0]  # the blossom: one point (2,)
         return point
 
-    points: NDArray[np.float64] = np.array(
-        [blossom(t0, t0, t0), blossom(t0, t0, t1), blossom(t0, t1, t1), blossom(t1, t1, t1)]
-    )
+    points: NDArray[np.float64] = np.array([blossom(t0, t0, t0), blossom(t0, t0, t1), blossom(t0, t1, t1), blossom(t1, t1, t1)])
     return points
 
 

@@ -510,7 +510,9 @@ def join_rows(
     order = order[made[order]]
     index = pool[order].astype(np.int64)
     every = SegmentRows.concatenate([rows, bridge])
-    measured = cast("Measured", tuple(np.concatenate(x)[index] for x in ((frames, bridge_frames), (floors, bridge_floors), (lengths, bridge_lengths))))
+    measured = cast(
+        "Measured", tuple(np.concatenate(x)[index] for x in ((frames, bridge_frames), (floors, bridge_floors), (lengths, bridge_lengths)))
+    )
     chain_objects = None
     if objects is not None and all(s.dim == dim for s in objects):
         pool_objects: list[Segment | None] = [*objects, *([None] * gaps)]
