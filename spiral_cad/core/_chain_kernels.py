@@ -22,8 +22,18 @@ curvature vector κN up to κ × the tangent angle (which is checked too).
 from __future__ import annotations
 
 import math
+from typing import TYPE_CHECKING
 
 from ._jit import Kernels
+
+if TYPE_CHECKING:  # annotations only: the kernels' namespace (what numba compiles against) stays as it is
+    from typing import TypeAlias
+
+    import numpy as np
+    import numpy.typing as npt
+
+    FloatArray: TypeAlias = npt.NDArray[np.float64]
+    KindArray: TypeAlias = npt.NDArray[np.int8]
 
 KERNELS = Kernels(globals())
 jit = KERNELS.jit
@@ -36,13 +46,13 @@ BASIS_ULPS = 8.0 * EPS
 
 
 @jit
-def norm3(x, y, z):
+def norm3(x: float, y: float, z: float) -> float:
     """|(x, y, z)| without overflow or underflow; exactly hypot(x, y) when z = 0."""
     return math.hypot(math.hypot(x, y), z)
 
 
 @jit
-def _max_abs(g, rows):
+def _max_abs(g: FloatArray, rows: int) -> float:
     """The largest |coordinate| of the first ``rows`` points of ``g`` (4, 3)."""
     big = 0.0
     for i in range(rows):
@@ -52,7 +62,7 @@ def _max_abs(g, rows):
 
 
 @jit
-def _line(g, frames, floors):
+def _line(g: FloatArray, frames: FloatArray, floors: FloatArray) -> float:
     dx, dy, dz = g[1, 0] - g[0, 0], g[1, 1] - g[0, 1], g[1, 2] - g[0, 2]
     length = norm3(dx, dy, dz)
     delta = 4.0 * EPS * _max_abs(g, 2)
@@ -66,7 +76,9 @@ def _line(g, frames, floors):
 
 
 @jit
-def _arc(g, p, flat, frames, floors):
+def _arc(g: FloatArray, p: FloatArray, flat: bool, frames: FloatArray, floors: FloatArray) -> float:
+    r: float  # elements of the float64 params row (declarations only: no code)
+    sweep: float
     r, a0, sweep = p[0], p[1], p[2]
     rho = abs(r)
     sense = math.copysign(1.0, r)
@@ -92,12 +104,12 @@ def _arc(g, p, flat, frames, floors):
 
 
 @jit
-def _cross(ax, ay, az, bx, by, bz):
+def _cross(ax: float, ay: float, az: float, bx: float, by: float, bz: float) -> tuple[float, float, float]:
     return ay * bz - az * by, az * bx - ax * bz, ax * by - ay * bx
 
 
 @jit
-def _spiral(g, frames, floors):
+def _spiral(g: FloatArray, frames: FloatArray, floors: FloatArray) -> None:
     """End frames from the legs: tangent a/|a|, ω = (2/3)·(a × b)/|a|³ at the start (c, b at the end)."""
     ux, uy, uz = g[1, 0] - g[0, 0], g[1, 1] - g[0, 1], g[1, 2] - g[0, 2]
     vx, vy, vz = g[2, 0] - g[1, 0], g[2, 1] - g[1, 1], g[2, 2] - g[1, 2]
@@ -135,7 +147,9 @@ def _spiral(g, frames, floors):
 
 
 @jit
-def segment_ends(kind, geometry, params, flat, frames, floors, lengths):
+def segment_ends(
+    kind: KindArray, geometry: FloatArray, params: FloatArray, flat: bool, frames: FloatArray, floors: FloatArray, lengths: FloatArray
+) -> None:
     """End frames (n, 2, 9), rounding floors (n, 2, 3: gap, angle, curvature) and lengths (n,)
     of segment rows; a spiral's length is left as it was (it needs quadrature)."""
     for i in range(len(kind)):
@@ -148,13 +162,24 @@ def segment_ends(kind, geometry, params, flat, frames, floors, lengths):
 
 
 @jit
-def _capped(floor, cap):
+def _capped(floor: float, cap: float) -> float:
     """min(floor, cap), with a floor float64 could not hold (NaN) taken as unbounded."""
     return floor if floor <= cap else cap
 
 
 @jit
-def joint_measures(end, floor_end, length_a, start, floor_start, length_b, own, tolerance, cap, out):
+def joint_measures(
+    end: FloatArray,
+    floor_end: FloatArray,
+    length_a: FloatArray,
+    start: FloatArray,
+    floor_start: FloatArray,
+    length_b: FloatArray,
+    own: FloatArray,
+    tolerance: float,
+    cap: float,
+    out: FloatArray,
+) -> int:
     """Measure and judge m joints: from frames ``end`` (m, 9) of the segments before to ``start``
     (m, 9) of the segments after, with their rounding floors (m, 3) and lengths (m,).
 
@@ -191,7 +216,20 @@ def joint_measures(end, floor_end, length_a, start, floor_start, length_b, own, 
 
 
 @jit
-def connectors(a, b, scale, circle, center, radius, basis, flat, tolerance, kind, geometry, params):
+def connectors(
+    a: FloatArray,
+    b: FloatArray,
+    scale: FloatArray,
+    circle: npt.NDArray[np.bool_],
+    center: FloatArray,
+    radius: FloatArray,
+    basis: FloatArray,
+    flat: bool,
+    tolerance: float,
+    kind: KindArray,
+    geometry: FloatArray,
+    params: FloatArray,
+) -> None:
     """The segment bridging each of m gaps from point ``a`` to ``b`` (m, 3).
 
     ``kind`` receives -1 where the points meet (|b − a| ≤ tolerance·scale),

@@ -13,7 +13,7 @@ from __future__ import annotations
 import math
 import numbers
 from collections.abc import Mapping, Set
-from typing import Any
+from typing import Any, cast
 
 import numpy as np
 from numpy.typing import NDArray
@@ -91,7 +91,7 @@ def as_xy(value: Any, name: str) -> tuple[float, float]:
         x, y = value.tolist()
         if math.isfinite(x) and math.isfinite(y):
             return x, y
-    return as_point(value, name, plane_only=True)
+    return cast(tuple[float, float], as_point(value, name, plane_only=True))  # plane_only: two coordinates
 
 
 def as_point(value: Any, name: str, plane_only: bool = False) -> tuple[float, ...]:
@@ -127,7 +127,7 @@ def as_unit(value: Any, name: str) -> tuple[float, float]:
     return x / length, y / length
 
 
-def as_real_array(value: Any, name: str) -> NDArray:
+def as_real_array(value: Any, name: str) -> NDArray[np.float64]:
     """``value`` as a float64 array of real numbers (no bools, strings, complex or objects that are not numbers)."""
     _refuse_masked(value, name)
     if _refused(value):
@@ -150,7 +150,7 @@ def as_real_array(value: Any, name: str) -> NDArray:
     return array.astype(np.float64, copy=False)
 
 
-def as_points(value: Any, name: str, shape: tuple[int, ...] = (2,)) -> NDArray:
+def as_points(value: Any, name: str, shape: tuple[int, ...] = (2,)) -> NDArray[np.float64]:
     """``value`` as a float64 array whose trailing shape is ``shape``."""
     array = as_real_array(value, name)
     if array.shape[array.ndim - len(shape) :] != shape:
@@ -158,7 +158,7 @@ def as_points(value: Any, name: str, shape: tuple[int, ...] = (2,)) -> NDArray:
     return array
 
 
-def per_item(value: Any, count: int, name: str, item: str) -> NDArray:
+def per_item(value: Any, count: int, name: str, item: str) -> NDArray[np.float64]:
     """``value`` as ``count`` finite floats: one number for all, or one per ``item`` (named in the error)."""
     array = as_real_array(value, name)
     if array.ndim == 0:

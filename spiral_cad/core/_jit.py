@@ -21,9 +21,12 @@ import math
 import threading
 from collections.abc import Callable
 from types import FunctionType, SimpleNamespace
-from typing import Any
+from typing import Any, TypeVar, cast
 
 import numpy as np
+
+#: A kernel function: the decorators return it unchanged, signature included.
+F = TypeVar("F", bound=Callable[..., Any])
 
 #: Scalar calls a process makes through the plain-Python kernels before it compiles them (a loop, not a REPL).
 SCALAR_CALLS_BEFORE_COMPILING = 200
@@ -45,14 +48,14 @@ class Kernels:
         self.scalar_calls = 0
         self._python: SimpleNamespace | None = None
 
-    def jit(self, function: FunctionType) -> FunctionType:
+    def jit(self, function: F) -> F:
         """Declare a kernel (compiled on its own, called from other kernels)."""
-        self.functions[function.__name__] = (function, False)
+        self.functions[function.__name__] = (cast(FunctionType, function), False)
         return function
 
-    def row_jit(self, function: FunctionType) -> FunctionType:
+    def row_jit(self, function: F) -> F:
         """Declare a kernel that is inlined into the kernels calling it (one solver row)."""
-        self.functions[function.__name__] = (function, True)
+        self.functions[function.__name__] = (cast(FunctionType, function), True)
         return function
 
     def seal(self) -> None:

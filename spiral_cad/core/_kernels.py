@@ -34,11 +34,25 @@ raise.
 from __future__ import annotations
 
 import math
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from ._jit import Kernels
 from .errors import Status
+
+if TYPE_CHECKING:  # annotations only: the kernels' namespace (what numba compiles against) stays as it is
+    from typing import TypeAlias
+
+    import numpy.typing as npt
+
+    FloatArray: TypeAlias = npt.NDArray[np.float64]
+    StatusArray: TypeAlias = npt.NDArray[np.int8]
+    #: What a row returns: (status, θ, measure, extra).
+    Row: TypeAlias = tuple[int, float, float, float]
+    #: Four control points (x0, y0, …, x3, y3).
+    Points8: TypeAlias = tuple[float, float, float, float, float, float, float, float]
+
 
 KERNELS = Kernels(globals())
 jit = KERNELS.jit
@@ -112,7 +126,7 @@ G2CBS_RATIO = 2.0 * (math.sqrt(6.0) - 1.0) / 5.0
 
 
 @row_jit
-def boundary_ratio(shape, cos_t):
+def boundary_ratio(shape: int, cos_t: float) -> float:
     """Leg ratio r = a/b of a member whose curvature peaks exactly at u = 1.
 
     κ'(1) = 0 means c = 6b·cos θ/(r + 4) (Walton, Meek & Ali 2003): the 1996
@@ -125,7 +139,7 @@ def boundary_ratio(shape, cos_t):
 
 
 @row_jit
-def leg_factors(shape, cos_t):
+def leg_factors(shape: int, cos_t: float) -> tuple[float, float, float]:
     """(α, β, γ): the legs (a, b, c) of the spiral turning by θ onto radius R are R·sin θ·(α, β, γ)."""
     r = boundary_ratio(shape, cos_t)
     k = r + 4.0
@@ -135,7 +149,7 @@ def leg_factors(shape, cos_t):
 
 
 @jit
-def in_shape_domain(shape, cos_t):
+def in_shape_domain(shape: int, cos_t: float) -> bool:
     """Whether the shape has a spiral of this angle (cos θ > 0; near-linear: θ ≤ 50°)."""
     if shape == NEAR_LINEAR:
         return cos_t >= NEAR_LINEAR_MIN_COS
@@ -143,7 +157,7 @@ def in_shape_domain(shape, cos_t):
 
 
 @row_jit
-def leg_offsets(alpha, beta, gamma, cos_t):
+def leg_offsets(alpha: float, beta: float, gamma: float, cos_t: float) -> tuple[float, float]:
     """(e1, e2) of the spiral with leg factors (α, β, γ) at θ: g1(θ) = 1 + sin²θ·e1, g2(θ) = sin θ·e2.
 
     The end circle's centre is B0 + R·(g2·T + g1·N) (N the normal towards
@@ -154,41 +168,41 @@ def leg_offsets(alpha, beta, gamma, cos_t):
 
 
 @jit
-def shape_offsets(shape, sin_t, cos_t):
+def shape_offsets(shape: int, sin_t: float, cos_t: float) -> tuple[float, float]:
     """(e1, e2) of ``leg_offsets`` for the shape's spiral of angle θ."""
     alpha, beta, gamma = leg_factors(shape, cos_t)
     return leg_offsets(alpha, beta, gamma, cos_t)
 
 
 @row_jit
-def centre_offset(sin_t, e1, e2):
+def centre_offset(sin_t: float, e1: float, e2: float) -> tuple[float, float]:
     """(g1, g2): the end circle's centre lies R·g1 off the start line and R·g2 along it."""
     return 1.0 + sin_t * sin_t * e1, sin_t * e2
 
 
 @jit
-def shape_g1(shape, sin_t, cos_t):
+def shape_g1(shape: int, sin_t: float, cos_t: float) -> float:
     """g1(θ): the end circle's centre lies R·g1 off the start line (1996 spiral: (5 + 4cos²θ)/(9 cos θ))."""
     e1, e2 = shape_offsets(shape, sin_t, cos_t)
     return centre_offset(sin_t, e1, e2)[0]
 
 
 @jit
-def shape_g2(shape, sin_t, cos_t):
+def shape_g2(shape: int, sin_t: float, cos_t: float) -> float:
     """g2(θ): the end circle's centre lies R·g2 along the start line (1996 spiral: 25 tan θ/(27 cos θ) − (4/9) sin θ)."""
     e1, e2 = shape_offsets(shape, sin_t, cos_t)
     return centre_offset(sin_t, e1, e2)[1]
 
 
 @jit
-def shape_offsets_batch(shape, sin_t, cos_t, e1, e2):
+def shape_offsets_batch(shape: int, sin_t: FloatArray, cos_t: FloatArray, e1: FloatArray, e2: FloatArray) -> None:
     """``shape_offsets`` over arrays of sin θ and cos θ, into ``e1`` and ``e2``."""
     for i in range(sin_t.shape[0]):
         e1[i], e2[i] = shape_offsets(shape, sin_t[i], cos_t[i])
 
 
 @row_jit
-def corner_factor(shape, sin_t, cos_t):
+def corner_factor(shape: int, sin_t: float, cos_t: float) -> float:
     """K(θ): a symmetric spiral pair at a corner of deflection 2θ starts K/κ from the
     corner, κ its joint curvature (1996 spiral: (40/27)·sin θ/cos²θ, Theorem 4.4).
 
@@ -199,21 +213,34 @@ def corner_factor(shape, sin_t, cos_t):
 
 
 @jit
-def corner_factor_batch(shape, sin_t, cos_t, out):
+def corner_factor_batch(shape: int, sin_t: FloatArray, cos_t: FloatArray, out: FloatArray) -> None:
     """``corner_factor`` over arrays of sin θ and cos θ, into ``out``."""
     for i in range(sin_t.shape[0]):
         out[i] = corner_factor(shape, sin_t[i], cos_t[i])
 
 
 @row_jit
-def corner_relation(shape, sin_t, cos_t, value):
+def corner_relation(shape: int, sin_t: float, cos_t: float, value: float) -> float:
     """K(θ)/value: a spiral pair's corner distance from its joint curvature, or the
     curvature from the distance (the relation is symmetric)."""
     return corner_factor(shape, sin_t, cos_t) / value
 
 
 @row_jit
-def spiral_points(bx, by, tx, ty, nx, ny, sin_t, cos_t, radius, alpha, beta, gamma):
+def spiral_points(
+    bx: float,
+    by: float,
+    tx: float,
+    ty: float,
+    nx: float,
+    ny: float,
+    sin_t: float,
+    cos_t: float,
+    radius: float,
+    alpha: float,
+    beta: float,
+    gamma: float,
+) -> Points8:
     """The spiral's control points (x0, y0, …, x3, y3) from its legs.
 
     Starts at (bx, by) along unit (tx, ty) and turns by |θ| towards the unit
@@ -230,14 +257,31 @@ def spiral_points(bx, by, tx, ty, nx, ny, sin_t, cos_t, radius, alpha, beta, gam
 
 
 @row_jit
-def spiral_in_world(bx, by, tx, ty, nx, ny, sin_t, cos_t, radius, alpha, beta, gamma, ox, oy, scale, flip):
+def spiral_in_world(
+    bx: float,
+    by: float,
+    tx: float,
+    ty: float,
+    nx: float,
+    ny: float,
+    sin_t: float,
+    cos_t: float,
+    radius: float,
+    alpha: float,
+    beta: float,
+    gamma: float,
+    ox: float,
+    oy: float,
+    scale: float,
+    flip: float,
+) -> Points8:
     """``spiral_points`` of a normalised frame in world coordinates (``to_world``)."""
     x0, y0, x1, y1, x2, y2, x3, y3 = spiral_points(bx, by, tx, ty, nx, ny, sin_t, cos_t, radius, alpha, beta, gamma)
     return to_world(x0, y0, x1, y1, x2, y2, x3, y3, ox, oy, scale, flip)
 
 
 @jit
-def curvature_ratio(sigma, alpha, beta, gamma, sin_t, cos_t):
+def curvature_ratio(sigma: float, alpha: float, beta: float, gamma: float, sin_t: float, cos_t: float) -> float:
     """κ(u)/κ(1) at u = 1 − σ of the spiral with leg factors (α, β, γ).
 
     With the legs as vectors, Q' × Q'' = 18·u·c·sin θ·(a(1 − u) + b·u), so
@@ -255,25 +299,25 @@ def curvature_ratio(sigma, alpha, beta, gamma, sin_t, cos_t):
 
 
 @row_jit
-def norm(x, y):
+def norm(x: float, y: float) -> float:
     """√(x² + y²) for values of moderate size (normalised frames; ``math.hypot`` is slower)."""
     return math.sqrt(x * x + y * y)
 
 
 @jit
-def power_of_two_near(x):
+def power_of_two_near(x: float) -> float:
     """A power of two within a factor 2 of ``x`` > 0: scaling by it is exact."""
     return math.ldexp(1.0, math.frexp(x)[1] - 1)
 
 
 @row_jit
-def ordinary(v):
+def ordinary(v: float) -> bool:
     """Whether a length lies where squares and cubes cannot overflow or underflow (1e-60 … 1e60)."""
     return 1e-60 < v < 1e60
 
 
 @jit
-def frame_scale(length):
+def frame_scale(length: float) -> float:
     """The normalising scale for a problem of natural size ``length`` > 0.
 
     Any power of two scales exactly; 1 is used where squares and cubes of
@@ -286,7 +330,7 @@ def frame_scale(length):
 
 
 @jit
-def unit(x, y):
+def unit(x: float, y: float) -> tuple[float, float]:
     """(x, y) / |(x, y)| without overflow or underflow; (0, 0) for a zero or non-finite vector."""
     big = max(abs(x), abs(y))
     if not (big > 0.0 and big < INF):
@@ -299,7 +343,7 @@ def unit(x, y):
 
 
 @row_jit
-def unit_ordinary(x, y):
+def unit_ordinary(x: float, y: float) -> tuple[float, float]:
     """(x, y) / |(x, y)| for a vector of ordinary length (``unit`` rescales the others first)."""
     n = norm(x, y)
     return x / n, y / n
@@ -318,7 +362,7 @@ SPLIT = 134217729.0
 
 
 @row_jit
-def two_sum(a, b):
+def two_sum(a: float, b: float) -> tuple[float, float]:
     """a + b as s + e exactly (Knuth)."""
     s = a + b
     v = s - a
@@ -326,7 +370,7 @@ def two_sum(a, b):
 
 
 @row_jit
-def two_product_error(a, b, p):
+def two_product_error(a: float, b: float, p: float) -> float:
     """a·b − p exactly for p = fl(a·b) (Dekker; |a|, |b| below 2^996)."""
     c = SPLIT * a
     ah = c - (c - a)
@@ -338,7 +382,7 @@ def two_product_error(a, b, p):
 
 
 @row_jit
-def angle(y, x):
+def angle(y: float, x: float) -> float:
     """atan2(y, x) for 0 ≤ y ≤ 1 and 0 < x ≤ 1, the spiral angle θ from its sine and cosine.
 
     fdlibm's arctangent of the reduced argument t = (n_hi + n_lo)/(d_hi + d_lo),
@@ -375,7 +419,7 @@ def angle(y, x):
 
 
 @jit
-def finite(*values):
+def finite(*values: float) -> bool:
     for v in values:
         if not math.isfinite(v):
             return False
@@ -383,7 +427,7 @@ def finite(*values):
 
 
 @jit
-def worst(a, b):
+def worst(a: float, b: float) -> float:
     """max(a, b), with NaN counted as infinitely bad."""
     if a != a or b != b:
         return INF
@@ -391,7 +435,9 @@ def worst(a, b):
 
 
 @row_jit
-def to_world(x0, y0, x1, y1, x2, y2, x3, y3, ox, oy, scale, flip):
+def to_world(
+    x0: float, y0: float, x1: float, y1: float, x2: float, y2: float, x3: float, y3: float, ox: float, oy: float, scale: float, flip: float
+) -> Points8:
     """Normalised points (x, flip·y) in world coordinates o + scale·(x, flip·y)."""
     sy = scale * flip
     return (ox + scale * x0, oy + sy * y0, ox + scale * x1, oy + sy * y1,
@@ -404,7 +450,7 @@ def to_world(x0, y0, x1, y1, x2, y2, x3, y3, ox, oy, scale, flip):
 
 
 @jit
-def store(out, i, k, x0, y0, x1, y1, x2, y2, x3, y3):
+def store(out: FloatArray, i: int, k: int, x0: float, y0: float, x1: float, y1: float, x2: float, y2: float, x3: float, y3: float) -> None:
     """Write four points into ``out[i, k]`` (4, 2)."""
     out[i, k, 0, 0] = x0
     out[i, k, 0, 1] = y0
@@ -417,7 +463,7 @@ def store(out, i, k, x0, y0, x1, y1, x2, y2, x3, y3):
 
 
 @jit
-def fail(out, i, status, measure):
+def fail(out: FloatArray, i: int, status: int, measure: float) -> Row:
     """A failed row: ``out[i]`` filled with NaN, θ NaN, the status and its measure."""
     for k in range(out.shape[1]):
         store(out, i, k, NAN, NAN, NAN, NAN, NAN, NAN, NAN, NAN)
@@ -438,7 +484,7 @@ def fail(out, i, status, measure):
 
 
 @jit
-def end_leg(x1, y1, x2, y2, x3, y3, inv):
+def end_leg(x1: float, y1: float, x2: float, y2: float, x3: float, y3: float, inv: float) -> tuple[float, float, float, float]:
     """At u = 1 of the Bézier ending b1, b2, b3: the last leg (bx, by) and its length,
     scaled by ``inv``, and the scaled signed curvature (2/3)(a × b)/|b|³, a = b2 − b1."""
     ax = (x2 - x1) * inv
@@ -450,7 +496,19 @@ def end_leg(x1, y1, x2, y2, x3, y3, inv):
 
 
 @jit
-def end_residual(x1, y1, x2, y2, x3, y3, cx, cy, radius, inv, rounding=ROUNDING):
+def end_residual(
+    x1: float,
+    y1: float,
+    x2: float,
+    y2: float,
+    x3: float,
+    y3: float,
+    cx: float,
+    cy: float,
+    radius: float,
+    inv: float,
+    rounding: float = ROUNDING,
+) -> float:
     """How far the end (b1, b2, b3) of a Bézier is from joining circle (c, radius) G2.
 
     ``radius`` is signed by the travel sense of the Bézier (positive:
@@ -477,7 +535,9 @@ def end_residual(x1, y1, x2, y2, x3, y3, cx, cy, radius, inv, rounding=ROUNDING)
 
 
 @jit
-def start_residual(x0, y0, x1, y1, x2, y2, tx, ty, inv):
+def start_residual(
+    x0: float, y0: float, x1: float, y1: float, x2: float, y2: float, tx: float, ty: float, inv: float
+) -> tuple[float, float]:
     """How far the start (b0, b1, b2) of a Bézier is from leaving along unit t with
     zero curvature (tangent angle, κ(0) × first leg; b1 − b0 must point along t).
     Also returns 1/|b1 − b0| (scaled)."""
@@ -495,7 +555,9 @@ def start_residual(x0, y0, x1, y1, x2, y2, tx, ty, inv):
 
 
 @jit
-def line_residual(x0, y0, x1, y1, x2, y2, px, py, tx, ty, inv):
+def line_residual(
+    x0: float, y0: float, x1: float, y1: float, x2: float, y2: float, px: float, py: float, tx: float, ty: float, inv: float
+) -> float:
     """How far the start (b0, b1, b2) of a spiral is from leaving the line through p
     along unit t with zero curvature (gap / first leg, tangent angle, κ(0) × first leg)."""
     res, inv_la = start_residual(x0, y0, x1, y1, x2, y2, tx, ty, inv)
@@ -506,14 +568,28 @@ def line_residual(x0, y0, x1, y1, x2, y2, px, py, tx, ty, inv):
 
 
 @jit
-def opposite_angle(ux, uy, lu, vx, vy, lv):
+def opposite_angle(ux: float, uy: float, lu: float, vx: float, vy: float, lv: float) -> float:
     """The tangent angle between u and −v (sine), given their lengths; infinite
     unless they point apart (two spirals' legs at the point they share)."""
     return abs(ux * vy - uy * vx) / (lu * lv) + (INF if ux * vx + uy * vy >= 0.0 else 0.0)
 
 
 @jit
-def joint_residual(ax1, ay1, ax2, ay2, ax3, ay3, bx1, by1, bx2, by2, bx3, by3, inv):
+def joint_residual(
+    ax1: float,
+    ay1: float,
+    ax2: float,
+    ay2: float,
+    ax3: float,
+    ay3: float,
+    bx1: float,
+    by1: float,
+    bx2: float,
+    by2: float,
+    bx3: float,
+    by3: float,
+    inv: float,
+) -> tuple[float, float, float]:
     """How far two spirals that meet at their ends (b3 of both, travelled towards
     each other) are from a G2 joint: gap, tangent angle, curvature jump × leg.
     Also returns the first spiral's scaled end curvature and end leg."""
@@ -542,13 +618,13 @@ FIT2 = FIT * FIT
 
 
 @row_jit
-def moderate(v):
+def moderate(v: float) -> bool:
     """Whether a squared length lies where the squared tests cannot overflow or underflow."""
     return 1e-100 < v < 1e100
 
 
 @row_jit
-def start_fits(x0, y0, x1, y1, x2, y2, tx, ty, inv):
+def start_fits(x0: float, y0: float, x1: float, y1: float, x2: float, y2: float, tx: float, ty: float, inv: float) -> bool:
     """Sufficient for ``start_residual`` ≤ VERIFY_TOL: |t × a| ≤ tol·|a| and
     |(2/3) a × b| ≤ tol·|a|², a = b1 − b0 along t, b = b2 − b1."""
     ax = (x1 - x0) * inv
@@ -562,7 +638,9 @@ def start_fits(x0, y0, x1, y1, x2, y2, tx, ty, inv):
 
 
 @row_jit
-def line_fits(x0, y0, x1, y1, x2, y2, px, py, tx, ty, inv):
+def line_fits(
+    x0: float, y0: float, x1: float, y1: float, x2: float, y2: float, px: float, py: float, tx: float, ty: float, inv: float
+) -> bool:
     """Sufficient for ``line_residual`` ≤ VERIFY_TOL: ``start_fits`` and |t × (b0 − p)| plus its
     rounding ≤ tol·|a|."""
     ax = (x1 - x0) * inv
@@ -574,7 +652,7 @@ def line_fits(x0, y0, x1, y1, x2, y2, px, py, tx, ty, inv):
 
 
 @row_jit
-def opposite_fits(ux, uy, vx, vy):
+def opposite_fits(ux: float, uy: float, vx: float, vy: float) -> bool:
     """Sufficient for ``opposite_angle`` ≤ VERIFY_TOL: u·v < 0 and |u × v| ≤ tol·|u||v|."""
     uu = ux * ux + uy * uy
     vv = vx * vx + vy * vy
@@ -583,7 +661,19 @@ def opposite_fits(ux, uy, vx, vy):
 
 
 @row_jit
-def end_fits(x1, y1, x2, y2, x3, y3, cx, cy, radius, inv, rounding=ROUNDING):
+def end_fits(
+    x1: float,
+    y1: float,
+    x2: float,
+    y2: float,
+    x3: float,
+    y3: float,
+    cx: float,
+    cy: float,
+    radius: float,
+    inv: float,
+    rounding: float = ROUNDING,
+) -> bool:
     """Sufficient for ``end_residual`` ≤ VERIFY_TOL, with o = b3 − c, b the end leg,
     r = radius and L = min(|b|, |r|): |o·o − r²| plus its rounding ≤ tol·|r|·L (then ||o| − |r|| ≤ tol·L),
     |b·o| ≤ tol·|b||o| with o × b of the sign of r, and |K·r − |b|³|·L ≤ tol·|b|³·|r|
@@ -615,7 +705,7 @@ def end_fits(x1, y1, x2, y2, x3, y3, cx, cy, radius, inv, rounding=ROUNDING):
 
 
 @jit
-def spiral_row(bx, by, dx, dy, theta, curvature, shape, out, i):
+def spiral_row(bx: float, by: float, dx: float, dy: float, theta: float, curvature: float, shape: int, out: FloatArray, i: int) -> Row:
     """Theorem 3.1 (or the shape's own legs): the spiral from (bx, by) along d turning by θ to curvature c."""
     if not finite(bx, by, dx, dy, theta, curvature):
         return fail(out, i, NOT_FINITE, NAN)
@@ -666,7 +756,7 @@ def spiral_row(bx, by, dx, dy, theta, curvature, shape, out, i):
 
 
 @jit
-def unit_spirals_batch(sin_t, cos_t, shape, out):
+def unit_spirals_batch(sin_t: FloatArray, cos_t: FloatArray, shape: int, out: FloatArray) -> None:
     """Spirals of ``shape`` from the origin along +x, turning left by θ to end radius 1 (one per row)."""
     rows = out.reshape((out.shape[0], 1, 4, 2))
     for i in range(sin_t.shape[0]):
@@ -679,14 +769,14 @@ def unit_spirals_batch(sin_t, cos_t, shape, out):
 
 
 @jit
-def _secant(lo, f_lo, hi, f_hi):
+def _secant(lo: float, f_lo: float, hi: float, f_hi: float) -> float:
     """The regula falsi point of the bracket [lo, hi] (its middle if that falls outside)."""
     x = (lo * f_hi - hi * f_lo) / (f_hi - f_lo)
     return x if lo < x < hi else 0.5 * (lo + hi)
 
 
 @jit
-def _illinois(lo, f_lo, hi, f_hi, side, x, f):
+def _illinois(lo: float, f_lo: float, hi: float, f_hi: float, side: int, x: float, f: float) -> tuple[float, float, float, float, int]:
     """Bracket [lo, hi] of an increasing function updated with the new point (x, f).
 
     The Illinois rule halves the value kept at an end that stays twice in a
@@ -707,7 +797,7 @@ C_CASE = 2
 
 
 @jit
-def shape_max_w(shape):
+def shape_max_w(shape: int) -> float:
     """The largest sin²θ of the shape's family (1: any θ < π/2)."""
     if shape == NEAR_LINEAR:
         return 1.0 - NEAR_LINEAR_MIN_COS * NEAR_LINEAR_MIN_COS
@@ -715,7 +805,7 @@ def shape_max_w(shape):
 
 
 @jit
-def _offset_measure(case, shape, w, a_hat):
+def _offset_measure(case: int, shape: int, w: float, a_hat: float) -> float:
     """The left-hand side of a circle pair's equation in w = sin²θ, increasing from 0.
 
     S: g1² + g2² − 1. C: Â·(g1² − 1) + g2² with Â = (r1 − r0)²/(r1 + r0)².
@@ -730,7 +820,7 @@ def _offset_measure(case, shape, w, a_hat):
 
 
 @jit
-def _solve_offset(case, shape, target, a_hat):
+def _solve_offset(case: int, shape: int, target: float, a_hat: float) -> float:
     """w = sin²θ where ``_offset_measure`` reaches ``target`` > 0; NaN beyond the shape's range."""
     hi = shape_max_w(shape)
     f_hi = _offset_measure(case, shape, hi, a_hat) - target
@@ -773,7 +863,7 @@ NL_LINE_F0, NL_LINE_F1, NL_LINE_F2, NL_LINE_F3 = _near_linear_line_cubic()
 
 
 @row_jit
-def _near_linear_line_step(q9, x, lo, hi, done):
+def _near_linear_line_step(q9: float, x: float, lo: float, hi: float, done: bool) -> tuple[float, float, float, bool]:
     """One safeguarded Newton step for cos θ = 5/6 + x of the near-linear continuation
     (33.56° ≤ θ ≤ 50°) that shifts its circle by q = q9/9: the root of
     F = 9c·(g1(θ) − 1 − q), a cubic in x that falls with x (``_near_linear_line_cubic``),
@@ -794,7 +884,7 @@ FAST_NEWTON_STEPS = 6
 
 
 @row_jit
-def _near_linear_line_start(q9):
+def _near_linear_line_start(q9: float) -> tuple[bool, float, float, float]:
     """The bracket [cos 50° − 5/6, 0] of x = cos θ − 5/6 on the near-linear continuation,
     its secant point and whether the shift is within reach (F > 0 at 50°)."""
     lo = NEAR_LINEAR_MIN_COS - EQUAL_LEG_COS
@@ -804,7 +894,7 @@ def _near_linear_line_start(q9):
 
 
 @row_jit
-def line_circle_angle_fast(shape, shift, measure):
+def line_circle_angle_fast(shape: int, shift: float, measure: float) -> tuple[bool, float, float]:
     """(found, sin θ, cos θ) of the spiral that shifts its circle by ``shift`` = g1(θ) − 1 > 0
     (``measure`` = d/r = 1 + shift) in straight-line code: the 1996 spiral's closed
     form, the near-linear equal-leg closed form (shift < 1/27) or, beyond it,
@@ -830,7 +920,7 @@ def line_circle_angle_fast(shape, shift, measure):
 
 
 @jit
-def line_circle_angle(shape, shift, measure):
+def line_circle_angle(shape: int, shift: float, measure: float) -> tuple[bool, float, float]:
     """``line_circle_angle_fast`` for any row: (found, sin θ, cos θ); ``found`` False
     beyond the shape's reach."""
     found, sin_t, cos_t = line_circle_angle_fast(shape, shift, measure)
@@ -850,7 +940,20 @@ def line_circle_angle(shape, shift, measure):
 
 
 @row_jit
-def line_circle_spiral(px, py, tx, ty, vx, vy, rs, sin_t, cos_t, side, shape, scale):
+def line_circle_spiral(
+    px: float,
+    py: float,
+    tx: float,
+    ty: float,
+    vx: float,
+    vy: float,
+    rs: float,
+    sin_t: float,
+    cos_t: float,
+    side: float,
+    shape: int,
+    scale: float,
+) -> Points8:
     """Theorem 4.1's spiral in world coordinates: it leaves the line through p along
     t and reaches radius ``rs`` (normalised) on the side ``side`` of the line, the
     circle's centre at v from p (normalised)."""
@@ -864,7 +967,9 @@ def line_circle_spiral(px, py, tx, ty, vx, vy, rs, sin_t, cos_t, side, shape, sc
 
 
 @row_jit
-def line_to_circle_fast(px, py, dx, dy, cx, cy, r, shape):
+def line_to_circle_fast(
+    px: float, py: float, dx: float, dy: float, cx: float, cy: float, r: float, shape: int
+) -> tuple[bool, float, float, float, float, float, float, float, float, float, float, float]:
     """``line_to_circle_row`` in straight-line code for the ordinary row: every number
     finite, the direction's and the radius's size within 1e-60 … 1e60 (a frame of
     scale 1), the circle clear of the line, an angle the shape reaches and a verification
@@ -891,7 +996,9 @@ def line_to_circle_fast(px, py, dx, dy, cx, cy, r, shape):
 
 
 @jit
-def line_to_circle_general(px, py, dx, dy, cx, cy, r, shape, out, i):
+def line_to_circle_general(
+    px: float, py: float, dx: float, dy: float, cx: float, cy: float, r: float, shape: int, out: FloatArray, i: int
+) -> Row:
     """``line_to_circle_row`` for any row: checks, scaled frames, every shape."""
     if not finite(px, py, dx, dy, cx, cy, r):
         return fail(out, i, NOT_FINITE, NAN)
@@ -929,7 +1036,9 @@ def line_to_circle_general(px, py, dx, dy, cx, cy, r, shape, out, i):
 
 
 @jit
-def line_to_circle_row(px, py, dx, dy, cx, cy, r, shape, out, i):
+def line_to_circle_row(
+    px: float, py: float, dx: float, dy: float, cx: float, cy: float, r: float, shape: int, out: FloatArray, i: int
+) -> Row:
     """Theorem 4.1: spiral from the directed line (p, d) to circle (c, r > 0).
 
     ``extra`` is the turn side: +1 left, −1 right.
@@ -945,20 +1054,20 @@ def line_to_circle_row(px, py, dx, dy, cx, cy, r, shape, out, i):
 
 
 @row_jit
-def _frame_vector(dx, dy, p, q):
+def _frame_vector(dx: float, dy: float, p: float, q: float) -> tuple[float, float]:
     """A vector along T where (dx, dy) = p·T + q·rot90(T), up to scale."""
     return p * dx + q * dy, p * dy - q * dx
 
 
 @jit
-def _frame_from_offset(dx, dy, p, q):
+def _frame_from_offset(dx: float, dy: float, p: float, q: float) -> tuple[float, float]:
     """Unit T with (dx, dy) = p·T + q·rot90(T) (up to scale)."""
     fx, fy = _frame_vector(dx, dy, p, q)
     return unit(fx, fy)
 
 
 @row_jit
-def _s_pair_w(eps, measure):
+def _s_pair_w(eps: float, measure: float) -> float:
     """w = sin²θ of the 1996 S pair, a quadratic in w; eps = D/(r0 + r1) − 1 = measure − 1."""
     gamma = -729.0 * eps * (2.0 + eps)
     beta = 1458.0 * measure * measure - 1208.0
@@ -967,7 +1076,7 @@ def _s_pair_w(eps, measure):
 
 
 @row_jit
-def _broken_back_cubic(a_hat, delta, one_minus_a):
+def _broken_back_cubic(a_hat: float, delta: float, one_minus_a: float) -> tuple[float, float, float, float]:
     """Coefficients (c0 … c3) of the broken-back C equation in w = sin²θ, scaled by B:
 
     f(w) = 9Â(1−w)(9−4w)² + w(13+12w)² − 729 D̂²(1−w)², with δ = D̂² − Â > 0,
@@ -978,7 +1087,9 @@ def _broken_back_cubic(a_hat, delta, one_minus_a):
 
 
 @row_jit
-def _broken_back_step(c0, c1, c2, c3, w, lo, hi, done):
+def _broken_back_step(
+    c0: float, c1: float, c2: float, c3: float, w: float, lo: float, hi: float, done: bool
+) -> tuple[float, float, float, bool]:
     """One safeguarded Halley step for the root of the C cubic in the bracket [lo, hi]:
     (w, lo, hi, done), left as it is once ``done`` (w the root found)."""
     f = ((c3 * w + c2) * w + c1) * w + c0
@@ -1000,7 +1111,7 @@ FAST_HALLEY_STEPS = 6
 
 
 @jit
-def _broken_back_w(a_hat, delta, one_minus_a):
+def _broken_back_w(a_hat: float, delta: float, one_minus_a: float) -> float:
     """Root w = sin²θ in (0, 1) of the broken-back C cubic (~3 Halley steps from the secant guess)."""
     c0, c1, c2, c3 = _broken_back_cubic(a_hat, delta, one_minus_a)
     w, lo, hi, done = -c0 / (625.0 - c0), 0.0, 1.0, False
@@ -1012,7 +1123,7 @@ def _broken_back_w(a_hat, delta, one_minus_a):
 
 
 @row_jit
-def _pair_gap(s_shape, dist, a0, a1):
+def _pair_gap(s_shape: bool, dist: float, a0: float, a1: float) -> tuple[float, float]:
     """(gap, D/gap): the centres must lie more than ``gap`` apart (r0 + r1 for an S,
     |r1 − r0| for a C)."""
     gap = a0 + a1 if s_shape else abs(a1 - a0)
@@ -1020,7 +1131,22 @@ def _pair_gap(s_shape, dist, a0, a1):
 
 
 @row_jit
-def _pair_spirals(dx, dy, tx, ty, a0, a1, sin_t, cos_t, shape, s_shape, ox, oy, scale, flip):
+def _pair_spirals(
+    dx: float,
+    dy: float,
+    tx: float,
+    ty: float,
+    a0: float,
+    a1: float,
+    sin_t: float,
+    cos_t: float,
+    shape: int,
+    s_shape: bool,
+    ox: float,
+    oy: float,
+    scale: float,
+    flip: float,
+) -> tuple[float, float, float, float, float, float, float, float, float, float, float, float, float, float]:
     """The C/S pair in world coordinates: Q1 = (s0, s1, s2, s3) and Q0 as built from
     their common start B0 = s0 = C1 − r1·g2·T − r1·g1·N, (s0, u1, u2, u3): Q1 turns
     left towards N, Q0 leaves along −T towards +N (C) or −N (S). Returns s0 … s3, u1 … u3."""
@@ -1042,7 +1168,9 @@ def _pair_spirals(dx, dy, tx, ty, a0, a1, sin_t, cos_t, shape, s_shape, ox, oy, 
 
 
 @row_jit
-def _pair_frame(dx, dy, a0, a1, sin_t, cos_t, gap_p, gap_q, shape):
+def _pair_frame(
+    dx: float, dy: float, a0: float, a1: float, sin_t: float, cos_t: float, gap_p: float, gap_q: float, shape: int
+) -> tuple[float, float]:
     """The vector along the common start tangent T: circle 1's centre lies at
     P·g2·T + Q·g1·rot90(T) from circle 0's (P, Q = ``gap_p``, ``gap_q``)."""
     alpha, beta, gamma = leg_factors(shape, cos_t)
@@ -1052,7 +1180,31 @@ def _pair_frame(dx, dy, a0, a1, sin_t, cos_t, gap_p, gap_q, shape):
 
 
 @row_jit
-def _pair_fits(s0x, s0y, s1x, s1y, s2x, s2y, s3x, s3y, u1x, u1y, u2x, u2y, u3x, u3y, wtx, wty, c0x, c0y, r0, c1x, c1y, r1, inv):
+def _pair_fits(
+    s0x: float,
+    s0y: float,
+    s1x: float,
+    s1y: float,
+    s2x: float,
+    s2y: float,
+    s3x: float,
+    s3y: float,
+    u1x: float,
+    u1y: float,
+    u2x: float,
+    u2y: float,
+    u3x: float,
+    u3y: float,
+    wtx: float,
+    wty: float,
+    c0x: float,
+    c0y: float,
+    r0: float,
+    c1x: float,
+    c1y: float,
+    r1: float,
+    inv: float,
+) -> bool:
     """Sufficient tests (``*_fits``) of the pair: Q0 leaves circle 0, Q1 reaches circle 1,
     both leave B0 = s0 along ∓T (world T = (wtx, wty)) with zero curvature, and
     their first legs are opposite there (each within the tolerance of T is not
@@ -1065,7 +1217,9 @@ def _pair_fits(s0x, s0y, s1x, s1y, s2x, s2y, s3x, s3y, u1x, u1y, u2x, u2y, u3x, 
 
 
 @row_jit
-def circle_to_circle_fast(c0x, c0y, r0, c1x, c1y, r1, shape):
+def circle_to_circle_fast(
+    c0x: float, c0y: float, r0: float, c1x: float, c1y: float, r1: float, shape: int
+) -> tuple[bool, float, float, float, float, float, float, float, float, float, float, float, float, float, float, float, float]:
     """``circle_to_circle_row`` in straight-line code for the ordinary row (see
     ``line_to_circle_fast``): finite input, radii within 1e-60 … 1e60, the 1996
     spiral, a C solved within ``FAST_HALLEY_STEPS``. Returns (ok, θ, measure,
@@ -1105,7 +1259,9 @@ def circle_to_circle_fast(c0x, c0y, r0, c1x, c1y, r1, shape):
 
 
 @jit
-def circle_to_circle_general(c0x, c0y, r0, c1x, c1y, r1, shape, out, i):
+def circle_to_circle_general(
+    c0x: float, c0y: float, r0: float, c1x: float, c1y: float, r1: float, shape: int, out: FloatArray, i: int
+) -> Row:
     """``circle_to_circle_row`` for any row: checks, scaled frames, every shape."""
     if not finite(c0x, c0y, r0, c1x, c1y, r1):
         return fail(out, i, NOT_FINITE, NAN)
@@ -1167,7 +1323,7 @@ def circle_to_circle_general(c0x, c0y, r0, c1x, c1y, r1, shape, out, i):
 
 
 @jit
-def circle_to_circle_row(c0x, c0y, r0, c1x, c1y, r1, shape, out, i):
+def circle_to_circle_row(c0x: float, c0y: float, r0: float, c1x: float, c1y: float, r1: float, shape: int, out: FloatArray, i: int) -> Row:
     """Theorems 4.2/4.3: from circle 0 to circle 1, radii signed by travel sense.
 
     Same signs give a broken-back C, opposite signs an S; the pair is
@@ -1186,7 +1342,22 @@ def circle_to_circle_row(c0x, c0y, r0, c1x, c1y, r1, shape, out, i):
 
 
 @row_jit
-def joint_fits(ax1, ay1, ax2, ay2, ax3, ay3, bx1, by1, bx2, by2, bx3, by3, joint, inv):
+def joint_fits(
+    ax1: float,
+    ay1: float,
+    ax2: float,
+    ay2: float,
+    ax3: float,
+    ay3: float,
+    bx1: float,
+    by1: float,
+    bx2: float,
+    by2: float,
+    bx3: float,
+    by3: float,
+    joint: float,
+    inv: float,
+) -> bool:
     """Sufficient for ``joint_residual`` ≤ VERIFY_TOL and for the first spiral's end
     curvature to be ``joint`` (a corner's check): with end legs u, v, κ = K/|u|³ and
     L = min(|u|, |v|, 1/|κa|): |b3a − b3b| ≤ tol·L, |u × v| ≤ tol·|u||v| with u·v < 0,
@@ -1218,7 +1389,20 @@ def joint_fits(ax1, ay1, ax2, ay2, ax3, ay3, bx1, by1, bx2, by2, bx3, by3, joint
 
 
 @row_jit
-def _corner_pair(px, py, t0x, t0y, t1x, t1y, a, sin_t, cos_t, side, shape, scale):
+def _corner_pair(
+    px: float,
+    py: float,
+    t0x: float,
+    t0y: float,
+    t1x: float,
+    t1y: float,
+    a: float,
+    sin_t: float,
+    cos_t: float,
+    side: float,
+    shape: int,
+    scale: float,
+) -> tuple[float, float, float, float, float, float, float, float, float, float, float, float, float, float, float, float, float]:
     """Theorem 4.4's pair, its starts ``a`` before the corner p along each line: the
     joint curvature (normalised) and Q0 (from the first line) and Q1 (built from the
     second line, travelled backwards) in world coordinates."""
@@ -1235,21 +1419,23 @@ def _corner_pair(px, py, t0x, t0y, t1x, t1y, a, sin_t, cos_t, side, shape, scale
 
 
 @row_jit
-def _corner_turn(t0x, t0y, bx, by):
+def _corner_turn(t0x: float, t0y: float, bx: float, by: float) -> tuple[float, float, float]:
     """(cross, sin θ, cos θ) of the corner from the first leg's direction and the unit bisector."""
     cross = t0x * by - t0y * bx
     return cross, abs(cross), t0x * bx + t0y * by
 
 
 @row_jit
-def _corner_start(shape, sin_t, cos_t, shortest, curvature, scale):
+def _corner_start(shape: int, sin_t: float, cos_t: float, shortest: float, curvature: float, scale: float) -> float:
     """How far before the corner the pair starts: the shorter leg (curvature NaN,
     Corollary 4.5) or K(θ)/κ."""
     return shortest if math.isnan(curvature) else corner_relation(shape, sin_t, cos_t, curvature * scale)
 
 
 @row_jit
-def line_to_line_fast(p0x, p0y, px, py, p1x, p1y, curvature, shape):
+def line_to_line_fast(
+    p0x: float, p0y: float, px: float, py: float, p1x: float, p1y: float, curvature: float, shape: int
+) -> tuple[bool, float, float, float, float, float, float, float, float, float, float, float, float, float, float, float, float, float, float]:
     """``line_to_line_row`` in straight-line code for the ordinary row (see
     ``line_to_circle_fast``): legs and their difference of ordinary size, a turn
     inside the shape's range, legs long enough. Returns (ok, θ, measure, Q0, Q1 as built)."""
@@ -1285,7 +1471,32 @@ def line_to_line_fast(p0x, p0y, px, py, p1x, p1y, curvature, shape):
 
 
 @jit
-def pair_residual(x0, y0, x1, y1, x2, y2, x3, y3, v0x, v0y, v1x, v1y, v2x, v2y, v3x, v3y, px, py, t0x, t0y, t1x, t1y, joint, inv):
+def pair_residual(
+    x0: float,
+    y0: float,
+    x1: float,
+    y1: float,
+    x2: float,
+    y2: float,
+    x3: float,
+    y3: float,
+    v0x: float,
+    v0y: float,
+    v1x: float,
+    v1y: float,
+    v2x: float,
+    v2y: float,
+    v3x: float,
+    v3y: float,
+    px: float,
+    py: float,
+    t0x: float,
+    t0y: float,
+    t1x: float,
+    t1y: float,
+    joint: float,
+    inv: float,
+) -> float:
     """How far a corner's spiral pair is from rounding it G2: the first spiral (x, y)
     must leave the line through corner p along unit t0, the second (v, read
     backwards from its end) the line through p along unit t1 (pointing at the
@@ -1301,7 +1512,9 @@ def pair_residual(x0, y0, x1, y1, x2, y2, x3, y3, v0x, v0y, v1x, v1y, v2x, v2y, 
 
 
 @jit
-def corner_residual(pair, px, py, t0x, t0y, t1x, t1y, joint, inv):
+def corner_residual(
+    pair: FloatArray, px: float, py: float, t0x: float, t0y: float, t1x: float, t1y: float, joint: float, inv: float
+) -> float:
     """``pair_residual`` of a pair stored in travel order, ``pair`` (2, 4, 2)."""
     a, b = pair[0], pair[1]
     return pair_residual(
@@ -1312,7 +1525,9 @@ def corner_residual(pair, px, py, t0x, t0y, t1x, t1y, joint, inv):
 
 
 @jit
-def line_to_line_general(p0x, p0y, px, py, p1x, p1y, curvature, shape, out, i):
+def line_to_line_general(
+    p0x: float, p0y: float, px: float, py: float, p1x: float, p1y: float, curvature: float, shape: int, out: FloatArray, i: int
+) -> Row:
     """``line_to_line_row`` for any row: checks, scaled frames, every shape."""
     if not finite(p0x, p0y, px, py, p1x, p1y):
         return fail(out, i, NOT_FINITE, NAN)
@@ -1369,7 +1584,9 @@ def line_to_line_general(p0x, p0y, px, py, p1x, p1y, curvature, shape, out, i):
 
 
 @jit
-def line_to_line_row(p0x, p0y, px, py, p1x, p1y, curvature, shape, out, i):
+def line_to_line_row(
+    p0x: float, p0y: float, px: float, py: float, p1x: float, p1y: float, curvature: float, shape: int, out: FloatArray, i: int
+) -> Row:
     """Theorem 4.4: two spirals from line p0→p to line p→p1.
 
     ``curvature`` > 0 is the joint curvature magnitude; NaN applies Corollary
@@ -1393,13 +1610,13 @@ def line_to_line_row(p0x, p0y, px, py, p1x, p1y, curvature, shape, out, i):
 
 
 @jit
-def shape_max_theta(shape):
+def shape_max_theta(shape: int) -> float:
     """The largest spiral angle of the shape's family (π/2, exclusive, for the κ'(1) = 0 members)."""
     return NEAR_LINEAR_MAX_THETA if shape == NEAR_LINEAR else math.pi / 2.0
 
 
 @jit
-def nested_band_lower(q, shape):
+def nested_band_lower(q: float, shape: int) -> float:
     """Infimum of D/(r0 − r1) for one spiral between nested circles, q = r1/r0.
 
     The distance between the centres falls as the spiral angle grows, so the
@@ -1408,14 +1625,14 @@ def nested_band_lower(q, shape):
     spirals the value at 50°.
     """
     if shape == WALTON_MEEK:
-        c = q ** (1.0 / 3.0)
+        c: float = q ** (1.0 / 3.0)  # a positive float to a float power (typeshed says Any)
         return (c - q) * math.sqrt(1.25 + 1.0 / (c * c)) / (1.0 - q)
     x, y = nested_center_offset(shape_max_theta(shape), 1.0, q, shape)[:2]
     return norm(x, y) / (1.0 - q)
 
 
 @jit
-def _nested_sigma(q, alpha, beta, gamma, sin_t, cos_t):
+def _nested_sigma(q: float, alpha: float, beta: float, gamma: float, sin_t: float, cos_t: float) -> float:
     """σ = 1 − t where κ(t) = q·κ(1): κ grows along the spiral, so an Illinois
     search on σ ∈ (0, 1) of q − κ(1 − σ)/κ(1) (increasing in σ)."""
     lo = 0.0
@@ -1434,7 +1651,9 @@ def _nested_sigma(q, alpha, beta, gamma, sin_t, cos_t):
 
 
 @jit
-def nested_center_offset(theta, r0, r1, shape):
+def nested_center_offset(
+    theta: float, r0: float, r1: float, shape: int
+) -> tuple[float, float, float, float, float, float, float, float, float, float, float]:
     """The fifth case for spiral angle θ: circle 1's centre relative to circle 0's.
 
     The spiral of ``shape`` turning by θ onto r1 meets the larger circle r0
@@ -1476,7 +1695,9 @@ def nested_center_offset(theta, r0, r1, shape):
 
 
 @jit
-def _nested_canonical(dx, dy, r0, r1, shape):
+def _nested_canonical(
+    dx: float, dy: float, r0: float, r1: float, shape: int
+) -> tuple[int, float, float, float, float, float, float, float, float, float, float, float]:
     """Fifth case, r0 > r1 > 0: the spiral piece [t, 1] from Ω0 to Ω1.
 
     Solves |C1 − C0|(θ) = D by Illinois regula falsi on θ between 0 and the
@@ -1515,7 +1736,7 @@ def _nested_canonical(dx, dy, r0, r1, shape):
 
 
 @row_jit
-def circle_in_circle_row(c0x, c0y, r0, c1x, c1y, r1, shape, out, i):
+def circle_in_circle_row(c0x: float, c0y: float, r0: float, c1x: float, c1y: float, r1: float, shape: int, out: FloatArray, i: int) -> Row:
     """Fifth case: one spiral from circle 0 to the nested circle 1 (or out of it).
 
     Radii are signed by travel sense and must share the sign.
@@ -1572,7 +1793,7 @@ def circle_in_circle_row(c0x, c0y, r0, c1x, c1y, r1, shape, out, i):
 
 
 @jit
-def polynomial_values(coefficients, u, out):
+def polynomial_values(coefficients: FloatArray, u: FloatArray, out: FloatArray) -> None:
     """``out[i, j]``: coordinate j of the polynomial at ``u[i]``, by Horner's rule.
 
     ``coefficients`` (k, d), lowest first, with k ≤ 4 (a cubic Bézier and its
@@ -1597,7 +1818,7 @@ def polynomial_values(coefficients, u, out):
 
 
 @jit
-def plane_curvatures(first, second, scale, u, out):
+def plane_curvatures(first: FloatArray, second: FloatArray, scale: float, u: FloatArray, out: FloatArray) -> None:
     """``out[i]``: signed curvature (Q' × Q'')/|Q'|³ at ``u[i]`` of a plane curve, from
     the power coefficients of Q' (3, 2) and Q'' (2, 2) divided by ``scale``."""
     for i in range(u.shape[0]):
@@ -1619,7 +1840,7 @@ def plane_curvatures(first, second, scale, u, out):
 
 
 @jit
-def step(a):
+def step(a: FloatArray) -> int:
     """1 for an input with a row per problem, 0 for one row shared by all."""
     return 1 if a.shape[0] > 1 else 0
 
@@ -1631,7 +1852,17 @@ BLOCK = 256
 
 
 @jit
-def line_to_circle_batch(p, d, c, r, shape, out, status, theta, measure):
+def line_to_circle_batch(
+    p: FloatArray,
+    d: FloatArray,
+    c: FloatArray,
+    r: FloatArray,
+    shape: int,
+    out: FloatArray,
+    status: StatusArray,
+    theta: FloatArray,
+    measure: FloatArray,
+) -> None:
     sp, sd, sc, sr = step(p), step(d), step(c), step(r)
     cols = np.empty(7 * BLOCK)  # px, py, dx, dy, cx, cy, r of the block's rows
     res = np.empty(12 * BLOCK)  # ok, θ, measure, x0 … y3
@@ -1658,7 +1889,7 @@ def line_to_circle_batch(p, d, c, r, shape, out, status, theta, measure):
                       res[8 * BLOCK + k], res[9 * BLOCK + k], res[10 * BLOCK + k], res[11 * BLOCK + k])  # fmt: skip
                 status[i], theta[i], measure[i] = OK, res[BLOCK + k], res[2 * BLOCK + k]
             else:
-                row = line_to_circle_general(
+                row = line_to_circle_general(  # type: ignore[assignment]  # numba types each assignment of a name on its own
                     cols[k], cols[BLOCK + k], cols[2 * BLOCK + k], cols[3 * BLOCK + k],
                     cols[4 * BLOCK + k], cols[5 * BLOCK + k], cols[6 * BLOCK + k], shape, out, i,
                 )  # fmt: skip
@@ -1666,7 +1897,17 @@ def line_to_circle_batch(p, d, c, r, shape, out, status, theta, measure):
 
 
 @jit
-def circle_to_circle_batch(c0, r0, c1, r1, shape, out, status, theta, measure):
+def circle_to_circle_batch(
+    c0: FloatArray,
+    r0: FloatArray,
+    c1: FloatArray,
+    r1: FloatArray,
+    shape: int,
+    out: FloatArray,
+    status: StatusArray,
+    theta: FloatArray,
+    measure: FloatArray,
+) -> None:
     s0, sr0, s1, sr1 = step(c0), step(r0), step(c1), step(r1)
     cols = np.empty(6 * BLOCK)  # c0x, c0y, r0, c1x, c1y, r1 of the block's rows
     res = np.empty(17 * BLOCK)  # ok, θ, measure, s0 … s3, u1 … u3
@@ -1698,7 +1939,7 @@ def circle_to_circle_batch(c0, r0, c1, r1, shape, out, status, theta, measure):
                       res[9 * BLOCK + k], res[10 * BLOCK + k])  # fmt: skip
                 status[i], theta[i], measure[i] = OK, res[BLOCK + k], res[2 * BLOCK + k]
             else:
-                row = circle_to_circle_general(
+                row = circle_to_circle_general(  # type: ignore[assignment]  # numba types each assignment of a name on its own
                     cols[k], cols[BLOCK + k], cols[2 * BLOCK + k], cols[3 * BLOCK + k], cols[4 * BLOCK + k], cols[5 * BLOCK + k],
                     shape, out, i,
                 )  # fmt: skip
@@ -1706,7 +1947,17 @@ def circle_to_circle_batch(c0, r0, c1, r1, shape, out, status, theta, measure):
 
 
 @jit
-def line_to_line_batch(p0, p, p1, k, shape, out, status, theta, measure):
+def line_to_line_batch(
+    p0: FloatArray,
+    p: FloatArray,
+    p1: FloatArray,
+    k: FloatArray,
+    shape: int,
+    out: FloatArray,
+    status: StatusArray,
+    theta: FloatArray,
+    measure: FloatArray,
+) -> None:
     s0, sp, s1, sk = step(p0), step(p), step(p1), step(k)
     cols = np.empty(7 * BLOCK)  # p0x, p0y, px, py, p1x, p1y, curvature of the block's rows
     res = np.empty(19 * BLOCK)  # ok, θ, measure, Q0, Q1 as built
@@ -1737,7 +1988,7 @@ def line_to_line_batch(p0, p, p1, k, shape, out, status, theta, measure):
                       res[15 * BLOCK + j], res[16 * BLOCK + j], res[17 * BLOCK + j], res[18 * BLOCK + j])  # fmt: skip
                 status[i], theta[i], measure[i] = OK, res[BLOCK + j], res[2 * BLOCK + j]
             else:
-                row = line_to_line_general(
+                row = line_to_line_general(  # type: ignore[assignment]  # numba types each assignment of a name on its own
                     cols[j], cols[BLOCK + j], cols[2 * BLOCK + j], cols[3 * BLOCK + j],
                     cols[4 * BLOCK + j], cols[5 * BLOCK + j], cols[6 * BLOCK + j], shape, out, i,
                 )  # fmt: skip
@@ -1745,7 +1996,18 @@ def line_to_line_batch(p0, p, p1, k, shape, out, status, theta, measure):
 
 
 @jit
-def circle_in_circle_batch(c0, r0, c1, r1, shape, out, status, theta, measure, param):
+def circle_in_circle_batch(
+    c0: FloatArray,
+    r0: FloatArray,
+    c1: FloatArray,
+    r1: FloatArray,
+    shape: int,
+    out: FloatArray,
+    status: StatusArray,
+    theta: FloatArray,
+    measure: FloatArray,
+    param: FloatArray,
+) -> None:
     s0, sr0, s1, sr1 = step(c0), step(r0), step(c1), step(r1)
     for i in range(out.shape[0]):
         i0, j0, i1, j1 = i * s0, i * sr0, i * s1, i * sr1

@@ -23,7 +23,8 @@ def thread_count(n: int, rows_per_thread: int = ROWS_PER_THREAD) -> int:
     ``NUMBA_NUM_THREADS`` (the cores, unless the environment says otherwise)."""
     from numba import config  # the batch that asks has compiled kernels: numba is loaded
 
-    return max(1, min(config.NUMBA_NUM_THREADS, n // rows_per_thread))
+    cores: int = config.NUMBA_NUM_THREADS  # type: ignore[attr-defined]  # set at import by numba's config, not in its stubs
+    return max(1, min(cores, n // rows_per_thread))
 
 
 def run_split(kernel: Any, args: list[Any], n: int, rows_per_thread: int = ROWS_PER_THREAD) -> None:

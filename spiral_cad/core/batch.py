@@ -8,7 +8,9 @@ that the scalar API uses (large batches split over threads) and returns a
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -39,18 +41,19 @@ class BatchResult:
     """
 
     case: str
-    spirals: tuple[NDArray, ...]
-    theta: NDArray
-    status: NDArray
-    measure: NDArray
-    parameter: NDArray | None
-    inputs: dict[str, NDArray]
+    spirals: tuple[NDArray[np.float64], ...]
+    theta: NDArray[np.float64]
+    status: NDArray[np.int8]
+    measure: NDArray[np.float64]
+    parameter: NDArray[np.float64] | None
+    inputs: dict[str, NDArray[np.float64]]
     shape: str = DEFAULT_SHAPE
 
     @property
-    def ok(self) -> NDArray:
+    def ok(self) -> NDArray[np.bool_]:
         """Boolean mask of solved rows."""
-        return self.status == Status.OK
+        solved: NDArray[np.bool_] = self.status == Status.OK
+        return solved
 
     def __len__(self) -> int:
         return len(self.status)
@@ -65,14 +68,14 @@ class BatchResult:
         """Why row ``i`` failed (the scalar API's error message), or ``"ok"``."""
         if self.status[i] == Status.OK:
             return "ok"
-        row = {k: tuple(v[i].tolist()) if v.ndim > 1 else float(v[i]) for k, v in self.inputs.items()}
+        row: dict[str, Any] = {k: tuple(v[i].tolist()) if v.ndim > 1 else float(v[i]) for k, v in self.inputs.items()}
         if self.case == "line_to_line" and np.isnan(row["curvature"]):
             row["curvature"] = None
         row["shape"] = self.shape
         return describe(self.case, int(self.status[i]), float(self.measure[i]), row)
 
 
-def _rows(**arrays: tuple[ArrayLike, tuple[int, ...]]) -> tuple[dict[str, NDArray], int]:
+def _rows(**arrays: tuple[ArrayLike, tuple[int, ...]]) -> tuple[dict[str, NDArray[np.float64]], int]:
     """Named inputs (value, trailing shape) as C-contiguous float64 arrays, and the row count N.
 
     Each input has N rows or is one row shared by all; a mismatch names both
@@ -93,7 +96,7 @@ def _rows(**arrays: tuple[ArrayLike, tuple[int, ...]]) -> tuple[dict[str, NDArra
     n = max(counts.values(), default=1)
     for name, count in counts.items():
         if count not in (1, n):
-            longest = max(counts, key=counts.get)
+            longest = max(counts, key=counts.__getitem__)
             raise ValueError(f"{name} has {count} rows but {longest} has {n}; each input needs N rows or one")
     rows = {}
     for name, a in parsed.items():
@@ -102,7 +105,7 @@ def _rows(**arrays: tuple[ArrayLike, tuple[int, ...]]) -> tuple[dict[str, NDArra
     return rows, n
 
 
-def _output(out: NDArray | None, n: int, spirals: int, rows: dict[str, NDArray]) -> NDArray:
+def _output(out: NDArray[np.float64] | None, n: int, spirals: int, rows: dict[str, NDArray[np.float64]]) -> NDArray[np.float64]:
     """The (N, k, 4, 2) control-point buffer: ``out`` if given (checked), else new."""
     shape = (n, spirals, 4, 2)
     if out is None:
@@ -117,7 +120,7 @@ def _output(out: NDArray | None, n: int, spirals: int, rows: dict[str, NDArray])
     return out
 
 
-def _run(case: str, kernel, spirals: int, inputs: tuple[dict[str, NDArray], int], out: NDArray | None, shape: str,
+def _run(case: str, kernel: Callable[..., None], spirals: int, inputs: tuple[dict[str, NDArray[np.float64]], int], out: NDArray[np.float64] | None, shape: str,
          extra: bool = False) -> BatchResult:  # fmt: skip
     rows, n = inputs
     out = _output(out, n, spirals, rows)
@@ -137,7 +140,7 @@ def line_to_circle(
     directions: ArrayLike,
     centers: ArrayLike,
     radii: ArrayLike,
-    out: NDArray | None = None,
+    out: NDArray[np.float64] | None = None,
     shape: str = DEFAULT_SHAPE,
 ) -> BatchResult:
     """Theorem 4.1 for N rows: points, directions, centers (N, 2); radii (N,) > 0.
@@ -164,7 +167,7 @@ def circle_to_circle(
     radii0: ArrayLike,
     centers1: ArrayLike,
     radii1: ArrayLike,
-    out: NDArray | None = None,
+    out: NDArray[np.float64] | None = None,
     shape: str = DEFAULT_SHAPE,
 ) -> BatchResult:
     """Theorems 4.2/4.3 for N rows (signed travel-sense radii: C or S per row)."""
@@ -177,7 +180,7 @@ def line_to_line(
     corners: ArrayLike,
     p1: ArrayLike,
     curvatures: ArrayLike | None = None,
-    out: NDArray | None = None,
+    out: NDArray[np.float64] | None = None,
     shape: str = DEFAULT_SHAPE,
 ) -> BatchResult:
     """Theorem 4.4 for N corners; ``curvatures`` NaN (or None) applies Corollary 4.5.
@@ -192,7 +195,7 @@ def circle_in_circle(
     radii0: ArrayLike,
     centers1: ArrayLike,
     radii1: ArrayLike,
-    out: NDArray | None = None,
+    out: NDArray[np.float64] | None = None,
     shape: str = DEFAULT_SHAPE,
 ) -> BatchResult:
     """The fifth case for N rows (nested circles, same-sign radii)."""

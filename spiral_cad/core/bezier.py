@@ -10,6 +10,7 @@ curves by numpy broadcasting.
 from __future__ import annotations
 
 import math
+from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -23,7 +24,7 @@ _U = ((np.arange(_PANELS)[:, None] + 0.5 * (_GL_NODES[None, :] + 1.0)) / _PANELS
 _W = np.tile(_GL_WEIGHTS / (2.0 * _PANELS), _PANELS)
 
 
-def _power_coefficients(cp: NDArray, order: int = 0) -> NDArray:
+def _power_coefficients(cp: NDArray[np.float64], order: int = 0) -> NDArray[np.float64]:
     """Power-basis coefficients of Q (order 0) or of its derivative of order 1-3, lowest first.
 
     ``cp`` is one curve (4, 2) or many (…, 4, 2); the result is (…, k, 2).
@@ -34,7 +35,7 @@ def _power_coefficients(cp: NDArray, order: int = 0) -> NDArray:
     d2 = d1[..., 1:, :] - d1[..., :-1, :]  # Δ²P0, Δ²P1
     d3 = d2[..., 1, :] - d2[..., 0, :]
     if order == 0:
-        terms = (cp[..., 0, :], 3.0 * d1[..., 0, :], 3.0 * d2[..., 0, :], d3)
+        terms: tuple[NDArray[np.float64], ...] = (cp[..., 0, :], 3.0 * d1[..., 0, :], 3.0 * d2[..., 0, :], d3)
     elif order == 1:
         terms = (3.0 * d1[..., 0, :], 6.0 * d2[..., 0, :], 3.0 * d3)
     elif order == 2:
@@ -44,7 +45,7 @@ def _power_coefficients(cp: NDArray, order: int = 0) -> NDArray:
     return np.stack(terms, axis=-2)
 
 
-def _horner(coefficients: NDArray, u: ArrayLike) -> NDArray:
+def _horner(coefficients: NDArray[np.float64], u: ArrayLike) -> NDArray[np.float64]:
     """Evaluate polynomials with 2-D coefficients (…, k, 2), lowest first, at ``u``.
 
     One curve (k, 2) gives ``u.shape + (2,)``; N curves (N, k, 2) broadcast
@@ -65,36 +66,37 @@ def _horner(coefficients: NDArray, u: ArrayLike) -> NDArray:
     return acc
 
 
-def _parameters(u: NDArray) -> NDArray:
+def _parameters(u: NDArray[np.float64]) -> NDArray[np.float64]:
     """``u`` as a flat contiguous float64 array (the one type the kernels compile for)."""
     return np.ascontiguousarray(u, dtype=float).reshape(-1)
 
 
-def point(cp: NDArray, u: ArrayLike) -> NDArray:
+def point(cp: NDArray[np.float64], u: ArrayLike) -> NDArray[np.float64]:
     """Points Q(u), shape ``u.shape + (2,)``."""
     return _horner(_power_coefficients(cp), u)
 
 
-def derivative(cp: NDArray, u: ArrayLike, order: int = 1) -> NDArray:
+def derivative(cp: NDArray[np.float64], u: ArrayLike, order: int = 1) -> NDArray[np.float64]:
     """Derivative of ``order`` 1, 2 or 3 at ``u``."""
     return _horner(_power_coefficients(cp, order), u)
 
 
-def _scale(coefficients: NDArray) -> float:
+def _scale(coefficients: NDArray[np.float64]) -> float:
     """A power of two near the largest coefficient (1 for zeros): dividing by it
     is exact and keeps squares and cubes of curves from 1e-300 to 1e300 in range."""
     big = float(np.abs(coefficients).max())
     return math.ldexp(1.0, math.frexp(big)[1]) if 0.0 < big < math.inf else 1.0
 
 
-def tangent(cp: NDArray, u: ArrayLike) -> NDArray:
+def tangent(cp: NDArray[np.float64], u: ArrayLike) -> NDArray[np.float64]:
     """Unit tangents Q'(u)/|Q'(u)|."""
     coefficients = _power_coefficients(cp, 1)
     d = _horner(coefficients / _scale(coefficients), u)
-    return d / np.linalg.norm(d, axis=-1, keepdims=True)
+    unit: NDArray[np.float64] = d / np.linalg.norm(d, axis=-1, keepdims=True)
+    return unit
 
 
-def curvature(cp: NDArray, u: ArrayLike) -> NDArray:
+def curvature(cp: NDArray[np.float64], u: ArrayLike) -> NDArray[np.float64]:
     """Signed curvature (Q' × Q'')/|Q'|³ (positive turns left)."""
     u = np.asarray(u, dtype=float)
     first, second = _power_coefficients(cp, 1), _power_coefficients(cp, 2)
@@ -105,7 +107,7 @@ def curvature(cp: NDArray, u: ArrayLike) -> NDArray:
     return out.reshape(u.shape)
 
 
-def arc_length(cp: ArrayLike, u: ArrayLike = 1.0) -> NDArray | float:
+def arc_length(cp: ArrayLike, u: ArrayLike = 1.0) -> NDArray[np.float64] | float:
     """Arc length from 0 to ``u`` by composite Gauss–Legendre (4 panels × 16 nodes).
 
     ``cp`` is one curve (4, 2) or N curves (N, 4, 2), broadcast against ``u``.
@@ -120,21 +122,21 @@ def arc_length(cp: ArrayLike, u: ArrayLike = 1.0) -> NDArray | float:
     return float(result) if result.ndim == 0 else result
 
 
-def split(cp: NDArray, t0: float, t1: float) -> NDArray:
+def split(cp: NDArray[np.float64], t0: float, t1: float) -> NDArray[np.float64]:
     """Exact control points of the sub-curve on [t0, t1] (de Casteljau/blossom)."""
 
-    def blossom(a: float, b: float, c: float) -> NDArray:
+    def blossom(a: float, b: float, c: float) -> NDArray[np.float64]:
         pts = cp
         for s in (a, b, c):
             pts = (1.0 - s) * pts[:-1] + s * pts[1:]
-        return pts[0]
+        point: NDArray[np.float64] = pts[0]  # the blossom: one point (2,)
+        return point
 
-    return np.array(
-        [blossom(t0, t0, t0), blossom(t0, t0, t1), blossom(t0, t1, t1), blossom(t1, t1, t1)]
-    )
+    points: NDArray[np.float64] = np.array([blossom(t0, t0, t0), blossom(t0, t0, t1), blossom(t0, t1, t1), blossom(t1, t1, t1)])
+    return points
 
 
-def curvature_rate(cp: ArrayLike, u: ArrayLike) -> NDArray:
+def curvature_rate(cp: ArrayLike, u: ArrayLike) -> NDArray[np.float64]:
     """dκ/ds at parameters ``u``.
 
     dκ/ds = κ'(u)/|Q'| with κ = (Q' × Q'')/|Q'|³, i.e.
@@ -151,10 +153,11 @@ def curvature_rate(cp: ArrayLike, u: ArrayLike) -> NDArray:
     cross13 = d1[..., 0] * d3[..., 1] - d1[..., 1] * d3[..., 0]
     speed2 = d1[..., 0] ** 2 + d1[..., 1] ** 2
     dot12 = d1[..., 0] * d2[..., 0] + d1[..., 1] * d2[..., 1]
-    return (cross13 * speed2 - 3.0 * cross12 * dot12) / speed2**3 / (scale * scale)
+    rate: NDArray[np.float64] = (cross13 * speed2 - 3.0 * cross12 * dot12) / speed2**3 / (scale * scale)
+    return rate
 
 
-def peak_curvature_rate(cp: ArrayLike, samples: int = 257) -> tuple:
+def peak_curvature_rate(cp: ArrayLike, samples: int = 257) -> tuple[Any, Any]:
     """The largest |dκ/ds| of one curve (cp (4, 2)) or of N curves (cp (N, 4, 2)), and the u where it occurs.
 
     A grid of ``samples`` parameters finds each peak's neighbourhood, then a

@@ -9,8 +9,8 @@ asked for.
 from __future__ import annotations
 
 import math
-from collections.abc import Iterable, Sequence
-from typing import Any
+from collections.abc import Iterable, Iterator, Sequence
+from typing import TYPE_CHECKING, Any, cast
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -26,6 +26,12 @@ from .spiral import BezierSpiral
 from .transitions import Transition
 from .units import DEFAULT_UNITS, length_unit
 
+if TYPE_CHECKING:
+    from typing import TypeAlias
+
+    #: End frames (n, 2, 9), rounding floors (n, 2, 3) and lengths (n,) of rows (``SegmentRows.measure``).
+    Measured: TypeAlias = tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]
+
 #: Default join tolerance: gap / chain size, tangent angle (rad) and
 #: curvature jump × chain size must each stay below it.
 JOIN_TOLERANCE = 1e-9
@@ -39,7 +45,7 @@ ROUNDING_CAP = 1e-6
 _KIND_NAMES = ("Line", "Arc", "BezierSpiral")
 
 
-def _problem(index: int, measures: NDArray, tolerance: float, units: str) -> str:
+def _problem(index: int, measures: NDArray[np.float64], tolerance: float, units: str) -> str:
     """The message of a joint that fails (``measures``: its row of ``joint_table``)."""
     gap, angle, jump, short, kappa = measures[:5].tolist()
     return (
@@ -142,7 +148,13 @@ class Chain:
 
     @classmethod
     def _of_rows(
-        cls, rows: SegmentRows, tolerance: float, units: str, measured=None, objects=None, owners: NDArray | None = None
+        cls,
+        rows: SegmentRows,
+        tolerance: float,
+        units: str,
+        measured: Measured | None = None,
+        objects: list[Segment | None] | None = None,
+        owners: NDArray[np.int64] | None = None,
     ) -> Chain:
         """A checked chain of ``rows`` (tolerance and units already checked). With ``owners`` (the
         ``Chain.join`` part of every row) a failing joint raises a ``JointError`` naming its part."""
@@ -157,10 +169,10 @@ class Chain:
             raise JointError(f"{error} (at parts[{part}])", error.joint, part) from None
         return chain
 
-    def _setup(self, rows: SegmentRows, measured, objects: list | None, tolerance: float, units: str) -> None:
+    def _setup(self, rows: SegmentRows, measured: Measured, objects: list[Segment | None] | None, tolerance: float, units: str) -> None:
         self._rows = rows
         self._frames, floors, self._lengths = measured
-        self._objects = objects if objects is not None else [None] * len(rows)
+        self._objects: list[Segment | None] = objects if objects is not None else [None] * len(rows)
         self._segments: tuple[Segment, ...] | None = None
         self.tolerance = tolerance
         self.units = units
@@ -245,7 +257,7 @@ class Chain:
     def __len__(self) -> int:
         return len(self._rows)
 
-    def __iter__(self):
+    def __iter__(self) -> Iterator[Segment]:
         return iter(self.segments)
 
     def __getitem__(self, index: int) -> Segment:
@@ -262,7 +274,7 @@ class Chain:
         return float(self._stations[-1])
 
     @property
-    def lengths(self) -> NDArray:
+    def lengths(self) -> NDArray[np.float64]:
         """Arc length of each segment (n,)."""
         return self._lengths.copy()
 
@@ -270,28 +282,31 @@ class Chain:
     def rows(self) -> SegmentRows:
         """The segments as arrays (``spiral_cad.core.rows.SegmentRows``; read-only views)."""
         rows = self._rows
-        views = [a.view() for a in (rows.kind, rows.geometry, rows.params, rows.shapes, self._lengths)]
-        for view in views:
+        views = SegmentRows(rows.kind.view(), rows.geometry.view(), rows.params.view(), rows.shapes.view(), rows.dim, self._lengths.view())
+        for view in (views.kind, views.geometry, views.params, views.shapes, views.lengths):
             view.flags.writeable = False
-        return SegmentRows(*views[:4], rows.dim, views[4])
+        return views
 
     @property
-    def stations(self) -> NDArray:
+    def stations(self) -> NDArray[np.float64]:
         """Arc length at the start of each segment, plus the total (len + 1)."""
         return self._stations.copy()
 
     @property
-    def start(self) -> NDArray:
-        return self._frames[0, 0, : self.dim].copy()
+    def start(self) -> NDArray[np.float64]:
+        point: NDArray[np.float64] = self._frames[0, 0, : self.dim].copy()
+        return point
 
     @property
-    def end(self) -> NDArray:
-        return self._frames[-1, 1, : self.dim].copy()
+    def end(self) -> NDArray[np.float64]:
+        point: NDArray[np.float64] = self._frames[-1, 1, : self.dim].copy()
+        return point
 
     @property
-    def segment_ends(self) -> NDArray:
+    def segment_ends(self) -> NDArray[np.float64]:
         """The start and end point of every segment, (n, 2, dim) (a copy)."""
-        return self._frames[:, :, : self.dim].copy()
+        points: NDArray[np.float64] = self._frames[:, :, : self.dim].copy()
+        return points
 
     def joins(self) -> list[Join]:
         """Mismatches at every internal joint, in order (``Join``)."""
@@ -314,7 +329,7 @@ class Chain:
 
     # --------------------------------------------------- station queries
 
-    def _locate(self, s: ArrayLike) -> tuple[NDArray, NDArray]:
+    def _locate(self, s: ArrayLike) -> tuple[NDArray[np.intp], NDArray[np.float64]]:
         s = as_real_array(s, "stations")
         if not np.all((s >= -1e-12 * self.length) & (s <= self.length * (1 + 1e-12))):
             bad = s[~((s >= -1e-12 * self.length) & (s <= self.length * (1 + 1e-12)))].ravel()[0]
@@ -322,7 +337,7 @@ class Chain:
         index = np.clip(np.searchsorted(self._stations, s, side="right") - 1, 0, len(self) - 1)
         return index, s - self._stations[index]
 
-    def _at(self, s: ArrayLike, method: str, width: tuple[int, ...]) -> NDArray:
+    def _at(self, s: ArrayLike, method: str, width: tuple[int, ...]) -> NDArray[np.float64]:
         index, local = self._locate(s)
         flat_index, flat_local = index.ravel(), local.ravel()
         out = np.empty(flat_index.shape + width)
@@ -336,23 +351,23 @@ class Chain:
                 out[group] = getattr(seg, method)(seg.parameter_at(flat_local[group]))
         return out.reshape(index.shape + width)
 
-    def point_at(self, s: ArrayLike) -> NDArray:
+    def point_at(self, s: ArrayLike) -> NDArray[np.float64]:
         """Points at stations ``s`` (arc length from the start), shape ``s.shape + (dim,)``."""
         return self._at(s, "point", (self.dim,))
 
-    def tangent_at(self, s: ArrayLike) -> NDArray:
+    def tangent_at(self, s: ArrayLike) -> NDArray[np.float64]:
         """Unit tangents at stations ``s``."""
         return self._at(s, "tangent", (self.dim,))
 
-    def curvature_at(self, s: ArrayLike) -> NDArray:
+    def curvature_at(self, s: ArrayLike) -> NDArray[np.float64]:
         """Curvature at stations ``s``: signed in the plane, κ ≥ 0 in space."""
         return self._at(s, "curvature", ())
 
-    def curvature_vector_at(self, s: ArrayLike) -> NDArray:
+    def curvature_vector_at(self, s: ArrayLike) -> NDArray[np.float64]:
         """Curvature vectors κN at stations ``s``, shape ``s.shape + (dim,)``."""
         return self._at(s, "curvature_vector", (self.dim,))
 
-    def sample(self, per_segment: int = 32) -> NDArray:
+    def sample(self, per_segment: int = 32) -> NDArray[np.float64]:
         """Points along the chain, ``per_segment`` per segment plus the end (for plots)."""
         u = np.linspace(0.0, 1.0, per_segment, endpoint=False)
         pts = [seg.point(u) for seg in self.segments]
@@ -371,7 +386,7 @@ class Chain:
         return chain_to_nurbs(self.segments)
 
 
-def _size(rows: SegmentRows, frames: NDArray) -> float:
+def _size(rows: SegmentRows, frames: NDArray[np.float64]) -> float:
     """The diagonal of the box around every segment's outline (``Segment.outline``), in one pass."""
     kind, g, p = rows.kind, rows.geometry, rows.params
     arc = kind == ARC
@@ -409,7 +424,7 @@ class PartCircles:
     def of_parts(cls, parts: Sequence[Transition | Segment]) -> PartCircles:
         """A transition's ``end_circle``; an ``Arc``'s own circle (in its plane); none after other segments."""
         circles = cls(len(parts))
-        found = []
+        found: list[tuple[int, tuple[float, ...], float, NDArray[np.float64]]] = []
         for k, part in enumerate(parts):
             circle = part.end_circle if isinstance(part, Transition) else None
             if circle is not None:
@@ -417,8 +432,8 @@ class PartCircles:
             elif isinstance(part, Arc):
                 found.append((k, tuple(lifted(tuple(part._c.tolist()), 3)), part._r, part.basis))
         if found:
-            index, centers, radii, bases = zip(*found)
-            index = list(index)
+            slots, centers, radii, bases = zip(*found)
+            index = list(slots)
             circles.present[index] = True
             circles.center[index], circles.radius[index], circles.basis[index] = centers, radii, bases
         return circles
@@ -426,13 +441,13 @@ class PartCircles:
 
 def join_rows(
     rows: SegmentRows,
-    counts: NDArray,
+    counts: NDArray[np.int64],
     circles: PartCircles,
     start: tuple[float, ...] | None,
     end: tuple[float, ...] | None,
     tolerance: float,
     units: str,
-    objects: list | None = None,
+    objects: Sequence[Segment] | None = None,
 ) -> Chain:
     """``Chain.join`` on arrays: parts of ``counts`` consecutive ``rows`` each, ending on ``circles``.
 
@@ -476,9 +491,9 @@ def join_rows(
     a, b, scale, owner = np.zeros((gaps, 3)), np.zeros((gaps, 3)), np.zeros(gaps), np.zeros(gaps, dtype=np.int64)
     a[inner], b[inner], owner[inner] = ends[:-1, :3], begins[1:, :3], np.arange(count - 1)
     scale[inner] = np.maximum(part_length[:-1], part_length[1:])
-    if head:
+    if start is not None:  # head
         a[0], b[0], scale[0] = lifted(start, 3), begins[0, :3], part_length[0]
-    if tail:
+    if end is not None:  # tail
         a[-1], b[-1], scale[-1], owner[-1] = ends[-1, :3], lifted(end, 3), part_length[-1], count - 1
     present, center, radius, basis = np.zeros(gaps, dtype=bool), np.zeros((gaps, 3)), np.zeros(gaps), np.zeros((gaps, 2, 3))
     present[inner], center[inner], radius[inner], basis[inner] = (x[:-1] for x in (circles.present, circles.center, circles.radius, circles.basis))
@@ -501,15 +516,29 @@ def join_rows(
     order = order[made[order]]
     index = pool[order].astype(np.int64)
     every = SegmentRows.concatenate([rows, bridge])
-    measured = tuple(np.concatenate(x)[index] for x in ((frames, bridge_frames), (floors, bridge_floors), (lengths, bridge_lengths)))
+    measured = cast(
+        "Measured", tuple(np.concatenate(x)[index] for x in ((frames, bridge_frames), (floors, bridge_floors), (lengths, bridge_lengths)))
+    )
     chain_objects = None
     if objects is not None and all(s.dim == dim for s in objects):
-        pool_objects = list(objects) + [None] * gaps
+        pool_objects: list[Segment | None] = [*objects, *([None] * gaps)]
         chain_objects = [pool_objects[i] for i in index.tolist()]
     return Chain._of_rows(every.take(index), tolerance, units, measured, chain_objects, owners[order])
 
 
-def _check_connectors(bridge, kind, lengths, a, b, dim, head, tail, begins, ends, count) -> None:
+def _check_connectors(
+    bridge: SegmentRows,
+    kind: NDArray[np.int8],
+    lengths: NDArray[np.float64],
+    a: NDArray[np.float64],
+    b: NDArray[np.float64],
+    dim: int,
+    head: bool,
+    tail: bool,
+    begins: NDArray[np.float64],
+    ends: NDArray[np.float64],
+    count: int,
+) -> None:
     """Raise, in travel order, what ``Line``/``Arc.between`` and the fold checks would raise for the connectors."""
     r, sweep = bridge.params[:, 0], bridge.params[:, 2]
     resolution = 4.0 * np.finfo(float).eps * np.abs(bridge.geometry[:, 0]).max(axis=1)
@@ -529,14 +558,15 @@ def _check_connectors(bridge, kind, lengths, a, b, dim, head, tail, begins, ends
             elif dim == 2:
                 Arc.between(bridge.geometry[i, 0, :2], bridge.params[i, 0], a[i, :2], b[i, :2])
             else:
-                Arc._of(bridge.geometry[i, 0], *bridge.params[i].tolist(), bridge.geometry[i, 1:3])._check()
+                radius, start_angle, sweep_i = bridge.params[i].tolist()
+                Arc._of(bridge.geometry[i, 0], radius, start_angle, sweep_i, bridge.geometry[i, 1:3])._check()
         if head and i == 0:
             _fold(a[0], begins[0], dim, "start", count)
         if tail and i == len(kind) - 1:
             _fold(b[i], ends[-1], dim, "end", count)
 
 
-def _fold(point: NDArray, frame: NDArray, dim: int, which: str, count: int) -> None:
+def _fold(point: NDArray[np.float64], frame: NDArray[np.float64], dim: int, which: str, count: int) -> None:
     """A start line must not run against the first part's start tangent (an end line: its end tangent)."""
     if which == "start":
         if float(np.dot(frame[:3] - point, frame[3:6])) < 0.0:

@@ -21,6 +21,7 @@ from __future__ import annotations
 
 import math
 from functools import lru_cache
+from typing import cast
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -38,7 +39,7 @@ WALTON_MEEK_SEARCH_MAX = math.radians(80.0)
 EQUAL_LEG_THETA = math.acos(K.EQUAL_LEG_COS)
 
 
-def unit_spirals(theta: ArrayLike, shape: str = "walton-meek") -> NDArray:
+def unit_spirals(theta: ArrayLike, shape: str = "walton-meek") -> NDArray[np.float64]:
     """Control points (N, 4, 2) of spirals of ``shape`` turning left by ``theta`` from the origin along +x to end radius 1."""
     theta = np.asarray(theta, dtype=float).ravel()
     out = np.empty((len(theta), 4, 2))
@@ -46,22 +47,24 @@ def unit_spirals(theta: ArrayLike, shape: str = "walton-meek") -> NDArray:
     return out
 
 
-def length_factor(theta: ArrayLike, shape: str = "walton-meek") -> NDArray:
+def length_factor(theta: ArrayLike, shape: str = "walton-meek") -> NDArray[np.float64]:
     """ℓ(θ): the length of unit spirals; a spiral onto radius r is r·ℓ long."""
     theta = np.asarray(theta, dtype=float)
-    return arc_length(unit_spirals(theta, shape)).reshape(theta.shape)
+    lengths = cast("NDArray[np.float64]", arc_length(unit_spirals(theta, shape)))  # N curves: an array
+    return lengths.reshape(theta.shape)
 
 
-def shift_factor(theta: ArrayLike, shape: str = "walton-meek") -> NDArray:
+def shift_factor(theta: ArrayLike, shape: str = "walton-meek") -> NDArray[np.float64]:
     """g1(θ) − 1: a spiral onto radius r shifts its circle r·(g1 − 1) off the start line (Theorem 4.1)."""
     theta = np.asarray(theta, dtype=float)
     flat = theta.ravel()
     e1 = np.empty(flat.shape)
     K.shape_offsets_batch(SHAPE_CODES[shape], np.sin(flat), np.cos(flat), e1, np.empty(flat.shape))
-    return (np.sin(flat) ** 2 * e1).reshape(theta.shape)
+    factor: NDArray[np.float64] = (np.sin(flat) ** 2 * e1).reshape(theta.shape)
+    return factor
 
 
-def shift_angle(shift: ArrayLike, radius: ArrayLike, shape: str = "walton-meek") -> NDArray:
+def shift_angle(shift: ArrayLike, radius: ArrayLike, shape: str = "walton-meek") -> NDArray[np.float64]:
     """The θ whose spiral shifts its circle ``shift`` off the tangent (p = r·(g1(θ) − 1));
     0 for a shift ≤ 0 (every spiral shifts its circle), NaN beyond the shape's reach."""
     shift, radius = np.broadcast_arrays(np.asarray(shift, dtype=float), np.asarray(radius, dtype=float))
@@ -71,15 +74,16 @@ def shift_angle(shift: ArrayLike, radius: ArrayLike, shape: str = "walton-meek")
     return np.where(shift > 0.0, theta, 0.0)
 
 
-def _start_rate(theta: NDArray, shape: str) -> NDArray:
+def _start_rate(theta: NDArray[np.float64], shape: str) -> NDArray[np.float64]:
     """|dκ/ds| at u = 0 of unit spirals: κ'(0)/|Q'(0)| = (2/9)·c·sin θ / a³ (legs a, c)."""
     legs = np.diff(unit_spirals(theta, shape), axis=1)
     a = np.hypot(legs[:, 0, 0], legs[:, 0, 1])
     c = np.hypot(legs[:, 2, 0], legs[:, 2, 1])
-    return (2.0 / 9.0 * c * np.sin(theta.ravel()) / a**3).reshape(theta.shape)
+    rate: NDArray[np.float64] = (2.0 / 9.0 * c * np.sin(theta.ravel()) / a**3).reshape(theta.shape)
+    return rate
 
 
-def _equal_leg_peak(theta: NDArray) -> NDArray:
+def _equal_leg_peak(theta: NDArray[np.float64]) -> NDArray[np.float64]:
     """F(θ) of the equal-leg near-linear spiral in closed form (module docstring)."""
     k = np.sin(theta / 2.0) ** 2
     m = np.full(theta.shape, 5.0 / 16.0)
@@ -87,7 +91,8 @@ def _equal_leg_peak(theta: NDArray) -> NDArray:
         f = 5.0 - 16.0 * m + 16.0 * k * m - 60.0 * k * m * m + 80.0 * k * m**3
         m -= f / (-16.0 + 16.0 * k - 120.0 * k * m + 240.0 * k * m * m)
     base = 1.0 - 4.0 * k * m * (1.0 - m)
-    return (1.0 + 8.0 * k * m - 20.0 * k * m * m) / (2.0 * np.sin(theta) * base**3)
+    peak: NDArray[np.float64] = (1.0 + 8.0 * k * m - 20.0 * k * m * m) / (2.0 * np.sin(theta) * base**3)
+    return peak
 
 
 def _peak_switch(lo: float, hi: float, shape: str, inside_at_hi: bool) -> tuple[float, float]:
@@ -125,7 +130,7 @@ def _interior_branch(shape: str) -> tuple[float, float, CubicSpline]:
     return start, stop, CubicSpline(theta, np.log(peak_curvature_rate(unit_spirals(theta, shape))[0]))
 
 
-def peak_rate_factor(theta: ArrayLike, shape: str = "walton-meek") -> NDArray:
+def peak_rate_factor(theta: ArrayLike, shape: str = "walton-meek") -> NDArray[np.float64]:
     """F(θ): the peak |dκ/ds| of unit spirals; a spiral onto radius r peaks at F/r² (module docstring)."""
     theta = np.asarray(theta, dtype=float)
     low, high, spline = _interior_branch(shape)

@@ -3,6 +3,8 @@
 from __future__ import annotations
 
 import math
+from collections.abc import Mapping
+from typing import Any
 
 from . import _kernels as K
 from .errors import MALFORMED, NoSolutionError, Status
@@ -13,7 +15,7 @@ def _g(value: float) -> str:
     return f"{value:.6g}"
 
 
-def describe(case: str, status: int, measure: float, inputs: dict[str, object]) -> str:
+def describe(case: str, status: int, measure: float, inputs: Mapping[str, Any]) -> str:
     """Human-readable reason for a failed row of solver ``case``.
 
     Args:
@@ -24,8 +26,8 @@ def describe(case: str, status: int, measure: float, inputs: dict[str, object]) 
     """
     status = Status(status)
     shown = ", ".join(f"{k}={v!r}" if isinstance(v, str) else f"{k}={v}" for k, v in inputs.items())
-    r0 = inputs.get("radius0")
-    r1 = inputs.get("radius1")
+    r0: Any = inputs.get("radius0")  # present (a number) for the circle cases that read it
+    r1: Any = inputs.get("radius1")
     shape = inputs.get("shape", "walton-meek")
     if status is Status.NOT_FINITE:
         return f"{case}: every input must be finite; got {shown}"
@@ -105,7 +107,7 @@ def describe(case: str, status: int, measure: float, inputs: dict[str, object]) 
     raise AssertionError(f"no description for status {status!r}")
 
 
-def _outside_shape(case: str, shape: str, measure: float, inputs: dict[str, object]) -> str:
+def _outside_shape(case: str, shape: str, measure: float, inputs: Mapping[str, Any]) -> str:
     """Why a problem lies beyond what spirals of ``shape`` reach (its largest spiral angle)."""
     limits = shape_limits(shape)
     largest = f"{math.degrees(limits['theta']):g}°"
@@ -138,7 +140,7 @@ def _outside_shape(case: str, shape: str, measure: float, inputs: dict[str, obje
     return f"{case}: the {shape} shape has no spiral for {', '.join(f'{k}={v}' for k, v in inputs.items())}{advice}"
 
 
-def error_for(case: str, status: int, measure: float, inputs: dict[str, object]) -> ValueError:
+def error_for(case: str, status: int, measure: float, inputs: Mapping[str, Any]) -> ValueError:
     """The exception the scalar API raises for a failed row."""
     message = describe(case, status, measure, inputs)
     return ValueError(message) if Status(status) in MALFORMED else NoSolutionError(message)

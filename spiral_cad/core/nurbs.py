@@ -16,6 +16,7 @@ runs from 0 to about the chain length.
 from __future__ import annotations
 
 import math
+from collections.abc import Iterable
 from dataclasses import dataclass
 
 import numpy as np
@@ -44,10 +45,10 @@ class Nurbs:
     """
 
     degree: int
-    knots: NDArray
-    multiplicities: NDArray
-    weights: NDArray
-    control_points: NDArray
+    knots: NDArray[np.float64]
+    multiplicities: NDArray[np.int64]
+    weights: NDArray[np.float64]
+    control_points: NDArray[np.float64]
     segment_index: tuple[int, ...] = ()
 
     def __post_init__(self) -> None:
@@ -61,7 +62,7 @@ class Nurbs:
             raise ValueError(f"Nurbs knots must be distinct and increasing; got {self.knots.tolist()}")
 
     @property
-    def knot_vector(self) -> NDArray:
+    def knot_vector(self) -> NDArray[np.float64]:
         """The full knot vector (each knot repeated by its multiplicity)."""
         return np.repeat(self.knots, self.multiplicities)
 
@@ -69,7 +70,7 @@ class Nurbs:
     def domain(self) -> tuple[float, float]:
         return float(self.knots[0]), float(self.knots[-1])
 
-    def point(self, t: ArrayLike) -> NDArray:
+    def point(self, t: ArrayLike) -> NDArray[np.float64]:
         """Points at parameters ``t`` (rational de Boor), shape ``t.shape + (2,)``.
 
         Raises:
@@ -92,10 +93,11 @@ class Nurbs:
                 alpha = ((flat - left) / (right - left))[:, None]
                 d[:, j] = (1.0 - alpha) * d[:, j - 1] + alpha * d[:, j]
         result = d[:, p, :2] / d[:, p, 2:]
-        return result.reshape(t.shape + (2,))
+        points: NDArray[np.float64] = result.reshape(t.shape + (2,))
+        return points
 
 
-def _arc_pieces(arc: Arc) -> list[tuple[NDArray, NDArray, float]]:
+def _arc_pieces(arc: Arc) -> list[tuple[NDArray[np.float64], NDArray[np.float64], float]]:
     """Rational cubic pieces (points, weights, length) of an arc, each ≤ MAX_ARC_PIECE."""
     count = max(1, math.ceil(arc.sweep / MAX_ARC_PIECE - 1e-12))
     half = 0.5 * arc.sweep / count
@@ -117,7 +119,7 @@ def _arc_pieces(arc: Arc) -> list[tuple[NDArray, NDArray, float]]:
     return pieces
 
 
-def _pieces(segment: Segment) -> list[tuple[NDArray, NDArray, float]]:
+def _pieces(segment: Segment) -> list[tuple[NDArray[np.float64], NDArray[np.float64], float]]:
     ones = np.ones(4)
     if isinstance(segment, BezierSpiral):
         return [(np.array(segment.control_points), ones, segment.length)]
@@ -129,7 +131,7 @@ def _pieces(segment: Segment) -> list[tuple[NDArray, NDArray, float]]:
     raise ValueError(f"segment must be a Line, Arc or BezierSpiral; got {segment!r}")
 
 
-def chain_to_nurbs(chain) -> Nurbs:
+def chain_to_nurbs(chain: Iterable[Segment]) -> Nurbs:
     """The exact rational cubic B-spline of a chain (or any segments in travel order).
 
     Each joint shares the end point of the piece before it; the chain's own
@@ -140,8 +142,8 @@ def chain_to_nurbs(chain) -> Nurbs:
             construction, so every knot span is non-empty), or a segment in
             space (``Nurbs`` is planar; 3-D chains reach CAD as exact edges).
     """
-    points: list[NDArray] = []
-    weights: list[NDArray] = []
+    points: list[NDArray[np.float64]] = []
+    weights: list[NDArray[np.float64]] = []
     spans: list[float] = []
     owners: list[int] = []
     for index, segment in enumerate(chain):

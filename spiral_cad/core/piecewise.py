@@ -13,7 +13,7 @@ from numpy.typing import ArrayLike, NDArray
 from ._inputs import as_real_array
 
 
-def polynomial(coefficients: NDArray, x: NDArray, derivative: int = 0) -> NDArray:
+def polynomial(coefficients: NDArray[np.float64], x: NDArray[np.float64], derivative: int = 0) -> NDArray[np.float64]:
     """Each row of ``coefficients`` (…, k) — or its ``derivative`` 0, 1 or 2 — at ``x`` (Horner)."""
     if derivative not in (0, 1, 2):
         raise ValueError(f"derivative must be 0, 1 or 2; got {derivative!r}")
@@ -29,20 +29,20 @@ def polynomial(coefficients: NDArray, x: NDArray, derivative: int = 0) -> NDArra
     return result
 
 
-def piece_at(starts: NDArray, s: ArrayLike) -> tuple[NDArray, NDArray]:
+def piece_at(starts: NDArray[np.float64], s: ArrayLike) -> tuple[NDArray[np.intp], NDArray[np.float64]]:
     """(index of the piece, distance from its start) for every ``s`` given the pieces' ``starts``."""
     s = np.asarray(s, dtype=float)
     index = np.clip(np.searchsorted(starts, s, side="right") - 1, 0, len(starts) - 1)
     return index, s - starts[index]
 
 
-def piecewise_at(starts: NDArray, coefficients: NDArray, s: ArrayLike, derivative: int = 0) -> NDArray:
+def piecewise_at(starts: NDArray[np.float64], coefficients: NDArray[np.float64], s: ArrayLike, derivative: int = 0) -> NDArray[np.float64]:
     """The piecewise polynomial (``starts`` (m,), ``coefficients`` (m, k)) or its ``derivative`` at ``s``."""
     index, x = piece_at(starts, s)
     return polynomial(coefficients[index], x, derivative)
 
 
-def inside(s: ArrayLike, first: float, last: float, what: str) -> NDArray:
+def inside(s: ArrayLike, first: float, last: float, what: str) -> NDArray[np.float64]:
     """``s`` as a float array, every value within [first, last] (to 1e-12 of their size), else
     ValueError naming the first outside and the range of ``what``."""
     s = as_real_array(s, "station")

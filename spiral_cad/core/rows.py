@@ -12,6 +12,7 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from dataclasses import dataclass
+from typing import Any, cast
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -44,12 +45,12 @@ class SegmentRows:
         lengths: (n,) known arc lengths, NaN where not yet measured (spirals).
     """
 
-    kind: NDArray
-    geometry: NDArray
-    params: NDArray
-    shapes: NDArray
+    kind: NDArray[np.int8]
+    geometry: NDArray[np.float64]
+    params: NDArray[np.float64]
+    shapes: NDArray[np.int8]
     dim: int
-    lengths: NDArray
+    lengths: NDArray[np.float64]
 
     def __len__(self) -> int:
         return len(self.kind)
@@ -90,11 +91,11 @@ class SegmentRows:
             for dim in (2, 3):  # one array per kind and dimension
                 rows._fill(kind, [i for i in index if dims[i] == dim], [segments[i] for i in index if dims[i] == dim], dim)
         for dim in (2, 3):  # spirals not yet measured: one quadrature for all (in their own dimension)
-            todo = [i for i in groups[BezierSpiral] if dims[i] == dim and segments[i]._length is None]
+            todo = [i for i in groups[BezierSpiral] if dims[i] == dim and cast(BezierSpiral, segments[i])._length is None]
             if todo:
                 rows.lengths[todo] = bezier.arc_length(rows.geometry[todo, :, :dim])
                 for i, length in zip(todo, rows.lengths[todo].tolist()):
-                    segments[i]._length = length
+                    cast(BezierSpiral, segments[i])._length = length
         return rows
 
     def _fill(self, kind: type, index: list[int], items: list[Segment], dim: int) -> None:
@@ -102,32 +103,38 @@ class SegmentRows:
             return
         g = self.geometry
         if kind is Line:
+            lines = cast("list[Line]", items)
             self.kind[index] = LINE
-            g[index, 0, :dim] = [s._a for s in items]
-            g[index, 1, :dim] = [s._b for s in items]
+            g[index, 0, :dim] = [s._a for s in lines]
+            g[index, 1, :dim] = [s._b for s in lines]
         elif kind is Arc:
+            arcs = cast("list[Arc]", items)
             self.kind[index] = ARC
-            self.params[index] = [(s._r, s._a0, s._sweep) for s in items]
-            g[index, 0, :dim] = [s._c for s in items]
-            g[index, 1:3] = _XY_BASIS if dim == 2 else [s._basis for s in items]
+            self.params[index] = [(s._r, s._a0, s._sweep) for s in arcs]
+            g[index, 0, :dim] = [s._c for s in arcs]
+            g[index, 1:3] = _XY_BASIS if dim == 2 else [s._basis for s in arcs]
         else:
+            spirals = cast("list[BezierSpiral]", items)
             self.kind[index] = SPIRAL
-            self.shapes[index] = [shape_number(s._shape) for s in items]
-            self.lengths[index] = [np.nan if s._length is None else s._length for s in items]
-            g[index, :, :dim] = [s._cp for s in items]
+            self.shapes[index] = [shape_number(s._shape) for s in spirals]
+            self.lengths[index] = [np.nan if s._length is None else s._length for s in spirals]
+            g[index, :, :dim] = [s._cp for s in spirals]
 
     @classmethod
     def concatenate(cls, parts: Sequence[SegmentRows]) -> SegmentRows:
-        return cls(*(np.concatenate([getattr(p, name) for p in parts]) for name in ("kind", "geometry", "params", "shapes")),
-                   max(p.dim for p in parts), np.concatenate([p.lengths for p in parts]))  # fmt: skip
+        def joined(name: str) -> NDArray[Any]:
+            return np.concatenate([getattr(p, name) for p in parts])
 
-    def take(self, index: NDArray) -> SegmentRows:
+        return cls(joined("kind"), joined("geometry"), joined("params"), joined("shapes"), max(p.dim for p in parts),
+                   np.concatenate([p.lengths for p in parts]))  # fmt: skip
+
+    def take(self, index: NDArray[np.intp]) -> SegmentRows:
         """The rows at ``index`` (in that order)."""
         return SegmentRows(self.kind[index], self.geometry[index], self.params[index], self.shapes[index], self.dim, self.lengths[index])
 
     # ------------------------------------------------------- measuring
 
-    def measure(self) -> tuple[NDArray, NDArray, NDArray]:
+    def measure(self) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
         """End frames (n, 2, 9), rounding floors (n, 2, 3) and lengths (n,) of every row in one pass;
         spiral lengths not yet known by one vectorised quadrature (``bezier.arc_length``)."""
         frames, floors, lengths = row_frames(self.kind, self.geometry, self.params, self.dim)

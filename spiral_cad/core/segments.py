@@ -42,7 +42,9 @@ def lifted(point: tuple[float, ...], dim: int) -> tuple[float, ...]:
     return point + (0.0,) * (dim - len(point))
 
 
-def row_frames(kind: NDArray, geometry: NDArray, params: NDArray, dim: int) -> tuple[NDArray, NDArray, NDArray]:
+def row_frames(
+    kind: NDArray[np.int8], geometry: NDArray[np.float64], params: NDArray[np.float64], dim: int
+) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
     """End frames (n, 2, 9), rounding floors (n, 2, 3) and lengths (n,; NaN for spirals) of segment rows.
 
     The layout of rows and frames is described in ``spiral_cad.core._chain_kernels``.
@@ -66,11 +68,11 @@ class Segment(ABC):
         return self._dim
 
     @abstractmethod
-    def _row(self) -> tuple[int, NDArray, tuple[float, float, float]]:
+    def _row(self) -> tuple[int, NDArray[np.float64], tuple[float, float, float]]:
         """(kind, geometry (4, 3), params): the segment as a row of a chain's arrays (``_chain_kernels``)."""
 
     @cached_property
-    def _ends(self) -> tuple[NDArray, NDArray]:
+    def _ends(self) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
         """End frames (2, 9) and rounding floors (2, 3), from the same kernel chains use."""
         kind, geometry, params = self._row()
         frames, floors, _ = row_frames(np.array([kind], dtype=np.int8), geometry[None], np.array([params]), self._dim)
@@ -89,19 +91,19 @@ class Segment(ABC):
         return (x0, y0, tx0, ty0, k0), (x1, y1, tx1, ty1, k1)
 
     @abstractmethod
-    def point(self, u: ArrayLike) -> NDArray:
+    def point(self, u: ArrayLike) -> NDArray[np.float64]:
         """Points at parameters ``u`` (shape ``u.shape + (dim,)``)."""
 
     @abstractmethod
-    def tangent(self, u: ArrayLike) -> NDArray:
+    def tangent(self, u: ArrayLike) -> NDArray[np.float64]:
         """Unit tangents in travel direction at ``u``."""
 
     @abstractmethod
-    def curvature(self, u: ArrayLike) -> NDArray | float:
+    def curvature(self, u: ArrayLike) -> NDArray[np.float64] | float:
         """Curvature at ``u``: signed in the plane (positive turns left), κ ≥ 0 in space."""
 
     @abstractmethod
-    def curvature_vector(self, u: ArrayLike) -> NDArray:
+    def curvature_vector(self, u: ArrayLike) -> NDArray[np.float64]:
         """The curvature vector κN at ``u`` (shape ``u.shape + (dim,)``): towards the centre of curvature, |κN| = |κ|."""
 
     @property
@@ -129,7 +131,7 @@ class Segment(ABC):
         if self._dim != 2:
             raise ValueError(f"{what} takes a plane segment; this {type(self).__name__} is already in space")
 
-    def parameter_at(self, s: ArrayLike) -> NDArray:
+    def parameter_at(self, s: ArrayLike) -> NDArray[np.float64]:
         """Parameters u where the arc length from the start equals ``s``."""
         return _u(s) / self.length
 
@@ -146,19 +148,19 @@ class Segment(ABC):
         return gap, angle, curvature
 
     @property
-    def start(self) -> NDArray:
+    def start(self) -> NDArray[np.float64]:
         return self._ends[0][0, : self._dim].copy()
 
     @property
-    def end(self) -> NDArray:
+    def end(self) -> NDArray[np.float64]:
         return self._ends[0][1, : self._dim].copy()
 
     @property
-    def start_tangent(self) -> NDArray:
+    def start_tangent(self) -> NDArray[np.float64]:
         return self._ends[0][0, 3 : 3 + self._dim].copy()
 
     @property
-    def end_tangent(self) -> NDArray:
+    def end_tangent(self) -> NDArray[np.float64]:
         return self._ends[0][1, 3 : 3 + self._dim].copy()
 
     def _end_curvature(self, end: int) -> float:
@@ -175,26 +177,26 @@ class Segment(ABC):
         """Curvature at the end: signed in the plane, κ ≥ 0 in space."""
         return self._end_curvature(1)
 
-    def _end_curvature_vector(self, end: int) -> NDArray:
+    def _end_curvature_vector(self, end: int) -> NDArray[np.float64]:
         frame = self._ends[0][end]
         return np.cross(frame[6:9], frame[3:6])[: self._dim]  # κN = ω × T (ω = κB)
 
     @property
-    def start_curvature_vector(self) -> NDArray:
+    def start_curvature_vector(self) -> NDArray[np.float64]:
         """κN at the start (``dim`` components)."""
         return self._end_curvature_vector(0)
 
     @property
-    def end_curvature_vector(self) -> NDArray:
+    def end_curvature_vector(self) -> NDArray[np.float64]:
         """κN at the end (``dim`` components)."""
         return self._end_curvature_vector(1)
 
 
-def _u(u: ArrayLike) -> NDArray:
+def _u(u: ArrayLike) -> NDArray[np.float64]:
     return np.asarray(u, dtype=float)
 
 
-def norm(v: NDArray) -> float:
+def norm(v: NDArray[np.float64]) -> float:
     """|v| of a 2- or 3-vector as the kernels compute it (exactly ``np.hypot(x, y)`` in the plane)."""
     return float(CK.norm3(*(v.tolist() + [0.0] * (3 - len(v)))))
 
@@ -226,11 +228,11 @@ class Line(Segment):
                 f"Line end points {tuple(self._a.tolist())} and {tuple(self._b.tolist())} are too far apart for float64"
             )
 
-    def _set(self, a: NDArray, b: NDArray) -> None:
+    def _set(self, a: NDArray[np.float64], b: NDArray[np.float64]) -> None:
         self._a, self._b, self._dim = a, b, len(a)
 
     @classmethod
-    def _of(cls, a: NDArray, b: NDArray) -> Line:
+    def _of(cls, a: NDArray[np.float64], b: NDArray[np.float64]) -> Line:
         """Adopt two checked end points (2 or 3 coordinates) without copying or checks."""
         line = object.__new__(cls)
         line._set(a, b)
@@ -239,7 +241,7 @@ class Line(Segment):
     def __repr__(self) -> str:
         return f"Line({tuple(self._a.tolist())}, {tuple(self._b.tolist())})"
 
-    def _row(self) -> tuple[int, NDArray, tuple[float, float, float]]:
+    def _row(self) -> tuple[int, NDArray[np.float64], tuple[float, float, float]]:
         geometry = np.zeros((4, 3))
         geometry[0, : self._dim], geometry[1, : self._dim] = self._a, self._b
         return CK.LINE, geometry, (0.0, 0.0, 0.0)
@@ -251,17 +253,17 @@ class Line(Segment):
     def length(self) -> float:
         return norm(self._b - self._a)
 
-    def point(self, u: ArrayLike) -> NDArray:
+    def point(self, u: ArrayLike) -> NDArray[np.float64]:
         return self._a + _u(u)[..., None] * (self._b - self._a)
 
-    def tangent(self, u: ArrayLike) -> NDArray:
+    def tangent(self, u: ArrayLike) -> NDArray[np.float64]:
         d = (self._b - self._a) / self.length
         return np.broadcast_to(d, _u(u).shape + (self._dim,)).copy()
 
-    def curvature(self, u: ArrayLike) -> NDArray | float:
+    def curvature(self, u: ArrayLike) -> NDArray[np.float64] | float:
         return np.zeros_like(_u(u))[()]
 
-    def curvature_vector(self, u: ArrayLike) -> NDArray:
+    def curvature_vector(self, u: ArrayLike) -> NDArray[np.float64]:
         return np.zeros(_u(u).shape + (self._dim,))
 
     def reversed(self) -> Line:
@@ -327,7 +329,7 @@ class Arc(Segment):
                   as_float(sweep, "sweep"), None)  # fmt: skip
         self._check()
 
-    def _set(self, center: NDArray, radius: float, start_angle: float, sweep: float, basis: NDArray | None) -> None:
+    def _set(self, center: NDArray[np.float64], radius: float, start_angle: float, sweep: float, basis: NDArray[np.float64] | None) -> None:
         self._c, self._r, self._a0, self._sweep, self._basis = center, radius, start_angle, sweep, basis
         self._dim = len(center)
 
@@ -343,7 +345,7 @@ class Arc(Segment):
             )
 
     @classmethod
-    def _of(cls, center: NDArray, radius: float, start_angle: float, sweep: float, basis: NDArray | None = None) -> Arc:
+    def _of(cls, center: NDArray[np.float64], radius: float, start_angle: float, sweep: float, basis: NDArray[np.float64] | None = None) -> Arc:
         """Adopt checked values without copying or checks (``basis`` (2, 3) for an arc in space)."""
         arc = object.__new__(cls)
         arc._set(center, radius, start_angle, sweep, basis)
@@ -411,14 +413,14 @@ class Arc(Segment):
             f"start={tuple(self.start.tolist())}, sweep={math.copysign(self._sweep, self._r)})"
         )
 
-    def _row(self) -> tuple[int, NDArray, tuple[float, float, float]]:
+    def _row(self) -> tuple[int, NDArray[np.float64], tuple[float, float, float]]:
         geometry = np.zeros((4, 3))
         geometry[0, : self._dim] = self._c
         geometry[1:3] = _XY_BASIS if self._basis is None else self._basis
         return CK.ARC, geometry, (self._r, self._a0, self._sweep)
 
     @property
-    def center(self) -> NDArray:
+    def center(self) -> NDArray[np.float64]:
         return self._c.copy()
 
     @property
@@ -437,13 +439,13 @@ class Arc(Segment):
         return self._sweep
 
     @property
-    def normal(self) -> NDArray:
+    def normal(self) -> NDArray[np.float64]:
         """Unit normal (3,) of the arc's plane: (0, 0, 1) in the plane; positive radius turns counterclockwise about it."""
         e1, e2 = _XY_BASIS if self._basis is None else self._basis
         return np.cross(e1, e2)
 
     @property
-    def basis(self) -> NDArray:
+    def basis(self) -> NDArray[np.float64]:
         """(2, 3) orthonormal vectors e1, e2 of the arc's plane in which polar angles are measured."""
         return (_XY_BASIS if self._basis is None else self._basis).copy()
 
@@ -462,28 +464,29 @@ class Arc(Segment):
     def length(self) -> float:
         return abs(self._r) * self._sweep
 
-    def _angle(self, u: ArrayLike) -> NDArray:
+    def _angle(self, u: ArrayLike) -> NDArray[np.float64]:
         return self._a0 + math.copysign(self._sweep, self._r) * _u(u)
 
-    def _in_plane(self, x: NDArray, y: NDArray) -> NDArray:
+    def _in_plane(self, x: NDArray[np.float64], y: NDArray[np.float64]) -> NDArray[np.float64]:
         """Plane-basis coordinates as points of the segment's space."""
         if self._basis is None:
             return np.stack([x, y], axis=-1)
-        return x[..., None] * self._basis[0] + y[..., None] * self._basis[1]
+        points: NDArray[np.float64] = x[..., None] * self._basis[0] + y[..., None] * self._basis[1]
+        return points
 
-    def point(self, u: ArrayLike) -> NDArray:
+    def point(self, u: ArrayLike) -> NDArray[np.float64]:
         a = self._angle(u)
         return self._c + abs(self._r) * self._in_plane(np.cos(a), np.sin(a))
 
-    def tangent(self, u: ArrayLike) -> NDArray:
+    def tangent(self, u: ArrayLike) -> NDArray[np.float64]:
         a = self._angle(u)
         s = math.copysign(1.0, self._r)
         return s * self._in_plane(-np.sin(a), np.cos(a))
 
-    def curvature(self, u: ArrayLike) -> NDArray | float:
+    def curvature(self, u: ArrayLike) -> NDArray[np.float64] | float:
         return np.full_like(_u(u), 1.0 / (self._r if self._dim == 2 else abs(self._r)))[()]
 
-    def curvature_vector(self, u: ArrayLike) -> NDArray:
+    def curvature_vector(self, u: ArrayLike) -> NDArray[np.float64]:
         a = self._angle(u)
         return self._in_plane(np.cos(a), np.sin(a)) / -abs(self._r)
 
@@ -521,9 +524,10 @@ def curvature_scales(frames: NDArray) -> NDArray:
 
 
 def joint_table(
-    end: NDArray, end_floor: NDArray, end_length: NDArray, start: NDArray, start_floor: NDArray, start_length: NDArray,
-    own: NDArray, tolerance: float, cap: float,
-) -> tuple[NDArray, int]:  # fmt: skip
+    end: NDArray[np.float64], end_floor: NDArray[np.float64], end_length: NDArray[np.float64],
+    start: NDArray[np.float64], start_floor: NDArray[np.float64], start_length: NDArray[np.float64],
+    own: NDArray[np.float64], tolerance: float, cap: float,
+) -> tuple[NDArray[np.float64], int]:  # fmt: skip
     """Measure and judge m joints in one pass (``_chain_kernels.joint_measures``): (m, 6) rows of gap,
     angle, curvature jump, shorter length, curvature scale and failure flag, and the first failing joint (-1: none).
     ``own`` (m,): the larger ``curvature_scales`` of each joint's two segments."""

@@ -26,7 +26,7 @@ from .units import COLLINEAR_TOL
 #: Legs whose |sin(turn)| is at most this span no plane.
 
 
-def place(points: ArrayLike, origin: ArrayLike, x_dir: ArrayLike, y_dir: ArrayLike) -> NDArray:
+def place(points: ArrayLike, origin: ArrayLike, x_dir: ArrayLike, y_dir: ArrayLike) -> NDArray[np.float64]:
     """Plane points (..., 2) in space: origin + x·x_dir + y·y_dir, shape (..., 3).
 
     ``origin``, ``x_dir`` and ``y_dir`` are (..., 3) and broadcast against the
@@ -58,7 +58,14 @@ POINTS_PER_THREAD = 100_000
 
 
 @K.jit
-def _place_row(points, origin, x_dir, y_dir, out, i):
+def _place_row(
+    points: NDArray[np.float64],
+    origin: NDArray[np.float64],
+    x_dir: NDArray[np.float64],
+    y_dir: NDArray[np.float64],
+    out: NDArray[np.float64],
+    i: int,
+) -> None:
     """out[i, k] = origin[i] + points[i, k, 0]·x_dir[i] + points[i, k, 1]·y_dir[i]."""
     for k in range(points.shape[1]):
         u, v = points[i, k, 0], points[i, k, 1]
@@ -67,25 +74,32 @@ def _place_row(points, origin, x_dir, y_dir, out, i):
 
 
 @K.jit
-def _place_rows(points, origin, x_dir, y_dir, out):
+def _place_rows(
+    points: NDArray[np.float64],
+    origin: NDArray[np.float64],
+    x_dir: NDArray[np.float64],
+    y_dir: NDArray[np.float64],
+    out: NDArray[np.float64],
+) -> None:
     for i in range(points.shape[0]):
         _place_row(points, origin, x_dir, y_dir, out, i)
 
 
-def norms(vectors: ArrayLike) -> NDArray:
+def norms(vectors: ArrayLike) -> NDArray[np.float64]:
     """|v| of (..., 2) or (..., 3) vectors without overflow or underflow (``math.hypot`` per row)."""
     v = np.asarray(vectors, dtype=float)
     if v.shape[-1] == 2:
-        return np.hypot(v[..., 0], v[..., 1])
+        plane: NDArray[np.float64] = np.hypot(v[..., 0], v[..., 1])
+        return plane
     with np.errstate(over="ignore", under="ignore"):
-        length = np.sqrt(np.einsum("...i,...i->...", v, v))  # 6x faster than hypot, within an ulp or two
+        length: NDArray[np.float64] = np.sqrt(np.einsum("...i,...i->...", v, v))  # 6x faster than hypot, within an ulp or two
     unsafe = ~((length > 1e-150) & (length < 1e150))  # squares that may have overflowed or underflowed
     if unsafe.any():
         length[unsafe] = np.hypot(np.hypot(v[unsafe][..., 0], v[unsafe][..., 1]), v[unsafe][..., 2])
     return length
 
 
-def corner_frames(before: ArrayLike, corners: ArrayLike, after: ArrayLike) -> tuple[NDArray, NDArray]:
+def corner_frames(before: ArrayLike, corners: ArrayLike, after: ArrayLike) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     """The planes of N corners before → corner → after, points (N, 3): unit x_dir (N, 3) along the
     incoming leg and unit y_dir (N, 3) perpendicular to it, towards the outgoing leg.
 
@@ -114,8 +128,9 @@ def corner_frames(before: ArrayLike, corners: ArrayLike, after: ArrayLike) -> tu
     return x, y
 
 
-def placed_pair_residuals(pairs: NDArray, corners: NDArray, x_dir: NDArray, y_dir: NDArray, outgoing: NDArray, peak: NDArray,
-                          residual: NDArray, deviation: NDArray) -> None:  # fmt: skip
+def placed_pair_residuals(pairs: NDArray[np.float64], corners: NDArray[np.float64], x_dir: NDArray[np.float64],
+                          y_dir: NDArray[np.float64], outgoing: NDArray[np.float64], peak: NDArray[np.float64],
+                          residual: NDArray[np.float64], deviation: NDArray[np.float64]) -> None:  # fmt: skip
     """Verify N corners' spiral pairs placed in space, measured on the placed control points.
 
     ``pairs`` (N, 2, 4, 3) were solved in the planes (``x_dir``, ``y_dir``)
@@ -134,7 +149,17 @@ def placed_pair_residuals(pairs: NDArray, corners: NDArray, x_dir: NDArray, y_di
 
 
 @K.jit
-def _pair_residual(pairs, corners, x_dir, y_dir, outgoing, peak, residual, deviation, i):
+def _pair_residual(
+    pairs: NDArray[np.float64],
+    corners: NDArray[np.float64],
+    x_dir: NDArray[np.float64],
+    y_dir: NDArray[np.float64],
+    outgoing: NDArray[np.float64],
+    peak: NDArray[np.float64],
+    residual: NDArray[np.float64],
+    deviation: NDArray[np.float64],
+    i: int,
+) -> None:
     """Row ``i`` of ``placed_pair_residuals``."""
     x, y = x_dir[i], y_dir[i]
     nx, ny, nz = x[1] * y[2] - x[2] * y[1], x[2] * y[0] - x[0] * y[2], x[0] * y[1] - x[1] * y[0]
@@ -159,13 +184,22 @@ def _pair_residual(pairs, corners, x_dir, y_dir, outgoing, peak, residual, devia
 
 
 @K.jit
-def _pair_residuals(pairs, corners, x_dir, y_dir, outgoing, peak, residual, deviation):
+def _pair_residuals(
+    pairs: NDArray[np.float64],
+    corners: NDArray[np.float64],
+    x_dir: NDArray[np.float64],
+    y_dir: NDArray[np.float64],
+    outgoing: NDArray[np.float64],
+    peak: NDArray[np.float64],
+    residual: NDArray[np.float64],
+    deviation: NDArray[np.float64],
+) -> None:
     for i in range(corners.shape[0]):
         _pair_residual(pairs, corners, x_dir, y_dir, outgoing, peak, residual, deviation, i)
 
 
 
-def _vector3(value: Any, name: str) -> NDArray:
+def _vector3(value: Any, name: str) -> NDArray[np.float64]:
     v = as_real_array(value, name)
     if v.shape not in ((2,), (3,)):
         raise ValueError(f"{name} must have 2 or 3 coordinates; got shape {v.shape}")
@@ -174,7 +208,7 @@ def _vector3(value: Any, name: str) -> NDArray:
     return out
 
 
-def _unit(v: NDArray, name: str) -> NDArray:
+def _unit(v: NDArray[np.float64], name: str) -> NDArray[np.float64]:
     length = math.hypot(*v.tolist())
     if not length > 0.0 or not math.isfinite(length):
         raise ValueError(f"{name} must be a non-zero finite vector; got {tuple(v.tolist())}")
@@ -229,19 +263,19 @@ class PlaneFrame:
         return cls(p, x, np.cross(x, y))
 
     @property
-    def basis(self) -> NDArray:
+    def basis(self) -> NDArray[np.float64]:
         """(2, 3): x_dir and y_dir."""
         return np.array([self.x_dir, self.y_dir])
 
-    def point(self, xy: ArrayLike) -> NDArray:
+    def point(self, xy: ArrayLike) -> NDArray[np.float64]:
         """Plane points (..., 2) in space (..., 3)."""
         return place(xy, self.origin, self.x_dir, self.y_dir)
 
-    def vector(self, xy: ArrayLike) -> NDArray:
+    def vector(self, xy: ArrayLike) -> NDArray[np.float64]:
         """Plane vectors (..., 2) in space (..., 3) (directions: no origin)."""
         return place(xy, (0.0, 0.0, 0.0), self.x_dir, self.y_dir)
 
-    def local(self, xyz: ArrayLike) -> NDArray:
+    def local(self, xyz: ArrayLike) -> NDArray[np.float64]:
         """Plane coordinates (..., 2) of points (..., 3): their projection onto the plane."""
         d = np.asarray(xyz, dtype=float) - self.origin
         return np.stack([d @ self.x_dir, d @ self.y_dir], axis=-1)

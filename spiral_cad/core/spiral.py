@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 import math
-from typing import Any
+from typing import Any, cast
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -50,7 +50,7 @@ class BezierSpiral(Segment):
     is κ ≥ 0 and ``normal`` is the binormal it turns about.
     """
 
-    def __init__(self, start: Any, direction: Any, theta: float, curvature: float, shape: str = DEFAULT_SHAPE):
+    def __init__(self, start: Any, direction: Any, theta: float, curvature: float, shape: str = DEFAULT_SHAPE) -> None:
         bx, by = as_xy(start, "start")
         dx, dy = as_xy(direction, "direction")
         theta = as_float(theta, "theta")
@@ -61,10 +61,10 @@ class BezierSpiral(Segment):
         if status != Status.OK:
             inputs = dict(start=(bx, by), direction=(dx, dy), theta=theta, curvature=curvature, shape=shape)
             raise error_for("BezierSpiral", status, measure, inputs)
-        self._cp = out[0, 0]
-        self._dim = 2
-        self._length = None
-        self._shape = shape
+        self._cp: NDArray[np.float64] = out[0, 0]
+        self._dim: int = 2
+        self._length: float | None = None
+        self._shape: str | None = shape
         self._cp.setflags(write=False)
 
     @classmethod
@@ -94,7 +94,8 @@ class BezierSpiral(Segment):
             raise ValueError(f"control_points must have shape (4, 2) or (4, 3); got {cp.shape}")
         if not np.isfinite(cp).all():
             raise ValueError(f"control_points must be finite; got {cp.tolist()}")
-        if cp.shape[1] == 3 and not cp[:, 2].any():
+        dim: int = cp.shape[1]  # as an int: mypy would narrow cp.shape to the first shape allowed above
+        if dim == 3 and not cp[:, 2].any():
             cp = np.ascontiguousarray(cp[:, :2])
         for leg, (a, b) in (("first", (0, 1)), ("last", (2, 3))):
             if np.array_equal(cp[a], cp[b]) or not np.isfinite(cp[b] - cp[a]).all():
@@ -107,7 +108,7 @@ class BezierSpiral(Segment):
         return cls._wrap(cp, shape)
 
     @classmethod
-    def _wrap(cls, cp: NDArray, shape: str | None, length: float | None = None) -> BezierSpiral:
+    def _wrap(cls, cp: NDArray[np.float64], shape: str | None, length: float | None = None) -> BezierSpiral:
         """Adopt a finite (4, 2) or (4, 3) float64 array without copying or checks (solver output)."""
         spiral = object.__new__(cls)
         cp.setflags(write=False)
@@ -126,11 +127,11 @@ class BezierSpiral(Segment):
         return self._shape
 
     @property
-    def control_points(self) -> NDArray:
+    def control_points(self) -> NDArray[np.float64]:
         """(4, 2) float64 control points in travel order, (4, 3) in space (read-only)."""
         return self._cp
 
-    def _row(self) -> tuple[int, NDArray, tuple[float, float, float]]:
+    def _row(self) -> tuple[int, NDArray[np.float64], tuple[float, float, float]]:
         geometry = np.zeros((4, 3))
         geometry[:, : self._dim] = self._cp
         return SPIRAL, geometry, (0.0, 0.0, 0.0)
@@ -144,7 +145,7 @@ class BezierSpiral(Segment):
         return float(turn_angles(self._cp[None])[0])
 
     @property
-    def normal(self) -> NDArray:
+    def normal(self) -> NDArray[np.float64]:
         """Unit normal (3,) of the spiral's plane: (0, 0, 1) in the plane (curvature signed about it);
         in space the binormal the spiral turns counterclockwise about.
 
@@ -163,10 +164,10 @@ class BezierSpiral(Segment):
     def length(self) -> float:
         """Arc length by composite Gauss–Legendre (≤ 1e-14 relative for |θ| ≤ 80°)."""
         if self._length is None:  # immutable curve: integrate once
-            self._length = bezier.arc_length(self._cp)
+            self._length = cast(float, bezier.arc_length(self._cp))  # one curve: a float
         return self._length
 
-    def parameter_at(self, s: ArrayLike) -> NDArray:
+    def parameter_at(self, s: ArrayLike) -> NDArray[np.float64]:
         """Parameters u with arc length ``s`` from the start (Newton, to 1e-14·length)."""
         s = np.asarray(s, dtype=float)
         total = self.length
@@ -178,18 +179,19 @@ class BezierSpiral(Segment):
                 break
         return u
 
-    def point(self, u: ArrayLike) -> NDArray:
+    def point(self, u: ArrayLike) -> NDArray[np.float64]:
         return bezier.point(self._cp, u)
 
-    def tangent(self, u: ArrayLike) -> NDArray:
+    def tangent(self, u: ArrayLike) -> NDArray[np.float64]:
         return bezier.tangent(self._cp, u)
 
-    def curvature(self, u: ArrayLike) -> NDArray | float:
+    def curvature(self, u: ArrayLike) -> NDArray[np.float64] | float:
         if self._dim == 2:
             return bezier.curvature(self._cp, u)[()]
-        return np.linalg.norm(self.curvature_vector(u), axis=-1)[()]
+        kappa: NDArray[np.float64] | float = np.linalg.norm(self.curvature_vector(u), axis=-1)[()]
+        return kappa
 
-    def curvature_vector(self, u: ArrayLike) -> NDArray:
+    def curvature_vector(self, u: ArrayLike) -> NDArray[np.float64]:
         """κN = ((Q' × Q'') × Q') / |Q'|⁴, on the control points scaled by a power of two (any magnitude)."""
         scale = math.ldexp(1.0, math.frexp(float(np.abs(np.diff(self._cp, axis=0)).max()))[1])
         cp = np.zeros((4, 3))
@@ -197,7 +199,8 @@ class BezierSpiral(Segment):
         d1, d2 = (bezier.derivative(cp, u, order) for order in (1, 2))
         speed2 = np.einsum("...i,...i->...", d1, d1)
         k = np.cross(np.cross(d1, d2), d1) / (speed2 * speed2)[..., None] / scale
-        return k[..., : self._dim]
+        vector: NDArray[np.float64] = k[..., : self._dim]
+        return vector
 
     def piece(self, t0: float, t1: float) -> BezierSpiral:
         """Exact sub-curve on [t0, t1] (de Casteljau) as a Bézier on [0, 1]."""
@@ -212,7 +215,7 @@ class BezierSpiral(Segment):
         return BezierSpiral._wrap(frame.point(self._cp), self._shape)
 
 
-def turn_angles(control_points: NDArray) -> NDArray:
+def turn_angles(control_points: NDArray[np.float64]) -> NDArray[np.float64]:
     """The turn from start to end tangent of N cubics (N, 4, 2 or 3): signed in the plane, ≥ 0 in space."""
     a = control_points[:, 1] - control_points[:, 0]
     c = control_points[:, 3] - control_points[:, 2]
@@ -231,7 +234,7 @@ def turn_angles(control_points: NDArray) -> NDArray:
     return np.array([math.atan2(y, x) for y, x in zip(cross.tolist(), dot.tolist())])
 
 
-def _turn(cp: NDArray) -> NDArray:
+def _turn(cp: NDArray[np.float64]) -> NDArray[np.float64]:
     """(a + b) × c of the legs a, b, c: along the binormal of a planar cubic that turns one way
     (a × b vanishes where a spiral starts straight, so it is not used alone)."""
     legs = np.diff(cp, axis=0)
@@ -239,7 +242,7 @@ def _turn(cp: NDArray) -> NDArray:
     return np.cross(legs[0] + legs[1], legs[2])
 
 
-def _check_planar(cp: NDArray) -> None:
+def _check_planar(cp: NDArray[np.float64]) -> None:
     """ValueError unless the (4, 3) control points lie in one plane (1e-9 of the legs plus rounding)."""
     n = _turn(cp)
     size = math.hypot(*n.tolist())

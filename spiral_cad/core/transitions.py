@@ -66,25 +66,25 @@ class Transition:
         return transition
 
     @property
-    def start(self) -> NDArray:
+    def start(self) -> NDArray[np.float64]:
         """Contact point where the transition leaves the first line/circle."""
         return self.spirals[0].start
 
     @property
-    def start_tangent(self) -> NDArray:
+    def start_tangent(self) -> NDArray[np.float64]:
         return self.spirals[0].start_tangent
 
     @property
-    def end(self) -> NDArray:
+    def end(self) -> NDArray[np.float64]:
         """Contact point where the transition reaches the last line/circle."""
         return self.spirals[-1].end
 
     @property
-    def end_tangent(self) -> NDArray:
+    def end_tangent(self) -> NDArray[np.float64]:
         return self.spirals[-1].end_tangent
 
     @property
-    def joint(self) -> NDArray | None:
+    def joint(self) -> NDArray[np.float64] | None:
         """Where two spirals meet (two-spiral cases), else None."""
         return self.spirals[0].end if len(self.spirals) == 2 else None
 
@@ -118,7 +118,7 @@ class Transition:
         return [measure_join(a, b, i) for i, (a, b) in enumerate(zip(chain, chain[1:]))]
 
 
-def _contact_piece(circle: Circle | None, line: Ray | None, point: NDArray, before: bool, size: float) -> Segment:
+def _contact_piece(circle: Circle | None, line: Ray | None, point: NDArray[np.float64], before: bool, size: float) -> Segment:
     """A short piece of the given circle/line ending (``before``) or starting at the foot of ``point``.
 
     A line piece is ``size`` long (the transition's length), so it stays
@@ -129,13 +129,14 @@ def _contact_piece(circle: Circle | None, line: Ray | None, point: NDArray, befo
         angle = math.atan2(point[1] - cy, point[0] - cx)
         step = 1e-3 * math.copysign(1.0, circle.radius)
         return Arc(circle.center, circle.radius, angle - step if before else angle, 1e-3)
+    assert line is not None  # every contact is a circle or a line
     (px, py), direction = line.point, np.asarray(line.direction) / math.hypot(*line.direction)
     foot = np.array([px, py]) + np.dot(point - (px, py), direction) * direction
-    step = size * direction
-    return Line(foot - step, foot) if before else Line(foot, foot + step)
+    leg = size * direction
+    return Line(foot - leg, foot) if before else Line(foot, foot + leg)
 
 
-def _spirals(out: NDArray, shape: str) -> list[BezierSpiral]:
+def _spirals(out: NDArray[np.float64], shape: str) -> list[BezierSpiral]:
     """The solved row ``out`` (1, k, 4, 2), k = 1 or 2, as spirals (read-only views)."""
     first = BezierSpiral._wrap(out[0, 0], shape)
     return [first] if out.shape[1] == 1 else [first, BezierSpiral._wrap(out[0, 1], shape)]
@@ -174,7 +175,9 @@ def line_to_circle(point: Any, direction: Any, center: Any, radius: float, shape
     return Transition._solved("line-circle", _spirals(out, shape), theta, shape, end_circle=circle, start_line=line)
 
 
-def _two_circles(case: str, center0: Any, radius0: Any, center1: Any, radius1: Any, shape: str) -> tuple:
+def _two_circles(
+    case: str, center0: Any, radius0: Any, center1: Any, radius1: Any, shape: str
+) -> tuple[tuple[float, float], float, tuple[float, float], float, NDArray[np.float64], float, float]:
     """Coerce the two circles' arguments (in argument order), solve ``case``'s row and
     raise its error if it fails: (c0, r0, c1, r1, out, θ, extra)."""
     c0 = as_xy(center0, "center0")
