@@ -72,12 +72,12 @@ _U = 0.5 * (_X + 1.0)  # nodes on [0, 1]
 _HALF_W = 0.5 * _W  # their weights on [0, 1]
 
 
-def _turn(s: NDArray, k0: NDArray, rate: NDArray) -> NDArray:
+def _turn(s: NDArray[np.float64], k0: NDArray[np.float64], rate: NDArray[np.float64]) -> NDArray[np.float64]:
     """An upper bound of the heading's total variation over [0, s]: max |κ| · s."""
     return np.maximum(np.abs(k0), np.abs(k0 + rate * s)) * np.abs(s)
 
 
-def _fresnel_condition(length: NDArray, k0: NDArray, rate: NDArray) -> NDArray:
+def _fresnel_condition(length: NDArray[np.float64], k0: NDArray[np.float64], rate: NDArray[np.float64]) -> NDArray[np.float64]:
     """Fresnel's rounding error over a piece of ``length``, in units of ε·length (inf where c = 0)."""
     with np.errstate(all="ignore"):
         safe = np.where(rate == 0.0, np.inf, rate)
@@ -88,7 +88,7 @@ def _fresnel_condition(length: NDArray, k0: NDArray, rate: NDArray) -> NDArray:
     return np.where((rate == 0.0) | ~np.isfinite(condition), np.inf, condition)
 
 
-def clothoid_method(length: ArrayLike, k0: ArrayLike, rate: ArrayLike) -> NDArray:
+def clothoid_method(length: ArrayLike, k0: ArrayLike, rate: ArrayLike) -> NDArray[np.int64]:
     """Which method (``ARC``, ``QUADRATURE``, ``FRESNEL`` or ``NONE``) evaluates each piece.
 
     Args:
@@ -113,7 +113,7 @@ def clothoid_method(length: ArrayLike, k0: ArrayLike, rate: ArrayLike) -> NDArra
     return np.where(bad, NONE, method)  # an arc whose turn overflows is evaluated: its points are NaN
 
 
-def clothoid_points(s: ArrayLike, k0: ArrayLike, rate: ArrayLike, method: ArrayLike | None = None) -> NDArray:
+def clothoid_points(s: ArrayLike, k0: ArrayLike, rate: ArrayLike, method: ArrayLike | None = None) -> NDArray[np.float64]:
     """Local points (..., 2) at arc lengths ``s`` of clothoids starting at the origin along +x.
 
     ``s``, ``k0`` and ``rate`` broadcast together; ``method`` (as from
@@ -144,7 +144,7 @@ def clothoid_frames(
     hdg: ArrayLike = 0.0,
     length: ArrayLike | None = None,
     method: ArrayLike | None = None,
-) -> tuple[NDArray, NDArray, NDArray]:
+) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
     """Points, headings and curvatures of clothoids at arc lengths ``s``.
 
     Every argument broadcasts against the others, so ``s`` of shape (n, m)
@@ -183,7 +183,7 @@ def clothoid_frames(
     return points, heading, curvature
 
 
-def _arc(s: NDArray, k: NDArray, _rate: NDArray) -> NDArray:
+def _arc(s: NDArray[np.float64], k: NDArray[np.float64], _rate: NDArray[np.float64]) -> NDArray[np.float64]:
     """Points of arcs (lines where k = 0) of curvature ``k`` at arc lengths ``s`` (1-d arrays)."""
     q = k * s
     small = np.abs(q) < _SERIES
@@ -194,7 +194,7 @@ def _arc(s: NDArray, k: NDArray, _rate: NDArray) -> NDArray:
     return np.stack([x, y], axis=-1)
 
 
-def _quadrature(s: NDArray, k0: NDArray, rate: NDArray) -> NDArray:
+def _quadrature(s: NDArray[np.float64], k0: NDArray[np.float64], rate: NDArray[np.float64]) -> NDArray[np.float64]:
     """Points by composite Gauss–Legendre quadrature of (cos θ, sin θ), θ = k0·t + rate·t²/2, over
     [0, s] in equal panels turning by at most ``PANEL_TURN`` each (1-d arrays; ragged panel counts
     are flattened into one array)."""
@@ -215,7 +215,7 @@ def _quadrature(s: NDArray, k0: NDArray, rate: NDArray) -> NDArray:
     return np.stack([np.bincount(owner, x, len(s)), np.bincount(owner, y, len(s))], axis=-1)
 
 
-def _fresnel(s: NDArray, k0: NDArray, rate: NDArray) -> NDArray:
+def _fresnel(s: NDArray[np.float64], k0: NDArray[np.float64], rate: NDArray[np.float64]) -> NDArray[np.float64]:
     """Points by Fresnel integrals after completing the square of the heading (1-d arrays;
     rate ≠ 0): θ = (c/2)(t + s0)² − φ with s0 = k0/c, φ = k0²/(2c)."""
     sign = np.sign(rate)

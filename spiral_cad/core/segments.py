@@ -517,23 +517,24 @@ class Join:
     curvature_jump: float
 
 
-def curvature_scales(frames: NDArray) -> NDArray:
+def curvature_scales(frames: NDArray[np.float64]) -> NDArray[np.float64]:
     """Each segment's own curvature scale from its end frames (n, 2, 9): the larger |κ| of its two ends
     (0 for a line, 1/r for an arc, the peak of a monotone-curvature spiral)."""
-    return np.sqrt(np.max(np.einsum("nej,nej->ne", frames[:, :, 6:9], frames[:, :, 6:9]), axis=1))
+    scales: NDArray[np.float64] = np.sqrt(np.max(np.einsum("nej,nej->ne", frames[:, :, 6:9], frames[:, :, 6:9]), axis=1))
+    return scales
 
 
 def joint_table(
     end: NDArray[np.float64], end_floor: NDArray[np.float64], end_length: NDArray[np.float64],
     start: NDArray[np.float64], start_floor: NDArray[np.float64], start_length: NDArray[np.float64],
-    own: NDArray[np.float64], tolerance: float, cap: float,
+    own: NDArray[np.float64] | float, tolerance: float, cap: float,
 ) -> tuple[NDArray[np.float64], int]:  # fmt: skip
     """Measure and judge m joints in one pass (``_chain_kernels.joint_measures``): (m, 6) rows of gap,
     angle, curvature jump, shorter length, curvature scale and failure flag, and the first failing joint (-1: none).
     ``own`` (m,): the larger ``curvature_scales`` of each joint's two segments."""
     out = np.empty((len(end), 6))
-    own = np.ascontiguousarray(np.broadcast_to(np.asarray(own, dtype=float), (len(end),)))
-    first = CK.joint_measures(end, end_floor, end_length, start, start_floor, start_length, own, tolerance, cap, out)
+    scales = np.ascontiguousarray(np.broadcast_to(np.asarray(own, dtype=float), (len(end),)))
+    first = CK.joint_measures(end, end_floor, end_length, start, start_floor, start_length, scales, tolerance, cap, out)
     return out, int(first)
 
 
