@@ -172,7 +172,11 @@ def main() -> None:
                         continue
                     results.setdefault((job, size, name), []).append(answer["seconds"])
                     segments[(job, size)] = answer["segments"]
-            print(f"{job} {size}: " + ", ".join(f"{name} {statistics.median(results.get((job, size, name), [math.nan])):.4f} s" for name, _ in workers), flush=True)
+            print(
+                f"{job} {size}: "
+                + ", ".join(f"{name} {statistics.median(results.get((job, size, name), [math.nan])):.4f} s" for name, _ in workers),
+                flush=True,
+            )
         for _, w in workers:
             w.close()
     header = ["job", "size", "segments", "ours: median s", "ours: segments/s"]
@@ -203,7 +207,9 @@ def main() -> None:
         if (job, 10_000, "ours") in results:
             t = statistics.median(results[(job, 10_000, "ours")])
             verdict = "met" if t <= goal else "missed"
-            notes.append(f"{labels[job]}, 10 000 PIs: {t:.3f} s (goal ≤ {goal} s: {verdict}; {segments[(job, 10_000)] / t:,.0f} segments/s)")
+            notes.append(
+                f"{labels[job]}, 10 000 PIs: {t:.3f} s (goal ≤ {goal} s: {verdict}; {segments[(job, 10_000)] / t:,.0f} segments/s)"
+            )
     print("| " + " | ".join(header) + " |")
     print("|" + "---|" * len(header))
     for row in rows:
@@ -212,7 +218,10 @@ def main() -> None:
         print(note)
     print(f"machine: {machine()}")
     if args.out:
-        note = f"Medians of {repeat} runs per job, ours and {args.baseline or 'no baseline'} alternating in two worker processes.\n\n" + "\n".join(f"- {n}" for n in notes)
+        note = (
+            f"Medians of {repeat} runs per job, ours and {args.baseline or 'no baseline'} alternating in two worker processes.\n\n"
+            + "\n".join(f"- {n}" for n in notes)
+        )
         write_markdown(args.out, "Chains and alignments at scale", note, header, rows)
 
 

@@ -111,8 +111,10 @@ def main() -> None:
         rows.append(f"| {moves:,} | {read['read']:.2f} s, {read['peak_mb']:,.0f} MB | "
                     + (f"{chain['round']:.2f} s, {chain['peak_mb']:,.0f} MB" if chain else "not run (above --chain-max)")
                     + f" | {arrays['round']:.2f} s, {arrays['peak_mb']:,.0f} MB |")  # fmt: skip
-    report.section("Peak memory per job (process maximum, imports and the program's text included)",
-                   "| moves | read_gcode | round_toolpath (Chain) | round_toolpath_arrays |\n|---|---|---|---|\n" + "\n".join(rows))
+    report.section(
+        "Peak memory per job (process maximum, imports and the program's text included)",
+        "| moves | read_gcode | round_toolpath (Chain) | round_toolpath_arrays |\n|---|---|---|---|\n" + "\n".join(rows),
+    )
     report.finish(args)
 
 

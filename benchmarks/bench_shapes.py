@@ -70,8 +70,11 @@ def main() -> None:
     designs, angles = (DESIGNS[2:3], ANGLES[:2]) if args.quick else (DESIGNS, ANGLES)
     report = Report("Spiral shapes")
     header = ["V km/h", "R m", "C m/s³", "clothoid L, p (m)", "1996 spiral L, p (m)", "near-linear L, p (m)"]
-    report.section("Spiral length at a jerk limit", "The shortest spiral whose peak lateral jerk v³·max dκ/ds equals C "
-                   "(the clothoid's is constant). Road criteria also ask 0.2 m ≤ p ≤ 1.0 m.\n\n" + table(header, design_rows(designs)))
+    report.section(
+        "Spiral length at a jerk limit",
+        "The shortest spiral whose peak lateral jerk v³·max dκ/ds equals C "
+        "(the clothoid's is constant). Road criteria also ask 0.2 m ≤ p ≤ 1.0 m.\n\n" + table(header, design_rows(designs)),
+    )
     report.section("Peak over mean dκ/ds by spiral angle", f"Measured on the spirals ({args.samples:,} samples): the clothoid's is 1.\n\n"
                    + table(["θ", "1996 spiral", "near-linear"], angle_rows(args.samples, angles)))  # fmt: skip
     report.finish(args)

@@ -64,8 +64,6 @@ def compare(jobs: dict[str, Callable[[], object]], rounds: int, warm_up: bool = 
     return {name: Timing(tuple(values)) for name, values in runs.items()}
 
 
-
-
 def latencies(calls: dict[str, Callable[[], object]], rounds: int, number: int) -> dict[str, Timing]:
     """``latency`` of several calls, taken in turn round by round (like ``compare``)."""
     for call in calls.values():

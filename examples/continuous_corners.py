@@ -71,9 +71,7 @@ ways = {
         [first, bd.BlendCurve(first, second, tangent_scalars=(tension, tension)), second]
     ),
     f"spiral_cad g2_fillet (r = {radius:.2f}, transition {TRANSITION})": g2_fillet(corner, radius, transition=TRANSITION),
-    f"spiral_cad g2_fillet near-linear (r = {radius_nl:.2f})": g2_fillet(
-        corner, radius_nl, transition=TRANSITION, shape="near-linear"
-    ),
+    f"spiral_cad g2_fillet near-linear (r = {radius_nl:.2f})": g2_fillet(corner, radius_nl, transition=TRANSITION, shape="near-linear"),
 }
 
 

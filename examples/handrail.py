@@ -46,10 +46,14 @@ export_step(path, out / "handrail_path.step", units="mm")
 report = check_continuity(out / "handrail_path.step")
 assert report.passes("G2"), report.describe()
 rounded = line.rounded
-print(f"handrail: {len(rounded.corners)} bends, centre line {rounded.chain.length:.1f} mm, "
-      f"smallest radius of curvature {1 / rounded.max_curvature:.1f} mm, tube volume {solid.volume / 1e6:.3f} dm³")
+print(
+    f"handrail: {len(rounded.corners)} bends, centre line {rounded.chain.length:.1f} mm, "
+    f"smallest radius of curvature {1 / rounded.max_curvature:.1f} mm, tube volume {solid.volume / 1e6:.3f} dm³"
+)
 for corner in rounded.corners:
-    print(f"  bend at point {corner.index}: turn {2 * corner.theta * 57.29577951308232:6.2f}°, "
-          f"spirals start {corner.distance:7.1f} mm from the corner, pass {corner.deviation:5.1f} mm inside it")
+    print(
+        f"  bend at point {corner.index}: turn {2 * corner.theta * 57.29577951308232:6.2f}°, "
+        f"spirals start {corner.distance:7.1f} mm from the corner, pass {corner.deviation:5.1f} mm inside it"
+    )
 print(report.describe())
 print(f"wrote {out / 'handrail.step'} and {out / 'handrail_path.step'}")

@@ -33,8 +33,10 @@ for column, method in enumerate(("walton-meek", "g2cbs")):
     peak = np.abs(path.chain.curvature_at(s)).max()
     assert peak <= kappa_max * (1 + 1e-9), (method, peak)
     corner_distance = sum(c.distance for c in path.corners)
-    print(f"{method:12} corners {len(path.corners)}  length {path.chain.length:.4f} m  "
-          f"measured max |κ| {peak:.6f} ≤ κmax {kappa_max}  total corner distance {corner_distance:.4f} m")
+    print(
+        f"{method:12} corners {len(path.corners)}  length {path.chain.length:.4f} m  "
+        f"measured max |κ| {peak:.6f} ≤ κmax {kappa_max}  total corner distance {corner_distance:.4f} m"
+    )
     plot_plan(path.chain, ax=axes[0, column])
     axes[0, column].plot(*waypoints.T, "k--", lw=0.8, marker="o", ms=3, label="waypoints")
     axes[0, column].set_title(f"{method}: κmax = {kappa_max} 1/m")

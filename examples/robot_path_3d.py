@@ -51,15 +51,21 @@ assert report.passes("G2"), report.describe()
 s = np.linspace(0.0, chain.length, 40001)
 kappa = chain.curvature_at(s)
 assert kappa.max() <= kappa_max * (1 + 1e-9)
-print(f"{len(path.corners)} corners, path {chain.length:.2f} mm (polyline {np.linalg.norm(np.diff(waypoints, axis=0), axis=1).sum():.2f} mm), "
-      f"{samples} samples; file check: {report.describe()}")
+print(
+    f"{len(path.corners)} corners, path {chain.length:.2f} mm (polyline {np.linalg.norm(np.diff(waypoints, axis=0), axis=1).sum():.2f} mm), "
+    f"{samples} samples; file check: {report.describe()}"
+)
 print("| corner | turn | raw polyline | rounded: peak κ (1/mm) | radius (mm) | deviation (mm) |")
 print("|---:|---:|---|---:|---:|---:|")
 for corner in path.corners:
-    print(f"| {corner.index} | {math.degrees(2 * corner.theta):.1f}° | kink: tangent turns at once, κ unbounded "
-          f"| {corner.curvature:.5f} | {1 / corner.curvature:.2f} | {corner.deviation:.4f} |")
-print(f"curvature jumps along the rounded path: none (G2 at every joint); largest |Δκ| between neighbouring "
-      f"samples {np.abs(np.diff(kappa)).max():.2e} 1/mm at {s[1] - s[0]:.4f} mm spacing")
+    print(
+        f"| {corner.index} | {math.degrees(2 * corner.theta):.1f}° | kink: tangent turns at once, κ unbounded "
+        f"| {corner.curvature:.5f} | {1 / corner.curvature:.2f} | {corner.deviation:.4f} |"
+    )
+print(
+    f"curvature jumps along the rounded path: none (G2 at every joint); largest |Δκ| between neighbouring "
+    f"samples {np.abs(np.diff(kappa)).max():.2e} 1/mm at {s[1] - s[0]:.4f} mm spacing"
+)
 
 fig = plt.figure(figsize=(12, 5))
 ax = fig.add_subplot(1, 2, 1, projection="3d")

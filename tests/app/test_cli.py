@@ -85,10 +85,14 @@ def bad(path, edit):
         (lambda d: d["designs"][2].update(colour="red"), r"unknown field\(s\) colour"),
         (lambda d: d["designs"][1].update(type="spline"), r"designs\[1\].type: must be one of"),
         (lambda d: d["designs"][0].update(pis=[[0, 0], [600, 120], [1150, -80], [1700, 260], [2300, "x"]]), r"pis\[4\]\[1\]"),
-        (lambda d: d["designs"][0].update(pis=[[1000 * k, 250 * (k % 2)] for k in range(20_001)]),
-         r"designs\[0\] \(highway\).pis: 20,001 points; at most 20,000 per design"),
-        (lambda d: d["designs"][0].update(profile={"pvis": [[k, 0] for k in range(2_001)], "curve_lengths": 0.1}),
-         r"designs\[0\] \(highway\).profile.pvis: 2,001 points; at most 2,000 per design"),
+        (
+            lambda d: d["designs"][0].update(pis=[[1000 * k, 250 * (k % 2)] for k in range(20_001)]),
+            r"designs\[0\] \(highway\).pis: 20,001 points; at most 20,000 per design",
+        ),
+        (
+            lambda d: d["designs"][0].update(profile={"pvis": [[k, 0] for k in range(2_001)], "curve_lengths": 0.1}),
+            r"designs\[0\] \(highway\).profile.pvis: 2,001 points; at most 2,000 per design",
+        ),
     ],
 )
 def test_bad_designs_name_the_field_and_write_nothing(tmp_path, capsys, edit, message):

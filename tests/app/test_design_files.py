@@ -14,8 +14,20 @@ from hypothesis import strategies as st
 
 from spiral_cad.app.cli import main
 
-DESIGN = {"units": "m", "designs": [{"name": "t", "type": "transition", "case": "line_to_circle",
-                                      "point": [0, 0], "direction": [1, 0], "center": [0, 105], "radius": 100}]}
+DESIGN = {
+    "units": "m",
+    "designs": [
+        {
+            "name": "t",
+            "type": "transition",
+            "case": "line_to_circle",
+            "point": [0, 0],
+            "direction": [1, 0],
+            "center": [0, 105],
+            "radius": 100,
+        }
+    ],
+}
 
 
 def run_build(tmp_path, content: bytes, capsys) -> tuple[int, str, Path]:
@@ -46,9 +58,25 @@ def design_with(**fields) -> bytes:
         (design_with(name="../etc"), r"name: must be 1–64 characters"),
         (design_with(radius=1e-300), "line_to_circle: the solution does not fit in float64"),
         (design_with(radius=float("nan")), "NaN is not a number in JSON"),
-        (json.dumps({**DESIGN, "designs": [{"name": "c", "type": "transition", "case": "line_to_line", "p0": [0, 0],
-                                              "corner": [100, 0], "p1": [160, 80], "curvature": 1e15}]}).encode(),
-         "line_to_line: the solution"),
+        (
+            json.dumps(
+                {
+                    **DESIGN,
+                    "designs": [
+                        {
+                            "name": "c",
+                            "type": "transition",
+                            "case": "line_to_line",
+                            "p0": [0, 0],
+                            "corner": [100, 0],
+                            "p1": [160, 80],
+                            "curvature": 1e15,
+                        }
+                    ],
+                }
+            ).encode(),
+            "line_to_line: the solution",
+        ),
         (json.dumps({"designs": DESIGN["designs"]}).encode(), "units: required"),
         (b"[]", "must be a JSON object"),
         (b"", "malformed JSON at line 1"),
@@ -76,14 +104,37 @@ JSON = st.recursive(
     lambda inner: st.lists(inner, max_size=4) | st.dictionaries(st.text(max_size=8), inner, max_size=4),
     max_leaves=20,
 )
-FIELDS = ["pis", "radii", "spiral_angles_deg", "spiral_lengths", "start_station", "circles", "points", "max_curvature",
-          "curvature", "method", "case", "point", "direction", "center", "radius", "p0", "corner", "p1", "center0",
-          "radius0", "center1", "radius1"]
+FIELDS = [
+    "pis",
+    "radii",
+    "spiral_angles_deg",
+    "spiral_lengths",
+    "start_station",
+    "circles",
+    "points",
+    "max_curvature",
+    "curvature",
+    "method",
+    "case",
+    "point",
+    "direction",
+    "center",
+    "radius",
+    "p0",
+    "corner",
+    "p1",
+    "center0",
+    "radius0",
+    "center1",
+    "radius1",
+]
 
 
 @settings(max_examples=150, suppress_health_check=[HealthCheck.function_scoped_fixture], deadline=None)
-@given(st.sampled_from(["alignment", "circle_chain", "rounded_polyline", "transition"]),
-       st.dictionaries(st.sampled_from(FIELDS), JSON, max_size=6))
+@given(
+    st.sampled_from(["alignment", "circle_chain", "rounded_polyline", "transition"]),
+    st.dictionaries(st.sampled_from(FIELDS), JSON, max_size=6),
+)
 def test_any_field_values_are_validated_by_name(tmp_path, capsys, kind, fields):
     design = {"units": "m", "designs": [{"name": "fuzz", "type": kind, **fields}]}
     status, err, _ = run_build(tmp_path, json.dumps(design).encode(), capsys)
@@ -104,8 +155,7 @@ def test_out_naming_a_file_is_an_error(tmp_path, capsys):
 
 def big_design(count: int) -> dict:
     pis = [[1000.0 * k, 300.0 * (k % 2)] for k in range(count + 2)]
-    return {"units": "m", "designs": [{"name": "long", "type": "alignment", "pis": pis, "radii": 200,
-                                       "spiral_angles_deg": 5}]}
+    return {"units": "m", "designs": [{"name": "long", "type": "alignment", "pis": pis, "radii": 200, "spiral_angles_deg": 5}]}
 
 
 def test_an_interrupted_build_leaves_nothing_behind(tmp_path):
@@ -116,7 +166,9 @@ def test_an_interrupted_build_leaves_nothing_behind(tmp_path):
     (out / "old.txt").write_text("from before")
     process = subprocess.Popen(
         [sys.executable, "-m", "spiral_cad.app.cli", "build", str(design), "--out", str(out)],
-        stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
     )
     for line in process.stdout:  # wait until the writing has begun
         if line.startswith("built "):
@@ -159,8 +211,18 @@ def test_units_of_a_design_reach_every_file(tmp_path, capsys, units, factor):
 
     from spiral_cad.cad.readers import read_shape
 
-    design = {"units": units, "designs": [{"name": "road", "type": "alignment", "pis": [[0, 0], [600, 120], [1150, -80],
-                                           [1700, 260]], "radii": [450, 400], "spiral_angles_deg": 8}]}
+    design = {
+        "units": units,
+        "designs": [
+            {
+                "name": "road",
+                "type": "alignment",
+                "pis": [[0, 0], [600, 120], [1150, -80], [1700, 260]],
+                "radii": [450, 400],
+                "spiral_angles_deg": 8,
+            }
+        ],
+    }
     path = tmp_path / "d.json"
     path.write_text(json.dumps(design))
     out = tmp_path / "out"
@@ -176,7 +238,7 @@ def test_units_of_a_design_reach_every_file(tmp_path, capsys, units, factor):
             explorer.Next()
         assert length == pytest.approx(chain.length * factor, rel=1e-12)
     assert ezdxf.readfile(out / "road.dxf").header["$INSUNITS"] == {"mm": 4, "m": 6}[units]
-    assert 'width="' in (svg := (out / "road.svg").read_text()) and "mm\"" in svg
+    assert 'width="' in (svg := (out / "road.svg").read_text()) and 'mm"' in svg
     assert f"TS [{units}]" in (out / "road_stations.csv").read_text().splitlines()[0]
     assert "1 wire of 9 edges" in (out / "road_continuity.txt").read_text().splitlines()[0]
     assert (out / "road_continuity.txt").read_text().startswith("road.step:")  # no staging path
@@ -210,8 +272,9 @@ def _rail():
 # --------------------------------------------------- all-or-nothing output
 
 EXAMPLE = Path(__file__).resolve().parents[2] / "examples" / "design.json"
-EXAMPLE_FILES = [f"{name}{suffix}" for name in ("rail", "loop", "cnc", "ramp")
-                 for suffix in (".step", ".svg", ".igs", "_continuity.txt", ".dxf")] + ["rail_stations.csv", "rail.xodr"]
+EXAMPLE_FILES = [
+    f"{name}{suffix}" for name in ("rail", "loop", "cnc", "ramp") for suffix in (".step", ".svg", ".igs", "_continuity.txt", ".dxf")
+] + ["rail_stations.csv", "rail.xodr"]
 
 
 def test_one_blocked_destination_leaves_every_existing_file_untouched(tmp_path, capsys):
@@ -234,8 +297,19 @@ def test_one_blocked_destination_leaves_every_existing_file_untouched(tmp_path, 
 
 
 def test_a_control_character_in_geo_reference_is_an_error_not_an_unreadable_file(tmp_path, capsys):
-    design = {"units": "m", "designs": [{"name": "road", "type": "alignment", "pis": [[0, 0], [600, 120], [1150, -80]],
-                                         "radii": [450], "spiral_angles_deg": 8, "geo_reference": "\u0001"}]}
+    design = {
+        "units": "m",
+        "designs": [
+            {
+                "name": "road",
+                "type": "alignment",
+                "pis": [[0, 0], [600, 120], [1150, -80]],
+                "radii": [450],
+                "spiral_angles_deg": 8,
+                "geo_reference": "\u0001",
+            }
+        ],
+    }
     status, err, out = run_build(tmp_path, json.dumps(design).encode(), capsys)
     assert status == 2
     assert err.startswith(r"error: designs[0] (road).geo_reference must be printable text; it holds U+0001")
@@ -303,9 +377,11 @@ EXAMPLE_DATA = json.loads(EXAMPLE.read_text())
 EXAMPLE_PATHS = paths_of(EXAMPLE_DATA)[1:]
 NUMERIC_PATHS = [p for p in EXAMPLE_PATHS if isinstance(_at(EXAMPLE_DATA, p), (int, float)) and not isinstance(_at(EXAMPLE_DATA, p), bool)]
 FACTORS = st.sampled_from([0.5, 0.9, 1.1, 2.0]) | st.sampled_from([1e-300, 1e-9, 1e9, 1e300, -1.0, 0])
-EDITS = (st.tuples(st.just("scale"), st.sampled_from(NUMERIC_PATHS), FACTORS)
-         | st.tuples(st.just("set"), st.sampled_from(EXAMPLE_PATHS), JSON)
-         | st.tuples(st.just("delete"), st.sampled_from(EXAMPLE_PATHS), st.none()))
+EDITS = (
+    st.tuples(st.just("scale"), st.sampled_from(NUMERIC_PATHS), FACTORS)
+    | st.tuples(st.just("set"), st.sampled_from(EXAMPLE_PATHS), JSON)
+    | st.tuples(st.just("delete"), st.sampled_from(EXAMPLE_PATHS), st.none())
+)
 BYTE_FLIPS = st.just([]) | st.just([]) | st.lists(st.tuples(st.integers(0, 10_000), st.integers(0, 255)), min_size=1, max_size=2)
 
 

@@ -46,29 +46,57 @@ MALFORMED = [
     (one(radii=[450]), "designs[0] (road).radii: needs one radius per interior PI (2); got 1"),
     (one(pis=[[0, 0], [1, "2"], [3, 4]]), "designs[0] (road).pis[1][1]: must be a finite number; got '2'"),
     (one(pis=[[0, 0], [1, 2]]), "designs[0] (road).pis: must be a list of at least 3 points [x, y]; got [[0, 0], [1, 2]]"),
-    (one(spiral_angles_deg=[8, [8, 95]]), "designs[0] (road).spiral_angles_deg[1][1]: spiral angles are in degrees and must lie in (0, 90); got 95"),
+    (
+        one(spiral_angles_deg=[8, [8, 95]]),
+        "designs[0] (road).spiral_angles_deg[1][1]: spiral angles are in degrees and must lie in (0, 90); got 95",
+    ),
     (one(strict=1), "designs[0] (road).strict: must be true or false; got 1"),
-    (one(cross_section={"driving_lanes": True}), "designs[0] (road).cross_section.driving_lanes: must be an integer from 1 to 10; got True"),
+    (
+        one(cross_section={"driving_lanes": True}),
+        "designs[0] (road).cross_section.driving_lanes: must be an integer from 1 to 10; got True",
+    ),
     (one(cross_section={"rule": "left"}), "designs[0] (road).cross_section.rule: must be one of RHT, LHT; got 'left'"),
     (one(cant_max=100), "designs[0] (road): cant_max belong(s) to rail criteria, not road"),
     (one(max_jerk=0.5), "designs[0] (road): design criteria need design_speed"),
     (one(spiral_lengths=50), "designs[0] (road): give at most one of spiral_angles_deg and spiral_lengths"),
     (one(speed=80, colour="red"), "designs[0] (road): unknown field(s) speed, colour"),
     ({"units": "m", "designs": [{"name": "road", "type": "alignment"}]}, "designs[0] (road): missing field(s) pis, radii"),
-    ({"units": "m", "designs": [{**ROAD, "type": "spline"}]}, "designs[0].type: must be one of alignment, circle_chain, rounded_polyline, transition; got 'spline'"),
-    ({"units": "m", "designs": [{"name": "road"}]}, "designs[0].type: required, one of alignment, circle_chain, rounded_polyline, transition"),
+    (
+        {"units": "m", "designs": [{**ROAD, "type": "spline"}]},
+        "designs[0].type: must be one of alignment, circle_chain, rounded_polyline, transition; got 'spline'",
+    ),
+    (
+        {"units": "m", "designs": [{"name": "road"}]},
+        "designs[0].type: required, one of alignment, circle_chain, rounded_polyline, transition",
+    ),
     ({"units": "m", "designs": [7]}, "designs[0]: must be an object; got 7"),
     (one(name="a b"), "designs[0].name: must be 1–64 characters of A–Z, a–z, 0–9, - and _ (starting with a letter or digit); got 'a b'"),
-    ({"units": "m", "designs": [{"name": "c", "type": "circle_chain", "circles": [{"center": [0, 0], "radius": 1},
-                                                                                    {"center": [5, 0], "radius": 0}]}]},
-     "designs[0] (c).circles[1].radius: must be non-zero (its sign is the travel sense); got 0"),
-    ({"units": "m", "designs": [{"name": "t", "type": "transition", "case": "line_to_line", "p0": [0, 0],
-                                 "corner": [1, 0], "p1": [2, 1], "radius": 3}]},
-     "designs[0] (t): unknown field(s) radius"),
-    ({"units": "m", "designs": [{"name": "t", "type": "transition", "case": "spiral"}]},
-     "designs[0] (t).case: must be one of line_to_circle, circle_to_circle, line_to_line, circle_in_circle; got 'spiral'"),
-    ({"units": "m", "designs": [{"name": "r", "type": "rounded_polyline", "points": [[0, 0], [1, 0], [1, 1]],
-                                 "samples": {}}]}, "designs[0] (r).samples: must be {\"step\": s} or {\"chord_tolerance\": c}"),
+    (
+        {
+            "units": "m",
+            "designs": [
+                {"name": "c", "type": "circle_chain", "circles": [{"center": [0, 0], "radius": 1}, {"center": [5, 0], "radius": 0}]}
+            ],
+        },
+        "designs[0] (c).circles[1].radius: must be non-zero (its sign is the travel sense); got 0",
+    ),
+    (
+        {
+            "units": "m",
+            "designs": [
+                {"name": "t", "type": "transition", "case": "line_to_line", "p0": [0, 0], "corner": [1, 0], "p1": [2, 1], "radius": 3}
+            ],
+        },
+        "designs[0] (t): unknown field(s) radius",
+    ),
+    (
+        {"units": "m", "designs": [{"name": "t", "type": "transition", "case": "spiral"}]},
+        "designs[0] (t).case: must be one of line_to_circle, circle_to_circle, line_to_line, circle_in_circle; got 'spiral'",
+    ),
+    (
+        {"units": "m", "designs": [{"name": "r", "type": "rounded_polyline", "points": [[0, 0], [1, 0], [1, 1]], "samples": {}}]},
+        'designs[0] (r).samples: must be {"step": s} or {"chord_tolerance": c}',
+    ),
     ({"units": "m", "designs": [ROAD, {**ROAD, "name": "ROAD"}]}, "designs[1].name: 'ROAD' is used twice"),
 ]
 

@@ -21,9 +21,7 @@ OUTPUTS = {
 @pytest.mark.parametrize("script", sorted(OUTPUTS))
 def test_example_runs(script, tmp_path):
     target = tmp_path / OUTPUTS[script][0] if script == "cadquery_plugin.py" else tmp_path
-    run = subprocess.run(
-        [sys.executable, str(EXAMPLES / script), str(target)], capture_output=True, text=True, timeout=300
-    )
+    run = subprocess.run([sys.executable, str(EXAMPLES / script), str(target)], capture_output=True, text=True, timeout=300)
     assert run.returncode == 0, run.stdout[-2000:] + run.stderr[-2000:]
     for name in OUTPUTS[script]:
         assert (tmp_path / name).stat().st_size > 0, name
@@ -58,5 +56,8 @@ def test_the_road_example_writes_metres(tmp_path):
     reader.TransferRoots()
     BRepGProp.LinearProperties_s(reader.OneShape(), props)
     chord = (820**2 + 90**2) ** 0.5 * 1e3
-    pis = sum(((bx - ax) ** 2 + (by - ay) ** 2) ** 0.5 for (ax, ay), (bx, by) in zip([(0, 0), (300, 60), (560, -40)], [(300, 60), (560, -40), (820, 90)]))
+    pis = sum(
+        ((bx - ax) ** 2 + (by - ay) ** 2) ** 0.5
+        for (ax, ay), (bx, by) in zip([(0, 0), (300, 60), (560, -40)], [(300, 60), (560, -40), (820, 90)])
+    )
     assert chord < props.Mass() < pis * 1e3 * 1.01

@@ -74,13 +74,15 @@ def core_env():
         subprocess.run([sys.executable, "-m", "venv", str(root / "venv")], check=True)
         env = CoreEnv(root / "venv", "")
         pip = [str(env.python), "-m", "pip", "--disable-pip-version-check"]
-        built = subprocess.run(pip + ["wheel", "-v", "--no-deps", "-w", str(root / "dist"), str(REPO)],
-                               capture_output=True, text=True, timeout=900)
+        built = subprocess.run(
+            pip + ["wheel", "-v", "--no-deps", "-w", str(root / "dist"), str(REPO)], capture_output=True, text=True, timeout=900
+        )
         assert built.returncode == 0, built.stdout[-2000:] + built.stderr[-2000:]
         env.build_log = built.stdout + built.stderr
         wheels = [str(w) for w in (root / "dist").glob("spiral_cad-*.whl")]
-        done = subprocess.run(pip + ["install", "-q", "-c", str(REPO / "requirements.lock"), *wheels],
-                              capture_output=True, text=True, timeout=900)
+        done = subprocess.run(
+            pip + ["install", "-q", "-c", str(REPO / "requirements.lock"), *wheels], capture_output=True, text=True, timeout=900
+        )
         assert done.returncode == 0, done.stdout[-2000:] + done.stderr[-2000:]
         if shared is not None:
             _chmod_tree(root, 0o555)  # readable by the unprivileged user whatever the umask
@@ -207,5 +209,7 @@ def test_the_numeric_core_names_no_cad_kernel_not_even_inside_a_function():
                 names = ["." * node.level + (node.module or "")]
             else:
                 continue
-            found += [f"{path.name}: {name}" for name in names if name.split(".")[0] in cad[:3] or name.startswith(("spiral_cad.cad", "..cad"))]
+            found += [
+                f"{path.name}: {name}" for name in names if name.split(".")[0] in cad[:3] or name.startswith(("spiral_cad.cad", "..cad"))
+            ]
     assert found == []

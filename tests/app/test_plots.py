@@ -35,7 +35,7 @@ def test_plan_with_comb(chain, tmp_path):
     ax = fig.axes[0]
     kinds = {type(s).__name__ for s in chain}
     for prefix in ("plan-", "comb-", "envelope-"):
-        assert {c.get_gid()[len(prefix):] for c in collections(ax, prefix)} == kinds
+        assert {c.get_gid()[len(prefix) :] for c in collections(ax, prefix)} == kinds
     # every segment drawn once, on its own polyline, through the segment's points
     drawn = sum(len(c.get_segments()) for c in collections(ax, "plan-"))
     assert drawn == len(chain)

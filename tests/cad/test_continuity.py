@@ -447,9 +447,7 @@ def test_cli_script_runs(step_files):
     script = Path(sys.executable).parent / "spiral-cad"
     if not script.exists():
         pytest.skip("spiral-cad script not installed next to this interpreter")
-    done = subprocess.run(
-        [str(script), "check", str(step_files["tangent-arc"]), "--require", "G2"], capture_output=True, text=True
-    )
+    done = subprocess.run([str(script), "check", str(step_files["tangent-arc"]), "--require", "G2"], capture_output=True, text=True)
     assert done.returncode == 1
     assert "worst G1" in done.stdout
 
@@ -503,6 +501,7 @@ def test_curvature_is_measured_at_any_scale():
 
 def scaled_step(text: str, factor: float) -> str:
     """A STEP text of lines and Bézier spirals with every length multiplied by ``factor``."""
+
     def scale(match: re.Match) -> str:
         return "%.17E" % (float(match.group(0)) * factor)
 

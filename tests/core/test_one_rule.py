@@ -115,7 +115,9 @@ LIMIT = st.one_of(st.none(), st.none(), EXTREME, st.just(0.0))
 
 @settings(max_examples=60)
 # Criteria are physical (speeds, friction): half the examples at the scale they are written for.
-@given(st.one_of(st.just(0.0), LOG_SCALE), OFFSET, st.floats(50, 3000), SPEED, LIMIT, LIMIT, st.sampled_from(["m", "ft", "mm"]), st.booleans())
+@given(
+    st.one_of(st.just(0.0), LOG_SCALE), OFFSET, st.floats(50, 3000), SPEED, LIMIT, LIMIT, st.sampled_from(["m", "ft", "mm"]), st.booleans()
+)
 def test_from_pis_with_criteria_returns_a_checked_alignment_or_refuses(outcome, log_scale, ox, radius, speed, low, high, units, rail):
     pis = placed(PIS, log_scale, ox, ox)
     scale = 10.0**log_scale
@@ -153,7 +155,12 @@ def test_relaxed_limits_and_extreme_speeds_of_the_issue():
 # ---------------------------------------------------------------- circle chains
 
 
-@given(LOG_SCALE, OFFSET, OFFSET, st.lists(st.tuples(st.floats(-30, 30), st.floats(-30, 30), st.floats(0.5, 8.0), st.booleans()), min_size=2, max_size=4))
+@given(
+    LOG_SCALE,
+    OFFSET,
+    OFFSET,
+    st.lists(st.tuples(st.floats(-30, 30), st.floats(-30, 30), st.floats(0.5, 8.0), st.booleans()), min_size=2, max_size=4),
+)
 def test_circle_chain_returns_a_checked_chain_or_refuses(outcome, log_scale, ox, oy, circles):
     scale = 10.0**log_scale
     centres = placed([(x, y) for x, y, _, _ in circles], log_scale, ox, oy)
@@ -240,7 +247,9 @@ def bulged(a, b, bulge):
 
 @given(LOG_SCALE, OFFSET, st.lists(st.tuples(st.floats(-10, 10), st.floats(-10, 10), st.sampled_from([0.0, 0.0, 0.3, -0.3, 0.9, -0.9])), min_size=3, max_size=5),
        st.floats(-3, 0.5), st.floats(0.05, 1.0), st.sampled_from(["nested", "C"]), st.booleans())  # fmt: skip
-def test_fillet_path_with_arcs_returns_checked_corners_or_refuses(outcome, log_scale, offset, points, log_radius, transition, same_sense, closed):
+def test_fillet_path_with_arcs_returns_checked_corners_or_refuses(
+    outcome, log_scale, offset, points, log_radius, transition, same_sense, closed
+):
     xy = placed([(x, y) for x, y, _ in points], log_scale, offset, offset)
     ends = xy + xy[:1] if closed else xy
     radius = 10.0**log_radius * 10.0**log_scale
@@ -289,11 +298,15 @@ def test_g2_fillet_returns_what_the_checker_grades_g2_or_refuses(outcome, log_sc
     scale = 10.0**log_scale
     try:  # the input itself must exist in OCCT (it refuses coordinates past ~1e100 and edges below 1e-7)
         if kind == "face":
-            shape = bd.Pos(offset * scale, offset * scale) * bd.Rectangle(abs(points[0][0]) * scale + scale, abs(points[0][1]) * scale + scale)
+            shape = bd.Pos(offset * scale, offset * scale) * bd.Rectangle(
+                abs(points[0][0]) * scale + scale, abs(points[0][1]) * scale + scale
+            )
         elif kind == "D":  # lines and an arc that bulges out (or in) by points[1][0] / 10
             a, b, c, d = placed([(0, 0), (10, 0), (10, 6), (0, 6)], log_scale, offset, offset)
             bulge = placed([(10 + points[1][0] / 2, 3)], log_scale, offset, offset)[0]
-            shape = bd.Wire([bd.Edge.make_line(a, b), bd.Edge.make_three_point_arc(b, bulge, c), bd.Edge.make_line(c, d), bd.Edge.make_line(d, a)])
+            shape = bd.Wire(
+                [bd.Edge.make_line(a, b), bd.Edge.make_three_point_arc(b, bulge, c), bd.Edge.make_line(c, d), bd.Edge.make_line(d, a)]
+            )
         else:
             shape = bd.Polyline(*placed(points, log_scale, offset, offset), close=True)
         shape = TILTED(bd) * shape if plane == "tilted" else getattr(bd.Plane, plane) * shape
@@ -349,7 +362,10 @@ MASKED = np.ma.masked_array([[0.0, 0.0], [5.0, 5.0]], mask=[[False, False], [Tru
         (lambda: sc.batch.line_to_line([0, 0], [1, 0], [1, 1], np.ma.masked_array([0.5], mask=[True])), "curvature"),
         (lambda: sc.batch.circle_to_circle([[0, 0], MASKED[1]], 1, [9, 0], 1), "center0"),
         (lambda: round_corners(np.ma.masked_array([(0, 0), (1, 0), (1, 1)], mask=[[0, 0], [1, 1], [0, 0]])), "points"),
-        (lambda: Alignment.from_pis([(0, 0), (1000, 0), (2000, 800)], np.ma.masked_array([300.0], mask=[True]), spiral_angles=0.1), "radii"),
+        (
+            lambda: Alignment.from_pis([(0, 0), (1000, 0), (2000, 800)], np.ma.masked_array([300.0], mask=[True]), spiral_angles=0.1),
+            "radii",
+        ),
         (lambda: sc.line_to_circle((0, 0), (1, 0), (0, 105), np.ma.masked), "radius"),
         (lambda: sc.line_to_circle(MASKED[1], (1, 0), (0, 105), 100), "point"),
         (lambda: sc.Chain([sc.Line((0, 0), (1, 0))]).point_at(np.ma.masked_array([0.5], mask=[True])), "stations"),
@@ -372,8 +388,14 @@ def test_masked_input_is_refused_by_name(call, name):
         (lambda: sc.line_to_circle((0, 0), (1, 0), (0, 5), np.complex128(1j)), "radius must be a real number; got complex128 1j"),
         (lambda: sc.line_to_circle((0, 0), (1, 0), (0, 5), np.str_("5")), "radius must be a real number; got str_ '5'"),
         (lambda: RoadCriteria(80, max_jerk=np.float64(-1)), "max_jerk must be positive; got -1.0"),
-        (lambda: circle_chain([np.array([1.0, 2.0, 3.0, 4.0]), ((0, 0), 1)]), "circle 0 must be a Circle, (center, radius) or (x, y, radius); got [1.0, 2.0, 3.0, 4.0]"),
-        (lambda: fillet_path([(0, 0), (1, 0), (1, 1)], 0.1, vertices=[np.float64(1)]), "vertices[0] must be a vertex index (an integer); got float64 1.0"),
+        (
+            lambda: circle_chain([np.array([1.0, 2.0, 3.0, 4.0]), ((0, 0), 1)]),
+            "circle 0 must be a Circle, (center, radius) or (x, y, radius); got [1.0, 2.0, 3.0, 4.0]",
+        ),
+        (
+            lambda: fillet_path([(0, 0), (1, 0), (1, 1)], 0.1, vertices=[np.float64(1)]),
+            "vertices[0] must be a vertex index (an integer); got float64 1.0",
+        ),
         (lambda: fillet_path([(0, 0), (1, 0), (1, 0), (2, 1)], 0.1), "path points 1 and 2 coincide at (1.0, 0.0)"),
     ],
 )
@@ -405,5 +427,8 @@ def test_a_joint_error_names_the_part_it_belongs_to():
 def test_a_joint_float64_cannot_hold_names_the_pi():
     """Spirals of θ ≈ 1e-4 rad on R = 300 m at 1 km from the origin: their end curvature holds
     only to ~1e-6 relative, which no G2 check accepts."""
-    with pytest.raises(sc.NoSolutionError, match=r"^PI 1: float64 cannot hold its curve G2 at these coordinates: Chain is not G2 at joint \d .*\(at parts\[[01]\]\)$"):
+    with pytest.raises(
+        sc.NoSolutionError,
+        match=r"^PI 1: float64 cannot hold its curve G2 at these coordinates: Chain is not G2 at joint \d .*\(at parts\[[01]\]\)$",
+    ):
         Alignment.from_pis(PIS, 300, units="m", criteria=RoadCriteria(5, side_friction=0.1, shift_min=0), shape="walton-meek")

@@ -15,6 +15,7 @@ from spiral_cad.core._kernels import nested_band_lower as band_lower
 def nested_band_lower(q):
     return band_lower(q, WALTON_MEEK)
 
+
 TOL = 1e-12
 UTM = np.array([6.5e5, 5.4e6])
 
@@ -232,7 +233,10 @@ def test_survey_coordinates_keep_joins_within_a_nanometre():
         (lambda: line_to_line((0, 0), (1, 0), (2, 0)), "collinear"),
         (lambda: line_to_line((0, 0), (1, 0), (0, 0)), "folds back"),
         (lambda: line_to_line((0, 0), (1, 0), (1, 1), curvature=0.01), "shorter leg"),
-        (lambda: circle_in_circle((0, 0), 1.0, (0, 0.3), 0.4), r"0.98707 ≤ D/\(r0 − r1\) < 1 at r1/r0 = 0.40; here D/\(r0 − r1\) = 0.50000"),
+        (
+            lambda: circle_in_circle((0, 0), 1.0, (0, 0.3), 0.4),
+            r"0.98707 ≤ D/\(r0 − r1\) < 1 at r1/r0 = 0.40; here D/\(r0 − r1\) = 0.50000",
+        ),
         (lambda: circle_in_circle((0, 0), 1.0, (0, 0.6), 0.4), r"here D/\(r0 − r1\) = 1.00000"),
         (lambda: circle_in_circle((0, 0), 1.0, (0, 0.5), 1.0), "different radii"),
     ],
@@ -296,9 +300,13 @@ def test_spiral_angle_is_atan2_of_its_sine_and_cosine_to_an_ulp():
 
 @pytest.mark.parametrize(
     "point, message",
-    [([True, 0.0], r"point\[0\] must be a real number"), ((0.0, math.inf), r"point\[1\] must be finite"),
-     ([0, 10**400], r"point\[1\] is too large"), ((1.5, "2"), r"point\[1\] must be a real number"),
-     ([0.0, 0.0, 1.0], "point must have 2 coordinates")],  # fmt: skip
+    [
+        ([True, 0.0], r"point\[0\] must be a real number"),
+        ((0.0, math.inf), r"point\[1\] must be finite"),
+        ([0, 10**400], r"point\[1\] is too large"),
+        ((1.5, "2"), r"point\[1\] must be a real number"),
+        ([0.0, 0.0, 1.0], "point must have 2 coordinates"),
+    ],  # fmt: skip
 )
 def test_two_number_points_are_checked_item_by_item(point, message):
     """Tuples and lists of two floats take a short path; anything else in them is named as before."""

@@ -119,7 +119,9 @@ def test_peak_rate_exceeds_mean_and_matches_sampling(theta):
         assert c.peak_rate_in == pytest.approx(fd, rel=2e-3)
     # Reversed spiral (exit) has the same peak magnitude.
     spiral = al.curves[0].entry.spirals[0]
-    assert peak_curvature_rate(spiral.reversed().control_points)[0] == pytest.approx(peak_curvature_rate(spiral.control_points)[0], rel=1e-9)
+    assert peak_curvature_rate(spiral.reversed().control_points)[0] == pytest.approx(
+        peak_curvature_rate(spiral.control_points)[0], rel=1e-9
+    )
 
 
 def test_small_angle_peak_is_about_1_84_times_mean():
@@ -195,7 +197,12 @@ def test_batch_built_curves_equal_the_scalar_solvers_bit_for_bit(shape, origin):
         exit_ = line_to_circle(pi, -t_out, center, c.radius, shape=shape).reversed()
         assert np.array_equal(c.entry.spirals[0].control_points, entry.spirals[0].control_points)
         assert np.array_equal(c.exit.spirals[0].control_points, exit_.spirals[0].control_points)
-        assert (c.entry.theta, c.exit.theta, c.entry.end_circle, c.exit.start_circle) == (entry.theta, exit_.theta, entry.end_circle, exit_.start_circle)
+        assert (c.entry.theta, c.exit.theta, c.entry.end_circle, c.exit.start_circle) == (
+            entry.theta,
+            exit_.theta,
+            entry.end_circle,
+            exit_.start_circle,
+        )
         assert c.entry.spirals[0] is al.chain[al.chain.segments.index(c.entry.spirals[0])]  # the chain's own segments
 
 

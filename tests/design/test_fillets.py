@@ -115,7 +115,10 @@ def test_continuous_shapes():
     assert_g2_everywhere(slot, closed=True)
     assert not any(isinstance(s, Line) and s.length < 1e-9 for s in slot.segments)
     ends = [s for s in slot.segments if isinstance(s, Line)]
-    assert len(ends) == 2 and all(s.length == pytest.approx(50 - 12 * 1.0 * 0 - 2 * corner_distance(slot.corners[0].radius, math.pi / 2, 1.0), rel=1e-12) for s in ends)
+    assert len(ends) == 2 and all(
+        s.length == pytest.approx(50 - 12 * 1.0 * 0 - 2 * corner_distance(slot.corners[0].radius, math.pi / 2, 1.0), rel=1e-12)
+        for s in ends
+    )
     hexagon = continuous_polygon(20, 6, 4)
     assert_g2_everywhere(hexagon, closed=True)
     assert max(abs(c.radius) for c in hexagon.corners) == 4
@@ -125,7 +128,10 @@ def test_continuous_shapes():
     "call, message",
     [
         (lambda: fillet_path([(0, 0), (10, 0), (10, 10)], 50.0), r"corner 1: the fillet needs 52\.8\d* more of edge 0 than it has \(10\)"),
-        (lambda: fillet_path([(0, 0), (10, 0), (10, 3), (0, 3)], 1.5), r"corner 1 and corner 2 both claim the same stretch of edge 1: .*missing 0\.77"),
+        (
+            lambda: fillet_path([(0, 0), (10, 0), (10, 3), (0, 3)], 1.5),
+            r"corner 1 and corner 2 both claim the same stretch of edge 1: .*missing 0\.77",
+        ),
         (lambda: fillet_path([(0, 0), (10, 0), (10, 10)], 0.0), "radius must be positive"),
         (lambda: fillet_path([(0, 0), (10, 0), (10, 10)], 1.0, transition=1.5), r"transition must lie in \(0, 1\]"),
         (lambda: fillet_path([(0, 0), (10, 0), (0, 0)], 1.0), "folds straight back"),

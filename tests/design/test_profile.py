@@ -142,7 +142,10 @@ def test_profile_table_and_csv(profile, tmp_path):
         (dict(points=[(0, 0), (100, 5), (200, 0)]), "give curve_lengths or k_values"),
         (dict(points=[(0, 0), (100, 5), (200, 0)], curve_lengths=[(1, 2, 3)]), r"PVI 1\) must be a length"),
         (dict(points=[(0, 0), (100, 5), (200, 0)], curve_lengths="12"), "must be a real number"),
-        (dict(points=[(0, 0), (100, 5), (200, 10)], curve_lengths=[5]), r"PVI 1 at station 100.0 lies on the grade of its neighbours \(5.0 %\)"),
+        (
+            dict(points=[(0, 0), (100, 5), (200, 10)], curve_lengths=[5]),
+            r"PVI 1 at station 100.0 lies on the grade of its neighbours \(5.0 %\)",
+        ),
     ],
 )
 def test_malformed_profiles_name_the_pvi(kwargs, message):

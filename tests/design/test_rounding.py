@@ -55,8 +55,7 @@ def test_g2cbs_constants_and_lower_peak():
     yang = round_corners_batch(p0, corner, p1, method="g2cbs")
     assert wm.distance[0] == yang.distance[0] == pytest.approx(3.0)  # the shorter leg
     peaks = [
-        max(float(np.max(np.abs(BezierSpiral.from_control_points(cp).curvature(U)))) for cp in r.control_points[0])
-        for r in (wm, yang)
+        max(float(np.max(np.abs(BezierSpiral.from_control_points(cp).curvature(U)))) for cp in r.control_points[0]) for r in (wm, yang)
     ]
     assert peaks[1] / peaks[0] == pytest.approx(G2CBS_C4 / (40 / 27), rel=1e-6)
     assert 0.74 < peaks[1] / peaks[0] < 0.78

@@ -105,7 +105,9 @@ def test_readme_pocket_rotated_and_moved_rounds_at_half_a_micrometre():
 
 def test_a_router_bed_rounds_at_a_hundredth():
     """A 1.2 m × 2.4 m bed outline with a notch, in mm, at 0.01 mm."""
-    bed = np.array([(0, 0), (2400, 0), (2400, 1200), (1300, 1200), (1250, 1150), (1150, 1150), (1100, 1200), (0, 1200), (0, 1)], dtype=float)
+    bed = np.array(
+        [(0, 0), (2400, 0), (2400, 1200), (1300, 1200), (1250, 1150), (1150, 1150), (1100, 1200), (0, 1200), (0, 1)], dtype=float
+    )
     path = round_corners(bed, max_deviation=0.01)
     assert len(path.corners) == len(bed) - 2
     assert path.max_deviation <= 0.01
@@ -177,7 +179,9 @@ def test_a_corner_limited_by_its_size_advises_a_larger_bound_and_that_helps():
     """1 µm at 1 km from the origin: float64 holds its spirals only to ~1e-7, and a larger bound helps."""
     turn = math.radians(120.0)
     points = [[1e6, 1e6], [1e6 + 100.0, 1e6], [1e6 + 100.0 + 100.0 * math.cos(turn), 1e6 + 100.0 * math.sin(turn)]]
-    with pytest.raises(NoSolutionError, match=r"^corner 1 at .*: the spiral pair would start .* holds only to .*; use a larger max_deviation$"):
+    with pytest.raises(
+        NoSolutionError, match=r"^corner 1 at .*: the spiral pair would start .* holds only to .*; use a larger max_deviation$"
+    ):
         round_corners(points, max_deviation=1e-3)
     assert round_corners(points, max_deviation=0.1).max_deviation <= 0.1
 
@@ -196,7 +200,9 @@ def _bound_reaching(points: np.ndarray, share: float) -> float:
     chord = float(np.linalg.norm(points[2] - points[1]))
     a, b = points[2] - points[1], points[3] - points[2]
     half = 0.5 * math.atan2(abs(a[0] * b[1] - a[1] * b[0]), float(a @ b))
-    reach = float(corner_scale(math.sin(half), math.cos(half), 1.0, "walton-meek") / deviation_factor(math.sin(half), math.cos(half), "walton-meek"))
+    reach = float(
+        corner_scale(math.sin(half), math.cos(half), 1.0, "walton-meek") / deviation_factor(math.sin(half), math.cos(half), "walton-meek")
+    )
     return 0.5 * chord * share / reach
 
 

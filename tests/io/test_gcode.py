@@ -152,7 +152,9 @@ def test_huge_and_tiny_coordinates():
     assert math.isclose(big.points[-1][1], 1e300)
     tiny = parse_gcode("G21\nG1 X0.000001\nG1 Y0.000001\nG1 Z0.000001\n")
     assert round_toolpath(tiny, max_deviation=1e-8, for_occt=False).chain.dim == 3
-    with pytest.raises(ValueError, match=r"line 3: the rounded path's segment 1 \(BezierSpiral, length .* mm\) is shorter than OCCT's 1e-07"):
+    with pytest.raises(
+        ValueError, match=r"line 3: the rounded path's segment 1 \(BezierSpiral, length .* mm\) is shorter than OCCT's 1e-07"
+    ):
         round_toolpath(tiny, max_deviation=1e-8)  # legs of 1e-6 mm: no STEP edge can be that short
 
 
@@ -208,11 +210,17 @@ def test_an_inch_program_is_converted_to_the_outputs_unit(tmp_path):
         (["--from-gcode", "pocket.nc", "--max-deviation", "5e-324"], r"max_deviation 4.94066e-324 is below what float64 resolves"),
         (["--from-gcode", "pocket.nc", "--max-deviation", "1", "--sample-step", "0"], r"--sample-step must be a positive"),
         (["--from-gcode", "pocket.nc", "--max-deviation", "1", "--sample-step", "1", "--chord-tolerance", "1"], r"not both"),
-        (["--from-gcode", "pocket.nc", "--max-deviation", "0.001", "--max-curvature", "1"], r"corner 2 \(line 9\) at \(5, 5, -1\): .*above max_curvature 1"),
+        (
+            ["--from-gcode", "pocket.nc", "--max-deviation", "0.001", "--max-curvature", "1"],
+            r"corner 2 \(line 9\) at \(5, 5, -1\): .*above max_curvature 1",
+        ),
         (["design.json", "--max-deviation", "1"], r"--max-deviation: only with --from-gcode"),
         (["design.json", "--interpreter", "rs274"], r"--interpreter: only with --from-gcode"),
         (["--from-gcode", "with_arcs.nc", "--max-deviation", "0.05"], r"with_arcs.nc line 5: G2 \(a clockwise arc\) is refused"),
-        (["--from-gcode", "with_arcs.nc", "--max-deviation", "0.05", "--arc-tolerance", "0"], r"arc_tolerance must be a positive finite length; got 0.0"),
+        (
+            ["--from-gcode", "with_arcs.nc", "--max-deviation", "0.05", "--arc-tolerance", "0"],
+            r"arc_tolerance must be a positive finite length; got 0.0",
+        ),
         ([], r"give a design file, or --from-gcode"),
     ],
 )

@@ -102,6 +102,7 @@ def test_absolute_arc_centres_and_the_xz_plane():
 def test_full_turns_and_radii_that_differ():
     once = parse_gcode("G21 F1\nG1 X10\nG3 X10 Y0 I-10 J0\n", arc_tolerance=0.01)
     twice = parse_gcode("G21 F1\nG1 X10\nG3 X10 Y0 I-10 J0 P2 Z-4\n", arc_tolerance=0.01)
+
     def swept(path):  # the angle turned about the centre (0, 0), unwrapped
         return np.unwrap(np.arctan2(path.points[:, 1], path.points[:, 0]))[-1]
 
@@ -128,7 +129,9 @@ def test_a_sliver_names_the_gcode_line_of_its_move():
     from spiral_cad.io.gcode import round_toolpath, segment_lines
 
     path = parse_gcode(sliver_program(4e-8), "sliver.nc")
-    with pytest.raises(ValueError, match=r"sliver.nc line 4: the rounded path's segment 3 \(Line, length 4e-08 mm\) is shorter than OCCT's 1e-07"):
+    with pytest.raises(
+        ValueError, match=r"sliver.nc line 4: the rounded path's segment 3 \(Line, length 4e-08 mm\) is shorter than OCCT's 1e-07"
+    ):
         round_toolpath(path, max_deviation=0.5)
     fine = round_toolpath(parse_gcode(sliver_program(1e-6)), max_deviation=0.5)
     assert segment_lines(fine, path).tolist() == [3, 3, 3, 4, 4, 4, 5]  # straight pieces: their move; spirals: the corner's
@@ -149,7 +152,9 @@ def test_arrays_round_as_the_chain_does_and_name_lines():
     expected = np.array([[s.control_points for s in c.spirals] for c in chain.corners])
     assert np.array_equal(arrays.control_points, expected)
     assert np.allclose(arrays.deviation, 0.05) and np.array_equal(arrays.curvature, [c.curvature for c in chain.corners])
-    with pytest.raises(ValueError, match=r"zigzag.nc: corner 1 \(line 3\) at \(10.1, 2, -0.1\): curvature 0.5 needs .* \(38 corners fail\)"):
+    with pytest.raises(
+        ValueError, match=r"zigzag.nc: corner 1 \(line 3\) at \(10.1, 2, -0.1\): curvature 0.5 needs .* \(38 corners fail\)"
+    ):
         round_toolpath_arrays(path, max_curvature=0.5)
     with pytest.raises(ValueError, match=r"max_deviation must be one positive finite number here"):
         round_toolpath_arrays(path, max_deviation=[0.1])

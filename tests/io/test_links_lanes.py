@@ -106,7 +106,11 @@ def test_lane_centre_curvature_on_an_arc_is_the_offset_circles(tmp_path):
     from spiral_cad.io.opendrive_lanes import lane_frame
 
     path = tmp_path / "arc.xodr"
-    path.write_text(lane_junction().replace('<line/></geometry></planView><lanes><laneOffset', '<arc curvature="0.01"/></geometry></planView><lanes><laneOffset'))
+    path.write_text(
+        lane_junction().replace(
+            "<line/></geometry></planView><lanes><laneOffset", '<arc curvature="0.01"/></geometry></planView><lanes><laneOffset'
+        )
+    )
     network = read_network(path)
     road = next(r for r in network.roads if r.id == "3")
     frame = lane_frame(road, read_lanes(path).roads["3"], 1, "end", "test")
@@ -175,7 +179,9 @@ def with_profiles(text: str, road: str, profiles: str) -> str:
 
 def test_lane_links_are_judged_with_elevation(tmp_path):
     # road 1 climbs at 2 % to z = 1 at its end; road 3 goes on from z = 1 at 2 % (G2) or at 5 % (a kink)
-    base = with_profiles(lane_junction(offset=0.0), "1", '<elevationProfile><elevation s="0" a="0" b="0.02" c="0" d="0"/></elevationProfile>')
+    base = with_profiles(
+        lane_junction(offset=0.0), "1", '<elevationProfile><elevation s="0" a="0" b="0.02" c="0" d="0"/></elevationProfile>'
+    )
     path = tmp_path / "climb.xodr"
     for grade, level, angle in ((0.02, "G2", 0.0), (0.05, "G0", math.atan(0.05) - math.atan(0.02))):
         path.write_text(with_profiles(base, "3", f'<elevationProfile><elevation s="0" a="1" b="{grade}" c="0" d="0"/></elevationProfile>'))
@@ -205,13 +211,15 @@ def test_lane_centre_curvature_on_a_spiral_with_a_growing_lane_matches_a_sampled
     width = np.polynomial.Polynomial([3.0, 0.02, 4e-4, -5e-6])
     offset = np.polynomial.Polynomial([0.3, -0.01, 2e-4, 0.0])
     path = tmp_path / "spiral.xodr"
-    path.write_text(HEADER.format(f"""
+    path.write_text(
+        HEADER.format(f"""
 <road id="1" junction="-1" length="{length!r}">
   <planView><geometry s="0" x="3" y="-2" hdg="0.4" length="{length!r}"><spiral curvStart="{k0!r}" curvEnd="{k1!r}"/></geometry></planView>
   <lanes><laneOffset s="0" a="{float(offset.coef[0])!r}" b="{float(offset.coef[1])!r}" c="{float(offset.coef[2])!r}" d="{float(offset.coef[3])!r}"/>
     <laneSection s="0"><center><lane id="0"/></center><right><lane id="-1" type="driving">
       <width sOffset="0" a="{float(width.coef[0])!r}" b="{float(width.coef[1])!r}" c="{float(width.coef[2])!r}" d="{float(width.coef[3])!r}"/></lane></right></laneSection></lanes>
-</road>"""))
+</road>""")
+    )
     (road,) = read_network(path).roads
     (geometry,) = road.geometries
     frame = lane_frame(road, read_lanes(path).roads["1"], -1, "end", "test")
@@ -249,12 +257,26 @@ def test_the_curvature_rate_at_a_road_end_matches_a_difference_of_curvatures(kin
 @pytest.mark.parametrize(
     "change, message",
     [
-        (('<width sOffset="0" a="3.5" b="0"', '<width sOffset="0" a="wide" b="0"'), r"road 1, lane 1 <width>: a must be a finite number; got 'wide'"),
-        (('<lane id="-1" type="driving">', '<lane id="minus one" type="driving">'), r"road 1, laneSection 0 <lane>: id must be an integer lane id"),
-        (('<laneLink from="1" to="1"/>', '<laneLink from="1"/>'), r"junction 9, connection 0 <laneLink>: to must be an integer lane id; got None"),
+        (
+            ('<width sOffset="0" a="3.5" b="0"', '<width sOffset="0" a="wide" b="0"'),
+            r"road 1, lane 1 <width>: a must be a finite number; got 'wide'",
+        ),
+        (
+            ('<lane id="-1" type="driving">', '<lane id="minus one" type="driving">'),
+            r"road 1, laneSection 0 <lane>: id must be an integer lane id",
+        ),
+        (
+            ('<laneLink from="1" to="1"/>', '<laneLink from="1"/>'),
+            r"junction 9, connection 0 <laneLink>: to must be an integer lane id; got None",
+        ),
         (('<laneOffset s="0" a="1.75"', '<laneOffset s="inf" a="1.75"'), r"road 3, laneOffset 0: s must be a finite number; got 'inf'"),
-        (('<width sOffset="0" a="3.5" b="0" c="0" d="0"/></lane></left>', '<border sOffset="0" a="3.5" b="0" c="0" d="0"/></lane></left>'),
-         r"road 1, lane 1 is given by <border>, which is not supported; give <width>"),
+        (
+            (
+                '<width sOffset="0" a="3.5" b="0" c="0" d="0"/></lane></left>',
+                '<border sOffset="0" a="3.5" b="0" c="0" d="0"/></lane></left>',
+            ),
+            r"road 1, lane 1 is given by <border>, which is not supported; give <width>",
+        ),
     ],
 )
 def test_bad_lanes_are_named(tmp_path, change, message):

@@ -99,7 +99,9 @@ def test_superelevation_ramps_along_the_spirals_and_falls_to_the_inside(highway,
     assert first.deflection < 0 and at_sc[1] == pytest.approx(math.atan(e)) and at_sc[2] == 0.0
     second = highway.curves[1]  # a left turn
     assert second.deflection > 0
-    assert [r for r in records if r[0] == pytest.approx(second.sc - highway.start_station)][0][1] == pytest.approx(-math.atan(highway.checks[1].banking))
+    assert [r for r in records if r[0] == pytest.approx(second.sc - highway.start_station)][0][1] == pytest.approx(
+        -math.atan(highway.checks[1].banking)
+    )
 
 
 def test_lanes_follow_the_cross_section(tmp_path):
@@ -107,7 +109,10 @@ def test_lanes_follow_the_cross_section(tmp_path):
     chain = round_corners([(0, 0), (40, 0), (40, 30)], units="m").chain
     export_opendrive(chain, path, cross_section=CrossSection(driving_lanes=2, lane_width=3.25, shoulder_width=0.0))
     lanes = ET.parse(path).getroot().findall("road/lanes/laneSection/right/lane")
-    assert [(lane.get("id"), lane.get("type"), lane.find("width").get("a")) for lane in lanes] == [("-1", "driving", "3.25"), ("-2", "driving", "3.25")]
+    assert [(lane.get("id"), lane.get("type"), lane.find("width").get("a")) for lane in lanes] == [
+        ("-1", "driving", "3.25"),
+        ("-2", "driving", "3.25"),
+    ]
 
 
 def test_a_design_in_feet_is_written_in_metres(tmp_path):
@@ -150,8 +155,13 @@ def write(tmp_path, body: str) -> Path:
 
 
 def test_a_line_into_an_arc_is_only_g1(tmp_path):
-    path = write(tmp_path, road('<geometry s="0" x="0" y="0" hdg="0" length="10"><line/></geometry>'
-                                '<geometry s="10" x="10" y="0" hdg="0" length="5"><arc curvature="0.02"/></geometry>'))
+    path = write(
+        tmp_path,
+        road(
+            '<geometry s="0" x="0" y="0" hdg="0" length="10"><line/></geometry>'
+            '<geometry s="10" x="10" y="0" hdg="0" length="5"><arc curvature="0.02"/></geometry>'
+        ),
+    )
     report = check_opendrive(path)
     (joint,) = report.joints
     assert str(joint.level) == "G1" and joint.curvature_after == pytest.approx(0.02)
@@ -162,8 +172,9 @@ def test_a_line_into_an_arc_is_only_g1(tmp_path):
 def test_a_clothoid_into_an_arc_is_g2(tmp_path):
     # clothoid from κ = 0 to 1/50 over 40 m: heading 0.4 rad at its end; the arc continues from there
     k, length = 1 / 50, 40.0
-    (road_,) = read_opendrive(write(tmp_path, road(
-        f'<geometry s="0" x="0" y="0" hdg="0" length="{length}"><spiral curvStart="0" curvEnd="{k}"/></geometry>')))
+    (road_,) = read_opendrive(
+        write(tmp_path, road(f'<geometry s="0" x="0" y="0" hdg="0" length="{length}"><spiral curvStart="0" curvEnd="{k}"/></geometry>'))
+    )
     (end,), (tangent,), _ = road_.geometries[0].evaluate([1.0])
     heading = math.atan2(tangent[1], tangent[0])
     assert heading == pytest.approx(k * length / 2, abs=1e-14)
@@ -173,9 +184,13 @@ def test_a_clothoid_into_an_arc_is_g2(tmp_path):
     x = quad(lambda s: math.cos(k * s * s / (2 * length)), 0, length, epsabs=0, epsrel=1e-13, limit=200)[0]
     y = quad(lambda s: math.sin(k * s * s / (2 * length)), 0, length, epsabs=0, epsrel=1e-13, limit=200)[0]
     assert end == pytest.approx([x, y], abs=1e-12)
-    path = write(tmp_path, road(
-        f'<geometry s="0" x="0" y="0" hdg="0" length="{length}"><spiral curvStart="0" curvEnd="{k}"/></geometry>'
-        f'<geometry s="{length}" x="{x!r}" y="{y!r}" hdg="{heading!r}" length="30"><arc curvature="{k}"/></geometry>'))
+    path = write(
+        tmp_path,
+        road(
+            f'<geometry s="0" x="0" y="0" hdg="0" length="{length}"><spiral curvStart="0" curvEnd="{k}"/></geometry>'
+            f'<geometry s="{length}" x="{x!r}" y="{y!r}" hdg="{heading!r}" length="30"><arc curvature="{k}"/></geometry>'
+        ),
+    )
     report = check_opendrive(path)
     assert [str(j.level) for j in report.joints] == ["G2"]
     assert not read_opendrive(path)[0].exact
@@ -211,13 +226,30 @@ def test_param_poly3_in_both_ranges_and_the_deprecated_poly3_are_evaluated(tmp_p
     [
         ("<OpenDRIVE><road", "not well-formed XML"),
         ('<road id="3" junction="-1" length="1"></road>', "road 3 has no planView"),
-        (road('<geometry s="0" x="0" y="0" hdg="0" length="1"><clothoid/></geometry>', "4"),
-         "road 4, planView geometry 0: needs exactly one of line, arc, spiral, paramPoly3, poly3; found clothoid"),
-        (road('<geometry s="0" x="0" y="0" hdg="0" length="nan"><line/></geometry>', "5"), "road 5, planView geometry 0: length must be finite"),
-        (road('<geometry s="0" x="0" y="0" hdg="0" length="-2"><line/></geometry>', "6"), "road 6, planView geometry 0: length must be positive"),
-        (road('<geometry s="5" x="0" y="0" hdg="0" length="1"><line/></geometry>'
-              '<geometry s="2" x="1" y="0" hdg="0" length="1"><line/></geometry>', "8"), "road 8, planView geometry 1: s = 2.0 is not after"),
-        (road('<geometry s="0" x="0" y="0" hdg="0" length="1"><arc/></geometry>', "9"), "road 9, planView geometry 0 <arc>: missing attribute curvature"),
+        (
+            road('<geometry s="0" x="0" y="0" hdg="0" length="1"><clothoid/></geometry>', "4"),
+            "road 4, planView geometry 0: needs exactly one of line, arc, spiral, paramPoly3, poly3; found clothoid",
+        ),
+        (
+            road('<geometry s="0" x="0" y="0" hdg="0" length="nan"><line/></geometry>', "5"),
+            "road 5, planView geometry 0: length must be finite",
+        ),
+        (
+            road('<geometry s="0" x="0" y="0" hdg="0" length="-2"><line/></geometry>', "6"),
+            "road 6, planView geometry 0: length must be positive",
+        ),
+        (
+            road(
+                '<geometry s="5" x="0" y="0" hdg="0" length="1"><line/></geometry>'
+                '<geometry s="2" x="1" y="0" hdg="0" length="1"><line/></geometry>',
+                "8",
+            ),
+            "road 8, planView geometry 1: s = 2.0 is not after",
+        ),
+        (
+            road('<geometry s="0" x="0" y="0" hdg="0" length="1"><arc/></geometry>', "9"),
+            "road 9, planView geometry 0 <arc>: missing attribute curvature",
+        ),
     ],
 )
 def test_bad_opendrive_is_refused_by_road_and_element(tmp_path, capsys, body, message):
@@ -235,8 +267,13 @@ def test_cli_checks_opendrive(highway, tmp_path, capsys):
     export_opendrive(highway, path)
     assert main(["check", str(path), "--require", "G2"]) == 0
     assert "OK: 1 road of 13 geometries" in capsys.readouterr().out
-    g1 = write(tmp_path, road('<geometry s="0" x="0" y="0" hdg="0" length="10"><line/></geometry>'
-                              '<geometry s="10" x="10" y="0" hdg="0" length="5"><arc curvature="0.02"/></geometry>'))
+    g1 = write(
+        tmp_path,
+        road(
+            '<geometry s="0" x="0" y="0" hdg="0" length="10"><line/></geometry>'
+            '<geometry s="10" x="10" y="0" hdg="0" length="5"><arc curvature="0.02"/></geometry>'
+        ),
+    )
     assert main(["check", str(g1), "--require", "G2"]) == 1
     assert "below the required G2" in capsys.readouterr().out
 
@@ -266,17 +303,25 @@ def line_at(s: str, x: str, length: str) -> str:
 @pytest.mark.parametrize(
     "body, message",
     [
-        (road(line_at("0", "0", "1e308") + line_at("1e308", "1e308", "1e308")),
-         r"road 7, planView geometry 1 <line>: its end point is not a finite number \(x=1e\+308"),
-        (road('<geometry s="0" x="0" y="0" hdg="0" length="10"><spiral curvStart="-1e300" curvEnd="0"/></geometry>'),
-         r"road 7, planView geometry 0 <spiral>: cannot be evaluated \(.*curvStart=-1e\+300"),
-        (road(line_at("0", "0", "10") + '<geometry s="10" x="10" y="0" hdg="0" length="10"><arc curvature="1e308"/></geometry>'),
-         r"road 7, planView geometry 1 <arc>: its end point is not a finite number .*curvature=1e\+308"),
+        (
+            road(line_at("0", "0", "1e308") + line_at("1e308", "1e308", "1e308")),
+            r"road 7, planView geometry 1 <line>: its end point is not a finite number \(x=1e\+308",
+        ),
+        (
+            road('<geometry s="0" x="0" y="0" hdg="0" length="10"><spiral curvStart="-1e300" curvEnd="0"/></geometry>'),
+            r"road 7, planView geometry 0 <spiral>: cannot be evaluated \(.*curvStart=-1e\+300",
+        ),
+        (
+            road(line_at("0", "0", "10") + '<geometry s="10" x="10" y="0" hdg="0" length="10"><arc curvature="1e308"/></geometry>'),
+            r"road 7, planView geometry 1 <arc>: its end point is not a finite number .*curvature=1e\+308",
+        ),
         (road(line_at("0", "0", "10")).replace('length="1"', 'length="abc"'), r"road 7: length must be a number; got 'abc'"),
         (road(line_at("0", "0", "10")).replace('length="1"', 'length="nan"'), r"road 7: length must be finite; got 'nan'"),
         (road(line_at("0", "0", "10")).replace('length="1"', 'length="-5"'), r"road 7: length must be positive"),
-        (road(line_at("0", "0", "10"), "&#10;" + "r" * 100).replace('length="1"', 'length="abc"'),
-         r"road '\\nr{39}'…: length must be a number"),  # a newline and 100 letters: quoted and cut
+        (
+            road(line_at("0", "0", "10"), "&#10;" + "r" * 100).replace('length="1"', 'length="abc"'),
+            r"road '\\nr{39}'…: length must be a number",
+        ),  # a newline and 100 letters: quoted and cut
     ],
 )
 def test_hostile_numbers_are_refused_by_road_and_element(tmp_path, capsys, body, message):
@@ -296,8 +341,10 @@ def test_a_model_wider_than_the_float_range_names_its_coordinates(tmp_path):
 
 def test_a_zero_speed_param_poly3_after_a_line_is_unmeasurable_never_g2(tmp_path, capsys):
     # bU = bV = 0: no tangent at its start (0/0), where a 90° kink hides; NaN used to pass every comparison
-    kink = road(line_at("0", "0", "10") + '<geometry s="10" x="10" y="0" hdg="0" length="10">'
-                '<paramPoly3 aU="0" bU="0" cU="0" dU="1" aV="0" bV="0" cV="1" dV="0" pRange="normalized"/></geometry>')
+    kink = road(
+        line_at("0", "0", "10") + '<geometry s="10" x="10" y="0" hdg="0" length="10">'
+        '<paramPoly3 aU="0" bU="0" cU="0" dU="1" aV="0" bV="0" cV="1" dV="0" pRange="normalized"/></geometry>'
+    )
     path = write(tmp_path, kink)
     (joint,) = check_opendrive(path).joints
     assert str(joint.level) == "unmeasurable" and math.isnan(joint.angle)
@@ -351,7 +398,9 @@ def documents(draw) -> str:
     for rid in range(draw(st.integers(1, 2))):
         length = draw(st.one_of(st.none(), NUMBERS))
         geometries = "".join(draw(st.lists(geometry_elements(), min_size=0, max_size=4)))
-        roads.append(f'<road id="{rid}"' + (f' length="{length}"' if length is not None else "") + f"><planView>{geometries}</planView></road>")
+        roads.append(
+            f'<road id="{rid}"' + (f' length="{length}"' if length is not None else "") + f"><planView>{geometries}</planView></road>"
+        )
     return HEADER.format("".join(roads))
 
 

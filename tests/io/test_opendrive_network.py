@@ -107,13 +107,15 @@ def test_the_cli_judges_roads_profiles_and_links(network_map, capsys):
 
 def test_a_direct_junction_offset_by_a_lane_is_reported_not_a_gap(tmp_path):
     path = tmp_path / "direct.xodr"
-    path.write_text(HEADER.format("""
+    path.write_text(
+        HEADER.format("""
 <road id="1" junction="-1" length="50"><link><successor elementType="junction" elementId="7"/></link>
   <planView><geometry s="0" x="0" y="0" hdg="0" length="50"><line/></geometry></planView></road>
 <road id="2" junction="-1" length="40">
   <planView><geometry s="0" x="50" y="-3.5" hdg="0" length="40"><line/></geometry></planView></road>
 <junction id="7" type="direct"><connection id="0" incomingRoad="1" linkedRoad="2" contactPoint="start"/></junction>
-"""))
+""")
+    )
     (link,) = check_opendrive(path).links
     assert link.via == "direct junction 7" and link.offset == pytest.approx(-3.5) and str(link.joint.level) == "G2"
     assert main(["check", str(path), "--links", "G2"]) == 0
@@ -122,13 +124,26 @@ def test_a_direct_junction_offset_by_a_lane_is_reported_not_a_gap(tmp_path):
 @pytest.mark.parametrize(
     "change, message",
     [
-        (('elementId="2" contactPoint="start"', 'elementId="9" contactPoint="start"'), "road 1 <successor> links to road 9, which is not in the file"),
-        (('elementId="2" contactPoint="start"', 'elementId="2" contactPoint="middle"'), "road 1 <successor>: a road link needs contactPoint start or end"),
-        (('<predecessor elementType="junction" elementId="100"/>', '<predecessor elementType="junction" elementId="101"/>'),
-         "road 3 links to junction 101, which is not in the file"),
-        (('<predecessor elementType="junction" elementId="100"/>', ""),
-         "junction 100, connection 0: its incoming road 3 names the junction as neither predecessor nor successor"),
-        (('connectingRoad="5" contactPoint="start"', 'connectingRoad="5"'), "junction 100, connection 1: contactPoint must be start or end"),
+        (
+            ('elementId="2" contactPoint="start"', 'elementId="9" contactPoint="start"'),
+            "road 1 <successor> links to road 9, which is not in the file",
+        ),
+        (
+            ('elementId="2" contactPoint="start"', 'elementId="2" contactPoint="middle"'),
+            "road 1 <successor>: a road link needs contactPoint start or end",
+        ),
+        (
+            ('<predecessor elementType="junction" elementId="100"/>', '<predecessor elementType="junction" elementId="101"/>'),
+            "road 3 links to junction 101, which is not in the file",
+        ),
+        (
+            ('<predecessor elementType="junction" elementId="100"/>', ""),
+            "junction 100, connection 0: its incoming road 3 names the junction as neither predecessor nor successor",
+        ),
+        (
+            ('connectingRoad="5" contactPoint="start"', 'connectingRoad="5"'),
+            "junction 100, connection 1: contactPoint must be start or end",
+        ),
         (('<elevation s="60"', '<elevation s="-60"'), "road 1, elevation 1: s = -60.0 is before s = 0.0 of elevation 0"),
         (('a="10.6"', 'a="nan"'), "road 1, elevation 1: a must be finite"),
     ],
