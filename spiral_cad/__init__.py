@@ -8,9 +8,9 @@ build123d objects in ``spiral_cad.build123d`` and the CadQuery plugin in
 """
 
 from .core import batch
-from .core.chain import Chain, Join
+from .core.chain import Chain
 from .core.errors import NoSolutionError, Status
-from .core.segments import Arc, Circle, Line, Segment
+from .core.segments import Arc, Circle, Join, Line, Segment
 from .core.space import PlaneFrame
 from .core.spiral import BezierSpiral
 from .core.transitions import Transition, circle_in_circle, circle_to_circle, line_to_circle, line_to_line

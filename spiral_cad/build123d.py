@@ -20,6 +20,7 @@ Example:
 from __future__ import annotations
 
 from collections.abc import Iterable
+from typing import Any
 
 from build123d import (
     Align,
@@ -372,7 +373,7 @@ def g2_fillet(
             and arcs, or edges that belong to no wire or face.
         NoSolutionError: a corner that cannot be rounded (named, with numbers).
     """
-    context = Builder._get_context("g2_fillet")
+    context: Builder | None = Builder._get_context("g2_fillet")
     in_builder = isinstance(target, Vertex) or (
         isinstance(target, Iterable) and not isinstance(target, (Shape, str, bytes))
     )
@@ -382,7 +383,7 @@ def g2_fillet(
             raise ValueError("g2_fillet of vertices needs a BuildSketch or BuildLine with an object")
         vertices, target = target, context._obj
     points = _points(vertices)
-    options = dict(transition=transition, same_sense=same_sense, shape=shape)
+    options: dict[str, Any] = dict(transition=transition, same_sense=same_sense, shape=shape)
     if not isinstance(target, Shape):
         raise ValueError(f"g2_fillet rounds a Wire, Face, Sketch or Curve; got {type(target).__name__}")
     solids = target.solids() or target.shells()
@@ -409,9 +410,10 @@ def g2_fillet(
             result = Sketch(Compound([Face(fillet_face(f.wrapped, radius, points, **options)) for f in faces]).wrapped)
         else:  # one plane for all the wires (a straight wire alone has none; here it passes through)
             frame = planar_frame(target.wrapped)
-            rounded = [fillet_wire(w.wrapped, radius, points, frame=frame, **options)[0] for w in wires]
-            result = Curve(Compound([Wire(w) for w in rounded]).wrapped)
+            rounded_wires = [fillet_wire(w.wrapped, radius, points, frame=frame, **options)[0] for w in wires]
+            result = Curve(Compound([Wire(w) for w in rounded_wires]).wrapped)
     if in_builder:
+        assert context is not None  # checked above: vertices need a builder
         context._add_to_context(result, mode=Mode.REPLACE)
     return result
 

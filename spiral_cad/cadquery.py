@@ -39,7 +39,7 @@ Example:
 from __future__ import annotations
 
 from collections.abc import Iterable
-from typing import Any, TypeVar
+from typing import TYPE_CHECKING, Any, TypeVar
 
 import cadquery as cq
 from OCP.gp import gp_Ax3
@@ -52,6 +52,9 @@ from .core.shapes import DEFAULT_SHAPE
 from .core.transitions import Transition, circle_in_circle, circle_to_circle, line_to_circle, line_to_line
 from .design.fillets import continuous_polygon, continuous_rectangle, continuous_slot
 from .design.rounding import curvature_bound, round_corners
+
+if TYPE_CHECKING:
+    from cadquery.sketch import Modes
 
 __all__ = [
     "METHODS",
@@ -241,7 +244,7 @@ def g2Fillet(self: W, radius: float, transition: float = 0.5, same_sense: str = 
     wires = list(self.ctx.pendingWires)
     if not wires:
         raise ValueError("g2Fillet rounds the pending wires; there are none (draw a closed wire first)")
-    options = dict(transition=transition, same_sense=same_sense, shape=shape)
+    options: dict[str, Any] = dict(transition=transition, same_sense=same_sense, shape=shape)
     rounded = [cq.Wire(fillet_wire(w.wrapped, radius, **options)[0]) for w in wires]
     self.ctx.pendingWires = []
     result = self.newObject(rounded)
@@ -297,7 +300,7 @@ for _method in METHODS:
 def sketch_g2fillet(self: S, radius: float, transition: float = 0.5, same_sense: str = "nested", shape: str = DEFAULT_SHAPE) -> S:
     """``cq.Sketch.g2fillet``: round the selected vertices with G2 fillets, as ``Sketch.fillet`` does with arcs."""
     faces = self._matchFacesToVertices()
-    options = dict(transition=transition, same_sense=same_sense, shape=shape)
+    options: dict[str, Any] = dict(transition=transition, same_sense=same_sense, shape=shape)
     self._faces = cq.Compound.makeCompound(
         cq.Face(fillet_face(face.wrapped, radius, [v.toTuple() for v in vertices], **options))
         if vertices else face
@@ -307,7 +310,7 @@ def sketch_g2fillet(self: S, radius: float, transition: float = 0.5, same_sense:
 
 
 def sketch_continuous_rect(self: S, w: float, h: float, radius: float, transition: float = 0.5, angle: float = 0,
-                           mode: str = "a", tag: str | None = None, shape: str = DEFAULT_SHAPE) -> S:  # fmt: skip
+                           mode: Modes = "a", tag: str | None = None, shape: str = DEFAULT_SHAPE) -> S:  # fmt: skip
     """``cq.Sketch.continuousRect``: a rectangular face with G2 corners (as ``Sketch.rect``)."""
     path = continuous_rectangle(w, h, radius, transition, shape=shape)
     face = cq.Face.makeFromWires(cq.Wire(chain_wire(path.segments)))
@@ -317,5 +320,5 @@ def sketch_continuous_rect(self: S, w: float, h: float, radius: float, transitio
 
 SKETCH_METHODS = {"g2fillet": sketch_g2fillet, "continuousRect": sketch_continuous_rect}
 
-for _name, _method in SKETCH_METHODS.items():
-    setattr(cq.Sketch, _name, _method)
+for _name, _sketch_method in SKETCH_METHODS.items():
+    setattr(cq.Sketch, _name, _sketch_method)

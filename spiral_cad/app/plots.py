@@ -10,6 +10,7 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass
+from typing import cast
 
 import numpy as np
 from matplotlib.axes import Axes
@@ -30,17 +31,17 @@ SEGMENT_COLORS = {"Line": "0.35", "Arc": "tab:blue", "BezierSpiral": "tab:red"}
 
 def _axes(ax: Axes | None, **figure_kw) -> tuple[Figure, Axes]:
     if ax is not None:
-        return ax.figure, ax
+        return ax.figure.get_figure(root=True), ax  # the root: an Axes in a SubFigure too gives a savable Figure
     fig = Figure(**figure_kw)
     return fig, fig.add_subplot()
 
 
-def _axes_pair(ax: tuple[Axes, Axes] | None) -> tuple[Figure, tuple[Axes, Axes]]:
+def _axes_pair(ax: Sequence[Axes] | None) -> tuple[Figure, tuple[Axes, Axes]]:
     """The given pair of axes, or a new two-panel figure."""
     if ax is not None:
-        return ax[0].figure, tuple(ax)
+        return ax[0].figure.get_figure(root=True), cast("tuple[Axes, Axes]", tuple(ax))
     fig = Figure(figsize=(11, 4.5))
-    return fig, tuple(fig.subplots(1, 2))
+    return fig, cast("tuple[Axes, Axes]", tuple(fig.subplots(1, 2)))
 
 
 def _kind(segment) -> str:
@@ -138,9 +139,10 @@ def plot_plan(chain: Chain, comb: bool = True, ax: Axes | None = None, per_segme
         if data is not None:
             rows = (index[:, None] * per_segment + np.arange(per_segment)).ravel()
             teeth = np.stack([data.points[rows, :2], data.tips[rows, :2]], axis=1)
-            ax.add_collection(LineCollection(teeth, colors=color, linewidths=0.6, alpha=0.5, gid=f"comb-{kind}"))
+            # ignores: matplotlib's stub takes only a Sequence, but an (n, m, 2) array is a documented list of lines
+            ax.add_collection(LineCollection(teeth, colors=color, linewidths=0.6, alpha=0.5, gid=f"comb-{kind}"))  # type: ignore[arg-type]
             envelopes = data.tips[rows, :2].reshape(len(index), per_segment, 2)
-            ax.add_collection(LineCollection(envelopes, colors=color, linewidths=0.8, alpha=0.8, gid=f"envelope-{kind}"))
+            ax.add_collection(LineCollection(envelopes, colors=color, linewidths=0.8, alpha=0.8, gid=f"envelope-{kind}"))  # type: ignore[arg-type]
     ax.set_aspect("equal", adjustable="datalim")
     ax.autoscale_view()
     unit = f" ({chain.units})"
@@ -231,7 +233,7 @@ def clothoid_points(theta: float, curvature: float, s: NDArray) -> NDArray:
 def plot_vs_clothoid(
     theta: float,
     curvature: float,
-    ax: Axes | Sequence[Axes] | None = None,
+    ax: Sequence[Axes] | None = None,
     samples: int = 200,
     shapes: Sequence[str] = ("walton-meek",),
 ) -> Figure:

@@ -294,7 +294,8 @@ class AlignmentDesign(_Model):
     strict: Flag = Field(False, description="true: a violated criterion is an error.")
     spiral_shape: TransitionShape = Field("near-linear", description="near-linear, or walton-meek (the 1996 spiral, "
                                           "1.6–1.8× longer for the same jerk).")  # fmt: skip
-    cross_section: CrossSection = Field(default_factory=CrossSection, description="OpenDRIVE lanes and the corridor.")
+    # ignore: without pydantic's mypy plugin, mypy misses Field's positional defaults and takes CrossSection() as incomplete
+    cross_section: CrossSection = Field(default_factory=CrossSection, description="OpenDRIVE lanes and the corridor.")  # type: ignore[arg-type]
     geo_reference: Annotated[str, PlainValidator(_text, json_schema_input_type=Annotated[str, Field(max_length=MAX_TEXT_LENGTH)])] | None = Field(
         None, description="OpenDRIVE geoReference: a PROJ string or WKT (printable text, ≤ 10 000 characters).")
     profile: Profile | None = Field(None, description="Optional vertical alignment.")

@@ -201,8 +201,8 @@ def _edge_frames(edges: list[TopoDS_Edge]) -> NDArray:
             frame[i, :9], frame[i, 9] = _frame(curve, u, 1.0 - 2.0 * end), math.nan
     out[:, 22:25] = raw[:, 18:21]
     reverse = raw[:, 24] == 1.0
-    start, end = out[reverse, :FRAME].copy(), out[reverse, FRAME : 2 * FRAME].copy()
-    out[reverse, :FRAME], out[reverse, FRAME : 2 * FRAME] = end, start
+    starts, ends = out[reverse, :FRAME].copy(), out[reverse, FRAME : 2 * FRAME].copy()
+    out[reverse, :FRAME], out[reverse, FRAME : 2 * FRAME] = ends, starts
     out[reverse, 3:6] *= -1.0
     out[reverse, FRAME + 3 : FRAME + 6] *= -1.0
     return out
@@ -381,7 +381,7 @@ def check_continuity(
             reader crashed on (``ReadError``, with the reason), a point that
             is not finite, or a negative/non-finite tolerance.
     """
-    tolerances = dict(gap_tol=gap_tol, angle_tol=angle_tol, curvature_tol=curvature_tol, snap=snap)
+    tolerances: dict[str, Any] = dict(gap_tol=gap_tol, angle_tol=angle_tol, curvature_tol=curvature_tol, snap=snap)
     if isinstance(shape_or_path, (str, os.PathLike)):
         with checking(shape_or_path, units=units, label=label, **tolerances) as report:
             return report()
@@ -398,7 +398,7 @@ def checking(path: str | os.PathLike, *, gap_tol: float = 1e-7, angle_tol: float
     """``check_continuity(path, ...)`` started: OCCT reads the file in its child process while
     the caller goes on; the function yielded waits for the report (leaving the block
     without asking for it stops the child). Arguments and errors as ``check_continuity``."""
-    tolerances = dict(gap_tol=gap_tol, angle_tol=angle_tol, curvature_tol=curvature_tol, snap=snap)
+    tolerances: dict[str, Any] = dict(gap_tol=gap_tol, angle_tol=angle_tol, curvature_tol=curvature_tol, snap=snap)
     _check_options(**tolerances)
     source = os.path.basename(os.fspath(path))
     reader = "the STEP reader (OCCT)" if Path(path).suffix.lower() in STEP_SUFFIXES else "the IGES reader (OCCT)"

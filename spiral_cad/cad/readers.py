@@ -44,7 +44,7 @@ import re
 from collections.abc import Callable
 from functools import cache
 from pathlib import Path
-from typing import Any
+from typing import Any, cast
 
 from OCP.BRep import BRep_Tool
 from OCP.TopAbs import TopAbs_EDGE
@@ -345,7 +345,7 @@ def _iges_curves(model: Any) -> list[tuple[Any, Any, int]]:
         members = ((k, curve.Curve(k)) for k in range(1, curve.NbCurves() + 1))
         return [(k, m) for k, m in members if m is None or is_curve(m)]
 
-    members = {model.DNum(m) for e in entities if e.TypeNumber() == 102 for _, m in parts(e) if m is not None}
+    members = {model.DNum(m) for e in entities if e.TypeNumber() == 102 for _, m in cast(list, parts(e)) if m is not None}
     found: list[tuple[Any, Any, int]] = []
     for entity in entities:
         if is_curve(entity) and entity.SubordinateStatus() % 2 == 0 and model.DNum(entity) not in members:
@@ -559,7 +559,7 @@ def _reader_failures(checks: Any, name: Callable[[Any], str] | None = None) -> l
         texts += [w for w in (check.CWarning(i) for i in range(1, check.NbWarnings() + 1)) if "Terminate Section" in w]
         entity = check.Entity() if name is not None else None
         for text in texts:
-            text = f"{name(entity)}: {text.strip()}" if entity is not None else text.strip()
+            text = f"{name(entity)}: {text.strip()}" if name is not None and entity is not None else text.strip()
             if text and text not in found:
                 found.append(text)
         checks.Next()

@@ -155,6 +155,7 @@ def _outcome(payload: bytes | None, status: int | None, failed: str, memory: int
     """(True, result) or (False, the ValueError to raise) from what a child sent and how it ended."""
     if payload is None:
         return False, ValueError(f"{failed} (no result within {TIME_LIMIT:g} s; stopped)")
+    assert status is not None  # a payload arrived, so the child was waited for
     if os.WIFSIGNALED(status):
         number = os.WTERMSIG(status)
         try:
@@ -178,7 +179,7 @@ def _outcome(payload: bytes | None, status: int | None, failed: str, memory: int
 
 def _receive(fd: int, deadline: float) -> bytes | None:
     """Everything written to ``fd`` until the child closes it, or None at ``deadline``."""
-    chunks = []
+    chunks: list[bytes] = []
     poller = select.poll()  # not select(): it fails on descriptors above 1023
     poller.register(fd, select.POLLIN)
     while True:

@@ -12,7 +12,7 @@ import math
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import Any, cast
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -28,7 +28,7 @@ from ..core.factors import WALTON_MEEK_SEARCH_MAX, length_factor, peak_rate_fact
 from ..core.rows import SegmentRows
 from ..core.segments import Circle, Ray
 from ..core.shapes import SHAPE_CODES, TRANSITION_SHAPES, shape_code, shape_limits
-from ..core.spiral import turn_angles
+from ..core.spiral import BezierSpiral, turn_angles
 from ..core.transitions import Transition
 from ..core.units import COLLINEAR_TOL, DEFAULT_UNITS, length_unit, speed_unit
 from .criteria import CRITERIA_DIMENSIONS, Criteria, CriteriaRow, RailCriteria, RoadCriteria
@@ -150,7 +150,7 @@ class CurveData:
         """The spiral shape of the curve's transitions."""
         return self.entry.shape
 
-    def row(self) -> dict[str, float]:
+    def row(self) -> dict[str, Any]:
         """The table row (Python numbers): lengths, chainages, angles in degrees, rates in 1/length², and the spiral shape."""
         values = {
             "x": self.pi[0],
@@ -281,6 +281,8 @@ class Alignment:
         if spiral_angles is not None and spiral_lengths is not None:
             raise ValueError("give at most one of spiral_angles and spiral_lengths")
         by_length = spiral_lengths is not None
+        shortest: NDArray | None  # spiral angle bounds per curve, when the criteria choose the spirals
+        longest: NDArray | None
         if spiral_angles is None and spiral_lengths is None:
             if criteria is None:
                 raise ValueError("give spiral_angles or spiral_lengths, or design criteria (design_speed) to choose them")
@@ -296,6 +298,7 @@ class Alignment:
         try:
             chain = join_rows(*_chain_rows(solved, shape), tuple(pts[0].tolist()), tuple(pts[-1].tolist()), tolerance, units)
         except JointError as error:
+            assert error.part is not None  # join_rows names the part
             raise NoSolutionError(f"PI {error.part // 2 + 1}: float64 cannot hold its curve G2 at these coordinates: {error}") from None
         curves = CurveList(chain, pts, solved, radius, origin, shape)
         checks = () if criteria is None else _judge(curves, criteria, units, shortest, longest, strict, shape)
@@ -303,7 +306,7 @@ class Alignment:
 
     # ------------------------------------------------------- table
 
-    def rows(self) -> list[dict[str, float]]:
+    def rows(self) -> list[dict[str, Any]]:
         """One dict per curve (see :meth:`CurveData.row`), in travel order; with a design
         speed also the peak lateral jerk (roads) or cant deficiency rate (rail) of each spiral."""
         rows = [c.row() for c in self.curves]
@@ -328,6 +331,7 @@ class Alignment:
         """The criteria table as text (empty without criteria)."""
         if not self.checks:
             return ""
+        assert self.criteria is not None  # checks come only with criteria
         speed = f"design speed {self.criteria.design_speed:g} {speed_unit(self.chain.units)}"
         return f"{type(self.criteria).__name__}, {speed}\n" + text_table(
             self.criteria_rows(), {**CRITERIA_DIMENSIONS, **self._dimensions()}, self.chain.units, digits
@@ -383,9 +387,9 @@ class _FirstProblem:
     """The error the PIs raise, in PI order and, within a PI, in the order the checks run."""
 
     def __init__(self) -> None:
-        self.found: tuple[int, int, Any] | None = None
+        self.found: tuple[int, float, Any] | None = None
 
-    def flag(self, failing: NDArray, step: int, make) -> None:
+    def flag(self, failing: NDArray, step: float, make) -> None:
         """Record ``make(j)`` (an exception) for the first PI index j where ``failing`` holds."""
         hit = np.flatnonzero(failing)
         if len(hit) and (self.found is None or (int(hit[0]), step) < self.found[:2]):
@@ -511,13 +515,13 @@ def _check_tangents(pts: NDArray, lengths: NDArray, directions: NDArray, solved:
     inner = pts[1:-1]
     back = np.concatenate([[0.0], np.einsum("ij,ij->i", inner - solved.entry[:, 0], directions[:-1])])
     ahead = np.concatenate([np.einsum("ij,ij->i", solved.exit[:, 3] - inner, directions[1:]), [0.0]])
-    used = np.concatenate([[0.0], ahead[:-1]])  # ST of the curve before tangent k
-    used_next = np.concatenate([back[1:], [0.0]])  # TS of the curve after it
-    over = np.flatnonzero(used + used_next > lengths * (1.0 + 1e-12))
+    used_all = np.concatenate([[0.0], ahead[:-1]])  # ST of the curve before tangent k
+    used_next_all = np.concatenate([back[1:], [0.0]])  # TS of the curve after it
+    over = np.flatnonzero(used_all + used_next_all > lengths * (1.0 + 1e-12))
     if not len(over):
         return
     k, last = int(over[0]), len(pts) - 1
-    used, used_next, length = float(used[k]), float(used_next[k]), float(lengths[k])
+    used, used_next, length = float(used_all[k]), float(used_next_all[k]), float(lengths[k])
     if k == 0:
         where = f"the TS of PI 1 lies {used_next:.6g} before PI 1, beyond the start point PI 0"
     elif k + 1 == last:
@@ -590,9 +594,9 @@ class CurveList(Sequence):
         center = tuple(solved.center[j].tolist())
         circle = Circle(center, float(solved.side[j] * self.radius[j]))
         t_in, t_out = (tuple(solved.directions[k].tolist()) for k in (j, j + 1))
-        entry = Transition("line-circle", [chain[int(self._first[j])]], float(solved.theta[j, 0]), end_circle=circle,
+        entry = Transition("line-circle", [cast(BezierSpiral, chain[int(self._first[j])])], float(solved.theta[j, 0]), end_circle=circle,
                            start_line=Ray(pi, t_in), shape=shape)  # fmt: skip
-        exit_ = Transition("circle-line", [chain[int(self._last[j])]], float(solved.theta[j, 1]), start_circle=circle,
+        exit_ = Transition("circle-line", [cast(BezierSpiral, chain[int(self._last[j])])], float(solved.theta[j, 1]), start_circle=circle,
                            end_line=Ray(pi, t_out), shape=shape)  # fmt: skip
         ts, sc, cs, st = self._stations[j].tolist()
         (theta_in, theta_out), (length_in, length_out), (rate_in, rate_out) = (a[j].tolist() for a in (self.thetas, self.lengths, self.peak_rates))

@@ -210,15 +210,15 @@ class _Lift:
     def control(self, pieces: list[tuple[int, float, float]]) -> tuple[NDArray, NDArray]:
         """(n, 6, 3) control points and (n, 6) weights: the exact plan piece raised to degree 5 and a
         quintic Hermite z taking the profile's z, dz/ds and d²z/ds² at both ends (so pieces meet G2)."""
-        plan, weights = [], []
+        plan_pieces, weight_pieces = [], []
         for k, u0, u1 in pieces:
             segment = self.chain[k]
             part = segment if (u0, u1) == (0.0, 1.0) else segment.piece(u0, u1)
             ((points, w, _),) = _pieces(part)
-            plan.append(points)
-            weights.append(w)
-        homogeneous = _raise_degree(np.concatenate([np.array(plan) * np.array(weights)[..., None],
-                                                    np.array(weights)[..., None]], axis=2), 2)  # fmt: skip
+            plan_pieces.append(points)
+            weight_pieces.append(w)
+        homogeneous = _raise_degree(np.concatenate([np.array(plan_pieces) * np.array(weight_pieces)[..., None],
+                                                    np.array(weight_pieces)[..., None]], axis=2), 2)  # fmt: skip
         weights = homogeneous[..., 2]
         plan = homogeneous[..., :2] / weights[..., None]
         segment = np.array([p[0] for p in pieces])

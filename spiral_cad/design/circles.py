@@ -26,7 +26,7 @@ from __future__ import annotations
 import math
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, cast
 
 import numpy as np
 from numpy.typing import NDArray
@@ -69,6 +69,7 @@ class CircleChain:
 
 
 def _as_circle(value: Any, index: int) -> Circle:
+    center: Any  # a point of any form until as_xy checks it
     if isinstance(value, Circle):
         center, radius = value.center, value.radius
     else:
@@ -164,6 +165,7 @@ def circle_chain(circles: Sequence[Any], units: str = DEFAULT_UNITS, shape: str 
     try:
         chain = Chain.join(transitions, units=units)
     except JointError as error:
+        assert error.part is not None  # Chain.join names the part
         k = error.part
         raise NoSolutionError(f"circles {k} and {k + 1}: float64 cannot hold the path G2 at these coordinates: {error}") from None
     return CircleChain(chain, items, transitions, sweeps)
@@ -193,12 +195,13 @@ def _transitions(items: list[Circle], shape: str) -> list[Transition]:
         for k, (i, spirals, theta) in enumerate(pairs):
             a, b = items[i], items[i + 1]
             if case == "nested":
+                assert result.parameter is not None  # the nested case carries t
                 kind, parameter = "circle-circle-nested", float(result.parameter[k])
             else:
                 kind, parameter = ("S" if (a.radius > 0) != (b.radius > 0) else "C"), None
             curves = [BezierSpiral._wrap(np.array(cp), shape) for cp in spirals]
             transitions[i] = Transition(kind, curves, theta, a, b, parameter=parameter, shape=shape)
-    return transitions
+    return cast("list[Transition]", transitions)  # every pair solved (a failure raised above)
 
 
 def _arc_sweep(items: list[Circle], transitions: list[Transition], k: int) -> float:

@@ -42,7 +42,7 @@ from __future__ import annotations
 
 from abc import ABC, abstractmethod
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, cast
 
 import numpy as np
 from numpy.typing import NDArray
@@ -79,6 +79,11 @@ def _smallest_theta(ok, count: int, theta_range: tuple[float, float]) -> NDArray
         hi = np.where(good, mid, hi)
         lo = np.where(good, lo, mid)
     return np.where(done, theta_range[0], np.where(feasible, hi, np.nan))
+
+
+def _pair(values: Any) -> tuple[float, float]:
+    """An (in, out) pair of plain floats."""
+    return cast("tuple[float, float]", tuple(map(float, values)))
 
 
 @dataclass(frozen=True)
@@ -272,7 +277,7 @@ class RoadCriteria(_Criteria):
         jerks = v * v * v * np.asarray(peak_rates) / to_metres(units) ** 2
         low, high = self.shifts(units)
         r_min = self.minimum_radius(units)
-        banking = self.superelevation(radii, units).tolist()
+        banking = cast(NDArray, self.superelevation(radii, units)).tolist()  # radii is 1-D: an array back
         rows = []
         columns = (np.asarray(a, dtype=float).tolist() for a in (radii, lengths, shifts, jerks, bounds))  # plain floats: cheap rows
         for pi, radius, length, shift, jerk, bound, e in zip(pis, *columns, banking):
@@ -284,8 +289,8 @@ class RoadCriteria(_Criteria):
                     violations.append(f"{side}: shift p = {p:.4g} < p_min = {low:.4g}")
                 if not p <= high * (1 + 1e-9):
                     violations.append(f"{side}: shift p = {p:.4g} > p_max = {high:.4g}")
-            rows.append(CriteriaRow(int(pi), float(radius), r_min, tuple(map(float, length)), tuple(map(float, bound)),
-                                    tuple(map(float, shift)), tuple(map(float, jerk)), self.max_jerk, e, e, tuple(violations),
+            rows.append(CriteriaRow(int(pi), float(radius), r_min, _pair(length), _pair(bound),
+                                    _pair(shift), _pair(jerk), self.max_jerk, e, e, tuple(violations),
                                     shape=shape))  # fmt: skip
         return rows
 
@@ -368,8 +373,8 @@ class RailCriteria(_Criteria):
                 for values, (what, limit) in zip((cant_rates, gradients, deficiency_rates), limits):
                     if not values[k, j] <= limit * (1 + 1e-9):
                         violations.append(f"{side}: {what} {values[k, j]:.4g} > {limit:g}")
-            rows.append(CriteriaRow(int(pi), float(radius), r_min, tuple(map(float, lengths[k])), tuple(map(float, bounds[k])),
-                                    tuple(map(float, shifts[k])), tuple(map(float, deficiency_rates[k])),
+            rows.append(CriteriaRow(int(pi), float(radius), r_min, _pair(lengths[k]), _pair(bounds[k]),
+                                    _pair(shifts[k]), _pair(deficiency_rates[k]),
                                     self.cant_deficiency_rate_max, float(cants[k]), float(cants[k]) / self.gauge,
                                     tuple(violations), "peak cant deficiency rate", "mm/s", shape))  # fmt: skip
         return rows

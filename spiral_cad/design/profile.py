@@ -41,7 +41,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import Any, cast
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -196,8 +196,8 @@ class VerticalCurve:
     def rates(self) -> tuple[float, float]:
         """d²z/ds² of the two parabolas (equal for a symmetric curve)."""
         g = self.middle_grade
-        return tuple((b - a) / length for a, b, length in
-                     ((self.grade_in, g, self.length_in), (g, self.grade_out, self.length_out)))  # fmt: skip
+        return cast("tuple[float, float]", tuple((b - a) / length for a, b, length in
+                     ((self.grade_in, g, self.length_in), (g, self.grade_out, self.length_out))))  # fmt: skip
 
     @property
     def k(self) -> float:
@@ -332,7 +332,7 @@ class Profile:
         if curve_lengths is not None and k_values is not None:
             raise ValueError("give at most one of curve_lengths and k_values")
         differences = grades[1:] - grades[:-1]
-        for j in np.flatnonzero(differences == 0.0):
+        for j in np.flatnonzero(differences == 0.0).tolist():
             raise ValueError(
                 f"PVI {j + 1} at station {float(pvis[j + 1, 0])!r} lies on the grade of its neighbours "
                 f"({100 * float(grades[j])!r} %): no vertical curve can be placed there; remove it"
@@ -342,11 +342,11 @@ class Profile:
         elif curve_lengths is not None:
             halves = _curve_halves(curve_lengths, count)
         elif k_values is not None:
-            k = per_item(k_values, count, "k_values", "interior PVI")
-            for j, value in enumerate(k):
+            ks = per_item(k_values, count, "k_values", "interior PVI")
+            for j, value in enumerate(ks):
                 if not value > 0.0:
                     raise ValueError(f"PVI {j + 1}: K must be positive; got {value}")
-            full = 100.0 * np.abs(differences) * k
+            full = 100.0 * np.abs(differences) * ks
             halves = np.stack([full / 2.0, full / 2.0], axis=1)
         else:
             if criteria is None:
@@ -516,7 +516,7 @@ def _check_room(pvis: NDArray, curves: tuple[VerticalCurve, ...], units: str, ch
                 f"{curve.bvc:.6g}; {'reduce the grade changes' if chosen else 'shorten them'} or move the PVIs apart"
             )
         previous_end, previous = curve.evc, curve
-    if curves and previous_end > end + 1e-12 * max(abs(end), previous.length):
+    if previous is not None and previous_end > end + 1e-12 * max(abs(end), previous.length):  # set by any curve
         raise NoSolutionError(
             f"PVI {previous.index}: {what} ({previous.length:.6g} {units}) ends at {previous_end:.6g}, past the "
             f"profile's end PVI {len(pvis) - 1} at {end:.6g}; {fix} or move the last PVI on"
@@ -570,9 +570,9 @@ def _pieces(pvis: NDArray, grades: NDArray, curves: tuple[VerticalCurve, ...]) -
             coefficients.append((z0, g0, 0.5 * rate))
         grade_line(k, curve.evc)
     stations = np.array(starts + [float(pvis[-1, 0])])
-    coefficients = np.array(coefficients, dtype=float)
+    table = np.array(coefficients, dtype=float)
     keep = np.diff(stations) > 0.0  # a curve ending exactly where the next begins leaves an empty grade line
-    return np.append(stations[:-1][keep], stations[-1]), coefficients[keep]
+    return np.append(stations[:-1][keep], stations[-1]), table[keep]
 
 
 def _verify(stations: NDArray, coefficients: NDArray, pvis: NDArray, units: str) -> None:

@@ -20,6 +20,7 @@ from __future__ import annotations
 import math
 import os
 from collections.abc import Sequence
+from typing import cast
 
 import numpy as np
 
@@ -117,7 +118,7 @@ def extents(chains: Sequence[Chain]) -> tuple[tuple[float, float, float], tuple[
         if len(spirals):
             points.append(_cubic_extreme_points(spirals).reshape(-1, 3))
         for i in np.flatnonzero(rows.kind == ARC).tolist():
-            arc = chain[i]
+            arc = cast(Arc, chain[i])  # the row's kind says so
             inside = _arc_extreme_parameters(arc)
             if inside:
                 found = np.atleast_2d(arc.point(np.array(inside)))

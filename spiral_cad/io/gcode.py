@@ -60,7 +60,7 @@ from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from contextvars import ContextVar
 from dataclasses import dataclass
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from numpy.typing import NDArray
@@ -185,7 +185,8 @@ class _Reader:
             kept.append(" ")
         kept.append(text[at:])
         text = "".join(kept)
-        found, at = [], 0
+        found: list[tuple[str, float, str]] = []
+        at = 0
         stripped = text.rstrip()
         while at < len(stripped):
             match = _WORD.match(stripped, at)
@@ -410,6 +411,7 @@ def parse_gcode(text: str, source: str = "G-code", *, arc_tolerance: float | Non
         raise ValueError(f"{source}: the program opens with % (line {reader.opened}) but has no closing % or M2/M30; LinuxCNC refuses it (file ended with no percent sign)")
     if len(reader.points) < 2:
         raise ValueError(f"{source}: the program has {len(reader.points)} move(s) to a new position; a path needs at least two")
+    assert reader.units is not None  # the reader refuses a move before G20/G21
     return GcodePath(np.array(reader.points), np.array(reader.lines), np.array(reader.rapid), reader.units, source, tuple(reader.notes))
 
 
@@ -491,7 +493,7 @@ def round_toolpath(path: GcodePath, *, for_occt: bool = True, **options) -> Roun
     except ValueError as error:
         raise type(error)(f"{path.source}: {path.at_lines(str(error))}") from None
     lengths = np.asarray(rounded.chain.lengths)
-    short = np.flatnonzero(lengths <= OCCT_CONFUSION) if for_occt else ()
+    short: NDArray | tuple[int, ...] = np.flatnonzero(lengths <= OCCT_CONFUSION) if for_occt else ()
     if len(short):
         i = int(short[0])
         kind = ("Line", "Arc", "BezierSpiral")[int(np.asarray(rounded.chain.rows.kind)[i])]
@@ -552,7 +554,7 @@ def round_toolpath_arrays(path: GcodePath, *, shape: str = "walton-meek", max_de
     for name, value in options.items():
         if value is not None and not (isinstance(value, (int, float)) and 0.0 < value < math.inf):
             raise ValueError(f"{name} must be one positive finite number here; got {value!r:.40}")
-    given = {name: value for name, value in options.items() if value is not None}
+    given: dict[str, Any] = {name: value for name, value in options.items() if value is not None}
     with ticking(f"rounding {path.source} ({len(path):,} points)"):
         try:
             p0, corners, p1, index = corner_legs(path.points)

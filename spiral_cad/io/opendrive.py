@@ -40,14 +40,15 @@ import os
 from collections.abc import Sequence
 from dataclasses import dataclass
 from datetime import datetime, timezone
+from typing import overload
 from xml.sax.saxutils import escape
 
 import numpy as np
 from numpy.typing import NDArray
 
+from ..core._chain_kernels import ARC, LINE, SPIRAL
 from ..core._inputs import shown
 from ..core.chain import Chain
-from ..core.rows import ARC, LINE, SPIRAL
 from ..core.segments import row_frames
 from ..core.units import to_metres
 from .decimals import shortest_decimal
@@ -243,6 +244,12 @@ def _polynomials(tag: str, element: str, rows: NDArray) -> list[str]:
     return lines + [f"    </{tag}>"]
 
 
+@overload
+def _scaled(rows: NDArray, scale: float, powers: tuple[int, ...]) -> NDArray: ...
+@overload
+def _scaled(rows: None, scale: float, powers: tuple[int, ...]) -> None: ...
+@overload
+def _scaled(rows: NDArray | None, scale: float, powers: tuple[int, ...]) -> NDArray | None: ...
 def _scaled(rows: NDArray | None, scale: float, powers: tuple[int, ...]) -> NDArray | None:
     """Polynomial rows (s, a, b, …) in the design's unit converted to metres: s·scale and each
     coefficient times scale**power (a value is a length: 1; a roll angle: 0)."""
@@ -308,7 +315,7 @@ def opendrive_text(
     lines += [f'    <userData code="spiral_cad:units" value={_attribute(note)} />', "  </header>"]
     lanes = _lanes(cross_section)
     for index, (road, plan) in enumerate(zip(roads, plans), 1):
-        lines.append(f'  <road id="{index}" junction="-1" length="{number(plan["total"])}" name={_attribute(road.name)} '
+        lines.append(f'  <road id="{index}" junction="-1" length="{number(float(plan["total"]))}" name={_attribute(road.name)} '
                      f'rule="{cross_section.rule}">')  # fmt: skip
         lines += _plan_view(plan)
         elevation = _scaled(road.elevation, scale, (1, 0, -1)) if road.elevation is not None else np.zeros((1, 4))

@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import os
 from dataclasses import dataclass, fields
+from typing import cast
 
 import numpy as np
 from numpy.typing import NDArray
@@ -202,7 +203,7 @@ def _profile_report(road: str, kind: str, records: NDArray, value_tol: float, sl
     with np.errstate(all="ignore"):
         x = s - records[:-1, 0]
         before = [polynomial(records[:-1, 1:], x, k) for k in range(3)]  # each piece at the start of the next
-        after = [polynomial(records[1:, 1:], 0.0, k) for k in range(3)]
+        after = [polynomial(records[1:, 1:], np.zeros_like(x), k) for k in range(3)]
         jumps = np.abs(np.stack(before) - np.stack(after))
         scale = np.maximum(np.maximum(np.abs(before[2]), np.abs(after[2])), floor)
         relative = jumps[2] / scale
@@ -212,7 +213,7 @@ def _profile_report(road: str, kind: str, records: NDArray, value_tol: float, sl
     )  # fmt: skip
     worst = int(np.argmin(levels))
     return ProfileReport(road, kind, len(records), PROFILE_LEVELS[int(levels[worst])],
-                         (float(s[worst]), *(float(v) for v in jumps[:, worst])))  # fmt: skip
+                         cast("tuple[float, float, float, float]", (float(s[worst]), *(float(v) for v in jumps[:, worst]))))  # fmt: skip
 
 
 def _links(source: str, path: str | os.PathLike, network: Network, gap_tol: float, angle_tol: float, curvature_tol: float,

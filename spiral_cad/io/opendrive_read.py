@@ -21,6 +21,7 @@ import os
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from functools import cached_property
+from typing import cast
 from xml.parsers import expat
 
 import numpy as np
@@ -95,7 +96,7 @@ class Geometry:
         reader fills them in as it evaluates every geometry at once."""
         with np.errstate(all="ignore"):
             points, tangents, curvature = self.evaluate(_ENDS)
-        return _frames(points, tangents, curvature)
+        return cast("tuple[Frame, Frame, Frame]", _frames(points, tangents, curvature))  # _ENDS: three parameters
 
     def frames(self) -> tuple[Frame, Frame]:
         """Start and end frames (point, unit tangent, curvature vector; z = 0) for the joint checks."""
@@ -333,7 +334,7 @@ class Road:
         for g in self.geometries:
             try:
                 with np.errstate(all="ignore"):
-                    segments.append(g.segment())
+                    segments.append(cast(Segment, g.segment()))  # the kinds checked above all have one
             except (ValueError, ArithmeticError) as error:  # a geometry at the edge of the float range
                 raise ValueError(f"road {self.id}, planView geometry {g.index} <{g.kind}>: no exact segment ({error})") from None
         try:
@@ -399,6 +400,7 @@ def _reals(texts: list, name: str, where) -> NDArray:
     if values is None or not np.isfinite(values).all():
         for i, text in enumerate(texts):
             _real(text, name, where(i))
+    assert values is not None  # _real raised on the text float() refused
     return values
 
 
@@ -585,12 +587,12 @@ def _plan(road_id: str, record: dict) -> Plan:
         found = ([others[bad]] if bad in others else []) + ([shapes[bad][0]] * counts[bad] if shapes[bad] else [])
         raise ValueError(f"{where(bad)}: needs exactly one of {', '.join(_KINDS)}; found {', '.join(found) or 'none'}")
     head = {name: _reals([e.get(name) for e in elements], name, where) for name in ("s", "x", "y", "hdg", "length")}
-    bad = np.flatnonzero(~(head["length"] > 0.0))
-    if len(bad):
-        raise ValueError(f"{where(bad[0])}: length must be positive; got {float(head['length'][bad[0]])!r}")
-    bad = np.flatnonzero(head["s"] < 0.0)
-    if len(bad):
-        raise ValueError(f"{where(bad[0])}: s must be ≥ 0; got {float(head['s'][bad[0]])!r}")
+    wrong = np.flatnonzero(~(head["length"] > 0.0))
+    if len(wrong):
+        raise ValueError(f"{where(wrong[0])}: length must be positive; got {float(head['length'][wrong[0]])!r}")
+    wrong = np.flatnonzero(head["s"] < 0.0)
+    if len(wrong):
+        raise ValueError(f"{where(wrong[0])}: s must be ≥ 0; got {float(head['s'][wrong[0]])!r}")
     kinds = tuple(tag for tag, _ in shapes)
     frames = np.empty((len(kinds), 3, 9))
     by_kind = {}
@@ -634,8 +636,9 @@ def _world_frames(kind: str, values: NDArray, head: dict[str, NDArray], ranges: 
         frames[..., 6] = -frames[..., 4] * curvature  # the curvature vector κN
         frames[..., 7] = frames[..., 3] * curvature
     problems: list = []
-    heading_bad = ~(np.isfinite(phase).all(axis=1) & np.isfinite(top))
-    point_bad = ~np.isfinite(frames[..., :2]).all(axis=2)
+    # casts: numpy's stubs type .all(axis=k) as a scalar or an array
+    heading_bad = cast(NDArray, ~(np.isfinite(phase).all(axis=1) & np.isfinite(top)))
+    point_bad = cast(NDArray, ~np.isfinite(frames[..., :2]).all(axis=2))
     for j in np.flatnonzero(heading_bad | point_bad.any(axis=1)).tolist():
         problems.append((j, None) if heading_bad[j] else (j, f"its {_END_NAMES[int(np.argmax(point_bad[j]))]} point is not a finite number"))
     return frames, problems

@@ -163,3 +163,12 @@ def test_chains_in_space_plot_as_a_plan_projection_and_a_curvature_magnitude(tmp
     assert "projected onto XY" in fig.axes[0].get_title() and saved(fig, tmp_path, "plan3d.png")
     fig = plots.plot_curvature(chain)
     assert "|κ|" in fig.axes[0].get_ylabel() and saved(fig, tmp_path, "curvature3d.png")
+
+
+def test_axes_in_a_subfigure_give_back_the_savable_root_figure(chain, tmp_path):
+    root = Figure()
+    left, right = root.subfigures(1, 2)
+    fig = plots.plot_plan(chain, comb=False, ax=left.add_subplot())
+    assert fig is root and saved(fig, tmp_path, "plan.png")
+    pair = plots.plot_vs_clothoid(0.3, 0.01, ax=right.subplots(1, 2))
+    assert pair is root and saved(pair, tmp_path, "pair.png")
