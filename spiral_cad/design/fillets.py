@@ -144,7 +144,7 @@ def _vertex_indices(vertices: Any) -> list[int]:
     for i, (v, index) in enumerate(zip(items, indices)):
         if index is None:
             raise ValueError(f"vertices[{i}] must be a vertex index (an integer); got {type(v).__name__} {shown(v):.80}")
-    return sorted(set(indices))
+    return sorted({index for index in indices if index is not None})
 
 
 def _side_geometry(segment: Segment, at_end: bool) -> tuple[str, Any]:
@@ -152,6 +152,7 @@ def _side_geometry(segment: Segment, at_end: bool) -> tuple[str, Any]:
     if isinstance(segment, Line):
         (x, y, tx, ty, _) = segment.ends[1 if at_end else 0]
         return "line", Ray((x, y), (tx, ty))
+    assert isinstance(segment, Arc)  # a path's pieces are lines and arcs
     return "arc", segment.circle
 
 
@@ -304,6 +305,7 @@ def _round_corner(
     except NoSolutionError as error:
         raise NoSolutionError(f"{where}: {error}") from None
     for t, side in ((onto, onto.end_circle), (off, off.start_circle)):
+        assert side is not None  # a transition onto or off a circle has that circle
         if side.radius * signed < 0:
             raise NoSolutionError(f"{where}: the fillet circle falls on the wrong side of the path; use a smaller radius")
     sweep = _signed_sweep(center, signed, onto.end, off.start)
@@ -344,6 +346,7 @@ def _parameter(segment: Segment, point: NDArray) -> float:
     if isinstance(segment, Line):
         (ax, ay, tx, ty, _), length = segment.ends[0], segment.length  # unit tangent: no |b − a|² to overflow
         return float((point[0] - ax) * tx + (point[1] - ay) * ty) / length
+    assert isinstance(segment, Arc)  # a path's pieces are lines and arcs
     c = segment.center
     angle = math.atan2(point[1] - c[1], point[0] - c[0]) - segment.start_angle
     travelled = (math.copysign(1.0, segment.radius) * angle) % (2.0 * math.pi)
@@ -456,7 +459,7 @@ def _assemble(
             owners.append(None)
         if end_corner is not None:
             onto, off = end_corner.transitions
-            corner = [*onto.spirals]
+            corner: list[Segment] = [*onto.spirals]
             if end_corner.sweep > 1e-9:
                 corner.append(Arc.between(end_corner.center, end_corner.radius, onto.end, off.start))
             corner += off.spirals

@@ -31,6 +31,7 @@ import math
 import re
 from collections.abc import Iterable
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -359,11 +360,12 @@ def _corner_rows(p0: ArrayLike, corners: ArrayLike, p1: ArrayLike) -> tuple[NDAr
     if len(dims) > 1:
         raise ValueError("p0, corners and p1 must all be 2-D or all 3-D points; got " + ", ".join(f"{n} {a.shape}" for (n, _), a in zip(named, arrays)))
     try:
-        arrays = np.broadcast_arrays(*arrays)
+        arrays = list(np.broadcast_arrays(*arrays))
     except ValueError:
         raise ValueError("p0, corners and p1 need N rows each (or one); got " + ", ".join(f"{n} {a.shape}" for (n, _), a in zip(named, arrays))) from None
     d = arrays[0].shape[-1]
-    return _plane_if_flat(*(np.ascontiguousarray(a.reshape(-1, d)) for a in arrays))
+    a, b, c = _plane_if_flat(*(np.ascontiguousarray(a.reshape(-1, d)) for a in arrays))
+    return a, b, c
 
 
 def _in_corner_planes(p0: NDArray, corners: NDArray, p1: NDArray) -> tuple[NDArray, NDArray, NDArray, NDArray]:
@@ -800,7 +802,7 @@ def round_corners(
     pts = _polyline(points)
     p0, corners, p1, index = corner_legs(pts)
     interior = len(pts) - 2
-    options = {name: _at_corners(v, name, interior, index) for name, v in
+    options: dict[str, Any] = {name: _at_corners(v, name, interior, index) for name, v in
                (("curvature", curvature), ("max_curvature", max_curvature), ("max_deviation", max_deviation), ("spiral_lengths", spiral_lengths))}  # fmt: skip
     dim = pts.shape[1]
     rounded: list[RoundedCorner] = []
@@ -907,7 +909,7 @@ def _without_slivers(result: CornerBatch, pts: NDArray, p0: NDArray, corners: ND
         why = None
         if not fixed.ok[m]:
             why = fixed.reason(m, label=f"corner {index[j]}")
-        elif bounded and not fixed.deviation[m] <= bound[j]:
+        elif bound is not None and not fixed.deviation[m] <= bound[j]:
             why = f"corner {index[j]}: closing a sliver line beside it would take it {fixed.deviation[m]:.6g} from the path"
         elif kmax is not None and not fixed.curvature[m] <= kmax[j] * (1.0 + DEVIATION_MARGIN):
             why = (f"corner {index[j]}: making the sliver line beside it a real edge needs curvature "
@@ -1019,7 +1021,7 @@ def fillet_polyline(
     unknown = [v for v in chosen if v not in candidates]
     if unknown:
         raise ValueError(f"vertices {unknown} are not corners of this polyline (corners: {candidates})")
-    rounded = {}
+    rounded: dict[int, None] = {}
     for v in chosen:
         before, after = ends[v - 1][0], ends[v % edges][1]
         if not straight_points(before[None], pts[v][None], after[None])[0][0]:

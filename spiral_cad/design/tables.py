@@ -75,7 +75,7 @@ def fixed_columns(columns: Sequence[tuple[str, str]], rows: Iterable[Sequence[An
         rows: the values, one sequence per row.
         rule: a line of dashes under the header.
     """
-    widths = [re.match(r"[<>^]?(\d*)", spec).group(1) for _, spec in columns]
+    widths = [re.sub(r"^[<>^]?(\d*).*$", r"\1", spec) for _, spec in columns]
     numeric = [spec[-1:] in ("f", "e", "g", "d", "%") for _, spec in columns]
     head = " ".join(f"{title:{'>' if number else '<'}{width}}" for (title, _), width, number in zip(columns, widths, numeric))
     lines = [head.rstrip()] + (["-" * len(head.rstrip())] if rule else [])

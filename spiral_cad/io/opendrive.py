@@ -40,7 +40,7 @@ import os
 from collections.abc import Sequence
 from dataclasses import dataclass
 from datetime import datetime, timezone
-from typing import overload
+from typing import Any, overload
 from xml.sax.saxutils import escape
 
 import numpy as np
@@ -142,7 +142,7 @@ class RoadToWrite:
     superelevation: NDArray | None = None
 
 
-def plan_records(chain: Chain, scale: float) -> dict[str, NDArray]:
+def plan_records(chain: Chain, scale: float) -> dict[str, Any]:
     """The planView of ``chain`` in metres, as arrays, from the chain's own rows (no segment objects).
 
     Keys: ``kind`` (``LINE``, ``ARC``, ``SPIRAL`` of ``spiral_cad.core.rows``),
