@@ -34,4 +34,3 @@ __all__ = [
     "line_to_line",
 ]
 __version__ = "0.2.0"
-

@@ -374,9 +374,7 @@ def g2_fillet(
         NoSolutionError: a corner that cannot be rounded (named, with numbers).
     """
     context: Builder | None = Builder._get_context("g2_fillet")
-    in_builder = isinstance(target, Vertex) or (
-        isinstance(target, Iterable) and not isinstance(target, (Shape, str, bytes))
-    )
+    in_builder = isinstance(target, Vertex) or (isinstance(target, Iterable) and not isinstance(target, (Shape, str, bytes)))
     if in_builder:
         _points(target)  # only vertices select corners of a builder's object
         if context is None or context._obj is None:

@@ -264,9 +264,7 @@ def continuousRect(self: W, xLen: float, yLen: float, radius: float, transition:
     return _place_closed(self, continuous_rectangle(xLen, yLen, radius, transition, shape=shape))
 
 
-def continuousPolygon(
-    self: W, nSides: int, diameter: float, radius: float, transition: float = 0.5, shape: str = DEFAULT_SHAPE
-) -> W:
+def continuousPolygon(self: W, nSides: int, diameter: float, radius: float, transition: float = 0.5, shape: str = DEFAULT_SHAPE) -> W:
     """A regular polygon (circumscribed ``diameter``) with G2 corners, as a pending wire."""
     return _place_closed(self, continuous_polygon(diameter / 2.0, nSides, radius, transition, shape=shape))
 

@@ -134,8 +134,17 @@ def _paper_plots(folder: Path) -> None:
 
 
 #: ``build`` options that describe a ``--from-gcode`` design (a design file states them per design).
-GCODE_OPTIONS = ("max_deviation", "max_curvature", "shape", "sample_step", "chord_tolerance", "name", "units", "interpreter",
-                 "arc_tolerance")
+GCODE_OPTIONS = (
+    "max_deviation",
+    "max_curvature",
+    "shape",
+    "sample_step",
+    "chord_tolerance",
+    "name",
+    "units",
+    "interpreter",
+    "arc_tolerance",
+)
 
 
 def _build(args: argparse.Namespace) -> int:
@@ -352,8 +361,7 @@ def _parser() -> argparse.ArgumentParser:
     build = sub.add_parser(
         "build",
         help="build a JSON design file and write STEP, IGES, DXF, SVG, plots, tables and a continuity report",
-        description="Build a JSON design file (spiral-cad schema prints its JSON Schema, the format's reference) "
-        "or a G-code program.",
+        description="Build a JSON design file (spiral-cad schema prints its JSON Schema, the format's reference) or a G-code program.",
     )
     build.add_argument("design", nargs="?", help="the design file (.json); or --from-gcode")
     build.add_argument("--out", default="out", help="output folder (default: out)")
@@ -372,10 +380,15 @@ def _parser() -> argparse.ArgumentParser:
     gcode.add_argument("--units", choices=["mm", "cm", "m", "km", "in", "ft"],
                        help="the unit of the outputs and of every length above (default mm; the program's G20/G21 is converted)")  # fmt: skip
     gcode.add_argument("--name", help="the design's name (default: the program's file name)")
-    gcode.add_argument("--interpreter", choices=["builtin", "rs274"],
-                       help="builtin (default: straight moves and arcs, no parameters) or rs274 (LinuxCNC's own, full NGC; "
-                            "Debian package linuxcnc-uspace)")
-    gcode.add_argument("--arc-tolerance", type=float, help="read arcs G2/G3 as chords at most this far from the arc (default: arcs refused)")
+    gcode.add_argument(
+        "--interpreter",
+        choices=["builtin", "rs274"],
+        help="builtin (default: straight moves and arcs, no parameters) or rs274 (LinuxCNC's own, full NGC; "
+        "Debian package linuxcnc-uspace)",
+    )
+    gcode.add_argument(
+        "--arc-tolerance", type=float, help="read arcs G2/G3 as chords at most this far from the arc (default: arcs refused)"
+    )
     build.set_defaults(run=_build)
     _add_check(sub)
     schema = sub.add_parser("schema", help="print the JSON Schema of design files (the format of build)")

@@ -276,7 +276,7 @@ def _profile(p: ProfileDesign, where: str, alignment: Any, strict: bool):
         except ValueError as e:
             raise DesignError(f"{where}: {e}") from None
     elif limits:
-        raise DesignError(f"{where}: {', '.join(limits)} need road criteria (a design_speed with criteria \"road\")")
+        raise DesignError(f'{where}: {", ".join(limits)} need road criteria (a design_speed with criteria "road")')
     if count and "curve_lengths" not in kw and "k_values" not in kw and "criteria" not in kw:
         raise DesignError(f"{where}: give curve_lengths or k_values (or a road design_speed to choose the curves)")
     try:

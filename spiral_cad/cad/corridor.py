@@ -169,8 +169,7 @@ def _sewn_solid(road: Roadway, roles: list[str]) -> tuple[Any, dict[str, list]]:
     shell = sewing.SewedShape()
     if shell.IsNull() or shell.ShapeType() != TopAbs_SHELL or sewing.NbFreeEdges() or sewing.NbMultipleEdges():
         raise ValueError(
-            f"the corridor's faces do not close into one shell ({sewing.NbFreeEdges()} free, "
-            f"{sewing.NbMultipleEdges()} multiple edges)"
+            f"the corridor's faces do not close into one shell ({sewing.NbFreeEdges()} free, {sewing.NbMultipleEdges()} multiple edges)"
         )
     solid = BRepBuilderAPI_MakeSolid(TopoDS.Shell_s(shell)).Solid()
     BRepLib.OrientClosedSolid_s(solid)

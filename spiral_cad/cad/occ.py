@@ -319,6 +319,7 @@ def nurbs_edge(nurbs: Nurbs, plane: gp_Ax3 | None = None) -> TopoDS_Edge:
 
 # ------------------------------------------------------------- console
 
+
 def print_model(printer: Any, protocol: Any, path: str | os.PathLike, kind: str) -> None:
     """Print an OCCT model (``printer``: its STEP or IGES writer) to ``path`` with 17 significant digits.
 

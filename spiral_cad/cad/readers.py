@@ -174,7 +174,6 @@ def _read_whole(path: Path, kind: str, units: str | None) -> tuple[TopoDS_Shape,
     """Read ``path`` with OCCT, check that it was read whole; (shape, unit read in)."""
     from OCP.IFSelect import IFSelect_RetDone
 
-
     with captured_messages() as printed:
         if kind == "STEP":
             from OCP.STEPControl import STEPControl_Reader

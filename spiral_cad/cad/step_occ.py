@@ -63,8 +63,14 @@ _STEP_UNIT = {"mm": "MM", "cm": "CM", "m": "M", "km": "KM", "in": "INCH", "ft": 
 
 
 def write_shape_step(
-    obj: Any, path: str | os.PathLike, name: str, units: str, originating_system: str, description: str | None = None,
-    *, occt_wires: bool = False,
+    obj: Any,
+    path: str | os.PathLike,
+    name: str,
+    units: str,
+    originating_system: str,
+    description: str | None = None,
+    *,
+    occt_wires: bool = False,
 ) -> None:
     """Write any OCP/build123d/CadQuery shape as STEP AP214 in ``units``, as one product (``description``:
     the header's FILE_DESCRIPTION, printable ASCII without quotes or backslashes).
@@ -216,7 +222,11 @@ def _add_wires(text: bytes, wires: list[list[TopoDS_Edge]], name: str) -> bytes:
         ends = [data.point(splines[0].StartPoint().Coord())]
         for i, spline in enumerate(splines):
             following = splines[i + 1].StartPoint() if i + 1 < len(splines) else None
-            if following is None and len(splines) > 1 and spline.EndPoint().Distance(splines[0].StartPoint()) <= BRep_Tool.Tolerance_s(edges[0]):
+            if (
+                following is None
+                and len(splines) > 1
+                and spline.EndPoint().Distance(splines[0].StartPoint()) <= BRep_Tool.Tolerance_s(edges[0])
+            ):
                 ends.append(ends[0])  # a closed wire ends on its first vertex
             else:
                 ends.append(data.point((following or spline.EndPoint()).Coord()))
@@ -230,6 +240,6 @@ def _add_wires(text: bytes, wires: list[list[TopoDS_Edge]], name: str) -> bytes:
     model = data.add(f"EDGE_BASED_WIREFRAME_MODEL('',({','.join(sets)}))")
     items = found.group(2).strip()
     representation = f"#{found.group(1).decode()} = SHAPE_REPRESENTATION('',({items.decode()},{model}),{found.group(3).decode()});"
-    text = text[:found.start()] + representation.encode("ascii") + text[found.end():]
+    text = text[: found.start()] + representation.encode("ascii") + text[found.end() :]
     tail = text.rindex(b"ENDSEC;")
     return text[:tail] + ("\n".join(data.lines) + "\n").encode("ascii") + text[tail:]

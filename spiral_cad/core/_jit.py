@@ -143,8 +143,29 @@ def _float_semantics(name: str) -> Callable[..., Any]:
 _FLOAT_MATH = SimpleNamespace(
     **{
         **{name: getattr(math, name) for name in dir(math) if not name.startswith("_")},
-        **{name: _float_semantics(name) for name in ("sqrt", "log", "log2", "log10", "log1p", "acos", "asin", "atan2", "exp",
-                                                      "expm1", "ldexp", "pow", "cosh", "sinh", "hypot", "fmod", "atanh", "acosh")},
+        **{
+            name: _float_semantics(name)
+            for name in (
+                "sqrt",
+                "log",
+                "log2",
+                "log10",
+                "log1p",
+                "acos",
+                "asin",
+                "atan2",
+                "exp",
+                "expm1",
+                "ldexp",
+                "pow",
+                "cosh",
+                "sinh",
+                "hypot",
+                "fmod",
+                "atanh",
+                "acosh",
+            )
+        },
     }
 )
 

@@ -694,7 +694,10 @@ def end_fits(
     dot = bx * ox + by * oy
     cube = bb * leg
     return (
-        moderate(bb) & moderate(oo) & moderate(rr) & ((ox * by - oy * bx) * rs > 0.0)
+        moderate(bb)
+        & moderate(oo)
+        & moderate(rr)
+        & ((ox * by - oy * bx) * rs > 0.0)
         & (abs(off) + rounding * (oo + rr) <= FIT * abs(rs) * length)
         & (dot * dot <= FIT2 * (bb * oo))
         & (abs(2.0 / 3.0 * (ax * by - ay * bx) * rs - cube) * length <= FIT * cube * abs(rs))
@@ -961,9 +964,7 @@ def line_circle_spiral(
     e1, e2 = leg_offsets(alpha, beta, gamma, cos_t)
     g2 = centre_offset(sin_t, e1, e2)[1]
     a = vx * tx + vy * ty - rs * g2  # B0 = p + a·T lies r·g2 before the centre's foot
-    return spiral_in_world(
-        a * tx, a * ty, tx, ty, -side * ty, side * tx, sin_t, cos_t, rs, alpha, beta, gamma, px, py, scale, 1.0
-    )
+    return spiral_in_world(a * tx, a * ty, tx, ty, -side * ty, side * tx, sin_t, cos_t, rs, alpha, beta, gamma, px, py, scale, 1.0)
 
 
 @row_jit
@@ -1435,7 +1436,9 @@ def _corner_start(shape: int, sin_t: float, cos_t: float, shortest: float, curva
 @row_jit
 def line_to_line_fast(
     p0x: float, p0y: float, px: float, py: float, p1x: float, p1y: float, curvature: float, shape: int
-) -> tuple[bool, float, float, float, float, float, float, float, float, float, float, float, float, float, float, float, float, float, float]:
+) -> tuple[
+    bool, float, float, float, float, float, float, float, float, float, float, float, float, float, float, float, float, float, float
+]:
     """``line_to_line_row`` in straight-line code for the ordinary row (see
     ``line_to_circle_fast``): legs and their difference of ordinary size, a turn
     inside the shape's range, legs long enough. Returns (ok, θ, measure, Q0, Q1 as built)."""
@@ -1573,9 +1576,7 @@ def line_to_line_general(
     fits = line_fits(x0, y0, x1, y1, x2, y2, px, py, t0x, t0y, inv)
     fits = fits and line_fits(v0x, v0y, v1x, v1y, v2x, v2y, px, py, t1x, t1y, inv)
     if not (fits and joint_fits(x1, y1, x2, y2, x3, y3, v1x, v1y, v2x, v2y, v3x, v3y, joint, inv)):
-        res = pair_residual(
-            x0, y0, x1, y1, x2, y2, x3, y3, v0x, v0y, v1x, v1y, v2x, v2y, v3x, v3y, px, py, t0x, t0y, t1x, t1y, joint, inv
-        )
+        res = pair_residual(x0, y0, x1, y1, x2, y2, x3, y3, v0x, v0y, v1x, v1y, v2x, v2y, v3x, v3y, px, py, t0x, t0y, t1x, t1y, joint, inv)
         if not res <= VERIFY_TOL:
             return fail(out, i, UNVERIFIED, res)
     store(out, i, 0, x0, y0, x1, y1, x2, y2, x3, y3)
@@ -1764,9 +1765,7 @@ def circle_in_circle_row(c0x: float, c0y: float, r0: float, c1x: float, c1y: flo
     if not finite(dx, dy):
         return fail(out, i, UNVERIFIED, INF)
     flip = 1.0 if big_r > 0.0 else -1.0
-    status, theta, ratio, t, x0, y0, x1, y1, x2, y2, x3, y3 = _nested_canonical(
-        dx, flip * dy, abs(big_r) * inv, abs(small_r) * inv, shape
-    )
+    status, theta, ratio, t, x0, y0, x1, y1, x2, y2, x3, y3 = _nested_canonical(dx, flip * dy, abs(big_r) * inv, abs(small_r) * inv, shape)
     if status != OK:
         return fail(out, i, status, ratio)
     if not inward:

@@ -38,10 +38,7 @@ def run_split(kernel: Any, args: list[Any], n: int, rows_per_thread: int = ROWS_
         kernel(*args)
         return
     bounds = [n * k // parts for k in range(parts + 1)]
-    calls = [
-        [a[lo:hi] if isinstance(a, np.ndarray) and a.ndim and len(a) == n else a for a in args]
-        for lo, hi in zip(bounds, bounds[1:])
-    ]
+    calls = [[a[lo:hi] if isinstance(a, np.ndarray) and a.ndim and len(a) == n else a for a in args] for lo, hi in zip(bounds, bounds[1:])]
     threads = [threading.Thread(target=kernel, args=call, daemon=True) for call in calls[1:]]
     for thread in threads:
         thread.start()

@@ -24,6 +24,7 @@ from .shapes import CORNER_SHAPES, DEFAULT_SHAPE, TRANSITION_SHAPES, shape_code
 
 __all__ = ["BatchResult", "circle_in_circle", "circle_to_circle", "line_to_circle", "line_to_line"]
 
+
 @dataclass(frozen=True)
 class BatchResult:
     """Solutions of N problems of one kind.

@@ -219,9 +219,7 @@ class Chain:
                 ``part`` is the index of the part the joint belongs to).
         """
         if isinstance(parts, (Segment, Transition, str, bytes)) or not isinstance(parts, Sequence):
-            raise ValueError(
-                f"parts must be a list of transitions and segments; got {type(parts).__name__} (wrap one part in a list)"
-            )
+            raise ValueError(f"parts must be a list of transitions and segments; got {type(parts).__name__} (wrap one part in a list)")
         for i, part in enumerate(parts):
             if not isinstance(part, (Transition, Segment)):
                 raise ValueError(f"parts[{i}] must be a Transition or a segment; got {type(part).__name__} {part!r:.80}")
@@ -380,7 +378,9 @@ class Chain:
             ValueError: a chain in space (``Nurbs`` is planar).
         """
         if self.dim != 2:
-            raise ValueError("to_nurbs takes a plane chain; this chain is in space (use spiral_cad.build123d.chain_edges/chain_to_wire for exact 3-D edges)")
+            raise ValueError(
+                "to_nurbs takes a plane chain; this chain is in space (use spiral_cad.build123d.chain_edges/chain_to_wire for exact 3-D edges)"
+            )
         from .nurbs import chain_to_nurbs
 
         return chain_to_nurbs(self.segments)
@@ -496,7 +496,9 @@ def join_rows(
     if end is not None:  # tail
         a[-1], b[-1], scale[-1], owner[-1] = ends[-1, :3], lifted(end, 3), part_length[-1], count - 1
     present, center, radius, basis = np.zeros(gaps, dtype=bool), np.zeros((gaps, 3)), np.zeros(gaps), np.zeros((gaps, 2, 3))
-    present[inner], center[inner], radius[inner], basis[inner] = (x[:-1] for x in (circles.present, circles.center, circles.radius, circles.basis))
+    present[inner], center[inner], radius[inner], basis[inner] = (
+        x[:-1] for x in (circles.present, circles.center, circles.radius, circles.basis)
+    )
     bridge = SegmentRows.empty(gaps, dim)
     kind = np.empty(gaps, dtype=np.int8)
     CK.connectors(a, b, scale, present, center, radius, basis, dim == 2, tolerance, kind, bridge.geometry, bridge.params)

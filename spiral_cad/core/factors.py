@@ -20,7 +20,7 @@ F(θ) is exact or interpolated to ~1e-12 relative:
 from __future__ import annotations
 
 import math
-from functools import lru_cache
+from functools import cache
 from typing import cast
 
 import numpy as np
@@ -109,7 +109,7 @@ def _peak_switch(lo: float, hi: float, shape: str, inside_at_hi: bool) -> tuple[
     return lo, hi
 
 
-@lru_cache(maxsize=None)
+@cache
 def _interior_branch(shape: str) -> tuple[float, float, CubicSpline]:
     """(θ_a, θ_b, spline of log F on [θ_a, θ_b]) where an interior maximum of |dκ/ds| is the peak.
 

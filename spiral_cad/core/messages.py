@@ -42,10 +42,7 @@ def describe(case: str, status: int, measure: float, inputs: Mapping[str, Any]) 
             return f"line_to_line: p0 and p1 must differ from the corner; got {shown}"
         return f"{case}: the circle centres coincide at {inputs.get('center0')}"
     if status is Status.SIGN_MISMATCH:
-        return (
-            f"{case}: nested circles are travelled in one sense, so the radii must share "
-            f"their sign; got radius0={r0}, radius1={r1}"
-        )
+        return f"{case}: nested circles are travelled in one sense, so the radii must share their sign; got radius0={r0}, radius1={r1}"
     if status is Status.BAD_CURVATURE:
         if case == "BezierSpiral":
             return (
@@ -64,10 +61,7 @@ def describe(case: str, status: int, measure: float, inputs: Mapping[str, Any]) 
             f"D > ||r1| - |r0||; here D/||r1| - |r0|| = {measure:.5f}"
         )
     if status is Status.CIRCLES_OVERLAP:
-        return (
-            "circle_to_circle (S): the circles must be disjoint, D > |r0| + |r1|; "
-            f"here D/(|r0| + |r1|) = {measure:.5f}"
-        )
+        return f"circle_to_circle (S): the circles must be disjoint, D > |r0| + |r1|; here D/(|r0| + |r1|) = {measure:.5f}"
     if status is Status.CORNER_STRAIGHT:
         return "line_to_line: p0, corner and p1 are collinear (θ = 0): there is no turn to make"
     if status is Status.CORNER_REVERSAL:

@@ -148,7 +148,9 @@ def chain_to_nurbs(chain: Iterable[Segment]) -> Nurbs:
     owners: list[int] = []
     for index, segment in enumerate(chain):
         if getattr(segment, "dim", 2) != 2:
-            raise ValueError(f"chain_to_nurbs takes plane segments; segment {index} is in space (use exact 3-D edges: spiral_cad.build123d.chain_edges/chain_to_wire)")
+            raise ValueError(
+                f"chain_to_nurbs takes plane segments; segment {index} is in space (use exact 3-D edges: spiral_cad.build123d.chain_edges/chain_to_wire)"
+            )
         for cp, w, length in _pieces(segment):
             points.append(cp if not points else cp[1:])
             weights.append(w if not weights else w[1:])

@@ -224,9 +224,7 @@ class Line(Segment):
         if np.array_equal(self._a, self._b):
             raise ValueError(f"Line needs distinct end points; both are {tuple(self._a.tolist())}")
         if not math.isfinite(self.length):
-            raise ValueError(
-                f"Line end points {tuple(self._a.tolist())} and {tuple(self._b.tolist())} are too far apart for float64"
-            )
+            raise ValueError(f"Line end points {tuple(self._a.tolist())} and {tuple(self._b.tolist())} are too far apart for float64")
 
     def _set(self, a: NDArray[np.float64], b: NDArray[np.float64]) -> None:
         self._a, self._b, self._dim = a, b, len(a)
@@ -345,7 +343,9 @@ class Arc(Segment):
             )
 
     @classmethod
-    def _of(cls, center: NDArray[np.float64], radius: float, start_angle: float, sweep: float, basis: NDArray[np.float64] | None = None) -> Arc:
+    def _of(
+        cls, center: NDArray[np.float64], radius: float, start_angle: float, sweep: float, basis: NDArray[np.float64] | None = None
+    ) -> Arc:
         """Adopt checked values without copying or checks (``basis`` (2, 3) for an arc in space)."""
         arc = object.__new__(cls)
         arc._set(center, radius, start_angle, sweep, basis)
@@ -375,7 +375,9 @@ class Arc(Segment):
         if not size > 0.0:
             raise ValueError(f"Arc normal must be a non-zero vector; got {tuple(n.tolist())}")
         if not radius > 0.0 or not math.isfinite(radius):
-            raise ValueError(f"Arc start {tuple((d + c).tolist())} must lie at a finite non-zero distance from the centre {tuple(c.tolist())}")
+            raise ValueError(
+                f"Arc start {tuple((d + c).tolist())} must lie at a finite non-zero distance from the centre {tuple(c.tolist())}"
+            )
         e1, n = d / radius, n / size
         off = float(np.dot(n, e1))
         if abs(off) > PLANE_TOL:

@@ -179,7 +179,11 @@ def _pair_residual(
     length = min(leg, 1.0 / (peak[i] * scale))
     # Off the plane, each leg may tilt by up to 2 × off / L beside its in-plane angle: the sum bounds the angle in space.
     residual[i] = K.worst(res + 2.0 * off * inv / length, res)
-    jx, jy, jz = (pairs[i, 0, 3, 0] - corners[i, 0]) * inv, (pairs[i, 0, 3, 1] - corners[i, 1]) * inv, (pairs[i, 0, 3, 2] - corners[i, 2]) * inv
+    jx, jy, jz = (
+        (pairs[i, 0, 3, 0] - corners[i, 0]) * inv,
+        (pairs[i, 0, 3, 1] - corners[i, 1]) * inv,
+        (pairs[i, 0, 3, 2] - corners[i, 2]) * inv,
+    )
     deviation[i] = math.sqrt(jx * jx + jy * jy + jz * jz) * scale
 
 
@@ -196,7 +200,6 @@ def _pair_residuals(
 ) -> None:
     for i in range(corners.shape[0]):
         _pair_residual(pairs, corners, x_dir, y_dir, outgoing, peak, residual, deviation, i)
-
 
 
 def _vector3(value: Any, name: str) -> NDArray[np.float64]:

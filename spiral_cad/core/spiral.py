@@ -100,8 +100,7 @@ class BezierSpiral(Segment):
         for leg, (a, b) in (("first", (0, 1)), ("last", (2, 3))):
             if np.array_equal(cp[a], cp[b]) or not np.isfinite(cp[b] - cp[a]).all():
                 raise ValueError(
-                    f"control_points make a degenerate spiral: the {leg} leg from {cp[a].tolist()} to "
-                    f"{cp[b].tolist()} has no direction"
+                    f"control_points make a degenerate spiral: the {leg} leg from {cp[a].tolist()} to {cp[b].tolist()} has no direction"
                 )
         if cp.shape[1] == 3:
             _check_planar(cp)

@@ -54,8 +54,7 @@ def theta_for_length(length: float, radius: float, shape: str = "walton-meek") -
         lo, hi = _length_bracket(shape)
         low, high = (radius * float(length_factor(t, shape)) for t in (lo, hi))
         raise NoSolutionError(
-            f"spiral length {length:.6g} is outside the range a spiral onto radius {radius:.6g} "
-            f"can have ({low:.3g} … {high:.3g})"
+            f"spiral length {length:.6g} is outside the range a spiral onto radius {radius:.6g} can have ({low:.3g} … {high:.3g})"
         )
     return theta
 
@@ -532,8 +531,7 @@ def _check_tangents(pts: NDArray, lengths: NDArray, directions: NDArray, solved:
             f"{used:.6g} after PI {k} and the TS of PI {k + 1} is {used_next:.6g} before PI {k + 1}"
         )
     raise NoSolutionError(
-        f"{where}; together {used + used_next:.6g} > tangent length {length:.6g}. "
-        "Move the PIs apart, or reduce the radii or spiral lengths"
+        f"{where}; together {used + used_next:.6g} > tangent length {length:.6g}. Move the PIs apart, or reduce the radii or spiral lengths"
     )
 
 
@@ -599,7 +597,9 @@ class CurveList(Sequence):
         exit_ = Transition("circle-line", [cast(BezierSpiral, chain[int(self._last[j])])], float(solved.theta[j, 1]), start_circle=circle,
                            end_line=Ray(pi, t_out), shape=shape)  # fmt: skip
         ts, sc, cs, st = self._stations[j].tolist()
-        (theta_in, theta_out), (length_in, length_out), (rate_in, rate_out) = (a[j].tolist() for a in (self.thetas, self.lengths, self.peak_rates))
+        (theta_in, theta_out), (length_in, length_out), (rate_in, rate_out) = (
+            a[j].tolist() for a in (self.thetas, self.lengths, self.peak_rates)
+        )
         return CurveData(i, pi, float(solved.deflection[j]), float(self.radius[j]), center, theta_in, theta_out, length_in,
                          length_out, float(self._stations[j, 2] - self._stations[j, 1]), ts, sc, cs, st, rate_in, rate_out,
                          entry, exit_)  # fmt: skip
@@ -625,9 +625,7 @@ def _choose(criteria: Criteria, radii: NDArray, units: str, shape: str) -> tuple
     return shortest[inverse], longest[inverse]
 
 
-def _judge(
-    curves: CurveList, criteria: Criteria, units: str, shortest, longest, strict: bool, shape: str
-) -> tuple[CriteriaRow, ...]:
+def _judge(curves: CurveList, criteria: Criteria, units: str, shortest, longest, strict: bool, shape: str) -> tuple[CriteriaRow, ...]:
     """The criteria row of every curve; with ``strict`` any violation raises."""
     radii = curves.radius
     if shortest is None:
@@ -663,5 +661,3 @@ def _sides(value: Any, count: int, name: str) -> NDArray:
     if not np.isfinite(array).all():
         raise ValueError(f"{name} must be finite; got {array.tolist()}")
     return array
-
-

@@ -123,9 +123,7 @@ def centerline_3d(alignment: Any, profile: Profile, tolerance: float | None = No
     lift = _Lift(alignment, profile)
     floor = float_floor(lift.chain.sample(2), profile.pvis[:, 1])
     if tolerance < floor:
-        raise ValueError(
-            f"tolerance {tolerance:.3g} {chain.units} is below what float64 can hold at these coordinates ({floor:.3g})"
-        )
+        raise ValueError(f"tolerance {tolerance:.3g} {chain.units} is below what float64 can hold at these coordinates ({floor:.3g})")
 
     def halves(piece):
         k, u0, u1 = piece

@@ -178,7 +178,10 @@ def _transitions(items: list[Circle], shape: str) -> list[Transition]:
     radii = np.array([c.radius for c in items])
     nested = np.array([_nested(a, b) for a, b in zip(items, items[1:])], dtype=bool)
     solved = {}
-    for case, solve, rows in (("nested", batch.circle_in_circle, np.flatnonzero(nested)), ("pair", batch.circle_to_circle, np.flatnonzero(~nested))):
+    for case, solve, rows in (
+        ("nested", batch.circle_in_circle, np.flatnonzero(nested)),
+        ("pair", batch.circle_to_circle, np.flatnonzero(~nested)),
+    ):
         if len(rows):
             solved[case] = (rows, solve(centers[rows], radii[rows], centers[rows + 1], radii[rows + 1], shape=shape))
     failed = [(int(rows[k]), result) for rows, result in solved.values() for k in np.flatnonzero(~result.ok)]

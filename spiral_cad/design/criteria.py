@@ -66,6 +66,7 @@ SIDE_FRICTION_MPH = ((10, 0.38), (15, 0.32), (20, 0.27), (25, 0.23), (30, 0.20),
                      (45, 0.15), (50, 0.14), (55, 0.13), (60, 0.12), (65, 0.11), (70, 0.10), (75, 0.09),
                      (80, 0.08))  # fmt: skip
 
+
 def _smallest_theta(ok, count: int, theta_range: tuple[float, float]) -> NDArray:
     """Vectorised bisection: for each of ``count`` curves the smallest θ in ``theta_range`` with
     ``ok(θ)`` true (``ok`` is monotone: false below, true above); NaN where even the largest θ fails."""

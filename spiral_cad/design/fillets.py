@@ -304,7 +304,7 @@ def _round_corner(
         off = _transition_off(kind_out, geometry_out, center, signed, same_sense, shape)
     except NoSolutionError as error:
         raise NoSolutionError(f"{where}: {error}") from None
-    for t, side in ((onto, onto.end_circle), (off, off.start_circle)):
+    for _, side in ((onto, onto.end_circle), (off, off.start_circle)):
         assert side is not None  # a transition onto or off a circle has that circle
         if side.radius * signed < 0:
             raise NoSolutionError(f"{where}: the fillet circle falls on the wrong side of the path; use a smaller radius")

@@ -410,8 +410,8 @@ class Profile:
         inside([start, end], self.start, self.end, "profile")
         first = int(piece_at(self.stations[:-1], start)[0])
         last = int(np.searchsorted(self.stations, end, side="left"))
-        coefficients = self.coefficients[first:max(last, first + 1)].copy()
-        starts = self.stations[first:first + len(coefficients)] - start
+        coefficients = self.coefficients[first : max(last, first + 1)].copy()
+        starts = self.stations[first : first + len(coefficients)] - start
         shift = -starts[0]  # re-centre the first piece on ``start``: its value, slope and curvature there
         coefficients[0] = [polynomial(coefficients[0], shift, k) / (1.0, 1.0, 2.0)[k] for k in range(3)]
         starts[0] = 0.0

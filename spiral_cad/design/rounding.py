@@ -296,6 +296,7 @@ def _steepest_deflection(shape: str) -> float:
     ``VERIFY_TOL``) for a corner with unit legs at the origin: beyond it a corner is too
     close to a reversal at any size. Bisected once per shape on the plane kernel."""
     if shape not in _STEEPEST:
+
         def holds(deflection: float) -> bool:
             end = (math.cos(deflection), math.sin(deflection))
             return bool(batch.line_to_line([(-1.0, 0.0)], [(0.0, 0.0)], [end], shape=shape).status[0] == Status.OK)
@@ -349,7 +350,9 @@ def _exclusive(curvature, max_curvature, max_deviation, spiral_lengths) -> None:
     given = [name for name, v in (("curvature", curvature), ("spiral_lengths", spiral_lengths)) if v is not None]
     bounds = [name for name, v in (("max_curvature", max_curvature), ("max_deviation", max_deviation)) if v is not None]
     if len(given) > 1 or (given and bounds):
-        raise ValueError(f"give curvature, spiral_lengths or the bounds (max_curvature, max_deviation), not both; got {', '.join(given + bounds)}")
+        raise ValueError(
+            f"give curvature, spiral_lengths or the bounds (max_curvature, max_deviation), not both; got {', '.join(given + bounds)}"
+        )
 
 
 def _corner_rows(p0: ArrayLike, corners: ArrayLike, p1: ArrayLike) -> tuple[NDArray, NDArray, NDArray]:
@@ -358,11 +361,15 @@ def _corner_rows(p0: ArrayLike, corners: ArrayLike, p1: ArrayLike) -> tuple[NDAr
     arrays = [_coordinates(v, name) for name, v in named]
     dims = {a.shape[-1] for a in arrays}
     if len(dims) > 1:
-        raise ValueError("p0, corners and p1 must all be 2-D or all 3-D points; got " + ", ".join(f"{n} {a.shape}" for (n, _), a in zip(named, arrays)))
+        raise ValueError(
+            "p0, corners and p1 must all be 2-D or all 3-D points; got " + ", ".join(f"{n} {a.shape}" for (n, _), a in zip(named, arrays))
+        )
     try:
         arrays = list(np.broadcast_arrays(*arrays))
     except ValueError:
-        raise ValueError("p0, corners and p1 need N rows each (or one); got " + ", ".join(f"{n} {a.shape}" for (n, _), a in zip(named, arrays))) from None
+        raise ValueError(
+            "p0, corners and p1 need N rows each (or one); got " + ", ".join(f"{n} {a.shape}" for (n, _), a in zip(named, arrays))
+        ) from None
     d = arrays[0].shape[-1]
     a, b, c = _plane_if_flat(*(np.ascontiguousarray(a.reshape(-1, d)) for a in arrays))
     return a, b, c
@@ -594,7 +601,9 @@ def _pair_joints(cp, ok, t_in, t_out, line_in, line_out, tolerance, cap, held, o
         off[i] = worst if worst == worst else math.inf
 
 
-def _joints_hold(pairs: NDArray, p0: NDArray, corners: NDArray, p1: NDArray, ok: NDArray, shape: str, tolerance: float) -> tuple[NDArray, NDArray]:
+def _joints_hold(
+    pairs: NDArray, p0: NDArray, corners: NDArray, p1: NDArray, ok: NDArray, shape: str, tolerance: float
+) -> tuple[NDArray, NDArray]:
     """Whether each OK corner's three joints (line → spiral → spiral → line) pass the ``Chain``'s own
     joint test (``joint_table``'s kernel), so that a corner the batch returns is one a chain accepts.
 
@@ -823,7 +832,9 @@ def round_corners(
         chain = join_rows(rows, np.full(len(rounded), 2), PartCircles(len(rounded)), tuple(pts[0].tolist()),
                           tuple(pts[-1].tolist()), join_tolerance(tolerance), length_unit(units), objects)  # fmt: skip
     except JointError as error:
-        raise _refusal(f"corner {index[error.part]}: float64 cannot hold its spirals G2 at these coordinates: {error}", int(index[error.part])) from None
+        raise _refusal(
+            f"corner {index[error.part]}: float64 cannot hold its spirals G2 at these coordinates: {error}", int(index[error.part])
+        ) from None
     return RoundedPath(chain, rounded, shape)
 
 
@@ -912,8 +923,10 @@ def _without_slivers(result: CornerBatch, pts: NDArray, p0: NDArray, corners: ND
         elif bound is not None and not fixed.deviation[m] <= bound[j]:
             why = f"corner {index[j]}: closing a sliver line beside it would take it {fixed.deviation[m]:.6g} from the path"
         elif kmax is not None and not fixed.curvature[m] <= kmax[j] * (1.0 + DEVIATION_MARGIN):
-            why = (f"corner {index[j]}: making the sliver line beside it a real edge needs curvature "
-                   f"{fixed.curvature[m]:.6g}, above max_curvature {kmax[j]:.6g}; allow a larger curvature or deviation")
+            why = (
+                f"corner {index[j]}: making the sliver line beside it a real edge needs curvature "
+                f"{fixed.curvature[m]:.6g}, above max_curvature {kmax[j]:.6g}; allow a larger curvature or deviation"
+            )
         if why is not None:
             raise _refusal(why, int(index[j]))
     arrays = {name: getattr(result, name).copy() for name in ("control_points", "distance", "curvature", "deviation")}

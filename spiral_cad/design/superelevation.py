@@ -138,4 +138,3 @@ class Superelevation:
     def ramp_ends(self) -> NDArray:
         """The stations where a ramp starts or ends (every interior piece boundary)."""
         return self.stations[1:-1]
-

@@ -193,7 +193,10 @@ class _Reader:
             if match is None:
                 bad = stripped[at:].strip()[:20]
                 if _FULL_NGC.match(stripped, at) or found and found[-1][0] == "O":
-                    raise self.error(number, f"{bad!r}: parameters, expressions and O-words are not read by the built-in reader; use interpreter='rs274' (--interpreter rs274), LinuxCNC's own")
+                    raise self.error(
+                        number,
+                        f"{bad!r}: parameters, expressions and O-words are not read by the built-in reader; use interpreter='rs274' (--interpreter rs274), LinuxCNC's own",
+                    )
                 raise self.error(number, f"{bad!r} is not a G-code word (a letter and a decimal number, no exponents)")
             letter, written = match.group(1).upper(), match.group(2).replace(" ", "")
             value = float(written)
@@ -234,7 +237,9 @@ class _Reader:
                     raise self.error(number, f"{written} is not a LinuxCNC G code this reader knows")
                 group, name = G_GROUPS[code]
                 if group and group in groups:
-                    raise self.error(number, f"{groups[group]} and {written} are both in modal group {group} ({name}); LinuxCNC allows one per line")
+                    raise self.error(
+                        number, f"{groups[group]} and {written} are both in modal group {group} ({name}); LinuxCNC allows one per line"
+                    )
                 groups[group] = written
                 if code in REFUSED_G:
                     raise self.error(number, f"{written} is refused: {REFUSED_G[code]}")
@@ -255,10 +260,15 @@ class _Reader:
                     pass
             elif letter == "M":
                 if code not in M_GROUPS:
-                    raise self.error(number, f"{written} is not in the supported subset (M0, M1, M2, M30, M60 stops and ends; M3–M9 spindle, tool change, coolant; M48–M53 overrides)")
+                    raise self.error(
+                        number,
+                        f"{written} is not in the supported subset (M0, M1, M2, M30, M60 stops and ends; M3–M9 spindle, tool change, coolant; M48–M53 overrides)",
+                    )
                 group = M_GROUPS[code]
                 if group in groups and not {groups[group].upper(), written.upper()} <= {"M7", "M8", "M07", "M08"}:
-                    raise self.error(number, f"{groups[group]} and {written} are both in M modal group {group}; LinuxCNC allows one per line")
+                    raise self.error(
+                        number, f"{groups[group]} and {written} are both in M modal group {group}; LinuxCNC allows one per line"
+                    )
                 groups[group] = written
                 if code in END_M:
                     self.end_at = number
@@ -276,14 +286,22 @@ class _Reader:
             elif letter == "P":
                 turn_count = value
             elif letter == "O":
-                raise self.error(number, f"{written}: O-words (subroutines, loops, conditions) are not read by the built-in reader; use interpreter='rs274' (--interpreter rs274), LinuxCNC's own")
+                raise self.error(
+                    number,
+                    f"{written}: O-words (subroutines, loops, conditions) are not read by the built-in reader; use interpreter='rs274' (--interpreter rs274), LinuxCNC's own",
+                )
             elif letter not in IGNORED_WORDS:
-                raise self.error(number, f"the word {written} is not in the supported subset (X, Y, Z, I, J, K, R, F, S, T, N, P, Q, D besides G and M codes)")
+                raise self.error(
+                    number,
+                    f"the word {written} is not in the supported subset (X, Y, Z, I, J, K, R, F, S, T, N, P, Q, D besides G and M codes)",
+                )
         if motion is not None:
             self.motion = None if motion == 800 else motion
         if target:
             if self.motion is None:
-                reason = "after G80 (motion cancelled)" if motion == 800 or self.cancelled else "with no motion mode in effect (G0, G1, G2, G3)"
+                reason = (
+                    "after G80 (motion cancelled)" if motion == 800 or self.cancelled else "with no motion mode in effect (G0, G1, G2, G3)"
+                )
                 raise self.error(number, f"coordinates {reason}; LinuxCNC: cannot use axis values without a G code that uses them")
             if self.units is None:
                 raise self.error(number, "the program sets no unit before its first move: add G21 (mm) or G20 (inch)")
@@ -318,7 +336,10 @@ class _Reader:
         """An arc (G2 clockwise, G3 counterclockwise) in the plane, as chords within ``arc_tolerance``."""
         name = "G2 (a clockwise arc)" if self.motion == 20 else "G3 (a counterclockwise arc)"
         if self.arc_tolerance is None:
-            raise self.error(number, f"{name} is refused: only straight moves (G0, G1) are read unless arc_tolerance is given (arcs become chords within it); have the CAM write straight moves, or linearise the arcs first")
+            raise self.error(
+                number,
+                f"{name} is refused: only straight moves (G0, G1) are read unless arc_tolerance is given (arcs become chords within it); have the CAM write straight moves, or linearise the arcs first",
+            )
         first, second, _ = PLANES[self.plane]
         offsets = {170: "IJ", 180: "KI", 190: "JK"}[self.plane]
         start = self.position
@@ -337,7 +358,10 @@ class _Reader:
             cb = (b0 + b1) / 2 + side * half * (a1 - a0) / chord
         else:
             if set(centre) - set(offsets) or not centre:
-                raise self.error(number, f"{name} in the {'XY' if self.plane == 170 else 'XZ' if self.plane == 180 else 'YZ'} plane takes {offsets[0]} and {offsets[1]}; got {', '.join(centre) or 'none'}")
+                raise self.error(
+                    number,
+                    f"{name} in the {'XY' if self.plane == 170 else 'XZ' if self.plane == 180 else 'YZ'} plane takes {offsets[0]} and {offsets[1]}; got {', '.join(centre) or 'none'}",
+                )
             i, j = centre.get(offsets[0], 0.0), centre.get(offsets[1], 0.0)
             ca, cb = (i, j) if self.absolute_centre else (a0 + i, b0 + j)
         r0, r1 = math.hypot(a0 - ca, b0 - cb), math.hypot(a1 - ca, b1 - cb)
@@ -348,7 +372,9 @@ class _Reader:
         if min(r0, r1) < 0.00005 * inch:
             raise self.error(number, f"{name}: a zero-radius arc (the start is {r0:g} from the centre, the end {r1:g})")
         if error > 100 * 0.002 * math.sqrt(2) * inch or error > 0.001 * max(r0, r1) and error > 0.002 * math.sqrt(2) * inch:
-            raise self.error(number, f"{name}: the start is {r0:g} from the centre and the end {r1:g}; LinuxCNC refuses radii that differ this much")
+            raise self.error(
+                number, f"{name}: the start is {r0:g} from the centre and the end {r1:g}; LinuxCNC refuses radii that differ this much"
+            )
         turns = 1
         if turn_count is not None:
             if turn_count != int(turn_count) or turn_count < 1:
@@ -408,7 +434,9 @@ def parse_gcode(text: str, source: str = "G-code", *, arc_tolerance: float | Non
             progress(number)
     progress.done(len(lines))
     if reader.opened is not None and not reader.ended:
-        raise ValueError(f"{source}: the program opens with % (line {reader.opened}) but has no closing % or M2/M30; LinuxCNC refuses it (file ended with no percent sign)")
+        raise ValueError(
+            f"{source}: the program opens with % (line {reader.opened}) but has no closing % or M2/M30; LinuxCNC refuses it (file ended with no percent sign)"
+        )
     if len(reader.points) < 2:
         raise ValueError(f"{source}: the program has {len(reader.points)} move(s) to a new position; a path needs at least two")
     assert reader.units is not None  # the reader refuses a move before G20/G21
@@ -536,9 +564,15 @@ class ToolpathCorners:
         return len(self.index)
 
 
-def round_toolpath_arrays(path: GcodePath, *, shape: str = "walton-meek", max_deviation: float | None = None,
-                          max_curvature: float | None = None, curvature: float | None = None,
-                          spiral_lengths: float | None = None) -> ToolpathCorners:
+def round_toolpath_arrays(
+    path: GcodePath,
+    *,
+    shape: str = "walton-meek",
+    max_deviation: float | None = None,
+    max_curvature: float | None = None,
+    curvature: float | None = None,
+    spiral_lengths: float | None = None,
+) -> ToolpathCorners:
     """Round every corner of a toolpath G2 as ``round_toolpath`` does, into arrays (one value per
     option for every corner): what a program of millions of moves needs.
 
@@ -572,4 +606,3 @@ def round_toolpath_arrays(path: GcodePath, *, shape: str = "walton-meek", max_de
     if control.shape[-1] == 2:  # a flat program is rounded in its plane: back to x, y, z
         control = np.concatenate([control, np.full(control.shape[:-1] + (1,), path.points[0, 2])], axis=-1)
     return ToolpathCorners(index, path.lines[index], control, result.curvature, result.deviation, path.units, shape)
-

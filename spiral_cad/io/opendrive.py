@@ -39,7 +39,7 @@ import math
 import os
 from collections.abc import Sequence
 from dataclasses import dataclass
-from datetime import datetime, timezone
+from datetime import UTC, datetime
 from typing import Any, overload
 from xml.sax.saxutils import escape
 
@@ -226,7 +226,9 @@ def _plan_view(plan: dict[str, NDArray]) -> list[str]:
             lines.append(f'        <arc curvature="{next(arcs)}" />')
         else:
             bu, cu, du, cv, dv = next(polys)
-            lines.append(f'        <paramPoly3 aU="0.0" bU="{bu}" cU="{cu}" dU="{du}" aV="0.0" bV="0.0" cV="{cv}" dV="{dv}" pRange="normalized" />')
+            lines.append(
+                f'        <paramPoly3 aU="0.0" bU="{bu}" cU="{cu}" dU="{du}" aV="0.0" bV="0.0" cV="{cv}" dV="{dv}" pRange="normalized" />'
+            )
         lines.append("      </geometry>")
     lines.append("    </planView>")
     return lines
@@ -301,7 +303,7 @@ def opendrive_text(
     boxes = np.array([plan["box"] for plan in plans])
     west, south = boxes[:, :2].min(axis=0)
     east, north = boxes[:, 2:].max(axis=0)
-    date = datetime.now(timezone.utc).strftime("%Y-%m-%dT%H:%M:%S")
+    date = datetime.now(UTC).strftime("%Y-%m-%dT%H:%M:%S")
     lines = [
         "<?xml version='1.0' encoding='utf-8'?>",
         "<OpenDRIVE>",
@@ -336,4 +338,3 @@ def write_opendrive(roads: Sequence[RoadToWrite], path: str | os.PathLike, name:
     text = opendrive_text(roads, name, units, originating_system, cross_section, geo_reference)
     with open(os.fspath(path), "w", encoding="utf-8", newline="\n") as handle:
         handle.write(text)
-

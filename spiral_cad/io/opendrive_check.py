@@ -318,8 +318,14 @@ def _links(source: str, path: str | os.PathLike, network: Network, gap_tol: floa
             if lanes is not None and (r.id in in_junctions or other.id in in_junctions):
                 lane_pairs = lane_links(lanes.roads[r.id], end) if r.id in lanes.roads else []
                 back = other.predecessor if contact == "start" else other.successor
-                if not lane_pairs and other.id in lanes.roads and back is not None and back.element_type == "road" \
-                        and _label(back.element_id) == r.id and back.contact_point == end:
+                if (
+                    not lane_pairs
+                    and other.id in lanes.roads
+                    and back is not None
+                    and back.element_type == "road"
+                    and _label(back.element_id) == r.id
+                    and back.contact_point == end
+                ):
                     lane_pairs = [(b, a) for a, b in lane_links(lanes.roads[other.id], contact)]
             if lane_pairs:
                 if frozenset({(r.id, end), (other.id, contact)}) in seen:

@@ -573,7 +573,9 @@ def _records(label: str, road_id: str, tag: str, elements: list[dict]) -> NDArra
         raise ValueError(f"{label}: road {road_id}, {tag} 0: s must be ≥ 0; got {float(rows[0, 0])!r}")
     if (steps < 0.0).any():
         i = int(np.argmax(steps < 0.0)) + 1
-        raise ValueError(f"{label}: road {road_id}, {tag} {i}: s = {float(rows[i, 0])!r} is before s = {float(rows[i - 1, 0])!r} of {tag} {i - 1}")
+        raise ValueError(
+            f"{label}: road {road_id}, {tag} {i}: s = {float(rows[i, 0])!r} is before s = {float(rows[i - 1, 0])!r} of {tag} {i - 1}"
+        )
     return rows
 
 
@@ -640,7 +642,9 @@ def _world_frames(kind: str, values: NDArray, head: dict[str, NDArray], ranges: 
     heading_bad = cast(NDArray, ~(np.isfinite(phase).all(axis=1) & np.isfinite(top)))
     point_bad = cast(NDArray, ~np.isfinite(frames[..., :2]).all(axis=2))
     for j in np.flatnonzero(heading_bad | point_bad.any(axis=1)).tolist():
-        problems.append((j, None) if heading_bad[j] else (j, f"its {_END_NAMES[int(np.argmax(point_bad[j]))]} point is not a finite number"))
+        problems.append(
+            (j, None) if heading_bad[j] else (j, f"its {_END_NAMES[int(np.argmax(point_bad[j]))]} point is not a finite number")
+        )
     return frames, problems
 
 

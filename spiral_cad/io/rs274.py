@@ -72,7 +72,7 @@ def numbered(text: str) -> str:
             continue
         match = _N_WORD.match(line)
         if match:
-            out.append(f"{match.group(1)}N{number} {line[match.end():]}")
+            out.append(f"{match.group(1)}N{number} {line[match.end() :]}")
         else:
             slash = line[: len(line) - len(line.lstrip(" \t/"))]
             out.append(f"{slash}N{number} {head}")
@@ -96,7 +96,9 @@ def run_rs274(text: str, source: str = "G-code", *, arc_tolerance: float | None 
     """
     executable = rs274_executable()
     if executable is None:
-        raise ValueError(f"interpreter 'rs274' is not installed: it is LinuxCNC's, in the Debian package {PACKAGE} (apt-get install {PACKAGE}); or use the built-in reader")
+        raise ValueError(
+            f"interpreter 'rs274' is not installed: it is LinuxCNC's, in the Debian package {PACKAGE} (apt-get install {PACKAGE}); or use the built-in reader"
+        )
     with tempfile.TemporaryDirectory(prefix="spiral_cad_rs274_") as folder:
         program = os.path.join(folder, "program.ngc")
         output = os.path.join(folder, "canon.txt")
@@ -113,7 +115,9 @@ def run_rs274(text: str, source: str = "G-code", *, arc_tolerance: float | None 
                     if time.monotonic() - started > limit:
                         raise ValueError(f"{source}: rs274 was still running after {limit:g} s (a loop that never ends?); stopped")
                     if os.path.exists(output) and os.path.getsize(output) > MAX_OUTPUT:
-                        raise ValueError(f"{source}: rs274 printed more than {MAX_OUTPUT / 1e6:,.0f} MB of moves (a loop that never ends?); stopped")
+                        raise ValueError(
+                            f"{source}: rs274 printed more than {MAX_OUTPUT / 1e6:,.0f} MB of moves (a loop that never ends?); stopped"
+                        )
             finally:
                 if process.poll() is None:
                     process.kill()
@@ -166,7 +170,9 @@ def _moves(calls, source: str, arc_tolerance: float | None) -> GcodePath:
         elif name == "ARC_FEED":
             values = [float(v) for v in arguments.split(",")]
             if arc_tolerance is None:
-                raise error("an arc (ARC_FEED) is refused: only straight moves are read unless arc_tolerance is given (arcs become chords within it)")
+                raise error(
+                    "an arc (ARC_FEED) is refused: only straight moves are read unless arc_tolerance is given (arcs become chords within it)"
+                )
             if any(values[6:9]):
                 raise error("ARC_FEED moves a rotary axis; only X, Y, Z are read")
             first, second, normal = {170: (0, 1, 2), 180: (2, 0, 1), 190: (1, 2, 0)}[plane]

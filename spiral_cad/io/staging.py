@@ -221,6 +221,4 @@ class Staging:
                 failed.append(f"{target.name} ({e.strerror})")
         if failed:
             self._keep = True
-            raise OSError(
-                f"could not restore {', '.join(failed)} in {str(self.out)!r}; the previous files are in {str(backups)!r}"
-            )
+            raise OSError(f"could not restore {', '.join(failed)} in {str(self.out)!r}; the previous files are in {str(backups)!r}")

@@ -47,7 +47,7 @@ from __future__ import annotations
 import math
 import os
 from collections.abc import Sequence
-from datetime import datetime, timezone
+from datetime import UTC, datetime
 
 import numpy as np
 from numpy.typing import NDArray
@@ -173,7 +173,7 @@ def _uncertainty(chains: Sequence[Chain], units: str) -> float:
 
 def step_text(chains: Sequence[Chain], name: str, units: str, originating_system: str, timestamp: datetime | None = None) -> str:
     """The whole STEP file for ``chains`` (one product ``name``, one connected edge set per chain)."""
-    when = (timestamp or datetime.now(timezone.utc)).strftime("%Y-%m-%dT%H:%M:%S")
+    when = (timestamp or datetime.now(UTC)).strftime("%Y-%m-%dT%H:%M:%S")
     data = _Entities()
     context = data.add("APPLICATION_CONTEXT('core data for automotive mechanical design processes')")
     data.add(f"APPLICATION_PROTOCOL_DEFINITION('international standard','automotive_design',2000,{context})")
@@ -185,15 +185,11 @@ def step_text(chains: Sequence[Chain], name: str, units: str, originating_system
     definition = data.add(f"PRODUCT_DEFINITION('design','',{formation},{definition_context})")
     shape = data.add(f"PRODUCT_DEFINITION_SHAPE('','',{definition})")
     representation_context = _units(data, units, _uncertainty(chains, units))
-    origin = data.add(
-        f"AXIS2_PLACEMENT_3D('',{data.point(0.0, 0.0)},{data.direction(0.0, 0.0, 1.0)},{data.direction(1.0, 0.0)})"
-    )
+    origin = data.add(f"AXIS2_PLACEMENT_3D('',{data.point(0.0, 0.0)},{data.direction(0.0, 0.0, 1.0)},{data.direction(1.0, 0.0)})")
     labels = [name] if len(chains) == 1 else [f"{name}-{i + 1}" for i in range(len(chains))]
     sets = [_edge_set(data, chain, label) for chain, label in zip(chains, labels)]
     model = data.add(f"EDGE_BASED_WIREFRAME_MODEL({step_string(name)},({','.join(sets)}))")
-    representation = data.add(
-        f"EDGE_BASED_WIREFRAME_SHAPE_REPRESENTATION({step_string(name)},({model},{origin}),{representation_context})"
-    )
+    representation = data.add(f"EDGE_BASED_WIREFRAME_SHAPE_REPRESENTATION({step_string(name)},({model},{origin}),{representation_context})")
     data.add(f"SHAPE_DEFINITION_REPRESENTATION({shape},{representation})")
     header = [
         "ISO-10303-21;",

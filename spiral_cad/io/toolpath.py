@@ -58,8 +58,9 @@ class GcodePath:
         return re.sub(r"\b(points?|corner) (\d+)\b", line, message)
 
 
-def arc_points(start: list[float], end: list[float], plane: int, ca: float, cb: float, rotation: int,
-               tolerance: float) -> list[list[float]]:
+def arc_points(
+    start: list[float], end: list[float], plane: int, ca: float, cb: float, rotation: int, tolerance: float
+) -> list[list[float]]:
     """The chords of an arc (helical along the plane's normal) from ``start`` to ``end`` about the centre
     (``ca``, ``cb``) in ``plane`` (170 XY, 180 ZX, 190 YZ): ends of chords at most ``tolerance`` from the arc.
 
