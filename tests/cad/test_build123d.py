@@ -27,6 +27,7 @@ from spiral_cad.build123d import (
     SpiralLineToCircle,
     SpiralLineToLine,
     chain_edges,
+    chain_to_wire,
 )
 
 CHAINS = transition_chains()
@@ -121,7 +122,7 @@ def test_enclosing_skip_clean_stays_in_force():
 def test_chain_to_edges_and_to_wire_on_a_plane(plane_name):
     chain, plane = CHAINS["S"], PLANES[plane_name]
     edges = chain_edges(chain, plane)
-    wire = chain.to_wire(plane)
+    wire = chain_to_wire(chain, plane)
     assert [e.geom_type for e in edges] == [GEOM[type(s)] for s in chain]
     assert [e.geom_type for e in wire.edges()] == [GEOM[type(s)] for s in chain]
     for edge, seg in zip(edges, chain):
@@ -129,7 +130,7 @@ def test_chain_to_edges_and_to_wire_on_a_plane(plane_name):
         assert (edge @ 1 - on_plane(plane, seg.end)).length <= 1e-12 * chain.size
     assert wire.length == pytest.approx(chain.length, rel=1e-6)  # OCCT integrates to ~1e-8
     with pytest.raises(ValueError, match="build123d Plane"):
-        chain.to_wire("XZ")
+        chain_to_wire(chain, "XZ")
 
 
 @pytest.mark.parametrize("name", [n for n in sorted(CHAINS) if n != "mixed"])
@@ -149,7 +150,7 @@ def test_profile_swept_along_a_chain_is_a_valid_solid(name):
 
 def test_round_profile_swept_along_a_tilted_chain_wire():
     chain, plane = CHAINS["mixed"], PLANES["tilted"]
-    rail = chain.to_wire(plane)
+    rail = chain_to_wire(chain, plane)
     with BuildPart() as part:
         with BuildSketch(Plane(origin=rail @ 0, z_dir=rail % 0)):
             Circle(0.5)

@@ -336,7 +336,7 @@ def test_a_g2_highway_at_survey_coordinates_is_g2_and_a_real_kink_there_is_caugh
     import spiral_cad.cad.continuity as checker
 
     path = tmp_path / "survey.step"
-    sc.export.export_step(survey_highway(), path)
+    sc.cad.export.export_step(survey_highway(), path)
     report = check_continuity(path)
     assert report.describe() == "1 wire of 81 edges" and report.passes("G2")
     # the spirals' zero start curvatures read ~1e-13 1/m there: beyond the tolerance without the rounding floor
@@ -418,7 +418,7 @@ def test_cli_check_unreadable_file_exits_2(tmp_path, capsys):
 def test_a_truncated_file_exits_2_with_the_readers_reason_and_no_chatter(tmp_path, capfd, suffix):
     chain = sc.design.Alignment.from_pis([(0, 0), (600, 120), (1150, -80), (1700, 260)], [450, 400], spiral_angles=0.12).chain
     whole = tmp_path / f"road.{suffix}"
-    (sc.export.export_step if suffix == "step" else sc.export.export_iges)(chain, whole)
+    (sc.cad.export.export_step if suffix == "step" else sc.cad.export.export_iges)(chain, whole)
     assert main(["check", str(whole), "--require", "G2"]) == 0
     assert "1 wire of 9 edges" in capfd.readouterr().out
     lines = whole.read_text().splitlines(keepends=True)
@@ -436,7 +436,7 @@ def test_cli_counts_pieces(tmp_path, capsys):
     first = sc.design.round_corners([(0, 0), (10, 0), (10, 10)]).chain
     second = sc.design.round_corners([(30, 0), (40, 0), (40, 10)]).chain
     path = tmp_path / "two.step"
-    sc.export.export_step([first, second], path)
+    sc.cad.export.export_step([first, second], path)
     assert main(["check", str(path), "--require", "G2"]) == 1
     assert "2 separate pieces, expected 1" in capsys.readouterr().out
     assert main(["check", str(path), "--require", "G2", "--pieces", "2"]) == 0
@@ -512,7 +512,7 @@ def scaled_step(text: str, factor: float) -> str:
 def test_a_file_at_1e300_is_measured_not_refused_for_its_snap(tmp_path, capsys):
     chain = sc.design.round_corners([(0, 0), (10, 0), (10, 10), (20, 10)], units="m").chain
     path = tmp_path / "huge.step"
-    sc.export.export_step(chain, path)
+    sc.cad.export.export_step(chain, path)
     path.write_text(scaled_step(path.read_text(), 1e300))
     status = main(["check", str(path), "--require", "G2"])
     out, err = capsys.readouterr()
@@ -573,7 +573,7 @@ def test_comb_refuses_to_overwrite_the_checked_file_by_any_name(step_files, tmp_
 def test_comb_is_written_in_the_unit_of_the_checked_file(tmp_path, capsys):
     chain = sc.design.round_corners([(0, 0), (10, 0), (10, 10)], units="m").chain
     path, comb = tmp_path / "r.step", tmp_path / "comb.STP"
-    sc.export.export_step(chain, path)
+    sc.cad.export.export_step(chain, path)
     assert main(["check", str(path), "--comb", str(comb), "--require", "G2"]) == 0
     assert check_continuity(comb).units == "m"
     assert check_continuity(comb).size == pytest.approx(check_continuity(path).size, rel=0.5)  # teeth stick out a little

@@ -267,8 +267,10 @@ def test_iges_global_section_names_the_design_and_no_login(tmp_path):
 
 def test_build123d_shapes_are_written_in_their_unit(tmp_path):
     build123d = pytest.importorskip("build123d")
+    from spiral_cad.build123d import chain_to_wire
+
     chain = CHAINS["C"]
-    rail = chain.to_wire(build123d.Plane.XZ)
+    rail = chain_to_wire(chain, build123d.Plane.XZ)
     solid = build123d.sweep(build123d.Plane(origin=rail @ 0, z_dir=rail % 0) * build123d.Circle(0.1), path=rail)
     path = tmp_path / "solid.step"
     export_step(solid, path, units="cm", name="tube")

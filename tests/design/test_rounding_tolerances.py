@@ -265,6 +265,8 @@ def test_the_rounded_linearised_arc_is_a_valid_occt_wire_edge_for_segment():
 
     points = _linearised_arc(40, 25.4)
     path = round_corners(points, max_deviation=_bound_reaching(points, 1.0 - 2e-8))
-    wire = path.chain.to_wire()
+    from spiral_cad.build123d import chain_to_wire
+
+    wire = chain_to_wire(path.chain)
     assert BRepCheck_Analyzer(wire.wrapped).IsValid()
     assert len(wire.edges()) == len(path.chain)
