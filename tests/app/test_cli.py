@@ -8,31 +8,13 @@ import sys
 from pathlib import Path
 
 import pytest
+from helpers import assert_plain_csv
 
 from spiral_cad.app.cli import DEMO_DESIGN, main
 from spiral_cad.cad.continuity import check_continuity
 from spiral_cad.design import circle_chain
 
 EXAMPLES = Path(__file__).resolve().parents[2] / "examples"
-
-
-def assert_plain_csv(path: Path) -> None:
-    """Every header carries a unit in brackets, every cell is a plain number (never a numpy repr),
-    except the documented text columns."""
-    import csv
-
-    from spiral_cad.design.tables import TEXT_COLUMNS
-
-    with path.open(newline="", encoding="utf-8") as handle:
-        head, *rows = list(csv.reader(handle))
-    assert rows
-    for k, column in enumerate(head):
-        if column in TEXT_COLUMNS:
-            continue
-        assert re.fullmatch(r"\S+ \[[^\]]+\]", column), (path.name, column)
-        for row in rows:
-            assert re.fullmatch(r"-?\d+(\.\d+)?(e[-+]\d+)?", row[k]), (path.name, column, row[k])
-            float(row[k])
 
 
 def test_demo_writes_every_output(tmp_path, capsys):

@@ -247,7 +247,7 @@ def test_units_of_a_design_reach_every_file(tmp_path, capsys, units, factor):
 @pytest.mark.parametrize("criteria", ["road", "rail"])
 def test_criteria_and_stations_csv_hold_plain_numbers_with_units(tmp_path, criteria):
     """np.float64(0.0407…) once stood in every banking cell: float() could not read it."""
-    from test_cli import assert_plain_csv
+    from helpers import assert_plain_csv
 
     from spiral_cad.design import Alignment
 

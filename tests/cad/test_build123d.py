@@ -17,7 +17,7 @@ from build123d import (
     Vector,
     sweep,
 )
-from cad_cases import transition_chains
+from helpers import transition_chains
 
 from spiral_cad import Arc, BezierSpiral, Chain, Line, circle_in_circle, circle_to_circle, line_to_circle, line_to_line
 from spiral_cad.build123d import (

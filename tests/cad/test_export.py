@@ -16,7 +16,7 @@ ezdxf = pytest.importorskip("ezdxf")
 svgelements = pytest.importorskip("svgelements")
 p21 = pytest.importorskip("steputils.p21")
 
-from cad_cases import curvature_vector, transition_chains
+from helpers import curvature_vector, transition_chains
 from OCP.BRepAdaptor import BRepAdaptor_Curve
 from OCP.BRepLProp import BRepLProp_CLProps
 from OCP.BRepTools import BRepTools_WireExplorer
@@ -233,7 +233,7 @@ def test_step_edges_share_their_vertices_in_travel_order(tmp_path, name):
 
 
 def test_a_chain_in_space_is_written_as_exact_3d_edges_of_one_wire(tmp_path):
-    from test_chain3d import helix_chain
+    from helpers import helix_chain
 
     from spiral_cad.cad.continuity import check_continuity
 
@@ -351,7 +351,7 @@ def test_dxf_extents_and_limits_are_the_drawings(tmp_path, name):
 
 def test_iges_names_the_top_entity_so_importers_show_the_design(tmp_path):
     """FreeCAD imports through OCCT's XDE reader, which labels a shape by its IGES name (406-15)."""
-    from test_names import iges_names
+    from helpers import iges_names
 
     path = tmp_path / "pair.igs"
     export_iges([CHAINS["S"], CHAINS["C"]], path, name="highway ramps")

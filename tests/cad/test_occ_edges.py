@@ -9,7 +9,7 @@ from hypothesis import strategies as st
 
 pytest.importorskip("OCP")
 
-from cad_cases import transition_chains
+from helpers import transition_chains
 from OCP.BRep import BRep_Tool
 from OCP.BRepAdaptor import BRepAdaptor_Curve
 from OCP.BRepCheck import BRepCheck_Analyzer

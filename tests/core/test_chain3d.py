@@ -8,6 +8,7 @@ import math
 
 import numpy as np
 import pytest
+from helpers import bezier_end, helix_chain
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
@@ -18,17 +19,6 @@ from spiral_cad.core.nurbs import chain_to_nurbs
 from spiral_cad.core.space import PlaneFrame, place
 
 # ------------------------------------------------------------ independent geometry
-
-
-def bezier_end(cp, at_end):
-    """Point, unit tangent and κN of a cubic Bézier at u = 0 or 1 (travel order)."""
-    cp = np.asarray(cp, dtype=float)
-    if at_end:
-        p, d1, d2 = cp[3], 3 * (cp[3] - cp[2]), 6 * (cp[3] - 2 * cp[2] + cp[1])
-    else:
-        p, d1, d2 = cp[0], 3 * (cp[1] - cp[0]), 6 * (cp[2] - 2 * cp[1] + cp[0])
-    speed2 = d1 @ d1
-    return p, d1 / math.sqrt(speed2), np.cross(np.cross(d1, d2), d1) / speed2**2
 
 
 def segment_end(segment, at_end):
@@ -61,36 +51,6 @@ def assert_g2_by_curvature_vector(chain, tol=1e-9):
 
 
 # ------------------------------------------------------------ a helix-like path
-
-
-def helix(count=9, radius=40.0, rise=9.0, step=0.9):
-    t = np.arange(count) * step
-    return np.stack([radius * np.cos(t), radius * np.sin(t), rise * t], axis=1)
-
-
-def corner_pair(before, corner, after, shrink=2.0):
-    """The spiral pair rounding one corner, solved in the corner's plane and placed in space.
-
-    The pair uses at most half of each leg (the Corollary 4.5 pair on the half legs, its
-    curvature raised by ``shrink`` so straight pieces remain between corners).
-    """
-    frame = PlaneFrame.of_corner(before, corner, after)
-    p0, p1 = frame.local([(before + corner) / 2, (corner + after) / 2])
-    largest = sc.line_to_line(p0, (0.0, 0.0), p1)
-    kappa = abs(largest.spirals[0].end_curvature) * shrink
-    pair = sc.line_to_line(p0, (0.0, 0.0), p1, curvature=kappa)
-    return [s.placed(frame) for s in pair.spirals], frame
-
-
-def helix_chain():
-    pts = helix()
-    pairs = [corner_pair(*pts[i - 1 : i + 2]) for i in range(1, len(pts) - 1)]
-    segments, previous = [], pts[0]
-    for spirals, _ in pairs:
-        segments += [Line(previous, spirals[0].start), *spirals]
-        previous = spirals[1].end
-    segments.append(Line(previous, pts[-1]))
-    return Chain(segments, units="mm"), pairs, pts
 
 
 def test_a_helix_of_lines_and_placed_spiral_pairs_is_g2_by_the_curvature_vector():

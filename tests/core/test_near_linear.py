@@ -10,9 +10,9 @@ import math
 
 import numpy as np
 import pytest
+from helpers import assert_meet_g2, assert_on_circle
 from hypothesis import example, given, settings
 from hypothesis import strategies as st
-from test_never_wrong import assert_meet_g2, assert_on_circle
 
 import spiral_cad as sc
 from spiral_cad.core import batch

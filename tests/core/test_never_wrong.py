@@ -9,6 +9,7 @@ import math
 import mpmath as mp
 import numpy as np
 import pytest
+from helpers import assert_meet_g2, assert_on_circle
 from hypothesis import given
 from hypothesis import strategies as st
 
@@ -22,43 +23,6 @@ mp.mp.dps = 40
 
 
 # ------------------------------------------------ independent verification
-
-
-def end_frame(cp, at_end=True):
-    """Point, unit tangent (travel sense), signed curvature and end-leg length of a cubic at u = 1 (or 0), in mpmath."""
-    p = [[mp.mpf(float(v)) for v in row] for row in cp]
-    if not at_end:
-        p = p[::-1]
-    d1 = [3 * (p[3][k] - p[2][k]) for k in range(2)]
-    d2 = [6 * (p[3][k] - 2 * p[2][k] + p[1][k]) for k in range(2)]
-    speed = mp.sqrt(d1[0] ** 2 + d1[1] ** 2)
-    kappa = (d1[0] * d2[1] - d1[1] * d2[0]) / speed**3
-    tangent = [d1[0] / speed, d1[1] / speed]
-    if not at_end:  # read backwards: the tangent and the curvature change sign
-        tangent, kappa = [-tangent[0], -tangent[1]], -kappa
-    return p[3], tangent, kappa, speed / 3
-
-
-def assert_on_circle(cp, center, radius, at_end, tol=1e-9):
-    """The spiral end (or start) joins the circle (centre, signed travel-sense radius) G2, by the
-    documented measures: gap / L, tangent angle, curvature error × L, L = min(end leg, |radius|)."""
-    point, tangent, kappa, leg = end_frame(cp, at_end)
-    r = mp.mpf(float(radius))
-    length = min(leg, abs(r))
-    radial = [(point[0] - center[0]) / r, (point[1] - center[1]) / r]
-    distance = mp.sqrt(radial[0] ** 2 + radial[1] ** 2)
-    assert abs(distance - 1) * abs(r) / length <= tol
-    assert abs(tangent[0] * radial[0] + tangent[1] * radial[1]) / distance <= tol
-    assert radial[0] * tangent[1] - radial[1] * tangent[0] > 0  # travels in the circle's sense
-    assert abs(kappa - 1 / r) * length <= tol
-
-
-def assert_meet_g2(cp_a, cp_b, size, tol=1e-9):
-    pa, ta, ka, _ = end_frame(cp_a, True)
-    pb, tb, kb, _ = end_frame(cp_b, False)
-    assert mp.sqrt((pa[0] - pb[0]) ** 2 + (pa[1] - pb[1]) ** 2) <= tol * size
-    assert abs(ta[0] * tb[1] - ta[1] * tb[0]) <= tol and ta[0] * tb[0] + ta[1] * tb[1] > 0
-    assert abs(ka - kb) * size <= tol * max(1, abs(ka) * size)
 
 
 # --------------------------------------------------- the issue's reproducers

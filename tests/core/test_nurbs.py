@@ -6,7 +6,7 @@ import sys
 
 import numpy as np
 import pytest
-from cad_cases import transition_chains
+from helpers import transition_chains
 from scipy.interpolate import BSpline
 
 from spiral_cad import Arc, Chain, Line

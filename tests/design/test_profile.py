@@ -126,7 +126,7 @@ def test_profile_table_and_csv(profile, tmp_path):
     head = path.read_text().splitlines()[0]
     assert "station [m]" in head and "K [m/%]" in head and "grade_in [%]" in head and "verdict" in head
     assert "K_min [m/%]" in profile.table()
-    from test_cli import assert_plain_csv
+    from helpers import assert_plain_csv
 
     assert_plain_csv(path)
 

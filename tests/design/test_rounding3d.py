@@ -9,9 +9,9 @@ import math
 
 import numpy as np
 import pytest
+from helpers import bezier_end  # the independent end frame (point, tangent, κN) of a cubic
 from hypothesis import given, settings
 from hypothesis import strategies as st
-from test_chain3d import bezier_end  # the independent end frame (point, tangent, κN) of a cubic
 
 from spiral_cad import BezierSpiral, NoSolutionError
 from spiral_cad.design import corner_legs, round_corners, round_corners_batch

@@ -16,8 +16,8 @@ ezdxf = pytest.importorskip("ezdxf")
 svgelements = pytest.importorskip("svgelements")
 p21 = pytest.importorskip("steputils.p21")
 
-from cad_cases import transition_chains
 from ezdxf.lldxf.validator import is_valid_layer_name
+from helpers import iges_names, transition_chains
 
 from spiral_cad import Chain
 from spiral_cad.cad.export import export_dxf, export_iges, export_opendrive, export_step, export_svg
@@ -54,34 +54,6 @@ def step_products(path) -> list[str]:
     model = reader.StepModel()
     entities = (model.Value(i) for i in range(1, model.NbEntities() + 1))
     return [e.Id().ToCString() for e in entities if isinstance(e, StepBasic_Product)]
-
-
-def iges_names(path) -> tuple[str, list[str]]:
-    """(the global section's sender product id, the names of the free shapes) as OCCT's IGES readers see them."""
-    from OCP.IGESCAFControl import IGESCAFControl_Reader
-    from OCP.TCollection import TCollection_ExtendedString
-    from OCP.TDataStd import TDataStd_Name
-    from OCP.TDF import TDF_LabelSequence
-    from OCP.TDocStd import TDocStd_Document
-    from OCP.XCAFDoc import XCAFDoc_DocumentTool
-
-    from spiral_cad.cad.console import captured_messages
-
-    with captured_messages():
-        document = TDocStd_Document(TCollection_ExtendedString("XmlXCAF"))
-        reader = IGESCAFControl_Reader()
-        reader.SetNameMode(True)
-        reader.ReadFile(str(path))
-        reader.Transfer(document)
-    sender = reader.WS().Model().GlobalSection().SendName().ToCString()
-    labels = TDF_LabelSequence()
-    XCAFDoc_DocumentTool.ShapeTool_s(document.Main()).GetFreeShapes(labels)
-    names = []
-    for i in range(1, labels.Length() + 1):
-        attribute = TDataStd_Name()
-        if labels.Value(i).FindAttribute(TDataStd_Name.GetID_s(), attribute):
-            names.append(attribute.Get().ToExtString())
-    return sender, names
 
 
 # ------------------------------------------------------------------ policy
@@ -237,7 +209,7 @@ def test_opendrive_names_read_back(tmp_path, name):
 
 
 def test_hostile_names_and_geo_reference_pass_the_opendrive_schema(tmp_path):
-    from test_opendrive import independent_check
+    from helpers import independent_check
 
     from spiral_cad.design import round_corners
 

@@ -1,14 +1,13 @@
 """OpenDRIVE: exact export checked by the ASAM XSD, the ASAM quality checker and pyxodr; reading and checking."""
 
-import json
 import math
 import os
-import subprocess
 import xml.etree.ElementTree as ET
 from pathlib import Path
 
 import numpy as np
 import pytest
+from helpers import independent_check
 
 import spiral_cad as sc
 from spiral_cad import Arc, BezierSpiral
@@ -19,21 +18,6 @@ from spiral_cad.io.opendrive import check_opendrive, read_opendrive
 
 REPO = Path(__file__).resolve().parents[2]
 PIS = [[0, 0], [600, 120], [1150, -80], [1700, 260], [2300, 200]]
-
-
-def tools_python() -> str:
-    """The python of the OpenDRIVE tools environment that `make test` builds (numpy < 2: not ours)."""
-    path = os.environ.get("SPIRAL_CAD_XODR_TOOLS") or str(REPO / ".venv-tools" / "bin" / "python")
-    if not Path(path).exists():
-        pytest.skip("the OpenDRIVE tools environment is missing: run `make test`")
-    return path
-
-
-def independent_check(path: Path) -> dict:
-    done = subprocess.run([tools_python(), str(REPO / "tests" / "tools" / "xodr_check.py"), str(path)],
-                          capture_output=True, text=True, timeout=600)  # fmt: skip
-    assert done.returncode == 0, done.stderr[-3000:]
-    return json.loads(done.stdout)
 
 
 @pytest.fixture(scope="module")

@@ -5,7 +5,7 @@ import xml.etree.ElementTree as ET
 
 import numpy as np
 import pytest
-from test_opendrive import independent_check
+from helpers import independent_check
 
 from spiral_cad.cad.export import export_opendrive
 from spiral_cad.design import Alignment, Profile, Superelevation

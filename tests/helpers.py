@@ -1,0 +1,215 @@
+"""Helpers the test modules share (not tests): chains of every transition kind, independent end frames
+of cubics (float64 and mpmath), a helix path, file readers we did not write (OCCT's IGES names, the
+OpenDRIVE tools environment), and the check of plain-number CSV tables."""
+
+from __future__ import annotations
+
+import json
+import math
+import os
+import re
+import subprocess
+from pathlib import Path
+
+import mpmath as mp
+import numpy as np
+import pytest
+
+import spiral_cad as sc
+from spiral_cad import Arc, Chain, Circle, Line, circle_in_circle, circle_to_circle, line_to_circle, line_to_line
+from spiral_cad.core.space import PlaneFrame
+
+REPO = Path(__file__).resolve().parents[1]
+mp.mp.dps = 40  # the independent end frames are taken at 40 digits
+
+
+def arc_on(circle: Circle, point, sweep: float, before: bool = False) -> Arc:
+    """Arc of ``circle`` (in its travel sense) ending at (``before``) or starting at ``point``."""
+    angle = math.atan2(point[1] - circle.center[1], point[0] - circle.center[0])
+    if before:
+        angle -= math.copysign(sweep, circle.radius)
+    return Arc(circle.center, circle.radius, angle, sweep)
+
+
+def around(transition, sweep: float = 0.6) -> Chain:
+    """The transition with a piece of its given lines/circles before and after."""
+    t = transition
+    if t.start_circle is not None:
+        first = arc_on(t.start_circle, t.start, sweep, before=True)
+    else:
+        d = t.start_tangent
+        first = Line(t.start - 3.0 * d, t.start)
+    if t.end_circle is not None:
+        last = arc_on(t.end_circle, t.end, sweep)
+    else:
+        d = t.end_tangent
+        last = Line(t.end, t.end + 3.0 * d)
+    return Chain([first, *t.spirals, last])
+
+
+def transition_chains() -> dict[str, Chain]:
+    """One chain per transition kind plus a mixed chain with full-size arcs."""
+    nested_distance = (3.0 - 1.2) * 0.9935
+    mixed = Chain.join(
+        [
+            line_to_circle((0, 0), (1, 0), (40, 25), 15.0),
+            circle_to_circle((40, 25), 15.0, (85, 30), -12.0),
+            circle_to_circle((85, 30), -12.0, (120, 10), -9.0),
+        ],
+        start=(-80, 0),
+    )
+    return {
+        "line-circle": around(line_to_circle((0, 0), (1, 0), (6, 4), 2.5)),
+        "circle-line": around(line_to_circle((0, 0), (1, 1), (2, 7), 3.0).reversed()),
+        "C": around(circle_to_circle((0, 0), 2.0, (7, 1), 1.5)),
+        "S": around(circle_to_circle((0, 0), 2.0, (8, -1), -1.5)),
+        "line-line": around(line_to_line((-10, 0), (0, 0), (6, 8))),
+        "nested": around(circle_in_circle((0, 0), 3.0, (nested_distance, 0.0), 1.2), sweep=2.0),
+        "mixed": mixed,
+    }
+
+
+def curvature_vector(d1: np.ndarray, d2: np.ndarray) -> np.ndarray:
+    """Curvature vector κN from first and second derivatives (independent of the parametrisation)."""
+    speed2 = float(d1 @ d1)
+    return (d2 - (d2 @ d1) / speed2 * d1) / speed2
+
+
+def assert_plain_csv(path: Path) -> None:
+    """Every header carries a unit in brackets, every cell is a plain number (never a numpy repr),
+    except the documented text columns."""
+    import csv
+
+    from spiral_cad.design.tables import TEXT_COLUMNS
+
+    with path.open(newline="", encoding="utf-8") as handle:
+        head, *rows = list(csv.reader(handle))
+    assert rows
+    for k, column in enumerate(head):
+        if column in TEXT_COLUMNS:
+            continue
+        assert re.fullmatch(r"\S+ \[[^\]]+\]", column), (path.name, column)
+        for row in rows:
+            assert re.fullmatch(r"-?\d+(\.\d+)?(e[-+]\d+)?", row[k]), (path.name, column, row[k])
+            float(row[k])
+
+
+def bezier_end(cp, at_end):
+    """Point, unit tangent and κN of a cubic Bézier at u = 0 or 1 (travel order)."""
+    cp = np.asarray(cp, dtype=float)
+    if at_end:
+        p, d1, d2 = cp[3], 3 * (cp[3] - cp[2]), 6 * (cp[3] - 2 * cp[2] + cp[1])
+    else:
+        p, d1, d2 = cp[0], 3 * (cp[1] - cp[0]), 6 * (cp[2] - 2 * cp[1] + cp[0])
+    speed2 = d1 @ d1
+    return p, d1 / math.sqrt(speed2), np.cross(np.cross(d1, d2), d1) / speed2**2
+
+
+def helix(count=9, radius=40.0, rise=9.0, step=0.9):
+    t = np.arange(count) * step
+    return np.stack([radius * np.cos(t), radius * np.sin(t), rise * t], axis=1)
+
+
+def corner_pair(before, corner, after, shrink=2.0):
+    """The spiral pair rounding one corner, solved in the corner's plane and placed in space.
+
+    The pair uses at most half of each leg (the Corollary 4.5 pair on the half legs, its
+    curvature raised by ``shrink`` so straight pieces remain between corners).
+    """
+    frame = PlaneFrame.of_corner(before, corner, after)
+    p0, p1 = frame.local([(before + corner) / 2, (corner + after) / 2])
+    largest = sc.line_to_line(p0, (0.0, 0.0), p1)
+    kappa = abs(largest.spirals[0].end_curvature) * shrink
+    pair = sc.line_to_line(p0, (0.0, 0.0), p1, curvature=kappa)
+    return [s.placed(frame) for s in pair.spirals], frame
+
+
+def helix_chain():
+    pts = helix()
+    pairs = [corner_pair(*pts[i - 1 : i + 2]) for i in range(1, len(pts) - 1)]
+    segments, previous = [], pts[0]
+    for spirals, _ in pairs:
+        segments += [Line(previous, spirals[0].start), *spirals]
+        previous = spirals[1].end
+    segments.append(Line(previous, pts[-1]))
+    return Chain(segments, units="mm"), pairs, pts
+
+
+def iges_names(path) -> tuple[str, list[str]]:
+    """(the global section's sender product id, the names of the free shapes) as OCCT's IGES readers see them."""
+    from OCP.IGESCAFControl import IGESCAFControl_Reader
+    from OCP.TCollection import TCollection_ExtendedString
+    from OCP.TDataStd import TDataStd_Name
+    from OCP.TDF import TDF_LabelSequence
+    from OCP.TDocStd import TDocStd_Document
+    from OCP.XCAFDoc import XCAFDoc_DocumentTool
+
+    from spiral_cad.cad.console import captured_messages
+
+    with captured_messages():
+        document = TDocStd_Document(TCollection_ExtendedString("XmlXCAF"))
+        reader = IGESCAFControl_Reader()
+        reader.SetNameMode(True)
+        reader.ReadFile(str(path))
+        reader.Transfer(document)
+    sender = reader.WS().Model().GlobalSection().SendName().ToCString()
+    labels = TDF_LabelSequence()
+    XCAFDoc_DocumentTool.ShapeTool_s(document.Main()).GetFreeShapes(labels)
+    names = []
+    for i in range(1, labels.Length() + 1):
+        attribute = TDataStd_Name()
+        if labels.Value(i).FindAttribute(TDataStd_Name.GetID_s(), attribute):
+            names.append(attribute.Get().ToExtString())
+    return sender, names
+
+
+def tools_python() -> str:
+    """The python of the OpenDRIVE tools environment that `make test` builds (numpy < 2: not ours)."""
+    path = os.environ.get("SPIRAL_CAD_XODR_TOOLS") or str(REPO / ".venv-tools" / "bin" / "python")
+    if not Path(path).exists():
+        pytest.skip("the OpenDRIVE tools environment is missing: run `make test`")
+    return path
+
+
+def independent_check(path: Path) -> dict:
+    done = subprocess.run([tools_python(), str(REPO / "tests" / "tools" / "xodr_check.py"), str(path)],
+                          capture_output=True, text=True, timeout=600)  # fmt: skip
+    assert done.returncode == 0, done.stderr[-3000:]
+    return json.loads(done.stdout)
+
+
+def end_frame(cp, at_end=True):
+    """Point, unit tangent (travel sense), signed curvature and end-leg length of a cubic at u = 1 (or 0), in mpmath."""
+    p = [[mp.mpf(float(v)) for v in row] for row in cp]
+    if not at_end:
+        p = p[::-1]
+    d1 = [3 * (p[3][k] - p[2][k]) for k in range(2)]
+    d2 = [6 * (p[3][k] - 2 * p[2][k] + p[1][k]) for k in range(2)]
+    speed = mp.sqrt(d1[0] ** 2 + d1[1] ** 2)
+    kappa = (d1[0] * d2[1] - d1[1] * d2[0]) / speed**3
+    tangent = [d1[0] / speed, d1[1] / speed]
+    if not at_end:  # read backwards: the tangent and the curvature change sign
+        tangent, kappa = [-tangent[0], -tangent[1]], -kappa
+    return p[3], tangent, kappa, speed / 3
+
+
+def assert_on_circle(cp, center, radius, at_end, tol=1e-9):
+    """The spiral end (or start) joins the circle (centre, signed travel-sense radius) G2, by the
+    documented measures: gap / L, tangent angle, curvature error × L, L = min(end leg, |radius|)."""
+    point, tangent, kappa, leg = end_frame(cp, at_end)
+    r = mp.mpf(float(radius))
+    length = min(leg, abs(r))
+    radial = [(point[0] - center[0]) / r, (point[1] - center[1]) / r]
+    distance = mp.sqrt(radial[0] ** 2 + radial[1] ** 2)
+    assert abs(distance - 1) * abs(r) / length <= tol
+    assert abs(tangent[0] * radial[0] + tangent[1] * radial[1]) / distance <= tol
+    assert radial[0] * tangent[1] - radial[1] * tangent[0] > 0  # travels in the circle's sense
+    assert abs(kappa - 1 / r) * length <= tol
+
+
+def assert_meet_g2(cp_a, cp_b, size, tol=1e-9):
+    pa, ta, ka, _ = end_frame(cp_a, True)
+    pb, tb, kb, _ = end_frame(cp_b, False)
+    assert mp.sqrt((pa[0] - pb[0]) ** 2 + (pa[1] - pb[1]) ** 2) <= tol * size
+    assert abs(ta[0] * tb[1] - ta[1] * tb[0]) <= tol and ta[0] * tb[0] + ta[1] * tb[1] > 0
+    assert abs(ka - kb) * size <= tol * max(1, abs(ka) * size)
