@@ -69,6 +69,23 @@ SLOW = {
     "test_fuzz_readers.py",
     "test_examples.py",
     "test_benchmarks.py",
+    "test_readme.py::test_every_block_runs",
+    "test_batch.py::test_circle_to_circle_batch_equals_scalar_for_c_and_s",
+    "test_batch.py::test_line_to_line_batch_equals_scalar_with_auto_and_given_curvature",
+    "test_batch.py::test_circle_in_circle_batch_equals_scalar",
+    "test_alignment.py::test_symmetric_curves_are_g2_and_honour_theta",
+    "test_alignment.py::test_batch_built_curves_equal_the_scalar_solvers_bit_for_bit",
+    "test_cadquery_plugin.py::test_example_script_runs_from_plain_python",
+    "test_design_files.py::test_any_field_values_are_validated_by_name",
+    "test_design_files.py::test_an_interrupted_build_leaves_nothing_behind",
+    "test_design_files.py::test_mutated_example_designs_build_or_fail_with_a_design_error",
+    "test_cli.py::test_ctrl_c_at_any_moment_is_one_line_and_130",
+    "test_cli.py::test_a_build_whose_output_pipe_closes_ends_with_141_and_changes_nothing",
+    "test_cli.py::test_build_example_design_and_check_it",
+    "test_clothoid.py::test_large_turns_to_1e_13_of_the_length_against_mpmath",
+    "test_clothoid.py::test_every_rate_to_1e_13_of_the_length_against_mpmath",
+    "test_names.py::test_any_name_the_policy_passes_reads_back_from_every_file",
+    "test_opendrive.py::test_a_broken_file_fails_the_schema",
 }
 _CAD = re.compile(r"^\s*(?:from|import) (?:build123d|cadquery|OCP)\b|importorskip\([\"'](?:build123d|cadquery|OCP)", re.M)
 _SUBPROCESS = re.compile(r"\bsubprocess\b|sys\.executable")
