@@ -55,8 +55,10 @@ __all__ = ["MAX_PIS", "MAX_PVIS", "NAME", "Built", "DesignError", "build", "load
 #: JSON integers longer than this are refused (they cannot be lengths in float64 anyway).
 MAX_DIGITS = 308
 #: Chains of more edges are not read back by OCCT for the continuity report (its wire repair grows
-#: as N^1.8: minutes at a few hundred thousand edges); every joint was checked when the chain was made.
-REREAD_EDGES = 50_000
+#: as N^1.8: minutes at a few hundred thousand edges; every joint was checked when the chain was
+#: made), nor written as IGES (OCCT's IGES writer holds about 6 kB per edge: 1.6 GB for 280 000;
+#: the STEP file holds the same exact curves).
+LARGE_CHAIN_EDGES = 50_000
 #: Design files larger than this are refused before they are read.
 MAX_DESIGN_BYTES = 10_000_000
 #: The packages of the ``cad`` extra and what needs them.
@@ -443,7 +445,7 @@ def _write_design(b: Built, stage: Path, units: str, missing: list[str], plots: 
 
     step = stage / f"{b.name}.step"
     export_step(b.chain, step, name=b.name)
-    reread = len(b.chain) <= REREAD_EDGES
+    reread = len(b.chain) <= LARGE_CHAIN_EDGES
     with contextlib.ExitStack() as children:
         continuity = None
         if "OCP" not in missing and reread:
@@ -461,7 +463,7 @@ def _write_design(b: Built, stage: Path, units: str, missing: list[str], plots: 
         if continuity is None:
             if not reread:
                 b.continuity = (f"G2 by the chain's own joint checks ({len(b.chain):,} edges: OCCT's re-read of the STEP, "
-                                f"whose wire repair grows as N^1.8, is skipped above {REREAD_EDGES:,})")  # fmt: skip
+                                f"whose wire repair grows as N^1.8, is skipped above {LARGE_CHAIN_EDGES:,})")  # fmt: skip
             return names
         with ticking(f"{b.name}: continuity report (OCCT reads the STEP back)"):
             report = continuity()
@@ -499,7 +501,9 @@ def _write_others(b: Built, stage: Path, units: str, missing: list[str], plots: 
             names.append("profile.csv")
             if "OCP" not in missing:
                 names += _road_3d(b, profile, stage, units)
-    if "OCP" not in missing:
+    if "OCP" not in missing and len(b.chain) > LARGE_CHAIN_EDGES:
+        names.append(f"no igs ({len(b.chain):,} edges, above {LARGE_CHAIN_EDGES:,}: the STEP file holds the same exact curves)")
+    elif "OCP" not in missing:
         from ..cad.export import export_iges
 
         export_iges(b.chain, stage / f"{b.name}.igs", name=b.name)

@@ -519,16 +519,17 @@ def test_built_designs_are_typed_by_kind():
     assert summary(built, units).count("\n") == len(built) + 1
 
 
-def test_a_chain_too_long_for_occts_reread_is_reported_by_its_own_joint_checks(tmp_path, monkeypatch, capsys):
+def test_a_chain_too_long_for_occts_reread_and_iges_is_reported_by_its_own_joint_checks(tmp_path, monkeypatch, capsys):
     pytest.importorskip("OCP")
     from spiral_cad.app import designfile
 
     (tmp_path / "pocket.nc").write_bytes(POCKET.read_bytes())
     design = {"units": "mm", "designs": [{"name": "pocket", "type": "rounded_polyline", "gcode": "pocket.nc", "max_deviation": 0.05}]}
     (tmp_path / "pocket.json").write_text(json.dumps(design))
-    monkeypatch.setattr(designfile, "REREAD_EDGES", 3)
+    monkeypatch.setattr(designfile, "LARGE_CHAIN_EDGES", 3)
     assert main(["build", str(tmp_path / "pocket.json"), "--out", str(tmp_path / "out"), "--no-plots"]) == 0
     out = capsys.readouterr().out
     assert "G2 by the chain's own joint checks" in out and "skipped above 3" in out
     assert not (tmp_path / "out" / "pocket_continuity.txt").exists()
+    assert not (tmp_path / "out" / "pocket.igs").exists() and "no igs (" in out
     assert (tmp_path / "out" / "pocket.step").is_file()
