@@ -48,7 +48,7 @@ from ..core.segments import Line, Segment
 from ..core.shapes import CORNER_SHAPES, DEFAULT_SHAPE, SHAPE_CODES, shape_code
 from ..core.space import PlaneFrame, corner_frames, norms, place, placed_pair_residuals
 from ..core.spiral import BezierSpiral
-from ..core.units import DEFAULT_UNITS, MM_PER_UNIT, length_unit
+from ..core.units import DEFAULT_UNITS, length_unit
 from .fillets import FilletCorner, _vertex_indices, fillet_path, first_broken_corner
 
 #: Yang & Sukkarieh's leg ratio g/h: the smallest that keeps κ monotone.
@@ -838,11 +838,14 @@ def round_corners(
     return RoundedPath(chain, rounded, shape)
 
 
-#: The shortest line left between rounded corners, in mm: ten times OCCT's Precision::Confusion
-#: (1e-7 mm), below which a line cannot become an edge of a wire.
-MIN_EDGE_MM = 1e-6
+#: The shortest line left between rounded corners, in the chain's unit: ten times OCCT's
+#: Precision::Confusion (1e-7), below which a line cannot become an edge of a wire. OCCT applies it
+#: in the model's own unit (a file is read in the unit it declares), whatever that unit is.
+MIN_EDGE = 1e-6
 #: ... and at most this share of the corner distance beside it (a path too small for CAD edges keeps its lines).
 SLIVER_SHARE = 1e-3
+#: Passes of mending slivers (each solves the moved corners again) before a corner is refused.
+SLIVER_PASSES = 4
 
 
 def _refusal(message: str, corner: int, kind: type[ValueError] = NoSolutionError) -> ValueError:
@@ -863,7 +866,7 @@ def _raise_first_failure(result: CornerBatch, index: NDArray) -> None:
 
 def _without_slivers(result: CornerBatch, pts: NDArray, p0: NDArray, corners: NDArray, p1: NDArray, index: NDArray,
                      options: dict, tolerance: float, units: str) -> CornerBatch:  # fmt: skip
-    """``result`` with no line shorter than ``MIN_EDGE_MM`` left between corners (or before the first,
+    """``result`` with no line shorter than ``MIN_EDGE`` left between corners (or before the first,
     after the last): such a sliver cannot become a CAD edge.
 
     The corners beside a sliver are re-solved with a fixed curvature: under ``max_deviation`` they
@@ -873,7 +876,7 @@ def _without_slivers(result: CornerBatch, pts: NDArray, p0: NDArray, corners: ND
     broken, the corner is refused, named.
     """
     n = len(result)
-    min_edge = MIN_EDGE_MM / MM_PER_UNIT[units]
+    min_edge = MIN_EDGE
     # Each gap's line runs along the polyline: before corner 0, between corners, after the last.
     heading = np.concatenate([corners[:1] - p0[:1], corners[1:] - corners[:-1], p1[-1:] - corners[-1:]])
     heading /= norms(heading)[:, None]
@@ -895,23 +898,54 @@ def _without_slivers(result: CornerBatch, pts: NDArray, p0: NDArray, corners: ND
         return result
     bound, kmax = (None if options[name] is None else np.broadcast_to(np.asarray(options[name], dtype=float).ravel(), (n,))
                    for name in ("max_deviation", "max_curvature"))  # fmt: skip
-    bounded = bound is not None
-    distance = result.distance.copy()
-    for g in np.flatnonzero(sliver).tolist():
-        pair = [j for j in (g - 1, g) if 0 <= j < n]  # the corners before and after gap g
-        edge = min(min_edge, SLIVER_SHARE * max(result.distance[j] for j in pair))
-        if bounded:  # step back: each corner by its share of what the line lacks
-            for j in pair:
-                distance[j] = min(distance[j], result.distance[j] - 1.01 * (edge - gaps[g]) / len(pair))
-        elif kmax is not None and gaps[g] > 0.0:
-            for j in pair:  # grow to meet: the gap's share of each corner
-                distance[j] = max(distance[j], result.distance[j] + gaps[g] / len(pair))
+    for _ in range(SLIVER_PASSES):
+        if bound is not None:  # step back: smaller pairs, smaller deviations
+            distance = result.distance - _steps_back(gaps, sliver, result.distance, min_edge)
         else:
-            j = pair[0]
-            raise _refusal(
-                f"corner {index[j]}: the line it leaves {'after' if j < g else 'before'} it would be {gaps[g]:.3g} long, "
-                f"too short for a CAD edge ({min_edge:.3g} {units} at least); give max_deviation or max_curvature "
-                "so the corners may move, or move the point", int(index[j]))  # fmt: skip
+            distance = result.distance.copy()
+            for g in np.flatnonzero(sliver).tolist():
+                pair = [j for j in (g - 1, g) if 0 <= j < n]  # the corners before and after gap g
+                if kmax is None or not gaps[g] > 0.0:
+                    j = pair[0]
+                    raise _refusal(
+                        f"corner {index[j]}: the line it leaves {'after' if j < g else 'before'} it would be {gaps[g]:.3g} long, "
+                        f"too short for a CAD edge ({min_edge:.3g} {units} at least); give max_deviation or max_curvature "
+                        "so the corners may move, or move the point", int(index[j]))  # fmt: skip
+                for j in pair:  # grow to meet: the gap's share of each corner
+                    distance[j] = max(distance[j], result.distance[j] + gaps[g] / len(pair))
+        result = _resolved(result, distance, p0, corners, p1, index, bound, kmax, tolerance)
+        gaps, sliver = lines(result)
+        if not sliver.any():
+            return result
+    g = int(np.argmax(sliver))
+    j = g - 1 if g > 0 else 0
+    raise _refusal(f"corner {index[j]}: the line it leaves {'after' if j < g else 'before'} it would be {gaps[g]:.3g} long, "
+                   f"too short for a CAD edge ({min_edge:.3g} {units} at least), and moving the corners beside it "
+                   "would break their bounds; move the point or change the bounds", int(index[j]))  # fmt: skip
+
+
+def _steps_back(gaps: NDArray, sliver: NDArray, distance: NDArray, min_edge: float) -> NDArray:
+    """How far each corner steps back so that no line between corners is a sliver, in one sweep
+    along the path: the whole deficit of a gap goes to the corner after it (before it, for the last),
+    and a corner that steps back opens its next gap by as much, so the sweep carries that along
+    (a densely linearised arc, whose pairs all meet, opens one gap rather than a chain of slivers)."""
+    n = len(distance)
+    steps = np.zeros(n)
+    for g in range(n + 1):
+        opened = gaps[g] + (steps[g - 1] if g > 0 else 0.0)
+        if not (sliver[g] or (g > 0 and steps[g - 1] > 0.0)):
+            continue
+        edge = min(min_edge, SLIVER_SHARE * max(distance[j] for j in (g - 1, g) if 0 <= j < n))
+        if opened >= edge:
+            continue
+        steps[g if g < n else g - 1] += 1.01 * (edge - opened)
+    return steps
+
+
+def _resolved(result: CornerBatch, distance: NDArray, p0: NDArray, corners: NDArray, p1: NDArray, index: NDArray,
+              bound: NDArray | None, kmax: NDArray | None, tolerance: float) -> CornerBatch:  # fmt: skip
+    """``result`` with the corners whose ``distance`` changed solved again at that distance, every
+    bound checked (a corner that cannot keep one is refused, named)."""
     changed = np.flatnonzero(distance != result.distance)
     s, c = np.sin(result.theta[changed]), np.cos(result.theta[changed])
     k = corner_scale(s, c, distance[changed], result.shape)
@@ -932,17 +966,9 @@ def _without_slivers(result: CornerBatch, pts: NDArray, p0: NDArray, corners: ND
     arrays = {name: getattr(result, name).copy() for name in ("control_points", "distance", "curvature", "deviation")}
     for name, array in arrays.items():
         array[changed] = getattr(fixed, name)
-    mended = CornerBatch(result.shape, arrays["control_points"], result.theta, arrays["distance"], arrays["curvature"],
+    return CornerBatch(result.shape, arrays["control_points"], result.theta, arrays["distance"], arrays["curvature"],
                        result.available, result.status, result.corners, result.requested, result.residual,
                        arrays["deviation"], result.max_deviation, result.max_curvature, result.spiral_length)  # fmt: skip
-    gaps, sliver = lines(mended)
-    if sliver.any():  # a corner moved into its other neighbour's way (or sits between two slivers)
-        g = int(np.argmax(sliver))
-        j = g - 1 if g > 0 else 0
-        raise _refusal(f"corner {index[j]}: the line it leaves {'after' if j < g else 'before'} it would be {gaps[g]:.3g} long, "
-                       f"too short for a CAD edge ({min_edge:.3g} {units} at least), and moving the corners beside it "
-                       "would break their bounds; move the point or change the bounds", int(index[j]))  # fmt: skip
-    return mended
 
 
 # ------------------------------------------------------------ fillets in space

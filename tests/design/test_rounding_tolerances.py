@@ -270,3 +270,22 @@ def test_the_rounded_linearised_arc_is_a_valid_occt_wire_edge_for_segment():
     wire = chain_to_wire(path.chain)
     assert BRepCheck_Analyzer(wire.wrapped).IsValid()
     assert len(wire.edges()) == len(path.chain)
+
+
+def test_a_dense_polyline_whose_pairs_all_meet_opens_real_edges_instead_of_slivers():
+    """LinuxCNC's trajectory test tangent_lines_smooth.ngc: y = 0.008 x³ in 0.05-inch steps, rounded
+    within 0.05 in, left lines of 5e-7 beside corners whose pairs meet; stepping one corner back opens
+    its next gap as well, which the mending carries along the path rather than refusing."""
+    x = np.arange(0.0, 5.0001, 0.05)
+    points = np.column_stack([x, 0.008 * x**3])
+    path = round_corners(points, max_deviation=0.05, units="in")
+    lines = [segment.length for segment in path.chain if type(segment).__name__ == "Line"]
+    assert lines and min(lines) >= 1e-6  # every line a CAD edge (1e-6 of the unit at least)
+    assert path.max_deviation <= 0.05
+    pytest.importorskip("OCP")
+    from OCP.BRepCheck import BRepCheck_Analyzer
+
+    from spiral_cad.build123d import chain_to_wire
+
+    wire = chain_to_wire(path.chain)
+    assert BRepCheck_Analyzer(wire.wrapped).IsValid() and len(wire.edges()) == len(path.chain)
