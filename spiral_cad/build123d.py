@@ -47,6 +47,7 @@ from build123d import (
 from OCP.BRepAdaptor import BRepAdaptor_Curve
 from OCP.BRepTools import BRepTools_WireExplorer
 from OCP.GeomAbs import GeomAbs_CurveType
+from OCP.gp import gp_Ax3
 from OCP.TopAbs import TopAbs_REVERSED
 from OCP.TopoDS import TopoDS
 
@@ -81,18 +82,41 @@ __all__ = [
 
 
 def chain_edges(chain: Iterable[Segment], plane: Plane | None = None) -> list[Edge]:
-    """The exact build123d edges (LINE, CIRCLE, BEZIER) in travel order.
+    """The exact build123d edges (LINE, CIRCLE, BEZIER) of a chain, in travel order.
 
     Args:
-        plane: a build123d ``Plane``: the coordinate system of the chain's
-            coordinates (x, y[, z]) (None: the global one, ``Plane.XY``).
+        chain: a ``Chain`` (or segments in travel order); its numbers go in as they are (build123d
+            works in mm: a chain in another unit keeps its numbers).
+        plane: a build123d ``Plane``: the coordinate system of the chain's coordinates
+            (x, y[, z]) (None: the global one, ``Plane.XY``).
+
+    Raises:
+        ValueError: ``chain`` is not segments, or ``plane`` not a ``Plane`` instance.
     """
-    return [Edge(e) for e in segment_edges(chain, plane_ax3(plane))]
+    return [Edge(e) for e in segment_edges(_segments(chain), _ax3(plane))]
 
 
 def chain_to_wire(chain: Iterable[Segment], plane: Plane | None = None) -> Wire:
-    """The chain as one build123d ``Wire`` in ``plane``'s coordinates (None: ``Plane.XY``)."""
-    return Wire(chain_wire(chain, plane_ax3(plane)))
+    """The chain as one build123d ``Wire`` in ``plane``'s coordinates (None: ``Plane.XY``); arguments
+    as ``chain_edges``."""
+    return Wire(chain_wire(_segments(chain), _ax3(plane)))
+
+
+def _segments(chain: Iterable[Segment]) -> list[Segment]:
+    """``chain`` as a list of segments, or ValueError naming what it is."""
+    if isinstance(chain, Chain):
+        return list(chain)
+    items = list(chain) if isinstance(chain, Iterable) and not isinstance(chain, (str, bytes)) else None
+    if not items or not all(isinstance(item, Segment) for item in items):
+        raise ValueError(f"chain must be a Chain or segments in travel order; got {type(chain).__name__}")
+    return items
+
+
+def _ax3(plane: Plane | None) -> gp_Ax3 | None:
+    """A build123d ``Plane`` instance (or None) as OCP's ``gp_Ax3``."""
+    if plane is not None and not isinstance(plane, Plane):
+        raise ValueError(f"plane must be a build123d Plane (such as Plane.XZ) or None; got {plane!r:.60}")
+    return plane_ax3(plane)
 
 
 def _xy(value: VectorLike, name: str) -> tuple[float, float]:

@@ -159,7 +159,7 @@ def _build(args: argparse.Namespace) -> int:
         raise ValueError("give a design file or --from-gcode, not both")
     from ..io.gcode import reading_options
 
-    with reading_options(args.interpreter or "builtin", args.arc_tolerance):
+    with reading_options(args.interpreter or "builtin", args.arc_tolerance, args.units or "mm"):
         return _write_design(gcode_design(args), Path(args.out), plots=not args.no_plots)
 
 

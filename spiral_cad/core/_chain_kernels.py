@@ -43,6 +43,8 @@ TAU = 2.0 * math.pi
 EPS = 2.220446049250313e-16
 #: Rounding allowance (angle, relative curvature) of an arc whose plane basis is not the xy axes.
 BASIS_ULPS = 8.0 * EPS
+#: Two ends within this many ulps of their coordinates meet: float64 cannot place a line between them.
+MEET_ULPS = 8.0
 
 
 @jit
@@ -232,8 +234,9 @@ def connectors(
 ) -> None:
     """The segment bridging each of m gaps from point ``a`` to ``b`` (m, 3).
 
-    ``kind`` receives -1 where the points meet (|b − a| ≤ tolerance·scale),
-    else LINE, or ARC where ``circle`` is set: the arc of that circle
+    ``kind`` receives -1 where the points meet (|b − a| ≤ tolerance·scale, or
+    within ``MEET_ULPS`` of the coordinates' rounding: a line there would point
+    anywhere), else LINE, or ARC where ``circle`` is set: the arc of that circle
     (``center``, signed ``radius``, plane ``basis`` (m, 2, 3)) from the polar
     angle of ``a`` to that of ``b`` in the radius's travel sense, sweep in
     [0, 2π) (``Arc.between``). ``geometry``/``params`` receive the rows.
@@ -244,7 +247,8 @@ def connectors(
             for j in range(3):
                 geometry[i, r, j] = 0.0
         params[i, 0], params[i, 1], params[i, 2] = 0.0, 0.0, 0.0
-        if norm3(dx, dy, dz) <= tolerance * scale[i]:
+        magnitude = max(abs(a[i, 0]), abs(a[i, 1]), abs(a[i, 2]), abs(b[i, 0]), abs(b[i, 1]), abs(b[i, 2]))
+        if norm3(dx, dy, dz) <= max(tolerance * scale[i], MEET_ULPS * EPS * magnitude):
             kind[i] = -1
         elif not circle[i]:
             kind[i] = LINE

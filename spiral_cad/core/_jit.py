@@ -104,6 +104,11 @@ class Kernels:
                 self._python = SimpleNamespace(**{name: scope[name] for name in self.functions})
         return self._python
 
+    def guarded(self) -> Any:
+        """The plain-Python kernels with the kernels' float model, not counted as scalar calls
+        (for a message's numbers: never compiles unless a kernel raises)."""
+        return _Python(self)
+
     def for_scalar_call(self) -> Any:
         """The kernels a scalar call should use: compiled ones once this process has them, else plain Python.
 
@@ -170,6 +175,17 @@ _FLOAT_MATH = SimpleNamespace(
 )
 
 
+def _plain(value: Any) -> Any:
+    """Numpy scalars as the Python numbers a compiled kernel returns (tuples element by element)."""
+    if isinstance(value, tuple):
+        return tuple(_plain(v) for v in value)
+    if isinstance(value, np.floating):
+        return float(value)
+    if isinstance(value, np.integer):
+        return int(value)
+    return value
+
+
 class _Python:
     """The plain-Python kernels, called with numpy floats (whose division by zero gives inf, as in
     the kernels, rather than raising); a kernel that still raises runs compiled instead."""
@@ -187,7 +203,7 @@ class _Python:
             floats = tuple(np.float64(a) if type(a) is float else a for a in args)
             try:
                 with np.errstate(all="ignore"):
-                    return function(*floats)
+                    return _plain(function(*floats))
             except (ArithmeticError, ValueError):
                 kernels.compile()
                 return kernels.namespace[name](*args)

@@ -75,10 +75,16 @@ def describe(case: str, status: int, measure: float, inputs: Mapping[str, Any]) 
     if status is Status.OUTSIDE_NESTED_BAND:
         big, small = sorted((abs(float(r0)), abs(float(r1))), reverse=True)
         q = small / big
+        lower = float(K.KERNELS.guarded().nested_band_lower(q, SHAPE_CODES[shape]))
+        if not lower < 1.0:  # r1/r0 so small (or underflowing) that the band is empty in float64
+            return (
+                f"circle_in_circle: a single {shape} spiral needs r1/r0 well above 0; here r1/r0 = {q:.6g} "
+                f"(radius0={r0}, radius1={r1}): no nested band is left"
+            )
+        shown = f"{lower:.5f}" if 1.0 - lower >= 1e-4 else f"1 − {1.0 - lower:.3g}"  # a narrow band: its width
         return (
             f"circle_in_circle: a single {shape} spiral exists only for "
-            f"{K.KERNELS.python.nested_band_lower(q, SHAPE_CODES[shape]):.5f} ≤ D/(r0 − r1) < 1 at r1/r0 = {q:.2f}; "
-            f"here D/(r0 − r1) = {measure:.5f}"
+            f"{shown} ≤ D/(r0 − r1) < 1 at r1/r0 = {q:.2f}{'' if q >= 0.01 else f' ({q:.3g})'}; here D/(r0 − r1) = {measure:.5f}"
         )
     if status is Status.OUTSIDE_SHAPE:
         return _outside_shape(case, shape, measure, inputs)

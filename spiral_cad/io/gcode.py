@@ -66,7 +66,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from .progress import Progress, ticking
-from .toolpath import PLANES, GcodePath, arc_points
+from .toolpath import PLANES, GcodePath, arc_points, in_program_unit
 
 if TYPE_CHECKING:
     from ..design.rounding import RoundedPath
@@ -143,9 +143,11 @@ _COMMENT = re.compile(r"\([^()]*\)|[;()]")
 class _Reader:
     """The interpreter's state while lines are read."""
 
-    def __init__(self, source: str, arc_tolerance: float | None = None, progress: Callable[[int], None] | None = None):
+    def __init__(self, source: str, arc_tolerance: float | None = None, progress: Callable[[int], None] | None = None,
+                 arc_units: str | None = None):  # fmt: skip
         self.source = source
         self.arc_tolerance = arc_tolerance
+        self.arc_units = arc_units  # the unit of arc_tolerance (None: the program's)
         self.progress = progress
         self.position = [0.0, 0.0, 0.0]
         self.absolute = True
@@ -159,7 +161,7 @@ class _Reader:
         self.rapid: list[bool] = []
         self.notes: list[str] = []
         self.opened: int | None = None  # the line of an opening %
-        self.any_words = False
+        self.any_line = False  # a line that is not blank was read (an opening % must be the first)
         self.end_at: int | None = None
         self.ended = False
 
@@ -211,18 +213,23 @@ class _Reader:
         stripped = text.strip()
         if self.ended or not stripped:
             return
-        if stripped == "%":  # LinuxCNC: a first line % opens the program, the next % ends it
-            if self.opened is None and not self.points and not self.any_words:
+        first = not self.any_line
+        self.any_line = True
+        if stripped == "%":  # LinuxCNC: a % as the first line that is not blank opens the program, the next ends it
+            if first:
                 self.opened = number
-            else:
+            elif self.opened is not None:
                 self.ended = True
+            else:
+                raise self.error(
+                    number,
+                    "a % ends only a program that opened with % on its first line; LinuxCNC refuses it here (bad character '%' used)",
+                )
             return
         if stripped[0] == "/":  # block delete: LinuxCNC's switch is off by default, so the line runs
             text = text.replace("/", " ", 1)
         words = self.words(number, text)
-        if words:
-            self.any_words = True
-        groups: dict[int, str] = {}
+        groups: dict[tuple[str, int], str] = {}
         motion: int | None = None
         target: dict[int, float] = {}
         centre: dict[str, float] = {}
@@ -236,11 +243,15 @@ class _Reader:
                 if code not in G_GROUPS:
                     raise self.error(number, f"{written} is not a LinuxCNC G code this reader knows")
                 group, name = G_GROUPS[code]
-                if group and group in groups:
-                    raise self.error(
-                        number, f"{groups[group]} and {written} are both in modal group {group} ({name}); LinuxCNC allows one per line"
-                    )
-                groups[group] = written
+                if group and ("G", group) in groups:
+                    if group == 1 and 800 in (code, motion):  # LinuxCNC drops a G80 beside another motion
+                        code = motion if code == 800 else code
+                    else:
+                        raise self.error(
+                            number,
+                            f"{groups['G', group]} and {written} are both in modal group {group} ({name}); LinuxCNC allows one per line",
+                        )
+                groups["G", group] = written
                 if code in REFUSED_G:
                     raise self.error(number, f"{written} is refused: {REFUSED_G[code]}")
                 if group == 1:
@@ -265,11 +276,11 @@ class _Reader:
                         f"{written} is not in the supported subset (M0, M1, M2, M30, M60 stops and ends; M3–M9 spindle, tool change, coolant; M48–M53 overrides)",
                     )
                 group = M_GROUPS[code]
-                if group in groups and not {groups[group].upper(), written.upper()} <= {"M7", "M8", "M07", "M08"}:
+                if ("M", group) in groups and not {groups["M", group].upper(), written.upper()} <= {"M7", "M8", "M07", "M08"}:
                     raise self.error(
-                        number, f"{groups[group]} and {written} are both in M modal group {group}; LinuxCNC allows one per line"
+                        number, f"{groups['M', group]} and {written} are both in M modal group {group}; LinuxCNC allows one per line"
                     )
-                groups[group] = written
+                groups["M", group] = written
                 if code in END_M:
                     self.end_at = number
                 elif code == 6:
@@ -380,36 +391,43 @@ class _Reader:
             if turn_count != int(turn_count) or turn_count < 1:
                 raise self.error(number, f"{name}: P{turn_count:g} must be a whole number of turns, at least 1")
             turns = int(turn_count)
-        for point in arc_points(start, end, self.plane, ca, cb, turns if self.motion == 30 else -turns, self.arc_tolerance):
+        tolerance = in_program_unit(self.arc_tolerance, self.arc_units, self.units or "mm")
+        for point in arc_points(start, end, self.plane, ca, cb, turns if self.motion == 30 else -turns, tolerance):
             self.add(number, point)
             self.position = point
 
 
 #: How ``read_gcode`` reads when its caller does not say (set by ``reading_options``).
-_DEFAULTS: ContextVar[tuple[str, float | None]] = ContextVar("gcode_reading", default=("builtin", None))
+_DEFAULTS: ContextVar[tuple[str, float | None, str | None]] = ContextVar("gcode_reading", default=("builtin", None, None))
 
 
 @contextmanager
-def reading_options(interpreter: str = "builtin", arc_tolerance: float | None = None) -> Iterator[None]:
+def reading_options(
+    interpreter: str = "builtin", arc_tolerance: float | None = None, arc_tolerance_units: str | None = None
+) -> Iterator[None]:
     """Within the block, ``read_gcode`` calls that do not name them use this interpreter and arc
     tolerance (how ``build --from-gcode --interpreter rs274`` reaches the design file's reader)."""
-    token = _DEFAULTS.set((interpreter, arc_tolerance))
+    token = _DEFAULTS.set((interpreter, arc_tolerance, arc_tolerance_units))
     try:
         yield
     finally:
         _DEFAULTS.reset(token)
 
 
-def parse_gcode(text: str, source: str = "G-code", *, arc_tolerance: float | None = None, interpreter: str = "builtin") -> GcodePath:
+def parse_gcode(
+    text: str, source: str = "G-code", *, arc_tolerance: float | None = None, interpreter: str = "builtin",
+    arc_tolerance_units: str | None = None,
+) -> GcodePath:  # fmt: skip
     """The moves of G-code ``text`` (see the module docstring).
 
     Args:
         text: the program.
         source: its name, for messages.
-        arc_tolerance: when given (in the program's unit), arcs G2/G3 are read as chords at most this
-            far from the arc; when None, arcs are refused by name.
+        arc_tolerance: when given, arcs G2/G3 are read as chords at most this far from the arc;
+            when None, arcs are refused by name.
         interpreter: ``"builtin"`` (this module's reader) or ``"rs274"`` (LinuxCNC's own interpreter,
             for parameters, expressions and O-word subroutines; see ``spiral_cad.io.rs274``).
+        arc_tolerance_units: the unit of ``arc_tolerance`` (None: the program's, G20/G21).
 
     Raises:
         ValueError: anything outside the subset, naming ``source``, the line and the word;
@@ -422,12 +440,12 @@ def parse_gcode(text: str, source: str = "G-code", *, arc_tolerance: float | Non
     if interpreter == "rs274":
         from .rs274 import run_rs274
 
-        return run_rs274(text, source, arc_tolerance=arc_tolerance)
+        return run_rs274(text, source, arc_tolerance=arc_tolerance, arc_tolerance_units=arc_tolerance_units)
     if interpreter != "builtin":
         raise ValueError(f"interpreter must be 'builtin' or 'rs274'; got {interpreter!r}")
     lines = text.replace("\r\n", "\n").replace("\r", "\n").split("\n")  # not splitlines: it breaks at \v, \f, …
     progress = Progress(f"reading {source}", len(lines))
-    reader = _Reader(source, arc_tolerance)
+    reader = _Reader(source, arc_tolerance, arc_units=arc_tolerance_units)
     for number, line in enumerate(lines, 1):
         reader.read_line(number, line)
         if not number & 0x3FFF:
@@ -443,7 +461,10 @@ def parse_gcode(text: str, source: str = "G-code", *, arc_tolerance: float | Non
     return GcodePath(np.array(reader.points), np.array(reader.lines), np.array(reader.rapid), reader.units, source, tuple(reader.notes))
 
 
-def read_gcode(path: str | os.PathLike, *, arc_tolerance: float | None = None, interpreter: str | None = None) -> GcodePath:
+def read_gcode(
+    path: str | os.PathLike, *, arc_tolerance: float | None = None, interpreter: str | None = None,
+    arc_tolerance_units: str | None = None,
+) -> GcodePath:  # fmt: skip
     """Read the straight moves of a G-code file (named ``*.nc``, ``.ngc``, ``.gcode``, ``.gc``, ``.g``,
     ``.tap``, ``.cnc``, ``.mpt`` or ``.mpf``).
 
@@ -470,9 +491,10 @@ def read_gcode(path: str | os.PathLike, *, arc_tolerance: float | None = None, i
         line = data[: error.start].count(b"\n") + 1
         raise ValueError(f"{label} line {line}: byte {data[error.start]:#04x} is not UTF-8 text") from None
     if interpreter is None:  # neither given: what reading_options set (the built-in reader, arcs refused)
-        interpreter, default_tolerance = _DEFAULTS.get()
-        arc_tolerance = default_tolerance if arc_tolerance is None else arc_tolerance
-    return parse_gcode(text, label, arc_tolerance=arc_tolerance, interpreter=interpreter)
+        interpreter, default_tolerance, default_units = _DEFAULTS.get()
+        if arc_tolerance is None:
+            arc_tolerance, arc_tolerance_units = default_tolerance, default_units
+    return parse_gcode(text, label, arc_tolerance=arc_tolerance, interpreter=interpreter, arc_tolerance_units=arc_tolerance_units)
 
 
 #: OCCT's Precision::Confusion (model units): two points closer than this are one point, so no edge is shorter.

@@ -518,6 +518,11 @@ def _read_network(path: str | os.PathLike) -> Network:
     if not collector.roads:
         raise ValueError(f"{label}: no <road> elements")
     roads = tuple(_road(label, number_, record) for number_, record in enumerate(collector.roads))
+    seen: dict[str, int] = {}
+    for number_, road in enumerate(roads):  # links name roads by id: two roads of one id make every link ambiguous
+        if road.id in seen:
+            raise ValueError(f"{label}: roads {seen[road.id]} and {number_} (in file order) both have id {road.id!r}; ids must be unique")
+        seen[road.id] = number_
     junctions = tuple(_junction(label, record) for record in collector.junctions)
     return Network(roads, junctions)
 

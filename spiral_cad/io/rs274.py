@@ -44,7 +44,7 @@ import time
 import numpy as np
 
 from .progress import Progress, ticking
-from .toolpath import GcodePath, arc_points
+from .toolpath import PLANES, GcodePath, arc_points, in_program_unit
 
 #: The Debian package that has ``rs274``.
 PACKAGE = "linuxcnc-uspace"
@@ -85,7 +85,10 @@ MAX_OUTPUT = 4 << 30
 TIMEOUT = 600.0
 
 
-def run_rs274(text: str, source: str = "G-code", *, arc_tolerance: float | None = None, timeout: float | None = None) -> GcodePath:
+def run_rs274(
+    text: str, source: str = "G-code", *, arc_tolerance: float | None = None, timeout: float | None = None,
+    arc_tolerance_units: str | None = None,
+) -> GcodePath:  # fmt: skip
     """The moves of G-code ``text`` as LinuxCNC's interpreter ``rs274`` executes them.
 
     Raises:
@@ -132,10 +135,10 @@ def run_rs274(text: str, source: str = "G-code", *, arc_tolerance: float | None 
             said = messages[0] if messages else f"exit status {returncode}"
             raise ValueError(f"{source}{line}: rs274 refused the program: {said}")
         with open(output, encoding="utf-8", errors="replace") as file:
-            return _moves(file, source, arc_tolerance)
+            return _moves(file, source, arc_tolerance, arc_tolerance_units)
 
 
-def _moves(calls, source: str, arc_tolerance: float | None) -> GcodePath:
+def _moves(calls, source: str, arc_tolerance: float | None, arc_units: str | None = None) -> GcodePath:
     """The toolpath of rs274's canonical calls (an iterable of its output lines)."""
     progress = Progress(f"reading rs274's moves of {source}")
     points: list[list[float]] = []
@@ -175,10 +178,11 @@ def _moves(calls, source: str, arc_tolerance: float | None) -> GcodePath:
                 )
             if any(values[6:9]):
                 raise error("ARC_FEED moves a rotary axis; only X, Y, Z are read")
-            first, second, normal = {170: (0, 1, 2), 180: (2, 0, 1), 190: (1, 2, 0)}[plane]
+            first, second, normal = PLANES[plane]
             end = [0.0, 0.0, 0.0]
             end[first], end[second], end[normal] = values[0], values[1], values[5]
-            for point in arc_points(position, end, plane, values[2], values[3], int(values[4]), arc_tolerance):
+            tolerance = in_program_unit(arc_tolerance, arc_units, units or "mm")
+            for point in arc_points(position, end, plane, values[2], values[3], int(values[4]), tolerance):
                 add(point, False)
                 position = point
         elif name == "SELECT_PLANE":

@@ -14,7 +14,7 @@ from numpy.typing import NDArray
 
 from ..core.units import MM_PER_UNIT, length_unit
 
-__all__ = ["PLANES", "GcodePath", "arc_points"]
+__all__ = ["PLANES", "GcodePath", "arc_points", "in_program_unit"]
 
 #: The arc planes by LinuxCNC's ARC_FEED codes: (first, second, normal axis).
 PLANES = {170: (0, 1, 2), 180: (2, 0, 1), 190: (1, 2, 0)}
@@ -90,3 +90,8 @@ def arc_points(
         points.append(point)
     points.append(list(end))
     return points
+
+
+def in_program_unit(length: float, units: str | None, program_units: str) -> float:
+    """``length`` given in ``units`` (None: already the program's) in the program's unit (G20/G21)."""
+    return length if units is None else length * MM_PER_UNIT[length_unit(units)] / MM_PER_UNIT[program_units]

@@ -167,3 +167,21 @@ def test_bad_inputs():
     with pytest.raises(RuntimeError):
         with BuildPart():
             SpiralChain(Chain([Line((0, 0), (1, 0))]))
+
+
+@pytest.mark.parametrize(
+    ("args", "message"),
+    [
+        ((0,), r"chain must be a Chain or segments"),
+        (("x",), r"chain must be a Chain"),
+        ((None, "Plane"), r"plane must be a build123d Plane"),
+    ],
+)
+def test_chain_edges_and_wire_name_a_wrong_argument(args, message):
+    from build123d import Plane
+
+    chain = CHAINS["C"]
+    call = (chain, Plane) if args[-1] == "Plane" else args
+    for function in (chain_edges, chain_to_wire):
+        with pytest.raises(ValueError, match=message):
+            function(*call)

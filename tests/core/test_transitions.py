@@ -1,6 +1,7 @@
 """The five G2 transitions: joins, travel senses, feasibility and errors."""
 
 import math
+import re
 
 import numpy as np
 import pytest
@@ -314,3 +315,31 @@ def test_two_number_points_are_checked_item_by_item(point, message):
         line_to_circle(point, (1, 0), (0, 105), 100)
     as_list = line_to_circle([0, 0.0], [1, 0], (0, 105), 100).spirals[0].control_points
     assert np.array_equal(as_list, line_to_circle((0, 0), (1, 0), (0, 105), 100).spirals[0].control_points)
+
+
+@pytest.mark.parametrize(
+    ("r1", "message"),
+    [
+        (1e-200, r"needs r1/r0 well above 0; here r1/r0 = 0 \(radius0=1e\+200, radius1=1e-200\)"),
+        (1e-20 * 1e200, r"1 − [0-9.e-]+ ≤ D/\(r0 − r1\) < 1"),
+    ],
+)
+def test_a_nested_circle_far_smaller_than_its_outer_is_refused_by_name_not_by_division(r1, message):
+    """r1/r0 underflowing to 0, or so small that the band is narrower than the digits shown."""
+    from spiral_cad import batch
+
+    with pytest.raises(NoSolutionError, match=message):
+        circle_in_circle((0, 0), 1e200, (5, 0), r1)
+    assert re.search(message, batch.circle_in_circle((0, 0), 1e200, (5, 0), r1).reason(0))
+
+
+def test_scalar_results_are_python_floats_before_and_after_the_kernels_compile():
+    """The scalar API runs plain Python until its process compiles: the same types either way."""
+    from spiral_cad.core import _kernels as K
+
+    before = circle_in_circle((0, 0), 1.0, (0.595, 0), 0.4)
+    K.KERNELS.compile()
+    after = circle_in_circle((0, 0), 1.0, (0.595, 0), 0.4)
+    for t in (before, after):
+        assert type(t.theta) is float and type(t.parameter) is float and repr(t.theta) == repr(float(t.theta))
+    assert (before.theta, before.parameter) == (after.theta, after.parameter)

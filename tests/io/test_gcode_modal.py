@@ -15,7 +15,7 @@ from spiral_cad.io.gcode import parse_gcode
         ("G20 G21\nG1 X1\n", r"line 1: G20 and G21 are both in modal group 6 \(units\)"),
         ("G21 G17 G18\n", r"line 1: G17 and G18 are both in modal group 2 \(plane\)"),
         ("G21 G54 G55\n", r"line 1: G54 and G55 are both in modal group 12"),
-        ("G21 G1 G80 X1\n", r"line 1: G1 and G80 are both in modal group 1"),
+        ("G21 G1 G2 X1\n", r"line 1: G1 and G2 are both in modal group 1"),
         ("G21 M3 M5\n", r"line 1: M3 and M5 are both in M modal group 7"),
         ("G21 F100\nG1 X1\nG80\nX2\n", r"line 4: coordinates after G80 \(motion cancelled\)"),
         ("G21 F100\nG1 X1\nG80 X2\n", r"line 3: coordinates after G80"),
@@ -188,3 +188,29 @@ def test_build_from_gcode_reads_arcs_with_an_arc_tolerance(tmp_path):
     # G2 from (20, 0) to (30, 10) about (20, 10) is clockwise: three quarters of a circle, by (10, 10) and (20, 20)
     on_arc = (table[:, 1] < 19.0) & (table[:, 2] > 1.0)
     assert on_arc.any() and np.abs(np.hypot(table[on_arc, 1] - 20, table[on_arc, 2] - 10) - 10).max() < 0.06
+
+
+def test_g_and_m_codes_have_modal_groups_of_their_own_and_g80_yields_to_a_motion():
+    """Fanuc/Haas safety blocks, as LinuxCNC's rs274 reads them: G40 beside M3, G80 beside G0."""
+    text = "G20\nT1 M06\nG00 G17 G40 G80 G90 G54 X0. Y0. S5000 M03\nG01 G80 X1. F20.\nG40 M8 Y1.\nM30\n"
+    path = parse_gcode(text)
+    assert path.points.tolist() == [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [1.0, 1.0, 0.0]]
+    assert path.rapid.tolist() == [True, False, False]
+    with pytest.raises(ValueError, match=r"line 2: M3 and M5 are both in M modal group 7"):
+        parse_gcode("G21\nM3 M5\nG1 X1 F1\nX2\n")
+
+
+@pytest.mark.parametrize("text", ["G21 G90 F100\nG1 X0 Y0\nX10\n%\nX0\nM30\n", "(a comment first)\n%\nG21\nG1 X1 F1\nX2\n%\n"])
+def test_a_percent_that_does_not_open_the_program_on_its_first_line_is_refused(text):
+    with pytest.raises(ValueError, match=r"a % ends only a program that opened with % on its first line"):
+        parse_gcode(text)
+
+
+def test_the_arc_tolerance_may_be_given_in_another_unit_than_the_programs():
+    text = "G20 G90 F10\nG1 X1 Y0\nG3 X-1 Y0 R1\nG1 X-1 Y-1\nM30\n"
+    inches = parse_gcode(text, arc_tolerance=0.01)
+    millimetres = parse_gcode(text, arc_tolerance=0.01, arc_tolerance_units="mm")
+    assert len(millimetres) > len(inches)
+    arc = millimetres.points[1:-1, :2]  # the chords' ends lie on the arc; their midpoints within 0.01 mm of it
+    middles = (arc[1:] + arc[:-1]) / 2
+    assert np.all((1.0 - np.hypot(*middles.T)) * 25.4 <= 0.01 + 1e-12)

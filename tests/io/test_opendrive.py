@@ -14,7 +14,7 @@ from spiral_cad import Arc, BezierSpiral
 from spiral_cad.app.cli import main
 from spiral_cad.cad.export import CrossSection, export_opendrive
 from spiral_cad.design import Alignment, round_corners
-from spiral_cad.io.opendrive import check_opendrive, read_opendrive
+from spiral_cad.io.opendrive import check_opendrive, read_network, read_opendrive
 
 REPO = Path(__file__).resolve().parents[2]
 PIS = [[0, 0], [600, 120], [1150, -80], [1700, 260], [2300, 200]]
@@ -442,3 +442,13 @@ def test_any_file_reads_as_verified_chains_or_a_value_error(text):
                 assert str(error).startswith(f"road {road_.id}")
             else:
                 assert isinstance(chain, Chain) and math.isfinite(chain.length)
+
+
+def test_two_roads_of_one_id_are_refused_by_name(tmp_path):
+    line = '<geometry s="0" x="{x}" y="0" hdg="0" length="10"><line/></geometry>'
+    body = "".join(
+        f'<road id="{rid}" length="10" junction="-1"><planView>{line.format(x=x)}</planView></road>'
+        for rid, x in (("1", 0), ("2", 10), ("1", 500))
+    )
+    with pytest.raises(ValueError, match=r"roads 0 and 2 \(in file order\) both have id '1'; ids must be unique"):
+        read_network(write(tmp_path, body))
