@@ -9,6 +9,7 @@ import math
 import os
 import re
 import subprocess
+from dataclasses import dataclass
 from pathlib import Path
 
 import mpmath as mp
@@ -213,3 +214,39 @@ def assert_meet_g2(cp_a, cp_b, size, tol=1e-9):
     assert mp.sqrt((pa[0] - pb[0]) ** 2 + (pa[1] - pb[1]) ** 2) <= tol * size
     assert abs(ta[0] * tb[1] - ta[1] * tb[0]) <= tol and ta[0] * tb[0] + ta[1] * tb[1] > 0
     assert abs(ka - kb) * size <= tol * max(1, abs(ka) * size)
+
+
+#: A fenced code block's opening line in Markdown.
+FENCE = re.compile(r"^(?P<indent> *)```(?P<info>[^`]*)$")
+
+
+@dataclass(frozen=True)
+class Block:
+    """A fenced ``python`` block of a Markdown page."""
+
+    first_line: int  # 1-based line of the block's first code line
+    code: str
+    skip_reason: str | None
+
+
+def python_blocks(text: str, marker: str, name: str = "page") -> list[Block]:
+    """The fenced ``python`` blocks of a Markdown text, with the reason of the skip marker that precedes
+    each, if any (``<!-- MARKER: skip (reason) -->``, ``marker`` being ``readme`` or ``docs``)."""
+    skip = re.compile(rf"<!-- {marker}: skip \((?P<reason>[^()]+)\) -->")
+    lines = text.splitlines()
+    blocks, i = [], 0
+    while i < len(lines):
+        opening = FENCE.match(lines[i])
+        if opening is None:
+            i += 1
+            continue
+        end = next((j for j in range(i + 1, len(lines)) if lines[j].strip() == "```"), None)
+        assert end is not None, f"{name}:{i + 1}: a code block is never closed"
+        if opening["info"].strip() == "python":
+            before = next((line for line in reversed(lines[:i]) if line.strip()), "")
+            found = skip.fullmatch(before.strip())
+            indent = len(opening["indent"])
+            code = "\n".join(line[indent:] for line in lines[i + 1 : end]) + "\n"
+            blocks.append(Block(i + 2, code, found["reason"] if found else None))
+        i = end + 1
+    return blocks

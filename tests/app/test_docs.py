@@ -24,15 +24,13 @@ import shutil
 import subprocess
 import sys
 import threading
-from dataclasses import dataclass
 from pathlib import Path
 
 import pytest
+from helpers import Block, python_blocks
 
 ROOT = Path(__file__).resolve().parents[2]
 DOCS = ROOT / "docs"
-SKIP = re.compile(r"<!-- docs: skip \((?P<reason>[^()]+)\) -->")
-FENCE = re.compile(r"^(?P<indent> *)```(?P<info>[^`]*)$")
 PAGES = sorted(DOCS.rglob("*.md"))
 
 # Runs the blocks given on stdin as [first line, code] pairs; tracebacks show the page's own line numbers.
@@ -45,50 +43,22 @@ for first_line, code in blocks:
 """
 
 
-@dataclass(frozen=True)
-class Block:
-    first_line: int  # 1-based line of the block's first code line
-    code: str
-    skip_reason: str | None
-
-
-def python_blocks(text: str, name: str = "page") -> list[Block]:
-    """The fenced ``python`` blocks of a Markdown text, with the skip marker that precedes each, if any."""
-    lines = text.splitlines()
-    blocks, i = [], 0
-    while i < len(lines):
-        opening = FENCE.match(lines[i])
-        if opening is None:
-            i += 1
-            continue
-        end = next((j for j in range(i + 1, len(lines)) if lines[j].strip() == "```"), None)
-        assert end is not None, f"{name}:{i + 1}: a code block is never closed"
-        if opening["info"].strip() == "python":
-            before = next((line for line in reversed(lines[:i]) if line.strip()), "")
-            marker = SKIP.fullmatch(before.strip())
-            indent = len(opening["indent"])
-            code = "\n".join(line[indent:] for line in lines[i + 1 : end]) + "\n"
-            blocks.append(Block(i + 2, code, marker["reason"] if marker else None))
-        i = end + 1
-    return blocks
-
-
 def rel(page: Path) -> str:
     return str(page.relative_to(ROOT))
 
 
-PAGES_WITH_CODE = [p for p in PAGES if python_blocks(p.read_text(encoding="utf-8"), rel(p))]
+PAGES_WITH_CODE = [p for p in PAGES if python_blocks(p.read_text(encoding="utf-8"), "docs", rel(p))]
 
 
 def test_the_extractor_finds_blocks_markers_and_line_numbers():
     text = "# t\n\n```python\nx = 1\n```\n\n<!-- docs: skip (needs a GUI) -->\n```python\nshow(x)\n```\n```sh\nls\n```\n"
-    assert python_blocks(text) == [Block(4, "x = 1\n", None), Block(9, "show(x)\n", "needs a GUI")]
+    assert python_blocks(text, "docs") == [Block(4, "x = 1\n", None), Block(9, "show(x)\n", "needs a GUI")]
     assert len(PAGES_WITH_CODE) >= 8, "the tutorials lost their Python blocks?"
 
 
 @pytest.mark.parametrize("page", PAGES, ids=rel)
 def test_every_block_is_valid_python(page):
-    for block in python_blocks(page.read_text(encoding="utf-8"), rel(page)):
+    for block in python_blocks(page.read_text(encoding="utf-8"), "docs", rel(page)):
         ast.parse(block.code, filename=f"{rel(page)}:{block.first_line}")
 
 
@@ -97,7 +67,7 @@ def test_every_block_is_valid_python(page):
 @pytest.mark.cad
 @pytest.mark.parametrize("page", PAGES_WITH_CODE, ids=rel)
 def test_every_block_runs(page, tmp_path):
-    blocks = python_blocks(page.read_text(encoding="utf-8"), rel(page))
+    blocks = python_blocks(page.read_text(encoding="utf-8"), "docs", rel(page))
     runnable = [[b.first_line, b.code] for b in blocks if b.skip_reason is None]
     env = {**os.environ, "MPLBACKEND": "Agg", "PYTHONPATH": os.pathsep.join([str(ROOT), os.environ.get("PYTHONPATH", "")])}
     done = subprocess.run(

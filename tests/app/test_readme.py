@@ -18,14 +18,12 @@ import os
 import re
 import subprocess
 import sys
-from dataclasses import dataclass
 from pathlib import Path
 
 import pytest
+from helpers import Block, python_blocks
 
 README = Path(__file__).resolve().parents[2] / "README.md"
-SKIP = re.compile(r"<!-- readme: skip \((?P<reason>[^()]+)\) -->")
-FENCE = re.compile(r"^(?P<indent> *)```(?P<info>[^`]*)$")
 
 # Runs the blocks given on stdin as [first line, code] pairs; tracebacks show README.md's own line numbers.
 RUNNER = """
@@ -37,40 +35,12 @@ for first_line, code in blocks:
 """
 
 
-@dataclass(frozen=True)
-class Block:
-    first_line: int  # 1-based line of the block's first code line
-    code: str
-    skip_reason: str | None
-
-
-def python_blocks(text: str) -> list[Block]:
-    """The fenced ``python`` blocks of a Markdown text, with the skip marker that precedes each, if any."""
-    lines = text.splitlines()
-    blocks, i = [], 0
-    while i < len(lines):
-        opening = FENCE.match(lines[i])
-        if opening is None:
-            i += 1
-            continue
-        end = next((j for j in range(i + 1, len(lines)) if lines[j].strip() == "```"), None)
-        assert end is not None, f"README.md:{i + 1}: a code block is never closed"
-        if opening["info"].strip() == "python":
-            before = next((line for line in reversed(lines[:i]) if line.strip()), "")
-            marker = SKIP.fullmatch(before.strip())
-            indent = len(opening["indent"])
-            code = "\n".join(line[indent:] for line in lines[i + 1 : end]) + "\n"
-            blocks.append(Block(i + 2, code, marker["reason"] if marker else None))
-        i = end + 1
-    return blocks
-
-
-BLOCKS = python_blocks(README.read_text(encoding="utf-8"))
+BLOCKS = python_blocks(README.read_text(encoding="utf-8"), "readme", "README.md")
 
 
 def test_the_extractor_finds_blocks_markers_and_line_numbers():
     text = "# t\n\n```python\nx = 1\n```\n\n<!-- readme: skip (needs a GUI) -->\n```python\nshow(x)\n```\n```sh\nls\n```\n"
-    assert python_blocks(text) == [Block(4, "x = 1\n", None), Block(9, "show(x)\n", "needs a GUI")]
+    assert python_blocks(text, "readme") == [Block(4, "x = 1\n", None), Block(9, "show(x)\n", "needs a GUI")]
     assert len(BLOCKS) >= 2, "README.md lost its Python blocks?"
 
 
