@@ -185,6 +185,16 @@ def _read(source: str | Path) -> bytes:
     return raw
 
 
+def _json_object(pairs: list[tuple[str, Any]]) -> dict[str, Any]:
+    """A JSON object whose keys are unique: a key given twice is refused (JSON readers disagree on which wins)."""
+    found: dict[str, Any] = {}
+    for key, value in pairs:
+        if key in found:
+            raise DesignError(f"the key {key!r} is given twice in one object")
+        found[key] = value
+    return found
+
+
 def _parse(source: str | Path) -> Any:
     """The JSON value in the file ``source``; any byte sequence either parses or raises DesignError."""
     label = Path(source).name
@@ -194,7 +204,7 @@ def _parse(source: str | Path) -> Any:
     except UnicodeDecodeError as e:
         raise DesignError(f"{label}: not UTF-8 text (byte {e.start}: 0x{raw[e.start]:02x})") from None
     try:
-        return json.loads(text, parse_int=_json_integer, parse_constant=_json_constant)
+        return json.loads(text, parse_int=_json_integer, parse_constant=_json_constant, object_pairs_hook=_json_object)
     except DesignError as e:
         raise DesignError(f"{label}: {e}") from None
     except json.JSONDecodeError as e:

@@ -85,6 +85,11 @@ MAX_OUTPUT = 4 << 30
 TIMEOUT = 600.0
 
 
+#: A G20 or G21 word (spaces may stand inside words in RS274), and comments, which hide words.
+_UNIT_WORD = re.compile(r"[Gg]\s*0*2\s*[01](?![\d.])")
+_COMMENTS = re.compile(r"\([^()]*\)|;[^\n]*")
+
+
 def run_rs274(
     text: str, source: str = "G-code", *, arc_tolerance: float | None = None, timeout: float | None = None,
     arc_tolerance_units: str | None = None,
@@ -101,6 +106,11 @@ def run_rs274(
     if executable is None:
         raise ValueError(
             f"interpreter 'rs274' is not installed: it is LinuxCNC's, in the Debian package {PACKAGE} (apt-get install {PACKAGE}); or use the built-in reader"
+        )
+    if not _UNIT_WORD.search(_COMMENTS.sub(" ", text)):
+        raise ValueError(
+            f"{source}: the program never says G20 (inches) or G21 (mm); rs274 would read it in mm, but a machine may "
+            "default to inches, and a path in the wrong unit is worse than none: add G20 or G21"
         )
     with tempfile.TemporaryDirectory(prefix="spiral_cad_rs274_") as folder:
         program = os.path.join(folder, "program.ngc")

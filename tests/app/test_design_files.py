@@ -533,3 +533,13 @@ def test_a_chain_too_long_for_occts_reread_and_iges_is_reported_by_its_own_joint
     assert not (tmp_path / "out" / "pocket_continuity.txt").exists()
     assert not (tmp_path / "out" / "pocket.igs").exists() and "no igs (" in out
     assert (tmp_path / "out" / "pocket.step").is_file()
+
+
+def test_a_key_given_twice_in_one_object_is_refused(tmp_path):
+    from spiral_cad.app.designfile import DesignError, build
+
+    path = tmp_path / "twice.json"
+    path.write_text('{"units": "mm", "designs": [{"name": "a", "name": "b", "type": "rounded_polyline", '
+                    '"points": [[0, 0], [1, 0], [1, 1]], "max_curvature": 1}]}')  # fmt: skip
+    with pytest.raises(DesignError, match=r"twice.json: the key 'name' is given twice in one object"):
+        build(path)

@@ -159,3 +159,11 @@ def test_a_program_that_prints_without_end_is_stopped_by_size(monkeypatch):
     endless = "G21 F100\n#100=0\no1 while [1]\nG1 X[#100 MOD 2]\n#100=[#100+1]\no1 endwhile\nM2\n"
     with pytest.raises(ValueError, match=r"rs274 printed more than 1 MB of moves"):
         rs274.run_rs274(endless, "endless.ngc", timeout=60)
+
+
+@needs_rs274
+def test_a_program_that_never_names_its_unit_is_refused_as_by_the_built_in_reader():
+    text = "G90 F10 (G21 only in a comment)\nG1 X1 Y0\nX2 Y1\nM30\n"
+    with pytest.raises(ValueError, match=r"never says G20 \(inches\) or G21 \(mm\)"):
+        parse_gcode(text, interpreter="rs274")
+    assert parse_gcode("G 2 1 G90 F10\nG1 X1 Y0\nX2 Y1\nM30\n", interpreter="rs274").units == "mm"
