@@ -23,6 +23,7 @@ import math
 import os
 import stat
 import time
+from abc import ABC, abstractmethod
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from dataclasses import dataclass
@@ -70,7 +71,7 @@ class DesignError(ValueError):
 
 
 @dataclass(kw_only=True)
-class Built:
+class Built(ABC):
     """One built design: its chain and the object that made it (for tables).
 
     ``continuity`` and ``road_3d`` are filled in by ``write``: the checked
@@ -84,16 +85,9 @@ class Built:
     road_3d: str | None = None
 
     @property
+    @abstractmethod
     def kind(self) -> str:
         """What the design is, as the summary shows it."""
-        raise NotImplementedError
-
-    @property
-    def notes(self) -> dict[str, Any]:
-        """The typed fields as the dict older callers read (``notes["profile"]``, ``notes["continuity"]``)."""
-        names = {"road_3d": "3d"}
-        skip = {"name", "chain", "source"}
-        return {names.get(k, k): v for k, v in vars(self).items() if k not in skip and v is not None}
 
 
 @dataclass(kw_only=True)

@@ -515,7 +515,6 @@ def test_built_designs_are_typed_by_kind():
     rail, loop, cnc, ramp = built
     assert rail.kind == "alignment" and rail.profile is None and rail.cross_section.driving_lanes == 1
     assert ramp.kind == f"transition ({ramp.source.kind})" and cnc.samples is None
-    assert rail.notes == {"cross_section": rail.cross_section}  # the dict view older callers read
     assert summary(built, units).count("\n") == len(built) + 1
 
 

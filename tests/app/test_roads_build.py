@@ -54,7 +54,7 @@ def test_build_writes_the_profile_table_the_3d_step_and_the_xodr(tmp_path, capsy
 
 def test_the_demo_highway_has_a_profile_inside_its_alignment():
     units, (highway, *_) = build(DEMO_DESIGN)
-    profile = highway.notes["profile"]
+    profile = highway.profile
     assert profile.start <= highway.source.start_station and profile.end >= highway.source.end_station
     assert [c.kind for c in profile.curves] == ["crest", "sag"] and all(row.ok for row in profile.checks)
 
@@ -89,10 +89,10 @@ def test_a_profile_without_road_criteria_needs_its_curves():
         build(data)
     data["designs"][0]["profile"]["k_values"] = 20
     (built,) = build(data)[1]
-    assert [c.k for c in built.notes["profile"].curves] == pytest.approx([20, 20])
+    assert [c.k for c in built.profile.curves] == pytest.approx([20, 20])
 
 
 def test_curve_lengths_in_a_design_file_are_whole_lengths_or_halves():
     (built,) = build(design(curve_lengths=[120, [50, 70]]))[1]
-    first, second = built.notes["profile"].curves
+    first, second = built.profile.curves
     assert (first.length_in, first.length_out, second.length_in, second.length_out) == (60, 60, 50, 70)

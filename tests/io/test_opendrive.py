@@ -273,7 +273,7 @@ def test_demo_writes_a_valid_highway_xodr(tmp_path):
 
     (highway, *_) = build(DEMO_DESIGN)[1]
     ((distance, z),) = [np.array(v).T for v in result["elevation"].values()]
-    assert np.abs(z - highway.notes["profile"].elevation(highway.source.start_station + distance)).max() <= 1e-5
+    assert np.abs(z - highway.profile.elevation(highway.source.start_station + distance)).max() <= 1e-5
     assert len(ET.parse(tmp_path / "highway.xodr").getroot().findall("road/lateralProfile/superelevation")) > 4
 
 
