@@ -250,3 +250,26 @@ def python_blocks(text: str, marker: str, name: str = "page") -> list[Block]:
             blocks.append(Block(i + 2, code, found["reason"] if found else None))
         i = end + 1
     return blocks
+
+
+#: Runs blocks as one Python session (one namespace), each compiled at its own line of the page.
+_RUNNER = """
+import json, sys
+page, blocks = json.load(sys.stdin)
+namespace = {"__name__": "__main__"}
+for first_line, code in blocks:
+    exec(compile("\\n" * (first_line - 1) + code, page, "exec"), namespace)
+"""
+
+
+def run_blocks(page: Path, blocks: list[Block], cwd: Path, timeout: float) -> None:
+    """Run a page's blocks that are not marked skip, top to bottom in one fresh Python process in
+    ``cwd``, with the repository first on the path; fail the test with the process's stderr."""
+    import sys
+
+    runnable = [[b.first_line, b.code] for b in blocks if b.skip_reason is None]
+    env = {**os.environ, "MPLBACKEND": "Agg", "PYTHONPATH": os.pathsep.join([str(REPO), os.environ.get("PYTHONPATH", "")])}
+    done = subprocess.run([sys.executable, "-c", _RUNNER], input=json.dumps([str(page), runnable]), capture_output=True,
+                          text=True, cwd=cwd, env=env, timeout=timeout)  # fmt: skip
+    if done.returncode != 0:
+        pytest.fail(done.stderr[-4000:], pytrace=False)

@@ -17,7 +17,6 @@ import ast
 import http.server
 import importlib
 import importlib.util
-import json
 import os
 import re
 import shutil
@@ -27,22 +26,14 @@ import threading
 from pathlib import Path
 
 import pytest
-from helpers import Block, python_blocks
+from helpers import Block, python_blocks, run_blocks
 
 ROOT = Path(__file__).resolve().parents[2]
 DOCS = ROOT / "docs"
 PAGES = sorted(DOCS.rglob("*.md"))
 
+
 # Runs the blocks given on stdin as [first line, code] pairs; tracebacks show the page's own line numbers.
-RUNNER = """
-import json, sys
-page, blocks = json.load(sys.stdin)
-namespace = {"__name__": "__main__"}
-for first_line, code in blocks:
-    exec(compile("\\n" * (first_line - 1) + code, page, "exec"), namespace)
-"""
-
-
 def rel(page: Path) -> str:
     return str(page.relative_to(ROOT))
 
@@ -67,20 +58,7 @@ def test_every_block_is_valid_python(page):
 @pytest.mark.cad
 @pytest.mark.parametrize("page", PAGES_WITH_CODE, ids=rel)
 def test_every_block_runs(page, tmp_path):
-    blocks = python_blocks(page.read_text(encoding="utf-8"), "docs", rel(page))
-    runnable = [[b.first_line, b.code] for b in blocks if b.skip_reason is None]
-    env = {**os.environ, "MPLBACKEND": "Agg", "PYTHONPATH": os.pathsep.join([str(ROOT), os.environ.get("PYTHONPATH", "")])}
-    done = subprocess.run(
-        [sys.executable, "-c", RUNNER],
-        input=json.dumps([str(page), runnable]),
-        capture_output=True,
-        text=True,
-        cwd=tmp_path,
-        env=env,
-        timeout=900,
-    )
-    if done.returncode != 0:
-        pytest.fail(done.stderr[-4000:], pytrace=False)
+    run_blocks(page, python_blocks(page.read_text(encoding="utf-8"), "docs", rel(page)), tmp_path, timeout=900)
 
 
 def _dotted_names() -> list[tuple[str, str]]:

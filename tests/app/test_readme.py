@@ -13,28 +13,15 @@ compiled.
 
 import ast
 import importlib
-import json
-import os
 import re
-import subprocess
-import sys
 from pathlib import Path
 
 import pytest
-from helpers import Block, python_blocks
+from helpers import Block, python_blocks, run_blocks
 
 README = Path(__file__).resolve().parents[2] / "README.md"
 
 # Runs the blocks given on stdin as [first line, code] pairs; tracebacks show README.md's own line numbers.
-RUNNER = """
-import json, sys
-readme, blocks = json.load(sys.stdin)
-namespace = {"__name__": "__main__"}
-for first_line, code in blocks:
-    exec(compile("\\n" * (first_line - 1) + code, readme, "exec"), namespace)
-"""
-
-
 BLOCKS = python_blocks(README.read_text(encoding="utf-8"), "readme", "README.md")
 
 
@@ -50,19 +37,7 @@ def test_every_block_is_valid_python(block):
 
 
 def test_every_block_runs(tmp_path):
-    runnable = [[b.first_line, b.code] for b in BLOCKS if b.skip_reason is None]
-    env = {**os.environ, "MPLBACKEND": "Agg"}
-    done = subprocess.run(
-        [sys.executable, "-c", RUNNER],
-        input=json.dumps([str(README), runnable]),
-        capture_output=True,
-        text=True,
-        cwd=tmp_path,
-        env=env,
-        timeout=600,
-    )
-    if done.returncode != 0:
-        pytest.fail(done.stderr[-4000:], pytrace=False)
+    run_blocks(README, BLOCKS, tmp_path, timeout=600)
 
 
 DOTTED = sorted(set(re.findall(r"`(spiral_cad(?:\.\w+)+)", README.read_text(encoding="utf-8"))))
