@@ -113,3 +113,15 @@ def pytest_collection_modifyitems(config, items):
             item.add_marker(pytest.mark.install)
         if path.name in SLOW or f"{path.name}::{item.originalname}" in SLOW:
             item.add_marker(pytest.mark.slow)
+
+
+@pytest.fixture(scope="session")
+def short_road():
+    """(alignment, profile) of a short road in metres with a crest and a sag whose vertical curves end on
+    spirals and arcs (not at plan joints): the corridor and STEP tests share it."""
+    from spiral_cad.design import Alignment, Profile
+
+    alignment = Alignment.from_pis([(0, 0), (220, 10), (430, 120)], 200, units="m", design_speed=60)
+    end = alignment.end_station
+    profile = Profile.from_pvis([(0, 10), (150, 14), (320, 8), (end, 10)], units="m", design_speed=60, alignment=alignment)
+    return alignment, profile

@@ -10,15 +10,12 @@ from OCP.BRepCheck import BRepCheck_Analyzer  # noqa: E402
 from spiral_cad.build123d import centerline_wire, corridor  # noqa: E402
 from spiral_cad.cad.export import CrossSection, export_step  # noqa: E402
 from spiral_cad.cad.readers import read_shape  # noqa: E402
-from spiral_cad.design import Alignment, Profile, centerline_3d  # noqa: E402
+from spiral_cad.design import Profile, centerline_3d  # noqa: E402
 
 
 @pytest.fixture(scope="module")
-def road():
-    alignment = Alignment.from_pis([(0, 0), (220, 10), (430, 120)], 200, units="m", design_speed=60)
-    end = alignment.end_station
-    profile = Profile.from_pvis([(0, 10), (150, 14), (320, 8), (end, 10)], units="m", design_speed=60, alignment=alignment)
-    return alignment, profile
+def road(short_road):
+    return short_road
 
 
 def test_the_corridor_is_a_valid_solid_with_the_volume_of_its_section(road, tmp_path):

@@ -35,15 +35,12 @@ from OCP.XCAFDoc import XCAFDoc_DocumentTool  # noqa: E402
 
 from spiral_cad.build123d import centerline_wire, corridor  # noqa: E402
 from spiral_cad.cad.export import CrossSection, export_step  # noqa: E402
-from spiral_cad.design import Alignment, Profile  # noqa: E402
 
 
 @pytest.fixture(scope="module")
-def road():
-    """A short road with a crest and a sag whose vertical curves end on spirals and arcs (not at plan joints)."""
-    alignment = Alignment.from_pis([(0, 0), (220, 10), (430, 120)], 200, units="m", design_speed=60)
-    end = alignment.end_station
-    profile = Profile.from_pvis([(0, 10), (150, 14), (320, 8), (end, 10)], units="m", design_speed=60, alignment=alignment)
+def road(short_road):
+    """The short road (conftest) with its corridor."""
+    alignment, profile = short_road
     built = corridor(alignment, profile, CrossSection(driving_lanes=1, lane_width=3.5, shoulder_width=1.0, depth=0.3))
     return alignment, profile, built
 
