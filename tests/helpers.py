@@ -273,3 +273,22 @@ def run_blocks(page: Path, blocks: list[Block], cwd: Path, timeout: float) -> No
                           text=True, cwd=cwd, env=env, timeout=timeout)  # fmt: skip
     if done.returncode != 0:
         pytest.fail(done.stderr[-4000:], pytrace=False)
+
+
+def unresolved(dotted: str) -> str | None:
+    """Why a dotted name the prose gives (``spiral_cad.design.fillet_path``) does not import as written,
+    or None: the longest importable module, then attributes."""
+    import importlib
+
+    parts = dotted.split(".")
+    for split in range(len(parts), 0, -1):
+        try:
+            found = importlib.import_module(".".join(parts[:split]))
+        except ModuleNotFoundError:
+            continue
+        for attribute in parts[split:]:
+            if not hasattr(found, attribute):
+                return f"{dotted}: {'.'.join(parts[:split])} has no {attribute}"
+            found = getattr(found, attribute)
+        return None
+    return f"{dotted}: no such module"

@@ -26,7 +26,7 @@ import threading
 from pathlib import Path
 
 import pytest
-from helpers import Block, python_blocks, run_blocks
+from helpers import Block, python_blocks, run_blocks, unresolved
 
 ROOT = Path(__file__).resolve().parents[2]
 DOCS = ROOT / "docs"
@@ -70,25 +70,11 @@ def _dotted_names() -> list[tuple[str, str]]:
 
 
 # The layer packages the API pages document; the prose names them only as packages.
-FUTURE_FACES = {"spiral_cad.check", "spiral_cad.io", "spiral_cad.app"}
-
-
 @pytest.mark.parametrize(("page", "dotted"), _dotted_names(), ids=lambda x: x)
 def test_every_dotted_name_in_the_text_exists(page, dotted):
     """Names the prose gives in full (`spiral_cad.design.fillet_path`) import as written."""
-    parts = dotted.split(".")
-    for split in range(len(parts), 0, -1):  # the longest importable module, then attributes
-        try:
-            found = importlib.import_module(".".join(parts[:split]))
-        except ModuleNotFoundError:
-            continue
-        for attribute in parts[split:]:
-            if f"{found.__name__}.{attribute}" in FUTURE_FACES:
-                pytest.skip(f"{dotted}: a layer package of the restructured layout")
-            assert hasattr(found, attribute), f"{page}: {dotted}: {'.'.join(parts[:split])} has no {attribute}"
-            found = getattr(found, attribute)
-        return
-    pytest.fail(f"{page}: {dotted}: no such module")
+    problem = unresolved(dotted)
+    assert problem is None, f"{page}: {problem}"
 
 
 def test_every_page_is_in_the_navigation_and_every_image_exists():

@@ -12,12 +12,11 @@ compiled.
 """
 
 import ast
-import importlib
 import re
 from pathlib import Path
 
 import pytest
-from helpers import Block, python_blocks, run_blocks
+from helpers import Block, python_blocks, run_blocks, unresolved
 
 README = Path(__file__).resolve().parents[2] / "README.md"
 
@@ -46,17 +45,8 @@ DOTTED = sorted(set(re.findall(r"`(spiral_cad(?:\.\w+)+)", README.read_text(enco
 @pytest.mark.parametrize("dotted", DOTTED)
 def test_every_dotted_name_in_the_text_exists(dotted):
     """Names the prose gives in full (`spiral_cad.design.fillet_path`) import as written."""
-    parts = dotted.split(".")
-    for split in range(len(parts), 0, -1):  # the longest importable module, then attributes
-        try:
-            found = importlib.import_module(".".join(parts[:split]))
-        except ModuleNotFoundError:
-            continue
-        for attribute in parts[split:]:
-            assert hasattr(found, attribute), f"{dotted}: {'.'.join(parts[:split])} has no {attribute}"
-            found = getattr(found, attribute)
-        return
-    pytest.fail(f"{dotted}: no such module")
+    problem = unresolved(dotted)
+    assert problem is None, problem
 
 
 TEXT = README.read_text(encoding="utf-8")
