@@ -363,11 +363,11 @@ def gcode_program(
         counts["chords"] += 1
     counts["moves"] = len(body)
 
-    unit_note = "" if factor == 1.0 else f", converted from the chain's {chain.units} (x{factor:g})"
+    unit_note = "" if factor == 1.0 else f", converted from the chain's {chain.units}, times {factor:g}"
     arcs_p, chord_p = arcs * factor, chord * factor
     head = [
         f"(spiral_cad: {name or 'path'}, {len(chain)} pieces, length {out.number(chain.length * factor)} {program}, dialect {dialect})",
-        f"(unit: {program} ({UNIT_CODE[program]}){unit_note}; numbers rounded to {10.0**-decimals:g} {program})",
+        f"(unit: {program}, {UNIT_CODE[program]}{unit_note}; numbers rounded to {10.0**-decimals:g} {program})",
         f"(lines: {counts['line']} G1; arcs: {counts['arc']} G2/G3 exact; spirals: {counts['G5']} G5 exact cubic, "
         f"{counts['biarcs']} as biarcs)",
         f"(biarcs within arc tolerance {arcs_p:g} {program}, measured {arc_error * factor:.3g})",
