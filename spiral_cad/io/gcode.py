@@ -17,6 +17,10 @@ What the built-in reader reads (anything else is refused with its line number an
   full turns; helical with the plane's normal axis) in the ``G17``/``G18``/``G19`` plane, as
   chords within ``arc_tolerance`` when it is given (refused by name otherwise), with
   LinuxCNC's tolerance on radii that differ;
+* cubic splines ``G5`` (``I J``: start to first control point, ``P Q``: end to second control
+  point) in the ``G17`` plane, with LinuxCNC's rules (P and Q always; I and J both or neither,
+  neither only after another G5, which continues its direction; no Z), as chords within
+  ``arc_tolerance`` (refused by name otherwise);
 * ``G90``/``G91`` absolute/incremental coordinates, ``G90.1``/``G91.1`` arc centres;
 * ``G20`` inch and ``G21`` mm: one of them must come before the first move (a CNC path in
   the wrong unit is worse than none), and the unit may not change after it;
@@ -37,7 +41,7 @@ LinuxCNC's modal rules: two codes of one modal group on a line (``G90 G91``, ``G
 Refused by name, with the line: canned cycles ``G73``–``G89`` (use ``interpreter="rs274"``,
 which expands them), ``G28``/``G30`` (moves to a home position the program does not state),
 ``G10``, ``G52``, ``G53``, ``G92`` (offsets), cutter compensation ``G41``/``G42``, tool length
-offsets ``G43``, ``G33``, probing ``G38``, splines and NURBS ``G5``–``G6.2``, ``G7``,
+offsets ``G43``, ``G33``, probing ``G38``, splines and NURBS ``G5.1``–``G6.2``, ``G7``,
 parameters (``#``), expressions (``[``) and O-words (use ``interpreter="rs274"``), other words
 (``A``, ``B``, ``C``, ``U``, ``V``, ``W``, ``L``, ``H``, ``E``, …), numbers that are not finite,
 text that is not a word (``X1e3``, ``X--1``), an unclosed comment, control characters (line
@@ -45,6 +49,9 @@ breaks are ``\n``, ``\r\n`` or ``\r``; a vertical tab, form feed or Unicode line
 refused, not read as a line break), lines longer than 65 536 characters, and bytes that are
 not UTF-8. LinuxCNC also refuses a program with neither M2/M30 nor ``%``; this reader takes the
 end of the file as its end.
+
+``read_gcode_chain`` reads a program as its exact path instead: lines, arcs and G5 cubics as the
+chain's segments (what ``spiral_cad.io.gcode_write`` writes reads back as the same chain).
 
 A move that ends where it started is not a point of the path (it would be a corner of no
 length); the path's first point is where the first move ends. Long reads and roundings say
