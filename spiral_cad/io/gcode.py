@@ -793,7 +793,10 @@ def parse_gcode_chain(text: str, source: str = "G-code", *, units: str | None = 
         return Chain(segments, tolerance=tolerance, units=target)
     except JointError as error:
         joint = error.joint
-        raise ValueError(f"{source} lines {owners[joint]} and {owners[joint + 1]}: {error}") from None
+        raise ValueError(
+            f"{source} lines {owners[joint]} and {owners[joint + 1]}: {error}; the program's curves do not join G2 "
+            "(arcs that approximate a curve, such as biarcs, never do)"
+        ) from None
 
 
 def read_gcode_chain(path: str | os.PathLike, *, units: str | None = None, tolerance: float = 1e-6) -> Chain:

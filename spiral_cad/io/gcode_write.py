@@ -16,9 +16,10 @@ Two dialects (``dialect=``):
 
 The program states its unit with ``G21`` (mm) or ``G20`` (inch): a chain in mm or inches
 is written as it is, one in cm, m or km is converted to mm, one in feet to inches (said in
-the header). Every number is written with a fixed number of decimals (``decimals``,
-default 9 in mm and 10 in inches: about a nanometre, far inside any tolerance; G-code has
-no exponent notation), and arc centres and spline offsets are differences of the rounded
+the header). Every number is written with a fixed number of decimals (``decimals``; by
+default 15 significant digits for the largest coordinate, between 6 and 15 decimals: the
+doubles nearly to the last bit, far inside any tolerance; G-code has no exponent
+notation), and arc centres and spline offsets are differences of the rounded
 points, so a reader lands on the rounded control points exactly. The header (comments)
 states the dialect, the unit, what each piece became and the tolerances with the distance
 measured for every approximation.
@@ -48,8 +49,9 @@ DIALECTS = ("linuxcnc", "generic")
 #: The program's unit for a chain's unit (G-code has only mm and inches).
 PROGRAM_UNIT = {"mm": "mm", "cm": "mm", "m": "mm", "km": "mm", "in": "in", "ft": "in"}
 UNIT_CODE = {"mm": "G21", "in": "G20"}
-#: Default decimals per program unit (1e-9 mm, 1e-10 in).
-DECIMALS = {"mm": 9, "in": 10}
+#: Significant digits of the largest coordinate by default (float64 holds 15 to 17), and the fewest and most decimals.
+DIGITS = 15
+MIN_DECIMALS, MAX_DECIMALS = 6, 15
 #: Default feed (program unit per minute) and tolerances (in mm, converted to the chain's unit).
 FEED = {"mm": 1000.0, "in": 40.0}
 TOLERANCE_MM = 0.001
@@ -267,7 +269,8 @@ def gcode_program(
         plane_tolerance: how far (the chain's unit) a piece's points may spread across a principal
             plane and still be written in it (default: half the last printed decimal).
         rapid_to_start: begin with a ``G0`` to the chain's start.
-        decimals: decimals of every number (default 9 in mm, 10 in inches).
+        decimals: decimals of every number (default: 15 significant digits for the largest
+            coordinate, at least 6 and at most 15 decimals).
         name: the path's name, for the header comment.
 
     Raises:
@@ -286,8 +289,9 @@ def gcode_program(
     default = TOLERANCE_MM / MM_PER_UNIT[chain.units]
     chord = default if chord_tolerance is None else _positive(chord_tolerance, "chord_tolerance")
     arcs = default if arc_tolerance is None else _positive(arc_tolerance, "arc_tolerance")
-    if decimals is None:
-        decimals = DECIMALS[program]
+    if decimals is None:  # DIGITS significant digits for the largest coordinate: the doubles, nearly to the bit
+        extent = float(np.abs(chain.rows.geometry).max()) * factor
+        decimals = min(MAX_DECIMALS, max(MIN_DECIMALS, DIGITS - max(0, math.ceil(math.log10(max(extent, 1.0))))))
     if isinstance(decimals, bool) or not isinstance(decimals, int) or not 1 <= decimals <= 15:
         raise ValueError(f"decimals must be a whole number from 1 to 15; got {decimals!r:.40}")
     plane_tol = 0.5 * 10.0**-decimals / factor if plane_tolerance is None else _positive(plane_tolerance, "plane_tolerance")
