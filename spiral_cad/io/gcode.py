@@ -417,6 +417,7 @@ class _Reader:
             self.pieces.append(("arc", number, False, list(start), end, self.plane, ca, cb, rotation))
             self.add(number, end)
             return
+        assert self.arc_tolerance is not None  # refused above unless exact
         tolerance = in_program_unit(self.arc_tolerance, self.arc_units, self.units or "mm")
         for point in arc_points(start, end, self.plane, ca, cb, rotation, tolerance):
             self.add(number, point)
@@ -758,7 +759,8 @@ def parse_gcode_chain(text: str, source: str = "G-code", *, units: str | None = 
     pieces = pieces[first:]
     flat = all(p[3][2] == 0.0 and (p[0] == "cubic" or p[4][2] == 0.0) and (p[0] != "arc" or p[5] == 170) for p in pieces)
     dim = 2 if flat else 3
-    segments, owners = [], []
+    segments: list[Line | Arc | BezierSpiral] = []
+    owners: list[int] = []
     for kind, number, rapid, start, *data in pieces:
         if rapid:
             raise ValueError(f"{source} line {number}: a rapid move (G0) between feed moves; the path is the feed moves "

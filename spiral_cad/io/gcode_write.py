@@ -131,9 +131,7 @@ class _Writer:
         """An arc about ``centre`` (rounded) to ``end`` (rounded) in ``plane``, counterclockwise about its normal axis."""
         name, first, second, _ = plane
         self.set_plane(name)
-        offsets = " ".join(
-            f"{CENTRE_WORDS[a]}{self.number(centre[a] - self.position[a])}" for a in sorted((first, second))
-        )
+        offsets = " ".join(f"{CENTRE_WORDS[a]}{self.number(centre[a] - self.position[a])}" for a in sorted((first, second)))
         self.lines.append(f"{'G3' if ccw else 'G2'} {self.axes(end)} {offsets}")
         self.position = end
 
@@ -339,20 +337,20 @@ def gcode_program(
                 counts["G5"] += 1
                 continue
             if plane is not None:
-                name_, first, second, normal_axis = plane
+                _, first, second, normal_axis = plane
                 flat = cp[:, [first, second]]
                 pieces, error = spiral_biarcs(flat, arcs)
                 arc_error = max(arc_error, error)
                 level = float(cp[:, normal_axis].mean())
-                for end, centre, radius in pieces:
+                for end, about, radius in pieces:
                     point = np.zeros(3)
                     point[first], point[second], point[normal_axis] = end[0], end[1], level
                     target = out.rounded(point)
-                    if centre is None:
+                    if about is None:
                         out.line(target)
                     else:
                         middle = np.zeros(3)
-                        middle[first], middle[second], middle[normal_axis] = centre[0], centre[1], level
+                        middle[first], middle[second], middle[normal_axis] = about[0], about[1], level
                         out.arc(plane, out.rounded(middle), target, radius > 0.0)
                 counts["biarcs"] += 1
                 continue
@@ -370,7 +368,7 @@ def gcode_program(
     unit_note = "" if factor == 1.0 else f", converted from the chain's {chain.units}, times {factor:g}"
     arcs_p, chord_p = arcs * factor, chord * factor
     head = [
-        f"(spiral_cad: {name or 'path'}, {len(chain)} pieces, length {out.number(chain.length * factor)} {program}, dialect {dialect})",
+        f"(spiral_cad: {name or 'path'}, {len(chain)} pieces, length {chain.length * factor:.6f} {program}, dialect {dialect})",
         f"(unit: {program}, {UNIT_CODE[program]}{unit_note}; numbers rounded to {10.0**-decimals:g} {program})",
         f"(lines: {counts['line']} G1; arcs: {counts['arc']} G2/G3 exact; spirals: {counts['G5']} G5 exact cubic, "
         f"{counts['biarcs']} as biarcs)",
