@@ -67,10 +67,9 @@ def child(job: str, moves: int) -> None:
         read = time.perf_counter() - started
         rounded = 0.0
         if job == "write":
+            from spiral_cad.design import round_corners
             from spiral_cad.io.gcode import parse_gcode_chain
             from spiral_cad.io.gcode_write import gcode_program
-
-            from spiral_cad.design import round_corners
 
             # the program's moves in the plane (every corner a G5 pair; LinuxCNC takes G5 in XY only)
             chain = round_corners(path.points[~path.rapid][1:, :2], max_deviation=MAX_DEVIATION, units=path.units).chain
