@@ -36,13 +36,13 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ..core import bezier
-from ..core._chain_kernels import ARC, LINE
+from ..core._chain_kernels import ARC, LINE, SPIRAL
 from ..core.chain import Chain
 from ..core.segments import Arc
 from ..core.units import MM_PER_UNIT
 from .samples import sample_path
 
-__all__ = ["DIALECTS", "GcodeProgram", "gcode_program", "write_gcode"]
+__all__ = ["DIALECTS", "GcodeProgram", "gcode_program", "spiral_biarcs", "spirals_biarcs", "write_gcode"]
 
 #: The dialects ``write_gcode`` writes.
 DIALECTS = ("linuxcnc", "generic")
@@ -147,96 +147,100 @@ def _plane_of(points: NDArray, normal: NDArray | None, tolerance: float) -> tupl
     return None
 
 
-def _arc_through(start: NDArray, tangent: NDArray, end: NDArray) -> tuple[NDArray, float] | None:
-    """The circle leaving ``start`` along ``tangent`` through ``end``: (centre, signed radius, positive
-    counterclockwise), or None when ``end`` lies on the tangent (a line)."""
+Piece = tuple[NDArray, NDArray | None, float]
+
+
+def _arcs_through(start: NDArray, tangent: NDArray, end: NDArray) -> tuple[NDArray, NDArray, NDArray]:
+    """The circles leaving each ``start`` (m, 2) along ``tangent`` through ``end``: (centres, signed radii,
+    positive counterclockwise, and whether the piece is a line: ``end`` on the tangent)."""
     chord = end - start
-    normal = np.array([-tangent[1], tangent[0]])
-    across = float(chord @ normal)
-    along = float(chord @ chord)
-    if abs(across) <= 1e-14 * along:
-        return None
-    radius = along / (2.0 * across)
-    return start + radius * normal, radius
+    normal = np.stack([-tangent[:, 1], tangent[:, 0]], axis=1)
+    across = np.einsum("ij,ij->i", chord, normal)
+    along = np.einsum("ij,ij->i", chord, chord)
+    line = np.abs(across) <= 1e-14 * along
+    radius = np.where(line, 0.0, along / (2.0 * np.where(line, 1.0, across)))
+    return start + radius[:, None] * normal, radius, line
 
 
-def _biarc(p0: NDArray, t0: NDArray, p1: NDArray, t1: NDArray) -> list[tuple[NDArray, NDArray | None, float]]:
-    """Two tangent arcs from ``p0`` (tangent ``t0``) to ``p1`` (tangent ``t1``), equal legs to the joint
-    (the biarc LinuxCNC's own G5 uses): [(end, centre or None for a line, signed radius)]."""
-    chord = p1 - p0
-    s = t0 + t1
-    a = 2.0 * (float(t0 @ t1) - 1.0)
-    b = -2.0 * float(chord @ s)
-    c = float(chord @ chord)
-    if abs(a) < 1e-12:
-        leg = c / -b if b < 0.0 else math.nan
-    else:
-        leg = (-b - math.sqrt(max(b * b - 4.0 * a * c, 0.0))) / (2.0 * a)  # the positive root (a < 0 < c)
-    if not leg > 0.0:
-        raise ValueError("no biarc")
-    q0, q1 = p0 + leg * t0, p1 - leg * t1
-    joint = (q0 + q1) / 2.0
-    middle = q1 - q0
-    middle = middle / np.linalg.norm(middle)
-    pieces: list[tuple[NDArray, NDArray | None, float]] = []
-    for start, tangent, end in ((p0, t0, joint), (joint, middle, p1)):
-        circle = _arc_through(start, tangent, end)
-        pieces.append((end, None, 0.0) if circle is None else (end, circle[0], circle[1]))
-    return pieces
+def _distances(points: NDArray, start: NDArray, end: NDArray, centre: NDArray, radius: NDArray, line: NDArray) -> NDArray:
+    """Distance of points (m, k, 2) from each piece: the arc from ``start`` to ``end`` about ``centre``
+    (or the line, where ``line``)."""
+    chord = (end - start)[:, None]
+    length2 = np.maximum(np.einsum("ijk,ijk->ij", chord, chord), np.finfo(float).tiny)
+    t = np.clip(np.einsum("ijk,ijk->ij", points - start[:, None], chord) / length2, 0.0, 1.0)
+    to_line = np.linalg.norm(points - start[:, None] - t[..., None] * chord, axis=-1)
+    sense = np.where(radius >= 0.0, 1.0, -1.0)[:, None]
+    a0 = np.arctan2(start[:, 1] - centre[:, 1], start[:, 0] - centre[:, 0])[:, None]
+    sweep = (sense * (np.arctan2(end[:, 1] - centre[:, 1], end[:, 0] - centre[:, 0])[:, None] - a0)) % (2 * math.pi)
+    offset = points - centre[:, None]
+    angle = (sense * (np.arctan2(offset[..., 1], offset[..., 0]) - a0)) % (2 * math.pi)
+    on_circle = np.abs(np.linalg.norm(offset, axis=-1) - np.abs(radius)[:, None])
+    to_ends = np.minimum(np.linalg.norm(points - start[:, None], axis=-1), np.linalg.norm(points - end[:, None], axis=-1))
+    return np.where(line[:, None], to_line, np.where(angle <= sweep, on_circle, to_ends))
 
 
-def _distance_to_arc(points: NDArray, start: NDArray, end: NDArray, centre: NDArray | None, radius: float) -> NDArray:
-    """Distance of each point from the arc (or line, ``centre`` None) from ``start`` to ``end``."""
-    if centre is None:
-        chord = end - start
-        t = np.clip((points - start) @ chord / float(chord @ chord), 0.0, 1.0)
-        return np.linalg.norm(points - (start + t[:, None] * chord), axis=1)
-    sense = 1.0 if radius > 0.0 else -1.0
-    a0 = math.atan2(start[1] - centre[1], start[0] - centre[0])
-    sweep = (sense * (math.atan2(end[1] - centre[1], end[0] - centre[0]) - a0)) % (2 * math.pi)
-    offset = points - centre
-    angle = (sense * (np.arctan2(offset[:, 1], offset[:, 0]) - a0)) % (2 * math.pi)
-    on_circle = np.abs(np.linalg.norm(offset, axis=1) - abs(radius))
-    to_ends = np.minimum(np.linalg.norm(points - start, axis=1), np.linalg.norm(points - end, axis=1))
-    return np.where(angle <= sweep, on_circle, to_ends)
-
-
-def spiral_biarcs(control_points: NDArray, tolerance: float) -> tuple[list[tuple[NDArray, NDArray | None, float]], float]:
-    """Biarcs within ``tolerance`` of a plane cubic (``control_points`` (4, 2)): the pieces
+def spirals_biarcs(control_points: NDArray, tolerance: float) -> list[tuple[list[Piece], float]]:
+    """Biarcs within ``tolerance`` of plane cubics (``control_points`` (n, 4, 2)): for each, the pieces
     [(end, centre or None for a line, signed radius)] in travel order and the largest measured distance.
 
-    The parameter interval is halved until every biarc stays within ``tolerance`` of the cubic at
-    ``BIARC_PROBES`` points of each piece and is itself within it at the points of its arcs.
+    A biarc is two tangent arcs between two points of the cubic with its tangents there, with equal
+    legs to their joint (the construction LinuxCNC uses for G5). Each cubic's parameter interval is
+    halved until every biarc is within ``tolerance`` of the cubic at ``BIARC_PROBES`` points between its
+    ends; all cubics are fitted at once, a level of halvings at a time.
 
     Raises:
-        ValueError: no biarc within ``tolerance`` after ``MAX_DEPTH`` halvings.
+        ValueError: no biarcs within ``tolerance`` after ``MAX_DEPTH`` halvings.
     """
-    out: list[tuple[NDArray, NDArray | None, float]] = []
-    worst = 0.0
-    pending = [(0.0, 1.0, 0)]
-    while pending:
-        u0, u1, depth = pending.pop()
-        p0, p1 = bezier.point(control_points, u0), bezier.point(control_points, u1)
-        t0, t1 = bezier.tangent(control_points, u0), bezier.tangent(control_points, u1)
-        probes = bezier.point(control_points, np.linspace(u0, u1, BIARC_PROBES + 2)[1:-1])
-        try:
-            pieces = _biarc(p0, t0, p1, t1)
-            start, distance = p0, np.full(len(probes), np.inf)
-            for end, centre, radius in pieces:
-                distance = np.minimum(distance, _distance_to_arc(probes, start, end, centre, radius))
-                start = end
-            error = float(distance.max())
-        except (ValueError, ZeroDivisionError, FloatingPointError):
-            error = math.inf
-        if error <= tolerance:
-            out.extend(pieces)
-            worst = max(worst, error)
-        elif depth >= MAX_DEPTH:
-            raise ValueError(f"arc_tolerance {tolerance:g}: no biarcs within it after {MAX_DEPTH} halvings of the spiral")
-        else:
-            middle = (u0 + u1) / 2.0
-            pending += [(middle, u1, depth + 1), (u0, middle, depth + 1)]  # the first half is popped first
-    return out, worst
+    cps = np.asarray(control_points, dtype=float)
+    found: list[list[tuple[float, list[Piece]]]] = [[] for _ in range(len(cps))]
+    worst = np.zeros(len(cps))
+    owner, u0, u1 = np.arange(len(cps)), np.zeros(len(cps)), np.ones(len(cps))
+    inside = np.linspace(0.0, 1.0, BIARC_PROBES + 2)[1:-1]
+    for _ in range(MAX_DEPTH + 1):
+        if not len(owner):
+            break
+        curves = cps[owner]
+        ends = bezier.point(curves, np.stack([u0, u1], axis=1))
+        tangents = bezier.tangent(curves, np.stack([u0, u1], axis=1))
+        probes = bezier.point(curves, u0[:, None] + (u1 - u0)[:, None] * inside)
+        p0, p1, t0, t1 = ends[:, 0], ends[:, 1], tangents[:, 0], tangents[:, 1]
+        chord = p1 - p0
+        a = 2.0 * (np.einsum("ij,ij->i", t0, t1) - 1.0)
+        b = -2.0 * np.einsum("ij,ij->i", chord, t0 + t1)
+        c = np.einsum("ij,ij->i", chord, chord)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            root = (-b - np.sqrt(np.maximum(b * b - 4.0 * a * c, 0.0))) / (2.0 * a)  # the positive root (a < 0 < c)
+            leg = np.where(np.abs(a) < 1e-12, c / -b, root)
+            q0, q1 = p0 + leg[:, None] * t0, p1 - leg[:, None] * t1
+            joint = (q0 + q1) / 2.0
+            middle = (q1 - q0) / np.linalg.norm(q1 - q0, axis=1, keepdims=True)
+            first = _arcs_through(p0, t0, joint)
+            second = _arcs_through(joint, middle, p1)
+            error = np.minimum(_distances(probes, p0, joint, *first), _distances(probes, joint, p1, *second)).max(axis=1)
+        good = (leg > 0.0) & np.isfinite(error) & (error <= tolerance)
+        for k in np.flatnonzero(good):
+            pieces: list[Piece] = [
+                (joint[k], None if first[2][k] else first[0][k], float(first[1][k])),
+                (p1[k], None if second[2][k] else second[0][k], float(second[1][k])),
+            ]
+            found[owner[k]].append((float(u0[k]), pieces))
+            worst[owner[k]] = max(worst[owner[k]], float(error[k]))
+        bad = ~good
+        half = (u0[bad] + u1[bad]) / 2.0
+        owner = np.repeat(owner[bad], 2)
+        u0, u1 = np.ravel(np.stack([u0[bad], half], axis=1)), np.ravel(np.stack([half, u1[bad]], axis=1))
+    if len(owner):
+        raise ValueError(f"arc_tolerance {tolerance:g}: no biarcs within it after {MAX_DEPTH} halvings of a spiral")
+    return [([piece for _, pieces in sorted(own, key=lambda f: f[0]) for piece in pieces], float(w)) for own, w in zip(found, worst)]
+
+
+def spiral_biarcs(control_points: NDArray, tolerance: float) -> tuple[list[Piece], float]:
+    """Biarcs within ``tolerance`` of one plane cubic (4, 2): ``spirals_biarcs`` of one.
+
+    Raises:
+        ValueError: as ``spirals_biarcs``.
+    """
+    return spirals_biarcs(np.asarray(control_points, dtype=float)[None], tolerance)[0]
 
 
 def gcode_program(
@@ -305,13 +309,24 @@ def gcode_program(
         out.line(out.rounded(chain.start), "G0")
     else:
         out.position = out.rounded(chain.start)
-    for i, segment in enumerate(chain):
-        kind = int(rows.kind[i])
+    kinds = np.asarray(rows.kind)
+    # the principal plane of every spiral, and the biarcs of those G5 cannot carry, fitted at once per plane
+    planes = {int(i): _plane_of(rows.geometry[i, :, :3], None, plane_tol) for i in np.flatnonzero(kinds == SPIRAL)}
+    fits: dict[int, tuple[list[Piece], float]] = {}
+    for plane_name, first, second, _ in PLANES:
+        wanted = [i for i, plane in planes.items() if plane is not None and plane[0] == plane_name
+                  and not (plane_name == "G17" and dialect == "linuxcnc")]  # fmt: skip
+        if wanted:
+            fitted = spirals_biarcs(rows.geometry[wanted][:, :, [first, second]], arcs)
+            fits.update(zip(wanted, fitted))
+    for i in range(len(chain)):
+        kind = int(kinds[i])
+        geometry = rows.geometry[i]
         if kind == LINE:
-            out.line(out.rounded(segment.end))
+            out.line(out.rounded(geometry[1]))
             counts["line"] += 1
             continue
-        geometry = rows.geometry[i]
+        segment = chain[i]
         if kind == ARC:
             assert isinstance(segment, Arc)
             normal = segment.normal
@@ -325,8 +340,8 @@ def gcode_program(
                 continue
         else:
             cp = geometry[:, :3]
-            plane = _plane_of(cp, None, plane_tol)
-            if plane is not None and plane[0] == "G17" and dialect == "linuxcnc":
+            plane = planes[i]
+            if plane is not None and i not in fits:  # G5: XY, LinuxCNC
                 out.set_plane("G17")
                 p = [out.rounded(point) for point in cp]
                 start = out.position
@@ -338,8 +353,7 @@ def gcode_program(
                 continue
             if plane is not None:
                 _, first, second, normal_axis = plane
-                flat = cp[:, [first, second]]
-                pieces, error = spiral_biarcs(flat, arcs)
+                pieces, error = fits[i]
                 arc_error = max(arc_error, error)
                 level = float(cp[:, normal_axis].mean())
                 for end, about, radius in pieces:
