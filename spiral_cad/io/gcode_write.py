@@ -31,6 +31,7 @@ import math
 import os
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
@@ -244,7 +245,7 @@ def spiral_biarcs(control_points: NDArray, tolerance: float) -> tuple[list[Piece
 
 
 def gcode_program(
-    chain: Chain,
+    chain: Chain | Any,
     *,
     dialect: str = "linuxcnc",
     feed: float | None = None,
@@ -259,7 +260,8 @@ def gcode_program(
     """The G-code program of ``chain`` and what it holds (see the module docstring; ``write_gcode`` writes it).
 
     Args:
-        chain: the path, in the plane (written without Z: the machine's Z is kept) or in space.
+        chain: the path, in the plane (written without Z: the machine's Z is kept) or in space; or an
+            object that holds one as ``chain`` (a ``RoundedPath``, ``CircleChain``, ``Alignment``).
         dialect: ``"linuxcnc"`` (G5 for spirals in XY) or ``"generic"`` (no G5: biarcs).
         feed: the F word, in the program's unit per minute (default 1000 mm/min, 40 in/min).
         units: the program's unit, ``"mm"`` (G21) or ``"in"`` (G20); default from the chain's
@@ -279,8 +281,10 @@ def gcode_program(
         ValueError: not a chain, an unknown dialect or unit, a feed or tolerance that is not a
             positive finite number, decimals outside 1–15, coordinates beyond 1e9 program units.
     """
+    if not isinstance(chain, Chain) and isinstance(getattr(chain, "chain", None), Chain):
+        chain = chain.chain
     if not isinstance(chain, Chain):
-        raise ValueError(f"chain must be a Chain; got {type(chain).__name__}")
+        raise ValueError(f"chain must be a Chain (or hold one as .chain); got {type(chain).__name__}")
     if dialect not in DIALECTS:
         raise ValueError(f"dialect must be one of {', '.join(DIALECTS)}; got {dialect!r:.40}")
     program = PROGRAM_UNIT[chain.units] if units is None else units
@@ -409,15 +413,30 @@ def _chord_error(points: NDArray, between: NDArray) -> float:
     return float(np.linalg.norm(between - (a + t[:, None] * chord), axis=1).max(initial=0.0))
 
 
-def write_gcode(chain: Chain, path: str | os.PathLike | None = None, **options) -> str | Path:
-    """Write ``chain`` as a G-code program (``gcode_program``'s ``options``): the file's path, or the
-    text when ``path`` is None.
+def write_gcode(
+    chain: Chain | Any,
+    path: str | os.PathLike | None = None,
+    *,
+    dialect: str = "linuxcnc",
+    feed: float | None = None,
+    units: str | None = None,
+    chord_tolerance: float | None = None,
+    arc_tolerance: float | None = None,
+    plane_tolerance: float | None = None,
+    rapid_to_start: bool = True,
+    decimals: int | None = None,
+    name: str | None = None,
+) -> str | Path:
+    """Write a chain (or a rounded path, circle chain or alignment: its ``chain``) as a G-code program
+    (see ``gcode_program`` for the options): the file's path, or the text when ``path`` is None.
 
     Raises:
         ValueError: as ``gcode_program``.
         OSError: the file could not be written.
     """
-    program = gcode_program(chain, **options)
+    program = gcode_program(chain, dialect=dialect, feed=feed, units=units, chord_tolerance=chord_tolerance,
+                            arc_tolerance=arc_tolerance, plane_tolerance=plane_tolerance, rapid_to_start=rapid_to_start,
+                            decimals=decimals, name=name)  # fmt: skip
     if path is None:
         return program.text
     target = Path(path)

@@ -69,8 +69,10 @@ def test_a_plane_path_is_lines_and_exact_g5_cubics():
 
 
 def test_our_reader_reads_the_program_back_as_the_same_chain(tmp_path):
-    chain = robot()
-    path = write_gcode(chain, tmp_path / "robot.ngc")
+    points = np.array([[0, 0], [1.0, 0.1], [1.4, 0.9], [2.4, 1.0], [2.6, 0.2], [3.6, 0.4]]) * 20.0
+    rounded = round_corners(points, max_curvature=0.3, units="mm")
+    chain = rounded.chain
+    path = write_gcode(rounded, tmp_path / "robot.ngc")  # a rounded path writes its chain
     again = read_gcode_chain(path)
     assert again.units == "mm" and again.dim == 2 and len(again) == len(chain)
     assert np.asarray(again.rows.kind).tolist() == np.asarray(chain.rows.kind).tolist()
@@ -239,7 +241,7 @@ def test_a_program_that_is_not_g2_is_refused_naming_its_lines():
 def test_refusals(options, message):
     with pytest.raises(ValueError, match=message):
         gcode_program(robot(), **options)
-    with pytest.raises(ValueError, match=r"chain must be a Chain; got list"):
+    with pytest.raises(ValueError, match=r"chain must be a Chain \(or hold one as .chain\); got list"):
         gcode_program([])  # type: ignore[arg-type]
 
 
