@@ -448,6 +448,8 @@ class _Reader:
         z = start[2]
         cp = np.array([[start[0], start[1], z], [start[0] + i, start[1] + j, z],
                        [end[0] + pq["P"], end[1] + pq["Q"], z], [end[0], end[1], z]])  # fmt: skip
+        if not np.isfinite(cp).all() or not np.isfinite(np.diff(cp, axis=0)).all():
+            raise self.error(number, "the G5 spline's control points are beyond the float range")
         if self.exact:
             self.pieces.append(("cubic", number, False, list(start), cp))
             self.add(number, list(end))
@@ -459,7 +461,11 @@ class _Reader:
                 "arc_tolerance (splines become chords within it)",
             )
         tolerance = in_program_unit(self.arc_tolerance, self.arc_units, self.units or "mm")
-        for point in spline_points(cp, tolerance):
+        try:
+            chords = spline_points(cp, tolerance)
+        except ValueError as error:
+            raise self.error(number, str(error)) from None
+        for point in chords:
             self.add(number, point)
             self.position = point
 
@@ -765,30 +771,13 @@ def parse_gcode_chain(text: str, source: str = "G-code", *, units: str | None = 
         if rapid:
             raise ValueError(f"{source} line {number}: a rapid move (G0) between feed moves; the path is the feed moves "
                              "after the rapids to its start")  # fmt: skip
-        begin = np.array(start) * factor
-        if kind == "line":
-            end = np.array(data[0]) * factor
-            if np.array_equal(begin, end):
-                continue
-            segments.append(Line(begin[:dim], end[:dim]))
-        elif kind == "arc":
-            end, plane, ca, cb, rotation = data
-            a, b, normal = PLANES[plane]
-            if end[normal] != start[normal] or abs(rotation) != 1:
-                raise ValueError(f"{source} line {number}: a helical or multi-turn arc is not one arc of a chain")
-            t0, sweep = arc_sweep(start, end, plane, ca, cb, rotation)
-            radius = math.hypot(start[a] - ca, start[b] - cb) * factor
-            if dim == 2:
-                segments.append(Arc((ca * factor, cb * factor), math.copysign(radius, sweep), t0, abs(sweep)))
-            else:
-                centre = begin.copy()
-                centre[a], centre[b] = ca * factor, cb * factor
-                axis = np.zeros(3)
-                axis[normal] = 1.0
-                segments.append(Arc.in_space(centre, axis, begin, sweep))
-        else:
-            segments.append(BezierSpiral.from_control_points(np.asarray(data[0])[:, :dim] * factor))
-        owners.append(number)
+        try:
+            segment = _piece_segment(kind, start, data, factor, dim)
+        except ValueError as error:
+            raise ValueError(f"{source} line {number}: {error}") from None
+        if segment is not None:
+            segments.append(segment)
+            owners.append(number)
     if not segments:
         raise ValueError(f"{source}: no feed move to a new position; a path needs one")
     try:
@@ -799,6 +788,34 @@ def parse_gcode_chain(text: str, source: str = "G-code", *, units: str | None = 
             f"{source} lines {owners[joint]} and {owners[joint + 1]}: {error}; the program's curves do not join G2 "
             "(arcs that approximate a curve, such as biarcs, never do)"
         ) from None
+    except ValueError as error:
+        raise ValueError(f"{source}: {error}") from None
+
+
+def _piece_segment(kind: str, start: list[float], data: list[Any], factor: float, dim: int) -> Any:
+    """The chain segment of one move read in exact mode (None for a move that goes nowhere)."""
+    from ..core.segments import Arc, Line
+    from ..core.spiral import BezierSpiral
+
+    begin = np.array(start) * factor
+    if kind == "line":
+        end = np.array(data[0]) * factor
+        return None if np.array_equal(begin, end) else Line(begin[:dim], end[:dim])
+    if kind == "arc":
+        end, plane, ca, cb, rotation = data
+        a, b, normal = PLANES[plane]
+        if end[normal] != start[normal] or abs(rotation) != 1:
+            raise ValueError("a helical or multi-turn arc is not one arc of a chain")
+        t0, sweep = arc_sweep(start, end, plane, ca, cb, rotation)
+        radius = math.hypot(start[a] - ca, start[b] - cb) * factor
+        if dim == 2:
+            return Arc((ca * factor, cb * factor), math.copysign(radius, sweep), t0, abs(sweep))
+        centre = begin.copy()
+        centre[a], centre[b] = ca * factor, cb * factor
+        axis = np.zeros(3)
+        axis[normal] = 1.0
+        return Arc.in_space(centre, axis, begin, sweep)
+    return BezierSpiral.from_control_points(np.asarray(data[0])[:, :dim] * factor)
 
 
 def read_gcode_chain(path: str | os.PathLike, *, units: str | None = None, tolerance: float = 1e-6) -> Chain:

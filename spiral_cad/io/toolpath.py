@@ -122,7 +122,9 @@ def spline_points(control_points: NDArray, tolerance: float) -> list[list[float]
         for inner in (1, 2):
             offset = pieces[:, inner] - pieces[:, 0]
             t = np.clip(np.einsum("ij,ij->i", offset, chord) / np.where(length2 > 0.0, length2, 1.0), 0.0, 1.0)
-            worst = max(worst, float(np.linalg.norm(offset - t[:, None] * chord, axis=1).max()))
+            worst = float(np.maximum(worst, np.linalg.norm(offset - t[:, None] * chord, axis=1)).max())  # NaN stays NaN
+        if not math.isfinite(worst):
+            raise ValueError("a G5 spline too large for float64 arithmetic")
         if worst <= tolerance:
             return [list(map(float, p)) for p in pieces[:, 3]]
         count *= 2

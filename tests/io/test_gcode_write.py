@@ -205,6 +205,11 @@ def test_g5_is_read_as_linuxcnc_reads_it():
         ("G21 G1 X0 F1\nG18 G5 I1 J0 P0 Q1 X1 Y1\n", r"line 2: G5 .* needs the XY plane \(G17\)"),
         ("G21 G1 X0 F1\nG5 I1 J0 P0 Q1 X1 Y1 Z1\n", r"line 2: G5 .* moves X and Y only"),
         ("G21 G1 X0 F1\nG1 X1\nG5 P0 Q-3 X2 Y1\n", r"line 3: the first G5 of a series needs I and J"),
+        (
+            f"G21\nG1 X{'9' * 308} F1\nG5 I{'9' * 308} J0 P0 Q0 X1 Y1\n",
+            r"line 3: the G5 spline's control points are beyond the float range",
+        ),
+        ("G21\nG1 X1 F1\nG5 I0 J0 P0 Q0 X2 Y0\n", r"line 3: control_points make a degenerate spiral"),  # not a chain's segment
     ],
 )
 def test_g5_refusals_follow_linuxcnc(text, message):
