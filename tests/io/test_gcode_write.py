@@ -264,3 +264,22 @@ def test_an_arc_chain_in_the_plane_is_exact_g2_g3(tmp_path):
     back = parse_gcode_chain(program.text)
     assert [a.radius for a in back] == pytest.approx([-5.0, -5.0], abs=1e-12)
     assert [a.sweep for a in back] == pytest.approx([3.0, 2 * np.pi], abs=1e-12)
+
+
+@needs_rs274
+def test_rs274_reads_paths_in_space_within_the_stated_tolerances():
+    """Chords in tilted planes (the helix) and G18/G19 arcs and biarcs: rs274's moves (4 decimals) stay within
+    the chord or arc tolerance of the chain, at every end and at the middle of every chord."""
+    helix, _, _ = helix_chain()
+    cases = [(helix, {"chord_tolerance": 0.01}, 0.01)]
+    for frame in (PlaneFrame(normal=(0, -1, 0)), PlaneFrame(x_dir=(0, 1, 0), normal=(1, 0, 0))):
+        cases.append((placed_road(frame), {"arc_tolerance": 0.01}, 0.01))
+    for chain, options, tolerance in cases:
+        program = gcode_program(chain, **options)
+        moves = rs274.run_rs274(program.text, arc_tolerance=1e-4)
+        points = moves.points[~moves.rapid]
+        middles = (points[1:] + points[:-1]) / 2.0
+        spacing = chain.length / 2000  # the nearest polyline point, then refined on the chain
+        assert distance_to_chain(chain, points, spacing).max() <= tolerance + 2e-4
+        if "chord_tolerance" in options:  # every move is a line or a chord: its middle too
+            assert distance_to_chain(chain, middles, spacing).max() <= tolerance + 2e-4
