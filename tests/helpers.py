@@ -304,7 +304,10 @@ def linuxcnc_preview(program: Path, units: str) -> list[tuple[str, int, np.ndarr
     probe = subprocess.run([LINUXCNC_PYTHON, "-c", "import gcode, rs274.interpret"], capture_output=True) if Path(
         LINUXCNC_PYTHON).exists() else None  # fmt: skip
     if probe is None or probe.returncode != 0:
-        pytest.skip("LinuxCNC's interpreter library (python3-gcode of the Debian package linuxcnc-uspace) is not installed")
+        pytest.skip(
+            "LinuxCNC's interpreter library (the `gcode` module of the Debian package linuxcnc-uspace, "
+            "which `make test` installs where it can) is not installed for /usr/bin/python3"
+        )
     done = subprocess.run([LINUXCNC_PYTHON, str(REPO / "tests" / "tools" / "linuxcnc_preview.py"), str(program), units],
                           capture_output=True, text=True, timeout=600)  # fmt: skip
     assert done.returncode == 0, done.stderr[-3000:]
