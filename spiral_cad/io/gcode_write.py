@@ -373,9 +373,9 @@ def gcode_program(
                 counts["biarcs"] += 1
                 continue
         # a piece in a plane that is not a principal one: chords
-        samples = sample_path(Chain([segment], units=chain.units), chord_tolerance=chord)
-        points = samples[:, 1:4]
         piece = Chain([segment], units=chain.units)
+        samples = sample_path(piece, chord_tolerance=chord)
+        points = samples[:, 1:4]
         between = piece.point_at((samples[1:, 0] + samples[:-1, 0]) / 2.0)
         chord_error = max(chord_error, _chord_error(points[:, : chain.dim], between))
         for point in points[1:]:

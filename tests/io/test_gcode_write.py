@@ -3,6 +3,7 @@ checked by LinuxCNC's rs274 and its interpreter library, and read back by our ow
 
 import re
 import subprocess
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -283,3 +284,17 @@ def test_rs274_reads_paths_in_space_within_the_stated_tolerances():
         assert distance_to_chain(chain, points, spacing).max() <= tolerance + 2e-4
         if "chord_tolerance" in options:  # every move is a line or a chord: its middle too
             assert distance_to_chain(chain, middles, spacing).max() <= tolerance + 2e-4
+
+
+def test_the_example_pocket_rounded_in_space_as_linuxcnc_reads_it(tmp_path):
+    """examples/pocket.nc rounded G2: G5 at the corners in XY, G18/G19 biarcs where the tool plunges; LinuxCNC's
+    interpreter library puts every point of it within the arc tolerance of the chain."""
+    from spiral_cad.io.gcode import read_gcode, round_toolpath
+
+    chain = round_toolpath(read_gcode(Path(__file__).parents[2] / "examples" / "pocket.nc"), max_deviation=0.05).chain
+    program = gcode_program(chain, arc_tolerance=0.002)
+    assert program.counts["G5"] > 0 and program.counts["biarcs"] > 0 and program.counts["chords"] == 0
+    path = tmp_path / "pocket.ngc"
+    path.write_text(program.text)
+    points = np.array([p for kind, _, p in linuxcnc_preview(path, "mm") if kind != "rapid"])
+    assert distance_to_chain(chain, points, chain.length / 2000).max() <= 0.002 + 1e-9
