@@ -298,3 +298,13 @@ def test_the_example_pocket_rounded_in_space_as_linuxcnc_reads_it(tmp_path):
     path.write_text(program.text)
     points = np.array([p for kind, _, p in linuxcnc_preview(path, "mm") if kind != "rapid"])
     assert distance_to_chain(chain, points, chain.length / 2000).max() <= 0.002 + 1e-9
+
+
+def test_a_mm_chain_as_an_inch_program_and_without_the_rapid():
+    chain = robot()
+    program = gcode_program(chain, units="in", rapid_to_start=False, feed=30)
+    lines = body(program.text)
+    assert lines[0].startswith("G20 ") and "F30" in lines and not any(line.startswith("G0") for line in lines)
+    assert "converted from the chain's mm, times 0.0393701" in program.text
+    back = parse_gcode_chain(program.text.replace("F30\n", "F30\nG0 X0 Y0\n"), units="mm")  # the machine starts at the start
+    assert np.abs(back.rows.geometry - chain.rows.geometry).max() < 1e-11
