@@ -1,13 +1,16 @@
 """Large G-code programs: reading, and rounding as a Chain (``round_toolpath``) or as arrays.
 
-Run: ``.venv/bin/python benchmarks/bench_gcode.py [--quick] [--sizes N ...] [--chain-max N] [--out FILE]``
+Run: ``.venv/bin/python benchmarks/bench_gcode.py [--quick] [--sizes N ...] [--chain-max N] [--write-max N] [--out FILE]``
 (the harness and its conventions: ``timing.py``). Each size is a generated pocketing
 program (a zigzag of G1 moves with jittered ends, layer after layer, 4 decimals in mm),
 written to a file; after a warm-up on 50 moves (the kernels compile), every job runs in a child process of its own, so its peak memory
 (the child's maximum resident set, imports included) is its own. Jobs: ``read_gcode``
 alone; ``read_gcode`` + ``round_toolpath`` (spirals as objects in a ``Chain``, what
 ``build --from-gcode`` writes STEP from), up to ``--chain-max`` moves; ``read_gcode`` +
-``round_toolpath_arrays`` (the same spirals as arrays). One run per job (a minute-long
+``round_toolpath_arrays`` (the same spirals as arrays); and, up to ``--write-max`` moves, the
+moves' plan (x, y after the plunge) rounded as a Chain and written as G-code (``gcode_program``:
+LinuxCNC with exact G5, and generic with biarcs within 0.001 mm), and the LinuxCNC program
+read back as the same chain (``parse_gcode_chain``). One run per job (a minute-long
 job on a shared machine: the spread is not measured); the peer of the arrays is the
 Chain at the same size. Goals: 100 000 moves read and rounded in ≤ 60 s and ≤ 1.5 GB;
 1 M moves rounded in ≤ 20 s and ≤ 3 GB.
@@ -50,7 +53,7 @@ def child(job: str, moves: int) -> None:
     from spiral_cad.io.gcode import parse_gcode, read_gcode, round_toolpath, round_toolpath_arrays
 
     warm = parse_gcode(program(50))  # compile the kernels first (one warm-up, as compare does)
-    if job == "chain":
+    if job in ("chain", "write"):
         round_toolpath(warm, max_deviation=MAX_DEVIATION, for_occt=False)
     else:
         round_toolpath_arrays(warm, max_deviation=MAX_DEVIATION)
@@ -63,6 +66,26 @@ def child(job: str, moves: int) -> None:
         path = read_gcode(file)
         read = time.perf_counter() - started
         rounded = 0.0
+        if job == "write":
+            from spiral_cad.design import round_corners
+            from spiral_cad.io.gcode import parse_gcode_chain
+            from spiral_cad.io.gcode_write import gcode_program
+
+            # the program's moves in the plane (every corner a G5 pair; LinuxCNC takes G5 in XY only)
+            chain = round_corners(path.points[~path.rapid][1:, :2], max_deviation=MAX_DEVIATION, units=path.units).chain
+            times = {}
+            started = time.perf_counter()
+            text = gcode_program(chain).text
+            times["linuxcnc"] = time.perf_counter() - started
+            started = time.perf_counter()
+            gcode_program(chain, dialect="generic")
+            times["generic"] = time.perf_counter() - started
+            started = time.perf_counter()
+            back = parse_gcode_chain(text)
+            times["back"] = time.perf_counter() - started
+            assert len(back) == len(chain), (len(back), len(chain))
+            print(json.dumps({**times, "segments": len(chain), "peak_mb": peak_mb()}))
+            return
         if job != "read":
             started = time.perf_counter()
             if job == "chain":
@@ -86,7 +109,7 @@ def main() -> None:
     if len(sys.argv) == 4 and sys.argv[1] == "--child":
         child(sys.argv[2], int(sys.argv[3]))
         return
-    args = arguments(__doc__, sizes=([10_000, 100_000, 1_000_000], [300, 2_000]), chain_max=(100_000, 2_000))
+    args = arguments(__doc__, sizes=([10_000, 100_000, 1_000_000], [300, 2_000]), chain_max=(100_000, 2_000), write_max=(10_000, 300))
     report = Report("G-code benchmark", f"Generated pocketing programs, max_deviation {MAX_DEVIATION} mm; one run per job, "
                                         "each in its own process (peak = that process's maximum resident set).")  # fmt: skip
     rows = []
@@ -108,6 +131,13 @@ def main() -> None:
             goal = f"rounded ≤ 20 s, ≤ 3 GB: {'met' if ok else 'missed'}"
         report.add(f"round_toolpath_arrays, {moves:,} moves", arrays["round"], "s", Timing((arrays["round"],)),
                    f"Chain {chain['round']:.2f} s" if chain else "", chain["round"] / arrays["round"] if chain else None, goal)  # fmt: skip
+        if moves <= args.write_max:
+            written = run("write", moves)
+            segments = f"{written['segments']:,} segments"
+            report.add(f"gcode_program (LinuxCNC, G5), {moves:,} moves", written["linuxcnc"], "s", Timing((written["linuxcnc"],)), segments)
+            report.add(f"gcode_program (generic, biarcs), {moves:,} moves", written["generic"], "s", Timing((written["generic"],)),
+                       f"LinuxCNC {written['linuxcnc']:.2f} s", written["linuxcnc"] / written["generic"])  # fmt: skip
+            report.add(f"parse_gcode_chain of it (the same chain), {moves:,} moves", written["back"], "s", Timing((written["back"],)))
         rows.append(f"| {moves:,} | {read['read']:.2f} s, {read['peak_mb']:,.0f} MB | "
                     + (f"{chain['round']:.2f} s, {chain['peak_mb']:,.0f} MB" if chain else "not run (above --chain-max)")
                     + f" | {arrays['round']:.2f} s, {arrays['peak_mb']:,.0f} MB |")  # fmt: skip

@@ -292,3 +292,45 @@ def unresolved(dotted: str) -> str | None:
             found = getattr(found, attribute)
         return None
     return f"{dotted}: no such module"
+
+
+#: LinuxCNC's own Python, with its interpreter library (`gcode`) and `rs274` package (Debian's linuxcnc-uspace).
+LINUXCNC_PYTHON = "/usr/bin/python3"
+
+
+def linuxcnc_preview(program: Path, units: str) -> list[tuple[str, int, np.ndarray]]:
+    """The moves of ``program`` as LinuxCNC's interpreter library executes them (tests/tools/linuxcnc_preview.py):
+    (kind, line, point) with G5 splines and arcs as points on the curves; skips where LinuxCNC is not installed."""
+    probe = subprocess.run([LINUXCNC_PYTHON, "-c", "import gcode, rs274.interpret"], capture_output=True) if Path(
+        LINUXCNC_PYTHON).exists() else None  # fmt: skip
+    if probe is None or probe.returncode != 0:
+        pytest.skip(
+            "LinuxCNC's interpreter library (the `gcode` module of the Debian package linuxcnc-uspace, "
+            "which `make test` installs where it can) is not installed for /usr/bin/python3"
+        )
+    done = subprocess.run([LINUXCNC_PYTHON, str(REPO / "tests" / "tools" / "linuxcnc_preview.py"), str(program), units],
+                          capture_output=True, text=True, timeout=600)  # fmt: skip
+    assert done.returncode == 0, done.stderr[-3000:]
+    return [(kind, line, np.array(point)) for kind, line, *point in json.loads(done.stdout)["moves"]]
+
+
+def distance_to_chain(chain: Chain, points: np.ndarray, spacing: float) -> np.ndarray:
+    """The distance of every point from ``chain`` (an independent measure: the nearest point of the
+    polyline through the chain's points ``spacing`` apart along it, then the foot of the perpendicular
+    on the chain from there, found by iterating the projection on the tangent)."""
+    s = np.linspace(0.0, chain.length, max(2, math.ceil(chain.length / spacing) + 1))
+    polyline = chain.point_at(s)
+    points = np.asarray(points, dtype=float)[:, : polyline.shape[1]]
+    a, d = polyline[:-1], np.diff(polyline, axis=0)
+    length2 = np.einsum("ij,ij->i", d, d)
+    nearest, station = np.empty(len(points)), np.empty(len(points))
+    for i, p in enumerate(points):
+        t = np.clip(np.einsum("ij,ij->i", p - a, d) / length2, 0.0, 1.0)
+        gaps = np.einsum("ij,ij->i", p - a - t[:, None] * d, p - a - t[:, None] * d)
+        k = int(np.argmin(gaps))
+        nearest[i], station[i] = math.sqrt(gaps[k]), s[k] + t[k] * (s[k + 1] - s[k])
+    for _ in range(8):  # then the foot of the perpendicular on the chain itself: s ← s + (p − C(s))·T(s)
+        step = np.einsum("ij,ij->i", points - chain.point_at(station), chain.tangent_at(station))
+        station = np.clip(station + step, 0.0, chain.length)
+    out = np.minimum(nearest, np.linalg.norm(points - chain.point_at(station), axis=1))
+    return out

@@ -83,6 +83,7 @@ class Built(ABC):
     source: Any
     continuity: str | None = None
     road_3d: str | None = None
+    gcode: dict[str, Any] | None = None  # write_gcode's options of NAME.ngc (None: no program)
 
     @property
     @abstractmethod
@@ -304,10 +305,15 @@ def _rounded(d: RoundedPolylineDesign, where: str, units: str, base: Path | None
     if d.points is not None:  # the model holds points or gcode
         result = round_corners(d.points, shape=d.shape, units=units, **d.rounding())
     else:
-        from ..io.gcode import read_gcode, round_toolpath
+        from ..io.gcode import holds_splines, read_gcode, read_gcode_chain, round_toolpath
 
         program = _own_file(str(d.gcode), base, f"{where}.gcode")
-        result = round_toolpath(read_gcode(program).in_units(units), shape=d.shape, **d.rounding())
+        if holds_splines(program):  # G5: the program states its curves (our own output reads back as its chain)
+            from ..design.rounding import RoundedPath
+
+            result = RoundedPath(read_gcode_chain(program, units=units), [], d.shape)
+        else:
+            result = round_toolpath(read_gcode(program).in_units(units), shape=d.shape, **d.rounding())
     samples = None if d.samples is None else d.samples.options()
     return BuiltRounded(name=d.name, chain=result.chain, source=result, samples=samples)
 
@@ -369,7 +375,10 @@ def build(source: str | Path | dict) -> tuple[str, list[Built]]:
     for i, d in enumerate(design_file.designs):
         where = f"designs[{i}] ({d.name})"
         try:
-            built.append(BUILDERS[d.type](d, where, design_file.units, base))
+            b = BUILDERS[d.type](d, where, design_file.units, base)
+            if d.gcode_out is not None or isinstance(b, BuiltRounded):  # a path gets its program
+                b.gcode = {} if d.gcode_out is None else d.gcode_out.options()
+            built.append(b)
         except DesignError:
             raise
         except (NoSolutionError, ValueError) as e:
@@ -484,6 +493,11 @@ def _write_others(b: Built, stage: Path, units: str, missing: list[str], plots: 
     if b.chain.dim == 2:  # SVG is a plane output (the plots draw a path in space as its plan)
         export_svg(b.chain, stage / f"{b.name}.svg", name=b.name)
         names.append("svg")
+    if b.gcode is not None:
+        from ..io.gcode_write import write_gcode
+
+        write_gcode(b.chain, stage / f"{b.name}.ngc", name=b.name, **b.gcode)
+        names.append("ngc")
     if isinstance(b, BuiltRounded) and b.samples:
         from ..cad.export import export_samples
 

@@ -216,6 +216,21 @@ class _Model(BaseModel):
     model_config = ConfigDict(extra="forbid")
 
 
+class GcodeOut(_Model):
+    """NAME.ngc, the path as a G-code program: written for every rounded polyline, for other designs when given."""
+
+    dialect: Literal["linuxcnc", "generic"] = Field(
+        "linuxcnc", description="linuxcnc: spirals in XY as exact G5 cubics; generic (Grbl, Marlin): spirals as biarcs."
+    )
+    feed: Positive | None = Field(None, description="The F word, in the program's unit per minute (default 1000 mm/min, 40 in/min).")
+    chord_tolerance: Positive | None = Field(None, description="Pieces in space as G1 chords within this (default 0.001 mm).")
+    arc_tolerance: Positive | None = Field(None, description="Spirals as biarcs within this (default 0.001 mm).")
+
+    def options(self) -> dict[str, Any]:
+        """The keywords of ``write_gcode``."""
+        return {k: v for k, v in self if v is not None}
+
+
 # ------------------------------------------------------------ alignment
 
 
@@ -275,6 +290,7 @@ class AlignmentDesign(_Model):
 
     name: Name = Field(description="Names the output files: 1–64 of A–Z, a–z, 0–9, - and _; no two differ only in case.")
     type: Literal["alignment"]
+    gcode_out: GcodeOut | None = Field(None, description="Also write NAME.ngc, the path as G-code.")
     pis: Annotated[
         list[tuple[float, float]],
         PlainValidator(_points(3, MAX_PIS), json_schema_input_type=Annotated[list[Point], Field(min_length=3, max_length=MAX_PIS)]),
@@ -361,6 +377,7 @@ class CircleChainDesign(_Model):
     type: Literal["circle_chain"]
     circles: list[Circle] = Field(min_length=2, description="At least 2 circles, in travel order.")
     spiral_shape: TransitionShape = Field("walton-meek", description="walton-meek or near-linear.")
+    gcode_out: GcodeOut | None = Field(None, description="Also write NAME.ngc, the path as G-code.")
 
 
 class Samples(_Model):
@@ -411,6 +428,7 @@ class RoundedPolylineDesign(_Model):
     spiral_lengths: PositiveOrList | None = Field(None, description="The spiral length of every corner (instead of the "
                                                   "bounds); none of these: as large as fits.")  # fmt: skip
     samples: Samples | None = Field(None, description="Optional samples for a machine.")
+    gcode_out: GcodeOut | None = Field(None, description="The options of NAME.ngc, the path as G-code (always written).")
     spiral_shape: CornerShape | None = Field(None, description="walton-meek (default), near-linear or g2cbs.")
     method: CornerShape | None = Field(None, description="The former name of spiral_shape.")
 
@@ -435,10 +453,11 @@ class RoundedPolylineDesign(_Model):
 class _Transition(_Model):
     name: Name = Field(description="Names the output files (see alignment).")
     type: Literal["transition"]
+    gcode_out: GcodeOut | None = Field(None, description="Also write NAME.ngc, the path as G-code.")
 
     def arguments(self) -> dict[str, Any]:
         """The transition function's keyword arguments."""
-        return {k: v for k, v in self if k not in ("name", "type", "case", "spiral_shape") and v is not None}
+        return {k: v for k, v in self if k not in ("name", "type", "case", "spiral_shape", "gcode_out") and v is not None}
 
 
 class LineToCircle(_Transition):

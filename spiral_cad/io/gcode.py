@@ -17,6 +17,10 @@ What the built-in reader reads (anything else is refused with its line number an
   full turns; helical with the plane's normal axis) in the ``G17``/``G18``/``G19`` plane, as
   chords within ``arc_tolerance`` when it is given (refused by name otherwise), with
   LinuxCNC's tolerance on radii that differ;
+* cubic splines ``G5`` (``I J``: start to first control point, ``P Q``: end to second control
+  point) in the ``G17`` plane, with LinuxCNC's rules (P and Q always; I and J both or neither,
+  neither only after another G5, which continues its direction; no Z), as chords within
+  ``arc_tolerance`` (refused by name otherwise);
 * ``G90``/``G91`` absolute/incremental coordinates, ``G90.1``/``G91.1`` arc centres;
 * ``G20`` inch and ``G21`` mm: one of them must come before the first move (a CNC path in
   the wrong unit is worse than none), and the unit may not change after it;
@@ -37,7 +41,7 @@ LinuxCNC's modal rules: two codes of one modal group on a line (``G90 G91``, ``G
 Refused by name, with the line: canned cycles ``G73``–``G89`` (use ``interpreter="rs274"``,
 which expands them), ``G28``/``G30`` (moves to a home position the program does not state),
 ``G10``, ``G52``, ``G53``, ``G92`` (offsets), cutter compensation ``G41``/``G42``, tool length
-offsets ``G43``, ``G33``, probing ``G38``, splines and NURBS ``G5``–``G6.2``, ``G7``,
+offsets ``G43``, ``G33``, probing ``G38``, splines and NURBS ``G5.1``–``G6.2``, ``G7``,
 parameters (``#``), expressions (``[``) and O-words (use ``interpreter="rs274"``), other words
 (``A``, ``B``, ``C``, ``U``, ``V``, ``W``, ``L``, ``H``, ``E``, …), numbers that are not finite,
 text that is not a word (``X1e3``, ``X--1``), an unclosed comment, control characters (line
@@ -45,6 +49,9 @@ breaks are ``\n``, ``\r\n`` or ``\r``; a vertical tab, form feed or Unicode line
 refused, not read as a line break), lines longer than 65 536 characters, and bytes that are
 not UTF-8. LinuxCNC also refuses a program with neither M2/M30 nor ``%``; this reader takes the
 end of the file as its end.
+
+``read_gcode_chain`` reads a program as its exact path instead: lines, arcs and G5 cubics as the
+chain's segments (what ``spiral_cad.io.gcode_write`` writes reads back as the same chain).
 
 A move that ends where it started is not a point of the path (it would be a corner of no
 length); the path's first point is where the first move ends. Long reads and roundings say
@@ -66,9 +73,10 @@ import numpy as np
 from numpy.typing import NDArray
 
 from .progress import Progress, ticking
-from .toolpath import PLANES, GcodePath, arc_points, in_program_unit
+from .toolpath import PLANES, GcodePath, arc_points, arc_sweep, in_program_unit, spline_points
 
 if TYPE_CHECKING:
+    from ..core.chain import Chain
     from ..design.rounding import RoundedPath
 
 #: Files larger than this are refused before reading (a full disk or a wrong file, not a program).
@@ -116,7 +124,7 @@ REFUSED_G = {
     432: "an added tool length offset (G43.2)",
     330: "spindle-synchronised motion (G33)", 331: "rigid tapping (G33.1)",
     382: "probing (G38.2)", 383: "probing (G38.3)", 384: "probing (G38.4)", 385: "probing (G38.5)",
-    62: "a NURBS curve (G6.2)", 50: "a cubic spline (G5)", 51: "a quadratic spline (G5.1)", 52: "a NURBS block (G5.2)", 53: "a NURBS block end (G5.3)",
+    62: "a NURBS curve (G6.2)", 51: "a quadratic spline (G5.1)", 52: "a NURBS block (G5.2)", 53: "a NURBS block end (G5.3)",
     171: "the UV plane (G17.1)", 181: "the WU plane (G18.1)", 191: "the VW plane (G19.1)",
     70: "lathe diameter mode (G7): X would be a diameter",
 }  # fmt: skip
@@ -164,6 +172,9 @@ class _Reader:
         self.any_line = False  # a line that is not blank was read (an opening % must be the first)
         self.end_at: int | None = None
         self.ended = False
+        self.exact = False  # arcs and G5 splines kept as pieces (``pieces``), no chords needed
+        self.pieces: list[tuple[Any, ...]] = []  # (kind, line, rapid, start, data…) of every move (with ``exact``)
+        self.spline_end: tuple[float, float] | None = None  # the last G5's (P, Q), while G5 moves follow each other
 
     def error(self, number: int, text: str) -> ValueError:
         return ValueError(f"{self.source} line {number}: {text}")
@@ -234,6 +245,7 @@ class _Reader:
         target: dict[int, float] = {}
         centre: dict[str, float] = {}
         turn_count: float | None = None  # P with G2/G3: the number of turns
+        spline_pq: dict[str, float] = {}  # P and Q with G5: the end's offset to the second control point
         for letter, value, written in words:
             if letter in "GM":
                 code = round(value * 10) if _CODE.fullmatch(written[1:]) else None
@@ -296,6 +308,9 @@ class _Reader:
                 centre[letter] = value
             elif letter == "P":
                 turn_count = value
+                spline_pq["P"] = value
+            elif letter == "Q":
+                spline_pq["Q"] = value
             elif letter == "O":
                 raise self.error(
                     number,
@@ -323,10 +338,16 @@ class _Reader:
                 raise self.error(number, "the move's position is beyond the float range")
             if self.motion in (20, 30):
                 self.arc(number, moved, centre, turn_count)
+            elif self.motion == 50:
+                self.spline(number, moved, target, centre, spline_pq)
             else:
                 if centre:
                     raise self.error(number, f"{', '.join(centre)} with a straight move: only arcs (G2, G3) take I, J, K, R")
+                if self.exact:
+                    self.pieces.append(("line", number, self.motion == 0, list(self.position), moved))
                 self.add(number, moved)
+            if self.motion != 50:
+                self.spline_end = None
             self.position = moved
         elif centre:
             raise self.error(number, f"{', '.join(centre)} with no axis word: LinuxCNC needs an end point for an arc")
@@ -346,7 +367,7 @@ class _Reader:
     def arc(self, number: int, end: list[float], centre: dict[str, float], turn_count: float | None) -> None:
         """An arc (G2 clockwise, G3 counterclockwise) in the plane, as chords within ``arc_tolerance``."""
         name = "G2 (a clockwise arc)" if self.motion == 20 else "G3 (a counterclockwise arc)"
-        if self.arc_tolerance is None:
+        if self.arc_tolerance is None and not self.exact:
             raise self.error(
                 number,
                 f"{name} is refused: only straight moves (G0, G1) are read unless arc_tolerance is given (arcs become chords within it); have the CAM write straight moves, or linearise the arcs first",
@@ -391,8 +412,60 @@ class _Reader:
             if turn_count != int(turn_count) or turn_count < 1:
                 raise self.error(number, f"{name}: P{turn_count:g} must be a whole number of turns, at least 1")
             turns = int(turn_count)
+        rotation = turns if self.motion == 30 else -turns
+        if self.exact:
+            self.pieces.append(("arc", number, False, list(start), end, self.plane, ca, cb, rotation))
+            self.add(number, end)
+            return
+        assert self.arc_tolerance is not None  # refused above unless exact
         tolerance = in_program_unit(self.arc_tolerance, self.arc_units, self.units or "mm")
-        for point in arc_points(start, end, self.plane, ca, cb, turns if self.motion == 30 else -turns, tolerance):
+        for point in arc_points(start, end, self.plane, ca, cb, rotation, tolerance):
+            self.add(number, point)
+            self.position = point
+
+    def spline(self, number: int, end: list[float], target: dict[int, float], centre: dict[str, float],
+               pq: dict[str, float]) -> None:  # fmt: skip
+        """A cubic spline (G5) in the XY plane, with LinuxCNC's rules; as chords within ``arc_tolerance``
+        (or kept exact as a piece, in ``exact`` mode)."""
+        if self.plane != 170:
+            raise self.error(number, "G5 (a cubic spline) needs the XY plane (G17); LinuxCNC refuses it in G18/G19")
+        if 2 in target:
+            raise self.error(number, "G5 (a cubic spline) moves X and Y only; LinuxCNC refuses a Z word with it")
+        if set(centre) - {"I", "J"}:
+            raise self.error(number, f"G5 takes I, J, P and Q; got {', '.join(sorted(set(centre) - {'I', 'J'}))}")
+        if set(pq) != {"P", "Q"}:
+            raise self.error(number, "G5 needs both P and Q (the end's offset to the second control point)")
+        if len(centre) == 1:
+            raise self.error(number, "G5 needs both I and J, or neither (to continue the previous G5's direction)")
+        start = self.position
+        if centre:
+            i, j = centre["I"], centre["J"]
+        elif self.spline_end is not None:  # LinuxCNC: I, J are the negation of the previous G5's P, Q
+            i, j = -self.spline_end[0], -self.spline_end[1]
+        else:
+            raise self.error(number, "the first G5 of a series needs I and J (the start's offset to the first control point)")
+        self.spline_end = (pq["P"], pq["Q"])
+        z = start[2]
+        cp = np.array([[start[0], start[1], z], [start[0] + i, start[1] + j, z],
+                       [end[0] + pq["P"], end[1] + pq["Q"], z], [end[0], end[1], z]])  # fmt: skip
+        if not np.isfinite(cp).all() or not np.isfinite(np.diff(cp, axis=0)).all():
+            raise self.error(number, "the G5 spline's control points are beyond the float range")
+        if self.exact:
+            self.pieces.append(("cubic", number, False, list(start), cp))
+            self.add(number, list(end))
+            return
+        if self.arc_tolerance is None:
+            raise self.error(
+                number,
+                "G5 (a cubic spline) is refused here: read the program with read_gcode_chain (the exact cubic), or give "
+                "arc_tolerance (splines become chords within it)",
+            )
+        tolerance = in_program_unit(self.arc_tolerance, self.arc_units, self.units or "mm")
+        try:
+            chords = spline_points(cp, tolerance)
+        except ValueError as error:
+            raise self.error(number, str(error)) from None
+        for point in chords:
             self.add(number, point)
             self.position = point
 
@@ -461,18 +534,8 @@ def parse_gcode(
     return GcodePath(np.array(reader.points), np.array(reader.lines), np.array(reader.rapid), reader.units, source, tuple(reader.notes))
 
 
-def read_gcode(
-    path: str | os.PathLike, *, arc_tolerance: float | None = None, interpreter: str | None = None,
-    arc_tolerance_units: str | None = None,
-) -> GcodePath:  # fmt: skip
-    """Read the straight moves of a G-code file (named ``*.nc``, ``.ngc``, ``.gcode``, ``.gc``, ``.g``,
-    ``.tap``, ``.cnc``, ``.mpt`` or ``.mpf``).
-
-    Raises:
-        ValueError: another file name, not a regular file (a folder, a device),
-            larger than 1 GiB, not UTF-8 text, or outside the subset (named with the line).
-        OSError: the file could not be read.
-    """
+def _program_text(path: str | os.PathLike) -> tuple[str, str]:
+    """(text, name for messages) of a G-code file, with ``read_gcode``'s checks."""
     name = os.fspath(path)
     label = os.path.basename(name) or name
     if not label.isprintable():  # a file name is shown in messages: never raw control characters
@@ -490,6 +553,22 @@ def read_gcode(
     except UnicodeDecodeError as error:
         line = data[: error.start].count(b"\n") + 1
         raise ValueError(f"{label} line {line}: byte {data[error.start]:#04x} is not UTF-8 text") from None
+    return text, label
+
+
+def read_gcode(
+    path: str | os.PathLike, *, arc_tolerance: float | None = None, interpreter: str | None = None,
+    arc_tolerance_units: str | None = None,
+) -> GcodePath:  # fmt: skip
+    """Read the straight moves of a G-code file (named ``*.nc``, ``.ngc``, ``.gcode``, ``.gc``, ``.g``,
+    ``.tap``, ``.cnc``, ``.mpt`` or ``.mpf``).
+
+    Raises:
+        ValueError: another file name, not a regular file (a folder, a device),
+            larger than 1 GiB, not UTF-8 text, or outside the subset (named with the line).
+        OSError: the file could not be read.
+    """
+    text, label = _program_text(path)
     if interpreter is None:  # neither given: what reading_options set (the built-in reader, arcs refused)
         interpreter, default_tolerance, default_units = _DEFAULTS.get()
         if arc_tolerance is None:
@@ -628,3 +707,123 @@ def round_toolpath_arrays(
     if control.shape[-1] == 2:  # a flat program is rounded in its plane: back to x, y, z
         control = np.concatenate([control, np.full(control.shape[:-1] + (1,), path.points[0, 2])], axis=-1)
     return ToolpathCorners(index, path.lines[index], control, result.curvature, result.deviation, path.units, shape)
+
+
+#: A G5 word outside comments (spaces may stand inside words in RS274).
+_G5_WORD = re.compile(r"[Gg]\s*0*5(?![\d.])")
+_COMMENTS = re.compile(r"\([^()]*\)|;[^\n]*")
+
+
+def holds_splines(path: str | os.PathLike) -> bool:
+    """Whether the G-code file has a cubic spline (G5): its path is then the exact curve it states
+    (``read_gcode_chain``), not a polyline to round."""
+    text, _ = _program_text(path)
+    return _G5_WORD.search(_COMMENTS.sub(" ", text)) is not None
+
+
+def parse_gcode_chain(text: str, source: str = "G-code", *, units: str | None = None, tolerance: float = 1e-6) -> Chain:
+    """The exact path of G-code ``text``: every feed move as the curve it states, joined G2.
+
+    ``G1`` moves are lines, ``G2``/``G3`` arcs (in G17, G18 or G19; not helical, at most one
+    turn) are arcs and ``G5`` cubic splines are cubic Bézier segments with the spline's own
+    control points, so a program written by ``spiral_cad.io.gcode_write`` reads back as its
+    chain (control points equal to the printed decimals). The rapids (``G0``) before the first
+    feed move lead to the path's start; the path is every feed move after them. The chain lies
+    in the plane when every Z is 0, else in space. The built-in reader's rules hold (see the
+    module docstring).
+
+    Args:
+        text: the program.
+        source: its name, for messages.
+        units: the chain's unit (mm, cm, m, km, in, ft); default the program's (G20/G21).
+        tolerance: the chain's relative join tolerance (``Chain``): the printed decimals of a
+            program leave ~1e-9 mm, so joints are checked to 1e-6 by default.
+
+    Raises:
+        ValueError: what the built-in reader refuses; a rapid between feed moves, a helical or
+            multi-turn arc, no feed move, or a joint that is not G2 (naming the lines).
+    """
+    from ..core.chain import Chain
+    from ..core.errors import JointError
+    from ..core.segments import Arc, Line
+    from ..core.spiral import BezierSpiral
+    from ..core.units import MM_PER_UNIT, length_unit
+
+    if not isinstance(text, str):
+        raise ValueError(f"text must be the program as str; got {type(text).__name__}")
+    lines = text.replace("\r\n", "\n").replace("\r", "\n").split("\n")
+    reader = _Reader(source)
+    reader.exact = True
+    for number, line in enumerate(lines, 1):
+        reader.read_line(number, line)
+    pieces = reader.pieces
+    first = next((k for k, piece in enumerate(pieces) if not piece[2]), None)
+    if first is None or reader.units is None:
+        raise ValueError(f"{source}: no feed move (G1, G2, G3, G5); a path is its feed moves")
+    target = reader.units if units is None else length_unit(units)
+    factor = MM_PER_UNIT[reader.units] / MM_PER_UNIT[target]
+    pieces = pieces[first:]
+    flat = all(p[3][2] == 0.0 and (p[0] == "cubic" or p[4][2] == 0.0) and (p[0] != "arc" or p[5] == 170) for p in pieces)
+    dim = 2 if flat else 3
+    segments: list[Line | Arc | BezierSpiral] = []
+    owners: list[int] = []
+    for kind, number, rapid, start, *data in pieces:
+        if rapid:
+            raise ValueError(f"{source} line {number}: a rapid move (G0) between feed moves; the path is the feed moves "
+                             "after the rapids to its start")  # fmt: skip
+        try:
+            segment = _piece_segment(kind, start, data, factor, dim)
+        except ValueError as error:
+            raise ValueError(f"{source} line {number}: {error}") from None
+        if segment is not None:
+            segments.append(segment)
+            owners.append(number)
+    if not segments:
+        raise ValueError(f"{source}: no feed move to a new position; a path needs one")
+    try:
+        return Chain(segments, tolerance=tolerance, units=target)
+    except JointError as error:
+        joint = error.joint
+        raise ValueError(
+            f"{source} lines {owners[joint]} and {owners[joint + 1]}: {error}; the program's curves do not join G2 "
+            "(arcs that approximate a curve, such as biarcs, never do)"
+        ) from None
+    except ValueError as error:
+        raise ValueError(f"{source}: {error}") from None
+
+
+def _piece_segment(kind: str, start: list[float], data: list[Any], factor: float, dim: int) -> Any:
+    """The chain segment of one move read in exact mode (None for a move that goes nowhere)."""
+    from ..core.segments import Arc, Line
+    from ..core.spiral import BezierSpiral
+
+    begin = np.array(start) * factor
+    if kind == "line":
+        end = np.array(data[0]) * factor
+        return None if np.array_equal(begin, end) else Line(begin[:dim], end[:dim])
+    if kind == "arc":
+        end, plane, ca, cb, rotation = data
+        a, b, normal = PLANES[plane]
+        if end[normal] != start[normal] or abs(rotation) != 1:
+            raise ValueError("a helical or multi-turn arc is not one arc of a chain")
+        t0, sweep = arc_sweep(start, end, plane, ca, cb, rotation)
+        radius = math.hypot(start[a] - ca, start[b] - cb) * factor
+        if dim == 2:
+            return Arc((ca * factor, cb * factor), math.copysign(radius, sweep), t0, abs(sweep))
+        centre = begin.copy()
+        centre[a], centre[b] = ca * factor, cb * factor
+        axis = np.zeros(3)
+        axis[normal] = 1.0
+        return Arc.in_space(centre, axis, begin, sweep)
+    return BezierSpiral.from_control_points(np.asarray(data[0])[:, :dim] * factor)
+
+
+def read_gcode_chain(path: str | os.PathLike, *, units: str | None = None, tolerance: float = 1e-6) -> Chain:
+    """The exact path of a G-code file (``parse_gcode_chain``), named as ``read_gcode`` requires.
+
+    Raises:
+        ValueError: as ``read_gcode`` and ``parse_gcode_chain``.
+        OSError: the file could not be read.
+    """
+    text, label = _program_text(path)
+    return parse_gcode_chain(text, label, units=units, tolerance=tolerance)

@@ -10,11 +10,16 @@ import math
 import re
 from dataclasses import dataclass
 
+import numpy as np
 from numpy.typing import NDArray
 
+from ..core import bezier
 from ..core.units import MM_PER_UNIT, length_unit
 
-__all__ = ["PLANES", "GcodePath", "arc_points", "in_program_unit"]
+__all__ = ["PLANES", "GcodePath", "arc_points", "arc_sweep", "in_program_unit", "spline_points"]
+
+#: The most chords of one G5 spline (a tolerance far below the spline's size is an error, not a full disk).
+MAX_SPLINE_CHORDS = 1 << 16
 
 #: The arc planes by LinuxCNC's ARC_FEED codes: (first, second, normal axis).
 PLANES = {170: (0, 1, 2), 180: (2, 0, 1), 190: (1, 2, 0)}
@@ -69,12 +74,7 @@ def arc_points(
     """
     first, second, normal = PLANES[plane]
     a0, b0, a1, b1 = start[first], start[second], end[first], end[second]
-    t0, t1 = math.atan2(b0 - cb, a0 - ca), math.atan2(b1 - cb, a1 - ca)
-    sweep = t1 - t0
-    if rotation > 0:
-        sweep = (sweep if sweep > 0 else sweep + 2 * math.pi) + 2 * math.pi * (rotation - 1)
-    else:
-        sweep = (sweep if sweep < 0 else sweep - 2 * math.pi) - 2 * math.pi * (-rotation - 1)
+    t0, sweep = arc_sweep(start, end, plane, ca, cb, rotation)
     radius = (math.hypot(a0 - ca, b0 - cb) + math.hypot(a1 - ca, b1 - cb)) / 2
     # a chord of angle step is at most radius·(1 − cos(step/2)) from its arc
     step = 2 * math.acos(1 - tolerance / radius) if tolerance < radius else math.pi / 2
@@ -90,6 +90,45 @@ def arc_points(
         points.append(point)
     points.append(list(end))
     return points
+
+
+def arc_sweep(start: list[float], end: list[float], plane: int, ca: float, cb: float, rotation: int) -> tuple[float, float]:
+    """(start angle, signed sweep) of LinuxCNC's arc from ``start`` to ``end`` about (``ca``, ``cb``) in ``plane``
+    (``rotation`` as in ``arc_points``; the same end point is a full turn)."""
+    first, second, _ = PLANES[plane]
+    t0 = math.atan2(start[second] - cb, start[first] - ca)
+    sweep = math.atan2(end[second] - cb, end[first] - ca) - t0
+    if rotation > 0:
+        sweep = (sweep if sweep > 0 else sweep + 2 * math.pi) + 2 * math.pi * (rotation - 1)
+    else:
+        sweep = (sweep if sweep < 0 else sweep - 2 * math.pi) - 2 * math.pi * (-rotation - 1)
+    return t0, sweep
+
+
+def spline_points(control_points: NDArray, tolerance: float) -> list[list[float]]:
+    """Chord ends of a cubic (``control_points`` (4, 3), a G5 spline) at most ``tolerance`` from it: the
+    parameter interval is cut into 2^k equal pieces until each piece's inner control points lie within
+    ``tolerance`` of its chord (the curve lies in their hull, so within it too); the start is not included.
+
+    Raises:
+        ValueError: more than ``MAX_SPLINE_CHORDS`` chords would be needed.
+    """
+    count = 1
+    while count <= MAX_SPLINE_CHORDS:
+        pieces = np.array([bezier.split(control_points, k / count, (k + 1) / count) for k in range(count)])
+        chord = pieces[:, 3] - pieces[:, 0]
+        length2 = np.einsum("ij,ij->i", chord, chord)
+        worst = 0.0
+        for inner in (1, 2):
+            offset = pieces[:, inner] - pieces[:, 0]
+            t = np.clip(np.einsum("ij,ij->i", offset, chord) / np.where(length2 > 0.0, length2, 1.0), 0.0, 1.0)
+            worst = float(np.maximum(worst, np.linalg.norm(offset - t[:, None] * chord, axis=1)).max())  # NaN stays NaN
+        if not math.isfinite(worst):
+            raise ValueError("a G5 spline too large for float64 arithmetic")
+        if worst <= tolerance:
+            return [list(map(float, p)) for p in pieces[:, 3]]
+        count *= 2
+    raise ValueError(f"a G5 spline needs more than {MAX_SPLINE_CHORDS:,} chords within {tolerance:g}")
 
 
 def in_program_unit(length: float, units: str | None, program_units: str) -> float:

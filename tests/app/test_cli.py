@@ -25,7 +25,8 @@ def test_demo_writes_every_output(tmp_path, capsys):
     (count,) = map(int, re.findall(r"wrote (\d+) files", text))
     progress = re.findall(r"^  \S.* → (.*?)(?: \(\d+\.\d s\))?$", text, re.MULTILINE)
     listed = sum(len(files.split(", ")) for files in progress)
-    assert count == listed == len(names) == 28
+    assert count == listed == len(names) == 29
+    assert "robot.ngc" in names  # the robot path's program
     for csv_file in ("highway_stations.csv", "highway_criteria.csv", "highway_profile.csv"):
         assert_plain_csv(tmp_path / csv_file)
     assert "np.float64" not in text
