@@ -363,7 +363,7 @@ def _alignment(r: _Reader, a: ET.Element, label: str) -> LandXMLAlignment:
     if not items:
         raise ValueError(f"{where}: CoordGeom holds no elements")
     # The file's own placement of each element: its Start and start direction, else the end of the one before.
-    starts, headings = [], []
+    starts, headings, ends = [], [], []
     point, heading = items[0].start, items[0].heading
     if point is None or heading is None:
         raise ValueError(f"{where}: the first element needs a Start point and a direction")
@@ -374,15 +374,24 @@ def _alignment(r: _Reader, a: ET.Element, label: str) -> LandXMLAlignment:
         headings.append(heading)
         (end,), (heading,), _ = clothoid_frames([item.length], item.k0, (item.k1 - item.k0) / item.length, x0=point[0], y0=point[1], hdg=heading)
         point = end
+        ends.append((end, heading))
     runs: list[list[Segment]] = [[]]
     breaks: list[str] = []
     point, heading = starts[0], headings[0]
     first = []  # (run, index of the element's first segment in it)
     for k, item in enumerate(items):
-        if k and abs(item.k0 - items[k - 1].k1) > _JUMP * max(abs(item.k0), abs(items[k - 1].k1)):
-            breaks.append(f"curvature jumps from {items[k - 1].k1:.6g} to {item.k0:.6g} 1/{r.units} at station {item.station:.6g} "
-                          f"(between elements {k - 1} and {k})")  # fmt: skip
-            runs.append([])
+        at = f"at station {item.station:.6g} (between elements {k - 1} and {k})"
+        if k:
+            gap = float(np.hypot(*(starts[k] - ends[k - 1][0])))
+            turn = abs(math.remainder(headings[k] - ends[k - 1][1], 2.0 * math.pi))
+            # after a spiral the chain goes on from our spiral (its offset is reported), not from the clothoid's end
+            if items[k - 1].kind != "Spiral" and (gap > _JUMP * max(item.length, items[k - 1].length) or turn > _JUMP):
+                breaks.append(f"the file's elements meet with a gap of {gap:.3g} {r.units} and a kink of {turn:.3g} rad {at}")
+                runs.append([])
+                point, heading = starts[k], headings[k]  # a new run starts where the file places the element
+            elif abs(item.k0 - items[k - 1].k1) > _JUMP * max(abs(item.k0), abs(items[k - 1].k1)):
+                breaks.append(f"curvature jumps from {items[k - 1].k1:.6g} to {item.k0:.6g} 1/{r.units} {at}")
+                runs.append([])
         first.append((len(runs) - 1, len(runs[-1])))
         pieces = _segments(item, point, heading)
         runs[-1] += pieces
