@@ -497,6 +497,10 @@ def _write_others(b: Built, stage: Path, units: str, missing: list[str], plots: 
         export_opendrive(b.source, stage / f"{b.name}.xodr", name=b.name, cross_section=b.cross_section,
                          geo_reference=b.geo_reference, profile=profile)  # fmt: skip
         names += ["stations.csv", "xodr"]
+        from ..io.landxml import write_landxml
+
+        write_landxml(b.source, stage / f"{b.name}.xml", name=b.name, profile=profile)
+        names.append("xml")
         if b.source.checks:
             b.source.criteria_to_csv(stage / f"{b.name}_criteria.csv")
             names.append("criteria.csv")

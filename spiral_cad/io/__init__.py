@@ -3,3 +3,16 @@ G-code in, OpenDRIVE model, writer, reader and checker, and all-or-nothing outpu
 
 IGES and the STEP of solids go through OCCT and live in ``spiral_cad.cad``.
 """
+
+from typing import Any
+
+__all__ = ["read_landxml"]
+
+
+def __getattr__(name: str) -> Any:
+    """``read_landxml`` on first use (the package itself imports nothing)."""
+    if name == "read_landxml":
+        from .landxml_read import read_landxml
+
+        return read_landxml
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
