@@ -234,12 +234,12 @@ def landxml_text(alignments: Sequence[AlignmentToWrite], units: str, name: str =
         f'{"celsius" if system == "Metric" else "fahrenheit"}" pressureUnit="{"milliBars" if system == "Metric" else "inchHG"}" '
         'angularUnit="decimal degrees" directionUnit="decimal degrees"/>',
         "  </Units>",
-        f"  <Application name={_attribute(application)} manufacturer=\"spiral_cad\" desc=\"directions counter-clockwise from east\"/>",
+        f'  <Application name={_attribute(application)} manufacturer="spiral_cad" desc="directions counter-clockwise from east"/>',
         f"  <Alignments name={_attribute(name)}>",
     ]
     for a in alignments:
         total = a.chain.length * scale
-        lines.append(f"    <Alignment name={_attribute(a.name)} length=\"{_text(total)}\" staStart=\"{_text(a.start_station * scale)}\">")
+        lines.append(f'    <Alignment name={_attribute(a.name)} length="{_text(total)}" staStart="{_text(a.start_station * scale)}">')
         lines += _coord_geom(a.chain, a.start_station, scale, unit)
         if a.profile is not None:
             lines += _prof_align(a.profile, a.name, scale)
@@ -270,5 +270,3 @@ def write_landxml(alignments: Sequence[AlignmentToWrite] | Any, path: str | os.P
     text = landxml_text(alignments, units, name, survey_feet=survey_feet)
     with open(os.fspath(path), "w", encoding="utf-8", newline="\n") as handle:
         handle.write(text)
-
-

@@ -174,13 +174,14 @@ class _Reader:
 
     def point(self, element: ET.Element, name: str, where: str) -> NDArray[np.float64] | None:
         child = _child(element, name)
-        if child is None or not (child.text or "").strip():
+        text = "" if child is None else (child.text or "").strip()
+        if not text:
             return None
-        parts = child.text.split()
+        parts = text.split()
         try:
             north, east = float(parts[0]), float(parts[1])
         except (ValueError, IndexError):
-            raise ValueError(f"{where}: <{name}> {child.text.strip()!r} is not 'northing easting'") from None
+            raise ValueError(f"{where}: <{name}> {text!r} is not 'northing easting'") from None
         return np.array([east, north]) * self.scale
 
     def direction(self, element: ET.Element, name: str) -> float | None:
@@ -277,7 +278,9 @@ def _element(r: _Reader, e: ET.Element, where: str) -> _Element:
             raise ValueError(f"{where}: Curve rot {rot!r} is not cw or ccw")
         sign = 1.0 if rot == "ccw" else -1.0
         center = r.point(e, "Center", where)
-        radius = r.number(e, "radius", where, 0.0) or (float(np.hypot(*(start - center))) if start is not None and center is not None else 0.0)
+        radius = r.number(e, "radius", where, 0.0) or (
+            float(np.hypot(*(start - center))) if start is not None and center is not None else 0.0
+        )
         if not radius > 0.0:
             raise ValueError(f"{where}: a Curve needs a radius (or Start and Center)")
         heading = None
@@ -372,7 +375,9 @@ def _alignment(r: _Reader, a: ET.Element, label: str) -> LandXMLAlignment:
         heading = item.heading if item.heading is not None else heading
         starts.append(point)
         headings.append(heading)
-        (end,), (heading,), _ = clothoid_frames([item.length], item.k0, (item.k1 - item.k0) / item.length, x0=point[0], y0=point[1], hdg=heading)
+        (end,), (heading,), _ = clothoid_frames(
+            [item.length], item.k0, (item.k1 - item.k0) / item.length, x0=point[0], y0=point[1], hdg=heading
+        )
         point = end
         ends.append((end, heading))
     runs: list[list[Segment]] = [[]]

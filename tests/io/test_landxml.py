@@ -123,9 +123,11 @@ def test_civil3d_spiral_rebuilt_with_the_stated_offset():
 def test_spiral_between_two_radii_and_through_an_inflection():
     head = ('<LandXML xmlns="http://www.landxml.org/schema/LandXML-1.2"><Units><Metric linearUnit="meter" '
             'angularUnit="grads" directionUnit="grads"/></Units><Alignments><Alignment name="c" staStart="0"><CoordGeom>')  # fmt: skip
-    body = ('<Spiral length="80" radiusStart="400" radiusEnd="200" rot="ccw" spiType="clothoid" dirStart="50">'
-            "<Start>0 0</Start><PI/><End/></Spiral>"
-            '<Spiral length="60" radiusStart="200" radiusEnd="INF" rot="ccw" spiType="clothoid"><Start/><PI/><End/></Spiral>')
+    body = (
+        '<Spiral length="80" radiusStart="400" radiusEnd="200" rot="ccw" spiType="clothoid" dirStart="50">'
+        "<Start>0 0</Start><PI/><End/></Spiral>"
+        '<Spiral length="60" radiusStart="200" radiusEnd="INF" rot="ccw" spiType="clothoid"><Start/><PI/><End/></Spiral>'
+    )
     (r,) = read_landxml(head + body + "</CoordGeom></Alignment></Alignments></LandXML>")
     first = r.chain.segments[0]
     assert first.start_curvature == pytest.approx(1 / 400, rel=1e-9) and first.end_curvature == pytest.approx(1 / 200, rel=1e-9)
