@@ -47,7 +47,16 @@ from ..core.segments import row_frames
 from ..core.shapes import SHAPE_NAMES
 from ..core.units import to_metres
 
-__all__ = ["METRIC_UNITS", "OFFSET_SAMPLES", "US_SURVEY_FOOT", "AlignmentToWrite", "landxml_text", "spiral_offsets", "write_landxml"]
+__all__ = [
+    "METRIC_UNITS",
+    "OFFSET_SAMPLES",
+    "segment_samples",
+    "US_SURVEY_FOOT",
+    "AlignmentToWrite",
+    "landxml_text",
+    "spiral_offsets",
+    "write_landxml",
+]
 
 #: LandXML's linear unit names of our units (``Metric`` or ``Imperial``).
 METRIC_UNITS = {"mm": "millimeter", "cm": "centimeter", "m": "meter", "km": "kilometer"}
@@ -111,31 +120,65 @@ def _meet(p: NDArray, t: NDArray, q: NDArray, u: NDArray) -> NDArray | None:
     return p + t * ((d[0] * u[1] - d[1] * u[0]) / cross)
 
 
+#: Gauss–Legendre nodes and weights on [0, 1] for the arc length of each sample interval of a cubic.
+_GL_X, _GL_W = np.polynomial.legendre.leggauss(8)
+_GL_U, _GL_HALF = 0.5 * (_GL_X + 1.0), 0.5 * _GL_W
+
+
+def segment_samples(chain: Chain, samples: int = OFFSET_SAMPLES) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
+    """Points of every segment of a plane chain at ``samples`` equal parameter steps, with their arc lengths.
+
+    Returns (points (n, samples, 2), arc lengths from each segment's start (n, samples), end frames (n, 2, 9)).
+    Lines and arcs are sampled in closed form, spirals as Bézier curves with the arc length of each step by
+    8-point Gauss–Legendre quadrature (all segments at once, no inversion of arc length).
+    """
+    rows = chain.rows
+    kind = np.array(rows.kind)
+    frames, _, _ = row_frames(kind, np.array(rows.geometry), np.array(rows.params), rows.dim)
+    u = np.linspace(0.0, 1.0, samples)
+    s = chain.lengths[:, None] * u[None, :]
+    k0 = frames[:, 0, 8]
+    points, _, _ = clothoid_frames(s, k0[:, None], 0.0, x0=frames[:, 0, 0, None], y0=frames[:, 0, 1, None],
+                                   hdg=np.arctan2(frames[:, 0, 4], frames[:, 0, 3])[:, None], length=chain.lengths[:, None])  # fmt: skip
+    spiral = np.flatnonzero(kind == SPIRAL)
+    if len(spiral):
+        cp = rows.geometry[spiral, :, :2]  # (m, 4, 2)
+        legs = np.diff(cp, axis=1)  # the derivative's control points / 3
+
+        def bezier(t: NDArray) -> NDArray:  # points at parameters t (..., k) of every spiral: (m, k, 2)
+            a, b = (1.0 - t)[..., None], t[..., None]
+            return (a**3 * cp[:, None, 0] + 3 * a * a * b * cp[:, None, 1] + 3 * a * b * b * cp[:, None, 2]
+                    + b**3 * cp[:, None, 3])  # fmt: skip
+
+        nodes = (u[:-1, None] + (u[1] - u[0]) * _GL_U[None, :]).ravel()  # (samples − 1)·8 parameters
+        a, b = (1.0 - nodes)[None, :, None], nodes[None, :, None]
+        speed = 3.0 * np.hypot(*(a * a * legs[:, None, 0] + 2 * a * b * legs[:, None, 1] + b * b * legs[:, None, 2]).transpose(2, 0, 1))
+        steps = (speed.reshape(len(spiral), samples - 1, len(_GL_U)) @ _GL_HALF) * (u[1] - u[0])
+        points[spiral] = bezier(u)
+        s[spiral] = np.concatenate([np.zeros((len(spiral), 1)), np.cumsum(steps, axis=1)], axis=1)
+    return points, s, frames
+
+
 def spiral_offsets(chain: Chain, samples: int = OFFSET_SAMPLES) -> NDArray[np.float64]:
     """Per segment the largest offset between it and the clothoid of the same length and end curvatures.
 
     The clothoid is placed at the segment's start point and direction (what a
-    reader rebuilds from a LandXML ``Spiral``) and both are compared at
-    ``samples`` equal arc lengths; lines and arcs give 0 (a clothoid of
-    constant curvature is the arc itself). In the chain's unit.
+    reader rebuilds from a LandXML ``Spiral``) and compared with the segment at
+    ``samples`` points, each with the clothoid's point at the same arc length;
+    lines and arcs give 0 (a clothoid of constant curvature is the arc itself).
+    In the chain's unit.
     """
-    rows = chain.rows
-    frames, _, _ = row_frames(np.array(rows.kind), np.array(rows.geometry), np.array(rows.params), rows.dim)
-    out = np.zeros(len(rows))
-    spiral = np.flatnonzero(np.asarray(rows.kind) == SPIRAL)
+    points, s, frames = segment_samples(chain, samples)
+    out = np.zeros(len(points))
+    spiral = np.flatnonzero(np.asarray(chain.rows.kind) == SPIRAL)
     if not len(spiral):
         return out
-    lengths, stations = chain.lengths[spiral], chain.stations[spiral]
-    u = np.linspace(0.0, 1.0, samples)
-    s = lengths[:, None] * u[None, :]
-    ours = chain.point_at((stations[:, None] + s).ravel())[:, :2].reshape(len(spiral), samples, 2)
-    ours[:, 0] = frames[spiral, 0, :2]  # the start exactly (point_at of a joint may pick the segment before)
-    ours[:, -1] = frames[spiral, 1, :2]
+    lengths = chain.lengths[spiral]
     k0, k1 = frames[spiral, 0, 8], frames[spiral, 1, 8]
     start = frames[spiral, 0]
-    points, _, _ = clothoid_frames(s, k0[:, None], ((k1 - k0) / lengths)[:, None], x0=start[:, None, 0], y0=start[:, None, 1],
+    theirs, _, _ = clothoid_frames(s[spiral], k0[:, None], ((k1 - k0) / lengths)[:, None], x0=start[:, None, 0], y0=start[:, None, 1],
                                    hdg=np.arctan2(start[:, 4], start[:, 3])[:, None], length=lengths[:, None])  # fmt: skip
-    out[spiral] = np.hypot(*(ours - points).transpose(2, 0, 1)).max(axis=1)
+    out[spiral] = np.hypot(*(points[spiral] - theirs).transpose(2, 0, 1)).max(axis=1)
     return out
 
 

@@ -51,7 +51,7 @@ from ..core.factors import length_factor
 from ..core.segments import Arc, Line, Segment
 from ..core.shapes import SHAPE_CODES, shape_limits
 from ..core.spiral import BezierSpiral
-from .landxml import DESC_PREFIX, US_SURVEY_FOOT
+from .landxml import DESC_PREFIX, US_SURVEY_FOOT, segment_samples
 
 __all__ = ["LandXMLAlignment", "read_landxml"]
 
@@ -214,11 +214,12 @@ def _theta(length: float, curvature: float, shape: str) -> float:
     return theta_for_length(length, 1.0 / abs(curvature), shape)
 
 
-def _growing(length: float, k0: float, k1: float, shape: str) -> BezierSpiral:
-    """Our spiral from curvature k0 to k1 (same sign, |k0| < |k1|, k0 may be 0), at the origin along +x."""
+def _growing(length: float, k0: float, k1: float, shape: str, theta: float | None = None) -> BezierSpiral:
+    """Our spiral from curvature k0 to k1 (same sign, |k0| < |k1|, k0 may be 0), at the origin along +x
+    (``theta``: its turn when k0 = 0, if already solved)."""
     sign = math.copysign(1.0, k1)
     if k0 == 0.0:
-        return BezierSpiral((0.0, 0.0), (1.0, 0.0), sign * _theta(length, k1, shape), k1, shape)
+        return BezierSpiral((0.0, 0.0), (1.0, 0.0), sign * (_theta(length, k1, shape) if theta is None else theta), k1, shape)
     largest = shape_limits(shape)["theta"] * (1.0 - 1e-9)
     longest = float(length_factor(largest, shape)) / abs(k1)
 
@@ -235,14 +236,15 @@ def _growing(length: float, k0: float, k1: float, shape: str) -> BezierSpiral:
     return spiral.piece(float(spiral.parameter_at(full - length)), 1.0)
 
 
-def _spirals(length: float, k0: float, k1: float, shape: str) -> list[BezierSpiral]:
-    """Our spirals (at the origin along +x, in travel order) for a clothoid from k0 to k1."""
+def _spirals(length: float, k0: float, k1: float, shape: str, theta: float | None = None) -> list[BezierSpiral]:
+    """Our spirals (at the origin along +x, in travel order) for a clothoid from k0 to k1 (``theta``:
+    the turn of a spiral with one straight end, if already solved)."""
     if k0 * k1 < 0.0:  # through an inflection: two spirals meeting at curvature 0
         first = length * abs(k0) / (abs(k0) + abs(k1))
         return _spirals(first, k0, 0.0, shape) + _spirals(length - first, 0.0, k1, shape)
     if abs(k1) >= abs(k0):
-        return [_growing(length, k0, k1, shape)]
-    backwards = _growing(length, -k1, -k0, shape).reversed()  # travelled backwards, a left turn is a right one
+        return [_growing(length, k0, k1, shape, theta)]
+    backwards = _growing(length, -k1, -k0, shape, theta).reversed()  # travelled backwards, a left turn is a right one
     return [backwards]
 
 
@@ -256,6 +258,7 @@ class _Element:
     k1: float
     station: float | None
     shape: str
+    theta: float | None = None
 
 
 def _element(r: _Reader, e: ET.Element, where: str) -> _Element:
@@ -335,11 +338,23 @@ def _segments(item: _Element, point: NDArray, heading: float) -> list[Segment]:
         center = point + radius * np.array([-math.sin(heading), math.cos(heading)])
         return [Arc(tuple(center), radius, _heading(point - center), abs(item.length * item.k0))]
     out: list[Segment] = []
-    for spiral in _spirals(item.length, item.k0, item.k1, item.shape):
+    for spiral in _spirals(item.length, item.k0, item.k1, item.shape, item.theta):
         placed = _placed_spiral(spiral.control_points[:, :2], point, heading, spiral.shape)
         out.append(placed)
         point, heading = placed.end[:2], _heading(placed.end_tangent[:2])
     return out
+
+
+def _solve_turns(items: list[_Element]) -> None:
+    """The turns of every spiral with one straight end, one batch per shape (``thetas_for_lengths``)."""
+    from ..design.alignment import thetas_for_lengths
+
+    plain = [i for i in items if i.kind == "Spiral" and (i.k0 == 0.0) != (i.k1 == 0.0)]
+    for shape in {i.shape for i in plain}:
+        chosen = [i for i in plain if i.shape == shape]
+        radii = [1.0 / abs(i.k0 + i.k1) for i in chosen]
+        for item, theta in zip(chosen, thetas_for_lengths([i.length for i in chosen], radii, shape)):
+            item.theta = None if math.isnan(theta) else float(theta)  # out of range: the scalar solver names it
 
 
 def _alignment(r: _Reader, a: ET.Element, label: str) -> LandXMLAlignment:
@@ -370,16 +385,18 @@ def _alignment(r: _Reader, a: ET.Element, label: str) -> LandXMLAlignment:
     point, heading = items[0].start, items[0].heading
     if point is None or heading is None:
         raise ValueError(f"{where}: the first element needs a Start point and a direction")
-    for item in items:
+    size = np.array([i.length for i in items])
+    bend = np.array([i.k0 for i in items])
+    local, turns, _ = clothoid_frames(size, bend, (np.array([i.k1 for i in items]) - bend) / size, length=size)
+    for item, (dx, dy), turn in zip(items, local, turns):  # each element's end: its local clothoid turned into place
         point = item.start if item.start is not None else point
         heading = item.heading if item.heading is not None else heading
         starts.append(point)
         headings.append(heading)
-        (end,), (heading,), _ = clothoid_frames(
-            [item.length], item.k0, (item.k1 - item.k0) / item.length, x0=point[0], y0=point[1], hdg=heading
-        )
-        point = end
-        ends.append((end, heading))
+        c, n = math.cos(heading), math.sin(heading)
+        point, heading = point + np.array([c * dx - n * dy, n * dx + c * dy]), heading + float(turn)
+        ends.append((point, heading))
+    _solve_turns(items)
     runs: list[list[Segment]] = [[]]
     breaks: list[str] = []
     point, heading = starts[0], headings[0]
@@ -402,21 +419,29 @@ def _alignment(r: _Reader, a: ET.Element, label: str) -> LandXMLAlignment:
         runs[-1] += pieces
         point, heading = pieces[-1].end[:2], _heading(pieces[-1].end_tangent[:2])
     chains = tuple(Chain(run, tolerance=1e-6, units=r.units) for run in runs)
-    lengths = np.array([i.length for i in items])
-    within = np.linspace(0.0, 1.0, SAMPLES)[None, :] * lengths[:, None]
-    ours = np.empty((len(items), SAMPLES, 2))
-    for run, chain in enumerate(chains):
-        mine = [k for k, (owner, _) in enumerate(first) if owner == run]
-        at = chain.stations[[first[k][1] for k in mine]][:, None] + within[mine]
-        ours[mine] = chain.point_at(np.minimum(at, chain.length).ravel())[:, :2].reshape(len(mine), SAMPLES, 2)
-    k0 = np.array([i.k0 for i in items])[:, None]
-    theirs, _, _ = clothoid_frames(within, k0, (np.array([i.k1 for i in items])[:, None] - k0) / lengths[:, None],
-                                   x0=np.array(starts)[:, None, 0], y0=np.array(starts)[:, None, 1],
-                                   hdg=np.array(headings)[:, None], length=lengths[:, None])  # fmt: skip
-    offsets = np.hypot(*(ours - theirs).transpose(2, 0, 1)).max(axis=1)
+    offsets = _offsets(items, chains, first, np.array(starts), np.array(headings))
     profile, notes = _profile(r, a, where)
     return LandXMLAlignment(name, chains, tuple(breaks), start_station, r.units, profile, offsets, tuple(i.kind for i in items),
                             np.array([i.station for i in items]), notes)  # fmt: skip
+
+
+def _offsets(items: list[_Element], chains: tuple[Chain, ...], first: list[tuple[int, int]], starts: NDArray,
+             headings: NDArray) -> NDArray[np.float64]:  # fmt: skip
+    """Per element the largest distance between our segments and the file's element placed at its own
+    start, each of our sample points against the file's point at the same arc length."""
+    k0 = np.array([i.k0 for i in items])
+    rate = (np.array([i.k1 for i in items]) - k0) / np.array([i.length for i in items])
+    offsets = np.zeros(len(items))
+    for run, chain in enumerate(chains):
+        mine = [k for k, (owner, _) in enumerate(first) if owner == run]
+        begin = np.array([first[k][1] for k in mine])
+        owner = np.repeat(mine, np.diff(np.append(begin, len(chain))))  # each segment's element
+        ours, s, _ = segment_samples(chain, SAMPLES)
+        s = s + (chain.stations[:-1] - chain.stations[begin][np.searchsorted(mine, owner)])[:, None]  # from the element's start
+        theirs, _, _ = clothoid_frames(s, k0[owner, None], rate[owner, None], x0=starts[owner, None, 0], y0=starts[owner, None, 1],
+                                       hdg=headings[owner, None], length=s[:, -1:])  # fmt: skip
+        np.maximum.at(offsets, owner, np.hypot(*(ours - theirs).transpose(2, 0, 1)).max(axis=1))
+    return offsets
 
 
 def _profile(r: _Reader, a: ET.Element, where: str) -> tuple[Any, tuple[str, ...]]:
