@@ -1,12 +1,11 @@
 """File formats that need no CAD kernel: STEP text, SVG, DXF (through ezdxf), samples CSV,
-G-code in, OpenDRIVE model, writer, reader and checker, and all-or-nothing output staging.
+G-code in, OpenDRIVE model, writer, reader and checker, LandXML out and in (``read_landxml``, loaded
+on first use), and all-or-nothing output staging.
 
 IGES and the STEP of solids go through OCCT and live in ``spiral_cad.cad``.
 """
 
 from typing import Any
-
-__all__ = ["read_landxml"]
 
 
 def __getattr__(name: str) -> Any:

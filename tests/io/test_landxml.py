@@ -156,3 +156,20 @@ def test_refusals_are_named(element, message):
 def test_alignpis_only_is_refused_by_name():
     with pytest.raises(ValueError, match="alignment 'MntnRoad': no CoordGeom .*AlignPIs"):
         read_landxml(DATA / "sdms_mntnroad_alignpis.xml")
+
+
+def test_chord_defined_curve_and_directions_in_degrees_minutes_seconds():
+    # a line along 30°15'36" (dir and length only), then a curve of R 100 ft given by its chord only
+    text = ('<LandXML><Units><Imperial linearUnit="foot" angularUnit="decimal dd.mm.ss" directionUnit="decimal dd.mm.ss"/></Units>'
+            '<Alignments><Alignment name="d" staStart="100"><CoordGeom>'
+            '<Line dir="30.1536" length="50"><Start>10 20</Start></Line>'
+            '<Curve rot="ccw" radius="100" chord="60"><Start/></Curve>'
+            "</CoordGeom></Alignment></Alignments></LandXML>")  # fmt: skip
+    (r,) = read_landxml(text)
+    line, arc = (chain.segments[0] for chain in r.chains)
+    heading = math.degrees(math.atan2(line.start_tangent[1], line.start_tangent[0]))
+    assert heading == pytest.approx(30 + 15 / 60 + 36 / 3600, abs=1e-12)
+    assert tuple(line.start[:2]) == (20.0, 10.0)  # easting 20, northing 10
+    assert arc.length == pytest.approx(200 * math.asin(0.3), rel=1e-12)
+    assert math.dist(arc.start[:2], arc.end[:2]) == pytest.approx(60.0, rel=1e-12)
+    assert r.start_station == 100 and r.stations[1] == pytest.approx(150.0)
