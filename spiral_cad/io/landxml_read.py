@@ -230,7 +230,9 @@ def _growing(length: float, k0: float, k1: float, shape: str, theta: float | Non
 
     low = length * (1.0 + 1e-12)
     if not longest > low or start_curvature(longest) < 0.0:
-        raise ValueError(f"no {shape} spiral piece of length {length:.6g} runs from curvature {k0:.6g} to {k1:.6g}")
+        turn = math.degrees(k1 * k1 * length / (2.0 * abs(k1 - k0)))  # the clothoid's turn from straight to k1
+        raise ValueError(f"the clothoid from curvature {k0:.6g} to {k1:.6g} over {length:.6g} is the end of one that turns "
+                         f"{turn:.3g}° from straight, and no {shape} spiral piece reaches it (up to {math.degrees(largest):.3g}°)")  # fmt: skip
     full = brentq(start_curvature, low, longest, xtol=1e-12 * length, rtol=1e-14)
     spiral = BezierSpiral((0.0, 0.0), (1.0, 0.0), sign * _theta(full, k1, shape), k1, shape)
     return spiral.piece(float(spiral.parameter_at(full - length)), 1.0)
@@ -259,6 +261,8 @@ class _Element:
     station: float | None
     shape: str
     theta: float | None = None
+    where: str = ""
+    notes: list[str] = field(default_factory=list)
 
 
 def _element(r: _Reader, e: ET.Element, where: str) -> _Element:
@@ -338,7 +342,16 @@ def _segments(item: _Element, point: NDArray, heading: float) -> list[Segment]:
         center = point + radius * np.array([-math.sin(heading), math.cos(heading)])
         return [Arc(tuple(center), radius, _heading(point - center), abs(item.length * item.k0))]
     out: list[Segment] = []
-    for spiral in _spirals(item.length, item.k0, item.k1, item.shape, item.theta):
+    try:
+        spirals = _spirals(item.length, item.k0, item.k1, item.shape, item.theta)
+    except ValueError as e:  # beyond the shape's turn (a long compound piece): the other shape, which turns up to 90°
+        other = "walton-meek" if item.shape == "near-linear" else "near-linear"
+        try:
+            spirals = _spirals(item.length, item.k0, item.k1, other)
+        except ValueError:
+            raise ValueError(f"{item.where}: {e}, nor a {other} one") from None
+        item.notes.append(f"{item.where}: rebuilt with {other} spirals ({e})")
+    for spiral in spirals:
         placed = _placed_spiral(spiral.control_points[:, :2], point, heading, spiral.shape)
         out.append(placed)
         point, heading = placed.end[:2], _heading(placed.end_tangent[:2])
@@ -372,6 +385,7 @@ def _alignment(r: _Reader, a: ET.Element, label: str) -> LandXMLAlignment:
             continue
         place = f"{where}, CoordGeom element {index} ({_local(e.tag)}) at station {station:.6g}"
         item = _element(r, e, place)
+        item.where = place
         if item.station is None:
             item.station = station
         if not item.length > 0.0:
@@ -421,6 +435,7 @@ def _alignment(r: _Reader, a: ET.Element, label: str) -> LandXMLAlignment:
     chains = tuple(Chain(run, tolerance=1e-6, units=r.units) for run in runs)
     offsets = _offsets(items, chains, first, np.array(starts), np.array(headings))
     profile, notes = _profile(r, a, where)
+    notes = tuple(note for item in items for note in item.notes) + notes
     return LandXMLAlignment(name, chains, tuple(breaks), start_station, r.units, profile, offsets, tuple(i.kind for i in items),
                             np.array([i.station for i in items]), notes)  # fmt: skip
 

@@ -173,3 +173,49 @@ def test_chord_defined_curve_and_directions_in_degrees_minutes_seconds():
     assert arc.length == pytest.approx(200 * math.asin(0.3), rel=1e-12)
     assert math.dist(arc.start[:2], arc.end[:2]) == pytest.approx(60.0, rel=1e-12)
     assert r.start_station == 100 and r.stations[1] == pytest.approx(150.0)
+
+
+def _file_ends(path: Path) -> np.ndarray:
+    """Every CoordGeom element's <End> (easting, northing) as the file states it, read without our reader."""
+    import xml.etree.ElementTree as ET
+
+    ends = [e for e in ET.parse(path).iter() if e.tag.endswith("}End") or e.tag == "End"]
+    return np.array([[float(v) for v in e.text.split()[1::-1]] for e in ends])
+
+
+def test_mdt_export_in_grads_with_sharp_spirals_and_its_profile():
+    path = DATA / "mdt_aplitop_alignment1.xml"
+    (r,) = read_landxml(path)
+    assert r.name == "Horizontal" and r.units == "m" and len(r.kinds) == 15 and r.kinds.count("Spiral") == 7
+    # element 0 is a line onto an arc without a spiral: two runs, the second G2 through every spiral
+    assert len(r.chains) == 2 and "at station 10 " in r.breaks[0]
+    ends = _file_ends(path)
+    assert np.abs(r.chains[0].end[:2] - ends[0]).max() < 1e-6
+    # the rebuilt chain ends within the offset it reports for the last element (the spirals' drift, metres here)
+    gap = math.dist(r.chains[-1].end[:2], ends[-1])
+    assert gap <= r.offsets[-1] + 1e-6 and 1.0 < r.offset < 5.0
+    assert np.all(np.diff(r.offsets[1:]) > -0.05)  # the drift grows along the spirals (R 22–60 m: far from cubics)
+    assert r.profile.elevation([0.0, 507.067]) == pytest.approx([365.8, 350.7], abs=1e-9)
+
+
+def test_mdt_compound_spiral_beyond_any_cubic_is_refused_by_name():
+    with pytest.raises(ValueError, match=r"alignment 'Alignment2', CoordGeom element 5 \(Spiral\) at station 3945.2: .* turns 63.8°"):
+        read_landxml(DATA / "mdt_aplitop_alignment2.xml")
+
+
+def test_openroads_export_in_us_survey_feet_with_three_coordinates():
+    path = DATA / "openroads_indot_twin_branch.xml"
+    (r,) = read_landxml(path)
+    assert (
+        r.units == "ft" and r.kinds == ("Line", "Curve", "Line") and r.start_station == pytest.approx(2103.72056 * US_SURVEY_FOOT / 0.3048)
+    )
+    ends = _file_ends(path) * (US_SURVEY_FOOT / 0.3048)
+    assert np.abs(np.array([c.end[:2] for c in r.chains]) - ends).max() < 1e-6
+    assert r.chains[1].segments[0].length == pytest.approx(1705.3152959346885 * US_SURVEY_FOOT / 0.3048, rel=1e-9)
+    assert r.profile is not None and len(r.profile.curves) == 4
+
+
+def test_novapoint_inframodel_profile_with_a_circular_vertical_curve():
+    (r,) = read_landxml(DATA / "novapoint_toi_y3.xml")
+    assert r.name == "Tie2 oikea" and r.kinds == ("Line",) and r.chain.length == pytest.approx(37.043112, abs=1e-6)
+    assert "CircCurve" in r.notes[0] and r.profile.curves[0].length == pytest.approx(9.901082)
