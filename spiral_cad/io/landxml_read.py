@@ -379,6 +379,7 @@ def _alignment(r: _Reader, a: ET.Element, label: str) -> LandXMLAlignment:
         raise ValueError(f"{where}: no CoordGeom (geometry given only as {', '.join(sorted({_local(c.tag) for c in a})) or 'nothing'}); "
                          "only CoordGeom alignments can be rebuilt")  # fmt: skip
     items: list[_Element] = []
+    skipped: list[str] = []
     station = start_station
     for index, e in enumerate(geometry):
         if not isinstance(e.tag, str):
@@ -388,6 +389,9 @@ def _alignment(r: _Reader, a: ET.Element, label: str) -> LandXMLAlignment:
         item.where = place
         if item.station is None:
             item.station = station
+        if item.length == 0.0:  # MDT writes zero-length curves between spirals: a point, nothing to build
+            skipped.append(f"{place}: zero length, skipped")
+            continue
         if not item.length > 0.0:
             raise ValueError(f"{place}: length {item.length!r} is not positive")
         items.append(item)
@@ -435,7 +439,7 @@ def _alignment(r: _Reader, a: ET.Element, label: str) -> LandXMLAlignment:
     chains = tuple(Chain(run, tolerance=1e-6, units=r.units) for run in runs)
     offsets = _offsets(items, chains, first, np.array(starts), np.array(headings))
     profile, notes = _profile(r, a, where)
-    notes = tuple(note for item in items for note in item.notes) + notes
+    notes = (*skipped, *(note for item in items for note in item.notes), *notes)
     return LandXMLAlignment(name, chains, tuple(breaks), start_station, r.units, profile, offsets, tuple(i.kind for i in items),
                             np.array([i.station for i in items]), notes)  # fmt: skip
 

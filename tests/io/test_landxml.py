@@ -219,3 +219,13 @@ def test_novapoint_inframodel_profile_with_a_circular_vertical_curve():
     (r,) = read_landxml(DATA / "novapoint_toi_y3.xml")
     assert r.name == "Tie2 oikea" and r.kinds == ("Line",) and r.chain.length == pytest.approx(37.043112, abs=1e-6)
     assert "CircCurve" in r.notes[0] and r.profile.curves[0].length == pytest.approx(9.901082)
+
+
+def test_zero_length_elements_are_skipped_and_noted_negative_ones_refused():
+    head = '<LandXML><Units><Metric linearUnit="meter"/></Units><Alignments><Alignment name="z"><CoordGeom>'
+    line = "<Line><Start>0 0</Start><End>0 10</End></Line>"
+    curve = '<Curve rot="cw" radius="50" length="{}"><Start>0 10</Start><Center>-50 10</Center></Curve>'
+    (r,) = read_landxml(head + line + curve.format(0) + "</CoordGeom></Alignment></Alignments></LandXML>")
+    assert r.kinds == ("Line",) and "element 1 (Curve) at station 10: zero length, skipped" in r.notes[0]
+    with pytest.raises(ValueError, match=r"element 1 \(Curve\) at station 10: length -5.0 is not positive"):
+        read_landxml(head + line + curve.format(-5) + "</CoordGeom></Alignment></Alignments></LandXML>")
