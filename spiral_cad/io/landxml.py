@@ -120,9 +120,23 @@ def _meet(p: NDArray, t: NDArray, q: NDArray, u: NDArray) -> NDArray | None:
     return p + t * ((d[0] * u[1] - d[1] * u[0]) / cross)
 
 
+#: Spirals evaluated at once when sampling (bounds the memory of long alignments).
+CHUNK = 1024
 #: Gauss–Legendre nodes and weights on [0, 1] for the arc length of each sample interval of a cubic.
 _GL_X, _GL_W = np.polynomial.legendre.leggauss(8)
 _GL_U, _GL_HALF = 0.5 * (_GL_X + 1.0), 0.5 * _GL_W
+
+
+def _bezier_samples(cp: NDArray, u: NDArray) -> tuple[NDArray, NDArray]:
+    """Points (m, k, 2) of cubic Bézier curves (m, 4, 2) at parameters ``u`` (k,) from 0, and their arc lengths (m, k)."""
+    legs = np.diff(cp, axis=1)  # the derivative's control points / 3
+    a, b = (1.0 - u)[None, :, None], u[None, :, None]
+    points = a**3 * cp[:, None, 0] + 3 * a * a * b * cp[:, None, 1] + 3 * a * b * b * cp[:, None, 2] + b**3 * cp[:, None, 3]
+    nodes = (u[:-1, None] + np.diff(u)[:, None] * _GL_U[None, :]).ravel()  # 8 Gauss–Legendre nodes per step
+    a, b = (1.0 - nodes)[None, :, None], nodes[None, :, None]
+    speed = 3.0 * np.hypot(*(a * a * legs[:, None, 0] + 2 * a * b * legs[:, None, 1] + b * b * legs[:, None, 2]).transpose(2, 0, 1))
+    steps = (speed.reshape(len(cp), len(u) - 1, len(_GL_U)) @ _GL_HALF) * np.diff(u)
+    return points, np.concatenate([np.zeros((len(cp), 1)), np.cumsum(steps, axis=1)], axis=1)
 
 
 def segment_samples(chain: Chain, samples: int = OFFSET_SAMPLES) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
@@ -141,21 +155,8 @@ def segment_samples(chain: Chain, samples: int = OFFSET_SAMPLES) -> tuple[NDArra
     points, _, _ = clothoid_frames(s, k0[:, None], 0.0, x0=frames[:, 0, 0, None], y0=frames[:, 0, 1, None],
                                    hdg=np.arctan2(frames[:, 0, 4], frames[:, 0, 3])[:, None], length=chain.lengths[:, None])  # fmt: skip
     spiral = np.flatnonzero(kind == SPIRAL)
-    if len(spiral):
-        cp = rows.geometry[spiral, :, :2]  # (m, 4, 2)
-        legs = np.diff(cp, axis=1)  # the derivative's control points / 3
-
-        def bezier(t: NDArray) -> NDArray:  # points at parameters t (..., k) of every spiral: (m, k, 2)
-            a, b = (1.0 - t)[..., None], t[..., None]
-            return (a**3 * cp[:, None, 0] + 3 * a * a * b * cp[:, None, 1] + 3 * a * b * b * cp[:, None, 2]
-                    + b**3 * cp[:, None, 3])  # fmt: skip
-
-        nodes = (u[:-1, None] + (u[1] - u[0]) * _GL_U[None, :]).ravel()  # (samples − 1)·8 parameters
-        a, b = (1.0 - nodes)[None, :, None], nodes[None, :, None]
-        speed = 3.0 * np.hypot(*(a * a * legs[:, None, 0] + 2 * a * b * legs[:, None, 1] + b * b * legs[:, None, 2]).transpose(2, 0, 1))
-        steps = (speed.reshape(len(spiral), samples - 1, len(_GL_U)) @ _GL_HALF) * (u[1] - u[0])
-        points[spiral] = bezier(u)
-        s[spiral] = np.concatenate([np.zeros((len(spiral), 1)), np.cumsum(steps, axis=1)], axis=1)
+    for block in np.array_split(spiral, -(-len(spiral) // CHUNK)) if len(spiral) else ():  # bounded memory
+        points[block], s[block] = _bezier_samples(rows.geometry[block, :, :2], u)
     return points, s, frames
 
 
@@ -173,12 +174,14 @@ def spiral_offsets(chain: Chain, samples: int = OFFSET_SAMPLES) -> NDArray[np.fl
     spiral = np.flatnonzero(np.asarray(chain.rows.kind) == SPIRAL)
     if not len(spiral):
         return out
-    lengths = chain.lengths[spiral]
-    k0, k1 = frames[spiral, 0, 8], frames[spiral, 1, 8]
-    start = frames[spiral, 0]
-    theirs, _, _ = clothoid_frames(s[spiral], k0[:, None], ((k1 - k0) / lengths)[:, None], x0=start[:, None, 0], y0=start[:, None, 1],
-                                   hdg=np.arctan2(start[:, 4], start[:, 3])[:, None], length=lengths[:, None])  # fmt: skip
-    out[spiral] = np.hypot(*(points[spiral] - theirs).transpose(2, 0, 1)).max(axis=1)
+    for block in np.array_split(spiral, -(-len(spiral) // CHUNK)):  # bounded memory: quadrature nodes per sample
+        lengths = chain.lengths[block]
+        k0, k1 = frames[block, 0, 8], frames[block, 1, 8]
+        start = frames[block, 0]
+        theirs, _, _ = clothoid_frames(s[block], k0[:, None], ((k1 - k0) / lengths)[:, None], x0=start[:, None, 0],
+                                       y0=start[:, None, 1], hdg=np.arctan2(start[:, 4], start[:, 3])[:, None],
+                                       length=lengths[:, None])  # fmt: skip
+        out[block] = np.hypot(*(points[block] - theirs).transpose(2, 0, 1)).max(axis=1)
     return out
 
 

@@ -51,7 +51,7 @@ from ..core.factors import length_factor
 from ..core.segments import Arc, Line, Segment
 from ..core.shapes import SHAPE_CODES, shape_limits
 from ..core.spiral import BezierSpiral
-from .landxml import DESC_PREFIX, US_SURVEY_FOOT, segment_samples
+from .landxml import CHUNK, DESC_PREFIX, US_SURVEY_FOOT, segment_samples
 
 __all__ = ["LandXMLAlignment", "read_landxml"]
 
@@ -451,15 +451,18 @@ def _offsets(items: list[_Element], chains: tuple[Chain, ...], first: list[tuple
     k0 = np.array([i.k0 for i in items])
     rate = (np.array([i.k1 for i in items]) - k0) / np.array([i.length for i in items])
     offsets = np.zeros(len(items))
-    for run, chain in enumerate(chains):
-        mine = [k for k, (owner, _) in enumerate(first) if owner == run]
+    runs = np.array([run for run, _ in first])
+    by_run = np.split(np.arange(len(items)), np.flatnonzero(np.diff(runs)) + 1)  # elements of each run, in order
+    for chain, mine in zip(chains, by_run):
         begin = np.array([first[k][1] for k in mine])
         owner = np.repeat(mine, np.diff(np.append(begin, len(chain))))  # each segment's element
         ours, s, _ = segment_samples(chain, SAMPLES)
         s = s + (chain.stations[:-1] - chain.stations[begin][np.searchsorted(mine, owner)])[:, None]  # from the element's start
-        theirs, _, _ = clothoid_frames(s, k0[owner, None], rate[owner, None], x0=starts[owner, None, 0], y0=starts[owner, None, 1],
-                                       hdg=headings[owner, None], length=s[:, -1:])  # fmt: skip
-        np.maximum.at(offsets, owner, np.hypot(*(ours - theirs).transpose(2, 0, 1)).max(axis=1))
+        for block in np.array_split(np.arange(len(owner)), -(-len(owner) // CHUNK)):  # bounded memory
+            o = owner[block]
+            theirs, _, _ = clothoid_frames(s[block], k0[o, None], rate[o, None], x0=starts[o, None, 0], y0=starts[o, None, 1],
+                                           hdg=headings[o, None], length=s[block, -1:])  # fmt: skip
+            np.maximum.at(offsets, o, np.hypot(*(ours[block] - theirs).transpose(2, 0, 1)).max(axis=1))
     return offsets
 
 
