@@ -404,6 +404,7 @@ BUILDERS: dict[str, Callable[[Any, str, str, Path | None], Built]] = {
 def build(source: str | Path | dict) -> tuple[str, list[Built]]:
     """Validate and build every design of ``source``: (units, built designs).
 
+    A LandXML file (``.xml``) is built by ``build_landxml``: every alignment, one design per G2 run.
     A G-code program named by a design file is read from the design file's
     folder (a dict's from the working folder).
 
