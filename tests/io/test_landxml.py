@@ -229,3 +229,31 @@ def test_zero_length_elements_are_skipped_and_noted_negative_ones_refused():
     assert r.kinds == ("Line",) and "element 1 (Curve) at station 10: zero length, skipped" in r.notes[0]
     with pytest.raises(ValueError, match=r"element 1 \(Curve\) at station 10: length -5.0 is not positive"):
         read_landxml(head + line + curve.format(-5) + "</CoordGeom></Alignment></Alignments></LandXML>")
+
+
+def test_written_geometry_is_consistent_as_a_plain_xml_reader_sees_it(tmp_path):
+    import xml.etree.ElementTree as ET
+
+    a, _ = _road("ft")
+    path = tmp_path / "road.xml"
+    write_landxml(a, path, name="rail")
+    ns = {"l": "http://www.landxml.org/schema/LandXML-1.2"}
+    elements = list(ET.parse(path).getroot().find("l:Alignments/l:Alignment/l:CoordGeom", ns))
+
+    def ne(e, tag):  # (easting, northing) of a point written northing first
+        north, east = map(float, e.find(f"l:{tag}", ns).text.split())
+        return np.array([east, north])
+
+    for before, after in zip(elements, elements[1:]):
+        assert np.abs(ne(before, "End") - ne(after, "Start")).max() < 1e-9  # continuous
+        assert float(before.get("staStart")) + float(before.get("length")) == pytest.approx(float(after.get("staStart")), abs=1e-9)
+        assert float(before.get("dirEnd", before.get("dir"))) == pytest.approx(float(after.get("dirStart", after.get("dir"))), abs=1e-9)
+    for curve in (e for e in elements if e.tag.endswith("Curve")):
+        radius = float(curve.get("radius"))
+        for tag in ("Start", "End"):
+            assert math.dist(ne(curve, tag), ne(curve, "Center")) == pytest.approx(radius, rel=1e-12)
+        sweep = math.radians((float(curve.get("dirEnd")) - float(curve.get("dirStart")) + 180) % 360 - 180)
+        assert abs(sweep) * radius == pytest.approx(float(curve.get("length")), rel=1e-12)
+        assert (sweep > 0) == (curve.get("rot") == "ccw")
+    spirals = [e for e in elements if e.tag.endswith("Spiral")]
+    assert [(s.get("radiusStart") == "INF", s.get("radiusEnd") == "INF") for s in spirals] == [(True, False), (False, True)] * 2
