@@ -182,11 +182,26 @@ class _Reader:
             north, east = float(parts[0]), float(parts[1])
         except (ValueError, IndexError):
             raise ValueError(f"{where}: <{name}> {text!r} is not 'northing easting'") from None
+        if not math.isfinite(north + east):
+            raise ValueError(f"{where}: <{name}> {text!r} is not finite")
         return np.array([east, north]) * self.scale
 
-    def direction(self, element: ET.Element, name: str) -> float | None:
+    def angle(self, element: ET.Element, name: str, where: str) -> float:
+        """An angle attribute (``angularUnit``) in radians."""
+        return self.direction(element, name, where, self.angular_unit) or 0.0
+
+    def direction(self, element: ET.Element, name: str, where: str, unit: str | None = None) -> float | None:
+        """A direction attribute (``directionUnit``) in radians, counter-clockwise from east; None if absent."""
         text = element.get(name)
-        return None if text is None else _angle(text, self.direction_unit)
+        if text is None:
+            return None
+        try:
+            angle = _angle(text, unit or self.direction_unit)
+        except ValueError:
+            raise ValueError(f"{where}: {name}={text!r} is not a number") from None
+        if not math.isfinite(angle):
+            raise ValueError(f"{where}: {name}={text!r} is not finite")
+        return angle
 
 
 def _heading(t: NDArray) -> float:
@@ -273,7 +288,7 @@ def _element(r: _Reader, e: ET.Element, where: str) -> _Element:
         if start is not None and end is not None:
             d = end - start
             return _Element(kind, start, _heading(d), float(np.hypot(*d)), 0.0, 0.0, station, r.shape)
-        heading = r.direction(e, "dir")
+        heading = r.direction(e, "dir", where)
         if heading is None:
             raise ValueError(f"{where}: a Line needs Start and End, or dir and length")
         return _Element(kind, start, heading, r.number(e, "length", where), 0.0, 0.0, station, r.shape)
@@ -294,13 +309,13 @@ def _element(r: _Reader, e: ET.Element, where: str) -> _Element:
         if start is not None and center is not None:
             heading = _heading(start - center) + sign * math.pi / 2
         elif e.get("dirStart") is not None:
-            heading = r.direction(e, "dirStart")
+            heading = r.direction(e, "dirStart", where)
         if e.get("length") is not None:
             length = r.number(e, "length", where)
         elif e.get("chord") is not None:  # chord-defined: the minor arc unless delta says more
             chord = r.number(e, "chord", where)
             length = 2.0 * radius * math.asin(min(1.0, chord / (2.0 * radius)))
-            if e.get("delta") is not None and abs(_angle(e.get("delta", "0"), r.angular_unit)) > math.pi:
+            if e.get("delta") is not None and abs(r.angle(e, "delta", where)) > math.pi:
                 length = 2.0 * math.pi * radius - length
         elif start is not None and end is not None and center is not None:
             a0, a1 = _heading(start - center), _heading(end - center)
@@ -318,7 +333,7 @@ def _element(r: _Reader, e: ET.Element, where: str) -> _Element:
         sign = 1.0 if rot == "ccw" else -1.0
         k0, k1 = (0.0 if (radius := r.number(e, name, where, math.inf)) in (0.0, math.inf) else sign / radius
                   for name in ("radiusStart", "radiusEnd"))  # fmt: skip
-        heading = r.direction(e, "dirStart")
+        heading = r.direction(e, "dirStart", where)
         if heading is None and start is not None:
             pi = r.point(e, "PI", where)
             if pi is not None and np.any(pi != start):

@@ -3,11 +3,14 @@
 from __future__ import annotations
 
 import math
+import re
 from pathlib import Path
 
 import numpy as np
 import pytest
 import xmlschema
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from spiral_cad.design import Alignment, Profile
 from spiral_cad.io import read_landxml
@@ -257,3 +260,23 @@ def test_written_geometry_is_consistent_as_a_plain_xml_reader_sees_it(tmp_path):
         assert (sweep > 0) == (curve.get("rot") == "ccw")
     spirals = [e for e in elements if e.tag.endswith("Spiral")]
     assert [(s.get("radiusStart") == "INF", s.get("radiusEnd") == "INF") for s in spirals] == [(True, False), (False, True)] * 2
+
+
+HOSTILE = ["nan", "inf", "-inf", "0", "-1", "1e308", "1e-308", "", "abc", "5e-324", "1 2 3", "-0"]
+
+
+@settings(max_examples=150, deadline=None)
+@given(data=st.data())
+def test_any_mutated_export_reads_or_is_refused_with_a_value_error(data):
+    """Every number of real exports replaced by hostile text: a result or a ValueError, nothing else."""
+    name = data.draw(st.sampled_from(["mdt_aplitop_alignment1.xml", "civil3d_gsg_basic_road.xml", "openroads_indot_twin_branch.xml"]))
+    text = (DATA / name).read_text(encoding="utf-8-sig")
+    numbers = list(re.finditer(r"-?\d+\.?\d*(?:e-?\d+)?", text))
+    for match in sorted(data.draw(st.lists(st.sampled_from(numbers), min_size=1, max_size=4, unique_by=lambda m: m.start())),
+                        key=lambda m: -m.start()):  # fmt: skip
+        text = text[: match.start()] + data.draw(st.sampled_from(HOSTILE)) + text[match.end() :]
+    try:
+        for r in read_landxml(text):
+            assert all(np.isfinite(c.length) for c in r.chains) and np.isfinite(r.offsets).all()
+    except ValueError:
+        pass
