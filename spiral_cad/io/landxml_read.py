@@ -204,6 +204,14 @@ class _Reader:
         return angle
 
 
+def _curvature(sign: float, radius: float, where: str) -> float:
+    """The signed curvature of a radius, refused where it is not positive or overflows."""
+    curvature = sign / radius
+    if not (radius > 0.0 and math.isfinite(curvature)):
+        raise ValueError(f"{where}: radius {radius!r} has no finite positive curvature")
+    return curvature
+
+
 def _heading(t: NDArray) -> float:
     return math.atan2(t[1], t[0])
 
@@ -322,7 +330,7 @@ def _element(r: _Reader, e: ET.Element, where: str) -> _Element:
             length = radius * ((sign * (a1 - a0)) % (2.0 * math.pi))
         else:
             raise ValueError(f"{where}: a Curve needs a length, a chord or Start, Center and End")
-        return _Element(kind, start, heading, length, sign / radius, sign / radius, station, r.shape)
+        return _Element(kind, start, heading, length, _curvature(sign, radius, where), _curvature(sign, radius, where), station, r.shape)
     if kind == "Spiral":
         spi = e.get("spiType", "clothoid")
         if spi != "clothoid":
@@ -331,7 +339,7 @@ def _element(r: _Reader, e: ET.Element, where: str) -> _Element:
         if rot not in ("cw", "ccw"):
             raise ValueError(f"{where}: Spiral rot {rot!r} is not cw or ccw")
         sign = 1.0 if rot == "ccw" else -1.0
-        k0, k1 = (0.0 if (radius := r.number(e, name, where, math.inf)) in (0.0, math.inf) else sign / radius
+        k0, k1 = (0.0 if (radius := r.number(e, name, where, math.inf)) in (0.0, math.inf) else _curvature(sign, radius, where)
                   for name in ("radiusStart", "radiusEnd"))  # fmt: skip
         heading = r.direction(e, "dirStart", where)
         if heading is None and start is not None:
@@ -381,8 +389,10 @@ def _solve_turns(items: list[_Element]) -> None:
     for shape in {i.shape for i in plain}:
         chosen = [i for i in plain if i.shape == shape]
         radii = [1.0 / abs(i.k0 + i.k1) for i in chosen]
-        for item, theta in zip(chosen, thetas_for_lengths([i.length for i in chosen], radii, shape)):
-            item.theta = None if math.isnan(theta) else float(theta)  # out of range: the scalar solver names it
+        with np.errstate(all="ignore"):  # a length or radius out of range gives NaN: the scalar solver then names it
+            thetas = thetas_for_lengths([i.length for i in chosen], radii, shape)
+        for item, theta in zip(chosen, thetas):
+            item.theta = None if math.isnan(theta) else float(theta)
 
 
 def _alignment(r: _Reader, a: ET.Element, label: str) -> LandXMLAlignment:
@@ -420,7 +430,12 @@ def _alignment(r: _Reader, a: ET.Element, label: str) -> LandXMLAlignment:
         raise ValueError(f"{where}: the first element needs a Start point and a direction")
     size = np.array([i.length for i in items])
     bend = np.array([i.k0 for i in items])
-    local, turns, _ = clothoid_frames(size, bend, (np.array([i.k1 for i in items]) - bend) / size, length=size)
+    with np.errstate(all="ignore"):
+        local, turns, _ = clothoid_frames(size, bend, (np.array([i.k1 for i in items]) - bend) / size, length=size)
+    bad = np.flatnonzero(~np.isfinite(local).all(axis=1) | ~np.isfinite(turns))
+    if len(bad):
+        raise ValueError(f"{items[bad[0]].where}: length {size[bad[0]]:.6g} and curvatures {bend[bad[0]]:.6g}, "
+                         f"{items[bad[0]].k1:.6g} give no point in floating point")  # fmt: skip
     for item, (dx, dy), turn in zip(items, local, turns):  # each element's end: its local clothoid turned into place
         point = item.start if item.start is not None else point
         heading = item.heading if item.heading is not None else heading

@@ -265,6 +265,7 @@ def test_written_geometry_is_consistent_as_a_plain_xml_reader_sees_it(tmp_path):
 HOSTILE = ["nan", "inf", "-inf", "0", "-1", "1e308", "1e-308", "", "abc", "5e-324", "1 2 3", "-0"]
 
 
+@pytest.mark.filterwarnings("error")  # no silent overflow either
 @settings(max_examples=150, deadline=None)
 @given(data=st.data())
 def test_any_mutated_export_reads_or_is_refused_with_a_value_error(data):
