@@ -15,9 +15,8 @@ end of the one before (so the chain is G2 by construction):
 * ``Spiral spiType="clothoid"`` from curvature κ0 to κ1 → our Bézier spiral
   (``shape``, default ``"near-linear"``: the nearest to a clothoid) with the
   same length and end curvatures: 0 → κ a spiral, κ → 0 its reversal, κ0 → κ1
-  of one sign the piece of a longer spiral whose start curvature is κ0
-  (found by a bracketed root), opposite signs two spirals meeting at the
-  inflection. A spiral this package wrote (its ``desc``) is rebuilt with its
+  (one ``rot``: one sign) the piece of a longer spiral whose start curvature
+  is κ0 (found by a bracketed root). A spiral this package wrote (its ``desc``) is rebuilt with its
   own shape: the very cubic.
 
 Per element the record keeps the offset between the file's element (placed at
@@ -264,9 +263,6 @@ def _growing(length: float, k0: float, k1: float, shape: str, theta: float | Non
 def _spirals(length: float, k0: float, k1: float, shape: str, theta: float | None = None) -> list[BezierSpiral]:
     """Our spirals (at the origin along +x, in travel order) for a clothoid from k0 to k1 (``theta``:
     the turn of a spiral with one straight end, if already solved)."""
-    if k0 * k1 < 0.0:  # through an inflection: two spirals meeting at curvature 0
-        first = length * abs(k0) / (abs(k0) + abs(k1))
-        return _spirals(first, k0, 0.0, shape) + _spirals(length - first, 0.0, k1, shape)
     if abs(k1) >= abs(k0):
         return [_growing(length, k0, k1, shape, theta)]
     backwards = _growing(length, -k1, -k0, shape, theta).reversed()  # travelled backwards, a left turn is a right one

@@ -123,7 +123,7 @@ def test_civil3d_spiral_rebuilt_with_the_stated_offset():
     assert 1.0 < w.offset < r.offset < 2.0  # a 45° spiral: walton-meek (1.39 m) is nearer than near-linear (1.65 m)
 
 
-def test_spiral_between_two_radii_and_through_an_inflection():
+def test_spiral_between_two_radii_and_spiral_to_spiral():
     head = ('<LandXML xmlns="http://www.landxml.org/schema/LandXML-1.2"><Units><Metric linearUnit="meter" '
             'angularUnit="grads" directionUnit="grads"/></Units><Alignments><Alignment name="c" staStart="0"><CoordGeom>')  # fmt: skip
     body = (
@@ -137,10 +137,9 @@ def test_spiral_between_two_radii_and_through_an_inflection():
     assert first.length == pytest.approx(80, rel=1e-9)
     assert math.degrees(math.atan2(*first.start_tangent[1::-1])) == pytest.approx(45.0)  # 50 grads
     assert r.offsets[0] < 0.5 and r.offset < 1.0  # measured 0.35 m for the piece, 0.96 m where the exit follows it
-    body = '<Spiral length="80" radiusStart="300" radiusEnd="150" rot="cw" spiType="clothoid" dirStart="0"><Start>0 0</Start><PI/><End/></Spiral>'
-    s_curve = body.replace('radiusStart="300"', 'radiusStart="-300"')
-    (r,) = read_landxml(head + s_curve + "</CoordGeom></Alignment></Alignments></LandXML>")
-    assert len(r.chain) == 2 and r.chain.length == pytest.approx(80, rel=1e-9)
+    negative = '<Spiral length="80" radiusStart="-300" radiusEnd="150" rot="cw" spiType="clothoid" dirStart="0"><Start>0 0</Start><PI/><End/></Spiral>'
+    with pytest.raises(ValueError, match=r"element 0 \(Spiral\) at station 0: radius -300.0 has no finite positive curvature"):
+        read_landxml(head + negative + "</CoordGeom></Alignment></Alignments></LandXML>")
 
 
 @pytest.mark.parametrize(("element", "message"), [
