@@ -133,6 +133,54 @@ class BuiltTransition(Built):
         return f"transition ({self.source.kind})"
 
 
+@dataclass(kw_only=True)
+class BuiltLandXML(Built):
+    """One G2 run of an alignment read from LandXML (``source``: its ``LandXMLAlignment``)."""
+
+    run: int = 0
+
+    @property
+    def kind(self) -> str:
+        return "LandXML alignment"
+
+
+def build_landxml(path: str | Path) -> tuple[str, list[Built]]:
+    """Every alignment of a LandXML file as designs: one per G2 run (``spiral_cad.io.read_landxml``).
+
+    Raises:
+        DesignError: the file cannot be read or holds an element that cannot be represented.
+    """
+    import re
+
+    from ..io import read_landxml
+
+    try:
+        alignments = read_landxml(path)
+    except (OSError, ValueError) as e:
+        raise DesignError(f"{path}: {e}") from None
+    built: list[Built] = []
+    for k, a in enumerate(alignments):
+        stem = (re.sub(r"[^A-Za-z0-9_-]", "_", a.name).strip("_-") or f"alignment{k + 1}")[:56]
+        for run, chain in enumerate(a.chains):
+            name = stem if len(a.chains) == 1 else f"{stem}_{run + 1}"
+            built.append(BuiltLandXML(name=name, chain=chain, source=a, run=run))
+    return alignments[0].units, built
+
+
+def _landxml_report(b: BuiltLandXML, stage: Path) -> list[str]:
+    """NAME_landxml.txt (per element: kind, station, offset from the file; the breaks) and NAME.xodr."""
+    from ..cad.export import export_opendrive
+
+    a = b.source
+    lines = [f"{a.name}: {len(a.kinds)} elements, largest offset from the file {a.offset:.3g} {a.units}",
+             "element  kind     station            offset"]  # fmt: skip
+    lines += [f"{k:7d}  {kind:7s}  {sta:17.6f}  {off:.3g}" for k, (kind, sta, off) in enumerate(zip(a.kinds, a.stations, a.offsets))]
+    lines += [f"break: {text}" for text in a.breaks] + [f"note: {text}" for text in a.notes]
+    (stage / f"{b.name}_landxml.txt").write_text("\n".join(lines) + "\n", encoding="utf-8")
+    export_opendrive(b.chain, stage / f"{b.name}.xodr", name=b.name)
+    return ["landxml.txt", "xodr"]
+
+
 # ------------------------------------------------------------ reading
 
 
@@ -362,6 +410,7 @@ BUILDERS: dict[str, Callable[[Any, str, str, Path | None], Built]] = {
 def build(source: str | Path | dict) -> tuple[str, list[Built]]:
     """Validate and build every design of ``source``: (units, built designs).
 
+    A LandXML file (``.xml``) is built by ``build_landxml``: every alignment, one design per G2 run.
     A G-code program named by a design file is read from the design file's
     folder (a dict's from the working folder).
 
@@ -369,6 +418,8 @@ def build(source: str | Path | dict) -> tuple[str, list[Built]]:
         DesignError: the first malformed field or infeasible design, named as
             ``designs[i] (name)``, or a file outside the design file's folder.
     """
+    if isinstance(source, (str, Path)) and Path(source).suffix.lower() == ".xml":
+        return build_landxml(source)
     design_file = load(source)
     base = None if isinstance(source, dict) else Path(source).parent
     built = []
@@ -511,6 +562,10 @@ def _write_others(b: Built, stage: Path, units: str, missing: list[str], plots: 
         export_opendrive(b.source, stage / f"{b.name}.xodr", name=b.name, cross_section=b.cross_section,
                          geo_reference=b.geo_reference, profile=profile)  # fmt: skip
         names += ["stations.csv", "xodr"]
+        from ..io.landxml import write_landxml
+
+        write_landxml(b.source, stage / f"{b.name}.xml", name=b.name, profile=profile)
+        names.append("xml")
         if b.source.checks:
             b.source.criteria_to_csv(stage / f"{b.name}_criteria.csv")
             names.append("criteria.csv")
@@ -519,6 +574,8 @@ def _write_others(b: Built, stage: Path, units: str, missing: list[str], plots: 
             names.append("profile.csv")
             if "OCP" not in missing:
                 names += _road_3d(b, profile, stage, units)
+    if isinstance(b, BuiltLandXML):
+        names += _landxml_report(b, stage)
     if "OCP" not in missing and len(b.chain) > LARGE_CHAIN_EDGES:
         names.append(f"no igs ({len(b.chain):,} edges, above {LARGE_CHAIN_EDGES:,}: the STEP file holds the same exact curves)")
     elif "OCP" not in missing:

@@ -1,5 +1,17 @@
 """File formats that need no CAD kernel: STEP text, SVG, DXF (through ezdxf), samples CSV,
-G-code in and out, OpenDRIVE model, writer, reader and checker, and all-or-nothing output staging.
+G-code in and out, OpenDRIVE model, writer, reader and checker, LandXML out and in (``read_landxml``, loaded
+on first use), and all-or-nothing output staging.
 
 IGES and the STEP of solids go through OCCT and live in ``spiral_cad.cad``.
 """
+
+from typing import Any
+
+
+def __getattr__(name: str) -> Any:
+    """``read_landxml`` on first use (the package itself imports nothing)."""
+    if name == "read_landxml":
+        from .landxml_read import read_landxml
+
+        return read_landxml
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

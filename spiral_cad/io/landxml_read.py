@@ -1,0 +1,560 @@
+"""LandXML in: every ``<Alignment>`` of a file rebuilt as our G2 chain (``read_landxml``).
+
+Reads LandXML 1.0–1.2 (any namespace) as Civil 3D, OpenRoads, Carlson, MDT
+and others write it: ``Metric``/``Imperial`` units (metres, millimetres,
+feet, US survey feet, inches — US survey feet become feet), angles and
+directions in radians, grads, decimal degrees or ``decimal dd.mm.ss``,
+points northing before easting, directions counter-clockwise from east.
+
+Each ``<CoordGeom>`` is rebuilt in order, every element continuing from the
+end of the one before (so the chain is G2 by construction):
+
+* ``Line`` → ``Line`` of the same length;
+* ``Curve`` (``crvType`` arc; also defined by its chord or by its points
+  only) → ``Arc`` of the same radius and length;
+* ``Spiral spiType="clothoid"`` from curvature κ0 to κ1 → our Bézier spiral
+  (``shape``, default ``"near-linear"``: the nearest to a clothoid) with the
+  same length and end curvatures: 0 → κ a spiral, κ → 0 its reversal, κ0 → κ1
+  (one ``rot``: one sign) the piece of a longer spiral whose start curvature
+  is κ0 (found by a bracketed root). A spiral this package wrote (its ``desc``) is rebuilt with its
+  own shape: the very cubic.
+
+Per element the record keeps the offset between the file's element (placed at
+its own Start and start direction; the exact clothoid of
+``spiral_cad.core.clothoid``) and ours, at ``SAMPLES`` arc lengths; the
+largest is the record's ``offset``. Elements that cannot be represented —
+other spiral types, ``IrregularLine``, ``Chain``, an alignment with no
+``CoordGeom`` (``AlignPIs`` only) — are refused with a ValueError naming the
+element, its index and station, and the alignment. ``Profile/ProfAlign``
+(``PVI``, ``ParaCurve``, ``UnsymParaCurve``, ``CircCurve`` — the last as the
+parabola of the same length, noted in ``notes``) becomes a
+``spiral_cad.design.Profile`` on the same stations.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import re
+import xml.etree.ElementTree as ET
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+from scipy.optimize import brentq
+
+from ..core.chain import Chain
+from ..core.clothoid import clothoid_frames
+from ..core.factors import length_factor
+from ..core.segments import Arc, Line, Segment
+from ..core.shapes import SHAPE_CODES, shape_limits
+from ..core.spiral import BezierSpiral
+from .landxml import CHUNK, DESC_PREFIX, US_SURVEY_FOOT, segment_samples
+
+__all__ = ["LandXMLAlignment", "read_landxml"]
+
+#: Arc lengths per element at which the offset from the file's element is measured.
+SAMPLES = 17
+#: Our unit of each LandXML linear unit, and the factor that takes the file's numbers to it.
+LINEAR = {"meter": ("m", 1.0), "millimeter": ("mm", 1.0), "centimeter": ("cm", 1.0), "kilometer": ("km", 1.0),
+          "foot": ("ft", 1.0), "USSurveyFoot": ("ft", US_SURVEY_FOOT / 0.3048), "inch": ("in", 1.0)}  # fmt: skip
+#: Radians per LandXML angular unit.
+ANGULAR = {"radians": 1.0, "grads": math.pi / 200.0, "decimal degrees": math.pi / 180.0, "degrees": math.pi / 180.0}
+#: Relative difference of curvature between two elements above which the file's geometry is only G1 there.
+_JUMP = 1e-6
+
+
+@dataclass(frozen=True)
+class LandXMLAlignment:
+    """One alignment read from LandXML.
+
+    Attributes:
+        name: the alignment's name.
+        chains: the rebuilt plane G2 chains (in ``units``): one, unless the
+            file's elements meet with a jump in curvature (a line onto an arc
+            without a spiral), where a new chain starts.
+        breaks: each such joint, named by station and the two curvatures.
+        start_station: the station of the chain's start.
+        units: the chain's length unit.
+        profile: the ``spiral_cad.design.Profile`` of its first ``ProfAlign``, or None.
+        offsets: per CoordGeom element the largest distance between the file's
+            element and ours (see the module docstring), in ``units``.
+        kinds: per element its tag (``Line``, ``Curve``, ``Spiral``).
+        stations: per element the station of its start in the file (``staStart``, else summed lengths).
+        notes: what was read approximately (e.g. a ``CircCurve`` as a parabola).
+    """
+
+    name: str
+    chains: tuple[Chain, ...]
+    breaks: tuple[str, ...]
+    start_station: float
+    units: str
+    profile: Any
+    offsets: NDArray[np.float64]
+    kinds: tuple[str, ...]
+    stations: NDArray[np.float64]
+    notes: tuple[str, ...] = field(default=())
+
+    @property
+    def chain(self) -> Chain:
+        """The one G2 chain of the alignment.
+
+        Raises:
+            ValueError: the file's geometry jumps in curvature (naming the first joint).
+        """
+        if len(self.chains) > 1:
+            raise ValueError(f"alignment {self.name!r} is not G2: {self.breaks[0]} ({len(self.chains)} G2 runs in `chains`)")
+        return self.chains[0]
+
+    @property
+    def offset(self) -> float:
+        """The largest offset between the file's geometry and the rebuilt chain."""
+        return float(self.offsets.max()) if len(self.offsets) else 0.0
+
+
+def _local(tag: str) -> str:
+    return tag.rsplit("}", 1)[-1]
+
+
+def _children(element: ET.Element, name: str) -> list[ET.Element]:
+    return [c for c in element if _local(c.tag) == name]
+
+
+def _child(element: ET.Element, name: str) -> ET.Element | None:
+    found = _children(element, name)
+    return found[0] if found else None
+
+
+def _angle(text: str, unit: str) -> float:
+    """An angle in radians from the file's text in ``unit``."""
+    if unit == "decimal dd.mm.ss":
+        value = float(text)
+        sign, value = math.copysign(1.0, value), abs(value)
+        degrees = math.floor(value)
+        minutes = math.floor(round((value - degrees) * 100.0, 9))
+        seconds = ((value - degrees) * 100.0 - minutes) * 100.0
+        return sign * math.radians(degrees + minutes / 60.0 + seconds / 3600.0)
+    return float(text) * ANGULAR[unit]
+
+
+class _Reader:
+    """The state of one file's read: units, scale and where errors point."""
+
+    def __init__(self, root: ET.Element, shape: str):
+        self.shape = shape
+        units = _child(root, "Units")
+        system = None if units is None else next(iter(units), None)
+        linear = "meter" if system is None else system.get("linearUnit", "meter")
+        if linear not in LINEAR:
+            raise ValueError(f"LandXML linearUnit {linear!r} is not one of {', '.join(LINEAR)}")
+        self.units, self.scale = LINEAR[linear]
+        self.direction_unit = "radians" if system is None else system.get("directionUnit", "radians")
+        self.angular_unit = "radians" if system is None else system.get("angularUnit", "radians")
+        for unit in (self.direction_unit, self.angular_unit):
+            if unit not in ANGULAR and unit != "decimal dd.mm.ss":
+                raise ValueError(f"LandXML angular unit {unit!r} is not radians, grads, decimal degrees or decimal dd.mm.ss")
+
+    def number(self, element: ET.Element, name: str, where: str, default: float | None = None) -> float:
+        text = element.get(name)
+        if text is None:
+            if default is None:
+                raise ValueError(f"{where}: no {name}")
+            return default
+        try:
+            value = float(text)
+        except ValueError:
+            raise ValueError(f"{where}: {name}={text!r} is not a number") from None
+        if math.isinf(value) and name.startswith("radius"):
+            return value
+        if not math.isfinite(value):
+            raise ValueError(f"{where}: {name}={text!r} is not finite")
+        return value * self.scale if name in ("length", "radius", "radiusStart", "radiusEnd", "chord", "staStart") else value
+
+    def point(self, element: ET.Element, name: str, where: str) -> NDArray[np.float64] | None:
+        child = _child(element, name)
+        text = "" if child is None else (child.text or "").strip()
+        if not text:
+            return None
+        parts = text.split()
+        try:
+            north, east = float(parts[0]), float(parts[1])
+        except (ValueError, IndexError):
+            raise ValueError(f"{where}: <{name}> {text!r} is not 'northing easting'") from None
+        if not math.isfinite(north + east):
+            raise ValueError(f"{where}: <{name}> {text!r} is not finite")
+        return np.array([east, north]) * self.scale
+
+    def angle(self, element: ET.Element, name: str, where: str) -> float:
+        """An angle attribute (``angularUnit``) in radians."""
+        return self.direction(element, name, where, self.angular_unit) or 0.0
+
+    def direction(self, element: ET.Element, name: str, where: str, unit: str | None = None) -> float | None:
+        """A direction attribute (``directionUnit``) in radians, counter-clockwise from east; None if absent."""
+        text = element.get(name)
+        if text is None:
+            return None
+        try:
+            angle = _angle(text, unit or self.direction_unit)
+        except ValueError:
+            raise ValueError(f"{where}: {name}={text!r} is not a number") from None
+        if not math.isfinite(angle):
+            raise ValueError(f"{where}: {name}={text!r} is not finite")
+        return angle
+
+
+def _curvature(sign: float, radius: float, where: str) -> float:
+    """The signed curvature of a radius, refused where it is not positive or overflows."""
+    curvature = sign / radius
+    if not (radius > 0.0 and math.isfinite(curvature)):
+        raise ValueError(f"{where}: radius {radius!r} has no finite positive curvature")
+    return curvature
+
+
+def _heading(t: NDArray) -> float:
+    return math.atan2(t[1], t[0])
+
+
+def _unit(angle: float) -> NDArray[np.float64]:
+    return np.array([math.cos(angle), math.sin(angle)])
+
+
+def _placed_spiral(cp: NDArray, point: NDArray, heading: float, shape: str | None) -> BezierSpiral:
+    """A spiral's control points moved rigidly so that it starts at ``point`` along ``heading``."""
+    start_heading = _heading(cp[1] - cp[0]) if np.any(cp[1] != cp[0]) else _heading(cp[2] - cp[0])
+    turn = heading - start_heading
+    c, s = math.cos(turn), math.sin(turn)
+    local = cp - cp[0]
+    moved = np.column_stack([c * local[:, 0] - s * local[:, 1], s * local[:, 0] + c * local[:, 1]]) + point
+    return BezierSpiral.from_control_points(moved, shape)
+
+
+def _theta(length: float, curvature: float, shape: str) -> float:
+    """The turn of our spiral of ``shape`` from 0 to |curvature| with arc length ``length``."""
+    from ..design.alignment import theta_for_length  # the one solver of spiral lengths
+
+    return theta_for_length(length, 1.0 / abs(curvature), shape)
+
+
+def _growing(length: float, k0: float, k1: float, shape: str, theta: float | None = None) -> BezierSpiral:
+    """Our spiral from curvature k0 to k1 (same sign, |k0| < |k1|, k0 may be 0), at the origin along +x
+    (``theta``: its turn when k0 = 0, if already solved)."""
+    sign = math.copysign(1.0, k1)
+    if k0 == 0.0:
+        return BezierSpiral((0.0, 0.0), (1.0, 0.0), sign * (_theta(length, k1, shape) if theta is None else theta), k1, shape)
+    largest = shape_limits(shape)["theta"] * (1.0 - 1e-9)
+    longest = float(length_factor(largest, shape)) / abs(k1)
+
+    def start_curvature(full: float) -> float:
+        spiral = BezierSpiral((0.0, 0.0), (1.0, 0.0), sign * _theta(full, k1, shape), k1, shape)
+        t0 = float(spiral.parameter_at(full - length))
+        return abs(float(spiral.curvature(t0))) - abs(k0)
+
+    low = length * (1.0 + 1e-12)
+    if not longest > low or start_curvature(longest) < 0.0:
+        turn = math.degrees(k1 * k1 * length / (2.0 * abs(k1 - k0)))  # the clothoid's turn from straight to k1
+        raise ValueError(f"the clothoid from curvature {k0:.6g} to {k1:.6g} over {length:.6g} is the end of one that turns "
+                         f"{turn:.3g}° from straight, and no {shape} spiral piece reaches it (up to {math.degrees(largest):.3g}°)")  # fmt: skip
+    full = brentq(start_curvature, low, longest, xtol=1e-12 * length, rtol=1e-14)
+    spiral = BezierSpiral((0.0, 0.0), (1.0, 0.0), sign * _theta(full, k1, shape), k1, shape)
+    return spiral.piece(float(spiral.parameter_at(full - length)), 1.0)
+
+
+def _spirals(length: float, k0: float, k1: float, shape: str, theta: float | None = None) -> list[BezierSpiral]:
+    """Our spirals (at the origin along +x, in travel order) for a clothoid from k0 to k1 (``theta``:
+    the turn of a spiral with one straight end, if already solved)."""
+    if abs(k1) >= abs(k0):
+        return [_growing(length, k0, k1, shape, theta)]
+    backwards = _growing(length, -k1, -k0, shape, theta).reversed()  # travelled backwards, a left turn is a right one
+    return [backwards]
+
+
+@dataclass
+class _Element:
+    kind: str
+    start: NDArray | None
+    heading: float | None
+    length: float
+    k0: float
+    k1: float
+    station: float | None
+    shape: str
+    theta: float | None = None
+    where: str = ""
+    notes: list[str] = field(default_factory=list)
+
+
+def _element(r: _Reader, e: ET.Element, where: str) -> _Element:
+    kind = _local(e.tag)
+    start, end = r.point(e, "Start", where), r.point(e, "End", where)
+    station = r.number(e, "staStart", where) if e.get("staStart") is not None else None
+    if kind == "Line":
+        if start is not None and end is not None:
+            d = end - start
+            return _Element(kind, start, _heading(d), float(np.hypot(*d)), 0.0, 0.0, station, r.shape)
+        heading = r.direction(e, "dir", where)
+        if heading is None:
+            raise ValueError(f"{where}: a Line needs Start and End, or dir and length")
+        return _Element(kind, start, heading, r.number(e, "length", where), 0.0, 0.0, station, r.shape)
+    if kind == "Curve":
+        if e.get("crvType", "arc") != "arc":
+            raise ValueError(f"{where}: Curve crvType {e.get('crvType')!r} is not an arc")
+        rot = e.get("rot")
+        if rot not in ("cw", "ccw"):
+            raise ValueError(f"{where}: Curve rot {rot!r} is not cw or ccw")
+        sign = 1.0 if rot == "ccw" else -1.0
+        center = r.point(e, "Center", where)
+        radius = r.number(e, "radius", where, 0.0) or (
+            float(np.hypot(*(start - center))) if start is not None and center is not None else 0.0
+        )
+        if not radius > 0.0:
+            raise ValueError(f"{where}: a Curve needs a radius (or Start and Center)")
+        heading = None
+        if start is not None and center is not None:
+            heading = _heading(start - center) + sign * math.pi / 2
+        elif e.get("dirStart") is not None:
+            heading = r.direction(e, "dirStart", where)
+        if e.get("length") is not None:
+            length = r.number(e, "length", where)
+        elif e.get("chord") is not None:  # chord-defined: the minor arc unless delta says more
+            chord = r.number(e, "chord", where)
+            length = 2.0 * radius * math.asin(min(1.0, chord / (2.0 * radius)))
+            if e.get("delta") is not None and abs(r.angle(e, "delta", where)) > math.pi:
+                length = 2.0 * math.pi * radius - length
+        elif start is not None and end is not None and center is not None:
+            a0, a1 = _heading(start - center), _heading(end - center)
+            length = radius * ((sign * (a1 - a0)) % (2.0 * math.pi))
+        else:
+            raise ValueError(f"{where}: a Curve needs a length, a chord or Start, Center and End")
+        return _Element(kind, start, heading, length, _curvature(sign, radius, where), _curvature(sign, radius, where), station, r.shape)
+    if kind == "Spiral":
+        spi = e.get("spiType", "clothoid")
+        if spi != "clothoid":
+            raise ValueError(f"{where}: spiral type {spi!r} is not a clothoid; only clothoids can be rebuilt")
+        rot = e.get("rot")
+        if rot not in ("cw", "ccw"):
+            raise ValueError(f"{where}: Spiral rot {rot!r} is not cw or ccw")
+        sign = 1.0 if rot == "ccw" else -1.0
+        k0, k1 = (0.0 if (radius := r.number(e, name, where, math.inf)) in (0.0, math.inf) else _curvature(sign, radius, where)
+                  for name in ("radiusStart", "radiusEnd"))  # fmt: skip
+        heading = r.direction(e, "dirStart", where)
+        if heading is None and start is not None:
+            pi = r.point(e, "PI", where)
+            if pi is not None and np.any(pi != start):
+                heading = _heading(pi - start)
+        shape = r.shape
+        desc = e.get("desc", "")
+        if desc.startswith(DESC_PREFIX):
+            found = re.search(r"\(shape ([a-z0-9-]+)\)", desc)
+            if found and found.group(1) in SHAPE_CODES:
+                shape = found.group(1)
+        return _Element(kind, start, heading, r.number(e, "length", where), k0, k1, station, shape)
+    raise ValueError(f"{where}: {kind} cannot be represented as a G2 chain of lines, arcs and spirals")
+
+
+def _segments(item: _Element, point: NDArray, heading: float) -> list[Segment]:
+    """Our segments for one element, starting at ``point`` along ``heading``."""
+    if item.k0 == item.k1 == 0.0:
+        return [Line(tuple(point), tuple(point + item.length * _unit(heading)))]
+    if item.k0 == item.k1:
+        radius = 1.0 / item.k0
+        center = point + radius * np.array([-math.sin(heading), math.cos(heading)])
+        return [Arc(tuple(center), radius, _heading(point - center), abs(item.length * item.k0))]
+    out: list[Segment] = []
+    try:
+        spirals = _spirals(item.length, item.k0, item.k1, item.shape, item.theta)
+    except ValueError as e:  # beyond the shape's turn (a long compound piece): the other shape, which turns up to 90°
+        other = "walton-meek" if item.shape == "near-linear" else "near-linear"
+        try:
+            spirals = _spirals(item.length, item.k0, item.k1, other)
+        except ValueError:
+            raise ValueError(f"{item.where}: {e}, nor a {other} one") from None
+        item.notes.append(f"{item.where}: rebuilt with {other} spirals ({e})")
+    for spiral in spirals:
+        placed = _placed_spiral(spiral.control_points[:, :2], point, heading, spiral.shape)
+        out.append(placed)
+        point, heading = placed.end[:2], _heading(placed.end_tangent[:2])
+    return out
+
+
+def _solve_turns(items: list[_Element]) -> None:
+    """The turns of every spiral with one straight end, one batch per shape (``thetas_for_lengths``)."""
+    from ..design.alignment import thetas_for_lengths
+
+    plain = [i for i in items if i.kind == "Spiral" and (i.k0 == 0.0) != (i.k1 == 0.0)]
+    for shape in {i.shape for i in plain}:
+        chosen = [i for i in plain if i.shape == shape]
+        radii = [1.0 / abs(i.k0 + i.k1) for i in chosen]
+        with np.errstate(all="ignore"):  # a length or radius out of range gives NaN: the scalar solver then names it
+            thetas = thetas_for_lengths([i.length for i in chosen], radii, shape)
+        for item, theta in zip(chosen, thetas):
+            item.theta = None if math.isnan(theta) else float(theta)
+
+
+def _alignment(r: _Reader, a: ET.Element, label: str) -> LandXMLAlignment:
+    name = a.get("name", label)
+    where = f"alignment {name!r}"
+    start_station = r.number(a, "staStart", where, 0.0)
+    geometry = _child(a, "CoordGeom")
+    if geometry is None:
+        raise ValueError(f"{where}: no CoordGeom (geometry given only as {', '.join(sorted({_local(c.tag) for c in a})) or 'nothing'}); "
+                         "only CoordGeom alignments can be rebuilt")  # fmt: skip
+    items: list[_Element] = []
+    skipped: list[str] = []
+    station = start_station
+    for index, e in enumerate(geometry):
+        if not isinstance(e.tag, str):
+            continue
+        place = f"{where}, CoordGeom element {index} ({_local(e.tag)}) at station {station:.6g}"
+        item = _element(r, e, place)
+        item.where = place
+        if item.station is None:
+            item.station = station
+        if item.length == 0.0:  # MDT writes zero-length curves between spirals: a point, nothing to build
+            skipped.append(f"{place}: zero length, skipped")
+            continue
+        if not item.length > 0.0:
+            raise ValueError(f"{place}: length {item.length!r} is not positive")
+        items.append(item)
+        station = item.station + item.length
+    if not items:
+        raise ValueError(f"{where}: CoordGeom holds no elements")
+    # The file's own placement of each element: its Start and start direction, else the end of the one before.
+    starts, headings, ends = [], [], []
+    point, heading = items[0].start, items[0].heading
+    if point is None or heading is None:
+        raise ValueError(f"{where}: the first element needs a Start point and a direction")
+    size = np.array([i.length for i in items])
+    bend = np.array([i.k0 for i in items])
+    with np.errstate(all="ignore"):
+        local, turns, _ = clothoid_frames(size, bend, (np.array([i.k1 for i in items]) - bend) / size, length=size)
+    bad = np.flatnonzero(~np.isfinite(local).all(axis=1) | ~np.isfinite(turns))
+    if len(bad):
+        raise ValueError(f"{items[bad[0]].where}: length {size[bad[0]]:.6g} and curvatures {bend[bad[0]]:.6g}, "
+                         f"{items[bad[0]].k1:.6g} give no point in floating point")  # fmt: skip
+    for item, (dx, dy), turn in zip(items, local, turns):  # each element's end: its local clothoid turned into place
+        point = item.start if item.start is not None else point
+        heading = item.heading if item.heading is not None else heading
+        starts.append(point)
+        headings.append(heading)
+        c, n = math.cos(heading), math.sin(heading)
+        point, heading = point + np.array([c * dx - n * dy, n * dx + c * dy]), heading + float(turn)
+        ends.append((point, heading))
+    _solve_turns(items)
+    runs: list[list[Segment]] = [[]]
+    breaks: list[str] = []
+    point, heading = starts[0], headings[0]
+    first = []  # (run, index of the element's first segment in it)
+    for k, item in enumerate(items):
+        at = f"at station {item.station:.6g} (between elements {k - 1} and {k})"
+        if k:
+            gap = float(np.hypot(*(starts[k] - ends[k - 1][0])))
+            turn = abs(math.remainder(headings[k] - ends[k - 1][1], 2.0 * math.pi))
+            # after a spiral the chain goes on from our spiral (its offset is reported), not from the clothoid's end
+            if items[k - 1].kind != "Spiral" and (gap > _JUMP * max(item.length, items[k - 1].length) or turn > _JUMP):
+                breaks.append(f"the file's elements meet with a gap of {gap:.3g} {r.units} and a kink of {turn:.3g} rad {at}")
+                runs.append([])
+                point, heading = starts[k], headings[k]  # a new run starts where the file places the element
+            elif abs(item.k0 - items[k - 1].k1) > _JUMP * max(abs(item.k0), abs(items[k - 1].k1)):
+                breaks.append(f"curvature jumps from {items[k - 1].k1:.6g} to {item.k0:.6g} 1/{r.units} {at}")
+                runs.append([])
+        first.append((len(runs) - 1, len(runs[-1])))
+        pieces = _segments(item, point, heading)
+        runs[-1] += pieces
+        point, heading = pieces[-1].end[:2], _heading(pieces[-1].end_tangent[:2])
+    chains = tuple(Chain(run, tolerance=1e-6, units=r.units) for run in runs)
+    offsets = _offsets(items, chains, first, np.array(starts), np.array(headings))
+    profile, notes = _profile(r, a, where)
+    notes = (*skipped, *(note for item in items for note in item.notes), *notes)
+    return LandXMLAlignment(name, chains, tuple(breaks), start_station, r.units, profile, offsets, tuple(i.kind for i in items),
+                            np.array([i.station for i in items]), notes)  # fmt: skip
+
+
+def _offsets(items: list[_Element], chains: tuple[Chain, ...], first: list[tuple[int, int]], starts: NDArray,
+             headings: NDArray) -> NDArray[np.float64]:  # fmt: skip
+    """Per element the largest distance between our segments and the file's element placed at its own
+    start, each of our sample points against the file's point at the same arc length."""
+    k0 = np.array([i.k0 for i in items])
+    rate = (np.array([i.k1 for i in items]) - k0) / np.array([i.length for i in items])
+    offsets = np.zeros(len(items))
+    runs = np.array([run for run, _ in first])
+    by_run = np.split(np.arange(len(items)), np.flatnonzero(np.diff(runs)) + 1)  # elements of each run, in order
+    for chain, mine in zip(chains, by_run):
+        begin = np.array([first[k][1] for k in mine])
+        owner = np.repeat(mine, np.diff(np.append(begin, len(chain))))  # each segment's element
+        ours, s, _ = segment_samples(chain, SAMPLES)
+        s = s + (chain.stations[:-1] - chain.stations[begin][np.searchsorted(mine, owner)])[:, None]  # from the element's start
+        for block in np.array_split(np.arange(len(owner)), -(-len(owner) // CHUNK)):  # bounded memory
+            o = owner[block]
+            theirs, _, _ = clothoid_frames(s[block], k0[o, None], rate[o, None], x0=starts[o, None, 0], y0=starts[o, None, 1],
+                                           hdg=headings[o, None], length=s[block, -1:])  # fmt: skip
+            np.maximum.at(offsets, o, np.hypot(*(ours[block] - theirs).transpose(2, 0, 1)).max(axis=1))
+    return offsets
+
+
+def _profile(r: _Reader, a: ET.Element, where: str) -> tuple[Any, tuple[str, ...]]:
+    """The first ``ProfAlign`` of an alignment as a ``Profile`` (None without one), and notes."""
+    node = _child(a, "Profile")
+    prof = None if node is None else _child(node, "ProfAlign")
+    if prof is None:
+        return None, ()
+    from ..design import Profile
+
+    points, lengths, notes = [], [], []
+    for index, e in enumerate(prof):
+        tag = _local(e.tag) if isinstance(e.tag, str) else ""
+        if tag not in ("PVI", "ParaCurve", "UnsymParaCurve", "CircCurve"):
+            continue
+        place = f"{where}, ProfAlign element {index} ({tag})"
+        try:
+            station, elevation = (float(v) * r.scale for v in (e.text or "").split()[:2])
+        except ValueError:
+            raise ValueError(f"{place}: {e.text!r} is not 'station elevation'") from None
+        points.append((station, elevation))
+        if tag == "UnsymParaCurve":
+            lengths.append((r.number(e, "lengthIn", place) * r.scale, r.number(e, "lengthOut", place) * r.scale))
+        elif tag in ("ParaCurve", "CircCurve"):
+            length = r.number(e, "length", place)
+            lengths.append((length / 2.0, length / 2.0))
+            if tag == "CircCurve":
+                notes.append(f"{place}: the circular vertical curve read as the parabola of the same length")
+        else:
+            lengths.append((0.0, 0.0))
+    if len(points) < 2:
+        raise ValueError(f"{where}: the ProfAlign has fewer than 2 PVIs")
+    try:
+        profile = Profile.from_pvis(points, curve_lengths=lengths[1:-1], units=r.units)
+    except ValueError as e:  # e.g. a grade break (a PVI without a vertical curve): no Profile holds it
+        return None, (*notes, f"{where}: the profile was not read: {e}")
+    return profile, tuple(notes)
+
+
+def read_landxml(source: str | os.PathLike, shape: str = "near-linear") -> list[LandXMLAlignment]:
+    """Every alignment of a LandXML file (a path, or the document's text) rebuilt as our G2 chain.
+
+    Args:
+        source: a path, or the XML text itself (starting with ``<``).
+        shape: the spiral shape of the rebuilt clothoids (``"near-linear"``,
+            the nearest, or ``"walton-meek"``); spirals this package wrote keep their own.
+
+    Returns:
+        One ``LandXMLAlignment`` per ``<Alignment>`` in file order.
+
+    Raises:
+        ValueError: not LandXML, no alignment, or an element that cannot be
+            represented (named with its index, station and alignment).
+    """
+    if shape not in ("near-linear", "walton-meek"):
+        raise ValueError(f"shape must be 'near-linear' or 'walton-meek'; got {shape!r}")
+    text = os.fspath(source)
+    try:
+        root = ET.fromstring(text) if text.lstrip().startswith("<") else ET.parse(text).getroot()
+    except ET.ParseError as e:
+        raise ValueError(f"not an XML document: {e}") from None
+    if _local(root.tag) != "LandXML":
+        raise ValueError(f"not a LandXML document (root element {_local(root.tag)!r})")
+    reader = _Reader(root, shape)
+    alignments = [a for group in _children(root, "Alignments") for a in _children(group, "Alignment")]
+    if not alignments:
+        raise ValueError("the LandXML document holds no Alignment")
+    return [_alignment(reader, a, f"alignment {k + 1}") for k, a in enumerate(alignments)]
