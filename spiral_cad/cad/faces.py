@@ -33,9 +33,11 @@ from __future__ import annotations
 
 import math
 import os
+import re
 import time
 from dataclasses import dataclass
 from functools import partial
+from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -54,9 +56,9 @@ from OCP.TopTools import TopTools_IndexedDataMapOfShapeListOfShape, TopTools_Ind
 from ..check.joints import check_tolerances, norms
 from ..core.units import length_unit
 from .occ import as_occ_shape
-from .readers import read_file
+from .readers import IGES_SUFFIXES, STEP_SUFFIXES, read_file
 
-__all__ = ["EDGE_CLASSES", "FEATURE_ANGLE", "FaceEdge", "FaceReport", "check_faces"]
+__all__ = ["EDGE_CLASSES", "FEATURE_ANGLE", "FaceEdge", "FaceReport", "check_faces", "holds_faces"]
 
 #: Normals further apart than this (radians, 5°) make an edge a sharp feature
 #: (a box's edge), listed and never failed; between ``angle_tol`` and this the
@@ -414,3 +416,32 @@ def check_faces(shape_or_path: Any, *, gap_tol: float = 1e-7, angle_tol: float =
         measured = _measure(as_occ_shape(shape_or_path), samples)
         source = label or type(shape_or_path).__name__
     return _classify(measured, source=source, units=unit, started=started, **options)
+
+
+#: STEP entities of a face (AP203/AP214/AP242 B-rep and surface models).
+_STEP_FACE = re.compile(rb"\b(?:ADVANCED_FACE|FACE_SURFACE|ORIENTED_FACE)\s*\(", re.IGNORECASE)
+#: IGES entity types of a face: 510 face, 144 trimmed surface, 143 bounded surface.
+_IGES_FACES = {b"510", b"144", b"143"}
+
+
+def holds_faces(path: str | os.PathLike) -> bool:
+    """Whether a STEP/IGES file declares faces, from its text alone (no reader runs): a STEP face
+    entity, or an IGES directory entry of a face (510), trimmed (144) or bounded (143) surface.
+
+    ``spiral-cad check`` judges faces when this is true and wires otherwise; False for a missing
+    file or another suffix (the wire checker then names the problem).
+    """
+    p = Path(path)
+    suffix = p.suffix.lower()
+    if not p.is_file() or suffix not in STEP_SUFFIXES + IGES_SUFFIXES:
+        return False
+    with open(p, "rb") as handle:
+        if suffix in STEP_SUFFIXES:
+            tail = b""
+            while chunk := handle.read(1 << 20):
+                if _STEP_FACE.search(tail + chunk):
+                    return True
+                tail = chunk[-64:]  # an entity name cut by the chunk boundary
+            return False
+        # IGES directory records: section letter D in column 73, the entity type in columns 1–8
+        return any(len(line) >= 73 and line[72:73] == b"D" and line[:8].strip() in _IGES_FACES for line in handle)
