@@ -27,7 +27,7 @@ def check_face_file(file: str, *, require: str | None = None, gap_tol: float | N
                     curvature_map: str | None = None) -> int | None:  # fmt: skip
     """Judge the faces of ``file`` and print the table; draw the pictures asked for.
 
-    Tolerances left None take ``check_faces``'s defaults. ``require`` "G2" or "G1" fails any
+    Tolerances left None take ``check_faces``'s defaults (gap 1e-7 × size, angle 1e-7 rad, curvature jump 1e-4). ``require`` "G2" or "G1" fails any
     tangent edge below it (and "G0" any gap); sharp features are listed, never failed.
 
     Returns:
@@ -37,9 +37,13 @@ def check_face_file(file: str, *, require: str | None = None, gap_tol: float | N
         ValueError: an unreadable file or a bad option (printed as ``error: …`` by the CLI).
     """
     zebra_png, map_png = _png("zebra", zebra), _png("curvature-map", curvature_map)
-    given = dict(gap_tol=gap_tol, angle_tol=angle_tol, curvature_tol=curvature_tol)
-    options = {name: value for name, value in given.items() if value is not None}
-    report = check_faces(file, feature_angle=FEATURE_ANGLE if feature_angle is None else feature_angle, **options)
+    report = check_faces(
+        file,
+        gap_tol=1e-7 if gap_tol is None else gap_tol,
+        angle_tol=1e-7 if angle_tol is None else angle_tol,
+        curvature_tol=1e-4 if curvature_tol is None else curvature_tol,
+        feature_angle=FEATURE_ANGLE if feature_angle is None else feature_angle,
+    )
     if report.faces == 0:
         return None
     print(report.table())

@@ -34,12 +34,12 @@ from ..core.units import length_unit
 from .occ import as_occ_shape
 from .readers import read_file
 
-__all__ = ["FaceMesh", "face_mesh"]
+__all__ = ["ANGULAR", "DEFLECTION", "FaceMesh", "face_mesh"]
 
 #: Default linear deflection of the mesh, relative to the model size.
 DEFLECTION = 5e-4
 #: Angular deflection of the mesh, radians: how far the normals may turn across a triangle (stripes stay straight).
-ANGULAR = 0.02
+ANGULAR = 0.03
 
 
 @dataclass(frozen=True)
@@ -71,13 +71,14 @@ class FaceMesh:
         return float(np.linalg.norm(self.points.max(axis=0) - self.points.min(axis=0))) if len(self.points) else 0.0
 
 
-def _mesh(shape: TopoDS_Shape, deflection: float | None) -> bytes:
+def _mesh(shape: TopoDS_Shape, deflection: float | None, angle: float) -> bytes:
     """Mesh ``shape`` and evaluate its surfaces at the vertices: the arrays of a ``FaceMesh`` as
     ``np.savez`` bytes (plain data: runs in the reader's child for a file)."""
     box = Bnd_Box()
     BRepBndLib.Add_s(shape, box, False)
     size = 1.0 if box.IsVoid() else math.sqrt(box.SquareExtent())
-    BRepMesh_IncrementalMesh(shape, deflection if deflection is not None else DEFLECTION * size, False, ANGULAR, True)
+    # not in parallel: a file is meshed in a forked child, where a thread pool the parent started would hang
+    BRepMesh_IncrementalMesh(shape, deflection if deflection is not None else DEFLECTION * size, False, angle, False)
     points, triangles, values, owners = [], [], [], []
     p, su, sv, suu, svv, suv = gp_Pnt(), gp_Vec(), gp_Vec(), gp_Vec(), gp_Vec(), gp_Vec()
     offset, index = 0, 0
@@ -135,7 +136,7 @@ def _curvatures(raw: NDArray, sign: float) -> NDArray:
     return np.column_stack([normal, mean, gauss])
 
 
-def face_mesh(shape_or_path: Any, *, deflection: float | None = None, units: str | None = "mm") -> FaceMesh:
+def face_mesh(shape_or_path: Any, *, deflection: float | None = None, angle: float = ANGULAR, units: str | None = "mm") -> FaceMesh:
     """Mesh the faces of a part with the surfaces' own normals and curvatures at the vertices.
 
     Args:
@@ -143,16 +144,18 @@ def face_mesh(shape_or_path: Any, *, deflection: float | None = None, units: str
             .step/.stp/.igs/.iges path (read in a child process).
         deflection: largest distance of a triangle from its surface, in ``units``
             (default ``DEFLECTION`` × model size: fine enough for smooth stripes).
+        angle: largest turn of the normals across a triangle, radians (default ``ANGULAR``).
         units: for a file, the unit to read it in (None: the unit it declares); for
             a shape, the unit its numbers are in.
 
     Raises:
-        ValueError: an unreadable file, a ``deflection`` that is not a positive number, or a shape
+        ValueError: an unreadable file, a ``deflection`` or ``angle`` that is not a positive number, or a shape
             without faces.
     """
-    if deflection is not None and not (isinstance(deflection, (int, float)) and math.isfinite(deflection) and deflection > 0):
-        raise ValueError(f"deflection must be a positive number; got {deflection!r}")
-    extract = partial(_mesh, deflection=deflection)
+    for name, value in (("deflection", deflection), ("angle", angle)):
+        if value is not None and not (isinstance(value, (int, float)) and math.isfinite(value) and value > 0):
+            raise ValueError(f"{name} must be a positive number; got {value!r}")
+    extract = partial(_mesh, deflection=deflection, angle=angle)
     if isinstance(shape_or_path, (str, os.PathLike)):
         unit, data = read_file(shape_or_path, units, extract)
     else:

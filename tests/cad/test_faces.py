@@ -3,8 +3,14 @@ through STEP and IGES files."""
 
 from __future__ import annotations
 
+import json
 import math
+import os
+import subprocess
+import textwrap
+from pathlib import Path
 
+import numpy as np
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
@@ -16,7 +22,8 @@ from OCP.IGESControl import IGESControl_Writer  # noqa: E402
 from OCP.Interface import Interface_Static  # noqa: E402
 
 from spiral_cad.build123d import ContinuousRectangle  # noqa: E402
-from spiral_cad.cad.faces import FEATURE_ANGLE, check_faces  # noqa: E402
+from spiral_cad.cad.faces import FEATURE_ANGLE, check_faces, holds_faces  # noqa: E402
+from spiral_cad.cad.mesh import face_mesh  # noqa: E402
 
 
 def filleted_box(radius: float = 2.0, length: float = 40.0, width: float = 20.0, height: float = 8.0) -> bd.Part:
@@ -157,3 +164,97 @@ def test_any_circular_fillet_of_a_box_is_g1_with_relative_jump_one_never_g2(radi
     assert report.counts["G1"] == 8 and report.counts["G2"] == 0
     assert all(e.jump == pytest.approx(1.0, abs=1e-9) for e in report.tangent_edges)
     assert not report.passes("G2")
+
+
+# ------------------------------------------------------------ FreeCAD's own evaluation of the same file
+
+
+def _freecad_lib() -> str | None:
+    """The directory holding FreeCAD's Python modules, if FreeCAD is installed."""
+    candidates = [os.environ.get("SPIRAL_CAD_FREECAD_LIB", ""), "/usr/lib/freecad-python3/lib", "/usr/lib/freecad/lib"]
+    return next((c for c in candidates if c and (Path(c) / "Part.so").exists()), None)
+
+
+FREECAD = _freecad_lib()
+#: In FreeCAD (system Python): for each point, the faces through it, each with its oriented normal
+#: (``Face.normalAt``) and its normal curvature across the edge through it, by Euler's formula from
+#: FreeCAD's principal curvatures and directions (``Surface.curvature``, ``Surface.curvatureDirections``).
+FREECAD_SCRIPT = textwrap.dedent(
+    """
+    import json, math, sys
+    sys.path.append(sys.argv[1])
+    import FreeCAD, Part
+    shape = Part.read(sys.argv[2])
+    out = []
+    for x, y, z in json.loads(sys.argv[3]):
+        p = FreeCAD.Vector(x, y, z)
+        vertex = Part.Vertex(p)
+        edge = min(shape.Edges, key=lambda e: e.distToShape(vertex)[0])
+        t = edge.tangentAt(edge.Curve.parameter(p))
+        found = []
+        for face in shape.Faces:
+            if face.distToShape(vertex)[0] > 1e-6:
+                continue
+            u, v = face.Surface.parameter(p)
+            n = face.normalAt(u, v)
+            k1, k2 = face.Surface.curvature(u, v, "Max"), face.Surface.curvature(u, v, "Min")
+            d1, d2 = face.Surface.curvatureDirections(u, v)
+            d = n.cross(t)
+            c = d.normalize().dot(d1.normalize())
+            found.append([n.x, n.y, n.z, abs(k1 * c * c + k2 * (1 - c * c))])
+        out.append(found)
+    print(json.dumps(out))
+    """
+)
+
+
+@pytest.mark.skipif(FREECAD is None, reason="FreeCAD is not installed (Debian/Ubuntu: apt-get install freecad-python3)")
+@pytest.mark.parametrize("name", ["box", "slab"])
+def test_freecad_evaluates_the_same_normals_and_normal_curvatures(tmp_path, name):
+    part = filleted_box() if name == "box" else continuous_slab()
+    path = tmp_path / f"{name}.step"
+    bd.export_step(part, str(path))
+    report = check_faces(path)
+    edges = report.tangent_edges
+    points = [list(e.jump_at) for e in edges]
+    run = subprocess.run(["/usr/bin/python3", "-c", FREECAD_SCRIPT, FREECAD, str(path), json.dumps(points)],
+                         capture_output=True, text=True, timeout=300)  # fmt: skip
+    assert run.returncode == 0, run.stderr[-2000:]
+    for edge, faces in zip(edges, json.loads(run.stdout.splitlines()[-1])):
+        assert len(faces) == 2, f"edge {edge.index}: FreeCAD finds {len(faces)} faces through {edge.jump_at}"
+        na, nb = np.array(faces[0][:3]), np.array(faces[1][:3])
+        ka, kb = faces[0][3], faces[1][3]
+        assert math.acos(min(1.0, float(na @ nb))) <= 1e-7  # FreeCAD's oriented normals agree: tangent
+        assert sorted([ka, kb]) == pytest.approx(sorted(abs(k) for k in edge.curvatures), abs=1e-9)
+        freecad_jump = abs(ka - kb) / max(ka, kb, 1.0 / report.size)
+        assert freecad_jump == pytest.approx(edge.jump, abs=1e-6)
+        assert (freecad_jump > report.curvature_tol) == (edge.level == "G1")
+
+
+# ------------------------------------------------------------ what the CLI and the pictures rest on
+
+
+def test_holds_faces_tells_solid_files_from_wire_files(tmp_path):
+    solid, iges, wire = tmp_path / "solid.step", tmp_path / "solid.igs", tmp_path / "wire.step"
+    bd.export_step(bd.Box(1, 2, 3), str(solid))
+    write_iges(bd.Box(1, 2, 3), iges)
+    bd.export_step(bd.Polyline((0, 0), (1, 0), (1, 1)), str(wire))
+    assert holds_faces(solid) and holds_faces(iges)
+    assert not holds_faces(wire) and not holds_faces(tmp_path / "missing.step") and not holds_faces(tmp_path)
+
+
+def test_mesh_normals_and_curvatures_are_the_surfaces(tmp_path):
+    mesh = face_mesh(bd.Sphere(5), angle=0.2)
+    radial = mesh.points / np.linalg.norm(mesh.points, axis=1)[:, None]
+    assert np.abs(np.einsum("ij,ij->i", mesh.normals, radial) - 1.0).max() < 1e-12  # outward, exact
+    assert mesh.mean_curvature == pytest.approx(0.2, abs=1e-9) and mesh.gaussian_curvature == pytest.approx(0.04, abs=1e-9)
+    # triangles wind counter-clockwise seen from outside, on a reversed face too
+    box = face_mesh(filleted_box(), angle=0.2)
+    a, b, c = (box.points[box.triangles[:, i]] for i in range(3))
+    assert (np.einsum("ij,ij->i", np.cross(b - a, c - a), box.normals[box.triangles].mean(axis=1)) > 0).all()
+    assert sorted(set(np.round(box.mean_curvature, 9))) == pytest.approx([0.0, 0.25])  # planes, r = 2 fillets (1/2r)
+    path = tmp_path / "box.step"
+    bd.export_step(filleted_box(), str(path))
+    assert face_mesh(path, units="cm", angle=0.2).size == pytest.approx(box.size / 10, rel=1e-9)
+    with pytest.raises(ValueError, match="no faces"):
+        face_mesh(bd.Polyline((0, 0, 0), (1, 0, 0)))
