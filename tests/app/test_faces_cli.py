@@ -15,6 +15,7 @@ from OCP.Interface import Interface_Static  # noqa: E402
 
 from spiral_cad.app.cli import main  # noqa: E402
 from spiral_cad.build123d import ContinuousRectangle  # noqa: E402
+from spiral_cad.cad.faces import holds_faces  # noqa: E402
 
 
 @pytest.fixture(scope="module")
@@ -97,3 +98,10 @@ def test_bad_picture_paths_are_errors_not_tracebacks(files, tmp_path, capsys):
     assert "give a .png file" in capsys.readouterr().err
     assert main(["check", str(files["box"]), "--curvature-map", str(tmp_path / "no" / "c.png")]) == 2
     assert "error: --curvature-map" in capsys.readouterr().err
+
+
+def test_comb_of_a_face_file_is_written_beside_the_face_verdict(files, tmp_path, capsys):
+    comb = tmp_path / "comb.step"
+    assert main(["check", str(files["box"]), "--require", "G1", "--comb", str(comb)]) == 0
+    assert "OK: 10 faces" in capsys.readouterr().out
+    assert comb.stat().st_size > 1000 and not holds_faces(comb)  # the comb is lines only
