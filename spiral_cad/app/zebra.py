@@ -5,9 +5,9 @@ the reflections of the tubes, so they follow the normals: across a G0 edge they 
 G1 edge (normals agree, curvature jumps) they stay joined but **kink**, across a G2 edge they
 bend smoothly. Here the mesh comes from ``spiral_cad.cad.mesh.face_mesh`` (the surfaces' exact
 normals at each vertex, a separate vertex per face along an edge), the view is orthographic, the
-reflected view vector r = 2 (n·v) n − v is computed per vertex, and the stripe pattern is
-``sign(sin(stripes · asin(r·e)))`` for a fixed direction e across the tubes, interpolated over
-each triangle (gouraud) so stripe borders are sharp even on coarse triangles. Triangles are
+reflected view vector r = 2 (n·v) n − v is computed from the surface normals interpolated over
+small pieces of each triangle, and the stripes are bands of ``asin(r·e)`` for a fixed direction e
+across the tubes. Triangles are
 drawn back to front, faces turned away are left out.
 
 Figures are ``matplotlib.figure.Figure`` (Agg, no pyplot state), as ``spiral_cad.app.plots``.
@@ -16,7 +16,7 @@ Figures are ``matplotlib.figure.Figure`` (Agg, no pyplot state), as ``spiral_cad
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from typing import Any
 
 import numpy as np
@@ -69,11 +69,15 @@ def _template(n: int) -> NDArray:
     return np.concatenate([1.0 - ij.sum(axis=2, keepdims=True), ij], axis=2)
 
 
-def _draw(mesh: FaceMesh, values: NDArray, view: Sequence[float], ax: Axes | None, title: str, subdivide: int,
-          **style: Any) -> tuple[Figure, Axes, PolyCollection]:  # fmt: skip
+def _draw(mesh: FaceMesh, values: NDArray | Callable[[NDArray], NDArray], view: Sequence[float], ax: Axes | None,
+          title: str, subdivide: int, **style: Any) -> tuple[Figure, Axes, PolyCollection]:  # fmt: skip
     """Draw the visible triangles back to front, each cut into ``subdivide``² flat-coloured pieces
-    whose value is interpolated linearly from the corners (matplotlib's gouraud shading would
-    interpolate the corners' *colours*, blurring the stripes)."""
+    (matplotlib's gouraud shading would interpolate the corners' *colours*, blurring stripes).
+
+    A piece's value is interpolated linearly from the corners' ``values``, or, when ``values`` is
+    a function of unit normals, is that function of the normal interpolated to the piece's centre
+    and renormalised (Phong's normals: a stripe border then follows the surface, not the triangles).
+    """
     v, right, up = _frame(view)
     if ax is None:
         fig = Figure(figsize=(6.4, 4.8), dpi=100)
@@ -84,7 +88,13 @@ def _draw(mesh: FaceMesh, values: NDArray, view: Sequence[float], ax: Axes | Non
     screen = np.column_stack([mesh.points @ right, mesh.points @ up])
     weights = _template(subdivide)
     corners = np.einsum("tkc,mcd->mtkd", weights, screen[tri]).reshape(-1, 3, 2)
-    shade = np.einsum("tc,mc->mt", weights.mean(axis=1), values[tri]).ravel()
+    centres = weights.mean(axis=1)
+    if callable(values):
+        normals = np.einsum("tc,mcd->mtd", centres, mesh.normals[tri]).reshape(-1, 3)
+        with np.errstate(all="ignore"):
+            shade = np.nan_to_num(values(normals / np.linalg.norm(normals, axis=1)[:, None]))
+    else:
+        shade = np.einsum("tc,mc->mt", centres, values[tri]).ravel()
     artist = PolyCollection(corners, array=shade, edgecolors="face", linewidths=0.4, antialiased=False, **style)
     ax.add_collection(artist)
     ax.set_aspect("equal")
@@ -127,14 +137,16 @@ def plot_zebra(part: Any, *, view: Sequence[float] = VIEW, stripes: int = 14, ac
         raise ValueError(f"across must be a non-zero 3-D direction; got {across!r}")
     mesh = _mesh_of(part, units)
     v = _frame(view)[0]
-    n = mesh.normals
-    reflected = 2.0 * (n @ v)[:, None] * n - v
-    # the reflected direction's elevation above the tubes' plane, interpolated over each triangle (not
-    # its stripe colour: a triangle may span several stripes) and cut into 2·stripes bands by the colours
-    phase = np.arcsin(np.clip(reflected @ (e / np.linalg.norm(e)), -1.0, 1.0))
+    e = e / np.linalg.norm(e)
+
+    def phase(n: NDArray) -> NDArray:
+        """The reflected view vector's elevation above the tubes' plane, cut into 2·stripes bands by the colours."""
+        reflected = 2.0 * (n @ v)[:, None] * n - v
+        return np.arcsin(np.clip(reflected @ e, -1.0, 1.0))
+
     bands = ListedColormap(["0.08", "0.97"] * stripes)
     style = dict(cmap=bands, norm=Normalize(-math.pi / 2, math.pi / 2))
-    return _draw(mesh, np.nan_to_num(phase), view, ax, title, subdivide, **style)[0]
+    return _draw(mesh, phase, view, ax, title, subdivide, **style)[0]
 
 
 def plot_curvature_map(part: Any, *, view: Sequence[float] = VIEW, kind: str = "mean", ax: Axes | None = None,
