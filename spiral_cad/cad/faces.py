@@ -16,7 +16,7 @@ parameters on the edge's pcurve:
   ``|κa − κb| / max(|κa|, |κb|, 1/size)`` — relative, as the curve checker's.
 
 The worst value of each along the edge, and where it was, give the edge's
-class (``EDGE_CLASSES``): ``"gap"`` (the faces do not meet: gap above
+class (``EDGE_CLASSES``): ``"unmeasurable"`` (no sample gave a point or a normal), ``"gap"`` (the faces do not meet: gap above
 ``gap_tol`` × model size), ``"sharp"`` (normals further apart than
 ``feature_angle``: a feature — a box's edge — listed, never failed),
 ``"crease"`` (an angle above ``angle_tol`` but below ``feature_angle``: a
@@ -71,8 +71,8 @@ FEATURE_ANGLE = math.radians(5.0)
 
 #: Edge classes, worst first. ``"sharp"`` is a feature and sits apart: it is
 #: never compared with the required class.
-EDGE_CLASSES = ("gap", "crease", "G1", "G2", "sharp")
-_RANK = {"gap": 0, "crease": 1, "G1": 2, "G2": 3}
+EDGE_CLASSES = ("unmeasurable", "gap", "crease", "G1", "G2", "sharp")
+_RANK = {"unmeasurable": 0, "gap": 0, "crease": 1, "G1": 2, "G2": 3}
 
 #: Floats per sample and face: point (3), oriented unit normal (3), normal curvature across the edge.
 _FACE_FLOATS = 7
@@ -95,14 +95,42 @@ def _surface_name(kind: GeomAbs_SurfaceType) -> str:
 
 def _face_derivatives(surface: BRepAdaptor_Surface, face: TopoDS_Face, edge: TopoDS_Edge, params: NDArray, out: NDArray) -> None:
     """Fill ``out`` (samples × 18) with the face's surface point and derivatives (P, Su, Sv, Suu,
-    Svv, Suv) at the pcurve's (u, v) at each edge parameter."""
-    pcurve = BRepAdaptor_Curve2d(edge, face)
+    Svv, Suv) at the pcurve's (u, v) at each edge parameter; where the edge has no pcurve on the
+    face (a file that left it out), at the (u, v) of the edge's points projected on the surface."""
     uv, p = gp_Pnt2d(), gp_Pnt()
     su, sv, suu, svv, suv = gp_Vec(), gp_Vec(), gp_Vec(), gp_Vec(), gp_Vec()
-    for k, t in enumerate(params.tolist()):
-        pcurve.D0(t, uv)
-        surface.D2(uv.X(), uv.Y(), p, su, sv, suu, svv, suv)
+    if BRep_Tool.CurveOnSurface_s(edge, face, 0.0, 0.0) is not None:
+        pcurve = BRepAdaptor_Curve2d(edge, face)
+        uvs = []
+        for t in params.tolist():
+            pcurve.D0(t, uv)
+            uvs.append((uv.X(), uv.Y()))
+    else:
+        uvs = _projected(edge, face, params)
+    for k, (u, v) in enumerate(uvs):
+        if not (math.isfinite(u) and math.isfinite(v)):
+            out[k] = math.nan
+            continue
+        surface.D2(u, v, p, su, sv, suu, svv, suv)
         out[k] = (*p.Coord(), *su.Coord(), *sv.Coord(), *suu.Coord(), *svv.Coord(), *suv.Coord())
+
+
+def _projected(edge: TopoDS_Edge, face: TopoDS_Face, params: NDArray) -> list[tuple[float, float]]:
+    """(u, v) on the face's surface of the edge's points at ``params`` (``ShapeAnalysis_Surface``:
+    periodic and singular surfaces handled); NaN where no projection is found."""
+    from OCP.ShapeAnalysis import ShapeAnalysis_Surface
+
+    curve = BRepAdaptor_Curve(edge)
+    analysis = ShapeAnalysis_Surface(BRep_Tool.Surface_s(face))  # located, as the edge's points
+    tolerance = BRep_Tool.Tolerance_s(edge)
+    found = []
+    for t in params.tolist():
+        try:
+            uv = analysis.ValueOfUV(curve.Value(t), tolerance)
+            found.append((uv.X(), uv.Y()))
+        except Exception:  # noqa: BLE001 - OCCT's Standard_Failure: this sample is not measured
+            found.append((math.nan, math.nan))
+    return found
 
 
 def _samples(raw: NDArray, sign: NDArray, tangents: NDArray) -> NDArray:
@@ -297,8 +325,9 @@ class FaceReport:
     def worst(self) -> str:
         """The worst class of a tangent edge (``"G2"`` when there is none); ``"gap"`` if any edge,
         sharp ones too, has a gap."""
-        if any(e.gap > self.gap_tol * self.size for e in self.edges):
-            return "gap"
+        for level in ("unmeasurable", "gap"):
+            if any(e.level == level for e in self.edges):
+                return level
         return min((e.level for e in self.tangent_edges), key=_RANK.__getitem__, default="G2")
 
     def passes(self, require: str = "G2") -> bool:
@@ -360,7 +389,9 @@ def _classify(measured: Measured, *, gap_tol: float, angle_tol: float, curvature
         # NaN (a sample at a singular point of a surface) never decides a worst value
         g, an, j = (int(np.nanargmax(v[i])) if np.isfinite(v[i]).any() else 0 for v in (gap, angle, jump))
         worst_gap, worst_angle, worst_jump = float(gap[i, g]), float(angle[i, an]), float(jump[i, j])
-        if worst_gap > gap_limit:
+        if not (math.isfinite(worst_gap) and math.isfinite(worst_angle)):
+            level = "unmeasurable"  # no sample gave a point or a normal: never passed
+        elif worst_gap > gap_limit:
             level = "gap"
         elif worst_angle > feature_angle:
             level = "sharp"
