@@ -51,6 +51,11 @@ def zebra_pictures() -> None:
         for ax, (title, mesh) in zip(fig.subplots(1, 2), parts.items()):
             draw(mesh, ax=ax, title=title, view=view)
         fig.savefig(IMAGES / name, bbox_inches="tight")
+    # every edge filleted: stripes cross the cylinder/sphere edges (G1) and kink there
+    fig = Figure(figsize=(6, 4.5), dpi=110)
+    rounded = bd.fillet(bd.Box(40, 20, 16).edges(), 6)
+    plot_zebra(rounded, ax=fig.add_subplot(), view=(1.0, -1.3, 1.0), stripes=6, subdivide=6, across=(0.3, 0.2, 1.0))
+    fig.savefig(IMAGES / "zebra_corners.png", bbox_inches="tight")
 
 
 def main() -> None:

@@ -288,3 +288,10 @@ def test_edges_without_pcurves_are_measured_by_projection(monkeypatch):
     monkeypatch.setattr(faces, "_projected", lambda *args: projected.append(args) or original(*args))
     assert_box_calibration(check_faces(shape))
     assert len(projected) == 16  # the fillets' edges (a plane's pcurves OCCT computes itself)
+
+
+def test_box_with_every_edge_filleted_is_g1_at_its_sphere_corners_too():
+    report = check_faces(bd.fillet(bd.Box(40, 20, 16).edges(), 6))
+    assert found(report) == {"G1": 48}
+    corners = [e for e in report.edges if "sphere" in e.surfaces]
+    assert len(corners) == 24 and all(e.jump == pytest.approx(1.0, abs=1e-6) for e in corners)  # 0 against 1/r
