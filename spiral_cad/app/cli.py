@@ -220,7 +220,7 @@ def _check(args: argparse.Namespace) -> int:
 
         status = check_face_file(args.file, require=args.require, gap_tol=args.gap_tol, angle_tol=args.angle_tol,
                                  curvature_tol=args.curvature_tol, feature_angle=args.feature_angle, zebra=args.zebra,
-                                 curvature_map=args.curvature_map)  # fmt: skip
+                                 curvature_map=args.curvature_map, timing=args.timing)  # fmt: skip
         if status is not None:  # None: the reader found no faces after all, so the wires are judged
             if args.comb:  # the comb of every edge of the part, in mm as build123d and FreeCAD read
                 from ..cad.continuity import curvature_comb
@@ -327,7 +327,8 @@ def _add_check(sub: argparse._SubParsersAction) -> None:
     check = sub.add_parser(
         "check",
         help="report G0/G1/G2 continuity at every joint of a STEP, IGES or OpenDRIVE file",
-        description="Report G0/G1/G2 continuity at every joint, in the unit the file declares. An OpenDRIVE file is "
+        description="Report G0/G1/G2 continuity at every joint, in the unit the file declares; a STEP/IGES file that holds "
+        "faces is judged face to face at every edge they share (sharp features listed, not failed). An OpenDRIVE file is "
         "judged road by road (its planView, its elevation and superelevation in s) and link by link. Exit status: 0 ok, "
         "1 below --require, --profiles or --links (or not --pieces pieces), 2 unreadable file or bad option, "
         "141 output pipe closed early.",

@@ -24,11 +24,12 @@ def _png(option: str, path: str | None) -> Path | None:
 
 def check_face_file(file: str, *, require: str | None = None, gap_tol: float | None = None, angle_tol: float | None = None,
                     curvature_tol: float | None = None, feature_angle: float | None = None, zebra: str | None = None,
-                    curvature_map: str | None = None) -> int | None:  # fmt: skip
+                    curvature_map: str | None = None, timing: bool = False) -> int | None:  # fmt: skip
     """Judge the faces of ``file`` and print the table; draw the pictures asked for.
 
     Tolerances left None take ``check_faces``'s defaults (gap 1e-7 × size, angle 1e-7 rad, curvature jump 1e-4). ``require`` "G2" or "G1" fails any
-    tangent edge below it (and "G0" any gap); sharp features are listed, never failed.
+    tangent edge below it (and "G0" any gap); sharp features are listed, never failed. ``timing``
+    also prints how long the check took.
 
     Returns:
         0 ok, 1 below ``require``, None when the reader found no faces (the caller judges the wires).
@@ -47,6 +48,8 @@ def check_face_file(file: str, *, require: str | None = None, gap_tol: float | N
     if report.faces == 0:
         return None
     print(report.table())
+    if timing:
+        print(f"time {report.seconds:.3g} s for {report.faces} faces and {len(report.edges)} edges, reading included")
     if zebra_png is not None or map_png is not None:
         from ..cad.mesh import face_mesh
         from .zebra import plot_curvature_map, plot_zebra

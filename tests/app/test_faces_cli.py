@@ -43,8 +43,9 @@ def test_check_judges_faces_g1_box_fails_g2_and_passes_g1(files, capsys, suffix)
     text = capsys.readouterr().out
     assert "10 faces, 24 shared edges (8 G1, 16 sharp); worst tangent edge G1" in text
     assert "FAIL: worst tangent edge is G1, below the required G2" in text
-    assert main(["check", str(files["box" + suffix]), "--require", "G1"]) == 0
-    assert "OK: 10 faces" in capsys.readouterr().out
+    assert main(["check", str(files["box" + suffix]), "--require", "G1", "--timing"]) == 0
+    text = capsys.readouterr().out
+    assert "OK: 10 faces" in text and "for 10 faces and 24 edges, reading included" in text
 
 
 @pytest.mark.parametrize("suffix", ["", "_iges"])
