@@ -42,12 +42,12 @@ def zebra_pictures() -> None:
     from spiral_cad.cad.mesh import face_mesh
 
     parts = {
-        "circular fillets r = 5: G1": face_mesh(bd.fillet(bd.Box(40, 20, 8).edges().filter_by(bd.Axis.Z), 5)),
-        "ContinuousRectangle(40, 20, 5) extruded: G2": face_mesh(bd.extrude(ContinuousRectangle(40, 20, 5), 8)),
+        "circular fillets, r = 5: G1": face_mesh(bd.fillet(bd.Box(40, 20, 8).edges().filter_by(bd.Axis.Z), 5)),
+        "continuous rectangle, extruded: G2": face_mesh(bd.extrude(ContinuousRectangle(40, 20, 5), 8)),
     }
     view = (1.0, -0.9, 0.45)
     for name, draw in (("zebra_boxes.png", partial(plot_zebra, stripes=5, subdivide=8)), ("zebra_curvature.png", plot_curvature_map)):
-        fig = Figure(figsize=(11, 3.6), dpi=110)
+        fig = Figure(figsize=(12, 3.6), dpi=110)
         for ax, (title, mesh) in zip(fig.subplots(1, 2), parts.items()):
             draw(mesh, ax=ax, title=title, view=view)
         fig.savefig(IMAGES / name, bbox_inches="tight")
