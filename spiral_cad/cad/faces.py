@@ -340,6 +340,18 @@ class FaceReport:
             raise ValueError(f"require must be 'G1' or 'G2'; got {require!r}")
         return _RANK[self.worst] >= _RANK[require]
 
+    def failing(self, require: str = "G2") -> list[FaceEdge]:
+        """The edges that keep the report from passing ``require``: tangent edges below it, and any
+        edge with a gap or that could not be measured — worst first, to name in a refusal.
+
+        Raises:
+            ValueError: ``require`` is not ``"G1"`` or ``"G2"``.
+        """
+        if require not in ("G1", "G2"):
+            raise ValueError(f"require must be 'G1' or 'G2'; got {require!r}")
+        bad = [e for e in self.edges if e.level in ("unmeasurable", "gap") or (e.tangent and _RANK[e.level] < _RANK[require])]
+        return sorted(bad, key=lambda e: (_RANK[e.level], -e.angle, -e.jump, e.index))
+
     def describe(self) -> str:
         """What was found, e.g. ``"10 faces, 24 shared edges (8 G1, 16 sharp)"``."""
         counts = ", ".join(f"{n} {level}" for level, n in self.counts.items() if n)

@@ -295,3 +295,14 @@ def test_box_with_every_edge_filleted_is_g1_at_its_sphere_corners_too():
     assert found(report) == {"G1": 48}
     corners = [e for e in report.edges if "sphere" in e.surfaces]
     assert len(corners) == 24 and all(e.jump == pytest.approx(1.0, abs=1e-6) for e in corners)  # 0 against 1/r
+
+
+def test_failing_names_the_edges_below_the_requirement_worst_first():
+    report = check_faces(filleted_box())
+    assert report.failing("G1") == [] and len(report.failing("G2")) == 8
+    assert all(e.level == "G1" and e.tangent for e in report.failing())
+    kink = bd.Polyline((0, 0), (10, 0), (20, 10 * math.tan(math.radians(1.0))), (20, 10), (0, 10), close=True)
+    creased = check_faces(bd.extrude(bd.make_face(kink), 5))
+    assert [e.level for e in creased.failing("G1")] == ["crease"]
+    with pytest.raises(ValueError, match="require"):
+        report.failing("G0")
