@@ -484,13 +484,15 @@ def check_faces(shape_or_path: Any, *, gap_tol: float = 1e-7, angle_tol: float =
 
 #: STEP entities of a face (AP203/AP214/AP242 B-rep and surface models).
 _STEP_FACE = re.compile(rb"\b(?:ADVANCED_FACE|FACE_SURFACE|ORIENTED_FACE)\s*\(", re.IGNORECASE)
-#: IGES entity types of a face: 510 face, 144 trimmed surface, 143 bounded surface.
-_IGES_FACES = {b"510", b"144", b"143"}
+#: IGES entity types OCCT makes faces of: surfaces (108 plane … 198 toroidal), bounded and trimmed
+#: surfaces (143, 144), faces, shells and solids (510, 514, 186). A file with none of them has no faces;
+#: one with them that still reads without faces is judged by its wires (``spiral-cad check``).
+_IGES_FACES = {str(t).encode() for t in (108, 114, 118, 120, 122, 128, 140, 143, 144, 186, 190, 192, 194, 196, 198, 510, 514)}
 
 
 def holds_faces(path: str | os.PathLike) -> bool:
     """Whether a STEP/IGES file declares faces, from its text alone (no reader runs): a STEP face
-    entity, or an IGES directory entry of a face (510), trimmed (144) or bounded (143) surface.
+    entity, or an IGES directory entry of a surface, face, shell or solid (``_IGES_FACES``).
 
     ``spiral-cad check`` judges faces when this is true and wires otherwise; False for a missing
     file or another suffix (the wire checker then names the problem).
