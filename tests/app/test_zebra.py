@@ -1,0 +1,50 @@
+"""Zebra stripes and curvature maps as figures: what they are drawn from and what they refuse."""
+
+from __future__ import annotations
+
+import math
+
+import pytest
+
+pytest.importorskip("OCP")
+
+import build123d as bd  # noqa: E402
+import numpy as np  # noqa: E402
+from matplotlib.backends.backend_agg import FigureCanvasAgg  # noqa: E402
+
+from spiral_cad.app.zebra import plot_curvature_map, plot_zebra  # noqa: E402
+from spiral_cad.cad.mesh import face_mesh  # noqa: E402
+
+
+@pytest.fixture(scope="module")
+def sphere():
+    return face_mesh(bd.Sphere(5), angle=0.2)
+
+
+def _pixels(fig) -> np.ndarray:
+    canvas = FigureCanvasAgg(fig)
+    canvas.draw()
+    return np.asarray(canvas.buffer_rgba())[..., :3] / 255.0
+
+
+def test_zebra_of_a_sphere_draws_rings_of_both_colours(sphere):
+    image = _pixels(plot_zebra(sphere, stripes=4, view=(0, 0, 1), across=(1, 0, 0)))
+    dark, light = (image < 0.2).all(axis=2).mean(), (image > 0.9).all(axis=2).mean()
+    assert dark > 0.05 and light > 0.05
+
+
+def test_curvature_map_of_a_sphere_is_one_colour_with_its_scale(sphere):
+    fig = plot_curvature_map(sphere, title="sphere")
+    assert len(fig.axes) == 2 and "1/mm" in fig.axes[1].get_ylabel()  # the colour bar names the unit
+    assert np.allclose(np.asarray(fig.axes[0].collections[0].get_array()), 0.2, atol=1e-9)  # 1/r everywhere
+
+
+@pytest.mark.parametrize(
+    ("call", "message"),
+    [(lambda m: plot_zebra(m, stripes=0), "stripes"), (lambda m: plot_zebra(m, subdivide=True), "subdivide"),
+     (lambda m: plot_zebra(m, view=(0, 0, 0)), "view"), (lambda m: plot_zebra(m, across=(math.nan, 0, 1)), "across"),
+     (lambda m: plot_curvature_map(m, kind="max"), "kind"), (lambda m: face_mesh(bd.Box(1, 1, 1), angle=0), "angle")],
+)  # fmt: skip
+def test_bad_arguments_raise_value_error_naming_them(sphere, call, message):
+    with pytest.raises(ValueError, match=message):
+        call(sphere)
