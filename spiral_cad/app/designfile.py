@@ -32,6 +32,8 @@ from importlib.util import find_spec
 from pathlib import Path, PurePosixPath, PureWindowsPath
 from typing import Any
 
+import numpy as np
+
 from ..core.chain import Chain
 from ..core.errors import NoSolutionError
 from ..core.spiral import BezierSpiral
@@ -46,12 +48,13 @@ from .schema import (
     AlignmentDesign,
     CircleChainDesign,
     DesignFile,
+    FitDesign,
     RoundedPolylineDesign,
     validate,
 )
 from .schema import Profile as ProfileDesign
 
-__all__ = ["MAX_PIS", "MAX_PVIS", "NAME", "Built", "DesignError", "build", "load", "write"]
+__all__ = ["MAX_PIS", "MAX_PVIS", "NAME", "Built", "BuiltFit", "DesignError", "build", "load", "write"]
 
 #: JSON integers longer than this are refused (they cannot be lengths in float64 anyway).
 MAX_DIGITS = 308
@@ -121,6 +124,25 @@ class BuiltRounded(Built):
     @property
     def kind(self) -> str:
         return "rounded_polyline"
+
+
+@dataclass(kw_only=True)
+class BuiltFit(Built):
+    """A path fitted to points (``source``: the ``PointFit``): ``points`` as given (N, 2) or (N, 3) in the
+    design's units, with its optional samples; NAME_residuals.csv and NAME_fit.png report the fit."""
+
+    points: Any
+    samples: dict[str, float] | None = None
+
+    @property
+    def kind(self) -> str:
+        return "fit" + " (closed)" * bool(getattr(self.source, "closed", False))
+
+    def fit_line(self) -> str:
+        """The fit in one line: how many points, the worst residual and the tolerance."""
+        fit = self.source
+        return (f"{len(self.points):,} points within {fit.max_residual:.3g} {fit.units} of the path "
+                f"(tolerance {fit.tolerance:g} {fit.units}), {fit.pieces} pieces")  # fmt: skip
 
 
 @dataclass(kw_only=True)
@@ -312,6 +334,25 @@ def _rounded(d: RoundedPolylineDesign, where: str, units: str, base: Path | None
     return BuiltRounded(name=d.name, chain=result.chain, source=result, samples=samples)
 
 
+def _fit(d: FitDesign, where: str, units: str, base: Path | None) -> BuiltFit:
+    if d.points is not None:
+        points = np.asarray(d.points, dtype=np.float64)
+    else:
+        from ..io.points import read_points
+
+        path = _own_file(d.points_file or "", base, f"{where}.points_file")
+        points = read_points(path, units=d.points_units or units).in_units(units).points
+    if points.shape[1] == 3:
+        raise DesignError(f"{where}: points with z (a 3-D survey) need the profile fit, which is not available yet; "
+                          "give x, y only")  # fmt: skip
+    from .. import fit_points
+
+    with ticking(f"{where}: fitting {len(points):,} points"):
+        fit = fit_points(points, d.tolerance, closed=d.closed, shape=d.spiral_shape, units=units, max_curvature=d.max_curvature)
+    samples = None if d.samples is None else d.samples.options()
+    return BuiltFit(name=d.name, chain=fit.chain, source=fit, points=points, samples=samples)
+
+
 def _own_file(given: str, base: Path | None, where: str) -> Path:
     """The file ``given`` by a design whose file is in ``base``: only a file in that folder (or below it).
 
@@ -350,6 +391,7 @@ BUILDERS: dict[str, Callable[[Any, str, str, Path | None], Built]] = {
     "circle_chain": _circle_chain,
     "rounded_polyline": _rounded,
     "transition": _transition,
+    "fit": _fit,
 }
 
 
@@ -484,7 +526,7 @@ def _write_others(b: Built, stage: Path, units: str, missing: list[str], plots: 
     if b.chain.dim == 2:  # SVG is a plane output (the plots draw a path in space as its plan)
         export_svg(b.chain, stage / f"{b.name}.svg", name=b.name)
         names.append("svg")
-    if isinstance(b, BuiltRounded) and b.samples:
+    if isinstance(b, BuiltRounded | BuiltFit) and b.samples:
         from ..cad.export import export_samples
 
         export_samples(b.chain, stage / f"{b.name}_samples.csv", **b.samples)
@@ -512,9 +554,27 @@ def _write_others(b: Built, stage: Path, units: str, missing: list[str], plots: 
 
         export_iges(b.chain, stage / f"{b.name}.igs", name=b.name)
         names.append("igs")
+    if isinstance(b, BuiltFit):
+        names += _fit_report(b, stage, units, plots and "matplotlib" not in missing)
     if plots and "matplotlib" not in missing:
         names += _plots(b, stage)
     return names
+
+
+def _fit_report(b: BuiltFit, stage: Path, units: str, plot: bool) -> list[str]:
+    """NAME_residuals.csv (every point's station and distance to the path) and the plot NAME_fit.png."""
+    fit = b.source
+    from .fitreport import write_residuals
+
+    write_residuals(stage / f"{b.name}_residuals.csv", b.points, fit.stations, fit.residuals, units)
+    if not plot:
+        return ["residuals.csv"]
+    from .fitreport import plot_fit
+
+    figure = plot_fit(b.chain, fit.stations, fit.residuals, fit.tolerance, fit.curvature_estimate)
+    figure.suptitle(f"{b.name} — {b.kind}")
+    figure.savefig(stage / f"{b.name}_fit.png", dpi=110)
+    return ["residuals.csv", "fit.png"]
 
 
 def _road_3d(b: BuiltAlignment, profile: Any, stage: Path, units: str) -> list[str]:
@@ -595,4 +655,5 @@ def summary(built: list[Built], units: str) -> str:
         rows.append((b.name, b.kind, "+".join(shapes), len(b.chain), b.chain.length, peak, f" {b.continuity or '-'}"))
     lines = fixed_columns(columns, rows)
     lines += [f"{b.name}: {b.road_3d}" for b in built if b.road_3d]
+    lines += [f"{b.name}: {b.fit_line()}" for b in built if isinstance(b, BuiltFit)]
     return "\n".join(lines)
