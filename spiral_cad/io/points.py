@@ -124,6 +124,7 @@ def read_points(path: str | os.PathLike, units: str = "mm") -> PointTable:
 def parse_points(text: str, units: str = "mm", source: str = "points") -> PointTable:
     """The points of ``text``, the content of a point file (see ``read_points``); ``source`` names it in errors."""
     units = length_unit(units)
+    text = text.removeprefix("\ufeff")  # a byte order mark, as spreadsheets write it
     stated: tuple[str, int] | None = None
     if "#" not in text:  # no comment anywhere: the lines as they are (most of a large file's time)
         stripped = [line.strip() for line in text.splitlines()]
@@ -145,7 +146,7 @@ def parse_points(text: str, units: str = "mm", source: str = "points") -> PointT
     width = len(order) if order is not None else len(_split(data[0], separator))
     if order is None:
         if width not in (2, 3):
-            raise ValueError(f"{source}: line {numbers[0]}: {width} columns; expected x, y or x, y, z "
+            raise ValueError(f"{source}: line {numbers[0]}: {width} column{'s' * (width != 1)}; expected x, y or x, y, z "
                              "(or a header naming the columns)")  # fmt: skip
         order = ("x", "y", "z")[:width]
     try:
