@@ -27,7 +27,7 @@ def survey() -> np.ndarray:
     road = sc.Chain.join([enter, leave], start=(-80, 0), end=(610, 1000), units="m")
     stations = np.arange(0.0, road.length, 5.0)
     noise = np.random.default_rng(24).normal(scale=0.002, size=(len(stations), 2))
-    return np.round(road.point_at(stations) + noise, 3)
+    return np.round(road.point_at(stations) + noise, 3) + 0.0  # + 0.0: no -0.000
 
 
 def write_survey(path: Path) -> Path:
