@@ -132,11 +132,12 @@ class BuiltFit(Built):
     design's units, with its optional samples; NAME_residuals.csv and NAME_fit.png report the fit."""
 
     points: Any
+    closed: bool = False
     samples: dict[str, float] | None = None
 
     @property
     def kind(self) -> str:
-        return "fit" + " (closed)" * bool(getattr(self.source, "closed", False))
+        return "fit (closed)" if self.closed else "fit"
 
     def fit_line(self) -> str:
         """The fit in one line: how many points, the worst residual and the tolerance."""
@@ -342,15 +343,25 @@ def _fit(d: FitDesign, where: str, units: str, base: Path | None) -> BuiltFit:
 
         path = _own_file(d.points_file or "", base, f"{where}.points_file")
         points = read_points(path, units=d.points_units or units).in_units(units).points
+    if d.design_speed is not None:
+        raise DesignError(f"{where}.design_speed: the road fit (Alignment.fit) is not available yet; leave design_speed out")
     if points.shape[1] == 3:
         raise DesignError(f"{where}: points with z (a 3-D survey) need the profile fit, which is not available yet; "
                           "give x, y only")  # fmt: skip
     from .. import fit_points
+    from ..io.progress import Progress
 
-    with ticking(f"{where}: fitting {len(points):,} points"):
-        fit = fit_points(points, d.tolerance, closed=d.closed, shape=d.spiral_shape, units=units, max_curvature=d.max_curvature)
+    meter = Progress(f"{where}: fitting {len(points):,} points, steps")
+
+    def progress(done: int, total: int) -> None:
+        meter.total = total
+        meter(done)
+
+    fit = fit_points(points, d.tolerance, closed=d.closed, shape=d.spiral_shape, units=units, max_curvature=d.max_curvature,
+                     progress=progress)  # fmt: skip
+    meter.done(meter.total or 0)
     samples = None if d.samples is None else d.samples.options()
-    return BuiltFit(name=d.name, chain=fit.chain, source=fit, points=points, samples=samples)
+    return BuiltFit(name=d.name, chain=fit.chain, source=fit, points=points, closed=d.closed, samples=samples)
 
 
 def _own_file(given: str, base: Path | None, where: str) -> Path:
