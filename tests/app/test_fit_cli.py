@@ -3,6 +3,7 @@ the residuals CSV and the fit plot, judged by readers we did not write (OCCT, ez
 
 import csv
 import json
+import runpy
 import subprocess
 import sys
 from pathlib import Path
@@ -176,6 +177,12 @@ def test_residuals_agree_with_an_independent_distance(fitted):
     np.testing.assert_allclose(np.abs(table[:, 4]), measured, atol=1e-6)
     np.testing.assert_allclose(table[:, 3], station, atol=1e-3)
     assert measured.max() <= TOLERANCE
+
+
+def test_the_example_survey_is_what_its_script_generates(tmp_path):
+    script = runpy.run_path(str(EXAMPLES / "fit_points.py"))
+    written = script["write_survey"](tmp_path / "survey.csv")
+    assert written.read_bytes() == (EXAMPLES / "survey.csv").read_bytes()
 
 
 def test_points_files_stay_in_the_design_files_folder(tmp_path):
