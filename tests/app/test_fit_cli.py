@@ -117,7 +117,7 @@ def test_a_bad_file_from_a_child_process_prints_no_traceback(tmp_path):
 def test_build_from_points_writes_a_g2_path_within_tolerance(tmp_path, capsys):
     """A surveyed road (every 5 m, σ = 2 mm) comes back as its five pieces, within 10 cm, G2 as OCCT reads it."""
     points = traced()
-    lines = "\n".join(f"{y!r} {x!r}" for x, y in points)  # northing first: the header says so
+    lines = "\n".join(f"{y!r} {x!r}" for x, y in points.tolist())  # northing first: the header says so
     path = write_csv(tmp_path / "trace.txt", f"# units: m\nnorthing easting\n{lines}\n")
     out = tmp_path / "out"
     assert main(["build", "--from-points", str(path), "--tolerance", str(TOLERANCE), "--units", "m", "-o", str(out)]) == 0
@@ -152,7 +152,7 @@ def fitted(tmp_path_factory):
 def test_the_fit_design_builds_typed():
     units, (built,) = build(EXAMPLES / "fit.json")
     assert units == "m" and isinstance(built, BuiltFit) and built.kind == "fit"
-    assert built.points.shape == (317, 2) and built.source.max_residual <= TOLERANCE
+    assert built.points.shape == (318, 2) and built.source.max_residual <= TOLERANCE
     # the noise-free road has five pieces: the 2 mm noise adds none
     assert len(built.chain) == 5, [type(seg).__name__ for seg in built.chain]
 
@@ -194,14 +194,15 @@ def test_points_files_stay_in_the_design_files_folder(tmp_path):
 
 
 def test_points_files_convert_to_the_design_units(tmp_path):
-    (tmp_path / "trace.csv").write_text("x,y\n" + "\n".join(f"{x!r},{y!r}" for x, y in traced() * 1000.0))
+    (tmp_path / "trace.csv").write_text("x,y\n" + "\n".join(f"{x!r},{y!r}" for x, y in (traced() * 1000.0).tolist()))
     design = {"units": "m", "designs": [{"name": "a", "type": "fit", "points_file": "trace.csv", "points_units": "mm",
                                          "tolerance": 0.1}]}  # fmt: skip
     path = tmp_path / "fit.json"
     path.write_text(json.dumps(design))
     _, (built,) = build(path)
     np.testing.assert_allclose(built.points, traced(), rtol=1e-15)
-    assert built.chain.units == "m" and abs(built.chain.length - road().length) < 0.5
+    assert built.chain.units == "m" and built.source.max_residual <= 0.1  # metres: 0.1 mm would not be met
+    assert abs(built.chain.length - 5.0 * (len(built.points) - 1)) < 0.5  # from the first point to the last
 
 
 # ------------------------------------------------------------------ the report from arrays
