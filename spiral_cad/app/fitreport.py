@@ -46,7 +46,8 @@ def write_residuals(path: str | Path, points: ArrayLike, stations: ArrayLike, re
         raise ValueError(f"points {xy.shape}, stations {s.shape} and residuals {r.shape} must hold one row per point")
     head = ",".join(f"{name} [{dim.replace('L', units)}]" if dim else name for name, dim in RESIDUAL_COLUMNS)
     table = np.column_stack([xy[:, 0], xy[:, 1], s, r]) + 0.0  # + 0.0: no -0.0
-    body = "\n".join(f"{i},{x!r},{y!r},{st!r},{res!r}" for i, (x, y, st, res) in enumerate(table.tolist()))
+    columns = [map(repr, column) for column in table.T.tolist()]  # repr: the shortest text that reads back exactly
+    body = "\n".join(map(",".join, zip(map(str, range(len(table))), *columns)))
     path = Path(path)
     with path.open("w", encoding="utf-8", newline="") as handle:
         handle.write(f"{head}\n{body}\n")

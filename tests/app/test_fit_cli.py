@@ -201,7 +201,7 @@ def test_points_files_convert_to_the_design_units(tmp_path):
     path.write_text(json.dumps(design))
     _, (built,) = build(path)
     np.testing.assert_allclose(built.points, traced(), rtol=1e-15)
-    assert built.chain.units == "m" and built.source.max_residual <= 0.1  # metres: 0.1 mm would not be met
+    assert built.chain.units == "m" and built.source.max_residual <= 0.1
     assert abs(built.chain.length - 5.0 * (len(built.points) - 1)) < 0.5  # from the first point to the last
 
 
