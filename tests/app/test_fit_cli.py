@@ -102,6 +102,19 @@ def test_bad_options_are_named(tmp_path, capsys, options, message):
     assert capsys.readouterr().err.startswith(message)
 
 
+@pytest.mark.parametrize(
+    "text, options, message",
+    [
+        ("x,y,z\n0,0,1\n1,0,1\n2,0,1\n", [], "points with z (a 3-D survey) need the profile fit"),
+        ("0,0\n1,0\n2,0\n", ["--design-speed", "80"], ".design_speed: the road fit (Alignment.fit) is not available yet"),
+    ],
+)
+def test_what_is_not_built_yet_is_refused_by_name(tmp_path, capsys, text, options, message):
+    path = write_csv(tmp_path / "trace.csv", text)
+    assert main(["build", "--from-points", str(path), "--tolerance", "0.1", *options, "-o", str(tmp_path / "out")]) == 2
+    assert message in capsys.readouterr().err
+
+
 def test_points_options_need_from_points(capsys):
     assert main(["build", str(EXAMPLES / "design.json"), "--tolerance", "1", "--closed"]) == 2
     assert capsys.readouterr().err.startswith("error: --tolerance, --closed: only with --from-points")
