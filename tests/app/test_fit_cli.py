@@ -256,3 +256,22 @@ def test_the_fit_plot_draws_residuals_band_and_both_curvatures():
     lines = [c for c in bottom.collections if (c.get_gid() or "").startswith("curvature-")]
     assert {c.get_gid() for c in lines} == {"curvature-Line", "curvature-Arc", "curvature-BezierSpiral"}
     assert behind.get_zorder() < min(c.get_zorder() for c in lines)
+
+
+def test_a_closed_fit_in_a_design_file_closes(tmp_path):
+    """Points around a circle, inline and closed: one arc all round, ending where it starts, G2 as OCCT reads it."""
+    t = np.linspace(0.0, 2.0 * np.pi, 90, endpoint=False)
+    points = np.column_stack([30.0 * np.cos(t), 30.0 * np.sin(t)]).tolist()
+    design = {"units": "mm", "designs": [{"name": "ring", "type": "fit", "points": points, "tolerance": 0.01, "closed": True}]}
+    path = tmp_path / "ring.json"
+    path.write_text(json.dumps(design))
+    assert main(["build", str(path), "-o", str(tmp_path / "out"), "--no-plots"]) == 0
+    _, (built,) = build(path)
+    assert built.kind == "fit (closed)" and np.allclose(built.chain.start, built.chain.end, atol=1e-9)
+    measured, _ = distances(built.chain, np.asarray(points))
+    assert measured.max() <= 0.01
+    from spiral_cad.cad.continuity import check_continuity
+
+    assert check_continuity(tmp_path / "out" / "ring.step").passes("G2")
+    header, table = read_table(tmp_path / "out" / "ring_residuals.csv")
+    assert len(table) == 90 and not (tmp_path / "out" / "ring_fit.png").exists()  # --no-plots: no plot
