@@ -21,6 +21,7 @@ import contextlib
 import json
 import math
 import os
+import re
 import stat
 import time
 from abc import ABC, abstractmethod
@@ -336,13 +337,15 @@ def _rounded(d: RoundedPolylineDesign, where: str, units: str, base: Path | None
 
 
 def _fit(d: FitDesign, where: str, units: str, base: Path | None) -> BuiltFit:
+    table = None
     if d.points is not None:
         points = np.asarray(d.points, dtype=np.float64)
     else:
         from ..io.points import read_points
 
         path = _own_file(d.points_file or "", base, f"{where}.points_file")
-        points = read_points(path, units=d.points_units or units).in_units(units).points
+        table = read_points(path, units=d.points_units or units).in_units(units)
+        points = table.points
     if d.design_speed is not None:
         raise DesignError(f"{where}.design_speed: the road fit (Alignment.fit) is not available yet; leave design_speed out")
     if points.shape[1] == 3:
@@ -357,8 +360,17 @@ def _fit(d: FitDesign, where: str, units: str, base: Path | None) -> BuiltFit:
         meter.total = total
         meter(done)
 
-    fit = fit_points(points, d.tolerance, closed=d.closed, shape=d.spiral_shape, units=units, max_curvature=d.max_curvature,
-                     progress=progress)  # fmt: skip
+    try:
+        fit = fit_points(points, d.tolerance, closed=d.closed, shape=d.spiral_shape, units=units, max_curvature=d.max_curvature,
+                         progress=progress)  # fmt: skip
+    except ValueError as e:
+        if table is None:
+            raise
+        # a point named by its index is also named by its line in the file
+        lines = table.lines
+        shown = re.sub(r"points\[(\d+)\]", lambda m: f"{m[0]} ({table.source} line {lines[int(m[1])]})"
+                       if int(m[1]) < len(lines) else m[0], str(e))  # fmt: skip
+        raise DesignError(f"{where}: {shown}") from None
     meter.done(meter.total or 0)
     samples = None if d.samples is None else d.samples.options()
     return BuiltFit(name=d.name, chain=fit.chain, source=fit, points=points, closed=d.closed, samples=samples)

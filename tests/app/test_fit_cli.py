@@ -275,3 +275,25 @@ def test_a_closed_fit_in_a_design_file_closes(tmp_path):
     assert check_continuity(tmp_path / "out" / "ring.step").passes("G2")
     header, table = read_table(tmp_path / "out" / "ring_residuals.csv")
     assert len(table) == 90 and not (tmp_path / "out" / "ring_fit.png").exists()  # --no-plots: no plot
+
+
+@pytest.mark.parametrize(
+    "text, message",
+    [
+        ("x,y\n0,0\n0,0\n0,0\n", "fit_points needs at least 3 distinct points; got 1 (of 3 points)"),
+        ("# a U-turn\n0 0\n10 0\n20 0\n10 0.001\n0 0.002\n", "the points double back at points[2] (trace.csv line 4)"),
+    ],
+)
+def test_points_no_fit_can_follow_are_refused_naming_the_line(tmp_path, capsys, text, message):
+    path = write_csv(tmp_path / "trace.csv", text)
+    assert main(["build", "--from-points", str(path), "--tolerance", "0.01", "-o", str(tmp_path / "out")]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("error: designs[0] (trace): ") and message in err and "Traceback" not in err
+
+
+def test_collinear_points_with_repeats_are_one_line(tmp_path):
+    path = write_csv(tmp_path / "trace.csv", "0,0\n1,0\n1,0\n2,0\n3,0\n")
+    assert main(["build", "--from-points", str(path), "--tolerance", "0.01", "-o", str(tmp_path / "out"), "--no-plots"]) == 0
+    header, table = read_table(tmp_path / "out" / "trace_residuals.csv")
+    assert len(table) == 5 and np.abs(table[:, 4]).max() <= 1e-12
+    np.testing.assert_allclose(table[:, 3], [0, 1, 1, 2, 3], atol=1e-12)
