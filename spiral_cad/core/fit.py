@@ -211,6 +211,10 @@ class _Primitive:
     center: NDArray[np.float64]
     radius: float
     span: float  # arc: the angle the run's points travel; line: their length
+    split: int = -1  # a line's point up to which the corner before it may reach, and from which the one after it
+
+    def split_point(self, points: NDArray[np.float64]) -> NDArray[np.float64]:
+        return _foot(self, points[self.split if self.split >= 0 else (self.a + self.b - 1) // 2])
 
     @property
     def curvature(self) -> float:
@@ -314,6 +318,13 @@ def _runs(points: NDArray[np.float64], order: NDArray[np.int64], tau: float, max
             covered[seed] = True
             continue
         a, b, best = max(grown, key=lambda g: g[1] - g[0])
+        if not best.line and len(grown) == 2:
+            # A circle little further than tau from its chord is a line's business (an inflection, a
+            # near-straight), when a line holds most of its points.
+            chord = math.hypot(*(points[b - 1] - points[a]))
+            line_run = grown[0][1] - grown[0][0]
+            if chord * chord / (8.0 * abs(best.radius)) <= 2.0 * tau and line_run >= 0.5 * (b - a):
+                a, b, best = grown[0]
         covered[a:b] = True
         bisect.insort(starts, a)
         runs[a] = best
@@ -414,21 +425,40 @@ def _corner(p: _Primitive, q: _Primitive, points: NDArray[np.float64], shape: st
     t = float(((q.point - p.point)[0] * q.direction[1] - (q.point - p.point)[1] * q.direction[0]) / cross)
     corner = p.point + t * p.direction
     a, c, b = tuple(p_from.tolist()), tuple(corner.tolist()), tuple(q_to.tolist())
+    points = points[:: max(1, len(points) // 500)]  # the search needs the shape, not every point
     try:
         widest = line_to_line(a, c, b, None, shape)
     except ValueError:
         return None
     lowest = abs(widest.spirals[0].end_curvature)
-    best, best_miss = widest, _miss(widest.spirals, points)
-    for factor in np.geomspace(1.0, 1000.0, 31)[1:].tolist():
+
+    def attempt(log_factor: float) -> tuple[float, Transition | None]:
         try:
-            trial = line_to_line(a, c, b, lowest * factor, shape)
+            trial = line_to_line(a, c, b, lowest * math.exp(log_factor), shape) if log_factor > 0 else widest
         except ValueError:
-            continue
-        miss = _miss(trial.spirals, points)
-        if miss < best_miss:
-            best, best_miss = trial, miss
-    return best
+            return math.inf, None
+        return _miss(trial.spirals, points), trial
+
+    # The pair scales as 1/κ about the corner: the κ whose apex lies as near the corner as the
+    # nearest point does, then golden-section search on log κ around it.
+    apex = math.hypot(*(np.asarray(widest.joint) - corner))
+    nearest = float(np.hypot(*(points - corner).T).min())
+    guess = math.log(max(apex / max(nearest, 1e-300), 1.0))
+    lo, hi = max(0.0, guess - 0.3), min(math.log(1000.0), guess + 0.3)
+    ratio = (math.sqrt(5.0) - 1.0) / 2.0
+    x1, x2 = hi - ratio * (hi - lo), lo + ratio * (hi - lo)
+    f1, f2 = attempt(x1)[0], attempt(x2)[0]
+    for _ in range(16):
+        if f1 <= f2:
+            hi, x2, f2 = x2, x1, f1
+            x1 = hi - ratio * (hi - lo)
+            f1 = attempt(x1)[0]
+        else:
+            lo, x1, f1 = x1, x2, f2
+            x2 = lo + ratio * (hi - lo)
+            f2 = attempt(x2)[0]
+    candidates = [(attempt(guess)[0], guess), (attempt(0.0)[0], 0.0), (f1, x1), (f2, x2)]
+    return attempt(min(candidates)[1])[1]
 
 
 def _miss(spirals: list[BezierSpiral], points: NDArray[np.float64]) -> float:
@@ -440,7 +470,7 @@ def _miss(spirals: list[BezierSpiral], points: NDArray[np.float64]) -> float:
     far = 1e3 * (first.length + last.length + 1.0)
     pieces.append(Line(first.start - far * first.start_tangent, first.start))
     pieces.append(Line(last.end, last.end + far * last.end_tangent))
-    return float(_nearest(pieces, points)[0].max())
+    return float(_nearest(pieces, points).max())
 
 
 def _clipped(prim: _Primitive, at: NDArray[np.float64], before: bool, far: float) -> Segment:
@@ -456,22 +486,19 @@ def _clipped(prim: _Primitive, at: NDArray[np.float64], before: bool, far: float
 # ------------------------------------------------------------- distances
 
 
-def _nearest(pieces: list[Segment], points: NDArray[np.float64]) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.int64]]:
-    """Distance of each point to the nearest of ``pieces`` (each tried: few pieces), its local arc length, the piece."""
+def _nearest(pieces: list[Segment], points: NDArray[np.float64]) -> NDArray[np.float64]:
+    """Distance of each point to the nearest of ``pieces`` (each tried: few pieces)."""
     best = np.full(len(points), np.inf)
-    local = np.zeros(len(points))
-    which = np.zeros(len(points), dtype=np.int64)
-    for k, piece in enumerate(pieces):
-        distance, along = _piece_distance(piece, points, None)
-        better = distance < best
-        best[better], local[better], which[better] = distance[better], along[better], k
-    return best, local, which
+    for piece in pieces:
+        np.minimum(best, _piece_distance(piece, points, None, False)[0], out=best)
+    return best
 
 
 def _piece_distance(
-    piece: Segment, points: NDArray[np.float64], u0: NDArray[np.float64] | None
+    piece: Segment, points: NDArray[np.float64], u0: NDArray[np.float64] | None, stations: bool = True
 ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-    """Distance of each point to ``piece`` and the arc length of its foot from the piece's start (``u0``: a spiral's start guesses)."""
+    """Distance of each point to ``piece`` and (``stations``) the arc length of its foot from the
+    piece's start (``u0``: a spiral's start guesses)."""
     if isinstance(piece, Line):
         a, b = piece.start, piece.end
         d = b - a
@@ -492,21 +519,28 @@ def _piece_distance(
         return np.hypot(*(points - foot).T), phi * abs(r)
     assert isinstance(piece, BezierSpiral)
     cp = piece.control_points
+    # Power basis about B0 (the points moved by −B0 too, so survey coordinates keep their digits).
+    c1, c2, c3 = 3.0 * (cp[1] - cp[0]), 3.0 * (cp[0] - 2.0 * cp[1] + cp[2]), cp[3] - cp[0] + 3.0 * (cp[1] - cp[2])
+    rel = points - cp[0]
     if u0 is None:
         grid = np.linspace(0.0, 1.0, 17)
-        samples = bezier.point(cp, grid)
-        gap = ((points[:, None, :] - samples[None]) ** 2).sum(axis=2)
+        samples = ((c3 * grid[:, None] + c2) * grid[:, None] + c1) * grid[:, None]
+        gap = (rel[:, None, 0] - samples[None, :, 0]) ** 2 + (rel[:, None, 1] - samples[None, :, 1]) ** 2
         u = grid[np.argmin(gap, axis=1)]
     else:
         u = u0.copy()
-    for _ in range(8):  # Newton on (B(u) − p)·B'(u) = 0
-        offset = bezier.point(cp, u) - points
-        d1, d2 = bezier.derivative(cp, u, 1), bezier.derivative(cp, u, 2)
+    for _ in range(6):  # Newton on (B(u) − p)·B'(u) = 0
+        uu = u[:, None]
+        offset = ((c3 * uu + c2) * uu + c1) * uu - rel
+        d1 = (3.0 * c3 * uu + 2.0 * c2) * uu + c1
+        d2 = 6.0 * c3 * uu + 2.0 * c2
         f = (offset * d1).sum(axis=1)
         df = (d1 * d1).sum(axis=1) + (offset * d2).sum(axis=1)
         u = np.clip(u - f / np.where(df > 0, df, 1.0), 0.0, 1.0)
-    along = np.asarray(bezier.arc_length(cp, u), dtype=float)
-    return np.hypot(*(bezier.point(cp, u) - points).T), along
+    uu = u[:, None]
+    offset = ((c3 * uu + c2) * uu + c1) * uu - rel
+    along = np.asarray(bezier.arc_length(cp, u), dtype=float) if stations else u
+    return np.hypot(offset[:, 0], offset[:, 1]), along
 
 
 def chain_distances(chain: Chain, points: ArrayLike) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
@@ -626,7 +660,7 @@ def fit_points(
     tau = min(max(tol / 8.0, 6.0 * sigma), tol / 2.0)
     chain = None
     try:
-        prims = _segment(pts, s[: len(pts)], kappa, h, tau, kmax)
+        prims = _segment(pts, s[: len(pts)], kappa, h, tau, kmax, bool(closed))
         report(3, _STEPS)
         chain = _assemble(prims, pts, tol, shape, units, bool(closed))
     except (ValueError, _Unfit):
@@ -661,11 +695,22 @@ def _check_max_curvature(chain: Chain, kmax: float) -> None:
 
 
 def _segment(pts: NDArray[np.float64], s: NDArray[np.float64], kappa: NDArray[np.float64], h: float, tau: float,
-             kmax: float | None) -> list[_Primitive]:  # fmt: skip
+             kmax: float | None, closed: bool) -> list[_Primitive]:  # fmt: skip
     """The runs, grown from the points where the curvature estimate changes least."""
     change = np.abs(np.interp(s + 2 * h, s, kappa) - np.interp(s - 2 * h, s, kappa))
     order = np.argsort(change, kind="stable")
-    return _runs(pts, order, tau, kmax)
+    runs = _runs(pts, order, tau, kmax)
+    for run in runs:
+        if not run.line:
+            continue
+        if run.a == 0 and not closed:
+            run.split = 0
+        elif run.b == len(pts) and not closed:
+            run.split = run.b - 1
+        elif kappa[run.a] * kappa[run.b - 1] < 0:
+            # Between corners that turn opposite ways: the inflection, where both pairs may meet.
+            run.split = run.a + int(np.argmin(np.abs(kappa[run.a : run.b])))
+    return runs
 
 
 @dataclass
@@ -674,55 +719,111 @@ class _Gap:
     miss: float
 
 
+#: How many runs ahead a join may reach (the runs skipped between are left to its spirals).
+_REACH = 10
+
+
 def _assemble(prims: list[_Primitive], pts: NDArray[np.float64], tol: float, shape: str, units: str, closed: bool) -> Chain:
-    """Join the runs, remove those the tolerance does not need (shortest first), and build the chain."""
+    """Choose the runs to keep, fewest pieces first (dynamic programming over the runs in order,
+    each join reaching up to ``_REACH`` runs ahead), and build the chain."""
     if not prims:
         raise _Unfit
     if len(prims) == 1:
         return _single(prims[0], pts, units, closed)
-    live = list(range(len(prims)))
+    if closed:
+        anchor = max(range(len(prims)), key=lambda k: prims[k].b - prims[k].a)
+        ring = prims[anchor:] + prims[:anchor]
+        order = ring + ring[:1]
+    else:
+        order = list(prims)
     gaps: dict[tuple[int, int], _Gap] = {}
 
     def gap(i: int, j: int) -> _Gap:
         if (i, j) not in gaps:
-            gaps[(i, j)] = _evaluate(prims[i], prims[j], pts, shape, tol)
+            gaps[(i, j)] = _evaluate(order[i], order[j], pts, shape, tol)
         return gaps[(i, j)]
 
-    def ok(i: int, j: int) -> bool:
+    def usable(i: int, j: int) -> Transition | None:
         g = gap(i, j)
-        return g.transition is not None and g.miss <= tol
+        return g.transition if g.miss <= tol else None
 
-    changed = True
-    while changed and len(live) > 1:
-        changed = False
-        for victim in sorted(live, key=lambda k: prims[k].b - prims[k].a):
-            if len(live) <= 1:
-                break
-            at = live.index(victim)
-            count = len(live)
-            if not closed and at in (0, count - 1):
-                continue
-            before, after = live[(at - 1) % count], live[(at + 1) % count]
-            if count == 2:
-                continue
-            if ok(before, after) and _folds_ok(prims, live[:at] + live[at + 1 :], gap, closed, pts, (before, after)):
-                live.remove(victim)
-                changed = True
-    pairs = list(zip(live, live[1:])) + ([(live[-1], live[0])] if closed else [])
-    if not all(ok(i, j) for i, j in pairs):
+    last = len(order) - 1
+    best_cost, best_path = math.inf, None
+    firsts = range(1, min(_REACH, last) + 1) if closed else [None]
+    for first in firsts:
+        cost, path = _cheapest(order, pts, usable, last, first, closed)
+        if cost < best_cost:
+            best_cost, best_path = cost, path
+    if best_path is None:
         raise _Unfit
-    transitions = [gap(i, j).transition for i, j in pairs]
-    return _build([prims[k] for k in live], [t for t in transitions if t is not None], pts, units, closed)
+    kept = [order[k] for k in best_path]
+    transitions = [usable(i, j) for i, j in zip(best_path, best_path[1:])]
+    if closed:
+        kept = kept[:-1]
+    return _build(kept, [t for t in transitions if t is not None], pts, units, closed)
+
+
+def _cheapest(order: list[_Primitive], pts: NDArray[np.float64], usable: Callable[[int, int], Transition | None], last: int,
+              first: int | None, closed: bool) -> tuple[float, list[int] | None]:  # fmt: skip
+    """The fewest pieces from run 0 to run ``last`` (states: the last two runs kept), each kept run's
+    transition in ending before its transition out starts. ``first``: the run kept after run 0 (closed)."""
+    cost: dict[tuple[int, int], float] = {}
+    back: dict[tuple[int, int], tuple[int, int] | None] = {}
+    starts = [first] if first is not None else range(1, min(_REACH, last) + 1)
+    for j in starts:
+        t = usable(0, j)
+        if t is None:
+            continue
+        enter = None if closed else _foot(order[0], pts[0])
+        if enter is not None and not _ahead(order[0], enter, t.start):
+            continue
+        cost[(0, j)] = 2 + len(t.spirals)
+        back[(0, j)] = None
+    for j in range(1, last + 1):
+        for i in range(max(0, j - _REACH), j):
+            if (i, j) not in cost:
+                continue
+            into = usable(i, j)
+            assert into is not None
+            for k in range(j + 1, min(j + _REACH, last) + 1):
+                out = usable(j, k)
+                if out is None or not _ahead(order[j], into.end, out.start):
+                    continue
+                total = cost[(i, j)] + 1 + len(out.spirals) - (1 if k == last and closed else 0)
+                if total < cost.get((j, k), math.inf):
+                    cost[(j, k)], back[(j, k)] = total, (i, j)
+    best, end = math.inf, None
+    for i in range(max(0, last - _REACH), last):
+        if (i, last) not in cost:
+            continue
+        into = usable(i, last)
+        assert into is not None
+        if closed:
+            assert first is not None
+            out = usable(0, first)
+            assert out is not None
+            fits = _ahead(order[last], into.end, out.start)
+        else:
+            fits = _ahead(order[last], into.end, _foot(order[last], pts[-1]))
+        if fits and cost[(i, last)] < best:
+            best, end = cost[(i, last)], (i, last)
+    if end is None:
+        return math.inf, None
+    path = [end[1]]
+    state: tuple[int, int] | None = end
+    while state is not None:
+        path.append(state[0])
+        state = back[state]
+    return best, path[::-1]
 
 
 def _evaluate(p: _Primitive, q: _Primitive, pts: NDArray[np.float64], shape: str, tol: float) -> _Gap:
-    """The transition from run p to run q and the largest distance of the points between them
-    (p's points to q's) to it, the runs' lines and circles clipped at its ends."""
-    if q.a >= p.a:
-        local = pts[p.a : q.b]
-    else:  # the closing gap
-        local = np.vstack([pts[p.a :], pts[: q.b]])
-    transition = _join(p, q, local, shape, tol, _foot(p, pts[p.a]), _foot(q, pts[q.b - 1]))
+    """The transition from run p to run q and the largest distance of the points between their
+    middles to it, the runs' lines and circles clipped at its ends."""
+    start, stop = (p.a + p.b) // 2, (q.a + q.b) // 2 + 1
+    local = pts[start:stop] if stop > start else np.vstack([pts[start:], pts[:stop]])
+    # A corner's spirals may reach the split point of either run, no further (the next corner owns the rest).
+    transition = _join(p, q, local, shape, tol, p.split_point(pts), q.split_point(pts))
     if transition is None:
         return _Gap(None, math.inf)
     far = 2.0 * float(np.hypot(*(local.max(axis=0) - local.min(axis=0)))) + 1.0
@@ -730,34 +831,7 @@ def _evaluate(p: _Primitive, q: _Primitive, pts: NDArray[np.float64], shape: str
         pieces: list[Segment] = [_clipped(p, transition.start, True, far), *transition.spirals, _clipped(q, transition.end, False, far)]
     except ValueError:
         return _Gap(None, math.inf)
-    return _Gap(transition, float(_nearest(pieces, local)[0].max()))
-
-
-def _folds_ok(prims: list[_Primitive], live: list[int], gap: Callable[[int, int], _Gap], closed: bool, pts: NDArray[np.float64],
-              around: tuple[int, int]) -> bool:  # fmt: skip
-    """On the runs at ``around`` the transition in must end before the transition out starts."""
-    count = len(live)
-    for k in around:
-        at = live.index(k)
-        enter: NDArray[np.float64] | None = None
-        leave: NDArray[np.float64] | None = None
-        if at > 0 or closed:
-            g = gap(live[(at - 1) % count], k)
-            if g.transition is None:
-                return False
-            enter = g.transition.end
-        else:
-            enter = _foot(prims[k], pts[0])
-        if at < count - 1 or closed:
-            g = gap(k, live[(at + 1) % count])
-            if g.transition is None:
-                return False
-            leave = g.transition.start
-        else:
-            leave = _foot(prims[k], pts[-1])
-        if not _ahead(prims[k], enter, leave):
-            return False
-    return True
+    return _Gap(transition, float(_nearest(pieces, local).max()))
 
 
 def _ahead(prim: _Primitive, enter: NDArray[np.float64], leave: NDArray[np.float64]) -> bool:
