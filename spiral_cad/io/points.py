@@ -203,6 +203,9 @@ def _cell(line: str, separator: str | None, column: int) -> str:
 
 
 def _is_number(cell: str) -> bool:
+    """A number as numpy reads it: Python's float() also takes '1_000' and non-ASCII digits, numpy does not."""
+    if not cell.isascii() or "_" in cell:
+        return False
     try:
         float(cell)
     except ValueError:

@@ -2,6 +2,8 @@
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from spiral_cad.io.points import parse_points, read_points
 
@@ -43,6 +45,8 @@ def test_lines_name_points_and_units_convert():
         ("0,0,0\n1,2,3,4\n", "line 2: 4 columns, expected 3 (x, y, z)"),
         ("0,0\n1,,\n", "line 2: 3 columns, expected 2"),
         ("0,0\n,1\n", "line 2: x is empty"),
+        ("0,0\n1_0,1\n", "line 2: x is '1_0', not a number"),
+        ("0,0\n\u0661,1\n", "line 2: x is '\u0661', not a number"),
         ("0 0\nnan 1\n", "line 2: x is 'nan'; every coordinate must be a finite number"),
         ("0 0\n1 -inf\n", "line 2: y is '-inf'"),
         ("0 0 0 0\n", "line 1: 4 columns; expected x, y or x, y, z"),
@@ -86,3 +90,16 @@ def test_a_million_rows_read_as_numpy_wrote_them(tmp_path):
     table = read_points(path)  # its speed is measured in benchmarks/bench_points.py
     np.testing.assert_array_equal(table.points, expected)
     assert table.units == "m" and table.lines[-1] == 1_000_002
+
+
+@settings(max_examples=300, deadline=None)
+@given(st.text(alphabet="0123456789.,;- \t\n#xyzEnaif[]m:u_\u0661", max_size=80))
+def test_any_text_is_points_or_a_named_error(text):
+    """Whatever the text, a table of finite points with a line number each, or a ValueError naming the source."""
+    try:
+        table = parse_points(text, source="fuzz.csv")
+    except ValueError as error:
+        assert str(error).startswith("fuzz.csv: ") and "could not be read as a table" not in str(error)  # a line named
+        return
+    assert np.isfinite(table.points).all() and table.dim in (2, 3) and len(table.lines) == len(table) >= 1
+    assert all(1 <= n <= len(text.splitlines()) for n in table.lines.tolist())
