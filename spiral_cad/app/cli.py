@@ -439,7 +439,11 @@ def _parser() -> argparse.ArgumentParser:
                           "else --units)")  # fmt: skip
     fit.add_argument("--tolerance", type=float, help="the largest distance from any point to the fitted path")
     fit.add_argument("--closed", action="store_true", help="the points go round a closed path (G2 at the closing joint)")
-    fit.add_argument("--design-speed", type=float, help="fit a road alignment and judge its curves at this speed (km/h; mph in ft)")
+    fit.add_argument(
+        "--design-speed",
+        type=float,
+        help="fit a road alignment and judge its curves at this speed (km/h; mph in ft); refused by name until the road fit (Alignment.fit) exists",
+    )
     build.set_defaults(run=_build)
     _add_check(sub)
     schema = sub.add_parser("schema", help="print the JSON Schema of design files (the format of build)")
