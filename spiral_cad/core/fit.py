@@ -104,7 +104,7 @@ def _as_points(points: Any) -> NDArray[np.float64]:
     bad = ~np.isfinite(array).all(axis=1)
     if bad.any():
         i = int(np.flatnonzero(bad)[0])
-        raise ValueError(f"points[{i}] is not finite: ({array[i, 0]!r}, {array[i, 1]!r})")
+        raise ValueError(f"points[{i}] is not finite: ({float(array[i, 0])!r}, {float(array[i, 1])!r})")
     return array
 
 
@@ -184,16 +184,20 @@ def curvature_estimate(points: NDArray[np.float64], s: NDArray[np.float64], h: f
 
 
 def _noise(points: NDArray[np.float64]) -> float:
-    """Robust noise level σ: the median offset of each point from its neighbours' midpoint, across their chord."""
-    if len(points) < 3:
+    """Robust noise level σ: each point's offset across the chord of its neighbours, less the mean
+    of its neighbours' offsets (which takes out the curve's own bending), as a median."""
+    if len(points) < 5:
         return 0.0
     chord = points[2:] - points[:-2]
     offset = points[1:-1] - 0.5 * (points[2:] + points[:-2])
     length = np.hypot(*chord.T)
-    ok = length > 0
-    normal = np.abs(chord[ok, 0] * offset[ok, 1] - chord[ok, 1] * offset[ok, 0]) / length[ok]
-    # Var(offset across) = 1.5 σ² for independent noise; 1.4826 · median = σ of a normal distribution.
-    return float(1.4826 * np.median(normal) / math.sqrt(1.5)) if len(normal) else 0.0
+    with np.errstate(invalid="ignore", divide="ignore"):
+        across = (chord[:, 0] * offset[:, 1] - chord[:, 1] * offset[:, 0]) / length
+    detrended = across[1:-1] - 0.5 * (across[2:] + across[:-2])
+    detrended = detrended[np.isfinite(detrended)]
+    # The detrended offset is 1.5·p(i) − p(i±1) + p(i±2)/4 across: variance 4.375 σ²;
+    # 1.4826 · median = σ of a normal distribution.
+    return float(1.4826 * np.median(np.abs(detrended)) / math.sqrt(4.375)) if len(detrended) else 0.0
 
 
 # ------------------------------------------------------------- primitives
@@ -577,6 +581,7 @@ def chain_distances(chain: Chain, points: ArrayLike) -> tuple[NDArray[np.float64
     piece_of, u_guess = owner[nearest], u_of[nearest]
     best = np.full(len(p), np.inf)
     foot = np.zeros(len(p))
+    ring = math.hypot(*(chain.end - chain.start)) <= 1e-9 * chain.size  # a closed chain: the ends are neighbours
     order = np.argsort(piece_of, kind="stable")
     bounds = np.flatnonzero(np.diff(piece_of[order])) + 1
     for group in np.split(order, bounds):
@@ -584,9 +589,11 @@ def chain_distances(chain: Chain, points: ArrayLike) -> tuple[NDArray[np.float64
             continue
         k = int(piece_of[group[0]])
         for j in (k - 1, k, k + 1):  # the neighbours too: a foot near a joint may lie on either side
-            if not 0 <= j < len(pieces):
+            if ring:
+                j %= len(pieces)
+            elif not 0 <= j < len(pieces):
                 continue
-            guess = u_guess[group] if j == k else np.full(len(group), 1.0 if j < k else 0.0)
+            guess = u_guess[group] if j == k else np.full(len(group), 1.0 if j == (k - 1) % len(pieces) else 0.0)
             distance, along = _piece_distance(pieces[j], p[group], guess)
             better = distance < best[group]
             best[group[better]] = distance[better]
@@ -645,7 +652,7 @@ def fit_points(
     if len(kept) < 3:
         raise ValueError(f"fit_points needs at least 3 distinct points; got {len(kept)} (of {len(raw)} points)")
     pts = raw[kept]
-    s = _arc_lengths(np.vstack([pts, pts[:1]]) if closed else pts)
+    s = _arc_lengths(pts)
     _check_doubling_back(
         np.vstack([pts, pts[:2]]) if closed else pts,
         _arc_lengths(np.vstack([pts, pts[:2]])) if closed else s,
@@ -654,15 +661,27 @@ def fit_points(
     )
     report(1, _STEPS)
     h = _window(s, tol)
-    kappa = curvature_estimate(pts, s[: len(pts)], h)
+    n = len(pts)
+    if closed:
+        # Round a closed trace the estimate wraps, and the runs start where the curvature changes
+        # most (inside a transition), so that no line or arc is cut in two by the array's ends.
+        pad = min(n, int(np.searchsorted(s, 3.0 * h)) + 2)
+        ring = np.vstack([pts[-pad:], pts, pts[:pad]])
+        kappa = curvature_estimate(ring, _arc_lengths(ring), h)[pad : pad + n]
+        change = np.abs(np.roll(kappa, -1) - np.roll(kappa, 1))
+        shift = int(np.argmax(change)) if float(change.max()) > 0.0 else 0
+    else:
+        kappa = curvature_estimate(pts, s, h)
+        shift = 0
+    work, work_kappa = np.roll(pts, -shift, axis=0), np.roll(kappa, -shift)
     report(2, _STEPS)
     sigma = _noise(pts)
     tau = min(max(tol / 8.0, 6.0 * sigma), tol / 2.0)
     chain = None
     try:
-        prims = _segment(pts, s[: len(pts)], kappa, h, tau, kmax, bool(closed))
+        prims = _segment(work, _arc_lengths(work), work_kappa, h, tau, kmax, bool(closed))
         report(3, _STEPS)
-        chain = _assemble(prims, pts, tol, shape, units, bool(closed))
+        chain = _assemble(prims, work, tol, shape, units, bool(closed))
     except (ValueError, _Unfit):
         chain = None
     report(4, _STEPS)
@@ -709,7 +728,11 @@ def _segment(pts: NDArray[np.float64], s: NDArray[np.float64], kappa: NDArray[np
             run.split = run.b - 1
         elif kappa[run.a] * kappa[run.b - 1] < 0:
             # Between corners that turn opposite ways: the inflection, where both pairs may meet.
-            run.split = run.a + int(np.argmin(np.abs(kappa[run.a : run.b])))
+            # The zero of the estimate's straight-line trend over the run (robust to its noise).
+            index = np.arange(run.a, run.b, dtype=float)
+            slope, offset = np.polyfit(index, kappa[run.a : run.b], 1)
+            zero = -offset / slope if slope != 0.0 else 0.5 * (run.a + run.b - 1)
+            run.split = int(np.clip(round(zero), run.a, run.b - 1))
     return runs
 
 
