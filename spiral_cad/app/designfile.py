@@ -55,7 +55,7 @@ from .schema import (
 )
 from .schema import Profile as ProfileDesign
 
-__all__ = ["MAX_PIS", "MAX_PVIS", "NAME", "Built", "BuiltFit", "DesignError", "build", "load", "write"]
+__all__ = ["MAX_PIS", "MAX_PVIS", "NAME", "Built", "BuiltFit", "BuiltRoadFit", "DesignError", "FitResiduals", "build", "load", "write"]
 
 #: JSON integers longer than this are refused (they cannot be lengths in float64 anyway).
 MAX_DIGITS = 308
@@ -127,12 +127,36 @@ class BuiltRounded(Built):
         return "rounded_polyline"
 
 
-@dataclass(kw_only=True)
-class BuiltFit(Built):
-    """A path fitted to points (``source``: the ``PointFit``): ``points`` as given (N, 2) or (N, 3) in the
-    design's units, with its optional samples; NAME_residuals.csv and NAME_fit.png report the fit."""
+@dataclass(frozen=True)
+class FitResiduals:
+    """Every fitted point's station on the path and its distance to it: NAME_residuals.csv and NAME_fit.png.
+
+    ``vertical`` (a 3-D survey): each point's |z − profile elevation|; ``estimate``: the
+    point-wise curvature the fit segmented (None when the fit does not give it).
+    """
 
     points: Any
+    stations: Any
+    residuals: Any
+    tolerance: float
+    units: str
+    estimate: Any = None
+    vertical: Any = None
+
+    def line(self) -> str:
+        """The fit in one line: how many points, the worst residual and the tolerance."""
+        text = (f"{len(self.points):,} points within {float(np.max(self.residuals)):.3g} {self.units} of the path "
+                f"(tolerance {self.tolerance:g} {self.units})")  # fmt: skip
+        if self.vertical is not None:
+            text += f", within {float(np.max(self.vertical)):.3g} {self.units} of the profile"
+        return text
+
+
+@dataclass(kw_only=True)
+class BuiltFit(Built):
+    """A path fitted to points (``source``: the ``PointFit``), its ``fit`` residuals and optional samples."""
+
+    fit: FitResiduals
     closed: bool = False
     samples: dict[str, float] | None = None
 
@@ -140,11 +164,16 @@ class BuiltFit(Built):
     def kind(self) -> str:
         return "fit (closed)" if self.closed else "fit"
 
-    def fit_line(self) -> str:
-        """The fit in one line: how many points, the worst residual and the tolerance."""
-        fit = self.source
-        return (f"{len(self.points):,} points within {fit.max_residual:.3g} {fit.units} of the path "
-                f"(tolerance {fit.tolerance:g} {fit.units}), {fit.pieces} pieces")  # fmt: skip
+
+@dataclass(kw_only=True)
+class BuiltRoadFit(BuiltAlignment):
+    """A road fitted to points (``source``: the ``Alignment``; with z also its profile), its ``fit`` residuals."""
+
+    fit: FitResiduals
+
+    @property
+    def kind(self) -> str:
+        return "fit (alignment)" if self.profile is None else "fit (alignment + profile)"
 
 
 @dataclass(kw_only=True)
@@ -336,7 +365,7 @@ def _rounded(d: RoundedPolylineDesign, where: str, units: str, base: Path | None
     return BuiltRounded(name=d.name, chain=result.chain, source=result, samples=samples)
 
 
-def _fit(d: FitDesign, where: str, units: str, base: Path | None) -> BuiltFit:
+def _fit(d: FitDesign, where: str, units: str, base: Path | None) -> Built:
     table = None
     if d.points is not None:
         points = np.asarray(d.points, dtype=np.float64)
@@ -346,12 +375,11 @@ def _fit(d: FitDesign, where: str, units: str, base: Path | None) -> BuiltFit:
         path = _own_file(d.points_file or "", base, f"{where}.points_file")
         table = read_points(path, units=d.points_units or units).in_units(units)
         points = table.points
-    if d.design_speed is not None:
-        raise DesignError(f"{where}.design_speed: the road fit (Alignment.fit) is not available yet; leave design_speed out")
-    if points.shape[1] == 3:
-        raise DesignError(f"{where}: points with z (a 3-D survey) need the profile fit, which is not available yet; "
-                          "give x, y only")  # fmt: skip
-    from .. import fit_points
+    road = d.design_speed is not None or points.shape[1] == 3
+    if road and d.closed:
+        raise DesignError(f"{where}.closed: a road (design_speed or points with z) is open; leave closed out")
+    if road and d.max_curvature is not None:
+        raise DesignError(f"{where}.max_curvature: a road's curves are judged by design_speed; leave max_curvature out")
     from ..io.progress import Progress
 
     meter = Progress(f"{where}: fitting {len(points):,} points, steps")
@@ -361,8 +389,7 @@ def _fit(d: FitDesign, where: str, units: str, base: Path | None) -> BuiltFit:
         meter(done)
 
     try:
-        fit = fit_points(points, d.tolerance, closed=d.closed, shape=d.spiral_shape, units=units, max_curvature=d.max_curvature,
-                         progress=progress)  # fmt: skip
+        built = _fit_road(d, points, units, progress) if road else _fit_path(d, points, units, progress)
     except ValueError as e:
         if table is None:
             raise
@@ -372,8 +399,42 @@ def _fit(d: FitDesign, where: str, units: str, base: Path | None) -> BuiltFit:
                        if int(m[1]) < len(lines) else m[0], str(e))  # fmt: skip
         raise DesignError(f"{where}: {shown}") from None
     meter.done(meter.total or 0)
+    return built
+
+
+def _fit_path(d: FitDesign, points: Any, units: str, progress: Callable[[int, int], None]) -> BuiltFit:
+    from .. import fit_points
+
+    fit = fit_points(points, d.tolerance, closed=d.closed, shape=d.spiral_shape, units=units, max_curvature=d.max_curvature,
+                     progress=progress)  # fmt: skip
+    residuals = FitResiduals(points, fit.stations, fit.residuals, fit.tolerance, units, fit.curvature_estimate)
     samples = None if d.samples is None else d.samples.options()
-    return BuiltFit(name=d.name, chain=fit.chain, source=fit, points=points, closed=d.closed, samples=samples)
+    return BuiltFit(name=d.name, chain=fit.chain, source=fit, fit=residuals, closed=d.closed, samples=samples)
+
+
+def _fit_road(d: FitDesign, points: Any, units: str, progress: Callable[[int, int], None]) -> BuiltRoadFit:
+    """A road alignment (``Alignment.fit``), with z plan and profile (``fit_survey``)."""
+    from ..core.fit import chain_distances
+    from ..design import Alignment
+    from ..design.survey import fit_survey
+    from ..io.opendrive import CrossSection
+
+    if d.samples is not None:
+        raise DesignError("samples: a road writes its stationing, OpenDRIVE and profile; leave samples out")
+    if points.shape[1] == 3:
+        survey = fit_survey(points, d.tolerance, d.vertical_tolerance, d.design_speed, units=units, shape=d.spiral_shape,
+                            progress=progress)  # fmt: skip
+        alignment, profile = survey.alignment, survey.profile
+        residuals = FitResiduals(points, survey.stations - alignment.start_station, survey.plan_residuals, d.tolerance, units,
+                                 vertical=survey.vertical_residuals)  # fmt: skip
+    else:
+        if d.vertical_tolerance is not None:
+            raise DesignError("vertical_tolerance: the points have no z (no profile to fit)")
+        alignment, profile = Alignment.fit(points, d.tolerance, d.design_speed, units=units, shape=d.spiral_shape, progress=progress), None
+        distance, stations = chain_distances(alignment.chain, points)
+        residuals = FitResiduals(points, stations, distance, d.tolerance, units)
+    return BuiltRoadFit(name=d.name, chain=alignment.chain, source=alignment, cross_section=CrossSection(), profile=profile,
+                        fit=residuals)  # fmt: skip
 
 
 def _own_file(given: str, base: Path | None, where: str) -> Path:
@@ -577,24 +638,23 @@ def _write_others(b: Built, stage: Path, units: str, missing: list[str], plots: 
 
         export_iges(b.chain, stage / f"{b.name}.igs", name=b.name)
         names.append("igs")
-    if isinstance(b, BuiltFit):
-        names += _fit_report(b, stage, units, plots and "matplotlib" not in missing)
+    if isinstance(b, BuiltFit | BuiltRoadFit):
+        names += _fit_report(b, b.fit, stage, plots and "matplotlib" not in missing)
     if plots and "matplotlib" not in missing:
         names += _plots(b, stage)
     return names
 
 
-def _fit_report(b: BuiltFit, stage: Path, units: str, plot: bool) -> list[str]:
+def _fit_report(b: Built, fit: FitResiduals, stage: Path, plot: bool) -> list[str]:
     """NAME_residuals.csv (every point's station and distance to the path) and the plot NAME_fit.png."""
-    fit = b.source
     from .fitreport import write_residuals
 
-    write_residuals(stage / f"{b.name}_residuals.csv", b.points, fit.stations, fit.residuals, units)
+    write_residuals(stage / f"{b.name}_residuals.csv", fit.points, fit.stations, fit.residuals, fit.units, vertical=fit.vertical)
     if not plot:
         return ["residuals.csv"]
     from .fitreport import plot_fit
 
-    figure = plot_fit(b.chain, fit.stations, fit.residuals, fit.tolerance, fit.curvature_estimate)
+    figure = plot_fit(b.chain, fit.stations, fit.residuals, fit.tolerance, fit.estimate)
     figure.suptitle(f"{b.name} — {b.kind}")
     figure.savefig(stage / f"{b.name}_fit.png", dpi=110)
     return ["residuals.csv", "fit.png"]
@@ -678,5 +738,5 @@ def summary(built: list[Built], units: str) -> str:
         rows.append((b.name, b.kind, "+".join(shapes), len(b.chain), b.chain.length, peak, f" {b.continuity or '-'}"))
     lines = fixed_columns(columns, rows)
     lines += [f"{b.name}: {b.road_3d}" for b in built if b.road_3d]
-    lines += [f"{b.name}: {b.fit_line()}" for b in built if isinstance(b, BuiltFit)]
+    lines += [f"{b.name}: {b.fit.line()}" for b in built if isinstance(b, BuiltFit | BuiltRoadFit)]
     return "\n".join(lines)

@@ -27,8 +27,11 @@ __all__ = ["RESIDUAL_COLUMNS", "plot_fit", "shown_points", "write_residuals"]
 RESIDUAL_COLUMNS = (("index", ""), ("x", "L"), ("y", "L"), ("station", "L"), ("residual", "L"))
 
 
-def write_residuals(path: str | Path, points: ArrayLike, stations: ArrayLike, residuals: ArrayLike, units: str) -> Path:
-    """Write one row per point (index, x, y, station, residual; full precision, units in the headers) to ``path``.
+def write_residuals(
+    path: str | Path, points: ArrayLike, stations: ArrayLike, residuals: ArrayLike, units: str, vertical: ArrayLike | None = None
+) -> Path:
+    """Write one row per point (index, x, y, station, residual; full precision, units in the headers) to ``path``;
+    with ``vertical`` (a 3-D survey) also z and the vertical residual.
 
     Args:
         path: the CSV file.
@@ -36,6 +39,7 @@ def write_residuals(path: str | Path, points: ArrayLike, stations: ArrayLike, re
         stations: the arc length of each point's nearest point on the path (N,).
         residuals: each point's distance to the path (N,).
         units: the unit of every length.
+        vertical: each point's |z − profile elevation| (N,), or None.
 
     Raises:
         ValueError: the arrays do not hold one row per point.
@@ -44,8 +48,10 @@ def write_residuals(path: str | Path, points: ArrayLike, stations: ArrayLike, re
     s, r = np.asarray(stations, dtype=np.float64), np.asarray(residuals, dtype=np.float64)
     if xy.ndim != 2 or xy.shape[1] < 2 or s.shape != (len(xy),) or r.shape != (len(xy),):
         raise ValueError(f"points {xy.shape}, stations {s.shape} and residuals {r.shape} must hold one row per point")
-    head = ",".join(f"{name} [{dim.replace('L', units)}]" if dim else name for name, dim in RESIDUAL_COLUMNS)
-    table = np.column_stack([xy[:, 0], xy[:, 1], s, r]) + 0.0  # + 0.0: no -0.0
+    names = RESIDUAL_COLUMNS + ((("z", "L"), ("vertical_residual", "L")) if vertical is not None else ())
+    head = ",".join(f"{name} [{dim.replace('L', units)}]" if dim else name for name, dim in names)
+    extra = [] if vertical is None else [xy[:, 2], np.asarray(vertical, dtype=np.float64)]
+    table = np.column_stack([xy[:, 0], xy[:, 1], s, r, *extra]) + 0.0  # + 0.0: no -0.0
     columns = [map(repr, column) for column in table.T.tolist()]  # repr: the shortest text that reads back exactly
     body = "\n".join(map(",".join, zip(map(str, range(len(table))), *columns)))
     path = Path(path)

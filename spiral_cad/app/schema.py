@@ -441,7 +441,8 @@ def _points_file(value: Any) -> str:
 class FitDesign(_Model):
     """Lines, arcs and spirals fitted G2 to measured or digitised points, every point within a tolerance
     (``spiral_cad.fit_points``); NAME_residuals.csv and NAME_fit.png report every point's distance. With a
-    design_speed the fit is a road alignment (``Alignment.fit``: also the stationing CSV and OpenDRIVE)."""
+    design_speed the fit is a road alignment (``Alignment.fit``: also the stationing CSV and OpenDRIVE); points
+    with z are a road's plan and profile (``fit_survey``: also the profile CSV and the road in 3-D)."""
 
     name: Name = Field(description="Names the output files (see alignment).")
     type: Literal["fit"]
@@ -464,6 +465,8 @@ class FitDesign(_Model):
     max_curvature: Positive | None = Field(None, description="A curvature bound for the fitted path (1/unit).")
     design_speed: Positive | None = Field(None, description="km/h (metric units) or mph (in, ft): fit a road alignment "
                                           "and report which curves meet the road criteria at this speed.")  # fmt: skip
+    vertical_tolerance: Positive | None = Field(None, description="Points with z (a 3-D survey, fitted as a road: plan "
+                                                "and profile): the largest |z − profile| (default: tolerance).")  # fmt: skip
     samples: Samples | None = Field(None, description="Optional samples for a machine.")
 
     @model_validator(mode="after")

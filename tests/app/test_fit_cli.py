@@ -102,15 +102,60 @@ def test_bad_options_are_named(tmp_path, capsys, options, message):
     assert capsys.readouterr().err.startswith(message)
 
 
+def test_a_road_fit_writes_the_road_files_and_judges_the_curves(tmp_path, capsys):
+    """--design-speed: the alignment through the points (Alignment.fit), its criteria, OpenDRIVE and residuals."""
+    points = traced()
+    path = write_csv(tmp_path / "road.csv", "x,y\n" + "\n".join(f"{x!r},{y!r}" for x, y in points.tolist()))
+    out = tmp_path / "out"
+    assert main(["build", "--from-points", str(path), "--tolerance", "0.1", "--units", "m", "--design-speed", "60",
+                 "--no-plots", "-o", str(out)]) == 0  # fmt: skip
+    printed = capsys.readouterr().out
+    assert "road: RoadCriteria, design speed 60 km/h" in printed and "fit (alignment)" in printed
+    names = {p.name for p in out.iterdir()}
+    assert {"road.xodr", "road_stations.csv", "road_criteria.csv", "road_residuals.csv", "road.step"} <= names
+    assert main(["check", str(out / "road.xodr"), "--require", "G2"]) == 0
+    _, table = read_table(out / "road_residuals.csv")
+    from spiral_cad.design import Alignment
+
+    chain = Alignment.fit(points, 0.1, 60, units="m").chain
+    measured, _ = distances(chain, points)
+    np.testing.assert_allclose(table[:, 4], measured, atol=1e-6)
+    assert measured.max() <= 0.1
+
+
+def test_a_3d_survey_is_plan_and_profile(tmp_path, capsys):
+    """x, y, z: the plan within the tolerance, the profile within the vertical tolerance, the road in 3-D."""
+    points = traced()
+    s = 5.0 * np.arange(len(points))
+    z = 100.0 + 0.04 * s - 2.5e-5 * s**2  # a crest over the whole road
+    rows = "\n".join(f"{x!r} {y!r} {h!r}" for x, y, h in np.column_stack([points, z]).tolist())
+    write_csv(tmp_path / "survey.xyz", f"# units: m\neasting northing elevation\n{rows}\n")
+    design = {"units": "m", "designs": [{"name": "s3", "type": "fit", "points_file": "survey.xyz", "tolerance": 0.1,
+                                         "vertical_tolerance": 0.02}]}  # fmt: skip
+    (tmp_path / "fit.json").write_text(json.dumps(design))
+    out = tmp_path / "out"
+    assert main(["build", str(tmp_path / "fit.json"), "--no-plots", "-o", str(out)]) == 0
+    assert "fit (alignment + profile)" in capsys.readouterr().out
+    assert {"s3_profile.csv", "s3_3d.step", "s3.xodr"} <= {p.name for p in out.iterdir()}
+    header, table = read_table(out / "s3_residuals.csv")
+    assert header[-2:] == ["z [m]", "vertical_residual [m]"]
+    np.testing.assert_array_equal(table[:, 5], z)
+    assert np.abs(table[:, 4]).max() <= 0.1 and table[:, 6].max() <= 0.02
+    _, (built,) = build(tmp_path / "fit.json")
+    elevation = built.profile.elevation(np.clip(table[:, 3] + built.source.start_station, *built.profile.pvis[[0, -1], 0]))
+    np.testing.assert_allclose(np.abs(elevation - z), table[:, 6], atol=1e-9)
+
+
 @pytest.mark.parametrize(
-    "text, options, message",
+    "options, message",
     [
-        ("x,y,z\n0,0,1\n1,0,1\n2,0,1\n", [], "points with z (a 3-D survey) need the profile fit"),
-        ("0,0\n1,0\n2,0\n", ["--design-speed", "80"], ".design_speed: the road fit (Alignment.fit) is not available yet"),
+        (["--design-speed", "60", "--closed"], ".closed: a road (design_speed or points with z) is open"),
+        (["--design-speed", "60", "--max-curvature", "0.1"], ".max_curvature: a road's curves are judged by design_speed"),
+        (["--design-speed", "60", "--sample-step", "1"], "samples: a road writes its stationing"),
     ],
 )
-def test_what_is_not_built_yet_is_refused_by_name(tmp_path, capsys, text, options, message):
-    path = write_csv(tmp_path / "trace.csv", text)
+def test_road_fits_refuse_what_a_road_does_not_take(tmp_path, capsys, options, message):
+    path = write_csv(tmp_path / "trace.csv", "0,0\n1,0\n2,0\n")
     assert main(["build", "--from-points", str(path), "--tolerance", "0.1", *options, "-o", str(tmp_path / "out")]) == 2
     assert message in capsys.readouterr().err
 
