@@ -442,7 +442,7 @@ def _parser() -> argparse.ArgumentParser:
     fit.add_argument(
         "--design-speed",
         type=float,
-        help="fit a road alignment and judge its curves at this speed (km/h; mph in ft); refused by name until the road fit (Alignment.fit) exists",
+        help="fit a road alignment and judge its curves at this speed (km/h; mph in ft); a file with z is a road anyway (plan and profile)",
     )
     build.set_defaults(run=_build)
     _add_check(sub)

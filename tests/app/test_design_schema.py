@@ -205,6 +205,7 @@ FIT = {"name": "survey", "type": "fit", "points": [[0, 0], [1, 0.1], [2, 0.4]], 
         ({"points_units": "m"}, "designs[0] (survey): points_units states the unit of a points_file"),
         ({"points": None, "points_file": ""}, "designs[0] (survey).points_file: must be the path of a points file"),
         ({"design_speed": -80}, "designs[0] (survey).design_speed: must be positive; got -80"),
+        ({"vertical_tolerance": 0}, "designs[0] (survey).vertical_tolerance: must be positive; got 0"),
         ({"smoothing": 1}, "designs[0] (survey): unknown field(s) smoothing"),
     ],
 )
