@@ -210,7 +210,7 @@ def fitted(tmp_path_factory):
 def test_the_fit_design_builds_typed():
     units, (built,) = build(EXAMPLES / "fit.json")
     assert units == "m" and isinstance(built, BuiltFit) and built.kind == "fit"
-    assert built.points.shape == (318, 2) and built.source.max_residual <= TOLERANCE
+    assert built.fit.points.shape == (318, 2) and built.source.max_residual <= TOLERANCE
     # the noise-free road has five pieces: the 2 mm noise adds none
     assert len(built.chain) == 5, [type(seg).__name__ for seg in built.chain]
 
@@ -258,9 +258,9 @@ def test_points_files_convert_to_the_design_units(tmp_path):
     path = tmp_path / "fit.json"
     path.write_text(json.dumps(design))
     _, (built,) = build(path)
-    np.testing.assert_allclose(built.points, traced(), rtol=1e-15)
+    np.testing.assert_allclose(built.fit.points, traced(), rtol=1e-15)
     assert built.chain.units == "m" and built.source.max_residual <= 0.1
-    assert abs(built.chain.length - 5.0 * (len(built.points) - 1)) < 0.5  # from the first point to the last
+    assert abs(built.chain.length - 5.0 * (len(built.fit.points) - 1)) < 0.5  # from the first point to the last
 
 
 # ------------------------------------------------------------------ the report from arrays
