@@ -654,7 +654,7 @@ def _fit_report(b: Built, fit: FitResiduals, stage: Path, plot: bool) -> list[st
         return ["residuals.csv"]
     from .fitreport import plot_fit
 
-    figure = plot_fit(b.chain, fit.stations, fit.residuals, fit.tolerance, fit.estimate)
+    figure = plot_fit(b.chain, fit.stations, fit.residuals, fit.tolerance, fit.estimate, vertical=fit.vertical)
     figure.suptitle(f"{b.name} — {b.kind}")
     figure.savefig(stage / f"{b.name}_fit.png", dpi=110)
     return ["residuals.csv", "fit.png"]

@@ -78,6 +78,7 @@ def plot_fit(
     tolerance: float,
     estimate: ArrayLike | None = None,
     ax: tuple[Axes, Axes] | None = None,
+    vertical: ArrayLike | None = None,
 ) -> Figure:
     """The fit's report plot: residuals and curvature against arc length.
 
@@ -94,6 +95,8 @@ def plot_fit(
         tolerance: the fit's tolerance.
         estimate: the curvature estimated at each point (N,), or None.
         ax: a pair of axes (residuals, curvature), or None for a new figure.
+        vertical: each point's |z − profile| (N,) of a 3-D survey, drawn beside the plan residuals
+            (scatter gid ``vertical``), or None.
     """
     s, r = np.asarray(stations, dtype=np.float64), np.asarray(residuals, dtype=np.float64)
     if ax is None:
@@ -106,6 +109,9 @@ def plot_fit(
     units = chain.units
     top.axhspan(-tolerance, tolerance, color="tab:green", alpha=0.12, lw=0, gid="tolerance", label=f"±{tolerance:g} {units}")
     top.scatter(s[shown], r[shown], s=4, color="tab:blue", gid="residuals", label=f"{len(r):,} points", rasterized=True)
+    if vertical is not None:
+        v = np.asarray(vertical, dtype=np.float64)
+        top.scatter(s[shown], v[shown], s=4, color="tab:orange", gid="vertical", label="vertical (z − profile)", rasterized=True)
     worst = int(np.argmax(np.abs(r))) if len(r) else 0
     top.set_ylabel(f"residual ({units})")
     top.set_title(f"Residuals: worst {abs(r[worst]) if len(r) else 0.0:.3g} {units} of {tolerance:g} {units}")

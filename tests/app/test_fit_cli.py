@@ -301,6 +301,9 @@ def test_the_fit_plot_draws_residuals_band_and_both_curvatures():
     lines = [c for c in bottom.collections if (c.get_gid() or "").startswith("curvature-")]
     assert {c.get_gid() for c in lines} == {"curvature-Line", "curvature-Arc", "curvature-BezierSpiral"}
     assert behind.get_zorder() < min(c.get_zorder() for c in lines)
+    assert not [c for c in top.collections if c.get_gid() == "vertical"]
+    (vertical,) = [c for c in plot_fit(chain, s, r, TOLERANCE, vertical=r * 0.5).axes[0].collections if c.get_gid() == "vertical"]
+    np.testing.assert_allclose(vertical.get_offsets(), np.column_stack([s, r * 0.5]))
 
 
 def test_a_closed_fit_in_a_design_file_closes(tmp_path):
