@@ -68,6 +68,7 @@ def main() -> None:
         run("examples/build123d_road.py", str(tmp / "road"))
         run("examples/cadquery_plugin.py", str(tmp / "cq" / "tube.step"))
         run("examples/continuous_corners.py", str(tmp / "corners"))
+        run("examples/fit_points.py", str(tmp / "fit"))
         picks = {
             "demo/highway_plan.png": "highway_plan.png",
             "demo/highway_curvature.png": "highway_curvature.png",
@@ -78,6 +79,7 @@ def main() -> None:
             "robot3d/robot_path_3d.png": "robot_path_3d.png",
             "road/road.svg": "road.svg",
             "corners/continuous_corners.png": "continuous_corners.png",
+            "fit/survey_fit.png": "fit_survey.png",
         }
         for source, target in picks.items():
             shutil.copy(tmp / source, IMAGES / target)

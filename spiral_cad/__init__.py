@@ -10,6 +10,7 @@ build123d objects in ``spiral_cad.build123d`` and the CadQuery plugin in
 from .core import batch
 from .core.chain import Chain
 from .core.errors import NoSolutionError, Status
+from .core.fit import PointFit, fit_points
 from .core.segments import Arc, Circle, Join, Line, Segment
 from .core.space import PlaneFrame
 from .core.spiral import BezierSpiral
@@ -24,12 +25,14 @@ __all__ = [
     "Line",
     "NoSolutionError",
     "PlaneFrame",
+    "PointFit",
     "Segment",
     "Status",
     "Transition",
     "batch",
     "circle_in_circle",
     "circle_to_circle",
+    "fit_points",
     "line_to_circle",
     "line_to_line",
 ]

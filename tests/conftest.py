@@ -66,6 +66,7 @@ def outcome():
 #: module or by ``module::test`` name.
 SLOW = {
     "test_install.py",
+    "test_fit.py",
     "test_fuzz_readers.py",
     "test_examples.py",
     "test_benchmarks.py",
@@ -98,6 +99,8 @@ SLOW = {
     "test_landxml_build.py::test_build_of_a_landxml_file_writes_every_output",
     "test_faces.py::test_freecad_evaluates_the_same_normals_and_normal_curvatures",
     "test_faces_cli.py::test_zebra_and_curvature_pictures_are_written_and_tell_g1_from_g2",
+    "test_fit_cli.py",
+    "test_points.py::test_a_million_rows_read_as_numpy_wrote_them",
 }
 _CAD = re.compile(r"^\s*(?:from|import) (?:build123d|cadquery|OCP)\b|importorskip\([\"'](?:build123d|cadquery|OCP)", re.M)
 _SUBPROCESS = re.compile(r"\bsubprocess\b|sys\.executable")

@@ -147,7 +147,18 @@ GCODE_OPTIONS = (
 )
 
 
+#: ``build`` options of ``--from-points`` only.
+POINTS_OPTIONS = ("tolerance", "closed", "design_speed")
+#: ``build`` options of ``--from-gcode`` only (the others it shares with ``--from-points``).
+GCODE_ONLY = ("max_deviation", "interpreter", "arc_tolerance")
+
+
 def _build(args: argparse.Namespace) -> int:
+    if args.from_points is not None:
+        return _write_design(points_design(args), Path(args.out), plots=not args.no_plots)
+    only = [f"--{o.replace('_', '-')}" for o in POINTS_OPTIONS if getattr(args, o) not in (None, False)]
+    if only:
+        raise ValueError(f"{', '.join(only)}: only with --from-points")
     if args.from_gcode is None:
         given = [f"--{o.replace('_', '-')}" for o in GCODE_OPTIONS if getattr(args, o) is not None]
         if args.design is None:
@@ -183,6 +194,35 @@ def gcode_design(args: argparse.Namespace) -> dict:
     else:
         default = (args.max_deviation / 10.0 or args.max_deviation) if args.max_deviation is not None else 0.001
         design["samples"] = {"chord_tolerance": args.chord_tolerance if args.chord_tolerance is not None else default}
+    return {"units": args.units or "mm", "designs": [design]}
+
+
+def points_design(args: argparse.Namespace) -> dict:
+    """The design of ``build --from-points``: one ``fit`` design of the file's points, the path within
+    ``--tolerance`` of every point (a road alignment with ``--design-speed``)."""
+    if args.design is not None or args.from_gcode is not None:
+        raise ValueError("give --from-points, a design file or --from-gcode, one of them")
+    given = [f"--{o.replace('_', '-')}" for o in GCODE_ONLY if getattr(args, o) is not None]
+    if given:
+        raise ValueError(f"{', '.join(given)}: only with --from-gcode")
+    if args.tolerance is None:
+        raise ValueError("--from-points needs --tolerance (the largest distance from any point to the fitted path)")
+    if args.sample_step is not None and args.chord_tolerance is not None:
+        raise ValueError("give --sample-step or --chord-tolerance, not both")
+    for key in ("tolerance", "max_curvature", "design_speed", "sample_step", "chord_tolerance"):
+        value = getattr(args, key)
+        if value is not None and not 0.0 < value < math.inf:
+            raise ValueError(f"--{key.replace('_', '-')} must be a positive finite number; got {value}")
+    if args.shape == "g2cbs":
+        raise ValueError("--shape g2cbs rounds corners; a fit's spirals are near-linear or walton-meek")
+    stem = re.sub(r"[^A-Za-z0-9_-]", "_", Path(args.from_points).stem).lstrip("_-")[:64] or "points"
+    design = {"name": args.name or stem, "type": "fit", "points_file": args.from_points, "tolerance": args.tolerance,
+              "closed": args.closed, "spiral_shape": args.shape or "near-linear"}  # fmt: skip
+    for key in ("max_curvature", "design_speed"):
+        if getattr(args, key) is not None:
+            design[key] = getattr(args, key)
+    if args.sample_step is not None or args.chord_tolerance is not None:
+        design["samples"] = {"step": args.sample_step} if args.sample_step is not None else {"chord_tolerance": args.chord_tolerance}
     return {"units": args.units or "mm", "designs": [design]}
 
 
@@ -379,6 +419,7 @@ def _parser() -> argparse.ArgumentParser:
             "  spiral-cad demo --out out                  the built-in design: STEP, IGES, DXF, SVG, plots, CSV\n"
             "  spiral-cad build examples/design.json      your own design file (spiral-cad schema prints the format)\n"
             "  spiral-cad build --from-gcode part.nc --max-deviation 0.01   a CNC program rounded G2: STEP and samples\n"
+            "  spiral-cad build --from-points survey.csv --tolerance 0.05 --units m   lines, arcs and spirals within 5 cm\n"
             "  spiral-cad check out/highway.step --require G2   G0/G1/G2 at every joint; exit 1 below G2\n"
             "  spiral-cad check out/highway.xodr --require G2 --profiles C1 --links G1   every road, profile and link of an OpenDRIVE map"
         ),
@@ -397,8 +438,8 @@ def _parser() -> argparse.ArgumentParser:
         help="build a JSON design file and write STEP, IGES, DXF, SVG, plots, tables and a continuity report",
         description="Build a JSON design file (spiral-cad schema prints its JSON Schema, the format's reference) or a G-code program.",
     )
-    build.add_argument("design", nargs="?", help="the design file (.json), or a LandXML file (.xml: every alignment); or --from-gcode")
-    build.add_argument("--out", default="out", help="output folder (default: out)")
+    build.add_argument("design", nargs="?", help="the design file (.json), or a LandXML file (.xml: every alignment); or --from-gcode or --from-points")
+    build.add_argument("-o", "--out", default="out", help="output folder (default: out)")
     build.add_argument("--no-plots", action="store_true", help="skip the PNG plots (the slowest output for long chains)")
     gcode = build.add_argument_group(
         "G-code", "round the straight moves (G0/G1) of a CNC program G2 and write STEP, IGES, DXF, samples, the\n"
@@ -423,6 +464,20 @@ def _parser() -> argparse.ArgumentParser:
     )
     gcode.add_argument(
         "--arc-tolerance", type=float, help="read arcs G2/G3 as chords at most this far from the arc (default: arcs refused)"
+    )
+    fit = build.add_argument_group(
+        "points", "fit lines, arcs and spirals G2 to measured or digitised points, every point within --tolerance; also\n"
+        "writes NAME_residuals.csv and NAME_fit.png (--units, --name, --max-curvature, the samples as above; --shape\n"
+        "near-linear by default)")  # fmt: skip
+    fit.add_argument("--from-points", metavar="FILE.csv",
+                     help="columns x, y (CSV or whitespace; header optional; '# units: m' states the file's unit, "
+                          "else --units)")  # fmt: skip
+    fit.add_argument("--tolerance", type=float, help="the largest distance from any point to the fitted path")
+    fit.add_argument("--closed", action="store_true", help="the points go round a closed path (G2 at the closing joint)")
+    fit.add_argument(
+        "--design-speed",
+        type=float,
+        help="fit a road alignment and judge its curves at this speed (km/h; mph in ft); a file with z is a road anyway (plan and profile)",
     )
     build.set_defaults(run=_build)
     _add_check(sub)

@@ -21,6 +21,7 @@ import contextlib
 import json
 import math
 import os
+import re
 import stat
 import time
 from abc import ABC, abstractmethod
@@ -31,6 +32,8 @@ from functools import partial
 from importlib.util import find_spec
 from pathlib import Path, PurePosixPath, PureWindowsPath
 from typing import Any
+
+import numpy as np
 
 from ..core.chain import Chain
 from ..core.errors import NoSolutionError
@@ -46,12 +49,13 @@ from .schema import (
     AlignmentDesign,
     CircleChainDesign,
     DesignFile,
+    FitDesign,
     RoundedPolylineDesign,
     validate,
 )
 from .schema import Profile as ProfileDesign
 
-__all__ = ["MAX_PIS", "MAX_PVIS", "NAME", "Built", "DesignError", "build", "load", "write"]
+__all__ = ["MAX_PIS", "MAX_PVIS", "NAME", "Built", "BuiltFit", "BuiltRoadFit", "DesignError", "FitResiduals", "build", "load", "write"]
 
 #: JSON integers longer than this are refused (they cannot be lengths in float64 anyway).
 MAX_DIGITS = 308
@@ -122,6 +126,55 @@ class BuiltRounded(Built):
     @property
     def kind(self) -> str:
         return "rounded_polyline"
+
+
+@dataclass(frozen=True)
+class FitResiduals:
+    """Every fitted point's station on the path and its distance to it: NAME_residuals.csv and NAME_fit.png.
+
+    ``vertical`` (a 3-D survey): each point's |z − profile elevation|; ``estimate``: the
+    point-wise curvature the fit segmented (None when the fit does not give it).
+    """
+
+    points: Any
+    stations: Any
+    residuals: Any
+    tolerance: float
+    units: str
+    estimate: Any = None
+    vertical: Any = None
+
+    def line(self) -> str:
+        """The fit in one line: how many points, the worst residual and the tolerance."""
+        text = (f"{len(self.points):,} points within {float(np.max(self.residuals)):.3g} {self.units} of the path "
+                f"(tolerance {self.tolerance:g} {self.units})")  # fmt: skip
+        if self.vertical is not None:
+            text += f", within {float(np.max(self.vertical)):.3g} {self.units} of the profile"
+        return text
+
+
+@dataclass(kw_only=True)
+class BuiltFit(Built):
+    """A path fitted to points (``source``: the ``PointFit``), its ``fit`` residuals and optional samples."""
+
+    fit: FitResiduals
+    closed: bool = False
+    samples: dict[str, float] | None = None
+
+    @property
+    def kind(self) -> str:
+        return "fit (closed)" if self.closed else "fit"
+
+
+@dataclass(kw_only=True)
+class BuiltRoadFit(BuiltAlignment):
+    """A road fitted to points (``source``: the ``Alignment``; with z also its profile), its ``fit`` residuals."""
+
+    fit: FitResiduals
+
+    @property
+    def kind(self) -> str:
+        return "fit (alignment)" if self.profile is None else "fit (alignment + profile)"
 
 
 @dataclass(kw_only=True)
@@ -366,6 +419,78 @@ def _rounded(d: RoundedPolylineDesign, where: str, units: str, base: Path | None
     return BuiltRounded(name=d.name, chain=result.chain, source=result, samples=samples)
 
 
+def _fit(d: FitDesign, where: str, units: str, base: Path | None) -> Built:
+    table = None
+    if d.points is not None:
+        points = np.asarray(d.points, dtype=np.float64)
+    else:
+        from ..io.points import read_points
+
+        path = _own_file(d.points_file or "", base, f"{where}.points_file")
+        table = read_points(path, units=d.points_units or units).in_units(units)
+        points = table.points
+    road = d.design_speed is not None or points.shape[1] == 3
+    if road and d.closed:
+        raise DesignError(f"{where}.closed: a road (design_speed or points with z) is open; leave closed out")
+    if road and d.max_curvature is not None:
+        raise DesignError(f"{where}.max_curvature: a road's curves are judged by design_speed; leave max_curvature out")
+    from ..io.progress import Progress
+
+    meter = Progress(f"{where}: fitting {len(points):,} points, steps")
+
+    def progress(done: int, total: int) -> None:
+        meter.total = total
+        meter(done)
+
+    try:
+        built = _fit_road(d, points, units, progress) if road else _fit_path(d, points, units, progress)
+    except ValueError as e:
+        if table is None:
+            raise
+        # a point named by its index is also named by its line in the file
+        lines = table.lines
+        shown = re.sub(r"points\[(\d+)\]", lambda m: f"{m[0]} ({table.source} line {lines[int(m[1])]})"
+                       if int(m[1]) < len(lines) else m[0], str(e))  # fmt: skip
+        raise DesignError(f"{where}: {shown}") from None
+    meter.done(meter.total or 0)
+    return built
+
+
+def _fit_path(d: FitDesign, points: Any, units: str, progress: Callable[[int, int], None]) -> BuiltFit:
+    from .. import fit_points
+
+    fit = fit_points(points, d.tolerance, closed=d.closed, shape=d.spiral_shape, units=units, max_curvature=d.max_curvature,
+                     progress=progress)  # fmt: skip
+    residuals = FitResiduals(points, fit.stations, fit.residuals, fit.tolerance, units, fit.curvature_estimate)
+    samples = None if d.samples is None else d.samples.options()
+    return BuiltFit(name=d.name, chain=fit.chain, source=fit, fit=residuals, closed=d.closed, samples=samples)
+
+
+def _fit_road(d: FitDesign, points: Any, units: str, progress: Callable[[int, int], None]) -> BuiltRoadFit:
+    """A road alignment (``Alignment.fit``), with z plan and profile (``fit_survey``)."""
+    from ..core.fit import chain_distances
+    from ..design import Alignment
+    from ..design.survey import fit_survey
+    from ..io.opendrive import CrossSection
+
+    if d.samples is not None:
+        raise DesignError("samples: a road writes its stationing, OpenDRIVE and profile; leave samples out")
+    if points.shape[1] == 3:
+        survey = fit_survey(points, d.tolerance, d.vertical_tolerance, d.design_speed, units=units, shape=d.spiral_shape,
+                            progress=progress)  # fmt: skip
+        alignment, profile = survey.alignment, survey.profile
+        residuals = FitResiduals(points, survey.stations - alignment.start_station, survey.plan_residuals, d.tolerance, units,
+                                 vertical=survey.vertical_residuals)  # fmt: skip
+    else:
+        if d.vertical_tolerance is not None:
+            raise DesignError("vertical_tolerance: the points have no z (no profile to fit)")
+        alignment, profile = Alignment.fit(points, d.tolerance, d.design_speed, units=units, shape=d.spiral_shape, progress=progress), None
+        distance, stations = chain_distances(alignment.chain, points)
+        residuals = FitResiduals(points, stations, distance, d.tolerance, units)
+    return BuiltRoadFit(name=d.name, chain=alignment.chain, source=alignment, cross_section=CrossSection(), profile=profile,
+                        fit=residuals)  # fmt: skip
+
+
 def _own_file(given: str, base: Path | None, where: str) -> Path:
     """The file ``given`` by a design whose file is in ``base``: only a file in that folder (or below it).
 
@@ -404,6 +529,7 @@ BUILDERS: dict[str, Callable[[Any, str, str, Path | None], Built]] = {
     "circle_chain": _circle_chain,
     "rounded_polyline": _rounded,
     "transition": _transition,
+    "fit": _fit,
 }
 
 
@@ -549,7 +675,7 @@ def _write_others(b: Built, stage: Path, units: str, missing: list[str], plots: 
 
         write_gcode(b.chain, stage / f"{b.name}.ngc", name=b.name, **b.gcode)
         names.append("ngc")
-    if isinstance(b, BuiltRounded) and b.samples:
+    if isinstance(b, BuiltRounded | BuiltFit) and b.samples:
         from ..cad.export import export_samples
 
         export_samples(b.chain, stage / f"{b.name}_samples.csv", **b.samples)
@@ -583,9 +709,26 @@ def _write_others(b: Built, stage: Path, units: str, missing: list[str], plots: 
 
         export_iges(b.chain, stage / f"{b.name}.igs", name=b.name)
         names.append("igs")
+    if isinstance(b, BuiltFit | BuiltRoadFit):
+        names += _fit_report(b, b.fit, stage, plots and "matplotlib" not in missing)
     if plots and "matplotlib" not in missing:
         names += _plots(b, stage)
     return names
+
+
+def _fit_report(b: Built, fit: FitResiduals, stage: Path, plot: bool) -> list[str]:
+    """NAME_residuals.csv (every point's station and distance to the path) and the plot NAME_fit.png."""
+    from .fitreport import write_residuals
+
+    write_residuals(stage / f"{b.name}_residuals.csv", fit.points, fit.stations, fit.residuals, fit.units, vertical=fit.vertical)
+    if not plot:
+        return ["residuals.csv"]
+    from .fitreport import plot_fit
+
+    figure = plot_fit(b.chain, fit.stations, fit.residuals, fit.tolerance, fit.estimate, vertical=fit.vertical)
+    figure.suptitle(f"{b.name} — {b.kind}")
+    figure.savefig(stage / f"{b.name}_fit.png", dpi=110)
+    return ["residuals.csv", "fit.png"]
 
 
 def _road_3d(b: BuiltAlignment, profile: Any, stage: Path, units: str) -> list[str]:
@@ -666,4 +809,5 @@ def summary(built: list[Built], units: str) -> str:
         rows.append((b.name, b.kind, "+".join(shapes), len(b.chain), b.chain.length, peak, f" {b.continuity or '-'}"))
     lines = fixed_columns(columns, rows)
     lines += [f"{b.name}: {b.road_3d}" for b in built if b.road_3d]
+    lines += [f"{b.name}: {b.fit.line()}" for b in built if isinstance(b, BuiltFit | BuiltRoadFit)]
     return "\n".join(lines)

@@ -1,7 +1,7 @@
 """The design-file format as pydantic models: the one description of a design file.
 
 A design file is a JSON object with ``units`` and a list of ``designs``; each
-design is one of four kinds, told apart by its ``type`` (a discriminated
+design is one of five kinds, told apart by its ``type`` (a discriminated
 union), and a transition by its ``case``. The field descriptions below are
 the reference: ``spiral-cad schema`` prints the JSON Schema made from them and
 ``schema_markdown`` renders the reference page (docs/reference/design-files.md).
@@ -450,6 +450,52 @@ class RoundedPolylineDesign(_Model):
         return {k: getattr(self, k) for k in ROUNDING_KEYS if getattr(self, k) is not None}
 
 
+def _points_file(value: Any) -> str:
+    if not isinstance(value, str) or not value or "\0" in value:
+        raise _error(f"must be the path of a points file (.csv, .txt or .xyz); got {_shown(value)}")
+    return value
+
+
+class FitDesign(_Model):
+    """Lines, arcs and spirals fitted G2 to measured or digitised points, every point within a tolerance
+    (``spiral_cad.fit_points``); NAME_residuals.csv and NAME_fit.png report every point's distance. With a
+    design_speed the fit is a road alignment (``Alignment.fit``: also the stationing CSV and OpenDRIVE); points
+    with z are a road's plan and profile (``fit_survey``: also the profile CSV and the road in 3-D)."""
+
+    name: Name = Field(description="Names the output files (see alignment).")
+    type: Literal["fit"]
+    points: Annotated[
+        list[tuple[float, ...]],
+        PlainValidator(_points_in_space, json_schema_input_type=Annotated[
+            list[Annotated[list[float], Field(min_length=2, max_length=3)]], Field(min_length=3)]),
+    ] | None = Field(None, description="≥ 3 points in order, all [x, y] or all [x, y, z]. Give points or points_file.")  # fmt: skip
+    points_file: Annotated[str, PlainValidator(_points_file, json_schema_input_type=Annotated[str, Field(min_length=1)])] | None = Field(
+        None,
+        description="A points file in the design file's folder (a relative path without '..'): CSV or "
+        "whitespace-separated columns x, y[, z], header optional (x/easting, y/northing, z/elevation in any order), "
+        "# comments, '# units: m' or 'x [m]' stating its unit (converted to units).",
+    )  # fmt: skip
+    points_units: Units | None = Field(None, description="The unit of the points file's numbers when the file states none "
+                                       "(default: the design file's units).")  # fmt: skip
+    tolerance: Positive = Field(description="The largest distance from any point to the fitted path.")
+    closed: Flag = Field(False, description="true: the path closes G2 through the first point.")
+    spiral_shape: TransitionShape = Field("near-linear", description="near-linear, or walton-meek.")
+    max_curvature: Positive | None = Field(None, description="A curvature bound for the fitted path (1/unit).")
+    design_speed: Positive | None = Field(None, description="km/h (metric units) or mph (in, ft): fit a road alignment "
+                                          "and report which curves meet the road criteria at this speed.")  # fmt: skip
+    vertical_tolerance: Positive | None = Field(None, description="Points with z (a 3-D survey, fitted as a road: plan "
+                                                "and profile): the largest |z − profile| (default: tolerance).")  # fmt: skip
+    samples: Samples | None = Field(None, description="Optional samples for a machine.")
+
+    @model_validator(mode="after")
+    def _one_source(self) -> FitDesign:
+        if (self.points is None) == (self.points_file is None):
+            raise _error("give points or points_file (one of them)")
+        if self.points_units is not None and self.points_file is None:
+            raise _error("points_units states the unit of a points_file; inline points are in the file's units")
+        return self
+
+
 class _Transition(_Model):
     name: Name = Field(description="Names the output files (see alignment).")
     type: Literal["transition"]
@@ -505,8 +551,8 @@ class LineToLine(_Transition):
 
 
 TransitionDesign = Annotated[LineToCircle | CircleToCircle | LineToLine | CircleInCircle, Field(discriminator="case")]
-Design = Annotated[AlignmentDesign | CircleChainDesign | RoundedPolylineDesign | TransitionDesign, Field(discriminator="type")]
-TYPES = ("alignment", "circle_chain", "rounded_polyline", "transition")
+Design = Annotated[AlignmentDesign | CircleChainDesign | RoundedPolylineDesign | TransitionDesign | FitDesign, Field(discriminator="type")]
+TYPES = ("alignment", "circle_chain", "rounded_polyline", "transition", "fit")
 CASES = ("line_to_circle", "circle_to_circle", "line_to_line", "circle_in_circle")
 
 

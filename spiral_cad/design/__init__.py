@@ -22,6 +22,7 @@ from .rounding import (
     round_corners_batch,
 )
 from .superelevation import Superelevation
+from .survey import SurveyFit, fit_survey
 
 __all__ = [
     "Alignment",
@@ -41,6 +42,7 @@ __all__ = [
     "RoundedPath",
     "SpaceFillet",
     "Superelevation",
+    "SurveyFit",
     "VerticalCurve",
     "centerline_3d",
     "circle_chain",
@@ -48,6 +50,7 @@ __all__ = [
     "curvature_rate",
     "fillet_path",
     "fillet_polyline",
+    "fit_survey",
     "peak_curvature_rate",
     "round_corners",
     "round_corners_batch",

@@ -32,6 +32,7 @@ from ..core.spiral import BezierSpiral, turn_angles
 from ..core.transitions import Transition
 from ..core.units import COLLINEAR_TOL, DEFAULT_UNITS, length_unit, speed_unit
 from .criteria import CRITERIA_DIMENSIONS, Criteria, CriteriaRow, RailCriteria, RoadCriteria
+from .fitting import fit_alignment
 from .tables import text_table, write_csv
 
 #: |sin(deflection)| at or below this counts as a straight PI.
@@ -192,6 +193,43 @@ class Alignment:
     criteria: Criteria | None = None
     checks: tuple[CriteriaRow, ...] = ()
     shape: str = "near-linear"
+
+    @classmethod
+    def fit(
+        cls,
+        points: ArrayLike,
+        tolerance: float,
+        design_speed: float | None = None,
+        *,
+        units: str = DEFAULT_UNITS,
+        shape: str = "near-linear",
+        start_station: float = 0.0,
+        max_jerk: float | None = None,
+        criteria: Criteria | None = None,
+        progress: Any = None,
+    ) -> Alignment:
+        """The alignment through measured plan points: ``spiral_cad.fit_points`` read as curves.
+
+        The points (a survey or GPS trace of an existing road, a centre line from a map) are
+        fitted within ``tolerance`` by tangents, spirals and arcs; the PIs are where the fitted
+        tangents meet, each curve keeps its fitted radius and spiral angles, and the alignment is
+        built from them by ``from_pis`` (with ``design_speed``, its ``checks`` say which fitted
+        curves meet the road criteria) and measured against the points again.
+
+        Args:
+            points: (N, 2) plan points in travel order, in ``units``.
+            tolerance: the largest distance of any point to the alignment.
+            design_speed, max_jerk, criteria: as ``from_pis`` (judged, never enforced).
+            units, shape, start_station: as ``from_pis``.
+            progress: ``progress(done, total)`` (``fit_points``).
+
+        Raises:
+            ValueError: malformed points or tolerance (``fit_points``).
+            NoSolutionError: the points double back, the fit is not tangent–spiral–arc–spiral–tangent
+                at every curve (naming the segment), or the rebuilt alignment misses a point (naming it).
+        """
+        return fit_alignment(cls, points, tolerance, design_speed, units=units, shape=shape, start_station=start_station,
+                             max_jerk=max_jerk, criteria=criteria, progress=progress)  # fmt: skip
 
     @classmethod
     def from_pis(

@@ -51,6 +51,7 @@ from ..core.errors import NoSolutionError
 from ..core.piecewise import inside, piece_at, piecewise_at, polynomial
 from ..core.units import DEFAULT_UNITS, FOOT, IMPERIAL, length_unit, speed_unit, to_metres
 from .alignment import Alignment
+from .fitting import fit_profile
 from .tables import text_table, write_csv
 
 #: AASHTO Green Book, rural arterials: maximum grade (%) by design speed for level, rolling and mountainous terrain
@@ -259,6 +260,29 @@ class Profile:
     coefficients: NDArray
     criteria: ProfileCriteria | None = None
     checks: tuple[ProfileRow, ...] = ()
+
+    @classmethod
+    def fit(
+        cls, stations: ArrayLike, elevations: ArrayLike, tolerance: float, *, units: str = DEFAULT_UNITS, design_speed: float | None = None
+    ) -> Profile:
+        """The profile through measured (station, elevation) points: grades and parabolic vertical curves.
+
+        The PVIs are the corners of a polyline of grades within half the tolerance (Douglas–Peucker on
+        elevation, tighter if needed); each interior PVI gets the longest symmetric vertical curve
+        its tangents allow, shortened where a point would miss the tolerance.
+
+        Args:
+            stations: (N,) stations (any order; repeated stations are averaged).
+            elevations: (N,) elevations, in ``units``.
+            tolerance: the largest |elevation − profile| of any point.
+            units: the length unit.
+            design_speed: judges every curve and grade (``ProfileCriteria``); never enforced.
+
+        Raises:
+            ValueError: malformed input (lengths differ, non-finite values, fewer than 2 stations).
+            NoSolutionError: no profile within the tolerance was found.
+        """
+        return fit_profile(cls, stations, elevations, tolerance, units=units, design_speed=design_speed)
 
     @classmethod
     def from_pvis(

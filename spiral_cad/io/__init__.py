@@ -1,6 +1,6 @@
 """File formats that need no CAD kernel: STEP text, SVG, DXF (through ezdxf), samples CSV,
-G-code in and out, OpenDRIVE model, writer, reader and checker, LandXML out and in (``read_landxml``, loaded
-on first use), and all-or-nothing output staging.
+G-code in and out, point files in, OpenDRIVE model, writer, reader and checker, LandXML out and in
+(``read_landxml``, loaded on first use), and all-or-nothing output staging.
 
 IGES and the STEP of solids go through OCCT and live in ``spiral_cad.cad``.
 """

@@ -63,11 +63,11 @@ MALFORMED = [
     ({"units": "m", "designs": [{"name": "road", "type": "alignment"}]}, "designs[0] (road): missing field(s) pis, radii"),
     (
         {"units": "m", "designs": [{**ROAD, "type": "spline"}]},
-        "designs[0].type: must be one of alignment, circle_chain, rounded_polyline, transition; got 'spline'",
+        "designs[0].type: must be one of alignment, circle_chain, rounded_polyline, transition, fit; got 'spline'",
     ),
     (
         {"units": "m", "designs": [{"name": "road"}]},
-        "designs[0].type: required, one of alignment, circle_chain, rounded_polyline, transition",
+        "designs[0].type: required, one of alignment, circle_chain, rounded_polyline, transition, fit",
     ),
     ({"units": "m", "designs": [7]}, "designs[0]: must be an object; got 7"),
     (one(name="a b"), "designs[0].name: must be 1–64 characters of A–Z, a–z, 0–9, - and _ (starting with a letter or digit); got 'a b'"),
@@ -186,3 +186,44 @@ def test_the_choices_are_the_librarys():
 
     assert get_args(Units) == UNITS and get_args(Terrain) == TERRAINS
     assert get_args(TransitionShape) == TRANSITION_SHAPES and get_args(CornerShape) == CORNER_SHAPES
+
+
+FIT = {"name": "survey", "type": "fit", "points": [[0, 0], [1, 0.1], [2, 0.4]], "tolerance": 0.05}
+
+
+@pytest.mark.parametrize(
+    "edit, message",
+    [
+        ({"points": None}, "designs[0] (survey): give points or points_file (one of them)"),
+        ({"points_file": "survey.csv"}, "designs[0] (survey): give points or points_file (one of them)"),
+        ({"tolerance": 0}, "designs[0] (survey).tolerance: must be positive; got 0"),
+        ({"tolerance": None}, "designs[0] (survey): missing field(s) tolerance"),
+        ({"points": [[0, 0], [1, 1]]}, "designs[0] (survey).points: must be a list of at least 3 points"),
+        ({"points": [[0, 0], [1, 1], [2, 2, 2]]}, "designs[0] (survey).points[2]: must be a point like the first"),
+        ({"closed": "yes"}, "designs[0] (survey).closed: must be true or false; got 'yes'"),
+        ({"spiral_shape": "g2cbs"}, "designs[0] (survey).spiral_shape: must be one of walton-meek, near-linear; got 'g2cbs'"),
+        ({"points_units": "m"}, "designs[0] (survey): points_units states the unit of a points_file"),
+        ({"points": None, "points_file": ""}, "designs[0] (survey).points_file: must be the path of a points file"),
+        ({"design_speed": -80}, "designs[0] (survey).design_speed: must be positive; got -80"),
+        ({"vertical_tolerance": 0}, "designs[0] (survey).vertical_tolerance: must be positive; got 0"),
+        ({"smoothing": 1}, "designs[0] (survey): unknown field(s) smoothing"),
+    ],
+)
+def test_fit_designs_are_checked(edit, message):
+    design = {k: v for k, v in {**FIT, **edit}.items() if v is not None}  # None: the field left out
+    with pytest.raises(ValueError) as info:
+        validate({"units": "m", "designs": [design]})
+    assert str(info.value).startswith(message)
+
+
+def test_fit_models_are_typed():
+    inline, from_file = validate({"units": "m", "designs": [
+        {**FIT, "closed": True, "design_speed": 60, "samples": {"step": 1}},
+        {"name": "file", "type": "fit", "points_file": "trace.csv", "points_units": "ft", "tolerance": 0.1,
+         "spiral_shape": "walton-meek", "max_curvature": 0.01}]}).designs  # fmt: skip
+    assert inline.points == [(0.0, 0.0), (1.0, 0.1), (2.0, 0.4)] and inline.closed and inline.design_speed == 60.0
+    assert inline.spiral_shape == "near-linear" and inline.samples.options() == {"step": 1.0}
+    assert (from_file.points_file, from_file.points_units, from_file.tolerance) == ("trace.csv", "ft", 0.1)
+    assert from_file.closed is False and from_file.max_curvature == 0.01
+    page = schema_markdown()
+    assert "`fit`: [FitDesign](#fitdesign)" in page and "| `points_file` |" in page

@@ -15,6 +15,7 @@ OUTPUTS = {
     "fig6.py": ["fig6.png", "bezier_vs_clothoid.png"],
     "cadquery_plugin.py": ["cadquery_plugin.step"],
     "continuous_corners.py": ["slab.step", "continuous_corners.png"],
+    "fit_points.py": ["survey.csv", "survey.step", "survey_residuals.csv", "survey_fit.png"],
 }
 
 

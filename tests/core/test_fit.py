@@ -1,0 +1,230 @@
+"""fit_points: chains built by our own solvers, sampled (with and without noise) and fitted again,
+must come back within the tolerance with their own piece count, G2 by the chain's check and by an
+independent finite-difference re-evaluation of positions only; malformed input is refused by name."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from spiral_cad import Arc, Chain, Line, NoSolutionError, PointFit, fit_points, line_to_circle, line_to_line
+from spiral_cad.core.chain import g2_mismatch
+from spiral_cad.core.fit import chain_distances
+
+SHAPE = "near-linear"
+
+
+def curve_chain(radius: float = 50.0, shift: float = 2.0, turn: float = 0.6) -> Chain:
+    """Line → spiral → arc → spiral → line, made by line_to_circle both ways; the arc turns by ``turn``."""
+    center = np.array([100.0, radius + shift])
+    enter = line_to_circle((0, 0), (1, 0), tuple(center), radius, SHAPE)
+    turn += 2.0 * abs(enter.spirals[0].theta)  # the spirals' turn, then the arc's
+    out = np.array([math.cos(turn), math.sin(turn)])
+    exit_point = center + (radius + shift) * np.array([math.sin(turn), -math.cos(turn)])
+    leave = line_to_circle(tuple(exit_point), tuple(-out), tuple(center), radius, SHAPE).reversed()
+    return Chain.join([enter, leave], start=(-60.0, 0.0), end=tuple(leave.end + 80.0 * out))
+
+
+def corner_chain() -> Chain:
+    """Line → spiral pair → line → spiral pair (turning the other way) → line."""
+    a, b, c, d = (0.0, 0.0), (100.0, 0.0), (160.0, 70.0), (260.0, 40.0)
+    first = line_to_line(a, b, (130.0, 35.0), 0.08, SHAPE)
+    second = line_to_line((130.0, 35.0), c, d, 0.06, SHAPE)
+    return Chain.join([first, second], start=a, end=d)
+
+
+def sample(chain: Chain, count: int, noise: float = 0.0, seed: int = 7) -> np.ndarray:
+    points = chain.point_at(np.linspace(0.0, chain.length, count))
+    if noise:
+        points = points + np.random.default_rng(seed).normal(0.0, noise, points.shape)
+    return points
+
+
+def kinds(chain: Chain) -> str:
+    return "".join(type(s).__name__[0] for s in chain)
+
+
+def menger(a: np.ndarray, b: np.ndarray, c: np.ndarray) -> float:
+    u, v, w = b - a, c - b, c - a
+    return 2.0 * (u[0] * v[1] - u[1] * v[0]) / (np.linalg.norm(u) * np.linalg.norm(v) * np.linalg.norm(w))
+
+
+def assert_g2_by_positions(chain: Chain, closed: bool = False) -> None:
+    """Independent of the chain's joint check: at every joint the one-sided tangents and curvatures,
+    taken from positions alone (one-sided differences and three-point circles extrapolated to the
+    joint, Richardson-style), agree."""
+    pairs = list(zip(chain.segments, chain.segments[1:]))
+    if closed:
+        pairs.append((chain.segments[-1], chain.segments[0]))
+    for before, after in pairs:
+        step = 1e-4 * min(before.length, after.length)
+        offsets = step * np.arange(5.0)
+        left = before.point(before.parameter_at(before.length - offsets))  # the joint first, then backwards
+        right = after.point(after.parameter_at(offsets))
+        assert np.linalg.norm(left[0] - right[0]) <= 1e-9 * chain.size
+        t_left = -(-3 * left[0] + 4 * left[1] - left[2])  # O(step²) one-sided derivatives
+        t_right = -3 * right[0] + 4 * right[1] - right[2]
+        angle = math.atan2(t_left[0] * t_right[1] - t_left[1] * t_right[0], float(t_left @ t_right))
+        assert abs(angle) <= 1e-6
+        k_left = 2 * menger(left[2], left[1], left[0]) - menger(left[4], left[2], left[0])
+        k_right = 2 * menger(right[0], right[1], right[2]) - menger(right[0], right[2], right[4])
+        scale = max(abs(k_left), abs(k_right), 1.0 / chain.size)
+        assert abs(k_left - k_right) <= 1e-3 * scale, (k_left, k_right)
+
+
+def assert_within(fit: PointFit, points: np.ndarray, tolerance: float) -> None:
+    """Every residual within the tolerance, and the residuals are true distances: a dense sampling
+    of the chain is never nearer a point than its residual says."""
+    assert fit.max_residual <= tolerance
+    assert fit.residuals.shape == (len(points),) and fit.stations.shape == (len(points),)
+    dense = fit.chain.point_at(np.linspace(0.0, fit.chain.length, 10_000))
+    spacing = fit.chain.length / 10_000
+    for chunk in np.array_split(np.arange(len(points)), 8):
+        brute = np.sqrt(((points[chunk, None, :] - dense[None]) ** 2).sum(axis=2)).min(axis=1)
+        assert np.all(fit.residuals[chunk] <= brute + 1e-9)
+        # ... nor farther than a foot half a sample spacing away would be.
+        assert np.all(brute <= fit.residuals[chunk] + spacing)
+    # The feet lie where the stations say.
+    feet = fit.chain.point_at(np.clip(fit.stations, 0.0, fit.chain.length))
+    assert np.allclose(np.linalg.norm(feet - points, axis=1), fit.residuals, atol=1e-6 * tolerance + 1e-9)
+
+
+@pytest.mark.parametrize("noise", [0.0, 0.01, 0.05])
+def test_a_curve_comes_back_with_its_own_pieces(noise):
+    chain, tolerance = curve_chain(), 0.05
+    points = sample(chain, 1200, noise * tolerance)
+    fit = fit_points(points, tolerance, shape=SHAPE)
+    assert kinds(fit.chain) == kinds(chain) == "LBABL"
+    assert_within(fit, points, tolerance)
+    assert_g2_by_positions(fit.chain)
+    arc = fit.chain[2]
+    assert isinstance(arc, Arc) and arc.radius == pytest.approx(50.0, rel=2e-3)
+
+
+@pytest.mark.parametrize("noise", [0.0, 0.01, 0.05])
+def test_corners_come_back_with_their_own_pieces(noise):
+    chain, tolerance = corner_chain(), 0.05
+    points = sample(chain, 2000, noise * tolerance)
+    fit = fit_points(points, tolerance, shape=SHAPE)
+    assert kinds(fit.chain) == kinds(chain) == "LBBLBBL"
+    assert_within(fit, points, tolerance)
+    assert_g2_by_positions(fit.chain)
+
+
+@pytest.mark.parametrize("noise", [0.0, 0.05])
+def test_a_closed_circle_is_one_arc(noise):
+    angle = np.linspace(0.0, 2 * math.pi, 800, endpoint=False)
+    points = np.c_[30 * np.cos(angle) + 5, 30 * np.sin(angle) - 2]
+    points += np.random.default_rng(1).normal(0.0, noise * 0.01, points.shape)
+    fit = fit_points(points, 0.01, closed=True)
+    assert fit.pieces == 1 and isinstance(fit.chain[0], Arc) and fit.chain[0].sweep == pytest.approx(2 * math.pi)
+    assert fit.chain[0].radius == pytest.approx(30.0, rel=1e-4)
+    assert_within(fit, points, 0.01)
+
+
+@pytest.mark.parametrize("noise", [0.0, 0.05])
+def test_an_ellipse_closes_g2(noise):
+    angle = np.linspace(0.0, 2 * math.pi, 1500, endpoint=False)
+    points = np.c_[80 * np.cos(angle), 40 * np.sin(angle)]
+    points += np.random.default_rng(2).normal(0.0, noise * 0.05, points.shape)
+    fit = fit_points(points, 0.05, closed=True)
+    chain = fit.chain
+    assert g2_mismatch(chain[len(chain) - 1], chain[0], chain.tolerance) is None
+    assert np.linalg.norm(chain.end - chain.start) <= 1e-9 * chain.size
+    assert_within(fit, points, 0.05)
+    assert_g2_by_positions(chain, closed=True)
+    # Arcs and spirals only (no lines on an ellipse), far fewer pieces than points.
+    assert set(kinds(chain)) <= {"A", "B"} and fit.pieces < 80
+
+
+def test_collinear_points_are_one_line_and_duplicates_keep_their_rows():
+    x = np.linspace(0.0, 100.0, 40)
+    points = np.repeat(np.c_[x, 0.5 * x + 3.0], 3, axis=0)
+    fit = fit_points(points, 1e-3)
+    assert fit.pieces == 1 and isinstance(fit.chain[0], Line)
+    assert fit.residuals.shape == (120,) and fit.max_residual <= 1e-9
+    assert fit.stations[0] == fit.stations[2] == pytest.approx(0.0, abs=1e-9)
+    assert fit.stations[-1] == pytest.approx(math.hypot(100.0, 50.0))
+
+
+def test_a_u_turn_is_fitted():
+    chain = curve_chain(radius=20.0, shift=1.0, turn=math.pi - 1.0)
+    points = sample(chain, 1500)
+    fit = fit_points(points, 0.02)
+    assert kinds(fit.chain) == "LBABL"
+    assert_within(fit, points, 0.02)
+
+
+def test_refusals_name_the_problem():
+    good = np.c_[np.arange(10.0), np.zeros(10)]
+    with pytest.raises(ValueError, match=r"points\[3\] is not finite"):
+        fit_points(np.vstack([good[:3], [[np.nan, 1.0]], good[3:]]), 0.1)
+    with pytest.raises(ValueError, match="at least 3 distinct points; got 1"):
+        fit_points([[1.0, 2.0]], 0.1)
+    with pytest.raises(ValueError, match="at least 3 distinct points; got 2"):
+        fit_points([[0.0, 0.0], [0.0, 0.0], [1.0, 0.0]], 0.1)
+    for bad in (0.0, -1.0, math.inf, math.nan, "1"):
+        with pytest.raises(ValueError, match="tolerance"):
+            fit_points(good, bad)
+    with pytest.raises(ValueError, match="shape"):
+        fit_points(good, 0.1, shape="g2cbs")
+    with pytest.raises(ValueError, match=r"shape \(N, 2\)"):
+        fit_points(np.zeros((5, 3)), 0.1)
+    back = np.r_[good, good[::-1][1:] + [0.0, 0.01]]
+    with pytest.raises(NoSolutionError, match=r"double back at points\[9\]"):
+        fit_points(back, 0.1)
+
+
+def test_max_curvature_is_honoured_or_refused():
+    points = sample(curve_chain(), 600)
+    fit = fit_points(points, 0.05, max_curvature=0.05)
+    assert max(abs(s.end_curvature) for s in fit.chain) <= 0.05
+    with pytest.raises(NoSolutionError, match="max_curvature"):
+        fit_points(points, 0.05, max_curvature=0.01)
+
+
+def test_progress_counts_up_to_its_total_and_units_travel():
+    calls: list[tuple[int, int]] = []
+    fit = fit_points(sample(curve_chain(), 400), 0.05, units="m", progress=lambda done, total: calls.append((done, total)))
+    assert calls and calls[-1][0] == calls[-1][1] and [d for d, _ in calls] == sorted(d for d, _ in calls)
+    assert fit.units == fit.chain.units == "m" and fit.tolerance == 0.05
+    assert fit.curvature_estimate.shape == (400,)
+    # The estimate follows the arc: 1/50 in its middle.
+    middle = np.argmin(np.abs(fit.stations - fit.chain.stations[2] - fit.chain[2].length / 2))
+    assert fit.curvature_estimate[middle] == pytest.approx(0.02, rel=0.05)
+
+
+def test_chain_distances_agree_with_a_dense_sampling():
+    chain = corner_chain()
+    points = np.random.default_rng(4).uniform((-10, -20), (270, 90), (300, 2))
+    distances, stations = chain_distances(chain, points)
+    dense = chain.point_at(np.linspace(0.0, chain.length, 200_001))
+    brute = np.array([np.sqrt(((dense - p) ** 2).sum(axis=1)).min() for p in points])
+    assert np.allclose(distances, brute, atol=1e-5)
+    assert np.allclose(np.linalg.norm(chain.point_at(stations) - points, axis=1), distances, atol=1e-9)
+
+
+@settings(max_examples=5, deadline=None)
+@given(
+    radius=st.floats(20.0, 200.0),
+    shift=st.floats(0.02, 0.08),
+    turn=st.floats(0.1, 2.0),
+    tolerance=st.floats(0.01, 0.2),
+    noise=st.floats(0.0, 0.05),
+)
+def test_any_fit_returned_is_within_tolerance_and_g2(outcome, radius, shift, turn, tolerance, noise):
+    def call():
+        chain = curve_chain(radius, shift * radius, turn)
+        points = sample(chain, 500, noise * tolerance)
+        return points, fit_points(points, tolerance)
+
+    result = outcome(call)
+    if result is not None:
+        points, fit = result
+        assert fit.max_residual <= tolerance
+        assert np.all(fit.residuals <= tolerance)
+        assert_g2_by_positions(fit.chain)
