@@ -438,7 +438,9 @@ def _parser() -> argparse.ArgumentParser:
         help="build a JSON design file and write STEP, IGES, DXF, SVG, plots, tables and a continuity report",
         description="Build a JSON design file (spiral-cad schema prints its JSON Schema, the format's reference) or a G-code program.",
     )
-    build.add_argument("design", nargs="?", help="the design file (.json), or a LandXML file (.xml: every alignment); or --from-gcode or --from-points")
+    build.add_argument(
+        "design", nargs="?", help="the design file (.json), or a LandXML file (.xml: every alignment); or --from-gcode or --from-points"
+    )
     build.add_argument("-o", "--out", default="out", help="output folder (default: out)")
     build.add_argument("--no-plots", action="store_true", help="skip the PNG plots (the slowest output for long chains)")
     gcode = build.add_argument_group(
