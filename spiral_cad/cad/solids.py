@@ -1,0 +1,527 @@
+"""G2 solids: a closed planar G2 outline extruded with rolled (curvature-continuous) top and bottom edges.
+
+The roll profile P(v) = (w(v), z(v)) — w measured inward from the outline,
+z up — is the exact 2-D G2 corner (line → spiral → arc → spiral → line)
+between the vertical wall and the horizontal top (``design.fillets``), or a
+quarter circle (``profile="circular"``, the ordinary fillet). It is swept
+along the outline C(s) with a vertical binormal::
+
+    S(s, v) = C(s) + w(v) N(s) + z(v) ez        (N: the inward unit normal)
+
+and written as a tensor-product NURBS Σ_i Σ_j B_i(s) R_j(v) (A_i + w_j B_i, z_j)
+whose weights are the outline's times the profile's:
+
+* over a line N is constant (an exact extrusion);
+* over an arc C + wN is the homothety c + (1 − σκw)(C − c) of the arc about
+  its centre (an exact surface of revolution);
+* over a spiral N is not rational: it is replaced by a quintic C2 B-spline
+  Ñ that matches N, N', N'' exactly at every knot (Hermite), so the patch
+  meets its exact neighbours G2; knots are doubled until the patch's
+  deviation from the true sweep, max(w)·max|Ñ − N|, is within ``tolerance``.
+  That deviation is measured on dense samples and returned.
+
+Each outline piece gives a wall face (the extrusion between the rolls) and
+a top and a bottom roll face; the top and bottom are planes bounded by the
+rolls' inner boundary curves (the same curves, so faces share edges). The
+faces are sewn, made a solid and checked (``BRepCheck_Analyzer``, one
+closed solid) before anything is returned.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Iterable, Sequence
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+from OCP.BRep import BRep_Tool
+from OCP.BRepBuilderAPI import (
+    BRepBuilderAPI_MakeEdge,
+    BRepBuilderAPI_MakeFace,
+    BRepBuilderAPI_MakeSolid,
+    BRepBuilderAPI_MakeWire,
+    BRepBuilderAPI_Sewing,
+)
+from OCP.BRepCheck import BRepCheck_Analyzer
+from OCP.BRepGProp import BRepGProp
+from OCP.BRepLib import BRepLib
+from OCP.Geom import Geom_BSplineCurve, Geom_BSplineSurface
+from OCP.gp import gp_Dir, gp_Pln, gp_Pnt
+from OCP.GProp import GProp_GProps
+from OCP.TColgp import TColgp_Array1OfPnt, TColgp_Array2OfPnt
+from OCP.TColStd import TColStd_Array1OfInteger, TColStd_Array1OfReal, TColStd_Array2OfReal
+from OCP.TopAbs import TopAbs_SHELL, TopAbs_SOLID
+from OCP.TopExp import TopExp_Explorer
+from OCP.TopoDS import TopoDS, TopoDS_Face, TopoDS_Shape, TopoDS_Solid
+
+from ..core import bezier
+from ..core._inputs import as_float, shown
+from ..core.chain import Chain
+from ..core.errors import NoSolutionError
+from ..core.nurbs import chain_to_nurbs
+from ..core.segments import Arc, Line, Segment
+from ..core.shapes import DEFAULT_SHAPE
+from ..core.spiral import BezierSpiral
+from ..core.units import DEFAULT_UNITS, length_unit
+from ..design.fillets import corner_distance, fillet_path
+
+__all__ = ["PROFILES", "Slab", "g2_slab", "roll_profile"]
+
+#: Roll profiles: the G2 corner (line → spiral → arc → spiral → line) or a quarter circle.
+PROFILES = ("g2", "circular")
+#: Relative slack on "the roll fits" comparisons (equality itself is decided by the construction).
+_FIT_SLACK = 1e-12
+#: Most Hermite spans over one spiral before the tolerance counts as unreachable.
+_MAX_SPANS = 256
+#: Samples per Hermite span when measuring |Ñ − N|.
+_SAMPLES = 48
+
+
+@dataclass(frozen=True)
+class Slab:
+    """A G2 slab and what its construction guarantees.
+
+    Attributes:
+        shape: the solid (OCP ``TopoDS_Solid``), checked valid and closed.
+        approximation: the largest deviation of a non-exact patch (over a
+            spiral of the outline) from the true sweep, in the outline's unit;
+            0.0 when every patch is exact.
+        roll: the horizontal (= vertical) extent of the top and bottom rolls.
+        height: the slab's height.
+        units: the length unit of the numbers.
+    """
+
+    shape: TopoDS_Solid
+    approximation: float
+    roll: tuple[float, float]
+    height: float
+    units: str = DEFAULT_UNITS
+
+    @property
+    def description(self) -> str:
+        """One line for a file header: what is exact and the approximation's tolerance."""
+        if self.approximation == 0.0:
+            return "spiral_cad G2 slab: every surface exact (extrusions, surfaces of revolution, planes)"
+        return (
+            f"spiral_cad G2 slab: sweeps over spirals approximated within {self.approximation:.3g} "
+            f"{self.units} of the exact sweep; all other surfaces exact"
+        )
+
+
+def roll_profile(
+    edge_radius: float, *, profile: str = "g2", transition: float = 0.5, shape: str = DEFAULT_SHAPE
+) -> list[Segment]:
+    """The roll's section in the (w, z) plane: from the wall (0, −d) going up to the top (d, 0) going +w.
+
+    Args:
+        edge_radius: the smallest radius of curvature of the section (> 0).
+        profile: ``"g2"`` (spiral → arc → spiral, from ``design.fillets``) or
+            ``"circular"`` (a quarter circle of ``edge_radius``).
+        transition, shape: of the G2 corner's spirals, as in ``fillet_path``.
+
+    Raises:
+        ValueError: an unknown profile or a non-positive radius.
+    """
+    r = as_float(edge_radius, "edge_radius")
+    if not r > 0.0:
+        raise ValueError(f"edge_radius must be positive; got {shown(edge_radius)}")
+    if profile not in PROFILES:
+        raise ValueError(f"profile must be one of {', '.join(PROFILES)}; got {profile!r:.40}")
+    if profile == "circular":
+        return [Arc((r, -r), -r, math.pi, math.pi / 2.0)]
+    reach = 2.0 * corner_distance(r, math.pi / 2.0, transition, shape)
+    corner = fillet_path([(0.0, -reach), (0.0, 0.0), (reach, 0.0)], r, transition=transition, vertices=[1], shape=shape)
+    return [s for s, owner in zip(corner.segments, corner.owners) if owner is not None]
+
+
+# ------------------------------------------------------------------ the sweep, direction s
+
+
+@dataclass(frozen=True)
+class _Along:
+    """One outline piece in the s direction: C(s) + w·N(s) has poles A + w·B with weights W."""
+
+    degree: int
+    knots: NDArray[np.float64]
+    mults: NDArray[np.int64]
+    weights: NDArray[np.float64]
+    a: NDArray[np.float64]
+    b: NDArray[np.float64]
+    deviation: float  # max |Ñ − N| (0 for exact pieces)
+
+
+def _left_normal_jets(cp: NDArray[np.float64], u: NDArray[np.float64]) -> tuple[NDArray, NDArray, NDArray]:
+    """The left unit normal of a cubic Bézier and its first two derivatives in u (dN = −a T, ddN = −a' T − a² N)."""
+    q, q2, q3 = (bezier.derivative(cp, u, k) for k in (1, 2, 3))
+    g2 = np.einsum("...i,...i", q, q)
+    tangent = q / np.sqrt(g2)[..., None]
+    normal = np.stack([-tangent[..., 1], tangent[..., 0]], axis=-1)
+    cross2 = q[..., 0] * q2[..., 1] - q[..., 1] * q2[..., 0]
+    cross3 = q[..., 0] * q3[..., 1] - q[..., 1] * q3[..., 0]
+    a = cross2 / g2  # κ·|q|: the normal's turning rate in u
+    da = cross3 / g2 - 2.0 * cross2 * np.einsum("...i,...i", q, q2) / g2**2
+    return normal, -a[..., None] * tangent, -da[..., None] * tangent - (a**2)[..., None] * normal
+
+
+def _elevate(points: NDArray[np.float64], times: int) -> NDArray[np.float64]:
+    """Bézier control points raised ``times`` degrees (exact)."""
+    for _ in range(times):
+        n = len(points)  # new degree
+        i = np.arange(1, n)[:, None] / n
+        points = np.vstack([points[:1], i * points[:-1] + (1.0 - i) * points[1:], points[-1:]])
+    return points
+
+
+def _hermite(f0, d0, s0, f1, d1, s1, h: float) -> NDArray[np.float64]:
+    """Quintic Bézier poles of the curve with value, first and second derivative f, d, s at both ends of a span h."""
+    return np.array([
+        f0,
+        f0 + h * d0 / 5.0,
+        f0 + 2.0 * h * d0 / 5.0 + h * h * s0 / 20.0,
+        f1 - 2.0 * h * d1 / 5.0 + h * h * s1 / 20.0,
+        f1 - h * d1 / 5.0,
+        f1,
+    ])  # fmt: skip
+
+
+def _bernstein(poles: NDArray[np.float64], t: NDArray[np.float64]) -> NDArray[np.float64]:
+    n = len(poles) - 1
+    basis = np.stack([math.comb(n, k) * t**k * (1.0 - t) ** (n - k) for k in range(n + 1)], axis=-1)
+    return basis @ poles
+
+
+def _spiral_along(cp: NDArray[np.float64], sigma: float, reach: float, tolerance: float) -> _Along:
+    """A spiral piece with Ñ a C2 quintic B-spline, knots doubled until reach·max|Ñ − N| ≤ tolerance."""
+    spans = 1
+    while True:
+        breaks = np.linspace(0.0, 1.0, spans + 1)
+        n, dn, ddn = (sigma * x for x in _left_normal_jets(cp, breaks))
+        a_rows, b_rows, worst = [], [], 0.0
+        t = np.linspace(0.0, 1.0, _SAMPLES)
+        for k in range(spans):
+            h = breaks[k + 1] - breaks[k]
+            normal_poles = _hermite(n[k], dn[k], ddn[k], n[k + 1], dn[k + 1], ddn[k + 1], h)
+            exact = sigma * _left_normal_jets(cp, breaks[k] + h * t)[0]
+            worst = max(worst, float(np.abs(np.linalg.norm(_bernstein(normal_poles, t) - exact, axis=1)).max()))
+            curve_poles = _elevate(bezier.split(cp, breaks[k], breaks[k + 1]), 2)
+            a_rows.append(curve_poles if k == 0 else curve_poles[1:])
+            b_rows.append(normal_poles if k == 0 else normal_poles[1:])
+        if reach * worst <= tolerance or spans >= _MAX_SPANS:
+            break
+        spans *= 2
+    if reach * worst > tolerance:
+        raise NoSolutionError(
+            f"the sweep over a spiral deviates {reach * worst:.3g} from the exact one with {spans} spans; "
+            f"tolerance {tolerance:.3g} is out of reach (give tolerance ≥ {reach * worst:.3g})"
+        )
+    mults = np.full(spans + 1, 5)
+    mults[[0, -1]] = 6
+    a = np.vstack(a_rows)
+    return _Along(5, breaks, mults, np.ones(len(a)), a, np.vstack(b_rows), worst)
+
+
+def _along(segment: Segment, sigma: float, reach: float, tolerance: float) -> _Along:
+    if isinstance(segment, BezierSpiral):
+        return _spiral_along(np.asarray(segment.control_points, dtype=float), sigma, reach, tolerance)
+    curve = chain_to_nurbs([segment])
+    poles = curve.control_points
+    if isinstance(segment, Line):
+        tangent = (segment.end - segment.start)[:2] / segment.length
+        b = np.broadcast_to(sigma * np.array([-tangent[1], tangent[0]]), poles.shape).copy()
+    elif isinstance(segment, Arc):
+        b = -(sigma / segment.radius) * (poles - np.asarray(segment.center)[:2])  # the homothety about the centre
+    else:
+        raise ValueError(f"outline segments must be lines, arcs or Bézier spirals; got {type(segment).__name__}")
+    return _Along(curve.degree, curve.knots, curve.multiplicities, curve.weights, poles, b, 0.0)
+
+
+# ------------------------------------------------------------------ OCP surfaces and curves
+
+
+def _reals(values: Iterable[float]) -> TColStd_Array1OfReal:
+    values = list(values)
+    array = TColStd_Array1OfReal(1, len(values))
+    for i, value in enumerate(values, 1):
+        array.SetValue(i, float(value))
+    return array
+
+
+def _ints(values: Iterable[int]) -> TColStd_Array1OfInteger:
+    values = list(values)
+    array = TColStd_Array1OfInteger(1, len(values))
+    for i, value in enumerate(values, 1):
+        array.SetValue(i, int(value))
+    return array
+
+
+@dataclass(frozen=True)
+class _Section:
+    """A profile piece in the v direction: poles (w, z), weights, knots."""
+
+    degree: int
+    knots: NDArray[np.float64]
+    mults: NDArray[np.int64]
+    weights: NDArray[np.float64]
+    points: NDArray[np.float64]
+
+
+def _sections(roll: list[Segment], top: float, bottom: float, height: float) -> list[_Section]:
+    """The bottom roll, the wall and the top roll (the ones of non-zero extent), in the (w, z) plane."""
+    curve = chain_to_nurbs(roll) if roll else None
+    sections = []
+    if bottom > 0.0 and curve is not None:
+        scale = bottom / float(curve.control_points[-1, 0])
+        points = curve.control_points * scale * np.array([1.0, -1.0])  # mirrored: the wall at (0, d) down to (d, 0)
+        sections.append(_Section(3, curve.knots, curve.multiplicities, curve.weights, points))
+    if height - top - bottom > 0.0:
+        wall = np.array([[0.0, bottom], [0.0, height - top]])
+        sections.append(_Section(1, np.array([0.0, 1.0]), np.array([2, 2]), np.ones(2), wall))
+    if top > 0.0 and curve is not None:
+        scale = top / float(curve.control_points[-1, 0])
+        points = curve.control_points * scale + np.array([0.0, height])
+        sections.append(_Section(3, curve.knots, curve.multiplicities, curve.weights, points))
+    return sections
+
+
+def _surface_face(along: _Along, section: _Section, degenerate: float) -> TopoDS_Face:
+    rows, cols = len(along.a), len(section.points)
+    poles, weights = TColgp_Array2OfPnt(1, rows, 1, cols), TColStd_Array2OfReal(1, rows, 1, cols)
+    for i in range(rows):
+        for j in range(cols):
+            w, z = section.points[j]
+            x, y = along.a[i] + w * along.b[i]
+            poles.SetValue(i + 1, j + 1, gp_Pnt(float(x), float(y), float(z)))
+            weights.SetValue(i + 1, j + 1, float(along.weights[i] * section.weights[j]))
+    surface = Geom_BSplineSurface(
+        poles, weights, _reals(along.knots), _reals(section.knots), _ints(along.mults), _ints(section.mults),
+        along.degree, section.degree,
+    )  # fmt: skip
+    return BRepBuilderAPI_MakeFace(surface, degenerate).Face()
+
+
+def _boundary_edge(along: _Along, w: float, z: float):
+    """The curve C(s) + w·Ñ(s) at height z — the roll's iso-curve, pole for pole — or None if it is a point."""
+    points = along.a + w * along.b
+    if float(np.ptp(points, axis=0).max()) == 0.0 or np.allclose(points, points[0], rtol=0.0, atol=1e-12 * (1.0 + w)):
+        return None
+    poles = TColgp_Array1OfPnt(1, len(points))
+    for i, (x, y) in enumerate(points, 1):
+        poles.SetValue(i, gp_Pnt(float(x), float(y), float(z)))
+    curve = Geom_BSplineCurve(poles, _reals(along.weights), _reals(along.knots), _ints(along.mults), along.degree)
+    return BRepBuilderAPI_MakeEdge(curve).Edge()
+
+
+def _cap(alongs: list[_Along], w: float, z: float) -> TopoDS_Face:
+    wire = BRepBuilderAPI_MakeWire()
+    for along in alongs:
+        edge = _boundary_edge(along, w, z)
+        if edge is not None:
+            wire.Add(edge)
+    if not wire.IsDone():
+        raise NoSolutionError(f"the cap at z = {z:.6g} has no closed boundary (the roll closes the outline)")
+    return BRepBuilderAPI_MakeFace(gp_Pln(gp_Pnt(0.0, 0.0, z), gp_Dir(0.0, 0.0, 1.0)), wire.Wire()).Face()
+
+
+# ------------------------------------------------------------------ input and fit
+
+
+def outline_segments(outline: Any) -> list[Segment]:
+    """The plane segments of a closed outline: a ``Chain``, a ``FilletedPath``, an object with ``.filleted``
+    (the continuous sketches) or segments in travel order.
+
+    Raises:
+        ValueError: anything else, segments in space, or an outline that does not close.
+    """
+    source = getattr(outline, "filleted", outline)
+    source = getattr(source, "segments", source)
+    if isinstance(source, Chain):
+        source = list(source)
+    if not isinstance(source, Sequence) or not source or not all(isinstance(s, Segment) for s in source):
+        raise ValueError(f"outline must be a closed Chain, a FilletedPath or segments in travel order; got {type(outline).__name__}")
+    segments = list(source)
+    if any(s.dim != 2 for s in segments):
+        raise ValueError("outline must lie in the plane (2-D segments)")
+    size = max(float(np.ptp(np.vstack([s.point(np.linspace(0, 1, 5)) for s in segments]), axis=0).max()), 1e-300)
+    gap = math.dist(segments[-1].end[:2], segments[0].start[:2])
+    if gap > 1e-9 * size:
+        raise ValueError(f"outline must be closed; its end is {gap:.3g} from its start")
+    return segments
+
+
+def _samples(segments: list[Segment], count: int = 64) -> tuple[NDArray, NDArray, NDArray]:
+    """Points, left normals and curvatures at ``count`` parameters per segment (closing point excluded)."""
+    u = np.linspace(0.0, 1.0, count, endpoint=False)
+    points = np.vstack([s.point(u)[:, :2] for s in segments])
+    tangents = np.vstack([s.tangent(u)[:, :2] for s in segments])
+    curvatures = np.concatenate([np.broadcast_to(s.curvature(u), u.shape) for s in segments])
+    return points, np.stack([-tangents[:, 1], tangents[:, 0]], axis=1), curvatures
+
+
+def _crossing(polygon: NDArray[np.float64]) -> NDArray[np.float64] | None:
+    """A point where the closed polygon crosses itself (non-adjacent edges), or None."""
+    a, b = polygon, np.roll(polygon, -1, axis=0)
+    d = b - a
+    n = len(a)
+    i, j = np.triu_indices(n, 2)
+    keep = (j - i) < n - 1  # the last edge is adjacent to the first
+    i, j = i[keep], j[keep]
+    denom = d[i, 0] * d[j, 1] - d[i, 1] * d[j, 0]
+    diff = a[j] - a[i]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        t = (diff[:, 0] * d[j, 1] - diff[:, 1] * d[j, 0]) / denom
+        u = (diff[:, 0] * d[i, 1] - diff[:, 1] * d[i, 0]) / denom
+    hit = (denom != 0.0) & (t > 0.0) & (t < 1.0) & (u > 0.0) & (u < 1.0)
+    if not hit.any():
+        return None
+    k = int(np.argmax(hit))
+    result: NDArray[np.float64] = a[i[k]] + t[k] * d[i[k]]
+    return result
+
+
+def _check_fit(segments: list[Segment], sigma: float, roll: float, radius: float, name: str) -> None:
+    """NoSolutionError unless a roll ``roll`` wide fits inside the outline: below every convex radius of
+    curvature (equal only on arcs: a clean pole) and with an inner offset that does not cross itself."""
+    for index, segment in enumerate(segments):
+        u = np.linspace(0.0, 1.0, 65)
+        bend = float(np.max(sigma * np.broadcast_to(segment.curvature(u), u.shape)))
+        if bend <= 0.0:
+            continue
+        product = roll * bend
+        exact_pole = isinstance(segment, Arc) and abs(product - 1.0) <= 1e-12
+        if product > 1.0 - _FIT_SLACK and not exact_pole:
+            raise NoSolutionError(
+                f"{name} {shown(radius)} gives a roll {roll:.6g} wide, not below the outline's smallest convex radius "
+                f"of curvature {1.0 / bend:.6g} (segment {index}, a {type(segment).__name__}): the inner offset "
+                f"would fold; {name} below {radius / product:.6g} fits"
+            )
+    points, normals, _ = _samples(segments)
+    place = _crossing(points + sigma * roll * normals)
+    if place is not None:
+        low, high = 0.0, roll  # the widest roll whose offset stays simple, for the message
+        for _ in range(30):
+            mid = 0.5 * (low + high)
+            low, high = (mid, high) if _crossing(points + sigma * mid * normals) is None else (low, mid)
+        raise NoSolutionError(
+            f"{name} {shown(radius)} gives a roll {roll:.6g} wide whose inner offset crosses itself near "
+            f"({place[0]:.6g}, {place[1]:.6g}): the outline is too narrow there; {name} below "
+            f"{radius * low / roll:.6g} fits"
+        )
+
+
+# ------------------------------------------------------------------ the solid
+
+
+def _solid(faces: list[TopoDS_Face], tolerance: float) -> TopoDS_Solid:
+    sewing = BRepBuilderAPI_Sewing(tolerance)
+    for face in faces:
+        sewing.Add(face)
+    sewing.Perform()
+    sewn = sewing.SewedShape()
+    shells = TopExp_Explorer(sewn, TopAbs_SHELL)
+    count = 0
+    shell = None
+    while shells.More():
+        count += 1
+        shell = TopoDS.Shell_s(shells.Current())
+        shells.Next()
+    if count != 1 or shell is None or not BRep_Tool.IsClosed_s(shell):
+        raise NoSolutionError(f"the slab's {len(faces)} faces did not sew into one closed shell ({count} shell(s))")
+    solid = BRepBuilderAPI_MakeSolid(shell).Solid()
+    BRepLib.OrientClosedSolid_s(solid)
+    return solid
+
+
+def verify_solid(shape: TopoDS_Shape, what: str = "slab") -> None:
+    """ValueError unless ``shape`` is one valid, closed solid with positive volume (``BRepCheck_Analyzer``)."""
+    solids = TopExp_Explorer(shape, TopAbs_SOLID)
+    count = 0
+    while solids.More():
+        count += 1
+        solids.Next()
+    if count != 1:
+        raise NoSolutionError(f"the {what} is {count} solids, not one")
+    if not BRepCheck_Analyzer(shape).IsValid():
+        raise NoSolutionError(f"the {what} is not a valid solid (BRepCheck_Analyzer)")
+    props = GProp_GProps()
+    BRepGProp.VolumeProperties_s(shape, props)
+    if not props.Mass() > 0.0:
+        raise NoSolutionError(f"the {what} encloses no volume ({props.Mass():.3g})")
+
+
+def g2_slab(
+    outline: Any,
+    height: float,
+    edge_radius: float,
+    *,
+    top: bool = True,
+    bottom: bool = True,
+    profile: str = "g2",
+    transition: float = 0.5,
+    shape: str = DEFAULT_SHAPE,
+    tolerance: float | None = None,
+    units: str = DEFAULT_UNITS,
+) -> Slab:
+    """A closed planar outline extruded by ``height`` with its top and bottom edges rolled (see the module docstring).
+
+    Args:
+        outline: a closed plane ``Chain`` of lines, arcs and spirals (G2 for a
+            G2 solid; tangent joints are swept as they are), a ``FilletedPath``
+            (``continuous_rectangle`` …) or its segments; convex or concave,
+            either sense. It lies in z = 0; the slab rises to z = ``height``.
+        height: the slab's height (> 0).
+        edge_radius: the roll profile's smallest radius of curvature (> 0).
+        top, bottom: roll the top / bottom edge (else the edge stays sharp).
+        profile: ``"g2"`` or ``"circular"`` (``roll_profile``).
+        transition, shape: of the G2 profile's spirals.
+        tolerance: the largest deviation allowed for the sweep over a spiral
+            (default 1e-7 × the outline's size).
+        units: the unit of the numbers (kept for the files written).
+
+    Returns:
+        The ``Slab``: the solid and the measured approximation.
+
+    Raises:
+        ValueError: malformed input.
+        NoSolutionError: the roll does not fit (it is as wide as it is high:
+            wider than the outline's smallest convex radius of curvature, an
+            inner offset that crosses itself, or both rolls higher than
+            ``height``) — the message names the value and what would fit.
+    """
+    units = length_unit(units)
+    segments = outline_segments(outline)
+    height = as_float(height, "height")
+    if not height > 0.0:
+        raise ValueError(f"height must be positive; got {shown(height)}")
+    roll = roll_profile(edge_radius, profile=profile, transition=transition, shape=shape)
+    reach = float(roll[-1].end[0])
+    d_top, d_bottom = (reach if top else 0.0), (reach if bottom else 0.0)
+    if d_top + d_bottom > height * (1.0 + _FIT_SLACK):
+        fits = float(edge_radius) * height / (d_top + d_bottom)
+        raise NoSolutionError(
+            f"edge_radius {shown(edge_radius)} gives rolls {reach:.6g} high; {'both' if top and bottom else 'it'} "
+            f"exceed height {shown(height)}; edge_radius up to {fits:.6g} fits"
+        )
+    if d_top + d_bottom > height:
+        d_top, d_bottom = (height / 2.0, height / 2.0) if top and bottom else (d_top and height, d_bottom and height)
+    points, _, _ = _samples(segments)
+    size = float(np.ptp(points, axis=0).max())
+    area = 0.5 * float(np.sum(points[:, 0] * np.roll(points[:, 1], -1) - np.roll(points[:, 0], -1) * points[:, 1]))
+    sigma = 1.0 if area > 0.0 else -1.0  # the inward normal is the left one of a counterclockwise outline
+    reach_max = max(d_top, d_bottom)
+    if reach_max > 0.0:
+        _check_fit(segments, sigma, reach_max, float(edge_radius), "edge_radius")
+    tol = 1e-7 * size if tolerance is None else as_float(tolerance, "tolerance")
+    if not tol > 0.0:
+        raise ValueError(f"tolerance must be positive; got {shown(tolerance)}")
+    alongs = [_along(s, sigma, reach_max, tol) for s in segments]
+    sections = _sections(roll, d_top, d_bottom, height)
+    degenerate = 1e-9 * size
+    faces = [_surface_face(a, sec, degenerate) for a in alongs for sec in sections]
+    faces.append(_cap(alongs, d_top, height))
+    faces.append(_cap(alongs, d_bottom, 0.0))
+    solid = _solid(faces, 1e-7 * size)
+    verify_solid(solid)
+    approximation = reach_max * max(a.deviation for a in alongs)
+    return Slab(solid, approximation, (d_top, d_bottom), height, units)
