@@ -37,24 +37,34 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 from OCP.BRep import BRep_Tool
+from OCP.BRepAdaptor import BRepAdaptor_Curve
 from OCP.BRepBuilderAPI import (
     BRepBuilderAPI_MakeEdge,
     BRepBuilderAPI_MakeFace,
     BRepBuilderAPI_MakeSolid,
+    BRepBuilderAPI_MakeVertex,
     BRepBuilderAPI_MakeWire,
     BRepBuilderAPI_Sewing,
+    BRepBuilderAPI_Transform,
 )
+from OCP.BRepExtrema import BRepExtrema_DistShapeShape
+from OCP.BRepPrimAPI import BRepPrimAPI_MakePrism
+from OCP.BRepTools import BRepTools
+from OCP.GeomAbs import GeomAbs_CurveType, GeomAbs_SurfaceType
+from OCP.GeomAdaptor import GeomAdaptor_Surface
+from OCP.TopExp import TopExp
+from OCP.TopTools import TopTools_IndexedDataMapOfShapeListOfShape
 from OCP.BRepCheck import BRepCheck_Analyzer
 from OCP.BRepGProp import BRepGProp
 from OCP.BRepLib import BRepLib
 from OCP.Geom import Geom_BSplineCurve, Geom_BSplineSurface
-from OCP.gp import gp_Dir, gp_Pln, gp_Pnt
+from OCP.gp import gp_Ax3, gp_Dir, gp_Pln, gp_Pnt, gp_Trsf, gp_Vec
 from OCP.GProp import GProp_GProps
 from OCP.TColgp import TColgp_Array1OfPnt, TColgp_Array2OfPnt
 from OCP.TColStd import TColStd_Array1OfInteger, TColStd_Array1OfReal, TColStd_Array2OfReal
-from OCP.TopAbs import TopAbs_SHELL, TopAbs_SOLID
+from OCP.TopAbs import TopAbs_EDGE, TopAbs_FACE, TopAbs_SHELL, TopAbs_SOLID, TopAbs_WIRE
 from OCP.TopExp import TopExp_Explorer
-from OCP.TopoDS import TopoDS, TopoDS_Face, TopoDS_Shape, TopoDS_Solid
+from OCP.TopoDS import TopoDS, TopoDS_Edge, TopoDS_Face, TopoDS_Shape, TopoDS_Solid
 
 from ..core import bezier
 from ..core._inputs import as_float, shown
@@ -65,9 +75,11 @@ from ..core.segments import Arc, Line, Segment
 from ..core.shapes import DEFAULT_SHAPE
 from ..core.spiral import BezierSpiral
 from ..core.units import DEFAULT_UNITS, length_unit
-from ..design.fillets import corner_distance, fillet_path
+from ..design.fillets import TANGENT_TOL, corner_distance, fillet_path
+from .fillet import wire_path
+from .occ import chain_wire
 
-__all__ = ["PROFILES", "Slab", "g2_slab", "roll_profile"]
+__all__ = ["PROFILES", "Slab", "approximation_note", "fillet_prism_edges", "g2_slab", "outline_segments", "roll_profile", "verify_solid"]
 
 #: Roll profiles: the G2 corner (line → spiral → arc → spiral → line) or a quarter circle.
 PROFILES = ("g2", "circular")
@@ -102,12 +114,17 @@ class Slab:
     @property
     def description(self) -> str:
         """One line for a file header: what is exact and the approximation's tolerance."""
-        if self.approximation == 0.0:
-            return "spiral_cad G2 slab: every surface exact (extrusions, surfaces of revolution, planes)"
-        return (
-            f"spiral_cad G2 slab: sweeps over spirals approximated within {self.approximation:.3g} "
-            f"{self.units} of the exact sweep; all other surfaces exact"
-        )
+        return approximation_note(self.approximation, self.units)
+
+
+def approximation_note(approximation: float, units: str = DEFAULT_UNITS) -> str:
+    """The STEP description of a G2 solid whose non-exact surfaces deviate ``approximation`` from the exact ones."""
+    if approximation == 0.0:
+        return "spiral_cad G2 solid: every surface exact (extrusions, surfaces of revolution, planes)"
+    return (
+        f"spiral_cad G2 solid: sweeps over spirals approximated within {approximation:.3g} {units} "
+        "of the exact sweep; all other surfaces exact"
+    )
 
 
 def roll_profile(
@@ -462,6 +479,7 @@ def g2_slab(
     shape: str = DEFAULT_SHAPE,
     tolerance: float | None = None,
     units: str = DEFAULT_UNITS,
+    _name: str = "edge_radius",
 ) -> Slab:
     """A closed planar outline extruded by ``height`` with its top and bottom edges rolled (see the module docstring).
 
@@ -500,8 +518,8 @@ def g2_slab(
     if d_top + d_bottom > height * (1.0 + _FIT_SLACK):
         fits = float(edge_radius) * height / (d_top + d_bottom)
         raise NoSolutionError(
-            f"edge_radius {shown(edge_radius)} gives rolls {reach:.6g} high; {'both' if top and bottom else 'it'} "
-            f"exceed height {shown(height)}; edge_radius up to {fits:.6g} fits"
+            f"{_name} {shown(edge_radius)} gives rolls {reach:.6g} high; {'both' if top and bottom else 'it'} "
+            f"exceed height {shown(height)}; {_name} up to {fits:.6g} fits"
         )
     if d_top + d_bottom > height:
         d_top, d_bottom = (height / 2.0, height / 2.0) if top and bottom else (d_top and height, d_bottom and height)
@@ -511,7 +529,7 @@ def g2_slab(
     sigma = 1.0 if area > 0.0 else -1.0  # the inward normal is the left one of a counterclockwise outline
     reach_max = max(d_top, d_bottom)
     if reach_max > 0.0:
-        _check_fit(segments, sigma, reach_max, float(edge_radius), "edge_radius")
+        _check_fit(segments, sigma, reach_max, float(edge_radius), _name)
     tol = 1e-7 * size if tolerance is None else as_float(tolerance, "tolerance")
     if not tol > 0.0:
         raise ValueError(f"tolerance must be positive; got {shown(tolerance)}")
@@ -525,3 +543,260 @@ def g2_slab(
     verify_solid(solid)
     approximation = reach_max * max(a.deviation for a in alongs)
     return Slab(solid, approximation, (d_top, d_bottom), height, units)
+
+
+# ------------------------------------------------------------------ solid edges of prisms
+
+
+@dataclass(frozen=True)
+class _Prism:
+    """A solid that is a right prism: two parallel planar caps, the bottom one framed with z into the solid."""
+
+    frame: gp_Ax3
+    bottom: TopoDS_Face
+    top: TopoDS_Face
+    height: float
+
+
+def _faces_of(shape: TopoDS_Shape) -> list[TopoDS_Face]:
+    found, explorer = [], TopExp_Explorer(shape, TopAbs_FACE)
+    while explorer.More():
+        found.append(TopoDS.Face_s(explorer.Current()))
+        explorer.Next()
+    return found
+
+
+def _edges_of(shape: TopoDS_Shape) -> list[TopoDS_Edge]:
+    found, explorer = [], TopExp_Explorer(shape, TopAbs_EDGE)
+    while explorer.More():
+        found.append(TopoDS.Edge_s(explorer.Current()))
+        explorer.Next()
+    return found
+
+
+def _plane(face: TopoDS_Face) -> gp_Pln | None:
+    surface = GeomAdaptor_Surface(BRep_Tool.Surface_s(face))
+    return surface.Plane() if surface.GetType() == GeomAbs_SurfaceType.GeomAbs_Plane else None
+
+
+def _line_direction(edge: TopoDS_Edge) -> tuple[gp_Pnt, gp_Pnt, gp_Dir] | None:
+    curve = BRepAdaptor_Curve(edge)
+    if curve.GetType() != GeomAbs_CurveType.GeomAbs_Line:
+        return None
+    return curve.Value(curve.FirstParameter()), curve.Value(curve.LastParameter()), curve.Line().Direction()
+
+
+def _where(point: gp_Pnt) -> str:
+    return f"({point.X():.6g}, {point.Y():.6g}, {point.Z():.6g})"
+
+
+def _volume(shape: TopoDS_Shape) -> float:
+    props = GProp_GProps()
+    BRepGProp.VolumeProperties_s(shape, props)
+    return props.Mass()
+
+
+def _area(shape: TopoDS_Shape) -> float:
+    props = GProp_GProps()
+    BRepGProp.SurfaceProperties_s(shape, props)
+    return props.Mass()
+
+
+def _prism(solid: TopoDS_Shape, direction: gp_Dir, edge_name: str) -> _Prism:
+    """The solid as a right prism along ``direction``, or NoSolutionError naming what is not."""
+    caps = [f for f in _faces_of(solid) if (p := _plane(f)) is not None and p.Axis().Direction().IsParallel(direction, 1e-12)]
+    if len(caps) != 2:
+        raise NoSolutionError(
+            f"g2_fillet rounds solid edges of right prisms (two parallel planar caps, side faces along the edges); "
+            f"{edge_name}: the part has {len(caps)} planar face(s) perpendicular to it, not 2 (a vertex blend is a later step)"
+        )
+    origins = [_plane(f).Location() for f in caps]  # type: ignore[union-attr]
+    offsets = [gp_Vec(direction).Dot(gp_Vec(o.XYZ())) for o in origins]
+    low, high = (0, 1) if offsets[0] < offsets[1] else (1, 0)
+    height = offsets[high] - offsets[low]
+    if not abs(_volume(solid) - _area(caps[low]) * height) <= 1e-9 * abs(_volume(solid)):
+        raise NoSolutionError(
+            f"g2_fillet rounds solid edges of right prisms; {edge_name}: the part is not its cap extruded by "
+            f"{height:.6g} (volume {_volume(solid):.9g}, cap area × height {_area(caps[low]) * height:.9g})"
+        )
+    plane = _plane(caps[low])
+    assert plane is not None
+    frame = gp_Ax3(plane.Location(), direction, plane.Position().XDirection())
+    if frame.XDirection().IsParallel(direction, 1e-9):
+        frame = gp_Ax3(plane.Location(), direction)
+    return _Prism(frame, caps[low], caps[high], height)
+
+
+def _on(face: TopoDS_Face, point: gp_Pnt, size: float) -> bool:
+    return BRepExtrema_DistShapeShape(BRepBuilderAPI_MakeVertex(point).Vertex(), face).Value() <= 1e-9 * size
+
+
+def fillet_prism_edges(
+    solid: TopoDS_Shape,
+    edges: Sequence[TopoDS_Edge],
+    radius: float,
+    *,
+    transition: float = 0.5,
+    same_sense: str = "nested",
+    shape: str = DEFAULT_SHAPE,
+    tolerance: float | None = None,
+) -> Slab:
+    """Round straight edges of a right prism with G2 fillets, exactly.
+
+    Side edges (along the prism's axis, between two planar faces, any
+    dihedral angle, convex or concave) become exact extrusions of the 2-D G2
+    corner of the cap's outline; when every edge of a cap is chosen too, the
+    cap's edge is rolled by the G2 profile of the same radius (``g2_slab``).
+
+    Args:
+        solid: one solid, a right prism (two parallel planar caps; the part's
+            volume is its cap's area times its height).
+        edges: the edges to round (all side edges, or side edges and every edge of
+            one or both caps).
+        radius: the smallest radius of curvature of each rounded edge.
+        transition, same_sense, shape: as in ``design.fillets.fillet_path``.
+        tolerance: for a slab's sweep over spirals, as in ``g2_slab``.
+
+    Raises:
+        NoSolutionError: an edge that is not straight, not between planar faces, a part that
+            is no right prism, or a cap partly chosen — named by edge index and point.
+    """
+    if not edges:
+        raise ValueError("g2_fillet needs at least one edge")
+    all_edges = _edges_of(solid)
+    index = {i: e for i, e in enumerate(all_edges)}
+    position = {}
+    for k, edge in enumerate(edges):
+        match = next((i for i, e in index.items() if e.IsSame(edge)), None)
+        if match is None:
+            raise ValueError(f"edge {k} of the selection is not an edge of the part")
+        position[k] = match
+    size = max(BRepAdaptor_Curve(e).Value(BRepAdaptor_Curve(e).FirstParameter()).Distance(gp_Pnt()) for e in all_edges) + 1.0
+    neighbours = TopTools_IndexedDataMapOfShapeListOfShape()
+    TopExp.MapShapesAndAncestors_s(solid, TopAbs_EDGE, TopAbs_FACE, neighbours)
+    axis: gp_Dir | None = None
+    named = []
+    for k, edge in enumerate(edges):
+        curve = BRepAdaptor_Curve(edge)
+        named.append(f"edge {position[k]} at {_where(curve.Value(curve.FirstParameter()))}")
+        line = _line_direction(edge)
+        if axis is None and line is not None:  # the axis: a straight edge whose ends both meet a perpendicular face
+            ends = [f for f in _faces_of(solid) if (p := _plane(f)) is not None and p.Axis().Direction().IsParallel(line[2], 1e-12)]
+            if all(any(_on(f, end, size) for f in ends) for end in line[:2]):
+                axis = line[2]
+    sides, caps = [], []
+    for k, edge in enumerate(edges):
+        line = _line_direction(edge)
+        if axis is not None and line is not None and line[2].IsParallel(axis, 1e-12):
+            sides.append(edge)
+        else:
+            caps.append((k, edge, named[k]))
+    if axis is None:  # only cap edges chosen: the axis is the normal of a planar face holding the first, if a prism's
+        for face in _faces_of(solid):
+            plane = _plane(face)
+            if plane is not None and any(edges[0].IsSame(h) for h in _edges_of(face)):
+                try:
+                    _prism(solid, plane.Axis().Direction(), named[0])
+                except NoSolutionError:
+                    continue
+                axis = plane.Axis().Direction()
+                break
+    if axis is None:
+        raise NoSolutionError(
+            f"g2_fillet rounds a solid's straight edges when each end meets a face perpendicular to it (prism side "
+            f"edges); {named[0]} does not, and no chosen edge does (a vertex blend is a later step)"
+        )
+    prism = _prism(solid, axis, f"edge {position[0]}")
+    by_cap = {"bottom": _edges_of(prism.bottom), "top": _edges_of(prism.top)}
+    chosen_caps = {}
+    for which, cap_edges in by_cap.items():
+        picked = [c for c in caps if any(c[1].IsSame(e) for e in cap_edges)]
+        if picked and len(picked) != len(cap_edges):
+            missing = next(e for e in cap_edges if not any(c[1].IsSame(e) for c in picked))
+            where = _where(BRepAdaptor_Curve(missing).Value(BRepAdaptor_Curve(missing).FirstParameter()))
+            raise NoSolutionError(
+                f"g2_fillet rounds a prism's {which} edges all together (a slab); the {which} cap's edge at {where} "
+                "is not chosen, and a vertex blend where rounded and sharp edges meet is a later step"
+            )
+        chosen_caps[which] = bool(picked)
+        for c in picked:
+            caps.remove(c)
+    if caps:
+        raise NoSolutionError(f"g2_fillet cannot round {caps[0][2]}: neither a side edge nor a cap edge of the prism")
+    frame = prism.frame
+    if BRepTools.OuterWire_s(prism.bottom).IsNull() or len(_wires_of(prism.bottom)) != 1:
+        raise NoSolutionError("g2_fillet rounds prisms whose caps have one boundary (no holes)")
+    segments, _ = wire_path(BRepTools.OuterWire_s(prism.bottom), frame, spirals=True)
+    feet = [BRepAdaptor_Curve(e).Value(BRepAdaptor_Curve(e).FirstParameter()) for e in sides]
+    feet += [BRepAdaptor_Curve(e).Value(BRepAdaptor_Curve(e).LastParameter()) for e in sides]
+    chosen = [i for i in _corner_vertices(segments, frame, feet, size) if _turns(segments[i - 1], segments[i])]
+    if chosen:
+        path = fillet_path(segments, radius, transition=transition, vertices=chosen, closed=True, same_sense=same_sense, shape=shape)
+        segments = list(path.segments)
+    if not any(chosen_caps.values()):
+        local = _extrusion(segments, prism.height)
+        approximation = 0.0
+        roll = (0.0, 0.0)
+    else:
+        for a, b in zip(segments, segments[1:] + segments[:1]):
+            if _turns(a, b):
+                corner = gp_Pnt(*a.end[:2], 0.0).Transformed(_to_global(frame))
+                raise NoSolutionError(
+                    f"g2_fillet rolls the cap edges along a smooth outline; the side edge at {_where(corner)} is sharp "
+                    "and not chosen (choose it too: a vertex blend of sharp and rounded edges is a later step)"
+                )
+        slab = g2_slab(segments, prism.height, radius, top=chosen_caps["top"], bottom=chosen_caps["bottom"],
+                       transition=transition, shape=shape, tolerance=tolerance, _name="radius")  # fmt: skip
+        local, approximation, roll = slab.shape, slab.approximation, slab.roll
+    placed = BRepBuilderAPI_Transform(local, _to_global(frame), True).Shape()
+    result = TopoDS.Solid_s(placed) if placed.ShapeType() == TopAbs_SOLID else _first_solid(placed)
+    verify_solid(result, "rounded part")
+    return Slab(result, approximation, roll, prism.height)
+
+
+def _turns(before: Segment, after: Segment) -> bool:
+    """Whether the outline turns (a sharp corner) from ``before`` into ``after`` (tangent joints are left alone)."""
+    (tx0, ty0), (tx1, ty1) = before.ends[1][2:4], after.ends[0][2:4]
+    return abs(math.atan2(tx0 * ty1 - ty0 * tx1, tx0 * tx1 + ty0 * ty1)) > TANGENT_TOL
+
+
+def _wires_of(face: TopoDS_Face) -> list[TopoDS_Shape]:
+    found, explorer = [], TopExp_Explorer(face, TopAbs_WIRE)
+    while explorer.More():
+        found.append(explorer.Current())
+        explorer.Next()
+    return found
+
+
+def _first_solid(shape: TopoDS_Shape) -> TopoDS_Solid:
+    explorer = TopExp_Explorer(shape, TopAbs_SOLID)
+    return TopoDS.Solid_s(explorer.Current())
+
+
+def _to_global(frame: gp_Ax3) -> gp_Trsf:
+    trsf = gp_Trsf()
+    trsf.SetTransformation(frame)  # global → local
+    return trsf.Inverted()
+
+
+def _corner_vertices(segments: list[Segment], frame: gp_Ax3, feet: list[gp_Pnt], size: float) -> list[int]:
+    """Indices of the outline vertices under the chosen side edges' ends."""
+    back = gp_Trsf()
+    back.SetTransformation(frame)
+    local = [p.Transformed(back) for p in feet]
+    chosen = []
+    for i, segment in enumerate(segments):
+        x, y = segment.start[:2]
+        if any(abs(p.X() - x) <= 1e-9 * size and abs(p.Y() - y) <= 1e-9 * size and abs(p.Z()) <= 1e-9 * size for p in local):
+            chosen.append(i)
+    return chosen
+
+
+def _extrusion(segments: list[Segment], height: float) -> TopoDS_Shape:
+    face = BRepBuilderAPI_MakeFace(chain_wire(segments), True).Face()
+    solid = BRepPrimAPI_MakePrism(face, gp_Vec(0.0, 0.0, height)).Shape()
+    explorer = TopExp_Explorer(solid, TopAbs_SOLID)
+    result = TopoDS.Solid_s(explorer.Current())
+    if _volume(result) < 0.0:
+        result = TopoDS.Solid_s(result.Reversed())
+    return result
