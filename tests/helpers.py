@@ -292,3 +292,11 @@ def unresolved(dotted: str) -> str | None:
             found = getattr(found, attribute)
         return None
     return f"{dotted}: no such module"
+
+
+def freecad_lib() -> str | None:
+    """The directory holding FreeCAD's Python modules (FreeCAD.so, Import.so), if FreeCAD is installed
+    (they are built for the system Python: run them with /usr/bin/python3 in a child process)."""
+    candidates = [os.environ.get("SPIRAL_CAD_FREECAD_LIB", ""), "/usr/lib/freecad-python3/lib", "/usr/lib/freecad/lib",
+                  "/usr/local/lib/freecad/lib"]  # fmt: skip
+    return next((c for c in candidates if c and (Path(c) / "Import.so").exists()), None)

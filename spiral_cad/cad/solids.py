@@ -191,52 +191,59 @@ def _elevate(points: NDArray[np.float64], times: int) -> NDArray[np.float64]:
     return points
 
 
-def _hermite(f0, d0, s0, f1, d1, s1, h: float) -> NDArray[np.float64]:
-    """Quintic Bézier poles of the curve with value, first and second derivative f, d, s at both ends of a span h."""
-    return np.array([
-        f0,
-        f0 + h * d0 / 5.0,
-        f0 + 2.0 * h * d0 / 5.0 + h * h * s0 / 20.0,
-        f1 - 2.0 * h * d1 / 5.0 + h * h * s1 / 20.0,
-        f1 - h * d1 / 5.0,
-        f1,
-    ])  # fmt: skip
+#: Degree of Ñ over a spiral: three poles at each end fix N, N', N''; the ones between are fitted.
+_DEGREE = 9
 
 
-def _bernstein(poles: NDArray[np.float64], t: NDArray[np.float64]) -> NDArray[np.float64]:
-    n = len(poles) - 1
-    basis = np.stack([math.comb(n, k) * t**k * (1.0 - t) ** (n - k) for k in range(n + 1)], axis=-1)
-    return basis @ poles
+def _basis(n: int, t: NDArray[np.float64]) -> NDArray[np.float64]:
+    """Bernstein basis of degree n at ``t``: (len(t), n + 1)."""
+    return np.stack([math.comb(n, k) * t**k * (1.0 - t) ** (n - k) for k in range(n + 1)], axis=-1)
+
+
+def _matched(jets: tuple[NDArray, ...], exact: NDArray[np.float64], t: NDArray[np.float64], h: float) -> NDArray[np.float64]:
+    """Bézier poles (degree ``_DEGREE``) of the curve with the value, first and second derivative ``jets`` at
+    both ends of a span h (Hermite: the end poles), the poles between fitted to ``exact`` at ``t`` by least squares."""
+    p = _DEGREE
+    (f0, f1), (d0, d1), (s0, s1) = ((x[0], x[1]) for x in jets)
+    head = [f0, f0 + h * d0 / p, f0 + 2.0 * h * d0 / p + h * h * s0 / (p * (p - 1))]
+    tail = [f1 - 2.0 * h * d1 / p + h * h * s1 / (p * (p - 1)), f1 - h * d1 / p, f1]
+    basis = _basis(p, t)
+    fixed = np.array(head + tail)
+    rest = exact - basis[:, [0, 1, 2, p - 2, p - 1, p]] @ fixed
+    inner, *_ = np.linalg.lstsq(basis[:, 3 : p - 2], rest, rcond=None)
+    return np.vstack([head, inner, tail])
 
 
 def _spiral_along(cp: NDArray[np.float64], sigma: float, reach: float, tolerance: float) -> _Along:
-    """A spiral piece with Ñ a C2 quintic B-spline, knots doubled until reach·max|Ñ − N| ≤ tolerance."""
+    """A spiral piece with Ñ a C2 B-spline (Hermite at every knot), knots doubled until reach·max|Ñ − N| ≤ tolerance."""
     spans = 1
+    t = np.linspace(0.0, 1.0, _SAMPLES)
+    check = np.linspace(0.0, 1.0, 2 * _SAMPLES + 1)  # judged between the fitted samples too
     while True:
         breaks = np.linspace(0.0, 1.0, spans + 1)
         n, dn, ddn = (sigma * x for x in _left_normal_jets(cp, breaks))
         a_rows, b_rows, worst = [], [], 0.0
-        t = np.linspace(0.0, 1.0, _SAMPLES)
         for k in range(spans):
             h = breaks[k + 1] - breaks[k]
-            normal_poles = _hermite(n[k], dn[k], ddn[k], n[k + 1], dn[k + 1], ddn[k + 1], h)
-            exact = sigma * _left_normal_jets(cp, breaks[k] + h * t)[0]
-            worst = max(worst, float(np.abs(np.linalg.norm(_bernstein(normal_poles, t) - exact, axis=1)).max()))
-            curve_poles = _elevate(bezier.split(cp, breaks[k], breaks[k + 1]), 2)
+            jets = (n[k : k + 2], dn[k : k + 2], ddn[k : k + 2])
+            normal_poles = _matched(jets, sigma * _left_normal_jets(cp, breaks[k] + h * t)[0], t, h)
+            exact = sigma * _left_normal_jets(cp, breaks[k] + h * check)[0]
+            worst = max(worst, float(np.linalg.norm(_basis(_DEGREE, check) @ normal_poles - exact, axis=1).max()))
+            curve_poles = _elevate(bezier.split(cp, breaks[k], breaks[k + 1]), _DEGREE - 3)
             a_rows.append(curve_poles if k == 0 else curve_poles[1:])
             b_rows.append(normal_poles if k == 0 else normal_poles[1:])
         if reach * worst <= tolerance or spans >= _MAX_SPANS:
             break
         spans *= 2
     if reach * worst > tolerance:
-        raise NoSolutionError(
+        raise NoSolutionError(  # pragma: no cover - the fit converges far below float64 noise for any spiral
             f"the sweep over a spiral deviates {reach * worst:.3g} from the exact one with {spans} spans; "
             f"tolerance {tolerance:.3g} is out of reach (give tolerance ≥ {reach * worst:.3g})"
         )
-    mults = np.full(spans + 1, 5)
-    mults[[0, -1]] = 6
+    mults = np.full(spans + 1, _DEGREE)
+    mults[[0, -1]] = _DEGREE + 1
     a = np.vstack(a_rows)
-    return _Along(5, breaks, mults, np.ones(len(a)), a, np.vstack(b_rows), worst)
+    return _Along(_DEGREE, breaks, mults, np.ones(len(a)), a, np.vstack(b_rows), worst)
 
 
 def _along(segment: Segment, sigma: float, reach: float, tolerance: float) -> _Along:
@@ -284,21 +291,38 @@ class _Section:
     points: NDArray[np.float64]
 
 
+def _spans(degree: int, weights: NDArray[np.float64], *rows: NDArray[np.float64]) -> list[tuple[NDArray, ...]]:
+    """A B-spline whose interior knots all have multiplicity ``degree`` as its Bézier spans: (weights, *rows) each.
+
+    Faces are made one per span pair: OCCT's default area and volume rule does not split a surface at
+    its C0 knots (it is ~1e-4 off there), and the checker then judges each joint as an edge."""
+    count = (len(weights) - 1) // degree
+    return [tuple(x[k * degree : k * degree + degree + 1] for x in (weights, *rows)) for k in range(count)]
+
+
+def _along_spans(along: _Along) -> list[_Along]:
+    return [
+        _Along(along.degree, np.array([0.0, 1.0]), np.array([along.degree + 1] * 2), w, a, b, along.deviation)
+        for w, a, b in _spans(along.degree, along.weights, along.a, along.b)
+    ]
+
+
 def _sections(roll: list[Segment], top: float, bottom: float, height: float) -> list[_Section]:
-    """The bottom roll, the wall and the top roll (the ones of non-zero extent), in the (w, z) plane."""
+    """The Bézier spans of the bottom roll, the wall and the top roll (those of non-zero extent), in the (w, z) plane."""
     curve = chain_to_nurbs(roll) if roll else None
+    ends = np.array([0.0, 1.0]), np.array([4, 4])
     sections = []
     if bottom > 0.0 and curve is not None:
         scale = bottom / float(curve.control_points[-1, 0])
         points = curve.control_points * scale * np.array([1.0, -1.0])  # mirrored: the wall at (0, d) down to (d, 0)
-        sections.append(_Section(3, curve.knots, curve.multiplicities, curve.weights, points))
+        sections += [_Section(3, *ends, w, p) for w, p in _spans(3, curve.weights, points)]
     if height - top - bottom > 0.0:
         wall = np.array([[0.0, bottom], [0.0, height - top]])
         sections.append(_Section(1, np.array([0.0, 1.0]), np.array([2, 2]), np.ones(2), wall))
     if top > 0.0 and curve is not None:
         scale = top / float(curve.control_points[-1, 0])
         points = curve.control_points * scale + np.array([0.0, height])
-        sections.append(_Section(3, curve.knots, curve.multiplicities, curve.weights, points))
+        sections += [_Section(3, *ends, w, p) for w, p in _spans(3, curve.weights, points)]
     return sections
 
 
@@ -397,9 +421,10 @@ def _crossing(polygon: NDArray[np.float64]) -> NDArray[np.float64] | None:
     return result
 
 
-def _check_fit(segments: list[Segment], sigma: float, roll: float, radius: float, name: str) -> None:
+def _check_fit(segments: list[Segment], sigma: float, roll: float, given: Any, name: str) -> None:
     """NoSolutionError unless a roll ``roll`` wide fits inside the outline: below every convex radius of
     curvature (equal only on arcs: a clean pole) and with an inner offset that does not cross itself."""
+    radius = float(given)
     for index, segment in enumerate(segments):
         u = np.linspace(0.0, 1.0, 65)
         bend = float(np.max(sigma * np.broadcast_to(segment.curvature(u), u.shape)))
@@ -409,7 +434,7 @@ def _check_fit(segments: list[Segment], sigma: float, roll: float, radius: float
         exact_pole = isinstance(segment, Arc) and abs(product - 1.0) <= 1e-12
         if product > 1.0 - _FIT_SLACK and not exact_pole:
             raise NoSolutionError(
-                f"{name} {shown(radius)} gives a roll {roll:.6g} wide, not below the outline's smallest convex radius "
+                f"{name} {shown(given)} gives a roll {roll:.6g} wide, not below the outline's smallest convex radius "
                 f"of curvature {1.0 / bend:.6g} (segment {index}, a {type(segment).__name__}): the inner offset "
                 f"would fold; {name} below {radius / product:.6g} fits"
             )
@@ -421,7 +446,7 @@ def _check_fit(segments: list[Segment], sigma: float, roll: float, radius: float
             mid = 0.5 * (low + high)
             low, high = (mid, high) if _crossing(points + sigma * mid * normals) is None else (low, mid)
         raise NoSolutionError(
-            f"{name} {shown(radius)} gives a roll {roll:.6g} wide whose inner offset crosses itself near "
+            f"{name} {shown(given)} gives a roll {roll:.6g} wide whose inner offset crosses itself near "
             f"({place[0]:.6g}, {place[1]:.6g}): the outline is too narrow there; {name} below "
             f"{radius * low / roll:.6g} fits"
         )
@@ -509,7 +534,7 @@ def g2_slab(
     """
     units = length_unit(units)
     segments = outline_segments(outline)
-    height = as_float(height, "height")
+    given_height, height = height, as_float(height, "height")
     if not height > 0.0:
         raise ValueError(f"height must be positive; got {shown(height)}")
     roll = roll_profile(edge_radius, profile=profile, transition=transition, shape=shape)
@@ -518,8 +543,8 @@ def g2_slab(
     if d_top + d_bottom > height * (1.0 + _FIT_SLACK):
         fits = float(edge_radius) * height / (d_top + d_bottom)
         raise NoSolutionError(
-            f"{_name} {shown(edge_radius)} gives rolls {reach:.6g} high; {'both' if top and bottom else 'it'} "
-            f"exceed height {shown(height)}; {_name} up to {fits:.6g} fits"
+            f"{_name} {shown(edge_radius)} gives rolls {reach:.6g} high; {'together they' if top and bottom else 'it'} "
+            f"exceed height {shown(given_height)}; {_name} up to {fits:.6g} fits"
         )
     if d_top + d_bottom > height:
         d_top, d_bottom = (height / 2.0, height / 2.0) if top and bottom else (d_top and height, d_bottom and height)
@@ -529,11 +554,11 @@ def g2_slab(
     sigma = 1.0 if area > 0.0 else -1.0  # the inward normal is the left one of a counterclockwise outline
     reach_max = max(d_top, d_bottom)
     if reach_max > 0.0:
-        _check_fit(segments, sigma, reach_max, float(edge_radius), _name)
+        _check_fit(segments, sigma, reach_max, edge_radius, _name)
     tol = 1e-7 * size if tolerance is None else as_float(tolerance, "tolerance")
     if not tol > 0.0:
         raise ValueError(f"tolerance must be positive; got {shown(tolerance)}")
-    alongs = [_along(s, sigma, reach_max, tol) for s in segments]
+    alongs = [span for s in segments for span in _along_spans(_along(s, sigma, reach_max, tol))]
     sections = _sections(roll, d_top, d_bottom, height)
     degenerate = 1e-9 * size
     faces = [_surface_face(a, sec, degenerate) for a in alongs for sec in sections]
@@ -674,38 +699,39 @@ def fillet_prism_edges(
     size = max(BRepAdaptor_Curve(e).Value(BRepAdaptor_Curve(e).FirstParameter()).Distance(gp_Pnt()) for e in all_edges) + 1.0
     neighbours = TopTools_IndexedDataMapOfShapeListOfShape()
     TopExp.MapShapesAndAncestors_s(solid, TopAbs_EDGE, TopAbs_FACE, neighbours)
-    axis: gp_Dir | None = None
     named = []
-    for k, edge in enumerate(edges):
+    candidates: list[gp_Dir] = []  # prism axes: chosen straight edges meeting perpendicular faces at both ends,
+    for k, edge in enumerate(edges):  # and the normals of planar faces holding chosen edges
         curve = BRepAdaptor_Curve(edge)
         named.append(f"edge {position[k]} at {_where(curve.Value(curve.FirstParameter()))}")
         line = _line_direction(edge)
-        if axis is None and line is not None:  # the axis: a straight edge whose ends both meet a perpendicular face
+        if line is not None:
             ends = [f for f in _faces_of(solid) if (p := _plane(f)) is not None and p.Axis().Direction().IsParallel(line[2], 1e-12)]
             if all(any(_on(f, end, size) for f in ends) for end in line[:2]):
-                axis = line[2]
+                candidates.append(line[2])
+    for face in _faces_of(solid):
+        plane = _plane(face)
+        if plane is not None and any(any(e.IsSame(h) for h in _edges_of(face)) for e in edges):
+            candidates.append(plane.Axis().Direction())
+    ranked = []
+    for candidate in candidates:
+        try:
+            ranked.append((_fit(solid, edges, candidate, named), candidate))
+        except NoSolutionError:
+            continue
+    if not ranked:
+        raise NoSolutionError(
+            f"g2_fillet rounds a solid's straight edges when each end meets a face perpendicular to it (prism side "
+            f"edges) and whole caps of right prisms; {named[0]} is neither (a vertex blend is a later step)"
+        )
+    axis = min(ranked, key=lambda row: row[0])[1]
     sides, caps = [], []
     for k, edge in enumerate(edges):
         line = _line_direction(edge)
-        if axis is not None and line is not None and line[2].IsParallel(axis, 1e-12):
+        if line is not None and line[2].IsParallel(axis, 1e-12):
             sides.append(edge)
         else:
             caps.append((k, edge, named[k]))
-    if axis is None:  # only cap edges chosen: the axis is the normal of a planar face holding the first, if a prism's
-        for face in _faces_of(solid):
-            plane = _plane(face)
-            if plane is not None and any(edges[0].IsSame(h) for h in _edges_of(face)):
-                try:
-                    _prism(solid, plane.Axis().Direction(), named[0])
-                except NoSolutionError:
-                    continue
-                axis = plane.Axis().Direction()
-                break
-    if axis is None:
-        raise NoSolutionError(
-            f"g2_fillet rounds a solid's straight edges when each end meets a face perpendicular to it (prism side "
-            f"edges); {named[0]} does not, and no chosen edge does (a vertex blend is a later step)"
-        )
     prism = _prism(solid, axis, f"edge {position[0]}")
     by_cap = {"bottom": _edges_of(prism.bottom), "top": _edges_of(prism.top)}
     chosen_caps = {}
@@ -752,6 +778,22 @@ def fillet_prism_edges(
     result = TopoDS.Solid_s(placed) if placed.ShapeType() == TopAbs_SOLID else _first_solid(placed)
     verify_solid(result, "rounded part")
     return Slab(result, approximation, roll, prism.height)
+
+
+def _fit(solid: TopoDS_Shape, edges: Sequence[TopoDS_Edge], axis: gp_Dir, named: list[str]) -> tuple:
+    """How well the chosen edges fit a prism along ``axis`` (smaller is better; NoSolutionError: no prism):
+    edges left unexplained, caps chosen in part, then the axis nearest z, y."""
+    prism = _prism(solid, axis, named[0])
+    caps = [_edges_of(prism.bottom), _edges_of(prism.top)]
+    unexplained, partial = 0, 0
+    for edge in edges:
+        line = _line_direction(edge)
+        if not (line is not None and line[2].IsParallel(axis, 1e-12)) and not any(any(edge.IsSame(e) for e in c) for c in caps):
+            unexplained += 1
+    for cap in caps:
+        count = sum(any(edge.IsSame(e) for edge in edges) for e in cap)
+        partial += 0 < count < len(cap)
+    return unexplained, partial, -abs(axis.Z()), -abs(axis.Y())
 
 
 def _turns(before: Segment, after: Segment) -> bool:
