@@ -492,7 +492,7 @@ def _fillet_edges(edges: list[Edge], radius: float, context: Builder | None, **o
 def _part(slab: Slab) -> Part:
     """A ``Part`` of the slab's solid that carries its ``approximation`` (written into STEP descriptions)."""
     result = Part(Compound([Solid(slab.shape)]).wrapped)
-    result.approximation = slab.approximation  # type: ignore[attr-defined]
+    result.approximation = slab.approximation
     return result
 
 

@@ -101,7 +101,13 @@ def wire_path(wire: TopoDS_Wire, frame: gp_Ax3, *, spirals: bool = False) -> tup
             radius = sense * curve.Circle().Radius()
             sweep = abs(t1 - t0)  # circle parameters are angles
             segments.append(Arc((cx, cy), radius, math.atan2(y0 - cy, x0 - cx), sweep))
-        elif spirals and kind == GeomAbs_CurveType.GeomAbs_BezierCurve and curve.Degree() == 3 and not curve.IsRational() and (first, last) == (0.0, 1.0):
+        elif (
+            spirals
+            and kind == GeomAbs_CurveType.GeomAbs_BezierCurve
+            and curve.Degree() == 3
+            and not curve.IsRational()
+            and (first, last) == (0.0, 1.0)
+        ):
             poles = [_local(frame, curve.Bezier().Pole(k)) for k in range(1, 5)]
             lifts += [p[2] for p in poles]
             points = [(x, y) for x, y, _ in (poles[::-1] if reverse else poles)]

@@ -47,24 +47,23 @@ from OCP.BRepBuilderAPI import (
     BRepBuilderAPI_Sewing,
     BRepBuilderAPI_Transform,
 )
-from OCP.BRepExtrema import BRepExtrema_DistShapeShape
-from OCP.BRepPrimAPI import BRepPrimAPI_MakePrism
-from OCP.BRepTools import BRepTools
-from OCP.GeomAbs import GeomAbs_CurveType, GeomAbs_SurfaceType
-from OCP.GeomAdaptor import GeomAdaptor_Surface
-from OCP.TopExp import TopExp
-from OCP.TopTools import TopTools_IndexedDataMapOfShapeListOfShape
 from OCP.BRepCheck import BRepCheck_Analyzer
+from OCP.BRepExtrema import BRepExtrema_DistShapeShape
 from OCP.BRepGProp import BRepGProp
 from OCP.BRepLib import BRepLib
+from OCP.BRepPrimAPI import BRepPrimAPI_MakePrism
+from OCP.BRepTools import BRepTools
 from OCP.Geom import Geom_BSplineCurve, Geom_BSplineSurface
+from OCP.GeomAbs import GeomAbs_CurveType, GeomAbs_SurfaceType
+from OCP.GeomAdaptor import GeomAdaptor_Surface
 from OCP.gp import gp_Ax3, gp_Dir, gp_Pln, gp_Pnt, gp_Trsf, gp_Vec
 from OCP.GProp import GProp_GProps
 from OCP.TColgp import TColgp_Array1OfPnt, TColgp_Array2OfPnt
 from OCP.TColStd import TColStd_Array1OfInteger, TColStd_Array1OfReal, TColStd_Array2OfReal
 from OCP.TopAbs import TopAbs_EDGE, TopAbs_FACE, TopAbs_SHELL, TopAbs_SOLID, TopAbs_WIRE
-from OCP.TopExp import TopExp_Explorer
+from OCP.TopExp import TopExp, TopExp_Explorer
 from OCP.TopoDS import TopoDS, TopoDS_Edge, TopoDS_Face, TopoDS_Shape, TopoDS_Solid
+from OCP.TopTools import TopTools_IndexedDataMapOfShapeListOfShape
 
 from ..core import bezier
 from ..core._inputs import as_float, shown
@@ -127,9 +126,7 @@ def approximation_note(approximation: float, units: str = DEFAULT_UNITS) -> str:
     )
 
 
-def roll_profile(
-    edge_radius: float, *, profile: str = "g2", transition: float = 0.5, shape: str = DEFAULT_SHAPE
-) -> list[Segment]:
+def roll_profile(edge_radius: float, *, profile: str = "g2", transition: float = 0.5, shape: str = DEFAULT_SHAPE) -> list[Segment]:
     """The roll's section in the (w, z) plane: from the wall (0, −d) going up to the top (d, 0) going +w.
 
     Args:

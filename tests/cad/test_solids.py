@@ -179,7 +179,7 @@ def _profile_integrals(roll) -> tuple[float, float, float, float]:
             def point(t, cx=cx, cy=cy, r=r, a0=a0):
                 return [cx + r * mp.cos(a0 + t), cy + r * mp.sin(a0 + t)]
 
-            def speed(t, r=r, a0=a0, sign=math.copysign(1.0, sweep)):
+            def speed(t, r=r, a0=a0):
                 return [-r * mp.sin(a0 + t), r * mp.cos(a0 + t)]
 
             span = [0, sweep]
