@@ -7,6 +7,7 @@ import shutil
 import subprocess
 import sys
 import tempfile
+from functools import partial
 from pathlib import Path
 
 import cadquery as cq
@@ -28,6 +29,28 @@ def first_curve() -> None:
     leave = sc.line_to_circle((300, 150), (-1, -1), (100, 60), 50.0).reversed()
     chain = sc.Chain.join([enter, leave], start=(-20, 0), end=(400, 250), units="mm")
     plot_plan(chain, comb=True).savefig(IMAGES / "first_curve.png")
+
+
+def zebra_pictures() -> None:
+    """Zebra stripes and mean curvature: a box with circular vertical fillets (G1) beside an extruded
+    continuous rectangle (G2), the pictures of the Faces guide."""
+    import build123d as bd
+    from matplotlib.figure import Figure
+
+    from spiral_cad.app.zebra import plot_curvature_map, plot_zebra
+    from spiral_cad.build123d import ContinuousRectangle
+    from spiral_cad.cad.mesh import face_mesh
+
+    parts = {
+        "circular fillets r = 5: G1": face_mesh(bd.fillet(bd.Box(40, 20, 8).edges().filter_by(bd.Axis.Z), 5)),
+        "ContinuousRectangle(40, 20, 5) extruded: G2": face_mesh(bd.extrude(ContinuousRectangle(40, 20, 5), 8)),
+    }
+    view = (1.0, -0.9, 0.45)
+    for name, draw in (("zebra_boxes.png", partial(plot_zebra, stripes=5)), ("zebra_curvature.png", plot_curvature_map)):
+        fig = Figure(figsize=(11, 3.6), dpi=110)
+        for ax, (title, mesh) in zip(fig.subplots(1, 2), parts.items()):
+            draw(mesh, ax=ax, title=title, view=view)
+        fig.savefig(IMAGES / name, bbox_inches="tight")
 
 
 def main() -> None:
@@ -59,6 +82,7 @@ def main() -> None:
         tube = cq.importers.importStep(str(tmp / "cq" / "tube.step"))
         cq.exporters.export(tube, str(IMAGES / "cadquery_tube.svg"), opt={"projectionDir": (0.4, -1.0, 0.5), "showHidden": False})
         first_curve()
+        zebra_pictures()
     for path in sorted(IMAGES.iterdir()):
         print(path.relative_to(ROOT))
 

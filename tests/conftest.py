@@ -94,6 +94,8 @@ SLOW = {
     "test_names.py::test_enormous_names_and_file_names_never_crash_the_iges_writer",
     "test_near_linear.py::test_the_100_kmh_design_file_builds_end_to_end",
     "test_solids.py",
+    "test_faces.py::test_freecad_evaluates_the_same_normals_and_normal_curvatures",
+    "test_faces_cli.py::test_zebra_and_curvature_pictures_are_written_and_tell_g1_from_g2",
 }
 _CAD = re.compile(r"^\s*(?:from|import) (?:build123d|cadquery|OCP)\b|importorskip\([\"'](?:build123d|cadquery|OCP)", re.M)
 _SUBPROCESS = re.compile(r"\bsubprocess\b|sys\.executable")

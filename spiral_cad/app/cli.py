@@ -198,6 +198,7 @@ def _check(args: argparse.Namespace) -> int:
     numpy's warnings about them off the terminal.)
     """
     if Path(args.file).suffix.lower() == ".xodr":
+        _wire_tolerances(args)
         if args.comb:
             print("error: --comb draws STEP/IGES edges; it does not apply to OpenDRIVE", file=sys.stderr)
             return 2
@@ -212,7 +213,34 @@ def _check(args: argparse.Namespace) -> int:
     if find_spec("OCP") is None:
         print(f"error: spiral-cad check reads STEP/IGES with OCCT, which comes with the CAD extra: {PIP_CAD}", file=sys.stderr)
         return 2
+    from ..cad.faces import holds_faces
+
+    if holds_faces(args.file):
+        from .faces_check import check_face_file
+
+        status = check_face_file(args.file, require=args.require, gap_tol=args.gap_tol, angle_tol=args.angle_tol,
+                                 curvature_tol=args.curvature_tol, feature_angle=args.feature_angle, zebra=args.zebra,
+                                 curvature_map=args.curvature_map)  # fmt: skip
+        if status is not None:  # None: the reader found no faces after all, so the wires are judged
+            if args.comb:  # the comb of every edge of the part, in mm as build123d and FreeCAD read
+                from ..cad.continuity import curvature_comb
+                from ..cad.export import export_step
+
+                export_step(curvature_comb(args.file, units="mm"), _comb_path(args.comb, args.file),
+                            name=f"{Path(args.file).name} curvature comb", units="mm")  # fmt: skip
+            return status
+    elif args.zebra or args.curvature_map:
+        print(f"error: --zebra and --curvature-map draw faces; {Path(args.file).name!r} holds none", file=sys.stderr)
+        return 2
+    _wire_tolerances(args)
     return _check_shape_file(args)
+
+
+def _wire_tolerances(args: argparse.Namespace) -> None:
+    """The wire checks' default tolerances where none was given (the face check has its own)."""
+    for name, default in (("gap_tol", 1e-7), ("angle_tol", 1e-7), ("curvature_tol", 1e-6)):
+        if getattr(args, name, None) is None:
+            setattr(args, name, default)
 
 
 def _check_shape_file(args: argparse.Namespace) -> int:
@@ -322,9 +350,14 @@ def _add_check(sub: argparse._SubParsersAction) -> None:
                        help="also write the curvature comb of every edge as STEP (STEP/IGES input; never the checked file)")  # fmt: skip
     check.add_argument("--timing", action="store_true",
                        help="also print where the check spent its time: the reader's share, and whether it limits the check")  # fmt: skip
-    check.add_argument("--gap-tol", type=float, default=1e-7, help="G0 gap, absolute model units (default 1e-7)")
-    check.add_argument("--angle-tol", type=float, default=1e-7, help="G1 tangent angle, radians (default 1e-7)")
-    check.add_argument("--curvature-tol", type=float, default=1e-6, help="G2 curvature jump, relative (default 1e-6)")
+    check.add_argument("--gap-tol", type=float, help="G0 gap, absolute model units (default 1e-7; faces: relative to the model size, 1e-7)")
+    check.add_argument("--angle-tol", type=float, help="G1 tangent angle, radians (default 1e-7; faces: between the normals)")
+    check.add_argument("--curvature-tol", type=float,
+                       help="G2 curvature jump, relative (default 1e-6; faces: normal curvature across the edge, 1e-4)")  # fmt: skip
+    check.add_argument("--feature-angle", type=float,
+                       help="faces: normals further apart (radians) make a sharp feature, listed and not failed (default 5°)")  # fmt: skip
+    check.add_argument("--zebra", metavar="OUT.png", help="faces: also draw zebra stripes (reflection lines) of the part as PNG")
+    check.add_argument("--curvature-map", metavar="OUT.png", help="faces: also draw the mean curvature of the part as PNG")
     check.set_defaults(run=_check)
 
 

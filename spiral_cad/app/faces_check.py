@@ -1,0 +1,69 @@
+"""``spiral-cad check`` on a STEP/IGES file that holds faces: the face-to-face table, the verdict,
+and the zebra and curvature pictures (``--zebra``, ``--curvature-map``)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from ..cad.faces import FEATURE_ANGLE, check_faces
+
+__all__ = ["check_face_file"]
+
+
+def _png(option: str, path: str | None) -> Path | None:
+    """The ``--zebra``/``--curvature-map`` file: a .png path whose folder exists."""
+    if path is None:
+        return None
+    p = Path(path)
+    if p.suffix.lower() != ".png":
+        raise ValueError(f"--{option} {path!r}: the picture is written as PNG; give a .png file")
+    if p.is_dir() or not p.parent.is_dir():
+        raise ValueError(f"--{option} {path!r}: " + ("a folder" if p.is_dir() else f"no folder {str(p.parent)!r}"))
+    return p
+
+
+def check_face_file(file: str, *, require: str | None = None, gap_tol: float | None = None, angle_tol: float | None = None,
+                    curvature_tol: float | None = None, feature_angle: float | None = None, zebra: str | None = None,
+                    curvature_map: str | None = None) -> int | None:  # fmt: skip
+    """Judge the faces of ``file`` and print the table; draw the pictures asked for.
+
+    Tolerances left None take ``check_faces``'s defaults (gap 1e-7 × size, angle 1e-7 rad, curvature jump 1e-4). ``require`` "G2" or "G1" fails any
+    tangent edge below it (and "G0" any gap); sharp features are listed, never failed.
+
+    Returns:
+        0 ok, 1 below ``require``, None when the reader found no faces (the caller judges the wires).
+
+    Raises:
+        ValueError: an unreadable file or a bad option (printed as ``error: …`` by the CLI).
+    """
+    zebra_png, map_png = _png("zebra", zebra), _png("curvature-map", curvature_map)
+    report = check_faces(
+        file,
+        gap_tol=1e-7 if gap_tol is None else gap_tol,
+        angle_tol=1e-7 if angle_tol is None else angle_tol,
+        curvature_tol=1e-4 if curvature_tol is None else curvature_tol,
+        feature_angle=FEATURE_ANGLE if feature_angle is None else feature_angle,
+    )
+    if report.faces == 0:
+        return None
+    print(report.table())
+    if zebra_png is not None or map_png is not None:
+        from ..cad.mesh import face_mesh
+        from .zebra import plot_curvature_map, plot_zebra
+
+        mesh = face_mesh(file, units=report.units)
+        if zebra_png is not None:
+            plot_zebra(mesh, title=f"{report.source}: zebra").savefig(zebra_png, dpi=120, bbox_inches="tight")
+            print(f"zebra stripes written to {zebra_png}")
+        if map_png is not None:
+            plot_curvature_map(mesh, title=f"{report.source}: mean curvature").savefig(map_png, dpi=120, bbox_inches="tight")
+            print(f"curvature map written to {map_png}")
+    if not require:
+        return 0
+    level = "crease" if require == "G0" else require  # a crease is G0, not G1
+    worst = report.worst
+    if worst == "gap" or (level != "crease" and not report.passes(level)):
+        print(f"FAIL: worst tangent edge is {worst}, below the required {require} ({report.describe()})")
+        return 1
+    print(f"OK: {report.describe()}, every tangent edge at least {require}; sharp features listed, not judged")
+    return 0

@@ -1,0 +1,107 @@
+"""``spiral-cad check`` on files that hold faces: verdicts on solids build123d and OCCT wrote,
+sharp features listed and not failed, and the zebra and curvature pictures."""
+
+from __future__ import annotations
+
+import pytest
+
+pytest.importorskip("OCP")
+
+import build123d as bd  # noqa: E402
+import numpy as np  # noqa: E402
+from matplotlib.image import imread  # noqa: E402
+from OCP.IGESControl import IGESControl_Writer  # noqa: E402
+from OCP.Interface import Interface_Static  # noqa: E402
+
+from spiral_cad.app.cli import main  # noqa: E402
+from spiral_cad.build123d import ContinuousRectangle  # noqa: E402
+from spiral_cad.cad.faces import holds_faces  # noqa: E402
+
+
+@pytest.fixture(scope="module")
+def files(tmp_path_factory):
+    """A box with circular vertical fillets (G1), an extruded continuous rectangle (G2), as STEP and IGES."""
+    folder = tmp_path_factory.mktemp("faces")
+    parts = {"box": bd.fillet(bd.Box(40, 20, 8).edges().filter_by(bd.Axis.Z), 5),
+             "slab": bd.extrude(ContinuousRectangle(40, 20, 5), 8)}  # fmt: skip
+    out = {}
+    for name, part in parts.items():
+        out[name] = folder / f"{name}.step"
+        bd.export_step(part, str(out[name]))
+        Interface_Static.SetIVal_s("write.iges.brep.mode", 1)
+        writer = IGESControl_Writer("MM", 1)
+        writer.AddShape(part.wrapped)
+        writer.ComputeModel()
+        out[f"{name}_iges"] = folder / f"{name}.igs"
+        assert writer.Write(str(out[f"{name}_iges"]))
+    return out
+
+
+@pytest.mark.parametrize("suffix", ["", "_iges"])
+def test_check_judges_faces_g1_box_fails_g2_and_passes_g1(files, capsys, suffix):
+    assert main(["check", str(files["box" + suffix]), "--require", "G2"]) == 1
+    text = capsys.readouterr().out
+    assert "10 faces, 24 shared edges (8 G1, 16 sharp); worst tangent edge G1" in text
+    assert "FAIL: worst tangent edge is G1, below the required G2" in text
+    assert main(["check", str(files["box" + suffix]), "--require", "G1"]) == 0
+    assert "OK: 10 faces" in capsys.readouterr().out
+
+
+@pytest.mark.parametrize("suffix", ["", "_iges"])
+def test_check_passes_the_continuous_slab_g2_with_its_sharp_edges_listed(files, capsys, suffix):
+    assert main(["check", str(files["slab" + suffix]), "--require", "G2"]) == 0
+    text = capsys.readouterr().out
+    assert "(16 G2, 32 sharp)" in text and "OK: 18 faces" in text
+    assert "separate pieces" not in text  # the face boundary wires are no longer judged as paths
+
+
+def test_tolerances_and_feature_angle_reach_the_face_check(files, capsys):
+    # a jump of 1 within a curvature tolerance of 2 is G2
+    assert main(["check", str(files["box"]), "--require", "G2", "--curvature-tol", "2"]) == 0
+    assert "curvature jump 2 relative" in capsys.readouterr().out
+    # with the feature angle above a right angle, the box's right-angled edges are creases: defects
+    assert main(["check", str(files["box"]), "--require", "G1", "--feature-angle", "2"]) == 1
+    assert "(16 crease, 8 G1)" in capsys.readouterr().out
+    assert main(["check", str(files["box"]), "--feature-angle", "4"]) == 2
+    assert "error: feature_angle must be" in capsys.readouterr().err
+
+
+def test_wire_files_are_still_judged_joint_by_joint(tmp_path, capsys):
+    path = tmp_path / "wire.step"
+    bd.export_step(bd.Polyline((0, 0), (10, 0), (10, 10)), str(path))
+    assert main(["check", str(path)]) == 0
+    assert "worst joint G0" in capsys.readouterr().out
+    assert main(["check", str(path), "--zebra", str(tmp_path / "z.png")]) == 2
+    assert "holds none" in capsys.readouterr().err
+
+
+def _picture(path):
+    return imread(str(path))[..., :3]
+
+
+def test_zebra_and_curvature_pictures_are_written_and_tell_g1_from_g2(files, tmp_path, capsys):
+    pictures = {}
+    for name in ("box", "slab"):
+        zebra, curvature = tmp_path / f"{name}_zebra.png", tmp_path / f"{name}_curvature.png"
+        assert main(["check", str(files[name]), "--zebra", str(zebra), "--curvature-map", str(curvature)]) == 0
+        pictures[name] = _picture(zebra)
+        assert _picture(curvature).std() > 0.05  # not blank
+    assert f"zebra stripes written to {tmp_path / 'slab_zebra.png'}" in capsys.readouterr().out
+    box, slab = pictures["box"], pictures["slab"]
+    dark = [(p < 0.2).all(axis=2).mean() for p in (box, slab)]
+    assert min(dark) > 0.02 and box.std() > 0.1  # stripes drawn, not a blank page
+    assert box.shape == slab.shape and np.abs(box - slab).mean() > 0.01  # G1 and G2 stripes differ
+
+
+def test_bad_picture_paths_are_errors_not_tracebacks(files, tmp_path, capsys):
+    assert main(["check", str(files["box"]), "--zebra", str(tmp_path / "z.jpg")]) == 2
+    assert "give a .png file" in capsys.readouterr().err
+    assert main(["check", str(files["box"]), "--curvature-map", str(tmp_path / "no" / "c.png")]) == 2
+    assert "error: --curvature-map" in capsys.readouterr().err
+
+
+def test_comb_of_a_face_file_is_written_beside_the_face_verdict(files, tmp_path, capsys):
+    comb = tmp_path / "comb.step"
+    assert main(["check", str(files["box"]), "--require", "G1", "--comb", str(comb)]) == 0
+    assert "OK: 10 faces" in capsys.readouterr().out
+    assert comb.stat().st_size > 1000 and not holds_faces(comb)  # the comb is lines only

@@ -1,0 +1,260 @@
+"""The face-to-face checker on solids that build123d and OCCT made (not spiral_cad's solids), also
+through STEP and IGES files."""
+
+from __future__ import annotations
+
+import json
+import math
+import os
+import subprocess
+import textwrap
+from pathlib import Path
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+pytest.importorskip("OCP")
+
+import build123d as bd  # noqa: E402
+from OCP.IGESControl import IGESControl_Writer  # noqa: E402
+from OCP.Interface import Interface_Static  # noqa: E402
+
+from spiral_cad.build123d import ContinuousRectangle  # noqa: E402
+from spiral_cad.cad.faces import FEATURE_ANGLE, check_faces, holds_faces  # noqa: E402
+from spiral_cad.cad.mesh import face_mesh  # noqa: E402
+
+
+def filleted_box(radius: float = 2.0, length: float = 40.0, width: float = 20.0, height: float = 8.0) -> bd.Part:
+    return bd.fillet(bd.Box(length, width, height).edges().filter_by(bd.Axis.Z), radius)
+
+
+def continuous_slab() -> bd.Part:
+    return bd.extrude(ContinuousRectangle(40, 20, 5), 8)
+
+
+def write_iges(shape, path) -> None:
+    Interface_Static.SetIVal_s("write.iges.brep.mode", 1)  # faces and solids (5.3), not trimmed surfaces only
+    writer = IGESControl_Writer("MM", 1)
+    writer.AddShape(shape.wrapped)
+    writer.ComputeModel()
+    assert writer.Write(str(path))
+
+
+def assert_box_calibration(report, radius: float = 2.0) -> None:
+    assert report.counts == {"gap": 0, "crease": 0, "G1": 8, "G2": 0, "sharp": 16}
+    for edge in report.tangent_edges:
+        assert sorted(edge.surfaces) == ["cylinder", "plane"]
+        assert edge.angle <= 1e-7
+        assert edge.jump == pytest.approx(1.0, abs=1e-9)  # κn 0 against 1/r, relative to 1/r
+        assert sorted(abs(k) for k in edge.curvatures) == pytest.approx([0.0, 1.0 / radius], abs=1e-9)
+    for edge in report.sharp_edges:
+        assert edge.angle == pytest.approx(math.pi / 2, abs=1e-9)
+    assert report.worst == "G1" and report.passes("G1") and not report.passes("G2")
+
+
+def test_box_with_circular_fillets_is_g1_with_a_jump_of_one_and_sixteen_sharp_edges():
+    report = check_faces(filleted_box())
+    assert report.faces == 10 and report.free_edges == 0
+    assert_box_calibration(report)
+    assert report.units == "mm" and report.size == pytest.approx(math.sqrt(40**2 + 20**2 + 8**2), rel=1e-3)
+
+
+def test_extruded_continuous_rectangle_is_g2_with_sharp_top_and_bottom():
+    report = check_faces(continuous_slab())
+    assert report.counts == {"gap": 0, "crease": 0, "G1": 0, "G2": 16, "sharp": 32}
+    assert max(e.jump for e in report.tangent_edges) < 1e-10
+    assert report.worst == "G2" and report.passes("G2")
+    # the spiral faces are B-spline/extrusion surfaces, not only planes and cylinders
+    assert any("extrusion" in e.surfaces or "bspline" in e.surfaces for e in report.tangent_edges)
+
+
+def test_filleted_cylinder_is_g1():
+    report = check_faces(bd.fillet(bd.Cylinder(10, 20).edges(), 2))
+    joins = [e for e in report.edges if not e.seam]
+    assert len(joins) == 4 and all(e.level == "G1" for e in joins)
+    assert all(e.jump == pytest.approx(1.0, abs=1e-6) for e in joins)
+    assert all(e.level == "G2" for e in report.edges if e.seam)  # a closed face meets itself smoothly
+    assert report.worst == "G1"
+
+
+def test_sphere_seam_is_g2_and_its_poles_are_skipped():
+    report = check_faces(bd.Sphere(5))
+    assert report.faces == 1 and len(report.edges) == 1
+    (seam,) = report.edges
+    assert seam.seam and seam.faces == (0, 0) and seam.surfaces == ("sphere", "sphere")
+    assert seam.level == "G2" and seam.curvatures == pytest.approx((-0.2, -0.2))
+
+
+def test_box_is_all_sharp_and_passes():
+    report = check_faces(bd.Box(10, 10, 10))
+    assert report.counts["sharp"] == 12 and not report.tangent_edges
+    assert report.worst == "G2" and report.passes("G2")
+
+
+def test_near_tangent_kink_is_a_crease_and_fails_g1():
+    kink = math.radians(1.0)
+    outline = bd.Polyline((0, 0), (10, 0), (20, 10 * math.tan(kink)), (20, 10), (0, 10), close=True)
+    report = check_faces(bd.extrude(bd.make_face(outline), 5))
+    creases = [e for e in report.edges if e.level == "crease"]
+    assert len(creases) == 1 and creases[0].angle == pytest.approx(kink, rel=1e-9)
+    assert report.worst == "crease" and not report.passes("G1")
+    # the same kink is a feature when the feature threshold is below it
+    assert check_faces(bd.extrude(bd.make_face(outline), 5), feature_angle=kink / 2).passes("G2")
+
+
+@pytest.mark.parametrize("suffix", [".step", ".igs"])
+def test_files_written_by_build123d_and_occt_give_the_same_verdicts(tmp_path, suffix):
+    for name, part, expected in (("box", filleted_box(), {"G1": 8, "sharp": 16}),
+                                 ("slab", continuous_slab(), {"G2": 16, "sharp": 32})):  # fmt: skip
+        path = tmp_path / f"{name}{suffix}"
+        if suffix == ".step":
+            assert bd.export_step(part, str(path))
+        else:
+            write_iges(part, path)
+        report = check_faces(path)
+        assert {k: v for k, v in report.counts.items() if v} == expected, report.table()
+        assert report.source == path.name and report.units == "mm"
+    assert_box_calibration(check_faces(tmp_path / f"box{suffix}"))
+
+
+def test_file_read_in_another_unit_scales_curvature_and_size(tmp_path):
+    path = tmp_path / "box.step"
+    bd.export_step(filleted_box(), str(path))
+    report = check_faces(path, units="cm")
+    assert report.units == "cm" and report.size == pytest.approx(check_faces(path).size / 10, rel=1e-6)  # the box grows by the tolerance
+    assert sorted(abs(k) for k in report.tangent_edges[0].curvatures) == pytest.approx([0.0, 5.0], abs=1e-9)
+
+
+def test_table_lists_every_edge_with_its_class():
+    text = check_faces(filleted_box()).table()
+    assert "10 faces, 24 shared edges (8 G1, 16 sharp); worst tangent edge G1" in text
+    assert text.count("  G1 ") == 8 and text.count("  sharp ") == 16
+    assert "model size 45.4" in text and "mm" in text
+
+
+@pytest.mark.parametrize(
+    "options",
+    [dict(gap_tol=-1.0), dict(angle_tol=math.nan), dict(curvature_tol=math.inf), dict(samples=0), dict(samples=2.5),
+     dict(feature_angle=0.0), dict(feature_angle=4.0)],
+)  # fmt: skip
+def test_bad_options_raise_value_error_naming_them(options):
+    with pytest.raises(ValueError, match=next(iter(options))):
+        check_faces(bd.Box(1, 1, 1), **options)
+
+
+def test_unreadable_file_and_bad_require_raise_value_error(tmp_path):
+    bad = tmp_path / "bad.step"
+    bad.write_text("not a step file\n")
+    with pytest.raises(ValueError, match="bad.step"):
+        check_faces(bad)
+    with pytest.raises(ValueError, match="require"):
+        check_faces(bd.Box(1, 1, 1)).passes("G3")
+
+
+def test_default_feature_angle_is_documented_five_degrees():
+    assert FEATURE_ANGLE == pytest.approx(math.radians(5.0))
+
+
+@settings(max_examples=6, deadline=None)
+@given(radius=st.floats(0.2, 3.9), length=st.floats(20.0, 60.0), width=st.floats(8.0, 30.0))
+def test_any_circular_fillet_of_a_box_is_g1_with_relative_jump_one_never_g2(radius, length, width):
+    report = check_faces(filleted_box(radius, length, width))
+    assert report.counts["G1"] == 8 and report.counts["G2"] == 0
+    assert all(e.jump == pytest.approx(1.0, abs=1e-9) for e in report.tangent_edges)
+    assert not report.passes("G2")
+
+
+# ------------------------------------------------------------ FreeCAD's own evaluation of the same file
+
+
+def _freecad_lib() -> str | None:
+    """The directory holding FreeCAD's Python modules, if FreeCAD is installed."""
+    candidates = [os.environ.get("SPIRAL_CAD_FREECAD_LIB", ""), "/usr/lib/freecad-python3/lib", "/usr/lib/freecad/lib"]
+    return next((c for c in candidates if c and (Path(c) / "Part.so").exists()), None)
+
+
+FREECAD = _freecad_lib()
+#: In FreeCAD (system Python): for each point, the faces through it, each with its oriented normal
+#: (``Face.normalAt``) and its normal curvature across the edge through it, by Euler's formula from
+#: FreeCAD's principal curvatures and directions (``Surface.curvature``, ``Surface.curvatureDirections``).
+FREECAD_SCRIPT = textwrap.dedent(
+    """
+    import json, math, sys
+    sys.path.append(sys.argv[1])
+    import FreeCAD, Part
+    shape = Part.read(sys.argv[2])
+    out = []
+    for x, y, z in json.loads(sys.argv[3]):
+        p = FreeCAD.Vector(x, y, z)
+        vertex = Part.Vertex(p)
+        edge = min(shape.Edges, key=lambda e: e.distToShape(vertex)[0])
+        t = edge.tangentAt(edge.Curve.parameter(p))
+        found = []
+        for face in shape.Faces:
+            if face.distToShape(vertex)[0] > 1e-6:
+                continue
+            u, v = face.Surface.parameter(p)
+            n = face.normalAt(u, v)
+            k1, k2 = face.Surface.curvature(u, v, "Max"), face.Surface.curvature(u, v, "Min")
+            d1, d2 = face.Surface.curvatureDirections(u, v)
+            d = n.cross(t)
+            c = d.normalize().dot(d1.normalize())
+            found.append([n.x, n.y, n.z, abs(k1 * c * c + k2 * (1 - c * c))])
+        out.append(found)
+    print(json.dumps(out))
+    """
+)
+
+
+@pytest.mark.skipif(FREECAD is None, reason="FreeCAD is not installed (Debian/Ubuntu: apt-get install freecad-python3)")
+@pytest.mark.parametrize("name", ["box", "slab"])
+def test_freecad_evaluates_the_same_normals_and_normal_curvatures(tmp_path, name):
+    part = filleted_box() if name == "box" else continuous_slab()
+    path = tmp_path / f"{name}.step"
+    bd.export_step(part, str(path))
+    report = check_faces(path)
+    edges = report.tangent_edges
+    points = [list(e.jump_at) for e in edges]
+    run = subprocess.run(["/usr/bin/python3", "-c", FREECAD_SCRIPT, FREECAD, str(path), json.dumps(points)],
+                         capture_output=True, text=True, timeout=300)  # fmt: skip
+    assert run.returncode == 0, run.stderr[-2000:]
+    for edge, faces in zip(edges, json.loads(run.stdout.splitlines()[-1])):
+        assert len(faces) == 2, f"edge {edge.index}: FreeCAD finds {len(faces)} faces through {edge.jump_at}"
+        na, nb = np.array(faces[0][:3]), np.array(faces[1][:3])
+        ka, kb = faces[0][3], faces[1][3]
+        assert math.acos(min(1.0, float(na @ nb))) <= 1e-7  # FreeCAD's oriented normals agree: tangent
+        assert sorted([ka, kb]) == pytest.approx(sorted(abs(k) for k in edge.curvatures), abs=1e-9)
+        freecad_jump = abs(ka - kb) / max(ka, kb, 1.0 / report.size)
+        assert freecad_jump == pytest.approx(edge.jump, abs=1e-6)
+        assert (freecad_jump > report.curvature_tol) == (edge.level == "G1")
+
+
+# ------------------------------------------------------------ what the CLI and the pictures rest on
+
+
+def test_holds_faces_tells_solid_files_from_wire_files(tmp_path):
+    solid, iges, wire = tmp_path / "solid.step", tmp_path / "solid.igs", tmp_path / "wire.step"
+    bd.export_step(bd.Box(1, 2, 3), str(solid))
+    write_iges(bd.Box(1, 2, 3), iges)
+    bd.export_step(bd.Polyline((0, 0), (1, 0), (1, 1)), str(wire))
+    assert holds_faces(solid) and holds_faces(iges)
+    assert not holds_faces(wire) and not holds_faces(tmp_path / "missing.step") and not holds_faces(tmp_path)
+
+
+def test_mesh_normals_and_curvatures_are_the_surfaces(tmp_path):
+    mesh = face_mesh(bd.Sphere(5), angle=0.2)
+    radial = mesh.points / np.linalg.norm(mesh.points, axis=1)[:, None]
+    assert np.abs(np.einsum("ij,ij->i", mesh.normals, radial) - 1.0).max() < 1e-12  # outward, exact
+    assert mesh.mean_curvature == pytest.approx(0.2, abs=1e-9) and mesh.gaussian_curvature == pytest.approx(0.04, abs=1e-9)
+    # triangles wind counter-clockwise seen from outside, on a reversed face too
+    box = face_mesh(filleted_box(), angle=0.2)
+    a, b, c = (box.points[box.triangles[:, i]] for i in range(3))
+    assert (np.einsum("ij,ij->i", np.cross(b - a, c - a), box.normals[box.triangles].mean(axis=1)) > 0).all()
+    assert sorted(set(np.round(box.mean_curvature, 9))) == pytest.approx([0.0, 0.25])  # planes, r = 2 fillets (1/2r)
+    path = tmp_path / "box.step"
+    bd.export_step(filleted_box(), str(path))
+    assert face_mesh(path, units="cm", angle=0.2).size == pytest.approx(box.size / 10, rel=1e-9)
+    with pytest.raises(ValueError, match="no faces"):
+        face_mesh(bd.Polyline((0, 0, 0), (1, 0, 0)))
