@@ -67,7 +67,7 @@ from OCP.TopTools import TopTools_IndexedDataMapOfShapeListOfShape
 
 from ..core import bezier
 from ..core._inputs import as_float, shown
-from ..core.chain import Chain
+from ..core.chain import JOIN_TOLERANCE, Chain, g2_mismatch
 from ..core.errors import NoSolutionError
 from ..core.nurbs import chain_to_nurbs
 from ..core.segments import Arc, Line, Segment
@@ -78,7 +78,18 @@ from ..design.fillets import TANGENT_TOL, corner_distance, fillet_path
 from .fillet import wire_path
 from .occ import chain_wire
 
-__all__ = ["PROFILES", "Slab", "approximation_note", "fillet_prism_edges", "g2_slab", "outline_segments", "roll_profile", "verify_solid"]
+__all__ = [
+    "PROFILES",
+    "Slab",
+    "approximation_note",
+    "fillet_prism_edges",
+    "g2_slab",
+    "outline_segments",
+    "expected_level",
+    "roll_profile",
+    "verify_faces",
+    "verify_solid",
+]
 
 #: Roll profiles: the G2 corner (line → spiral → arc → spiral → line) or a quarter circle.
 PROFILES = ("g2", "circular")
@@ -489,6 +500,34 @@ def verify_solid(shape: TopoDS_Shape, what: str = "slab") -> None:
         raise NoSolutionError(f"the {what} encloses no volume ({props.Mass():.3g})")
 
 
+def expected_level(segments: Sequence[Segment], profile: str = "g2") -> str:
+    """The continuity the construction promises for tangent edges: ``"G2"`` for a G2 profile along an
+    outline whose tangent joints are all G2, else ``"G1"`` (circular profiles, circularly filleted outlines)."""
+    if profile != "g2":
+        return "G1"
+    for index, (a, b) in enumerate(zip(segments, [*segments[1:], segments[0]])):
+        if not _turns(a, b) and g2_mismatch(a, b, JOIN_TOLERANCE, index=index) is not None:
+            return "G1"
+    return "G2"
+
+
+def verify_faces(shape: TopoDS_Shape, level: str, what: str = "slab", units: str = DEFAULT_UNITS) -> None:
+    """NoSolutionError unless the face checker (``spiral_cad.cad.faces.check_faces``, default tolerances:
+    normals ≤ 1e-7 rad, normal-curvature jump ≤ 1e-4 relative, gaps ≤ 1e-7 × size) finds every tangent
+    edge at least ``level`` and no gap; sharp edges are features, listed there and not failed."""
+    from .faces import check_faces  # late: the checker reads files through this layer's readers
+
+    report = check_faces(shape, units=units)
+    if report.passes(level):
+        return
+    worst = min(report.edges, key=lambda e: (e.level == "sharp", e.level == level, -e.jump, -e.angle))
+    raise NoSolutionError(
+        f"the {what} is refused: the face checker finds edge {worst.index} ({worst.surfaces[0]}–{worst.surfaces[1]}) "
+        f"{worst.level}, not {level} (gap {worst.gap:.3g}, normal angle {worst.angle:.3g} rad, relative curvature "
+        f"jump {worst.jump:.3g} at {worst.jump_at}); {report.describe()}"
+    )
+
+
 def g2_slab(
     outline: Any,
     height: float,
@@ -520,7 +559,9 @@ def g2_slab(
         units: the unit of the numbers (kept for the files written).
 
     Returns:
-        The ``Slab``: the solid and the measured approximation.
+        The ``Slab``: the solid and the measured approximation. It is verified as returned: one valid
+        closed solid (``BRepCheck_Analyzer``), and the face checker finds every edge G2 (G1 for a
+        circular profile or an outline with G1 joints) or a sharp feature (unrolled edges).
 
     Raises:
         ValueError: malformed input.
@@ -563,6 +604,7 @@ def g2_slab(
     faces.append(_cap(alongs, d_bottom, 0.0))
     solid = _solid(faces, 1e-7 * size)
     verify_solid(solid)
+    verify_faces(solid, expected_level(segments, profile), units=units)
     approximation = reach_max * max(a.deviation for a in alongs)
     return Slab(solid, approximation, (d_top, d_bottom), height, units)
 
@@ -774,6 +816,7 @@ def fillet_prism_edges(
     placed = BRepBuilderAPI_Transform(local, _to_global(frame), True).Shape()
     result = TopoDS.Solid_s(placed) if placed.ShapeType() == TopAbs_SOLID else _first_solid(placed)
     verify_solid(result, "rounded part")
+    verify_faces(result, expected_level(segments), "rounded part")
     return Slab(result, approximation, roll, prism.height)
 
 

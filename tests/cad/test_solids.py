@@ -412,3 +412,17 @@ def test_plain_wires_and_sketch_outlines_are_accepted():
     from_face = g2_slab(ContinuousRectangle(30, 20, 5).faces()[0], 6, 1)
     assert from_sketch.volume == pytest.approx(from_face.volume, rel=1e-12)
     assert all(isinstance(s, BezierSpiral) for s in roll_profile(1)[::2])
+
+
+def test_the_face_checker_finds_every_edge_g2_and_the_verification_refuses_a_g1_solid():
+    from spiral_cad.cad.faces import check_faces
+    from spiral_cad.cad.solids import verify_faces
+
+    report = check_faces(ContinuousBox(40, 20, 8, 6, edge_radius=1.5))
+    assert report.counts["G2"] == len(report.edges) and report.passes("G2")
+    sides = check_faces(g2_fillet(Box(40, 20, 8).edges().filter_by(Axis.Z), 3))
+    assert sides.counts["G2"] == 16 and sides.counts["sharp"] == 32
+    circular = fillet(Box(40, 20, 8).edges(), 3)
+    with pytest.raises(NoSolutionError, match=r"refused: the face checker finds edge \d+ .* G1, not G2"):
+        verify_faces(circular.wrapped, "G2", "box")
+    verify_faces(circular.wrapped, "G1", "box")
