@@ -60,7 +60,7 @@ from OCP.TopoDS import TopoDS
 from .cad.corridor import Corridor, centerline_wire, corridor
 from .cad.fillet import fillet_face, fillet_wire, planar_frame
 from .cad.occ import chain_wire, plane_ax3, segment_edges
-from .cad.solids import Slab, fillet_prism_edges, roll_profile
+from .cad.solids import Slab, continuous_box, fillet_prism_edges
 from .cad.solids import g2_slab as _slab
 from .core.chain import Chain
 from .core.segments import Segment
@@ -596,13 +596,8 @@ class ContinuousBox(BasePartObject):
                  align: Align | tuple[Align, Align, Align] | None = (Align.CENTER, Align.CENTER, Align.CENTER),
                  mode: Mode = Mode.ADD):  # fmt: skip
         self.length, self.width, self.box_height = length, width, height
-        plan = continuous_rectangle(length, width, radius, transition, shape=shape)
-        if edge_radius is None:  # a roll half as wide as the plan radius and the half height allow
-            unit = float(roll_profile(1.0, profile=profile, transition=transition, shape=shape)[-1].end[0])
-            edge_radius = 0.5 * min(float(radius), float(height) / 2.0) / unit
-        self.edge_radius = edge_radius
-        self.slab = _slab(plan, height, edge_radius, top=top, bottom=bottom, profile=profile, transition=transition,
-                          shape=shape, tolerance=tolerance)  # fmt: skip
+        self.slab = continuous_box(length, width, height, radius, edge_radius, transition=transition, shape=shape,
+                                   profile=profile, top=top, bottom=bottom, tolerance=tolerance)  # fmt: skip
         self.approximation = self.slab.approximation
         solid = Solid(self.slab.shape)
         if align is not None:  # the box's extent is known: OCCT's optimal bounding box of the sweeps costs seconds

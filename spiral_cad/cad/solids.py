@@ -74,7 +74,7 @@ from ..core.segments import Arc, Line, Segment
 from ..core.shapes import DEFAULT_SHAPE
 from ..core.spiral import BezierSpiral
 from ..core.units import DEFAULT_UNITS, length_unit
-from ..design.fillets import TANGENT_TOL, corner_distance, fillet_path
+from ..design.fillets import TANGENT_TOL, continuous_rectangle, corner_distance, fillet_path
 from .fillet import wire_path
 from .occ import chain_wire
 
@@ -498,6 +498,32 @@ def verify_solid(shape: TopoDS_Shape, what: str = "slab") -> None:
     BRepGProp.VolumeProperties_s(shape, props)
     if not props.Mass() > 0.0:
         raise NoSolutionError(f"the {what} encloses no volume ({props.Mass():.3g})")
+
+
+def continuous_box(
+    length: float,
+    width: float,
+    height: float,
+    radius: float,
+    edge_radius: float | None = None,
+    *,
+    transition: float = 0.5,
+    shape: str = DEFAULT_SHAPE,
+    profile: str = "g2",
+    top: bool = True,
+    bottom: bool = True,
+    tolerance: float | None = None,
+    units: str = DEFAULT_UNITS,
+) -> Slab:
+    """A box with every edge and corner G2: ``g2_slab`` of a ``continuous_rectangle`` (centred on the origin,
+    z from 0 to ``height``). ``edge_radius`` None: the roll half as wide as the smaller of ``radius`` and
+    ``height``/2 allows. Other arguments and errors as ``g2_slab`` and ``continuous_rectangle``."""
+    plan = continuous_rectangle(length, width, radius, transition, units=units, shape=shape)
+    if edge_radius is None:  # the roll's extent is proportional to its radius
+        unit = float(roll_profile(1.0, profile=profile, transition=transition, shape=shape)[-1].end[0])
+        edge_radius = 0.5 * min(as_float(radius, "radius"), as_float(height, "height") / 2.0) / unit
+    return g2_slab(plan, height, edge_radius, top=top, bottom=bottom, profile=profile, transition=transition,
+                   shape=shape, tolerance=tolerance, units=units)  # fmt: skip
 
 
 def expected_level(segments: Sequence[Segment], profile: str = "g2") -> str:

@@ -426,3 +426,19 @@ def test_the_face_checker_finds_every_edge_g2_and_the_verification_refuses_a_g1_
     with pytest.raises(NoSolutionError, match=r"refused: the face checker finds edge \d+ .* G1, not G2"):
         verify_faces(circular.wrapped, "G2", "box")
     verify_faces(circular.wrapped, "G1", "box")
+
+
+def test_cadquery_continuous_box_is_the_same_solid_placed_like_box():
+    import cadquery as cq
+
+    import spiral_cad.cadquery  # noqa: F401  (registers the methods)
+
+    solid = cq.Workplane("XY").continuousBox(40, 20, 8, 6, 1.5).val()
+    assert solid.isValid()
+    ours = ContinuousBox(40, 20, 8, 6, edge_radius=1.5)
+    assert solid.Volume() == pytest.approx(ours.volume, rel=1e-12)
+    bb = solid.BoundingBox()
+    assert (bb.zmin, bb.zmax) == pytest.approx((-4, 4), abs=1e-6)
+    corners = cq.Workplane("XY").rect(100, 100, forConstruction=True).vertices().continuousBox(10, 10, 4, 2, centered=False)
+    assert len(corners.val().Solids()) == 4
+    assert corners.val().BoundingBox().xmin == pytest.approx(-50, abs=1e-6)
