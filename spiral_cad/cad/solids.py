@@ -399,7 +399,7 @@ def outline_segments(outline: Any) -> list[Segment]:
     return segments
 
 
-def _samples(segments: list[Segment], count: int = 64) -> tuple[NDArray, NDArray, NDArray]:
+def _samples(segments: list[Segment], count: int = 24) -> tuple[NDArray, NDArray, NDArray]:
     """Points, left normals and curvatures at ``count`` parameters per segment (closing point excluded)."""
     u = np.linspace(0.0, 1.0, count, endpoint=False)
     points = np.vstack([s.point(u)[:, :2] for s in segments])
