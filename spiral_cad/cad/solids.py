@@ -97,6 +97,8 @@ PROFILES = ("g2", "circular")
 _FIT_SLACK = 1e-12
 #: Most Hermite spans over one spiral before the tolerance counts as unreachable.
 _MAX_SPANS = 256
+#: A joint of the outline turning more than this (radians) is a corner no roll can follow.
+_CORNER_TOL = 1e-7
 #: Samples per Hermite span when measuring |Ñ − N|.
 _SAMPLES = 48
 
@@ -396,6 +398,14 @@ def outline_segments(outline: Any) -> list[Segment]:
     gap = math.dist(segments[-1].end[:2], segments[0].start[:2])
     if gap > 1e-9 * size:
         raise ValueError(f"outline must be closed; its end is {gap:.3g} from its start")
+    for index, (a, b) in enumerate(zip(segments, [*segments[1:], segments[0]])):
+        (x, y, tx0, ty0, _), (_, _, tx1, ty1, _) = a.ends[1], b.ends[0]
+        turn = abs(math.atan2(tx0 * ty1 - ty0 * tx1, tx0 * tx1 + ty0 * ty1))
+        if turn > _CORNER_TOL:
+            raise ValueError(
+                f"outline must be tangent at every joint (a roll cannot follow a corner); the joint after segment "
+                f"{index} at ({x:.6g}, {y:.6g}) turns {turn:.3g} rad: round it first (g2_fillet, fillet_path)"
+            )
     return segments
 
 

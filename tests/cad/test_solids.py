@@ -260,14 +260,24 @@ def test_circular_profile_with_equal_radii_is_the_ordinary_filleted_box():
     assert worst <= 1e-9 * length
 
 
+def _peanut() -> list:
+    """Two convex arcs of radius 10 joined G1 by concave arcs of radius 3: a waist 4 wide (centres (0, ±5))."""
+    t = math.atan2(5, -12)  # the tangent points lie on the lines between the centres
+    return [Arc((12, 0), 10, -t, 2 * t), Arc((0, 5), -3, math.atan2(-5, 12), 2 * t - math.pi),
+            Arc((-12, 0), 10, math.atan2(5, 12), 2 * t), Arc((0, -5), -3, math.atan2(5, -12), 2 * t - math.pi)]  # fmt: skip
+
+
 def test_refusals_name_the_value_and_what_fits():
     with pytest.raises(NoSolutionError, match=r"edge_radius 5 .* smallest convex radius of curvature 6 .*edge_radius below"):
         ContinuousBox(40, 20, 30, 6, edge_radius=5)
     with pytest.raises(NoSolutionError, match=r"exceed height 2; edge_radius up to"):
         ContinuousBox(40, 20, 2, 6, edge_radius=1.5)
-    neck = [(0, 0), (30, 0), (30, 10), (16, 10), (16, 2), (14, 2), (14, 10), (0, 10)]  # a slot 2 wide: concave
-    with pytest.raises(NoSolutionError, match=r"edge_radius .* inner offset crosses itself .* edge_radius below"):
-        g2_slab([Line(a, b) for a, b in zip(neck, neck[1:] + neck[:1])], 10, 0.2, profile="circular")
+    with pytest.raises(NoSolutionError, match=r"edge_radius 2.5 .* inner offset crosses itself .* edge_radius below 2 fits"):
+        g2_slab(_peanut(), 10, 2.5, profile="circular")  # its waist is 4 wide
+    assert g2_slab(_peanut(), 10, 1.9, profile="circular").is_valid
+    square = [(0, 0), (10, 0), (10, 10), (0, 10)]
+    with pytest.raises(ValueError, match=r"tangent at every joint .*; the joint after segment 0 at \(10, 0\) turns 1.57"):
+        g2_slab([Line(a, b) for a, b in zip(square, square[1:] + square[:1])], 5, 1)
     with pytest.raises(ValueError, match="closed"):
         g2_slab([Line((0, 0), (1, 0)), Line((1, 0), (1, 1))], 1, 0.1)
 
@@ -378,6 +388,10 @@ def test_step_file_carries_the_approximation_and_reads_back_as_one_solid(tmp_pat
     shape = reader.OneShape()
     _assert_one_valid_solid(shape)
     assert _props(shape)[0] == pytest.approx(box.volume, rel=1e-9)
+    from spiral_cad.cad.faces import check_faces
+
+    report = check_faces(path)  # the file as another program reads it: every edge still G2
+    assert report.units == "mm" and report.passes("G2") and report.counts["G2"] == len(report.edges)
 
 
 FREECAD = freecad_lib()
