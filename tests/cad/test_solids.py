@@ -456,3 +456,15 @@ def test_cadquery_continuous_box_is_the_same_solid_placed_like_box():
     corners = cq.Workplane("XY").rect(100, 100, forConstruction=True).vertices().continuousBox(10, 10, 4, 2, centered=False)
     assert len(corners.val().Solids()) == 4
     assert corners.val().BoundingBox().xmin == pytest.approx(-50, abs=1e-6)
+
+
+def test_side_edges_of_a_concave_prism_round_to_the_extruded_2d_g2_corners():
+    from spiral_cad.design.fillets import fillet_path
+
+    l_shape = [(0, 0), (30, 0), (30, 10), (10, 10), (10, 25), (0, 25)]  # one reflex (concave) corner at (10, 10)
+    rounded = g2_fillet(_prism(l_shape, 6).edges().filter_by(Axis.Z), 2)
+    _assert_one_valid_solid(rounded.wrapped)
+    _assert_g2_edges(rounded.wrapped, sharp=0.1)
+    plan = fillet_path([*l_shape, l_shape[0]], 2, closed=True)
+    area, _ = _outline_integrals(list(plan.segments))
+    assert _props(rounded.wrapped)[0] == pytest.approx(6 * area, rel=1e-9)
