@@ -519,8 +519,8 @@ def g2_slab(
     Args:
         outline: a ``ContinuousRectangle``/``ContinuousPolygon``/``ContinuousSlot``, a
             closed ``Chain``, a ``FilletedPath`` or segments (in the XY plane), or a
-            planar face or closed wire of lines, arcs and cubic Bézier spirals
-            (``g2_fillet`` output) lying in the XY plane.
+            planar face, one-face sketch or closed wire of lines, arcs and cubic Bézier
+            spirals (``g2_fillet`` output) lying in the XY plane.
         height: the part's height.
         edge_radius: the roll's smallest radius of curvature.
         top, bottom: roll the top / bottom edge. Default True.
@@ -532,6 +532,10 @@ def g2_slab(
         ValueError: malformed input.
         NoSolutionError: the roll does not fit (named, with what would fit).
     """
+    if isinstance(outline, Sketch) and not hasattr(outline, "filleted"):
+        if len(outline.faces()) != 1:
+            raise ValueError(f"g2_slab takes a sketch of one face; this one has {len(outline.faces())}")
+        outline = outline.faces()[0]
     if isinstance(outline, (Face, Wire)) and not hasattr(outline, "filleted"):
         outline = _plane_outline(outline)
     slab = _slab(outline, height, edge_radius, top=top, bottom=bottom, profile=profile, transition=transition,

@@ -18,7 +18,7 @@ import textwrap
 import mpmath as mp
 import numpy as np
 import pytest
-from build123d import Align, Axis, Box, BuildPart, BuildSketch, Cone, Cylinder, Part, Polygon, extrude, fillet
+from build123d import Align, Axis, Box, BuildPart, BuildSketch, Cone, Cylinder, Part, Polygon, Rectangle, extrude, fillet
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 from OCP.BRep import BRep_Tool
@@ -425,6 +425,8 @@ def test_plain_wires_and_sketch_outlines_are_accepted():
     from_sketch = g2_slab(ContinuousRectangle(30, 20, 5), 6, 1)
     from_face = g2_slab(ContinuousRectangle(30, 20, 5).faces()[0], 6, 1)
     assert from_sketch.volume == pytest.approx(from_face.volume, rel=1e-12)
+    rounded = g2_fillet(Rectangle(30, 20), 5)  # build123d's own sketch, rounded G2: the same outline
+    assert g2_slab(rounded, 6, 1).volume == pytest.approx(from_sketch.volume, rel=1e-12)
     assert all(isinstance(s, BezierSpiral) for s in roll_profile(1)[::2])
 
 
