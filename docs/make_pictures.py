@@ -58,6 +58,28 @@ def zebra_pictures() -> None:
     fig.savefig(IMAGES / "zebra_corners.png", bbox_inches="tight")
 
 
+def solids_pictures() -> None:
+    """The G2 solids tutorial's picture: zebra stripes on a ContinuousBox beside build123d's box with
+    circular fillets of the same radii (the stripes kink at every G1 edge, not at the G2 ones)."""
+    import build123d as bd
+    from matplotlib.figure import Figure
+
+    from spiral_cad.app.zebra import plot_zebra
+    from spiral_cad.build123d import ContinuousBox
+    from spiral_cad.cad.mesh import face_mesh
+
+    circular = bd.fillet(bd.Box(40, 20, 8).edges().filter_by(bd.Axis.Z), 6)
+    circular = bd.fillet(circular.edges().filter_by(bd.Axis.Z, reverse=True), 1.5)
+    parts = {
+        "build123d Box + fillet (6, then 1.5): G1": face_mesh(circular),
+        "ContinuousBox(40, 20, 8, 6, edge_radius=1.5): G2": face_mesh(ContinuousBox(40, 20, 8, 6, edge_radius=1.5)),
+    }
+    fig = Figure(figsize=(11, 3.6), dpi=110)
+    for ax, (title, mesh) in zip(fig.subplots(1, 2), parts.items()):
+        plot_zebra(mesh, ax=ax, title=title, view=(1.0, -0.9, 0.7), stripes=6)
+    fig.savefig(IMAGES / "solids_zebra.png", bbox_inches="tight")
+
+
 def main() -> None:
     IMAGES.mkdir(parents=True, exist_ok=True)
     with tempfile.TemporaryDirectory() as tmp:
@@ -90,6 +112,7 @@ def main() -> None:
         cq.exporters.export(tube, str(IMAGES / "cadquery_tube.svg"), opt={"projectionDir": (0.4, -1.0, 0.5), "showHidden": False})
         first_curve()
         zebra_pictures()
+        solids_pictures()
     for path in sorted(IMAGES.iterdir()):
         print(path.relative_to(ROOT))
 

@@ -25,19 +25,25 @@ from typing import Any
 from build123d import (
     Align,
     BaseLineObject,
+    BasePartObject,
     BaseSketchObject,
     Builder,
     BuildLine,
+    BuildPart,
     BuildSketch,
     Compound,
     Curve,
     Edge,
     Face,
+    Location,
     Mode,
+    Part,
     Plane,
+    RotationLike,
     Shape,
     Sketch,
     SkipClean,
+    Solid,
     Vector,
     VectorLike,
     Vertex,
@@ -54,6 +60,8 @@ from OCP.TopoDS import TopoDS
 from .cad.corridor import Corridor, centerline_wire, corridor
 from .cad.fillet import fillet_face, fillet_wire, planar_frame
 from .cad.occ import chain_wire, plane_ax3, segment_edges
+from .cad.solids import Slab, continuous_box, fillet_prism_edges
+from .cad.solids import g2_slab as _slab
 from .core.chain import Chain
 from .core.segments import Segment
 from .core.shapes import DEFAULT_SHAPE
@@ -64,6 +72,7 @@ from .design.rounding import curvature_bound, fillet_polyline, round_corners
 __all__ = [
     "chain_edges",
     "chain_to_wire",
+    "ContinuousBox",
     "ContinuousPolygon",
     "ContinuousRectangle",
     "ContinuousSlot",
@@ -78,6 +87,7 @@ __all__ = [
     "corridor",
     "curvature_comb",
     "g2_fillet",
+    "g2_slab",
 ]
 
 
@@ -359,13 +369,13 @@ def _points(vertices) -> list[tuple[float, float, float]] | None:
 
 
 def g2_fillet(
-    target: Wire | Face | Sketch | Curve | Vertex | Iterable[Vertex],
+    target: Wire | Face | Sketch | Curve | Vertex | Iterable[Vertex] | Edge | Iterable[Edge],
     radius: float,
     vertices: Iterable[Vertex] | None = None,
     transition: float = 0.5,
     same_sense: str = "nested",
     shape: str = DEFAULT_SHAPE,
-) -> Wire | Face | Sketch | Curve:
+) -> Wire | Face | Sketch | Curve | Part:
     """Operation: G2 Fillet
 
     Round corners with curvature-continuous fillets ("continuous corners"):
@@ -380,8 +390,17 @@ def g2_fillet(
     ``sketch.vertices()``), it rounds those vertices of the builder's object
     and replaces it (``Mode.REPLACE``).
 
+    Given straight edges of a solid (``part.edges().filter_by(Axis.Z)``), as
+    build123d's ``fillet`` takes them, it returns the part rounded G2: side
+    edges of a right prism (between two planar faces, any dihedral angle,
+    convex or concave, each end meeting a cap perpendicular to it) become
+    exact extrusions of the 2-D G2 corner; when every edge of a cap is chosen
+    too, the cap's edge is rolled by the G2 profile of the same radius
+    (``g2_slab``). Inside ``BuildPart`` the builder's part is replaced.
+
     Args:
-        target: the shape to round, or the vertices to round in a builder.
+        target: the shape to round, the vertices to round in a builder, or
+            the edges of a part to round.
         radius (float): the smallest radius of curvature in each corner.
         vertices (Iterable[Vertex], optional): corners to round; default all.
         transition (float, optional): share of each corner's turn made by the
@@ -395,9 +414,14 @@ def g2_fillet(
         ValueError: a solid or shell (round one of its faces, or use build123d's
             ``fillet`` on its edges), non-planar input, edges other than lines
             and arcs, or edges that belong to no wire or face.
-        NoSolutionError: a corner that cannot be rounded (named, with numbers).
+        NoSolutionError: a corner that cannot be rounded (named, with numbers);
+            solid edges that are not a prism's straight side edges or whole caps
+            (named by edge and point: a vertex blend is a later step).
     """
     context: Builder | None = Builder._get_context("g2_fillet")
+    edges = _solid_edges(target)
+    if edges is not None:
+        return _fillet_edges(edges, radius, context, transition=transition, same_sense=same_sense, shape=shape)
     in_builder = isinstance(target, Vertex) or (isinstance(target, Iterable) and not isinstance(target, (Shape, str, bytes)))
     if in_builder:
         _points(target)  # only vertices select corners of a builder's object
@@ -438,6 +462,155 @@ def g2_fillet(
         assert context is not None  # checked above: vertices need a builder
         context._add_to_context(result, mode=Mode.REPLACE)
     return result
+
+
+def _solid_edges(target: Any) -> list[Edge] | None:
+    """The edges of ``target`` when it is an edge or edges (a solid's, for ``g2_fillet``), else None."""
+    if isinstance(target, Edge):
+        return [target]
+    if isinstance(target, Iterable) and not isinstance(target, (Shape, str, bytes)):
+        items = list(flatten_sequence(target))
+        if items and all(isinstance(item, Edge) for item in items):
+            return items
+    return None
+
+
+def _fillet_edges(edges: list[Edge], radius: float, context: Builder | None, **options: Any) -> Part:
+    """``g2_fillet`` of a part's straight edges: the rounded part (the builder's part replaced in ``BuildPart``)."""
+    part = context._obj if isinstance(context, BuildPart) else edges[0].topo_parent
+    if part is None or not part.solids():
+        raise ValueError("g2_fillet of edges needs edges of a part (from part.edges(), or inside BuildPart)")
+    if len(part.solids()) != 1:
+        raise ValueError(f"g2_fillet of edges rounds one solid; the part has {len(part.solids())}")
+    slab = fillet_prism_edges(part.solids()[0].wrapped, [e.wrapped for e in edges], radius, **options)
+    result = _part(slab)
+    if isinstance(context, BuildPart):
+        context._add_to_context(result, mode=Mode.REPLACE)
+    return result
+
+
+def _part(slab: Slab) -> Part:
+    """A ``Part`` of the slab's solid that carries its ``approximation`` (written into STEP descriptions)."""
+    result = Part(Compound([Solid(slab.shape)]).wrapped)
+    result.approximation = slab.approximation
+    return result
+
+
+def g2_slab(
+    outline: Any,
+    height: float,
+    edge_radius: float,
+    *,
+    top: bool = True,
+    bottom: bool = True,
+    profile: str = "g2",
+    transition: float = 0.5,
+    shape: str = DEFAULT_SHAPE,
+    tolerance: float | None = None,
+) -> Part:
+    """A closed G2 outline extruded along +z by ``height`` with its top and bottom edges rolled G2.
+
+    The roll (line → spiral → arc → spiral → line in the vertical section,
+    smallest radius of curvature ``edge_radius``) is swept along the outline:
+    exact over its lines and arcs, over spirals within ``tolerance`` (the
+    measured deviation is the part's ``approximation`` attribute and goes into
+    the STEP description). See ``spiral_cad.cad.solids.g2_slab``.
+
+    Args:
+        outline: a ``ContinuousRectangle``/``ContinuousPolygon``/``ContinuousSlot``, a
+            closed ``Chain``, a ``FilletedPath`` or segments (in the XY plane), or a
+            planar face, one-face sketch or closed wire of lines, arcs and cubic Bézier
+            spirals (``g2_fillet`` output) lying in the XY plane.
+        height: the part's height.
+        edge_radius: the roll's smallest radius of curvature.
+        top, bottom: roll the top / bottom edge. Default True.
+        profile: ``"g2"`` or ``"circular"``. Default "g2".
+        transition, shape: of the roll's spirals.
+        tolerance: the largest deviation of a sweep over a spiral (default 1e-7 × size).
+
+    Raises:
+        ValueError: malformed input.
+        NoSolutionError: the roll does not fit (named, with what would fit).
+    """
+    if isinstance(outline, Sketch) and not hasattr(outline, "filleted"):
+        if len(outline.faces()) != 1:
+            raise ValueError(f"g2_slab takes a sketch of one face; this one has {len(outline.faces())}")
+        outline = outline.faces()[0]
+    if isinstance(outline, (Face, Wire)) and not hasattr(outline, "filleted"):
+        outline = _plane_outline(outline)
+    slab = _slab(outline, height, edge_radius, top=top, bottom=bottom, profile=profile, transition=transition,
+                 shape=shape, tolerance=tolerance)  # fmt: skip
+    return _part(slab)
+
+
+def _plane_outline(shape: Face | Wire) -> list[Segment]:
+    """The outer wire of a face (or a closed wire) in the XY plane as segments."""
+    from .cad.fillet import wire_path
+
+    wire = shape.outer_wire() if isinstance(shape, Face) else shape
+    if any(abs(v.Z) > 1e-9 * max(1.0, wire.bounding_box().diagonal) for v in wire.vertices()):
+        raise ValueError("g2_slab takes an outline in the XY plane (z = 0)")
+    segments, closed = wire_path(wire.wrapped, gp_Ax3(), spirals=True)
+    if not closed:
+        raise ValueError("g2_slab needs a closed outline")
+    return segments
+
+
+class ContinuousBox(BasePartObject):
+    """Part Object: Continuous Box
+
+    A box whose every edge and corner is curvature continuous (G2): the plan
+    outline is a ``ContinuousRectangle`` (corners spiral → arc of ``radius``
+    → spiral) and the top and bottom edges are rolled by a G2 profile
+    (line → spiral → arc of ``edge_radius`` → spiral → line) swept along it
+    (``g2_slab``). With ``profile="circular"`` the rolls are quarter circles.
+
+    The sweep over the outline's spirals is approximated (a B-spline that
+    meets the exact patches G2); the measured deviation is ``approximation``.
+
+    Args:
+        length (float): box length (x)
+        width (float): box width (y)
+        height (float): box height (z)
+        radius (float): the plan corners' smallest radius of curvature
+        edge_radius (float, optional): the rolled edges' smallest radius of curvature; None: the roll
+            whose extent is half of the smaller of ``radius`` and ``height``/2. Defaults to None
+        transition (float, optional): share of each turn made by spirals (plan and roll). Defaults to 0.5
+        shape (str, optional): spiral shape, "walton-meek" or "near-linear". Defaults to "walton-meek"
+        profile (str, optional): roll profile, "g2" or "circular". Defaults to "g2"
+        top (bool, optional): roll the top edge. Defaults to True
+        bottom (bool, optional): roll the bottom edge. Defaults to True
+        tolerance (float, optional): largest deviation of the sweep over spirals; None: 1e-7 × size.
+            Defaults to None
+        rotation (RotationLike, optional): angles to rotate about axes. Defaults to (0, 0, 0)
+        align (Align | tuple[Align, Align, Align] | None, optional): align MIN, CENTER,
+            or MAX of object. Defaults to (Align.CENTER, Align.CENTER, Align.CENTER)
+        mode (Mode, optional): combine mode. Defaults to Mode.ADD
+
+    Raises:
+        ValueError: malformed input.
+        NoSolutionError: plan corners or rolls that do not fit (named, with what would fit).
+    """
+
+    _applies_to = [BuildPart._tag]
+
+    def __init__(self, length: float, width: float, height: float, radius: float, edge_radius: float | None = None,
+                 transition: float = 0.5, shape: str = DEFAULT_SHAPE, profile: str = "g2", top: bool = True,
+                 bottom: bool = True, tolerance: float | None = None, rotation: RotationLike = (0, 0, 0),
+                 align: Align | tuple[Align, Align, Align] | None = (Align.CENTER, Align.CENTER, Align.CENTER),
+                 mode: Mode = Mode.ADD):  # fmt: skip
+        self.length, self.width, self.box_height = length, width, height
+        self.slab = continuous_box(length, width, height, radius, edge_radius, transition=transition, shape=shape,
+                                   profile=profile, top=top, bottom=bottom, tolerance=tolerance)  # fmt: skip
+        self.approximation = self.slab.approximation
+        solid = Solid(self.slab.shape)
+        if align is not None:  # the box's extent is known: OCCT's optimal bounding box of the sweeps costs seconds
+            aligns = (align,) * 3 if isinstance(align, Align) else tuple(align)
+            low, high = (-length / 2.0, -width / 2.0, 0.0), (length / 2.0, width / 2.0, height)
+            offset = [{Align.MIN: -lo, Align.CENTER: -(lo + hi) / 2.0, Align.MAX: -hi, Align.NONE: 0.0}[a]
+                      for a, lo, hi in zip(aligns, low, high)]  # fmt: skip
+            solid = solid.moved(Location(offset))
+        super().__init__(part=solid, rotation=rotation, align=None, mode=mode)
 
 
 def _lines_in_space(wire: Wire) -> tuple[list[tuple[float, float, float]], bool] | None:

@@ -46,6 +46,7 @@ from OCP.gp import gp_Ax3
 
 from .cad.fillet import fillet_face, fillet_wire
 from .cad.occ import chain_wire, segment_edges
+from .cad.solids import continuous_box
 from .core.chain import Chain
 from .core.segments import Segment
 from .core.shapes import DEFAULT_SHAPE
@@ -274,6 +275,30 @@ def continuousSlot2D(self: W, length: float, diameter: float, transition: float 
     return _place_closed(self, continuous_slot(length, diameter, transition, shape=shape))
 
 
+def continuousBox(self: W, length: float, width: float, height: float, radius: float, edgeRadius: float | None = None,
+                  transition: float = 0.5, shape: str = DEFAULT_SHAPE, profile: str = "g2",
+                  centered: bool | tuple[bool, bool, bool] = True, combine: Any = True, clean: bool = True) -> W:  # fmt: skip
+    """A box with every edge and corner G2 at each point on the stack (as ``box``): a continuous rectangle
+    in plan, its top and bottom edges rolled by a G2 profile (``spiral_cad.build123d.ContinuousBox``).
+
+    Args:
+        length, width, height: the box's size.
+        radius: the plan corners' smallest radius of curvature.
+        edgeRadius: the rolled edges' smallest radius of curvature (None: a roll half as wide as
+            the smaller of ``radius`` and ``height``/2 allows).
+        transition, shape, profile: of the spirals and the roll (``"g2"`` or ``"circular"``).
+        centered, combine, clean: as for ``box``.
+
+    Raises:
+        NoSolutionError: corners or rolls that do not fit (named, with what would fit).
+    """
+    slab = continuous_box(length, width, height, radius, edgeRadius, transition=transition, shape=shape, profile=profile)
+    flags = (centered,) * 3 if isinstance(centered, bool) else tuple(centered)
+    offset = cq.Vector(0 if flags[0] else length / 2, 0 if flags[1] else width / 2, -height / 2 if flags[2] else 0)
+    box = cq.Solid(slab.shape).moved(cq.Location(offset))  # built centred in x, y; z from 0 to height
+    return self.eachpoint(lambda loc: box.moved(loc), True, combine, clean)
+
+
 METHODS = (
     spiralTransition,
     spiralLineToCircle,
@@ -286,6 +311,7 @@ METHODS = (
     continuousRect,
     continuousPolygon,
     continuousSlot2D,
+    continuousBox,
 )
 
 for _method in METHODS:

@@ -334,3 +334,11 @@ def distance_to_chain(chain: Chain, points: np.ndarray, spacing: float) -> np.nd
         station = np.clip(station + step, 0.0, chain.length)
     out = np.minimum(nearest, np.linalg.norm(points - chain.point_at(station), axis=1))
     return out
+
+
+def freecad_lib() -> str | None:
+    """The directory holding FreeCAD's Python modules (FreeCAD.so, Import.so), if FreeCAD is installed
+    (they are built for the system Python: run them with /usr/bin/python3 in a child process)."""
+    candidates = [os.environ.get("SPIRAL_CAD_FREECAD_LIB", ""), "/usr/lib/freecad-python3/lib", "/usr/lib/freecad/lib",
+                  "/usr/local/lib/freecad/lib"]  # fmt: skip
+    return next((c for c in candidates if c and (Path(c) / "Import.so").exists()), None)

@@ -105,7 +105,9 @@ def export_step(obj: Any, path: PathLike, *, name: str | None = None, units: str
     and faces through OCCT's writer (17 significant digits), its wires as
     connected edge sets of their exact B-splines, in wire order
     (``spiral_cad.cad.step_occ``), so FreeCAD and OCCT read one part
-    with real wires.
+    with real wires. A G2 solid (``ContinuousBox``, ``g2_slab``, ``g2_fillet``
+    of edges) has the deviation of its approximated surfaces written into the
+    header's FILE_DESCRIPTION.
 
     Args:
         obj: a Chain, a list of Chains, or a build123d/CadQuery/OCP shape.
@@ -125,9 +127,12 @@ def export_step(obj: Any, path: PathLike, *, name: str | None = None, units: str
 
         write_step(chains, path, label, unit, originating_system())
     else:
+        from .solids import approximation_note
         from .step_occ import write_shape_step
 
-        write_shape_step(obj, path, label, unit, originating_system())
+        approximation = getattr(obj, "approximation", None)  # G2 solids say how far any surface is from exact
+        note = None if approximation is None else approximation_note(float(approximation), unit)
+        write_shape_step(obj, path, label, unit, originating_system(), note)
 
 
 def export_iges(obj: Any, path: PathLike, *, name: str | None = None, units: str | None = None) -> None:

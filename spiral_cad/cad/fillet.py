@@ -27,6 +27,7 @@ from OCP.TopoDS import TopoDS, TopoDS_Face, TopoDS_Wire
 from ..check.joints import Continuity
 from ..core.errors import NoSolutionError
 from ..core.segments import Arc, Line, Segment
+from ..core.spiral import BezierSpiral
 from ..design.fillets import FilletedPath, fillet_path
 from .occ import chain_wire
 
@@ -68,8 +69,9 @@ def _local(frame: gp_Ax3, p: gp_Pnt) -> tuple[float, float, float]:
     return v.Dot(gp_Vec(frame.XDirection())), v.Dot(gp_Vec(frame.YDirection())), v.Dot(gp_Vec(frame.Direction()))
 
 
-def wire_path(wire: TopoDS_Wire, frame: gp_Ax3) -> tuple[list[Segment], bool]:
-    """The wire's edges, in connection order, as lines and arcs in the frame's plane coordinates.
+def wire_path(wire: TopoDS_Wire, frame: gp_Ax3, *, spirals: bool = False) -> tuple[list[Segment], bool]:
+    """The wire's edges, in connection order, as lines and arcs in the frame's plane coordinates
+    (and, with ``spirals``, cubic Bézier edges as ``BezierSpiral``: the outlines of G2 sketches).
 
     Raises:
         ValueError: an edge other than a line or circular arc (named by its
@@ -99,6 +101,17 @@ def wire_path(wire: TopoDS_Wire, frame: gp_Ax3) -> tuple[list[Segment], bool]:
             radius = sense * curve.Circle().Radius()
             sweep = abs(t1 - t0)  # circle parameters are angles
             segments.append(Arc((cx, cy), radius, math.atan2(y0 - cy, x0 - cx), sweep))
+        elif (
+            spirals
+            and kind == GeomAbs_CurveType.GeomAbs_BezierCurve
+            and curve.Degree() == 3
+            and not curve.IsRational()
+            and (first, last) == (0.0, 1.0)
+        ):
+            poles = [_local(frame, curve.Bezier().Pole(k)) for k in range(1, 5)]
+            lifts += [p[2] for p in poles]
+            points = [(x, y) for x, y, _ in (poles[::-1] if reverse else poles)]
+            segments.append(BezierSpiral.from_control_points(points))
         else:
             name = kind.name.removeprefix("GeomAbs_").removesuffix("Curve").upper()
             raise ValueError(f"g2 fillets round lines and circular arcs; edge {index} is a {name} curve")

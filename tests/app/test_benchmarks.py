@@ -16,6 +16,7 @@ SCRIPTS = sorted(BENCH.glob("bench_*.py"))
 EXPECTED = {
     "bench_paths3d": ("3-D batch", "G-code", "valid True", "per-corner"),
     "bench_roads3d": ("corridor", "valid", "growth exponent"),
+    "bench_solids": ("ContinuousBox", "valid True", "build123d fillet"),
 }
 
 

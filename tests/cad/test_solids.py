@@ -1,0 +1,472 @@
+"""G2 solids: g2_slab, ContinuousBox and g2_fillet of solid edges.
+
+Judged by readers we did not write: OCCT's BRepCheck_Analyzer and GProp
+(volume, area), build123d's own circular fillet (the sphere-octant box),
+FreeCAD's STEP import; the volume and area are integrated independently
+from the chains (Green's theorem on the outline, Steiner's offset formula,
+mpmath quadrature on the profile); the G2 verdict per edge is measured here
+from OCCT's surface evaluators (normals and normal curvatures across each
+edge), not from the construction.
+"""
+
+from __future__ import annotations
+
+import math
+import subprocess
+import textwrap
+
+import mpmath as mp
+import numpy as np
+import pytest
+from build123d import Align, Axis, Box, BuildPart, BuildSketch, Cone, Cylinder, Part, Polygon, Rectangle, extrude, fillet
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+from OCP.BRep import BRep_Tool
+from OCP.BRepAdaptor import BRepAdaptor_Curve, BRepAdaptor_Curve2d
+from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeVertex
+from OCP.BRepCheck import BRepCheck_Analyzer
+from OCP.BRepExtrema import BRepExtrema_DistShapeShape
+from OCP.BRepGProp import BRepGProp
+from OCP.BRepMesh import BRepMesh_IncrementalMesh
+from OCP.GeomLProp import GeomLProp_SLProps
+from OCP.gp import gp_Dir, gp_Pnt, gp_Vec
+from OCP.GProp import GProp_GProps
+from OCP.IFSelect import IFSelect_ReturnStatus
+from OCP.STEPControl import STEPControl_Reader
+from OCP.TopAbs import TopAbs_EDGE, TopAbs_FACE, TopAbs_REVERSED, TopAbs_SOLID
+from OCP.TopExp import TopExp, TopExp_Explorer
+from OCP.TopLoc import TopLoc_Location
+from OCP.TopoDS import TopoDS
+from OCP.TopTools import TopTools_IndexedDataMapOfShapeListOfShape
+
+from spiral_cad import Arc, Line
+from spiral_cad.build123d import ContinuousBox, ContinuousRectangle, g2_fillet, g2_slab
+from spiral_cad.cad.export import export_step
+from spiral_cad.cad.solids import g2_slab as occ_slab
+from spiral_cad.cad.solids import roll_profile
+from spiral_cad.core.errors import NoSolutionError
+from spiral_cad.core.spiral import BezierSpiral
+from spiral_cad.design.fillets import continuous_rectangle
+from tests.helpers import freecad_lib
+
+# ------------------------------------------------------------------ measures
+
+
+def _props(shape) -> tuple[float, float]:
+    """OCCT's volume and area (its default Gauss rule: exact enough on Bézier patches, ~1e-4 off across
+    C0 knots inside one face, which is why the slab makes one face per span)."""
+    volume, area = GProp_GProps(), GProp_GProps()
+    BRepGProp.VolumeProperties_s(shape, volume)
+    BRepGProp.SurfaceProperties_s(shape, area)
+    return volume.Mass(), area.Mass()
+
+
+def _oriented_normal_and_curvature(face, edge, t: float, across: gp_Vec | None) -> tuple[np.ndarray, float]:
+    """The outward normal of ``face`` at parameter ``t`` of ``edge`` (its curve on the face) and the normal
+    curvature in direction ``across`` (OCCT's evaluators)."""
+    uv = BRepAdaptor_Curve2d(edge, face).Value(t)
+    props = GeomLProp_SLProps(BRep_Tool.Surface_s(face), uv.X(), uv.Y(), 2, 1e-12)
+    normal = np.array(props.Normal().Coord())
+    sign = -1.0 if face.Orientation() == TopAbs_REVERSED else 1.0
+    if across is None or not props.IsCurvatureDefined():
+        return sign * normal, 0.0
+    if props.IsUmbilic():
+        return sign * normal, sign * props.MeanCurvature()
+    a, b = gp_Dir(), gp_Dir()
+    props.CurvatureDirections(a, b)  # of the largest and the smallest curvature
+    direction = np.array(across.Coord())
+    direction = direction - normal * (direction @ normal)
+    direction /= np.linalg.norm(direction)
+    c = float(direction @ np.array(a.Coord()))
+    kn = props.MaxCurvature() * c * c + props.MinCurvature() * (1.0 - c * c)
+    return sign * normal, sign * kn
+
+
+def _edge_rows(shape, samples: int = 3):
+    """Per edge shared by two faces: the worst normal angle and relative normal-curvature jump across it."""
+    neighbours = TopTools_IndexedDataMapOfShapeListOfShape()
+    TopExp.MapShapesAndAncestors_s(shape, TopAbs_EDGE, TopAbs_FACE, neighbours)
+    box = _props(shape)
+    size = box[0] ** (1.0 / 3.0)
+    rows = []
+    for i in range(1, neighbours.Extent() + 1):
+        edge = TopoDS.Edge_s(neighbours.FindKey(i))
+        faces = [TopoDS.Face_s(f) for f in neighbours.FindFromIndex(i)]
+        if BRep_Tool.Degenerated_s(edge) or len(faces) != 2:
+            continue
+        curve = BRepAdaptor_Curve(edge)
+        angle, jump = 0.0, 0.0
+        for t in np.linspace(curve.FirstParameter(), curve.LastParameter(), samples + 2)[1:-1]:
+            p, d = gp_Pnt(), gp_Vec()
+            curve.D1(t, p, d)
+            n0, _ = _oriented_normal_and_curvature(faces[0], edge, t, None)
+            across = gp_Vec(*np.cross(n0, np.array(d.Coord())))
+            (n0, k0), (n1, k1) = (_oriented_normal_and_curvature(f, edge, t, across) for f in faces)
+            angle = max(angle, math.acos(max(-1.0, min(1.0, float(n0 @ n1)))))
+            jump = max(jump, abs(k0 - k1) / max(abs(k0), abs(k1), 1.0 / size))
+        rows.append((angle, jump))
+    return rows
+
+
+def _assert_g2_edges(shape, sharp: float = 0.1) -> None:
+    """Every edge is G2 (normals ≤ 1e-7 rad, relative normal-curvature jump ≤ 1e-4) or a sharp feature."""
+    rows = _edge_rows(shape)
+    assert rows
+    for angle, jump in rows:
+        if angle > sharp:
+            continue
+        assert angle <= 1e-7 and jump <= 1e-4, (angle, jump)
+
+
+def _assert_one_valid_solid(shape) -> None:
+    assert BRepCheck_Analyzer(shape).IsValid()
+    count, solids = 0, TopExp_Explorer(shape, TopAbs_SOLID)
+    while solids.More():
+        count += 1
+        solids.Next()
+    assert count == 1
+    assert _props(shape)[0] > 0.0
+
+
+# ------------------------------------------------------------------ independent integrals
+
+
+def _outline_integrals(segments) -> tuple[float, float]:
+    """Area (Green's theorem, mpmath) and length of a closed outline, from its segments' own formulas."""
+    mp.mp.dps = 30
+    area = mp.mpf(0)
+    length = mp.mpf(0)
+    for s in segments:
+        if isinstance(s, Line):
+            (x0, y0), (x1, y1) = s.start[:2], s.end[:2]
+            area += (mp.mpf(x0) * y1 - mp.mpf(x1) * y0) / 2
+            length += mp.sqrt((mp.mpf(x1) - x0) ** 2 + (mp.mpf(y1) - y0) ** 2)
+        elif isinstance(s, Arc):
+            cx, cy = s.center[:2]
+            r, a0, sweep = mp.mpf(s.radius), mp.mpf(s.start_angle), mp.mpf(s.sweep) * mp.sign(s.radius)
+            x = lambda t: cx + abs(r) * mp.cos(a0 + t)  # noqa: E731
+            y = lambda t: cy + abs(r) * mp.sin(a0 + t)  # noqa: E731
+            area += mp.quad(lambda t: (x(t) * abs(r) * mp.cos(a0 + t) + y(t) * abs(r) * mp.sin(a0 + t)) / 2, [0, sweep])
+            length += abs(r) * abs(sweep)
+        else:
+            cp = [[mp.mpf(c) for c in p] for p in s.control_points]
+            point, speed = _bezier(cp)
+            area += mp.quad(lambda u: (point(u)[0] * speed(u)[1] - point(u)[1] * speed(u)[0]) / 2, [0, 1])
+            length += mp.quad(lambda u: mp.sqrt(speed(u)[0] ** 2 + speed(u)[1] ** 2), [0, 1])
+    return float(abs(area)), float(length)
+
+
+def _bezier(cp):
+    def point(u):
+        b = [(1 - u) ** 3, 3 * u * (1 - u) ** 2, 3 * u**2 * (1 - u), u**3]
+        return [sum(b[k] * cp[k][i] for k in range(4)) for i in range(2)]
+
+    def speed(u):
+        b = [(1 - u) ** 2, 2 * u * (1 - u), u**2]
+        return [3 * sum(b[k] * (cp[k + 1][i] - cp[k][i]) for k in range(3)) for i in range(2)]
+
+    return point, speed
+
+
+def _profile_integrals(roll) -> tuple[float, float, float, float]:
+    """Along the roll (w, z): ∫w dz, ∫w² dz, ∫w dℓ and its length ℓ (mpmath)."""
+    totals = [mp.mpf(0)] * 4
+    for s in roll:
+        if isinstance(s, Arc):
+            cx, cy = s.center[:2]
+            r, a0, sweep = abs(s.radius), s.start_angle, s.sweep * math.copysign(1.0, s.radius)
+
+            def point(t, cx=cx, cy=cy, r=r, a0=a0):
+                return [cx + r * mp.cos(a0 + t), cy + r * mp.sin(a0 + t)]
+
+            def speed(t, r=r, a0=a0):
+                return [-r * mp.sin(a0 + t), r * mp.cos(a0 + t)]
+
+            span = [0, sweep]
+        else:
+            point, speed = _bezier([[mp.mpf(c) for c in p] for p in s.control_points])
+            span = [0, 1]
+        parts = [
+            mp.quad(lambda u: point(u)[0] * speed(u)[1], span),
+            mp.quad(lambda u: point(u)[0] ** 2 * speed(u)[1], span),
+            mp.quad(lambda u: point(u)[0] * mp.sqrt(speed(u)[0] ** 2 + speed(u)[1] ** 2), span),
+            mp.quad(lambda u: mp.sqrt(speed(u)[0] ** 2 + speed(u)[1] ** 2), span),
+        ]
+        totals = [a + abs(b) for a, b in zip(totals, parts)]
+    return tuple(float(t) for t in totals)  # type: ignore[return-value]
+
+
+def _expected_volume_and_area(segments, roll, height: float) -> tuple[float, float]:
+    """Steiner: a simple closed curve's inner offset at w encloses A − Lw + πw² and is L − 2πw long."""
+    a0, length = _outline_integrals(segments)
+    w_dz, w2_dz, w_dl, ell = _profile_integrals(roll)
+    d = float(roll[-1].end[0])
+    volume = height * a0 - length * 2 * w_dz + math.pi * 2 * w2_dz
+    area = length * (2 * ell + height - 2 * d) - 2 * math.pi * 2 * w_dl + 2 * (a0 - length * d + math.pi * d * d)
+    return volume, area
+
+
+# ------------------------------------------------------------------ tests
+
+
+def test_continuous_box_is_one_valid_solid_with_every_edge_g2():
+    box = ContinuousBox(40, 20, 8, 6, edge_radius=1.5)
+    _assert_one_valid_solid(box.wrapped)
+    _assert_g2_edges(box.wrapped, sharp=math.inf)  # no sharp edge at all
+    bb = box.bounding_box()
+    assert bb.min.Z == pytest.approx(-4, abs=1e-6) and bb.max.X == pytest.approx(20, abs=1e-6)
+    assert 0.0 < box.approximation <= 1e-7 * 40
+
+
+@pytest.mark.parametrize("profile", ["g2", "circular"])
+def test_volume_and_area_match_an_independent_integration(profile):
+    plan = continuous_rectangle(40, 20, 6)
+    roll = roll_profile(1.5, profile=profile)
+    slab = occ_slab(plan, 8, 1.5, profile=profile, tolerance=1e-10)
+    volume, area = _props(slab.shape)
+    expected_volume, expected_area = _expected_volume_and_area(list(plan.segments), roll, 8)
+    assert volume == pytest.approx(expected_volume, rel=1e-9)
+    assert area == pytest.approx(expected_area, rel=1e-9)
+    assert slab.approximation <= 1e-10
+
+
+def _circular_rectangle(length, width, r):
+    a, b = length / 2, width / 2
+    h = math.pi / 2
+    return [Line((-a + r, -b), (a - r, -b)), Arc((a - r, -b + r), r, -h, h), Line((a, -b + r), (a, b - r)),
+            Arc((a - r, b - r), r, 0, h), Line((a - r, b), (-a + r, b)), Arc((-a + r, b - r), r, h, h),
+            Line((-a, b - r), (-a, -b + r)), Arc((-a + r, -b + r), r, math.pi, h)]  # fmt: skip
+
+
+def test_circular_profile_with_equal_radii_is_the_ordinary_filleted_box():
+    length, width, height, r = 40.0, 20.0, 8.0, 3.0
+    ours = g2_slab(_circular_rectangle(length, width, r), height, r, profile="circular")
+    theirs = fillet(Box(length, width, height, align=(Align.CENTER, Align.CENTER, Align.MIN)).edges(), r)
+    _assert_one_valid_solid(ours.wrapped)
+    assert ours.approximation == 0.0
+    assert ours.volume == pytest.approx(theirs.volume, rel=1e-9)
+    assert ours.area == pytest.approx(theirs.area, rel=1e-9)
+    BRepMesh_IncrementalMesh(theirs.wrapped, 0.5)
+    explorer = TopExp_Explorer(theirs.wrapped, TopAbs_FACE)
+    worst = 0.0
+    while explorer.More():
+        face = TopoDS.Face_s(explorer.Current())
+        location = TopLoc_Location()
+        mesh = BRep_Tool.Triangulation_s(face, location)
+        for k in range(1, mesh.NbNodes() + 1, 7):
+            vertex = BRepBuilderAPI_MakeVertex(mesh.Node(k).Transformed(location.Transformation())).Vertex()
+            worst = max(worst, BRepExtrema_DistShapeShape(vertex, ours.wrapped).Value())
+        explorer.Next()
+    assert worst <= 1e-9 * length
+
+
+def _peanut() -> list:
+    """Two convex arcs of radius 10 joined G1 by concave arcs of radius 3: a waist 4 wide (centres (0, ±5))."""
+    t = math.atan2(5, -12)  # the tangent points lie on the lines between the centres
+    return [Arc((12, 0), 10, -t, 2 * t), Arc((0, 5), -3, math.atan2(-5, 12), 2 * t - math.pi),
+            Arc((-12, 0), 10, math.atan2(5, 12), 2 * t), Arc((0, -5), -3, math.atan2(5, -12), 2 * t - math.pi)]  # fmt: skip
+
+
+def test_refusals_name_the_value_and_what_fits():
+    with pytest.raises(NoSolutionError, match=r"edge_radius 5 .* smallest convex radius of curvature 6 .*edge_radius below"):
+        ContinuousBox(40, 20, 30, 6, edge_radius=5)
+    with pytest.raises(NoSolutionError, match=r"exceed height 2; edge_radius up to"):
+        ContinuousBox(40, 20, 2, 6, edge_radius=1.5)
+    with pytest.raises(NoSolutionError, match=r"edge_radius 2.5 .* inner offset crosses itself .* edge_radius below 2 fits"):
+        g2_slab(_peanut(), 10, 2.5, profile="circular")  # its waist is 4 wide
+    assert g2_slab(_peanut(), 10, 1.9, profile="circular").is_valid
+    square = [(0, 0), (10, 0), (10, 10), (0, 10)]
+    with pytest.raises(ValueError, match=r"tangent at every joint .*; the joint after segment 0 at \(10, 0\) turns 1.57"):
+        g2_slab([Line(a, b) for a, b in zip(square, square[1:] + square[:1])], 5, 1)
+    with pytest.raises(ValueError, match="closed"):
+        g2_slab([Line((0, 0), (1, 0)), Line((1, 0), (1, 1))], 1, 0.1)
+
+
+def test_a_concave_g2_outline_makes_a_g2_slab():
+    star = [(math.cos(a) * (10 if k % 2 else 5), math.sin(a) * (10 if k % 2 else 5))
+            for k, a in enumerate(np.linspace(0, 2 * math.pi, 10, endpoint=False))]  # fmt: skip
+    from spiral_cad.design.fillets import fillet_path
+
+    plan = fillet_path([*star, star[0]], 1.5, closed=True)
+    part = g2_slab(plan, 4, 0.4)
+    _assert_one_valid_solid(part.wrapped)
+    _assert_g2_edges(part.wrapped, sharp=math.inf)
+
+
+def test_g2_fillet_rounds_a_box_side_edges_exactly_and_rolls_whole_caps():
+    box = Box(40, 20, 8)
+    sides = g2_fillet(box.edges().filter_by(Axis.Z), 3)
+    assert isinstance(sides, Part)
+    _assert_one_valid_solid(sides.wrapped)
+    assert {e.geom_type.name for e in sides.edges().filter_by(Axis.Z, reverse=True)} == {"LINE", "CIRCLE", "BEZIER"}
+    _assert_g2_edges(sides.wrapped, sharp=0.1)  # top and bottom stay sharp (π/2)
+    rolled = g2_fillet(sides.edges(), 1.0 * 0.7)
+    _assert_one_valid_solid(rolled.wrapped)
+    _assert_g2_edges(rolled.wrapped, sharp=math.inf)
+    assert rolled.approximation > 0.0
+    with BuildPart() as builder:
+        Box(40, 20, 8)
+        g2_fillet(builder.edges().filter_by(Axis.Z), 3)
+    assert builder.part.volume == pytest.approx(sides.volume, rel=1e-12)
+
+
+def test_g2_fillet_on_solid_edges_refuses_by_name():
+    box = Box(40, 20, 8)
+    with pytest.raises(NoSolutionError, match=r"not chosen"):
+        g2_fillet(box.edges().filter_by(Axis.Z) + box.edges().group_by(Axis.Z)[-1][:1], 2)
+    with pytest.raises(NoSolutionError, match=r"side edge at .* is sharp and not chosen"):
+        g2_fillet(box.edges().group_by(Axis.Z)[-1], 1)
+    with pytest.raises(NoSolutionError, match=r"right prisms"):
+        g2_fillet(Cone(5, 2, 10).edges(), 1)
+
+
+def test_a_cylinder_with_all_edges_chosen_is_rolled_into_a_g2_disc():
+    disc = g2_fillet(Cylinder(5, 10).edges(), 1)
+    _assert_one_valid_solid(disc.wrapped)
+    _assert_g2_edges(disc.wrapped, sharp=math.inf)
+    assert disc.approximation == 0.0  # a circle's sweep is a surface of revolution: exact
+
+
+def _prism(points, height):
+    with BuildPart() as builder:
+        with BuildSketch():
+            Polygon(*points, align=None)
+        extrude(amount=height)
+    return builder.part
+
+
+@settings(max_examples=8, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(
+    turn=st.floats(0.3, 2.6),
+    concave=st.booleans(),
+    radius=st.floats(0.2, 3.0),
+    height=st.floats(0.5, 10.0),
+)
+def test_property_prism_side_edges_at_any_dihedral_angle_round_g2_or_refuse_by_name(turn, concave, radius, height):
+    # an arrow-like pentagon: one corner of interior angle π − turn, one reflex corner when concave
+    tip = (20 + 10 / math.tan(turn / 2) if turn < math.pi / 2 else 20 + 10 * math.tan(math.pi / 2 - turn / 2), 0)
+    notch = (6, 0) if concave else (0, 0)
+    points = [(0, -10), (20, -10), tip, (20, 10), (0, 10), notch] if concave else [(0, -10), (20, -10), tip, (20, 10), (0, 10)]
+    part = _prism(points, height)
+    try:
+        result = g2_fillet(part.edges().filter_by(Axis.Z), radius)
+    except NoSolutionError as error:
+        assert "corner" in str(error)
+        return
+    _assert_one_valid_solid(result.wrapped)
+    _assert_g2_edges(result.wrapped, sharp=0.1)
+    assert result.volume < part.volume if not concave else True
+
+
+@settings(max_examples=6, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(
+    length=st.floats(5.0, 60.0),
+    width=st.floats(5.0, 60.0),
+    height=st.floats(0.5, 20.0),
+    radius=st.floats(0.5, 10.0),
+    edge=st.floats(0.05, 6.0),
+)
+def test_property_continuous_boxes_are_g2_solids_or_named_refusals(length, width, height, radius, edge):
+    try:
+        box = ContinuousBox(length, width, height, radius, edge_radius=edge)
+    except NoSolutionError as error:
+        assert any(word in str(error) for word in ("edge_radius", "corner")), str(error)
+        return
+    _assert_one_valid_solid(box.wrapped)
+    _assert_g2_edges(box.wrapped, sharp=math.inf)
+
+
+def test_step_file_carries_the_approximation_and_reads_back_as_one_solid(tmp_path):
+    box = ContinuousBox(40, 20, 8, 6, edge_radius=1.5)
+    path = tmp_path / "box.step"
+    export_step(box, path)
+    text = path.read_text()
+    assert "sweeps over spirals approximated within" in text and "SI_UNIT(.MILLI.,.METRE.)" in text
+    reader = STEPControl_Reader()
+    assert reader.ReadFile(str(path)) == IFSelect_ReturnStatus.IFSelect_RetDone
+    reader.TransferRoots()
+    shape = reader.OneShape()
+    _assert_one_valid_solid(shape)
+    assert _props(shape)[0] == pytest.approx(box.volume, rel=1e-9)
+    from spiral_cad.cad.faces import check_faces
+
+    report = check_faces(path)  # the file as another program reads it: every edge still G2
+    assert report.units == "mm" and report.passes("G2") and report.counts["G2"] == len(report.edges)
+
+
+FREECAD = freecad_lib()
+READ = textwrap.dedent(
+    """
+    import sys
+    sys.path.append(sys.argv[1])
+    import FreeCAD, Import
+    doc = FreeCAD.newDocument("d")
+    Import.insert(sys.argv[2], "d")
+    shapes = [o.Shape for o in doc.Objects if hasattr(o, "Shape") and not o.Shape.isNull()]
+    solids = [s for shape in shapes for s in shape.Solids]
+    print(len(shapes), len(solids), all(s.isValid() for s in solids), repr(sum(s.Volume for s in solids)))
+    """
+)
+
+
+@pytest.mark.skipif(FREECAD is None, reason="FreeCAD is not installed (Debian/Ubuntu: apt-get install freecad-python3)")
+def test_freecad_reads_the_step_as_one_valid_solid(tmp_path):
+    box = ContinuousBox(40, 20, 8, 6, edge_radius=1.5)
+    path = tmp_path / "box.step"
+    export_step(box, path)
+    run = subprocess.run(["/usr/bin/python3", "-c", READ, FREECAD, str(path)], capture_output=True, text=True, timeout=600)
+    assert run.returncode == 0, run.stderr[-2000:]
+    objects, solids, valid, volume = run.stdout.split()[-4:]
+    assert (objects, solids, valid) == ("1", "1", "True")
+    assert float(volume) == pytest.approx(box.volume, rel=1e-9)
+
+
+def test_plain_wires_and_sketch_outlines_are_accepted():
+    from_sketch = g2_slab(ContinuousRectangle(30, 20, 5), 6, 1)
+    from_face = g2_slab(ContinuousRectangle(30, 20, 5).faces()[0], 6, 1)
+    assert from_sketch.volume == pytest.approx(from_face.volume, rel=1e-12)
+    rounded = g2_fillet(Rectangle(30, 20), 5)  # build123d's own sketch, rounded G2: the same outline
+    assert g2_slab(rounded, 6, 1).volume == pytest.approx(from_sketch.volume, rel=1e-12)
+    assert all(isinstance(s, BezierSpiral) for s in roll_profile(1)[::2])
+
+
+def test_the_face_checker_finds_every_edge_g2_and_the_verification_refuses_a_g1_solid():
+    from spiral_cad.cad.faces import check_faces
+    from spiral_cad.cad.solids import verify_faces
+
+    report = check_faces(ContinuousBox(40, 20, 8, 6, edge_radius=1.5))
+    assert report.counts["G2"] == len(report.edges) and report.passes("G2")
+    sides = check_faces(g2_fillet(Box(40, 20, 8).edges().filter_by(Axis.Z), 3))
+    assert sides.counts["G2"] == 16 and sides.counts["sharp"] == 32
+    circular = fillet(Box(40, 20, 8).edges(), 3)
+    with pytest.raises(NoSolutionError, match=r"refused: the face checker finds edge \d+ .* G1, not G2"):
+        verify_faces(circular.wrapped, "G2", "box")
+    verify_faces(circular.wrapped, "G1", "box")
+
+
+def test_cadquery_continuous_box_is_the_same_solid_placed_like_box():
+    import cadquery as cq
+
+    import spiral_cad.cadquery  # noqa: F401  (registers the methods)
+
+    solid = cq.Workplane("XY").continuousBox(40, 20, 8, 6, 1.5).val()
+    assert solid.isValid()
+    ours = ContinuousBox(40, 20, 8, 6, edge_radius=1.5)
+    assert solid.Volume() == pytest.approx(ours.volume, rel=1e-12)
+    bb = solid.BoundingBox()
+    assert (bb.zmin, bb.zmax) == pytest.approx((-4, 4), abs=1e-6)
+    corners = cq.Workplane("XY").rect(100, 100, forConstruction=True).vertices().continuousBox(10, 10, 4, 2, centered=False)
+    assert len(corners.val().Solids()) == 4
+    assert corners.val().BoundingBox().xmin == pytest.approx(-50, abs=1e-6)
+
+
+def test_side_edges_of_a_concave_prism_round_to_the_extruded_2d_g2_corners():
+    from spiral_cad.design.fillets import fillet_path
+
+    l_shape = [(0, 0), (30, 0), (30, 10), (10, 10), (10, 25), (0, 25)]  # one reflex (concave) corner at (10, 10)
+    rounded = g2_fillet(_prism(l_shape, 6).edges().filter_by(Axis.Z), 2)
+    _assert_one_valid_solid(rounded.wrapped)
+    _assert_g2_edges(rounded.wrapped, sharp=0.1)
+    plan = fillet_path([*l_shape, l_shape[0]], 2, closed=True)
+    area, _ = _outline_integrals(list(plan.segments))
+    assert _props(rounded.wrapped)[0] == pytest.approx(6 * area, rel=1e-9)
