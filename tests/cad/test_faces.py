@@ -5,10 +5,8 @@ from __future__ import annotations
 
 import json
 import math
-import os
 import subprocess
 import textwrap
-from pathlib import Path
 
 import numpy as np
 import pytest
@@ -18,6 +16,7 @@ from hypothesis import strategies as st
 pytest.importorskip("OCP")
 
 import build123d as bd  # noqa: E402
+from helpers import freecad_lib  # noqa: E402
 from OCP.IGESControl import IGESControl_Writer  # noqa: E402
 from OCP.Interface import Interface_Static  # noqa: E402
 
@@ -174,13 +173,7 @@ def test_any_circular_fillet_of_a_box_is_g1_with_relative_jump_one_never_g2(radi
 # ------------------------------------------------------------ FreeCAD's own evaluation of the same file
 
 
-def _freecad_lib() -> str | None:
-    """The directory holding FreeCAD's Python modules, if FreeCAD is installed."""
-    candidates = [os.environ.get("SPIRAL_CAD_FREECAD_LIB", ""), "/usr/lib/freecad-python3/lib", "/usr/lib/freecad/lib"]
-    return next((c for c in candidates if c and (Path(c) / "Part.so").exists()), None)
-
-
-FREECAD = _freecad_lib()
+FREECAD = freecad_lib()
 #: In FreeCAD (system Python): for each point, the faces through it, each with its oriented normal
 #: (``Face.normalAt``) and its normal curvature across the edge through it, by Euler's formula from
 #: FreeCAD's principal curvatures and directions (``Surface.curvature``, ``Surface.curvatureDirections``).

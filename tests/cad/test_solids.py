@@ -19,6 +19,7 @@ import mpmath as mp
 import numpy as np
 import pytest
 from build123d import Align, Axis, Box, BuildPart, BuildSketch, Cone, Cylinder, Part, Polygon, Rectangle, extrude, fillet
+from helpers import freecad_lib
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 from OCP.BRep import BRep_Tool
@@ -47,7 +48,6 @@ from spiral_cad.cad.solids import roll_profile
 from spiral_cad.core.errors import NoSolutionError
 from spiral_cad.core.spiral import BezierSpiral
 from spiral_cad.design.fillets import continuous_rectangle
-from tests.helpers import freecad_lib
 
 # ------------------------------------------------------------------ measures
 

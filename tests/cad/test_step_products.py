@@ -7,17 +7,16 @@ of every joint and knot of the file's centre line, and FreeCAD's
 process when FreeCAD is installed (Debian: ``apt-get install freecad-python3``).
 """
 
-import os
 import subprocess
 import sys
 import textwrap
-from pathlib import Path
 
 import numpy as np
 import pytest
 
 pytest.importorskip("OCP")
 
+from helpers import freecad_lib  # noqa: E402
 from OCP.BRep import BRep_Tool  # noqa: E402
 from OCP.BRepTools import BRepTools_WireExplorer  # noqa: E402
 from OCP.Geom import Geom_BSplineCurve  # noqa: E402
@@ -163,14 +162,7 @@ def test_the_description_names_the_g1_joints(road):
 # ------------------------------------------------------------------ FreeCAD
 
 
-def _freecad_lib() -> str | None:
-    """The directory holding FreeCAD's Python modules (FreeCAD.so, Import.so), if FreeCAD is installed."""
-    candidates = [os.environ.get("SPIRAL_CAD_FREECAD_LIB", ""), "/usr/lib/freecad-python3/lib", "/usr/lib/freecad/lib",
-                  "/usr/local/lib/freecad/lib"]  # fmt: skip
-    return next((c for c in candidates if c and (Path(c) / "Import.so").exists()), None)
-
-
-FREECAD = _freecad_lib()
+FREECAD = freecad_lib()
 INSERT = textwrap.dedent(
     """
     import sys
