@@ -486,6 +486,7 @@ class FitDesign(_Model):
     vertical_tolerance: Positive | None = Field(None, description="Points with z (a 3-D survey, fitted as a road: plan "
                                                 "and profile): the largest |z − profile| (default: tolerance).")  # fmt: skip
     samples: Samples | None = Field(None, description="Optional samples for a machine.")
+    gcode_out: GcodeOut | None = Field(None, description="Also write NAME.ngc, the path as G-code.")
 
     @model_validator(mode="after")
     def _one_source(self) -> FitDesign:
