@@ -845,6 +845,8 @@ def _evaluate(p: _Primitive, q: _Primitive, pts: NDArray[np.float64], shape: str
     middles to it, the runs' lines and circles clipped at its ends."""
     start, stop = (p.a + p.b) // 2, (q.a + q.b) // 2 + 1
     local = pts[start:stop] if stop > start else np.vstack([pts[start:], pts[:stop]])
+    # Choosing runs needs a gap's shape, not every point (the chain is measured at every point after).
+    local = local[:: max(1, len(local) // 4000)]
     # A corner's spirals may reach the split point of either run, no further (the next corner owns the rest).
     transition = _join(p, q, local, shape, tol, p.split_point(pts), q.split_point(pts))
     if transition is None:
