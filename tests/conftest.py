@@ -93,6 +93,7 @@ SLOW = {
     "test_names.py::test_hostile_names_and_geo_reference_pass_the_opendrive_schema",
     "test_names.py::test_enormous_names_and_file_names_never_crash_the_iges_writer",
     "test_near_linear.py::test_the_100_kmh_design_file_builds_end_to_end",
+    "test_ifc.py",
 }
 _CAD = re.compile(r"^\s*(?:from|import) (?:build123d|cadquery|OCP)\b|importorskip\([\"'](?:build123d|cadquery|OCP)", re.M)
 _SUBPROCESS = re.compile(r"\bsubprocess\b|sys\.executable")

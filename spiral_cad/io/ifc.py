@@ -52,6 +52,7 @@ import math
 import os
 import time
 from collections.abc import Sequence
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
@@ -62,11 +63,15 @@ from ..core._chain_kernels import ARC, LINE, SPIRAL
 from ..core.units import length_unit, to_metres
 from .opendrive import plan_records
 
-__all__ = ["IFC_SCHEMA", "graph_length_scales", "ifc_file", "write_ifc"]
+__all__ = [
+    "IFC_SCHEMA", "IfcAlignmentLayout", "LayoutSegment", "graph_length_scales", "ifc_file", "layout_segments",
+    "read_ifc_alignments", "write_ifc",
+]  # fmt: skip
 
 #: The schema written: IFC 4.3 ADD2 (ISO 16739-1:2024).
 IFC_SCHEMA = "IFC4X3_ADD2"
-#: The precision of the geometric context (the validation rules' default), in the file's length unit.
+#: The precision of the geometric context in metres: IFC's default of 1e-5 length units for a metre file,
+#: and the same 10 µm in every unit (1e-5 mm would ask for more than ifcopenshell's evaluator holds: 1e-7 m).
 CONTEXT_PRECISION = 1e-5
 #: Our length units as IFC units: (SI prefix or None, SI name) or the conversion-based unit's name.
 _SI_UNITS = {"mm": "MILLI", "cm": "CENTI", "m": None, "km": "KILO"}
@@ -118,7 +123,7 @@ def _new_file(units: str, application: str, project_name: str) -> tuple[Any, Any
     angle = ifcopenshell.api.unit.add_si_unit(model, unit_type="PLANEANGLEUNIT")
     ifcopenshell.api.unit.assign_unit(model, units=[length, angle])
     body = ifcopenshell.api.context.add_context(model, context_type="Model")
-    body.Precision = CONTEXT_PRECISION
+    body.Precision = CONTEXT_PRECISION / to_metres(units)
     axis = ifcopenshell.api.context.add_context(
         model, context_type="Model", context_identifier="Axis", target_view="MODEL_VIEW", parent=body
     )
@@ -168,10 +173,12 @@ def _horizontal(w: _Writer, chain: Any, scale: float) -> tuple[list[Any], list[A
     plan = plan_records(chain, scale)
     rows = chain.rows
     frames, _, _ = row_frames(np.array(rows.kind), np.array(rows.geometry), np.array(rows.params), rows.dim)
-    kappa = frames[:, :, 8] / scale  # signed curvature at both ends, in the file's unit
-    with np.errstate(divide="ignore"):
-        radius = np.where(np.abs(kappa) > 0.0, 1.0 / kappa, 0.0)  # IFC: 0 for a straight end, positive turns left
     kind, x, y, hdg, length = (plan[k] for k in ("kind", "x", "y", "hdg", "length"))
+    kappa = frames[:, :, 8] / scale  # signed curvature at both ends, in the file's unit
+    # a spiral's straight end has |κ|·L at rounding level, not 0: IFC says 0 for a straight end
+    kappa[np.abs(kappa) * length[:, None] <= 1e-9] = 0.0
+    with np.errstate(divide="ignore"):
+        radius = np.where(kappa != 0.0, 1.0 / np.where(kappa != 0.0, kappa, 1.0), 0.0)  # positive turns left
     spiral = kind == SPIRAL
     lam = np.ones(len(kind))
     if spiral.any():
@@ -360,3 +367,108 @@ def write_ifc(
     model.header.file_name.time_stamp = time.strftime("%Y-%m-%dT%H:%M:%S")
     model.write(str(path))
     return path
+
+
+# ------------------------------------------------------------------ reading
+
+
+@dataclass(frozen=True)
+class LayoutSegment:
+    """One segment of an IFC alignment layout, in the file's length unit (angles in radians).
+
+    Attributes:
+        type: the ``PredefinedType`` (``LINE``, ``CIRCULARARC``, ``CUBIC``, ``CONSTANTGRADIENT``, …).
+        length: ``SegmentLength`` (horizontal) or ``HorizontalLength`` (vertical).
+        start: the start point (horizontal) or (distance along, height) (vertical).
+        direction: the start direction (horizontal) or the start gradient (vertical).
+        radii: start and end radius of curvature (horizontal; 0 straight, positive turns left);
+            (radius, end gradient) for a vertical segment.
+        curve: the entity type of the matching ``IfcCurveSegment.ParentCurve`` in the
+            representation, or None when the alignment has no representation.
+    """
+
+    type: str
+    length: float
+    start: tuple[float, float]
+    direction: float
+    radii: tuple[float, float]
+    curve: str | None
+
+
+@dataclass(frozen=True)
+class IfcAlignmentLayout:
+    """An ``IfcAlignment`` as read: its name, length unit (metres per unit) and layouts."""
+
+    name: str
+    metres_per_unit: float
+    horizontal: tuple[LayoutSegment, ...]
+    vertical: tuple[LayoutSegment, ...]
+
+
+def layout_segments(layout: Any) -> list[Any]:
+    """The ``IfcAlignmentSegment`` design parameters nested in ``layout``, in nesting order."""
+    out = []
+    for rel in layout.IsNestedBy:
+        out += [s.DesignParameters for s in rel.RelatedObjects if s.is_a("IfcAlignmentSegment")]
+    return out
+
+
+def read_ifc_alignments(source: Any) -> list[IfcAlignmentLayout]:
+    """Every ``IfcAlignment`` of an IFC 4.3 file (a path or an ``ifcopenshell.file``) with its horizontal
+    and vertical layouts, each segment beside the type of its representation's parent curve.
+
+    Raises:
+        ValueError: the file cannot be read or is not IFC 4.3.
+    """
+    import ifcopenshell
+    import ifcopenshell.util.unit
+
+    model = source
+    if not isinstance(source, ifcopenshell.file):
+        try:
+            model = ifcopenshell.open(os.fspath(source))
+        except (OSError, RuntimeError) as error:
+            raise ValueError(f"{os.fspath(source)}: not a readable IFC file ({error})") from None
+    if not model.schema.startswith("IFC4X3"):
+        raise ValueError(f"IfcAlignment layouts are IFC 4.3; this file is {model.schema}")
+    scale = float(ifcopenshell.util.unit.calculate_unit_scale(model, "LENGTHUNIT"))
+    result = []
+    for alignment in model.by_type("IfcAlignment"):
+        layouts = [obj for rel in alignment.IsNestedBy for obj in rel.RelatedObjects]
+        curves = _representation_curves(alignment)
+        horizontal: list[LayoutSegment] = []
+        vertical: list[LayoutSegment] = []
+        for layout in layouts:
+            if layout.is_a("IfcAlignmentHorizontal"):
+                parents = _parent_types(curves.get("IfcCompositeCurve"))
+                for k, p in enumerate(layout_segments(layout)):
+                    start = tuple(float(v) for v in p.StartPoint.Coordinates[:2])
+                    horizontal.append(LayoutSegment(p.PredefinedType, float(p.SegmentLength), start,  # type: ignore[arg-type]
+                                                    float(p.StartDirection),
+                                                    (float(p.StartRadiusOfCurvature), float(p.EndRadiusOfCurvature)),
+                                                    parents[k] if k < len(parents) else None))  # fmt: skip
+            elif layout.is_a("IfcAlignmentVertical"):
+                parents = _parent_types(curves.get("IfcGradientCurve"))
+                for k, p in enumerate(layout_segments(layout)):
+                    radius = float(p.RadiusOfCurvature) if p.RadiusOfCurvature is not None else 0.0
+                    vertical.append(LayoutSegment(p.PredefinedType, float(p.HorizontalLength),
+                                                  (float(p.StartDistAlong), float(p.StartHeight)), float(p.StartGradient),
+                                                  (radius, float(p.EndGradient)), parents[k] if k < len(parents) else None))  # fmt: skip
+        result.append(IfcAlignmentLayout(alignment.Name or "", scale, tuple(horizontal), tuple(vertical)))
+    return result
+
+
+def _representation_curves(alignment: Any) -> dict[str, Any]:
+    """The alignment's representation curves by exact type (the gradient curve's base curve included)."""
+    found: dict[str, Any] = {}
+    shape = alignment.Representation
+    for rep in shape.Representations if shape is not None else ():
+        for item in rep.Items:
+            while item is not None:
+                found.setdefault(item.is_a(), item)
+                item = getattr(item, "BaseCurve", None)
+    return found
+
+
+def _parent_types(curve: Any) -> list[str]:
+    return [] if curve is None else [s.ParentCurve.is_a() for s in curve.Segments]
