@@ -110,11 +110,10 @@ def _new_file(units: str, application: str, project_name: str) -> tuple[Any, Any
     import ifcopenshell
     import ifcopenshell.api.aggregate
     import ifcopenshell.api.context
-    import ifcopenshell.api.project
     import ifcopenshell.api.root
     import ifcopenshell.api.unit
 
-    model = ifcopenshell.api.project.create_file(version=IFC_SCHEMA)
+    model = ifcopenshell.file(schema=IFC_SCHEMA)  # type: ignore[arg-type]  # its stubs list IFC4X3, not the ADD2 release it supports
     project = ifcopenshell.api.root.create_entity(model, ifc_class="IfcProject", name=project_name)
     if units in _CONVERTED_UNITS:
         length = ifcopenshell.api.unit.add_conversion_based_unit(model, name=_CONVERTED_UNITS[units])
@@ -211,7 +210,8 @@ def _horizontal(w: _Writer, chain: Any, scale: float) -> tuple[list[Any], list[A
         None, None, m.createIfcCartesianPoint(tuple(end.tolist())), heading, 0.0, 0.0, 0.0, None, "LINE"
     )
     layout.append(w.layout_segment(parameters))
-    curve.append(w.segment(w.placement(*end.tolist(), float(tangent[0]), float(tangent[1])), 0.0, w.unit_line, "DISCONTINUOUS"))
+    ex, ey = end.tolist()
+    curve.append(w.segment(w.placement(ex, ey, float(tangent[0]), float(tangent[1])), 0.0, w.unit_line, "DISCONTINUOUS"))
     stations = np.concatenate([[0.0], np.cumsum(length)])
     return layout, curve, stations
 
@@ -365,6 +365,7 @@ def write_ifc(
     model = ifc_file(alignments, units=units, profile=profile, names=names, project=project, application=application)
     path = Path(os.fspath(path))
     model.header.file_name.time_stamp = time.strftime("%Y-%m-%dT%H:%M:%S")
+    model.header.file_name.name = path.name
     model.write(str(path))
     return path
 

@@ -13,7 +13,8 @@ from spiral_cad.core._chain_kernels import ARC, LINE, SPIRAL
 from spiral_cad.design import Alignment, Profile
 from spiral_cad.io.ifc import graph_length_scales, ifc_file, layout_segments, read_ifc_alignments, write_ifc
 
-ifcopenshell = pytest.importorskip("ifcopenshell")
+pytest.importorskip("ifcopenshell")
+import ifcopenshell  # noqa: E402
 import ifcopenshell.geom  # noqa: E402
 import ifcopenshell.ifcopenshell_wrapper as wrapper  # noqa: E402
 import ifcopenshell.util.unit  # noqa: E402
@@ -264,8 +265,10 @@ def test_graph_length_scales_solve_their_equation():
 
     poly = np.array([[30.0, 0.5, -0.2, 0.8, 0.3], [10.0, -0.1, 0.0, -2.0, 0.4]])
     lengths = np.array([31.0, 10.5])
-    for (bu, cu, du, cv, dv), length, lam in zip(poly, lengths, graph_length_scales(poly, lengths)):
-        value = quad(lambda u: math.hypot(lam, 2 * cv * u + 3 * dv * u * u), 0, 1, epsabs=0.0, epsrel=1e-13, limit=200)[0]
+    for (cv, dv), length, lam in zip(poly[:, 3:], lengths, graph_length_scales(poly, lengths)):
+        value = quad(
+            lambda u, lam=lam, cv=cv, dv=dv: math.hypot(lam, 2 * cv * u + 3 * dv * u * u), 0, 1, epsabs=0.0, epsrel=1e-13, limit=200
+        )[0]
         assert value == pytest.approx(length, rel=1e-13)
 
 
