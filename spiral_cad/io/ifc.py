@@ -140,13 +140,20 @@ class _Writer:
     def __init__(self, model: Any):
         self.model = model
         self.origin = model.createIfcAxis2Placement2D(model.createIfcCartesianPoint((0.0, 0.0)), model.createIfcDirection((1.0, 0.0)))
+        self.circles: dict[float, Any] = {}
         self.unit_line = model.createIfcLine(
             model.createIfcCartesianPoint((0.0, 0.0)), model.createIfcVector(model.createIfcDirection((1.0, 0.0)), 1.0)
         )
 
-    def placement(self, x: float, y: float, dx: float, dy: float) -> Any:
-        m = self.model
-        return m.createIfcAxis2Placement2D(m.createIfcCartesianPoint((x, y)), m.createIfcDirection((dx, dy)))
+    def placement(self, point: Any, dx: float, dy: float) -> Any:
+        """A 2-D placement at ``point`` (an IfcCartesianPoint, shared with the layout segment's start)."""
+        return self.model.createIfcAxis2Placement2D(point, self.model.createIfcDirection((dx, dy)))
+
+    def circle(self, radius: float) -> Any:
+        """The parent circle of radius ``radius`` at the origin (one per radius: the arcs of a road share few)."""
+        if radius not in self.circles:
+            self.circles[radius] = self.model.createIfcCircle(self.origin, radius)
+        return self.circles[radius]
 
     def segment(self, placement: Any, length: float, parent: Any, transition: str) -> Any:
         m = self.model
@@ -187,31 +194,28 @@ def _horizontal(w: _Writer, chain: Any, scale: float) -> tuple[list[Any], list[A
     for k in range(len(kind)):
         code, start, heading, size = int(kind[k]), (float(x[k]), float(y[k])), float(hdg[k]), float(length[k])
         r0, r1 = (0.0, 0.0) if code == LINE else (float(radius[k, 0]), float(radius[k, 1]))
-        parameters = m.createIfcAlignmentHorizontalSegment(
-            None, None, m.createIfcCartesianPoint(start), heading, r0, r1, size, None, types[code]
-        )
+        point = m.createIfcCartesianPoint(start)
+        parameters = m.createIfcAlignmentHorizontalSegment(None, None, point, heading, r0, r1, size, None, types[code])
         layout.append(w.layout_segment(parameters))
         if code == LINE:
             parent, signed = w.unit_line, size
         elif code == ARC:
-            parent = m.createIfcCircle(w.origin, abs(r0))
+            parent = w.circle(abs(r0))
             signed = math.copysign(size, r0)
         else:
             bu, cu, du, cv, dv = plan["poly"][k].tolist()
             s = float(lam[k])
             parent = m.createIfcPolynomialCurve(w.origin, (0.0, bu / s, cu / s**2, du / s**3), (0.0, 0.0, cv / s**2, dv / s**3), None)
             signed = size
-        place = w.placement(*start, math.cos(heading), math.sin(heading))
+        place = w.placement(point, math.cos(heading), math.sin(heading))
         curve.append(w.segment(place, signed, parent, "CONTSAMEGRADIENTSAMECURVATURE"))
     # the zero-length end segment: at the chain's end, in its end direction and curvature
     end, tangent = frames[-1, 1, :2] * scale, frames[-1, 1, 3:5]
     heading = math.atan2(float(tangent[1]), float(tangent[0]))
-    parameters = m.createIfcAlignmentHorizontalSegment(
-        None, None, m.createIfcCartesianPoint(tuple(end.tolist())), heading, 0.0, 0.0, 0.0, None, "LINE"
-    )
+    point = m.createIfcCartesianPoint(tuple(end.tolist()))
+    parameters = m.createIfcAlignmentHorizontalSegment(None, None, point, heading, 0.0, 0.0, 0.0, None, "LINE")
     layout.append(w.layout_segment(parameters))
-    ex, ey = end.tolist()
-    curve.append(w.segment(w.placement(ex, ey, float(tangent[0]), float(tangent[1])), 0.0, w.unit_line, "DISCONTINUOUS"))
+    curve.append(w.segment(w.placement(point, float(tangent[0]), float(tangent[1])), 0.0, w.unit_line, "DISCONTINUOUS"))
     stations = np.concatenate([[0.0], np.cumsum(length)])
     return layout, curve, stations
 
@@ -247,7 +251,14 @@ def _vertical(w: _Writer, profile: Any, start: float, end: float, scale: float) 
             parent = w.unit_line
         layout.append(w.layout_segment(parameters))
         norm = math.hypot(1.0, grade)
-        curve.append(w.segment(w.placement(start_k, height, 1.0 / norm, grade / norm), float(along[k]), parent, "CONTSAMEGRADIENT"))
+        curve.append(
+            w.segment(
+                w.placement(m.createIfcCartesianPoint((start_k, height)), 1.0 / norm, grade / norm),
+                float(along[k]),
+                parent,
+                "CONTSAMEGRADIENT",
+            )
+        )
     last = len(s) - 1
     finish = float(s[last] + run[last])
     height = float(a[last] + b[last] * run[last] + c[last] * run[last] ** 2)
@@ -255,7 +266,9 @@ def _vertical(w: _Writer, profile: Any, start: float, end: float, scale: float) 
     parameters = m.createIfcAlignmentVerticalSegment(None, None, finish, 0.0, height, grade, grade, None, "CONSTANTGRADIENT")
     layout.append(w.layout_segment(parameters))
     norm = math.hypot(1.0, grade)
-    curve.append(w.segment(w.placement(finish, height, 1.0 / norm, grade / norm), 0.0, w.unit_line, "DISCONTINUOUS"))
+    curve.append(
+        w.segment(w.placement(m.createIfcCartesianPoint((finish, height)), 1.0 / norm, grade / norm), 0.0, w.unit_line, "DISCONTINUOUS")
+    )
     return layout, curve
 
 
@@ -273,9 +286,6 @@ def ifc_file(
     Args and Raises: as ``write_ifc``; ``names`` are the ``IfcAlignment`` names
     (default ``alignment 1``, …), ``project`` the ``IfcProject`` name.
     """
-    import ifcopenshell.api.aggregate
-    import ifcopenshell.api.geometry
-    import ifcopenshell.api.spatial
     import ifcopenshell.guid
 
     from ..design.alignment import Alignment
@@ -326,8 +336,10 @@ def ifc_file(
         entity.Representation = model.createIfcProductDefinitionShape(None, None, reps)
         w.nest(entity, layouts)
         made.append(entity)
-    ifcopenshell.api.aggregate.assign_object(model, products=made, relating_object=proj)
-    ifcopenshell.api.spatial.reference_structure(model, products=made, relating_structure=site)
+    # the relationships ifcopenshell's alignment API makes (aggregated to the project, referenced by the
+    # site), written directly: its aggregate call re-reads every placement (and trips over 2-D ones)
+    model.createIfcRelAggregates(ifcopenshell.guid.new(), None, None, None, proj, made)
+    model.createIfcRelReferencedInSpatialStructure(ifcopenshell.guid.new(), None, None, None, made, site)
     return model
 
 
