@@ -440,7 +440,7 @@ def read_ifc_alignments(source: Any) -> list[IfcAlignmentLayout]:
     if not isinstance(source, ifcopenshell.file):
         try:
             model = ifcopenshell.open(os.fspath(source))
-        except (OSError, RuntimeError) as error:
+        except (OSError, RuntimeError, ifcopenshell.Error) as error:
             raise ValueError(f"{os.fspath(source)}: not a readable IFC file ({error})") from None
     if not model.schema.startswith("IFC4X3"):
         raise ValueError(f"IfcAlignment layouts are IFC 4.3; this file is {model.schema}")
