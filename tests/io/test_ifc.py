@@ -376,3 +376,19 @@ def test_malformed_input_is_refused_by_name():
         ifc_file([])
     with pytest.raises(ValueError, match="not a readable IFC file"):
         read_ifc_alignments(DATA / "README.md")
+
+
+def test_the_design_file_build_writes_the_ifc_or_names_it_skipped(tmp_path, monkeypatch):
+    from spiral_cad.app import designfile
+
+    design = {"units": "m", "designs": [{"name": "road", "type": "alignment", "pis": PIS[:4], "radii": [450, 400],
+                                         "spiral_angles_deg": 5.0}]}  # fmt: skip
+    units, built = designfile.build(design)
+    written = designfile.write(built, tmp_path / "with", units, progress=lambda _: None, plots=False)
+    (read,) = read_ifc_alignments(tmp_path / "with" / "road.ifc")
+    assert read.name == "road" and len(read.horizontal) == len(built[0].chain) + 1
+    assert not any("IFC" in s for s in written.skipped)
+    monkeypatch.setattr(designfile, "missing_cad_extra", lambda: ["ifcopenshell"])
+    written = designfile.write(built, tmp_path / "without", units, progress=lambda _: None, plots=False)
+    assert not (tmp_path / "without" / "road.ifc").exists() and (tmp_path / "without" / "road.xodr").exists()
+    assert written.skipped == ["IFC (needs ifcopenshell)"]
