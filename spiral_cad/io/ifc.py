@@ -286,6 +286,7 @@ def ifc_file(
     Args and Raises: as ``write_ifc``; ``names`` are the ``IfcAlignment`` names
     (default ``alignment 1``, …), ``project`` the ``IfcProject`` name.
     """
+    import ifcopenshell.api.alignment
     import ifcopenshell.guid
 
     from ..design.alignment import Alignment
@@ -335,6 +336,10 @@ def ifc_file(
                     model.createIfcShapeRepresentation(axis, "Axis", "Curve3D", [gradient])]  # fmt: skip
         entity.Representation = model.createIfcProductDefinitionShape(None, None, reps)
         w.nest(entity, layouts)
+        # the design's start station: the stationing referent at distance 0 (Pset_Stationing)
+        station = alignment.start_station * scale
+        ifcopenshell.api.alignment.add_stationing_referent(model, name=f"{station:g}", alignment=entity, distance_along=0.0,
+                                                           station=station)  # fmt: skip
         made.append(entity)
     # the relationships ifcopenshell's alignment API makes (aggregated to the project, referenced by the
     # site), written directly: its aggregate call re-reads every placement (and trips over 2-D ones)
@@ -410,12 +415,14 @@ class LayoutSegment:
 
 @dataclass(frozen=True)
 class IfcAlignmentLayout:
-    """An ``IfcAlignment`` as read: its name, length unit (metres per unit) and layouts."""
+    """An ``IfcAlignment`` as read: its name, length unit (metres per unit), layouts and start station
+    (its stationing referent's, 0 without one)."""
 
     name: str
     metres_per_unit: float
     horizontal: tuple[LayoutSegment, ...]
     vertical: tuple[LayoutSegment, ...]
+    start_station: float = 0.0
 
 
 def layout_segments(layout: Any) -> list[Any]:
@@ -434,6 +441,7 @@ def read_ifc_alignments(source: Any) -> list[IfcAlignmentLayout]:
         ValueError: the file cannot be read or is not IFC 4.3.
     """
     import ifcopenshell
+    import ifcopenshell.api.alignment
     import ifcopenshell.util.unit
 
     model = source
@@ -467,7 +475,8 @@ def read_ifc_alignments(source: Any) -> list[IfcAlignmentLayout]:
                     vertical.append(LayoutSegment(p.PredefinedType, float(p.HorizontalLength),
                                                   (float(p.StartDistAlong), float(p.StartHeight)), float(p.StartGradient),
                                                   (radius, float(p.EndGradient)), parents[k] if k < len(parents) else None))  # fmt: skip
-        result.append(IfcAlignmentLayout(alignment.Name or "", scale, tuple(horizontal), tuple(vertical)))
+        station = ifcopenshell.api.alignment.get_alignment_start_station(model, alignment)  # None: a referent without one
+        result.append(IfcAlignmentLayout(alignment.Name or "", scale, tuple(horizontal), tuple(vertical), float(station or 0.0)))
     return result
 
 

@@ -183,6 +183,7 @@ def test_ifcopenshell_validates_the_file_and_the_rules_hold(road, with_profile, 
     np.testing.assert_allclose([s.length for s in read.horizontal[:-1]], alignment.chain.lengths, rtol=1e-15)
     assert read.horizontal[-1].length == 0.0 and np.allclose(read.horizontal[-1].start, alignment.chain.end, atol=1e-9)
     assert read.metres_per_unit == pytest.approx(1.0 if alignment.chain.units == "m" else 0.3048, rel=1e-15)
+    assert read.start_station == alignment.start_station
     if with_profile:
         assert {s.type for s in read.vertical} == {"CONSTANTGRADIENT", "PARABOLICARC"} and read.vertical[-1].length == 0.0
         assert sum(s.length for s in read.vertical) == pytest.approx(alignment.chain.length, rel=1e-13)
