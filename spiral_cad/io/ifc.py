@@ -73,7 +73,7 @@ IFC_SCHEMA = "IFC4X3_ADD2"
 #: The precision of the geometric context in metres: IFC's default of 1e-5 length units for a metre file,
 #: and the same 10 µm in every unit (1e-5 mm would ask for more than ifcopenshell's evaluator holds: 1e-7 m).
 CONTEXT_PRECISION = 1e-5
-#: Our length units as IFC units: (SI prefix or None, SI name) or the conversion-based unit's name.
+#: Our length units as IFC units: the prefix of the metre (None: none), or the conversion-based unit's name.
 _SI_UNITS = {"mm": "MILLI", "cm": "CENTI", "m": None, "km": "KILO"}
 _CONVERTED_UNITS = {"ft": "foot", "in": "inch"}
 _NODES, _WEIGHTS = np.polynomial.legendre.leggauss(32)
