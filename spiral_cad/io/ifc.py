@@ -272,6 +272,26 @@ def _vertical(w: _Writer, profile: Any, start: float, end: float, scale: float) 
     return layout, curve
 
 
+def _stationing(w: _Writer, alignment: Any, basis: Any, chain: Any, station: float, scale: float) -> None:
+    """The design's start station: an ``IfcReferent`` (STATION) at distance 0 on the basis curve with
+    ``Pset_Stationing.Station``, nested in the alignment — what ``ifcopenshell.api.alignment.add_stationing_referent``
+    makes, with the fallback position taken from the chain (that call evaluates the whole curve)."""
+    import ifcopenshell.api.pset
+    import ifcopenshell.guid
+
+    m = w.model
+    x, y = (chain.start[:2] * scale).tolist()
+    tx, ty = chain.tangent_at(0.0)[:2].tolist()
+    fallback = m.createIfcAxis2Placement3D(m.createIfcCartesianPoint((x, y, 0.0)), m.createIfcDirection((0.0, 0.0, 1.0)),
+                                           m.createIfcDirection((tx, ty, 0.0)))  # fmt: skip
+    location = m.createIfcPointByDistanceExpression(m.createIfcLengthMeasure(0.0), None, None, None, basis)
+    placement = m.createIfcLinearPlacement(None, m.createIfcAxis2PlacementLinear(location, None, None), fallback)
+    referent = m.createIfcReferent(ifcopenshell.guid.new(), None, f"{station:g}", None, None, placement, None, "STATION")
+    pset = ifcopenshell.api.pset.add_pset(m, product=referent, name="Pset_Stationing")
+    ifcopenshell.api.pset.edit_pset(m, pset=pset, properties={"Station": station})
+    w.nest(alignment, [referent])
+
+
 def ifc_file(
     alignments: Any,
     *,
@@ -286,7 +306,6 @@ def ifc_file(
     Args and Raises: as ``write_ifc``; ``names`` are the ``IfcAlignment`` names
     (default ``alignment 1``, …), ``project`` the ``IfcProject`` name.
     """
-    import ifcopenshell.api.alignment
     import ifcopenshell.guid
 
     from ..design.alignment import Alignment
@@ -336,10 +355,7 @@ def ifc_file(
                     model.createIfcShapeRepresentation(axis, "Axis", "Curve3D", [gradient])]  # fmt: skip
         entity.Representation = model.createIfcProductDefinitionShape(None, None, reps)
         w.nest(entity, layouts)
-        # the design's start station: the stationing referent at distance 0 (Pset_Stationing)
-        station = alignment.start_station * scale
-        ifcopenshell.api.alignment.add_stationing_referent(model, name=f"{station:g}", alignment=entity, distance_along=0.0,
-                                                           station=station)  # fmt: skip
+        _stationing(w, entity, plan, chain, alignment.start_station * scale, scale)
         made.append(entity)
     # the relationships ifcopenshell's alignment API makes (aggregated to the project, referenced by the
     # site), written directly: its aggregate call re-reads every placement (and trips over 2-D ones)
