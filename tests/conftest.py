@@ -102,6 +102,7 @@ SLOW = {
     "test_faces_cli.py::test_zebra_and_curvature_pictures_are_written_and_tell_g1_from_g2",
     "test_fit_cli.py",
     "test_points.py::test_a_million_rows_read_as_numpy_wrote_them",
+    "test_ifc.py",
 }
 _CAD = re.compile(r"^\s*(?:from|import) (?:build123d|cadquery|OCP)\b|importorskip\([\"'](?:build123d|cadquery|OCP)", re.M)
 _SUBPROCESS = re.compile(r"\bsubprocess\b|sys\.executable")

@@ -67,7 +67,7 @@ LARGE_CHAIN_EDGES = 50_000
 #: Design files larger than this are refused before they are read.
 MAX_DESIGN_BYTES = 10_000_000
 #: The packages of the ``cad`` extra and what needs them.
-CAD_EXTRA = {"OCP": "IGES, the 3-D STEP of roads and the continuity check", "ezdxf": "DXF", "matplotlib": "plots"}
+CAD_EXTRA = {"OCP": "IGES, the 3-D STEP of roads and the continuity check", "ezdxf": "DXF", "matplotlib": "plots", "ifcopenshell": "IFC"}
 
 
 class DesignError(ValueError):
@@ -692,6 +692,13 @@ def _write_others(b: Built, stage: Path, units: str, missing: list[str], plots: 
 
         write_landxml(b.source, stage / f"{b.name}.xml", name=b.name, profile=profile)
         names.append("xml")
+        if "ifcopenshell" not in missing:
+            from ..cad.export import originating_system
+            from ..io.ifc import write_ifc
+
+            write_ifc(b.source, stage / f"{b.name}.ifc", profile=profile, names=[b.name], project=b.name,
+                      application=originating_system())  # fmt: skip
+            names.append("ifc")
         if b.source.checks:
             b.source.criteria_to_csv(stage / f"{b.name}_criteria.csv")
             names.append("criteria.csv")

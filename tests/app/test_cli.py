@@ -25,7 +25,7 @@ def test_demo_writes_every_output(tmp_path, capsys):
     (count,) = map(int, re.findall(r"wrote (\d+) files", text))
     progress = re.findall(r"^  \S.* → (.*?)(?: \(\d+\.\d s\))?$", text, re.MULTILINE)
     listed = sum(len(files.split(", ")) for files in progress)
-    assert count == listed == len(names) == 30
+    assert count == listed == len(names) == 31
     assert "robot.ngc" in names  # the robot path's program
     for csv_file in ("highway_stations.csv", "highway_criteria.csv", "highway_profile.csv"):
         assert_plain_csv(tmp_path / csv_file)
@@ -34,7 +34,7 @@ def test_demo_writes_every_output(tmp_path, capsys):
         for suffix in (".step", ".igs", ".dxf", ".svg", "_plan.png", "_curvature.png", "_continuity.txt"):
             assert design + suffix in names
         assert check_continuity(tmp_path / f"{design}.step").passes("G2")
-    assert {"highway_stations.csv", "highway_profile.csv", "highway_3d.step", "highway.xml", "fig6.png", "bezier_vs_clothoid.png"} <= names
+    assert {"highway_stations.csv", "highway_profile.csv", "highway_3d.step", "highway.xml", "highway.ifc", "fig6.png", "bezier_vs_clothoid.png"} <= names
     assert "circle in circle (5th case)" in text and "G2" in text
     circles = [(c["center"], c["radius"]) for c in DEMO_DESIGN["designs"][1]["circles"]]
     kinds = {t.kind for t in circle_chain(circles).transitions}

@@ -1,0 +1,512 @@
+"""IFC 4.3 (ISO 16739-1:2024) alignments, written through ifcopenshell.
+
+``write_ifc`` writes one ``IfcAlignment`` per alignment, aggregated to the
+``IfcProject`` and referenced by the ``IfcSite`` (as ifcopenshell's alignment
+API places them), with
+
+* the horizontal layout: an ``IfcAlignmentHorizontal`` nesting one
+  ``IfcAlignmentSegment`` per piece, whose ``IfcAlignmentHorizontalSegment``
+  is ``LINE``, ``CIRCULARARC`` or ``CUBIC`` (our spirals), and the
+  ``IfcCompositeCurve`` of ``IfcCurveSegment`` that represents it: lines on
+  ``IfcLine``, arcs on ``IfcCircle`` (``SegmentLength`` negative for a right
+  turn) and spirals on ``IfcPolynomialCurve`` (the mapping the concept
+  templates and the validation rule ALB023 give for ``CUBIC``);
+* with a profile, the vertical layout (``IfcAlignmentVertical``:
+  ``CONSTANTGRADIENT`` and ``PARABOLICARC``) and the ``IfcGradientCurve`` over
+  the composite curve: grades on ``IfcLine``, parabolas on
+  ``IfcPolynomialCurve`` with ``CoefficientsX = (0, 1)``;
+* the zero-length segment that ends every layout and every curve;
+* the project's length unit from the design (``IfcSIUnit`` metre with its
+  prefix, ``IfcConversionBasedUnit`` foot or inch), angles in radians.
+
+**A spiral exactly.** Our spiral is a cubic Bézier, so in the frame at its
+start (placement: start point and heading) it is the parametric cubic
+x(u) = bU·u + cU·u² + dU·u³, y(u) = cV·u² + dV·u³, u ∈ [0, 1] (OpenDRIVE's
+``paramPoly3`` numbers). The ``IfcPolynomialCurve`` holds it in the parameter
+t = λ·u, so its coefficients are bU/λ, cU/λ², … and ``SegmentStart`` = 0,
+``SegmentLength`` = the spiral's true arc length L. ``SegmentStart`` and
+``SegmentLength`` are ``IfcLengthMeasure``: lengths along the parent curve.
+Two readings of that length exist in practice, and λ makes them agree:
+
+* the schema's: arc length along the parametric curve, which reaches
+  u = 1 at L whatever λ is;
+* the concept template's (``CUBIC`` and ``PARABOLICARC`` assume
+  ``CoefficientsX = (0, 1)``, x = t, so the length of the graph y(t) is
+  ∫ √(1 + y'(t)²) dt), which ifcopenshell 0.9 evaluates for every
+  ``IfcPolynomialCurve``: it ends at u = 1 exactly when
+  ∫₀¹ √(λ² + y_u'(u)²) du = L — one λ per spiral, solved here by Newton's
+  method on a 32-node Gauss–Legendre rule (the integrand is smooth).
+
+Both readings start at u = 0 (the spiral's start) and end at u = 1 (its
+end), so the trimmed curve is the same cubic; only the map from a distance
+in between to a point differs in ifcopenshell (the point is still on the
+cubic). A bare parameter reading (``SegmentLength`` as a value of t) is what
+``IfcParameterValue`` would mean, not ``IfcLengthMeasure``.
+
+Needs ifcopenshell (the ``cad`` extra). No CAD kernel.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import time
+from collections.abc import Sequence
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from ..core._chain_kernels import ARC, LINE, SPIRAL
+from ..core.units import length_unit, to_metres
+from .opendrive import plan_records
+
+__all__ = [
+    "IFC_SCHEMA", "IfcAlignmentLayout", "LayoutSegment", "graph_length_scales", "ifc_file", "layout_segments",
+    "read_ifc_alignments", "write_ifc",
+]  # fmt: skip
+
+#: The schema written: IFC 4.3 ADD2 (ISO 16739-1:2024).
+IFC_SCHEMA = "IFC4X3_ADD2"
+#: The precision of the geometric context in metres: IFC's default of 1e-5 length units for a metre file,
+#: and the same 10 µm in every unit (1e-5 mm would ask for more than ifcopenshell's evaluator holds: 1e-7 m).
+CONTEXT_PRECISION = 1e-5
+#: Our length units as IFC units: the prefix of the metre (None: none), or the conversion-based unit's name.
+_SI_UNITS = {"mm": "MILLI", "cm": "CENTI", "m": None, "km": "KILO"}
+_CONVERTED_UNITS = {"ft": "foot", "in": "inch"}
+_NODES, _WEIGHTS = np.polynomial.legendre.leggauss(32)
+_NODES, _WEIGHTS = 0.5 * (_NODES + 1.0), 0.5 * _WEIGHTS  # on [0, 1]
+
+
+def graph_length_scales(poly: NDArray, lengths: NDArray) -> NDArray:
+    """λ per spiral: ∫₀¹ √(λ² + y_u'(u)²) du = L (see the module docstring).
+
+    Args:
+        poly: (N, 5) the spirals' bU, cU, dU, cV, dV in their own frames.
+        lengths: (N,) their arc lengths.
+
+    The function of λ is increasing and convex, from ∫|y'| (< L) at 0, so
+    Newton's method from λ = L (where it is ≥ L) descends monotonically.
+    """
+    poly = np.asarray(poly, dtype=float)
+    lengths = np.asarray(lengths, dtype=float)
+    slope = 2.0 * poly[:, 3:4] * _NODES + 3.0 * poly[:, 4:5] * _NODES**2  # y_u'(u) at the nodes
+    square = slope * slope
+    lam = lengths.copy()
+    for _ in range(60):
+        root = np.sqrt(lam[:, None] ** 2 + square)
+        value = root @ _WEIGHTS - lengths
+        step = value / ((lam[:, None] / root) @ _WEIGHTS)
+        lam = lam - step
+        if np.all(np.abs(step) <= 1e-15 * lam):
+            break
+    return lam
+
+
+def _new_file(units: str, application: str, project_name: str) -> tuple[Any, Any, Any, Any]:
+    """An IFC 4.3 file with its project, units, site and the Model/Axis context: (file, project, site, axis context)."""
+    import ifcopenshell
+    import ifcopenshell.api.aggregate
+    import ifcopenshell.api.context
+    import ifcopenshell.api.root
+    import ifcopenshell.api.unit
+
+    model = ifcopenshell.file(schema=IFC_SCHEMA)  # type: ignore[arg-type]  # its stubs list IFC4X3, not the ADD2 release it supports
+    project = ifcopenshell.api.root.create_entity(model, ifc_class="IfcProject", name=project_name)
+    if units in _CONVERTED_UNITS:
+        length = ifcopenshell.api.unit.add_conversion_based_unit(model, name=_CONVERTED_UNITS[units])
+    else:
+        length = ifcopenshell.api.unit.add_si_unit(model, unit_type="LENGTHUNIT", prefix=_SI_UNITS[units])
+    angle = ifcopenshell.api.unit.add_si_unit(model, unit_type="PLANEANGLEUNIT")
+    ifcopenshell.api.unit.assign_unit(model, units=[length, angle])
+    body = ifcopenshell.api.context.add_context(model, context_type="Model")
+    body.Precision = CONTEXT_PRECISION / to_metres(units)
+    axis = ifcopenshell.api.context.add_context(
+        model, context_type="Model", context_identifier="Axis", target_view="MODEL_VIEW", parent=body
+    )
+    site = ifcopenshell.api.root.create_entity(model, ifc_class="IfcSite", name="Site")
+    ifcopenshell.api.aggregate.assign_object(model, products=[site], relating_object=project)
+    header = model.header.file_name
+    header.originating_system = application
+    header.preprocessor_version = f"IfcOpenShell {ifcopenshell.version}"
+    return model, project, site, axis
+
+
+class _Writer:
+    """Creates the entities of one file (a few shared placements and directions, the rest per segment)."""
+
+    def __init__(self, model: Any):
+        self.model = model
+        self.origin = model.createIfcAxis2Placement2D(model.createIfcCartesianPoint((0.0, 0.0)), model.createIfcDirection((1.0, 0.0)))
+        self.circles: dict[float, Any] = {}
+        self.unit_line = model.createIfcLine(
+            model.createIfcCartesianPoint((0.0, 0.0)), model.createIfcVector(model.createIfcDirection((1.0, 0.0)), 1.0)
+        )
+
+    def placement(self, point: Any, dx: float, dy: float) -> Any:
+        """A 2-D placement at ``point`` (an IfcCartesianPoint, shared with the layout segment's start)."""
+        return self.model.createIfcAxis2Placement2D(point, self.model.createIfcDirection((dx, dy)))
+
+    def circle(self, radius: float) -> Any:
+        """The parent circle of radius ``radius`` at the origin (one per radius: the arcs of a road share few)."""
+        if radius not in self.circles:
+            self.circles[radius] = self.model.createIfcCircle(self.origin, radius)
+        return self.circles[radius]
+
+    def segment(self, placement: Any, length: float, parent: Any, transition: str) -> Any:
+        m = self.model
+        return m.createIfcCurveSegment(transition, placement, m.createIfcLengthMeasure(0.0), m.createIfcLengthMeasure(length), parent)
+
+    def nest(self, parent: Any, children: list[Any]) -> None:
+        import ifcopenshell.guid
+
+        self.model.createIfcRelNests(ifcopenshell.guid.new(), None, None, None, parent, children)
+
+    def layout_segment(self, parameters: Any) -> Any:
+        import ifcopenshell.guid
+
+        return self.model.createIfcAlignmentSegment(ifcopenshell.guid.new(), None, None, None, None, None, None, parameters)
+
+
+def _horizontal(w: _Writer, chain: Any, scale: float) -> tuple[list[Any], list[Any], NDArray]:
+    """The horizontal layout segments and curve segments of ``chain`` (lengths × ``scale``), each list
+    ending with its zero-length segment; and the stations (in the file's unit) of the segment starts."""
+    from ..core.segments import row_frames
+
+    m = w.model
+    plan = plan_records(chain, scale)
+    rows = chain.rows
+    frames, _, _ = row_frames(np.array(rows.kind), np.array(rows.geometry), np.array(rows.params), rows.dim)
+    kind, x, y, hdg, length = (plan[k] for k in ("kind", "x", "y", "hdg", "length"))
+    kappa = frames[:, :, 8] / scale  # signed curvature at both ends, in the file's unit
+    # a spiral's straight end has |κ|·L at rounding level, not 0: IFC says 0 for a straight end
+    kappa[np.abs(kappa) * length[:, None] <= 1e-9] = 0.0
+    with np.errstate(divide="ignore"):
+        radius = np.where(kappa != 0.0, 1.0 / np.where(kappa != 0.0, kappa, 1.0), 0.0)  # positive turns left
+    spiral = kind == SPIRAL
+    lam = np.ones(len(kind))
+    if spiral.any():
+        lam[spiral] = graph_length_scales(plan["poly"][spiral], length[spiral])
+    layout, curve = [], []
+    types = {LINE: "LINE", ARC: "CIRCULARARC", SPIRAL: "CUBIC"}
+    for k in range(len(kind)):
+        code, start, heading, size = int(kind[k]), (float(x[k]), float(y[k])), float(hdg[k]), float(length[k])
+        r0, r1 = (0.0, 0.0) if code == LINE else (float(radius[k, 0]), float(radius[k, 1]))
+        point = m.createIfcCartesianPoint(start)
+        parameters = m.createIfcAlignmentHorizontalSegment(None, None, point, heading, r0, r1, size, None, types[code])
+        layout.append(w.layout_segment(parameters))
+        if code == LINE:
+            parent, signed = w.unit_line, size
+        elif code == ARC:
+            parent = w.circle(abs(r0))
+            signed = math.copysign(size, r0)
+        else:
+            bu, cu, du, cv, dv = plan["poly"][k].tolist()
+            s = float(lam[k])
+            parent = m.createIfcPolynomialCurve(w.origin, (0.0, bu / s, cu / s**2, du / s**3), (0.0, 0.0, cv / s**2, dv / s**3), None)
+            signed = size
+        place = w.placement(point, math.cos(heading), math.sin(heading))
+        curve.append(w.segment(place, signed, parent, "CONTSAMEGRADIENTSAMECURVATURE"))
+    # the zero-length end segment: at the chain's end, in its end direction and curvature
+    end, tangent = frames[-1, 1, :2] * scale, frames[-1, 1, 3:5]
+    heading = math.atan2(float(tangent[1]), float(tangent[0]))
+    point = m.createIfcCartesianPoint(tuple(end.tolist()))
+    parameters = m.createIfcAlignmentHorizontalSegment(None, None, point, heading, 0.0, 0.0, 0.0, None, "LINE")
+    layout.append(w.layout_segment(parameters))
+    curve.append(w.segment(w.placement(point, float(tangent[0]), float(tangent[1])), 0.0, w.unit_line, "DISCONTINUOUS"))
+    stations = np.concatenate([[0.0], np.cumsum(length)])
+    return layout, curve, stations
+
+
+def _parabola_length(grade: NDArray, rate: NDArray, run: NDArray) -> NDArray:
+    """Arc length of z = g·d + c·d² over d ∈ [0, run] in the (distance, height) plane (32-node Gauss–Legendre)."""
+    slope = grade[:, None] + 2.0 * rate[:, None] * (run[:, None] * _NODES)
+    return np.sqrt(1.0 + slope * slope) @ _WEIGHTS * run
+
+
+def _vertical(w: _Writer, profile: Any, start: float, end: float, scale: float) -> tuple[list[Any], list[Any]]:
+    """The vertical layout and gradient curve segments of ``profile`` from station ``start`` to ``end``
+    (distance along from 0 at ``start``), each list ending with its zero-length segment."""
+    m = w.model
+    records = profile.records(start, end)
+    s, a, b, c = records.T
+    run = np.diff(np.append(s, end - start))
+    s, a, run, c = s * scale, a * scale, run * scale, c / scale
+    end_grade = b + 2.0 * c * run
+    parabola = c != 0.0
+    along = np.where(parabola, _parabola_length(b, c, run), run * np.sqrt(1.0 + b * b))
+    layout, curve = [], []
+    for k in range(len(s)):
+        start_k, height, grade, size = float(s[k]), float(a[k]), float(b[k]), float(run[k])
+        if parabola[k]:
+            rate = float(c[k])
+            parameters = m.createIfcAlignmentVerticalSegment(
+                None, None, start_k, size, height, grade, float(end_grade[k]), 1.0 / (2.0 * rate), "PARABOLICARC"
+            )
+            parent = m.createIfcPolynomialCurve(w.origin, (0.0, 1.0), (0.0, grade, rate), None)
+        else:
+            parameters = m.createIfcAlignmentVerticalSegment(None, None, start_k, size, height, grade, grade, None, "CONSTANTGRADIENT")
+            parent = w.unit_line
+        layout.append(w.layout_segment(parameters))
+        norm = math.hypot(1.0, grade)
+        curve.append(
+            w.segment(
+                w.placement(m.createIfcCartesianPoint((start_k, height)), 1.0 / norm, grade / norm),
+                float(along[k]),
+                parent,
+                "CONTSAMEGRADIENT",
+            )
+        )
+    last = len(s) - 1
+    finish = float(s[last] + run[last])
+    height = float(a[last] + b[last] * run[last] + c[last] * run[last] ** 2)
+    grade = float(end_grade[last])
+    parameters = m.createIfcAlignmentVerticalSegment(None, None, finish, 0.0, height, grade, grade, None, "CONSTANTGRADIENT")
+    layout.append(w.layout_segment(parameters))
+    norm = math.hypot(1.0, grade)
+    curve.append(
+        w.segment(w.placement(m.createIfcCartesianPoint((finish, height)), 1.0 / norm, grade / norm), 0.0, w.unit_line, "DISCONTINUOUS")
+    )
+    return layout, curve
+
+
+def _stationing(w: _Writer, alignment: Any, basis: Any, chain: Any, station: float, scale: float) -> None:
+    """The design's start station: an ``IfcReferent`` (STATION) at distance 0 on the basis curve with
+    ``Pset_Stationing.Station``, nested in the alignment — what ``ifcopenshell.api.alignment.add_stationing_referent``
+    makes, with the fallback position taken from the chain (that call evaluates the whole curve)."""
+    import ifcopenshell.api.pset
+    import ifcopenshell.guid
+
+    m = w.model
+    x, y = (chain.start[:2] * scale).tolist()
+    tx, ty = chain.tangent_at(0.0)[:2].tolist()
+    fallback = m.createIfcAxis2Placement3D(m.createIfcCartesianPoint((x, y, 0.0)), m.createIfcDirection((0.0, 0.0, 1.0)),
+                                           m.createIfcDirection((tx, ty, 0.0)))  # fmt: skip
+    location = m.createIfcPointByDistanceExpression(m.createIfcLengthMeasure(0.0), None, None, None, basis)
+    placement = m.createIfcLinearPlacement(None, m.createIfcAxis2PlacementLinear(location, None, None), fallback)
+    referent = m.createIfcReferent(ifcopenshell.guid.new(), None, f"{station:g}", None, None, placement, None, "STATION")
+    pset = ifcopenshell.api.pset.add_pset(m, product=referent, name="Pset_Stationing")
+    ifcopenshell.api.pset.edit_pset(m, pset=pset, properties={"Station": station})
+    w.nest(alignment, [referent])
+
+
+def ifc_file(
+    alignments: Any,
+    *,
+    units: str | None = None,
+    profile: Any = None,
+    names: Sequence[str] | None = None,
+    project: str = "spiral_cad",
+    application: str = "spiral_cad",
+) -> Any:
+    """The IFC 4.3 model of ``alignments`` as an ``ifcopenshell.file`` (``write_ifc`` writes it).
+
+    Args and Raises: as ``write_ifc``; ``names`` are the ``IfcAlignment`` names
+    (default ``alignment 1``, …), ``project`` the ``IfcProject`` name.
+    """
+    import ifcopenshell.guid
+
+    from ..design.alignment import Alignment
+
+    items = [alignments] if isinstance(alignments, Alignment) else list(alignments)
+    if not items or not all(isinstance(a, Alignment) for a in items):
+        raise ValueError("alignments must be an Alignment or a non-empty list of them")
+    profiles = list(profile) if isinstance(profile, (list, tuple)) else [profile] * len(items)
+    if len(profiles) != len(items):
+        raise ValueError(f"profile: give one profile (or None) per alignment ({len(items)}); got {len(profiles)}")
+    own = {a.chain.units for a in items}
+    if len(own) != 1:
+        raise ValueError(f"the alignments must share one length unit; got {', '.join(sorted(own))}")
+    design_units = own.pop()
+    units = design_units if units is None else length_unit(units)
+    scale = to_metres(design_units) / to_metres(units)
+    names = [f"alignment {k}" for k in range(1, len(items) + 1)] if names is None else list(names)
+    if len(names) != len(items):
+        raise ValueError(f"names: give one name per alignment ({len(items)}); got {len(names)}")
+    for k, p in enumerate(profiles):
+        if p is not None and p.units != design_units:
+            raise ValueError(f"profile {k}: in {p.units}, its alignment in {design_units}")
+
+    model, proj, site, axis = _new_file(units, application, project)
+    w = _Writer(model)
+    made = []
+    for alignment, p, name in zip(items, profiles, names):
+        chain = alignment.chain
+        if chain.dim != 2:
+            raise ValueError(f"{name}: an IFC horizontal layout is plane; this chain lies in space")
+        entity = model.createIfcAlignment(ifcopenshell.guid.new(), None, name, None, None,
+                                          model.createIfcLocalPlacement(None, w.origin), None, None)  # fmt: skip
+        horizontal = model.createIfcAlignmentHorizontal(ifcopenshell.guid.new(), None, None, None, None, None, None)
+        layouts = [horizontal]
+        h_layout, h_curve, _ = _horizontal(w, chain, scale)
+        w.nest(horizontal, h_layout)
+        plan = model.createIfcCompositeCurve(h_curve, False)
+        if p is None:
+            reps = [model.createIfcShapeRepresentation(axis, "Axis", "Curve2D", [plan])]
+        else:
+            vertical = model.createIfcAlignmentVertical(ifcopenshell.guid.new(), None, None, None, None, None, None)
+            layouts.append(vertical)
+            v_layout, v_curve = _vertical(w, p, alignment.start_station, alignment.end_station, scale)
+            w.nest(vertical, v_layout)
+            gradient = model.createIfcGradientCurve(v_curve, False, plan, None)
+            reps = [model.createIfcShapeRepresentation(axis, "FootPrint", "Curve2D", [plan]),
+                    model.createIfcShapeRepresentation(axis, "Axis", "Curve3D", [gradient])]  # fmt: skip
+        entity.Representation = model.createIfcProductDefinitionShape(None, None, reps)
+        w.nest(entity, layouts)
+        _stationing(w, entity, plan, chain, alignment.start_station * scale, scale)
+        made.append(entity)
+    # the relationships ifcopenshell's alignment API makes (aggregated to the project, referenced by the
+    # site), written directly: its aggregate call re-reads every placement (and trips over 2-D ones)
+    model.createIfcRelAggregates(ifcopenshell.guid.new(), None, None, None, proj, made)
+    model.createIfcRelReferencedInSpatialStructure(ifcopenshell.guid.new(), None, None, None, made, site)
+    return model
+
+
+def write_ifc(
+    alignments: Any,
+    path: str | os.PathLike,
+    *,
+    units: str | None = None,
+    profile: Any = None,
+    names: Sequence[str] | None = None,
+    project: str = "spiral_cad",
+    application: str = "spiral_cad",
+) -> Path:
+    """Write IFC 4.3 alignments (see the module docstring for the mapping).
+
+    Args:
+        alignments: an ``Alignment`` or a list of them (one unit).
+        path: the .ifc file to write (STEP physical file, ISO 10303-21).
+        units: the file's length unit (default: the alignments'); mm, cm,
+            m and km are SI units, ft and in conversion-based units.
+        profile: the ``Profile`` of an alignment, or one per alignment (None
+            for none): adds the vertical layout and the ``IfcGradientCurve``.
+        names: the alignments' names.
+        project: the ``IfcProject``'s name.
+        application: the application named in the file's owner history.
+
+    Returns:
+        The path written.
+
+    Raises:
+        ValueError: no alignments, alignments in different units, an
+            unknown unit, profiles that do not match the alignments, or a
+            chain in space.
+    """
+    model = ifc_file(alignments, units=units, profile=profile, names=names, project=project, application=application)
+    path = Path(os.fspath(path))
+    model.header.file_name.time_stamp = time.strftime("%Y-%m-%dT%H:%M:%S")
+    model.header.file_name.name = path.name
+    model.write(str(path))
+    return path
+
+
+# ------------------------------------------------------------------ reading
+
+
+@dataclass(frozen=True)
+class LayoutSegment:
+    """One segment of an IFC alignment layout, in the file's length unit (angles in radians).
+
+    Attributes:
+        type: the ``PredefinedType`` (``LINE``, ``CIRCULARARC``, ``CUBIC``, ``CONSTANTGRADIENT``, …).
+        length: ``SegmentLength`` (horizontal) or ``HorizontalLength`` (vertical).
+        start: the start point (horizontal) or (distance along, height) (vertical).
+        direction: the start direction (horizontal) or the start gradient (vertical).
+        radii: start and end radius of curvature (horizontal; 0 straight, positive turns left);
+            (radius, end gradient) for a vertical segment.
+        curve: the entity type of the matching ``IfcCurveSegment.ParentCurve`` in the
+            representation, or None when the alignment has no representation.
+    """
+
+    type: str
+    length: float
+    start: tuple[float, float]
+    direction: float
+    radii: tuple[float, float]
+    curve: str | None
+
+
+@dataclass(frozen=True)
+class IfcAlignmentLayout:
+    """An ``IfcAlignment`` as read: its name, length unit (metres per unit), layouts and start station
+    (its stationing referent's, 0 without one)."""
+
+    name: str
+    metres_per_unit: float
+    horizontal: tuple[LayoutSegment, ...]
+    vertical: tuple[LayoutSegment, ...]
+    start_station: float = 0.0
+
+
+def layout_segments(layout: Any) -> list[Any]:
+    """The ``IfcAlignmentSegment`` design parameters nested in ``layout``, in nesting order."""
+    out = []
+    for rel in layout.IsNestedBy:
+        out += [s.DesignParameters for s in rel.RelatedObjects if s.is_a("IfcAlignmentSegment")]
+    return out
+
+
+def read_ifc_alignments(source: Any) -> list[IfcAlignmentLayout]:
+    """Every ``IfcAlignment`` of an IFC 4.3 file (a path or an ``ifcopenshell.file``) with its horizontal
+    and vertical layouts, each segment beside the type of its representation's parent curve.
+
+    Raises:
+        ValueError: the file cannot be read or is not IFC 4.3.
+    """
+    import ifcopenshell
+    import ifcopenshell.api.alignment
+    import ifcopenshell.util.unit
+
+    model = source
+    if not isinstance(source, ifcopenshell.file):
+        try:
+            model = ifcopenshell.open(os.fspath(source))
+        except (OSError, RuntimeError, ifcopenshell.Error) as error:
+            raise ValueError(f"{os.fspath(source)}: not a readable IFC file ({error})") from None
+    if not model.schema.startswith("IFC4X3"):
+        raise ValueError(f"IfcAlignment layouts are IFC 4.3; this file is {model.schema}")
+    scale = float(ifcopenshell.util.unit.calculate_unit_scale(model, "LENGTHUNIT"))
+    result = []
+    for alignment in model.by_type("IfcAlignment"):
+        layouts = [obj for rel in alignment.IsNestedBy for obj in rel.RelatedObjects]
+        curves = _representation_curves(alignment)
+        horizontal: list[LayoutSegment] = []
+        vertical: list[LayoutSegment] = []
+        for layout in layouts:
+            if layout.is_a("IfcAlignmentHorizontal"):
+                parents = _parent_types(curves.get("IfcCompositeCurve"))
+                for k, p in enumerate(layout_segments(layout)):
+                    start = tuple(float(v) for v in p.StartPoint.Coordinates[:2])
+                    horizontal.append(LayoutSegment(p.PredefinedType, float(p.SegmentLength), start,  # type: ignore[arg-type]
+                                                    float(p.StartDirection),
+                                                    (float(p.StartRadiusOfCurvature), float(p.EndRadiusOfCurvature)),
+                                                    parents[k] if k < len(parents) else None))  # fmt: skip
+            elif layout.is_a("IfcAlignmentVertical"):
+                parents = _parent_types(curves.get("IfcGradientCurve"))
+                for k, p in enumerate(layout_segments(layout)):
+                    radius = float(p.RadiusOfCurvature) if p.RadiusOfCurvature is not None else 0.0
+                    vertical.append(LayoutSegment(p.PredefinedType, float(p.HorizontalLength),
+                                                  (float(p.StartDistAlong), float(p.StartHeight)), float(p.StartGradient),
+                                                  (radius, float(p.EndGradient)), parents[k] if k < len(parents) else None))  # fmt: skip
+        station = ifcopenshell.api.alignment.get_alignment_start_station(model, alignment)  # None: a referent without one
+        result.append(IfcAlignmentLayout(alignment.Name or "", scale, tuple(horizontal), tuple(vertical), float(station or 0.0)))
+    return result
+
+
+def _representation_curves(alignment: Any) -> dict[str, Any]:
+    """The alignment's representation curves by exact type (the gradient curve's base curve included)."""
+    found: dict[str, Any] = {}
+    shape = alignment.Representation
+    for rep in shape.Representations if shape is not None else ():
+        for item in rep.Items:
+            while item is not None:
+                found.setdefault(item.is_a(), item)
+                item = getattr(item, "BaseCurve", None)
+    return found
+
+
+def _parent_types(curve: Any) -> list[str]:
+    return [] if curve is None else [s.ParentCurve.is_a() for s in curve.Segments]
