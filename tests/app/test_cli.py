@@ -34,7 +34,15 @@ def test_demo_writes_every_output(tmp_path, capsys):
         for suffix in (".step", ".igs", ".dxf", ".svg", "_plan.png", "_curvature.png", "_continuity.txt"):
             assert design + suffix in names
         assert check_continuity(tmp_path / f"{design}.step").passes("G2")
-    assert {"highway_stations.csv", "highway_profile.csv", "highway_3d.step", "highway.xml", "highway.ifc", "fig6.png", "bezier_vs_clothoid.png"} <= names
+    assert {
+        "highway_stations.csv",
+        "highway_profile.csv",
+        "highway_3d.step",
+        "highway.xml",
+        "highway.ifc",
+        "fig6.png",
+        "bezier_vs_clothoid.png",
+    } <= names
     assert "circle in circle (5th case)" in text and "G2" in text
     circles = [(c["center"], c["radius"]) for c in DEMO_DESIGN["designs"][1]["circles"]]
     kinds = {t.kind for t in circle_chain(circles).transitions}
