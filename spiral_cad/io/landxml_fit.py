@@ -233,11 +233,13 @@ class _Theirs:
 def distance_to_file(segments: Sequence[Segment], elements: Sequence[int], starts: NDArray, headings: NDArray, k0: NDArray,
                      k1: NDArray, lengths: NDArray) -> float:  # fmt: skip
     """The largest distance from samples of ``segments`` to the file's ``elements`` (to choose between solutions)."""
-    ours = _Ours(list(segments))
-    u = np.linspace(0.0, 1.0, SAMPLES)
-    points, _ = ours(np.repeat(np.arange(len(segments)), SAMPLES), np.tile(u, len(segments)))
-    theirs = _Theirs(starts, headings, k0, k1, lengths)
-    return float(_distances(points, np.broadcast_to(np.asarray(elements), (len(points), len(elements))), theirs).max())
+    with np.errstate(all="ignore"):  # a distance that overflows: the worst choice
+        ours = _Ours(list(segments))
+        u = np.linspace(0.0, 1.0, SAMPLES)
+        points, _ = ours(np.repeat(np.arange(len(segments)), SAMPLES), np.tile(u, len(segments)))
+        theirs = _Theirs(starts, headings, k0, k1, lengths)
+        found = float(_distances(points, np.broadcast_to(np.asarray(elements), (len(points), len(elements))), theirs).max())
+    return found if math.isfinite(found) else math.inf
 
 
 def _distances(points: NDArray, window: NDArray, curve: Callable[[NDArray, NDArray], tuple[NDArray, NDArray]]) -> NDArray:
@@ -251,7 +253,9 @@ def _distances(points: NDArray, window: NDArray, curve: Callable[[NDArray, NDArr
         u = grid[np.argmin(np.hypot(*(sampled - p[:, :, None, :]).transpose(3, 0, 1, 2)), axis=2)]
         for _ in range(_STEPS):
             at, der = curve(w, u)
-            u = np.clip(u + np.einsum("...j,...j->...", p - at, der) / np.einsum("...j,...j->...", der, der), 0.0, 1.0)
+            speed = np.einsum("...j,...j->...", der, der)
+            step = np.einsum("...j,...j->...", p - at, der) / np.where(speed > 0.0, speed, 1.0)  # a point-like piece: no step
+            u = np.clip(u + step, 0.0, 1.0)
         at, _ = curve(w, u)
         out[block] = np.hypot(*(p - at).transpose(2, 0, 1)).min(axis=1)
     return out
@@ -265,7 +269,19 @@ def offsets(chains: Sequence[Chain], owners: Sequence[NDArray], starts: NDArray,
         chains: our chains; ``owners[c]`` gives the file element of each segment of ``chains[c]``.
         starts, headings, k0, k1, lengths: the file's elements at their own placement.
         runs: the chain of each element.
+
+    Raises:
+        ValueError: the geometry is too large to measure in floating point (a distance overflows).
     """
+    with np.errstate(all="ignore"):
+        found = _offsets(chains, owners, starts, headings, k0, k1, lengths, runs)
+    if not np.isfinite(found).all():
+        raise ValueError("the offsets from the file's elements overflow in floating point")
+    return found
+
+
+def _offsets(chains: Sequence[Chain], owners: Sequence[NDArray], starts: NDArray, headings: NDArray, k0: NDArray, k1: NDArray,
+            lengths: NDArray, runs: NDArray) -> NDArray[np.float64]:  # fmt: skip
     count = len(lengths)
     theirs = _Theirs(starts, headings, k0, k1, lengths)
     segments = [s for chain in chains for s in chain.segments]

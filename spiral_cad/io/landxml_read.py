@@ -6,22 +6,24 @@ feet, US survey feet, inches — US survey feet become feet), angles and
 directions in radians, grads, decimal degrees or ``decimal dd.mm.ss``,
 points northing before easting, directions counter-clockwise from east.
 
-Each ``<CoordGeom>`` is rebuilt in order, every element continuing from the
-end of the one before (so the chain is G2 by construction):
-
-* ``Line`` → ``Line`` of the same length;
-* ``Curve`` (``crvType`` arc; also defined by its chord or by its points
-  only) → ``Arc`` of the same radius and length;
-* ``Spiral spiType="clothoid"`` from curvature κ0 to κ1 → our Bézier spiral
-  (``shape``, default ``"near-linear"``: the nearest to a clothoid) with the
-  same length and end curvatures: 0 → κ a spiral, κ → 0 its reversal, κ0 → κ1
-  (one ``rot``: one sign) the piece of a longer spiral whose start curvature
-  is κ0 (found by a bracketed root). A spiral this package wrote (its ``desc``) is rebuilt with its
-  own shape: the very cubic.
+Each ``<CoordGeom>`` is rebuilt in order (``placement="neighbours"``, the
+default): the file's ``Line`` and ``Curve`` elements (``crvType`` arc; also
+defined by its chord or by its points only) stay on the file's line or circle,
+and each run of ``Spiral spiType="clothoid"`` elements between them becomes
+our Bézier spiral(s) (``shape``, default ``"near-linear"``) that the exact
+solvers find between the same two neighbours (``spiral_cad.io.landxml_fit``);
+the lines and arcs are trimmed to the spirals' contact points, so lengths and
+stations follow our chain. Where no solution exists, or the spirals have no
+line or arc of the file on either side, a clothoid from κ0 to κ1 is rebuilt
+as before with ``placement="length"``: our spiral with the same length and end
+curvatures continuing from the element before (0 → κ a spiral, κ → 0 its
+reversal, κ0 → κ1 the piece of a longer spiral whose start curvature is κ0,
+found by a bracketed root). A spiral this package wrote (its ``desc``) is
+rebuilt with its own shape: the very cubic.
 
 Per element the record keeps the offset between the file's element (placed at
 its own Start and start direction; the exact clothoid of
-``spiral_cad.core.clothoid``) and ours, at ``SAMPLES`` arc lengths; the
+``spiral_cad.core.clothoid``) and ours, measured both ways; the
 largest is the record's ``offset``. Elements that cannot be represented —
 other spiral types, ``IrregularLine``, ``Chain``, an alignment with no
 ``CoordGeom`` (``AlignPIs`` only) — are refused with a ValueError naming the
@@ -671,7 +673,10 @@ def _alignment(r: _Reader, a: ET.Element, label: str) -> LandXMLAlignment:
         owners.append(np.array(owner, dtype=np.int64))
         methods.update(found)
     run_of = np.repeat(np.arange(len(runs)), [len(m) for m in runs])
-    offsets = fit_offsets(chains, owners, *file, run_of)
+    try:
+        offsets = fit_offsets(chains, owners, *file, run_of)
+    except ValueError as e:
+        raise ValueError(f"{where}: {e}") from None
     ours = np.zeros(len(items))
     for chain, held in zip(chains, owners):
         np.add.at(ours, held, chain.lengths)
