@@ -46,9 +46,9 @@ __all__: list[str] = []
 
 #: Samples per element at which offsets are measured, and grid points per curve for the first foot.
 SAMPLES = 17
-_GRID = 33
+_GRID = 9
 #: Newton steps refining each foot.
-_STEPS = 5
+_STEPS = 3
 
 
 @dataclass(frozen=True)

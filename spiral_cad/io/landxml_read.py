@@ -572,7 +572,9 @@ def _run(items: list[_Element], mine: list[int], starts: list[NDArray], headings
                 problems.append(f"{shape}: {e}")
         if candidates:
             near = [k for k in range(ks[0] - 1, ks[-1] + 2) if k in mine]
-            name, shape, found = min(candidates, key=lambda c: distance_to_file([seg for _, seg in c[2]], near, *file))
+            name, shape, found = (
+                candidates[0] if len(candidates) == 1 else min(candidates, key=lambda c: distance_to_file([seg for _, seg in c[2]], near, *file))
+            )
             close(pending[0].station(found[0][1].start) if pending is not None else 0.0)
             for i, segment in found:
                 emit([segment], ks[i])
