@@ -46,7 +46,7 @@ __all__: list[str] = []
 
 #: Samples per element at which offsets are measured, and grid points per curve for the first foot.
 SAMPLES = 17
-_GRID = 9
+_GRID = 17
 #: Newton steps refining each foot.
 _STEPS = 3
 
@@ -247,9 +247,12 @@ def _distances(points: NDArray, window: NDArray, curve: Callable[[NDArray, NDArr
     point, then Gauss–Newton steps on u clamped to [0, 1]."""
     out = np.empty(len(points))
     grid = np.linspace(0.0, 1.0, _GRID)
+    used = np.unique(window)
+    on_grid = np.empty((int(used.max()) + 1, _GRID, 2))
+    on_grid[used] = curve(np.repeat(used, _GRID).reshape(-1, _GRID), np.broadcast_to(grid, (len(used), _GRID)))[0]  # once per curve
     for block in np.array_split(np.arange(len(points)), max(1, -(-len(points) * window.shape[1] // (16 * CHUNK)))):
         p, w = points[block, None, :], window[block]
-        sampled, _ = curve(np.broadcast_to(w[:, :, None], (*w.shape, _GRID)), np.broadcast_to(grid, (*w.shape, _GRID)))
+        sampled = on_grid[w]
         u = grid[np.argmin(np.hypot(*(sampled - p[:, :, None, :]).transpose(3, 0, 1, 2)), axis=2)]
         for _ in range(_STEPS):
             at, der = curve(w, u)
