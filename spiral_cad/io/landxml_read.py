@@ -539,7 +539,7 @@ def _run(items: list[_Element], mine: list[int], starts: list[NDArray], headings
                 if how == "one":
                     name, solved = solve_run(entry, exit_, curvatures, shape)
                     if value < 0.0:  # a symmetric C: its peak curvature chosen nearest the file's (asymmetric) pair
-                        near = [k for k in range(ks[0] - 1, ks[-1] + 2) if k in mine]
+                        near = list(range(max(ks[0] - 1, mine[0]), min(ks[-1] + 2, mine[-1] + 1)))  # a run is consecutive elements
 
                         def apart(log_scale: float) -> float:
                             try:
@@ -571,9 +571,11 @@ def _run(items: list[_Element], mine: list[int], starts: list[NDArray], headings
             except ValueError as e:
                 problems.append(f"{shape}: {e}")
         if candidates:
-            near = [k for k in range(ks[0] - 1, ks[-1] + 2) if k in mine]
+            near = list(range(max(ks[0] - 1, mine[0]), min(ks[-1] + 2, mine[-1] + 1)))  # a run is consecutive elements
             name, shape, found = (
-                candidates[0] if len(candidates) == 1 else min(candidates, key=lambda c: distance_to_file([seg for _, seg in c[2]], near, *file))
+                candidates[0]
+                if len(candidates) == 1
+                else min(candidates, key=lambda c: distance_to_file([seg for _, seg in c[2]], near, *file))
             )
             close(pending[0].station(found[0][1].start) if pending is not None else 0.0)
             for i, segment in found:
@@ -588,7 +590,8 @@ def _run(items: list[_Element], mine: list[int], starts: list[NDArray], headings
             try:
                 emit(_segments(items[k], point, heading), k)
             except ValueError as e:
-                raise ValueError(f"{e}; no transition joins its neighbours either ({'; '.join(problems)})") from None
+                why = f"; no transition joins its neighbours either ({'; '.join(problems)})" if problems else ""
+                raise ValueError(f"{e}{why}") from None
             methods[k] = "length"
             if problems:
                 items[k].notes.append(f"{items[k].where}: rebuilt with its own length ({'; '.join(problems)})")
