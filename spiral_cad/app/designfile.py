@@ -221,13 +221,16 @@ def build_landxml(path: str | Path) -> tuple[str, list[Built]]:
 
 
 def _landxml_report(b: BuiltLandXML, stage: Path) -> list[str]:
-    """NAME_landxml.txt (per element: kind, station, offset from the file; the breaks) and NAME.xodr."""
+    """NAME_landxml.txt (per element: kind, station, offset from the file, length change, how it was rebuilt;
+    the station shift, the breaks) and NAME.xodr."""
     from ..cad.export import export_opendrive
 
     a = b.source
-    lines = [f"{a.name}: {len(a.kinds)} elements, largest offset from the file {a.offset:.3g} {a.units}",
-             "element  kind     station            offset"]  # fmt: skip
-    lines += [f"{k:7d}  {kind:7s}  {sta:17.6f}  {off:.3g}" for k, (kind, sta, off) in enumerate(zip(a.kinds, a.stations, a.offsets))]
+    lines = [f"{a.name}: {len(a.kinds)} elements, largest offset from the file {a.offset:.3g} {a.units}, "
+             f"station shift at the end {a.station_shift:.3g} {a.units}",
+             "element  kind     station            offset     length change  rebuilt by"]  # fmt: skip
+    lines += [f"{k:7d}  {kind:7s}  {sta:17.6f}  {off:9.3g}  {dl:13.3g}  {how}"
+              for k, (kind, sta, off, dl, how) in enumerate(zip(a.kinds, a.stations, a.offsets, a.length_changes, a.methods))]  # fmt: skip
     lines += [f"break: {text}" for text in a.breaks] + [f"note: {text}" for text in a.notes]
     (stage / f"{b.name}_landxml.txt").write_text("\n".join(lines) + "\n", encoding="utf-8")
     export_opendrive(b.chain, stage / f"{b.name}.xodr", name=b.name)

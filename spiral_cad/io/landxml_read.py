@@ -6,22 +6,24 @@ feet, US survey feet, inches — US survey feet become feet), angles and
 directions in radians, grads, decimal degrees or ``decimal dd.mm.ss``,
 points northing before easting, directions counter-clockwise from east.
 
-Each ``<CoordGeom>`` is rebuilt in order, every element continuing from the
-end of the one before (so the chain is G2 by construction):
-
-* ``Line`` → ``Line`` of the same length;
-* ``Curve`` (``crvType`` arc; also defined by its chord or by its points
-  only) → ``Arc`` of the same radius and length;
-* ``Spiral spiType="clothoid"`` from curvature κ0 to κ1 → our Bézier spiral
-  (``shape``, default ``"near-linear"``: the nearest to a clothoid) with the
-  same length and end curvatures: 0 → κ a spiral, κ → 0 its reversal, κ0 → κ1
-  (one ``rot``: one sign) the piece of a longer spiral whose start curvature
-  is κ0 (found by a bracketed root). A spiral this package wrote (its ``desc``) is rebuilt with its
-  own shape: the very cubic.
+Each ``<CoordGeom>`` is rebuilt in order (``placement="neighbours"``, the
+default): the file's ``Line`` and ``Curve`` elements (``crvType`` arc; also
+defined by its chord or by its points only) stay on the file's line or circle,
+and each run of ``Spiral spiType="clothoid"`` elements between them becomes
+our Bézier spiral(s) (``shape``, default ``"near-linear"``) that the exact
+solvers find between the same two neighbours (``spiral_cad.io.landxml_fit``);
+the lines and arcs are trimmed to the spirals' contact points, so lengths and
+stations follow our chain. Where no solution exists, or the spirals have no
+line or arc of the file on either side, a clothoid from κ0 to κ1 is rebuilt
+as before with ``placement="length"``: our spiral with the same length and end
+curvatures continuing from the element before (0 → κ a spiral, κ → 0 its
+reversal, κ0 → κ1 the piece of a longer spiral whose start curvature is κ0,
+found by a bracketed root). A spiral this package wrote (its ``desc``) is
+rebuilt with its own shape: the very cubic.
 
 Per element the record keeps the offset between the file's element (placed at
 its own Start and start direction; the exact clothoid of
-``spiral_cad.core.clothoid``) and ours, at ``SAMPLES`` arc lengths; the
+``spiral_cad.core.clothoid``) and ours, measured both ways; the
 largest is the record's ``offset``. Elements that cannot be represented —
 other spiral types, ``IrregularLine``, ``Chain``, an alignment with no
 ``CoordGeom`` (``AlignPIs`` only) — are refused with a ValueError naming the
@@ -42,7 +44,7 @@ from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
-from scipy.optimize import brentq
+from scipy.optimize import brentq, minimize_scalar
 
 from ..core.chain import Chain
 from ..core.clothoid import clothoid_frames
@@ -50,7 +52,9 @@ from ..core.factors import length_factor
 from ..core.segments import Arc, Line, Segment
 from ..core.shapes import SHAPE_CODES, shape_limits
 from ..core.spiral import BezierSpiral
-from .landxml import CHUNK, DESC_PREFIX, US_SURVEY_FOOT, segment_samples
+from .landxml import DESC_PREFIX, US_SURVEY_FOOT
+from .landxml_fit import Carrier, distance_to_file, solve_compound, solve_run
+from .landxml_fit import offsets as fit_offsets
 
 __all__ = ["LandXMLAlignment", "read_landxml"]
 
@@ -78,11 +82,20 @@ class LandXMLAlignment:
         start_station: the station of the chain's start.
         units: the chain's length unit.
         profile: the ``spiral_cad.design.Profile`` of its first ``ProfAlign``, or None.
-        offsets: per CoordGeom element the largest distance between the file's
-            element and ours (see the module docstring), in ``units``.
+        offsets: per CoordGeom element the largest distance, either way, between
+            the file's element and ours (see ``spiral_cad.io.landxml_fit``), in ``units``.
         kinds: per element its tag (``Line``, ``Curve``, ``Spiral``).
-        stations: per element the station of its start in the file (``staStart``, else summed lengths).
-        notes: what was read approximately (e.g. a ``CircCurve`` as a parabola).
+        stations: per element the station of its start on our chain (from ``start_station``).
+        notes: what was read approximately (e.g. a ``CircCurve`` as a parabola,
+            a spiral rebuilt with its own length where no transition joins its neighbours).
+        file_stations: per element the station of its start in the file (``staStart``, else summed lengths).
+        length_changes: per element our length minus the file's.
+        methods: per element how it was rebuilt: ``"file"`` (a line or arc on the
+            file's carrier), the solver of a spiral (``"line_to_circle"``,
+            ``"circle_in_circle"``, ``"circle_to_circle"``, ``"line_to_line"``, with
+            the other shape in brackets where the element's own had no solution),
+            or ``"length"`` (the file's length and end curvatures, continuing from the element before).
+        owners: per chain, the element (an index into ``kinds``) of each of its segments.
     """
 
     name: str
@@ -95,6 +108,10 @@ class LandXMLAlignment:
     kinds: tuple[str, ...]
     stations: NDArray[np.float64]
     notes: tuple[str, ...] = field(default=())
+    file_stations: NDArray[np.float64] = field(default_factory=lambda: np.zeros(0))
+    length_changes: NDArray[np.float64] = field(default_factory=lambda: np.zeros(0))
+    methods: tuple[str, ...] = field(default=())
+    owners: tuple[NDArray[np.int64], ...] = field(default=())
 
     @property
     def chain(self) -> Chain:
@@ -111,6 +128,13 @@ class LandXMLAlignment:
     def offset(self) -> float:
         """The largest offset between the file's geometry and the rebuilt chain."""
         return float(self.offsets.max()) if len(self.offsets) else 0.0
+
+    @property
+    def station_shift(self) -> float:
+        """Our end station minus the file's: how far the stations of the rebuilt chain have moved by its end."""
+        if not len(self.stations):
+            return 0.0
+        return float(self.stations[-1] + self.length_changes[-1] - self.file_stations[-1])
 
 
 def _local(tag: str) -> str:
@@ -141,8 +165,9 @@ def _angle(text: str, unit: str) -> float:
 class _Reader:
     """The state of one file's read: units, scale and where errors point."""
 
-    def __init__(self, root: ET.Element, shape: str):
+    def __init__(self, root: ET.Element, shape: str, placement: str = "neighbours"):
         self.shape = shape
+        self.placement = placement
         units = _child(root, "Units")
         system = None if units is None else next(iter(units), None)
         linear = "meter" if system is None else system.get("linearUnit", "meter")
@@ -391,6 +416,191 @@ def _solve_turns(items: list[_Element]) -> None:
             item.theta = None if math.isnan(theta) else float(theta)
 
 
+#: How nearly the middle circle of a compound clothoid touches its neighbours (centre distance over radius difference), tried in turn.
+_NEARNESS = (0.9995, 0.999, 0.9998, 0.998)
+
+
+def _middle(item: _Element, start: NDArray, heading: float, entry: Carrier, exit_: Carrier, nearness: float) -> Carrier:
+    """The circle of the clothoid's middle curvature whose centre is ``nearness`` × the radius difference from
+    both neighbours' centres (the one nearer the clothoid's own centre of curvature there), as a carrier
+    at its point nearest the clothoid's middle.
+
+    Raises:
+        ValueError: no such centre.
+    """
+    curvature = 0.5 * (item.k0 + item.k1)
+    (mid,), (mid_heading,), _ = clothoid_frames([0.5 * item.length], item.k0, (item.k1 - item.k0) / item.length, x0=start[0],
+                                                y0=start[1], hdg=heading, length=item.length)  # fmt: skip
+    own = Carrier(mid, float(mid_heading), curvature, 0.0).center
+    c0, c1, r = entry.center, exit_.center, 1.0 / abs(curvature)
+    d0, d1 = nearness * abs(abs(entry.radius) - r), nearness * abs(r - abs(exit_.radius))
+    span = float(np.hypot(*(c1 - c0)))
+    along = (span * span + d0 * d0 - d1 * d1) / (2.0 * span)
+    if not d0 * d0 - along * along > 0.0:
+        raise ValueError(f"no middle circle of radius {r:.6g} is {nearness} nested in both neighbours")
+    axis = (c1 - c0) / span
+    normal = np.array([-axis[1], axis[0]])
+    centers = [c0 + along * axis + side * math.sqrt(d0 * d0 - along * along) * normal for side in (1.0, -1.0)]
+    center = min(centers, key=lambda c: float(np.hypot(*(c - own))))
+    out = (mid - center) / float(np.hypot(*(mid - center)))
+    point = center + r * out
+    return Carrier(point, math.atan2(out[1], out[0]) + math.copysign(math.pi / 2, curvature), curvature, 0.0)
+
+
+def _division(item: _Element, pieces: int) -> list[float]:
+    """The curvatures of a clothoid at its start, ``pieces - 1`` equally spaced points and its end."""
+    return list(item.k0 + (item.k1 - item.k0) * np.linspace(0.0, 1.0, pieces + 1))
+
+
+def _inner(item: _Element, start: NDArray, heading: float, pieces: int) -> list[Carrier]:
+    """The file's clothoid at ``pieces - 1`` equally spaced interior points, as carriers of its osculating circles."""
+    s = item.length * np.linspace(0.0, 1.0, pieces + 1)[1:-1]
+    points, headings, curvatures = clothoid_frames(s, item.k0, (item.k1 - item.k0) / item.length, x0=start[0], y0=start[1],
+                                                   hdg=heading, length=item.length)  # fmt: skip
+    return [Carrier(p, float(h), float(k), 0.0) for p, h, k in zip(points, headings, curvatures)]
+
+
+def _run(items: list[_Element], mine: list[int], starts: list[NDArray], headings: list[float], ends: list[tuple[NDArray, float]],
+         placement: str, file: tuple[NDArray, ...]) -> tuple[list[Segment], list[int], dict[int, str]]:  # fmt: skip
+    """Our segments for one G2 run of the file's elements ``mine``, each segment's element and each
+    spiral's method (see ``landxml_fit``): the file's lines and arcs kept, the spirals solved between them."""
+    entries: list[tuple[str, list[int]]] = []  # ("fixed", [k]), ("spirals", [k, ...]) or ("implied", [k]): the tangent after spiral k
+    for k in mine:
+        if items[k].kind == "Spiral" and entries and entries[-1][0] == "spirals":
+            entries[-1][1].append(k)
+        else:
+            entries.append(("spirals" if items[k].kind == "Spiral" else "fixed", [k]))
+    split: list[tuple[str, list[int]]] = []
+    for n, (kind, ks) in enumerate(entries):
+        between_arcs = 0 < n < len(entries) - 1 and all(
+            entries[m][0] == "fixed" and items[entries[m][1][0]].k0 != 0.0 for m in (n - 1, n + 1)
+        )
+        if kind != "spirals" or (len(ks) == 2 and between_arcs):
+            split.append((kind, ks))
+            continue
+        part: list[int] = []
+        for k in ks:  # split where the file's curvature passes through zero: the tangent there is a neighbour of both parts
+            part.append(k)
+            if items[k].k1 == 0.0 and k != ks[-1]:
+                split += [("spirals", part), ("implied", [k])]
+                part = []
+        split.append(("spirals", part))
+
+    def carrier(k: int, at_end: bool = False) -> Carrier:
+        if at_end:  # osculating the file's element at its end
+            return Carrier(ends[k][0], ends[k][1], items[k].k1, 0.0)
+        return Carrier(starts[k], headings[k], items[k].k0, 0.0 if items[k].kind == "Spiral" else items[k].length)
+
+    segments: list[Segment] = []
+    owner: list[int] = []
+    methods: dict[int, str] = {}
+    pending: tuple[Carrier, int, float] | None = None  # a line or arc whose end is not known yet: carrier, element, begin
+    point, heading = starts[mine[0]], headings[mine[0]]
+    solved_end: NDArray | None = None  # where the last solved transition ended
+
+    def emit(segs: list[Segment], k: int) -> None:
+        nonlocal point, heading
+        segments.extend(segs)
+        owner.extend([k] * len(segs))
+        point, heading = segs[-1].end[:2], _heading(segs[-1].end_tangent[:2])
+
+    def close(end: float) -> None:
+        nonlocal pending
+        if pending is not None:
+            c, k, begin = pending
+            if end - begin > 1e-12 * max(c.length, 1.0):
+                emit([c.piece(begin, end)], k)
+            pending = None
+
+    for n, (kind, ks) in enumerate(split):
+        if kind in ("fixed", "implied"):
+            c = carrier(ks[0], at_end=kind == "implied")
+            if solved_end is None:  # after a fallback (or at the start): continue from our chain
+                c = Carrier(point, heading, c.curvature, c.length)
+            pending, solved_end = (c, ks[0], c.station(solved_end) if solved_end is not None else 0.0), None
+            continue
+        entry = pending[0] if pending is not None else carrier(ks[0])
+        after = split[n + 1] if n + 1 < len(split) else None
+        exit_ = carrier(ks[-1], at_end=True) if after is None else carrier(after[1][0], at_end=after[0] == "implied")
+        curvatures = [items[ks[0]].k0, *(items[k].k1 for k in ks)]
+        candidates: list[tuple[str, str, list[tuple[int, Segment]]]] = []
+        problems: list[str] = []
+        shapes = [items[ks[0]].shape, "walton-meek" if items[ks[0]].shape == "near-linear" else "near-linear"]
+        attempts: list[tuple[str, str, float]] = [(shape, "one", 1.0) for shape in shapes]
+        if len(ks) > 1 and all(items[k].k1 for k in ks[:-1]):  # also through the circles osculating the file's joints
+            attempts += [(shape, "joints", 0.0) for shape in shapes]
+        if len(ks) == 2 and entry.curvature == exit_.curvature == 0.0:  # a C between lines: also as long as the file's
+            attempts += [(shape, "one", -1.0) for shape in shapes]
+        if len(ks) == 1 and entry.curvature * exit_.curvature > 0.0:  # a compound clothoid: through a middle circle if need be
+            attempts += [(shape, "middle", nearness) for nearness in _NEARNESS for shape in shapes]
+        lone = pending is None and after is None  # no line or arc of the file to keep: its own length is nearer
+        for shape, how, value in attempts if placement == "neighbours" and not lone else ():
+            try:
+                if how == "one":
+                    name, solved = solve_run(entry, exit_, curvatures, shape)
+                    if value < 0.0:  # a symmetric C: its peak curvature chosen nearest the file's (asymmetric) pair
+                        near = list(range(max(ks[0] - 1, mine[0]), min(ks[-1] + 2, mine[-1] + 1)))  # a run is consecutive elements
+
+                        def apart(log_scale: float) -> float:
+                            try:
+                                trial = solve_run(entry, exit_, [0.0, curvatures[1] * math.exp(log_scale), 0.0], shape)[1]
+                            except ValueError:
+                                return math.inf
+                            return distance_to_file(trial, near, *file)
+
+                        best = minimize_scalar(apart, bounds=(-0.7, 0.7), method="bounded", options={"xatol": 1e-4})
+                        name, solved = solve_run(entry, exit_, [0.0, curvatures[1] * math.exp(best.x), 0.0], shape)
+                        name += f" (peak curvature ×{math.exp(best.x):.3g})"
+                    found: list[tuple[int, Segment]] = list(enumerate(solved))
+                elif how == "joints":
+                    name = "through its joints"
+                    found = solve_compound(entry, exit_, [carrier(k, at_end=True) for k in ks[:-1]], curvatures, shape)
+                else:
+                    name = "circle_in_circle ×2"
+                    middle = _middle(items[ks[0]], starts[ks[0]], headings[ks[0]], entry, exit_, value)
+                    found = [(0, segment) for _, segment in
+                             solve_compound(entry, exit_, [middle], [curvatures[0], middle.curvature, curvatures[-1]], shape)]  # fmt: skip
+                first, last = found[0][1].start, found[-1][1].end
+                if pending is not None and not pending[0].station(first) - pending[2] > -1e-9 * max(pending[0].length, 1.0):
+                    raise ValueError(f"the spirals would start {pending[2] - pending[0].station(first):.6g} before the end of the element before them")  # fmt: skip
+                if exit_.length and not exit_.station(last) < exit_.length:
+                    raise ValueError(f"the spirals would end beyond the element after them ({exit_.station(last):.6g} of {exit_.length:.6g})")  # fmt: skip
+                candidates.append((name, shape, found))
+                if len(ks) == 1 and how == "one":  # the one transition of a single spiral: nothing to choose
+                    break
+            except ValueError as e:
+                problems.append(f"{shape}: {e}")
+        if candidates:
+            near = list(range(max(ks[0] - 1, mine[0]), min(ks[-1] + 2, mine[-1] + 1)))  # a run is consecutive elements
+            name, shape, found = (
+                candidates[0]
+                if len(candidates) == 1
+                else min(candidates, key=lambda c: distance_to_file([seg for _, seg in c[2]], near, *file))
+            )
+            close(pending[0].station(found[0][1].start) if pending is not None else 0.0)
+            for i, segment in found:
+                emit([segment], ks[i])
+            for k in ks:
+                methods[k] = name + ("" if shape == items[k].shape else f" ({shape})")
+            solved_end = found[-1][1].end[:2]
+            continue
+        if pending is not None:
+            close(pending[0].length)
+        for k in ks:  # the file's length and end curvatures, continuing from our chain
+            try:
+                emit(_segments(items[k], point, heading), k)
+            except ValueError as e:
+                why = f"; no transition joins its neighbours either ({'; '.join(problems)})" if problems else ""
+                raise ValueError(f"{e}{why}") from None
+            methods[k] = "length"
+            if problems:
+                items[k].notes.append(f"{items[k].where}: rebuilt with its own length ({'; '.join(problems)})")
+        solved_end = None
+    if pending is not None:
+        close(pending[0].length)
+    return segments, owner, methods
+
+
 def _alignment(r: _Reader, a: ET.Element, label: str) -> LandXMLAlignment:
     name = a.get("name", label)
     where = f"alignment {name!r}"
@@ -440,11 +650,10 @@ def _alignment(r: _Reader, a: ET.Element, label: str) -> LandXMLAlignment:
         c, n = math.cos(heading), math.sin(heading)
         point, heading = point + np.array([c * dx - n * dy, n * dx + c * dy]), heading + float(turn)
         ends.append((point, heading))
-    _solve_turns(items)
-    runs: list[list[Segment]] = [[]]
+    if r.placement == "length":
+        _solve_turns(items)
+    runs: list[list[int]] = [[]]
     breaks: list[str] = []
-    point, heading = starts[0], headings[0]
-    first = []  # (run, index of the element's first segment in it)
     for k, item in enumerate(items):
         at = f"at station {item.station:.6g} (between elements {k - 1} and {k})"
         if k:
@@ -454,42 +663,34 @@ def _alignment(r: _Reader, a: ET.Element, label: str) -> LandXMLAlignment:
             if items[k - 1].kind != "Spiral" and (gap > _JUMP * max(item.length, items[k - 1].length) or turn > _JUMP):
                 breaks.append(f"the file's elements meet with a gap of {gap:.3g} {r.units} and a kink of {turn:.3g} rad {at}")
                 runs.append([])
-                point, heading = starts[k], headings[k]  # a new run starts where the file places the element
             elif abs(item.k0 - items[k - 1].k1) > _JUMP * max(abs(item.k0), abs(items[k - 1].k1)):
                 breaks.append(f"curvature jumps from {items[k - 1].k1:.6g} to {item.k0:.6g} 1/{r.units} {at}")
                 runs.append([])
-        first.append((len(runs) - 1, len(runs[-1])))
-        pieces = _segments(item, point, heading)
-        runs[-1] += pieces
-        point, heading = pieces[-1].end[:2], _heading(pieces[-1].end_tangent[:2])
-    chains = tuple(Chain(run, tolerance=1e-6, units=r.units) for run in runs)
-    offsets = _offsets(items, chains, first, np.array(starts), np.array(headings))
+        runs[-1].append(k)
+    k1 = np.array([i.k1 for i in items])
+    file = (np.array(starts), np.array(headings), bend, k1, size)
+    chains: list[Chain] = []
+    owners: list[NDArray[np.int64]] = []
+    methods: dict[int, str] = {}
+    for mine in runs:
+        segments, owner, found = _run(items, mine, starts, headings, ends, r.placement, file)
+        chains.append(Chain(segments, tolerance=1e-6, units=r.units))
+        owners.append(np.array(owner, dtype=np.int64))
+        methods.update(found)
+    run_of = np.repeat(np.arange(len(runs)), [len(m) for m in runs])
+    try:
+        offsets = fit_offsets(chains, owners, *file, run_of)
+    except ValueError as e:
+        raise ValueError(f"{where}: {e}") from None
+    ours = np.zeros(len(items))
+    for chain, held in zip(chains, owners):
+        np.add.at(ours, held, chain.lengths)
     profile, notes = _profile(r, a, where)
     notes = (*skipped, *(note for item in items for note in item.notes), *notes)
-    return LandXMLAlignment(name, chains, tuple(breaks), start_station, r.units, profile, offsets, tuple(i.kind for i in items),
-                            np.array([i.station for i in items]), notes)  # fmt: skip
-
-
-def _offsets(items: list[_Element], chains: tuple[Chain, ...], first: list[tuple[int, int]], starts: NDArray,
-             headings: NDArray) -> NDArray[np.float64]:  # fmt: skip
-    """Per element the largest distance between our segments and the file's element placed at its own
-    start, each of our sample points against the file's point at the same arc length."""
-    k0 = np.array([i.k0 for i in items])
-    rate = (np.array([i.k1 for i in items]) - k0) / np.array([i.length for i in items])
-    offsets = np.zeros(len(items))
-    runs = np.array([run for run, _ in first])
-    by_run = np.split(np.arange(len(items)), np.flatnonzero(np.diff(runs)) + 1)  # elements of each run, in order
-    for chain, mine in zip(chains, by_run):
-        begin = np.array([first[k][1] for k in mine])
-        owner = np.repeat(mine, np.diff(np.append(begin, len(chain))))  # each segment's element
-        ours, s, _ = segment_samples(chain, SAMPLES)
-        s = s + (chain.stations[:-1] - chain.stations[begin][np.searchsorted(mine, owner)])[:, None]  # from the element's start
-        for block in np.array_split(np.arange(len(owner)), -(-len(owner) // CHUNK)):  # bounded memory
-            o = owner[block]
-            theirs, _, _ = clothoid_frames(s[block], k0[o, None], rate[o, None], x0=starts[o, None, 0], y0=starts[o, None, 1],
-                                           hdg=headings[o, None], length=s[block, -1:])  # fmt: skip
-            np.maximum.at(offsets, o, np.hypot(*(ours[block] - theirs).transpose(2, 0, 1)).max(axis=1))
-    return offsets
+    return LandXMLAlignment(name, tuple(chains), tuple(breaks), start_station, r.units, profile, offsets, tuple(i.kind for i in items),
+                            start_station + np.concatenate([[0.0], np.cumsum(ours)[:-1]]), notes,
+                            np.array([i.station for i in items]), ours - size,
+                            tuple(methods.get(k, "file") for k in range(len(items))), tuple(owners))  # fmt: skip
 
 
 def _profile(r: _Reader, a: ET.Element, where: str) -> tuple[Any, tuple[str, ...]]:
@@ -529,13 +730,17 @@ def _profile(r: _Reader, a: ET.Element, where: str) -> tuple[Any, tuple[str, ...
     return profile, tuple(notes)
 
 
-def read_landxml(source: str | os.PathLike, shape: str = "near-linear") -> list[LandXMLAlignment]:
+def read_landxml(source: str | os.PathLike, shape: str = "near-linear", placement: str = "neighbours") -> list[LandXMLAlignment]:
     """Every alignment of a LandXML file (a path, or the document's text) rebuilt as our G2 chain.
 
     Args:
         source: a path, or the XML text itself (starting with ``<``).
         shape: the spiral shape of the rebuilt clothoids (``"near-linear"``,
             the nearest, or ``"walton-meek"``); spirals this package wrote keep their own.
+        placement: ``"neighbours"`` (the file's lines and arcs kept, each run of
+            clothoids replaced by our transition between the same neighbours,
+            see ``spiral_cad.io.landxml_fit``) or ``"length"`` (every clothoid
+            rebuilt with its own length and end curvatures, continuing from the element before).
 
     Returns:
         One ``LandXMLAlignment`` per ``<Alignment>`` in file order.
@@ -546,6 +751,8 @@ def read_landxml(source: str | os.PathLike, shape: str = "near-linear") -> list[
     """
     if shape not in ("near-linear", "walton-meek"):
         raise ValueError(f"shape must be 'near-linear' or 'walton-meek'; got {shape!r}")
+    if placement not in ("neighbours", "length"):
+        raise ValueError(f"placement must be 'neighbours' or 'length'; got {placement!r}")
     text = os.fspath(source)
     try:
         root = ET.fromstring(text) if text.lstrip().startswith("<") else ET.parse(text).getroot()
@@ -553,7 +760,7 @@ def read_landxml(source: str | os.PathLike, shape: str = "near-linear") -> list[
         raise ValueError(f"not an XML document: {e}") from None
     if _local(root.tag) != "LandXML":
         raise ValueError(f"not a LandXML document (root element {_local(root.tag)!r})")
-    reader = _Reader(root, shape)
+    reader = _Reader(root, shape, placement)
     alignments = [a for group in _children(root, "Alignments") for a in _children(group, "Alignment")]
     if not alignments:
         raise ValueError("the LandXML document holds no Alignment")

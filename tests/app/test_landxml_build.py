@@ -33,6 +33,7 @@ def test_build_of_a_landxml_file_writes_every_output(tmp_path, capsys):
     assert {"spiral_R63.step", "spiral_R63.svg", "spiral_R63.xodr", "spiral_R63_landxml.txt"} <= names
     report = (tmp_path / "spiral_R63_landxml.txt").read_text()
     assert "largest offset from the file 1.65 m" in report and "Spiral" in report
+    assert "station shift at the end" in report and "length change  rebuilt by" in report and report.rstrip().endswith("length")
     assert "LandXML alignment" in capsys.readouterr().out
 
 
