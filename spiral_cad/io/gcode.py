@@ -178,7 +178,7 @@ class _Reader:
         self.spline_end: tuple[float, float] | None = None  # the last G5's (P, Q), while G5 moves follow each other
         self.feed: float | None = None  # the modal F (program unit per minute under G94)
         self.feed_mode = 940  # G93 inverse time, G94 units per minute, G95 per revolution
-        self.feeds: list[float | None] = []  # the F in force on every feed move (None: no F, or not G94)
+        self.feeds: dict[float, None] = {}  # the distinct F values in force on feed moves under G94, in order
 
     def error(self, number: int, text: str) -> ValueError:
         return ValueError(f"{self.source} line {number}: {text}")
@@ -365,8 +365,8 @@ class _Reader:
             self.ended = True
 
     def add(self, number: int, moved: list[float]) -> None:
-        if self.motion != 0:
-            self.feeds.append(self.feed if self.feed_mode == 940 else None)
+        if self.motion != 0 and self.feed_mode == 940 and self.feed is not None and self.feed > 0.0:
+            self.feeds[self.feed] = None
         if moved != self.position or not self.points:
             self.points.append((moved[0], moved[1], moved[2]))
             self.lines.append(number)
@@ -541,7 +541,8 @@ def parse_gcode(
     if len(reader.points) < 2:
         raise ValueError(f"{source}: the program has {len(reader.points)} move(s) to a new position; a path needs at least two")
     assert reader.units is not None  # the reader refuses a move before G20/G21
-    return GcodePath(np.array(reader.points), np.array(reader.lines), np.array(reader.rapid), reader.units, source, tuple(reader.notes))
+    return GcodePath(np.array(reader.points), np.array(reader.lines), np.array(reader.rapid), reader.units, source, tuple(reader.notes),
+                     tuple(reader.feeds))  # fmt: skip
 
 
 def _program_text(path: str | os.PathLike) -> tuple[str, str]:
@@ -829,7 +830,7 @@ def program_feeds(path: str | os.PathLike) -> tuple[tuple[float, ...], str | Non
     """
     text, label = _program_text(path)
     reader = _read_exact(text, label)
-    return tuple(dict.fromkeys(f for f in reader.feeds if f is not None and f > 0.0)), reader.units
+    return tuple(reader.feeds), reader.units
 
 
 def _piece_segment(kind: str, start: list[float], data: list[Any], factor: float, dim: int) -> Any:

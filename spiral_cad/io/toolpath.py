@@ -36,6 +36,8 @@ class GcodePath:
         units: ``"mm"`` (G21) or ``"in"`` (G20).
         source: the file's name, for messages.
         notes: what was read but does not move the tool and is worth telling (tool changes).
+        feeds: the distinct feed rates (F, program unit per minute under G94) of the feed moves, in
+            the order first used (empty when not read: LinuxCNC's rs274 reader).
     """
 
     points: NDArray
@@ -44,6 +46,7 @@ class GcodePath:
     units: str
     source: str = "G-code"
     notes: tuple[str, ...] = ()
+    feeds: tuple[float, ...] = ()
 
     def __len__(self) -> int:
         return len(self.points)
@@ -51,7 +54,8 @@ class GcodePath:
     def in_units(self, units: str) -> GcodePath:
         """The same moves in ``units`` (mm, cm, m, km, in, ft): converted from the program's G20/G21."""
         factor = MM_PER_UNIT[self.units] / MM_PER_UNIT[length_unit(units)]
-        return GcodePath(self.points * factor if factor != 1.0 else self.points, self.lines, self.rapid, units, self.source, self.notes)
+        points = self.points * factor if factor != 1.0 else self.points
+        return GcodePath(points, self.lines, self.rapid, units, self.source, self.notes, self.feeds)
 
     def at_lines(self, message: str) -> str:
         """``message`` with every ``point i``/``corner i`` followed by the G-code line of that move."""
