@@ -448,8 +448,9 @@ def _parser() -> argparse.ArgumentParser:
     build.add_argument("--no-plots", action="store_true", help="skip the PNG plots (the slowest output for long chains)")
     gcode = build.add_argument_group(
         "G-code", "round the straight moves (G0/G1) of a CNC program G2 and write STEP, IGES, DXF, samples, the\n"
-        "continuity report and NAME.ngc, the rounded program (README: the G-code subset; a program with G5 splines\n"
-        "is read as the exact path it states; other codes are refused by name and line)")  # fmt: skip
+        "continuity report and NAME.ngc, the rounded program at the program's feed (never over the input; README: the\n"
+        "G-code subset; a program with G5 splines is read as the exact path it states; other codes are refused by\n"
+        "name and line)")  # fmt: skip
     gcode.add_argument("--from-gcode", metavar="FILE.nc", help="the program to round (instead of a design file)")
     gcode.add_argument("--max-deviation", type=float, help="the largest distance between a corner point and the path")
     gcode.add_argument("--max-curvature", type=float, help="the curvature bound (1/unit)")
