@@ -71,8 +71,8 @@ CENTRE_WORDS = "IJK"
 BIARC_PROBES = 24
 #: The most halvings of a spiral's parameter interval for biarcs.
 MAX_DEPTH = 40
-#: The most biarc pieces of one fit (a tolerance far below the spirals' size is refused, not a full disk).
-MAX_BIARCS = 1 << 18
+#: The most biarcs of one spiral (a tolerance far below the spiral's size is refused, not minutes of halving).
+MAX_BIARCS = 1 << 14
 #: Tolerances below this times the largest coordinate are refused: float64 (about 2.2e-16 relative)
 #: cannot place points that finely, so the fit would halve without end.
 MIN_RELATIVE_TOLERANCE = 1e-13
@@ -206,7 +206,7 @@ def spirals_biarcs(control_points: NDArray, tolerance: float) -> list[tuple[list
     Raises:
         ValueError: ``tolerance`` below what float64 resolves at the cubics' coordinates
             (``MIN_RELATIVE_TOLERANCE`` times the largest; the smallest usable one is named), more
-            than ``MAX_BIARCS`` pieces, or no biarcs within ``tolerance`` after ``MAX_DEPTH`` halvings.
+            than ``MAX_BIARCS`` biarcs for one cubic, or no biarcs within ``tolerance`` after ``MAX_DEPTH`` halvings.
     """
     cps = np.asarray(control_points, dtype=float)
     if cps.size:
@@ -215,13 +215,16 @@ def spirals_biarcs(control_points: NDArray, tolerance: float) -> list[tuple[list
     worst = np.zeros(len(cps))
     owner, u0, u1 = np.arange(len(cps)), np.zeros(len(cps)), np.ones(len(cps))
     inside = np.linspace(0.0, 1.0, BIARC_PROBES + 2)[1:-1]
-    pieces_found = 0
+    fitted = np.zeros(len(cps), dtype=np.int64)  # biarcs found per cubic
     for _ in range(MAX_DEPTH + 1):
         if not len(owner):
             break
-        if pieces_found + 2 * len(owner) > 2 * MAX_BIARCS:
-            raise ValueError(f"arc_tolerance {tolerance:g}: more than {MAX_BIARCS:,} biarcs would be needed "
-                             f"({pieces_found // 2:,} fitted, {len(owner):,} still to fit); give a larger arc_tolerance")  # fmt: skip
+        needed = fitted + np.bincount(owner, minlength=len(cps))
+        if needed.max() > MAX_BIARCS:
+            k = int(np.argmax(needed))
+            raise ValueError(f"arc_tolerance {tolerance:g}: spiral {k} would need more than {MAX_BIARCS:,} biarcs "
+                             f"({int(fitted[k]):,} fitted, {int(needed[k] - fitted[k]):,} still to fit); "
+                             "give a larger arc_tolerance")  # fmt: skip
         curves = cps[owner]
         ends = bezier.point(curves, np.stack([u0, u1], axis=1))
         tangents = bezier.tangent(curves, np.stack([u0, u1], axis=1))
@@ -247,7 +250,7 @@ def spirals_biarcs(control_points: NDArray, tolerance: float) -> list[tuple[list
                 (p1[k], None if second[2][k] else second[0][k], float(second[1][k])),
             ]
             found[owner[k]].append((float(u0[k]), pieces))
-            pieces_found += 2
+            fitted[owner[k]] += 1
             worst[owner[k]] = max(worst[owner[k]], float(error[k]))
         bad = ~good
         half = (u0[bad] + u1[bad]) / 2.0
@@ -314,7 +317,7 @@ def gcode_program(
             decimals too coarse for a tolerance (printed curves may stray √3·10^-decimals, which
             must be at most half of ``arc_tolerance`` and ``chord_tolerance``: the fewest decimals
             are named); a tolerance below what float64 resolves at the chain's coordinates
-            (``MIN_RELATIVE_TOLERANCE`` of the largest); more than ``MAX_BIARCS`` biarcs; a feed
+            (``MIN_RELATIVE_TOLERANCE`` of the largest); more than ``MAX_BIARCS`` biarcs of a spiral; a feed
             that would print as 0 or beyond 1e9.
     """
     if not isinstance(chain, Chain) and isinstance(getattr(chain, "chain", None), Chain):

@@ -71,7 +71,7 @@ def test_biarcs_refuse_a_tolerance_float64_cannot_resolve_and_bound_the_pieces(m
     with pytest.raises(ValueError, match=r"arc_tolerance 1e-15 mm is below .* smallest usable is 7.2e-12 mm"):
         gcode_program(zigzag(), dialect="generic", arc_tolerance=1e-15)
     monkeypatch.setattr(gcode_write, "MAX_BIARCS", 16)
-    with pytest.raises(ValueError, match=r"more than 16 biarcs would be needed"):
+    with pytest.raises(ValueError, match=r"spiral 0 would need more than 16 biarcs"):
         spiral_biarcs(spiral, 1e-9)
     pieces, error = spiral_biarcs(spiral, 1e-3)
     assert len(pieces) <= 32 and error <= 1e-3
