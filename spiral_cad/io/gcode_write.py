@@ -221,9 +221,9 @@ def spirals_biarcs(control_points: NDArray, tolerance: float) -> list[tuple[list
             break
         needed = fitted + np.bincount(owner, minlength=len(cps))
         if needed.max() > MAX_BIARCS:
-            k = int(np.argmax(needed))
-            raise ValueError(f"arc_tolerance {tolerance:g}: spiral {k} would need more than {MAX_BIARCS:,} biarcs "
-                             f"({int(fitted[k]):,} fitted, {int(needed[k] - fitted[k]):,} still to fit); "
+            most = int(np.argmax(needed))
+            raise ValueError(f"arc_tolerance {tolerance:g}: spiral {most} would need more than {MAX_BIARCS:,} biarcs "
+                             f"({int(fitted[most]):,} fitted, {int(needed[most] - fitted[most]):,} still to fit); "
                              "give a larger arc_tolerance")  # fmt: skip
         curves = cps[owner]
         ends = bezier.point(curves, np.stack([u0, u1], axis=1))
