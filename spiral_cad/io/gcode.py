@@ -53,7 +53,7 @@ end of the file as its end.
 ``read_gcode_chain`` reads a program as its exact path instead: lines, arcs and G5 cubics as the
 chain's segments (what ``spiral_cad.io.gcode_write`` writes reads back as the same chain; a cubic
 that is not a spiral is cut where its curvature changes sign or turns, so its curvature stays its
-own). Every reader keeps the feed rates (``F`` under ``G94``) of the feed moves (``GcodePath.feeds``,
+own). The built-in reader keeps the feed rates (``F`` under ``G94``) of the feed moves (``GcodePath.feeds``,
 ``program_feeds``).
 
 A move that ends where it started is not a point of the path (it would be a corner of no
