@@ -90,6 +90,7 @@ class Built(ABC):
     gcode: dict[str, Any] | None = None  # write_gcode's options of NAME.ngc (None: no program)
     inputs: tuple[Path, ...] = ()  # files the design was read from: never written over
     program_feed: float | None = None  # the feed of the program a path was read from (chain's program unit per minute)
+    segment_feeds: Any = None  # that program's feed per segment (the same unit; NaN: program_feed), or None
 
     @property
     @abstractmethod
@@ -417,13 +418,23 @@ def _rounded(d: RoundedPolylineDesign, where: str, units: str, base: Path | None
 
             result = RoundedPath(read_gcode_chain(program, units=units), [], d.shape)
             feeds, program_units = program_feeds(program)
+            per_segment = None
         else:
+            from ..core.units import MM_PER_UNIT
+            from ..io.gcode import segment_feeds
+            from ..io.gcode_write import PROGRAM_UNIT
+
             path = read_gcode(program)
             feeds, program_units = path.feeds, path.units
-            result = round_toolpath(path.in_units(units), shape=d.shape, **d.rounding())
+            moves = path.in_units(units)
+            result = round_toolpath(moves, shape=d.shape, **d.rounding())
+            per_segment = segment_feeds(result, moves)  # in units per minute: to the written program's unit
+            if per_segment is not None:
+                per_segment = per_segment * (MM_PER_UNIT[units] / MM_PER_UNIT[PROGRAM_UNIT[units]])
         feed = _program_feed(feeds, program_units, units)
         samples = None if d.samples is None else d.samples.options()
-        return BuiltRounded(name=d.name, chain=result.chain, source=result, samples=samples, inputs=(program,), program_feed=feed)
+        return BuiltRounded(name=d.name, chain=result.chain, source=result, samples=samples, inputs=(program,), program_feed=feed,
+                            segment_feeds=per_segment)  # fmt: skip
     samples = None if d.samples is None else d.samples.options()
     return BuiltRounded(name=d.name, chain=result.chain, source=result, samples=samples)
 
@@ -576,8 +587,10 @@ def build(source: str | Path | dict) -> tuple[str, list[Built]]:
             b = BUILDERS[d.type](d, where, design_file.units, base)
             if d.gcode_out is not None or isinstance(b, BuiltRounded):  # a path gets its program
                 b.gcode = {} if d.gcode_out is None else d.gcode_out.options()
-                if b.program_feed is not None:  # the program's own feed, unless the design states one
-                    b.gcode.setdefault("feed", b.program_feed)
+                if b.program_feed is not None and "feed" not in b.gcode:  # the program's own feeds, unless one is stated
+                    b.gcode["feed"] = b.program_feed
+                    if b.segment_feeds is not None:
+                        b.gcode["feeds"] = b.segment_feeds
             built.append(b)
         except DesignError:
             raise

@@ -182,6 +182,7 @@ class _Reader:
         self.feed: float | None = None  # the modal F (program unit per minute under G94)
         self.feed_mode = 940  # G93 inverse time, G94 units per minute, G95 per revolution
         self.feeds: dict[float, None] = {}  # the distinct F values in force on feed moves under G94, in order
+        self.point_feeds: list[float] = []  # the F in force on the move to each point (NaN: none)
 
     def error(self, number: int, text: str) -> ValueError:
         return ValueError(f"{self.source} line {number}: {text}")
@@ -368,10 +369,13 @@ class _Reader:
             self.ended = True
 
     def add(self, number: int, moved: list[float]) -> None:
+        feed = math.nan
         if self.motion != 0 and self.feed_mode == 940 and self.feed is not None and self.feed > 0.0:
             self.feeds[self.feed] = None
+            feed = self.feed
         if moved != self.position or not self.points:
             self.points.append((moved[0], moved[1], moved[2]))
+            self.point_feeds.append(feed)
             self.lines.append(number)
             self.rapid.append(self.motion == 0)
         if self.progress is not None:
@@ -545,7 +549,7 @@ def parse_gcode(
         raise ValueError(f"{source}: the program has {len(reader.points)} move(s) to a new position; a path needs at least two")
     assert reader.units is not None  # the reader refuses a move before G20/G21
     return GcodePath(np.array(reader.points), np.array(reader.lines), np.array(reader.rapid), reader.units, source, tuple(reader.notes),
-                     tuple(reader.feeds))  # fmt: skip
+                     tuple(reader.feeds), np.array(reader.point_feeds))  # fmt: skip
 
 
 def _program_text(path: str | os.PathLike) -> tuple[str, str]:
@@ -614,6 +618,18 @@ def segment_lines(rounded: RoundedPath, path: GcodePath) -> NDArray:
         for i, middle in enumerate(middles):
             lines[i] = path.lines[int(np.argmin(np.linalg.norm(path.points - middle, axis=1)))]
     return lines
+
+
+def segment_feeds(rounded: RoundedPath, path: GcodePath) -> NDArray | None:
+    """The feed of every segment of ``rounded.chain`` (rounded from ``path``, its unit per minute): the F in force
+    on the move of the segment's line (``segment_lines``); NaN where that move has none, None when ``path`` has no
+    feeds (read by rs274)."""
+    if path.point_feeds is None or not len(path.point_feeds):
+        return None
+    lines = segment_lines(rounded, path)
+    at = np.clip(np.searchsorted(path.lines, lines, side="right") - 1, 0, len(path.lines) - 1)
+    feeds: NDArray = path.point_feeds[at]
+    return feeds
 
 
 def round_toolpath(path: GcodePath, *, for_occt: bool = True, **options) -> RoundedPath:

@@ -290,6 +290,7 @@ def gcode_program(
     rapid_to_start: bool = True,
     decimals: int | None = None,
     name: str | None = None,
+    feeds: Any = None,
 ) -> GcodeProgram:
     """The G-code program of ``chain`` and what it holds (see the module docstring; ``write_gcode`` writes it).
 
@@ -310,6 +311,8 @@ def gcode_program(
         decimals: decimals of every number (default: 15 significant digits for the largest
             coordinate, at least 6 and at most 15 decimals).
         name: the path's name, for the header comment.
+        feeds: one feed per segment of the chain (program unit per minute; NaN: ``feed``), as read
+            from the program a path was rounded from: an ``F`` word is written where it changes.
 
     Raises:
         ValueError: not a chain, an unknown dialect or unit, a feed or tolerance that is not a
@@ -350,9 +353,14 @@ def gcode_program(
             raise ValueError(f"decimals {decimals} round the printed numbers by up to {0.5 * 10.0**-decimals:g} {program}: "
                              f"printed curves may stray {printing:.2g} {program}, more than half of {label} "
                              f"{value * factor:g} {program}; give decimals of at least {fewest}, or a larger {label}")  # fmt: skip
-    if not 0.5 * 10.0**-decimals <= feed <= MAX_COORDINATE:
-        raise ValueError(f"feed {feed:g} {program}/min cannot be printed with {decimals} decimals: it must be from "
-                         f"{0.5 * 10.0**-decimals:g} to {MAX_COORDINATE:g}")  # fmt: skip
+    per_segment = np.full(len(chain), feed) if feeds is None else np.array(feeds, dtype=float).ravel()
+    if per_segment.shape != (len(chain),):
+        raise ValueError(f"feeds must hold one feed per segment ({len(chain)}); got {per_segment.size}")
+    per_segment = np.where(np.isnan(per_segment), feed, per_segment)
+    for value in (feed, *np.unique(per_segment).tolist()):
+        if not 0.5 * 10.0**-decimals <= value <= MAX_COORDINATE:
+            raise ValueError(f"feed {value:g} {program}/min cannot be printed with {decimals} decimals: it must be from "
+                             f"{0.5 * 10.0**-decimals:g} to {MAX_COORDINATE:g}")  # fmt: skip
     plane_tol = 0.5 * 10.0**-decimals / factor if plane_tolerance is None else _positive(plane_tolerance, "plane_tolerance")
     if name is not None and ("(" in name or ")" in name or not name.isprintable()):
         raise ValueError(f"name {name!r:.60} cannot stand in a G-code comment (no parentheses, printable)")
@@ -376,9 +384,14 @@ def gcode_program(
         if wanted:
             fitted = spirals_biarcs(rows.geometry[wanted][:, :, [first, second]], arcs - printing / factor)
             fits.update(zip(wanted, fitted))
+    in_force, feed_words = float(per_segment[0]) if len(chain) else feed, 0
     for i in range(len(chain)):
         kind = int(kinds[i])
         geometry = rows.geometry[i]
+        if per_segment[i] != in_force:  # the program's own feed changes here
+            in_force = float(per_segment[i])
+            body.append(f"F{out.number(round(in_force, decimals))}")
+            feed_words += 1
         if kind == LINE:
             out.line(out.rounded(geometry[1]))
             counts["line"] += 1
@@ -434,7 +447,7 @@ def gcode_program(
         for point in points[1:]:
             out.line(out.rounded(point))
         counts["chords"] += 1
-    counts["moves"] = len(body)
+    counts["moves"] = len(body) - feed_words
 
     unit_note = "" if factor == 1.0 else f", converted from the chain's {chain.units}, times {factor:g}"
     arcs_p, chord_p = arcs * factor, chord * factor
@@ -459,7 +472,7 @@ def gcode_program(
         head += [f"{UNIT_CODE[program]} G90 G91.1 G94 G17 G40 G49", f"G64 P{out.number(blend)}"]
     else:
         head += [f"{UNIT_CODE[program]} G90 G94 G17"]
-    head.append(f"F{out.number(round(feed, decimals))}")
+    head.append(f"F{out.number(round(float(per_segment[0]) if len(chain) else feed, decimals))}")
     head = [line if len(line) <= MAX_LINE else line[: MAX_LINE - 4] + "...)" for line in head]
     text = "\n".join(head + body + ["M2", ""])
     return GcodeProgram(text, program, counts, chord_error * factor, arc_error * factor)
@@ -486,6 +499,7 @@ def write_gcode(
     rapid_to_start: bool = True,
     decimals: int | None = None,
     name: str | None = None,
+    feeds: Any = None,
 ) -> str | Path:
     """Write a chain (or a rounded path, circle chain or alignment: its ``chain``) as a G-code program
     (see ``gcode_program`` for the options): the file's path, or the text when ``path`` is None.
@@ -496,7 +510,7 @@ def write_gcode(
     """
     program = gcode_program(chain, dialect=dialect, feed=feed, units=units, chord_tolerance=chord_tolerance,
                             arc_tolerance=arc_tolerance, plane_tolerance=plane_tolerance, rapid_to_start=rapid_to_start,
-                            decimals=decimals, name=name)  # fmt: skip
+                            decimals=decimals, name=name, feeds=feeds)  # fmt: skip
     if path is None:
         return program.text
     target = Path(path)

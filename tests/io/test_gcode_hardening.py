@@ -149,3 +149,35 @@ def test_a_g5_program_ending_with_a_retract_is_read_as_with_g1():
     assert len(chain) >= 1 and np.allclose(chain.end, [1, 1])
     with pytest.raises(ValueError, match=r"line 4: a rapid move \(G0\) between feed moves"):
         parse_gcode_chain("G21 G90 G17\nG0 X0 Y0\nG5 I0 J3 P0 Q-3 X1 Y1 F100\nG0 Z5\nG1 X2\nM2\n")
+
+
+def test_each_move_keeps_its_own_feed_and_a_corner_takes_the_feed_of_the_move_into_it(tmp_path):
+    program = tmp_path / "f3.ngc"
+    program.write_text("G21 G90\nG0 X0 Y0\nG1 X10 Y0 F100\nG1 X10 Y10 F300\nG1 X20 Y10\nG1 X20 Y20 F100\nM2\n")
+    units, built = build(
+        {"units": "mm", "designs": [{"name": "f3", "type": "rounded_polyline", "gcode": str(program), "max_deviation": 0.5}]}
+    )
+    write(built, tmp_path / "out", units, progress=lambda line: None, plots=False)
+    lines = (tmp_path / "out" / "f3.ngc").read_text().splitlines()
+    words = [(i, float(line[1:])) for i, line in enumerate(lines) if re.fullmatch(r"F[0-9.]+", line)]
+    assert [f for _, f in words] == [100.0, 300.0, 100.0]
+    # F300 from the straight piece of the move to (10, 10) on; back to F100 for the last move, to (20, 20)
+    assert lines[words[1][0] + 1].startswith("G1 X10 Y8.11") and lines[words[2][0] + 1] == "G1 X20 Y20"
+    # as LinuxCNC's interpreter reads it: the feed of every move
+    feeds = parse_gcode("\n".join(lines), arc_tolerance=0.01).point_feeds
+    assert feeds[-1] == 100.0 and set(feeds[1:].tolist()) == {100.0, 300.0}
+
+
+def test_feeds_per_segment_are_validated_and_nan_takes_the_feed():
+    chain = zigzag()
+    with pytest.raises(ValueError, match=r"feeds must hold one feed per segment \(13\); got 2"):
+        gcode_program(chain, feeds=[1.0, 2.0])
+    with pytest.raises(ValueError, match=re.escape("feed 1e+300 mm/min cannot be printed")):
+        gcode_program(chain, feeds=[1e300] * 13)
+    text = gcode_program(chain, feed=700, feeds=[np.nan] * 12 + [50.0]).text
+    assert re.findall(r"^F([0-9.]+)$", text, re.MULTILINE) == ["700", "50"]
+
+
+def test_a_path_in_other_units_converts_its_feeds():
+    path = parse_gcode("G20 G90\nG0 X0\nG1 X1 F10\nM2\n").in_units("mm")
+    assert path.feeds == (254.0,) and path.point_feeds[-1] == 254.0 and np.isnan(path.point_feeds[0])
