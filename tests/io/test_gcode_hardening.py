@@ -3,6 +3,7 @@ tolerances and coarse decimals are refused by name, a G5 cubic's curvature is it
 as with G1, and every line of a program fits LinuxCNC's 255 characters."""
 
 import re
+import subprocess
 
 import numpy as np
 import pytest
@@ -12,7 +13,7 @@ from spiral_cad.app.cli import main
 from spiral_cad.app.designfile import build, write
 from spiral_cad.core import bezier
 from spiral_cad.design import round_corners
-from spiral_cad.io import gcode_write
+from spiral_cad.io import gcode_write, rs274
 from spiral_cad.io.gcode import parse_gcode, parse_gcode_chain, program_feeds, read_gcode_chain
 from spiral_cad.io.gcode_write import gcode_program, spiral_biarcs
 
@@ -181,3 +182,17 @@ def test_feeds_per_segment_are_validated_and_nan_takes_the_feed():
 def test_a_path_in_other_units_converts_its_feeds():
     path = parse_gcode("G20 G90\nG0 X0\nG1 X1 F10\nM2\n").in_units("mm")
     assert path.feeds == (254.0,) and path.point_feeds[-1] == 254.0 and np.isnan(path.point_feeds[0])
+
+
+@pytest.mark.skipif(rs274.rs274_executable() is None, reason=f"LinuxCNC's rs274 is not installed ({rs274.PACKAGE})")
+def test_linuxcnc_reads_the_feeds_and_a_long_named_program(tmp_path):
+    """rs274 runs the program (no "Command too long" for the header of a 400-character name) at our feeds."""
+    chain = zigzag()
+    program = tmp_path / "p.ngc"
+    program.write_text(gcode_program(chain, name="x" * 400, feed=700, feeds=[np.nan] * 6 + [250.0] * 7).text)
+    canon = tmp_path / "canon.txt"
+    done = subprocess.run([rs274.rs274_executable(), "-g", str(program), str(canon)], stdin=subprocess.DEVNULL,
+                          capture_output=True, text=True, timeout=60)  # fmt: skip
+    assert done.returncode == 0 and "too long" not in done.stdout + done.stderr
+    feeds = [float(f) for f in re.findall(r"SET_FEED_RATE\(([0-9.]+)\)", canon.read_text())]
+    assert [f for f in feeds if f] == [700.0, 250.0]
