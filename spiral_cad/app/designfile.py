@@ -728,7 +728,10 @@ def _write_others(b: Built, stage: Path, units: str, missing: list[str], plots: 
     if b.gcode is not None:
         from ..io.gcode_write import write_gcode
 
-        write_gcode(b.chain, stage / f"{b.name}.ngc", name=b.name, **b.gcode)
+        try:
+            write_gcode(b.chain, stage / f"{b.name}.ngc", name=b.name, **b.gcode)
+        except ValueError as error:  # name the design and the file: a design file may hold many
+            raise ValueError(f"{b.name}.ngc: {error}") from None
         names.append("ngc")
     if isinstance(b, BuiltRounded | BuiltFit) and b.samples:
         from ..cad.export import export_samples

@@ -196,3 +196,12 @@ def test_linuxcnc_reads_the_feeds_and_a_long_named_program(tmp_path):
     assert done.returncode == 0 and "too long" not in done.stdout + done.stderr
     feeds = [float(f) for f in re.findall(r"SET_FEED_RATE\(([0-9.]+)\)", canon.read_text())]
     assert [f for f in feeds if f] == [700.0, 250.0]
+
+
+def test_a_design_files_unattainable_arc_tolerance_is_refused_naming_the_design(tmp_path, capsys):
+    design = tmp_path / "d.json"
+    design.write_text('{"units": "mm", "designs": [{"name": "robot", "type": "rounded_polyline", "max_curvature": 0.3, '
+                      '"points": [[0, 0], [20, 2], [28, 18], [48, 20]], "gcode_out": {"dialect": "generic", "arc_tolerance": 1e-15}}]}')  # fmt: skip
+    assert main(["build", str(design), "--out", str(tmp_path / "out"), "--no-plots"]) == 2
+    assert "error: robot.ngc: arc_tolerance 1e-15 mm is below what float64 resolves" in capsys.readouterr().err
+    assert not (tmp_path / "out").exists()
