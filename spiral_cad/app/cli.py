@@ -144,13 +144,14 @@ GCODE_OPTIONS = (
     "units",
     "interpreter",
     "arc_tolerance",
+    "feed",
 )
 
 
 #: ``build`` options of ``--from-points`` only.
 POINTS_OPTIONS = ("tolerance", "closed", "design_speed")
 #: ``build`` options of ``--from-gcode`` only (the others it shares with ``--from-points``).
-GCODE_ONLY = ("max_deviation", "interpreter", "arc_tolerance")
+GCODE_ONLY = ("max_deviation", "interpreter", "arc_tolerance", "feed")
 
 
 def _build(args: argparse.Namespace) -> int:
@@ -180,7 +181,7 @@ def gcode_design(args: argparse.Namespace) -> dict:
         raise ValueError("--from-gcode needs --max-deviation (the tolerance at every corner) and/or --max-curvature")
     if args.sample_step is not None and args.chord_tolerance is not None:
         raise ValueError("give --sample-step or --chord-tolerance, not both")
-    for key in ("max_deviation", "max_curvature", "sample_step", "chord_tolerance"):
+    for key in ("max_deviation", "max_curvature", "sample_step", "chord_tolerance", "feed"):
         value = getattr(args, key)
         if value is not None and not 0.0 < value < math.inf:
             raise ValueError(f"--{key.replace('_', '-')} must be a positive finite number; got {value}")
@@ -194,6 +195,8 @@ def gcode_design(args: argparse.Namespace) -> dict:
     else:
         default = (args.max_deviation / 10.0 or args.max_deviation) if args.max_deviation is not None else 0.001
         design["samples"] = {"chord_tolerance": args.chord_tolerance if args.chord_tolerance is not None else default}
+    if args.feed is not None:  # else the program's own feed
+        design["gcode_out"] = {"feed": args.feed}
     return {"units": args.units or "mm", "designs": [design]}
 
 
@@ -445,8 +448,9 @@ def _parser() -> argparse.ArgumentParser:
     build.add_argument("--no-plots", action="store_true", help="skip the PNG plots (the slowest output for long chains)")
     gcode = build.add_argument_group(
         "G-code", "round the straight moves (G0/G1) of a CNC program G2 and write STEP, IGES, DXF, samples, the\n"
-        "continuity report and NAME.ngc, the rounded program (README: the G-code subset; a program with G5 splines\n"
-        "is read as the exact path it states; other codes are refused by name and line)")  # fmt: skip
+        "continuity report and NAME.ngc, the rounded program at the program's feed (never over the input; README: the\n"
+        "G-code subset; a program with G5 splines is read as the exact path it states; other codes are refused by\n"
+        "name and line)")  # fmt: skip
     gcode.add_argument("--from-gcode", metavar="FILE.nc", help="the program to round (instead of a design file)")
     gcode.add_argument("--max-deviation", type=float, help="the largest distance between a corner point and the path")
     gcode.add_argument("--max-curvature", type=float, help="the curvature bound (1/unit)")
@@ -458,6 +462,9 @@ def _parser() -> argparse.ArgumentParser:
     gcode.add_argument("--units", choices=["mm", "cm", "m", "km", "in", "ft"],
                        help="the unit of the outputs and of every length above (default mm; the program's G20/G21 is converted)")  # fmt: skip
     gcode.add_argument("--name", help="the design's name (default: the program's file name)")
+    gcode.add_argument("--feed", type=float,
+                       help="the F word of the rounded program NAME.ngc, in its unit per minute (default: the program's "
+                            "own F, the lowest if it has several)")  # fmt: skip
     gcode.add_argument(
         "--interpreter",
         choices=["builtin", "rs274"],

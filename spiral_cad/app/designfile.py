@@ -88,6 +88,9 @@ class Built(ABC):
     continuity: str | None = None
     road_3d: str | None = None
     gcode: dict[str, Any] | None = None  # write_gcode's options of NAME.ngc (None: no program)
+    inputs: tuple[Path, ...] = ()  # files the design was read from: never written over
+    program_feed: float | None = None  # the feed of the program a path was read from (chain's program unit per minute)
+    segment_feeds: Any = None  # that program's feed per segment (the same unit; NaN: program_feed), or None
 
     @property
     @abstractmethod
@@ -414,12 +417,41 @@ def _rounded(d: RoundedPolylineDesign, where: str, units: str, base: Path | None
         program = _own_file(str(d.gcode), base, f"{where}.gcode")
         if holds_splines(program):  # G5: the program states its curves (our own output reads back as its chain)
             from ..design.rounding import RoundedPath
+            from ..io.gcode import program_feeds
 
             result = RoundedPath(read_gcode_chain(program, units=units), [], d.shape)
+            feeds, program_units = program_feeds(program)
+            per_segment = None
         else:
-            result = round_toolpath(read_gcode(program).in_units(units), shape=d.shape, **d.rounding())
+            from ..core.units import MM_PER_UNIT
+            from ..io.gcode import segment_feeds
+            from ..io.gcode_write import PROGRAM_UNIT
+
+            path = read_gcode(program)
+            feeds, program_units = path.feeds, path.units
+            moves = path.in_units(units)
+            result = round_toolpath(moves, shape=d.shape, **d.rounding())
+            per_segment = segment_feeds(result, moves)  # in units per minute: to the written program's unit
+            if per_segment is not None:
+                per_segment = per_segment * (MM_PER_UNIT[units] / MM_PER_UNIT[PROGRAM_UNIT[units]])
+        feed = _program_feed(feeds, program_units, units)
+        samples = None if d.samples is None else d.samples.options()
+        return BuiltRounded(name=d.name, chain=result.chain, source=result, samples=samples, inputs=(program,), program_feed=feed,
+                            segment_feeds=per_segment)  # fmt: skip
     samples = None if d.samples is None else d.samples.options()
     return BuiltRounded(name=d.name, chain=result.chain, source=result, samples=samples)
+
+
+def _program_feed(feeds: tuple[float, ...], program_units: str | None, units: str) -> float | None:
+    """The feed of the rounded program of a G-code program with ``feeds`` (in its ``program_units`` per minute),
+    in the unit per minute of the program written for a chain in ``units``: the one F of its feed moves, or the
+    lowest of several (never faster than the program asked); None without one (a program read by rs274)."""
+    from ..core.units import MM_PER_UNIT
+    from ..io.gcode_write import PROGRAM_UNIT
+
+    if not feeds or program_units is None:
+        return None
+    return min(feeds) * MM_PER_UNIT[program_units] / MM_PER_UNIT[PROGRAM_UNIT[units]]
 
 
 def _fit(d: FitDesign, where: str, units: str, base: Path | None) -> Built:
@@ -558,6 +590,10 @@ def build(source: str | Path | dict) -> tuple[str, list[Built]]:
             b = BUILDERS[d.type](d, where, design_file.units, base)
             if d.gcode_out is not None or isinstance(b, BuiltRounded):  # a path gets its program
                 b.gcode = {} if d.gcode_out is None else d.gcode_out.options()
+                if b.program_feed is not None and "feed" not in b.gcode:  # the program's own feeds, unless one is stated
+                    b.gcode["feed"] = b.program_feed
+                    if b.segment_feeds is not None:
+                        b.gcode["feeds"] = b.segment_feeds
             built.append(b)
         except DesignError:
             raise
@@ -606,6 +642,7 @@ def write(
         OSError: writing or moving a file failed; nothing in ``out`` was changed.
         KeyboardInterrupt: Ctrl-C, SIGTERM or SIGHUP; nothing in ``out`` was changed.
     """
+    _refuse_overwriting_inputs(built, Path(out))
     missing = missing_cad_extra()
     with Staging(out) as staging, _interrupts_raise():
         for b in built:
@@ -624,6 +661,24 @@ def write(
         written = staging.commit()
     skipped = [f"{CAD_EXTRA[name]} (needs {name})" for name in missing if plots or name != "matplotlib"]
     return Written(written, skipped)
+
+
+def _refuse_overwriting_inputs(built: list[Built], out: Path) -> None:
+    """Refuse, before anything is written, outputs that would replace a file a design was read from.
+
+    Every output of a design is named NAME.ext or NAME_what.ext in ``out``: ``build --from-gcode
+    d/part.ngc --out d`` would replace the program with its rounded one (part.ngc).
+    """
+    inputs = [source for b in built for source in b.inputs]
+    if not inputs or not out.is_dir():
+        return
+    for b in built:
+        for source in inputs:
+            if not source.name.startswith((f"{b.name}.", f"{b.name}_")) or not source.parent.is_dir():
+                continue
+            if os.path.samefile(source.parent, out):
+                raise ValueError(f"{b.name}: the output {str(out / source.name)!r} would replace the input {str(source)!r}; "
+                                 "nothing was written: give another output folder (--out) or name (--name)")  # fmt: skip
 
 
 def _write_design(b: Built, stage: Path, units: str, missing: list[str], plots: bool) -> list[str]:
@@ -676,7 +731,10 @@ def _write_others(b: Built, stage: Path, units: str, missing: list[str], plots: 
     if b.gcode is not None:
         from ..io.gcode_write import write_gcode
 
-        write_gcode(b.chain, stage / f"{b.name}.ngc", name=b.name, **b.gcode)
+        try:
+            write_gcode(b.chain, stage / f"{b.name}.ngc", name=b.name, **b.gcode)
+        except ValueError as error:  # name the design and the file: a design file may hold many
+            raise ValueError(f"{b.name}.ngc: {error}") from None
         names.append("ngc")
     if isinstance(b, BuiltRounded | BuiltFit) and b.samples:
         from ..cad.export import export_samples

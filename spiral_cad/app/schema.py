@@ -222,7 +222,11 @@ class GcodeOut(_Model):
     dialect: Literal["linuxcnc", "generic"] = Field(
         "linuxcnc", description="linuxcnc: spirals in XY as exact G5 cubics; generic (Grbl, Marlin): spirals as biarcs."
     )
-    feed: Positive | None = Field(None, description="The F word, in the program's unit per minute (default 1000 mm/min, 40 in/min).")
+    feed: Positive | None = Field(
+        None,
+        description="The F word, in the program's unit per minute (default: a path read from a G-code program keeps that "
+        "program's F, else 1000 mm/min, 40 in/min).",
+    )
     chord_tolerance: Positive | None = Field(None, description="Pieces in space as G1 chords within this (default 0.001 mm).")
     arc_tolerance: Positive | None = Field(None, description="Spirals as biarcs within this (default 0.001 mm).")
 

@@ -185,3 +185,51 @@ def peak_curvature_rate(cp: ArrayLike, samples: int = 257) -> tuple[Any, Any]:
     better = refined > best_rate
     best_rate, best_u = np.where(better, refined, best_rate), np.where(better, middle, best_u)
     return (float(best_rate[0]), float(best_u[0])) if single else (best_rate, best_u)
+
+
+def monotone_pieces(cp: ArrayLike, samples: int = 513) -> list[tuple[float, float]]:
+    """Parameter intervals [u0, u1] covering [0, 1] on which a plane cubic's curvature is one-signed and monotone.
+
+    Any cubic (a G5 spline, a general Bézier) is cut at its inflections (κ = 0) and curvature
+    extrema (dκ/ds = 0); each interval is then a spiral piece whose curvature peaks at an end.
+    Sign changes are found on a grid of ``samples`` parameters (values within 1e-9 of the
+    largest are rounding, not a sign) and refined by bisection to ~1e-15 in u; two roots
+    closer than a grid step may be missed together (a wiggle far below the grid's resolution).
+
+    Args:
+        cp: (4, 2) control points.
+        samples: grid parameters for the sign search.
+
+    Raises:
+        ValueError: a cusp or a stop: the tangent vanishes inside the curve (its curvature
+            is unbounded there), naming the parameter.
+    """
+    cp = np.asarray(cp, dtype=float)
+    grid = np.linspace(0.0, 1.0, samples)
+    speed = np.linalg.norm(derivative(cp, grid), axis=-1)
+    top = float(speed.max())
+    if top == 0.0 or float(speed[1:-1].min(initial=top)) <= 1e-9 * top:
+        at = float(grid[1 + int(np.argmin(speed[1:-1]))]) if samples > 2 else 0.0
+        raise ValueError(f"the cubic {cp.tolist()} has a cusp: its tangent vanishes near u = {at:.6g}, where its curvature is unbounded")
+    cuts: list[float] = []
+    for function in (curvature, curvature_rate):
+        with np.errstate(invalid="ignore", divide="ignore"):  # a leg of zero length: no tangent at that end
+            values = np.nan_to_num(np.asarray(function(cp, grid), dtype=float), nan=0.0, posinf=0.0, neginf=0.0)
+        noise = 1e-9 * float(np.abs(values).max())
+        signs = np.where(np.abs(values) <= noise, 0.0, np.sign(values))
+        kept = np.flatnonzero(signs)
+        for a, b in zip(kept[:-1], kept[1:], strict=True):
+            if signs[a] == signs[b]:
+                continue
+            lo, hi = float(grid[a]), float(grid[b])
+            for _ in range(60):  # bisection: the bracket halves to ~1e-15 in u
+                middle = 0.5 * (lo + hi)
+                if np.sign(float(function(cp, middle))) == signs[a]:
+                    lo = middle
+                else:
+                    hi = middle
+            cuts.append(0.5 * (lo + hi))
+    ends = [0.0] + [u for u in sorted(cuts) if 1e-9 < u < 1.0 - 1e-9] + [1.0]
+    kept_ends = [ends[0]] + [u for previous, u in zip(ends[:-1], ends[1:], strict=True) if u - previous > 1e-9]
+    kept_ends[-1] = 1.0
+    return list(zip(kept_ends[:-1], kept_ends[1:], strict=True))

@@ -51,7 +51,10 @@ not UTF-8. LinuxCNC also refuses a program with neither M2/M30 nor ``%``; this r
 end of the file as its end.
 
 ``read_gcode_chain`` reads a program as its exact path instead: lines, arcs and G5 cubics as the
-chain's segments (what ``spiral_cad.io.gcode_write`` writes reads back as the same chain).
+chain's segments (what ``spiral_cad.io.gcode_write`` writes reads back as the same chain; a cubic
+that is not a spiral is cut where its curvature changes sign or turns, so its curvature stays its
+own). The built-in reader keeps the feed rates (``F`` under ``G94``) of the feed moves (``GcodePath.feeds``,
+``program_feeds``).
 
 A move that ends where it started is not a point of the path (it would be a corner of no
 length); the path's first point is where the first move ends. Long reads and roundings say
@@ -72,6 +75,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 from numpy.typing import NDArray
 
+from ..core import bezier
 from .progress import Progress, ticking
 from .toolpath import PLANES, GcodePath, arc_points, arc_sweep, in_program_unit, spline_points
 
@@ -175,6 +179,10 @@ class _Reader:
         self.exact = False  # arcs and G5 splines kept as pieces (``pieces``), no chords needed
         self.pieces: list[tuple[Any, ...]] = []  # (kind, line, rapid, start, data…) of every move (with ``exact``)
         self.spline_end: tuple[float, float] | None = None  # the last G5's (P, Q), while G5 moves follow each other
+        self.feed: float | None = None  # the modal F (program unit per minute under G94)
+        self.feed_mode = 940  # G93 inverse time, G94 units per minute, G95 per revolution
+        self.feeds: dict[float, None] = {}  # the distinct F values in force on feed moves under G94, in order
+        self.point_feeds: list[float] = []  # the F in force on the move to each point (NaN: none)
 
     def error(self, number: int, text: str) -> ValueError:
         return ValueError(f"{self.source} line {number}: {text}")
@@ -247,6 +255,8 @@ class _Reader:
         turn_count: float | None = None  # P with G2/G3: the number of turns
         spline_pq: dict[str, float] = {}  # P and Q with G5: the end's offset to the second control point
         for letter, value, written in words:
+            if letter == "F":  # F applies to the move on its own line too
+                self.feed = value
             if letter in "GM":
                 code = round(value * 10) if _CODE.fullmatch(written[1:]) else None
                 if letter == "M":
@@ -279,6 +289,8 @@ class _Reader:
                     self.units = units
                 elif code in PLANES:
                     self.plane = code
+                elif code in (930, 940, 950):
+                    self.feed_mode = code
                 elif code == 40 or code in NEUTRAL_G:
                     pass
             elif letter == "M":
@@ -357,8 +369,13 @@ class _Reader:
             self.ended = True
 
     def add(self, number: int, moved: list[float]) -> None:
+        feed = math.nan
+        if self.motion != 0 and self.feed_mode == 940 and self.feed is not None and self.feed > 0.0:
+            self.feeds[self.feed] = None
+            feed = self.feed
         if moved != self.position or not self.points:
             self.points.append((moved[0], moved[1], moved[2]))
+            self.point_feeds.append(feed)
             self.lines.append(number)
             self.rapid.append(self.motion == 0)
         if self.progress is not None:
@@ -531,7 +548,8 @@ def parse_gcode(
     if len(reader.points) < 2:
         raise ValueError(f"{source}: the program has {len(reader.points)} move(s) to a new position; a path needs at least two")
     assert reader.units is not None  # the reader refuses a move before G20/G21
-    return GcodePath(np.array(reader.points), np.array(reader.lines), np.array(reader.rapid), reader.units, source, tuple(reader.notes))
+    return GcodePath(np.array(reader.points), np.array(reader.lines), np.array(reader.rapid), reader.units, source, tuple(reader.notes),
+                     tuple(reader.feeds), np.array(reader.point_feeds))  # fmt: skip
 
 
 def _program_text(path: str | os.PathLike) -> tuple[str, str]:
@@ -600,6 +618,18 @@ def segment_lines(rounded: RoundedPath, path: GcodePath) -> NDArray:
         for i, middle in enumerate(middles):
             lines[i] = path.lines[int(np.argmin(np.linalg.norm(path.points - middle, axis=1)))]
     return lines
+
+
+def segment_feeds(rounded: RoundedPath, path: GcodePath) -> NDArray | None:
+    """The feed of every segment of ``rounded.chain`` (rounded from ``path``, its unit per minute): the F in force
+    on the move of the segment's line (``segment_lines``); NaN where that move has none, None when ``path`` has no
+    feeds (read by rs274)."""
+    if path.point_feeds is None or not len(path.point_feeds):
+        return None
+    lines = segment_lines(rounded, path)
+    at = np.clip(np.searchsorted(path.lines, lines, side="right") - 1, 0, len(path.lines) - 1)
+    feeds: NDArray = path.point_feeds[at]
+    return feeds
 
 
 def round_toolpath(path: GcodePath, *, for_occt: bool = True, **options) -> RoundedPath:
@@ -727,8 +757,11 @@ def parse_gcode_chain(text: str, source: str = "G-code", *, units: str | None = 
     ``G1`` moves are lines, ``G2``/``G3`` arcs (in G17, G18 or G19; not helical, at most one
     turn) are arcs and ``G5`` cubic splines are cubic Bézier segments with the spline's own
     control points, so a program written by ``spiral_cad.io.gcode_write`` reads back as its
-    chain (control points equal to the printed decimals). The rapids (``G0``) before the first
-    feed move lead to the path's start; the path is every feed move after them. The chain lies
+    chain (control points equal to the printed decimals). A G5 cubic may be any cubic: it is
+    split at its inflections and curvature extrema (``bezier.monotone_pieces``) into spiral pieces
+    whose curvature is one-signed and monotone, so the chain's curvatures are the cubic's own.
+    The rapids (``G0``) before the first feed move lead to the path's start and those after
+    the last (a retract) are left out; the path is every feed move between them. The chain lies
     in the plane when every Z is 0, else in space. The built-in reader's rules hold (see the
     module docstring).
 
@@ -741,7 +774,7 @@ def parse_gcode_chain(text: str, source: str = "G-code", *, units: str | None = 
 
     Raises:
         ValueError: what the built-in reader refuses; a rapid between feed moves, a helical or
-            multi-turn arc, no feed move, or a joint that is not G2 (naming the lines).
+            multi-turn arc, a G5 cubic with a cusp, no feed move, or a joint that is not G2 (naming the lines).
     """
     from ..core.chain import Chain
     from ..core.errors import JointError
@@ -749,20 +782,15 @@ def parse_gcode_chain(text: str, source: str = "G-code", *, units: str | None = 
     from ..core.spiral import BezierSpiral
     from ..core.units import MM_PER_UNIT, length_unit
 
-    if not isinstance(text, str):
-        raise ValueError(f"text must be the program as str; got {type(text).__name__}")
-    lines = text.replace("\r\n", "\n").replace("\r", "\n").split("\n")
-    reader = _Reader(source)
-    reader.exact = True
-    for number, line in enumerate(lines, 1):
-        reader.read_line(number, line)
+    reader = _read_exact(text, source)
     pieces = reader.pieces
     first = next((k for k, piece in enumerate(pieces) if not piece[2]), None)
     if first is None or reader.units is None:
         raise ValueError(f"{source}: no feed move (G1, G2, G3, G5); a path is its feed moves")
     target = reader.units if units is None else length_unit(units)
     factor = MM_PER_UNIT[reader.units] / MM_PER_UNIT[target]
-    pieces = pieces[first:]
+    last = max(k for k, piece in enumerate(pieces) if not piece[2])
+    pieces = pieces[first : last + 1]  # the rapids after the last feed move (the retract) leave the path, as with G1
     flat = all(p[3][2] == 0.0 and (p[0] == "cubic" or p[4][2] == 0.0) and (p[0] != "arc" or p[5] == 170) for p in pieces)
     dim = 2 if flat else 3
     segments: list[Line | Arc | BezierSpiral] = []
@@ -775,8 +803,8 @@ def parse_gcode_chain(text: str, source: str = "G-code", *, units: str | None = 
             segment = _piece_segment(kind, start, data, factor, dim)
         except ValueError as error:
             raise ValueError(f"{source} line {number}: {error}") from None
-        if segment is not None:
-            segments.append(segment)
+        for piece in segment or ():
+            segments.append(piece)
             owners.append(number)
     if not segments:
         raise ValueError(f"{source}: no feed move to a new position; a path needs one")
@@ -792,15 +820,47 @@ def parse_gcode_chain(text: str, source: str = "G-code", *, units: str | None = 
         raise ValueError(f"{source}: {error}") from None
 
 
+def _read_exact(text: str, source: str) -> _Reader:
+    """The built-in reader after reading ``text`` with arcs and splines kept as pieces."""
+    if not isinstance(text, str):
+        raise ValueError(f"text must be the program as str; got {type(text).__name__}")
+    reader = _Reader(source)
+    reader.exact = True
+    for number, line in enumerate(text.replace("\r\n", "\n").replace("\r", "\n").split("\n"), 1):
+        reader.read_line(number, line)
+    return reader
+
+
+def program_feeds(path: str | os.PathLike) -> tuple[tuple[float, ...], str | None]:
+    """The feed rates a G-code program's feed moves run at, and the program's unit.
+
+    Args:
+        path: the program (read by the built-in reader, arcs and splines as they are).
+
+    Returns:
+        The distinct F values in force on the feed moves (G1, G2, G3, G5) under ``G94``
+        (program unit per minute), in the order they are first used (empty: none, or only
+        inverse-time ``G93`` or per-revolution ``G95`` feeds), and ``"mm"`` or ``"in"``
+        (None: the program has no move).
+
+    Raises:
+        ValueError: as ``read_gcode_chain``'s reading.
+        OSError: the file could not be read.
+    """
+    text, label = _program_text(path)
+    reader = _read_exact(text, label)
+    return tuple(reader.feeds), reader.units
+
+
 def _piece_segment(kind: str, start: list[float], data: list[Any], factor: float, dim: int) -> Any:
-    """The chain segment of one move read in exact mode (None for a move that goes nowhere)."""
+    """The chain segments of one move read in exact mode (None for a move that goes nowhere)."""
     from ..core.segments import Arc, Line
     from ..core.spiral import BezierSpiral
 
     begin = np.array(start) * factor
     if kind == "line":
         end = np.array(data[0]) * factor
-        return None if np.array_equal(begin, end) else Line(begin[:dim], end[:dim])
+        return None if np.array_equal(begin, end) else [Line(begin[:dim], end[:dim])]
     if kind == "arc":
         end, plane, ca, cb, rotation = data
         a, b, normal = PLANES[plane]
@@ -809,13 +869,21 @@ def _piece_segment(kind: str, start: list[float], data: list[Any], factor: float
         t0, sweep = arc_sweep(start, end, plane, ca, cb, rotation)
         radius = math.hypot(start[a] - ca, start[b] - cb) * factor
         if dim == 2:
-            return Arc((ca * factor, cb * factor), math.copysign(radius, sweep), t0, abs(sweep))
+            return [Arc((ca * factor, cb * factor), math.copysign(radius, sweep), t0, abs(sweep))]
         centre = begin.copy()
         centre[a], centre[b] = ca * factor, cb * factor
         axis = np.zeros(3)
         axis[normal] = 1.0
-        return Arc.in_space(centre, axis, begin, sweep)
-    return BezierSpiral.from_control_points(np.asarray(data[0])[:, :dim] * factor)
+        return [Arc.in_space(centre, axis, begin, sweep)]
+    cp = np.asarray(data[0]) * factor
+    cubic = cp[:, :2]
+    if not np.any(np.diff(cubic, axis=0)):
+        return None
+    pieces = []
+    for u0, u1 in bezier.monotone_pieces(cubic):
+        piece = cp.copy() if (u0, u1) == (0.0, 1.0) else np.column_stack([bezier.split(cubic, u0, u1), cp[:, 2]])
+        pieces.append(BezierSpiral.from_control_points(piece[:, :dim]))
+    return pieces
 
 
 def read_gcode_chain(path: str | os.PathLike, *, units: str | None = None, tolerance: float = 1e-6) -> Chain:

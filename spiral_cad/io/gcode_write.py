@@ -22,7 +22,12 @@ doubles nearly to the last bit, far inside any tolerance; G-code has no exponent
 notation), and arc centres and spline offsets are differences of the rounded
 points, so a reader lands on the rounded control points exactly. The header (comments)
 states the dialect, the unit, what each piece became and the tolerances with the distance
-measured for every approximation.
+measured for every approximation. Approximations are fitted within their tolerance less
+what printing may add (√3·10^-decimals), so the printed program is within the stated
+tolerances; decimals too coarse for them are refused, as are tolerances float64 cannot
+resolve at the chain's size. ``G64 P`` (LinuxCNC's blend tolerance) is never ``P0``, which
+LinuxCNC reads as blending without a limit. Header comments stay within LinuxCNC's
+255-character lines (a long name is cut).
 """
 
 from __future__ import annotations
@@ -66,6 +71,15 @@ CENTRE_WORDS = "IJK"
 BIARC_PROBES = 24
 #: The most halvings of a spiral's parameter interval for biarcs.
 MAX_DEPTH = 40
+#: The most biarcs of one spiral (a tolerance far below the spiral's size is refused, not minutes of halving).
+MAX_BIARCS = 1 << 14
+#: Tolerances below this times the largest coordinate are refused: float64 (about 2.2e-16 relative)
+#: cannot place points that finely, so the fit would halve without end.
+MIN_RELATIVE_TOLERANCE = 1e-13
+#: LinuxCNC's longest line (characters); header comments are cut to fit.
+MAX_LINE = 255
+#: The most characters of the name shown in the header.
+MAX_NAME = 120
 
 
 @dataclass
@@ -190,16 +204,27 @@ def spirals_biarcs(control_points: NDArray, tolerance: float) -> list[tuple[list
     ends; all cubics are fitted at once, a level of halvings at a time.
 
     Raises:
-        ValueError: no biarcs within ``tolerance`` after ``MAX_DEPTH`` halvings.
+        ValueError: ``tolerance`` below what float64 resolves at the cubics' coordinates
+            (``MIN_RELATIVE_TOLERANCE`` times the largest; the smallest usable one is named), more
+            than ``MAX_BIARCS`` biarcs for one cubic, or no biarcs within ``tolerance`` after ``MAX_DEPTH`` halvings.
     """
     cps = np.asarray(control_points, dtype=float)
+    if cps.size:
+        _resolvable(tolerance, float(np.abs(cps).max()), "arc_tolerance", "")
     found: list[list[tuple[float, list[Piece]]]] = [[] for _ in range(len(cps))]
     worst = np.zeros(len(cps))
     owner, u0, u1 = np.arange(len(cps)), np.zeros(len(cps)), np.ones(len(cps))
     inside = np.linspace(0.0, 1.0, BIARC_PROBES + 2)[1:-1]
+    fitted = np.zeros(len(cps), dtype=np.int64)  # biarcs found per cubic
     for _ in range(MAX_DEPTH + 1):
         if not len(owner):
             break
+        needed = fitted + np.bincount(owner, minlength=len(cps))
+        if needed.max() > MAX_BIARCS:
+            most = int(np.argmax(needed))
+            raise ValueError(f"arc_tolerance {tolerance:g}: spiral {most} would need more than {MAX_BIARCS:,} biarcs "
+                             f"({int(fitted[most]):,} fitted, {int(needed[most] - fitted[most]):,} still to fit); "
+                             "give a larger arc_tolerance")  # fmt: skip
         curves = cps[owner]
         ends = bezier.point(curves, np.stack([u0, u1], axis=1))
         tangents = bezier.tangent(curves, np.stack([u0, u1], axis=1))
@@ -225,6 +250,7 @@ def spirals_biarcs(control_points: NDArray, tolerance: float) -> list[tuple[list
                 (p1[k], None if second[2][k] else second[0][k], float(second[1][k])),
             ]
             found[owner[k]].append((float(u0[k]), pieces))
+            fitted[owner[k]] += 1
             worst[owner[k]] = max(worst[owner[k]], float(error[k]))
         bad = ~good
         half = (u0[bad] + u1[bad]) / 2.0
@@ -233,6 +259,14 @@ def spirals_biarcs(control_points: NDArray, tolerance: float) -> list[tuple[list
     if len(owner):
         raise ValueError(f"arc_tolerance {tolerance:g}: no biarcs within it after {MAX_DEPTH} halvings of a spiral")
     return [([piece for _, pieces in sorted(own, key=lambda f: f[0]) for piece in pieces], float(w)) for own, w in zip(found, worst)]
+
+
+def _resolvable(tolerance: float, extent: float, name: str, unit: str) -> None:
+    """Refuse a tolerance float64 cannot resolve at coordinates up to ``extent`` (the smallest usable one named)."""
+    smallest = MIN_RELATIVE_TOLERANCE * min(extent, MAX_COORDINATE)
+    if tolerance < smallest:
+        raise ValueError(f"{name} {tolerance:g}{unit} is below what float64 resolves at coordinates up to {extent:g}{unit}; "
+                         f"the smallest usable is {smallest:.2g}{unit} ({MIN_RELATIVE_TOLERANCE:g} of the largest coordinate)")  # fmt: skip
 
 
 def spiral_biarcs(control_points: NDArray, tolerance: float) -> tuple[list[Piece], float]:
@@ -256,6 +290,7 @@ def gcode_program(
     rapid_to_start: bool = True,
     decimals: int | None = None,
     name: str | None = None,
+    feeds: Any = None,
 ) -> GcodeProgram:
     """The G-code program of ``chain`` and what it holds (see the module docstring; ``write_gcode`` writes it).
 
@@ -276,10 +311,17 @@ def gcode_program(
         decimals: decimals of every number (default: 15 significant digits for the largest
             coordinate, at least 6 and at most 15 decimals).
         name: the path's name, for the header comment.
+        feeds: one feed per segment of the chain (program unit per minute; NaN: ``feed``), as read
+            from the program a path was rounded from: an ``F`` word is written where it changes.
 
     Raises:
         ValueError: not a chain, an unknown dialect or unit, a feed or tolerance that is not a
-            positive finite number, decimals outside 1–15, coordinates beyond 1e9 program units.
+            positive finite number, decimals outside 1–15, coordinates beyond 1e9 program units;
+            decimals too coarse for a tolerance (printed curves may stray √3·10^-decimals, which
+            must be at most half of ``arc_tolerance`` and ``chord_tolerance``: the fewest decimals
+            are named); a tolerance below what float64 resolves at the chain's coordinates
+            (``MIN_RELATIVE_TOLERANCE`` of the largest); more than ``MAX_BIARCS`` biarcs of a spiral; a feed
+            that would print as 0 or beyond 1e9.
     """
     if not isinstance(chain, Chain) and isinstance(getattr(chain, "chain", None), Chain):
         chain = chain.chain
@@ -300,6 +342,25 @@ def gcode_program(
         decimals = min(MAX_DECIMALS, max(MIN_DECIMALS, DIGITS - max(0, math.ceil(math.log10(max(extent, 1.0))))))
     if isinstance(decimals, bool) or not isinstance(decimals, int) or not 1 <= decimals <= 15:
         raise ValueError(f"decimals must be a whole number from 1 to 15; got {decimals!r:.40}")
+    # a printed point is within printing of the chain's (each coordinate rounded by half the last decimal);
+    # an arc's centre and end both are, so its printed curve strays up to twice that
+    printing = math.sqrt(3.0) * 10.0**-decimals
+    extent_chain = float(np.abs(chain.rows.geometry).max(initial=0.0))
+    for label, value in (("arc_tolerance", arcs), ("chord_tolerance", chord)):
+        _resolvable(value, extent_chain, label, f" {chain.units}")
+        if value * factor < 2.0 * printing:  # the approximation keeps at least half of the tolerance
+            fewest = math.ceil(math.log10(2.0 * math.sqrt(3.0) / (value * factor)))
+            raise ValueError(f"decimals {decimals} round the printed numbers by up to {0.5 * 10.0**-decimals:g} {program}: "
+                             f"printed curves may stray {printing:.2g} {program}, more than half of {label} "
+                             f"{value * factor:g} {program}; give decimals of at least {fewest}, or a larger {label}")  # fmt: skip
+    per_segment = np.full(len(chain), feed) if feeds is None else np.array(feeds, dtype=float).ravel()
+    if per_segment.shape != (len(chain),):
+        raise ValueError(f"feeds must hold one feed per segment ({len(chain)}); got {per_segment.size}")
+    per_segment = np.where(np.isnan(per_segment), feed, per_segment)
+    for value in (feed, *np.unique(per_segment).tolist()):
+        if not 0.5 * 10.0**-decimals <= value <= MAX_COORDINATE:
+            raise ValueError(f"feed {value:g} {program}/min cannot be printed with {decimals} decimals: it must be from "
+                             f"{0.5 * 10.0**-decimals:g} to {MAX_COORDINATE:g}")  # fmt: skip
     plane_tol = 0.5 * 10.0**-decimals / factor if plane_tolerance is None else _positive(plane_tolerance, "plane_tolerance")
     if name is not None and ("(" in name or ")" in name or not name.isprintable()):
         raise ValueError(f"name {name!r:.60} cannot stand in a G-code comment (no parentheses, printable)")
@@ -321,11 +382,16 @@ def gcode_program(
         wanted = [i for i, plane in planes.items() if plane is not None and plane[0] == plane_name
                   and not (plane_name == "G17" and dialect == "linuxcnc")]  # fmt: skip
         if wanted:
-            fitted = spirals_biarcs(rows.geometry[wanted][:, :, [first, second]], arcs)
+            fitted = spirals_biarcs(rows.geometry[wanted][:, :, [first, second]], arcs - printing / factor)
             fits.update(zip(wanted, fitted))
+    in_force, feed_words = float(per_segment[0]) if len(chain) else feed, 0
     for i in range(len(chain)):
         kind = int(kinds[i])
         geometry = rows.geometry[i]
+        if per_segment[i] != in_force:  # the program's own feed changes here
+            in_force = float(per_segment[i])
+            body.append(f"F{out.number(round(in_force, decimals))}")
+            feed_words += 1
         if kind == LINE:
             out.line(out.rounded(geometry[1]))
             counts["line"] += 1
@@ -374,33 +440,40 @@ def gcode_program(
                 continue
         # a piece in a plane that is not a principal one: chords
         piece = Chain([segment], units=chain.units)
-        samples = sample_path(piece, chord_tolerance=chord)
+        samples = sample_path(piece, chord_tolerance=chord - printing / factor)
         points = samples[:, 1:4]
         between = piece.point_at((samples[1:, 0] + samples[:-1, 0]) / 2.0)
         chord_error = max(chord_error, _chord_error(points[:, : chain.dim], between))
         for point in points[1:]:
             out.line(out.rounded(point))
         counts["chords"] += 1
-    counts["moves"] = len(body)
+    counts["moves"] = len(body) - feed_words
 
     unit_note = "" if factor == 1.0 else f", converted from the chain's {chain.units}, times {factor:g}"
     arcs_p, chord_p = arcs * factor, chord * factor
+    shown = name or "path"
+    if len(shown) > MAX_NAME:  # LinuxCNC refuses lines beyond MAX_LINE characters
+        shown = shown[: MAX_NAME - 3] + "..."
+
+    printed = f"printed numbers add up to {printing:.2g}"
     head = [
-        f"(spiral_cad: {name or 'path'}, {len(chain)} pieces, length {chain.length * factor:.6f} {program}, dialect {dialect})",
+        f"(spiral_cad: {shown}, {len(chain)} pieces, length {chain.length * factor:.6f} {program}, dialect {dialect})",
         f"(unit: {program}, {UNIT_CODE[program]}{unit_note}; numbers rounded to {10.0**-decimals:g} {program})",
         f"(lines: {counts['line']} G1; arcs: {counts['arc']} G2/G3 exact; spirals: {counts['G5']} G5 exact cubic, "
         f"{counts['biarcs']} as biarcs)",
-        f"(biarcs within arc tolerance {arcs_p:g} {program}, measured {arc_error * factor:.3g})",
+        f"(biarcs within arc tolerance {arcs_p:g} {program}, measured {arc_error * factor:.3g}; {printed})",
         f"(pieces in space as G1 chords: {counts['chords']}, within chord tolerance {chord_p:g} {program}, "
-        f"measured {chord_error * factor:.3g})",
+        f"measured {chord_error * factor:.3g}; {printed})",
         "(a plane path keeps the machine's Z)" if chain.dim == 2 else "(a path in space: X Y Z)",
     ]
     if dialect == "linuxcnc":
-        blend = min(arcs_p, chord_p)
-        head += [f"{UNIT_CODE[program]} G90 G91.1 G94 G17 G40 G49", f"G64 P{out.number(round(blend, decimals))}"]
+        # the blend tolerance, never printed as P0 (LinuxCNC's planner reads P0 as blending without a limit)
+        blend = max(round(min(arcs_p, chord_p), decimals), 10.0**-decimals)
+        head += [f"{UNIT_CODE[program]} G90 G91.1 G94 G17 G40 G49", f"G64 P{out.number(blend)}"]
     else:
         head += [f"{UNIT_CODE[program]} G90 G94 G17"]
-    head.append(f"F{out.number(round(feed, decimals))}")
+    head.append(f"F{out.number(round(float(per_segment[0]) if len(chain) else feed, decimals))}")
+    head = [line if len(line) <= MAX_LINE else line[: MAX_LINE - 4] + "...)" for line in head]
     text = "\n".join(head + body + ["M2", ""])
     return GcodeProgram(text, program, counts, chord_error * factor, arc_error * factor)
 
@@ -426,6 +499,7 @@ def write_gcode(
     rapid_to_start: bool = True,
     decimals: int | None = None,
     name: str | None = None,
+    feeds: Any = None,
 ) -> str | Path:
     """Write a chain (or a rounded path, circle chain or alignment: its ``chain``) as a G-code program
     (see ``gcode_program`` for the options): the file's path, or the text when ``path`` is None.
@@ -436,7 +510,7 @@ def write_gcode(
     """
     program = gcode_program(chain, dialect=dialect, feed=feed, units=units, chord_tolerance=chord_tolerance,
                             arc_tolerance=arc_tolerance, plane_tolerance=plane_tolerance, rapid_to_start=rapid_to_start,
-                            decimals=decimals, name=name)  # fmt: skip
+                            decimals=decimals, name=name, feeds=feeds)  # fmt: skip
     if path is None:
         return program.text
     target = Path(path)

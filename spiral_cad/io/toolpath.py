@@ -36,6 +36,10 @@ class GcodePath:
         units: ``"mm"`` (G21) or ``"in"`` (G20).
         source: the file's name, for messages.
         notes: what was read but does not move the tool and is worth telling (tool changes).
+        feeds: the distinct feed rates (F, program unit per minute under G94) of the feed moves, in
+            the order first used (empty when not read: LinuxCNC's rs274 reader).
+        point_feeds: (n,) the feed in force on the move to each point (NaN for a rapid, a move with
+            no F or not under G94); None when not read.
     """
 
     points: NDArray
@@ -44,14 +48,20 @@ class GcodePath:
     units: str
     source: str = "G-code"
     notes: tuple[str, ...] = ()
+    feeds: tuple[float, ...] = ()
+    point_feeds: NDArray | None = None
 
     def __len__(self) -> int:
         return len(self.points)
 
     def in_units(self, units: str) -> GcodePath:
-        """The same moves in ``units`` (mm, cm, m, km, in, ft): converted from the program's G20/G21."""
+        """The same moves in ``units`` (mm, cm, m, km, in, ft): converted from the program's G20/G21 (feeds too)."""
         factor = MM_PER_UNIT[self.units] / MM_PER_UNIT[length_unit(units)]
-        return GcodePath(self.points * factor if factor != 1.0 else self.points, self.lines, self.rapid, units, self.source, self.notes)
+        if factor == 1.0:
+            return GcodePath(self.points, self.lines, self.rapid, units, self.source, self.notes, self.feeds, self.point_feeds)
+        point_feeds = None if self.point_feeds is None else self.point_feeds * factor
+        return GcodePath(self.points * factor, self.lines, self.rapid, units, self.source, self.notes,
+                         tuple(f * factor for f in self.feeds), point_feeds)  # fmt: skip
 
     def at_lines(self, message: str) -> str:
         """``message`` with every ``point i``/``corner i`` followed by the G-code line of that move."""
