@@ -1,7 +1,8 @@
 """spiral_cad: exact curvature-continuous (G2) cubic Bézier spirals for CAD.
 
 This namespace is the numeric core's face: segments, the Bézier spiral, the
-five transitions, chains, and ``batch`` (the same solvers over arrays). It
+five transitions, chains, fitting points (``fit_points``), and ``batch`` (the
+same solvers over arrays). It
 needs only numpy, scipy and numba. Design tools live in ``spiral_cad.design``;
 build123d objects in ``spiral_cad.build123d`` and the CadQuery plugin in
 ``spiral_cad.cadquery`` (these two import OCP).
