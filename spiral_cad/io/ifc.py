@@ -61,6 +61,7 @@ from numpy.typing import NDArray
 
 from ..core._chain_kernels import ARC, LINE, SPIRAL
 from ..core.units import length_unit, to_metres
+from .names import check_name
 from .opendrive import plan_records
 
 __all__ = [
@@ -325,6 +326,8 @@ def ifc_file(
     names = [f"alignment {k}" for k in range(1, len(items) + 1)] if names is None else list(names)
     if len(names) != len(items):
         raise ValueError(f"names: give one name per alignment ({len(items)}); got {len(names)}")
+    names = [check_name(n, f"names[{k}]") for k, n in enumerate(names)]  # IfcLabel: at most 255 characters
+    project = check_name(project, "project")
     for k, p in enumerate(profiles):
         if p is not None and p.units != design_units:
             raise ValueError(f"profile {k}: in {p.units}, its alignment in {design_units}")

@@ -393,3 +393,13 @@ def test_the_design_file_build_writes_the_ifc_or_names_it_skipped(tmp_path, monk
     written = designfile.write(built, tmp_path / "without", units, progress=lambda _: None, plots=False)
     assert not (tmp_path / "without" / "road.ifc").exists() and (tmp_path / "without" / "road.xodr").exists()
     assert written.skipped == ["IFC (needs ifcopenshell)"]
+
+
+def test_names_that_ifc_labels_cannot_hold_are_refused_by_name(tmp_path):
+    """IfcLabel holds at most 255 characters of text: a longer or control-character name is refused, naming it."""
+    alignment = Alignment.from_pis(PIS, [450, 400, 600], spiral_angles=0.1, units="m")
+    with pytest.raises(ValueError, match=r"names\[0\]"):
+        write_ifc(alignment, tmp_path / "long.ifc", names=["x" * 256])
+    with pytest.raises(ValueError, match="project"):
+        write_ifc(alignment, tmp_path / "ctl.ifc", project="a\x01b")
+    assert not (tmp_path / "long.ifc").exists() and not (tmp_path / "ctl.ifc").exists()
