@@ -53,6 +53,12 @@ _STEPS = 5
 _TAU = 2.0 * math.pi
 #: Turn between chords 2·tolerance long above which the points double back.
 _DOUBLE_BACK = math.radians(150.0)
+#: Largest coordinate or tolerance, and smallest extent or tolerance, the fit works with: the
+#: input is checked with squared lengths, which must stay normal float64 numbers.
+_LARGEST, _SMALLEST = 1e150, 1e-150
+#: Smallest tolerance relative to the largest coordinate: float64 resolves about 2e-16 of a
+#: coordinate, and the solvers and the distance check need room below the tolerance.
+_RESOLUTION = 1e-11
 
 
 @dataclass(frozen=True)
@@ -118,6 +124,26 @@ def _positive(value: Any, name: str) -> float:
     if not (math.isfinite(number) and number > 0.0):
         raise ValueError(f"{name} must be a finite number > 0; got {number!r}")
     return number
+
+
+def _check_scale(points: NDArray[np.float64], tolerance: float) -> None:
+    """ValueError where the points or the tolerance lie outside what float64 geometry resolves."""
+    magnitude = float(np.abs(points).max())
+    extent = float(np.hypot(*(points.max(axis=0) - points.min(axis=0))))
+    if magnitude > _LARGEST or tolerance > _LARGEST:
+        raise ValueError(
+            f"points and tolerance must lie within ±{_LARGEST:g}; got coordinates up to {magnitude:g} and tolerance {tolerance:g} "
+            f"(scale them, e.g. with other units)"
+        )
+    if extent < _SMALLEST or tolerance < _SMALLEST:
+        raise ValueError(
+            f"the points span {extent:g} with tolerance {tolerance:g}: both must be at least {_SMALLEST:g} (scale them, e.g. with other units)"
+        )
+    if tolerance < _RESOLUTION * magnitude:
+        raise ValueError(
+            f"tolerance {tolerance:g} is below what float64 resolves at coordinates up to {magnitude:g} "
+            f"(at least {_RESOLUTION:g} of them: {_RESOLUTION * magnitude:g}); move the points nearer the origin or loosen the tolerance"
+        )
 
 
 def _distinct(points: NDArray[np.float64], tolerance: float, closed: bool) -> NDArray[np.int64]:
@@ -577,6 +603,8 @@ def chain_distances(chain: Chain, points: ArrayLike) -> tuple[NDArray[np.float64
     samples = np.concatenate([piece.point(np.linspace(0.0, 1.0, int(m))) for piece, m in zip(pieces, counts.tolist())])
     owner = np.repeat(np.arange(len(pieces)), counts)
     u_of = np.concatenate([np.linspace(0.0, 1.0, int(m)) for m in counts.tolist()])
+    if not np.isfinite(samples).all():
+        raise ValueError("chain_distances: the chain's points are not finite float64 numbers (coordinates beyond ±1e308)")
     _, nearest = cKDTree(samples).query(p)
     piece_of, u_guess = owner[nearest], u_of[nearest]
     best = np.full(len(p), np.inf)
@@ -648,9 +676,11 @@ def fit_points(
     units = length_unit(units)
     kmax = None if max_curvature is None else _positive(max_curvature, "max_curvature")
     report = progress or (lambda done, total: None)
-    kept = _distinct(raw, tol, bool(closed))
+    with np.errstate(over="ignore"):  # differences beyond ±1e308 are inf: distinct, and refused by scale next
+        kept = _distinct(raw, tol, bool(closed))
     if len(kept) < 3:
         raise ValueError(f"fit_points needs at least 3 distinct points; got {len(kept)} (of {len(raw)} points)")
+    _check_scale(raw, tol)
     pts = raw[kept]
     s = _arc_lengths(pts)
     _check_doubling_back(
@@ -660,6 +690,13 @@ def fit_points(
         np.concatenate([kept, kept[:2]]) if closed else kept,
     )
     report(1, _STEPS)
+    # The fit works on points scaled by a power of two to an extent near 1 (exact both ways, where a
+    # move would round the short legs of tiny pieces), so that its thresholds hold at any scale.
+    factor = 2.0 ** -round(math.log2(float(np.hypot(*(pts.max(axis=0) - pts.min(axis=0))))))
+    raw_pts, raw_tol, raw_kmax = pts, tol, kmax
+    pts, tol = pts * factor, tol * factor
+    kmax = None if kmax is None else kmax / factor
+    s = _arc_lengths(pts)
     h = _window(s, tol)
     n = len(pts)
     if closed:
@@ -693,6 +730,15 @@ def fit_points(
     if chain is None:
         chain, residual, stations = _fallback(pts, tol, shape, units, bool(closed))
     assert residual is not None and stations is not None
+    if factor != 1.0:
+        chain = _scaled(chain, 1.0 / factor)
+        residual, stations = chain_distances(chain, raw_pts)
+        if float(residual.max()) > raw_tol:
+            raise NoSolutionError(
+                f"the fit misses a point by {float(residual.max()):.6g} > tolerance {raw_tol:g} once scaled back "
+                f"(float64 rounding at coordinates up to {float(np.abs(raw_pts).max()):g}); move the points nearer the origin"
+            )
+    kappa, tol, kmax = kappa * factor, raw_tol, raw_kmax
     if kmax is not None:
         _check_max_curvature(chain, kmax)
     report(5, _STEPS)
@@ -701,6 +747,21 @@ def fit_points(
     slot = np.searchsorted(kept, index)
     slot = np.minimum(slot, len(kept) - 1)
     return PointFit(chain, residual[slot], stations[slot], kappa[slot], tol, units)
+
+
+def _scaled(chain: Chain, scale: float) -> Chain:
+    """The chain scaled by ``scale`` (a power of two: exact) about the origin."""
+    pieces: list[Segment] = []
+    for piece in chain:
+        if isinstance(piece, Line):
+            pieces.append(Line(tuple((piece.start * scale).tolist()), tuple((piece.end * scale).tolist())))
+        elif isinstance(piece, Arc):
+            center = tuple((piece.center * scale).tolist())
+            pieces.append(Arc(center, piece.radius * scale, piece.start_angle, piece.sweep))
+        else:
+            assert isinstance(piece, BezierSpiral)
+            pieces.append(BezierSpiral.from_control_points(piece.control_points * scale, piece.shape))
+    return Chain(pieces, chain.tolerance, chain.units)
 
 
 class _Unfit(Exception):

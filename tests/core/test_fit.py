@@ -61,7 +61,7 @@ def assert_g2_by_positions(chain: Chain, closed: bool = False) -> None:
     if closed:
         pairs.append((chain.segments[-1], chain.segments[0]))
     for before, after in pairs:
-        step = 1e-4 * min(before.length, after.length)
+        step = 1e-3 * min(before.length, after.length)  # rounding in the differences grows as 1/step²
         offsets = step * np.arange(5.0)
         left = before.point(before.parameter_at(before.length - offsets))  # the joint first, then backwards
         right = after.point(after.parameter_at(offsets))
@@ -228,3 +228,37 @@ def test_any_fit_returned_is_within_tolerance_and_g2(outcome, radius, shift, tur
         assert fit.max_residual <= tolerance
         assert np.all(fit.residuals <= tolerance)
         assert_g2_by_positions(fit.chain)
+
+
+@settings(max_examples=12, deadline=None)
+@given(
+    scale=st.integers(-320, 308),
+    offset=st.floats(-1e308, 1e308, allow_nan=False),
+    ratio=st.integers(-18, 3),
+    order=st.sampled_from(["curve", "three", "shuffled"]),
+)
+def test_any_magnitude_gives_a_fit_or_a_named_refusal(scale, offset, ratio, order):
+    """Any float64 coordinates and tolerance: a fit within the tolerance, or ValueError/NoSolutionError by name."""
+    with np.errstate(all="ignore"):
+        base = sample(curve_chain(), 60) if order != "three" else np.array([[1.0, 1.0], [0.0, 0.0], [0.0, 1.0]])
+        if order == "shuffled":
+            base = base[np.random.default_rng(5).permutation(len(base))]
+        points = base * 10.0**scale + offset
+        tolerance = 0.05 * 10.0 ** (scale + ratio)
+    if not (np.isfinite(points).all() and math.isfinite(tolerance) and tolerance > 0):
+        return
+    try:
+        fit = fit_points(points, tolerance)
+    except ValueError as error:  # NoSolutionError included
+        assert str(error)
+        return
+    assert fit.max_residual <= tolerance and np.isfinite(fit.residuals).all()
+
+
+@pytest.mark.parametrize(
+    "points", [[[1, 1], [0, 0], [0, 1e300]], [[5e-324, 0], [0, 5e-324], [1e-323, 1e-323]], [[0, 0], [1e-310, 0], [2e-310, 1e-310]]]
+)
+def test_extreme_coordinates_are_refused_by_name(points):
+    for tolerance in (1e-8, 1e-320):
+        with pytest.raises(ValueError, match="scale them|distinct points"):
+            fit_points(points, tolerance)
