@@ -10,6 +10,7 @@ vertical curves that keep every point within the tolerance.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from collections.abc import Callable
 from typing import TYPE_CHECKING, Any
@@ -96,7 +97,7 @@ def fit_alignment(
             f"the alignment rebuilt from the fitted PIs misses points[{worst}] by {float(residuals[worst]):.6g} "
             f"(tolerance {tolerance:g} {units})"
         )
-    return alignment
+    return dataclasses.replace(alignment, point_fit=fit)
 
 
 def _vertical_polyline(stations: NDArray[np.float64], z: NDArray[np.float64], epsilon: float) -> NDArray[np.int64]:

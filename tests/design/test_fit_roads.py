@@ -29,6 +29,11 @@ def test_alignment_fit_recovers_the_curves(designed, noise):
     assert chain_distances(fitted.chain, points)[0].max() <= 0.05
     # The road criteria judge every fitted curve (a verdict per curve).
     assert len(fitted.checks) == 2 and "80 km/h" in fitted.criteria_table()
+    # The PointFit it was read from: the point-wise curvature estimate, 1/300 in the first arc's middle.
+    estimate = fitted.point_fit.curvature_estimate
+    assert estimate.shape == (1500,)
+    middle = designed.chain.stations[2] + designed.chain[2].length / 2
+    assert estimate[np.argmin(np.abs(fitted.point_fit.stations - middle))] == pytest.approx(1 / 300, rel=0.05)
 
 
 def test_alignment_fit_refuses_points_without_curves():
