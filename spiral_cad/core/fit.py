@@ -796,13 +796,20 @@ def _fit_chain(pts: NDArray[np.float64], tol: float, shape: str, units: str, clo
     work, work_kappa = np.roll(pts, -shift, axis=0), np.roll(kappa, -shift)
     report(2, _STEPS)
     sigma = _noise(pts)
-    tau = min(max(tol / 8.0, 6.0 * sigma), tol / 2.0)
+    core = min(max(tol / 8.0, 6.0 * sigma), tol / 2.0)
+    work_s = _arc_lengths(work)
     chain = None
-    try:
-        prims = _segment(work, _arc_lengths(work), work_kappa, h, tau, kmax, closed)
-        report(3, _STEPS)
-        chain = _assemble(prims, work, tol, shape, units, closed)
-    except (ValueError, _Unfit):
+    # Runs too short for the transitions between them (sparse points round a tight smooth shape,
+    # where every arc is short) cannot be joined: looser runs are longer, and fewer.
+    for tau in sorted({core, min(2.0 * core, tol / 2.0), tol / 2.0}):
+        try:
+            prims = _segment(work, work_s, work_kappa, h, tau, kmax, closed)
+            report(3, _STEPS)
+            chain = _assemble(prims, work, tol, shape, units, closed)
+        except (ValueError, _Unfit):
+            continue
+        if tau == core or float(chain_distances(chain, pts)[0].max()) <= tol:
+            break
         chain = None
     report(4, _STEPS)
     return chain, kappa

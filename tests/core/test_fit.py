@@ -262,3 +262,21 @@ def test_extreme_coordinates_are_refused_by_name(points):
     for tolerance in (1e-8, 1e-320):
         with pytest.raises(ValueError, match="scale them|distinct points"):
             fit_points(points, tolerance)
+
+
+@pytest.mark.parametrize("decimals", [None, 4])
+def test_a_sparse_tight_ellipse_has_few_pieces(decimals):
+    """120 points round a 40 × 25 ellipse (as a design file gives them, rounded or not), tolerance 0.05:
+    every arc is short, so the runs are loosened until the transitions fit; a fit of noise-free samples
+    of the result comes back with (nearly) its own piece count."""
+    t = np.linspace(0.0, 2 * math.pi, 120, endpoint=False)
+    points = np.c_[20.0 * np.cos(t), 12.5 * np.sin(t)]
+    if decimals is not None:
+        points = points.round(decimals)
+    fit = fit_points(points, 0.05, closed=True)
+    assert set(kinds(fit.chain)) <= {"A", "B"} and fit.pieces <= 30
+    assert_within(fit, points, 0.05)
+    assert_g2_by_positions(fit.chain, closed=True)
+    again = fit.chain.point_at(np.linspace(0.0, fit.chain.length, 400, endpoint=False))
+    refit = fit_points(again, 0.05, closed=True)
+    assert fit.pieces - 2 <= refit.pieces <= fit.pieces
