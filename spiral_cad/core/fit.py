@@ -924,7 +924,106 @@ def _assemble(prims: list[_Primitive], pts: NDArray[np.float64], tol: float, sha
     transitions = [usable(i, j) for i, j in zip(best_path, best_path[1:])]
     if closed:
         kept = kept[:-1]
-    return _build(kept, [t for t in transitions if t is not None], pts, units, closed)
+    joins = [t for t in transitions if t is not None]
+    chain = _build(kept, joins, pts, units, closed)
+    refined = _refine(kept, pts, shape, tol, closed)
+    if refined is not None:
+        try:
+            better = _build(*refined, pts, units, closed)
+        except (ValueError, _Unfit):
+            return chain
+        if float(chain_distances(better, pts)[0].max()) <= tol:
+            return better
+    return chain
+
+
+#: Gauss–Newton iterations (scipy ``least_squares`` evaluations) per line or circle refined, and
+#: the sweeps over all of them (each moves its neighbours' optimum a little).
+_REFINE_EVALUATIONS, _REFINE_SWEEPS = 20, 3
+
+
+def _refine(prims: list[_Primitive], pts: NDArray[np.float64], shape: str, tol: float, closed: bool
+            ) -> tuple[list[_Primitive], list[Transition]] | None:  # fmt: skip
+    """The kept lines and circles adjusted, one at a time, to the least squares of every point of
+    their run and of the spirals on either side (the spirals solved again at each step): a line or
+    circle fitted to its run alone is pulled by the spiral points the run took in, and the spirals it
+    decides carry that error as a bump. None where a transition fails."""
+    from scipy.optimize import least_squares
+
+    prims = list(prims)
+    count = len(prims)
+    if count < 2:
+        return None
+    ring = closed
+
+    def neighbours(k: int) -> tuple[_Primitive | None, _Primitive | None]:
+        before = prims[k - 1] if (k > 0 or ring) else None
+        after = prims[(k + 1) % count] if (k < count - 1 or ring) else None
+        return before, after
+
+    def moved(prim: _Primitive, x: NDArray[np.float64]) -> _Primitive:
+        if prim.line:
+            c, s_ = math.cos(x[1]), math.sin(x[1])
+            d = np.array([c * prim.direction[0] - s_ * prim.direction[1], s_ * prim.direction[0] + c * prim.direction[1]])
+            normal = np.array([-prim.direction[1], prim.direction[0]])
+            return _Primitive(prim.a, prim.b, True, prim.point + x[0] * normal, d, prim.center, prim.radius, prim.span, prim.split)
+        sense = 1.0 if prim.radius > 0 else -1.0
+        return _Primitive(prim.a, prim.b, False, prim.point, prim.direction, prim.center + x[:2], prim.radius + sense * x[2],
+                          prim.span, prim.split)  # fmt: skip
+
+    def local_points(k: int) -> NDArray[np.float64]:
+        before, after = neighbours(k)
+        lo = (before.a + before.b) // 2 if before is not None else prims[k].a
+        hi = (after.a + after.b) // 2 + 1 if after is not None else prims[k].b
+        window = pts[lo:hi] if hi > lo else np.vstack([pts[lo:], pts[:hi]])
+        return window[:: max(1, len(window) // 1000)]
+
+    def distances(k: int, prim: _Primitive, local: NDArray[np.float64]) -> NDArray[np.float64]:
+        before, after = neighbours(k)
+        far = 2.0 * float(np.hypot(*(local.max(axis=0) - local.min(axis=0)))) + 1.0
+        pieces: list[Segment] = []
+        try:
+            if before is not None:
+                t = _join(before, prim, local, shape, tol, before.split_point(pts), prim.split_point(pts))
+                if t is None:
+                    raise ValueError
+                pieces += [_clipped(before, t.start, True, far), *t.spirals, _clipped(prim, t.end, False, far)]
+            if after is not None:
+                t = _join(prim, after, local, shape, tol, prim.split_point(pts), after.split_point(pts))
+                if t is None:
+                    raise ValueError
+                pieces += [_clipped(prim, t.start, True, far), *t.spirals, _clipped(after, t.end, False, far)]
+        except ValueError:
+            return np.full(len(local), 1e3 * tol)
+        return _nearest(pieces, local)
+
+    gains = [0.0] * count  # each sweep: how much each line or circle lowered its cost
+    for k in list(range(count)) * _REFINE_SWEEPS:
+        if k == 0 and gains[0] >= 0.0 and any(gains) and max(gains) < 0.05:
+            break  # the last sweep moved nothing by 5 %: settled
+        prim = prims[k]
+        if prim.line and any(n is not None and n.line for n in neighbours(k)):
+            continue  # beside a corner the line's own fit stands (corner pairs are searched, not solved)
+        local = local_points(k)
+        start = distances(k, prim, local)
+        if float(start.max()) >= 1e3 * tol:
+            return None
+        size = 3 if not prim.line else 2
+        result = least_squares(lambda x: distances(k, moved(prim, x), local), np.zeros(size), max_nfev=_REFINE_EVALUATIONS,
+                               x_scale=np.full(size, tol), ftol=1e-4, xtol=1e-4)  # fmt: skip
+        before_cost = 0.5 * float(start @ start)
+        gains[k] = 1.0 - float(result.cost) / before_cost if before_cost > 0.0 else 0.0
+        if float(result.cost) < before_cost:
+            prims[k] = moved(prim, result.x)
+    joins: list[Transition] = []
+    for k in range(count if ring else count - 1):
+        p, q = prims[k], prims[(k + 1) % count]
+        t = _join(p, q, pts[p.a : q.b][:: max(1, (q.b - p.a) // 4000)] if q.b > p.a else pts[:0], shape, tol, p.split_point(pts),
+                  q.split_point(pts))  # fmt: skip
+        if t is None:
+            return None
+        joins.append(t)
+    return prims, joins
 
 
 def _cheapest(order: list[_Primitive], pts: NDArray[np.float64], usable: Callable[[int, int], Transition | None], last: int,
