@@ -362,3 +362,18 @@ def test_a_road_fit_reports_the_point_wise_curvature_estimate():
     kappa = built.chain.curvature_at(np.clip(s, 0.0, built.chain.length))
     steady = np.abs(kappa) > 0.5 * np.abs(kappa).max()
     assert steady.any() and np.median(np.abs(estimate[steady] - kappa[steady])) <= 0.2 * np.abs(kappa).max()
+
+
+@pytest.mark.parametrize(
+    "text, message",
+    [
+        ("1,1\n0,0\n0,1e300\n", "points and tolerance must lie within ±1e+150"),
+        ("0,0\n1e-310,0\n2e-310,1e-310\n", "at least 3 distinct points"),
+    ],
+)
+def test_extreme_coordinates_exit_2_naming_the_scale(tmp_path, capsys, text, message):
+    """Any float64 points: a fit or a named refusal, never an internal error."""
+    path = write_csv(tmp_path / "trace.csv", text)
+    assert main(["build", "--from-points", str(path), "--tolerance", "1e-8", "-o", str(tmp_path / "out")]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("error: ") and message in err and "internal error" not in err and "Traceback" not in err
