@@ -1018,8 +1018,10 @@ def _refine(prims: list[_Primitive], pts: NDArray[np.float64], shape: str, tol: 
     joins: list[Transition] = []
     for k in range(count if ring else count - 1):
         p, q = prims[k], prims[(k + 1) % count]
-        t = _join(p, q, pts[p.a : q.b][:: max(1, (q.b - p.a) // 4000)] if q.b > p.a else pts[:0], shape, tol, p.split_point(pts),
-                  q.split_point(pts))  # fmt: skip
+        # The points between the two runs' middles, as _evaluate gives them (round the ring's end too).
+        lo, hi = (p.a + p.b) // 2, (q.a + q.b) // 2 + 1
+        between = pts[lo:hi] if hi > lo else np.vstack([pts[lo:], pts[:hi]])
+        t = _join(p, q, between[:: max(1, len(between) // 4000)], shape, tol, p.split_point(pts), q.split_point(pts))
         if t is None:
             return None
         joins.append(t)
