@@ -118,9 +118,12 @@ def main() -> None:
     seconds = []
     for n in args.sizes:
         many = truth.point_at(np.linspace(0.0, truth.length, n)) + rng.normal(0.0, 0.05 * TOLERANCE, (n, 2))
-        started = time.perf_counter()
-        fit = fit_points(many, TOLERANCE, units="m")
-        seconds.append(time.perf_counter() - started)
+        runs = []
+        for _ in range(1 if args.quick else 3):  # the median of three runs: the machine is shared
+            started = time.perf_counter()
+            fit = fit_points(many, TOLERANCE, units="m")
+            runs.append(time.perf_counter() - started)
+        seconds.append(float(np.median(runs)))
         goal = "" if n < 1_000_000 else ("1 M points ≤ 10 s" if seconds[-1] <= 10 else "1 M points ≤ 10 s: missed")
         report.add(f"fit_points, {n:,} points ({fit.pieces} pieces, worst residual {fit.max_residual:.3g} m)", seconds[-1], "s", goal=goal)
     if len(seconds) > 1:

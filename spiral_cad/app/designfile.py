@@ -515,15 +515,20 @@ def _fit_road(d: FitDesign, points: Any, units: str, progress: Callable[[int, in
                             progress=progress)  # fmt: skip
         alignment, profile = survey.alignment, survey.profile
         residuals = FitResiduals(points, survey.stations - alignment.start_station, survey.plan_residuals, d.tolerance, units,
-                                 vertical=survey.vertical_residuals)  # fmt: skip
+                                 _estimate(alignment), vertical=survey.vertical_residuals)  # fmt: skip
     else:
         if d.vertical_tolerance is not None:
             raise DesignError("vertical_tolerance: the points have no z (no profile to fit)")
         alignment, profile = Alignment.fit(points, d.tolerance, d.design_speed, units=units, shape=d.spiral_shape, progress=progress), None
         distance, stations = chain_distances(alignment.chain, points)
-        residuals = FitResiduals(points, stations, distance, d.tolerance, units)
+        residuals = FitResiduals(points, stations, distance, d.tolerance, units, _estimate(alignment))
     return BuiltRoadFit(name=d.name, chain=alignment.chain, source=alignment, cross_section=CrossSection(), profile=profile,
                         fit=residuals)  # fmt: skip
+
+
+def _estimate(alignment: Any) -> Any:
+    """The point-wise curvature estimate an ``Alignment.fit`` segmented (None without one)."""
+    return None if alignment.point_fit is None else alignment.point_fit.curvature_estimate
 
 
 def _own_file(given: str, base: Path | None, where: str) -> Path:

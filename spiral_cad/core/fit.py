@@ -53,6 +53,12 @@ _STEPS = 5
 _TAU = 2.0 * math.pi
 #: Turn between chords 2·tolerance long above which the points double back.
 _DOUBLE_BACK = math.radians(150.0)
+#: Largest coordinate or tolerance, and smallest extent or tolerance, the fit works with: the
+#: input is checked with squared lengths, which must stay normal float64 numbers.
+_LARGEST, _SMALLEST = 1e150, 1e-150
+#: Smallest tolerance relative to the largest coordinate: float64 resolves about 2e-16 of a
+#: coordinate, and the solvers and the distance check need room below the tolerance.
+_RESOLUTION = 1e-11
 
 
 @dataclass(frozen=True)
@@ -118,6 +124,26 @@ def _positive(value: Any, name: str) -> float:
     if not (math.isfinite(number) and number > 0.0):
         raise ValueError(f"{name} must be a finite number > 0; got {number!r}")
     return number
+
+
+def _check_scale(points: NDArray[np.float64], tolerance: float) -> None:
+    """ValueError where the points or the tolerance lie outside what float64 geometry resolves."""
+    magnitude = float(np.abs(points).max())
+    extent = float(np.hypot(*(points.max(axis=0) - points.min(axis=0))))
+    if magnitude > _LARGEST or tolerance > _LARGEST:
+        raise ValueError(
+            f"points and tolerance must lie within ±{_LARGEST:g}; got coordinates up to {magnitude:g} and tolerance {tolerance:g} "
+            f"(scale them, e.g. with other units)"
+        )
+    if extent < _SMALLEST or tolerance < _SMALLEST:
+        raise ValueError(
+            f"the points span {extent:g} with tolerance {tolerance:g}: both must be at least {_SMALLEST:g} (scale them, e.g. with other units)"
+        )
+    if tolerance < _RESOLUTION * magnitude:
+        raise ValueError(
+            f"tolerance {tolerance:g} is below what float64 resolves at coordinates up to {magnitude:g} "
+            f"(at least {_RESOLUTION:g} of them: {_RESOLUTION * magnitude:g}); move the points nearer the origin or loosen the tolerance"
+        )
 
 
 def _distinct(points: NDArray[np.float64], tolerance: float, closed: bool) -> NDArray[np.int64]:
@@ -543,15 +569,42 @@ def _piece_distance(
         u = np.clip(u - f / np.where(df > 0, df, 1.0), 0.0, 1.0)
     uu = u[:, None]
     offset = ((c3 * uu + c2) * uu + c1) * uu - rel
-    along = np.asarray(bezier.arc_length(cp, u), dtype=float) if stations else u
+    along = _spiral_stations(cp, c1, c2, c3, u) if stations else u
     return np.hypot(offset[:, 0], offset[:, 1]), along
+
+
+#: Nodes of the arc length table a spiral's stations are interpolated from.
+_NODES = 129
+
+
+def _spiral_stations(cp: NDArray[np.float64], c1: NDArray[np.float64], c2: NDArray[np.float64], c3: NDArray[np.float64],
+                     u: NDArray[np.float64]) -> NDArray[np.float64]:  # fmt: skip
+    """Arc length from the spiral's start to each parameter ``u``: few points by quadrature, many
+    by cubic Hermite interpolation of a quadrature table with the speed |B'| as its slope (the
+    speed is smooth: the error is ~1e-12 of the length at 129 nodes)."""
+    if len(u) <= 4 * _NODES:
+        return np.asarray(bezier.arc_length(cp, u), dtype=float)
+    nodes = np.linspace(0.0, 1.0, _NODES)
+    table = np.asarray(bezier.arc_length(cp, nodes), dtype=float)
+    speed = np.hypot(*((3.0 * c3 * nodes[:, None] + 2.0 * c2) * nodes[:, None] + c1).T)
+    width = 1.0 / (_NODES - 1)
+    k = np.minimum((u / width).astype(np.int64), _NODES - 2)
+    t = u / width - k
+    t2, t3 = t * t, t * t * t
+    h00, h10, h01, h11 = 2 * t3 - 3 * t2 + 1, t3 - 2 * t2 + t, -2 * t3 + 3 * t2, t3 - t2
+    out: NDArray[np.float64] = h00 * table[k] + h10 * width * speed[k] + h01 * table[k + 1] + h11 * width * speed[k + 1]
+    return out
+
+
+#: Most samples chain_distances places along a chain (beside at least 8 per piece).
+_SAMPLES = 100_000
 
 
 def chain_distances(chain: Chain, points: ArrayLike) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     """Distance of every point to a plane chain and the station (arc length) of its foot.
 
     Each point is located at the nearest of samples along every piece (a k-d
-    tree, about two per point), then its foot is solved on that piece
+    tree, about two per point up to 100 000 samples), then its foot is solved on that piece
     (lines and arcs in closed form, spirals by Newton's method) and on the
     neighbouring pieces.
 
@@ -571,12 +624,15 @@ def chain_distances(chain: Chain, points: ArrayLike) -> tuple[NDArray[np.float64
         raise ValueError("chain_distances takes a plane chain")
     p = _as_points(points)
     lengths, stations = chain.lengths, chain.stations
-    spacing = max(chain.length / max(2 * len(p), 1), 1e-300)
+    # Samples enough to tell the pieces apart, not one per point: Newton finds each foot from there.
+    spacing = max(chain.length / min(max(2 * len(p), 1), _SAMPLES), 1e-300)
     counts = np.clip(np.ceil(lengths / spacing).astype(np.int64), 8, 1_000_000)
     pieces = list(chain)
     samples = np.concatenate([piece.point(np.linspace(0.0, 1.0, int(m))) for piece, m in zip(pieces, counts.tolist())])
     owner = np.repeat(np.arange(len(pieces)), counts)
     u_of = np.concatenate([np.linspace(0.0, 1.0, int(m)) for m in counts.tolist()])
+    if not np.isfinite(samples).all():
+        raise ValueError("chain_distances: the chain's points are not finite float64 numbers (coordinates beyond ±1e308)")
     _, nearest = cKDTree(samples).query(p)
     piece_of, u_guess = owner[nearest], u_of[nearest]
     best = np.full(len(p), np.inf)
@@ -648,9 +704,11 @@ def fit_points(
     units = length_unit(units)
     kmax = None if max_curvature is None else _positive(max_curvature, "max_curvature")
     report = progress or (lambda done, total: None)
-    kept = _distinct(raw, tol, bool(closed))
+    with np.errstate(over="ignore"):  # differences beyond ±1e308 are inf: distinct, and refused by scale next
+        kept = _distinct(raw, tol, bool(closed))
     if len(kept) < 3:
         raise ValueError(f"fit_points needs at least 3 distinct points; got {len(kept)} (of {len(raw)} points)")
+    _check_scale(raw, tol)
     pts = raw[kept]
     s = _arc_lengths(pts)
     _check_doubling_back(
@@ -660,6 +718,68 @@ def fit_points(
         np.concatenate([kept, kept[:2]]) if closed else kept,
     )
     report(1, _STEPS)
+    # The fit works on points scaled by a power of two to an extent near 1 (exact both ways, where a
+    # move would round the short legs of tiny pieces), so that its thresholds hold at any scale.
+    factor = 2.0 ** -round(math.log2(float(np.hypot(*(pts.max(axis=0) - pts.min(axis=0))))))
+    raw_pts, raw_tol, raw_kmax = pts, tol, kmax
+    pts, tol = pts * factor, tol * factor
+    kmax = None if kmax is None else kmax / factor
+    s = _arc_lengths(pts)
+    chain: Chain | None = None
+    if len(pts) > _REDUCED:
+        # Many points: fit their block means (the noise averaged, the work bounded), then measure every point.
+        reduced, reduced_s = _reduce(pts, s, bool(closed))
+        chain, reduced_kappa = _fit_chain(reduced, tol, shape, units, bool(closed), kmax, report)
+        kappa = np.interp(s, reduced_s, reduced_kappa, period=s[-1] + math.hypot(*(pts[0] - pts[-1])) if closed else None)
+        chain, residual, stations = _measured(chain, factor, raw_pts, raw_tol)
+    if chain is None:
+        chain, kappa = _fit_chain(pts, tol, shape, units, bool(closed), kmax, report if len(pts) <= _REDUCED else None)
+        chain, residual, stations = _measured(chain, factor, raw_pts, raw_tol)
+    if chain is None:
+        fallback, _, _ = _fallback(pts, tol, shape, units, bool(closed))
+        chain, residual, stations = _measured(fallback, factor, raw_pts, raw_tol)
+        if chain is None:
+            raise NoSolutionError(
+                f"the fit misses a point by more than the tolerance {raw_tol:g} once scaled back "
+                f"(float64 rounding at coordinates up to {float(np.abs(raw_pts).max()):g}); move the points nearer the origin"
+            )
+    assert residual is not None and stations is not None
+    kappa, tol, kmax = kappa * factor, raw_tol, raw_kmax
+    if kmax is not None:
+        _check_max_curvature(chain, kmax)
+    report(5, _STEPS)
+    # Every input point (duplicates included) gets the values of the kept point it repeats.
+    index = np.maximum.accumulate(np.where(np.isin(np.arange(len(raw)), kept), np.arange(len(raw)), 0))
+    slot = np.searchsorted(kept, index)
+    slot = np.minimum(slot, len(kept) - 1)
+    return PointFit(chain, residual[slot], stations[slot], kappa[slot], tol, units)
+
+
+#: Above this many points the fit works on block means of the points (about this many).
+_REDUCED = 20_000
+
+
+def _reduce(pts: NDArray[np.float64], s: NDArray[np.float64], closed: bool) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """Means of consecutive blocks of points (and of their arc lengths), about ``_REDUCED`` of them;
+    an open trace keeps its first and last point, where the chain ends."""
+    block = math.ceil(len(pts) / _REDUCED)
+    inner = slice(0, len(pts)) if closed else slice(1, len(pts) - 1)
+    body, body_s = pts[inner], s[inner]
+    starts = np.arange(0, len(body), block)
+    sizes = np.diff(np.append(starts, len(body)))[:, None]
+    means = np.add.reduceat(body, starts, axis=0) / sizes
+    means_s = np.add.reduceat(body_s, starts) / sizes[:, 0]
+    if closed:
+        return means, means_s
+    return np.vstack([pts[:1], means, pts[-1:]]), np.concatenate([s[:1], means_s, s[-1:]])
+
+
+def _fit_chain(pts: NDArray[np.float64], tol: float, shape: str, units: str, closed: bool, kmax: float | None,
+               report: ProgressCallback | None) -> tuple[Chain | None, NDArray[np.float64]]:  # fmt: skip
+    """The chain of runs and transitions (not yet measured; None where the runs cannot be joined)
+    and the point-wise curvature estimate."""
+    report = report or (lambda done, total: None)
+    s = _arc_lengths(pts)
     h = _window(s, tol)
     n = len(pts)
     if closed:
@@ -676,31 +796,52 @@ def fit_points(
     work, work_kappa = np.roll(pts, -shift, axis=0), np.roll(kappa, -shift)
     report(2, _STEPS)
     sigma = _noise(pts)
-    tau = min(max(tol / 8.0, 6.0 * sigma), tol / 2.0)
+    core = min(max(tol / 8.0, 6.0 * sigma), tol / 2.0)
+    work_s = _arc_lengths(work)
     chain = None
-    try:
-        prims = _segment(work, _arc_lengths(work), work_kappa, h, tau, kmax, bool(closed))
-        report(3, _STEPS)
-        chain = _assemble(prims, work, tol, shape, units, bool(closed))
-    except (ValueError, _Unfit):
+    # Runs too short for the transitions between them (sparse points round a tight smooth shape,
+    # where every arc is short) cannot be joined: looser runs are longer, and fewer.
+    for tau in sorted({core, min(2.0 * core, tol / 2.0), tol / 2.0}):
+        try:
+            prims = _segment(work, work_s, work_kappa, h, tau, kmax, closed)
+            report(3, _STEPS)
+            chain = _assemble(prims, work, tol, shape, units, closed)
+        except (ValueError, _Unfit):
+            continue
+        if tau == core or float(chain_distances(chain, pts)[0].max()) <= tol:
+            break
         chain = None
     report(4, _STEPS)
-    residual = stations = None
-    if chain is not None:
-        residual, stations = chain_distances(chain, pts)
-        if float(residual.max()) > tol:
-            chain = None
+    return chain, kappa
+
+
+def _measured(chain: Chain | None, factor: float, points: NDArray[np.float64], tolerance: float
+              ) -> tuple[Chain | None, NDArray[np.float64] | None, NDArray[np.float64] | None]:  # fmt: skip
+    """The chain scaled back to the points' coordinates with every point's distance and station,
+    or Nones where it misses a point by more than ``tolerance``."""
     if chain is None:
-        chain, residual, stations = _fallback(pts, tol, shape, units, bool(closed))
-    assert residual is not None and stations is not None
-    if kmax is not None:
-        _check_max_curvature(chain, kmax)
-    report(5, _STEPS)
-    # Every input point (duplicates included) gets the values of the kept point it repeats.
-    index = np.maximum.accumulate(np.where(np.isin(np.arange(len(raw)), kept), np.arange(len(raw)), 0))
-    slot = np.searchsorted(kept, index)
-    slot = np.minimum(slot, len(kept) - 1)
-    return PointFit(chain, residual[slot], stations[slot], kappa[slot], tol, units)
+        return None, None, None
+    if factor != 1.0:
+        chain = _scaled(chain, 1.0 / factor)
+    residual, stations = chain_distances(chain, points)
+    if float(residual.max()) > tolerance:
+        return None, None, None
+    return chain, residual, stations
+
+
+def _scaled(chain: Chain, scale: float) -> Chain:
+    """The chain scaled by ``scale`` (a power of two: exact) about the origin."""
+    pieces: list[Segment] = []
+    for piece in chain:
+        if isinstance(piece, Line):
+            pieces.append(Line(tuple((piece.start * scale).tolist()), tuple((piece.end * scale).tolist())))
+        elif isinstance(piece, Arc):
+            center = tuple((piece.center * scale).tolist())
+            pieces.append(Arc(center, piece.radius * scale, piece.start_angle, piece.sweep))
+        else:
+            assert isinstance(piece, BezierSpiral)
+            pieces.append(BezierSpiral.from_control_points(piece.control_points * scale, piece.shape))
+    return Chain(pieces, chain.tolerance, chain.units)
 
 
 class _Unfit(Exception):
@@ -783,7 +924,108 @@ def _assemble(prims: list[_Primitive], pts: NDArray[np.float64], tol: float, sha
     transitions = [usable(i, j) for i, j in zip(best_path, best_path[1:])]
     if closed:
         kept = kept[:-1]
-    return _build(kept, [t for t in transitions if t is not None], pts, units, closed)
+    joins = [t for t in transitions if t is not None]
+    chain = _build(kept, joins, pts, units, closed)
+    refined = _refine(kept, pts, shape, tol, closed)
+    if refined is not None:
+        try:
+            better = _build(*refined, pts, units, closed)
+        except (ValueError, _Unfit):
+            return chain
+        if float(chain_distances(better, pts)[0].max()) <= tol:
+            return better
+    return chain
+
+
+#: Gauss–Newton iterations (scipy ``least_squares`` evaluations) per line or circle refined, and
+#: the sweeps over all of them (each moves its neighbours' optimum a little).
+_REFINE_EVALUATIONS, _REFINE_SWEEPS = 20, 3
+
+
+def _refine(prims: list[_Primitive], pts: NDArray[np.float64], shape: str, tol: float, closed: bool
+            ) -> tuple[list[_Primitive], list[Transition]] | None:  # fmt: skip
+    """The kept lines and circles adjusted, one at a time, to the least squares of every point of
+    their run and of the spirals on either side (the spirals solved again at each step): a line or
+    circle fitted to its run alone is pulled by the spiral points the run took in, and the spirals it
+    decides carry that error as a bump. None where a transition fails."""
+    from scipy.optimize import least_squares
+
+    prims = list(prims)
+    count = len(prims)
+    if count < 2:
+        return None
+    ring = closed
+
+    def neighbours(k: int) -> tuple[_Primitive | None, _Primitive | None]:
+        before = prims[k - 1] if (k > 0 or ring) else None
+        after = prims[(k + 1) % count] if (k < count - 1 or ring) else None
+        return before, after
+
+    def moved(prim: _Primitive, x: NDArray[np.float64]) -> _Primitive:
+        if prim.line:
+            c, s_ = math.cos(x[1]), math.sin(x[1])
+            d = np.array([c * prim.direction[0] - s_ * prim.direction[1], s_ * prim.direction[0] + c * prim.direction[1]])
+            normal = np.array([-prim.direction[1], prim.direction[0]])
+            return _Primitive(prim.a, prim.b, True, prim.point + x[0] * normal, d, prim.center, prim.radius, prim.span, prim.split)
+        sense = 1.0 if prim.radius > 0 else -1.0
+        return _Primitive(prim.a, prim.b, False, prim.point, prim.direction, prim.center + x[:2], prim.radius + sense * x[2],
+                          prim.span, prim.split)  # fmt: skip
+
+    def local_points(k: int) -> NDArray[np.float64]:
+        before, after = neighbours(k)
+        lo = (before.a + before.b) // 2 if before is not None else prims[k].a
+        hi = (after.a + after.b) // 2 + 1 if after is not None else prims[k].b
+        window = pts[lo:hi] if hi > lo else np.vstack([pts[lo:], pts[:hi]])
+        return window[:: max(1, len(window) // 1000)]
+
+    def distances(k: int, prim: _Primitive, local: NDArray[np.float64]) -> NDArray[np.float64]:
+        before, after = neighbours(k)
+        far = 2.0 * float(np.hypot(*(local.max(axis=0) - local.min(axis=0)))) + 1.0
+        pieces: list[Segment] = []
+        try:
+            if before is not None:
+                t = _join(before, prim, local, shape, tol, before.split_point(pts), prim.split_point(pts))
+                if t is None:
+                    raise ValueError
+                pieces += [_clipped(before, t.start, True, far), *t.spirals, _clipped(prim, t.end, False, far)]
+            if after is not None:
+                t = _join(prim, after, local, shape, tol, prim.split_point(pts), after.split_point(pts))
+                if t is None:
+                    raise ValueError
+                pieces += [_clipped(prim, t.start, True, far), *t.spirals, _clipped(after, t.end, False, far)]
+        except ValueError:
+            return np.full(len(local), 1e3 * tol)
+        return _nearest(pieces, local)
+
+    gains = [0.0] * count  # each sweep: how much each line or circle lowered its cost
+    for k in list(range(count)) * _REFINE_SWEEPS:
+        if k == 0 and gains[0] >= 0.0 and any(gains) and max(gains) < 0.05:
+            break  # the last sweep moved nothing by 5 %: settled
+        prim = prims[k]
+        if prim.line and any(n is not None and n.line for n in neighbours(k)):
+            continue  # beside a corner the line's own fit stands (corner pairs are searched, not solved)
+        local = local_points(k)
+        start = distances(k, prim, local)
+        if float(start.max()) >= 1e3 * tol:
+            return None
+        size = 3 if not prim.line else 2
+        result = least_squares(lambda x: distances(k, moved(prim, x), local), np.zeros(size), max_nfev=_REFINE_EVALUATIONS,
+                               x_scale=np.full(size, tol), ftol=1e-4, xtol=1e-4)  # fmt: skip
+        before_cost = 0.5 * float(start @ start)
+        gains[k] = 1.0 - float(result.cost) / before_cost if before_cost > 0.0 else 0.0
+        if float(result.cost) < before_cost:
+            prims[k] = moved(prim, result.x)
+    joins: list[Transition] = []
+    for k in range(count if ring else count - 1):
+        p, q = prims[k], prims[(k + 1) % count]
+        # The points between the two runs' middles, as _evaluate gives them (round the ring's end too).
+        lo, hi = (p.a + p.b) // 2, (q.a + q.b) // 2 + 1
+        between = pts[lo:hi] if hi > lo else np.vstack([pts[lo:], pts[:hi]])
+        t = _join(p, q, between[:: max(1, len(between) // 4000)], shape, tol, p.split_point(pts), q.split_point(pts))
+        if t is None:
+            return None
+        joins.append(t)
+    return prims, joins
 
 
 def _cheapest(order: list[_Primitive], pts: NDArray[np.float64], usable: Callable[[int, int], Transition | None], last: int,

@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, cast
 
@@ -25,6 +25,7 @@ from ..core.bezier import peak_curvature_rate
 from ..core.chain import JOIN_TOLERANCE, Chain, PartCircles, join_rows, join_tolerance
 from ..core.errors import JointError, NoSolutionError
 from ..core.factors import WALTON_MEEK_SEARCH_MAX, length_factor, peak_rate_factor, search_range
+from ..core.fit import PointFit
 from ..core.rows import SegmentRows
 from ..core.segments import Circle, Ray
 from ..core.shapes import SHAPE_CODES, TRANSITION_SHAPES, shape_code, shape_limits
@@ -185,6 +186,8 @@ class Alignment:
         criteria: the design criteria the curves were chosen or checked by, if any.
         checks: one ``CriteriaRow`` per curve when there are criteria.
         shape: the spiral shape of every transition (``"near-linear"`` or ``"walton-meek"``).
+        point_fit: ``Alignment.fit``: the ``PointFit`` of the points the curves were read from
+            (its residuals, stations and point-wise ``curvature_estimate``); None otherwise.
     """
 
     chain: Chain
@@ -193,6 +196,7 @@ class Alignment:
     criteria: Criteria | None = None
     checks: tuple[CriteriaRow, ...] = ()
     shape: str = "near-linear"
+    point_fit: PointFit | None = field(default=None, compare=False, repr=False)
 
     @classmethod
     def fit(

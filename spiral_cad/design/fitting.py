@@ -3,13 +3,15 @@
 The plan is ``spiral_cad.fit_points`` read as tangent–spiral–arc–spiral–tangent curves: the PIs
 are where consecutive fitted tangents meet, each curve keeps its fitted radius and spiral angles,
 and the alignment is built again from them by ``Alignment.from_pis`` (so the road criteria judge
-it) and measured against the points once more. The profile is a polyline of grades within half
+it) and measured against the points once more. The profile is read from the grade change rate
+(zero on grades, constant on curves); failing that (noise), it is a polyline of grades within half
 the vertical tolerance (Douglas–Peucker on elevation) whose PVIs get the longest parabolic
 vertical curves that keep every point within the tolerance.
 """
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from collections.abc import Callable
 from typing import TYPE_CHECKING, Any
@@ -96,7 +98,73 @@ def fit_alignment(
             f"the alignment rebuilt from the fitted PIs misses points[{worst}] by {float(residuals[worst]):.6g} "
             f"(tolerance {tolerance:g} {units})"
         )
-    return alignment
+    return dataclasses.replace(alignment, point_fit=fit)
+
+
+def _segmented_profile(cls: type[Profile], s: NDArray[np.float64], z: NDArray[np.float64], tolerance: float, units: str,
+                       design_speed: float | None) -> Profile | None:  # fmt: skip
+    """The profile read from its grade change rate z'' (the second difference): runs where it is
+    zero are grades, runs where it is a constant are parabolic curves (as the plan fit reads its
+    curvature). PVIs where consecutive grade lines meet (two curves meeting without a grade between
+    share the line tangent to both), each curve as long as its grade change over its rate. None where
+    the points are not of that form, or the profile misses a point by more than ``tolerance``."""
+    if len(s) < 5:
+        return None
+    grade = np.diff(z) / np.diff(s)
+    middle = 0.5 * (s[1:] + s[:-1])  # a parabola's chord slope is its grade at the chord's middle
+    rate = np.diff(grade) / np.diff(middle)
+    # Equal rates within what the points resolve: the tolerance over the span, as a second difference.
+    eps = max(4.0 * tolerance / float(s[-1] - s[0]) ** 2, 1e-9 * float(np.abs(rate).max()))
+    runs: list[tuple[int, int, float]] = []  # rate indices [a, b) and the run's rate
+    a = 0
+    for j in range(1, len(rate) + 1):
+        if j == len(rate) or abs(rate[j] - rate[a]) > eps:
+            runs.append((a, j, float(np.median(rate[a:j]))))
+            a = j
+    # A single rate between two runs straddles their boundary: not a piece of its own.
+    runs = [r for r in runs if r[1] - r[0] > 1]
+    if not runs or abs(runs[0][2]) > eps or abs(runs[-1][2]) > eps:
+        return None  # a profile starts and ends on a grade
+    # Each run as a polynomial in s over its points (rate index j spans points j .. j + 2).
+    fits = []
+    for a, b, r in runs:
+        flat = abs(r) <= eps
+        coefficients = np.polyfit(s[a : b + 2], z[a : b + 2], 1 if flat else 2)
+        fits.append((flat, np.pad(coefficients, (1, 0)) if flat else coefficients))  # (c2, c1, c0)
+    lines: list[tuple[float, float]] = []  # (grade, elevation at s = 0) of each grade line, in order
+    curves: list[float] = []  # each curve's z'' (2 c2)
+    for k, (flat, c) in enumerate(fits):
+        if flat:
+            lines.append((float(c[1]), float(c[2])))
+            continue
+        curves.append(2.0 * float(c[0]))
+        after_flat, after = fits[k + 1]
+        if not after_flat:
+            # Two parabolas touching: their difference has a double root where the shared line touches both.
+            d = c - after
+            if abs(d[0]) <= 0.0:
+                return None
+            touch = -d[1] / (2.0 * d[0])
+            slope = 2.0 * c[0] * touch + c[1]
+            lines.append((float(slope), float(np.polyval(c, touch) - slope * touch)))
+    if len(lines) != len(curves) + 1:
+        return None
+    pvis = [(float(s[0]), float(lines[0][0] * s[0] + lines[0][1]))]
+    lengths = []
+    for (g1, b1), (g2, b2), rate_k in zip(lines, lines[1:], curves):
+        if g1 == g2:
+            return None
+        at = (b2 - b1) / (g1 - g2)
+        pvis.append((at, g1 * at + b1))
+        lengths.append((g2 - g1) / rate_k)
+    pvis.append((float(s[-1]), float(lines[-1][0] * s[-1] + lines[-1][1])))
+    try:
+        profile = cls.from_pvis(np.array(pvis), curve_lengths=lengths if lengths else None, units=units, design_speed=design_speed)
+    except ValueError:
+        return None
+    if float(np.abs(profile.elevation(s) - z).max()) > tolerance:
+        return None
+    return profile
 
 
 def _vertical_polyline(stations: NDArray[np.float64], z: NDArray[np.float64], epsilon: float) -> NDArray[np.int64]:
@@ -144,6 +212,9 @@ def fit_profile(
     unique, first = np.unique(s, return_index=True)
     z = np.add.reduceat(z, first) / np.diff(np.append(first, len(s)))
     s, zs = unique, z
+    segmented = _segmented_profile(cls, s, zs, tolerance, units, design_speed)
+    if segmented is not None:
+        return segmented
     worst = math.inf
     for level in range(6):
         keep = _vertical_polyline(s, zs, tolerance / 2.0 ** (level + 1))

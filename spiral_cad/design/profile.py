@@ -267,9 +267,12 @@ class Profile:
     ) -> Profile:
         """The profile through measured (station, elevation) points: grades and parabolic vertical curves.
 
-        The PVIs are the corners of a polyline of grades within half the tolerance (Douglas–Peucker on
-        elevation, tighter if needed); each interior PVI gets the longest symmetric vertical curve
-        its tangents allow, shortened where a point would miss the tolerance.
+        The grade change rate (the points' second difference) is read first: runs where it is zero
+        are grades, runs where it is constant are parabolic curves, so points of a designed profile
+        give back its PVIs and curves. Where that misses the tolerance (noise), the PVIs are the
+        corners of a polyline of grades within half the tolerance (Douglas–Peucker on elevation,
+        tighter if needed); each interior PVI gets the longest symmetric vertical curve its tangents
+        allow, shortened where a point would miss the tolerance.
 
         Args:
             stations: (N,) stations (any order; repeated stations are averaged).

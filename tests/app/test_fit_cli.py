@@ -345,3 +345,35 @@ def test_collinear_points_with_repeats_are_one_line(tmp_path):
     header, table = read_table(tmp_path / "out" / "trace_residuals.csv")
     assert len(table) == 5 and np.abs(table[:, 4]).max() <= 1e-12
     np.testing.assert_allclose(table[:, 3], [0, 1, 1, 2, 3], atol=1e-12)
+
+
+def test_a_road_fit_reports_the_point_wise_curvature_estimate():
+    """A road fit (Alignment.fit) carries the estimate its PointFit segmented, for the report plot's dots."""
+    points = traced()
+    design = {"units": "m", "designs": [{"name": "road", "type": "fit", "points": points.tolist(), "tolerance": 0.1,
+                                         "design_speed": 60}]}  # fmt: skip
+    _, (built,) = build(design)
+    estimate = np.asarray(built.fit.estimate)
+    assert estimate.shape == (len(points),)
+    fitted = built.source.point_fit
+    np.testing.assert_array_equal(estimate, fitted.curvature_estimate)
+    # The estimate follows the fitted curvature where the curvature is steady (an arc's middle).
+    s = np.asarray(built.fit.stations)
+    kappa = built.chain.curvature_at(np.clip(s, 0.0, built.chain.length))
+    steady = np.abs(kappa) > 0.5 * np.abs(kappa).max()
+    assert steady.any() and np.median(np.abs(estimate[steady] - kappa[steady])) <= 0.2 * np.abs(kappa).max()
+
+
+@pytest.mark.parametrize(
+    "text, message",
+    [
+        ("1,1\n0,0\n0,1e300\n", "points and tolerance must lie within ±1e+150"),
+        ("0,0\n1e-310,0\n2e-310,1e-310\n", "at least 3 distinct points"),
+    ],
+)
+def test_extreme_coordinates_exit_2_naming_the_scale(tmp_path, capsys, text, message):
+    """Any float64 points: a fit or a named refusal, never an internal error."""
+    path = write_csv(tmp_path / "trace.csv", text)
+    assert main(["build", "--from-points", str(path), "--tolerance", "1e-8", "-o", str(tmp_path / "out")]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("error: ") and message in err and "internal error" not in err and "Traceback" not in err

@@ -29,6 +29,11 @@ def test_alignment_fit_recovers_the_curves(designed, noise):
     assert chain_distances(fitted.chain, points)[0].max() <= 0.05
     # The road criteria judge every fitted curve (a verdict per curve).
     assert len(fitted.checks) == 2 and "80 km/h" in fitted.criteria_table()
+    # The PointFit it was read from: the point-wise curvature estimate, 1/300 in the first arc's middle.
+    estimate = fitted.point_fit.curvature_estimate
+    assert estimate.shape == (1500,)
+    middle = designed.chain.stations[2] + designed.chain[2].length / 2
+    assert estimate[np.argmin(np.abs(fitted.point_fit.stations - middle))] == pytest.approx(1 / 300, rel=0.05)
 
 
 def test_alignment_fit_refuses_points_without_curves():
@@ -69,3 +74,24 @@ def test_a_survey_gives_plan_and_profile_on_shared_stations(designed):
     assert len(survey.alignment.chain) == 9
     with pytest.raises(ValueError, match=r"\(N, 3\)"):
         fit_survey(xyz[:, :2], 0.05)
+
+
+@pytest.mark.parametrize(
+    "pvis, lengths",
+    [
+        ([(0, 100), (300, 112), (600, 100)], [250]),  # one crest
+        ([(0, 100), (400, 110), (900, 95), (1200, 100)], [200, 250]),
+        ([(0, 50), (200, 56), (500, 50), (800, 62), (1000, 60)], [150, 200, 180]),
+        ([(0, 50), (200, 56), (500, 50), (800, 62), (1000, 60)], [200, 400, 180]),  # two curves meet with no grade between
+    ],
+)
+def test_profile_fit_returns_the_designed_pvis(pvis, lengths):
+    """Noise-free samples of a designed profile: its grade change rate is zero on grades and constant on
+    curves, so the fit returns the designed PVIs and curves, not a polyline's corners."""
+    designed = Profile.from_pvis(pvis, curve_lengths=lengths, units="m")
+    stations = np.linspace(0.0, pvis[-1][0], 801)
+    fitted = Profile.fit(stations, designed.elevation(stations), 0.01, units="m")
+    assert len(fitted.pvis) == len(pvis)
+    np.testing.assert_allclose(fitted.pvis, np.array(pvis, dtype=float), atol=1e-6)
+    dense = np.linspace(0.0, pvis[-1][0], 5001)
+    assert np.abs(fitted.elevation(dense) - designed.elevation(dense)).max() <= 1e-6
