@@ -45,7 +45,7 @@ from .spiral import BezierSpiral
 from .transitions import Transition, circle_in_circle, circle_to_circle, line_to_circle, line_to_line
 from .units import length_unit
 
-__all__ = ["PointFit", "chain_distances", "curvature_estimate", "fit_points"]
+__all__ = ["PointFit", "chain_distances", "curvature_estimate", "douglas_peucker", "fit_points"]
 
 #: ``progress(done, total)``: called as the fit's steps complete.
 ProgressCallback = Callable[[int, int], None]
@@ -1174,8 +1174,9 @@ def _build(prims: list[_Primitive], transitions: list[Transition], pts: NDArray[
 # --------------------------------------------------------------- fallback
 
 
-def _simplify(pts: NDArray[np.float64], epsilon: float) -> NDArray[np.int64]:
-    """Douglas–Peucker: indices of a polyline within ``epsilon`` of every point."""
+def douglas_peucker(pts: NDArray[np.float64], epsilon: float, *, vertical: bool = False) -> NDArray[np.int64]:
+    """Douglas–Peucker: indices of a polyline through some of ``pts`` (n, 2) within ``epsilon`` of every point,
+    measured across each chord, or along y (``vertical``: elevations over increasing stations)."""
     keep = np.zeros(len(pts), dtype=bool)
     keep[0] = keep[-1] = True
     stack = [(0, len(pts) - 1)]
@@ -1187,7 +1188,9 @@ def _simplify(pts: NDArray[np.float64], epsilon: float) -> NDArray[np.int64]:
         d = b - a
         length = math.hypot(*d)
         rel = pts[i + 1 : j] - a
-        if length > 0:
+        if vertical:
+            off = np.abs(rel[:, 1] - rel[:, 0] * (d[1] / d[0]))
+        elif length > 0:
             off = np.abs(rel[:, 0] * d[1] - rel[:, 1] * d[0]) / length
         else:
             off = np.hypot(*rel.T)
@@ -1208,7 +1211,7 @@ def _fallback(
     for level in range(6):
         epsilon = tol / 2.0 ** (level + 1)
         ring = np.vstack([pts, pts[:1]]) if closed else pts
-        vertices = ring[_simplify(ring, epsilon)]
+        vertices = ring[douglas_peucker(ring, epsilon)]
         if closed:
             vertices = vertices[:-1]
         try:

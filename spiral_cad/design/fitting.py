@@ -21,7 +21,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from ..core._inputs import as_real_array
 from ..core.errors import NoSolutionError
-from ..core.fit import PointFit, chain_distances, fit_points
+from ..core.fit import PointFit, chain_distances, douglas_peucker, fit_points
 from ..core.segments import Arc, Line
 from ..core.spiral import BezierSpiral
 from ..core.units import DEFAULT_UNITS
@@ -167,24 +167,6 @@ def _segmented_profile(cls: type[Profile], s: NDArray[np.float64], z: NDArray[np
     return profile
 
 
-def _vertical_polyline(stations: NDArray[np.float64], z: NDArray[np.float64], epsilon: float) -> NDArray[np.int64]:
-    """Douglas–Peucker on elevation: indices of a polyline within ``epsilon`` (vertically) of every point."""
-    keep = np.zeros(len(z), dtype=bool)
-    keep[0] = keep[-1] = True
-    stack = [(0, len(z) - 1)]
-    while stack:
-        i, j = stack.pop()
-        if j - i < 2:
-            continue
-        line = z[i] + (z[j] - z[i]) * (stations[i + 1 : j] - stations[i]) / (stations[j] - stations[i])
-        off = np.abs(z[i + 1 : j] - line)
-        m = int(np.argmax(off))
-        if off[m] > epsilon:
-            keep[i + 1 + m] = True
-            stack.extend([(i, i + 1 + m), (i + 1 + m, j)])
-    return np.flatnonzero(keep)
-
-
 def fit_profile(
     cls: type[Profile],
     stations: ArrayLike,
@@ -217,7 +199,7 @@ def fit_profile(
         return segmented
     worst = math.inf
     for level in range(6):
-        keep = _vertical_polyline(s, zs, tolerance / 2.0 ** (level + 1))
+        keep = douglas_peucker(np.column_stack([s, zs]), tolerance / 2.0 ** (level + 1), vertical=True)
         pvis = np.c_[s[keep], zs[keep]]
         if len(pvis) == 2:
             profile = cls.from_pvis(pvis, units=units)
