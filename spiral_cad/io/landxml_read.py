@@ -96,6 +96,10 @@ class LandXMLAlignment:
             the other shape in brackets where the element's own had no solution),
             or ``"length"`` (the file's length and end curvatures, continuing from the element before).
         owners: per chain, the element (an index into ``kinds``) of each of its segments.
+        directions: how the file counts its directions, inferred from its elements that have both a
+            direction and points (or chosen with ``read_landxml(directions=)``): ``"east-ccw"``
+            (counter-clockwise from east) or ``"north-cw"`` (clockwise from north, azimuths);
+            ``"unknown"`` when the file tells nothing and no element was placed by its direction.
     """
 
     name: str
@@ -112,6 +116,7 @@ class LandXMLAlignment:
     length_changes: NDArray[np.float64] = field(default_factory=lambda: np.zeros(0))
     methods: tuple[str, ...] = field(default=())
     owners: tuple[NDArray[np.int64], ...] = field(default=())
+    directions: str = "unknown"
 
     @property
     def chain(self) -> Chain:
@@ -168,6 +173,9 @@ class _Reader:
     def __init__(self, root: ET.Element, shape: str, placement: str = "neighbours"):
         self.shape = shape
         self.placement = placement
+        self.directions = "unknown"  # the file's convention of directions (DIRECTIONS), once known
+        self.evidence = ""  # why: which elements' points agree with it
+        self.used = 0  # directions that placed an element in the alignment being read
         units = _child(root, "Units")
         system = None if units is None else next(iter(units), None)
         linear = "meter" if system is None else system.get("linearUnit", "meter")
@@ -212,10 +220,10 @@ class _Reader:
 
     def angle(self, element: ET.Element, name: str, where: str) -> float:
         """An angle attribute (``angularUnit``) in radians."""
-        return self.direction(element, name, where, self.angular_unit) or 0.0
+        return self.raw_direction(element, name, where, self.angular_unit) or 0.0
 
-    def direction(self, element: ET.Element, name: str, where: str, unit: str | None = None) -> float | None:
-        """A direction attribute (``directionUnit``) in radians, counter-clockwise from east; None if absent."""
+    def raw_direction(self, element: ET.Element, name: str, where: str, unit: str | None = None) -> float | None:
+        """A direction attribute (``directionUnit``) in radians as the file counts it; None if absent."""
         text = element.get(name)
         if text is None:
             return None
@@ -226,6 +234,24 @@ class _Reader:
         if not math.isfinite(angle):
             raise ValueError(f"{where}: {name}={text!r} is not finite")
         return angle
+
+    def direction(self, element: ET.Element, name: str, where: str) -> float | None:
+        """A direction attribute in radians counter-clockwise from east (our heading), converted from the
+        file's convention (``directions``); None if absent.
+
+        Raises:
+            ValueError: the file gives no evidence of its convention (naming the element).
+        """
+        raw = self.raw_direction(element, name, where)
+        if raw is None:
+            return None
+        if self.directions == "unknown":
+            raise ValueError(f"{where}: the element is placed only by its {name}, and no element of the file has both a "
+                             "direction and the points it joins, so whether directions count counter-clockwise from east "
+                             "or clockwise from north (the XSD's '0 degrees = north') cannot be told; choose with "
+                             "read_landxml(directions='east-ccw' or 'north-cw')")  # fmt: skip
+        self.used += 1
+        return raw if self.directions == "east-ccw" else math.pi / 2 - raw
 
 
 def _curvature(sign: float, radius: float, where: str) -> float:
@@ -292,6 +318,74 @@ def _spirals(length: float, k0: float, k1: float, shape: str, theta: float | Non
         return [_growing(length, k0, k1, shape, theta)]
     backwards = _growing(length, -k1, -k0, shape, theta).reversed()  # travelled backwards, a left turn is a right one
     return [backwards]
+
+
+#: The conventions of LandXML directions: counter-clockwise from east (Civil 3D, Carlson, this package's
+#: writer) and clockwise from north (azimuths, the XSD's "0 degrees = north": MDT, Novapoint, others).
+DIRECTIONS = ("east-ccw", "north-cw")
+#: A direction agrees with its element's points within this (rad), and disagrees beyond ``_APART``:
+#: between the two an element near the 45° diagonal tells nothing (both conventions give its direction).
+_AGREE, _APART = 0.01, 0.05
+
+
+def _clues(r: _Reader, e: ET.Element, where: str) -> list[tuple[float, float, str]]:
+    """What an element tells of the file's direction convention: (its direction as the file counts it,
+    the heading its points give, the attribute) for each direction it has with the points to check it."""
+    kind = _local(e.tag)
+    if kind not in ("Line", "Curve", "Spiral"):
+        return []
+    start, end = r.point(e, "Start", where), r.point(e, "End", where)
+    out: list[tuple[float, float, str]] = []
+
+    def clue(name: str, a: NDArray | None, b: NDArray | None, turn: float = 0.0) -> None:
+        raw = r.raw_direction(e, name, where)
+        if raw is not None and a is not None and b is not None and np.any(a != b):
+            out.append((raw, _heading(b - a) + turn, name))
+
+    if kind == "Line":
+        clue("dir", start, end)
+        return out
+    pi, center = r.point(e, "PI", where), r.point(e, "Center", where)
+    clue("dirStart", start, pi)  # the PI is where the end tangents meet
+    clue("dirEnd", pi, end)
+    if kind == "Curve" and center is not None and e.get("rot") in ("cw", "ccw"):
+        quarter = math.pi / 2 if e.get("rot") == "ccw" else -math.pi / 2  # the tangent is the radius turned a quarter
+        clue("dirStart", center, start, quarter)
+        clue("dirEnd", center, end, quarter)
+    return out
+
+
+def _convention(r: _Reader, alignments: list[ET.Element]) -> None:
+    """Set ``r.directions`` from the file's own evidence: every direction whose element also has the
+    points it joins (a Line's Start→End, a Curve's or Spiral's Start→PI→End, a Curve's Center) agrees
+    with the points counted one way or the other.
+
+    Raises:
+        ValueError: some directions agree only counted from east and others only from north (naming one of each).
+    """
+    found: dict[str, list[str]] = {"east-ccw": [], "north-cw": []}
+    for k, a in enumerate(alignments):
+        geometry = _child(a, "CoordGeom")
+        for index, e in enumerate(() if geometry is None else geometry):
+            if not isinstance(e.tag, str):
+                continue
+            where = f"alignment {a.get('name', f'alignment {k + 1}')!r}, CoordGeom element {index} ({_local(e.tag)})"
+            for raw, heading, name in _clues(r, e, where):
+                east = abs(math.remainder(raw - heading, 2.0 * math.pi))
+                north = abs(math.remainder(math.pi / 2 - raw - heading, 2.0 * math.pi))
+                if east < _AGREE and north > _APART:
+                    found["east-ccw"].append(f"{where} {name}")
+                elif north < _AGREE and east > _APART:
+                    found["north-cw"].append(f"{where} {name}")
+    east, north = found["east-ccw"], found["north-cw"]
+    if east and north:
+        raise ValueError(f"the file's directions are inconsistent: {east[0]} agrees with its points counted "
+                         f"counter-clockwise from east ({len(east)} such), {north[0]} only counted clockwise from north "
+                         f"({len(north)} such); choose with read_landxml(directions='east-ccw' or 'north-cw')")  # fmt: skip
+    if east or north:
+        r.directions = "east-ccw" if east else "north-cw"
+        r.evidence = (f"{len(east or north)} direction(s) of the file agree with their points only counted "
+                      + ("counter-clockwise from east" if east else "clockwise from north"))  # fmt: skip
 
 
 @dataclass
@@ -362,11 +456,12 @@ def _element(r: _Reader, e: ET.Element, where: str) -> _Element:
         sign = 1.0 if rot == "ccw" else -1.0
         k0, k1 = (0.0 if (radius := r.number(e, name, where, math.inf)) in (0.0, math.inf) else _curvature(sign, radius, where)
                   for name in ("radiusStart", "radiusEnd"))  # fmt: skip
-        heading = r.direction(e, "dirStart", where)
-        if heading is None and start is not None:
-            pi = r.point(e, "PI", where)
-            if pi is not None and np.any(pi != start):
-                heading = _heading(pi - start)
+        pi = r.point(e, "PI", where)
+        heading = None
+        if e.get("dirStart") is not None and (r.directions != "unknown" or pi is None or start is None):
+            heading = r.direction(e, "dirStart", where)
+        elif start is not None and pi is not None and np.any(pi != start):
+            heading = _heading(pi - start)
         shape = r.shape
         desc = e.get("desc", "")
         if desc.startswith(DESC_PREFIX):
@@ -611,6 +706,7 @@ def _alignment(r: _Reader, a: ET.Element, label: str) -> LandXMLAlignment:
                          "only CoordGeom alignments can be rebuilt")  # fmt: skip
     items: list[_Element] = []
     skipped: list[str] = []
+    r.used = 0
     station = start_station
     for index, e in enumerate(geometry):
         if not isinstance(e.tag, str):
@@ -686,11 +782,14 @@ def _alignment(r: _Reader, a: ET.Element, label: str) -> LandXMLAlignment:
     for chain, held in zip(chains, owners):
         np.add.at(ours, held, chain.lengths)
     profile, notes = _profile(r, a, where)
+    if r.used:  # the directions placed elements: say how they were counted
+        how = "counter-clockwise from east" if r.directions == "east-ccw" else "clockwise from north"
+        notes = (f"{where}: {r.used} direction(s) placed elements, counted {how} ({r.evidence or 'as chosen'})", *notes)
     notes = (*skipped, *(note for item in items for note in item.notes), *notes)
     return LandXMLAlignment(name, tuple(chains), tuple(breaks), start_station, r.units, profile, offsets, tuple(i.kind for i in items),
                             start_station + np.concatenate([[0.0], np.cumsum(ours)[:-1]]), notes,
                             np.array([i.station for i in items]), ours - size,
-                            tuple(methods.get(k, "file") for k in range(len(items))), tuple(owners))  # fmt: skip
+                            tuple(methods.get(k, "file") for k in range(len(items))), tuple(owners), r.directions)  # fmt: skip
 
 
 def _profile(r: _Reader, a: ET.Element, where: str) -> tuple[Any, tuple[str, ...]]:
@@ -730,7 +829,8 @@ def _profile(r: _Reader, a: ET.Element, where: str) -> tuple[Any, tuple[str, ...
     return profile, tuple(notes)
 
 
-def read_landxml(source: str | os.PathLike, shape: str = "near-linear", placement: str = "neighbours") -> list[LandXMLAlignment]:
+def read_landxml(source: str | os.PathLike, shape: str = "near-linear", placement: str = "neighbours",
+                 directions: str = "auto") -> list[LandXMLAlignment]:  # fmt: skip
     """Every alignment of a LandXML file (a path, or the document's text) rebuilt as our G2 chain.
 
     Args:
@@ -741,18 +841,28 @@ def read_landxml(source: str | os.PathLike, shape: str = "near-linear", placemen
             clothoids replaced by our transition between the same neighbours,
             see ``spiral_cad.io.landxml_fit``) or ``"length"`` (every clothoid
             rebuilt with its own length and end curvatures, continuing from the element before).
+        directions: how the file counts its directions: ``"auto"`` (inferred from
+            the elements that have both a direction and the points it joins — a
+            Line's Start→End, a Curve's Center or PI, a Spiral's PI), ``"east-ccw"``
+            (counter-clockwise from east: Civil 3D, Carlson) or ``"north-cw"``
+            (clockwise from north, the XSD's "0 degrees = north": MDT, Novapoint).
 
     Returns:
         One ``LandXMLAlignment`` per ``<Alignment>`` in file order.
 
     Raises:
-        ValueError: not LandXML, no alignment, or an element that cannot be
-            represented (named with its index, station and alignment).
+        ValueError: not LandXML, no alignment, an element that cannot be
+            represented (named with its index, station and alignment), directions
+            that agree with their points one way in some elements and the other
+            way in others, or (``"auto"``) an element placed only by its direction
+            in a file whose convention cannot be told.
     """
     if shape not in ("near-linear", "walton-meek"):
         raise ValueError(f"shape must be 'near-linear' or 'walton-meek'; got {shape!r}")
     if placement not in ("neighbours", "length"):
         raise ValueError(f"placement must be 'neighbours' or 'length'; got {placement!r}")
+    if directions not in ("auto", *DIRECTIONS):
+        raise ValueError(f"directions must be 'auto', 'east-ccw' or 'north-cw'; got {directions!r}")
     text = os.fspath(source)
     try:
         root = ET.fromstring(text) if text.lstrip().startswith("<") else ET.parse(text).getroot()
@@ -764,4 +874,8 @@ def read_landxml(source: str | os.PathLike, shape: str = "near-linear", placemen
     alignments = [a for group in _children(root, "Alignments") for a in _children(group, "Alignment")]
     if not alignments:
         raise ValueError("the LandXML document holds no Alignment")
+    if directions == "auto":
+        _convention(reader, alignments)
+    else:
+        reader.directions = directions
     return [_alignment(reader, a, f"alignment {k + 1}") for k, a in enumerate(alignments)]
