@@ -4,7 +4,13 @@ Reads LandXML 1.0–1.2 (any namespace) as Civil 3D, OpenRoads, Carlson, MDT
 and others write it: ``Metric``/``Imperial`` units (metres, millimetres,
 feet, US survey feet, inches — US survey feet become feet), angles and
 directions in radians, grads, decimal degrees or ``decimal dd.mm.ss``,
-points northing before easting, directions counter-clockwise from east.
+points northing before easting. Directions are counted counter-clockwise
+from east (Civil 3D, Carlson) or clockwise from north (the XSD's "0 degrees =
+north": MDT, Novapoint): which, the file itself tells — every direction whose
+element also has the points it joins agrees with them one way — and an
+element placed by its direction alone in a file that tells neither, or a file
+whose directions agree one way here and the other there, is refused by name
+(``directions=`` chooses).
 
 Each ``<CoordGeom>`` is rebuilt in order (``placement="neighbours"``, the
 default): the file's ``Line`` and ``Curve`` elements (``crvType`` arc; also
