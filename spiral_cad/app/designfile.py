@@ -188,9 +188,11 @@ class BuiltTransition(Built):
 
 @dataclass(kw_only=True)
 class BuiltLandXML(Built):
-    """One G2 run of an alignment read from LandXML (``source``: its ``LandXMLAlignment``)."""
+    """One G2 run of an alignment read from LandXML (``source``: its ``LandXMLAlignment``); ``renamed``
+    says why its name has a suffix (another alignment's outputs already had the name), else empty."""
 
     run: int = 0
+    renamed: str = ""
 
     @property
     def kind(self) -> str:
@@ -199,6 +201,12 @@ class BuiltLandXML(Built):
 
 def build_landxml(path: str | Path) -> tuple[str, list[Built]]:
     """Every alignment of a LandXML file as designs: one per G2 run (``spiral_cad.io.read_landxml``).
+
+    Each design is named after its alignment (characters other than letters, digits, ``_`` and ``-``
+    replaced by ``_``, at most 56 of them, ``_1``, ``_2`` … per G2 run); where that name is already
+    taken by an earlier design (names compared ignoring case: they name files) — equal alignment
+    names, names equal once sanitised or in their first 56 characters — the first free suffix
+    ``_2``, ``_3`` … is added and ``renamed`` says so.
 
     Raises:
         DesignError: the file cannot be read or holds an element that cannot be represented.
@@ -212,11 +220,19 @@ def build_landxml(path: str | Path) -> tuple[str, list[Built]]:
     except (OSError, ValueError) as e:
         raise DesignError(f"{path}: {e}") from None
     built: list[Built] = []
+    taken: dict[str, str] = {}  # each design name (lower case) taken, and the alignment that took it
     for k, a in enumerate(alignments):
         stem = (re.sub(r"[^A-Za-z0-9_-]", "_", a.name).strip("_-") or f"alignment{k + 1}")[:56]
         for run, chain in enumerate(a.chains):
-            name = stem if len(a.chains) == 1 else f"{stem}_{run + 1}"
-            built.append(BuiltLandXML(name=name, chain=chain, source=a, run=run))
+            wanted = stem if len(a.chains) == 1 else f"{stem}_{run + 1}"
+            name, suffix = wanted, 1
+            while name.lower() in taken:  # one alignment's outputs never overwrite another's
+                suffix += 1
+                name = f"{wanted}_{suffix}"
+            renamed = "" if name == wanted else (f"alignment {a.name!r} (number {k + 1}) written as {name!r}: "
+                                                 f"{wanted!r} names the outputs of alignment {taken[wanted.lower()]!r}")  # fmt: skip
+            taken[name.lower()] = f"{a.name}" if len(a.chains) == 1 else f"{a.name} (G2 run {run + 1})"
+            built.append(BuiltLandXML(name=name, chain=chain, source=a, run=run, renamed=renamed))
     return alignments[0].units, built
 
 
@@ -232,6 +248,7 @@ def _landxml_report(b: BuiltLandXML, stage: Path) -> list[str]:
     lines += [f"{k:7d}  {kind:7s}  {sta:17.6f}  {off:9.3g}  {dl:13.3g}  {how}"
               for k, (kind, sta, off, dl, how) in enumerate(zip(a.kinds, a.stations, a.offsets, a.length_changes, a.methods))]  # fmt: skip
     lines += [f"break: {text}" for text in a.breaks] + [f"note: {text}" for text in a.notes]
+    lines += [f"note: {b.renamed}"] if b.renamed else []
     (stage / f"{b.name}_landxml.txt").write_text("\n".join(lines) + "\n", encoding="utf-8")
     export_opendrive(b.chain, stage / f"{b.name}.xodr", name=b.name)
     return ["landxml.txt", "xodr"]
@@ -820,4 +837,5 @@ def summary(built: list[Built], units: str) -> str:
     lines = fixed_columns(columns, rows)
     lines += [f"{b.name}: {b.road_3d}" for b in built if b.road_3d]
     lines += [f"{b.name}: {b.fit.line()}" for b in built if isinstance(b, BuiltFit | BuiltRoadFit)]
+    lines += [f"{b.name}: {b.renamed}" for b in built if isinstance(b, BuiltLandXML) and b.renamed]
     return "\n".join(lines)
