@@ -377,11 +377,11 @@ def _convention(r: _Reader, alignments: list[ET.Element]) -> None:
                 continue
             where = f"alignment {a.get('name', f'alignment {k + 1}')!r}, CoordGeom element {index} ({_local(e.tag)})"
             for raw, heading, name in _clues(r, e, where):
-                east = abs(math.remainder(raw - heading, 2.0 * math.pi))
-                north = abs(math.remainder(math.pi / 2 - raw - heading, 2.0 * math.pi))
-                if east < _AGREE and north > _APART:
+                off_east = abs(math.remainder(raw - heading, 2.0 * math.pi))
+                off_north = abs(math.remainder(math.pi / 2 - raw - heading, 2.0 * math.pi))
+                if off_east < _AGREE and off_north > _APART:
                     found["east-ccw"].append(f"{where} {name}")
-                elif north < _AGREE and east > _APART:
+                elif off_north < _AGREE and off_east > _APART:
                     found["north-cw"].append(f"{where} {name}")
     east, north = found["east-ccw"], found["north-cw"]
     if east and north:
