@@ -186,6 +186,10 @@ class BuiltTransition(Built):
         return f"transition ({self.source.kind})"
 
 
+#: The share of an element's length beyond which the build warns of the offset between the file's element and ours.
+WARN_OFFSET = 1e-3
+
+
 @dataclass(kw_only=True)
 class BuiltLandXML(Built):
     """One G2 run of an alignment read from LandXML (``source``: its ``LandXMLAlignment``); ``renamed``
@@ -194,19 +198,26 @@ class BuiltLandXML(Built):
     run: int = 0
     renamed: str = ""
 
+    def landxml_offset(self) -> str:
+        """The alignment's largest offset from the file, a warning above ``WARN_OFFSET`` of its element's length."""
+        a = self.source
+        k = int(np.argmax(a.offsets))
+        warn = a.offsets[k] > WARN_OFFSET * a.file_lengths[k]
+        return f"{'warning: ' if warn else ''}largest offset from the file's alignment {a.name!r}: {a.worst}"
+
     @property
     def kind(self) -> str:
         return "LandXML alignment"
 
 
-def build_landxml(path: str | Path) -> tuple[str, list[Built]]:
+def build_landxml(path: str | Path, max_offset: float | None = None) -> tuple[str, list[Built]]:
     """Every alignment of a LandXML file as designs: one per G2 run (``spiral_cad.io.read_landxml``).
 
     Each design is named after its alignment (characters other than letters, digits, ``_`` and ``-``
     replaced by ``_``, at most 56 of them, ``_1``, ``_2`` … per G2 run); where that name is already
     taken by an earlier design (names compared ignoring case: they name files) — equal alignment
     names, names equal once sanitised or in their first 56 characters — the first free suffix
-    ``_2``, ``_3`` … is added and ``renamed`` says so.
+    ``_2``, ``_3`` … is added and ``renamed`` says so. ``max_offset``: see ``read_landxml``.
 
     Raises:
         DesignError: the file cannot be read or holds an element that cannot be represented.
@@ -216,7 +227,7 @@ def build_landxml(path: str | Path) -> tuple[str, list[Built]]:
     from ..io import read_landxml
 
     try:
-        alignments = read_landxml(path)
+        alignments = read_landxml(path, max_offset=max_offset)
     except (OSError, ValueError) as e:
         raise DesignError(f"{path}: {e}") from None
     built: list[Built] = []
@@ -553,10 +564,11 @@ BUILDERS: dict[str, Callable[[Any, str, str, Path | None], Built]] = {
 }
 
 
-def build(source: str | Path | dict) -> tuple[str, list[Built]]:
+def build(source: str | Path | dict, max_offset: float | None = None) -> tuple[str, list[Built]]:
     """Validate and build every design of ``source``: (units, built designs).
 
-    A LandXML file (``.xml``) is built by ``build_landxml``: every alignment, one design per G2 run.
+    A LandXML file (``.xml``) is built by ``build_landxml``: every alignment, one design per G2 run
+    (``max_offset``: the largest offset accepted from the file's elements, see ``read_landxml``).
     A G-code program named by a design file is read from the design file's
     folder (a dict's from the working folder).
 
@@ -565,7 +577,7 @@ def build(source: str | Path | dict) -> tuple[str, list[Built]]:
             ``designs[i] (name)``, or a file outside the design file's folder.
     """
     if isinstance(source, (str, Path)) and Path(source).suffix.lower() == ".xml":
-        return build_landxml(source)
+        return build_landxml(source, max_offset)
     design_file = load(source)
     base = None if isinstance(source, dict) else Path(source).parent
     built = []
@@ -838,4 +850,5 @@ def summary(built: list[Built], units: str) -> str:
     lines += [f"{b.name}: {b.road_3d}" for b in built if b.road_3d]
     lines += [f"{b.name}: {b.fit.line()}" for b in built if isinstance(b, BuiltFit | BuiltRoadFit)]
     lines += [f"{b.name}: {b.renamed}" for b in built if isinstance(b, BuiltLandXML) and b.renamed]
+    lines += [f"{b.name}: {b.landxml_offset()}" for b in built if isinstance(b, BuiltLandXML) and b.run == 0]
     return "\n".join(lines)

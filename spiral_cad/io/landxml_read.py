@@ -71,6 +71,10 @@ LINEAR = {"meter": ("m", 1.0), "millimeter": ("mm", 1.0), "centimeter": ("cm", 1
           "foot": ("ft", 1.0), "USSurveyFoot": ("ft", US_SURVEY_FOOT / 0.3048), "inch": ("in", 1.0)}  # fmt: skip
 #: Radians per LandXML angular unit.
 ANGULAR = {"radians": 1.0, "grads": math.pi / 200.0, "decimal degrees": math.pi / 180.0, "degrees": math.pi / 180.0}
+#: The largest offset accepted by default between the file's element and ours, as a fraction of the element's
+#: length (``read_landxml(max_offset=None)``): ordinary road spirals stay far below (the Civil 3D spiral of
+#: R 63 m over 100 m, turning 45°, is 1.65 m off); a clothoid no cubic spiral follows is metres off.
+MAX_OFFSET_FRACTION = 0.05
 #: Relative difference of curvature between two elements above which the file's geometry is only G1 there.
 _JUMP = 1e-6
 
@@ -106,6 +110,7 @@ class LandXMLAlignment:
             direction and points (or chosen with ``read_landxml(directions=)``): ``"east-ccw"``
             (counter-clockwise from east) or ``"north-cw"`` (clockwise from north, azimuths);
             ``"unknown"`` when the file tells nothing and no element was placed by its direction.
+        file_lengths: per element its length in the file.
     """
 
     name: str
@@ -123,6 +128,7 @@ class LandXMLAlignment:
     methods: tuple[str, ...] = field(default=())
     owners: tuple[NDArray[np.int64], ...] = field(default=())
     directions: str = "unknown"
+    file_lengths: NDArray[np.float64] = field(default_factory=lambda: np.zeros(0))
 
     @property
     def chain(self) -> Chain:
@@ -139,6 +145,16 @@ class LandXMLAlignment:
     def offset(self) -> float:
         """The largest offset between the file's geometry and the rebuilt chain."""
         return float(self.offsets.max()) if len(self.offsets) else 0.0
+
+    @property
+    def worst(self) -> str:
+        """Where the largest offset is: the element's index, kind and station (the file's), and the offset."""
+        if not len(self.offsets):
+            return "no element"
+        k = int(np.argmax(self.offsets))
+        share = f" ({self.offsets[k] / self.file_lengths[k]:.2%} of its length)" if len(self.file_lengths) else ""
+        station = self.file_stations[k] if len(self.file_stations) else self.stations[k]
+        return f"element {k} ({self.kinds[k]}) at station {station:.6g}: {self.offsets[k]:.3g} {self.units}{share}"
 
     @property
     def station_shift(self) -> float:
@@ -182,6 +198,7 @@ class _Reader:
         self.directions = "unknown"  # the file's convention of directions (DIRECTIONS), once known
         self.evidence = ""  # why: which elements' points agree with it
         self.used = 0  # directions that placed an element in the alignment being read
+        self.max_offset: float | None = None  # the largest offset accepted (None: MAX_OFFSET_FRACTION of each length)
         units = _child(root, "Units")
         system = None if units is None else next(iter(units), None)
         linear = "meter" if system is None else system.get("linearUnit", "meter")
@@ -784,6 +801,14 @@ def _alignment(r: _Reader, a: ET.Element, label: str) -> LandXMLAlignment:
         offsets = fit_offsets(chains, owners, *file, run_of)
     except ValueError as e:
         raise ValueError(f"{where}: {e}") from None
+    limits = MAX_OFFSET_FRACTION * size if r.max_offset is None else np.full(len(size), r.max_offset)
+    over = np.flatnonzero(offsets > limits)
+    if len(over):  # a clothoid none of our spirals follows: refused rather than silently metres away
+        k = int(over[np.argmax(offsets[over] / limits[over])])
+        limit = (f"{MAX_OFFSET_FRACTION:g} of its length {size[k]:.6g}" if r.max_offset is None
+                 else f"max_offset {r.max_offset:.6g}")  # fmt: skip
+        raise ValueError(f"{items[k].where}: ours lies {offsets[k]:.3g} {r.units} from the file's element, more than "
+                         f"{limit} ({len(over)} element(s) beyond; max_offset=math.inf accepts them)")  # fmt: skip
     ours = np.zeros(len(items))
     for chain, held in zip(chains, owners):
         np.add.at(ours, held, chain.lengths)
@@ -795,7 +820,7 @@ def _alignment(r: _Reader, a: ET.Element, label: str) -> LandXMLAlignment:
     return LandXMLAlignment(name, tuple(chains), tuple(breaks), start_station, r.units, profile, offsets, tuple(i.kind for i in items),
                             start_station + np.concatenate([[0.0], np.cumsum(ours)[:-1]]), notes,
                             np.array([i.station for i in items]), ours - size,
-                            tuple(methods.get(k, "file") for k in range(len(items))), tuple(owners), r.directions)  # fmt: skip
+                            tuple(methods.get(k, "file") for k in range(len(items))), tuple(owners), r.directions, size)  # fmt: skip
 
 
 def _profile(r: _Reader, a: ET.Element, where: str) -> tuple[Any, tuple[str, ...]]:
@@ -836,7 +861,7 @@ def _profile(r: _Reader, a: ET.Element, where: str) -> tuple[Any, tuple[str, ...
 
 
 def read_landxml(source: str | os.PathLike, shape: str = "near-linear", placement: str = "neighbours",
-                 directions: str = "auto") -> list[LandXMLAlignment]:  # fmt: skip
+                 directions: str = "auto", max_offset: float | None = None) -> list[LandXMLAlignment]:  # fmt: skip
     """Every alignment of a LandXML file (a path, or the document's text) rebuilt as our G2 chain.
 
     Args:
@@ -852,6 +877,9 @@ def read_landxml(source: str | os.PathLike, shape: str = "near-linear", placemen
             Line's Start→End, a Curve's Center or PI, a Spiral's PI), ``"east-ccw"``
             (counter-clockwise from east: Civil 3D, Carlson) or ``"north-cw"``
             (clockwise from north, the XSD's "0 degrees = north": MDT, Novapoint).
+        max_offset: the largest offset (in the result's ``units``) accepted between
+            the file's element and ours; None: ``MAX_OFFSET_FRACTION`` of each
+            element's length; ``math.inf`` accepts any.
 
     Returns:
         One ``LandXMLAlignment`` per ``<Alignment>`` in file order.
@@ -861,12 +889,15 @@ def read_landxml(source: str | os.PathLike, shape: str = "near-linear", placemen
             represented (named with its index, station and alignment), directions
             that agree with their points one way in some elements and the other
             way in others, or (``"auto"``) an element placed only by its direction
-            in a file whose convention cannot be told.
+            in a file whose convention cannot be told, or an element ours lies
+            farther from than ``max_offset`` (naming the farthest).
     """
     if shape not in ("near-linear", "walton-meek"):
         raise ValueError(f"shape must be 'near-linear' or 'walton-meek'; got {shape!r}")
     if placement not in ("neighbours", "length"):
         raise ValueError(f"placement must be 'neighbours' or 'length'; got {placement!r}")
+    if max_offset is not None and not max_offset >= 0.0:
+        raise ValueError(f"max_offset must be a length >= 0 (or None); got {max_offset!r}")
     if directions not in ("auto", *DIRECTIONS):
         raise ValueError(f"directions must be 'auto', 'east-ccw' or 'north-cw'; got {directions!r}")
     text = os.fspath(source)
@@ -877,6 +908,7 @@ def read_landxml(source: str | os.PathLike, shape: str = "near-linear", placemen
     if _local(root.tag) != "LandXML":
         raise ValueError(f"not a LandXML document (root element {_local(root.tag)!r})")
     reader = _Reader(root, shape, placement)
+    reader.max_offset = None if max_offset is None else float(max_offset)
     alignments = [a for group in _children(root, "Alignments") for a in _children(group, "Alignment")]
     if not alignments:
         raise ValueError("the LandXML document holds no Alignment")

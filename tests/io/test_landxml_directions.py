@@ -124,3 +124,22 @@ def test_evidence_from_one_element_places_another_placed_only_by_its_direction(f
 def test_the_directions_argument_is_checked():
     with pytest.raises(ValueError, match="directions must be 'auto'"):
         read_landxml(_file(EAST_LINE), directions="clockwise")
+
+
+def test_a_clothoid_no_cubic_follows_is_refused_beyond_max_offset():
+    # a clothoid straight → R 40 m over 80 m (57° of turn) after a line: ours strays 4.5 m (5.6% of its length)
+    text = _file('<Line><Start>0 0</Start><End>0 100</End></Line>',
+                 '<Spiral length="80" radiusStart="INF" radiusEnd="40" rot="ccw" spiType="clothoid"><Start>0 100</Start><PI/><End/></Spiral>')  # fmt: skip
+    (a,) = read_landxml(text, max_offset=math.inf)
+    assert a.worst.startswith("element 1 (Spiral) at station 100: ") and a.offset > 0.5
+    with pytest.raises(
+        ValueError, match=r"element 1 \(Spiral\) at station 100: ours lies .* m from the file's element, more than max_offset 0.1"
+    ):
+        read_landxml(text, max_offset=0.1)
+    with pytest.raises(ValueError, match=r"element 1 \(Spiral\) at station 100: .* more than 0.05 of its length 80 "):
+        read_landxml(text)  # the default: 5% of the element's length
+    huge = text.replace('length="80"', 'length="1000"').replace('radiusEnd="40"', 'radiusEnd="10"')  # the tester's 972 m
+    with pytest.raises(ValueError, match=r"more than 0.05 of its length 1000 .*max_offset=math.inf accepts"):
+        read_landxml(huge)
+    with pytest.raises(ValueError, match="max_offset must be a length"):
+        read_landxml(text, max_offset=-1.0)
