@@ -28,8 +28,11 @@ Needs no CAD kernel.
 
 from __future__ import annotations
 
+import contextlib
 import math
 import os
+import re
+import tempfile
 from collections.abc import Sequence
 from dataclasses import dataclass
 from datetime import UTC, datetime
@@ -94,6 +97,19 @@ def _text(value: float) -> str:
     if math.isinf(value):
         return "INF"
     return repr(float(value) + 0.0)
+
+
+#: A character XML 1.0 cannot hold (not even escaped): controls other than tab, newline and return,
+#: lone surrogates, U+FFFE and U+FFFF.
+_NOT_XML = re.compile("[^\t\n\r\x20-\ud7ff\ue000-\ufffd\U00010000-\U0010ffff]")
+
+
+def _check_name(text: str, what: str) -> None:
+    """Refuse a name XML cannot hold, naming the character and where it is."""
+    bad = _NOT_XML.search(text)
+    if bad:
+        raise ValueError(f"{what} {text!r}: the character U+{ord(bad.group()):04X} at position {bad.start()} cannot be "
+                         "written in XML")  # fmt: skip
 
 
 def _attribute(text: str) -> str:
@@ -259,8 +275,13 @@ def landxml_text(alignments: Sequence[AlignmentToWrite], units: str, name: str =
         application: the ``<Application>`` name.
 
     Raises:
-        ValueError: a chain in space, or a unit LandXML has no name for.
+        ValueError: a chain in space, a unit LandXML has no name for, or a name
+            with a character XML cannot hold (naming it).
     """
+    _check_name(name, "the collection name")
+    _check_name(application, "the application name")
+    for k, a in enumerate(alignments):
+        _check_name(a.name, f"alignment {k + 1}'s name")
     if survey_feet:
         scale, system, linear = to_metres(units) / US_SURVEY_FOOT, "Imperial", "USSurveyFoot"
         unit = "US survey ft"
@@ -306,6 +327,12 @@ def write_landxml(alignments: Sequence[AlignmentToWrite] | Any, path: str | os.P
         name: the collection's name (and the alignment's, for a single one).
         survey_feet: write lengths in US survey feet.
         profile: the ``Profile`` of a single alignment.
+
+    The file is written whole to a temporary file beside ``path`` and then
+    renamed onto it: an existing file is replaced only by a complete one.
+
+    Raises:
+        ValueError: see ``landxml_text`` (then nothing was written).
     """
     if isinstance(alignments, Chain):
         alignments = [AlignmentToWrite(alignments, name, 0.0, profile)]
@@ -313,6 +340,22 @@ def write_landxml(alignments: Sequence[AlignmentToWrite] | Any, path: str | os.P
         alignments = [AlignmentToWrite(alignments.chain, name, alignments.start_station, profile)]
     alignments = list(alignments)
     units = units or (alignments[0].chain.units if alignments else "m")
-    text = landxml_text(alignments, units, name, survey_feet=survey_feet)
-    with open(os.fspath(path), "w", encoding="utf-8", newline="\n") as handle:
-        handle.write(text)
+    data = landxml_text(alignments, units, name, survey_feet=survey_feet).encode("utf-8")
+    target = os.fspath(path)
+    handle, temporary = tempfile.mkstemp(prefix=f".{os.path.basename(target)}.", suffix=".tmp", dir=os.path.dirname(target) or ".")
+    try:
+        with os.fdopen(handle, "wb") as stream:
+            stream.write(data)
+        os.chmod(temporary, 0o666 & ~_umask())  # mkstemp makes it private: give it an ordinary file's mode
+        os.replace(temporary, target)  # atomic on one file system: the old file or the whole new one
+    except BaseException:
+        with contextlib.suppress(OSError):
+            os.unlink(temporary)
+        raise
+
+
+def _umask() -> int:
+    """The process's file-creation mask (read by setting it and back)."""
+    mask = os.umask(0o022)
+    os.umask(mask)
+    return mask
