@@ -152,7 +152,7 @@ class LandXMLAlignment:
         if not len(self.offsets):
             return "no element"
         k = int(np.argmax(self.offsets))
-        share = f" ({self.offsets[k] / self.file_lengths[k]:.2%} of its length)" if len(self.file_lengths) else ""
+        share = f" ({float(self.offsets[k]) / float(self.file_lengths[k]):.2%} of its length)" if len(self.file_lengths) else ""
         station = self.file_stations[k] if len(self.file_stations) else self.stations[k]
         return f"element {k} ({self.kinds[k]}) at station {station:.6g}: {self.offsets[k]:.3g} {self.units}{share}"
 
@@ -804,7 +804,8 @@ def _alignment(r: _Reader, a: ET.Element, label: str) -> LandXMLAlignment:
     limits = MAX_OFFSET_FRACTION * size if r.max_offset is None else np.full(len(size), r.max_offset)
     over = np.flatnonzero(offsets > limits)
     if len(over):  # a clothoid none of our spirals follows: refused rather than silently metres away
-        k = int(over[np.argmax(offsets[over] / limits[over])])
+        with np.errstate(divide="ignore", over="ignore", invalid="ignore"):  # a limit may underflow to 0
+            k = int(over[np.argmax(offsets[over] / limits[over])])
         limit = (f"{MAX_OFFSET_FRACTION:g} of its length {size[k]:.6g}" if r.max_offset is None
                  else f"max_offset {r.max_offset:.6g}")  # fmt: skip
         raise ValueError(f"{items[k].where}: ours lies {offsets[k]:.3g} {r.units} from the file's element, more than "
