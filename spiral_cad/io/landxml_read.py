@@ -199,6 +199,9 @@ class _Reader:
         self.evidence = ""  # why: which elements' points agree with it
         self.used = 0  # directions that placed an element in the alignment being read
         self.max_offset: float | None = None  # the largest offset accepted (None: MAX_OFFSET_FRACTION of each length)
+        # the file's named points (a point may be given as pntRef="name"), wherever its CgPoints are
+        self.cg_points = {e.get("name", ""): (e.text or "").strip() for e in root.iter() if isinstance(e.tag, str)
+                          and _local(e.tag) == "CgPoint" and e.get("name")}  # fmt: skip
         units = _child(root, "Units")
         system = None if units is None else next(iter(units), None)
         linear = "meter" if system is None else system.get("linearUnit", "meter")
@@ -230,6 +233,11 @@ class _Reader:
     def point(self, element: ET.Element, name: str, where: str) -> NDArray[np.float64] | None:
         child = _child(element, name)
         text = "" if child is None else (child.text or "").strip()
+        ref = None if child is None else child.get("pntRef")
+        if not text and ref is not None:  # the XSD's PointType: a reference to a CgPoint instead of coordinates
+            if ref not in self.cg_points or not self.cg_points[ref]:
+                raise ValueError(f"{where}: <{name} pntRef={ref!r}> names no CgPoint with coordinates in the file")
+            text = self.cg_points[ref]
         if not text:
             return None
         parts = text.split()
@@ -393,7 +401,11 @@ def _convention(r: _Reader, alignments: list[ET.Element]) -> None:
             if not isinstance(e.tag, str):
                 continue
             where = f"alignment {a.get('name', f'alignment {k + 1}')!r}, CoordGeom element {index} ({_local(e.tag)})"
-            for raw, heading, name in _clues(r, e, where):
+            try:
+                clues = _clues(r, e, where)
+            except ValueError:  # a malformed element tells nothing here; the read names it with its station
+                continue
+            for raw, heading, name in clues:
                 off_east = abs(math.remainder(raw - heading, 2.0 * math.pi))
                 off_north = abs(math.remainder(math.pi / 2 - raw - heading, 2.0 * math.pi))
                 if off_east < _AGREE and off_north > _APART:

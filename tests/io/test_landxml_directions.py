@@ -143,3 +143,13 @@ def test_a_clothoid_no_cubic_follows_is_refused_beyond_max_offset():
         read_landxml(huge)
     with pytest.raises(ValueError, match="max_offset must be a length"):
         read_landxml(text, max_offset=-1.0)
+
+
+def test_points_given_by_pntref_are_read_from_the_files_cgpoints():
+    # the tester's pntref.xml: the XSD's PointType may name a CgPoint instead of holding coordinates
+    points = '<CgPoints><CgPoint name="P1">0 0</CgPoint><CgPoint name="P2">0 100</CgPoint></CgPoints>'
+    text = _file('<Line length="100"><Start pntRef="P1"/><End pntRef="P2"/></Line>').replace("<Alignments>", points + "<Alignments>")
+    (a,) = read_landxml(text)
+    assert np.allclose(a.chain.start[:2], [0, 0]) and np.allclose(a.chain.end[:2], [100, 0])  # northing 0, easting 100
+    with pytest.raises(ValueError, match=r"element 0 \(Line\) at station 0: <End pntRef='P3'> names no CgPoint"):
+        read_landxml(text.replace('pntRef="P2"', 'pntRef="P3"'))
