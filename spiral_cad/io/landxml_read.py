@@ -461,6 +461,8 @@ def _element(r: _Reader, e: ET.Element, where: str) -> _Element:
         radius = r.number(e, "radius", where, 0.0) or (
             float(np.hypot(*(start - center))) if start is not None and center is not None else 0.0
         )
+        if math.isinf(radius):  # a Curve is an arc: INF would silently make it a line
+            raise ValueError(f"{where}: a Curve's radius {e.get('radius')!r} is not finite")
         if not radius > 0.0:
             raise ValueError(f"{where}: a Curve needs a radius (or Start and Center)")
         heading = None
@@ -472,6 +474,8 @@ def _element(r: _Reader, e: ET.Element, where: str) -> _Element:
             length = r.number(e, "length", where)
         elif e.get("chord") is not None:  # chord-defined: the minor arc unless delta says more
             chord = r.number(e, "chord", where)
+            if not 0.0 < chord <= 2.0 * radius * (1.0 + 1e-9):  # beyond the diameter (up to its rounding) no arc has it
+                raise ValueError(f"{where}: chord {chord:.6g} is not in (0, 2 × radius {radius:.6g}]")
             length = 2.0 * radius * math.asin(min(1.0, chord / (2.0 * radius)))
             if e.get("delta") is not None and abs(r.angle(e, "delta", where)) > math.pi:
                 length = 2.0 * math.pi * radius - length
@@ -482,14 +486,19 @@ def _element(r: _Reader, e: ET.Element, where: str) -> _Element:
             raise ValueError(f"{where}: a Curve needs a length, a chord or Start, Center and End")
         return _Element(kind, start, heading, length, _curvature(sign, radius, where), _curvature(sign, radius, where), station, r.shape)
     if kind == "Spiral":
-        spi = e.get("spiType", "clothoid")
+        spi = e.get("spiType")
+        if spi is None:  # required by the XSD and written by every exporter we have seen: not guessed
+            raise ValueError(f"{where}: a Spiral needs spiType (required by LandXML; only clothoids can be rebuilt)")
         if spi != "clothoid":
             raise ValueError(f"{where}: spiral type {spi!r} is not a clothoid; only clothoids can be rebuilt")
         rot = e.get("rot")
         if rot not in ("cw", "ccw"):
             raise ValueError(f"{where}: Spiral rot {rot!r} is not cw or ccw")
         sign = 1.0 if rot == "ccw" else -1.0
-        k0, k1 = (0.0 if (radius := r.number(e, name, where, math.inf)) in (0.0, math.inf) else _curvature(sign, radius, where)
+        for name in ("radiusStart", "radiusEnd"):  # required by the XSD: a missing one is not taken as straight
+            if e.get(name) is None:
+                raise ValueError(f"{where}: a Spiral needs {name} (INF where straight)")
+        k0, k1 = (0.0 if (radius := r.number(e, name, where)) in (0.0, math.inf) else _curvature(sign, radius, where)
                   for name in ("radiusStart", "radiusEnd"))  # fmt: skip
         pi = r.point(e, "PI", where)
         heading = None

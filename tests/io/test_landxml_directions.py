@@ -153,3 +153,16 @@ def test_points_given_by_pntref_are_read_from_the_files_cgpoints():
     assert np.allclose(a.chain.start[:2], [0, 0]) and np.allclose(a.chain.end[:2], [100, 0])  # northing 0, easting 100
     with pytest.raises(ValueError, match=r"element 0 \(Line\) at station 0: <End pntRef='P3'> names no CgPoint"):
         read_landxml(text.replace('pntRef="P2"', 'pntRef="P3"'))
+
+
+@pytest.mark.parametrize(("element", "message"), [
+    ('<Spiral rot="ccw" radiusStart="100" length="20" spiType="clothoid"/>', "a Spiral needs radiusEnd"),  # spiral_missing_re.xml
+    ('<Spiral rot="ccw" radiusEnd="100" length="20" spiType="clothoid"/>', "a Spiral needs radiusStart"),
+    ('<Spiral rot="ccw" radiusStart="INF" radiusEnd="100" length="20"/>', "a Spiral needs spiType"),
+    ('<Curve rot="ccw" radius="50" chord="200"/>', r"chord 200 is not in \(0, 2 × radius 50\]"),  # curve_chord_too_long.xml
+    ('<Curve rot="ccw" radius="INF" length="20"/>', "a Curve's radius 'INF' is not finite"),
+])  # fmt: skip
+def test_missing_or_impossible_values_are_refused_by_name(element, message):
+    text = _file('<Line length="100"><Start>0 0</Start><End>0 100</End></Line>', element).replace('name="d"', 'name="A"')
+    with pytest.raises(ValueError, match=rf"alignment 'A', CoordGeom element 1 \(\w+\) at station 100: {message}"):
+        read_landxml(text)
