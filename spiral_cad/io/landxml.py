@@ -43,6 +43,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ..core._chain_kernels import ARC, LINE, SPIRAL
+from ..core.bezier import curvature
 from ..core.chain import Chain
 from ..core.clothoid import clothoid_frames
 from ..core.rows import NO_SHAPE
@@ -201,6 +202,32 @@ def spiral_offsets(chain: Chain, samples: int = OFFSET_SAMPLES) -> NDArray[np.fl
     return out
 
 
+#: Parameters at which a cubic's curvature is checked to be a spiral's (one sense, monotone in size).
+_CHECK = np.linspace(0.0, 1.0, 33)
+
+
+def _check_spiral(cp: NDArray, index: int, unit: str, scale: float) -> None:
+    """Refuse a cubic that no LandXML ``Spiral`` describes: its curvature changes sign (an S, an
+    inflection) or does not grow or shrink monotonically in size between its ends.
+
+    Raises:
+        ValueError: naming the segment and its curvatures.
+    """
+    k = curvature(cp, _CHECK)
+    size, tol = np.abs(k), 1e-9 * float(np.abs(k).max())
+    steps = np.diff(size)
+    if k.min() < -tol and k.max() > tol:
+        why = f"its curvature changes sign ({k.min() / scale:.6g} to {k.max() / scale:.6g} 1/{unit}: an inflection)"
+    elif (steps > tol).any() and (steps < -tol).any():
+        why = (
+            f"its curvature does not change monotonically ({k[0] / scale:.6g}, peak {size.max() / scale:.6g}, {k[-1] / scale:.6g} 1/{unit})"
+        )
+    else:
+        return
+    raise ValueError(f"segment {index} (a cubic) is not a spiral: {why}, and a LandXML Spiral turns one way with its "
+                     "curvature running monotonically between its end radii; split it where its curvature turns")  # fmt: skip
+
+
 def _coord_geom(chain: Chain, start_station: float, scale: float, unit: str) -> list[str]:
     """The ``<CoordGeom>`` lines of one chain (lengths times ``scale``)."""
     if chain.dim != 2:
@@ -233,6 +260,7 @@ def _coord_geom(chain: Chain, start_station: float, scale: float, unit: str) -> 
                 lines.append(f"          <PI>{_ne(pi, scale)}</PI>")
             lines.append("        </Curve>")
             continue
+        _check_spiral(rows.geometry[i, :, :2], i, unit, scale)
         shape = SHAPE_NAMES[int(rows.shapes[i])] if int(rows.shapes[i]) != NO_SHAPE else "unstated"
         desc = (f"{DESC_PREFIX} (shape {shape}); written as the clothoid of the same length and end radii, "
                 f"which lies within {offsets[i] * scale:.3g} {unit} of it")  # fmt: skip

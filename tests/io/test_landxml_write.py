@@ -5,6 +5,7 @@ from __future__ import annotations
 import os
 import xml.etree.ElementTree as ET
 
+import numpy as np
 import pytest
 
 from spiral_cad.design import Alignment
@@ -40,3 +41,15 @@ def test_a_written_file_replaces_the_old_one_whole_and_reads_back(tmp_path, road
     plain = tmp_path / "plain"
     plain.write_text("", encoding="utf-8")  # the mode an ordinary new file gets here, not mkstemp's private 0600
     assert path.stat().st_mode & 0o777 == plain.stat().st_mode & 0o777
+
+
+def test_a_cubic_with_an_inflection_is_refused_not_written_as_a_spiral(tmp_path):
+    # the tester's scurve.ngc: G5 I3 J3 P-3 Q-3 X10 Y0, curvature −0.26 → +0.26, was written as one "Spiral"
+    from spiral_cad.core.chain import Chain
+    from spiral_cad.core.spiral import BezierSpiral
+
+    s_curve = BezierSpiral.from_control_points(np.array([[0.0, 0.0], [3.0, 3.0], [7.0, -3.0], [10.0, 0.0]]))
+    path = tmp_path / "s.xml"
+    with pytest.raises(ValueError, match=r"segment 0 \(a cubic\) is not a spiral: its curvature changes sign \(-0.388485 to 0.388485 1/mm: an inflection"):
+        write_landxml(Chain([s_curve], units="mm"), path, name="s")
+    assert not path.exists()
