@@ -12,7 +12,9 @@ Every plane chain (an ``Alignment``'s, or any other) becomes one
   its ``desc`` states the shape of our cubic and the largest offset between
   the cubic and that clothoid placed at the same start point and direction
   (measured with ``spiral_cad.core.clothoid`` at ``OFFSET_SAMPLES`` arc
-  lengths). ``spiral_cad.io.read_landxml`` rebuilds the very cubic from it.
+  lengths); a ``<Feature name="spiral_cad">`` holds the cubic's control points
+  (``Property label="controlPoints"``, northing easting four times), from
+  which ``spiral_cad.io.read_landxml`` rebuilds the very cubic.
 
 Coordinates are written northing before easting; directions in decimal
 degrees counter-clockwise from east (what Civil 3D and Carlson write); every
@@ -71,6 +73,9 @@ US_SURVEY_FOOT = 1200.0 / 3937.0
 OFFSET_SAMPLES = 65
 #: The prefix of the ``desc`` of every spiral written here (the reader recognises its own).
 DESC_PREFIX = "spiral_cad cubic Bezier spiral"
+#: The name of the ``Feature`` of each spiral written here that holds our cubic's control points (northing
+#: easting, four times): ``read_landxml`` rebuilds the very cubic from it.
+FEATURE = "spiral_cad"
 #: |κ|·length below which a spiral's end counts as straight (radius ``INF``): rounding of the zero end.
 STRAIGHT = 1e-9
 NAMESPACE = "http://www.landxml.org/schema/LandXML-1.2"
@@ -268,8 +273,10 @@ def _coord_geom(chain: Chain, start_station: float, scale: float, unit: str) -> 
         lines.append(f'        <Spiral {common} radiusStart="{_text(radii[0] * scale)}" radiusEnd="{_text(radii[1] * scale)}" '
                      f'rot="{rot}" spiType="clothoid" {directions} desc={_attribute(desc)}>')  # fmt: skip
         pi = (p0 + p1) / 2 if pi is None else pi
+        cp = " ".join(_ne(point, scale) for point in rows.geometry[i, :, :2])
         lines += [f"          <Start>{_ne(p0, scale)}</Start>", f"          <PI>{_ne(pi, scale)}</PI>",
-                  f"          <End>{_ne(p1, scale)}</End>", "        </Spiral>"]  # fmt: skip
+                  f"          <End>{_ne(p1, scale)}</End>", f'          <Feature name="{FEATURE}">',
+                  f'            <Property label="controlPoints" value="{cp}"/>', "          </Feature>", "        </Spiral>"]  # fmt: skip
     return lines + ["      </CoordGeom>"]
 
 

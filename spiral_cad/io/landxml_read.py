@@ -58,7 +58,7 @@ from ..core.factors import length_factor
 from ..core.segments import Arc, Line, Segment
 from ..core.shapes import SHAPE_CODES, shape_limits
 from ..core.spiral import BezierSpiral
-from .landxml import DESC_PREFIX, US_SURVEY_FOOT
+from .landxml import DESC_PREFIX, FEATURE, US_SURVEY_FOOT
 from .landxml_fit import Carrier, distance_to_file, solve_compound, solve_run
 from .landxml_fit import offsets as fit_offsets
 
@@ -93,7 +93,8 @@ class LandXMLAlignment:
         units: the chain's length unit.
         profile: the ``spiral_cad.design.Profile`` of its first ``ProfAlign``, or None.
         offsets: per CoordGeom element the largest distance, either way, between
-            the file's element and ours (see ``spiral_cad.io.landxml_fit``), in ``units``.
+            the file's element and ours (see ``spiral_cad.io.landxml_fit``), in ``units``
+            (for a spiral this package wrote, between our cubic and the clothoid its attributes state).
         kinds: per element its tag (``Line``, ``Curve``, ``Spiral``).
         stations: per element the station of its start on our chain (from ``start_station``).
         notes: what was read approximately (e.g. a ``CircCurve`` as a parabola,
@@ -104,7 +105,8 @@ class LandXMLAlignment:
             file's carrier), the solver of a spiral (``"line_to_circle"``,
             ``"circle_in_circle"``, ``"circle_to_circle"``, ``"line_to_line"``, with
             the other shape in brackets where the element's own had no solution),
-            or ``"length"`` (the file's length and end curvatures, continuing from the element before).
+            or ``"length"`` (the file's length and end curvatures, continuing from the element before),
+            or ``"spiral_cad cubic"`` (a spiral this package wrote: the cubic of its ``Feature``).
         owners: per chain, the element (an index into ``kinds``) of each of its segments.
         directions: how the file counts its directions, inferred from its elements that have both a
             direction and points (or chosen with ``read_landxml(directions=)``): ``"east-ccw"``
@@ -436,6 +438,7 @@ class _Element:
     theta: float | None = None
     where: str = ""
     notes: list[str] = field(default_factory=list)
+    cubic: BezierSpiral | None = None  # our very cubic, where this package wrote the spiral (its Feature)
 
 
 def _element(r: _Reader, e: ET.Element, where: str) -> _Element:
@@ -512,8 +515,38 @@ def _element(r: _Reader, e: ET.Element, where: str) -> _Element:
             found = re.search(r"\(shape ([a-z0-9-]+)\)", desc)
             if found and found.group(1) in SHAPE_CODES:
                 shape = found.group(1)
-        return _Element(kind, start, heading, r.number(e, "length", where), k0, k1, station, shape)
+        item = _Element(kind, start, heading, r.number(e, "length", where), k0, k1, station, shape)
+        item.cubic = _our_cubic(r, e, item, shape, end, where)
+        return item
     raise ValueError(f"{where}: {kind} cannot be represented as a G2 chain of lines, arcs and spirals")
+
+
+def _our_cubic(r: _Reader, e: ET.Element, item: _Element, shape: str, end: NDArray | None, where: str) -> BezierSpiral | None:
+    """The cubic this package wrote for a Spiral (its ``Feature name="spiral_cad"``), if it is still the
+    element's: it starts at Start, ends at End and has the element's length and end curvatures."""
+    feature = next((f for f in _children(e, "Feature") if f.get("name") == FEATURE), None)
+    value = None if feature is None else next((p.get("value") for p in _children(feature, "Property")
+                                               if p.get("label") == "controlPoints"), None)  # fmt: skip
+    if value is None:
+        return None
+    try:
+        numbers = np.array([float(v) for v in value.split()]) * r.scale
+        cubic = BezierSpiral.from_control_points(numbers.reshape(4, 2)[:, ::-1], shape)  # northing easting → x, y
+    except ValueError:
+        item.notes.append(f"{where}: the spiral_cad control points {value!r} are not 8 numbers of a spiral; not used")
+        return None
+    size = max(item.length, 1e-300)
+    near = 1e-9 * size
+    same = (
+        (item.start is None or math.dist(cubic.start[:2], item.start) <= near)
+        and (end is None or math.dist(cubic.end[:2], end) <= near)
+        and abs(cubic.length - item.length) <= near
+        and all(abs(a - b) * size <= 1e-6 for a, b in ((cubic.start_curvature, item.k0), (cubic.end_curvature, item.k1)))
+    )
+    if not same:
+        item.notes.append(f"{where}: the spiral_cad control points do not fit the element (edited since?); not used")
+        return None
+    return cubic
 
 
 def _segments(item: _Element, point: NDArray, heading: float) -> list[Segment]:
@@ -673,6 +706,11 @@ def _run(items: list[_Element], mine: list[int], starts: list[NDArray], headings
         if len(ks) == 1 and entry.curvature * exit_.curvature > 0.0:  # a compound clothoid: through a middle circle if need be
             attempts += [(shape, "middle", nearness) for nearness in _NEARNESS for shape in shapes]
         lone = pending is None and after is None  # no line or arc of the file to keep: its own length is nearer
+        if all(items[k].cubic is not None for k in ks):  # our own spirals: the very cubics, nothing to solve
+            candidates.append(
+                ("spiral_cad cubic", items[ks[0]].shape, [(i, cubic) for i, k in enumerate(ks) if (cubic := items[k].cubic) is not None])
+            )
+            attempts = []
         for shape, how, value in attempts if placement == "neighbours" and not lone else ():
             try:
                 if how == "one":
@@ -823,6 +861,9 @@ def _alignment(r: _Reader, a: ET.Element, label: str) -> LandXMLAlignment:
     except ValueError as e:
         raise ValueError(f"{where}: {e}") from None
     limits = MAX_OFFSET_FRACTION * size if r.max_offset is None else np.full(len(size), r.max_offset)
+    # a spiral this package wrote is the very cubic of its Feature: its offset from the clothoid its
+    # attributes describe is reported, not refused
+    limits[[k for k in range(len(items)) if methods.get(k) == "spiral_cad cubic"]] = np.inf
     over = np.flatnonzero(offsets > limits)
     if len(over):  # a clothoid none of our spirals follows: refused rather than silently metres away
         with np.errstate(divide="ignore", over="ignore", invalid="ignore"):  # a limit may underflow to 0
