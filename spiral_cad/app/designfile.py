@@ -210,14 +210,14 @@ class BuiltLandXML(Built):
         return "LandXML alignment"
 
 
-def build_landxml(path: str | Path, max_offset: float | None = None) -> tuple[str, list[Built]]:
+def build_landxml(path: str | Path, max_offset: float | None = None, directions: str = "auto") -> tuple[str, list[Built]]:
     """Every alignment of a LandXML file as designs: one per G2 run (``spiral_cad.io.read_landxml``).
 
     Each design is named after its alignment (characters other than letters, digits, ``_`` and ``-``
     replaced by ``_``, at most 56 of them, ``_1``, ``_2`` … per G2 run); where that name is already
     taken by an earlier design (names compared ignoring case: they name files) — equal alignment
     names, names equal once sanitised or in their first 56 characters — the first free suffix
-    ``_2``, ``_3`` … is added and ``renamed`` says so. ``max_offset``: see ``read_landxml``.
+    ``_2``, ``_3`` … is added and ``renamed`` says so. ``max_offset``, ``directions``: see ``read_landxml``.
 
     Raises:
         DesignError: the file cannot be read or holds an element that cannot be represented.
@@ -227,7 +227,7 @@ def build_landxml(path: str | Path, max_offset: float | None = None) -> tuple[st
     from ..io import read_landxml
 
     try:
-        alignments = read_landxml(path, max_offset=max_offset)
+        alignments = read_landxml(path, max_offset=max_offset, directions=directions)
     except (OSError, ValueError) as e:
         raise DesignError(f"{path}: {e}") from None
     built: list[Built] = []
@@ -564,11 +564,12 @@ BUILDERS: dict[str, Callable[[Any, str, str, Path | None], Built]] = {
 }
 
 
-def build(source: str | Path | dict, max_offset: float | None = None) -> tuple[str, list[Built]]:
+def build(source: str | Path | dict, max_offset: float | None = None, directions: str = "auto") -> tuple[str, list[Built]]:
     """Validate and build every design of ``source``: (units, built designs).
 
     A LandXML file (``.xml``) is built by ``build_landxml``: every alignment, one design per G2 run
-    (``max_offset``: the largest offset accepted from the file's elements, see ``read_landxml``).
+    (``max_offset``: the largest offset accepted from the file's elements; ``directions``: how the file
+    counts directions; see ``read_landxml``).
     A G-code program named by a design file is read from the design file's
     folder (a dict's from the working folder).
 
@@ -577,7 +578,7 @@ def build(source: str | Path | dict, max_offset: float | None = None) -> tuple[s
             ``designs[i] (name)``, or a file outside the design file's folder.
     """
     if isinstance(source, (str, Path)) and Path(source).suffix.lower() == ".xml":
-        return build_landxml(source, max_offset)
+        return build_landxml(source, max_offset, directions)
     design_file = load(source)
     base = None if isinstance(source, dict) else Path(source).parent
     built = []

@@ -282,7 +282,7 @@ class _Reader:
             raise ValueError(f"{where}: the element is placed only by its {name}, and no element of the file has both a "
                              "direction and the points it joins, so whether directions count counter-clockwise from east "
                              "or clockwise from north (the XSD's '0 degrees = north') cannot be told; choose with "
-                             "read_landxml(directions='east-ccw' or 'north-cw')")  # fmt: skip
+                             "read_landxml(directions='east-ccw' or 'north-cw') or build --directions")  # fmt: skip
         self.used += 1
         return raw if self.directions == "east-ccw" else math.pi / 2 - raw
 
@@ -418,7 +418,7 @@ def _convention(r: _Reader, alignments: list[ET.Element]) -> None:
     if east and north:
         raise ValueError(f"the file's directions are inconsistent: {east[0]} agrees with its points counted "
                          f"counter-clockwise from east ({len(east)} such), {north[0]} only counted clockwise from north "
-                         f"({len(north)} such); choose with read_landxml(directions='east-ccw' or 'north-cw')")  # fmt: skip
+                         f"({len(north)} such); choose with read_landxml(directions='east-ccw' or 'north-cw') or build --directions")  # fmt: skip
     if east or north:
         r.directions = "east-ccw" if east else "north-cw"
         r.evidence = (f"{len(east or north)} direction(s) of the file agree with their points only counted "
@@ -871,7 +871,7 @@ def _alignment(r: _Reader, a: ET.Element, label: str) -> LandXMLAlignment:
         limit = (f"{MAX_OFFSET_FRACTION:g} of its length {size[k]:.6g}" if r.max_offset is None
                  else f"max_offset {r.max_offset:.6g}")  # fmt: skip
         raise ValueError(f"{items[k].where}: ours lies {offsets[k]:.3g} {r.units} from the file's element, more than "
-                         f"{limit} ({len(over)} element(s) beyond; max_offset=math.inf accepts them)")  # fmt: skip
+                         f"{limit} ({len(over)} element(s) beyond; max_offset=math.inf, or build --max-offset inf, accepts them)")  # fmt: skip
     ours = np.zeros(len(items))
     for chain, held in zip(chains, owners):
         np.add.at(ours, held, chain.lengths)

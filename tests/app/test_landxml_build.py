@@ -86,6 +86,8 @@ def test_build_refuses_a_file_whose_direction_convention_cannot_be_told(tmp_path
     err = capsys.readouterr().err
     assert err.startswith("error: ") and "CoordGeom element 0 (Line) at station 0: the element is placed only by its dir" in err
     assert "Traceback" not in err
+    assert main(["build", str(path), "--out", str(tmp_path / "out"), "--no-plots", "--directions", "north-cw"]) == 0
+    assert "north-cw" not in capsys.readouterr().err
 
 
 def test_the_build_states_each_alignments_largest_offset_and_refuses_beyond_max_offset(tmp_path, capsys):
@@ -95,7 +97,9 @@ def test_the_build_states_each_alignments_largest_offset_and_refuses_beyond_max_
     assert "spiral_R63: warning: largest offset from the file's alignment 'spiral R63': element 0 (Spiral) at station 0: 1.65 m (1.65% of its length)" in out  # fmt: skip
     assert main(["build", source, "--out", str(tmp_path / "b"), "--max-offset", "0.5"]) == 2
     err = capsys.readouterr().err
-    assert err.startswith("error: ") and "element 0 (Spiral) at station 0: ours lies 1.65 m from the file's element, more than max_offset 0.5" in err  # fmt: skip
+    assert err.startswith("error: ") and "element 0 (Spiral) at station 0: ours lies 1.65 m from the file's element, more than max_offset 0.5" in err and "--max-offset inf" in err  # fmt: skip
     assert not (tmp_path / "b").exists()
     assert main(["build", str(DATA / "sdms_mntnroad_alignpis.xml").replace(".xml", ".json"), "--max-offset", "1"]) == 2
     assert "--max-offset: only with a LandXML file" in capsys.readouterr().err
+    assert main(["build", str(DATA / "x.json"), "--directions", "north-cw"]) == 2
+    assert "--directions: only with a LandXML file" in capsys.readouterr().err
