@@ -87,11 +87,12 @@ DEMO_DESIGN: dict = {
 PIP_CAD = 'pip install "spiral_cad[cad]"'
 
 
-def _write_design(design: dict | str, out: Path, plots: bool, extra: Callable[[Path], None] | None = None) -> int:
+def _write_design(design: dict | str, out: Path, plots: bool, extra: Callable[[Path], None] | None = None,
+                  max_offset: float | None = None, directions: str = "auto") -> int:  # fmt: skip
     from .designfile import build, criteria_tables, summary, write
 
     started = time.perf_counter()
-    units, built = build(design)
+    units, built = build(design, max_offset=max_offset, directions=directions)
     print(f"built {len(built)} design(s); writing to {out}/", flush=True)
     try:
         written = write(built, out, units, progress=lambda line: print(line, flush=True), plots=plots, extra=extra)
@@ -155,6 +156,9 @@ GCODE_ONLY = ("max_deviation", "interpreter", "arc_tolerance", "feed")
 
 
 def _build(args: argparse.Namespace) -> int:
+    landxml = [o for o, given in (("--max-offset", args.max_offset is not None), ("--directions", args.directions != "auto")) if given]
+    if landxml and (args.design is None or Path(args.design).suffix.lower() != ".xml"):
+        raise ValueError(f"{', '.join(landxml)}: only with a LandXML file (.xml)")
     if args.from_points is not None:
         return _write_design(points_design(args), Path(args.out), plots=not args.no_plots)
     only = [f"--{o.replace('_', '-')}" for o in POINTS_OPTIONS if getattr(args, o) not in (None, False)]
@@ -166,7 +170,7 @@ def _build(args: argparse.Namespace) -> int:
             raise ValueError("give a design file, or --from-gcode FILE.nc")
         if given:
             raise ValueError(f"{', '.join(given)}: only with --from-gcode (a design file states these per design)")
-        return _write_design(args.design, Path(args.out), plots=not args.no_plots)
+        return _write_design(args.design, Path(args.out), plots=not args.no_plots, max_offset=args.max_offset, directions=args.directions)
     if args.design is not None:
         raise ValueError("give a design file or --from-gcode, not both")
     from ..io.gcode import reading_options
@@ -446,6 +450,12 @@ def _parser() -> argparse.ArgumentParser:
     )
     build.add_argument("-o", "--out", default="out", help="output folder (default: out)")
     build.add_argument("--no-plots", action="store_true", help="skip the PNG plots (the slowest output for long chains)")
+    build.add_argument("--max-offset", type=float, metavar="LENGTH",
+                       help="LandXML: the largest offset accepted between a file's element and ours, in the file's unit "
+                            "(default: 5%% of each element's length; inf accepts any)")  # fmt: skip
+    build.add_argument("--directions", choices=["auto", "east-ccw", "north-cw"], default="auto",
+                       help="LandXML: how the file counts directions: counter-clockwise from east or clockwise from north "
+                            "(default auto: told from the file's own points)")  # fmt: skip
     gcode = build.add_argument_group(
         "G-code", "round the straight moves (G0/G1) of a CNC program G2 and write STEP, IGES, DXF, samples, the\n"
         "continuity report and NAME.ngc, the rounded program at the program's feed (never over the input; README: the\n"

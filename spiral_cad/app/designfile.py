@@ -189,19 +189,38 @@ class BuiltTransition(Built):
         return f"transition ({self.source.kind})"
 
 
+#: The share of an element's length beyond which the build warns of the offset between the file's element and ours.
+WARN_OFFSET = 1e-3
+
+
 @dataclass(kw_only=True)
 class BuiltLandXML(Built):
-    """One G2 run of an alignment read from LandXML (``source``: its ``LandXMLAlignment``)."""
+    """One G2 run of an alignment read from LandXML (``source``: its ``LandXMLAlignment``); ``renamed``
+    says why its name has a suffix (another alignment's outputs already had the name), else empty."""
 
     run: int = 0
+    renamed: str = ""
+
+    def landxml_offset(self) -> str:
+        """The alignment's largest offset from the file, a warning above ``WARN_OFFSET`` of its element's length."""
+        a = self.source
+        k = int(np.argmax(a.offsets))
+        warn = a.offsets[k] > WARN_OFFSET * a.file_lengths[k]
+        return f"{'warning: ' if warn else ''}largest offset from the file's alignment {a.name!r}: {a.worst}"
 
     @property
     def kind(self) -> str:
         return "LandXML alignment"
 
 
-def build_landxml(path: str | Path) -> tuple[str, list[Built]]:
+def build_landxml(path: str | Path, max_offset: float | None = None, directions: str = "auto") -> tuple[str, list[Built]]:
     """Every alignment of a LandXML file as designs: one per G2 run (``spiral_cad.io.read_landxml``).
+
+    Each design is named after its alignment (characters other than letters, digits, ``_`` and ``-``
+    replaced by ``_``, at most 56 of them, ``_1``, ``_2`` … per G2 run); where that name is already
+    taken by an earlier design (names compared ignoring case: they name files) — equal alignment
+    names, names equal once sanitised or in their first 56 characters — the first free suffix
+    ``_2``, ``_3`` … is added and ``renamed`` says so. ``max_offset``, ``directions``: see ``read_landxml``.
 
     Raises:
         DesignError: the file cannot be read or holds an element that cannot be represented.
@@ -211,15 +230,23 @@ def build_landxml(path: str | Path) -> tuple[str, list[Built]]:
     from ..io import read_landxml
 
     try:
-        alignments = read_landxml(path)
+        alignments = read_landxml(path, max_offset=max_offset, directions=directions)
     except (OSError, ValueError) as e:
         raise DesignError(f"{path}: {e}") from None
     built: list[Built] = []
+    taken: dict[str, str] = {}  # each design name (lower case) taken, and the alignment that took it
     for k, a in enumerate(alignments):
         stem = (re.sub(r"[^A-Za-z0-9_-]", "_", a.name).strip("_-") or f"alignment{k + 1}")[:56]
         for run, chain in enumerate(a.chains):
-            name = stem if len(a.chains) == 1 else f"{stem}_{run + 1}"
-            built.append(BuiltLandXML(name=name, chain=chain, source=a, run=run))
+            wanted = stem if len(a.chains) == 1 else f"{stem}_{run + 1}"
+            name, suffix = wanted, 1
+            while name.lower() in taken:  # one alignment's outputs never overwrite another's
+                suffix += 1
+                name = f"{wanted}_{suffix}"
+            renamed = "" if name == wanted else (f"alignment {a.name!r} (number {k + 1}) written as {name!r}: "
+                                                 f"{wanted!r} names the outputs of alignment {taken[wanted.lower()]!r}")  # fmt: skip
+            taken[name.lower()] = f"{a.name}" if len(a.chains) == 1 else f"{a.name} (G2 run {run + 1})"
+            built.append(BuiltLandXML(name=name, chain=chain, source=a, run=run, renamed=renamed))
     return alignments[0].units, built
 
 
@@ -235,6 +262,7 @@ def _landxml_report(b: BuiltLandXML, stage: Path) -> list[str]:
     lines += [f"{k:7d}  {kind:7s}  {sta:17.6f}  {off:9.3g}  {dl:13.3g}  {how}"
               for k, (kind, sta, off, dl, how) in enumerate(zip(a.kinds, a.stations, a.offsets, a.length_changes, a.methods))]  # fmt: skip
     lines += [f"break: {text}" for text in a.breaks] + [f"note: {text}" for text in a.notes]
+    lines += [f"note: {b.renamed}"] if b.renamed else []
     (stage / f"{b.name}_landxml.txt").write_text("\n".join(lines) + "\n", encoding="utf-8")
     export_opendrive(b.chain, stage / f"{b.name}.xodr", name=b.name)
     return ["landxml.txt", "xodr"]
@@ -573,10 +601,12 @@ BUILDERS: dict[str, Callable[[Any, str, str, Path | None], Built]] = {
 }
 
 
-def build(source: str | Path | dict) -> tuple[str, list[Built]]:
+def build(source: str | Path | dict, max_offset: float | None = None, directions: str = "auto") -> tuple[str, list[Built]]:
     """Validate and build every design of ``source``: (units, built designs).
 
-    A LandXML file (``.xml``) is built by ``build_landxml``: every alignment, one design per G2 run.
+    A LandXML file (``.xml``) is built by ``build_landxml``: every alignment, one design per G2 run
+    (``max_offset``: the largest offset accepted from the file's elements; ``directions``: how the file
+    counts directions; see ``read_landxml``).
     A G-code program named by a design file is read from the design file's
     folder (a dict's from the working folder).
 
@@ -585,7 +615,7 @@ def build(source: str | Path | dict) -> tuple[str, list[Built]]:
             ``designs[i] (name)``, or a file outside the design file's folder.
     """
     if isinstance(source, (str, Path)) and Path(source).suffix.lower() == ".xml":
-        return build_landxml(source)
+        return build_landxml(source, max_offset, directions)
     design_file = load(source)
     base = None if isinstance(source, dict) else Path(source).parent
     built = []
@@ -883,4 +913,6 @@ def summary(built: list[Built], units: str) -> str:
     lines = fixed_columns(columns, rows)
     lines += [f"{b.name}: {b.road_3d}" for b in built if b.road_3d]
     lines += [f"{b.name}: {b.fit.line()}" for b in built if isinstance(b, BuiltFit | BuiltRoadFit)]
+    lines += [f"{b.name}: {b.renamed}" for b in built if isinstance(b, BuiltLandXML) and b.renamed]
+    lines += [f"{b.name}: {b.landxml_offset()}" for b in built if isinstance(b, BuiltLandXML) and b.run == 0]
     return "\n".join(lines)

@@ -12,7 +12,9 @@ Every plane chain (an ``Alignment``'s, or any other) becomes one
   its ``desc`` states the shape of our cubic and the largest offset between
   the cubic and that clothoid placed at the same start point and direction
   (measured with ``spiral_cad.core.clothoid`` at ``OFFSET_SAMPLES`` arc
-  lengths). ``spiral_cad.io.read_landxml`` rebuilds the very cubic from it.
+  lengths); a ``<Feature name="spiral_cad">`` holds the cubic's control points
+  (``Property label="controlPoints"``, northing easting four times), from
+  which ``spiral_cad.io.read_landxml`` rebuilds the very cubic.
 
 Coordinates are written northing before easting; directions in decimal
 degrees counter-clockwise from east (what Civil 3D and Carlson write); every
@@ -28,8 +30,11 @@ Needs no CAD kernel.
 
 from __future__ import annotations
 
+import contextlib
 import math
 import os
+import re
+import tempfile
 from collections.abc import Sequence
 from dataclasses import dataclass
 from datetime import UTC, datetime
@@ -40,6 +45,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ..core._chain_kernels import ARC, LINE, SPIRAL
+from ..core.bezier import curvature
 from ..core.chain import Chain
 from ..core.clothoid import clothoid_frames
 from ..core.rows import NO_SHAPE
@@ -67,6 +73,9 @@ US_SURVEY_FOOT = 1200.0 / 3937.0
 OFFSET_SAMPLES = 65
 #: The prefix of the ``desc`` of every spiral written here (the reader recognises its own).
 DESC_PREFIX = "spiral_cad cubic Bezier spiral"
+#: The name of the ``Feature`` of each spiral written here that holds our cubic's control points (northing
+#: easting, four times): ``read_landxml`` rebuilds the very cubic from it.
+FEATURE = "spiral_cad"
 #: |κ|·length below which a spiral's end counts as straight (radius ``INF``): rounding of the zero end.
 STRAIGHT = 1e-9
 NAMESPACE = "http://www.landxml.org/schema/LandXML-1.2"
@@ -94,6 +103,19 @@ def _text(value: float) -> str:
     if math.isinf(value):
         return "INF"
     return repr(float(value) + 0.0)
+
+
+#: A character XML 1.0 cannot hold (not even escaped): controls other than tab, newline and return,
+#: lone surrogates, U+FFFE and U+FFFF.
+_NOT_XML = re.compile("[^\t\n\r\x20-\ud7ff\ue000-\ufffd\U00010000-\U0010ffff]")
+
+
+def _check_name(text: str, what: str) -> None:
+    """Refuse a name XML cannot hold, naming the character and where it is."""
+    bad = _NOT_XML.search(text)
+    if bad:
+        raise ValueError(f"{what} {text!r}: the character U+{ord(bad.group()):04X} at position {bad.start()} cannot be "
+                         "written in XML")  # fmt: skip
 
 
 def _attribute(text: str) -> str:
@@ -185,6 +207,32 @@ def spiral_offsets(chain: Chain, samples: int = OFFSET_SAMPLES) -> NDArray[np.fl
     return out
 
 
+#: Parameters at which a cubic's curvature is checked to be a spiral's (one sense, monotone in size).
+_CHECK = np.linspace(0.0, 1.0, 33)
+
+
+def _check_spiral(cp: NDArray, index: int, unit: str, scale: float) -> None:
+    """Refuse a cubic that no LandXML ``Spiral`` describes: its curvature changes sign (an S, an
+    inflection) or does not grow or shrink monotonically in size between its ends.
+
+    Raises:
+        ValueError: naming the segment and its curvatures.
+    """
+    k = curvature(cp, _CHECK)
+    size, tol = np.abs(k), 1e-9 * float(np.abs(k).max())
+    steps = np.diff(size)
+    if k.min() < -tol and k.max() > tol:
+        why = f"its curvature changes sign ({k.min() / scale:.6g} to {k.max() / scale:.6g} 1/{unit}: an inflection)"
+    elif (steps > tol).any() and (steps < -tol).any():
+        why = (
+            f"its curvature does not change monotonically ({k[0] / scale:.6g}, peak {size.max() / scale:.6g}, {k[-1] / scale:.6g} 1/{unit})"
+        )
+    else:
+        return
+    raise ValueError(f"segment {index} (a cubic) is not a spiral: {why}, and a LandXML Spiral turns one way with its "
+                     "curvature running monotonically between its end radii; split it where its curvature turns")  # fmt: skip
+
+
 def _coord_geom(chain: Chain, start_station: float, scale: float, unit: str) -> list[str]:
     """The ``<CoordGeom>`` lines of one chain (lengths times ``scale``)."""
     if chain.dim != 2:
@@ -217,6 +265,7 @@ def _coord_geom(chain: Chain, start_station: float, scale: float, unit: str) -> 
                 lines.append(f"          <PI>{_ne(pi, scale)}</PI>")
             lines.append("        </Curve>")
             continue
+        _check_spiral(rows.geometry[i, :, :2], i, unit, scale)
         shape = SHAPE_NAMES[int(rows.shapes[i])] if int(rows.shapes[i]) != NO_SHAPE else "unstated"
         desc = (f"{DESC_PREFIX} (shape {shape}); written as the clothoid of the same length and end radii, "
                 f"which lies within {offsets[i] * scale:.3g} {unit} of it")  # fmt: skip
@@ -224,8 +273,10 @@ def _coord_geom(chain: Chain, start_station: float, scale: float, unit: str) -> 
         lines.append(f'        <Spiral {common} radiusStart="{_text(radii[0] * scale)}" radiusEnd="{_text(radii[1] * scale)}" '
                      f'rot="{rot}" spiType="clothoid" {directions} desc={_attribute(desc)}>')  # fmt: skip
         pi = (p0 + p1) / 2 if pi is None else pi
+        cp = " ".join(_ne(point, scale) for point in rows.geometry[i, :, :2])
         lines += [f"          <Start>{_ne(p0, scale)}</Start>", f"          <PI>{_ne(pi, scale)}</PI>",
-                  f"          <End>{_ne(p1, scale)}</End>", "        </Spiral>"]  # fmt: skip
+                  f"          <End>{_ne(p1, scale)}</End>", f'          <Feature name="{FEATURE}">',
+                  f'            <Property label="controlPoints" value="{cp}"/>', "          </Feature>", "        </Spiral>"]  # fmt: skip
     return lines + ["      </CoordGeom>"]
 
 
@@ -259,8 +310,13 @@ def landxml_text(alignments: Sequence[AlignmentToWrite], units: str, name: str =
         application: the ``<Application>`` name.
 
     Raises:
-        ValueError: a chain in space, or a unit LandXML has no name for.
+        ValueError: a chain in space, a unit LandXML has no name for, or a name
+            with a character XML cannot hold (naming it).
     """
+    _check_name(name, "the collection name")
+    _check_name(application, "the application name")
+    for k, a in enumerate(alignments):
+        _check_name(a.name, f"alignment {k + 1}'s name")
     if survey_feet:
         scale, system, linear = to_metres(units) / US_SURVEY_FOOT, "Imperial", "USSurveyFoot"
         unit = "US survey ft"
@@ -306,6 +362,12 @@ def write_landxml(alignments: Sequence[AlignmentToWrite] | Any, path: str | os.P
         name: the collection's name (and the alignment's, for a single one).
         survey_feet: write lengths in US survey feet.
         profile: the ``Profile`` of a single alignment.
+
+    The file is written whole to a temporary file beside ``path`` and then
+    renamed onto it: an existing file is replaced only by a complete one.
+
+    Raises:
+        ValueError: see ``landxml_text`` (then nothing was written).
     """
     if isinstance(alignments, Chain):
         alignments = [AlignmentToWrite(alignments, name, 0.0, profile)]
@@ -313,6 +375,22 @@ def write_landxml(alignments: Sequence[AlignmentToWrite] | Any, path: str | os.P
         alignments = [AlignmentToWrite(alignments.chain, name, alignments.start_station, profile)]
     alignments = list(alignments)
     units = units or (alignments[0].chain.units if alignments else "m")
-    text = landxml_text(alignments, units, name, survey_feet=survey_feet)
-    with open(os.fspath(path), "w", encoding="utf-8", newline="\n") as handle:
-        handle.write(text)
+    data = landxml_text(alignments, units, name, survey_feet=survey_feet).encode("utf-8")
+    target = os.fspath(path)
+    handle, temporary = tempfile.mkstemp(prefix=f".{os.path.basename(target)}.", suffix=".tmp", dir=os.path.dirname(target) or ".")
+    try:
+        with os.fdopen(handle, "wb") as stream:
+            stream.write(data)
+        os.chmod(temporary, 0o666 & ~_umask())  # mkstemp makes it private: give it an ordinary file's mode
+        os.replace(temporary, target)  # atomic on one file system: the old file or the whole new one
+    except BaseException:
+        with contextlib.suppress(OSError):
+            os.unlink(temporary)
+        raise
+
+
+def _umask() -> int:
+    """The process's file-creation mask (read by setting it and back)."""
+    mask = os.umask(0o022)
+    os.umask(mask)
+    return mask

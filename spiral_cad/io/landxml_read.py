@@ -4,7 +4,13 @@ Reads LandXML 1.0–1.2 (any namespace) as Civil 3D, OpenRoads, Carlson, MDT
 and others write it: ``Metric``/``Imperial`` units (metres, millimetres,
 feet, US survey feet, inches — US survey feet become feet), angles and
 directions in radians, grads, decimal degrees or ``decimal dd.mm.ss``,
-points northing before easting, directions counter-clockwise from east.
+points northing before easting. Directions are counted counter-clockwise
+from east (Civil 3D, Carlson) or clockwise from north (the XSD's "0 degrees =
+north": MDT, Novapoint): which, the file itself tells — every direction whose
+element also has the points it joins agrees with them one way — and an
+element placed by its direction alone in a file that tells neither, or a file
+whose directions agree one way here and the other there, is refused by name
+(``directions=`` chooses).
 
 Each ``<CoordGeom>`` is rebuilt in order (``placement="neighbours"``, the
 default): the file's ``Line`` and ``Curve`` elements (``crvType`` arc; also
@@ -52,7 +58,7 @@ from ..core.factors import length_factor
 from ..core.segments import Arc, Line, Segment
 from ..core.shapes import SHAPE_CODES, shape_limits
 from ..core.spiral import BezierSpiral
-from .landxml import DESC_PREFIX, US_SURVEY_FOOT
+from .landxml import DESC_PREFIX, FEATURE, US_SURVEY_FOOT
 from .landxml_fit import Carrier, distance_to_file, solve_compound, solve_run
 from .landxml_fit import offsets as fit_offsets
 
@@ -65,6 +71,10 @@ LINEAR = {"meter": ("m", 1.0), "millimeter": ("mm", 1.0), "centimeter": ("cm", 1
           "foot": ("ft", 1.0), "USSurveyFoot": ("ft", US_SURVEY_FOOT / 0.3048), "inch": ("in", 1.0)}  # fmt: skip
 #: Radians per LandXML angular unit.
 ANGULAR = {"radians": 1.0, "grads": math.pi / 200.0, "decimal degrees": math.pi / 180.0, "degrees": math.pi / 180.0}
+#: The largest offset accepted by default between the file's element and ours, as a fraction of the element's
+#: length (``read_landxml(max_offset=None)``): ordinary road spirals stay far below (the Civil 3D spiral of
+#: R 63 m over 100 m, turning 45°, is 1.65 m off); a clothoid no cubic spiral follows is metres off.
+MAX_OFFSET_FRACTION = 0.05
 #: Relative difference of curvature between two elements above which the file's geometry is only G1 there.
 _JUMP = 1e-6
 
@@ -83,7 +93,8 @@ class LandXMLAlignment:
         units: the chain's length unit.
         profile: the ``spiral_cad.design.Profile`` of its first ``ProfAlign``, or None.
         offsets: per CoordGeom element the largest distance, either way, between
-            the file's element and ours (see ``spiral_cad.io.landxml_fit``), in ``units``.
+            the file's element and ours (see ``spiral_cad.io.landxml_fit``), in ``units``
+            (for a spiral this package wrote, between our cubic and the clothoid its attributes state).
         kinds: per element its tag (``Line``, ``Curve``, ``Spiral``).
         stations: per element the station of its start on our chain (from ``start_station``).
         notes: what was read approximately (e.g. a ``CircCurve`` as a parabola,
@@ -94,8 +105,14 @@ class LandXMLAlignment:
             file's carrier), the solver of a spiral (``"line_to_circle"``,
             ``"circle_in_circle"``, ``"circle_to_circle"``, ``"line_to_line"``, with
             the other shape in brackets where the element's own had no solution),
-            or ``"length"`` (the file's length and end curvatures, continuing from the element before).
+            or ``"length"`` (the file's length and end curvatures, continuing from the element before),
+            or ``"spiral_cad cubic"`` (a spiral this package wrote: the cubic of its ``Feature``).
         owners: per chain, the element (an index into ``kinds``) of each of its segments.
+        directions: how the file counts its directions, inferred from its elements that have both a
+            direction and points (or chosen with ``read_landxml(directions=)``): ``"east-ccw"``
+            (counter-clockwise from east) or ``"north-cw"`` (clockwise from north, azimuths);
+            ``"unknown"`` when the file tells nothing and no element was placed by its direction.
+        file_lengths: per element its length in the file.
     """
 
     name: str
@@ -112,6 +129,8 @@ class LandXMLAlignment:
     length_changes: NDArray[np.float64] = field(default_factory=lambda: np.zeros(0))
     methods: tuple[str, ...] = field(default=())
     owners: tuple[NDArray[np.int64], ...] = field(default=())
+    directions: str = "unknown"
+    file_lengths: NDArray[np.float64] = field(default_factory=lambda: np.zeros(0))
 
     @property
     def chain(self) -> Chain:
@@ -128,6 +147,16 @@ class LandXMLAlignment:
     def offset(self) -> float:
         """The largest offset between the file's geometry and the rebuilt chain."""
         return float(self.offsets.max()) if len(self.offsets) else 0.0
+
+    @property
+    def worst(self) -> str:
+        """Where the largest offset is: the element's index, kind and station (the file's), and the offset."""
+        if not len(self.offsets):
+            return "no element"
+        k = int(np.argmax(self.offsets))
+        share = f" ({float(self.offsets[k]) / float(self.file_lengths[k]):.2%} of its length)" if len(self.file_lengths) else ""
+        station = self.file_stations[k] if len(self.file_stations) else self.stations[k]
+        return f"element {k} ({self.kinds[k]}) at station {station:.6g}: {self.offsets[k]:.3g} {self.units}{share}"
 
     @property
     def station_shift(self) -> float:
@@ -168,6 +197,13 @@ class _Reader:
     def __init__(self, root: ET.Element, shape: str, placement: str = "neighbours"):
         self.shape = shape
         self.placement = placement
+        self.directions = "unknown"  # the file's convention of directions (DIRECTIONS), once known
+        self.evidence = ""  # why: which elements' points agree with it
+        self.used = 0  # directions that placed an element in the alignment being read
+        self.max_offset: float | None = None  # the largest offset accepted (None: MAX_OFFSET_FRACTION of each length)
+        # the file's named points (a point may be given as pntRef="name"), wherever its CgPoints are
+        self.cg_points = {e.get("name", ""): (e.text or "").strip() for e in root.iter() if isinstance(e.tag, str)
+                          and _local(e.tag) == "CgPoint" and e.get("name")}  # fmt: skip
         units = _child(root, "Units")
         system = None if units is None else next(iter(units), None)
         linear = "meter" if system is None else system.get("linearUnit", "meter")
@@ -199,6 +235,11 @@ class _Reader:
     def point(self, element: ET.Element, name: str, where: str) -> NDArray[np.float64] | None:
         child = _child(element, name)
         text = "" if child is None else (child.text or "").strip()
+        ref = None if child is None else child.get("pntRef")
+        if not text and ref is not None:  # the XSD's PointType: a reference to a CgPoint instead of coordinates
+            if ref not in self.cg_points or not self.cg_points[ref]:
+                raise ValueError(f"{where}: <{name} pntRef={ref!r}> names no CgPoint with coordinates in the file")
+            text = self.cg_points[ref]
         if not text:
             return None
         parts = text.split()
@@ -212,10 +253,10 @@ class _Reader:
 
     def angle(self, element: ET.Element, name: str, where: str) -> float:
         """An angle attribute (``angularUnit``) in radians."""
-        return self.direction(element, name, where, self.angular_unit) or 0.0
+        return self.raw_direction(element, name, where, self.angular_unit) or 0.0
 
-    def direction(self, element: ET.Element, name: str, where: str, unit: str | None = None) -> float | None:
-        """A direction attribute (``directionUnit``) in radians, counter-clockwise from east; None if absent."""
+    def raw_direction(self, element: ET.Element, name: str, where: str, unit: str | None = None) -> float | None:
+        """A direction attribute (``directionUnit``) in radians as the file counts it; None if absent."""
         text = element.get(name)
         if text is None:
             return None
@@ -226,6 +267,24 @@ class _Reader:
         if not math.isfinite(angle):
             raise ValueError(f"{where}: {name}={text!r} is not finite")
         return angle
+
+    def direction(self, element: ET.Element, name: str, where: str) -> float | None:
+        """A direction attribute in radians counter-clockwise from east (our heading), converted from the
+        file's convention (``directions``); None if absent.
+
+        Raises:
+            ValueError: the file gives no evidence of its convention (naming the element).
+        """
+        raw = self.raw_direction(element, name, where)
+        if raw is None:
+            return None
+        if self.directions == "unknown":
+            raise ValueError(f"{where}: the element is placed only by its {name}, and no element of the file has both a "
+                             "direction and the points it joins, so whether directions count counter-clockwise from east "
+                             "or clockwise from north (the XSD's '0 degrees = north') cannot be told; choose with "
+                             "read_landxml(directions='east-ccw' or 'north-cw') or build --directions")  # fmt: skip
+        self.used += 1
+        return raw if self.directions == "east-ccw" else math.pi / 2 - raw
 
 
 def _curvature(sign: float, radius: float, where: str) -> float:
@@ -294,6 +353,78 @@ def _spirals(length: float, k0: float, k1: float, shape: str, theta: float | Non
     return [backwards]
 
 
+#: The conventions of LandXML directions: counter-clockwise from east (Civil 3D, Carlson, this package's
+#: writer) and clockwise from north (azimuths, the XSD's "0 degrees = north": MDT, Novapoint, others).
+DIRECTIONS = ("east-ccw", "north-cw")
+#: A direction agrees with its element's points within this (rad), and disagrees beyond ``_APART``:
+#: between the two an element near the 45° diagonal tells nothing (both conventions give its direction).
+_AGREE, _APART = 0.01, 0.05
+
+
+def _clues(r: _Reader, e: ET.Element, where: str) -> list[tuple[float, float, str]]:
+    """What an element tells of the file's direction convention: (its direction as the file counts it,
+    the heading its points give, the attribute) for each direction it has with the points to check it."""
+    kind = _local(e.tag)
+    if kind not in ("Line", "Curve", "Spiral"):
+        return []
+    start, end = r.point(e, "Start", where), r.point(e, "End", where)
+    out: list[tuple[float, float, str]] = []
+
+    def clue(name: str, a: NDArray | None, b: NDArray | None, turn: float = 0.0) -> None:
+        raw = r.raw_direction(e, name, where)
+        if raw is not None and a is not None and b is not None and np.any(a != b):
+            out.append((raw, _heading(b - a) + turn, name))
+
+    if kind == "Line":
+        clue("dir", start, end)
+        return out
+    pi, center = r.point(e, "PI", where), r.point(e, "Center", where)
+    clue("dirStart", start, pi)  # the PI is where the end tangents meet
+    clue("dirEnd", pi, end)
+    if kind == "Curve" and center is not None and e.get("rot") in ("cw", "ccw"):
+        quarter = math.pi / 2 if e.get("rot") == "ccw" else -math.pi / 2  # the tangent is the radius turned a quarter
+        clue("dirStart", center, start, quarter)
+        clue("dirEnd", center, end, quarter)
+    return out
+
+
+def _convention(r: _Reader, alignments: list[ET.Element]) -> None:
+    """Set ``r.directions`` from the file's own evidence: every direction whose element also has the
+    points it joins (a Line's Start→End, a Curve's or Spiral's Start→PI→End, a Curve's Center) agrees
+    with the points counted one way or the other.
+
+    Raises:
+        ValueError: some directions agree only counted from east and others only from north (naming one of each).
+    """
+    found: dict[str, list[str]] = {"east-ccw": [], "north-cw": []}
+    for k, a in enumerate(alignments):
+        geometry = _child(a, "CoordGeom")
+        for index, e in enumerate(() if geometry is None else geometry):
+            if not isinstance(e.tag, str):
+                continue
+            where = f"alignment {a.get('name', f'alignment {k + 1}')!r}, CoordGeom element {index} ({_local(e.tag)})"
+            try:
+                clues = _clues(r, e, where)
+            except ValueError:  # a malformed element tells nothing here; the read names it with its station
+                continue
+            for raw, heading, name in clues:
+                off_east = abs(math.remainder(raw - heading, 2.0 * math.pi))
+                off_north = abs(math.remainder(math.pi / 2 - raw - heading, 2.0 * math.pi))
+                if off_east < _AGREE and off_north > _APART:
+                    found["east-ccw"].append(f"{where} {name}")
+                elif off_north < _AGREE and off_east > _APART:
+                    found["north-cw"].append(f"{where} {name}")
+    east, north = found["east-ccw"], found["north-cw"]
+    if east and north:
+        raise ValueError(f"the file's directions are inconsistent: {east[0]} agrees with its points counted "
+                         f"counter-clockwise from east ({len(east)} such), {north[0]} only counted clockwise from north "
+                         f"({len(north)} such); choose with read_landxml(directions='east-ccw' or 'north-cw') or build --directions")  # fmt: skip
+    if east or north:
+        r.directions = "east-ccw" if east else "north-cw"
+        r.evidence = (f"{len(east or north)} direction(s) of the file agree with their points only counted "
+                      + ("counter-clockwise from east" if east else "clockwise from north"))  # fmt: skip
+
+
 @dataclass
 class _Element:
     kind: str
@@ -307,6 +438,7 @@ class _Element:
     theta: float | None = None
     where: str = ""
     notes: list[str] = field(default_factory=list)
+    cubic: BezierSpiral | None = None  # our very cubic, where this package wrote the spiral (its Feature)
 
 
 def _element(r: _Reader, e: ET.Element, where: str) -> _Element:
@@ -332,6 +464,8 @@ def _element(r: _Reader, e: ET.Element, where: str) -> _Element:
         radius = r.number(e, "radius", where, 0.0) or (
             float(np.hypot(*(start - center))) if start is not None and center is not None else 0.0
         )
+        if math.isinf(radius):  # a Curve is an arc: INF would silently make it a line
+            raise ValueError(f"{where}: a Curve's radius {e.get('radius')!r} is not finite")
         if not radius > 0.0:
             raise ValueError(f"{where}: a Curve needs a radius (or Start and Center)")
         heading = None
@@ -343,6 +477,8 @@ def _element(r: _Reader, e: ET.Element, where: str) -> _Element:
             length = r.number(e, "length", where)
         elif e.get("chord") is not None:  # chord-defined: the minor arc unless delta says more
             chord = r.number(e, "chord", where)
+            if not 0.0 < chord <= 2.0 * radius * (1.0 + 1e-9):  # beyond the diameter (up to its rounding) no arc has it
+                raise ValueError(f"{where}: chord {chord:.6g} is not in (0, 2 × radius {radius:.6g}]")
             length = 2.0 * radius * math.asin(min(1.0, chord / (2.0 * radius)))
             if e.get("delta") is not None and abs(r.angle(e, "delta", where)) > math.pi:
                 length = 2.0 * math.pi * radius - length
@@ -353,28 +489,64 @@ def _element(r: _Reader, e: ET.Element, where: str) -> _Element:
             raise ValueError(f"{where}: a Curve needs a length, a chord or Start, Center and End")
         return _Element(kind, start, heading, length, _curvature(sign, radius, where), _curvature(sign, radius, where), station, r.shape)
     if kind == "Spiral":
-        spi = e.get("spiType", "clothoid")
+        spi = e.get("spiType")
+        if spi is None:  # required by the XSD and written by every exporter we have seen: not guessed
+            raise ValueError(f"{where}: a Spiral needs spiType (required by LandXML; only clothoids can be rebuilt)")
         if spi != "clothoid":
             raise ValueError(f"{where}: spiral type {spi!r} is not a clothoid; only clothoids can be rebuilt")
         rot = e.get("rot")
         if rot not in ("cw", "ccw"):
             raise ValueError(f"{where}: Spiral rot {rot!r} is not cw or ccw")
         sign = 1.0 if rot == "ccw" else -1.0
-        k0, k1 = (0.0 if (radius := r.number(e, name, where, math.inf)) in (0.0, math.inf) else _curvature(sign, radius, where)
+        for name in ("radiusStart", "radiusEnd"):  # required by the XSD: a missing one is not taken as straight
+            if e.get(name) is None:
+                raise ValueError(f"{where}: a Spiral needs {name} (INF where straight)")
+        k0, k1 = (0.0 if (radius := r.number(e, name, where)) in (0.0, math.inf) else _curvature(sign, radius, where)
                   for name in ("radiusStart", "radiusEnd"))  # fmt: skip
-        heading = r.direction(e, "dirStart", where)
-        if heading is None and start is not None:
-            pi = r.point(e, "PI", where)
-            if pi is not None and np.any(pi != start):
-                heading = _heading(pi - start)
+        pi = r.point(e, "PI", where)
+        heading = None
+        if e.get("dirStart") is not None and (r.directions != "unknown" or pi is None or start is None):
+            heading = r.direction(e, "dirStart", where)
+        elif start is not None and pi is not None and np.any(pi != start):
+            heading = _heading(pi - start)
         shape = r.shape
         desc = e.get("desc", "")
         if desc.startswith(DESC_PREFIX):
             found = re.search(r"\(shape ([a-z0-9-]+)\)", desc)
             if found and found.group(1) in SHAPE_CODES:
                 shape = found.group(1)
-        return _Element(kind, start, heading, r.number(e, "length", where), k0, k1, station, shape)
+        item = _Element(kind, start, heading, r.number(e, "length", where), k0, k1, station, shape)
+        item.cubic = _our_cubic(r, e, item, shape, end, where)
+        return item
     raise ValueError(f"{where}: {kind} cannot be represented as a G2 chain of lines, arcs and spirals")
+
+
+def _our_cubic(r: _Reader, e: ET.Element, item: _Element, shape: str, end: NDArray | None, where: str) -> BezierSpiral | None:
+    """The cubic this package wrote for a Spiral (its ``Feature name="spiral_cad"``), if it is still the
+    element's: it starts at Start, ends at End and has the element's length and end curvatures."""
+    feature = next((f for f in _children(e, "Feature") if f.get("name") == FEATURE), None)
+    value = None if feature is None else next((p.get("value") for p in _children(feature, "Property")
+                                               if p.get("label") == "controlPoints"), None)  # fmt: skip
+    if value is None:
+        return None
+    try:
+        numbers = np.array([float(v) for v in value.split()]) * r.scale
+        cubic = BezierSpiral.from_control_points(numbers.reshape(4, 2)[:, ::-1], shape)  # northing easting → x, y
+    except ValueError:
+        item.notes.append(f"{where}: the spiral_cad control points {value!r} are not 8 numbers of a spiral; not used")
+        return None
+    size = max(item.length, 1e-300)
+    near = 1e-9 * size
+    same = (
+        (item.start is None or math.dist(cubic.start[:2], item.start) <= near)
+        and (end is None or math.dist(cubic.end[:2], end) <= near)
+        and abs(cubic.length - item.length) <= near
+        and all(abs(a - b) * size <= 1e-6 for a, b in ((cubic.start_curvature, item.k0), (cubic.end_curvature, item.k1)))
+    )
+    if not same:
+        item.notes.append(f"{where}: the spiral_cad control points do not fit the element (edited since?); not used")
+        return None
+    return cubic
 
 
 def _segments(item: _Element, point: NDArray, heading: float) -> list[Segment]:
@@ -534,6 +706,11 @@ def _run(items: list[_Element], mine: list[int], starts: list[NDArray], headings
         if len(ks) == 1 and entry.curvature * exit_.curvature > 0.0:  # a compound clothoid: through a middle circle if need be
             attempts += [(shape, "middle", nearness) for nearness in _NEARNESS for shape in shapes]
         lone = pending is None and after is None  # no line or arc of the file to keep: its own length is nearer
+        if all(items[k].cubic is not None for k in ks):  # our own spirals: the very cubics, nothing to solve
+            candidates.append(
+                ("spiral_cad cubic", items[ks[0]].shape, [(i, cubic) for i, k in enumerate(ks) if (cubic := items[k].cubic) is not None])
+            )
+            attempts = []
         for shape, how, value in attempts if placement == "neighbours" and not lone else ():
             try:
                 if how == "one":
@@ -611,6 +788,7 @@ def _alignment(r: _Reader, a: ET.Element, label: str) -> LandXMLAlignment:
                          "only CoordGeom alignments can be rebuilt")  # fmt: skip
     items: list[_Element] = []
     skipped: list[str] = []
+    r.used = 0
     station = start_station
     for index, e in enumerate(geometry):
         if not isinstance(e.tag, str):
@@ -682,15 +860,30 @@ def _alignment(r: _Reader, a: ET.Element, label: str) -> LandXMLAlignment:
         offsets = fit_offsets(chains, owners, *file, run_of)
     except ValueError as e:
         raise ValueError(f"{where}: {e}") from None
+    limits = MAX_OFFSET_FRACTION * size if r.max_offset is None else np.full(len(size), r.max_offset)
+    # a spiral this package wrote is the very cubic of its Feature: its offset from the clothoid its
+    # attributes describe is reported, not refused
+    limits[[k for k in range(len(items)) if methods.get(k) == "spiral_cad cubic"]] = np.inf
+    over = np.flatnonzero(offsets > limits)
+    if len(over):  # a clothoid none of our spirals follows: refused rather than silently metres away
+        with np.errstate(divide="ignore", over="ignore", invalid="ignore"):  # a limit may underflow to 0
+            k = int(over[np.argmax(offsets[over] / limits[over])])
+        limit = (f"{MAX_OFFSET_FRACTION:g} of its length {size[k]:.6g}" if r.max_offset is None
+                 else f"max_offset {r.max_offset:.6g}")  # fmt: skip
+        raise ValueError(f"{items[k].where}: ours lies {offsets[k]:.3g} {r.units} from the file's element, more than "
+                         f"{limit} ({len(over)} element(s) beyond; max_offset=math.inf, or build --max-offset inf, accepts them)")  # fmt: skip
     ours = np.zeros(len(items))
     for chain, held in zip(chains, owners):
         np.add.at(ours, held, chain.lengths)
     profile, notes = _profile(r, a, where)
+    if r.used:  # the directions placed elements: say how they were counted
+        how = "counter-clockwise from east" if r.directions == "east-ccw" else "clockwise from north"
+        notes = (f"{where}: {r.used} direction(s) placed elements, counted {how} ({r.evidence or 'as chosen'})", *notes)
     notes = (*skipped, *(note for item in items for note in item.notes), *notes)
     return LandXMLAlignment(name, tuple(chains), tuple(breaks), start_station, r.units, profile, offsets, tuple(i.kind for i in items),
                             start_station + np.concatenate([[0.0], np.cumsum(ours)[:-1]]), notes,
                             np.array([i.station for i in items]), ours - size,
-                            tuple(methods.get(k, "file") for k in range(len(items))), tuple(owners))  # fmt: skip
+                            tuple(methods.get(k, "file") for k in range(len(items))), tuple(owners), r.directions, size)  # fmt: skip
 
 
 def _profile(r: _Reader, a: ET.Element, where: str) -> tuple[Any, tuple[str, ...]]:
@@ -730,7 +923,8 @@ def _profile(r: _Reader, a: ET.Element, where: str) -> tuple[Any, tuple[str, ...
     return profile, tuple(notes)
 
 
-def read_landxml(source: str | os.PathLike, shape: str = "near-linear", placement: str = "neighbours") -> list[LandXMLAlignment]:
+def read_landxml(source: str | os.PathLike, shape: str = "near-linear", placement: str = "neighbours",
+                 directions: str = "auto", max_offset: float | None = None) -> list[LandXMLAlignment]:  # fmt: skip
     """Every alignment of a LandXML file (a path, or the document's text) rebuilt as our G2 chain.
 
     Args:
@@ -741,18 +935,34 @@ def read_landxml(source: str | os.PathLike, shape: str = "near-linear", placemen
             clothoids replaced by our transition between the same neighbours,
             see ``spiral_cad.io.landxml_fit``) or ``"length"`` (every clothoid
             rebuilt with its own length and end curvatures, continuing from the element before).
+        directions: how the file counts its directions: ``"auto"`` (inferred from
+            the elements that have both a direction and the points it joins — a
+            Line's Start→End, a Curve's Center or PI, a Spiral's PI), ``"east-ccw"``
+            (counter-clockwise from east: Civil 3D, Carlson) or ``"north-cw"``
+            (clockwise from north, the XSD's "0 degrees = north": MDT, Novapoint).
+        max_offset: the largest offset (in the result's ``units``) accepted between
+            the file's element and ours; None: ``MAX_OFFSET_FRACTION`` of each
+            element's length; ``math.inf`` accepts any.
 
     Returns:
         One ``LandXMLAlignment`` per ``<Alignment>`` in file order.
 
     Raises:
-        ValueError: not LandXML, no alignment, or an element that cannot be
-            represented (named with its index, station and alignment).
+        ValueError: not LandXML, no alignment, an element that cannot be
+            represented (named with its index, station and alignment), directions
+            that agree with their points one way in some elements and the other
+            way in others, or (``"auto"``) an element placed only by its direction
+            in a file whose convention cannot be told, or an element ours lies
+            farther from than ``max_offset`` (naming the farthest).
     """
     if shape not in ("near-linear", "walton-meek"):
         raise ValueError(f"shape must be 'near-linear' or 'walton-meek'; got {shape!r}")
     if placement not in ("neighbours", "length"):
         raise ValueError(f"placement must be 'neighbours' or 'length'; got {placement!r}")
+    if max_offset is not None and not max_offset >= 0.0:
+        raise ValueError(f"max_offset must be a length >= 0 (or None); got {max_offset!r}")
+    if directions not in ("auto", *DIRECTIONS):
+        raise ValueError(f"directions must be 'auto', 'east-ccw' or 'north-cw'; got {directions!r}")
     text = os.fspath(source)
     try:
         root = ET.fromstring(text) if text.lstrip().startswith("<") else ET.parse(text).getroot()
@@ -761,7 +971,12 @@ def read_landxml(source: str | os.PathLike, shape: str = "near-linear", placemen
     if _local(root.tag) != "LandXML":
         raise ValueError(f"not a LandXML document (root element {_local(root.tag)!r})")
     reader = _Reader(root, shape, placement)
+    reader.max_offset = None if max_offset is None else float(max_offset)
     alignments = [a for group in _children(root, "Alignments") for a in _children(group, "Alignment")]
     if not alignments:
         raise ValueError("the LandXML document holds no Alignment")
+    if directions == "auto":
+        _convention(reader, alignments)
+    else:
+        reader.directions = directions
     return [_alignment(reader, a, f"alignment {k + 1}") for k, a in enumerate(alignments)]

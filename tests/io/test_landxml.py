@@ -133,7 +133,7 @@ def test_spiral_between_two_radii_and_spiral_to_spiral():
         "<Start>0 0</Start><PI/><End/></Spiral>"
         '<Spiral length="60" radiusStart="200" radiusEnd="INF" rot="ccw" spiType="clothoid"><Start/><PI/><End/></Spiral>'
     )
-    (r,) = read_landxml(head + body + "</CoordGeom></Alignment></Alignments></LandXML>")
+    (r,) = read_landxml(head + body + "</CoordGeom></Alignment></Alignments></LandXML>", directions="east-ccw")
     first = r.chain.segments[0]
     assert first.start_curvature == pytest.approx(1 / 400, rel=1e-9) and first.end_curvature == pytest.approx(1 / 200, rel=1e-9)
     assert first.length == pytest.approx(80, rel=1e-9)
@@ -169,7 +169,7 @@ def test_chord_defined_curve_and_directions_in_degrees_minutes_seconds():
             '<Line dir="30.1536" length="50"><Start>10 20</Start></Line>'
             '<Curve rot="ccw" radius="100" chord="60"><Start/></Curve>'
             "</CoordGeom></Alignment></Alignments></LandXML>")  # fmt: skip
-    (r,) = read_landxml(text)
+    (r,) = read_landxml(text, directions="east-ccw")  # placed by dir alone: the file cannot tell its convention
     line, arc = (chain.segments[0] for chain in r.chains)
     heading = math.degrees(math.atan2(line.start_tangent[1], line.start_tangent[0]))
     assert heading == pytest.approx(30 + 15 / 60 + 36 / 3600, abs=1e-12)
