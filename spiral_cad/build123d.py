@@ -520,7 +520,7 @@ def g2_slab(
         outline: a ``ContinuousRectangle``/``ContinuousPolygon``/``ContinuousSlot``, a
             closed ``Chain``, a ``FilletedPath`` or segments (in the XY plane), or a
             planar face, one-face sketch or closed wire of lines, arcs and cubic Bézier
-            spirals (``g2_fillet`` output) lying in the XY plane.
+            spirals (``g2_fillet`` output; a builder's cubic B-spline edges are read as their Bézier spans) lying in the XY plane.
         height: the part's height.
         edge_radius: the roll's smallest radius of curvature.
         top, bottom: roll the top / bottom edge. Default True.
@@ -529,7 +529,7 @@ def g2_slab(
         tolerance: the largest deviation of a sweep over a spiral (default 1e-7 × size).
 
     Raises:
-        ValueError: malformed input.
+        ValueError: malformed input, or a face with holes (one outline is rolled; cut holes afterwards).
         NoSolutionError: the roll does not fit (named, with what would fit).
     """
     if isinstance(outline, Sketch) and not hasattr(outline, "filleted"):
@@ -544,9 +544,15 @@ def g2_slab(
 
 
 def _plane_outline(shape: Face | Wire) -> list[Segment]:
-    """The outer wire of a face (or a closed wire) in the XY plane as segments."""
+    """The outline of a face without holes (or of a closed wire) in the XY plane as segments."""
     from .cad.fillet import wire_path
 
+    holes = len(shape.inner_wires()) if isinstance(shape, Face) else 0
+    if holes:  # the solid would silently be the outer outline's: a different volume
+        raise ValueError(
+            f"the face has {holes} hole{'s' if holes > 1 else ''}; g2_slab rolls one outline: make the slab of the "
+            "outer outline and cut the holes from it afterwards (their rims stay sharp)"
+        )
     wire = shape.outer_wire() if isinstance(shape, Face) else shape
     if any(abs(v.Z) > 1e-9 * max(1.0, wire.bounding_box().diagonal) for v in wire.vertices()):
         raise ValueError("g2_slab takes an outline in the XY plane (z = 0)")

@@ -18,13 +18,13 @@ import textwrap
 import mpmath as mp
 import numpy as np
 import pytest
-from build123d import Align, Axis, Box, BuildPart, BuildSketch, Cone, Cylinder, Part, Polygon, Rectangle, extrude, fillet
+from build123d import Align, Axis, Box, BuildPart, BuildSketch, Cone, Cylinder, Mode, Part, Polygon, Rectangle, extrude, fillet
 from helpers import freecad_lib
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 from OCP.BRep import BRep_Tool
 from OCP.BRepAdaptor import BRepAdaptor_Curve, BRepAdaptor_Curve2d
-from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeVertex
+from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeEdge, BRepBuilderAPI_MakeVertex
 from OCP.BRepCheck import BRepCheck_Analyzer
 from OCP.BRepExtrema import BRepExtrema_DistShapeShape
 from OCP.BRepGProp import BRepGProp
@@ -41,7 +41,7 @@ from OCP.TopoDS import TopoDS
 from OCP.TopTools import TopTools_IndexedDataMapOfShapeListOfShape
 
 from spiral_cad import Arc, Line
-from spiral_cad.build123d import ContinuousBox, ContinuousRectangle, g2_fillet, g2_slab
+from spiral_cad.build123d import ContinuousBox, ContinuousPolygon, ContinuousRectangle, g2_fillet, g2_slab
 from spiral_cad.cad.export import export_step
 from spiral_cad.cad.solids import g2_slab as occ_slab
 from spiral_cad.cad.solids import roll_profile
@@ -470,3 +470,36 @@ def test_side_edges_of_a_concave_prism_round_to_the_extruded_2d_g2_corners():
     plan = fillet_path([*l_shape, l_shape[0]], 2, closed=True)
     area, _ = _outline_integrals(list(plan.segments))
     assert _props(rounded.wrapped)[0] == pytest.approx(6 * area, rel=1e-9)
+
+
+def test_a_face_with_a_hole_is_refused_by_name_not_rolled_without_it():
+    with BuildSketch() as sketch:
+        Rectangle(40, 20)
+        Rectangle(20, 4, mode=Mode.SUBTRACT)
+    face = g2_fillet(sketch.sketch, 1)
+    assert len(face.faces()[0].inner_wires()) == 1
+    with pytest.raises(ValueError, match=r"the face has 1 hole; g2_slab rolls one outline"):
+        g2_slab(face, 5, 0.5)
+    with pytest.raises(ValueError, match=r"has 1 hole"):
+        g2_slab(face.faces()[0], 5, 0.5)
+
+
+def test_a_builder_sketch_whose_spiral_pairs_were_merged_into_b_splines_makes_the_same_slab():
+    with BuildSketch() as sketch:
+        ContinuousPolygon(12, 6, corner_radius=3, transition=1.0)
+    kinds = {e.geom_type.name for e in sketch.sketch.edges()}
+    assert "BSPLINE" in kinds  # the builder joined each spiral pair: what is read back here
+    direct = g2_slab(ContinuousPolygon(12, 6, corner_radius=3, transition=1.0), 5, 0.8)
+    built = g2_slab(sketch.sketch, 5, 0.8)
+    _assert_one_valid_solid(built.wrapped)
+    assert _props(built.wrapped)[0] == pytest.approx(_props(direct.wrapped)[0], rel=1e-12)
+    assert _props(built.wrapped)[1] == pytest.approx(_props(direct.wrapped)[1], rel=1e-12)
+    from build123d import Edge as B3dEdge
+    from build123d import Wire as B3dWire
+    from OCP.GC import GC_MakeCircle
+    from OCP.GeomConvert import GeomConvert
+
+    rational = GeomConvert.CurveToBSplineCurve_s(GC_MakeCircle(gp_Pnt(0, 0, 0), gp_Dir(0, 0, 1), 5.0).Value())
+    circle = B3dWire([B3dEdge(BRepBuilderAPI_MakeEdge(rational).Edge())])
+    with pytest.raises(ValueError, match=r"edge 0 is a BSPLINE curve that is not joined cubic Bézier spans .*pass the"):
+        g2_slab(circle, 1, 0.1)
