@@ -62,6 +62,7 @@ from OCP.TColgp import TColgp_Array1OfPnt, TColgp_Array2OfPnt
 from OCP.TColStd import TColStd_Array1OfInteger, TColStd_Array1OfReal, TColStd_Array2OfReal
 from OCP.TopAbs import TopAbs_EDGE, TopAbs_FACE, TopAbs_SHELL, TopAbs_SOLID, TopAbs_WIRE
 from OCP.TopExp import TopExp, TopExp_Explorer
+from OCP.TopLoc import TopLoc_Location
 from OCP.TopoDS import TopoDS, TopoDS_Edge, TopoDS_Face, TopoDS_Shape, TopoDS_Solid
 from OCP.TopTools import TopTools_IndexedDataMapOfShapeListOfShape
 
@@ -86,6 +87,7 @@ __all__ = [
     "g2_slab",
     "outline_segments",
     "expected_level",
+    "recorded_approximation",
     "roll_profile",
     "verify_faces",
     "verify_solid",
@@ -101,6 +103,10 @@ _MAX_SPANS = 256
 _CORNER_TOL = 1e-7
 #: Samples per Hermite span when measuring |Ñ − N|.
 _SAMPLES = 48
+#: Surfaces made here, by their shape's fingerprint (``_fingerprint``): the deviation of each from the exact sweep.
+_RECORDED: dict[bytes, float] = {}
+#: Most fingerprints kept (the oldest are forgotten first).
+_RECORD_LIMIT = 100_000
 
 
 @dataclass(frozen=True)
@@ -375,6 +381,50 @@ def _cap(alongs: list[_Along], w: float, z: float) -> TopoDS_Face:
     return BRepBuilderAPI_MakeFace(gp_Pln(gp_Pnt(0.0, 0.0, z), gp_Dir(0.0, 0.0, 1.0)), wire.Wire()).Face()
 
 
+# ------------------------------------------------------------------ what parts made of slabs carry
+
+
+def _fingerprint(face: TopoDS_Face) -> bytes | None:
+    """A B-spline surface's shape, unchanged by rigid motions and copies: degrees, knots, weights and the
+    distances of its poles from its two corner poles (relative, 9 digits); None for other surfaces."""
+    surface = BRep_Tool.Surface_s(face, TopLoc_Location())  # without the face's placement
+    if not isinstance(surface, Geom_BSplineSurface):
+        return None
+    rows, cols = surface.NbUPoles(), surface.NbVPoles()
+    poles = np.array([[surface.Pole(i, j).Coord() for j in range(1, cols + 1)] for i in range(1, rows + 1)])
+    poles = poles.reshape(-1, 3)
+    distances = np.concatenate([np.linalg.norm(poles - poles[0], axis=1), np.linalg.norm(poles - poles[-1], axis=1)])
+    scale = float(distances.max()) or 1.0
+    weights = [surface.Weight(i, j) for i in range(1, rows + 1) for j in range(1, cols + 1)]
+    knots = [surface.UKnot(k) for k in range(1, surface.NbUKnots() + 1)] + [surface.VKnot(k) for k in range(1, surface.NbVKnots() + 1)]
+    numbers = np.concatenate([[surface.UDegree(), surface.VDegree(), rows, cols], knots, weights, distances / scale])
+    return np.round(numbers, 9).tobytes() + np.float64(f"{scale:.9g}").tobytes()
+
+
+def _record(face: TopoDS_Face, deviation: float) -> None:
+    key = _fingerprint(face)
+    if key is None:
+        return
+    _RECORDED[key] = max(deviation, _RECORDED.pop(key, 0.0))
+    while len(_RECORDED) > _RECORD_LIMIT:
+        del _RECORDED[next(iter(_RECORDED))]
+
+
+def recorded_approximation(shape: TopoDS_Shape) -> float | None:
+    """The largest deviation from the exact sweep of the faces of ``shape`` that are surfaces of G2 slabs
+    made in this process (``g2_slab``, ``ContinuousBox``, ``g2_fillet`` of cap edges), or None when it
+    has none.
+
+    Faces are recognised by their surface's shape (degrees, knots, weights, the poles' distances), so
+    they are found in a part the slab was added to in ``BuildPart``, moved, copied or cut by a
+    boolean that trims but keeps their surfaces; a scaled copy, or a surface rebuilt by another
+    operation, is not recognised.
+    """
+    found = [_RECORDED.get(key) for face in _faces_of(shape) if (key := _fingerprint(face)) is not None]
+    known = [value for value in found if value is not None]
+    return max(known) if known else None
+
+
 # ------------------------------------------------------------------ input and fit
 
 
@@ -636,6 +686,8 @@ def g2_slab(
     sections = _sections(roll, d_top, d_bottom, height)
     degenerate = 1e-9 * size
     faces = [_surface_face(a, sec, degenerate) for a in alongs for sec in sections]
+    for k, face in enumerate(faces):  # so export_step finds the note on parts built from this solid
+        _record(face, reach_max * alongs[k // len(sections)].deviation)
     faces.append(_cap(alongs, d_top, height))
     faces.append(_cap(alongs, d_bottom, 0.0))
     solid = _solid(faces, 1e-7 * size)

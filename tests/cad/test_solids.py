@@ -18,7 +18,7 @@ import textwrap
 import mpmath as mp
 import numpy as np
 import pytest
-from build123d import Align, Axis, Box, BuildPart, BuildSketch, Cone, Cylinder, Mode, Part, Polygon, Rectangle, extrude, fillet
+from build123d import Align, Axis, Box, BuildPart, BuildSketch, Cone, Cylinder, Location, Mode, Part, Polygon, Rectangle, extrude, fillet
 from helpers import freecad_lib
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
@@ -503,3 +503,23 @@ def test_a_builder_sketch_whose_spiral_pairs_were_merged_into_b_splines_makes_th
     circle = B3dWire([B3dEdge(BRepBuilderAPI_MakeEdge(rational).Edge())])
     with pytest.raises(ValueError, match=r"edge 0 is a BSPLINE curve that is not joined cubic Bézier spans .*pass the"):
         g2_slab(circle, 1, 0.1)
+
+
+def _description(path) -> str:
+    text = path.read_text()
+    return text[text.index("FILE_DESCRIPTION") : text.index("FILE_NAME")]
+
+
+def test_the_step_note_survives_build_part_moves_and_booleans_and_is_absent_from_other_parts(tmp_path):
+    box = ContinuousBox(40, 20, 8, 6, edge_radius=1.5)
+    note = f"approximated within {box.approximation:.3g}"
+    with BuildPart() as builder:
+        ContinuousBox(40, 20, 8, 6, edge_radius=1.5)
+    assert not hasattr(builder.part, "approximation")
+    cut = box - Cylinder(3, 30)
+    moved = builder.part.moved(Location((100, -50, 7), (0, 0, 1), 33))
+    for name, part in {"builder": builder.part, "cut": cut, "moved": moved}.items():
+        export_step(part, tmp_path / f"{name}.step")
+        assert note in _description(tmp_path / f"{name}.step"), name
+    export_step(Box(4, 4, 4) - Cylinder(1, 5), tmp_path / "plain.step")
+    assert "spiral_cad G2 solid" not in _description(tmp_path / "plain.step")
