@@ -30,7 +30,7 @@ closed solid) before anything is returned.
 from __future__ import annotations
 
 import math
-from collections.abc import Iterable, Sequence
+from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass
 from typing import Any
 
@@ -87,6 +87,8 @@ __all__ = [
     "g2_slab",
     "outline_segments",
     "expected_level",
+    "plan_radius",
+    "PLAN_OVER_REACH",
     "recorded_approximation",
     "roll_profile",
     "verify_faces",
@@ -489,10 +491,9 @@ def _crossing(polygon: NDArray[np.float64]) -> NDArray[np.float64] | None:
     return result
 
 
-def _check_fit(segments: list[Segment], sigma: float, roll: float, given: Any, name: str) -> None:
-    """NoSolutionError unless a roll ``roll`` wide fits inside the outline: below every convex radius of
-    curvature (equal only on arcs: a clean pole) and with an inner offset that does not cross itself."""
-    radius = float(given)
+def _fit_problem(segments: list[Segment], sigma: float, roll: float, given: Any, name: str) -> str | None:
+    """Why a roll ``roll`` wide does not fit inside the outline, or None: it must stay below every convex
+    radius of curvature (equal only on arcs: a clean pole) and its inner offset must not cross itself."""
     for index, segment in enumerate(segments):
         u = np.linspace(0.0, 1.0, 65)
         bend = float(np.max(sigma * np.broadcast_to(segment.curvature(u), u.shape)))
@@ -501,23 +502,64 @@ def _check_fit(segments: list[Segment], sigma: float, roll: float, given: Any, n
         product = roll * bend
         exact_pole = isinstance(segment, Arc) and abs(product - 1.0) <= 1e-12
         if product > 1.0 - _FIT_SLACK and not exact_pole:
-            raise NoSolutionError(
+            return (
                 f"{name} {shown(given)} gives a roll {roll:.6g} wide, not below the outline's smallest convex radius "
                 f"of curvature {1.0 / bend:.6g} (segment {index}, a {type(segment).__name__}): the inner offset "
-                f"would fold; {name} below {radius / product:.6g} fits"
+                "would fold"
             )
     points, normals, _ = _samples(segments)
     place = _crossing(points + sigma * roll * normals)
     if place is not None:
-        low, high = 0.0, roll  # the widest roll whose offset stays simple, for the message
-        for _ in range(30):
-            mid = 0.5 * (low + high)
-            low, high = (mid, high) if _crossing(points + sigma * mid * normals) is None else (low, mid)
-        raise NoSolutionError(
+        return (
             f"{name} {shown(given)} gives a roll {roll:.6g} wide whose inner offset crosses itself near "
-            f"({place[0]:.6g}, {place[1]:.6g}): the outline is too narrow there; {name} below "
-            f"{radius * low / roll:.6g} fits"
+            f"({place[0]:.6g}, {place[1]:.6g}): the outline is too narrow there"
         )
+    return None
+
+
+def _inward(segments: list[Segment]) -> float:
+    """+1 when the outline runs counterclockwise (its inward normal is the left one), else −1."""
+    points, _, _ = _samples(segments)
+    area = 0.5 * float(np.sum(points[:, 0] * np.roll(points[:, 1], -1) - np.roll(points[:, 0], -1) * points[:, 1]))
+    return 1.0 if area > 0.0 else -1.0
+
+
+def _roll_problem(segments: list[Segment], height: float, edge_radius: Any, given_height: Any, name: str,
+                  **options: Any) -> str | None:  # fmt: skip
+    """Why rolls of ``edge_radius`` (``options``: top, bottom, profile, transition, shape) do not fit the
+    outline and the height, or None."""
+    top, bottom = options.pop("top"), options.pop("bottom")
+    reach = float(roll_profile(float(edge_radius), **options)[-1].end[0])
+    d_top, d_bottom = (reach if top else 0.0), (reach if bottom else 0.0)
+    if d_top + d_bottom > height * (1.0 + _FIT_SLACK):
+        return (
+            f"{name} {shown(edge_radius)} gives rolls {reach:.6g} high; {'together they' if top and bottom else 'it'} "
+            f"exceed height {shown(given_height)}"
+        )
+    if max(d_top, d_bottom) == 0.0:
+        return None
+    return _fit_problem(segments, _inward(segments), min(max(d_top, d_bottom), height), edge_radius, name)
+
+
+def _largest(fits: Callable[[float], bool], upper: float) -> float | None:
+    """The largest value in (0, upper) for which ``fits`` holds (bisection; it must hold below it), rounded
+    down to 6 significant digits and checked itself, or None."""
+    low, high = 0.0, upper
+    for _ in range(60):
+        mid = 0.5 * (low + high)
+        low, high = (mid, high) if fits(mid) else (low, mid)
+    if not low > 0.0:
+        return None
+    step = 10.0 ** (math.floor(math.log10(low)) - 5)
+    for k in range(3):  # rounding down may still land on a value that fails: a step further
+        value = float(f"{(math.floor(low / step) - k) * step:.6g}")
+        if value > 0.0 and fits(value):
+            return value
+    return None
+
+
+def _refusal(problem: str, name: str, fits: float | None) -> NoSolutionError:
+    return NoSolutionError(f"{problem}; {name} up to {fits:.6g} fits" if fits is not None else f"{problem}; no {name} fits")
 
 
 # ------------------------------------------------------------------ the solid
@@ -661,24 +703,21 @@ def g2_slab(
     given_height, height = height, as_float(height, "height")
     if not height > 0.0:
         raise ValueError(f"height must be positive; got {shown(height)}")
+    options = dict(top=top, bottom=bottom, profile=profile, transition=transition, shape=shape)
+    radius = as_float(edge_radius, "edge_radius")
+    problem = _roll_problem(segments, height, edge_radius, given_height, _name, **options)
+    if problem is not None:
+        fits = _largest(lambda r: _roll_problem(segments, height, r, given_height, _name, **options) is None, radius)
+        raise _refusal(problem, _name, fits)
     roll = roll_profile(edge_radius, profile=profile, transition=transition, shape=shape)
     reach = float(roll[-1].end[0])
     d_top, d_bottom = (reach if top else 0.0), (reach if bottom else 0.0)
-    if d_top + d_bottom > height * (1.0 + _FIT_SLACK):
-        fits = float(edge_radius) * height / (d_top + d_bottom)
-        raise NoSolutionError(
-            f"{_name} {shown(edge_radius)} gives rolls {reach:.6g} high; {'together they' if top and bottom else 'it'} "
-            f"exceed height {shown(given_height)}; {_name} up to {fits:.6g} fits"
-        )
-    if d_top + d_bottom > height:
-        d_top, d_bottom = (height / 2.0, height / 2.0) if top and bottom else (d_top and height, d_bottom and height)
     points, _, _ = _samples(segments)
     size = float(np.ptp(points, axis=0).max())
-    area = 0.5 * float(np.sum(points[:, 0] * np.roll(points[:, 1], -1) - np.roll(points[:, 0], -1) * points[:, 1]))
-    sigma = 1.0 if area > 0.0 else -1.0  # the inward normal is the left one of a counterclockwise outline
+    if d_top + d_bottom > height - 1e-7 * size:  # a wall thinner than the sewing tolerance: the rolls meet
+        d_top, d_bottom = (height / 2.0, height / 2.0) if top and bottom else (d_top and height, d_bottom and height)
+    sigma = _inward(segments)
     reach_max = max(d_top, d_bottom)
-    if reach_max > 0.0:
-        _check_fit(segments, sigma, reach_max, edge_radius, _name)
     tol = 1e-7 * size if tolerance is None else as_float(tolerance, "tolerance")
     if not tol > 0.0:
         raise ValueError(f"tolerance must be positive; got {shown(tolerance)}")
@@ -883,10 +922,13 @@ def fillet_prism_edges(
     feet = [BRepAdaptor_Curve(e).Value(BRepAdaptor_Curve(e).FirstParameter()) for e in sides]
     feet += [BRepAdaptor_Curve(e).Value(BRepAdaptor_Curve(e).LastParameter()) for e in sides]
     chosen = [i for i in _corner_vertices(segments, frame, feet, size) if _turns(segments[i - 1], segments[i])]
-    if chosen:
+    rolled = any(chosen_caps.values())
+    if chosen and rolled:  # one radius for all: the roll's, the plan corners wide enough to hold it
+        segments = _rolled_plan(segments, chosen, prism.height, radius, chosen_caps, transition, same_sense, shape)
+    elif chosen:
         path = fillet_path(segments, radius, transition=transition, vertices=chosen, closed=True, same_sense=same_sense, shape=shape)
         segments = list(path.segments)
-    if not any(chosen_caps.values()):
+    if not rolled:
         local = _extrusion(segments, prism.height)
         approximation = 0.0
         roll = (0.0, 0.0)
@@ -906,6 +948,46 @@ def fillet_prism_edges(
     verify_solid(result, "rounded part")
     verify_faces(result, expected_level(segments), "rounded part")
     return Slab(result, approximation, roll, prism.height)
+
+
+#: Side edges chosen with the cap edges: their plan corners' radius over the roll's reach into the part.
+PLAN_OVER_REACH = 1.25
+
+
+def plan_radius(radius: float, *, transition: float = 0.5, shape: str = DEFAULT_SHAPE) -> float:
+    """The plan corner radius ``fillet_prism_edges`` gives side edges chosen together with the cap edges
+    and one ``radius``: ``PLAN_OVER_REACH`` × the G2 roll's reach (1.25 × 1.257 × radius = 1.571 × radius
+    with the default transition), so the roll fits inside every plan corner and ``radius`` stays the
+    smallest radius of curvature of every rounded edge."""
+    return PLAN_OVER_REACH * float(roll_profile(radius, transition=transition, shape=shape)[-1].end[0])
+
+
+def _rolled_plan(segments: list[Segment], chosen: list[int], height: float, radius: float, caps: dict[str, bool],
+                 transition: float, same_sense: str, shape: str) -> list[Segment]:  # fmt: skip
+    """The cap outline with the chosen corners rounded by ``plan_radius(radius)``, or NoSolutionError naming
+    what does not fit and the largest radius that does (side corners, rolls and height together)."""
+    options = dict(top=caps["top"], bottom=caps["bottom"], profile="g2", transition=transition, shape=shape)
+
+    def attempt(r: float) -> tuple[list[Segment] | None, str | None]:
+        corner = plan_radius(r, transition=transition, shape=shape)
+        try:
+            path = fillet_path(segments, corner, transition=transition, vertices=chosen, closed=True,
+                               same_sense=same_sense, shape=shape)  # fmt: skip
+        except NoSolutionError as error:
+            return None, f"radius {shown(r)} rounds the side edges with the plan radius {corner:.6g} ({error})"
+        plan = list(path.segments)
+        return plan, _roll_problem(plan, height, r, height, "radius", **dict(options))
+
+    plan, problem = attempt(radius)
+    if problem is None and plan is not None:
+        return plan
+    fits = _largest(lambda r: attempt(r)[1] is None, radius)
+    raise _refusal(
+        f"{problem} (side and cap edges chosen together: the side edges get the plan radius "
+        f"{PLAN_OVER_REACH:g} × the roll's reach)",
+        "radius",
+        fits,
+    )
 
 
 def _fit(solid: TopoDS_Shape, edges: Sequence[TopoDS_Edge], axis: gp_Dir, named: list[str]) -> tuple:

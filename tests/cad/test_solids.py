@@ -12,6 +12,7 @@ edge), not from the construction.
 from __future__ import annotations
 
 import math
+import re
 import subprocess
 import textwrap
 
@@ -268,11 +269,11 @@ def _peanut() -> list:
 
 
 def test_refusals_name_the_value_and_what_fits():
-    with pytest.raises(NoSolutionError, match=r"edge_radius 5 .* smallest convex radius of curvature 6 .*edge_radius below"):
+    with pytest.raises(NoSolutionError, match=r"edge_radius 5 .* smallest convex radius of curvature 6 .*edge_radius up to"):
         ContinuousBox(40, 20, 30, 6, edge_radius=5)
     with pytest.raises(NoSolutionError, match=r"exceed height 2; edge_radius up to"):
         ContinuousBox(40, 20, 2, 6, edge_radius=1.5)
-    with pytest.raises(NoSolutionError, match=r"edge_radius 2.5 .* inner offset crosses itself .* edge_radius below 2 fits"):
+    with pytest.raises(NoSolutionError, match=r"edge_radius 2.5 .* inner offset crosses itself .* edge_radius up to 1.99999 fits"):
         g2_slab(_peanut(), 10, 2.5, profile="circular")  # its waist is 4 wide
     assert g2_slab(_peanut(), 10, 1.9, profile="circular").is_valid
     square = [(0, 0), (10, 0), (10, 10), (0, 10)]
@@ -523,3 +524,42 @@ def test_the_step_note_survives_build_part_moves_and_booleans_and_is_absent_from
         assert note in _description(tmp_path / f"{name}.step"), name
     export_step(Box(4, 4, 4) - Cylinder(1, 5), tmp_path / "plain.step")
     assert "spiral_cad G2 solid" not in _description(tmp_path / "plain.step")
+
+
+def test_every_edge_of_a_box_rounds_with_one_radius_the_side_corners_wide_enough_for_the_roll():
+    from spiral_cad.cad.solids import plan_radius
+
+    box = Box(40, 20, 8)
+    rounded = g2_fillet(box.edges(), 1)  # refused before: one radius set both the plan corners and the roll
+    _assert_one_valid_solid(rounded.wrapped)
+    _assert_g2_edges(rounded.wrapped, sharp=math.inf)
+    corner = plan_radius(1)
+    assert corner == pytest.approx(1.25 * float(roll_profile(1)[-1].end[0]), rel=1e-15) and corner > 1.25 * 1.2569
+    same = occ_slab(continuous_rectangle(40, 20, corner), 8, 1)  # the rule: plan radius, then the roll of radius 1
+    assert _props(rounded.wrapped)[0] == pytest.approx(_props(same.shape)[0], rel=1e-12)
+    assert rounded.approximation == pytest.approx(same.approximation, rel=1e-6)
+
+
+def _fits(message: str) -> float:
+    found = re.search(r"up to ([0-9.e+-]+) fits$", message)
+    assert found, message
+    return float(found.group(1))
+
+
+@pytest.mark.parametrize(
+    ("make", "radius", "said"),
+    [
+        (lambda r: g2_fillet(Box(40, 20, 8).edges(), r), 4, "exceed height 8"),
+        (lambda r: g2_fillet(Box(40, 20, 30).edges(), r), 20, "plan radius 31.4"),
+        (lambda r: ContinuousBox(40, 20, 2, 6, edge_radius=r), 1.5, "exceed height 2"),
+        (lambda r: ContinuousBox(40, 20, 30, 6, edge_radius=r), 5, "would fold"),
+        (lambda r: g2_slab(_peanut(), 10, r, profile="circular"), 2.5, "crosses itself"),
+    ],
+    ids=["prism-height", "prism-plan", "box-height", "box-fold", "neck"],
+)
+def test_every_value_a_refusal_says_fits_builds(make, radius, said):
+    with pytest.raises(NoSolutionError, match=said) as refused:
+        make(radius)
+    fits = _fits(str(refused.value))
+    assert fits < radius
+    assert make(fits).is_valid
