@@ -396,7 +396,11 @@ def g2_fillet(
     convex or concave, each end meeting a cap perpendicular to it) become
     exact extrusions of the 2-D G2 corner; when every edge of a cap is chosen
     too, the cap's edge is rolled by the G2 profile of the same radius
-    (``g2_slab``). Inside ``BuildPart`` the builder's part is replaced.
+    (``g2_slab``). Side and cap edges chosen together (``box.edges()``) get
+    one radius as the smallest radius of curvature of every edge: the rolls
+    are of ``radius`` and the side corners of ``plan_radius(radius)`` (1.25 ×
+    the roll's reach, 1.571 × radius), wide enough to hold the roll. Inside
+    ``BuildPart`` the builder's part is replaced.
 
     Args:
         target: the shape to round, the vertices to round in a builder, or

@@ -837,7 +837,10 @@ def fillet_prism_edges(
     Side edges (along the prism's axis, between two planar faces, any
     dihedral angle, convex or concave) become exact extrusions of the 2-D G2
     corner of the cap's outline; when every edge of a cap is chosen too, the
-    cap's edge is rolled by the G2 profile of the same radius (``g2_slab``).
+    cap's edge is rolled by the G2 profile of the same radius (``g2_slab``),
+    and the chosen side corners are rounded with ``plan_radius(radius)`` so
+    the roll fits inside them (``radius`` stays the smallest radius of
+    curvature of every rounded edge).
 
     Args:
         solid: one solid, a right prism (two parallel planar caps; the part's
@@ -850,7 +853,8 @@ def fillet_prism_edges(
 
     Raises:
         NoSolutionError: an edge that is not straight, not between planar faces, a part that
-            is no right prism, or a cap partly chosen — named by edge index and point.
+            is no right prism, or a cap partly chosen — named by edge index and point;
+            side corners, rolls and height that do not fit together — with the largest radius that does.
     """
     if not edges:
         raise ValueError("g2_fillet needs at least one edge")
@@ -958,7 +962,15 @@ def plan_radius(radius: float, *, transition: float = 0.5, shape: str = DEFAULT_
     """The plan corner radius ``fillet_prism_edges`` gives side edges chosen together with the cap edges
     and one ``radius``: ``PLAN_OVER_REACH`` × the G2 roll's reach (1.25 × 1.257 × radius = 1.571 × radius
     with the default transition), so the roll fits inside every plan corner and ``radius`` stays the
-    smallest radius of curvature of every rounded edge."""
+    smallest radius of curvature of every rounded edge.
+
+    Args:
+        radius: the roll's smallest radius of curvature (> 0).
+        transition, shape: of the roll's spirals, as in ``roll_profile``.
+
+    Raises:
+        ValueError: a non-positive radius.
+    """
     return PLAN_OVER_REACH * float(roll_profile(radius, transition=transition, shape=shape)[-1].end[0])
 
 
@@ -983,8 +995,7 @@ def _rolled_plan(segments: list[Segment], chosen: list[int], height: float, radi
         return plan
     fits = _largest(lambda r: attempt(r)[1] is None, radius)
     raise _refusal(
-        f"{problem} (side and cap edges chosen together: the side edges get the plan radius "
-        f"{PLAN_OVER_REACH:g} × the roll's reach)",
+        f"{problem} (side and cap edges chosen together: the side edges get the plan radius {PLAN_OVER_REACH:g} × the roll's reach)",
         "radius",
         fits,
     )
