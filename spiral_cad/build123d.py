@@ -396,7 +396,11 @@ def g2_fillet(
     convex or concave, each end meeting a cap perpendicular to it) become
     exact extrusions of the 2-D G2 corner; when every edge of a cap is chosen
     too, the cap's edge is rolled by the G2 profile of the same radius
-    (``g2_slab``). Inside ``BuildPart`` the builder's part is replaced.
+    (``g2_slab``). Side and cap edges chosen together (``box.edges()``) get
+    one radius as the smallest radius of curvature of every edge: the rolls
+    are of ``radius`` and the side corners of ``plan_radius(radius)`` (1.25 ×
+    the roll's reach, 1.571 × radius), wide enough to hold the roll. Inside
+    ``BuildPart`` the builder's part is replaced.
 
     Args:
         target: the shape to round, the vertices to round in a builder, or
@@ -520,7 +524,7 @@ def g2_slab(
         outline: a ``ContinuousRectangle``/``ContinuousPolygon``/``ContinuousSlot``, a
             closed ``Chain``, a ``FilletedPath`` or segments (in the XY plane), or a
             planar face, one-face sketch or closed wire of lines, arcs and cubic Bézier
-            spirals (``g2_fillet`` output) lying in the XY plane.
+            spirals (``g2_fillet`` output; a builder's cubic B-spline edges are read as their Bézier spans) lying in the XY plane.
         height: the part's height.
         edge_radius: the roll's smallest radius of curvature.
         top, bottom: roll the top / bottom edge. Default True.
@@ -529,7 +533,7 @@ def g2_slab(
         tolerance: the largest deviation of a sweep over a spiral (default 1e-7 × size).
 
     Raises:
-        ValueError: malformed input.
+        ValueError: malformed input, or a face with holes (one outline is rolled; cut holes afterwards).
         NoSolutionError: the roll does not fit (named, with what would fit).
     """
     if isinstance(outline, Sketch) and not hasattr(outline, "filleted"):
@@ -544,9 +548,15 @@ def g2_slab(
 
 
 def _plane_outline(shape: Face | Wire) -> list[Segment]:
-    """The outer wire of a face (or a closed wire) in the XY plane as segments."""
+    """The outline of a face without holes (or of a closed wire) in the XY plane as segments."""
     from .cad.fillet import wire_path
 
+    holes = len(shape.inner_wires()) if isinstance(shape, Face) else 0
+    if holes:  # the solid would silently be the outer outline's: a different volume
+        raise ValueError(
+            f"the face has {holes} hole{'s' if holes > 1 else ''}; g2_slab rolls one outline: make the slab of the "
+            "outer outline and cut the holes from it afterwards (their rims stay sharp)"
+        )
     wire = shape.outer_wire() if isinstance(shape, Face) else shape
     if any(abs(v.Z) > 1e-9 * max(1.0, wire.bounding_box().diagonal) for v in wire.vertices()):
         raise ValueError("g2_slab takes an outline in the XY plane (z = 0)")

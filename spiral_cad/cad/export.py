@@ -107,7 +107,9 @@ def export_step(obj: Any, path: PathLike, *, name: str | None = None, units: str
     (``spiral_cad.cad.step_occ``), so FreeCAD and OCCT read one part
     with real wires. A G2 solid (``ContinuousBox``, ``g2_slab``, ``g2_fillet``
     of edges) has the deviation of its approximated surfaces written into the
-    header's FILE_DESCRIPTION.
+    header's FILE_DESCRIPTION; so has a part built of them (``BuildPart``, a
+    move, a boolean that keeps their surfaces: ``solids.recorded_approximation``
+    recognises their faces; not a scaled copy).
 
     Args:
         obj: a Chain, a list of Chains, or a build123d/CadQuery/OCP shape.
@@ -127,10 +129,13 @@ def export_step(obj: Any, path: PathLike, *, name: str | None = None, units: str
 
         write_step(chains, path, label, unit, originating_system())
     else:
-        from .solids import approximation_note
+        from .occ import as_occ_shape
+        from .solids import approximation_note, recorded_approximation
         from .step_occ import write_shape_step
 
         approximation = getattr(obj, "approximation", None)  # G2 solids say how far any surface is from exact
+        if approximation is None:  # a part built of them (BuildPart, booleans) carries their faces
+            approximation = recorded_approximation(as_occ_shape(obj))
         note = None if approximation is None else approximation_note(float(approximation), unit)
         write_shape_step(obj, path, label, unit, originating_system(), note)
 

@@ -16,6 +16,7 @@ from OCP.BRepAdaptor import BRepAdaptor_Curve
 from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeFace
 from OCP.BRepLib import BRepLib_FindSurface
 from OCP.BRepTools import BRepTools, BRepTools_WireExplorer
+from OCP.Geom import Geom_BSplineCurve
 from OCP.GeomAbs import GeomAbs_CurveType, GeomAbs_SurfaceType
 from OCP.GeomAdaptor import GeomAdaptor_Surface
 from OCP.gp import gp_Ax3, gp_Pnt, gp_Vec
@@ -112,6 +113,20 @@ def wire_path(wire: TopoDS_Wire, frame: gp_Ax3, *, spirals: bool = False) -> tup
             lifts += [p[2] for p in poles]
             points = [(x, y) for x, y, _ in (poles[::-1] if reverse else poles)]
             segments.append(BezierSpiral.from_control_points(points))
+        elif spirals and kind == GeomAbs_CurveType.GeomAbs_BSplineCurve:
+            # a builder (BuildSketch) merges joined Bézier spirals into one B-spline: read its cubic spans back
+            pieces = _bezier_spans(curve, first, last)
+            if pieces is None:
+                raise ValueError(
+                    f"g2 fillets round lines and circular arcs; edge {index} is a BSPLINE curve that is not joined cubic "
+                    "Bézier spans (degree 3, non-rational, its whole knot range): pass "
+                    "the continuous sketch object itself (not the builder's sketch) or its Chain"
+                )
+            for poles in pieces[::-1] if reverse else pieces:
+                local = [_local(frame, p) for p in poles]
+                lifts += [p[2] for p in local]
+                points = [(x, y) for x, y, _ in (local[::-1] if reverse else local)]
+                segments.append(BezierSpiral.from_control_points(points))
         else:
             name = kind.name.removeprefix("GeomAbs_").removesuffix("Curve").upper()
             raise ValueError(f"g2 fillets round lines and circular arcs; edge {index} is a {name} curve")
@@ -124,6 +139,21 @@ def wire_path(wire: TopoDS_Wire, frame: gp_Ax3, *, spirals: bool = False) -> tup
         raise ValueError(f"g2 fillets need a planar wire; its points leave the plane by {lift:.3g}")
     closed = BRep_Tool.IsClosed_s(wire) or math.dist(segments[-1].ends[1][:2], segments[0].ends[0][:2]) <= 1e-9 * size
     return segments, closed
+
+
+def _bezier_spans(curve: BRepAdaptor_Curve, first: float, last: float) -> list[list[gp_Pnt]] | None:
+    """The poles of the cubic Bézier spans of a non-rational, non-periodic cubic B-spline edge over its whole
+    knot range (its interior knots raised to multiplicity 3: exact), else None."""
+    if curve.Degree() != 3 or curve.IsRational():
+        return None
+    spline = curve.BSpline().Copy()  # the edge keeps its own curve
+    assert isinstance(spline, Geom_BSplineCurve)
+    if spline.IsPeriodic() or (first, last) != (spline.FirstParameter(), spline.LastParameter()):
+        return None
+    for k in range(2, spline.NbKnots()):
+        spline.IncreaseMultiplicity(k, 3)
+    poles = [spline.Pole(k) for k in range(1, spline.NbPoles() + 1)]
+    return [poles[3 * k : 3 * k + 4] for k in range(spline.NbKnots() - 1)]
 
 
 def _vertex_indices(segments: Sequence[Segment], closed: bool, frame: gp_Ax3, points: Iterable | None) -> list[int] | None:

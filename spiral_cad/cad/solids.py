@@ -30,7 +30,7 @@ closed solid) before anything is returned.
 from __future__ import annotations
 
 import math
-from collections.abc import Iterable, Sequence
+from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass
 from typing import Any
 
@@ -62,6 +62,7 @@ from OCP.TColgp import TColgp_Array1OfPnt, TColgp_Array2OfPnt
 from OCP.TColStd import TColStd_Array1OfInteger, TColStd_Array1OfReal, TColStd_Array2OfReal
 from OCP.TopAbs import TopAbs_EDGE, TopAbs_FACE, TopAbs_SHELL, TopAbs_SOLID, TopAbs_WIRE
 from OCP.TopExp import TopExp, TopExp_Explorer
+from OCP.TopLoc import TopLoc_Location
 from OCP.TopoDS import TopoDS, TopoDS_Edge, TopoDS_Face, TopoDS_Shape, TopoDS_Solid
 from OCP.TopTools import TopTools_IndexedDataMapOfShapeListOfShape
 
@@ -86,6 +87,9 @@ __all__ = [
     "g2_slab",
     "outline_segments",
     "expected_level",
+    "plan_radius",
+    "PLAN_OVER_REACH",
+    "recorded_approximation",
     "roll_profile",
     "verify_faces",
     "verify_solid",
@@ -101,6 +105,10 @@ _MAX_SPANS = 256
 _CORNER_TOL = 1e-7
 #: Samples per Hermite span when measuring |Ñ − N|.
 _SAMPLES = 48
+#: Surfaces made here, by their shape's fingerprint (``_fingerprint``): the deviation of each from the exact sweep.
+_RECORDED: dict[bytes, float] = {}
+#: Most fingerprints kept (the oldest are forgotten first).
+_RECORD_LIMIT = 100_000
 
 
 @dataclass(frozen=True)
@@ -375,6 +383,50 @@ def _cap(alongs: list[_Along], w: float, z: float) -> TopoDS_Face:
     return BRepBuilderAPI_MakeFace(gp_Pln(gp_Pnt(0.0, 0.0, z), gp_Dir(0.0, 0.0, 1.0)), wire.Wire()).Face()
 
 
+# ------------------------------------------------------------------ what parts made of slabs carry
+
+
+def _fingerprint(face: TopoDS_Face) -> bytes | None:
+    """A B-spline surface's shape, unchanged by rigid motions and copies: degrees, knots, weights and the
+    distances of its poles from its two corner poles (relative, 9 digits); None for other surfaces."""
+    surface = BRep_Tool.Surface_s(face, TopLoc_Location())  # without the face's placement
+    if not isinstance(surface, Geom_BSplineSurface):
+        return None
+    rows, cols = surface.NbUPoles(), surface.NbVPoles()
+    poles = np.array([[surface.Pole(i, j).Coord() for j in range(1, cols + 1)] for i in range(1, rows + 1)])
+    poles = poles.reshape(-1, 3)
+    distances = np.concatenate([np.linalg.norm(poles - poles[0], axis=1), np.linalg.norm(poles - poles[-1], axis=1)])
+    scale = float(distances.max()) or 1.0
+    weights = [surface.Weight(i, j) for i in range(1, rows + 1) for j in range(1, cols + 1)]
+    knots = [surface.UKnot(k) for k in range(1, surface.NbUKnots() + 1)] + [surface.VKnot(k) for k in range(1, surface.NbVKnots() + 1)]
+    numbers = np.concatenate([[surface.UDegree(), surface.VDegree(), rows, cols], knots, weights, distances / scale])
+    return np.round(numbers, 9).tobytes() + np.float64(f"{scale:.9g}").tobytes()
+
+
+def _record(face: TopoDS_Face, deviation: float) -> None:
+    key = _fingerprint(face)
+    if key is None:
+        return
+    _RECORDED[key] = max(deviation, _RECORDED.pop(key, 0.0))
+    while len(_RECORDED) > _RECORD_LIMIT:
+        del _RECORDED[next(iter(_RECORDED))]
+
+
+def recorded_approximation(shape: TopoDS_Shape) -> float | None:
+    """The largest deviation from the exact sweep of the faces of ``shape`` that are surfaces of G2 slabs
+    made in this process (``g2_slab``, ``ContinuousBox``, ``g2_fillet`` of cap edges), or None when it
+    has none.
+
+    Faces are recognised by their surface's shape (degrees, knots, weights, the poles' distances), so
+    they are found in a part the slab was added to in ``BuildPart``, moved, copied or cut by a
+    boolean that trims but keeps their surfaces; a scaled copy, or a surface rebuilt by another
+    operation, is not recognised.
+    """
+    found = [_RECORDED.get(key) for face in _faces_of(shape) if (key := _fingerprint(face)) is not None]
+    known = [value for value in found if value is not None]
+    return max(known) if known else None
+
+
 # ------------------------------------------------------------------ input and fit
 
 
@@ -439,10 +491,9 @@ def _crossing(polygon: NDArray[np.float64]) -> NDArray[np.float64] | None:
     return result
 
 
-def _check_fit(segments: list[Segment], sigma: float, roll: float, given: Any, name: str) -> None:
-    """NoSolutionError unless a roll ``roll`` wide fits inside the outline: below every convex radius of
-    curvature (equal only on arcs: a clean pole) and with an inner offset that does not cross itself."""
-    radius = float(given)
+def _fit_problem(segments: list[Segment], sigma: float, roll: float, given: Any, name: str) -> str | None:
+    """Why a roll ``roll`` wide does not fit inside the outline, or None: it must stay below every convex
+    radius of curvature (equal only on arcs: a clean pole) and its inner offset must not cross itself."""
     for index, segment in enumerate(segments):
         u = np.linspace(0.0, 1.0, 65)
         bend = float(np.max(sigma * np.broadcast_to(segment.curvature(u), u.shape)))
@@ -451,23 +502,64 @@ def _check_fit(segments: list[Segment], sigma: float, roll: float, given: Any, n
         product = roll * bend
         exact_pole = isinstance(segment, Arc) and abs(product - 1.0) <= 1e-12
         if product > 1.0 - _FIT_SLACK and not exact_pole:
-            raise NoSolutionError(
+            return (
                 f"{name} {shown(given)} gives a roll {roll:.6g} wide, not below the outline's smallest convex radius "
                 f"of curvature {1.0 / bend:.6g} (segment {index}, a {type(segment).__name__}): the inner offset "
-                f"would fold; {name} below {radius / product:.6g} fits"
+                "would fold"
             )
     points, normals, _ = _samples(segments)
     place = _crossing(points + sigma * roll * normals)
     if place is not None:
-        low, high = 0.0, roll  # the widest roll whose offset stays simple, for the message
-        for _ in range(30):
-            mid = 0.5 * (low + high)
-            low, high = (mid, high) if _crossing(points + sigma * mid * normals) is None else (low, mid)
-        raise NoSolutionError(
+        return (
             f"{name} {shown(given)} gives a roll {roll:.6g} wide whose inner offset crosses itself near "
-            f"({place[0]:.6g}, {place[1]:.6g}): the outline is too narrow there; {name} below "
-            f"{radius * low / roll:.6g} fits"
+            f"({place[0]:.6g}, {place[1]:.6g}): the outline is too narrow there"
         )
+    return None
+
+
+def _inward(segments: list[Segment]) -> float:
+    """+1 when the outline runs counterclockwise (its inward normal is the left one), else −1."""
+    points, _, _ = _samples(segments)
+    area = 0.5 * float(np.sum(points[:, 0] * np.roll(points[:, 1], -1) - np.roll(points[:, 0], -1) * points[:, 1]))
+    return 1.0 if area > 0.0 else -1.0
+
+
+def _roll_problem(segments: list[Segment], height: float, edge_radius: Any, given_height: Any, name: str,
+                  **options: Any) -> str | None:  # fmt: skip
+    """Why rolls of ``edge_radius`` (``options``: top, bottom, profile, transition, shape) do not fit the
+    outline and the height, or None."""
+    top, bottom = options.pop("top"), options.pop("bottom")
+    reach = float(roll_profile(float(edge_radius), **options)[-1].end[0])
+    d_top, d_bottom = (reach if top else 0.0), (reach if bottom else 0.0)
+    if d_top + d_bottom > height * (1.0 + _FIT_SLACK):
+        return (
+            f"{name} {shown(edge_radius)} gives rolls {reach:.6g} high; {'together they' if top and bottom else 'it'} "
+            f"exceed height {shown(given_height)}"
+        )
+    if max(d_top, d_bottom) == 0.0:
+        return None
+    return _fit_problem(segments, _inward(segments), min(max(d_top, d_bottom), height), edge_radius, name)
+
+
+def _largest(fits: Callable[[float], bool], upper: float) -> float | None:
+    """The largest value in (0, upper) for which ``fits`` holds (bisection; it must hold below it), rounded
+    down to 6 significant digits and checked itself, or None."""
+    low, high = 0.0, upper
+    for _ in range(60):
+        mid = 0.5 * (low + high)
+        low, high = (mid, high) if fits(mid) else (low, mid)
+    if not low > 0.0:
+        return None
+    step = 10.0 ** (math.floor(math.log10(low)) - 5)
+    for k in range(3):  # rounding down may still land on a value that fails: a step further
+        value = float(f"{(math.floor(low / step) - k) * step:.6g}")
+        if value > 0.0 and fits(value):
+            return value
+    return None
+
+
+def _refusal(problem: str, name: str, fits: float | None) -> NoSolutionError:
+    return NoSolutionError(f"{problem}; {name} up to {fits:.6g} fits" if fits is not None else f"{problem}; no {name} fits")
 
 
 # ------------------------------------------------------------------ the solid
@@ -611,24 +703,21 @@ def g2_slab(
     given_height, height = height, as_float(height, "height")
     if not height > 0.0:
         raise ValueError(f"height must be positive; got {shown(height)}")
+    options = dict(top=top, bottom=bottom, profile=profile, transition=transition, shape=shape)
+    radius = as_float(edge_radius, "edge_radius")
+    problem = _roll_problem(segments, height, edge_radius, given_height, _name, **options)
+    if problem is not None:
+        fits = _largest(lambda r: _roll_problem(segments, height, r, given_height, _name, **options) is None, radius)
+        raise _refusal(problem, _name, fits)
     roll = roll_profile(edge_radius, profile=profile, transition=transition, shape=shape)
     reach = float(roll[-1].end[0])
     d_top, d_bottom = (reach if top else 0.0), (reach if bottom else 0.0)
-    if d_top + d_bottom > height * (1.0 + _FIT_SLACK):
-        fits = float(edge_radius) * height / (d_top + d_bottom)
-        raise NoSolutionError(
-            f"{_name} {shown(edge_radius)} gives rolls {reach:.6g} high; {'together they' if top and bottom else 'it'} "
-            f"exceed height {shown(given_height)}; {_name} up to {fits:.6g} fits"
-        )
-    if d_top + d_bottom > height:
-        d_top, d_bottom = (height / 2.0, height / 2.0) if top and bottom else (d_top and height, d_bottom and height)
     points, _, _ = _samples(segments)
     size = float(np.ptp(points, axis=0).max())
-    area = 0.5 * float(np.sum(points[:, 0] * np.roll(points[:, 1], -1) - np.roll(points[:, 0], -1) * points[:, 1]))
-    sigma = 1.0 if area > 0.0 else -1.0  # the inward normal is the left one of a counterclockwise outline
+    if d_top + d_bottom > height - 1e-7 * size:  # a wall thinner than the sewing tolerance: the rolls meet
+        d_top, d_bottom = (height / 2.0, height / 2.0) if top and bottom else (d_top and height, d_bottom and height)
+    sigma = _inward(segments)
     reach_max = max(d_top, d_bottom)
-    if reach_max > 0.0:
-        _check_fit(segments, sigma, reach_max, edge_radius, _name)
     tol = 1e-7 * size if tolerance is None else as_float(tolerance, "tolerance")
     if not tol > 0.0:
         raise ValueError(f"tolerance must be positive; got {shown(tolerance)}")
@@ -636,6 +725,8 @@ def g2_slab(
     sections = _sections(roll, d_top, d_bottom, height)
     degenerate = 1e-9 * size
     faces = [_surface_face(a, sec, degenerate) for a in alongs for sec in sections]
+    for k, face in enumerate(faces):  # so export_step finds the note on parts built from this solid
+        _record(face, reach_max * alongs[k // len(sections)].deviation)
     faces.append(_cap(alongs, d_top, height))
     faces.append(_cap(alongs, d_bottom, 0.0))
     solid = _solid(faces, 1e-7 * size)
@@ -746,7 +837,10 @@ def fillet_prism_edges(
     Side edges (along the prism's axis, between two planar faces, any
     dihedral angle, convex or concave) become exact extrusions of the 2-D G2
     corner of the cap's outline; when every edge of a cap is chosen too, the
-    cap's edge is rolled by the G2 profile of the same radius (``g2_slab``).
+    cap's edge is rolled by the G2 profile of the same radius (``g2_slab``),
+    and the chosen side corners are rounded with ``plan_radius(radius)`` so
+    the roll fits inside them (``radius`` stays the smallest radius of
+    curvature of every rounded edge).
 
     Args:
         solid: one solid, a right prism (two parallel planar caps; the part's
@@ -759,7 +853,8 @@ def fillet_prism_edges(
 
     Raises:
         NoSolutionError: an edge that is not straight, not between planar faces, a part that
-            is no right prism, or a cap partly chosen — named by edge index and point.
+            is no right prism, or a cap partly chosen — named by edge index and point;
+            side corners, rolls and height that do not fit together — with the largest radius that does.
     """
     if not edges:
         raise ValueError("g2_fillet needs at least one edge")
@@ -831,10 +926,13 @@ def fillet_prism_edges(
     feet = [BRepAdaptor_Curve(e).Value(BRepAdaptor_Curve(e).FirstParameter()) for e in sides]
     feet += [BRepAdaptor_Curve(e).Value(BRepAdaptor_Curve(e).LastParameter()) for e in sides]
     chosen = [i for i in _corner_vertices(segments, frame, feet, size) if _turns(segments[i - 1], segments[i])]
-    if chosen:
+    rolled = any(chosen_caps.values())
+    if chosen and rolled:  # one radius for all: the roll's, the plan corners wide enough to hold it
+        segments = _rolled_plan(segments, chosen, prism.height, radius, chosen_caps, transition, same_sense, shape)
+    elif chosen:
         path = fillet_path(segments, radius, transition=transition, vertices=chosen, closed=True, same_sense=same_sense, shape=shape)
         segments = list(path.segments)
-    if not any(chosen_caps.values()):
+    if not rolled:
         local = _extrusion(segments, prism.height)
         approximation = 0.0
         roll = (0.0, 0.0)
@@ -854,6 +952,53 @@ def fillet_prism_edges(
     verify_solid(result, "rounded part")
     verify_faces(result, expected_level(segments), "rounded part")
     return Slab(result, approximation, roll, prism.height)
+
+
+#: Side edges chosen with the cap edges: their plan corners' radius over the roll's reach into the part.
+PLAN_OVER_REACH = 1.25
+
+
+def plan_radius(radius: float, *, transition: float = 0.5, shape: str = DEFAULT_SHAPE) -> float:
+    """The plan corner radius ``fillet_prism_edges`` gives side edges chosen together with the cap edges
+    and one ``radius``: ``PLAN_OVER_REACH`` × the G2 roll's reach (1.25 × 1.257 × radius = 1.571 × radius
+    with the default transition), so the roll fits inside every plan corner and ``radius`` stays the
+    smallest radius of curvature of every rounded edge.
+
+    Args:
+        radius: the roll's smallest radius of curvature (> 0).
+        transition, shape: of the roll's spirals, as in ``roll_profile``.
+
+    Raises:
+        ValueError: a non-positive radius.
+    """
+    return PLAN_OVER_REACH * float(roll_profile(radius, transition=transition, shape=shape)[-1].end[0])
+
+
+def _rolled_plan(segments: list[Segment], chosen: list[int], height: float, radius: float, caps: dict[str, bool],
+                 transition: float, same_sense: str, shape: str) -> list[Segment]:  # fmt: skip
+    """The cap outline with the chosen corners rounded by ``plan_radius(radius)``, or NoSolutionError naming
+    what does not fit and the largest radius that does (side corners, rolls and height together)."""
+    options = dict(top=caps["top"], bottom=caps["bottom"], profile="g2", transition=transition, shape=shape)
+
+    def attempt(r: float) -> tuple[list[Segment] | None, str | None]:
+        corner = plan_radius(r, transition=transition, shape=shape)
+        try:
+            path = fillet_path(segments, corner, transition=transition, vertices=chosen, closed=True,
+                               same_sense=same_sense, shape=shape)  # fmt: skip
+        except NoSolutionError as error:
+            return None, f"radius {shown(r)} rounds the side edges with the plan radius {corner:.6g} ({error})"
+        plan = list(path.segments)
+        return plan, _roll_problem(plan, height, r, height, "radius", **dict(options))
+
+    plan, problem = attempt(radius)
+    if problem is None and plan is not None:
+        return plan
+    fits = _largest(lambda r: attempt(r)[1] is None, radius)
+    raise _refusal(
+        f"{problem} (side and cap edges chosen together: the side edges get the plan radius {PLAN_OVER_REACH:g} × the roll's reach)",
+        "radius",
+        fits,
+    )
 
 
 def _fit(solid: TopoDS_Shape, edges: Sequence[TopoDS_Edge], axis: gp_Dir, named: list[str]) -> tuple:

@@ -12,19 +12,20 @@ edge), not from the construction.
 from __future__ import annotations
 
 import math
+import re
 import subprocess
 import textwrap
 
 import mpmath as mp
 import numpy as np
 import pytest
-from build123d import Align, Axis, Box, BuildPart, BuildSketch, Cone, Cylinder, Part, Polygon, Rectangle, extrude, fillet
+from build123d import Align, Axis, Box, BuildPart, BuildSketch, Cone, Cylinder, Location, Mode, Part, Polygon, Rectangle, extrude, fillet
 from helpers import freecad_lib
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 from OCP.BRep import BRep_Tool
 from OCP.BRepAdaptor import BRepAdaptor_Curve, BRepAdaptor_Curve2d
-from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeVertex
+from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeEdge, BRepBuilderAPI_MakeVertex
 from OCP.BRepCheck import BRepCheck_Analyzer
 from OCP.BRepExtrema import BRepExtrema_DistShapeShape
 from OCP.BRepGProp import BRepGProp
@@ -41,7 +42,7 @@ from OCP.TopoDS import TopoDS
 from OCP.TopTools import TopTools_IndexedDataMapOfShapeListOfShape
 
 from spiral_cad import Arc, Line
-from spiral_cad.build123d import ContinuousBox, ContinuousRectangle, g2_fillet, g2_slab
+from spiral_cad.build123d import ContinuousBox, ContinuousPolygon, ContinuousRectangle, g2_fillet, g2_slab
 from spiral_cad.cad.export import export_step
 from spiral_cad.cad.solids import g2_slab as occ_slab
 from spiral_cad.cad.solids import roll_profile
@@ -268,11 +269,11 @@ def _peanut() -> list:
 
 
 def test_refusals_name_the_value_and_what_fits():
-    with pytest.raises(NoSolutionError, match=r"edge_radius 5 .* smallest convex radius of curvature 6 .*edge_radius below"):
+    with pytest.raises(NoSolutionError, match=r"edge_radius 5 .* smallest convex radius of curvature 6 .*edge_radius up to"):
         ContinuousBox(40, 20, 30, 6, edge_radius=5)
     with pytest.raises(NoSolutionError, match=r"exceed height 2; edge_radius up to"):
         ContinuousBox(40, 20, 2, 6, edge_radius=1.5)
-    with pytest.raises(NoSolutionError, match=r"edge_radius 2.5 .* inner offset crosses itself .* edge_radius below 2 fits"):
+    with pytest.raises(NoSolutionError, match=r"edge_radius 2.5 .* inner offset crosses itself .* edge_radius up to 1.99999 fits"):
         g2_slab(_peanut(), 10, 2.5, profile="circular")  # its waist is 4 wide
     assert g2_slab(_peanut(), 10, 1.9, profile="circular").is_valid
     square = [(0, 0), (10, 0), (10, 10), (0, 10)]
@@ -371,6 +372,8 @@ def test_property_continuous_boxes_are_g2_solids_or_named_refusals(length, width
         box = ContinuousBox(length, width, height, radius, edge_radius=edge)
     except NoSolutionError as error:
         assert any(word in str(error) for word in ("edge_radius", "corner")), str(error)
+        if "edge_radius up to" in str(error):  # the value it names builds
+            assert ContinuousBox(length, width, height, radius, edge_radius=_fits(str(error))).is_valid
         return
     _assert_one_valid_solid(box.wrapped)
     _assert_g2_edges(box.wrapped, sharp=math.inf)
@@ -470,3 +473,95 @@ def test_side_edges_of_a_concave_prism_round_to_the_extruded_2d_g2_corners():
     plan = fillet_path([*l_shape, l_shape[0]], 2, closed=True)
     area, _ = _outline_integrals(list(plan.segments))
     assert _props(rounded.wrapped)[0] == pytest.approx(6 * area, rel=1e-9)
+
+
+def test_a_face_with_a_hole_is_refused_by_name_not_rolled_without_it():
+    with BuildSketch() as sketch:
+        Rectangle(40, 20)
+        Rectangle(20, 4, mode=Mode.SUBTRACT)
+    face = g2_fillet(sketch.sketch, 1)
+    assert len(face.faces()[0].inner_wires()) == 1
+    with pytest.raises(ValueError, match=r"the face has 1 hole; g2_slab rolls one outline"):
+        g2_slab(face, 5, 0.5)
+    with pytest.raises(ValueError, match=r"has 1 hole"):
+        g2_slab(face.faces()[0], 5, 0.5)
+
+
+def test_a_builder_sketch_whose_spiral_pairs_were_merged_into_b_splines_makes_the_same_slab():
+    with BuildSketch() as sketch:
+        ContinuousPolygon(12, 6, corner_radius=3, transition=1.0)
+    kinds = {e.geom_type.name for e in sketch.sketch.edges()}
+    assert "BSPLINE" in kinds  # the builder joined each spiral pair: what is read back here
+    direct = g2_slab(ContinuousPolygon(12, 6, corner_radius=3, transition=1.0), 5, 0.8)
+    built = g2_slab(sketch.sketch, 5, 0.8)
+    _assert_one_valid_solid(built.wrapped)
+    assert _props(built.wrapped)[0] == pytest.approx(_props(direct.wrapped)[0], rel=1e-12)
+    assert _props(built.wrapped)[1] == pytest.approx(_props(direct.wrapped)[1], rel=1e-12)
+    from build123d import Edge as B3dEdge
+    from build123d import Wire as B3dWire
+    from OCP.GC import GC_MakeCircle
+    from OCP.GeomConvert import GeomConvert
+
+    rational = GeomConvert.CurveToBSplineCurve_s(GC_MakeCircle(gp_Pnt(0, 0, 0), gp_Dir(0, 0, 1), 5.0).Value())
+    circle = B3dWire([B3dEdge(BRepBuilderAPI_MakeEdge(rational).Edge())])
+    with pytest.raises(ValueError, match=r"edge 0 is a BSPLINE curve that is not joined cubic Bézier spans .*pass the"):
+        g2_slab(circle, 1, 0.1)
+
+
+def _description(path) -> str:
+    text = path.read_text()
+    return text[text.index("FILE_DESCRIPTION") : text.index("FILE_NAME")]
+
+
+def test_the_step_note_survives_build_part_moves_and_booleans_and_is_absent_from_other_parts(tmp_path):
+    box = ContinuousBox(40, 20, 8, 6, edge_radius=1.5)
+    note = f"approximated within {box.approximation:.3g}"
+    with BuildPart() as builder:
+        ContinuousBox(40, 20, 8, 6, edge_radius=1.5)
+    assert not hasattr(builder.part, "approximation")
+    cut = box - Cylinder(3, 30)
+    moved = builder.part.moved(Location((100, -50, 7), (0, 0, 1), 33))
+    for name, part in {"builder": builder.part, "cut": cut, "moved": moved}.items():
+        export_step(part, tmp_path / f"{name}.step")
+        assert note in _description(tmp_path / f"{name}.step"), name
+    export_step(Box(4, 4, 4) - Cylinder(1, 5), tmp_path / "plain.step")
+    assert "spiral_cad G2 solid" not in _description(tmp_path / "plain.step")
+
+
+def test_every_edge_of_a_box_rounds_with_one_radius_the_side_corners_wide_enough_for_the_roll():
+    from spiral_cad.cad.solids import plan_radius
+
+    box = Box(40, 20, 8)
+    rounded = g2_fillet(box.edges(), 1)  # refused before: one radius set both the plan corners and the roll
+    _assert_one_valid_solid(rounded.wrapped)
+    _assert_g2_edges(rounded.wrapped, sharp=math.inf)
+    corner = plan_radius(1)
+    assert corner == pytest.approx(1.25 * float(roll_profile(1)[-1].end[0]), rel=1e-15) and corner > 1.25 * 1.2569
+    same = occ_slab(continuous_rectangle(40, 20, corner), 8, 1)  # the rule: plan radius, then the roll of radius 1
+    assert _props(rounded.wrapped)[0] == pytest.approx(_props(same.shape)[0], rel=1e-12)
+    assert rounded.approximation == pytest.approx(same.approximation, rel=1e-6)
+
+
+def _fits(message: str) -> float:
+    found = re.search(r"up to ([0-9.e+-]+) fits$", message)
+    assert found, message
+    return float(found.group(1))
+
+
+@pytest.mark.parametrize(
+    ("make", "radius", "said"),
+    [
+        (lambda r: g2_fillet(Box(40, 20, 8).edges(), r), 4, "exceed height 8"),
+        (lambda r: g2_fillet(Box(40, 20, 30).edges(), r), 20, "plan radius 31.4"),
+        (lambda r: ContinuousBox(40, 20, 2, 6, edge_radius=r), 1.5, "exceed height 2"),
+        (lambda r: ContinuousBox(40, 20, 30, 6, edge_radius=r), 5, "would fold"),
+        (lambda r: g2_slab(_peanut(), 10, r, profile="circular"), 2.5, "crosses itself"),
+    ],
+    ids=["prism-height", "prism-plan", "box-height", "box-fold", "neck"],
+)
+def test_every_value_a_refusal_says_fits_builds(make, radius, said):
+    with pytest.raises(NoSolutionError, match=said) as refused:
+        make(radius)
+    fits = _fits(str(refused.value))
+    assert fits < radius
+    assert make(fits).is_valid
