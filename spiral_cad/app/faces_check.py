@@ -32,7 +32,7 @@ def check_face_file(file: str, *, require: str | None = None, gap_tol: float | N
     also prints how long the check took.
 
     Returns:
-        0 ok, 1 below ``require``, None when the reader found no faces (the caller judges the wires).
+        0 ok, 1 below ``require`` or no shared edge judged (loose faces that could not be sewn), None when the reader found no faces (the caller judges the wires).
 
     Raises:
         ValueError: an unreadable file or a bad option (printed as ``error: …`` by the CLI).
@@ -63,6 +63,10 @@ def check_face_file(file: str, *, require: str | None = None, gap_tol: float | N
             print(f"curvature map written to {map_png}")
     if not require:
         return 0
+    if not report.edges:
+        print(f"FAIL: no shared edges were judged, so nothing shows {require} ({report.describe()}); "
+              "the faces meet nowhere, even after sewing")  # fmt: skip
+        return 1
     level = "crease" if require == "G0" else require  # a crease is G0, not G1
     worst = report.worst
     if worst == "gap" or (level != "crease" and not report.passes(level)):

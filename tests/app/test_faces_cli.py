@@ -106,3 +106,22 @@ def test_comb_of_a_face_file_is_written_beside_the_face_verdict(files, tmp_path,
     assert main(["check", str(files["box"]), "--require", "G1", "--comb", str(comb)]) == 0
     assert "OK: 10 faces" in capsys.readouterr().out
     assert comb.stat().st_size > 1000 and not holds_faces(comb)  # the comb is lines only
+
+
+def test_faces_that_meet_nowhere_fail_a_requirement_with_nothing_judged(tmp_path, capsys):
+    path = tmp_path / "apart.step"
+    bd.export_step(bd.Compound([bd.Face.make_rect(10, 10), bd.Face.make_rect(10, 10).moved(bd.Location((50, 0, 0)))]), str(path))
+    assert main(["check", str(path), "--require", "G1"]) == 1
+    out = capsys.readouterr().out
+    assert "FAIL: no shared edges were judged" in out and "free edges that no other face could be sewn to (8)" in out
+
+
+def test_loose_faces_in_a_file_are_sewn_and_judged(tmp_path, capsys):
+    from OCP.BRepBuilderAPI import BRepBuilderAPI_Copy
+
+    box = bd.fillet(bd.Box(40, 20, 8).edges().filter_by(bd.Axis.Z), 5)
+    path = tmp_path / "loose.step"
+    bd.export_step(bd.Compound([bd.Face(BRepBuilderAPI_Copy(f.wrapped).Shape()) for f in box.faces()]), str(path))
+    assert main(["check", str(path), "--require", "G2"]) == 1
+    out = capsys.readouterr().out
+    assert "24 stitched" in out and "8 G1" in out and "FAIL: worst tangent edge is G1" in out
