@@ -3,9 +3,15 @@ and the zebra and curvature pictures (``--zebra``, ``--curvature-map``)."""
 
 from __future__ import annotations
 
+import warnings
+from collections.abc import Callable
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from ..cad.faces import FEATURE_ANGLE, check_faces
+
+if TYPE_CHECKING:
+    from matplotlib.figure import Figure  # matplotlib is imported only when a picture is drawn
 
 __all__ = ["check_face_file"]
 
@@ -20,6 +26,24 @@ def _png(option: str, path: str | None) -> Path | None:
     if p.is_dir() or not p.parent.is_dir():
         raise ValueError(f"--{option} {path!r}: " + ("a folder" if p.is_dir() else f"no folder {str(p.parent)!r}"))
     return p
+
+
+def _picture(draw: Callable[[], Figure], path: Path, what: str) -> None:
+    """Draw and write one picture; a failure names the stage (drawing or writing) and the file, and a
+    warning (nothing visible) is printed."""
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        try:
+            fig = draw()
+        except MemoryError:
+            raise ValueError(f"drawing the {what} for {str(path)!r} ran out of memory") from None
+    for warning in caught:
+        print(f"warning: {what}: {warning.message}")
+    try:
+        fig.savefig(path, dpi=120, bbox_inches="tight")
+    except OSError as error:
+        raise ValueError(f"cannot write the {what} to {str(path)!r}: {error.strerror or error}") from None
+    print(f"{what} written to {path}")
 
 
 def check_face_file(file: str, *, require: str | None = None, gap_tol: float | None = None, angle_tol: float | None = None,
@@ -56,11 +80,9 @@ def check_face_file(file: str, *, require: str | None = None, gap_tol: float | N
 
         mesh = face_mesh(file, units=report.units)
         if zebra_png is not None:
-            plot_zebra(mesh, title=f"{report.source}: zebra").savefig(zebra_png, dpi=120, bbox_inches="tight")
-            print(f"zebra stripes written to {zebra_png}")
+            _picture(lambda: plot_zebra(mesh, title=f"{report.source}: zebra"), zebra_png, "zebra stripes")
         if map_png is not None:
-            plot_curvature_map(mesh, title=f"{report.source}: mean curvature").savefig(map_png, dpi=120, bbox_inches="tight")
-            print(f"curvature map written to {map_png}")
+            _picture(lambda: plot_curvature_map(mesh, title=f"{report.source}: mean curvature"), map_png, "curvature map")
     if not require:
         return 0
     if not report.edges:
