@@ -125,3 +125,26 @@ def test_loose_faces_in_a_file_are_sewn_and_judged(tmp_path, capsys):
     assert main(["check", str(path), "--require", "G2"]) == 1
     out = capsys.readouterr().out
     assert "24 stitched" in out and "8 G1" in out and "FAIL: worst tangent edge is G1" in out
+
+
+def test_a_picture_that_cannot_be_written_is_named(files, tmp_path, capsys, monkeypatch):
+    from matplotlib.figure import Figure
+
+    def full(self, *args, **kwargs):
+        raise OSError(28, "No space left on device")
+
+    monkeypatch.setattr(Figure, "savefig", full)
+    assert main(["check", str(files["box"]), "--zebra", str(tmp_path / "z.png")]) == 2
+    err = capsys.readouterr().err
+    assert "cannot write the zebra stripes to" in err and "z.png" in err and "No space left on device" in err
+
+
+def test_a_failure_while_meshing_is_named_meshing_not_reading(files, monkeypatch):
+    from spiral_cad.cad import mesh
+
+    def timed_out(*args, **kwargs):
+        raise ValueError("the STEP reader failed on 'box.step': it timed out after 120 s")
+
+    monkeypatch.setattr(mesh, "read_file", timed_out)
+    with pytest.raises(ValueError, match=r"^meshing for the picture: reading and meshing failed on 'box.step': it timed out"):
+        mesh.face_mesh(files["box"])

@@ -48,3 +48,30 @@ def test_curvature_map_of_a_sphere_is_one_colour_with_its_scale(sphere):
 def test_bad_arguments_raise_value_error_naming_them(sphere, call, message):
     with pytest.raises(ValueError, match=message):
         call(sphere)
+
+
+def test_an_open_dome_seen_from_behind_is_drawn_not_left_blank():
+    dome = next(f for f in bd.Sphere(5).faces()).split(bd.Plane.XY, keep=bd.Keep.TOP)  # the upper half, open below
+    image = _pixels(plot_zebra(face_mesh(dome, angle=0.2), stripes=4, view=(0.2, 0.1, -1), across=(1, 0, 0)))
+    dark, light = (image < 0.2).all(axis=2).mean(), (image > 0.9).all(axis=2).mean()
+    assert dark > 0.05 and light > 0.05  # seen from inside: stripes of both colours
+
+
+def test_a_face_seen_edge_on_warns_that_nothing_is_visible():
+    with pytest.warns(UserWarning, match="nothing is visible"):
+        plot_zebra(face_mesh(bd.Face.make_rect(10, 10)), view=(1, 0, 0))
+
+
+def test_the_mesh_keeps_below_its_triangle_cap_and_follows_the_pictures_size():
+    part = bd.fillet(bd.Box(40, 20, 16).edges(), 6)
+    fine = face_mesh(part)
+    capped = face_mesh(part, max_triangles=5_000)
+    assert len(fine.triangles) > 20_000 and len(capped.triangles) <= 5_000
+    coarse = face_mesh(part, pixels=100, angle=0.3)
+    assert len(coarse.triangles) < len(face_mesh(part, angle=0.3).triangles)  # deflection of half a pixel
+
+
+def test_curvature_map_is_one_image_whatever_the_mesh(sphere):
+    fig = plot_curvature_map(sphere, pixels=200)
+    assert len(fig.axes[0].images) == 1 and not fig.axes[0].collections
+    assert max(fig.axes[0].images[0].get_array().shape) == 200
