@@ -225,6 +225,54 @@ def _edge_uses(face: TopoDS_Face, edges: TopTools_IndexedMapOfShape) -> dict[int
     return uses
 
 
+def _knot_lines(face: TopoDS_Face, samples: int) -> list[tuple[str, NDArray, NDArray]]:
+    """The internal knot lines of a B-spline face where it may crease (knot multiplicity ≥ degree) or
+    its curvature may jump (≥ degree − 1): per line its name, the surface derivatives from either
+    side (samples × 2 × 18, the two spans' polynomials, ``LocalD2``) and the line's unit tangents.
+    The line is sampled across the face's (u, v) bounds, so a trimmed face's line may be sampled
+    a little beyond its trimming."""
+    from OCP.BRepTools import BRepTools
+    from OCP.Geom import Geom_BSplineSurface
+
+    surface = BRep_Tool.Surface_s(face)  # located: the points come out where the face is
+    if not isinstance(surface, Geom_BSplineSurface):
+        return []
+    u0, u1, v0, v1 = BRepTools.UVBounds_s(face)
+    p = gp_Pnt()
+    su, sv, suu, svv, suv = gp_Vec(), gp_Vec(), gp_Vec(), gp_Vec(), gp_Vec()
+    lines = []
+    for along_u in (True, False):
+        degree = surface.UDegree() if along_u else surface.VDegree()
+        first, last = (surface.FirstUKnotIndex(), surface.LastUKnotIndex()) if along_u else (
+            surface.FirstVKnotIndex(), surface.LastVKnotIndex())  # fmt: skip
+        knot = surface.UKnot if along_u else surface.VKnot
+        multiplicity = surface.UMultiplicity if along_u else surface.VMultiplicity
+        low, high = (u0, u1) if along_u else (v0, v1)
+        other_low, other_high = (v0, v1) if along_u else (u0, u1)
+        ofirst, olast = (surface.FirstVKnotIndex(), surface.LastVKnotIndex()) if along_u else (
+            surface.FirstUKnotIndex(), surface.LastUKnotIndex())  # fmt: skip
+        oknots = np.array([(surface.VKnot if along_u else surface.UKnot)(i) for i in range(ofirst, olast + 1)])
+        for i in range(first + 1, last):
+            k = knot(i)
+            if multiplicity(i) < max(1, degree - 1) or not low < k < high:
+                continue
+            others = other_low + (other_high - other_low) * (np.arange(samples) + 0.5) / samples
+            spans = ofirst + np.clip(np.searchsorted(oknots, others, side="right") - 1, 0, len(oknots) - 2)
+            raw = np.empty((samples, 2, 18))
+            for n, (t, j) in enumerate(zip(others.tolist(), spans.tolist())):
+                for side, (a, b) in enumerate(((i - 1, i), (i, i + 1))):
+                    if along_u:
+                        surface.LocalD2(k, t, a, b, j, j + 1, p, su, sv, suu, svv, suv)
+                    else:
+                        surface.LocalD2(t, k, j, j + 1, a, b, p, su, sv, suu, svv, suv)
+                    raw[n, side] = (*p.Coord(), *su.Coord(), *sv.Coord(), *suu.Coord(), *svv.Coord(), *suv.Coord())
+            tangents = raw[:, 0, 6:9] if along_u else raw[:, 0, 3:6]  # along the line: Sv on a u line, Su on a v line
+            with np.errstate(all="ignore"):
+                tangents = tangents / norms(tangents)[:, None]
+            lines.append((f"{'u' if along_u else 'v'} = {k:.6g} (knot of multiplicity {multiplicity(i)})", raw, tangents))
+    return lines
+
+
 def _measure(shape: TopoDS_Shape, samples: int) -> Measured:
     """Everything ``check_faces`` needs of ``shape``, as plain data (see ``Measured``); runs in the
     reader's child process for a file. Faces that were written unstitched (coinciding free edges)
@@ -297,6 +345,13 @@ def _measure(shape: TopoDS_Shape, samples: int) -> Measured:
             tangents.append(row_tangents)
             sign.append((signs[0], signs[1]))
             pairs.append((index - 1, faces.FindIndex(fa) - 1, faces.FindIndex(fb) - 1, len(found) == 1, note))
+    for face_index in range(1, faces.Extent() + 1):
+        face = TopoDS.Face_s(faces.FindKey(face_index))
+        for name, row, row_tangents in _knot_lines(face, samples):
+            raw.append(row)
+            tangents.append(row_tangents)
+            sign.append((-1.0, -1.0) if face.Orientation() == TopAbs_REVERSED else (1.0, 1.0))
+            pairs.append((-1, face_index - 1, face_index - 1, False, f"inside face {face_index - 1}, {name}"))
     count = len(pairs)
     if count:
         flat = _samples(np.stack(raw).reshape(-1, 18), np.repeat(np.array(sign)[:, None, :], samples, axis=1).reshape(-1),
@@ -315,7 +370,8 @@ class FaceEdge:
     """How two faces meet along one edge: the worst of each measure along it, and where.
 
     Attributes:
-        index: the edge's index among the shape's edges (0-based, ``TopExp.MapShapes`` order).
+        index: the edge's index among the shape's edges (0-based, ``TopExp.MapShapes`` order); -1 for a
+            knot line inside a B-spline face (a pseudo-edge: the face's two polynomial spans meet there).
         faces: the indices of the two faces (0-based, ``TopExp.MapShapes`` order); equal for a seam.
         surfaces: their surface types (``"plane"``, ``"cylinder"``, ``"bspline"``, …).
         seam: the edge is a seam where one closed face meets itself.

@@ -394,3 +394,49 @@ def test_an_edge_tangent_over_part_of_its_length_is_a_crease_not_a_feature():
     (edge,) = report.edges
     assert edge.angle > FEATURE_ANGLE and edge.level == "crease" and "partly tangent" in edge.note
     assert not report.passes("G1")
+
+
+def bspline_face(heights: list[float]) -> bd.Face:
+    """A cubic B-spline face over 0 ≤ x ≤ 6, 0 ≤ y ≤ 3 whose u knot at x = 3 has multiplicity 3
+    (a Bézier join: C0 there): ``heights`` are the z of its seven rows of poles."""
+    from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeFace
+    from OCP.Geom import Geom_BSplineSurface
+    from OCP.TColgp import TColgp_Array2OfPnt
+    from OCP.TColStd import TColStd_Array1OfInteger, TColStd_Array1OfReal
+
+    poles = TColgp_Array2OfPnt(1, len(heights), 1, 4)
+    for i, z in enumerate(heights):
+        for j in range(4):
+            poles.SetValue(i + 1, j + 1, bd.Vector(i, j, z).to_pnt())
+
+    def array(kind, values):
+        out = kind(1, len(values))
+        for k, value in enumerate(values):
+            out.SetValue(k + 1, value)
+        return out
+
+    surface = Geom_BSplineSurface(poles, array(TColStd_Array1OfReal, [0.0, 1.0, 2.0]), array(TColStd_Array1OfReal, [0.0, 1.0]),
+                                  array(TColStd_Array1OfInteger, [4, 3, 4]), array(TColStd_Array1OfInteger, [4, 4]), 3, 3)  # fmt: skip
+    return bd.Face(BRepBuilderAPI_MakeFace(surface, 1e-7).Face())
+
+
+@pytest.mark.parametrize(
+    ("heights", "level"),
+    [([0, 0, 0, 0, 0, 0.5, 1.0], "G1"),  # flat, then bending away: tangent, curvature jumps from 0
+     ([0, 0, 0, 0, 0.02, 0.04, 0.06], "crease"),  # a kink of 0.02 rad inside the face
+     ([0, 0, 0, 0, 0.2, 0.4, 0.6], "sharp")],  # 0.2 rad: a feature, listed
+)  # fmt: skip
+def test_a_knot_line_inside_a_bspline_face_is_judged_as_a_pseudo_edge(heights, level):
+    face = bspline_face(heights)
+    for part, lines in ((face, 1), (bd.extrude(face, 1, dir=(0, 0, -1)), 2)):  # the slab: its top and bottom
+        inside = [e for e in check_faces(part).edges if e.index == -1]
+        assert len(inside) == lines and {e.level for e in inside} == {level}
+        assert all(e.note.startswith("inside face") and "u = 1 (knot of multiplicity 3)" in e.note for e in inside)
+        assert all(e.jump_at[0] == pytest.approx(3.0) for e in inside)
+
+
+def test_a_smooth_knot_line_stays_g2():
+    # poles collinear across the join and equally spaced: the two spans are one cubic, C2 at x = 3
+    report = check_faces(bspline_face([0, 0.1, 0.2, 0.3, 0.4, 0.5, 0.6]))
+    (inside,) = [e for e in report.edges if e.index == -1]
+    assert inside.level == "G2"
