@@ -440,3 +440,20 @@ def test_a_smooth_knot_line_stays_g2():
     report = check_faces(bspline_face([0, 0.1, 0.2, 0.3, 0.4, 0.5, 0.6]))
     (inside,) = [e for e in report.edges if e.index == -1]
     assert inside.level == "G2"
+
+
+def test_table_columns_stay_in_line_with_long_surface_names():
+    from spiral_cad.build123d import G2Polyline
+
+    with bd.BuildPart() as vase:
+        with bd.BuildSketch(bd.Plane.XZ):
+            with bd.BuildLine():
+                G2Polyline((0, 0), (10, 0), (10, 10), (4, 20), (0, 20), radius=2)
+                bd.Line((0, 20), (0, 0))
+            bd.make_face()
+        bd.revolve(axis=bd.Axis.Z)
+    lines = check_faces(vase.part).table().splitlines()
+    rows = lines[3:]
+    assert any(len(f"{e.surfaces[0]}/{e.surfaces[1]} seam") > 22 for e in check_faces(vase.part).edges if e.seam)
+    start = lines[2].index("gap") + 3  # the gap column ends here in the header and in every row
+    assert all(row[start - 1] != " " and row[start] == " " for row in rows)
