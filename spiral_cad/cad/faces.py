@@ -331,8 +331,11 @@ def _measure(shape: TopoDS_Shape, samples: int) -> Measured:
                 _face_derivatives(adaptors[face_index], face, oriented, params, row[:, side])
                 signs.append(-1.0 if face.Orientation() == TopAbs_REVERSED else 1.0)
             if fa is not fb and not fa.IsSame(fb):
-                ua = uses.setdefault(faces.FindIndex(fa), _edge_uses(fa, edges)).get(index, set())
-                ub = uses.setdefault(faces.FindIndex(fb), _edge_uses(fb, edges)).get(index, set())
+                for face in (fa, fb):
+                    if faces.FindIndex(face) not in uses:  # each face's edges explored once
+                        uses[faces.FindIndex(face)] = _edge_uses(face, edges)
+                ua = uses[faces.FindIndex(fa)].get(index, set())
+                ub = uses[faces.FindIndex(fb)].get(index, set())
                 if len(ua) == 1 and ua == ub:
                     # a consistent shell uses each edge once FORWARD and once REVERSED: these two faces
                     # disagree on their outside, so one normal is flipped before they are compared
