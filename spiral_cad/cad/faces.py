@@ -431,7 +431,7 @@ class FaceReport:
         units: the unit of every length (``""``: not known).
         seconds: how long the check took, reading included.
         stitched: edges where faces written unstitched were sewn together (within ``SEW_TOL`` × size)
-            before being judged.
+            before being judged; face and edge indices then count in the sewn shape.
         free_at: the free edges left after sewing: (edge index, midpoint) each.
     """
 
