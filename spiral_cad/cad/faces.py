@@ -21,8 +21,17 @@ class (``EDGE_CLASSES``): ``"unmeasurable"`` (no sample gave a point or a normal
 ``feature_angle``: a feature — a box's edge — listed, never failed),
 ``"crease"`` (an angle above ``angle_tol`` but below ``feature_angle``: a
 near-tangent kink, a defect), ``"G1"`` (tangent, the curvature jumps),
-``"G2"``. Edges that bound one face only (an open shell) are counted as
-free; degenerate edges (a sphere's poles) are skipped.
+``"G2"``. An edge is sharp only if it is sharp at every sample: one tangent
+over part of its length is a crease. Edges that bound one face only (an open
+shell) are counted as free; degenerate edges (a sphere's poles) are skipped.
+
+What a file holds is not always one clean shell: faces written unstitched are
+sewn first (``SEW_TOL`` × size) and the stitches counted; two faces that use
+their edge in the same direction (an inconsistently oriented shell) are
+compared with one normal flipped and the row says so; at an edge of three or
+more faces every pair is judged; an internal knot line of a B-spline face
+whose multiplicity allows a crease or a curvature jump is judged as a
+pseudo-edge (index −1) between the two polynomial spans.
 
 Files are read and measured in a child process (``spiral_cad.cad.readers``);
 only the measured numbers come back. The time is linear in the faces: one
