@@ -25,6 +25,7 @@ from OCP.BRepAdaptor import BRepAdaptor_Surface
 from OCP.BRepBndLib import BRepBndLib
 from OCP.BRepMesh import BRepMesh_IncrementalMesh
 from OCP.gp import gp_Pnt, gp_Vec
+from OCP.IMeshTools import IMeshTools_Parameters
 from OCP.TopAbs import TopAbs_FACE, TopAbs_REVERSED
 from OCP.TopExp import TopExp, TopExp_Explorer
 from OCP.TopLoc import TopLoc_Location
@@ -95,8 +96,12 @@ def _mesh(shape: TopoDS_Shape, deflection: float | None, angle: float, pixels: i
     coarsest = max(angle, _COARSEST)
     angular = min(angle * max(1.0, math.sqrt(faces.Extent() / _FACES_AT_FINEST)), coarsest)
     while True:
+        parameters = IMeshTools_Parameters()
+        parameters.Deflection, parameters.Angle = linear, angular
+        parameters.MinSize = 2.0 * linear  # no triangle edge below a pixel: finer ones cannot show
         # not in parallel: a file is meshed in a forked child, where a thread pool the parent started would hang
-        BRepMesh_IncrementalMesh(shape, linear, False, angular, False)
+        parameters.InParallel = False
+        BRepMesh_IncrementalMesh(shape, parameters)
         if _triangles(shape) <= max_triangles or angular >= coarsest:
             break
         BRepTools.Clean_s(shape)
@@ -181,7 +186,8 @@ def face_mesh(shape_or_path: Any, *, deflection: float | None = None, angle: flo
         shape_or_path: a build123d or CadQuery shape, a ``TopoDS_Shape``, or a
             .step/.stp/.igs/.iges path (read in a child process).
         deflection: largest distance of a triangle from its surface, in ``units``
-            (default half a pixel of a picture ``pixels`` wide: ``DEFLECTION`` × model size at ``PIXELS``).
+            (default half a pixel of a picture ``pixels`` wide: ``DEFLECTION`` × model size at ``PIXELS``);
+            no triangle edge is made shorter than twice it (a pixel).
         angle: largest turn of the normals across a triangle, radians (default ``ANGULAR``),
             for up to 64 faces; coarser as the square root of the face count beyond.
         units: for a file, the unit to read it in (None: the unit it declares); for
