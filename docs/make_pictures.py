@@ -46,7 +46,7 @@ def zebra_pictures() -> None:
         "continuous rectangle, extruded: G2": face_mesh(bd.extrude(ContinuousRectangle(40, 20, 5), 8)),
     }
     view = (1.0, -0.9, 0.45)
-    for name, draw in (("zebra_boxes.png", partial(plot_zebra, stripes=5, subdivide=8)), ("zebra_curvature.png", plot_curvature_map)):
+    for name, draw in (("zebra_boxes.png", partial(plot_zebra, stripes=5)), ("zebra_curvature.png", plot_curvature_map)):
         fig = Figure(figsize=(12, 3.6), dpi=110)
         for ax, (title, mesh) in zip(fig.subplots(1, 2), parts.items()):
             draw(mesh, ax=ax, title=title, view=view)
@@ -54,7 +54,7 @@ def zebra_pictures() -> None:
     # every edge filleted: stripes cross the cylinder/sphere edges (G1) and kink there
     fig = Figure(figsize=(6, 4.5), dpi=110)
     rounded = bd.fillet(bd.Box(40, 20, 16).edges(), 6)
-    plot_zebra(rounded, ax=fig.add_subplot(), view=(1.0, -1.3, 1.0), stripes=6, subdivide=6, across=(0.3, 0.2, 1.0))
+    plot_zebra(rounded, ax=fig.add_subplot(), view=(1.0, -1.3, 1.0), stripes=6, across=(0.3, 0.2, 1.0))
     fig.savefig(IMAGES / "zebra_corners.png", bbox_inches="tight")
 
 

@@ -3,9 +3,15 @@ and the zebra and curvature pictures (``--zebra``, ``--curvature-map``)."""
 
 from __future__ import annotations
 
+import warnings
+from collections.abc import Callable
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from ..cad.faces import FEATURE_ANGLE, check_faces
+
+if TYPE_CHECKING:
+    from matplotlib.figure import Figure  # matplotlib is imported only when a picture is drawn
 
 __all__ = ["check_face_file"]
 
@@ -22,6 +28,24 @@ def _png(option: str, path: str | None) -> Path | None:
     return p
 
 
+def _picture(draw: Callable[[], Figure], path: Path, what: str) -> None:
+    """Draw and write one picture; a failure names the stage (drawing or writing) and the file, and a
+    warning (nothing visible) is printed."""
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        try:
+            fig = draw()
+        except MemoryError:
+            raise ValueError(f"drawing the {what} for {str(path)!r} ran out of memory") from None
+    for warning in caught:
+        print(f"warning: {what}: {warning.message}")
+    try:
+        fig.savefig(path, dpi=120, bbox_inches="tight")
+    except OSError as error:
+        raise ValueError(f"cannot write the {what} to {str(path)!r}: {error.strerror or error}") from None
+    print(f"{what} written to {path}")
+
+
 def check_face_file(file: str, *, require: str | None = None, gap_tol: float | None = None, angle_tol: float | None = None,
                     curvature_tol: float | None = None, feature_angle: float | None = None, zebra: str | None = None,
                     curvature_map: str | None = None, timing: bool = False) -> int | None:  # fmt: skip
@@ -32,7 +56,7 @@ def check_face_file(file: str, *, require: str | None = None, gap_tol: float | N
     also prints how long the check took.
 
     Returns:
-        0 ok, 1 below ``require``, None when the reader found no faces (the caller judges the wires).
+        0 ok, 1 below ``require`` or no shared edge judged (loose faces that could not be sewn), None when the reader found no faces (the caller judges the wires).
 
     Raises:
         ValueError: an unreadable file or a bad option (printed as ``error: …`` by the CLI).
@@ -56,13 +80,15 @@ def check_face_file(file: str, *, require: str | None = None, gap_tol: float | N
 
         mesh = face_mesh(file, units=report.units)
         if zebra_png is not None:
-            plot_zebra(mesh, title=f"{report.source}: zebra").savefig(zebra_png, dpi=120, bbox_inches="tight")
-            print(f"zebra stripes written to {zebra_png}")
+            _picture(lambda: plot_zebra(mesh, title=f"{report.source}: zebra"), zebra_png, "zebra stripes")
         if map_png is not None:
-            plot_curvature_map(mesh, title=f"{report.source}: mean curvature").savefig(map_png, dpi=120, bbox_inches="tight")
-            print(f"curvature map written to {map_png}")
+            _picture(lambda: plot_curvature_map(mesh, title=f"{report.source}: mean curvature"), map_png, "curvature map")
     if not require:
         return 0
+    if not report.edges:
+        print(f"FAIL: no shared edges were judged, so nothing shows {require} ({report.describe()}); "
+              "the faces meet nowhere, even after sewing")  # fmt: skip
+        return 1
     level = "crease" if require == "G0" else require  # a crease is G0, not G1
     worst = report.worst
     if worst == "gap" or (level != "crease" and not report.passes(level)):

@@ -21,8 +21,17 @@ class (``EDGE_CLASSES``): ``"unmeasurable"`` (no sample gave a point or a normal
 ``feature_angle``: a feature — a box's edge — listed, never failed),
 ``"crease"`` (an angle above ``angle_tol`` but below ``feature_angle``: a
 near-tangent kink, a defect), ``"G1"`` (tangent, the curvature jumps),
-``"G2"``. Edges that bound one face only (an open shell) are counted as
-free; degenerate edges (a sphere's poles) are skipped.
+``"G2"``. An edge is sharp only if it is sharp at every sample: one tangent
+over part of its length is a crease. Edges that bound one face only (an open
+shell) are counted as free; degenerate edges (a sphere's poles) are skipped.
+
+What a file holds is not always one clean shell: faces written unstitched are
+sewn first (``SEW_TOL`` × size) and the stitches counted; two faces that use
+their edge in the same direction (an inconsistently oriented shell) are
+compared with one normal flipped and the row says so; at an edge of three or
+more faces every pair is judged; an internal knot line of a B-spline face
+whose multiplicity allows a crease or a curvature jump is judged as a
+pseudo-edge (index −1) between the two polynomial spans.
 
 Files are read and measured in a child process (``spiral_cad.cad.readers``);
 only the measured numbers come back. The time is linear in the faces: one
@@ -62,7 +71,7 @@ from ..core.units import length_unit
 from .occ import as_occ_shape
 from .readers import IGES_SUFFIXES, STEP_SUFFIXES, read_file
 
-__all__ = ["EDGE_CLASSES", "FEATURE_ANGLE", "FaceEdge", "FaceReport", "check_faces", "holds_faces"]
+__all__ = ["EDGE_CLASSES", "FEATURE_ANGLE", "SEW_TOL", "FaceEdge", "FaceReport", "check_faces", "holds_faces"]
 
 #: Normals further apart than this (radians, 5°) make an edge a sharp feature
 #: (a box's edge), listed and never failed; between ``angle_tol`` and this the
@@ -77,11 +86,16 @@ _RANK = {"unmeasurable": 0, "gap": 0, "crease": 1, "G1": 2, "G2": 3}
 #: Floats per sample and face: point (3), oriented unit normal (3), normal curvature across the edge.
 _FACE_FLOATS = 7
 
+#: Free edges that coincide within this distance, relative to the model size, are sewn together
+#: before the faces are judged (faces written one by one: IGES surface exports, loose compounds).
+SEW_TOL = 1e-6
+
 #: What is measured of a shape, as plain data for the reader's child process:
-#: face count, per face its surface type, per checked edge (edge index, face a,
-#: face b, seam), the number of free edges, the model size, and the samples as
-#: float64 bytes (edges × samples × 2 faces × ``_FACE_FLOATS``).
-Measured = tuple[int, list[str], list[tuple[int, int, int, bool]], int, float, bytes]
+#: face count, per face its surface type, per checked pair (edge index, face a,
+#: face b, seam, note), the free edges (index, midpoint), the model size, the samples as
+#: float64 bytes (pairs × samples × 2 faces × ``_FACE_FLOATS``), and how many edges were sewn.
+Measured = tuple[int, list[str], list[tuple[int, int, int, bool, str]], list[tuple[int, tuple[float, float, float]]], float,
+                 bytes, int]  # fmt: skip
 
 
 # ------------------------------------------------------------ measuring
@@ -177,9 +191,105 @@ def _shapes(shapes: TopTools_ListOfShape) -> list[TopoDS_Shape]:
     return found
 
 
+def _free_edges(shape: TopoDS_Shape) -> list[TopoDS_Edge]:
+    """The edges of ``shape`` that bound one face only and are not its seam (degenerate edges left out)."""
+    ancestors = TopTools_IndexedDataMapOfShapeListOfShape()
+    TopExp.MapShapesAndAncestors_s(shape, TopAbs_EDGE, TopAbs_FACE, ancestors)
+    free = []
+    for i in range(1, ancestors.Extent() + 1):
+        edge = TopoDS.Edge_s(ancestors.FindKey(i))
+        if BRep_Tool.Degenerated_s(edge) or not BRep_Tool.IsGeometric_s(edge):
+            continue
+        faces = _shapes(ancestors.FindFromIndex(i))
+        if all(f.IsSame(faces[0]) for f in faces) and not BRep_Tool.IsClosed_s(edge, TopoDS.Face_s(faces[0])):
+            free.append(edge)
+    return free
+
+
+def _sewn(shape: TopoDS_Shape, size: float) -> tuple[TopoDS_Shape, int]:
+    """``shape`` with its coinciding free edges sewn (``SEW_TOL`` × ``size``), and how many edges were
+    stitched; ``shape`` itself when it has no free edges or none could be joined."""
+    from OCP.BRepBuilderAPI import BRepBuilderAPI_Sewing
+
+    if size <= 0.0 or not _free_edges(shape):
+        return shape, 0
+    sewing = BRepBuilderAPI_Sewing(SEW_TOL * size)
+    sewing.SetNonManifoldMode(True)  # an edge where three faces meet is sewn to all three
+    sewing.Add(shape)
+    sewing.Perform()
+    stitched = sewing.NbContigousEdges() + sewing.NbMultipleEdges()
+    return (sewing.SewedShape(), stitched) if stitched else (shape, 0)
+
+
+def _edge_uses(face: TopoDS_Face, edges: TopTools_IndexedMapOfShape) -> dict[int, set[Any]]:
+    """The orientations with which ``face`` (as placed in its shell) uses each of its edges, by edge index."""
+    from OCP.TopExp import TopExp_Explorer
+
+    uses: dict[int, set[Any]] = {}
+    explorer = TopExp_Explorer(face, TopAbs_EDGE)
+    while explorer.More():
+        current = explorer.Current()
+        uses.setdefault(edges.FindIndex(current), set()).add(current.Orientation())
+        explorer.Next()
+    return uses
+
+
+def _knot_lines(face: TopoDS_Face, samples: int) -> list[tuple[str, NDArray, NDArray]]:
+    """The internal knot lines of a B-spline face where it may crease (knot multiplicity ≥ degree) or
+    its curvature may jump (≥ degree − 1): per line its name, the surface derivatives from either
+    side (samples × 2 × 18, the two spans' polynomials, ``LocalD2``) and the line's unit tangents.
+    The line is sampled across the face's (u, v) bounds, so a trimmed face's line may be sampled
+    a little beyond its trimming."""
+    from OCP.BRepTools import BRepTools
+    from OCP.Geom import Geom_BSplineSurface
+
+    surface = BRep_Tool.Surface_s(face)  # located: the points come out where the face is
+    if not isinstance(surface, Geom_BSplineSurface):
+        return []
+    u0, u1, v0, v1 = BRepTools.UVBounds_s(face)
+    p = gp_Pnt()
+    su, sv, suu, svv, suv = gp_Vec(), gp_Vec(), gp_Vec(), gp_Vec(), gp_Vec()
+    lines = []
+    for along_u in (True, False):
+        degree = surface.UDegree() if along_u else surface.VDegree()
+        first, last = (surface.FirstUKnotIndex(), surface.LastUKnotIndex()) if along_u else (
+            surface.FirstVKnotIndex(), surface.LastVKnotIndex())  # fmt: skip
+        knot = surface.UKnot if along_u else surface.VKnot
+        multiplicity = surface.UMultiplicity if along_u else surface.VMultiplicity
+        low, high = (u0, u1) if along_u else (v0, v1)
+        other_low, other_high = (v0, v1) if along_u else (u0, u1)
+        ofirst, olast = (surface.FirstVKnotIndex(), surface.LastVKnotIndex()) if along_u else (
+            surface.FirstUKnotIndex(), surface.LastUKnotIndex())  # fmt: skip
+        oknots = np.array([(surface.VKnot if along_u else surface.UKnot)(i) for i in range(ofirst, olast + 1)])
+        for i in range(first + 1, last):
+            k = knot(i)
+            if multiplicity(i) < max(1, degree - 1) or not low < k < high:
+                continue
+            others = other_low + (other_high - other_low) * (np.arange(samples) + 0.5) / samples
+            spans = ofirst + np.clip(np.searchsorted(oknots, others, side="right") - 1, 0, len(oknots) - 2)
+            raw = np.empty((samples, 2, 18))
+            for n, (t, j) in enumerate(zip(others.tolist(), spans.tolist())):
+                for side, (a, b) in enumerate(((i - 1, i), (i, i + 1))):
+                    if along_u:
+                        surface.LocalD2(k, t, a, b, j, j + 1, p, su, sv, suu, svv, suv)
+                    else:
+                        surface.LocalD2(t, k, j, j + 1, a, b, p, su, sv, suu, svv, suv)
+                    raw[n, side] = (*p.Coord(), *su.Coord(), *sv.Coord(), *suu.Coord(), *svv.Coord(), *suv.Coord())
+            tangents = raw[:, 0, 6:9] if along_u else raw[:, 0, 3:6]  # along the line: Sv on a u line, Su on a v line
+            with np.errstate(all="ignore"):
+                tangents = tangents / norms(tangents)[:, None]
+            lines.append((f"{'u' if along_u else 'v'} = {k:.6g} (knot of multiplicity {multiplicity(i)})", raw, tangents))
+    return lines
+
+
 def _measure(shape: TopoDS_Shape, samples: int) -> Measured:
     """Everything ``check_faces`` needs of ``shape``, as plain data (see ``Measured``); runs in the
-    reader's child process for a file."""
+    reader's child process for a file. Faces that were written unstitched (coinciding free edges)
+    are sewn first."""
+    box = Bnd_Box()
+    BRepBndLib.Add_s(shape, box, False)
+    size = 0.0 if box.IsVoid() else math.sqrt(box.SquareExtent())
+    shape, stitched = _sewn(shape, size)
     faces = TopTools_IndexedMapOfShape()
     TopExp.MapShapes_s(shape, TopAbs_FACE, faces)
     edges = TopTools_IndexedMapOfShape()
@@ -187,48 +297,81 @@ def _measure(shape: TopoDS_Shape, samples: int) -> Measured:
     ancestors = TopTools_IndexedDataMapOfShapeListOfShape()
     TopExp.MapShapesAndAncestors_s(shape, TopAbs_EDGE, TopAbs_FACE, ancestors)
     adaptors: dict[int, BRepAdaptor_Surface] = {}
+    uses: dict[int, dict[int, set[Any]]] = {}
     kinds: list[str] = []
     for i in range(1, faces.Extent() + 1):
         kinds.append(_surface_name(BRepAdaptor_Surface(TopoDS.Face_s(faces.FindKey(i)), False).GetType()))
-    pairs: list[tuple[int, int, int, bool]] = []
-    raw = np.empty((ancestors.Extent(), samples, 2, 18))  # surface derivatives per edge, sample, side
-    tangents = np.empty((ancestors.Extent(), samples, 3))
-    sign = np.empty((ancestors.Extent(), 2))
-    free = 0
+    pairs: list[tuple[int, int, int, bool, str]] = []
+    raw: list[NDArray] = []  # surface derivatives per pair: samples × 2 sides × 18
+    tangents: list[NDArray] = []
+    sign: list[tuple[float, float]] = []
+    free: list[tuple[int, tuple[float, float, float]]] = []
     for i in range(1, ancestors.Extent() + 1):
         edge = TopoDS.Edge_s(ancestors.FindKey(i))
         if BRep_Tool.Degenerated_s(edge) or not BRep_Tool.IsGeometric_s(edge):
             continue
+        index = edges.FindIndex(edge)
         found: list[TopoDS_Face] = []
         for f in _shapes(ancestors.FindFromIndex(i)):
             if not any(f.IsSame(g) for g in found):
                 found.append(TopoDS.Face_s(f))
         if len(found) == 1 and BRep_Tool.IsClosed_s(edge, found[0]):  # a seam: the face meets itself
             face = found[0]
-            sides = [(face, TopoDS.Edge_s(edge.Oriented(TopAbs_FORWARD))), (face, TopoDS.Edge_s(edge.Oriented(TopAbs_REVERSED)))]
+            forward, backward = TopoDS.Edge_s(edge.Oriented(TopAbs_FORWARD)), TopoDS.Edge_s(edge.Oriented(TopAbs_REVERSED))
+            couples = [((face, forward), (face, backward), "")]
         elif len(found) >= 2:
-            sides = [(found[0], edge), (found[1], edge)]  # a non-manifold edge: its first two faces
+            # a non-manifold edge (three or more faces): every pair of its faces is judged
+            note = f"non-manifold: {len(found)} faces" if len(found) > 2 else ""
+            couples = [((a, edge), (b, edge), note) for k, a in enumerate(found) for b in found[k + 1 :]]
         else:
-            free += 1
+            point = BRepAdaptor_Curve(edge)
+            middle = point.Value(0.5 * (point.FirstParameter() + point.LastParameter()))
+            free.append((index - 1, (middle.X(), middle.Y(), middle.Z())))
             continue
-        row = len(pairs)
-        params = _edge_points(edge, samples, tangents[row])
-        for side, (face, oriented) in enumerate(sides):
-            index = faces.FindIndex(face)
-            if index not in adaptors:
-                adaptors[index] = BRepAdaptor_Surface(face)
-            _face_derivatives(adaptors[index], face, oriented, params, raw[row, :, side])
-            sign[row, side] = -1.0 if face.Orientation() == TopAbs_REVERSED else 1.0
-        pairs.append((edges.FindIndex(edge) - 1, faces.FindIndex(sides[0][0]) - 1, faces.FindIndex(sides[1][0]) - 1,
-                      len(found) == 1))  # fmt: skip
+        for (fa, ea), (fb, eb), note in couples:
+            row_tangents = np.empty((samples, 3))
+            params = _edge_points(edge, samples, row_tangents)
+            row = np.empty((samples, 2, 18))
+            signs = []
+            for side, (face, oriented) in enumerate(((fa, ea), (fb, eb))):
+                face_index = faces.FindIndex(face)
+                if face_index not in adaptors:
+                    adaptors[face_index] = BRepAdaptor_Surface(face)
+                _face_derivatives(adaptors[face_index], face, oriented, params, row[:, side])
+                signs.append(-1.0 if face.Orientation() == TopAbs_REVERSED else 1.0)
+            if fa is not fb and not fa.IsSame(fb):
+                for face in (fa, fb):
+                    if faces.FindIndex(face) not in uses:  # each face's edges explored once
+                        uses[faces.FindIndex(face)] = _edge_uses(face, edges)
+                ua = uses[faces.FindIndex(fa)].get(index, set())
+                ub = uses[faces.FindIndex(fb)].get(index, set())
+                if len(ua) == 1 and ua == ub:
+                    # a consistent shell uses each edge once FORWARD and once REVERSED: these two faces
+                    # disagree on their outside, so one normal is flipped before they are compared
+                    # (at a non-manifold edge no orientation suits every pair: flipped, not reported)
+                    signs[1] = -signs[1]
+                    if len(found) == 2:
+                        note = "; ".join(filter(None, [note, "orientation: both faces use the edge in the same direction "
+                                                       "(inconsistent shell); compared with one normal flipped"]))  # fmt: skip
+            raw.append(row)
+            tangents.append(row_tangents)
+            sign.append((signs[0], signs[1]))
+            pairs.append((index - 1, faces.FindIndex(fa) - 1, faces.FindIndex(fb) - 1, len(found) == 1, note))
+    for face_index in range(1, faces.Extent() + 1):
+        face = TopoDS.Face_s(faces.FindKey(face_index))
+        for name, row, row_tangents in _knot_lines(face, samples):
+            raw.append(row)
+            tangents.append(row_tangents)
+            sign.append((-1.0, -1.0) if face.Orientation() == TopAbs_REVERSED else (1.0, 1.0))
+            pairs.append((-1, face_index - 1, face_index - 1, False, f"inside face {face_index - 1}, {name}"))
     count = len(pairs)
-    flat = _samples(raw[:count].reshape(-1, 18), sign[:count, None, :].repeat(samples, axis=1).reshape(-1),
-                    tangents[:count, :, None, :].repeat(2, axis=2).reshape(-1, 3))  # fmt: skip
+    if count:
+        flat = _samples(np.stack(raw).reshape(-1, 18), np.repeat(np.array(sign)[:, None, :], samples, axis=1).reshape(-1),
+                        np.repeat(np.stack(tangents)[:, :, None, :], 2, axis=2).reshape(-1, 3))  # fmt: skip
+    else:
+        flat = np.empty((0, _FACE_FLOATS))
     data = flat.reshape(count, samples, 2, _FACE_FLOATS)
-    box = Bnd_Box()
-    BRepBndLib.Add_s(shape, box, False)
-    size = 0.0 if box.IsVoid() else math.sqrt(box.SquareExtent())
-    return faces.Extent(), kinds, pairs, free, size, data.tobytes()
+    return faces.Extent(), kinds, pairs, free, size, data.tobytes(), stitched
 
 
 # ------------------------------------------------------------ the report
@@ -239,7 +382,8 @@ class FaceEdge:
     """How two faces meet along one edge: the worst of each measure along it, and where.
 
     Attributes:
-        index: the edge's index among the shape's edges (0-based, ``TopExp.MapShapes`` order).
+        index: the edge's index among the shape's edges (0-based, ``TopExp.MapShapes`` order); -1 for a
+            knot line inside a B-spline face (a pseudo-edge: the face's two polynomial spans meet there).
         faces: the indices of the two faces (0-based, ``TopExp.MapShapes`` order); equal for a seam.
         surfaces: their surface types (``"plane"``, ``"cylinder"``, ``"bspline"``, …).
         seam: the edge is a seam where one closed face meets itself.
@@ -253,6 +397,9 @@ class FaceEdge:
         curvatures: the two faces' normal curvatures across the edge there (sign: positive
             bends towards the normal), in 1/unit.
         level: the edge's class, one of ``EDGE_CLASSES``.
+        note: what else was seen, e.g. ``"non-manifold: 3 faces"``, an orientation defect (the two
+            faces use the edge in the same direction; compared with one normal flipped) or a
+            partly tangent edge (angle below ``feature_angle`` at some samples, judged there).
     """
 
     index: int
@@ -267,6 +414,7 @@ class FaceEdge:
     jump_at: tuple[float, float, float]
     curvatures: tuple[float, float]
     level: str
+    note: str = ""
 
     @property
     def tangent(self) -> bool:
@@ -291,6 +439,9 @@ class FaceReport:
         source: file name or shape description.
         units: the unit of every length (``""``: not known).
         seconds: how long the check took, reading included.
+        stitched: edges where faces written unstitched were sewn together (within ``SEW_TOL`` × size)
+            before being judged; face and edge indices then count in the sewn shape.
+        free_at: the free edges left after sewing: (edge index, midpoint) each.
     """
 
     edges: tuple[FaceEdge, ...]
@@ -305,6 +456,8 @@ class FaceReport:
     source: str = ""
     units: str = ""
     seconds: float = 0.0
+    stitched: int = 0
+    free_at: tuple[tuple[int, tuple[float, float, float]], ...] = ()
 
     @property
     def tangent_edges(self) -> list[FaceEdge]:
@@ -331,14 +484,15 @@ class FaceReport:
         return min((e.level for e in self.tangent_edges), key=_RANK.__getitem__, default="G2")
 
     def passes(self, require: str = "G2") -> bool:
-        """True when every tangent edge is at least ``require`` (``"G2"`` or ``"G1"``) and no edge has a gap.
+        """True when every tangent edge is at least ``require`` (``"G2"`` or ``"G1"``) and no edge has a gap;
+        never when no shared edge was judged at all (loose faces that could not be sewn).
 
         Raises:
             ValueError: ``require`` is not ``"G1"`` or ``"G2"``.
         """
         if require not in ("G1", "G2"):
             raise ValueError(f"require must be 'G1' or 'G2'; got {require!r}")
-        return _RANK[self.worst] >= _RANK[require]
+        return bool(self.edges) and _RANK[self.worst] >= _RANK[require]
 
     def failing(self, require: str = "G2") -> list[FaceEdge]:
         """The edges that keep the report from passing ``require``: tangent edges below it, and any
@@ -356,35 +510,49 @@ class FaceReport:
         """What was found, e.g. ``"10 faces, 24 shared edges (8 G1, 16 sharp)"``."""
         counts = ", ".join(f"{n} {level}" for level, n in self.counts.items() if n)
         free = f", {self.free_edges} free" if self.free_edges else ""
-        return f"{self.faces} faces, {len(self.edges)} shared edges ({counts or 'none'}){free}"
+        sewn = f", {self.stitched} stitched" if self.stitched else ""
+        return f"{self.faces} faces, {len(self.edges)} shared edges ({counts or 'none'}){sewn}{free}"
 
     def table(self) -> str:
-        """Readable text: what was found, the tolerances, then one line per edge (worst first)."""
+        """Readable text: what was found, the tolerances, then one line per edge (worst first), then
+        the free edges left unjoined."""
+        from ..design.tables import fixed_columns
+
         unit = f" {self.units}" if self.units else " (model units)"
         inverse = f" 1/{self.units}" if self.units else ""
+        sewn = f"; faces sewn within {SEW_TOL:g} × size" if self.stitched else ""
         out = [
             f"{self.source or 'shape'}: {self.describe()}; worst tangent edge {self.worst}",
             f"  tolerances: gap {self.gap_tol:g} × size, angle {self.angle_tol:g} rad, curvature jump "
             f"{self.curvature_tol:g} relative, sharp above {math.degrees(self.feature_angle):g}°; "
-            f"{self.samples} samples per edge; model size {self.size:.6g}{unit}",
-            f"  {'edge':>5} {'faces':>9} {'surfaces':<22} {'gap':>10} {'angle rad':>10} "
-            f"{'κa':>10} {'κb':>10} {'jump rel':>9}  class  (worst jump at){inverse and f'  κ in{inverse}'}",
+            f"{self.samples} samples per edge; model size {self.size:.6g}{unit}{sewn}",
         ]
         order = sorted(self.edges, key=lambda e: (e.level == "sharp", _RANK.get(e.level, 9), -e.jump, e.index))
-        for e in order:
-            surfaces = f"{e.surfaces[0]}/{e.surfaces[1]}" + (" seam" if e.seam else "")
-            at = ", ".join(f"{v:.4g}" for v in e.jump_at)
-            out.append(
-                f"  {e.index:5d} {e.faces[0]:4d}-{e.faces[1]:<4d} {surfaces:<22} {e.gap:10.3e} {e.angle:10.3e} "
-                f"{e.curvatures[0]:10.4g} {e.curvatures[1]:10.4g} {e.jump:9.2e}  {e.level:<6} ({at})"
-            )
+        names = [f"{e.surfaces[0]}/{e.surfaces[1]}" + (" seam" if e.seam else "") for e in order]
+        width = max([22, *map(len, names)])  # long surface names widen the column, never shift the others
+        columns = [("  edge", "6d"), ("faces", ">9"), ("surfaces", f"<{width}"), ("gap", "10.3e"), ("angle rad", "10.3e"),
+                   ("κa", "10.4g"), ("κb", "10.4g"), ("jump rel", "9.2e"), (" class", "<7"),
+                   (f"(worst jump at){inverse and f'  κ in{inverse}'}", "")]  # fmt: skip
+        rows = [(e.index, f"{e.faces[0]}-{e.faces[1]}", name, e.gap, e.angle, e.curvatures[0], e.curvatures[1], e.jump,
+                 f" {e.level}", f"({', '.join(f'{v:.4g}' for v in e.jump_at)})" + (f"  {e.note}" if e.note else ""))
+                for e, name in zip(order, names)]  # fmt: skip
+        out += fixed_columns(columns, rows, rule=False)
+        if self.free_at:
+            out.append(f"  free edges that no other face could be sewn to ({len(self.free_at)}):")
+            out += [f"  {i:6d} at ({', '.join(f'{v:.4g}' for v in at)})" for i, at in self.free_at[:_FREE_LISTED]]
+            if len(self.free_at) > _FREE_LISTED:
+                out.append(f"  … and {len(self.free_at) - _FREE_LISTED} more")
         return "\n".join(out)
+
+
+#: Free edges listed by name in a table; the rest are counted.
+_FREE_LISTED = 20
 
 
 def _classify(measured: Measured, *, gap_tol: float, angle_tol: float, curvature_tol: float, feature_angle: float,
               samples: int, source: str, units: str, started: float) -> FaceReport:  # fmt: skip
     """The report of the measured samples: worst values per edge (vectorised over all edges) and classes."""
-    count, kinds, pairs, free, size, data = measured
+    count, kinds, pairs, free, size, data, stitched = measured
     x = np.frombuffer(data, dtype=float).reshape(len(pairs), samples, 2, _FACE_FLOATS)
     a, b = x[:, :, 0], x[:, :, 1]
     with np.errstate(all="ignore"):
@@ -397,18 +565,22 @@ def _classify(measured: Measured, *, gap_tol: float, angle_tol: float, curvature
         jump = np.abs(ka - kb) / np.maximum(np.maximum(np.abs(ka), np.abs(kb)), floor)
     rows = []
     gap_limit = gap_tol * size
-    for i, (edge, fa, fb, seam) in enumerate(pairs):
+    for i, (edge, fa, fb, seam, note) in enumerate(pairs):
         # NaN (a sample at a singular point of a surface) never decides a worst value
         g, an, j = (int(np.nanargmax(v[i])) if np.isfinite(v[i]).any() else 0 for v in (gap, angle, jump))
         worst_gap, worst_angle, worst_jump = float(gap[i, g]), float(angle[i, an]), float(jump[i, j])
+        least_angle = float(np.nanmin(angle[i])) if np.isfinite(angle[i]).any() else math.nan
         if not (math.isfinite(worst_gap) and math.isfinite(worst_angle)):
             level = "unmeasurable"  # no sample gave a point or a normal: never passed
         elif worst_gap > gap_limit:
             level = "gap"
-        elif worst_angle > feature_angle:
-            level = "sharp"
+        elif least_angle > feature_angle:
+            level = "sharp"  # sharp at every sample: a feature
         elif worst_angle > angle_tol:
-            level = "crease"
+            level = "crease"  # a kink somewhere, or tangent over part of the edge and sharp over the rest
+            if worst_angle > feature_angle:
+                note = "; ".join(filter(None, [note, f"partly tangent: angle {least_angle:.3g} to {worst_angle:.3g} rad "
+                                               "along the edge, judged where below the feature angle"]))  # fmt: skip
         elif worst_jump > curvature_tol or worst_jump != worst_jump:
             level = "G1"
         else:
@@ -418,9 +590,9 @@ def _classify(measured: Measured, *, gap_tol: float, angle_tol: float, curvature
             return (float(a[row, k, 0]), float(a[row, k, 1]), float(a[row, k, 2]))
 
         rows.append(FaceEdge(edge, (fa, fb), (kinds[fa], kinds[fb]), seam, worst_gap, at(g), worst_angle, at(an),
-                             worst_jump, at(j), (float(ka[i, j]), float(kb[i, j])), level))  # fmt: skip
-    return FaceReport(tuple(rows), count, free, size, gap_tol, angle_tol, curvature_tol, feature_angle, samples,
-                      source, units, time.perf_counter() - started)  # fmt: skip
+                             worst_jump, at(j), (float(ka[i, j]), float(kb[i, j])), level, note))  # fmt: skip
+    return FaceReport(tuple(rows), count, len(free), size, gap_tol, angle_tol, curvature_tol, feature_angle, samples,
+                      source, units, time.perf_counter() - started, stitched, tuple(free))  # fmt: skip
 
 
 def check_faces(shape_or_path: Any, *, gap_tol: float = 1e-7, angle_tol: float = 1e-7, curvature_tol: float = 1e-4,

@@ -106,3 +106,45 @@ def test_comb_of_a_face_file_is_written_beside_the_face_verdict(files, tmp_path,
     assert main(["check", str(files["box"]), "--require", "G1", "--comb", str(comb)]) == 0
     assert "OK: 10 faces" in capsys.readouterr().out
     assert comb.stat().st_size > 1000 and not holds_faces(comb)  # the comb is lines only
+
+
+def test_faces_that_meet_nowhere_fail_a_requirement_with_nothing_judged(tmp_path, capsys):
+    path = tmp_path / "apart.step"
+    bd.export_step(bd.Compound([bd.Face.make_rect(10, 10), bd.Face.make_rect(10, 10).moved(bd.Location((50, 0, 0)))]), str(path))
+    assert main(["check", str(path), "--require", "G1"]) == 1
+    out = capsys.readouterr().out
+    assert "FAIL: no shared edges were judged" in out and "free edges that no other face could be sewn to (8)" in out
+
+
+def test_loose_faces_in_a_file_are_sewn_and_judged(tmp_path, capsys):
+    from OCP.BRepBuilderAPI import BRepBuilderAPI_Copy
+
+    box = bd.fillet(bd.Box(40, 20, 8).edges().filter_by(bd.Axis.Z), 5)
+    path = tmp_path / "loose.step"
+    bd.export_step(bd.Compound([bd.Face(BRepBuilderAPI_Copy(f.wrapped).Shape()) for f in box.faces()]), str(path))
+    assert main(["check", str(path), "--require", "G2"]) == 1
+    out = capsys.readouterr().out
+    assert "24 stitched" in out and "8 G1" in out and "FAIL: worst tangent edge is G1" in out
+
+
+def test_a_picture_that_cannot_be_written_is_named(files, tmp_path, capsys, monkeypatch):
+    from matplotlib.figure import Figure
+
+    def full(self, *args, **kwargs):
+        raise OSError(28, "No space left on device")
+
+    monkeypatch.setattr(Figure, "savefig", full)
+    assert main(["check", str(files["box"]), "--zebra", str(tmp_path / "z.png")]) == 2
+    err = capsys.readouterr().err
+    assert "cannot write the zebra stripes to" in err and "z.png" in err and "No space left on device" in err
+
+
+def test_a_failure_while_meshing_is_named_meshing_not_reading(files, monkeypatch):
+    from spiral_cad.cad import mesh
+
+    def timed_out(*args, **kwargs):
+        raise ValueError("the STEP reader failed on 'box.step': it timed out after 120 s")
+
+    monkeypatch.setattr(mesh, "read_file", timed_out)
+    with pytest.raises(ValueError, match=r"^meshing for the picture: reading and meshing failed on 'box.step': it timed out"):
+        mesh.face_mesh(files["box"])

@@ -36,15 +36,42 @@ def test_zebra_of_a_sphere_draws_rings_of_both_colours(sphere):
 def test_curvature_map_of_a_sphere_is_one_colour_with_its_scale(sphere):
     fig = plot_curvature_map(sphere, title="sphere")
     assert len(fig.axes) == 2 and "1/mm" in fig.axes[1].get_ylabel()  # the colour bar names the unit
-    assert np.allclose(np.asarray(fig.axes[0].collections[0].get_array()), 0.2, atol=1e-9)  # 1/r everywhere
+    assert np.allclose(np.asarray(fig.axes[0].images[0].get_array().compressed()), 0.2, atol=1e-9)  # 1/r everywhere
 
 
 @pytest.mark.parametrize(
     ("call", "message"),
-    [(lambda m: plot_zebra(m, stripes=0), "stripes"), (lambda m: plot_zebra(m, subdivide=True), "subdivide"),
+    [(lambda m: plot_zebra(m, stripes=0), "stripes"), (lambda m: plot_zebra(m, pixels=True), "pixels"),
      (lambda m: plot_zebra(m, view=(0, 0, 0)), "view"), (lambda m: plot_zebra(m, across=(math.nan, 0, 1)), "across"),
      (lambda m: plot_curvature_map(m, kind="max"), "kind"), (lambda m: face_mesh(bd.Box(1, 1, 1), angle=0), "angle")],
 )  # fmt: skip
 def test_bad_arguments_raise_value_error_naming_them(sphere, call, message):
     with pytest.raises(ValueError, match=message):
         call(sphere)
+
+
+def test_an_open_dome_seen_from_behind_is_drawn_not_left_blank():
+    dome = next(f for f in bd.Sphere(5).faces()).split(bd.Plane.XY, keep=bd.Keep.TOP)  # the upper half, open below
+    image = _pixels(plot_zebra(face_mesh(dome, angle=0.2), stripes=4, view=(0.2, 0.1, -1), across=(1, 0, 0)))
+    dark, light = (image < 0.2).all(axis=2).mean(), (image > 0.9).all(axis=2).mean()
+    assert dark > 0.05 and light > 0.05  # seen from inside: stripes of both colours
+
+
+def test_a_face_seen_edge_on_warns_that_nothing_is_visible():
+    with pytest.warns(UserWarning, match="nothing is visible"):
+        plot_zebra(face_mesh(bd.Face.make_rect(10, 10)), view=(1, 0, 0))
+
+
+def test_the_mesh_keeps_below_its_triangle_cap_and_follows_the_pictures_size():
+    part = bd.fillet(bd.Box(40, 20, 16).edges(), 6)
+    fine = face_mesh(part)
+    capped = face_mesh(part, max_triangles=5_000)
+    assert len(fine.triangles) > 20_000 and len(capped.triangles) <= 5_000
+    coarse = face_mesh(part, pixels=100, angle=0.3)
+    assert len(coarse.triangles) < len(face_mesh(part, angle=0.3).triangles)  # deflection of half a pixel
+
+
+def test_curvature_map_is_one_image_whatever_the_mesh(sphere):
+    fig = plot_curvature_map(sphere, pixels=200)
+    assert len(fig.axes[0].images) == 1 and not fig.axes[0].collections
+    assert max(fig.axes[0].images[0].get_array().shape) == 200

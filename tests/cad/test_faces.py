@@ -299,3 +299,161 @@ def test_failing_names_the_edges_below_the_requirement_worst_first():
     assert [e.level for e in creased.failing("G1")] == ["crease"]
     with pytest.raises(ValueError, match="require"):
         report.failing("G0")
+
+
+def loose_faces(part) -> bd.Compound:
+    """The part's faces each copied on its own: nothing shared, as a surface export writes them."""
+    from OCP.BRepBuilderAPI import BRepBuilderAPI_Copy
+
+    return bd.Compound([bd.Face(BRepBuilderAPI_Copy(f.wrapped).Shape()) for f in part.faces()])
+
+
+def test_loose_faces_are_sewn_before_judging_and_the_stitches_counted():
+    report = check_faces(loose_faces(filleted_box()))
+    assert_box_calibration(report)
+    assert report.stitched == 24 and report.free_edges == 0
+    assert "24 stitched" in report.describe()
+
+
+def test_surface_only_iges_export_is_sewn_and_judged(tmp_path):
+    Interface_Static.SetIVal_s("write.iges.brep.mode", 0)  # trimmed surfaces, one by one: no shared edges
+    writer = IGESControl_Writer("MM", 0)
+    writer.AddShape(filleted_box().wrapped)
+    writer.ComputeModel()
+    assert writer.Write(str(tmp_path / "faces.igs"))
+    report = check_faces(tmp_path / "faces.igs")
+    assert found(report) == {"G1": 8, "sharp": 16}  # the fillets come back as surfaces of revolution
+    assert report.worst == "G1" and report.passes("G1") and not report.passes("G2")
+    assert report.stitched == 24
+
+
+def test_faces_that_meet_nowhere_never_pass_and_their_free_edges_are_listed():
+    apart = bd.Compound([bd.Face.make_rect(10, 10), bd.Face.make_rect(10, 10).moved(bd.Location((50, 0, 0)))])
+    report = check_faces(apart)
+    assert report.edges == () and report.stitched == 0 and report.free_edges == 8
+    assert not report.passes("G1") and not report.passes("G2")
+    assert {round(at[0]) for _, at in report.free_at} == {-5, 0, 5, 45, 50, 55}
+    assert "free edges that no other face could be sewn to (8)" in report.table()
+
+
+def shell_of(faces) -> bd.Shell:
+    from OCP.BRep import BRep_Builder
+    from OCP.TopoDS import TopoDS_Shell
+
+    builder, shell = BRep_Builder(), TopoDS_Shell()
+    builder.MakeShell(shell)
+    for face in faces:
+        builder.Add(shell, face)
+    return bd.Shell(shell)
+
+
+@pytest.mark.parametrize("reversed_fillets", [1, 4])
+def test_a_face_reversed_in_its_shell_is_an_orientation_note_never_a_sharp_edge(reversed_fillets):
+    box = filleted_box()
+    cylinders = [f for f in box.faces() if f.geom_type == bd.GeomType.CYLINDER][:reversed_fillets]
+    shell = shell_of([f.wrapped.Reversed() if f in cylinders else f.wrapped for f in box.faces()])
+    report = check_faces(shell)
+    assert_box_calibration(report)
+    flagged = [e for e in report.edges if "orientation" in e.note]
+    assert len(flagged) == 4 * reversed_fillets  # each reversed fillet: two tangent edges and its top and bottom
+    assert sorted(e.level for e in flagged) == ["G1"] * 2 * reversed_fillets + ["sharp"] * 2 * reversed_fillets
+    assert "inconsistent shell" in report.table()
+
+
+def test_every_pair_of_faces_at_a_non_manifold_edge_is_judged():
+    from OCP.BOPAlgo import BOPAlgo_Builder
+
+    plane = bd.Face.make_rect(10, 10).moved(bd.Location((-5, 0, 0)))  # z = 0, x ≤ 0
+    cylinder = next(f for f in bd.Cylinder(5, 10, rotation=(90, 0, 0)).moved(bd.Location((0, 0, 5))).faces()
+                    if f.geom_type == bd.GeomType.CYLINDER)  # fmt: skip
+    quarter = (cylinder & bd.Box(5, 10, 5, align=(bd.Align.MIN, bd.Align.CENTER, bd.Align.MIN))).faces()[0]
+    fin = bd.Face.make_rect(10, 10, plane=bd.Plane.YZ).moved(bd.Location((0, 0, -5)))  # x = 0, going down
+    for order in ([plane, fin, quarter], [fin, plane, quarter], [plane, quarter, fin]):
+        builder = BOPAlgo_Builder()
+        for face in order:
+            builder.AddArgument(face.wrapped)
+        builder.Perform()
+        report = check_faces(builder.Shape())
+        shared = [e for e in report.edges if e.note.startswith("non-manifold: 3 faces")]
+        assert len(shared) == 3 and len({e.index for e in shared}) == 1
+        assert sorted(e.level for e in shared) == ["G1", "sharp", "sharp"]  # the plane meets the fillet G1, the fin at 90°
+        assert not report.passes("G2")
+
+
+def test_an_edge_tangent_over_part_of_its_length_is_a_crease_not_a_feature():
+    from OCP.BRepBuilderAPI import BRepBuilderAPI_Sewing
+
+    flat = bd.Face.make_bezier_surface([[bd.Vector(i, j, 0) for j in range(4)] for i in range(4)])
+    # the second face leaves the first tangent at y = 0 and at 0.2 rad (11°) at y = 3
+    fading = bd.Face.make_bezier_surface([[bd.Vector(3 + i, j, i * 0.2 * j / 3) for j in range(4)] for i in range(4)])
+    sewing = BRepBuilderAPI_Sewing(1e-6)
+    for face in (flat, fading):
+        sewing.Add(face.wrapped)
+    sewing.Perform()
+    report = check_faces(sewing.SewedShape())
+    (edge,) = report.edges
+    assert edge.angle > FEATURE_ANGLE and edge.level == "crease" and "partly tangent" in edge.note
+    assert not report.passes("G1")
+
+
+def bspline_face(heights: list[float]) -> bd.Face:
+    """A cubic B-spline face over 0 ≤ x ≤ 6, 0 ≤ y ≤ 3 whose u knot at x = 3 has multiplicity 3
+    (a Bézier join: C0 there): ``heights`` are the z of its seven rows of poles."""
+    from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeFace
+    from OCP.Geom import Geom_BSplineSurface
+    from OCP.TColgp import TColgp_Array2OfPnt
+    from OCP.TColStd import TColStd_Array1OfInteger, TColStd_Array1OfReal
+
+    poles = TColgp_Array2OfPnt(1, len(heights), 1, 4)
+    for i, z in enumerate(heights):
+        for j in range(4):
+            poles.SetValue(i + 1, j + 1, bd.Vector(i, j, z).to_pnt())
+
+    def array(kind, values):
+        out = kind(1, len(values))
+        for k, value in enumerate(values):
+            out.SetValue(k + 1, value)
+        return out
+
+    surface = Geom_BSplineSurface(poles, array(TColStd_Array1OfReal, [0.0, 1.0, 2.0]), array(TColStd_Array1OfReal, [0.0, 1.0]),
+                                  array(TColStd_Array1OfInteger, [4, 3, 4]), array(TColStd_Array1OfInteger, [4, 4]), 3, 3)  # fmt: skip
+    return bd.Face(BRepBuilderAPI_MakeFace(surface, 1e-7).Face())
+
+
+@pytest.mark.parametrize(
+    ("heights", "level"),
+    [([0, 0, 0, 0, 0, 0.5, 1.0], "G1"),  # flat, then bending away: tangent, curvature jumps from 0
+     ([0, 0, 0, 0, 0.02, 0.04, 0.06], "crease"),  # a kink of 0.02 rad inside the face
+     ([0, 0, 0, 0, 0.2, 0.4, 0.6], "sharp")],  # 0.2 rad: a feature, listed
+)  # fmt: skip
+def test_a_knot_line_inside_a_bspline_face_is_judged_as_a_pseudo_edge(heights, level):
+    face = bspline_face(heights)
+    for part, lines in ((face, 1), (bd.extrude(face, 1, dir=(0, 0, -1)), 2)):  # the slab: its top and bottom
+        inside = [e for e in check_faces(part).edges if e.index == -1]
+        assert len(inside) == lines and {e.level for e in inside} == {level}
+        assert all(e.note.startswith("inside face") and "u = 1 (knot of multiplicity 3)" in e.note for e in inside)
+        assert all(e.jump_at[0] == pytest.approx(3.0) for e in inside)
+
+
+def test_a_smooth_knot_line_stays_g2():
+    # poles collinear across the join and equally spaced: the two spans are one cubic, C2 at x = 3
+    report = check_faces(bspline_face([0, 0.1, 0.2, 0.3, 0.4, 0.5, 0.6]))
+    (inside,) = [e for e in report.edges if e.index == -1]
+    assert inside.level == "G2"
+
+
+def test_table_columns_stay_in_line_with_long_surface_names():
+    from spiral_cad.build123d import G2Polyline
+
+    with bd.BuildPart() as vase:
+        with bd.BuildSketch(bd.Plane.XZ):
+            with bd.BuildLine():
+                G2Polyline((0, 0), (10, 0), (10, 10), (4, 20), (0, 20), radius=2)
+                bd.Line((0, 20), (0, 0))
+            bd.make_face()
+        bd.revolve(axis=bd.Axis.Z)
+    lines = check_faces(vase.part).table().splitlines()
+    rows = lines[3:]
+    assert any(len(f"{e.surfaces[0]}/{e.surfaces[1]} seam") > 22 for e in check_faces(vase.part).edges if e.seam)
+    start = lines[2].index("gap") + 3  # the gap column ends here in the header and in every row
+    assert all(row[start - 1] != " " and row[start] == " " for row in rows)
