@@ -179,16 +179,21 @@ def _build(args: argparse.Namespace) -> int:
         return _write_design(gcode_design(args), Path(args.out), plots=not args.no_plots)
 
 
+def _check_numbers(args: argparse.Namespace, keys: tuple[str, ...]) -> None:
+    """Refuse a non-positive or infinite number among ``keys``, and samples given two ways."""
+    if args.sample_step is not None and args.chord_tolerance is not None:
+        raise ValueError("give --sample-step or --chord-tolerance, not both")
+    for key in keys:
+        value = getattr(args, key)
+        if value is not None and not 0.0 < value < math.inf:
+            raise ValueError(f"--{key.replace('_', '-')} must be a positive finite number; got {value}")
+
+
 def gcode_design(args: argparse.Namespace) -> dict:
     """The design of ``build --from-gcode``: one ``rounded_polyline`` of the program's moves, with samples."""
     if args.max_deviation is None and args.max_curvature is None:
         raise ValueError("--from-gcode needs --max-deviation (the tolerance at every corner) and/or --max-curvature")
-    if args.sample_step is not None and args.chord_tolerance is not None:
-        raise ValueError("give --sample-step or --chord-tolerance, not both")
-    for key in ("max_deviation", "max_curvature", "sample_step", "chord_tolerance", "feed"):
-        value = getattr(args, key)
-        if value is not None and not 0.0 < value < math.inf:
-            raise ValueError(f"--{key.replace('_', '-')} must be a positive finite number; got {value}")
+    _check_numbers(args, ("max_deviation", "max_curvature", "sample_step", "chord_tolerance", "feed"))
     stem = re.sub(r"[^A-Za-z0-9_-]", "_", Path(args.from_gcode).stem).lstrip("_-")[:64] or "toolpath"
     design = {"name": args.name or stem, "type": "rounded_polyline", "gcode": args.from_gcode, "spiral_shape": args.shape or "walton-meek"}
     for key in ("max_deviation", "max_curvature"):
@@ -214,12 +219,7 @@ def points_design(args: argparse.Namespace) -> dict:
         raise ValueError(f"{', '.join(given)}: only with --from-gcode")
     if args.tolerance is None:
         raise ValueError("--from-points needs --tolerance (the largest distance from any point to the fitted path)")
-    if args.sample_step is not None and args.chord_tolerance is not None:
-        raise ValueError("give --sample-step or --chord-tolerance, not both")
-    for key in ("tolerance", "max_curvature", "design_speed", "sample_step", "chord_tolerance"):
-        value = getattr(args, key)
-        if value is not None and not 0.0 < value < math.inf:
-            raise ValueError(f"--{key.replace('_', '-')} must be a positive finite number; got {value}")
+    _check_numbers(args, ("tolerance", "max_curvature", "design_speed", "sample_step", "chord_tolerance"))
     if args.shape == "g2cbs":
         raise ValueError("--shape g2cbs rounds corners; a fit's spirals are near-linear or walton-meek")
     stem = re.sub(r"[^A-Za-z0-9_-]", "_", Path(args.from_points).stem).lstrip("_-")[:64] or "points"
