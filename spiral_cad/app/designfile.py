@@ -225,8 +225,6 @@ def build_landxml(path: str | Path, max_offset: float | None = None, directions:
     Raises:
         DesignError: the file cannot be read or holds an element that cannot be represented.
     """
-    import re
-
     from ..io import read_landxml
 
     try:
