@@ -30,10 +30,11 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 from numpy.typing import NDArray
+from scipy.optimize import brentq
 
 from ..core.chain import Chain
 from ..core.clothoid import clothoid_frames
@@ -175,6 +176,41 @@ def solve_compound(entry: Carrier, exit_: Carrier, inner: Sequence[Carrier], cur
         out.append((n, spiral))
         current, begin = target, target.station(spiral.end)
     return out
+
+
+def solve_inflection(
+    entry: Carrier, exit_: Carrier, tangent: Carrier, curvatures: Sequence[float], shape: str
+) -> list[tuple[int, Segment]]:
+    """An S (or C) of two spirals through a straight point between two arcs, asymmetric as the file's: each
+    spiral ``line_to_circle`` between its arc and the file's tangent at the inflection, that tangent moved
+    along its normal until the two spirals meet on it (the file's clothoids have the same lengths' ratio).
+
+    Raises:
+        ValueError: no shift of the tangent joins the two spirals.
+    """
+    normal = np.array([-math.sin(tangent.heading), math.cos(tangent.heading)])
+
+    def gap(shift: float) -> float:
+        moved = replace(tangent, point=tangent.point + shift * normal)
+        _, (first,) = solve_run(entry, moved, curvatures[:2], shape)
+        _, (second,) = solve_run(moved, exit_, curvatures[1:], shape)
+        return moved.station(second.start) - moved.station(first.end)
+
+    try:
+        at_zero = gap(0.0)
+    except ValueError as e:
+        raise ValueError(f"no spiral reaches the file's inflection tangent ({e})") from None
+    scale = max(abs(at_zero), 1e-12)
+    for step in scale * 1e-3 * 2.0 ** np.arange(16):  # a bracket of the shift that closes the gap, either way
+        for shift in (step, -step):
+            try:
+                if gap(shift) * at_zero <= 0.0:
+                    root = brentq(gap, 0.0, shift, xtol=1e-13 * scale + 1e-15, maxiter=200)
+                    moved = replace(tangent, point=tangent.point + root * normal)
+                    return solve_compound(entry, exit_, [moved], curvatures, shape)
+            except ValueError:
+                continue
+    raise ValueError(f"no shift of the file's inflection tangent joins the two spirals (apart by {at_zero:.6g} on it)")
 
 
 def _bezier(cp: NDArray, u: NDArray) -> tuple[NDArray, NDArray]:

@@ -20,9 +20,10 @@ from ..core.factors import length_factor
 from ..core.segments import Arc, Line, Segment
 from ..core.shapes import shape_limits
 from ..core.spiral import BezierSpiral
-from .landxml_fit import Carrier, distance_to_file, solve_compound, solve_run
+from .landxml_fit import Carrier, distance_to_file, solve_compound, solve_inflection, solve_run
 
 __all__: list[str] = []
+
 
 def _heading(t: NDArray) -> float:
     return math.atan2(t[1], t[0])
@@ -82,7 +83,6 @@ def _spirals(length: float, k0: float, k1: float, shape: str, theta: float | Non
     return [backwards]
 
 
-
 @dataclass
 class _Element:
     kind: str
@@ -97,7 +97,6 @@ class _Element:
     where: str = ""
     notes: list[str] = field(default_factory=list)
     cubic: BezierSpiral | None = None  # our very cubic, where this package wrote the spiral (its Feature)
-
 
 
 def _segments(item: _Element, point: NDArray, heading: float) -> list[Segment]:
@@ -237,6 +236,8 @@ def _run(items: list[_Element], mine: list[int], starts: list[NDArray], headings
 
     for n, (kind, ks) in enumerate(split):
         if kind in ("fixed", "implied"):
+            if pending is not None:  # a line or arc after another (two arcs of one centre, two lines): kept whole
+                close(pending[0].length)
             c = carrier(ks[0], at_end=kind == "implied")
             if solved_end is None:  # after a fallback (or at the start): continue from our chain
                 c = Carrier(point, heading, c.curvature, c.length)
@@ -250,8 +251,12 @@ def _run(items: list[_Element], mine: list[int], starts: list[NDArray], headings
         problems: list[str] = []
         shapes = [items[ks[0]].shape, "walton-meek" if items[ks[0]].shape == "near-linear" else "near-linear"]
         attempts: list[tuple[str, str, float]] = [(shape, "one", 1.0) for shape in shapes]
-        if len(ks) > 1 and all(items[k].k1 for k in ks[:-1]):  # also through the circles osculating the file's joints
+        # also through the circles (or, at an inflection, the tangent) osculating the file's joints: an asymmetric S
+        # between arcs is two line_to_circle spirals on the file's inflection tangent, not circle_to_circle's symmetric one
+        if len(ks) > 1:
             attempts += [(shape, "joints", 0.0) for shape in shapes]
+        if len(ks) == 2 and curvatures[1] == 0.0 and entry.curvature and exit_.curvature:
+            attempts += [(shape, "inflection", 0.0) for shape in shapes]
         if len(ks) == 2 and entry.curvature == exit_.curvature == 0.0:  # a C between lines: also as long as the file's
             attempts += [(shape, "one", -1.0) for shape in shapes]
         if len(ks) == 1 and entry.curvature * exit_.curvature > 0.0:  # a compound clothoid: through a middle circle if need be
@@ -280,6 +285,9 @@ def _run(items: list[_Element], mine: list[int], starts: list[NDArray], headings
                         name, solved = solve_run(entry, exit_, [0.0, curvatures[1] * math.exp(best.x), 0.0], shape)
                         name += f" (peak curvature ×{math.exp(best.x):.3g})"
                     found: list[tuple[int, Segment]] = list(enumerate(solved))
+                elif how == "inflection":
+                    name = "line_to_circle ×2 (inflection tangent)"
+                    found = solve_inflection(entry, exit_, carrier(ks[0], at_end=True), curvatures, shape)
                 elif how == "joints":
                     name = "through its joints"
                     found = solve_compound(entry, exit_, [carrier(k, at_end=True) for k in ks[:-1]], curvatures, shape)

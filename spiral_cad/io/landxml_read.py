@@ -12,6 +12,12 @@ element placed by its direction alone in a file that tells neither, or a file
 whose directions agree one way here and the other there, is refused by name
 (``directions=`` chooses).
 
+Unit strings are read tolerantly (case and runs of white space: J-LandXML's
+``"decimal  dd.mm.ss"``). A ``Curve`` given only by its PI, start direction,
+radius and length (FreeCAD) starts one tangent length R·tan(Δ/2) before its PI;
+a Curve's sense against its ``dirStart`` and ``dirEnd`` also tells how the file
+counts directions.
+
 Each ``<CoordGeom>`` is rebuilt in order (``placement="neighbours"``, the
 default): the file's ``Line`` and ``Curve`` elements (``crvType`` arc; also
 defined by its chord or by its points only) stay on the file's line or circle,
@@ -26,6 +32,17 @@ curvatures continuing from the element before (0 → κ a spiral, κ → 0 its
 reversal, κ0 → κ1 the piece of a longer spiral whose start curvature is κ0,
 found by a bracketed root). A spiral this package wrote (its ``desc``) is
 rebuilt with its own shape: the very cubic.
+
+No element is ever left out: lines and arcs that follow one another (two arcs of
+one centre, collinear lines) are each kept whole, and a rebuild holding nothing
+of an element is refused by name. Where the file is not G2 — a kink, a curvature
+jump — the joint is reported: a kink of up to ``ABSORBED_KINK`` stays inside the
+run (the element after it continues from ours, its offset measured), a curvature
+jump at a sliver (an element of at most ``SLIVER`` of the alignment's length) too,
+the sliver rebuilt with its neighbour's curvature; other joints part the G2 runs
+(``breaks``). An asymmetric S (two clothoids between arcs of opposite senses) is
+also solved as two ``line_to_circle`` spirals on the file's inflection tangent,
+moved along its normal until they meet (``landxml_fit.solve_inflection``).
 
 Per element the record keeps the offset between the file's element (placed at
 its own Start and start direction; the exact clothoid of
@@ -45,7 +62,7 @@ import math
 import os
 import re
 import xml.etree.ElementTree as ET
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Any
 
 import numpy as np
@@ -57,7 +74,7 @@ from ..core.shapes import SHAPE_CODES
 from ..core.spiral import BezierSpiral
 from .landxml import DESC_PREFIX, FEATURE, US_SURVEY_FOOT
 from .landxml_fit import offsets as fit_offsets
-from .landxml_place import _Element, _heading, _run, _solve_turns
+from .landxml_place import _Element, _heading, _run, _solve_turns, _unit
 
 __all__ = ["LandXMLAlignment", "read_landxml"]
 
@@ -74,6 +91,13 @@ ANGULAR = {"radians": 1.0, "grads": math.pi / 200.0, "decimal degrees": math.pi 
 MAX_OFFSET_FRACTION = 0.05
 #: Relative difference of curvature between two elements above which the file's geometry is only G1 there.
 _JUMP = 1e-6
+#: The largest kink (rad) between two of the file's elements kept inside one G2 run: the element after it
+#: continues from ours and its offset from the file is measured (Civil 3D leaves kinks of 2e-4 to 2e-3 rad
+#: between elements meant to be tangent). Where that puts an element beyond the limit, the run parts there.
+ABSORBED_KINK = 0.005
+#: An element of at most this fraction of its alignment's length is a sliver (Civil 3D's sub-millimetre lines
+#: at the ends): a curvature jump at it is kept inside the run, the sliver rebuilt with its neighbour's curvature.
+SLIVER = 1e-5
 
 
 @dataclass(frozen=True)
@@ -85,7 +109,9 @@ class LandXMLAlignment:
         chains: the rebuilt plane G2 chains (in ``units``): one, unless the
             file's elements meet with a jump in curvature (a line onto an arc
             without a spiral), where a new chain starts.
-        breaks: each such joint, named by station and the two curvatures.
+        breaks: each joint that parts two chains (a gap, a kink beyond ``ABSORBED_KINK``
+            or a curvature jump), named by station and the numbers; the joints kept inside
+            a chain (small kinks, curvature jumps at slivers) are told in ``notes``.
         start_station: the station of the chain's start.
         units: the chain's length unit.
         profile: the ``spiral_cad.design.Profile`` of its first ``ProfAlign``, or None.
@@ -176,6 +202,13 @@ def _child(element: ET.Element, name: str) -> ET.Element | None:
     return found[0] if found else None
 
 
+def _unit_name(text: str, known: Any) -> str | None:
+    """The unit of ``known`` that ``text`` names, read tolerantly: case and runs of white space do not
+    matter (J-LandXML writes ``"decimal  dd.mm.ss"``); None if it names none."""
+    wanted = " ".join(text.split()).casefold()
+    return next((name for name in known if name.casefold() == wanted), None)
+
+
 def _angle(text: str, unit: str) -> float:
     """An angle in radians from the file's text in ``unit``."""
     if unit == "decimal dd.mm.ss":
@@ -204,14 +237,19 @@ class _Reader:
         units = _child(root, "Units")
         system = None if units is None else next(iter(units), None)
         linear = "meter" if system is None else system.get("linearUnit", "meter")
-        if linear not in LINEAR:
+        known = _unit_name(linear, LINEAR)
+        if known is None:
             raise ValueError(f"LandXML linearUnit {linear!r} is not one of {', '.join(LINEAR)}")
-        self.units, self.scale = LINEAR[linear]
-        self.direction_unit = "radians" if system is None else system.get("directionUnit", "radians")
-        self.angular_unit = "radians" if system is None else system.get("angularUnit", "radians")
-        for unit in (self.direction_unit, self.angular_unit):
-            if unit not in ANGULAR and unit != "decimal dd.mm.ss":
-                raise ValueError(f"LandXML angular unit {unit!r} is not radians, grads, decimal degrees or decimal dd.mm.ss")
+        self.units, self.scale = LINEAR[known]
+        angular = [*ANGULAR, "decimal dd.mm.ss"]
+        names = []
+        for name in ("directionUnit", "angularUnit"):
+            unit = "radians" if system is None else system.get(name, "radians")
+            found = _unit_name(unit, angular)
+            if found is None:
+                raise ValueError(f"LandXML {name} {unit!r} is not radians, grads, decimal degrees or decimal dd.mm.ss")
+            names.append(found)
+        self.direction_unit, self.angular_unit = names
 
     def number(self, element: ET.Element, name: str, where: str, default: float | None = None) -> float:
         text = element.get(name)
@@ -324,6 +362,15 @@ def _clues(r: _Reader, e: ET.Element, where: str) -> list[tuple[float, float, st
         quarter = math.pi / 2 if e.get("rot") == "ccw" else -math.pi / 2  # the tangent is the radius turned a quarter
         clue("dirStart", center, start, quarter)
         clue("dirEnd", center, end, quarter)
+    start_dir, end_dir = r.raw_direction(e, "dirStart", where), r.raw_direction(e, "dirEnd", where)
+    if kind == "Curve" and e.get("rot") in ("cw", "ccw") and start_dir is not None and end_dir is not None:
+        # a Curve's sense against its directions: counted from east a left turn increases them, counted from
+        # north it decreases them. The pair (change + π/4, turn + π/4) makes _convention's two comparisons
+        # |change - turn| (east) and |-change - turn| (north).
+        length, radius = (float(e.get(name, "nan")) for name in ("length", "radius"))
+        turn = math.copysign(length / radius, 1.0 if e.get("rot") == "ccw" else -1.0) if radius > 0.0 else math.nan
+        if _APART < abs(turn) < math.pi - _APART:
+            out.append((math.remainder(end_dir - start_dir, 2.0 * math.pi) + math.pi / 4, turn + math.pi / 4, "rot"))
     return out
 
 
@@ -410,6 +457,12 @@ def _element(r: _Reader, e: ET.Element, where: str) -> _Element:
             length = radius * ((sign * (a1 - a0)) % (2.0 * math.pi))
         else:
             raise ValueError(f"{where}: a Curve needs a length, a chord or Start, Center and End")
+        pi = r.point(e, "PI", where)
+        if start is None and center is None and pi is not None and heading is not None:
+            # given by its PI, start direction, radius and length (FreeCAD): the start is one tangent length before the PI
+            if not length < math.pi * radius:
+                raise ValueError(f"{where}: a Curve given by its PI turns less than 180°; length {length:.6g} and radius {radius:.6g} turn more")  # fmt: skip
+            start = pi - radius * math.tan(length / (2.0 * radius)) * _unit(heading)
         return _Element(kind, start, heading, length, _curvature(sign, radius, where), _curvature(sign, radius, where), station, r.shape)
     if kind == "Spiral":
         spi = e.get("spiType")
@@ -524,41 +577,35 @@ def _alignment(r: _Reader, a: ET.Element, label: str) -> LandXMLAlignment:
         ends.append((point, heading))
     if r.placement == "length":
         _solve_turns(items)
-    runs: list[list[int]] = [[]]
-    breaks: list[str] = []
-    for k, item in enumerate(items):
-        at = f"at station {item.station:.6g} (between elements {k - 1} and {k})"
-        if k:
-            gap = float(np.hypot(*(starts[k] - ends[k - 1][0])))
-            turn = abs(math.remainder(headings[k] - ends[k - 1][1], 2.0 * math.pi))
-            # after a spiral the chain goes on from our spiral (its offset is reported), not from the clothoid's end
-            if items[k - 1].kind != "Spiral" and (gap > _JUMP * max(item.length, items[k - 1].length) or turn > _JUMP):
-                breaks.append(f"the file's elements meet with a gap of {gap:.3g} {r.units} and a kink of {turn:.3g} rad {at}")
-                runs.append([])
-            elif abs(item.k0 - items[k - 1].k1) > _JUMP * max(abs(item.k0), abs(items[k - 1].k1)):
-                breaks.append(f"curvature jumps from {items[k - 1].k1:.6g} to {item.k0:.6g} 1/{r.units} {at}")
-                runs.append([])
-        runs[-1].append(k)
     k1 = np.array([i.k1 for i in items])
     file = (np.array(starts), np.array(headings), bend, k1, size)
-    chains: list[Chain] = []
-    owners: list[NDArray[np.int64]] = []
-    methods: dict[int, str] = {}
-    for mine in runs:
-        segments, owner, found = _run(items, mine, starts, headings, ends, r.placement, file)
-        chains.append(Chain(segments, tolerance=1e-6, units=r.units))
-        owners.append(np.array(owner, dtype=np.int64))
-        methods.update(found)
-    run_of = np.repeat(np.arange(len(runs)), [len(m) for m in runs])
-    try:
-        offsets = fit_offsets(chains, owners, *file, run_of)
-    except ValueError as e:
-        raise ValueError(f"{where}: {e}") from None
-    limits = MAX_OFFSET_FRACTION * size if r.max_offset is None else np.full(len(size), r.max_offset)
-    # a spiral this package wrote is the very cubic of its Feature: its offset from the clothoid its
-    # attributes describe is reported, not refused
-    limits[[k for k in range(len(items)) if methods.get(k) == "spiral_cad cubic"]] = np.inf
-    over = np.flatnonzero(offsets > limits)
+    # a sliver's limit is that of an element of SLIVER × the alignment's length: its own would be below rounding
+    limits = MAX_OFFSET_FRACTION * np.maximum(size, SLIVER * size.sum()) if r.max_offset is None else np.full(len(size), r.max_offset)
+    for kink in (ABSORBED_KINK, 0.0):  # small kinks absorbed where the offsets allow it, else G2 runs apart there
+        runs, breaks, joints, continued = _joints(items, starts, headings, ends, r.units, kink)
+        placed = [replace(item, k0=continued[k], k1=continued[k]) if k in continued else item for k, item in enumerate(items)]
+        chains: list[Chain] = []
+        owners: list[NDArray[np.int64]] = []
+        methods: dict[int, str] = {}
+        for mine in runs:
+            segments, owner, found = _run(placed, mine, starts, headings, ends, r.placement, file)
+            chains.append(Chain(segments, tolerance=1e-6, units=r.units))
+            owners.append(np.array(owner, dtype=np.int64))
+            methods.update(found)
+        dropped = sorted(set(range(len(items))) - set(np.concatenate(owners).tolist()))
+        if dropped:  # never silently: a rebuild that lost an element is a defect, named
+            raise ValueError(f"{items[dropped[0]].where}: the rebuilt chain holds nothing of this element ({len(dropped)} such)")
+        run_of = np.repeat(np.arange(len(runs)), [len(m) for m in runs])
+        try:
+            offsets = fit_offsets(chains, owners, *file, run_of)
+        except ValueError as e:
+            raise ValueError(f"{where}: {e}") from None
+        # a spiral this package wrote is the very cubic of its Feature: its offset from the clothoid its
+        # attributes describe is reported, not refused
+        limits[[k for k in range(len(items)) if methods.get(k) == "spiral_cad cubic"]] = np.inf
+        over = np.flatnonzero(offsets > limits)
+        if not len(over) or not any("kink" in j for j in joints):
+            break
     if len(over):  # a clothoid none of our spirals follows: refused rather than silently metres away
         with np.errstate(divide="ignore", over="ignore", invalid="ignore"):  # a limit may underflow to 0
             k = int(over[np.argmax(offsets[over] / limits[over])])
@@ -573,11 +620,50 @@ def _alignment(r: _Reader, a: ET.Element, label: str) -> LandXMLAlignment:
     if r.used:  # the directions placed elements: say how they were counted
         how = "counter-clockwise from east" if r.directions == "east-ccw" else "clockwise from north"
         notes = (f"{where}: {r.used} direction(s) placed elements, counted {how} ({r.evidence or 'as chosen'})", *notes)
-    notes = (*skipped, *(note for item in items for note in item.notes), *notes)
+    notes = (*skipped, *joints, *(note for item in items for note in item.notes), *notes)
     return LandXMLAlignment(name, tuple(chains), tuple(breaks), start_station, r.units, profile, offsets, tuple(i.kind for i in items),
                             start_station + np.concatenate([[0.0], np.cumsum(ours)[:-1]]), notes,
                             np.array([i.station for i in items]), ours - size,
                             tuple(methods.get(k, "file") for k in range(len(items))), tuple(owners), r.directions, size)  # fmt: skip
+
+
+def _joints(items: list[_Element], starts: list[NDArray], headings: list[float], ends: list[tuple[NDArray, float]], units: str,
+            kink: float) -> tuple[list[list[int]], list[str], list[str], dict[int, float]]:  # fmt: skip
+    """Where the file's elements are not G2: the G2 runs (element indices), the joints that part them
+    (``breaks``), the joints kept inside a run (reported, not parting it: kinks up to ``kink`` rad, where the
+    element after continues from ours; curvature jumps at a sliver, an element of at most ``SLIVER`` of the
+    alignment's length), and the curvature each sliver is rebuilt with (its neighbour's)."""
+    total = sum(i.length for i in items)
+    runs: list[list[int]] = [[]]
+    breaks: list[str] = []
+    joints: list[str] = []
+    continued: dict[int, float] = {}
+    for k, item in enumerate(items):
+        at = f"at station {item.station:.6g} (between elements {k - 1} and {k})"
+        if k:
+            before = items[k - 1]
+            gap = float(np.hypot(*(starts[k] - ends[k - 1][0])))
+            turn = abs(math.remainder(headings[k] - ends[k - 1][1], 2.0 * math.pi))
+            # after a spiral the chain goes on from our spiral (its offset is reported), not from the clothoid's end
+            apart = before.kind != "Spiral" and (gap > _JUMP * max(item.length, before.length) or turn > _JUMP)
+            jump = abs(item.k0 - before.k1) > _JUMP * max(abs(item.k0), abs(before.k1))
+            sliver = next((m for m in (k, k - 1) if items[m].length <= SLIVER * total), None)
+            if jump and sliver is not None and "Spiral" not in (item.kind, before.kind):
+                continued[sliver] = before.k1 if sliver == k else item.k0
+                joints.append(f"joint {at}: curvature jumps from {before.k1:.6g} to {item.k0:.6g} 1/{units} at element {sliver} "
+                              f"of length {items[sliver].length:.3g} {units}, rebuilt with its neighbour's curvature")  # fmt: skip
+                jump = False
+            if apart and gap <= _JUMP * max(item.length, before.length) and turn <= kink:
+                joints.append(f"joint {at}: a kink of {turn:.3g} rad, the element after it continues from ours (its offset measured)")
+                apart = False
+            if apart:
+                breaks.append(f"the file's elements meet with a gap of {gap:.3g} {units} and a kink of {turn:.3g} rad {at}")
+                runs.append([])
+            elif jump:
+                breaks.append(f"curvature jumps from {before.k1:.6g} to {item.k0:.6g} 1/{units} {at}")
+                runs.append([])
+        runs[-1].append(k)
+    return runs, breaks, joints, continued
 
 
 def _profile(r: _Reader, a: ET.Element, where: str) -> tuple[Any, tuple[str, ...]]:
@@ -636,7 +722,8 @@ def read_landxml(source: str | os.PathLike, shape: str = "near-linear", placemen
             (clockwise from north, the XSD's "0 degrees = north": MDT, Novapoint).
         max_offset: the largest offset (in the result's ``units``) accepted between
             the file's element and ours; None: ``MAX_OFFSET_FRACTION`` of each
-            element's length; ``math.inf`` accepts any.
+            element's length (of ``SLIVER`` × the alignment's length for a sliver);
+            ``math.inf`` accepts any. An element beyond it refuses the read; none is ever left out.
 
     Returns:
         One ``LandXMLAlignment`` per ``<Alignment>`` in file order.
