@@ -19,35 +19,31 @@ API places them), with
 * the project's length unit from the design (``IfcSIUnit`` metre with its
   prefix, ``IfcConversionBasedUnit`` foot or inch), angles in radians.
 
-**A spiral exactly.** Our spiral is a cubic Bézier, so in the frame at its
-start (placement: start point and heading) it is the parametric cubic
-x(u) = bU·u + cU·u² + dU·u³, y(u) = cV·u² + dV·u³, u ∈ [0, 1] (OpenDRIVE's
-``paramPoly3`` numbers). The ``IfcPolynomialCurve`` holds it in the parameter
-t = λ·u, so its coefficients are bU/λ, cU/λ², … and ``SegmentStart`` = 0,
-``SegmentLength`` = the spiral's true arc length L. ``SegmentStart`` and
-``SegmentLength`` are ``IfcLengthMeasure``: lengths along the parent curve.
-Two readings of that length exist in practice, and λ makes them agree:
-
-* the schema's: arc length along the parametric curve, which reaches
-  u = 1 at L whatever λ is;
-* the concept template's (``CUBIC`` and ``PARABOLICARC`` assume
-  ``CoefficientsX = (0, 1)``, x = t, so the length of the graph y(t) is
-  ∫ √(1 + y'(t)²) dt), which ifcopenshell 0.9 evaluates for every
-  ``IfcPolynomialCurve``: it ends at u = 1 exactly when
-  ∫₀¹ √(λ² + y_u'(u)²) du = L — one λ per spiral, solved here by Newton's
-  method on a 32-node Gauss–Legendre rule (the integrand is smooth).
-
-Both readings start at u = 0 (the spiral's start) and end at u = 1 (its
-end), so the trimmed curve is the same cubic; only the map from a distance
-in between to a point differs in ifcopenshell (the point is still on the
-cubic). A bare parameter reading (``SegmentLength`` as a value of t) is what
-``IfcParameterValue`` would mean, not ``IfcLengthMeasure``.
+**A spiral as a graph, so that stations agree.** ``SegmentStart`` and
+``SegmentLength`` are ``IfcLengthMeasure``: lengths along the parent curve. Our
+spiral is a cubic Bézier, a parametric cubic x(u), y(u) in its start frame; but
+ifcopenshell (0.8, 0.9, like the concept template of ``CUBIC``, which takes
+``CoefficientsX`` = (0, 1)) reads a length along an ``IfcPolynomialCurve`` as the
+length of the graph of ``CoefficientsY``, ∫ √(1 + y'(t)²) dt, and only then evaluates
+x(t): written as the parametric cubic, its station inside a spiral lands metres
+away from ours (2–5 m on ordinary roads, 24 m in a hairpin) although its points lie
+on the cubic. So each spiral is written as the graph y = p(x) of a polynomial in its
+start frame (``CoefficientsX`` = (0, 1), ``graph_polynomials``): the parameter is x,
+the graph's length is the arc length, and the schema's reading, the template's and
+ifcopenshell's all put a distance along the segment at our station. p interpolates
+the cubic at Chebyshev–Lobatto points, at the lowest degree (6 to 20) within
+``GRAPH_TOLERANCE`` (1 nm) of it — degree 8 to 14 on road spirals; a spiral that no
+degree follows within it (one turning about 45° or more) is written as its two halves
+(each its own layout and curve segment), again if need be. ifcopenshell then puts every
+distance along within 1.3 µm of our station and every segment end within 1 µm of ours
+(its own trapezoidal graph length, relative tolerance 1.5e-8, is most of that).
 
 Needs ifcopenshell (the ``cad`` extra). No CAD kernel.
 """
 
 from __future__ import annotations
 
+import functools
 import math
 import os
 import time
@@ -65,8 +61,8 @@ from .names import check_name
 from .opendrive import plan_records
 
 __all__ = [
-    "IFC_SCHEMA", "IfcAlignmentLayout", "LayoutSegment", "graph_length_scales", "ifc_file", "layout_segments",
-    "read_ifc_alignments", "write_ifc",
+    "GRAPH_DEGREES", "GRAPH_TOLERANCE", "IFC_SCHEMA", "IfcAlignmentLayout", "LayoutSegment", "graph_polynomials",
+    "ifc_file", "layout_segments", "read_ifc_alignments", "write_ifc",
 ]  # fmt: skip
 
 #: The schema written: IFC 4.3 ADD2 (ISO 16739-1:2024).
@@ -77,33 +73,92 @@ CONTEXT_PRECISION = 1e-5
 #: Our length units as IFC units: the prefix of the metre (None: none), or the conversion-based unit's name.
 _SI_UNITS = {"mm": "MILLI", "cm": "CENTI", "m": None, "km": "KILO"}
 _CONVERTED_UNITS = {"ft": "foot", "in": "inch"}
+
+
 _NODES, _WEIGHTS = np.polynomial.legendre.leggauss(32)
 _NODES, _WEIGHTS = 0.5 * (_NODES + 1.0), 0.5 * _WEIGHTS  # on [0, 1]
+#: The degrees tried, in turn, for a spiral's graph polynomial (above 20 the monomials lose more than they gain).
+GRAPH_DEGREES = (6, 8, 10, 12, 14, 16, 18, 20)
+#: The largest distance (m) between a spiral's graph polynomial and our cubic; a spiral no degree brings
+#: within it (one turning about 45° or more) is written as its two halves, each its own segment.
+GRAPH_TOLERANCE = 1e-9
 
 
-def graph_length_scales(poly: NDArray, lengths: NDArray) -> NDArray:
-    """λ per spiral: ∫₀¹ √(λ² + y_u'(u)²) du = L (see the module docstring).
+def _local_spirals(poly: NDArray, u: NDArray) -> tuple[NDArray, NDArray, NDArray]:
+    """Our spirals (``poly``: bU, cU, dU, cV, dV in their start frames) at parameters ``u`` (N, M): x, y, dx/du."""
+    bu, cu, du, cv, dv = (c[:, None] for c in poly.T)
+    return ((du * u + cu) * u + bu) * u, (dv * u + cv) * u * u, (3.0 * du * u + 2.0 * cu) * u + bu
+
+
+@functools.cache
+def _chebyshev_powers(degree: int) -> NDArray:
+    """(degree + 1, degree + 1): row k the power coefficients in s of T_k(2s − 1), the Chebyshev polynomials on [0, 1]."""
+    out = np.zeros((degree + 1, degree + 1))
+    for k in range(degree + 1):
+        power = np.polynomial.Chebyshev.basis(k, domain=[0.0, 1.0]).convert(kind=np.polynomial.Polynomial).coef
+        out[k, : len(power)] = power
+    return out
+
+
+def _horner(coefficients: NDArray, x: NDArray) -> NDArray:
+    out = np.zeros_like(x)
+    for k in range(coefficients.shape[1] - 1, -1, -1):
+        out = out * x + coefficients[:, k : k + 1]
+    return out
+
+
+def graph_polynomials(poly: NDArray, tolerance: float) -> tuple[NDArray, NDArray]:
+    """Each spiral as the graph of a polynomial y = p(x) in its start frame (p(0) = p'(0) = 0 exactly).
+
+    ifcopenshell (0.8, 0.9) reads a distance d along an ``IfcPolynomialCurve`` segment as the x where
+    ∫₀ˣ √(1 + y'(x)²) dx = d — the length of the graph of ``CoefficientsY`` — and then evaluates both
+    polynomials there: the arc length only where ``CoefficientsX`` = (0, 1). Written as a graph, every
+    reading of a distance along the segment (the schema's arc length, the concept template's y(x),
+    ifcopenshell's) lands on the same point, at our station. p = x²·q, q interpolating y/x² at the
+    Chebyshev–Lobatto points of x (both ends exactly), at the first degree of ``GRAPH_DEGREES`` that keeps
+    p within ``tolerance`` of the cubic (checked at 129 points of the cubic).
 
     Args:
-        poly: (N, 5) the spirals' bU, cU, dU, cV, dV in their own frames.
-        lengths: (N,) their arc lengths.
+        poly: (N, 5) the spirals' bU, cU, dU, cV, dV in their start frames (turning less than 90°).
+        tolerance: the largest distance accepted, in the spirals' unit.
 
-    The function of λ is increasing and convex, from ∫|y'| (< L) at 0, so
-    Newton's method from λ = L (where it is ≥ L) descends monotonically.
+    Returns:
+        (coefficients (N, 21) of p in powers of x, zeros above its degree; the largest vertical distance from
+        the cubic (N,), above ``tolerance`` where no degree reaches it).
     """
     poly = np.asarray(poly, dtype=float)
-    lengths = np.asarray(lengths, dtype=float)
-    slope = 2.0 * poly[:, 3:4] * _NODES + 3.0 * poly[:, 4:5] * _NODES**2  # y_u'(u) at the nodes
-    square = slope * slope
-    lam = lengths.copy()
-    for _ in range(60):
-        root = np.sqrt(lam[:, None] ** 2 + square)
-        value = root @ _WEIGHTS - lengths
-        step = value / ((lam[:, None] / root) @ _WEIGHTS)
-        lam = lam - step
-        if np.all(np.abs(step) <= 1e-15 * lam):
+    count = len(poly)
+    width = poly[:, 0] + poly[:, 1] + poly[:, 2]  # x at u = 1
+    coefficients = np.zeros((count, GRAPH_DEGREES[-1] + 1))
+    error = np.full(count, np.inf)
+    exact_x, exact_y, _ = _local_spirals(poly, np.broadcast_to(np.linspace(0.0, 1.0, 129), (count, 129)))
+    todo = np.arange(count)
+    for degree in GRAPH_DEGREES:
+        if not len(todo):
             break
-    return lam
+        nodes = 0.5 * (1.0 - np.cos(np.pi * np.arange(degree - 1) / (degree - 2)))
+        target = nodes * width[todo, None]
+        u = np.broadcast_to(nodes, target.shape).copy()
+        for _ in range(40):  # Newton on x(u) = target: x increases along a spiral turning less than 90°
+            x, _, dx = _local_spirals(poly[todo], u)
+            step = (x - target) / dx
+            u -= step
+            if np.abs(step).max() <= 1e-15:
+                break
+        x, y, _ = _local_spirals(poly[todo], u)
+        # p = x²·q: the start and its direction exactly (a reader turns the curve to its start tangent), q at
+        # the Lobatto points, at x = 0 its limit cV/bU²
+        quotient = np.where(nodes > 0.0, y / np.where(nodes > 0.0, x * x, 1.0), (poly[todo, 3] / poly[todo, 0] ** 2)[:, None])
+        cheb = np.linalg.solve(np.polynomial.chebyshev.chebvander(2.0 * nodes - 1.0, degree - 2), quotient.T).T
+        found = np.zeros((len(todo), degree + 1))
+        found[:, 2:] = (cheb @ _chebyshev_powers(degree - 2)) / width[todo, None] ** np.arange(degree - 1)
+        off = np.abs(_horner(found, exact_x[todo]) - exact_y[todo]).max(axis=1)
+        better = off < error[todo]
+        coefficients[todo[better]] = 0.0
+        coefficients[todo[better], : degree + 1] = found[better]
+        error[todo[better]] = off[better]
+        todo = todo[error[todo] > tolerance]
+    return coefficients, error
 
 
 def _new_file(units: str, application: str, project_name: str) -> tuple[Any, Any, Any, Any]:
@@ -171,13 +226,26 @@ class _Writer:
         return self.model.createIfcAlignmentSegment(ifcopenshell.guid.new(), None, None, None, None, None, None, parameters)
 
 
-def _horizontal(w: _Writer, chain: Any, scale: float) -> tuple[list[Any], list[Any], NDArray]:
+def _horizontal(w: _Writer, chain: Any, scale: float, tolerance: float) -> tuple[list[Any], list[Any], NDArray]:
     """The horizontal layout segments and curve segments of ``chain`` (lengths × ``scale``), each list
-    ending with its zero-length segment; and the stations (in the file's unit) of the segment starts."""
+    ending with its zero-length segment; and the stations (in the file's unit) of the segment starts.
+    ``tolerance``: ``GRAPH_TOLERANCE`` in the file's unit."""
     from ..core.segments import row_frames
 
     m = w.model
-    plan = plan_records(chain, scale)
+    for _ in range(6):  # a spiral no graph polynomial follows closely enough is written as its two halves
+        plan = plan_records(chain, scale)
+        spiral = plan["kind"] == SPIRAL
+        graphs = np.zeros((len(spiral), GRAPH_DEGREES[-1] + 1))
+        error = np.zeros(len(spiral))
+        if spiral.any():
+            graphs[spiral], error[spiral] = graph_polynomials(plan["poly"][spiral], tolerance)
+        if not (error > tolerance).any():
+            break
+        chain = _halved(chain, np.flatnonzero(error > tolerance))
+    else:
+        k = int(np.argmax(error))
+        raise ValueError(f"segment {k}: no polynomial graph of its spiral lies within {tolerance:.3g} of it ({error[k]:.3g} at best)")
     rows = chain.rows
     frames, _, _ = row_frames(np.array(rows.kind), np.array(rows.geometry), np.array(rows.params), rows.dim)
     kind, x, y, hdg, length = (plan[k] for k in ("kind", "x", "y", "hdg", "length"))
@@ -186,10 +254,6 @@ def _horizontal(w: _Writer, chain: Any, scale: float) -> tuple[list[Any], list[A
     kappa[np.abs(kappa) * length[:, None] <= 1e-9] = 0.0
     with np.errstate(divide="ignore"):
         radius = np.where(kappa != 0.0, 1.0 / np.where(kappa != 0.0, kappa, 1.0), 0.0)  # positive turns left
-    spiral = kind == SPIRAL
-    lam = np.ones(len(kind))
-    if spiral.any():
-        lam[spiral] = graph_length_scales(plan["poly"][spiral], length[spiral])
     layout, curve = [], []
     types = {LINE: "LINE", ARC: "CIRCULARARC", SPIRAL: "CUBIC"}
     for k in range(len(kind)):
@@ -203,10 +267,9 @@ def _horizontal(w: _Writer, chain: Any, scale: float) -> tuple[list[Any], list[A
         elif code == ARC:
             parent = w.circle(abs(r0))
             signed = math.copysign(size, r0)
-        else:
-            bu, cu, du, cv, dv = plan["poly"][k].tolist()
-            s = float(lam[k])
-            parent = m.createIfcPolynomialCurve(w.origin, (0.0, bu / s, cu / s**2, du / s**3), (0.0, 0.0, cv / s**2, dv / s**3), None)
+        else:  # the graph y = p(x) in the spiral's start frame (graph_polynomials)
+            last = max(int(np.flatnonzero(graphs[k])[-1]) if graphs[k].any() else 0, 2)
+            parent = m.createIfcPolynomialCurve(w.origin, (0.0, 1.0), tuple(graphs[k, : last + 1].tolist()), None)
             signed = size
         place = w.placement(point, math.cos(heading), math.sin(heading))
         curve.append(w.segment(place, signed, parent, "CONTSAMEGRADIENTSAMECURVATURE"))
@@ -219,6 +282,18 @@ def _horizontal(w: _Writer, chain: Any, scale: float) -> tuple[list[Any], list[A
     curve.append(w.segment(w.placement(point, float(tangent[0]), float(tangent[1])), 0.0, w.unit_line, "DISCONTINUOUS"))
     stations = np.concatenate([[0.0], np.cumsum(length)])
     return layout, curve, stations
+
+
+def _halved(chain: Any, spirals: NDArray) -> Any:
+    """``chain`` with the segments ``spirals`` (indices of spirals) each split into its two halves of arc length."""
+    from ..core.chain import Chain
+
+    segments = list(chain.segments)
+    for k in sorted(spirals.tolist(), reverse=True):
+        spiral = segments[k]
+        middle = float(spiral.parameter_at(0.5 * spiral.length))
+        segments[k : k + 1] = [spiral.piece(0.0, middle), spiral.piece(middle, 1.0)]
+    return Chain(segments, tolerance=chain.tolerance, units=chain.units)
 
 
 def _parabola_length(grade: NDArray, rate: NDArray, run: NDArray) -> NDArray:
@@ -343,7 +418,7 @@ def ifc_file(
                                           model.createIfcLocalPlacement(None, w.origin), None, None)  # fmt: skip
         horizontal = model.createIfcAlignmentHorizontal(ifcopenshell.guid.new(), None, None, None, None, None, None)
         layouts = [horizontal]
-        h_layout, h_curve, _ = _horizontal(w, chain, scale)
+        h_layout, h_curve, _ = _horizontal(w, chain, scale, GRAPH_TOLERANCE / to_metres(units))
         w.nest(horizontal, h_layout)
         plan = model.createIfcCompositeCurve(h_curve, False)
         if p is None:

@@ -11,7 +11,7 @@ import pytest
 
 from spiral_cad.core._chain_kernels import ARC, LINE, SPIRAL
 from spiral_cad.design import Alignment, Profile
-from spiral_cad.io.ifc import graph_length_scales, ifc_file, layout_segments, read_ifc_alignments, write_ifc
+from spiral_cad.io.ifc import GRAPH_TOLERANCE, graph_polynomials, ifc_file, layout_segments, read_ifc_alignments, write_ifc
 
 pytest.importorskip("ifcopenshell")
 import ifcopenshell  # noqa: E402
@@ -219,6 +219,9 @@ def test_ifcopenshell_evaluates_our_chain_within_a_micrometre(road, tmp_path):
     stations = np.linspace(0.0, chain.length, 3001)
     points = np.array([np.array(evaluate(float(s * metres)))[:2, 3] for s in stations]) / metres
     assert _project(chain, points, stations).max() * metres < 1e-6
+    # and ifcopenshell's distance along is our station, inside the spirals too (2–5 m apart when the
+    # spirals were written as parametric cubics): measured 0.9 µm, its quadrature's
+    assert np.hypot(*(points - chain.point_at(stations)).T).max() * metres < 1e-5
     # the gradient curve: the same plan, and the profile's heights at the same distance along
     (gradient,) = model.by_type("IfcGradientCurve")
     function = wrapper.map_shape(SETTINGS, gradient)
@@ -229,10 +232,10 @@ def test_ifcopenshell_evaluates_our_chain_within_a_micrometre(road, tmp_path):
     assert np.abs(space[:, 2] - heights).max() * metres < 1e-6
 
 
-def test_every_reading_of_segment_length_ends_a_spiral_at_its_end(road):
-    """The polynomial reaches the spiral's end point at one parameter λ, and up to λ both readings of
-    SegmentLength measure the spiral's length: the arc length of the parametric curve (the schema's) and
-    the length of its graph ∫√(1 + y'(t)²) dt (the concept template's x = t, which ifcopenshell applies)."""
+def test_every_reading_of_a_length_along_a_spiral_is_our_station(road):
+    """Each spiral is the graph y = p(x) (CoefficientsX = (0, 1)): the schema's arc length of the parametric
+    curve, the concept template's graph length and ifcopenshell's are one integral, and it reaches our
+    station at every point of the spiral and SegmentLength at its end (scipy's quadrature, not ours)."""
     from scipy.integrate import quad
     from scipy.optimize import brentq
 
@@ -244,33 +247,58 @@ def test_every_reading_of_segment_length_ends_a_spiral_at_its_end(road):
     for k, segment in enumerate(plan.Segments[:-1]):
         if not segment.ParentCurve.is_a("IfcPolynomialCurve"):
             continue
-        cx, cy = (np.polynomial.Polynomial(c) for c in (segment.ParentCurve.CoefficientsX, segment.ParentCurve.CoefficientsY))
+        assert tuple(segment.ParentCurve.CoefficientsX) == (0.0, 1.0)
+        p = np.polynomial.Polynomial(segment.ParentCurve.CoefficientsY)
         place = segment.Placement
         origin, (dx, dy) = np.array(place.Location.Coordinates), place.RefDirection.DirectionRatios
         assert np.allclose(origin, chain.point_at(chain.stations[k]), atol=1e-9)
-        offset = chain.point_at(chain.stations[k + 1]) - origin
-        x_end, y_end = offset[0] * dx + offset[1] * dy, offset[1] * dx - offset[0] * dy
         length = segment.SegmentLength.wrappedValue
-        lam = brentq(lambda t: cx(t) - x_end, 0.0, 2.0 * length, xtol=1e-14)
-        assert abs(cy(lam) - y_end) < 1e-9 * length
-        speed = quad(lambda t: math.hypot(cx.deriv()(t), cy.deriv()(t)), 0, lam, epsabs=0.0, epsrel=1e-12, limit=200)[0]
-        graph = quad(lambda t: math.hypot(1.0, cy.deriv()(t)), 0, lam, epsabs=0.0, epsrel=1e-12, limit=200)[0]
-        assert speed == pytest.approx(length, rel=1e-11)
-        assert graph == pytest.approx(length, rel=1e-11)
+
+        def graph(x, p=p):
+            return quad(lambda t: math.hypot(1.0, p.deriv()(t)), 0.0, x, epsabs=0.0, epsrel=1e-13, limit=200)[0]
+
+        for along in np.linspace(0.0, 1.0, 9)[1:] * length:
+            x = brentq(lambda x, along=along: graph(x) - along, 0.0, 2.0 * length, xtol=1e-13)
+            point = origin + x * np.array([dx, dy]) + p(x) * np.array([-dy, dx])
+            assert np.hypot(*(point - chain.point_at(chain.stations[k] + along))) < 1e-9 * length + 2 * GRAPH_TOLERANCE
         checked += 1
     assert checked == 6
 
 
-def test_graph_length_scales_solve_their_equation():
-    from scipy.integrate import quad
+def test_graph_polynomials_follow_the_cubic_or_say_they_do_not():
+    rng = np.random.default_rng(3)
+    theta = rng.uniform(0.05, 1.4, 200)  # turns of spirals in their start frames
+    u = np.linspace(0.0, 1.0, 401)
+    # cubic spirals' shapes: x(u) = u + small terms, y(u) = a·u² + b·u³ turning by θ at the end
+    poly = np.column_stack([np.full(200, 100.0), rng.uniform(-5, 5, 200), rng.uniform(-5, 5, 200), np.zeros(200), np.zeros(200)])
+    poly[:, 4] = 100.0 * np.tan(theta) / 3.0 * rng.uniform(0.3, 0.7, 200)
+    poly[:, 3] = (100.0 * np.tan(theta) - 3.0 * poly[:, 4]) / 2.0 * (1 + 0 * theta)
+    coefficients, error = graph_polynomials(poly, 1e-7)
+    x = poly[:, :1] * u + poly[:, 1:2] * u**2 + poly[:, 2:3] * u**3
+    y = poly[:, 3:4] * u**2 + poly[:, 4:5] * u**3
+    measured = np.array([np.abs(np.polynomial.polynomial.polyval(xi, c) - yi).max() for xi, yi, c in zip(x, y, coefficients)])
+    assert np.all(measured <= 1.05 * error + 1e-12)  # the error it states is the error there is (401 points, not its 129)
+    assert np.all(error[theta < 0.6] <= 1e-7)  # moderate turns always fit
 
-    poly = np.array([[30.0, 0.5, -0.2, 0.8, 0.3], [10.0, -0.1, 0.0, -2.0, 0.4]])
-    lengths = np.array([31.0, 10.5])
-    for (cv, dv), length, lam in zip(poly[:, 3:], lengths, graph_length_scales(poly, lengths)):
-        value = quad(
-            lambda u, lam=lam, cv=cv, dv=dv: math.hypot(lam, 2 * cv * u + 3 * dv * u * u), 0, 1, epsabs=0.0, epsrel=1e-13, limit=200
-        )[0]
-        assert value == pytest.approx(length, rel=1e-13)
+
+@pytest.mark.parametrize("shape, theta", [("near-linear", 0.8), ("walton-meek", 1.0)])
+def test_a_hairpins_stations_agree_with_ifcopenshell(shape, theta):
+    """Spirals turning 46° and 57° (once up to 24 m apart inside them): ifcopenshell's distance along is our
+    station; a spiral no graph polynomial follows within 10 nm is written as its halves."""
+    alignment = Alignment.from_pis([[0, 0], [600, 0], [0, 500]], [60], spiral_angles=theta, units="m", shape=shape)
+    chain = alignment.chain
+    model = ifc_file(alignment)
+    (plan,) = model.by_type("IfcCompositeCurve", include_subtypes=False)
+    lengths = [abs(segment.SegmentLength.wrappedValue) for segment in plan.Segments[:-1]]
+    assert len(lengths) > len(chain) and sum(lengths) == pytest.approx(chain.length, rel=1e-12)  # spirals halved
+    evaluate = wrapper.function_item_evaluator(SETTINGS, wrapper.map_shape(SETTINGS, plan)).evaluate
+    stations = np.linspace(0.0, chain.length, 2001)
+    points = np.array([np.array(evaluate(float(s)))[:2, 3] for s in stations])
+    assert np.hypot(*(points - chain.point_at(stations)).T).max() < 1e-5  # measured 0.7 and 1.3 µm
+    ends = np.concatenate([[0.0], np.cumsum(lengths)])
+    points = np.array([np.array(evaluate(float(s)))[:2, 3] for s in ends])
+    assert np.hypot(*(points - chain.point_at(np.minimum(ends, chain.length))).T).max() < 1e-6  # measured 0.7 and 0.9 µm
+    assert not continuity_warnings(model) and not agreement_errors(model) and not schema_issues(model)
 
 
 # ------------------------------------------------- buildingSMART's files, and a broken copy of ours
