@@ -190,49 +190,108 @@ def _new_file(units: str, application: str, project_name: str) -> tuple[Any, Any
     return model, project, site, axis
 
 
-class _Writer:
-    """Creates the entities of one file (a few shared placements and directions, the rest per segment)."""
+#: The 64 characters of IFC's compressed GUIDs, in order.
+_GUID_CHARS = np.frombuffer(b"0123456789ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz_$", dtype=np.uint8)
 
-    def __init__(self, model: Any):
-        self.model = model
-        self.origin = model.createIfcAxis2Placement2D(model.createIfcCartesianPoint((0.0, 0.0)), model.createIfcDirection((1.0, 0.0)))
-        self.circles: dict[float, Any] = {}
-        self.unit_line = model.createIfcLine(
-            model.createIfcCartesianPoint((0.0, 0.0)), model.createIfcVector(model.createIfcDirection((1.0, 0.0)), 1.0)
-        )
 
-    def placement(self, point: Any, dx: float, dy: float) -> Any:
-        """A 2-D placement at ``point`` (an IfcCartesianPoint, shared with the layout segment's start)."""
-        return self.model.createIfcAxis2Placement2D(point, self.model.createIfcDirection((dx, dy)))
+def _guids(count: int) -> list[str]:
+    """``count`` new IFC GlobalIds: random (version 4) UUIDs in IFC's 22-character compression (the 128 bits
+    as 2 + 21 × 6 bits, most significant first), made at once."""
+    raw = np.frombuffer(os.urandom(16 * count), dtype=np.uint8).reshape(count, 16).copy()
+    raw[:, 6] = (raw[:, 6] & 0x0F) | 0x40  # version 4
+    raw[:, 8] = (raw[:, 8] & 0x3F) | 0x80  # the RFC 4122 variant
+    bits = np.concatenate([np.zeros((count, 4), dtype=np.uint8), np.unpackbits(raw, axis=1)], axis=1).reshape(count, 22, 6)
+    digits = (bits * np.array([32, 16, 8, 4, 2, 1], dtype=np.uint8)).sum(axis=2)
+    return [g.decode() for g in np.ascontiguousarray(_GUID_CHARS[digits]).view("S22")[:, 0]]
 
-    def circle(self, radius: float) -> Any:
+
+def _real(value: float) -> str:
+    """A REAL of ISO 10303-21: the shortest repr that reads back exactly, with the point its grammar needs."""
+    text = repr(float(value))
+    if "e" in text:
+        mantissa, exponent = text.split("e")
+        return f"{mantissa if '.' in mantissa else mantissa + '.'}E{exponent}"
+    return text
+
+
+def _reals(values: Sequence[float]) -> str:
+    return "(" + ",".join(_real(v) for v in values) + ")"
+
+
+def _string(text: str) -> str:
+    """A STRING of ISO 10303-21: apostrophes and backslashes doubled, other than printable ASCII as \\X2\\ (UTF-16) or \\X4\\."""
+    out = []
+    for char in text:
+        code = ord(char)
+        if char in "'\\":
+            out.append(char * 2)
+        elif 32 <= code < 127:
+            out.append(char)
+        elif code <= 0xFFFF:
+            out.append(f"\\X2\\{code:04X}\\X0\\")
+        else:
+            out.append(f"\\X4\\{code:08X}\\X0\\")
+    return f"'{''.join(out)}'"
+
+
+class _Step:
+    """The entities of the alignments as lines of the STEP file's DATA section, numbered from ``first`` on:
+    written as text, one line per entity, rather than one ifcopenshell call per attribute (a 10 000-PI road
+    holds 0.4 M entities). A few shared placements and directions, the rest per segment."""
+
+    def __init__(self, first: int):
+        self.lines: list[str] = []
+        self.next = first
+        self.spare: list[str] = []
+        self.origin = self.add(f"IFCAXIS2PLACEMENT2D({self.point(0.0, 0.0)},{self.direction(1.0, 0.0)})")
+        self.circles: dict[float, str] = {}
+        vector = self.add(f"IFCVECTOR({self.direction(1.0, 0.0)},1.)")
+        self.unit_line = self.add(f"IFCLINE({self.point(0.0, 0.0)},{vector})")
+
+    def add(self, entity: str) -> str:
+        """Append ``entity`` (its type and attributes, e.g. ``IFCLINE(#1,#2)``); its reference ``#n``."""
+        ref = f"#{self.next}"
+        self.lines.append(f"{ref}={entity};")
+        self.next += 1
+        return ref
+
+    def guid(self) -> str:
+        if not self.spare:
+            self.spare = _guids(4096)
+        return self.spare.pop()
+
+    def point(self, *coordinates: float) -> str:
+        return self.add(f"IFCCARTESIANPOINT({_reals(coordinates)})")
+
+    def direction(self, *ratios: float) -> str:
+        return self.add(f"IFCDIRECTION({_reals(ratios)})")
+
+    def placement(self, point: str, dx: float, dy: float) -> str:
+        """A 2-D placement at ``point`` (shared with the layout segment's start)."""
+        return self.add(f"IFCAXIS2PLACEMENT2D({point},{self.direction(dx, dy)})")
+
+    def circle(self, radius: float) -> str:
         """The parent circle of radius ``radius`` at the origin (one per radius: the arcs of a road share few)."""
         if radius not in self.circles:
-            self.circles[radius] = self.model.createIfcCircle(self.origin, radius)
+            self.circles[radius] = self.add(f"IFCCIRCLE({self.origin},{_real(radius)})")
         return self.circles[radius]
 
-    def segment(self, placement: Any, length: float, parent: Any, transition: str) -> Any:
-        m = self.model
-        return m.createIfcCurveSegment(transition, placement, m.createIfcLengthMeasure(0.0), m.createIfcLengthMeasure(length), parent)
+    def segment(self, placement: str, length: float, parent: str, transition: str) -> str:
+        return self.add(f"IFCCURVESEGMENT(.{transition}.,{placement},IFCLENGTHMEASURE(0.),IFCLENGTHMEASURE({_real(length)}),{parent})")
 
-    def nest(self, parent: Any, children: list[Any]) -> None:
-        import ifcopenshell.guid
+    def nest(self, parent: str, children: list[str]) -> None:
+        self.add(f"IFCRELNESTS('{self.guid()}',$,$,$,{parent},({','.join(children)}))")
 
-        self.model.createIfcRelNests(ifcopenshell.guid.new(), None, None, None, parent, children)
-
-    def layout_segment(self, parameters: Any) -> Any:
-        import ifcopenshell.guid
-
-        return self.model.createIfcAlignmentSegment(ifcopenshell.guid.new(), None, None, None, None, None, None, parameters)
+    def layout_segment(self, parameters: str) -> str:
+        return self.add(f"IFCALIGNMENTSEGMENT('{self.guid()}',$,$,$,$,$,$,{parameters})")
 
 
-def _horizontal(w: _Writer, chain: Any, scale: float, tolerance: float) -> tuple[list[Any], list[Any], NDArray]:
+def _horizontal(w: _Step, chain: Any, scale: float, tolerance: float) -> tuple[list[str], list[str], NDArray]:
     """The horizontal layout segments and curve segments of ``chain`` (lengths × ``scale``), each list
     ending with its zero-length segment; and the stations (in the file's unit) of the segment starts.
     ``tolerance``: ``GRAPH_TOLERANCE`` in the file's unit."""
     from ..core.segments import row_frames
 
-    m = w.model
     for _ in range(6):  # a spiral no graph polynomial follows closely enough is written as its two halves
         plan = plan_records(chain, scale)
         spiral = plan["kind"] == SPIRAL
@@ -259,8 +318,10 @@ def _horizontal(w: _Writer, chain: Any, scale: float, tolerance: float) -> tuple
     for k in range(len(kind)):
         code, start, heading, size = int(kind[k]), (float(x[k]), float(y[k])), float(hdg[k]), float(length[k])
         r0, r1 = (0.0, 0.0) if code == LINE else (float(radius[k, 0]), float(radius[k, 1]))
-        point = m.createIfcCartesianPoint(start)
-        parameters = m.createIfcAlignmentHorizontalSegment(None, None, point, heading, r0, r1, size, None, types[code])
+        point = w.point(*start)
+        parameters = w.add(
+            f"IFCALIGNMENTHORIZONTALSEGMENT($,$,{point},{_real(heading)},{_real(r0)},{_real(r1)},{_real(size)},$,.{types[code]}.)"
+        )
         layout.append(w.layout_segment(parameters))
         if code == LINE:
             parent, signed = w.unit_line, size
@@ -269,15 +330,15 @@ def _horizontal(w: _Writer, chain: Any, scale: float, tolerance: float) -> tuple
             signed = math.copysign(size, r0)
         else:  # the graph y = p(x) in the spiral's start frame (graph_polynomials)
             last = max(int(np.flatnonzero(graphs[k])[-1]) if graphs[k].any() else 0, 2)
-            parent = m.createIfcPolynomialCurve(w.origin, (0.0, 1.0), tuple(graphs[k, : last + 1].tolist()), None)
+            parent = w.add(f"IFCPOLYNOMIALCURVE({w.origin},(0.,1.),{_reals(graphs[k, : last + 1].tolist())},$)")
             signed = size
         place = w.placement(point, math.cos(heading), math.sin(heading))
         curve.append(w.segment(place, signed, parent, "CONTSAMEGRADIENTSAMECURVATURE"))
     # the zero-length end segment: at the chain's end, in its end direction and curvature
     end, tangent = frames[-1, 1, :2] * scale, frames[-1, 1, 3:5]
     heading = math.atan2(float(tangent[1]), float(tangent[0]))
-    point = m.createIfcCartesianPoint(tuple(end.tolist()))
-    parameters = m.createIfcAlignmentHorizontalSegment(None, None, point, heading, 0.0, 0.0, 0.0, None, "LINE")
+    point = w.point(*end.tolist())
+    parameters = w.add(f"IFCALIGNMENTHORIZONTALSEGMENT($,$,{point},{_real(heading)},0.,0.,0.,$,.LINE.)")
     layout.append(w.layout_segment(parameters))
     curve.append(w.segment(w.placement(point, float(tangent[0]), float(tangent[1])), 0.0, w.unit_line, "DISCONTINUOUS"))
     stations = np.concatenate([[0.0], np.cumsum(length)])
@@ -302,10 +363,9 @@ def _parabola_length(grade: NDArray, rate: NDArray, run: NDArray) -> NDArray:
     return np.sqrt(1.0 + slope * slope) @ _WEIGHTS * run
 
 
-def _vertical(w: _Writer, profile: Any, start: float, end: float, scale: float) -> tuple[list[Any], list[Any]]:
+def _vertical(w: _Step, profile: Any, start: float, end: float, scale: float) -> tuple[list[str], list[str]]:
     """The vertical layout and gradient curve segments of ``profile`` from station ``start`` to ``end``
     (distance along from 0 at ``start``), each list ending with its zero-length segment."""
-    m = w.model
     records = profile.records(start, end)
     s, a, b, c = records.T
     run = np.diff(np.append(s, end - start))
@@ -316,55 +376,47 @@ def _vertical(w: _Writer, profile: Any, start: float, end: float, scale: float) 
     layout, curve = [], []
     for k in range(len(s)):
         start_k, height, grade, size = float(s[k]), float(a[k]), float(b[k]), float(run[k])
+        numbers = f"{_real(start_k)},{_real(size)},{_real(height)},{_real(grade)}"
         if parabola[k]:
             rate = float(c[k])
-            parameters = m.createIfcAlignmentVerticalSegment(
-                None, None, start_k, size, height, grade, float(end_grade[k]), 1.0 / (2.0 * rate), "PARABOLICARC"
+            parameters = w.add(
+                f"IFCALIGNMENTVERTICALSEGMENT($,$,{numbers},{_real(float(end_grade[k]))},{_real(1.0 / (2.0 * rate))},.PARABOLICARC.)"
             )
-            parent = m.createIfcPolynomialCurve(w.origin, (0.0, 1.0), (0.0, grade, rate), None)
+            parent = w.add(f"IFCPOLYNOMIALCURVE({w.origin},(0.,1.),{_reals((0.0, grade, rate))},$)")
         else:
-            parameters = m.createIfcAlignmentVerticalSegment(None, None, start_k, size, height, grade, grade, None, "CONSTANTGRADIENT")
+            parameters = w.add(f"IFCALIGNMENTVERTICALSEGMENT($,$,{numbers},{_real(grade)},$,.CONSTANTGRADIENT.)")
             parent = w.unit_line
         layout.append(w.layout_segment(parameters))
         norm = math.hypot(1.0, grade)
         curve.append(
-            w.segment(
-                w.placement(m.createIfcCartesianPoint((start_k, height)), 1.0 / norm, grade / norm),
-                float(along[k]),
-                parent,
-                "CONTSAMEGRADIENT",
-            )
+            w.segment(w.placement(w.point(start_k, height), 1.0 / norm, grade / norm), float(along[k]), parent, "CONTSAMEGRADIENT")
         )
     last = len(s) - 1
     finish = float(s[last] + run[last])
     height = float(a[last] + b[last] * run[last] + c[last] * run[last] ** 2)
     grade = float(end_grade[last])
-    parameters = m.createIfcAlignmentVerticalSegment(None, None, finish, 0.0, height, grade, grade, None, "CONSTANTGRADIENT")
+    parameters = w.add(
+        f"IFCALIGNMENTVERTICALSEGMENT($,$,{_real(finish)},0.,{_real(height)},{_real(grade)},{_real(grade)},$,.CONSTANTGRADIENT.)"
+    )
     layout.append(w.layout_segment(parameters))
     norm = math.hypot(1.0, grade)
-    curve.append(
-        w.segment(w.placement(m.createIfcCartesianPoint((finish, height)), 1.0 / norm, grade / norm), 0.0, w.unit_line, "DISCONTINUOUS")
-    )
+    curve.append(w.segment(w.placement(w.point(finish, height), 1.0 / norm, grade / norm), 0.0, w.unit_line, "DISCONTINUOUS"))
     return layout, curve
 
 
-def _stationing(w: _Writer, alignment: Any, basis: Any, chain: Any, station: float, scale: float) -> None:
+def _stationing(w: _Step, alignment: str, basis: str, chain: Any, station: float, scale: float) -> None:
     """The design's start station: an ``IfcReferent`` (STATION) at distance 0 on the basis curve with
     ``Pset_Stationing.Station``, nested in the alignment — what ``ifcopenshell.api.alignment.add_stationing_referent``
     makes, with the fallback position taken from the chain (that call evaluates the whole curve)."""
-    import ifcopenshell.api.pset
-    import ifcopenshell.guid
-
-    m = w.model
     x, y = (chain.start[:2] * scale).tolist()
     tx, ty = chain.tangent_at(0.0)[:2].tolist()
-    fallback = m.createIfcAxis2Placement3D(m.createIfcCartesianPoint((x, y, 0.0)), m.createIfcDirection((0.0, 0.0, 1.0)),
-                                           m.createIfcDirection((tx, ty, 0.0)))  # fmt: skip
-    location = m.createIfcPointByDistanceExpression(m.createIfcLengthMeasure(0.0), None, None, None, basis)
-    placement = m.createIfcLinearPlacement(None, m.createIfcAxis2PlacementLinear(location, None, None), fallback)
-    referent = m.createIfcReferent(ifcopenshell.guid.new(), None, f"{station:g}", None, None, placement, None, "STATION")
-    pset = ifcopenshell.api.pset.add_pset(m, product=referent, name="Pset_Stationing")
-    ifcopenshell.api.pset.edit_pset(m, pset=pset, properties={"Station": station})
+    fallback = w.add(f"IFCAXIS2PLACEMENT3D({w.point(x, y, 0.0)},{w.direction(0.0, 0.0, 1.0)},{w.direction(tx, ty, 0.0)})")
+    location = w.add(f"IFCPOINTBYDISTANCEEXPRESSION(IFCLENGTHMEASURE(0.),$,$,$,{basis})")
+    placement = w.add(f"IFCLINEARPLACEMENT($,{w.add(f'IFCAXIS2PLACEMENTLINEAR({location},$,$)')},{fallback})")
+    referent = w.add(f"IFCREFERENT('{w.guid()}',$,{_string(f'{station:g}')},$,$,{placement},$,.STATION.)")
+    value = w.add(f"IFCPROPERTYSINGLEVALUE('Station',$,IFCLENGTHMEASURE({_real(station)}),$)")
+    pset = w.add(f"IFCPROPERTYSET('{w.guid()}',$,'Pset_Stationing',$,({value}))")
+    w.add(f"IFCRELDEFINESBYPROPERTIES('{w.guid()}',$,$,$,({referent}),{pset})")
     w.nest(alignment, [referent])
 
 
@@ -377,13 +429,21 @@ def ifc_file(
     project: str = "spiral_cad",
     application: str = "spiral_cad",
 ) -> Any:
-    """The IFC 4.3 model of ``alignments`` as an ``ifcopenshell.file`` (``write_ifc`` writes it).
+    """The IFC 4.3 model of ``alignments`` as an ``ifcopenshell.file`` (``write_ifc`` writes the same text).
 
     Args and Raises: as ``write_ifc``; ``names`` are the ``IfcAlignment`` names
     (default ``alignment 1``, …), ``project`` the ``IfcProject`` name.
     """
-    import ifcopenshell.guid
+    import ifcopenshell
 
+    text = _ifc_text(alignments, units=units, profile=profile, names=names, project=project, application=application)
+    return ifcopenshell.file.from_string(text)
+
+
+def _ifc_text(alignments: Any, *, units: str | None, profile: Any, names: Sequence[str] | None, project: str, application: str,
+              file_name: str = "") -> str:  # fmt: skip
+    """The STEP text of ``ifc_file``: the project, units, contexts and site made by ifcopenshell's API, the
+    alignments' entities appended as text (``_Step``)."""
     from ..design.alignment import Alignment
 
     items = [alignments] if isinstance(alignments, Alignment) else list(alignments)
@@ -406,40 +466,44 @@ def ifc_file(
     for k, p in enumerate(profiles):
         if p is not None and p.units != design_units:
             raise ValueError(f"profile {k}: in {p.units}, its alignment in {design_units}")
+    for name, alignment in zip(names, items):
+        if alignment.chain.dim != 2:
+            raise ValueError(f"{name}: an IFC horizontal layout is plane; this chain lies in space")
 
     model, proj, site, axis = _new_file(units, application, project)
-    w = _Writer(model)
+    model.header.file_name.time_stamp = time.strftime("%Y-%m-%dT%H:%M:%S")
+    model.header.file_name.name = file_name
+    w = _Step(max(entity.id() for entity in model) + 1)
+    context = f"#{axis.id()}"
     made = []
     for alignment, p, name in zip(items, profiles, names):
         chain = alignment.chain
-        if chain.dim != 2:
-            raise ValueError(f"{name}: an IFC horizontal layout is plane; this chain lies in space")
-        entity = model.createIfcAlignment(ifcopenshell.guid.new(), None, name, None, None,
-                                          model.createIfcLocalPlacement(None, w.origin), None, None)  # fmt: skip
-        horizontal = model.createIfcAlignmentHorizontal(ifcopenshell.guid.new(), None, None, None, None, None, None)
+        horizontal = w.add(f"IFCALIGNMENTHORIZONTAL('{w.guid()}',$,$,$,$,$,$)")
         layouts = [horizontal]
         h_layout, h_curve, _ = _horizontal(w, chain, scale, GRAPH_TOLERANCE / to_metres(units))
         w.nest(horizontal, h_layout)
-        plan = model.createIfcCompositeCurve(h_curve, False)
+        plan = w.add(f"IFCCOMPOSITECURVE(({','.join(h_curve)}),.F.)")
         if p is None:
-            reps = [model.createIfcShapeRepresentation(axis, "Axis", "Curve2D", [plan])]
+            reps = [w.add(f"IFCSHAPEREPRESENTATION({context},'Axis','Curve2D',({plan}))")]
         else:
-            vertical = model.createIfcAlignmentVertical(ifcopenshell.guid.new(), None, None, None, None, None, None)
+            vertical = w.add(f"IFCALIGNMENTVERTICAL('{w.guid()}',$,$,$,$,$,$)")
             layouts.append(vertical)
             v_layout, v_curve = _vertical(w, p, alignment.start_station, alignment.end_station, scale)
             w.nest(vertical, v_layout)
-            gradient = model.createIfcGradientCurve(v_curve, False, plan, None)
-            reps = [model.createIfcShapeRepresentation(axis, "FootPrint", "Curve2D", [plan]),
-                    model.createIfcShapeRepresentation(axis, "Axis", "Curve3D", [gradient])]  # fmt: skip
-        entity.Representation = model.createIfcProductDefinitionShape(None, None, reps)
+            gradient = w.add(f"IFCGRADIENTCURVE(({','.join(v_curve)}),.F.,{plan},$)")
+            reps = [w.add(f"IFCSHAPEREPRESENTATION({context},'FootPrint','Curve2D',({plan}))"),
+                    w.add(f"IFCSHAPEREPRESENTATION({context},'Axis','Curve3D',({gradient}))")]  # fmt: skip
+        representation = w.add(f"IFCPRODUCTDEFINITIONSHAPE($,$,({','.join(reps)}))")
+        local = w.add(f"IFCLOCALPLACEMENT($,{w.origin})")
+        entity = w.add(f"IFCALIGNMENT('{w.guid()}',$,{_string(name)},$,$,{local},{representation},$)")
         w.nest(entity, layouts)
         _stationing(w, entity, plan, chain, alignment.start_station * scale, scale)
         made.append(entity)
-    # the relationships ifcopenshell's alignment API makes (aggregated to the project, referenced by the
-    # site), written directly: its aggregate call re-reads every placement (and trips over 2-D ones)
-    model.createIfcRelAggregates(ifcopenshell.guid.new(), None, None, None, proj, made)
-    model.createIfcRelReferencedInSpatialStructure(ifcopenshell.guid.new(), None, None, None, made, site)
-    return model
+    # the relationships ifcopenshell's alignment API makes (aggregated to the project, referenced by the site)
+    w.add(f"IFCRELAGGREGATES('{w.guid()}',$,$,$,#{proj.id()},({','.join(made)}))")
+    w.add(f"IFCRELREFERENCEDINSPATIALSTRUCTURE('{w.guid()}',$,$,$,({','.join(made)}),#{site.id()})")
+    head, tail = model.to_string().rsplit("ENDSEC;", 1)
+    return head + "\n".join(w.lines) + "\nENDSEC;" + tail
 
 
 def write_ifc(
@@ -473,11 +537,10 @@ def write_ifc(
             unknown unit, profiles that do not match the alignments, or a
             chain in space.
     """
-    model = ifc_file(alignments, units=units, profile=profile, names=names, project=project, application=application)
     path = Path(os.fspath(path))
-    model.header.file_name.time_stamp = time.strftime("%Y-%m-%dT%H:%M:%S")
-    model.header.file_name.name = path.name
-    model.write(str(path))
+    text = _ifc_text(alignments, units=units, profile=profile, names=names, project=project, application=application,
+                     file_name=path.name)  # fmt: skip
+    path.write_text(text, encoding="ascii")
     return path
 
 

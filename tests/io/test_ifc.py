@@ -431,3 +431,15 @@ def test_names_that_ifc_labels_cannot_hold_are_refused_by_name(tmp_path):
     with pytest.raises(ValueError, match="project"):
         write_ifc(alignment, tmp_path / "ctl.ifc", project="a\x01b")
     assert not (tmp_path / "long.ifc").exists() and not (tmp_path / "ctl.ifc").exists()
+
+
+def test_global_ids_are_ifc_compressed_version_4_uuids_and_unique():
+    import ifcopenshell.guid
+
+    from spiral_cad.io.ifc import _guids
+
+    made = _guids(5000)
+    assert len(set(made)) == 5000 and all(len(g) == 22 for g in made)
+    for g in made[:200]:
+        expanded = ifcopenshell.guid.expand(g)  # ifcopenshell's own decoding, back and forth
+        assert ifcopenshell.guid.compress(expanded) == g and expanded[12] == "4" and expanded[16] in "89ab"
