@@ -103,3 +103,19 @@ def test_the_build_states_each_alignments_largest_offset_and_refuses_beyond_max_
     assert "--max-offset: only with a LandXML file" in capsys.readouterr().err
     assert main(["build", str(DATA / "x.json"), "--directions", "north-cw"]) == 2
     assert "--directions: only with a LandXML file" in capsys.readouterr().err
+
+
+def test_the_build_of_public_exports_keeps_every_element(tmp_path, capsys):
+    """Civil 3D 2023 (lines and arcs, two arcs of one centre) once lost a 391 ft arc and a 72 ft line with
+    --max-offset inf; Civil 3D 2020's asymmetric S was cut into three designs by 3e-4 rad kinks."""
+    source = DATA / "civil3d2023_main_road_lines_arcs.xml"
+    assert main(["build", str(source), "--out", str(tmp_path / "c3d"), "--no-plots", "--max-offset", "inf"]) == 0
+    reports = sorted((tmp_path / "c3d").glob("*_landxml.txt"))
+    rows = {int(m.group(1)) for r in reports for m in re.finditer(r"^\s+(\d+)  (?:Line|Curve)", r.read_text(), re.M)}
+    assert rows == set(range(8))  # every element of the file in the report
+    assert all("Curve" in r.read_text() or "Line" in r.read_text() for r in reports)
+    assert main(["build", str(DATA / "civil3d2020_a_kolu_asymmetric_s.xml"), "--out", str(tmp_path / "kolu"), "--no-plots"]) == 0
+    (report,) = (tmp_path / "kolu").glob("*_landxml.txt")  # one design
+    text = report.read_text()
+    assert text.count("note: joint at station") == 3 and "break:" not in text
+    capsys.readouterr()
