@@ -734,7 +734,8 @@ def read_landxml(source: str | os.PathLike, shape: str = "near-linear", placemen
             that agree with their points one way in some elements and the other
             way in others, or (``"auto"``) an element placed only by its direction
             in a file whose convention cannot be told, or an element ours lies
-            farther from than ``max_offset`` (naming the farthest).
+            farther from than ``max_offset`` (naming the farthest), or a rebuild that holds
+            nothing of some element (naming it: no element is ever left out).
     """
     if shape not in ("near-linear", "walton-meek"):
         raise ValueError(f"shape must be 'near-linear' or 'walton-meek'; got {shape!r}")

@@ -100,3 +100,22 @@ def test_unit_strings_are_read_tolerantly(unit):
     # 30°30' (dd.mm.ss, not 30.3°), counted from north as the first line's points tell: the second line straight on
     assert a.units == "m" and a.directions == "north-cw" and len(a.kinds) == 2
     assert a.offset < 1e-9 and len(a.chains) == 1 and not any("kink" in note for note in a.notes)
+
+
+def test_a_rebuild_that_loses_an_element_is_refused_by_name(monkeypatch):
+    """The guard behind "never dropped": a placement that left an element out (as one once did with two
+    arcs of one centre) is refused, naming the element, rather than built without it."""
+    import spiral_cad.io.landxml_read as reader
+
+    placed = reader._run
+
+    def losing(items, mine, *rest):
+        segments, owner, methods = placed(items, mine, *rest)
+        kept = [k for k, o in enumerate(owner) if o != 3]
+        return [segments[k] for k in kept], [owner[k] for k in kept], methods
+
+    monkeypatch.setattr(reader, "_run", losing)
+    with pytest.raises(
+        ValueError, match=r"CoordGeom element 3 \(Curve\) at station [\d.]+: the rebuilt chain holds nothing of this element"
+    ):
+        read_landxml(DATA / "civil3d2023_main_road_lines_arcs.xml", max_offset=math.inf)
