@@ -179,15 +179,18 @@ def solve_compound(entry: Carrier, exit_: Carrier, inner: Sequence[Carrier], cur
 
 
 def solve_inflection(
-    entry: Carrier, exit_: Carrier, tangent: Carrier, curvatures: Sequence[float], shape: str
+    entry: Carrier, exit_: Carrier, tangent: Carrier, curvatures: Sequence[float], shape: str, turn: float = 0.0
 ) -> list[tuple[int, Segment]]:
     """An S (or C) of two spirals through a straight point between two arcs, asymmetric as the file's: each
     spiral ``line_to_circle`` between its arc and the file's tangent at the inflection, that tangent moved
     along its normal until the two spirals meet on it (the file's clothoids have the same lengths' ratio).
 
+    ``turn`` (rad) turns the tangent about its point first.
+
     Raises:
         ValueError: no shift of the tangent joins the two spirals.
     """
+    tangent = replace(tangent, heading=tangent.heading + turn)
     normal = np.array([-math.sin(tangent.heading), math.cos(tangent.heading)])
 
     def gap(shift: float) -> float:

@@ -287,7 +287,20 @@ def _run(items: list[_Element], mine: list[int], starts: list[NDArray], headings
                     found: list[tuple[int, Segment]] = list(enumerate(solved))
                 elif how == "inflection":
                     name = "line_to_circle ×2 (inflection tangent)"
-                    found = solve_inflection(entry, exit_, carrier(ks[0], at_end=True), curvatures, shape)
+                    tangent = carrier(ks[0], at_end=True)
+                    near = list(range(max(ks[0] - 1, mine[0]), min(ks[-1] + 2, mine[-1] + 1)))
+
+                    def off(turn: float) -> float:  # the tangent turned a little nearer the file's pair
+                        try:
+                            trial = solve_inflection(entry, exit_, tangent, curvatures, shape, turn)
+                        except ValueError:
+                            return 1e300  # no solution: the worst, finite for the bounded search's arithmetic
+                        return distance_to_file([segment for _, segment in trial], near, *file)
+
+                    best = minimize_scalar(off, bounds=(-0.02, 0.02), method="bounded", options={"xatol": 1e-6})
+                    turn = float(best.x) if off(float(best.x)) < off(0.0) else 0.0
+                    found = solve_inflection(entry, exit_, tangent, curvatures, shape, turn)
+                    name += f" (turned {turn:.3g} rad)" if turn else ""
                 elif how == "joints":
                     name = "through its joints"
                     found = solve_compound(entry, exit_, [carrier(k, at_end=True) for k in ks[:-1]], curvatures, shape)

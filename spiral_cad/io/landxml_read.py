@@ -42,7 +42,8 @@ jump at a sliver (an element of at most ``SLIVER`` of the alignment's length) to
 the sliver rebuilt with its neighbour's curvature; other joints part the G2 runs
 (``breaks``). An asymmetric S (two clothoids between arcs of opposite senses) is
 also solved as two ``line_to_circle`` spirals on the file's inflection tangent,
-moved along its normal until they meet (``landxml_fit.solve_inflection``).
+moved along its normal until they meet (``landxml_fit.solve_inflection``), the
+tangent turned by up to 0.02 rad to come nearest the file's pair.
 
 Per element the record keeps the offset between the file's element (placed at
 its own Start and start direction; the exact clothoid of
@@ -581,6 +582,7 @@ def _alignment(r: _Reader, a: ET.Element, label: str) -> LandXMLAlignment:
     file = (np.array(starts), np.array(headings), bend, k1, size)
     # a sliver's limit is that of an element of SLIVER × the alignment's length: its own would be below rounding
     limits = MAX_OFFSET_FRACTION * np.maximum(size, SLIVER * size.sum()) if r.max_offset is None else np.full(len(size), r.max_offset)
+    tried: list[tuple[NDArray[np.float64], NDArray[np.int64]]] = []
     for kink in (ABSORBED_KINK, 0.0):  # small kinks absorbed where the offsets allow it, else G2 runs apart there
         runs, breaks, joints, continued = _joints(items, starts, headings, ends, r.units, kink)
         placed = [replace(item, k0=continued[k], k1=continued[k]) if k in continued else item for k, item in enumerate(items)]
@@ -604,9 +606,11 @@ def _alignment(r: _Reader, a: ET.Element, label: str) -> LandXMLAlignment:
         # attributes describe is reported, not refused
         limits[[k for k in range(len(items)) if methods.get(k) == "spiral_cad cubic"]] = np.inf
         over = np.flatnonzero(offsets > limits)
+        tried.append((offsets, over))
         if not len(over) or not any("kink" in j for j in joints):
             break
     if len(over):  # a clothoid none of our spirals follows: refused rather than silently metres away
+        offsets, over = tried[0]  # named as the first rebuild (the small kinks inside the runs) found it
         with np.errstate(divide="ignore", over="ignore", invalid="ignore"):  # a limit may underflow to 0
             k = int(over[np.argmax(offsets[over] / limits[over])])
         limit = (f"{MAX_OFFSET_FRACTION:g} of its length {size[k]:.6g}" if r.max_offset is None

@@ -70,13 +70,12 @@ def test_mdt_road_keeps_its_lines_and_arcs_and_no_longer_drifts():
     (old,) = read_landxml(path, placement="length", max_offset=math.inf)  # before: metres of drift
     _assert_lines_and_arcs_kept(new, path)
     spirals = [k for k, kind in enumerate(new.kinds) if kind == "Spiral"]
-    # measured: 0.012 m (the S-curve between R 25 and R 22: 0.0072 m on the file's inflection tangent, 0.042 m as
-    # circle_to_circle's symmetric S) against 3.07 m of drift before
+    # measured: 0.012 m (a line_to_circle spiral; the S-curve between R 25 and R 22: 0.5 mm on the file's inflection
+    # tangent, 0.042 m as circle_to_circle's symmetric S) against 3.07 m of drift before
     assert new.offset < 0.02 and old.offset > 2.0 and new.offset < old.offset / 20
     assert new.offsets[-1] < 1e-6 < 1.0 < old.offsets[-1]  # the last line is the file's again
-    assert new.methods[2:4] == ("line_to_circle ×2 (inflection tangent)",) * 2 and all(
-        new.methods[k] == "line_to_circle" for k in spirals[2:]
-    )
+    assert all(m.startswith("line_to_circle ×2 (inflection tangent)") for m in new.methods[2:4]) and new.offsets[2:4].max() < 0.002
+    assert all(new.methods[k] == "line_to_circle" for k in spirals[2:])
     # our spirals differ in length from the file's (metres), the lines and arcs give it back: millimetres at the end
     assert np.abs(new.length_changes).max() > 1.0 and abs(new.station_shift) < 0.01
     ours = np.concatenate([np.bincount(o, c.lengths, minlength=len(new.kinds)) for c, o in zip(new.chains, new.owners)])
