@@ -96,3 +96,26 @@ def test_a_spirals_control_points_that_no_longer_fit_it_are_not_used(tmp_path):
     edited = re.sub(r'(<Spiral [^>]*?length=")([^"]+)"', lambda m: f'{m.group(1)}{float(m.group(2)) * 1.01!r}"', text)
     (back,) = read_landxml(edited, max_offset=float("inf"))
     assert back.methods != ("spiral_cad cubic",) and any("do not fit the element" in note for note in back.notes)
+
+
+def test_the_batch_spiral_check_never_passes_what_monotone_pieces_would_cut():
+    """The writer certifies most cubics at once (_plain_spirals) and sends only the rest through
+    bezier.monotone_pieces: every cubic it certifies must be one piece there too, and real spirals pass."""
+    from spiral_cad.core.bezier import monotone_pieces
+    from spiral_cad.io.landxml import _plain_spirals
+
+    rng = np.random.default_rng(29)
+    spirals = np.array([BezierSpiral((0.0, 0.0), (1.0, 0.0), theta, 0.01, shape).control_points[:, :2]
+                        for theta in np.linspace(0.05, 0.8, 16) for shape in ("near-linear", "walton-meek")])  # fmt: skip
+    # spirals disturbed by up to a tenth of their size: some stay spirals, others gain an inflection or a peak
+    size = np.ptp(spirals, axis=1).max(axis=1)[:, None, None]
+    cubics = np.concatenate([spirals + rng.normal(size=spirals.shape) * size * scale for scale in (1e-3, 1e-2, 0.1)])
+    plain = _plain_spirals(cubics)
+    for cp, certified in zip(cubics, plain):
+        try:
+            pieces = len(monotone_pieces(cp))
+        except ValueError:  # a cusp: monotone_pieces refuses it, the batch must not certify it
+            pieces = 0
+        assert not certified or pieces == 1
+    assert 0 < plain.sum() < len(plain)
+    assert _plain_spirals(spirals).all()
