@@ -33,7 +33,7 @@ the graph's length is the arc length, and the schema's reading, the template's a
 ifcopenshell's all put a distance along the segment at our station. p interpolates
 the cubic at Chebyshev–Lobatto points, at the lowest degree (6 to 20) within
 ``GRAPH_TOLERANCE`` (1 nm) of it — degree 8 to 14 on road spirals; a spiral that no
-degree follows within it (one turning about 45° or more) is written as its two halves
+degree follows within it (one turning more than about 40°) is written as its two halves
 (each its own layout and curve segment), again if need be. ifcopenshell then puts every
 distance along within 1.3 µm of our station and every segment end within 1 µm of ours
 (its own trapezoidal graph length, relative tolerance 1.5e-8, is most of that).
@@ -80,7 +80,7 @@ _NODES, _WEIGHTS = 0.5 * (_NODES + 1.0), 0.5 * _WEIGHTS  # on [0, 1]
 #: The degrees tried, in turn, for a spiral's graph polynomial (above 20 the monomials lose more than they gain).
 GRAPH_DEGREES = (6, 8, 10, 12, 14, 16, 18, 20)
 #: The largest distance (m) between a spiral's graph polynomial and our cubic; a spiral no degree brings
-#: within it (one turning about 45° or more) is written as its two halves, each its own segment.
+#: within it (one turning more than about 40°) is written as its two halves, each its own segment.
 GRAPH_TOLERANCE = 1e-9
 
 
