@@ -37,7 +37,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 from OCP.BRep import BRep_Tool
-from OCP.BRepAdaptor import BRepAdaptor_Curve
+from OCP.BRepAdaptor import BRepAdaptor_Curve, BRepAdaptor_Surface
 from OCP.BRepBuilderAPI import (
     BRepBuilderAPI_MakeEdge,
     BRepBuilderAPI_MakeFace,
@@ -60,7 +60,7 @@ from OCP.gp import gp_Ax3, gp_Dir, gp_Pln, gp_Pnt, gp_Trsf, gp_Vec
 from OCP.GProp import GProp_GProps
 from OCP.TColgp import TColgp_Array1OfPnt, TColgp_Array2OfPnt
 from OCP.TColStd import TColStd_Array1OfInteger, TColStd_Array1OfReal, TColStd_Array2OfReal
-from OCP.TopAbs import TopAbs_EDGE, TopAbs_FACE, TopAbs_SHELL, TopAbs_SOLID, TopAbs_WIRE
+from OCP.TopAbs import TopAbs_EDGE, TopAbs_FORWARD, TopAbs_FACE, TopAbs_SHELL, TopAbs_SOLID, TopAbs_WIRE
 from OCP.TopExp import TopExp, TopExp_Explorer
 from OCP.TopLoc import TopLoc_Location
 from OCP.TopoDS import TopoDS, TopoDS_Edge, TopoDS_Face, TopoDS_Shape, TopoDS_Solid
@@ -84,6 +84,7 @@ __all__ = [
     "Slab",
     "approximation_note",
     "fillet_prism_edges",
+    "forward_solid",
     "g2_slab",
     "outline_segments",
     "expected_level",
@@ -582,7 +583,31 @@ def _solid(faces: list[TopoDS_Face], tolerance: float) -> TopoDS_Solid:
         raise NoSolutionError(f"the slab's {len(faces)} faces did not sew into one closed shell ({count} shell(s))")
     solid = BRepBuilderAPI_MakeSolid(shell).Solid()
     BRepLib.OrientClosedSolid_s(solid)
-    return solid
+    return forward_solid(solid)
+
+
+def forward_solid(solid: TopoDS_Shape) -> TopoDS_Solid:
+    """The solid FORWARD with its shells facing out: the same volume, usable in booleans.
+
+    ``BRepLib.OrientClosedSolid`` (and ``Reversed``) may leave a solid REVERSED with a
+    positive volume; a fuse of a compound holding such a solid drops it. The solid is
+    made again from its shells as they face (orientations composed down from the solid)."""
+    if solid.Orientation() == TopAbs_FORWARD and _volume(solid) > 0.0:
+        return TopoDS.Solid_s(solid)
+    maker = BRepBuilderAPI_MakeSolid()
+    shells = TopExp_Explorer(solid, TopAbs_SHELL)
+    while shells.More():
+        maker.Add(TopoDS.Shell_s(shells.Current()))
+        shells.Next()
+    rebuilt = maker.Solid()
+    if _volume(rebuilt) < 0.0:  # inside out: every shell turned
+        maker = BRepBuilderAPI_MakeSolid()
+        shells = TopExp_Explorer(rebuilt, TopAbs_SHELL)
+        while shells.More():
+            maker.Add(TopoDS.Shell_s(shells.Current().Reversed()))
+            shells.Next()
+        rebuilt = maker.Solid()
+    return rebuilt
 
 
 def verify_solid(shape: TopoDS_Shape, what: str = "slab") -> None:
@@ -594,6 +619,8 @@ def verify_solid(shape: TopoDS_Shape, what: str = "slab") -> None:
         solids.Next()
     if count != 1:
         raise NoSolutionError(f"the {what} is {count} solids, not one")
+    if _first_solid(shape).Orientation() != TopAbs_FORWARD:
+        raise NoSolutionError(f"the {what} is a {_first_solid(shape).Orientation().name} solid, not FORWARD (booleans drop it)")
     if not BRepCheck_Analyzer(shape).IsValid():
         raise NoSolutionError(f"the {what} is not a valid solid (BRepCheck_Analyzer)")
     props = GProp_GProps()
@@ -620,6 +647,9 @@ def continuous_box(
     """A box with every edge and corner G2: ``g2_slab`` of a ``continuous_rectangle`` (centred on the origin,
     z from 0 to ``height``). ``edge_radius`` None: the roll half as wide as the smaller of ``radius`` and
     ``height``/2 allows. Other arguments and errors as ``g2_slab`` and ``continuous_rectangle``."""
+    for value, name in ((length, "length"), (width, "width"), (height, "height")):
+        if not as_float(value, name) > 0.0:
+            raise ValueError(f"{name} must be positive; got {shown(value)}")
     plan = continuous_rectangle(length, width, radius, transition, units=units, shape=shape)
     if edge_radius is None:  # the roll's extent is proportional to its radius
         unit = float(roll_profile(1.0, profile=profile, transition=transition, shape=shape)[-1].end[0])
@@ -801,6 +831,18 @@ def _prism(solid: TopoDS_Shape, direction: gp_Dir, edge_name: str) -> _Prism:
             f"g2_fillet rounds solid edges of right prisms (two parallel planar caps, side faces along the edges); "
             f"{edge_name}: the part has {len(caps)} planar face(s) perpendicular to it, not 2 (a vertex blend is a later step)"
         )
+    for index, face in enumerate(_faces_of(solid)):
+        if any(face.IsSame(cap) for cap in caps):
+            continue
+        lean = _lean(face, direction)
+        if lean > _SIDE_TOL:
+            surface = BRepAdaptor_Surface(face)
+            u, v = 0.5 * (surface.FirstUParameter() + surface.LastUParameter()), 0.5 * (surface.FirstVParameter() + surface.LastVParameter())
+            raise NoSolutionError(
+                f"g2_fillet rounds solid edges of right prisms (side faces perpendicular to the caps); {edge_name}: "
+                f"side face {index} near {_where(surface.Value(u, v))} leans {math.degrees(lean):.6g}° from the caps' "
+                "normal: the part is an oblique prism, which g2_fillet does not round"
+            )
     origins = [_plane(f).Location() for f in caps]  # type: ignore[union-attr]
     offsets = [gp_Vec(direction).Dot(gp_Vec(o.XYZ())) for o in origins]
     low, high = (0, 1) if offsets[0] < offsets[1] else (1, 0)
@@ -816,6 +858,37 @@ def _prism(solid: TopoDS_Shape, direction: gp_Dir, edge_name: str) -> _Prism:
     if frame.XDirection().IsParallel(direction, 1e-9):
         frame = gp_Ax3(plane.Location(), direction)
     return _Prism(frame, caps[low], caps[high], height)
+
+
+#: Most angle (radians) a prism's side face may lean from the caps' normal.
+_SIDE_TOL = 1e-9
+#: Samples per parameter direction when a side face's surface gives no direction of its own.
+_SIDE_SAMPLES = 9
+
+
+def _lean(face: TopoDS_Face, axis: gp_Dir) -> float:
+    """How far (radians) the face leans from containing the direction ``axis`` everywhere: from its
+    surface's own direction (plane normal, cylinder axis, extrusion direction) where it has one, else
+    the largest over a grid of its normals (a face perpendicular to the caps has every normal ⟂ axis)."""
+    surface = BRepAdaptor_Surface(face)
+    kind = surface.GetType()
+    if kind == GeomAbs_SurfaceType.GeomAbs_Plane:
+        return abs(math.asin(max(-1.0, min(1.0, surface.Plane().Axis().Direction().Dot(axis)))))
+    along = {GeomAbs_SurfaceType.GeomAbs_Cylinder: lambda: surface.Cylinder().Axis().Direction(),
+             GeomAbs_SurfaceType.GeomAbs_SurfaceOfExtrusion: surface.Direction}.get(kind)  # fmt: skip
+    if along is not None:
+        angle = along().Angle(axis)
+        return min(angle, math.pi - angle)
+    u0, u1, v0, v1 = surface.FirstUParameter(), surface.LastUParameter(), surface.FirstVParameter(), surface.LastVParameter()
+    worst = 0.0
+    for u in np.linspace(u0, u1, _SIDE_SAMPLES):
+        for v in np.linspace(v0, v1, _SIDE_SAMPLES):
+            point, du, dv = gp_Pnt(), gp_Vec(), gp_Vec()
+            surface.D1(float(u), float(v), point, du, dv)
+            normal = du.Crossed(dv)
+            if normal.Magnitude() > 1e-12 * (1.0 + du.Magnitude() * dv.Magnitude()):
+                worst = max(worst, abs(math.asin(max(-1.0, min(1.0, normal.Normalized().Dot(gp_Vec(axis)))))))
+    return worst
 
 
 def _on(face: TopoDS_Face, point: gp_Pnt, size: float) -> bool:
@@ -883,23 +956,26 @@ def fillet_prism_edges(
         plane = _plane(face)
         if plane is not None and any(any(e.IsSame(h) for h in _edges_of(face)) for e in edges):
             candidates.append(plane.Axis().Direction())
-    ranked = []
+    ranked, leaning = [], []
     for candidate in candidates:
         try:
             ranked.append((_fit(solid, edges, candidate, named), candidate))
-        except NoSolutionError:
-            continue
+        except NoSolutionError as error:
+            leaning += [error] if "oblique prism" in str(error) else []
+    if not ranked and leaning:
+        raise leaning[0]
     if not ranked:
         raise NoSolutionError(
             f"g2_fillet rounds a solid's straight edges when each end meets a face perpendicular to it (prism side "
             f"edges) and whole caps of right prisms; {named[0]} is neither (a vertex blend is a later step)"
         )
     axis = min(ranked, key=lambda row: row[0])[1]
-    sides, caps = [], []
+    sides, caps, side_names = [], [], []
     for k, edge in enumerate(edges):
         line = _line_direction(edge)
         if line is not None and line[2].IsParallel(axis, 1e-12):
             sides.append(edge)
+            side_names.append(named[k])
         else:
             caps.append((k, edge, named[k]))
     prism = _prism(solid, axis, f"edge {position[0]}")
@@ -925,6 +1001,19 @@ def fillet_prism_edges(
     segments, _ = wire_path(BRepTools.OuterWire_s(prism.bottom), frame, spirals=True)
     feet = [BRepAdaptor_Curve(e).Value(BRepAdaptor_Curve(e).FirstParameter()) for e in sides]
     feet += [BRepAdaptor_Curve(e).Value(BRepAdaptor_Curve(e).LastParameter()) for e in sides]
+    for name, edge in zip(side_names, sides):
+        ends = [BRepAdaptor_Curve(edge).Value(BRepAdaptor_Curve(edge).FirstParameter()),
+                BRepAdaptor_Curve(edge).Value(BRepAdaptor_Curve(edge).LastParameter())]  # fmt: skip
+        for i in _corner_vertices(segments, frame, ends, size):
+            before, after = segments[i - 1], segments[i]
+            mismatch = None if _turns(before, after) else g2_mismatch(before, after, JOIN_TOLERANCE, index=i)
+            if mismatch is not None:
+                jump = (float(np.ravel(before.curvature(1.0))[0]), float(np.ravel(after.curvature(0.0))[0]))
+                raise NoSolutionError(
+                    f"g2_fillet rounds corners; {name} is a tangent joint, not a corner: the outline's curvature "
+                    f"jumps from {jump[0]:.6g} to {jump[1]:.6g} there, so its faces meet G1; making tangent joints G2 "
+                    "is a separate feature: leave the edge out of the selection"
+                )
     chosen = [i for i in _corner_vertices(segments, frame, feet, size) if _turns(segments[i - 1], segments[i])]
     rolled = any(chosen_caps.values())
     if chosen and rolled:  # one radius for all: the roll's, the plan corners wide enough to hold it
@@ -948,7 +1037,7 @@ def fillet_prism_edges(
                        transition=transition, shape=shape, tolerance=tolerance, _name="radius")  # fmt: skip
         local, approximation, roll = slab.shape, slab.approximation, slab.roll
     placed = BRepBuilderAPI_Transform(local, _to_global(frame), True).Shape()
-    result = TopoDS.Solid_s(placed) if placed.ShapeType() == TopAbs_SOLID else _first_solid(placed)
+    result = forward_solid(TopoDS.Solid_s(placed) if placed.ShapeType() == TopAbs_SOLID else _first_solid(placed))
     verify_solid(result, "rounded part")
     verify_faces(result, expected_level(segments), "rounded part")
     return Slab(result, approximation, roll, prism.height)
@@ -1059,7 +1148,4 @@ def _extrusion(segments: list[Segment], height: float) -> TopoDS_Shape:
     face = BRepBuilderAPI_MakeFace(chain_wire(segments), True).Face()
     solid = BRepPrimAPI_MakePrism(face, gp_Vec(0.0, 0.0, height)).Shape()
     explorer = TopExp_Explorer(solid, TopAbs_SOLID)
-    result = TopoDS.Solid_s(explorer.Current())
-    if _volume(result) < 0.0:
-        result = TopoDS.Solid_s(result.Reversed())
-    return result
+    return forward_solid(TopoDS.Solid_s(explorer.Current()))
