@@ -60,7 +60,7 @@ from OCP.gp import gp_Ax3, gp_Dir, gp_Pln, gp_Pnt, gp_Trsf, gp_Vec
 from OCP.GProp import GProp_GProps
 from OCP.TColgp import TColgp_Array1OfPnt, TColgp_Array2OfPnt
 from OCP.TColStd import TColStd_Array1OfInteger, TColStd_Array1OfReal, TColStd_Array2OfReal
-from OCP.TopAbs import TopAbs_EDGE, TopAbs_FORWARD, TopAbs_FACE, TopAbs_SHELL, TopAbs_SOLID, TopAbs_WIRE
+from OCP.TopAbs import TopAbs_EDGE, TopAbs_FACE, TopAbs_FORWARD, TopAbs_SHELL, TopAbs_SOLID, TopAbs_WIRE
 from OCP.TopExp import TopExp, TopExp_Explorer
 from OCP.TopLoc import TopLoc_Location
 from OCP.TopoDS import TopoDS, TopoDS_Edge, TopoDS_Face, TopoDS_Shape, TopoDS_Solid
@@ -76,6 +76,7 @@ from ..core.shapes import DEFAULT_SHAPE
 from ..core.spiral import BezierSpiral
 from ..core.units import DEFAULT_UNITS, length_unit
 from ..design.fillets import TANGENT_TOL, continuous_rectangle, corner_distance, fillet_path
+from .advice import advice, refusal
 from .fillet import wire_path
 from .occ import chain_wire
 
@@ -542,27 +543,6 @@ def _roll_problem(segments: list[Segment], height: float, edge_radius: Any, give
     return _fit_problem(segments, _inward(segments), min(max(d_top, d_bottom), height), edge_radius, name)
 
 
-def _largest(fits: Callable[[float], bool], upper: float) -> float | None:
-    """The largest value in (0, upper) for which ``fits`` holds (bisection; it must hold below it), rounded
-    down to 6 significant digits and checked itself, or None."""
-    low, high = 0.0, upper
-    for _ in range(60):
-        mid = 0.5 * (low + high)
-        low, high = (mid, high) if fits(mid) else (low, mid)
-    if not low > 0.0:
-        return None
-    step = 10.0 ** (math.floor(math.log10(low)) - 5)
-    for k in range(3):  # rounding down may still land on a value that fails: a step further
-        value = float(f"{(math.floor(low / step) - k) * step:.6g}")
-        if value > 0.0 and fits(value):
-            return value
-    return None
-
-
-def _refusal(problem: str, name: str, fits: float | None) -> NoSolutionError:
-    return NoSolutionError(f"{problem}; {name} up to {fits:.6g} fits" if fits is not None else f"{problem}; no {name} fits")
-
-
 # ------------------------------------------------------------------ the solid
 
 
@@ -643,6 +623,7 @@ def continuous_box(
     bottom: bool = True,
     tolerance: float | None = None,
     units: str = DEFAULT_UNITS,
+    _advise: bool = True,
 ) -> Slab:
     """A box with every edge and corner G2: ``g2_slab`` of a ``continuous_rectangle`` (centred on the origin,
     z from 0 to ``height``). ``edge_radius`` None: the roll half as wide as the smaller of ``radius`` and
@@ -650,12 +631,38 @@ def continuous_box(
     for value, name in ((length, "length"), (width, "width"), (height, "height")):
         if not as_float(value, name) > 0.0:
             raise ValueError(f"{name} must be positive; got {shown(value)}")
-    plan = continuous_rectangle(length, width, radius, transition, units=units, shape=shape)
+    try:
+        plan = continuous_rectangle(length, width, radius, transition, units=units, shape=shape)
+    except NoSolutionError as error:
+        if not _advise:
+            raise
+        options: dict[str, Any] = dict(transition=transition, shape=shape, profile=profile, top=top, bottom=bottom,
+                                       tolerance=tolerance, units=units)  # fmt: skip
+        fits = advice(
+            lambda r: _plan_fits(length, width, height, r, edge_radius, **options),
+            lambda r: continuous_box(length, width, height, r, edge_radius, **options, _advise=False),
+            as_float(radius, "radius"),
+        )
+        raise refusal(f"{error} (the plan corners)", "radius", fits) from None
     if edge_radius is None:  # the roll's extent is proportional to its radius
         unit = float(roll_profile(1.0, profile=profile, transition=transition, shape=shape)[-1].end[0])
         edge_radius = 0.5 * min(as_float(radius, "radius"), as_float(height, "height") / 2.0) / unit
     return g2_slab(plan, height, edge_radius, top=top, bottom=bottom, profile=profile, transition=transition,
-                   shape=shape, tolerance=tolerance, units=units)  # fmt: skip
+                   shape=shape, tolerance=tolerance, units=units, _advise=_advise)  # fmt: skip
+
+
+def _plan_fits(length: float, width: float, height: float, radius: float, edge_radius: float | None, *,
+               transition: float, shape: str, profile: str, top: bool, bottom: bool, **_: Any) -> bool:  # fmt: skip
+    """Whether ``continuous_box`` of these numbers passes its fit checks (plan corners, then rolls)."""
+    try:
+        plan = continuous_rectangle(length, width, radius, transition, shape=shape)
+    except NoSolutionError:
+        return False
+    if edge_radius is None:
+        unit = float(roll_profile(1.0, profile=profile, transition=transition, shape=shape)[-1].end[0])
+        edge_radius = 0.5 * min(radius, height / 2.0) / unit
+    options = dict(top=top, bottom=bottom, profile=profile, transition=transition, shape=shape)
+    return _roll_problem(outline_segments(plan), height, edge_radius, height, "edge_radius", **options) is None
 
 
 def expected_level(segments: Sequence[Segment], profile: str = "g2") -> str:
@@ -699,6 +706,7 @@ def g2_slab(
     tolerance: float | None = None,
     units: str = DEFAULT_UNITS,
     _name: str = "edge_radius",
+    _advise: bool = True,
 ) -> Slab:
     """A closed planar outline extruded by ``height`` with its top and bottom edges rolled (see the module docstring).
 
@@ -737,8 +745,31 @@ def g2_slab(
     radius = as_float(edge_radius, "edge_radius")
     problem = _roll_problem(segments, height, edge_radius, given_height, _name, **options)
     if problem is not None:
-        fits = _largest(lambda r: _roll_problem(segments, height, r, given_height, _name, **options) is None, radius)
-        raise _refusal(problem, _name, fits)
+        if not _advise:
+            raise NoSolutionError(problem)
+        raise refusal(problem, _name, _slabadvice(segments, height, radius, given_height, _name, options, tolerance, units))
+    try:
+        return _built_slab(segments, height, edge_radius, options, tolerance, units)
+    except NoSolutionError as error:  # fits, yet does not build: nearly singular (rolls meeting, an offset folding)
+        if not _advise:
+            raise
+        raise refusal(str(error), _name, _slabadvice(segments, height, radius, given_height, _name, options, tolerance, units)) from None
+
+
+def _slabadvice(segments: list[Segment], height: float, radius: float, given_height: Any, name: str,
+                 options: dict[str, Any], tolerance: float | None, units: str) -> float | None:  # fmt: skip
+    """The largest roll radius below ``radius`` a refusal may name: it fits with a margin and builds."""
+    return advice(
+        lambda r: _roll_problem(segments, height, r, given_height, name, **options) is None,
+        lambda r: g2_slab(segments, height, r, **options, tolerance=tolerance, units=units, _advise=False),
+        radius,
+    )
+
+
+def _built_slab(segments: list[Segment], height: float, edge_radius: float, options: dict[str, Any],
+                tolerance: float | None, units: str) -> Slab:  # fmt: skip
+    """The slab of rolls that fit, verified (``g2_slab`` after its fit checks)."""
+    top, bottom, profile, transition, shape = (options[k] for k in ("top", "bottom", "profile", "transition", "shape"))
     roll = roll_profile(edge_radius, profile=profile, transition=transition, shape=shape)
     reach = float(roll[-1].end[0])
     d_top, d_bottom = (reach if top else 0.0), (reach if bottom else 0.0)
@@ -837,7 +868,10 @@ def _prism(solid: TopoDS_Shape, direction: gp_Dir, edge_name: str) -> _Prism:
         lean = _lean(face, direction)
         if lean > _SIDE_TOL:
             surface = BRepAdaptor_Surface(face)
-            u, v = 0.5 * (surface.FirstUParameter() + surface.LastUParameter()), 0.5 * (surface.FirstVParameter() + surface.LastVParameter())
+            u, v = (
+                0.5 * (surface.FirstUParameter() + surface.LastUParameter()),
+                0.5 * (surface.FirstVParameter() + surface.LastVParameter()),
+            )
             raise NoSolutionError(
                 f"g2_fillet rounds solid edges of right prisms (side faces perpendicular to the caps); {edge_name}: "
                 f"side face {index} near {_where(surface.Value(u, v))} leans {math.degrees(lean):.6g}° from the caps' "
@@ -904,6 +938,7 @@ def fillet_prism_edges(
     same_sense: str = "nested",
     shape: str = DEFAULT_SHAPE,
     tolerance: float | None = None,
+    _advise: bool = True,
 ) -> Slab:
     """Round straight edges of a right prism with G2 fillets, exactly.
 
@@ -1016,10 +1051,24 @@ def fillet_prism_edges(
                 )
     chosen = [i for i in _corner_vertices(segments, frame, feet, size) if _turns(segments[i - 1], segments[i])]
     rolled = any(chosen_caps.values())
+    options: dict[str, Any] = dict(transition=transition, same_sense=same_sense, shape=shape, tolerance=tolerance)
+
+    def builds(r: float) -> Slab:  # the same edges rounded with ``r``: what a refusal may suggest
+        return fillet_prism_edges(solid, edges, r, **options, _advise=False)
+
+    outline = segments
     if chosen and rolled:  # one radius for all: the roll's, the plan corners wide enough to hold it
-        segments = _rolled_plan(segments, chosen, prism.height, radius, chosen_caps, transition, same_sense, shape)
+        segments = _rolled_plan(outline, chosen, prism.height, radius, chosen_caps, transition, same_sense, shape,
+                                builds if _advise else None)  # fmt: skip
     elif chosen:
-        path = fillet_path(segments, radius, transition=transition, vertices=chosen, closed=True, same_sense=same_sense, shape=shape)
+        plan_options = dict(transition=transition, vertices=chosen, closed=True, same_sense=same_sense, shape=shape)
+        try:
+            path = fillet_path(segments, radius, **plan_options)  # type: ignore[arg-type]
+        except NoSolutionError as error:
+            if not _advise:
+                raise
+            fits = advice(lambda r: _succeeds(lambda: fillet_path(segments, r, **plan_options)), builds, as_float(radius, "radius"))  # type: ignore[arg-type]
+            raise refusal(str(error), "radius", fits) from None
         segments = list(path.segments)
     if not rolled:
         local = _extrusion(segments, prism.height)
@@ -1033,8 +1082,17 @@ def fillet_prism_edges(
                     f"g2_fillet rolls the cap edges along a smooth outline; the side edge at {_where(corner)} is sharp "
                     "and not chosen (choose it too: a vertex blend of sharp and rounded edges is a later step)"
                 )
-        slab = g2_slab(segments, prism.height, radius, top=chosen_caps["top"], bottom=chosen_caps["bottom"],
-                       transition=transition, shape=shape, tolerance=tolerance, _name="radius")  # fmt: skip
+        try:  # with chosen side edges the plan changes with the radius: a suggestion is built from the start
+            slab = g2_slab(segments, prism.height, radius, top=chosen_caps["top"], bottom=chosen_caps["bottom"],
+                           transition=transition, shape=shape, tolerance=tolerance, _name="radius",
+                           _advise=_advise and not chosen)  # fmt: skip
+        except NoSolutionError as error:
+            if not (_advise and chosen):
+                raise
+            plan_fits = lambda r: _succeeds(  # noqa: E731
+                lambda: _rolled_plan(outline, chosen, prism.height, r, chosen_caps, transition, same_sense, shape, None)
+            )
+            raise refusal(str(error), "radius", advice(plan_fits, builds, as_float(radius, "radius"))) from None
         local, approximation, roll = slab.shape, slab.approximation, slab.roll
     placed = BRepBuilderAPI_Transform(local, _to_global(frame), True).Shape()
     result = forward_solid(TopoDS.Solid_s(placed) if placed.ShapeType() == TopAbs_SOLID else _first_solid(placed))
@@ -1063,8 +1121,18 @@ def plan_radius(radius: float, *, transition: float = 0.5, shape: str = DEFAULT_
     return PLAN_OVER_REACH * float(roll_profile(radius, transition=transition, shape=shape)[-1].end[0])
 
 
+def _succeeds(make: Callable[[], object]) -> bool:
+    """Whether ``make()`` returns rather than refusing (NoSolutionError)."""
+    try:
+        make()
+    except NoSolutionError:
+        return False
+    return True
+
+
 def _rolled_plan(segments: list[Segment], chosen: list[int], height: float, radius: float, caps: dict[str, bool],
-                 transition: float, same_sense: str, shape: str) -> list[Segment]:  # fmt: skip
+                 transition: float, same_sense: str, shape: str,
+                 builds: Callable[[float], object] | None) -> list[Segment]:  # fmt: skip
     """The cap outline with the chosen corners rounded by ``plan_radius(radius)``, or NoSolutionError naming
     what does not fit and the largest radius that does (side corners, rolls and height together)."""
     options = dict(top=caps["top"], bottom=caps["bottom"], profile="g2", transition=transition, shape=shape)
@@ -1082,8 +1150,10 @@ def _rolled_plan(segments: list[Segment], chosen: list[int], height: float, radi
     plan, problem = attempt(radius)
     if problem is None and plan is not None:
         return plan
-    fits = _largest(lambda r: attempt(r)[1] is None, radius)
-    raise _refusal(
+    if builds is None:
+        raise NoSolutionError(str(problem))
+    fits = advice(lambda r: attempt(r)[1] is None, builds, radius)
+    raise refusal(
         f"{problem} (side and cap edges chosen together: the side edges get the plan radius {PLAN_OVER_REACH:g} × the roll's reach)",
         "radius",
         fits,
