@@ -207,7 +207,7 @@ def fillet_wire(
         again = dict(transition=transition, same_sense=same_sense, shape=shape, frame=frame, _advise=False)
         fits = advice(
             lambda r: _fillets(segments, r, options),
-            lambda r: fillet_wire(wire, r, vertices, **again),  # type: ignore[arg-type]
+            lambda r: fillet_wire(wire, r, vertices, **again),
             as_float(radius, "radius"),
         )
         raise refusal(str(error), "radius", fits) from None
@@ -281,7 +281,7 @@ def fillet_face(
     wires = [outer] + [w for w in _wires(face) if not w.IsSame(outer)]
     options = dict(transition=transition, same_sense=same_sense, shape=shape, frame=frame, _advise=False)
     try:
-        rounded = [fillet_wire(w, radius, points, **options)[0] for w in wires]  # type: ignore[arg-type]
+        rounded = [fillet_wire(w, radius, points, **options)[0] for w in wires]
     except NoSolutionError as error:
         if not _advise or "fits" in str(error):
             raise
