@@ -50,7 +50,6 @@ from OCP.BRepBuilderAPI import (
 from OCP.BRepCheck import BRepCheck_Analyzer
 from OCP.BRepExtrema import BRepExtrema_DistShapeShape
 from OCP.BRepGProp import BRepGProp
-from OCP.BRepLib import BRepLib
 from OCP.BRepPrimAPI import BRepPrimAPI_MakePrism
 from OCP.BRepTools import BRepTools
 from OCP.Geom import Geom_BSplineCurve, Geom_BSplineSurface
@@ -546,7 +545,8 @@ def _roll_problem(segments: list[Segment], height: float, edge_radius: Any, give
 # ------------------------------------------------------------------ the solid
 
 
-def _solid(faces: list[TopoDS_Face], tolerance: float) -> TopoDS_Solid:
+def _solid(faces: list[TopoDS_Face], tolerance: float) -> tuple[TopoDS_Solid, float]:
+    """The faces sewn into one closed shell and made a FORWARD solid facing out, with its volume."""
     sewing = BRepBuilderAPI_Sewing(tolerance)
     for face in faces:
         sewing.Add(face)
@@ -562,36 +562,31 @@ def _solid(faces: list[TopoDS_Face], tolerance: float) -> TopoDS_Solid:
     if count != 1 or shell is None or not BRep_Tool.IsClosed_s(shell):
         raise NoSolutionError(f"the slab's {len(faces)} faces did not sew into one closed shell ({count} shell(s))")
     solid = BRepBuilderAPI_MakeSolid(shell).Solid()
-    BRepLib.OrientClosedSolid_s(solid)
-    return forward_solid(solid)
+    volume = _volume(solid)
+    if volume < 0.0:  # the shell faces in: the solid of the turned shell (a fresh solid is FORWARD)
+        solid, volume = BRepBuilderAPI_MakeSolid(TopoDS.Shell_s(shell.Reversed())).Solid(), -volume
+    return solid, volume
 
 
 def forward_solid(solid: TopoDS_Shape) -> TopoDS_Solid:
-    """The solid FORWARD with its shells facing out: the same volume, usable in booleans.
+    """The solid FORWARD: the same volume, usable in booleans.
 
-    ``BRepLib.OrientClosedSolid`` (and ``Reversed``) may leave a solid REVERSED with a
-    positive volume; a fuse of a compound holding such a solid drops it. The solid is
-    made again from its shells as they face (orientations composed down from the solid)."""
-    if solid.Orientation() == TopAbs_FORWARD and _volume(solid) > 0.0:
+    ``BRepLib.OrientClosedSolid`` and ``Reversed`` may leave a solid REVERSED with a positive
+    volume; a fuse of a compound holding such a solid drops it (CadQuery's ``combine``). The
+    solid is made again from its shells as they face (orientations composed down from it)."""
+    if solid.Orientation() == TopAbs_FORWARD:
         return TopoDS.Solid_s(solid)
     maker = BRepBuilderAPI_MakeSolid()
     shells = TopExp_Explorer(solid, TopAbs_SHELL)
     while shells.More():
         maker.Add(TopoDS.Shell_s(shells.Current()))
         shells.Next()
-    rebuilt = maker.Solid()
-    if _volume(rebuilt) < 0.0:  # inside out: every shell turned
-        maker = BRepBuilderAPI_MakeSolid()
-        shells = TopExp_Explorer(rebuilt, TopAbs_SHELL)
-        while shells.More():
-            maker.Add(TopoDS.Shell_s(shells.Current().Reversed()))
-            shells.Next()
-        rebuilt = maker.Solid()
-    return rebuilt
+    return maker.Solid()
 
 
-def verify_solid(shape: TopoDS_Shape, what: str = "slab") -> None:
-    """ValueError unless ``shape`` is one valid, closed solid with positive volume (``BRepCheck_Analyzer``)."""
+def verify_solid(shape: TopoDS_Shape, what: str = "slab", volume: float | None = None) -> None:
+    """NoSolutionError unless ``shape`` is one valid, closed, FORWARD solid with positive volume
+    (``BRepCheck_Analyzer``; ``volume``: the shape's, when the caller measured it already)."""
     solids = TopExp_Explorer(shape, TopAbs_SOLID)
     count = 0
     while solids.More():
@@ -603,10 +598,9 @@ def verify_solid(shape: TopoDS_Shape, what: str = "slab") -> None:
         raise NoSolutionError(f"the {what} is a {_first_solid(shape).Orientation().name} solid, not FORWARD (booleans drop it)")
     if not BRepCheck_Analyzer(shape).IsValid():
         raise NoSolutionError(f"the {what} is not a valid solid (BRepCheck_Analyzer)")
-    props = GProp_GProps()
-    BRepGProp.VolumeProperties_s(shape, props)
-    if not props.Mass() > 0.0:
-        raise NoSolutionError(f"the {what} encloses no volume ({props.Mass():.3g})")
+    volume = _volume(shape) if volume is None else volume
+    if not volume > 0.0:
+        raise NoSolutionError(f"the {what} encloses no volume ({volume:.3g})")
 
 
 def continuous_box(
@@ -790,8 +784,8 @@ def _built_slab(segments: list[Segment], height: float, edge_radius: float, opti
         _record(face, reach_max * alongs[k // len(sections)].deviation)
     faces.append(_cap(alongs, d_top, height))
     faces.append(_cap(alongs, d_bottom, 0.0))
-    solid = _solid(faces, 1e-7 * size)
-    verify_solid(solid)
+    solid, volume = _solid(faces, 1e-7 * size)
+    verify_solid(solid, volume=volume)
     verify_faces(solid, expected_level(segments, profile), units=units)
     approximation = reach_max * max(a.deviation for a in alongs)
     return Slab(solid, approximation, (d_top, d_bottom), height, units)
@@ -1218,4 +1212,5 @@ def _extrusion(segments: list[Segment], height: float) -> TopoDS_Shape:
     face = BRepBuilderAPI_MakeFace(chain_wire(segments), True).Face()
     solid = BRepPrimAPI_MakePrism(face, gp_Vec(0.0, 0.0, height)).Shape()
     explorer = TopExp_Explorer(solid, TopAbs_SOLID)
-    return forward_solid(TopoDS.Solid_s(explorer.Current()))
+    result = TopoDS.Solid_s(explorer.Current())
+    return forward_solid(TopoDS.Solid_s(result.Reversed()) if _volume(result) < 0.0 else result)
