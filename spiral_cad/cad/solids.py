@@ -345,20 +345,24 @@ def _sections(roll: list[Segment], top: float, bottom: float, height: float) -> 
     return sections
 
 
-def _surface_face(along: _Along, section: _Section, degenerate: float) -> TopoDS_Face:
+def _surface_face(along: _Along, section: _Section, degenerate: float) -> tuple[TopoDS_Face, bytes]:
+    """The face of the patch and its ``_fingerprint`` (from the same numbers OCCT is given)."""
     rows, cols = len(along.a), len(section.points)
+    w, z = section.points[:, 0], section.points[:, 1]
+    xy = along.a[:, None, :] + w[None, :, None] * along.b[:, None, :]
+    grid = np.concatenate([xy, np.broadcast_to(z[None, :, None], (rows, cols, 1))], axis=2).astype(float)
+    products = along.weights[:, None] * section.weights[None, :]
     poles, weights = TColgp_Array2OfPnt(1, rows, 1, cols), TColStd_Array2OfReal(1, rows, 1, cols)
     for i in range(rows):
         for j in range(cols):
-            w, z = section.points[j]
-            x, y = along.a[i] + w * along.b[i]
-            poles.SetValue(i + 1, j + 1, gp_Pnt(float(x), float(y), float(z)))
-            weights.SetValue(i + 1, j + 1, float(along.weights[i] * section.weights[j]))
+            poles.SetValue(i + 1, j + 1, gp_Pnt(*(float(c) for c in grid[i, j])))
+            weights.SetValue(i + 1, j + 1, float(products[i, j]))
     surface = Geom_BSplineSurface(
         poles, weights, _reals(along.knots), _reals(section.knots), _ints(along.mults), _ints(section.mults),
         along.degree, section.degree,
     )  # fmt: skip
-    return BRepBuilderAPI_MakeFace(surface, degenerate).Face()
+    key = _fingerprint_of((along.degree, section.degree), grid, products, [*along.knots, *section.knots])
+    return BRepBuilderAPI_MakeFace(surface, degenerate).Face(), key
 
 
 def _boundary_edge(along: _Along, w: float, z: float):
@@ -395,19 +399,24 @@ def _fingerprint(face: TopoDS_Face) -> bytes | None:
         return None
     rows, cols = surface.NbUPoles(), surface.NbVPoles()
     poles = np.array([[surface.Pole(i, j).Coord() for j in range(1, cols + 1)] for i in range(1, rows + 1)])
-    poles = poles.reshape(-1, 3)
-    distances = np.concatenate([np.linalg.norm(poles - poles[0], axis=1), np.linalg.norm(poles - poles[-1], axis=1)])
-    scale = float(distances.max()) or 1.0
     weights = [surface.Weight(i, j) for i in range(1, rows + 1) for j in range(1, cols + 1)]
     knots = [surface.UKnot(k) for k in range(1, surface.NbUKnots() + 1)] + [surface.VKnot(k) for k in range(1, surface.NbVKnots() + 1)]
-    numbers = np.concatenate([[surface.UDegree(), surface.VDegree(), rows, cols], knots, weights, distances / scale])
+    return _fingerprint_of((surface.UDegree(), surface.VDegree()), poles, np.asarray(weights), knots)
+
+
+def _fingerprint_of(degrees: tuple[int, int], poles: NDArray[np.float64], weights: NDArray[np.float64],
+                    knots: Sequence[float]) -> bytes:  # fmt: skip
+    """``_fingerprint`` of a surface given by its numbers: poles (rows, cols, 3), weights in row order, the
+    u then v knots (distinct values)."""
+    rows, cols = poles.shape[:2]
+    flat = poles.reshape(-1, 3)
+    distances = np.concatenate([np.linalg.norm(flat - flat[0], axis=1), np.linalg.norm(flat - flat[-1], axis=1)])
+    scale = float(distances.max()) or 1.0
+    numbers = np.concatenate([[degrees[0], degrees[1], rows, cols], knots, np.ravel(weights), distances / scale])
     return np.round(numbers, 9).tobytes() + np.float64(f"{scale:.9g}").tobytes()
 
 
-def _record(face: TopoDS_Face, deviation: float) -> None:
-    key = _fingerprint(face)
-    if key is None:
-        return
+def _record(key: bytes, deviation: float) -> None:
     _RECORDED[key] = max(deviation, _RECORDED.pop(key, 0.0))
     while len(_RECORDED) > _RECORD_LIMIT:
         del _RECORDED[next(iter(_RECORDED))]
@@ -779,9 +788,10 @@ def _built_slab(segments: list[Segment], height: float, edge_radius: float, opti
     alongs = [span for s in segments for span in _along_spans(_along(s, sigma, reach_max, tol))]
     sections = _sections(roll, d_top, d_bottom, height)
     degenerate = 1e-9 * size
-    faces = [_surface_face(a, sec, degenerate) for a in alongs for sec in sections]
-    for k, face in enumerate(faces):  # so export_step finds the note on parts built from this solid
-        _record(face, reach_max * alongs[k // len(sections)].deviation)
+    made = [_surface_face(a, sec, degenerate) for a in alongs for sec in sections]
+    faces = [face for face, _ in made]
+    for k, (_, key) in enumerate(made):  # so export_step finds the note on parts built from this solid
+        _record(key, reach_max * alongs[k // len(sections)].deviation)
     faces.append(_cap(alongs, d_top, height))
     faces.append(_cap(alongs, d_bottom, 0.0))
     solid, volume = _solid(faces, 1e-7 * size)
