@@ -59,7 +59,7 @@ from OCP.gp import gp_Ax3, gp_Dir, gp_Pln, gp_Pnt, gp_Trsf, gp_Vec
 from OCP.GProp import GProp_GProps
 from OCP.TColgp import TColgp_Array1OfPnt, TColgp_Array2OfPnt
 from OCP.TColStd import TColStd_Array1OfInteger, TColStd_Array1OfReal, TColStd_Array2OfReal
-from OCP.TopAbs import TopAbs_EDGE, TopAbs_FACE, TopAbs_FORWARD, TopAbs_SHELL, TopAbs_SOLID, TopAbs_WIRE
+from OCP.TopAbs import TopAbs_EDGE, TopAbs_FACE, TopAbs_FORWARD, TopAbs_REVERSED, TopAbs_SHELL, TopAbs_SOLID, TopAbs_WIRE
 from OCP.TopExp import TopExp, TopExp_Explorer
 from OCP.TopLoc import TopLoc_Location
 from OCP.TopoDS import TopoDS, TopoDS_Edge, TopoDS_Face, TopoDS_Shape, TopoDS_Solid
@@ -554,8 +554,9 @@ def _roll_problem(segments: list[Segment], height: float, edge_radius: Any, give
 # ------------------------------------------------------------------ the solid
 
 
-def _solid(faces: list[TopoDS_Face], tolerance: float) -> tuple[TopoDS_Solid, float]:
-    """The faces sewn into one closed shell and made a FORWARD solid facing out, with its volume."""
+def _solid(faces: list[TopoDS_Face], tolerance: float, top: TopoDS_Face) -> TopoDS_Solid:
+    """The faces sewn into one closed shell and made a FORWARD solid facing out: the shell faces out
+    when the top cap (``top``, a plane z = height) does, as the construction knows (no volume needed)."""
     sewing = BRepBuilderAPI_Sewing(tolerance)
     for face in faces:
         sewing.Add(face)
@@ -570,11 +571,14 @@ def _solid(faces: list[TopoDS_Face], tolerance: float) -> tuple[TopoDS_Solid, fl
         shells.Next()
     if count != 1 or shell is None or not BRep_Tool.IsClosed_s(shell):
         raise NoSolutionError(f"the slab's {len(faces)} faces did not sew into one closed shell ({count} shell(s))")
-    solid = BRepBuilderAPI_MakeSolid(shell).Solid()
-    volume = _volume(solid)
-    if volume < 0.0:  # the shell faces in: the solid of the turned shell (a fresh solid is FORWARD)
-        solid, volume = BRepBuilderAPI_MakeSolid(TopoDS.Shell_s(shell.Reversed())).Solid(), -volume
-    return solid, volume
+    sewn_top = sewing.Modified(top)
+    cap = next((f for f in _faces_of(shell) if f.IsSame(sewn_top)), None)
+    if cap is None or (plane := _plane(cap)) is None:
+        raise NoSolutionError("the slab's top cap is not a plane of the sewn shell")
+    up = plane.Axis().Direction().Z() * (-1.0 if cap.Orientation() == TopAbs_REVERSED else 1.0)
+    if up < 0.0:  # the shell faces in: the solid of the turned shell (a fresh solid is FORWARD)
+        shell = TopoDS.Shell_s(shell.Reversed())
+    return BRepBuilderAPI_MakeSolid(shell).Solid()
 
 
 def forward_solid(solid: TopoDS_Shape) -> TopoDS_Solid:
@@ -593,9 +597,10 @@ def forward_solid(solid: TopoDS_Shape) -> TopoDS_Solid:
     return maker.Solid()
 
 
-def verify_solid(shape: TopoDS_Shape, what: str = "slab", volume: float | None = None) -> None:
+def verify_solid(shape: TopoDS_Shape, what: str = "slab", facing_out: bool = False) -> None:
     """NoSolutionError unless ``shape`` is one valid, closed, FORWARD solid with positive volume
-    (``BRepCheck_Analyzer``; ``volume``: the shape's, when the caller measured it already)."""
+    (``BRepCheck_Analyzer``, which also finds a shell whose faces do not all face the same way;
+    ``facing_out``: the caller knows the shell faces out, so its volume is positive, unmeasured)."""
     solids = TopExp_Explorer(shape, TopAbs_SOLID)
     count = 0
     while solids.More():
@@ -607,7 +612,7 @@ def verify_solid(shape: TopoDS_Shape, what: str = "slab", volume: float | None =
         raise NoSolutionError(f"the {what} is a {_first_solid(shape).Orientation().name} solid, not FORWARD (booleans drop it)")
     if not BRepCheck_Analyzer(shape).IsValid():
         raise NoSolutionError(f"the {what} is not a valid solid (BRepCheck_Analyzer)")
-    volume = _volume(shape) if volume is None else volume
+    volume = 1.0 if facing_out else _volume(shape)
     if not volume > 0.0:
         raise NoSolutionError(f"the {what} encloses no volume ({volume:.3g})")
 
@@ -792,10 +797,10 @@ def _built_slab(segments: list[Segment], height: float, edge_radius: float, opti
     faces = [face for face, _ in made]
     for k, (_, key) in enumerate(made):  # so export_step finds the note on parts built from this solid
         _record(key, reach_max * alongs[k // len(sections)].deviation)
-    faces.append(_cap(alongs, d_top, height))
-    faces.append(_cap(alongs, d_bottom, 0.0))
-    solid, volume = _solid(faces, 1e-7 * size)
-    verify_solid(solid, volume=volume)
+    top_cap = _cap(alongs, d_top, height)
+    faces += [top_cap, _cap(alongs, d_bottom, 0.0)]
+    solid = _solid(faces, 1e-7 * size, top_cap)
+    verify_solid(solid, facing_out=True)
     verify_faces(solid, expected_level(segments, profile), units=units)
     approximation = reach_max * max(a.deviation for a in alongs)
     return Slab(solid, approximation, (d_top, d_bottom), height, units)
