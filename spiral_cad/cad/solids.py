@@ -884,7 +884,7 @@ def _prism(solid: TopoDS_Shape, direction: gp_Dir, edge_name: str) -> _Prism:
             raise NoSolutionError(
                 f"g2_fillet rounds solid edges of right prisms (side faces perpendicular to the caps); {edge_name}: "
                 f"side face {index} near {_where(surface.Value(u, v))} leans {math.degrees(lean):.6g}° from the caps' "
-                "normal: the part is an oblique prism, which g2_fillet does not round"
+                "normal: the part is no right prism (an oblique prism, a taper), which g2_fillet does not round"
             )
     origins = [_plane(f).Location() for f in caps]  # type: ignore[union-attr]
     offsets = [gp_Vec(direction).Dot(gp_Vec(o.XYZ())) for o in origins]
@@ -1005,7 +1005,7 @@ def fillet_prism_edges(
         try:
             ranked.append((_fit(solid, edges, candidate, named), candidate))
         except NoSolutionError as error:
-            leaning += [error] if "oblique prism" in str(error) else []
+            leaning += [error] if " leans " in str(error) else []
     if not ranked and leaning:
         raise leaning[0]
     if not ranked:
