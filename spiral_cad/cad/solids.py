@@ -644,14 +644,9 @@ def continuous_box(
     except NoSolutionError as error:
         if not _advise:
             raise
-        options: dict[str, Any] = dict(transition=transition, shape=shape, profile=profile, top=top, bottom=bottom,
-                                       tolerance=tolerance, units=units)  # fmt: skip
-        fits = advice(
-            lambda r: _plan_fits(length, width, height, r, edge_radius, **options),
-            lambda r: continuous_box(length, width, height, r, edge_radius, **options, _advise=False),
-            as_float(radius, "radius"),
-        )
-        raise refusal(f"{error} (the plan corners)", "radius", fits) from None
+        raise _plan_refusal(error, length, width, height, as_float(radius, "radius"), edge_radius,
+                            dict(transition=transition, shape=shape, profile=profile, top=top, bottom=bottom),
+                            tolerance, units) from None  # fmt: skip
     if edge_radius is None:  # the roll's extent is proportional to its radius
         unit = float(roll_profile(1.0, profile=profile, transition=transition, shape=shape)[-1].end[0])
         edge_radius = 0.5 * min(as_float(radius, "radius"), as_float(height, "height") / 2.0) / unit
@@ -659,18 +654,40 @@ def continuous_box(
                    shape=shape, tolerance=tolerance, units=units, _advise=_advise)  # fmt: skip
 
 
-def _plan_fits(length: float, width: float, height: float, radius: float, edge_radius: float | None, *,
-               transition: float, shape: str, profile: str, top: bool, bottom: bool, **_: Any) -> bool:  # fmt: skip
-    """Whether ``continuous_box`` of these numbers passes its fit checks (plan corners, then rolls)."""
-    try:
-        plan = continuous_rectangle(length, width, radius, transition, shape=shape)
-    except NoSolutionError:
-        return False
-    if edge_radius is None:
-        unit = float(roll_profile(1.0, profile=profile, transition=transition, shape=shape)[-1].end[0])
-        edge_radius = 0.5 * min(radius, height / 2.0) / unit
-    options = dict(top=top, bottom=bottom, profile=profile, transition=transition, shape=shape)
-    return _roll_problem(outline_segments(plan), height, edge_radius, height, "edge_radius", **options) is None
+def _plan_refusal(error: NoSolutionError, length: float, width: float, height: float, radius: float,
+                  edge_radius: float | None, options: dict[str, Any], tolerance: float | None,
+                  units: str) -> NoSolutionError:  # fmt: skip
+    """The refusal of plan corners too large for the box, with the largest ``radius`` that fits and builds
+    (with the given ``edge_radius``); when that roll fits no plan radius that fits, the largest plan radius
+    and the largest roll it holds, built together."""
+    transition, shape = options["transition"], options["shape"]
+
+    def plan_fits(r: float) -> bool:  # shrinking corners only ever fit better
+        try:
+            continuous_rectangle(length, width, r, transition, shape=shape)
+        except NoSolutionError:
+            return False
+        return True
+
+    def box(r: float) -> Slab:
+        return continuous_box(length, width, height, r, edge_radius, **options, tolerance=tolerance, units=units,
+                              _advise=False)  # fmt: skip
+
+    problem = f"{error} (the plan corners)"
+    fits = advice(plan_fits, box, radius)
+    if fits is not None or edge_radius is None:
+        return refusal(problem, "radius", fits)
+    corner = advice(plan_fits, lambda r: continuous_rectangle(length, width, r, transition, shape=shape), radius)
+    problem += f"; no radius fits with edge_radius {shown(edge_radius)}"
+    if corner is None:
+        return refusal(problem, "radius", None)
+    plan = outline_segments(continuous_rectangle(length, width, corner, transition, shape=shape))
+    slab_options = dict(options, profile=options["profile"])
+    roll = _slab_advice(plan, height, as_float(edge_radius, "edge_radius"), height, "edge_radius", slab_options,
+                        tolerance, units)  # fmt: skip
+    if roll is None:
+        return refusal(problem, "radius", None)
+    return NoSolutionError(f"{problem}; with radius {corner:.6g}, edge_radius up to {roll:.6g} fits")
 
 
 def expected_level(segments: Sequence[Segment], profile: str = "g2") -> str:
@@ -755,16 +772,16 @@ def g2_slab(
     if problem is not None:
         if not _advise:
             raise NoSolutionError(problem)
-        raise refusal(problem, _name, _slabadvice(segments, height, radius, given_height, _name, options, tolerance, units))
+        raise refusal(problem, _name, _slab_advice(segments, height, radius, given_height, _name, options, tolerance, units))
     try:
         return _built_slab(segments, height, edge_radius, options, tolerance, units)
     except NoSolutionError as error:  # fits, yet does not build: nearly singular (rolls meeting, an offset folding)
         if not _advise:
             raise
-        raise refusal(str(error), _name, _slabadvice(segments, height, radius, given_height, _name, options, tolerance, units)) from None
+        raise refusal(str(error), _name, _slab_advice(segments, height, radius, given_height, _name, options, tolerance, units)) from None
 
 
-def _slabadvice(segments: list[Segment], height: float, radius: float, given_height: Any, name: str,
+def _slab_advice(segments: list[Segment], height: float, radius: float, given_height: Any, name: str,
                  options: dict[str, Any], tolerance: float | None, units: str) -> float | None:  # fmt: skip
     """The largest roll radius below ``radius`` a refusal may name: it fits with a margin and builds."""
     return advice(

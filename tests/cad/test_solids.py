@@ -398,7 +398,10 @@ def test_property_continuous_boxes_are_g2_solids_or_named_refusals(length, width
     except NoSolutionError as error:
         assert any(word in str(error) for word in ("edge_radius", "corner")), str(error)
         assert "fits" in str(error), str(error)  # every refusal names a value, or says none fits
-        if "edge_radius up to" in str(error):  # the value it names builds
+        both = re.search(r"with radius ([0-9.e+-]+), edge_radius up to ([0-9.e+-]+) fits$", str(error))
+        if both:  # the roll fits no plan radius that fits: a plan radius and the roll it holds
+            assert ContinuousBox(length, width, height, float(both[1]), edge_radius=float(both[2])).is_valid
+        elif "edge_radius up to" in str(error):  # the value it names builds
             assert ContinuousBox(length, width, height, radius, edge_radius=_fits(str(error))).is_valid
         elif "radius up to" in str(error):
             assert ContinuousBox(length, width, height, _fits(str(error)), edge_radius=edge).is_valid
@@ -770,6 +773,21 @@ def test_every_suggested_value_of_a_refusal_was_built_and_builds(make, radius, s
     assert fits < radius
     built = make(fits)
     assert built.is_valid and _forward(built.wrapped)
+
+
+def test_a_roll_too_wide_for_every_plan_radius_that_fits_gets_a_pair_that_builds():
+    """Plan corners of 7.7 do not fit a box 19.2 wide, and a roll of 4.9 (6.2 high) fits no plan radius that
+    does with the height 8: the refusal names the largest plan radius and the largest roll it holds."""
+    with pytest.raises(NoSolutionError, match=r"both claim .*; no radius fits with edge_radius 4.9; with radius") as refused:
+        ContinuousBox(42, 19.2, 8, 7.7, edge_radius=4.9)
+    both = re.search(r"with radius ([0-9.e+-]+), edge_radius up to ([0-9.e+-]+) fits$", str(refused.value))
+    assert both, str(refused.value)
+    radius, edge = float(both[1]), float(both[2])
+    assert radius < 7.7 and edge < 4.9
+    built = ContinuousBox(42, 19.2, 8, radius, edge_radius=edge)
+    assert built.is_valid and _forward(built.wrapped)
+    with pytest.raises(NoSolutionError, match=r"both claim .*; radius up to [0-9.]+ fits$"):  # a roll that fits
+        ContinuousBox(42, 19.2, 8, 7.7, edge_radius=2)
 
 
 def test_the_suggested_roll_keeps_a_margin_from_the_fold_freecad_agrees_it_is_g2(tmp_path):
