@@ -55,7 +55,7 @@ from OCP.BRepTools import BRepTools
 from OCP.Geom import Geom_BSplineCurve, Geom_BSplineSurface
 from OCP.GeomAbs import GeomAbs_CurveType, GeomAbs_SurfaceType
 from OCP.GeomAdaptor import GeomAdaptor_Surface
-from OCP.gp import gp_Ax3, gp_Dir, gp_Pln, gp_Pnt, gp_Trsf, gp_TrsfForm, gp_Vec
+from OCP.gp import gp_Ax3, gp_Dir, gp_Pln, gp_Pnt, gp_Trsf, gp_Vec
 from OCP.GProp import GProp_GProps
 from OCP.TColgp import TColgp_Array1OfPnt, TColgp_Array2OfPnt
 from OCP.TColStd import TColStd_Array1OfInteger, TColStd_Array1OfReal, TColStd_Array2OfReal
@@ -1120,10 +1120,7 @@ def fillet_prism_edges(
             )
             raise refusal(str(error), "radius", advice(plan_fits, builds, as_float(radius, "radius"))) from None
         local, approximation, roll = slab.shape, slab.approximation, slab.roll
-    to_global = _to_global(frame)
-    if rolled and to_global.Form() == gp_TrsfForm.gp_Identity:  # the slab as verified when it was built
-        return Slab(forward_solid(local), approximation, roll, prism.height)
-    placed = BRepBuilderAPI_Transform(local, to_global, True).Shape()
+    placed = BRepBuilderAPI_Transform(local, _to_global(frame), True).Shape()
     result = forward_solid(TopoDS.Solid_s(placed) if placed.ShapeType() == TopAbs_SOLID else _first_solid(placed))
     verify_solid(result, "rounded part")
     verify_faces(result, expected_level(segments), "rounded part")
