@@ -846,3 +846,41 @@ CURVATURES = textwrap.dedent(
     print(json.dumps(out))
     """
 )
+
+
+#: In FreeCAD (system Python): per STEP file, its solids, whether each is valid, their volume.
+READ_MANY = textwrap.dedent(
+    """
+    import sys
+    sys.path.append(sys.argv[1])
+    import FreeCAD, Part  # FreeCAD first: Part alone crashes
+    for path in sys.argv[2:]:
+        shape = Part.read(path)
+        print(len(shape.Solids), all(s.isValid() for s in shape.Solids), repr(sum(s.Volume for s in shape.Solids)))
+    """
+)
+
+
+@pytest.mark.skipif(FREECAD is None, reason="FreeCAD is not installed (Debian/Ubuntu: apt-get install freecad-python3)")
+def test_freecad_finds_suggested_parts_and_a_fused_box_valid(tmp_path):
+    """Parts built from refusals' suggestions, and the CadQuery box fused onto a plate, read by FreeCAD."""
+    cq = pytest.importorskip("cadquery")
+    import spiral_cad.cadquery  # noqa: F401  (registers the methods)
+
+    parts = {
+        "sew": ContinuousBox(5, 5, 2, 1.0, edge_radius=0.787673),  # said by the refusal of 1.0 (tested above)
+        "cube": ContinuousBox(10, 10, 10, 3.93836),  # said by the refusal of radius 5
+        "fused": cq.Workplane().box(100, 100, 10).continuousBox(60, 40, 12, 8, 3).val(),
+    }
+    paths = []
+    for name, part in parts.items():
+        path = tmp_path / f"{name}.step"
+        export_step(part, path) if name != "fused" else cq.exporters.export(cq.Workplane().add(part), str(path))
+        paths.append(str(path))
+    run = subprocess.run(["/usr/bin/python3", "-c", READ_MANY, FREECAD, *paths], capture_output=True, text=True, timeout=600)
+    assert run.returncode == 0, run.stderr[-2000:]
+    for (name, part), line in zip(parts.items(), run.stdout.splitlines()[-len(parts) :]):
+        solids, valid, volume = line.split()
+        assert (solids, valid) == ("1", "True"), name
+        expected = part.volume if hasattr(part, "volume") else part.Volume()
+        assert float(volume) == pytest.approx(expected, rel=1e-6), name
