@@ -7,18 +7,68 @@ bottom edges rolled G2 of radius 1.5 — built, sewn, checked by ``BRepCheck_Ana
 face checker (every edge G2) before it is returned. Peer: build123d's ``Box(40, 20, 8)`` with
 its vertical edges filleted at 6 and then every other edge at 1.5 (OCCT's circular fillets,
 G1, unchecked). Second pair: the sphere-octant box both ways — ``g2_slab`` of a circularly
-rounded rectangle with a circular roll of 3 against ``fillet(Box.edges(), 3)``.
+rounded rectangle with a circular roll of 3 against ``fillet(Box.edges(), 3)``. Third pair (issue 30's):
+``ContinuousBox(60, 40, 12, 8, edge_radius=3)`` against ``fillet(Box(60, 40, 12).edges(), 3)``, with what
+each step of ours costs (median over the runs: fit checks, sweeps, faces, sewing, BRepCheck, face check).
 """
 
 from __future__ import annotations
 
 import math
+import time
+from collections import defaultdict
+from statistics import median
 
 import build123d as bd
 from timing import arguments, compare, machine, write_markdown
 
+import spiral_cad.cad.solids as solids
 from spiral_cad import Arc, Line
 from spiral_cad.build123d import ContinuousBox, g2_slab
+
+#: The steps of a slab, by the function of ``spiral_cad.cad.solids`` doing each.
+STEPS = {
+    "fit checks": "_roll_problem",
+    "sweeps (s direction)": "_along",
+    "surfaces and faces": "_surface_face",
+    "STEP-note fingerprints": "_record",
+    "caps": "_cap",
+    "sewing and solid": "_solid",
+    "BRepCheck": "verify_solid",
+    "face check": "verify_faces",
+}
+
+
+def step_costs(make, rounds: int) -> dict[str, float]:
+    """Median seconds per step of ``make()`` over ``rounds`` runs (the steps' functions timed in place)."""
+    spent: dict[str, list[float]] = defaultdict(list)
+    originals = {name: getattr(solids, name) for name in STEPS.values()}
+    this_run: dict[str, float] = {}
+
+    def timed(name, function):
+        def run(*args, **kwargs):
+            start = time.perf_counter()
+            try:
+                return function(*args, **kwargs)
+            finally:
+                this_run[name] = this_run.get(name, 0.0) + time.perf_counter() - start
+
+        return run
+
+    try:
+        for name, function in originals.items():
+            setattr(solids, name, timed(name, function))
+        for _ in range(rounds):
+            this_run.clear()
+            start = time.perf_counter()
+            make()
+            this_run["total"] = time.perf_counter() - start
+            for name, value in this_run.items():
+                spent[name].append(value)
+    finally:
+        for name, function in originals.items():
+            setattr(solids, name, function)
+    return {name: median(values) for name, values in spent.items()}
 
 
 def peer_box() -> bd.Part:
@@ -41,11 +91,15 @@ def main() -> None:
         "build123d fillet": peer_box,
         "g2_slab circular": lambda: g2_slab(rounded_rectangle(40, 20, 3), 8, 3, profile="circular"),
         "build123d fillet all": lambda: bd.fillet(bd.Box(40, 20, 8).edges(), 3),
+        "ContinuousBox 60×40×12": lambda: ContinuousBox(60, 40, 12, 8, edge_radius=3),
+        "build123d fillet 60×40×12": lambda: bd.fillet(bd.Box(60, 40, 12).edges(), 3),
     }
     best = compare(jobs, args.repeat)
     ours, theirs = ContinuousBox(40, 20, 8, 6, edge_radius=1.5), peer_box()
     rows = []
-    for name, peer in (("ContinuousBox", "build123d fillet"), ("g2_slab circular", "build123d fillet all")):
+    pairs = (("ContinuousBox", "build123d fillet"), ("g2_slab circular", "build123d fillet all"),
+             ("ContinuousBox 60×40×12", "build123d fillet 60×40×12"))  # fmt: skip
+    for name, peer in pairs:
         shape, other = jobs[name](), jobs[peer]()
         ratio = best[peer].median / best[name].median
         rows.append((name, f"{best[name].median * 1000:,.0f} ms", f"{len(shape.faces())} faces, valid {shape.is_valid}",
@@ -57,6 +111,10 @@ def main() -> None:
     note = (f"Medians of {args.repeat} interleaved runs (ratio > 1: ours is faster). Ours includes sewing, "
             f"BRepCheck and the face check; its sweeps over spirals deviate {ours.approximation:.2g} mm from exact. "
             f"Volumes: ours {ours.volume:.6g}, peer {theirs.volume:.6g} mm³ (different shapes: G2 vs circular).")  # fmt: skip
+    costs = step_costs(jobs["ContinuousBox 60×40×12"], args.repeat)
+    total = costs.pop("total")
+    steps = ", ".join(f"{step} {costs.get(function, 0.0) * 1000:.0f} ms" for step, function in STEPS.items())
+    note += f" ContinuousBox(60, 40, 12, 8, edge_radius=3) step by step (total {total * 1000:.0f} ms): {steps}."
     print(note)
     print(machine())
     if args.out:

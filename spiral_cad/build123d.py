@@ -423,6 +423,10 @@ def g2_fillet(
             (named by edge and point: a vertex blend is a later step).
     """
     context: Builder | None = Builder._get_context("g2_fillet")
+    if isinstance(target, Iterable) and not isinstance(target, (Shape, str, bytes)):
+        target = list(flatten_sequence(target))
+        if not target:
+            raise ValueError("g2_fillet got an empty list of edges (or vertices): there is nothing to round")
     edges = _solid_edges(target)
     if edges is not None:
         return _fillet_edges(edges, radius, context, transition=transition, same_sense=same_sense, shape=shape)

@@ -26,10 +26,12 @@ from OCP.TopExp import TopExp_Explorer
 from OCP.TopoDS import TopoDS, TopoDS_Face, TopoDS_Wire
 
 from ..check.joints import Continuity
+from ..core._inputs import as_float
 from ..core.errors import NoSolutionError
 from ..core.segments import Arc, Line, Segment
 from ..core.spiral import BezierSpiral
 from ..design.fillets import FilletedPath, fillet_path
+from .advice import advice, refusal
 from .occ import chain_wire
 
 __all__ = ["fillet_face", "fillet_wire", "planar_frame", "wire_path"]
@@ -180,6 +182,7 @@ def fillet_wire(
     same_sense: str = "nested",
     shape: str = "walton-meek",
     frame: gp_Ax3 | None = None,
+    _advise: bool = True,
 ) -> tuple[TopoDS_Wire, FilletedPath]:
     """Round the wire's corners at ``vertices`` (3-D points; None: every corner) with G2 fillets.
 
@@ -195,7 +198,19 @@ def fillet_wire(
     frame = planar_frame(wire) if frame is None else frame
     segments, closed = wire_path(wire, frame)
     chosen = _vertex_indices(segments, closed, frame, vertices)
-    result = fillet_path(segments, radius, transition=transition, vertices=chosen, closed=closed, same_sense=same_sense, shape=shape)
+    options = dict(transition=transition, vertices=chosen, closed=closed, same_sense=same_sense, shape=shape)
+    try:
+        result = fillet_path(segments, radius, **options)  # type: ignore[arg-type]
+    except NoSolutionError as error:
+        if not _advise:
+            raise
+        again = dict(transition=transition, same_sense=same_sense, shape=shape, frame=frame, _advise=False)
+        fits = advice(
+            lambda r: _fillets(segments, r, options),
+            lambda r: fillet_wire(wire, r, vertices, **again),
+            as_float(radius, "radius"),
+        )
+        raise refusal(str(error), "radius", fits) from None
     if not result.corners:  # nothing to round: the wire stays as it was
         return wire, result
     shortest = 2.0 * Precision.Confusion_s()
@@ -211,6 +226,15 @@ def fillet_wire(
     rounded = chain_wire(result.segments, frame)
     _verify(rounded, result)
     return rounded, result
+
+
+def _fillets(segments: list[Segment], radius: float, options: dict) -> bool:
+    """Whether ``fillet_path`` rounds the corners with ``radius`` (a refusal's advice bisects on it)."""
+    try:
+        fillet_path(segments, radius, **options)
+    except NoSolutionError:
+        return False
+    return True
 
 
 def _verify(wire: TopoDS_Wire, result: FilletedPath) -> None:
@@ -243,6 +267,7 @@ def fillet_face(
     transition: float = 0.5,
     same_sense: str = "nested",
     shape: str = "walton-meek",
+    _advise: bool = True,
 ) -> TopoDS_Face:
     """Round the corners of a planar face (outer and inner wires) at ``vertices`` (None: every corner).
 
@@ -254,8 +279,23 @@ def fillet_face(
     points = None if vertices is None else list(vertices)
     outer = BRepTools.OuterWire_s(face)
     wires = [outer] + [w for w in _wires(face) if not w.IsSame(outer)]
-    options = dict(transition=transition, same_sense=same_sense, shape=shape, frame=frame)
-    rounded = [fillet_wire(w, radius, points, **options)[0] for w in wires]
+    options = dict(transition=transition, same_sense=same_sense, shape=shape, frame=frame, _advise=False)
+    try:
+        rounded = [fillet_wire(w, radius, points, **options)[0] for w in wires]
+    except NoSolutionError as error:
+        if not _advise or "fits" in str(error):
+            raise
+        paths = [wire_path(w, frame) for w in wires]
+        chosen = [_vertex_indices(segments, closed, frame, points) for segments, closed in paths]
+        fits = advice(
+            lambda r: all(
+                _fillets(segments, r, dict(transition=transition, vertices=c, closed=closed, same_sense=same_sense, shape=shape))
+                for (segments, closed), c in zip(paths, chosen)
+            ),  # fmt: skip
+            lambda r: fillet_face(face, r, points, transition=transition, same_sense=same_sense, shape=shape, _advise=False),
+            as_float(radius, "radius"),
+        )
+        raise refusal(str(error), "radius", fits) from None
     maker = BRepBuilderAPI_MakeFace(BRep_Tool.Surface_s(face), rounded[0], True)
     for inner in rounded[1:]:
         maker.Add(inner)

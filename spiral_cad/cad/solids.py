@@ -37,7 +37,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 from OCP.BRep import BRep_Tool
-from OCP.BRepAdaptor import BRepAdaptor_Curve
+from OCP.BRepAdaptor import BRepAdaptor_Curve, BRepAdaptor_Surface
 from OCP.BRepBuilderAPI import (
     BRepBuilderAPI_MakeEdge,
     BRepBuilderAPI_MakeFace,
@@ -50,7 +50,6 @@ from OCP.BRepBuilderAPI import (
 from OCP.BRepCheck import BRepCheck_Analyzer
 from OCP.BRepExtrema import BRepExtrema_DistShapeShape
 from OCP.BRepGProp import BRepGProp
-from OCP.BRepLib import BRepLib
 from OCP.BRepPrimAPI import BRepPrimAPI_MakePrism
 from OCP.BRepTools import BRepTools
 from OCP.Geom import Geom_BSplineCurve, Geom_BSplineSurface
@@ -60,7 +59,7 @@ from OCP.gp import gp_Ax3, gp_Dir, gp_Pln, gp_Pnt, gp_Trsf, gp_Vec
 from OCP.GProp import GProp_GProps
 from OCP.TColgp import TColgp_Array1OfPnt, TColgp_Array2OfPnt
 from OCP.TColStd import TColStd_Array1OfInteger, TColStd_Array1OfReal, TColStd_Array2OfReal
-from OCP.TopAbs import TopAbs_EDGE, TopAbs_FACE, TopAbs_SHELL, TopAbs_SOLID, TopAbs_WIRE
+from OCP.TopAbs import TopAbs_EDGE, TopAbs_FACE, TopAbs_FORWARD, TopAbs_REVERSED, TopAbs_SHELL, TopAbs_SOLID, TopAbs_WIRE
 from OCP.TopExp import TopExp, TopExp_Explorer
 from OCP.TopLoc import TopLoc_Location
 from OCP.TopoDS import TopoDS, TopoDS_Edge, TopoDS_Face, TopoDS_Shape, TopoDS_Solid
@@ -76,6 +75,7 @@ from ..core.shapes import DEFAULT_SHAPE
 from ..core.spiral import BezierSpiral
 from ..core.units import DEFAULT_UNITS, length_unit
 from ..design.fillets import TANGENT_TOL, continuous_rectangle, corner_distance, fillet_path
+from .advice import advice, refusal
 from .fillet import wire_path
 from .occ import chain_wire
 
@@ -84,6 +84,7 @@ __all__ = [
     "Slab",
     "approximation_note",
     "fillet_prism_edges",
+    "forward_solid",
     "g2_slab",
     "outline_segments",
     "expected_level",
@@ -344,20 +345,24 @@ def _sections(roll: list[Segment], top: float, bottom: float, height: float) -> 
     return sections
 
 
-def _surface_face(along: _Along, section: _Section, degenerate: float) -> TopoDS_Face:
+def _surface_face(along: _Along, section: _Section, degenerate: float) -> tuple[TopoDS_Face, bytes]:
+    """The face of the patch and its ``_fingerprint`` (from the same numbers OCCT is given)."""
     rows, cols = len(along.a), len(section.points)
+    w, z = section.points[:, 0], section.points[:, 1]
+    xy = along.a[:, None, :] + w[None, :, None] * along.b[:, None, :]
+    grid = np.concatenate([xy, np.broadcast_to(z[None, :, None], (rows, cols, 1))], axis=2).astype(float)
+    products = along.weights[:, None] * section.weights[None, :]
     poles, weights = TColgp_Array2OfPnt(1, rows, 1, cols), TColStd_Array2OfReal(1, rows, 1, cols)
     for i in range(rows):
         for j in range(cols):
-            w, z = section.points[j]
-            x, y = along.a[i] + w * along.b[i]
-            poles.SetValue(i + 1, j + 1, gp_Pnt(float(x), float(y), float(z)))
-            weights.SetValue(i + 1, j + 1, float(along.weights[i] * section.weights[j]))
+            poles.SetValue(i + 1, j + 1, gp_Pnt(*(float(c) for c in grid[i, j])))
+            weights.SetValue(i + 1, j + 1, float(products[i, j]))
     surface = Geom_BSplineSurface(
         poles, weights, _reals(along.knots), _reals(section.knots), _ints(along.mults), _ints(section.mults),
         along.degree, section.degree,
     )  # fmt: skip
-    return BRepBuilderAPI_MakeFace(surface, degenerate).Face()
+    key = _fingerprint_of((along.degree, section.degree), grid, products, [*along.knots, *section.knots])
+    return BRepBuilderAPI_MakeFace(surface, degenerate).Face(), key
 
 
 def _boundary_edge(along: _Along, w: float, z: float):
@@ -394,19 +399,24 @@ def _fingerprint(face: TopoDS_Face) -> bytes | None:
         return None
     rows, cols = surface.NbUPoles(), surface.NbVPoles()
     poles = np.array([[surface.Pole(i, j).Coord() for j in range(1, cols + 1)] for i in range(1, rows + 1)])
-    poles = poles.reshape(-1, 3)
-    distances = np.concatenate([np.linalg.norm(poles - poles[0], axis=1), np.linalg.norm(poles - poles[-1], axis=1)])
-    scale = float(distances.max()) or 1.0
     weights = [surface.Weight(i, j) for i in range(1, rows + 1) for j in range(1, cols + 1)]
     knots = [surface.UKnot(k) for k in range(1, surface.NbUKnots() + 1)] + [surface.VKnot(k) for k in range(1, surface.NbVKnots() + 1)]
-    numbers = np.concatenate([[surface.UDegree(), surface.VDegree(), rows, cols], knots, weights, distances / scale])
+    return _fingerprint_of((surface.UDegree(), surface.VDegree()), poles, np.asarray(weights), knots)
+
+
+def _fingerprint_of(degrees: tuple[int, int], poles: NDArray[np.float64], weights: NDArray[np.float64],
+                    knots: Sequence[float]) -> bytes:  # fmt: skip
+    """``_fingerprint`` of a surface given by its numbers: poles (rows, cols, 3), weights in row order, the
+    u then v knots (distinct values)."""
+    rows, cols = poles.shape[:2]
+    flat = poles.reshape(-1, 3)
+    distances = np.concatenate([np.linalg.norm(flat - flat[0], axis=1), np.linalg.norm(flat - flat[-1], axis=1)])
+    scale = float(distances.max()) or 1.0
+    numbers = np.concatenate([[degrees[0], degrees[1], rows, cols], knots, np.ravel(weights), distances / scale])
     return np.round(numbers, 9).tobytes() + np.float64(f"{scale:.9g}").tobytes()
 
 
-def _record(face: TopoDS_Face, deviation: float) -> None:
-    key = _fingerprint(face)
-    if key is None:
-        return
+def _record(key: bytes, deviation: float) -> None:
     _RECORDED[key] = max(deviation, _RECORDED.pop(key, 0.0))
     while len(_RECORDED) > _RECORD_LIMIT:
         del _RECORDED[next(iter(_RECORDED))]
@@ -541,31 +551,12 @@ def _roll_problem(segments: list[Segment], height: float, edge_radius: Any, give
     return _fit_problem(segments, _inward(segments), min(max(d_top, d_bottom), height), edge_radius, name)
 
 
-def _largest(fits: Callable[[float], bool], upper: float) -> float | None:
-    """The largest value in (0, upper) for which ``fits`` holds (bisection; it must hold below it), rounded
-    down to 6 significant digits and checked itself, or None."""
-    low, high = 0.0, upper
-    for _ in range(60):
-        mid = 0.5 * (low + high)
-        low, high = (mid, high) if fits(mid) else (low, mid)
-    if not low > 0.0:
-        return None
-    step = 10.0 ** (math.floor(math.log10(low)) - 5)
-    for k in range(3):  # rounding down may still land on a value that fails: a step further
-        value = float(f"{(math.floor(low / step) - k) * step:.6g}")
-        if value > 0.0 and fits(value):
-            return value
-    return None
-
-
-def _refusal(problem: str, name: str, fits: float | None) -> NoSolutionError:
-    return NoSolutionError(f"{problem}; {name} up to {fits:.6g} fits" if fits is not None else f"{problem}; no {name} fits")
-
-
 # ------------------------------------------------------------------ the solid
 
 
-def _solid(faces: list[TopoDS_Face], tolerance: float) -> TopoDS_Solid:
+def _solid(faces: list[TopoDS_Face], tolerance: float, top: TopoDS_Face) -> TopoDS_Solid:
+    """The faces sewn into one closed shell and made a FORWARD solid facing out: the shell faces out
+    when the top cap (``top``, a plane z = height) does, as the construction knows (no volume needed)."""
     sewing = BRepBuilderAPI_Sewing(tolerance)
     for face in faces:
         sewing.Add(face)
@@ -580,13 +571,36 @@ def _solid(faces: list[TopoDS_Face], tolerance: float) -> TopoDS_Solid:
         shells.Next()
     if count != 1 or shell is None or not BRep_Tool.IsClosed_s(shell):
         raise NoSolutionError(f"the slab's {len(faces)} faces did not sew into one closed shell ({count} shell(s))")
-    solid = BRepBuilderAPI_MakeSolid(shell).Solid()
-    BRepLib.OrientClosedSolid_s(solid)
-    return solid
+    sewn_top = sewing.Modified(top)
+    cap = next((f for f in _faces_of(shell) if f.IsSame(sewn_top)), None)
+    if cap is None or (plane := _plane(cap)) is None:
+        raise NoSolutionError("the slab's top cap is not a plane of the sewn shell")
+    up = plane.Axis().Direction().Z() * (-1.0 if cap.Orientation() == TopAbs_REVERSED else 1.0)
+    if up < 0.0:  # the shell faces in: the solid of the turned shell (a fresh solid is FORWARD)
+        shell = TopoDS.Shell_s(shell.Reversed())
+    return BRepBuilderAPI_MakeSolid(shell).Solid()
 
 
-def verify_solid(shape: TopoDS_Shape, what: str = "slab") -> None:
-    """ValueError unless ``shape`` is one valid, closed solid with positive volume (``BRepCheck_Analyzer``)."""
+def forward_solid(solid: TopoDS_Shape) -> TopoDS_Solid:
+    """The solid FORWARD: the same volume, usable in booleans.
+
+    ``BRepLib.OrientClosedSolid`` and ``Reversed`` may leave a solid REVERSED with a positive
+    volume; a fuse of a compound holding such a solid drops it (CadQuery's ``combine``). The
+    solid is made again from its shells as they face (orientations composed down from it)."""
+    if solid.Orientation() == TopAbs_FORWARD:
+        return TopoDS.Solid_s(solid)
+    maker = BRepBuilderAPI_MakeSolid()
+    shells = TopExp_Explorer(solid, TopAbs_SHELL)
+    while shells.More():
+        maker.Add(TopoDS.Shell_s(shells.Current()))
+        shells.Next()
+    return maker.Solid()
+
+
+def verify_solid(shape: TopoDS_Shape, what: str = "slab", facing_out: bool = False) -> None:
+    """NoSolutionError unless ``shape`` is one valid, closed, FORWARD solid with positive volume
+    (``BRepCheck_Analyzer``, which also finds a shell whose faces do not all face the same way;
+    ``facing_out``: the caller knows the shell faces out, so its volume is positive, unmeasured)."""
     solids = TopExp_Explorer(shape, TopAbs_SOLID)
     count = 0
     while solids.More():
@@ -594,12 +608,13 @@ def verify_solid(shape: TopoDS_Shape, what: str = "slab") -> None:
         solids.Next()
     if count != 1:
         raise NoSolutionError(f"the {what} is {count} solids, not one")
+    if _first_solid(shape).Orientation() != TopAbs_FORWARD:
+        raise NoSolutionError(f"the {what} is a {_first_solid(shape).Orientation().name} solid, not FORWARD (booleans drop it)")
     if not BRepCheck_Analyzer(shape).IsValid():
         raise NoSolutionError(f"the {what} is not a valid solid (BRepCheck_Analyzer)")
-    props = GProp_GProps()
-    BRepGProp.VolumeProperties_s(shape, props)
-    if not props.Mass() > 0.0:
-        raise NoSolutionError(f"the {what} encloses no volume ({props.Mass():.3g})")
+    volume = 1.0 if facing_out else _volume(shape)
+    if not volume > 0.0:
+        raise NoSolutionError(f"the {what} encloses no volume ({volume:.3g})")
 
 
 def continuous_box(
@@ -616,16 +631,63 @@ def continuous_box(
     bottom: bool = True,
     tolerance: float | None = None,
     units: str = DEFAULT_UNITS,
+    _advise: bool = True,
 ) -> Slab:
     """A box with every edge and corner G2: ``g2_slab`` of a ``continuous_rectangle`` (centred on the origin,
     z from 0 to ``height``). ``edge_radius`` None: the roll half as wide as the smaller of ``radius`` and
     ``height``/2 allows. Other arguments and errors as ``g2_slab`` and ``continuous_rectangle``."""
-    plan = continuous_rectangle(length, width, radius, transition, units=units, shape=shape)
+    for value, name in ((length, "length"), (width, "width"), (height, "height")):
+        if not as_float(value, name) > 0.0:
+            raise ValueError(f"{name} must be positive; got {shown(value)}")
+    try:
+        plan = continuous_rectangle(length, width, radius, transition, units=units, shape=shape)
+    except NoSolutionError as error:
+        if not _advise:
+            raise
+        raise _plan_refusal(error, length, width, height, as_float(radius, "radius"), edge_radius,
+                            dict(transition=transition, shape=shape, profile=profile, top=top, bottom=bottom),
+                            tolerance, units) from None  # fmt: skip
     if edge_radius is None:  # the roll's extent is proportional to its radius
         unit = float(roll_profile(1.0, profile=profile, transition=transition, shape=shape)[-1].end[0])
         edge_radius = 0.5 * min(as_float(radius, "radius"), as_float(height, "height") / 2.0) / unit
     return g2_slab(plan, height, edge_radius, top=top, bottom=bottom, profile=profile, transition=transition,
-                   shape=shape, tolerance=tolerance, units=units)  # fmt: skip
+                   shape=shape, tolerance=tolerance, units=units, _advise=_advise)  # fmt: skip
+
+
+def _plan_refusal(error: NoSolutionError, length: float, width: float, height: float, radius: float,
+                  edge_radius: float | None, options: dict[str, Any], tolerance: float | None,
+                  units: str) -> NoSolutionError:  # fmt: skip
+    """The refusal of plan corners too large for the box, with the largest ``radius`` that fits and builds
+    (with the given ``edge_radius``); when that roll fits no plan radius that fits, the largest plan radius
+    and the largest roll it holds, built together."""
+    transition, shape = options["transition"], options["shape"]
+
+    def plan_fits(r: float) -> bool:  # shrinking corners only ever fit better
+        try:
+            continuous_rectangle(length, width, r, transition, shape=shape)
+        except NoSolutionError:
+            return False
+        return True
+
+    def box(r: float) -> Slab:
+        return continuous_box(length, width, height, r, edge_radius, **options, tolerance=tolerance, units=units,
+                              _advise=False)  # fmt: skip
+
+    problem = f"{error} (the plan corners)"
+    fits = advice(plan_fits, box, radius)
+    if fits is not None or edge_radius is None:
+        return refusal(problem, "radius", fits)
+    corner = advice(plan_fits, lambda r: continuous_rectangle(length, width, r, transition, shape=shape), radius)
+    problem += f"; no radius fits with edge_radius {shown(edge_radius)}"
+    if corner is None:
+        return refusal(problem, "radius", None)
+    plan = outline_segments(continuous_rectangle(length, width, corner, transition, shape=shape))
+    slab_options = dict(options, profile=options["profile"])
+    roll = _slab_advice(plan, height, as_float(edge_radius, "edge_radius"), height, "edge_radius", slab_options,
+                        tolerance, units)  # fmt: skip
+    if roll is None:
+        return refusal(problem, "radius", None)
+    return NoSolutionError(f"{problem}; with radius {corner:.6g}, edge_radius up to {roll:.6g} fits")
 
 
 def expected_level(segments: Sequence[Segment], profile: str = "g2") -> str:
@@ -669,6 +731,7 @@ def g2_slab(
     tolerance: float | None = None,
     units: str = DEFAULT_UNITS,
     _name: str = "edge_radius",
+    _advise: bool = True,
 ) -> Slab:
     """A closed planar outline extruded by ``height`` with its top and bottom edges rolled (see the module docstring).
 
@@ -707,8 +770,31 @@ def g2_slab(
     radius = as_float(edge_radius, "edge_radius")
     problem = _roll_problem(segments, height, edge_radius, given_height, _name, **options)
     if problem is not None:
-        fits = _largest(lambda r: _roll_problem(segments, height, r, given_height, _name, **options) is None, radius)
-        raise _refusal(problem, _name, fits)
+        if not _advise:
+            raise NoSolutionError(problem)
+        raise refusal(problem, _name, _slab_advice(segments, height, radius, given_height, _name, options, tolerance, units))
+    try:
+        return _built_slab(segments, height, edge_radius, options, tolerance, units)
+    except NoSolutionError as error:  # fits, yet does not build: nearly singular (rolls meeting, an offset folding)
+        if not _advise:
+            raise
+        raise refusal(str(error), _name, _slab_advice(segments, height, radius, given_height, _name, options, tolerance, units)) from None
+
+
+def _slab_advice(segments: list[Segment], height: float, radius: float, given_height: Any, name: str,
+                 options: dict[str, Any], tolerance: float | None, units: str) -> float | None:  # fmt: skip
+    """The largest roll radius below ``radius`` a refusal may name: it fits with a margin and builds."""
+    return advice(
+        lambda r: _roll_problem(segments, height, r, given_height, name, **options) is None,
+        lambda r: g2_slab(segments, height, r, **options, tolerance=tolerance, units=units, _advise=False),
+        radius,
+    )
+
+
+def _built_slab(segments: list[Segment], height: float, edge_radius: float, options: dict[str, Any],
+                tolerance: float | None, units: str) -> Slab:  # fmt: skip
+    """The slab of rolls that fit, verified (``g2_slab`` after its fit checks)."""
+    top, bottom, profile, transition, shape = (options[k] for k in ("top", "bottom", "profile", "transition", "shape"))
     roll = roll_profile(edge_radius, profile=profile, transition=transition, shape=shape)
     reach = float(roll[-1].end[0])
     d_top, d_bottom = (reach if top else 0.0), (reach if bottom else 0.0)
@@ -724,13 +810,14 @@ def g2_slab(
     alongs = [span for s in segments for span in _along_spans(_along(s, sigma, reach_max, tol))]
     sections = _sections(roll, d_top, d_bottom, height)
     degenerate = 1e-9 * size
-    faces = [_surface_face(a, sec, degenerate) for a in alongs for sec in sections]
-    for k, face in enumerate(faces):  # so export_step finds the note on parts built from this solid
-        _record(face, reach_max * alongs[k // len(sections)].deviation)
-    faces.append(_cap(alongs, d_top, height))
-    faces.append(_cap(alongs, d_bottom, 0.0))
-    solid = _solid(faces, 1e-7 * size)
-    verify_solid(solid)
+    made = [_surface_face(a, sec, degenerate) for a in alongs for sec in sections]
+    faces = [face for face, _ in made]
+    for k, (_, key) in enumerate(made):  # so export_step finds the note on parts built from this solid
+        _record(key, reach_max * alongs[k // len(sections)].deviation)
+    top_cap = _cap(alongs, d_top, height)
+    faces += [top_cap, _cap(alongs, d_bottom, 0.0)]
+    solid = _solid(faces, 1e-7 * size, top_cap)
+    verify_solid(solid, facing_out=True)
     verify_faces(solid, expected_level(segments, profile), units=units)
     approximation = reach_max * max(a.deviation for a in alongs)
     return Slab(solid, approximation, (d_top, d_bottom), height, units)
@@ -801,6 +888,21 @@ def _prism(solid: TopoDS_Shape, direction: gp_Dir, edge_name: str) -> _Prism:
             f"g2_fillet rounds solid edges of right prisms (two parallel planar caps, side faces along the edges); "
             f"{edge_name}: the part has {len(caps)} planar face(s) perpendicular to it, not 2 (a vertex blend is a later step)"
         )
+    for index, face in enumerate(_faces_of(solid)):
+        if any(face.IsSame(cap) for cap in caps):
+            continue
+        lean = _lean(face, direction)
+        if lean > _SIDE_TOL:
+            surface = BRepAdaptor_Surface(face)
+            u, v = (
+                0.5 * (surface.FirstUParameter() + surface.LastUParameter()),
+                0.5 * (surface.FirstVParameter() + surface.LastVParameter()),
+            )
+            raise NoSolutionError(
+                f"g2_fillet rounds solid edges of right prisms (side faces perpendicular to the caps); {edge_name}: "
+                f"side face {index} near {_where(surface.Value(u, v))} leans {math.degrees(lean):.6g}° from the caps' "
+                "normal: the part is no right prism (an oblique prism, a taper), which g2_fillet does not round"
+            )
     origins = [_plane(f).Location() for f in caps]  # type: ignore[union-attr]
     offsets = [gp_Vec(direction).Dot(gp_Vec(o.XYZ())) for o in origins]
     low, high = (0, 1) if offsets[0] < offsets[1] else (1, 0)
@@ -818,6 +920,37 @@ def _prism(solid: TopoDS_Shape, direction: gp_Dir, edge_name: str) -> _Prism:
     return _Prism(frame, caps[low], caps[high], height)
 
 
+#: Most angle (radians) a prism's side face may lean from the caps' normal.
+_SIDE_TOL = 1e-9
+#: Samples per parameter direction when a side face's surface gives no direction of its own.
+_SIDE_SAMPLES = 9
+
+
+def _lean(face: TopoDS_Face, axis: gp_Dir) -> float:
+    """How far (radians) the face leans from containing the direction ``axis`` everywhere: from its
+    surface's own direction (plane normal, cylinder axis, extrusion direction) where it has one, else
+    the largest over a grid of its normals (a face perpendicular to the caps has every normal ⟂ axis)."""
+    surface = BRepAdaptor_Surface(face)
+    kind = surface.GetType()
+    if kind == GeomAbs_SurfaceType.GeomAbs_Plane:
+        return abs(math.asin(max(-1.0, min(1.0, surface.Plane().Axis().Direction().Dot(axis)))))
+    along = {GeomAbs_SurfaceType.GeomAbs_Cylinder: lambda: surface.Cylinder().Axis().Direction(),
+             GeomAbs_SurfaceType.GeomAbs_SurfaceOfExtrusion: surface.Direction}.get(kind)  # fmt: skip
+    if along is not None:
+        angle = along().Angle(axis)
+        return min(angle, math.pi - angle)
+    u0, u1, v0, v1 = surface.FirstUParameter(), surface.LastUParameter(), surface.FirstVParameter(), surface.LastVParameter()
+    worst = 0.0
+    for u in np.linspace(u0, u1, _SIDE_SAMPLES):
+        for v in np.linspace(v0, v1, _SIDE_SAMPLES):
+            point, du, dv = gp_Pnt(), gp_Vec(), gp_Vec()
+            surface.D1(float(u), float(v), point, du, dv)
+            normal = du.Crossed(dv)
+            if normal.Magnitude() > 1e-12 * (1.0 + du.Magnitude() * dv.Magnitude()):
+                worst = max(worst, abs(math.asin(max(-1.0, min(1.0, normal.Normalized().Dot(gp_Vec(axis)))))))
+    return worst
+
+
 def _on(face: TopoDS_Face, point: gp_Pnt, size: float) -> bool:
     return BRepExtrema_DistShapeShape(BRepBuilderAPI_MakeVertex(point).Vertex(), face).Value() <= 1e-9 * size
 
@@ -831,6 +964,7 @@ def fillet_prism_edges(
     same_sense: str = "nested",
     shape: str = DEFAULT_SHAPE,
     tolerance: float | None = None,
+    _advise: bool = True,
 ) -> Slab:
     """Round straight edges of a right prism with G2 fillets, exactly.
 
@@ -883,23 +1017,26 @@ def fillet_prism_edges(
         plane = _plane(face)
         if plane is not None and any(any(e.IsSame(h) for h in _edges_of(face)) for e in edges):
             candidates.append(plane.Axis().Direction())
-    ranked = []
+    ranked, leaning = [], []
     for candidate in candidates:
         try:
             ranked.append((_fit(solid, edges, candidate, named), candidate))
-        except NoSolutionError:
-            continue
+        except NoSolutionError as error:
+            leaning += [error] if " leans " in str(error) else []
+    if not ranked and leaning:
+        raise leaning[0]
     if not ranked:
         raise NoSolutionError(
             f"g2_fillet rounds a solid's straight edges when each end meets a face perpendicular to it (prism side "
             f"edges) and whole caps of right prisms; {named[0]} is neither (a vertex blend is a later step)"
         )
     axis = min(ranked, key=lambda row: row[0])[1]
-    sides, caps = [], []
+    sides, caps, side_names = [], [], []
     for k, edge in enumerate(edges):
         line = _line_direction(edge)
         if line is not None and line[2].IsParallel(axis, 1e-12):
             sides.append(edge)
+            side_names.append(named[k])
         else:
             caps.append((k, edge, named[k]))
     prism = _prism(solid, axis, f"edge {position[0]}")
@@ -925,12 +1062,39 @@ def fillet_prism_edges(
     segments, _ = wire_path(BRepTools.OuterWire_s(prism.bottom), frame, spirals=True)
     feet = [BRepAdaptor_Curve(e).Value(BRepAdaptor_Curve(e).FirstParameter()) for e in sides]
     feet += [BRepAdaptor_Curve(e).Value(BRepAdaptor_Curve(e).LastParameter()) for e in sides]
+    for name, edge in zip(side_names, sides):
+        ends = [BRepAdaptor_Curve(edge).Value(BRepAdaptor_Curve(edge).FirstParameter()),
+                BRepAdaptor_Curve(edge).Value(BRepAdaptor_Curve(edge).LastParameter())]  # fmt: skip
+        for i in _corner_vertices(segments, frame, ends, size):
+            before, after = segments[i - 1], segments[i]
+            mismatch = None if _turns(before, after) else g2_mismatch(before, after, JOIN_TOLERANCE, index=i)
+            if mismatch is not None:
+                jump = (float(np.ravel(before.curvature(1.0))[0]), float(np.ravel(after.curvature(0.0))[0]))
+                raise NoSolutionError(
+                    f"g2_fillet rounds corners; {name} is a tangent joint, not a corner: the outline's curvature "
+                    f"jumps from {jump[0]:.6g} to {jump[1]:.6g} there, so its faces meet G1; making tangent joints G2 "
+                    "is a separate feature: leave the edge out of the selection"
+                )
     chosen = [i for i in _corner_vertices(segments, frame, feet, size) if _turns(segments[i - 1], segments[i])]
     rolled = any(chosen_caps.values())
+    options: dict[str, Any] = dict(transition=transition, same_sense=same_sense, shape=shape, tolerance=tolerance)
+
+    def builds(r: float) -> Slab:  # the same edges rounded with ``r``: what a refusal may suggest
+        return fillet_prism_edges(solid, edges, r, **options, _advise=False)
+
+    outline = segments
     if chosen and rolled:  # one radius for all: the roll's, the plan corners wide enough to hold it
-        segments = _rolled_plan(segments, chosen, prism.height, radius, chosen_caps, transition, same_sense, shape)
+        segments = _rolled_plan(outline, chosen, prism.height, radius, chosen_caps, transition, same_sense, shape,
+                                builds if _advise else None)  # fmt: skip
     elif chosen:
-        path = fillet_path(segments, radius, transition=transition, vertices=chosen, closed=True, same_sense=same_sense, shape=shape)
+        plan_options = dict(transition=transition, vertices=chosen, closed=True, same_sense=same_sense, shape=shape)
+        try:
+            path = fillet_path(segments, radius, **plan_options)  # type: ignore[arg-type]
+        except NoSolutionError as error:
+            if not _advise:
+                raise
+            fits = advice(lambda r: _succeeds(lambda: fillet_path(segments, r, **plan_options)), builds, as_float(radius, "radius"))  # type: ignore[arg-type]
+            raise refusal(str(error), "radius", fits) from None
         segments = list(path.segments)
     if not rolled:
         local = _extrusion(segments, prism.height)
@@ -944,11 +1108,20 @@ def fillet_prism_edges(
                     f"g2_fillet rolls the cap edges along a smooth outline; the side edge at {_where(corner)} is sharp "
                     "and not chosen (choose it too: a vertex blend of sharp and rounded edges is a later step)"
                 )
-        slab = g2_slab(segments, prism.height, radius, top=chosen_caps["top"], bottom=chosen_caps["bottom"],
-                       transition=transition, shape=shape, tolerance=tolerance, _name="radius")  # fmt: skip
+        try:  # with chosen side edges the plan changes with the radius: a suggestion is built from the start
+            slab = g2_slab(segments, prism.height, radius, top=chosen_caps["top"], bottom=chosen_caps["bottom"],
+                           transition=transition, shape=shape, tolerance=tolerance, _name="radius",
+                           _advise=_advise and not chosen)  # fmt: skip
+        except NoSolutionError as error:
+            if not (_advise and chosen):
+                raise
+            plan_fits = lambda r: _succeeds(  # noqa: E731
+                lambda: _rolled_plan(outline, chosen, prism.height, r, chosen_caps, transition, same_sense, shape, None)
+            )
+            raise refusal(str(error), "radius", advice(plan_fits, builds, as_float(radius, "radius"))) from None
         local, approximation, roll = slab.shape, slab.approximation, slab.roll
     placed = BRepBuilderAPI_Transform(local, _to_global(frame), True).Shape()
-    result = TopoDS.Solid_s(placed) if placed.ShapeType() == TopAbs_SOLID else _first_solid(placed)
+    result = forward_solid(TopoDS.Solid_s(placed) if placed.ShapeType() == TopAbs_SOLID else _first_solid(placed))
     verify_solid(result, "rounded part")
     verify_faces(result, expected_level(segments), "rounded part")
     return Slab(result, approximation, roll, prism.height)
@@ -974,8 +1147,18 @@ def plan_radius(radius: float, *, transition: float = 0.5, shape: str = DEFAULT_
     return PLAN_OVER_REACH * float(roll_profile(radius, transition=transition, shape=shape)[-1].end[0])
 
 
+def _succeeds(make: Callable[[], object]) -> bool:
+    """Whether ``make()`` returns rather than refusing (NoSolutionError)."""
+    try:
+        make()
+    except NoSolutionError:
+        return False
+    return True
+
+
 def _rolled_plan(segments: list[Segment], chosen: list[int], height: float, radius: float, caps: dict[str, bool],
-                 transition: float, same_sense: str, shape: str) -> list[Segment]:  # fmt: skip
+                 transition: float, same_sense: str, shape: str,
+                 builds: Callable[[float], object] | None) -> list[Segment]:  # fmt: skip
     """The cap outline with the chosen corners rounded by ``plan_radius(radius)``, or NoSolutionError naming
     what does not fit and the largest radius that does (side corners, rolls and height together)."""
     options = dict(top=caps["top"], bottom=caps["bottom"], profile="g2", transition=transition, shape=shape)
@@ -993,8 +1176,10 @@ def _rolled_plan(segments: list[Segment], chosen: list[int], height: float, radi
     plan, problem = attempt(radius)
     if problem is None and plan is not None:
         return plan
-    fits = _largest(lambda r: attempt(r)[1] is None, radius)
-    raise _refusal(
+    if builds is None:
+        raise NoSolutionError(str(problem))
+    fits = advice(lambda r: attempt(r)[1] is None, builds, radius)
+    raise refusal(
         f"{problem} (side and cap edges chosen together: the side edges get the plan radius {PLAN_OVER_REACH:g} × the roll's reach)",
         "radius",
         fits,
@@ -1060,6 +1245,4 @@ def _extrusion(segments: list[Segment], height: float) -> TopoDS_Shape:
     solid = BRepPrimAPI_MakePrism(face, gp_Vec(0.0, 0.0, height)).Shape()
     explorer = TopExp_Explorer(solid, TopAbs_SOLID)
     result = TopoDS.Solid_s(explorer.Current())
-    if _volume(result) < 0.0:
-        result = TopoDS.Solid_s(result.Reversed())
-    return result
+    return forward_solid(TopoDS.Solid_s(result.Reversed()) if _volume(result) < 0.0 else result)

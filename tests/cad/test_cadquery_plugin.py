@@ -139,3 +139,30 @@ def test_example_script_runs_from_plain_python(tmp_path):
     assert done.returncode == 0, done.stderr
     assert f"wrote {target}" in done.stdout and "worst joint G2" in done.stdout
     assert check_continuity(target).wires  # the file reads back
+
+
+def _fits(message: str) -> float:
+    import re
+
+    found = re.search(r"up to ([0-9.e+-]+) fits$", message)
+    assert found, message
+    return float(found.group(1))
+
+
+def test_refusals_name_a_value_that_builds_in_cadquery():
+    """Issue 29: the box's plan corners and a sliver's corners were refused without a value; the value named
+    now builds (a FORWARD solid fused onto the stack, a G2 wire)."""
+    with pytest.raises(sc.NoSolutionError, match=r"both claim .*; radius up to [0-9.]+ fits$") as refused:
+        cq.Workplane().continuousBox(10, 10, 10, 5)
+    fits = _fits(str(refused.value))
+    assert fits < 5
+    part = cq.Workplane().box(20, 20, 4).continuousBox(10, 10, 10, fits)
+    solid = part.val()
+    assert solid.isValid() and 20 * 20 * 4 < solid.Volume() < 20 * 20 * 4 + 10 * 10 * 6
+    sliver = cq.Workplane().polyline([(0, 0), (30, 0), (30, 1)]).close()
+    with pytest.raises(sc.NoSolutionError, match=r"radius up to [0-9.]+ fits$") as refused:
+        sliver.g2Fillet(2)
+    fits = _fits(str(refused.value))
+    wire = cq.Workplane().polyline([(0, 0), (30, 0), (30, 1)]).close().g2Fillet(fits).val()
+    report = check_continuity(wire.wrapped)
+    assert report.wires[0].closed and all(j.level >= Continuity.G2 for j in report.wires[0].joints)
