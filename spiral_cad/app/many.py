@@ -21,6 +21,7 @@ import csv
 import glob
 import io
 import os
+import signal
 import sys
 import threading
 import time
@@ -205,13 +206,43 @@ def _client(workers: int | None, scheduler: str | None, files: int) -> Any:
     dask.config.set({"distributed.scheduler.allowed-failures": 0, "distributed.admin.tick.limit": "1h"})
     if scheduler is not None:
         try:
-            return Client(scheduler, timeout="20s")
+            return Client(scheduler, timeout="10s")
         except (OSError, TimeoutError) as error:
             raise ValueError(f"--scheduler {scheduler!r}: no dask scheduler answered ({error})") from None
     count = workers if workers is not None else max(1, min(os.cpu_count() or 1, files))
     cluster = LocalCluster(n_workers=count, threads_per_worker=1, processes=True, host="127.0.0.1",
-                           dashboard_address=None, silence_logs=logging.ERROR)  # fmt: skip
+                           dashboard_address="127.0.0.1:0", silence_logs=logging.ERROR)  # fmt: skip
     return Client(cluster)
+
+
+_INTERRUPTS = {signal.SIGINT}
+
+
+@contextlib.contextmanager
+def _interrupts_held() -> Iterator[None]:
+    """Ctrl-C held back while the block runs (it arrives at ``_interrupts_released``).
+
+    Processes and threads started meanwhile inherit the blocked signal, so a Ctrl-C in the
+    terminal reaches the command alone (not every worker, which would each print a
+    traceback); the command stops the cluster itself.
+    """
+    if not hasattr(signal, "pthread_sigmask"):  # Windows: no signal masks
+        yield
+        return
+    from multiprocessing import resource_tracker
+
+    resource_tracker.ensure_running()  # now: starting it later would unblock Ctrl-C in the thread that starts the workers
+    signal.pthread_sigmask(signal.SIG_BLOCK, _INTERRUPTS)
+    try:
+        yield
+    except BaseException:
+        _interrupts_released()
+        raise
+
+
+def _interrupts_released() -> None:
+    if hasattr(signal, "pthread_sigmask"):
+        signal.pthread_sigmask(signal.SIG_UNBLOCK, _INTERRUPTS)
 
 
 class _Progress:
@@ -292,8 +323,10 @@ def run_many(task: Callable[[argparse.Namespace], int], files: Sequence[str], ch
     if len(files) == 1 and scheduler is None:
         results.add(0, run_one(task, files[0], args, changes[0]))
         return results.finish(summary)
-    client = _client(workers, scheduler, len(files))
+    with _interrupts_held():  # the workers start with Ctrl-C blocked: the command alone answers it
+        client = _client(workers, scheduler, len(files))
     try:
+        _interrupts_released()  # a Ctrl-C during the start arrives here, where the cluster is closed
         from distributed import as_completed
 
         window = max(64, 8 * sum(client.nthreads().values()))  # a bounded number of tasks in flight

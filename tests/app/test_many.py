@@ -11,6 +11,7 @@ from pathlib import Path
 import pytest
 
 from spiral_cad import Chain, Line
+from spiral_cad.app import many as many_module
 from spiral_cad.app.cli import core_examples, main
 from spiral_cad.app.many import expand_inputs, wants_many
 from spiral_cad.io.step import write_step
@@ -57,10 +58,20 @@ def test_twenty_files_on_two_workers_match_the_files_checked_one_by_one(tmp_path
     expected = step_files(folder)
     assert len(expected) == 20
     monkeypatch.chdir(tmp_path)
+    addresses = []
+
+    def recording(*args):
+        client = start(*args)
+        addresses.extend([client.scheduler.address, *client.scheduler_info()["workers"]])
+        return client
+
+    start = many_module._client
+    monkeypatch.setattr(many_module, "_client", recording)
     summary = tmp_path / "summary.csv"
     status = main(["check", "parts", "--require", "G2", "--workers", "2", "--summary", str(summary)])
     many = capsys.readouterr()
     assert status == 2 and "Traceback" not in many.err
+    assert len(addresses) == 3 and all(a.startswith("tcp://127.0.0.1:") for a in addresses)  # a scheduler, two workers, on loopback
     outputs = blocks(many.out)
     files = [f"parts/{name}" for name in sorted(expected)]
     assert list(outputs) == files  # every file once, in order, whatever order the workers finished in
@@ -156,3 +167,56 @@ def test_many_programs_build_each_into_its_own_folder_as_one_by_one(tmp_path, ca
     for shop in ("shop_a", "shop_b"):
         for name in ("pocket.ngc", "pocket_samples.csv", "pocket_continuity.txt"):
             assert (tmp_path / "many" / shop / "pocket" / name).read_bytes() == (tmp_path / "alone" / name).read_bytes(), name
+
+
+@pytest.mark.slow
+def test_scheduler_runs_on_an_existing_cluster_and_leaves_it_running(tmp_path, capsys, monkeypatch):
+    from distributed import Client, LocalCluster
+
+    monkeypatch.chdir(tmp_path)
+    Path("parts").mkdir()
+    for k, (_, transition) in enumerate(core_examples()[:4]):
+        write_step([Chain(transition.spirals)], Path("parts") / f"t{k}.step", f"t{k}", "mm", "test")
+    with LocalCluster(n_workers=1, threads_per_worker=1, processes=True, host="127.0.0.1", dashboard_address="127.0.0.1:0") as cluster:
+        status = main(["check", "parts/*.step", "--require", "G2", "--scheduler", cluster.scheduler_address])
+        out = capsys.readouterr().out
+        assert status == 0 and list(blocks(out)) == [f"parts/t{k}.step" for k in range(4)]
+        assert all(text.splitlines()[-1].startswith("OK: 1 wire") for text in blocks(out).values())
+        with Client(cluster) as client:  # ours closed only its client
+            assert client.submit(sum, [1, 2]).result() == 3
+    assert main(["check", "parts", "--scheduler", "tcp://127.0.0.1:9"]) == 2
+    assert "error: --scheduler 'tcp://127.0.0.1:9': no dask scheduler answered" in capsys.readouterr().err
+
+
+@pytest.mark.slow
+@pytest.mark.subprocess
+def test_ctrl_c_in_the_terminal_stops_the_run_and_its_workers_in_one_line(tmp_path):
+    import os
+    import signal
+
+    import psutil
+
+    for k in range(30):
+        write_step([Chain(core_examples()[k % 10][1].spirals)], tmp_path / f"t{k:02d}.step", f"t{k}", "mm", "test")
+    code = "import sys; from spiral_cad_launcher import main; sys.exit(main())"
+    process = subprocess.Popen([sys.executable, "-c", code, "check", str(tmp_path), "--workers", "2"], stdout=subprocess.PIPE,
+                               stderr=subprocess.PIPE, text=True, start_new_session=True)  # fmt: skip
+    assert process.stdout is not None
+    for line in process.stdout:
+        if line.startswith("== "):  # the cluster runs and a result came back
+            break
+    os.killpg(process.pid, signal.SIGINT)  # as a terminal does: the command and every process it started
+    _, err = process.communicate(timeout=120)
+    assert process.returncode == 130 and "Traceback" not in err, err
+    assert err.splitlines()[-1] == "error: interrupted"
+    left = [p for p in psutil.process_iter(["status"]) if _session(p.pid) == process.pid and p.info["status"] != psutil.STATUS_ZOMBIE]
+    assert not left, left
+
+
+def _session(pid):
+    try:
+        import os
+
+        return os.getsid(pid)
+    except OSError:
+        return None
