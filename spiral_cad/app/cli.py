@@ -442,7 +442,7 @@ def _run_many(args: argparse.Namespace, task: Callable[[argparse.Namespace], int
 
 def _check_inputs(args: argparse.Namespace) -> int:
     """``spiral-cad check``: one file as ever (no cluster), or many on dask (``many.py``)."""
-    if not wants_many(args.file) and all(getattr(args, o) is None for o in MANY_OPTIONS):
+    if not wants_many(args.file, CHECK_SUFFIXES) and all(getattr(args, o) is None for o in MANY_OPTIONS):
         args.file = args.file[0]
         return _check(args)
     files = expand_inputs(args.file, CHECK_SUFFIXES)
@@ -469,7 +469,7 @@ def _build_inputs(args: argparse.Namespace) -> int:
         if first is not None:
             expanded = bool(designs) and all(Path(d).suffix.lower() in kinds for d in designs)
             field, inputs, suffixes = option, [first, *designs] if expanded else [first], kinds
-    if not wants_many(inputs) and all(getattr(args, o) is None for o in MANY_OPTIONS):
+    if not wants_many(inputs, suffixes) and all(getattr(args, o) is None for o in MANY_OPTIONS):
         args.design = designs[0] if designs else None
         return _build(args)
     if field != "design" and inputs == [getattr(args, field)] and designs:

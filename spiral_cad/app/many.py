@@ -82,9 +82,15 @@ def _is_pattern(text: str) -> bool:
     return not Path(text).exists() and any(c in _GLOB_CHARACTERS for c in text)
 
 
-def wants_many(inputs: Sequence[str]) -> bool:
-    """True when ``inputs`` name more than one file: several, a folder or a glob pattern."""
-    return len(inputs) > 1 or any(Path(text).is_dir() or _is_pattern(text) for text in inputs)
+def _holds(folder: Path, suffixes: Sequence[str]) -> bool:
+    wanted = {suffix.lower() for suffix in suffixes}
+    return any(p.suffix.lower() in wanted and p.is_file() for p in folder.rglob("*"))
+
+
+def wants_many(inputs: Sequence[str], suffixes: Sequence[str]) -> bool:
+    """True when ``inputs`` name more than one file: several, a glob pattern, or a folder that holds
+    a file with one of ``suffixes`` (any other folder is refused as the one file it is not)."""
+    return len(inputs) > 1 or any(_is_pattern(text) or (Path(text).is_dir() and _holds(Path(text), suffixes)) for text in inputs)
 
 
 def expand_inputs(inputs: Sequence[str], suffixes: Sequence[str]) -> list[str]:

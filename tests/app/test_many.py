@@ -111,7 +111,8 @@ def test_inputs_are_files_patterns_and_folders_each_file_once(tmp_path, monkeypa
     Path("empty").mkdir()
     with pytest.raises(ValueError, match="folder 'empty' holds no"):
         expand_inputs(["empty"], suffixes)
-    assert not wants_many(["a/one.step"]) and wants_many(["a"]) and wants_many(["*.step"]) and wants_many(["x", "y"])
+    assert not wants_many(["a/one.step"], suffixes) and wants_many(["a"], suffixes) and wants_many(["*.step"], suffixes)
+    assert wants_many(["x", "y"], suffixes) and not wants_many(["empty"], suffixes)  # refused as the one file it is not
 
 
 @pytest.mark.parametrize(
