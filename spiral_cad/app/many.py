@@ -146,6 +146,13 @@ class _ThreadStream(io.TextIOBase):
     def fileno(self) -> int:
         return self.stream.fileno()
 
+    def isatty(self) -> bool:
+        return getattr(_capture, self.which) is None and self.stream.isatty()
+
+    @property
+    def encoding(self) -> str:  # type: ignore[override]
+        return getattr(self.stream, "encoding", None) or "utf-8"
+
 
 _install_lock = threading.Lock()
 
@@ -208,8 +215,9 @@ def _client(workers: int | None, scheduler: str | None, files: int) -> Any:
         raise ValueError(f"many files run on dask.distributed, which is not installed: {PIP_MANY}") from None
     import logging
 
-    # a file that kills its worker (OCCT crashing outside the reader's sandbox) is that file's error, not three restarts
-    dask.config.set({"distributed.scheduler.allowed-failures": 0, "distributed.admin.tick.limit": "1h"})
+    # a file that kills its worker (OCCT crashing outside the reader's sandbox) is that file's error after one retry (the
+    # retry spares a file that was only queued on the same worker), not after dask's default three
+    dask.config.set({"distributed.scheduler.allowed-failures": 1, "distributed.admin.tick.limit": "1h"})
     if scheduler is not None:
         try:
             return Client(scheduler, timeout="10s")
@@ -327,7 +335,12 @@ def run_many(task: Callable[[argparse.Namespace], int], files: Sequence[str], ch
         raise ValueError(f"--summary {summary!r}: the summary is CSV; give a .csv file")
     results = _Results(files, verb)
     if len(files) == 1 and scheduler is None:
-        results.add(0, run_one(task, files[0], args, changes[0]))
+        streams = sys.stdout, sys.stderr
+        try:
+            result = run_one(task, files[0], args, changes[0])
+        finally:
+            sys.stdout, sys.stderr = streams  # this process's own again
+        results.add(0, result)
         return results.finish(summary)
     with _interrupts_held():  # the workers start with Ctrl-C blocked: the command alone answers it
         client = _client(workers, scheduler, len(files))

@@ -221,3 +221,29 @@ def _session(pid):
         return os.getsid(pid)
     except OSError:
         return None
+
+
+def stop_the_process_on_a_bad_file(args) -> int:
+    """A one-file command that kills its worker on a file named ``bad…`` (an OCCT crash the reader's sandbox missed)."""
+    import os
+
+    if Path(args.file).name.startswith("bad"):
+        os._exit(3)
+    print(f"read {Path(args.file).name}")
+    return 0
+
+
+@pytest.mark.slow
+def test_a_file_that_kills_its_worker_is_that_file_s_error_and_the_others_pass(capsys):
+    import argparse
+
+    from spiral_cad.app.many import run_many
+
+    files = ["a.step", "bad.step", "b.step", "c.step", "d.step"]
+    status = run_many(stop_the_process_on_a_bad_file, files, [{"file": f} for f in files], argparse.Namespace(file=None),
+                      verb="checked", workers=2)  # fmt: skip
+    out, err = capsys.readouterr()
+    assert status == 2 and "Traceback" not in err
+    assert blocks(out) == {f: "" if f == "bad.step" else f"read {f}\n" for f in files} and list(blocks(out)) == files
+    errors = [line for line in err.splitlines() if line.startswith("error: ")]
+    assert len(errors) == 1 and errors[0].startswith("error: bad.step: its worker stopped (KilledWorker"), errors
