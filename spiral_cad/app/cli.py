@@ -19,6 +19,7 @@ from ..core.transitions import Transition
 from ..design.tables import fixed_columns
 from ..io.opendrive_check import PROFILE_LEVELS, OpenDriveReport
 from ..io.signals import signals_handled
+from .many import PIP_MANY, expand_inputs, note_worst, wants_many
 
 
 def core_examples() -> list[tuple[str, Transition]]:
@@ -106,6 +107,8 @@ def _write_design(design: dict | str, out: Path, plots: bool, extra: Callable[[P
         if tables:
             print(tables + "\n")
         print(summary(built, units))
+        for b in built:  # "G2 (…)": the level the STEP file was checked at
+            note_worst((b.continuity or "").split(" ", 1)[0])
         print(f"\nwrote {len(written.files)} files to {out}/ in {time.perf_counter() - started:.1f} s")
     except KeyboardInterrupt:
         raise KeyboardInterrupt(f"every file had been written to {out}/") from None
@@ -326,6 +329,7 @@ def _comb_path(comb: str, checked: str) -> Path:
 def _print_report(report: ContinuityReport, args: argparse.Namespace) -> int:
     """Print ``report`` for ``spiral-cad check``; exit status 0 ok, 1 below ``--require`` or not ``--pieces`` pieces."""
     print(report.format_table())
+    note_worst(str(report.min_level))
     if getattr(args, "timing", False) and report.timing is not None:
         print(report.timing_line())
     if not args.require:
@@ -348,6 +352,7 @@ def _print_opendrive_report(report: OpenDriveReport, args: argparse.Namespace) -
     an elevation or superelevation below ``--profiles``, a link below ``--links``, or the file does
     not hold ``--pieces`` roads; else 0."""
     print(report.format_table())
+    note_worst(str(report.min_level))
     failures = []
     if args.pieces is not None and report.pieces != args.pieces:
         failures.append(f"{report.pieces} roads, expected {args.pieces}")
@@ -380,7 +385,8 @@ def _add_check(sub: argparse._SubParsersAction) -> None:
         "1 below --require, --profiles or --links (or not --pieces pieces), 2 unreadable file or bad option, "
         "141 output pipe closed early.",
     )
-    check.add_argument("file", help="a .step/.stp, .igs/.iges or .xodr file (OpenDRIVE: one piece per road)")
+    check.add_argument("file", nargs="+", help="a .step/.stp, .igs/.iges or .xodr file (OpenDRIVE: one piece per road); several "
+                       "files, folders or glob patterns are checked in parallel (see --workers)")  # fmt: skip
     check.add_argument(
         "--require", choices=["G0", "G1", "G2"],
         help="exit 1 if any joint (OpenDRIVE: of any road's planView) is below this level or the file is not in --pieces pieces",
@@ -406,7 +412,74 @@ def _add_check(sub: argparse._SubParsersAction) -> None:
                        help="faces: normals further apart (radians) make a sharp feature, listed and not failed (default 5°)")  # fmt: skip
     check.add_argument("--zebra", metavar="OUT.png", help="faces: also draw zebra stripes (reflection lines) of the part as PNG")
     check.add_argument("--curvature-map", metavar="OUT.png", help="faces: also draw the mean curvature of the part as PNG")
-    check.set_defaults(run=_check)
+    _add_many(check)
+    check.set_defaults(run=_check_inputs)
+
+
+#: The files ``check`` looks for in a folder it is given.
+CHECK_SUFFIXES = (".step", ".stp", ".igs", ".iges", ".xodr")
+#: The options of ``many.py``: none of them changes what a file gives.
+MANY_OPTIONS = ("workers", "scheduler", "summary")
+
+
+def _add_many(command: argparse.ArgumentParser) -> None:
+    many = command.add_argument_group(
+        "many files", "several files, folders or glob patterns ('**' reaches into subfolders) run in parallel on dask.distributed,\n"
+        "one task per file, each file's output in the order given; exit 0 only when every file passes, else 2 with an\n"
+        f"'error: FILE: …' line per file (needs {PIP_MANY})")  # fmt: skip
+    many.add_argument("--workers", type=int, metavar="N", help="worker processes of the local cluster (default: one per core)")
+    many.add_argument("--scheduler", metavar="ADDRESS",
+                      help="run on the dask cluster of this scheduler (tcp://host:8786) instead of a local one; every worker "
+                           "must see the files at the same paths")  # fmt: skip
+    many.add_argument("--summary", metavar="FILE.csv", help="also write one row per file: file, verdict, worst joint, seconds")
+
+
+def _run_many(args: argparse.Namespace, task: Callable[[argparse.Namespace], int], files: list[str], changes: list[dict], verb: str) -> int:
+    from .many import run_many
+
+    return run_many(task, files, changes, args, verb=verb, workers=args.workers, scheduler=args.scheduler, summary=args.summary)
+
+
+def _check_inputs(args: argparse.Namespace) -> int:
+    """``spiral-cad check``: one file as ever (no cluster), or many on dask (``many.py``)."""
+    if not wants_many(args.file, CHECK_SUFFIXES) and all(getattr(args, o) is None for o in MANY_OPTIONS):
+        args.file = args.file[0]
+        return _check(args)
+    files = expand_inputs(args.file, CHECK_SUFFIXES)
+    drawn = [f"--{o.replace('_', '-')}" for o in ("comb", "zebra", "curvature_map") if getattr(args, o)]
+    if drawn and len(files) > 1:
+        raise ValueError(f"{', '.join(drawn)}: each writes one file; give one file to check")
+    where = os.path.abspath if args.scheduler else str  # a remote worker's working folder is not ours
+    return _run_many(args, _check, files, [{"file": where(f)} for f in files], "checked")
+
+
+def _build_inputs(args: argparse.Namespace) -> int:
+    """``spiral-cad build``: one design or program as ever, or many on dask, each into OUT/ its name.
+
+    Many programs or point files come as a folder or pattern after ``--from-gcode``/``--from-points``,
+    or as the shell expands one (the first after the option, the others where a design file goes).
+    """
+    from ..io.gcode import SUFFIXES as GCODE_SUFFIXES
+
+    designs: list[str] = args.design
+    field, inputs = "design", designs
+    suffixes: tuple[str, ...] = (".json", ".xml")
+    for option, kinds in (("from_gcode", GCODE_SUFFIXES), ("from_points", (".csv", ".txt", ".xyz"))):
+        first = getattr(args, option)
+        if first is not None:
+            expanded = bool(designs) and all(Path(d).suffix.lower() in kinds for d in designs)
+            field, inputs, suffixes = option, [first, *designs] if expanded else [first], kinds
+    if not wants_many(inputs, suffixes) and all(getattr(args, o) is None for o in MANY_OPTIONS):
+        args.design = designs[0] if designs else None
+        return _build(args)
+    if field != "design" and inputs == [getattr(args, field)] and designs:
+        raise ValueError(f"give design files or --{field.replace('_', '-')}, not both")
+    files = expand_inputs(inputs, suffixes)
+    where = os.path.abspath if args.scheduler else str
+    top = os.path.commonpath([os.path.dirname(os.path.abspath(f)) for f in files])
+    outs = [Path(args.out) / Path(os.path.relpath(os.path.abspath(f), top)).with_suffix("") for f in files]
+    changes = [{"design": None, field: where(f), "out": where(str(out))} for f, out in zip(files, outs)]
+    return _run_many(args, _build, files, changes, "built")
 
 
 def _schema(args: argparse.Namespace) -> int:
@@ -446,7 +519,10 @@ def _parser() -> argparse.ArgumentParser:
         description="Build a JSON design file (spiral-cad schema prints its JSON Schema, the format's reference) or a G-code program.",
     )
     build.add_argument(
-        "design", nargs="?", help="the design file (.json), or a LandXML file (.xml: every alignment); or --from-gcode or --from-points"
+        "design",
+        nargs="*",
+        help="the design file (.json), or a LandXML file (.xml: every alignment); or --from-gcode or --from-points; "
+        "several files, folders or glob patterns are built in parallel, each into OUT/ its name (see --workers)",
     )
     build.add_argument("-o", "--out", default="out", help="output folder (default: out)")
     build.add_argument("--no-plots", action="store_true", help="skip the PNG plots (the slowest output for long chains)")
@@ -498,7 +574,8 @@ def _parser() -> argparse.ArgumentParser:
         type=float,
         help="fit a road alignment and judge its curves at this speed (km/h; mph in ft); a file with z is a road anyway (plan and profile)",
     )
-    build.set_defaults(run=_build)
+    _add_many(build)
+    build.set_defaults(run=_build_inputs)
     _add_check(sub)
     schema = sub.add_parser("schema", help="print the JSON Schema of design files (the format of build)")
     schema.set_defaults(run=_schema)

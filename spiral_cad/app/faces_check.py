@@ -9,6 +9,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from ..cad.faces import FEATURE_ANGLE, check_faces
+from .many import note_worst
 
 if TYPE_CHECKING:
     from matplotlib.figure import Figure  # matplotlib is imported only when a picture is drawn
@@ -72,6 +73,7 @@ def check_face_file(file: str, *, require: str | None = None, gap_tol: float | N
     if report.faces == 0:
         return None
     print(report.table())
+    note_worst(report.worst)
     if timing:
         print(f"time {report.seconds:.3g} s for {report.faces} faces and {len(report.edges)} edges, reading included")
     if zebra_png is not None or map_png is not None:
