@@ -20,8 +20,13 @@ from numpy.typing import ArrayLike, NDArray
 
 from . import _kernels as K
 from ._inputs import as_float, as_real_array
+from ._jit import Kernels
 from ._threads import run_split
 from .units import COLLINEAR_TOL
+
+#: This module's kernels (placing and verifying points in their planes), compiled into this module.
+KERNELS = Kernels(globals())
+jit = KERNELS.jit
 
 #: Legs whose |sin(turn)| is at most this span no plane.
 
@@ -57,7 +62,7 @@ def place(points: ArrayLike, origin: ArrayLike, x_dir: ArrayLike, y_dir: ArrayLi
 POINTS_PER_THREAD = 100_000
 
 
-@K.jit
+@jit
 def _place_row(
     points: NDArray[np.float64],
     origin: NDArray[np.float64],
@@ -73,7 +78,7 @@ def _place_row(
             out[i, k, j] = origin[i, j] + u * x_dir[i, j] + v * y_dir[i, j]
 
 
-@K.jit
+@jit
 def _place_rows(
     points: NDArray[np.float64],
     origin: NDArray[np.float64],
@@ -148,7 +153,7 @@ def placed_pair_residuals(pairs: NDArray[np.float64], corners: NDArray[np.float6
     run_split(_pair_residuals, args, len(corners), POINTS_PER_THREAD // 8)
 
 
-@K.jit
+@jit
 def _pair_residual(
     pairs: NDArray[np.float64],
     corners: NDArray[np.float64],
@@ -187,7 +192,7 @@ def _pair_residual(
     deviation[i] = math.sqrt(jx * jx + jy * jy + jz * jz) * scale
 
 
-@K.jit
+@jit
 def _pair_residuals(
     pairs: NDArray[np.float64],
     corners: NDArray[np.float64],
@@ -282,3 +287,6 @@ class PlaneFrame:
         """Plane coordinates (..., 2) of points (..., 3): their projection onto the plane."""
         d = np.asarray(xyz, dtype=float) - self.origin
         return np.stack([d @ self.x_dir, d @ self.y_dir], axis=-1)
+
+
+KERNELS.seal()

@@ -40,6 +40,7 @@ from ..core import _chain_kernels as CK
 from ..core import _kernels as K
 from ..core import batch
 from ..core._inputs import as_float, as_real_array
+from ..core._jit import Kernels
 from ..core.chain import JOIN_TOLERANCE, ROUNDING_CAP, Chain, PartCircles, join_rows, join_tolerance
 from ..core.errors import JointError, NoSolutionError, Status
 from ..core.factors import length_factor
@@ -66,6 +67,10 @@ G2CBS_C4 = (G2CBS_C2 + 4.0) ** 2 / (54.0 * G2CBS_C3)
 DEVIATION_MARGIN = 1e-12
 ROUNDING_ULPS = 8.0
 EPS = float(np.finfo(float).eps)
+
+#: This module's kernel (the joints of corner pairs), compiled into this module.
+KERNELS = Kernels(globals())
+jit = KERNELS.jit
 
 
 def corner_scale(theta_sin: ArrayLike, theta_cos: ArrayLike, value: ArrayLike, shape: str) -> NDArray:
@@ -530,7 +535,7 @@ def round_corners_batch(
                        given["max_deviation"], given["max_curvature"], given["spiral_lengths"])  # fmt: skip
 
 
-@K.jit
+@jit
 def _pair_joints(cp, ok, t_in, t_out, line_in, line_out, tolerance, cap, held, off):  # pragma: no cover - compiled
     """``_joints_hold`` per row: the spirals' end frames and floors (``_chain_kernels._spiral``), the
     legs' lines, and the three joints judged by ``_chain_kernels.joint_measures``."""
@@ -1100,3 +1105,6 @@ def fillet_polyline(
     if broken:
         raise NoSolutionError(f"corner {broken[0]}: float64 cannot hold its fillet G2 at these coordinates ({broken[1]})")
     return FilletedPolyline(tuple(segments), tuple(owners), fillets, closed, length_unit(units))
+
+
+KERNELS.seal()
