@@ -164,11 +164,11 @@ def _pair_residual(
     residual: NDArray[np.float64],
     deviation: NDArray[np.float64],
     i: int,
+    local: NDArray[np.float64],
 ) -> None:
-    """Row ``i`` of ``placed_pair_residuals``."""
+    """Row ``i`` of ``placed_pair_residuals`` (``local`` (2, 4, 2): room for the pair in plane coordinates)."""
     x, y = x_dir[i], y_dir[i]
     nx, ny, nz = x[1] * y[2] - x[2] * y[1], x[2] * y[0] - x[0] * y[2], x[0] * y[1] - x[1] * y[0]
-    local = np.empty((2, 4, 2))
     off = 0.0
     for k in range(2):
         for m in range(4):
@@ -203,8 +203,9 @@ def _pair_residuals(
     residual: NDArray[np.float64],
     deviation: NDArray[np.float64],
 ) -> None:
+    local = np.empty((2, 4, 2))  # once per call: an allocation per row would cost as much as the row
     for i in range(corners.shape[0]):
-        _pair_residual(pairs, corners, x_dir, y_dir, outgoing, peak, residual, deviation, i)
+        _pair_residual(pairs, corners, x_dir, y_dir, outgoing, peak, residual, deviation, i, local)
 
 
 def _vector3(value: Any, name: str) -> NDArray[np.float64]:
