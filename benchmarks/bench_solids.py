@@ -20,6 +20,9 @@ from timing import arguments, compare, machine, write_markdown
 from spiral_cad import Arc, Line
 from spiral_cad.build123d import ContinuousBox, g2_slab
 
+#: The modules whose code these numbers measure (stamped into the results: ``timing.code_stamp``).
+MEASURES = ("spiral_cad.build123d", "spiral_cad.cad.solids")
+
 
 def peer_box() -> bd.Part:
     """build123d's box: vertical edges filleted at 6, then the top and bottom edges at 1.5."""
