@@ -23,14 +23,14 @@ CAD = ("faces", "box")
 
 @pytest.mark.parametrize("name", [n for n in guard.GUARDS if n not in CAD])
 def test_the_numeric_operations_keep_their_speed(name):
-    verdict = guard.judge(guard.GUARDS[name](), rounds=3)
+    verdict = guard.judge(guard.GUARDS[name]())
     assert verdict.passed, " | ".join(verdict.row())
 
 
 @pytest.mark.parametrize("name", CAD)
 def test_the_cad_operations_keep_their_speed(name):
     pytest.importorskip("build123d")
-    verdict = guard.judge(guard.GUARDS[name](), rounds=3)
+    verdict = guard.judge(guard.GUARDS[name]())
     assert verdict.passed, " | ".join(verdict.row())
 
 
@@ -50,7 +50,7 @@ def test_the_guard_fails_when_a_kernel_falls_back_to_plain_python(name, module, 
     owner = importlib.import_module(module)
     owner.KERNELS.compile()
     small = guard.GUARDS[name](scale)  # smaller inputs (plain Python takes seconds even so), large enough to pass compiled
-    compiled = guard.judge(small, rounds=3)
+    compiled = guard.judge(small)
     assert compiled.passed, " | ".join(compiled.row())
     for kernel in owner.KERNELS.functions:
         monkeypatch.setitem(vars(owner), kernel, getattr(owner.KERNELS.python, kernel))
