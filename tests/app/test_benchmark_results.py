@@ -70,7 +70,9 @@ def test_every_results_file_was_measured_on_the_code_as_it_is(results):
         pytest.skip(f"{results.name} predates the stamps: rerun {script.name} to stamp it")
     assert len(stated) == 1, f"{results.name} states no code stamp: rerun {script.name}"
     now = timing.code_stamp(str(script), measures(script))
-    assert stated[0] == now, f"{results.name} was measured on other code than today's: rerun {script.name}\n  file: {stated[0]}\n  now:  {now}"
+    assert stated[0] == now, (
+        f"{results.name} was measured on other code than today's: rerun {script.name}\n  file: {stated[0]}\n  now:  {now}"
+    )
 
 
 def test_a_change_to_a_measured_module_changes_the_stamp_and_a_docstring_does_not(tmp_path):
