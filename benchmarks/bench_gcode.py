@@ -39,6 +39,10 @@ MEASURES = (
     "spiral_cad.design.rounding",
     "spiral_cad.core.space",
     "spiral_cad.core.chain",
+    "spiral_cad.app.designfile",
+    "spiral_cad.io.samples",
+    "spiral_cad.io.step",
+    "spiral_cad.core.bezier",
 )
 
 MAX_DEVIATION = 0.01  # mm at every corner
