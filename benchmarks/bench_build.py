@@ -25,6 +25,9 @@ from pathlib import Path
 from bench_roads import zigzag
 from timing import Report, Timing, arguments, growth_exponent
 
+#: The modules whose code these numbers measure (stamped into the results: ``timing.code_stamp``).
+MEASURES = ("spiral_cad.app.cli", "spiral_cad.app.designfile", "spiral_cad.cad.export")
+
 COMMAND = [str(Path(sys.executable).parent / "spiral-cad")]  # the installed command, as a user runs it
 
 

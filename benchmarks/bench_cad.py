@@ -25,6 +25,9 @@ from spiral_cad.cad.export import export_step
 from spiral_cad.cad.occ import chain_wire
 from spiral_cad.cad.readers import read_shape
 
+#: The modules whose code these numbers measure (stamped into the results: ``timing.code_stamp``).
+MEASURES = ("spiral_cad.cad.occ", "spiral_cad.cad.export", "spiral_cad.cad.continuity", "spiral_cad.cad.readers", "spiral_cad.core.chain")
+
 
 def snake(segments: int) -> Chain:
     """Circles of alternating sense joined by S transitions: arc, spiral, spiral, …"""

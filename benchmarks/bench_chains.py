@@ -32,6 +32,15 @@ from pathlib import Path
 
 from timing import growth_exponent, machine, write_markdown
 
+#: The modules whose code these numbers measure (stamped into the results: ``timing.code_stamp``).
+MEASURES = (
+    "spiral_cad.core.chain",
+    "spiral_cad.core.segments",
+    "spiral_cad.core.rows",
+    "spiral_cad.core._chain_kernels",
+    "spiral_cad.design.alignment",
+)
+
 ROOT = Path(__file__).resolve().parent.parent
 CHAIN_SIZES = (1_000, 10_000, 40_000)
 PI_SIZES = (100, 300, 1_000, 3_000, 10_000)

@@ -27,6 +27,9 @@ from spiral_cad.cad.readers import read_shape
 from spiral_cad.cad.sandbox import run_isolated
 from spiral_cad.design import Alignment
 
+#: The modules whose code these numbers measure (stamped into the results: ``timing.code_stamp``).
+MEASURES = ("spiral_cad.cad.continuity", "spiral_cad.cad.readers", "spiral_cad.cad.sandbox", "spiral_cad.cad.export")
+
 
 def in_process_check(path: Path) -> None:
     """The peer: OCCT reads in this process, the same measures follow."""

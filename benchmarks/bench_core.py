@@ -18,6 +18,16 @@ import spiral_cad as sc
 from spiral_cad.core import _kernels as K
 from spiral_cad.core import batch
 
+#: The modules whose code these numbers measure (stamped into the results: ``timing.code_stamp``).
+MEASURES = (
+    "spiral_cad.core._kernels",
+    "spiral_cad.core._jit",
+    "spiral_cad.core._threads",
+    "spiral_cad.core.batch",
+    "spiral_cad.core.transitions",
+    "spiral_cad.core.bezier",
+)
+
 
 def line_circle_problems(n: int, rng: np.random.Generator, near: bool = False):
     """Lines along +x through the origin, circles above at d/r ∈ [1.01, 1.5] (``near``:

@@ -26,6 +26,9 @@ from timing import arguments, compare, growth_exponent, machine, table, write_ma
 
 from spiral_cad.cad.faces import check_faces
 
+#: The modules whose code these numbers measure (stamped into the results: ``timing.code_stamp``).
+MEASURES = ("spiral_cad.cad.faces", "spiral_cad.cad.mesh", "spiral_cad.app.zebra")
+
 
 def boxes(count: int) -> bd.Compound:
     """``count`` filleted boxes on a grid, one compound."""

@@ -26,6 +26,9 @@ from timing import Report, arguments, table
 from spiral_cad import NoSolutionError
 from spiral_cad.build123d import g2_fillet
 
+#: The modules whose code these numbers measure (stamped into the results: ``timing.code_stamp``).
+MEASURES = ("spiral_cad.build123d", "spiral_cad.cad.fillet")
+
 
 def zigzag_face(corners: int) -> tuple[bd.Face, float]:
     k = np.arange(corners)

@@ -23,6 +23,9 @@ from spiral_cad import fit_points
 from spiral_cad.core.fit import chain_distances
 from spiral_cad.design import Alignment
 
+#: The modules whose code these numbers measure (stamped into the results: ``timing.code_stamp``).
+MEASURES = ("spiral_cad.core.fit",)
+
 TOLERANCE = 0.05  # m
 
 

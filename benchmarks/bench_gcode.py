@@ -1,6 +1,6 @@
 """Large G-code programs: reading, and rounding as a Chain (``round_toolpath``) or as arrays.
 
-Run: ``.venv/bin/python benchmarks/bench_gcode.py [--quick] [--sizes N ...] [--chain-max N] [--write-max N] [--out FILE]``
+Run: ``.venv/bin/python benchmarks/bench_gcode.py [--quick] [--sizes N ...] [--chain-max N] [--write-max N] [--build-max N] [--out FILE]``
 (the harness and its conventions: ``timing.py``). Each size is a generated pocketing
 program (a zigzag of G1 moves with jittered ends, layer after layer, 4 decimals in mm),
 written to a file; after a warm-up on 50 moves (the kernels compile), every job runs in a child process of its own, so its peak memory
@@ -10,10 +10,12 @@ alone; ``read_gcode`` + ``round_toolpath`` (spirals as objects in a ``Chain``, w
 ``round_toolpath_arrays`` (the same spirals as arrays); and, up to ``--write-max`` moves, the
 moves' plan (x, y after the plunge) rounded as a Chain and written as G-code (``gcode_program``:
 LinuxCNC with exact G5, and generic with biarcs within 0.001 mm), and the LinuxCNC program
-read back as the same chain (``parse_gcode_chain``). One run per job (a minute-long
+read back as the same chain (``parse_gcode_chain``); and, up to ``--build-max`` moves, the whole
+command ``spiral-cad build --from-gcode FILE --max-deviation 0.01 --no-plots`` (read, round, write
+STEP, G-code, samples and DXF; peak = the larger of the command's process and its children). One run per job (a minute-long
 job on a shared machine: the spread is not measured); the peer of the arrays is the
 Chain at the same size. Goals: 100 000 moves read and rounded in ≤ 60 s and ≤ 1.5 GB;
-1 M moves rounded in ≤ 20 s and ≤ 3 GB.
+1 M moves rounded in ≤ 20 s and ≤ 3 GB; ``build --from-gcode`` of 100 000 moves in ≤ 30 s and ≤ 1 GB.
 """
 
 from __future__ import annotations
@@ -28,6 +30,20 @@ import time
 
 import numpy as np
 from timing import Report, Timing, arguments
+
+#: The modules whose code these numbers measure (stamped into the results: ``timing.code_stamp``).
+MEASURES = (
+    "spiral_cad.io.gcode",
+    "spiral_cad.io.toolpath",
+    "spiral_cad.io.gcode_write",
+    "spiral_cad.design.rounding",
+    "spiral_cad.core.space",
+    "spiral_cad.core.chain",
+    "spiral_cad.app.designfile",
+    "spiral_cad.io.samples",
+    "spiral_cad.io.step",
+    "spiral_cad.core.bezier",
+)
 
 MAX_DEVIATION = 0.01  # mm at every corner
 
@@ -50,6 +66,9 @@ def peak_mb() -> float:
 
 def child(job: str, moves: int) -> None:
     """One job in this process; prints its seconds and peak memory as JSON."""
+    if job == "build":
+        build(moves)
+        return
     from spiral_cad.io.gcode import parse_gcode, read_gcode, round_toolpath, round_toolpath_arrays
 
     warm = parse_gcode(program(50))  # compile the kernels first (one warm-up, as compare does)
@@ -98,6 +117,38 @@ def child(job: str, moves: int) -> None:
     print(json.dumps({"read": read, "round": rounded, "peak_mb": peak_mb(), "before_mb": before, "moves": len(path)}))
 
 
+def build(moves: int) -> None:
+    """``spiral-cad build --from-gcode`` of a program of ``moves`` moves, as the command runs it (its stderr kept)."""
+    from spiral_cad.app.cli import main
+
+    with tempfile.TemporaryDirectory() as folder:
+        file = os.path.join(folder, f"pocket{moves}.nc")
+        with open(file, "w", encoding="ascii") as handle:
+            handle.write(program(moves))
+        started = time.perf_counter()
+        with open(os.devnull, "w") as quiet:
+            stdout, sys.stdout = sys.stdout, quiet
+            try:
+                code = main(
+                    [
+                        "build",
+                        "--from-gcode",
+                        file,
+                        "--max-deviation",
+                        str(MAX_DEVIATION),
+                        "--out",
+                        os.path.join(folder, "out"),
+                        "--no-plots",
+                    ]
+                )
+            finally:
+                sys.stdout = stdout
+        seconds = time.perf_counter() - started
+    children = resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss / 1024.0
+    assert code == 0, code
+    print(json.dumps({"build": seconds, "peak_mb": max(peak_mb(), children)}))
+
+
 def run(job: str, moves: int) -> dict:
     done = subprocess.run([sys.executable, __file__, "--child", job, str(moves)], capture_output=True, text=True, check=False)
     if done.returncode != 0:
@@ -109,7 +160,8 @@ def main() -> None:
     if len(sys.argv) == 4 and sys.argv[1] == "--child":
         child(sys.argv[2], int(sys.argv[3]))
         return
-    args = arguments(__doc__, sizes=([10_000, 100_000, 1_000_000], [300, 2_000]), chain_max=(100_000, 2_000), write_max=(10_000, 300))
+    args = arguments(__doc__, sizes=([10_000, 100_000, 1_000_000], [300, 2_000]), chain_max=(100_000, 2_000), write_max=(10_000, 300),
+                     build_max=(10_000, 300))  # fmt: skip
     report = Report("G-code benchmark", f"Generated pocketing programs, max_deviation {MAX_DEVIATION} mm; one run per job, "
                                         "each in its own process (peak = that process's maximum resident set).")  # fmt: skip
     rows = []
@@ -138,6 +190,13 @@ def main() -> None:
             report.add(f"gcode_program (generic, biarcs), {moves:,} moves", written["generic"], "s", Timing((written["generic"],)),
                        f"LinuxCNC {written['linuxcnc']:.2f} s", written["linuxcnc"] / written["generic"])  # fmt: skip
             report.add(f"parse_gcode_chain of it (the same chain), {moves:,} moves", written["back"], "s", Timing((written["back"],)))
+        if moves <= args.build_max:
+            built = run("build", moves)
+            goal = ""
+            if moves == 100_000:
+                goal = f"≤ 30 s, ≤ 1 GB: {'met' if built['build'] <= 30 and built['peak_mb'] <= 1024 else 'missed'}"
+            report.add(f"spiral-cad build --from-gcode, {moves:,} moves", built["build"], "s", Timing((built["build"],)),
+                       f"peak {built['peak_mb']:,.0f} MB", goal=goal)  # fmt: skip
         rows.append(f"| {moves:,} | {read['read']:.2f} s, {read['peak_mb']:,.0f} MB | "
                     + (f"{chain['round']:.2f} s, {chain['peak_mb']:,.0f} MB" if chain else "not run (above --chain-max)")
                     + f" | {arrays['round']:.2f} s, {arrays['peak_mb']:,.0f} MB |")  # fmt: skip

@@ -23,6 +23,9 @@ from spiral_cad.cad.export import export_opendrive
 from spiral_cad.design import Alignment, Profile
 from spiral_cad.io.ifc import read_ifc_alignments, write_ifc
 
+#: The modules whose code these numbers measure (stamped into the results: ``timing.code_stamp``).
+MEASURES = ("spiral_cad.io.ifc",)
+
 
 def road(count: int) -> tuple[Alignment, Profile]:
     pis = [[1000.0 * k, 250.0 * (k % 2)] for k in range(count + 2)]

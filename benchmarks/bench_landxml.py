@@ -23,6 +23,9 @@ from spiral_cad.io import read_landxml
 from spiral_cad.io.landxml import write_landxml
 from spiral_cad.io.opendrive import read_opendrive
 
+#: The modules whose code these numbers measure (stamped into the results: ``timing.code_stamp``).
+MEASURES = ("spiral_cad.io.landxml", "spiral_cad.io.landxml_read")
+
 
 def zigzag(count: int) -> list[list[float]]:
     return [[1000.0 * k, 250.0 * (k % 2)] for k in range(count + 2)]

@@ -29,7 +29,17 @@ import time
 from pathlib import Path
 
 import numpy as np
-from timing import arguments, machine, median_time
+from timing import arguments, code_stamp, load, machine, median_time
+
+#: The modules whose code these numbers measure (stamped into the results: ``timing.code_stamp``).
+MEASURES = (
+    "spiral_cad.design.rounding",
+    "spiral_cad.core.space",
+    "spiral_cad.core._chain_kernels",
+    "spiral_cad.io.gcode",
+    "spiral_cad.cad.export",
+    "spiral_cad.build123d",
+)
 
 SIZES = {"corners": 1_000_000, "moves": 100_000, "handrail": 1_000, "scalar": 2_000}
 QUICK = {"corners": 20_000, "moves": 2_000, "handrail": 30, "scalar": 200}
@@ -171,8 +181,8 @@ def main() -> None:
     head = ["job", "size", "time (s)", "rate / detail", "peer in the same run", "note"]
     with tempfile.TemporaryDirectory() as folder:
         rows = rounding_rows(sizes, repeat) + gcode_rows(sizes, Path(folder)) + sweep_rows(sizes)
-    lines = [f"Machine: {machine()}; medians of {repeat} runs (G-code and sweep: one run each)", "",
-             "| " + " | ".join(head) + " |", "|" + "---|" * len(head)]  # fmt: skip
+    lines = [f"Machine: {machine()}; load {load()} when written; medians of {repeat} runs (G-code and sweep: one run each)", "",
+             code_stamp(__file__, MEASURES), "", "| " + " | ".join(head) + " |", "|" + "---|" * len(head)]  # fmt: skip
     lines += ["| " + " | ".join(row) + " |" for row in rows]
     print("\n".join(lines))
     if args.out:

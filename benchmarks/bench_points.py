@@ -22,6 +22,9 @@ from timing import Report, arguments, compare, per_second
 from spiral_cad.app.fitreport import write_residuals
 from spiral_cad.io.points import read_points
 
+#: The modules whose code these numbers measure (stamped into the results: ``timing.code_stamp``).
+MEASURES = ("spiral_cad.io.points", "spiral_cad.app.fitreport")
+
 
 def survey(rows: int) -> np.ndarray:
     return np.random.default_rng(24).normal(scale=1e4, size=(rows, 3))

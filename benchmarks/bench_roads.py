@@ -22,6 +22,15 @@ from spiral_cad.cad.export import export_opendrive
 from spiral_cad.design import Alignment
 from spiral_cad.io.opendrive import check_opendrive, read_network, read_opendrive
 
+#: The modules whose code these numbers measure (stamped into the results: ``timing.code_stamp``).
+MEASURES = (
+    "spiral_cad.design.alignment",
+    "spiral_cad.io.opendrive",
+    "spiral_cad.io.opendrive_read",
+    "spiral_cad.io.opendrive_check",
+    "spiral_cad.app.plots",
+)
+
 
 def zigzag(count: int) -> list[list[float]]:
     return [[1000.0 * k, 250.0 * (k % 2)] for k in range(count + 2)]

@@ -14,6 +14,15 @@ from timing import Report, arguments, compare, per_second
 
 from spiral_cad.design import corner_legs, round_corners_batch
 
+#: The modules whose code these numbers measure (stamped into the results: ``timing.code_stamp``).
+MEASURES = (
+    "spiral_cad.design.rounding",
+    "spiral_cad.core.space",
+    "spiral_cad.core._chain_kernels",
+    "spiral_cad.core._kernels",
+    "spiral_cad.core.batch",
+)
+
 
 def random_polyline(corners: int, rng: np.random.Generator) -> np.ndarray:
     """A walk with legs in [1, 10] and turns in ±[5°, 150°]."""

@@ -22,6 +22,9 @@ from spiral_cad import BezierSpiral
 from spiral_cad.core.factors import length_factor, shift_factor
 from spiral_cad.design import RoadCriteria
 
+#: The modules whose code these numbers measure (stamped into the results: ``timing.code_stamp``).
+MEASURES = ("spiral_cad.core.spiral", "spiral_cad.core.factors", "spiral_cad.design.criteria")
+
 SHAPES = ("walton-meek", "near-linear")
 DESIGNS = ((60, 120, 0.9), (80, 250, 0.6), (100, 500, 0.5), (100, 700, 0.5), (120, 1000, 0.3))
 ANGLES = (2, 5, 8, 15, 30, 45, 60)

@@ -26,6 +26,9 @@ import spiral_cad.cad.solids as solids
 from spiral_cad import Arc, Line
 from spiral_cad.build123d import ContinuousBox, g2_slab
 
+#: The modules whose code these numbers measure (stamped into the results: ``timing.code_stamp``).
+MEASURES = ("spiral_cad.build123d", "spiral_cad.cad.solids")
+
 #: The steps of a slab, by the function of ``spiral_cad.cad.solids`` doing each.
 STEPS = {
     "fit checks": "_roll_problem",

@@ -48,6 +48,9 @@ from spiral_cad.cad.step_occ import write_shape_step
 from spiral_cad.check.joints import ContinuityReport
 from spiral_cad.design import Alignment
 
+#: The modules whose code these numbers measure (stamped into the results: ``timing.code_stamp``).
+MEASURES = ("spiral_cad.cad.export", "spiral_cad.cad.step_occ", "spiral_cad.cad.occ", "spiral_cad.cad.continuity")
+
 
 def zigzag(count: int) -> list[list[float]]:
     return [[1000.0 * k, 250.0 * (k % 2)] for k in range(count + 2)]

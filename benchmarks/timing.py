@@ -18,20 +18,32 @@ and runs them all; ``make bench``; the test suite runs them with ``--quick``):
 * ``--quick`` shrinks every size and round to the least that exercises the
   code (a smoke test: the test suite checks that every script runs and writes
   its table, never its numbers).
+* It names the modules whose code its numbers measure in ``MEASURES``
+  (module names); every results file it writes states the ``code_stamp`` of
+  them and of the script, and ``tests/app/test_benchmark_results.py`` fails
+  when a results file no longer matches the code it measured.
 """
 
 from __future__ import annotations
 
 import argparse
+import ast
+import hashlib
 import math
 import os
 import platform
 import statistics
+import sys
 import time
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
+
+#: The repository (the folder above ``benchmarks/``).
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+#: How a results file states the code it measured.
+STAMP_PREFIX = "Code measured: "
 
 
 @dataclass(frozen=True)
@@ -81,6 +93,42 @@ def latencies(calls: dict[str, Callable[[], object]], rounds: int, number: int) 
 def growth_exponent(sizes: Sequence[float], seconds: Sequence[float]) -> float:
     """k in time ∝ size^k, fitted by least squares on logs (1: linear)."""
     return float(np.polyfit(np.log(np.asarray(sizes, dtype=float)), np.log(np.asarray(seconds, dtype=float)), 1)[0])
+
+
+def _source(module: str) -> str:
+    """The file of a module of this repository by its dotted name (``spiral_cad.core.space``)."""
+    base = os.path.join(ROOT, *module.split("."))
+    return os.path.join(base, "__init__.py") if os.path.isdir(base) else base + ".py"
+
+
+def _code(path: str) -> str:
+    """A file's code without its docstrings, comments or layout (``ast.dump``): what changes its speed."""
+    with open(path, encoding="utf-8") as handle:
+        tree = ast.parse(handle.read())
+    for node in ast.walk(tree):
+        body = getattr(node, "body", None)
+        if isinstance(body, list) and body and isinstance(body[0], ast.Expr) and isinstance(getattr(body[0], "value", None), ast.Constant):
+            if isinstance(body[0].value.value, str):
+                node.body = body[1:] or [ast.Pass()]  # type: ignore[attr-defined]
+    return ast.dump(tree)
+
+
+def code_stamp(script: str, measures: Sequence[str]) -> str:
+    """The stamp line of a results file: a hash of the code of ``script`` (a path) and of the
+    ``measures`` modules, then what was hashed. Docstrings, comments and layout do not count."""
+    digest = hashlib.sha256()
+    name = os.path.relpath(os.path.abspath(script), ROOT)
+    for label, path in [(name, script), *((m, _source(m)) for m in measures)]:
+        digest.update(label.encode() + b"\0" + _code(path).encode() + b"\0")
+    return f"{STAMP_PREFIX}{digest.hexdigest()[:16]} ({', '.join([name, *measures])})."
+
+
+def _stamp() -> str:
+    """The stamp of the running script (``__main__``), from its ``MEASURES``; empty without them."""
+    main = sys.modules.get("__main__")
+    measures = getattr(main, "MEASURES", None)
+    script = getattr(main, "__file__", None)
+    return code_stamp(script, measures) if measures is not None and script else ""
 
 
 def machine() -> str:
@@ -149,6 +197,8 @@ class Report:
 
     def markdown(self) -> str:
         lines = [f"# {self.title}", "", f"Machine: {machine()}; load {load()} when written. {self.note}".rstrip(), ""]
+        if _stamp():
+            lines[4:4] = [_stamp(), ""]
         if self.rows:
             lines += ["| " + " | ".join(self.HEADER) + " |", "|" + "---|" * len(self.HEADER)]
             lines += ["| " + " | ".join(row) + " |" for row in self.rows]
@@ -172,7 +222,8 @@ def median_time(fn: Callable[[], object], repeat: int, warm_up: bool = True) -> 
 def write_markdown(path: str, title: str, note: str, header: Sequence[str], rows: Sequence[Sequence[str]]) -> None:
     """A markdown file: title, machine line and note, then one table (scripts with a ``Report`` use ``finish``)."""
     with open(path, "w", encoding="utf-8") as fh:
-        fh.write(f"# {title}\n\nMachine: {machine()}; load {load()} when written. {note}\n\n{table(header, rows)}\n")
+        stamp = f"{_stamp()}\n\n" if _stamp() else ""
+        fh.write(f"# {title}\n\nMachine: {machine()}; load {load()} when written. {note}\n\n{stamp}{table(header, rows)}\n")
 
 
 def table(header: Sequence[str], rows: Sequence[Sequence[str]]) -> str:

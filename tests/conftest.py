@@ -106,6 +106,7 @@ SLOW = {
     "test_fit_cli.py",
     "test_points.py::test_a_million_rows_read_as_numpy_wrote_them",
     "test_ifc.py",
+    "test_speed_guard.py::test_the_guard_fails_when_a_kernel_falls_back_to_plain_python",
 }
 _CAD = re.compile(r"^\s*(?:from|import) (?:build123d|cadquery|OCP)\b|importorskip\([\"'](?:build123d|cadquery|OCP)", re.M)
 _SUBPROCESS = re.compile(r"\bsubprocess\b|sys\.executable")

@@ -725,7 +725,8 @@ def _write_design(b: Built, stage: Path, units: str, missing: list[str], plots: 
     from ..cad.sandbox import Isolated
 
     step = stage / f"{b.name}.step"
-    export_step(b.chain, step, name=b.name)
+    with ticking(f"{b.name}: writing {step.name} ({len(b.chain):,} edges)"):
+        export_step(b.chain, step, name=b.name)
     reread = len(b.chain) <= LARGE_CHAIN_EDGES
     with contextlib.ExitStack() as children:
         continuity = None
@@ -739,7 +740,8 @@ def _write_design(b: Built, stage: Path, units: str, missing: list[str], plots: 
                                                   what="the DXF writer", subject=f"{b.name}.dxf"))  # fmt: skip
         names = ["step"] + _write_others(b, stage, units, missing, plots)
         if dxf is not None:
-            dxf.result()
+            with ticking(f"{b.name}: writing {b.name}.dxf (beside the others)"):
+                dxf.result()
             names.append("dxf")
         if continuity is None:
             if not reread:
@@ -759,20 +761,23 @@ def _write_others(b: Built, stage: Path, units: str, missing: list[str], plots: 
 
     names = []
     if b.chain.dim == 2:  # SVG is a plane output (the plots draw a path in space as its plan)
-        export_svg(b.chain, stage / f"{b.name}.svg", name=b.name)
+        with ticking(f"{b.name}: writing {b.name}.svg"):
+            export_svg(b.chain, stage / f"{b.name}.svg", name=b.name)
         names.append("svg")
     if b.gcode is not None:
         from ..io.gcode_write import write_gcode
 
         try:
-            write_gcode(b.chain, stage / f"{b.name}.ngc", name=b.name, **b.gcode)
+            with ticking(f"{b.name}: writing {b.name}.ngc"):
+                write_gcode(b.chain, stage / f"{b.name}.ngc", name=b.name, **b.gcode)
         except ValueError as error:  # name the design and the file: a design file may hold many
             raise ValueError(f"{b.name}.ngc: {error}") from None
         names.append("ngc")
     if isinstance(b, BuiltRounded | BuiltFit) and b.samples:
         from ..cad.export import export_samples
 
-        export_samples(b.chain, stage / f"{b.name}_samples.csv", **b.samples)
+        with ticking(f"{b.name}: writing {b.name}_samples.csv"):
+            export_samples(b.chain, stage / f"{b.name}_samples.csv", **b.samples)
         names.append("samples.csv")
     if isinstance(b, BuiltAlignment):
         from ..cad.export import export_opendrive

@@ -1,18 +1,23 @@
 """Kernels compiled by numba when first needed, and the same kernels as plain Python meanwhile.
 
-A kernel module declares its functions with ``jit`` / ``row_jit`` from its own
-``Kernels`` and ends with ``seal()``. Its functions then leave the module's
-namespace: the first access to any of them (``K.name``) imports numba and
-makes every kernel of the module a compiled dispatcher (each compiles, or is
-loaded from numba's on-disk cache, at its first call). Until then nothing
-imports numba, so ``import spiral_cad`` costs numpy alone.
+A kernel module declares its functions with ``jit`` / ``row_jit`` of its own
+``Kernels(globals())`` (one per module: a function declared with another
+module's ``Kernels`` is refused) and ends with ``seal()``. Each kernel's name
+then holds a stand-in whose first call imports numba and compiles: every
+kernel of every sealed module becomes a numba dispatcher at once, written
+back into the module that declared it (so its own Python code and the other
+kernels calling it find the dispatcher there), and each compiles, or is loaded
+from numba's on-disk cache, at its first call. A module sealed after that
+compiles at ``seal()``. Until then nothing imports numba, so
+``import spiral_cad`` costs numpy alone.
 
 ``Kernels.python`` is the same source run by CPython: each function a copy
 whose globals hold the other copies. The scalar API uses it while the kernels
 are not compiled in this process (a first call answers in microseconds rather
 than waiting seconds for a compiler), then compiles them once a process has
 made ``SCALAR_CALLS_BEFORE_COMPILING`` scalar calls. One source, one formula:
-the two differ only in who executes it.
+the two differ only in who executes it. Nothing else runs a kernel as plain
+Python: an array call through a stand-in compiles first.
 """
 
 from __future__ import annotations
@@ -33,64 +38,87 @@ SCALAR_CALLS_BEFORE_COMPILING = 200
 
 _LOCK = threading.RLock()
 
+#: Every module's ``Kernels``, in import order: they compile together (a kernel may call another module's).
+REGISTRIES: list[Kernels] = []
+
+#: Whether this process has compiled its kernels (a module sealed later compiles at once).
+_compiled_all = False
+
 
 class Kernels:
     """The kernel functions of one module: plain Python until compiled.
 
     Args:
-        namespace: the module's ``globals()``.
+        namespace: the module's ``globals()``; every kernel declared here must be defined in that
+            module, and its dispatcher is written back there.
     """
 
     def __init__(self, namespace: dict[str, Any]) -> None:
         self.namespace = namespace
+        #: The module that declares these kernels and holds their dispatchers once compiled.
+        self.module: str = namespace["__name__"]
         self.functions: dict[str, tuple[FunctionType, bool]] = {}
         self.compiled = False
+        self.sealed = False
         self.scalar_calls = 0
         self._python: SimpleNamespace | None = None
+        with _LOCK:
+            REGISTRIES.append(self)
 
     def jit(self, function: F) -> F:
         """Declare a kernel (compiled on its own, called from other kernels)."""
-        self.functions[function.__name__] = (cast(FunctionType, function), False)
-        return function
+        return self._declare(function, False)
 
     def row_jit(self, function: F) -> F:
         """Declare a kernel that is inlined into the kernels calling it (one solver row)."""
-        self.functions[function.__name__] = (cast(FunctionType, function), True)
+        return self._declare(function, True)
+
+    def _declare(self, function: F, inline: bool) -> F:
+        home = getattr(function, "__module__", None)
+        if home != self.module:
+            raise ValueError(f"kernel {function.__qualname__} of module {home} is declared with the Kernels of {self.module}; "
+                             f"give {home} its own Kernels(globals()) so that its dispatcher is compiled into it")  # fmt: skip
+        if self.sealed:
+            raise ValueError(f"kernel {function.__qualname__} is declared after {self.module} was sealed")
+        self.functions[function.__name__] = (cast(FunctionType, function), inline)
         return function
 
     def seal(self) -> None:
-        """Take the kernels out of the module's namespace: the first access compiles them all."""
-        for name in self.functions:
-            del self.namespace[name]
-        module = self.namespace["__name__"]
-
-        def module_getattr(name: str) -> Any:
-            if name in self.functions:
+        """Put a stand-in under each kernel's name: its first call compiles every module's kernels."""
+        with _LOCK:
+            self.sealed = True
+            for name in self.functions:
+                self.namespace[name] = _Uncompiled(self, name)
+            if _compiled_all:
                 self.compile()
-                return self.namespace[name]
-            raise AttributeError(f"module {module!r} has no attribute {name!r}")
-
-        self.namespace["__getattr__"] = module_getattr
 
     def compile(self) -> None:
-        """Make every kernel a numba dispatcher, cached on disk where a cache can be written.
+        """Make every kernel of every sealed module a numba dispatcher, in the module that declared it,
+        cached on disk where a cache can be written.
 
         Numba refuses to decorate a cached function when it finds no writable
         cache location (a read-only install without a writable home): the
         kernels then compile in memory at first use.
         """
+        global _compiled_all
         with _LOCK:
             if self.compiled:
                 return
             from numba import njit
 
-            for name, (function, inline) in self.functions.items():
-                options: dict[str, Any] = dict(nogil=True, error_model="numpy", inline="always" if inline else "never")
-                try:
-                    self.namespace[name] = njit(cache=True, **options)(function)
-                except RuntimeError:
-                    self.namespace[name] = njit(cache=False, **options)(function)
-            self.compiled = True
+            for registry in REGISTRIES:
+                if registry.sealed and not registry.compiled:
+                    registry._make_dispatchers(njit)
+            _compiled_all = True
+
+    def _make_dispatchers(self, njit: Callable[..., Any]) -> None:
+        for name, (function, inline) in self.functions.items():
+            options: dict[str, Any] = dict(nogil=True, error_model="numpy", inline="always" if inline else "never")
+            try:
+                self.namespace[name] = njit(cache=True, **options)(function)
+            except RuntimeError:
+                self.namespace[name] = njit(cache=False, **options)(function)
+        self.compiled = True
 
     @property
     def python(self) -> SimpleNamespace:
@@ -209,6 +237,25 @@ class _Python:
                 return kernels.namespace[name](*args)
 
         return guarded
+
+
+class _Uncompiled:
+    """A kernel's name before its process compiles: calling it compiles every kernel, then calls the
+    dispatcher (which from then on is what the name holds)."""
+
+    def __init__(self, kernels: Kernels, name: str) -> None:
+        function = kernels.functions[name][0]
+        self._kernels = kernels
+        self.__name__ = name
+        self.__doc__ = function.__doc__
+        self.__wrapped__ = function
+
+    def __call__(self, *args: Any) -> Any:
+        self._kernels.compile()
+        return self._kernels.namespace[self.__name__](*args)
+
+    def __repr__(self) -> str:
+        return f"<kernel {self._kernels.module}.{self.__name__}, not compiled yet>"
 
 
 class _Compiled:

@@ -197,7 +197,7 @@ def _u(u: ArrayLike) -> NDArray[np.float64]:
 
 
 def norm(v: NDArray[np.float64]) -> float:
-    """|v| of a 2- or 3-vector as the kernels compute it (exactly ``np.hypot(x, y)`` in the plane)."""
+    """|v| of a 2- or 3-vector as the kernels compute it (``_chain_kernels.norm3``)."""
     return float(CK.norm3(*(v.tolist() + [0.0] * (3 - len(v)))))
 
 

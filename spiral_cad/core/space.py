@@ -20,8 +20,13 @@ from numpy.typing import ArrayLike, NDArray
 
 from . import _kernels as K
 from ._inputs import as_float, as_real_array
+from ._jit import Kernels
 from ._threads import run_split
 from .units import COLLINEAR_TOL
+
+#: This module's kernels (placing and verifying points in their planes), compiled into this module.
+KERNELS = Kernels(globals())
+jit = KERNELS.jit
 
 #: Legs whose |sin(turn)| is at most this span no plane.
 
@@ -57,7 +62,7 @@ def place(points: ArrayLike, origin: ArrayLike, x_dir: ArrayLike, y_dir: ArrayLi
 POINTS_PER_THREAD = 100_000
 
 
-@K.jit
+@jit
 def _place_row(
     points: NDArray[np.float64],
     origin: NDArray[np.float64],
@@ -73,7 +78,7 @@ def _place_row(
             out[i, k, j] = origin[i, j] + u * x_dir[i, j] + v * y_dir[i, j]
 
 
-@K.jit
+@jit
 def _place_rows(
     points: NDArray[np.float64],
     origin: NDArray[np.float64],
@@ -148,7 +153,7 @@ def placed_pair_residuals(pairs: NDArray[np.float64], corners: NDArray[np.float6
     run_split(_pair_residuals, args, len(corners), POINTS_PER_THREAD // 8)
 
 
-@K.jit
+@jit
 def _pair_residual(
     pairs: NDArray[np.float64],
     corners: NDArray[np.float64],
@@ -159,11 +164,11 @@ def _pair_residual(
     residual: NDArray[np.float64],
     deviation: NDArray[np.float64],
     i: int,
+    local: NDArray[np.float64],
 ) -> None:
-    """Row ``i`` of ``placed_pair_residuals``."""
+    """Row ``i`` of ``placed_pair_residuals`` (``local`` (2, 4, 2): room for the pair in plane coordinates)."""
     x, y = x_dir[i], y_dir[i]
     nx, ny, nz = x[1] * y[2] - x[2] * y[1], x[2] * y[0] - x[0] * y[2], x[0] * y[1] - x[1] * y[0]
-    local = np.empty((2, 4, 2))
     off = 0.0
     for k in range(2):
         for m in range(4):
@@ -187,7 +192,7 @@ def _pair_residual(
     deviation[i] = math.sqrt(jx * jx + jy * jy + jz * jz) * scale
 
 
-@K.jit
+@jit
 def _pair_residuals(
     pairs: NDArray[np.float64],
     corners: NDArray[np.float64],
@@ -198,8 +203,9 @@ def _pair_residuals(
     residual: NDArray[np.float64],
     deviation: NDArray[np.float64],
 ) -> None:
+    local = np.empty((2, 4, 2))  # once per call: an allocation per row would cost as much as the row
     for i in range(corners.shape[0]):
-        _pair_residual(pairs, corners, x_dir, y_dir, outgoing, peak, residual, deviation, i)
+        _pair_residual(pairs, corners, x_dir, y_dir, outgoing, peak, residual, deviation, i, local)
 
 
 def _vector3(value: Any, name: str) -> NDArray[np.float64]:
@@ -282,3 +288,6 @@ class PlaneFrame:
         """Plane coordinates (..., 2) of points (..., 3): their projection onto the plane."""
         d = np.asarray(xyz, dtype=float) - self.origin
         return np.stack([d @ self.x_dir, d @ self.y_dir], axis=-1)
+
+
+KERNELS.seal()

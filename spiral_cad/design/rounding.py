@@ -40,6 +40,8 @@ from ..core import _chain_kernels as CK
 from ..core import _kernels as K
 from ..core import batch
 from ..core._inputs import as_float, as_real_array
+from ..core._jit import Kernels
+from ..core._threads import run_split
 from ..core.chain import JOIN_TOLERANCE, ROUNDING_CAP, Chain, PartCircles, join_rows, join_tolerance
 from ..core.errors import JointError, NoSolutionError, Status
 from ..core.factors import length_factor
@@ -66,6 +68,10 @@ G2CBS_C4 = (G2CBS_C2 + 4.0) ** 2 / (54.0 * G2CBS_C3)
 DEVIATION_MARGIN = 1e-12
 ROUNDING_ULPS = 8.0
 EPS = float(np.finfo(float).eps)
+
+#: This module's kernel (the joints of corner pairs), compiled into this module.
+KERNELS = Kernels(globals())
+jit = KERNELS.jit
 
 
 def corner_scale(theta_sin: ArrayLike, theta_cos: ArrayLike, value: ArrayLike, shape: str) -> NDArray:
@@ -313,7 +319,7 @@ def _steepest_deflection(shape: str) -> float:
 
 
 def _half_deflection(p0: NDArray, corners: NDArray, p1: NDArray):
-    """Leg lengths and sin/cos of half the deflection (plane points)."""
+    """Leg lengths, sin/cos of half the deflection and the legs' unit directions (plane points)."""
     vin = corners - p0
     vout = p1 - corners
     lin = np.hypot(vin[:, 0], vin[:, 1])
@@ -325,7 +331,7 @@ def _half_deflection(p0: NDArray, corners: NDArray, p1: NDArray):
         joint /= np.hypot(joint[:, 0], joint[:, 1])[:, None]
     sin_t = np.abs(t_in[:, 0] * joint[:, 1] - t_in[:, 1] * joint[:, 0])
     cos_t = np.einsum("ij,ij->i", t_in, joint)
-    return lin, lout, sin_t, cos_t
+    return lin, lout, sin_t, cos_t, t_in, t_out
 
 
 def _per_corner(value: ArrayLike | None, name: str, n: int, first: int = 0) -> NDArray | None:
@@ -455,7 +461,7 @@ def round_corners_batch(
         local_corners = np.zeros((n, 2))
     else:
         local_p0, local_corners, local_p1 = p0, corners, p1
-    lin, lout, sin_t, cos_t = _half_deflection(local_p0, local_corners, local_p1)
+    lin, lout, sin_t, cos_t, t_in, t_out = _half_deflection(local_p0, local_corners, local_p1)
     theta = np.where(sin_t > 0.0, np.arctan2(sin_t, cos_t), np.nan)
     available = np.minimum(lin, lout)
     with np.errstate(invalid="ignore", divide="ignore", over="ignore"):  # a tiny leg: the curvature it needs overflows
@@ -478,8 +484,8 @@ def round_corners_batch(
             k = values["max_curvature"]
         fit = np.isnan(k)
         distance = np.where(fit, available, corner_scale(sin_t, cos_t, k, shape))
-    result = batch.line_to_line(local_p0, local_corners, local_p1, k, shape=shape)
-    pairs = np.stack(result.spirals, axis=1)
+    pairs = np.empty((n, 2, 4, 2))
+    result = batch.line_to_line(local_p0, local_corners, local_p1, k, shape=shape, out=pairs)
     status = result.status.astype(np.int8)
     residual = np.where(status == Status.UNVERIFIED, result.measure, np.nan)
     if dim == 2:
@@ -514,7 +520,8 @@ def round_corners_batch(
         residual[failed] = off[failed]
     else:
         deviation = norms(pairs[:, 0, 3] - corners)
-    joined, off = _joints_hold(pairs, p0, corners, p1, status == Status.OK, shape, tolerance)
+    legs = (lin, lout, t_in, t_out) if dim == 2 else None  # the plane's legs as measured above
+    joined, off = _joints_hold(pairs, p0, corners, p1, status == Status.OK, shape, tolerance, legs)
     status[~joined] = Status.UNVERIFIED
     residual[~joined] = off[~joined]
     if values["max_deviation"] is not None:
@@ -530,7 +537,7 @@ def round_corners_batch(
                        given["max_deviation"], given["max_curvature"], given["spiral_lengths"])  # fmt: skip
 
 
-@K.jit
+@jit
 def _pair_joints(cp, ok, t_in, t_out, line_in, line_out, tolerance, cap, held, off):  # pragma: no cover - compiled
     """``_joints_hold`` per row: the spirals' end frames and floors (``_chain_kernels._spiral``), the
     legs' lines, and the three joints judged by ``_chain_kernels.joint_measures``."""
@@ -555,10 +562,10 @@ def _pair_joints(cp, ok, t_in, t_out, line_in, line_out, tolerance, cap, held, o
                     g[r, j] = cp[i, s, r, j]
                     big = max(big, abs(g[r, j]))
             CK._spiral(g, frames[s], floors[s])
-            # hypot: lengths of any magnitude, no square under- or overflows.
-            chord[s] = math.hypot(math.hypot(g[3, 0] - g[0, 0], g[3, 1] - g[0, 1]), g[3, 2] - g[0, 2])
+            # norm3: lengths of any magnitude, no square under- or overflows.
+            chord[s] = CK.norm3(g[3, 0] - g[0, 0], g[3, 1] - g[0, 1], g[3, 2] - g[0, 2])
             for r in range(3):
-                polygon[s] += math.hypot(math.hypot(g[r + 1, 0] - g[r, 0], g[r + 1, 1] - g[r, 1]), g[r + 1, 2] - g[r, 2])
+                polygon[s] += CK.norm3(g[r + 1, 0] - g[r, 0], g[r + 1, 1] - g[r, 1], g[r + 1, 2] - g[r, 2])
         peak = 0.0
         for s in range(2):
             for e in range(2):
@@ -601,8 +608,19 @@ def _pair_joints(cp, ok, t_in, t_out, line_in, line_out, tolerance, cap, held, o
         off[i] = worst if worst == worst else math.inf
 
 
+#: Corners per thread from which the joint check splits over threads (about a millisecond of work).
+JOINTS_PER_THREAD = 4_096
+
+
 def _joints_hold(
-    pairs: NDArray, p0: NDArray, corners: NDArray, p1: NDArray, ok: NDArray, shape: str, tolerance: float
+    pairs: NDArray,
+    p0: NDArray,
+    corners: NDArray,
+    p1: NDArray,
+    ok: NDArray,
+    shape: str,
+    tolerance: float,
+    legs: tuple[NDArray, NDArray, NDArray, NDArray] | None = None,
 ) -> tuple[NDArray, NDArray]:
     """Whether each OK corner's three joints (line → spiral → spiral → line) pass the ``Chain``'s own
     joint test (``joint_table``'s kernel), so that a corner the batch returns is one a chain accepts.
@@ -611,17 +629,21 @@ def _joints_hold(
     corner (twice its leg); each spiral's length is bounded by its chord (below) and control polygon
     (above) instead of its quadrature, the shorter taken below and the longer above: the test is
     never more lenient than the chain's. Returns whether each row holds and, for the rows judged,
-    its largest relative mismatch (NaN elsewhere).
+    its largest relative mismatch (NaN elsewhere). ``legs``: the legs' lengths and unit directions
+    (len_in, len_out, t_in, t_out) when already measured (``_half_deflection``).
     """
     del shape  # the frames come from the control points alone
     held = np.ones(len(ok), dtype=np.bool_)
     off = np.full(len(ok), np.nan)
-    with np.errstate(invalid="ignore", divide="ignore"):
-        leg_in, leg_out = corners - p0, p1 - corners
-        len_in, len_out = norms(leg_in), norms(leg_out)
-        t_in, t_out = leg_in / len_in[:, None], leg_out / len_out[:, None]
-    _pair_joints(np.ascontiguousarray(pairs), np.ascontiguousarray(ok, dtype=np.bool_), np.ascontiguousarray(t_in), np.ascontiguousarray(t_out), 2.0 * len_in,
-                 2.0 * len_out, join_tolerance(tolerance), ROUNDING_CAP, held, off)  # fmt: skip
+    if legs is None:
+        with np.errstate(invalid="ignore", divide="ignore"):
+            leg_in, leg_out = corners - p0, p1 - corners
+            len_in, len_out = norms(leg_in), norms(leg_out)
+            legs = (len_in, len_out, leg_in / len_in[:, None], leg_out / len_out[:, None])
+    len_in, len_out, t_in, t_out = legs
+    args = [np.ascontiguousarray(pairs), np.ascontiguousarray(ok, dtype=np.bool_), np.ascontiguousarray(t_in), np.ascontiguousarray(t_out),
+            2.0 * len_in, 2.0 * len_out, join_tolerance(tolerance), ROUNDING_CAP, held, off]  # fmt: skip
+    run_split(_pair_joints, args, len(ok), JOINTS_PER_THREAD)
     return held, off
 
 
@@ -1100,3 +1122,6 @@ def fillet_polyline(
     if broken:
         raise NoSolutionError(f"corner {broken[0]}: float64 cannot hold its fillet G2 at these coordinates ({broken[1]})")
     return FilletedPolyline(tuple(segments), tuple(owners), fillets, closed, length_unit(units))
+
+
+KERNELS.seal()
