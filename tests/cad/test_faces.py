@@ -265,7 +265,7 @@ def test_edges_without_pcurves_are_measured_by_projection(monkeypatch):
     from OCP.TopExp import TopExp_Explorer
     from OCP.TopoDS import TopoDS
 
-    import spiral_cad.cad.faces as faces
+    import spiral_cad.cad.face_sampling as sampling
 
     shape = filleted_box().wrapped
     builder, faces_found = BRep_Builder(), TopExp_Explorer(shape, TopAbs_FACE)
@@ -277,10 +277,12 @@ def test_edges_without_pcurves_are_measured_by_projection(monkeypatch):
             edges.Next()
         faces_found.Next()
     projected = []
-    original = faces._projected
-    monkeypatch.setattr(faces, "_projected", lambda *args: projected.append(args) or original(*args))
+    original = sampling.projected
+    monkeypatch.setattr(sampling, "projected", lambda *args: projected.append(args) or original(*args))
     assert_box_calibration(check_faces(shape))
-    assert len(projected) == 16  # the fillets' edges (a plane's pcurves OCCT computes itself)
+    # the fillets' edges, once each: nothing turns or changes along them, so no second round (a plane's
+    # pcurves OCCT computes itself)
+    assert len(projected) == 16
 
 
 def test_box_with_every_edge_filleted_is_g1_at_its_sphere_corners_too():
@@ -429,10 +431,14 @@ def bspline_face(heights: list[float]) -> bd.Face:
 def test_a_knot_line_inside_a_bspline_face_is_judged_as_a_pseudo_edge(heights, level):
     face = bspline_face(heights)
     for part, lines in ((face, 1), (bd.extrude(face, 1, dir=(0, 0, -1)), 2)):  # the slab: its top and bottom
-        inside = [e for e in check_faces(part).edges if e.index == -1]
+        inside = [e for e in check_faces(part).edges if e.index == -1 and "bspline" in e.surfaces]
         assert len(inside) == lines and {e.level for e in inside} == {level}
         assert all(e.note.startswith("inside face") and "u = 1 (knot of multiplicity 3)" in e.note for e in inside)
         assert all(e.jump_at[0] == pytest.approx(3.0) for e in inside)
+    # the slab's sides are extrusions of its edges, B-splines that bend at x = 3 within the planes y = 0 and
+    # y = 3: their knot lines are judged too, and a plane is G2 however its curve bends
+    sides = [e for e in check_faces(bd.extrude(face, 1, dir=(0, 0, -1))).edges if e.surfaces == ("extrusion", "extrusion")]
+    assert len(sides) == 2 and all(e.level == "G2" and "extrusion surface's B-spline" in e.note for e in sides)
 
 
 def test_a_smooth_knot_line_stays_g2():
