@@ -66,6 +66,7 @@ def outcome():
 #: module or by ``module::test`` name.
 SLOW = {
     "test_install.py",
+    "test_faces_mutation.py",
     "test_fit.py",
     "test_fuzz_readers.py",
     "test_examples.py",

@@ -1,9 +1,12 @@
 """G0/G1/G2 continuity of faces across every edge they share: the face-to-face checker.
 
 For every edge shared by two faces (and every seam edge, where a closed face
-meets itself) the edge is sampled at ``samples`` interior points. At each
-point both faces give, from their surface derivatives at the point's
-parameters on the edge's pcurve:
+meets itself) the edge is sampled where its geometry asks for it
+(``spiral_cad.cad.face_sampling``): a floor of ``samples`` points and both
+ends, every polynomial span between the knots of the edge's curve and of both
+faces' surfaces, and bisection where the edge turns or a measure may cross its
+tolerance between two samples. At each point both faces give, from their
+surface derivatives at the point's parameters on the edge's pcurve:
 
 * the surface point — the **gap** is the distance between the two;
 * the oriented unit normal (flipped for a face REVERSED in its shell) — the
@@ -29,13 +32,15 @@ What a file holds is not always one clean shell: faces written unstitched are
 sewn first (``SEW_TOL`` × size) and the stitches counted; two faces that use
 their edge in the same direction (an inconsistently oriented shell) are
 compared with one normal flipped and the row says so; at an edge of three or
-more faces every pair is judged; an internal knot line of a B-spline face
-whose multiplicity allows a crease or a curvature jump is judged as a
-pseudo-edge (index −1) between the two polynomial spans.
+more faces every pair is judged; an internal knot line of a face whose
+surface is less than C2 there — a B-spline surface, an extrusion or
+revolution of a B-spline curve, an offset or trimmed surface of one — is
+judged as a pseudo-edge (index −1) between the two polynomial spans.
 
 Files are read and measured in a child process (``spiral_cad.cad.readers``);
 only the measured numbers come back. The time is linear in the faces: one
-pass over the edge → faces map, a fixed number of evaluations per edge.
+pass over the edge → faces map, the floor of evaluations per edge and more
+only where knots or refinement ask for them.
 """
 
 from __future__ import annotations
@@ -491,8 +496,10 @@ def check_faces(shape_or_path: Any, *, gap_tol: float = 1e-7, angle_tol: float =
             ``max(|κa|, |κb|, 1/size)``.
         feature_angle: normals further apart than this (radians) make an edge a sharp
             feature, listed and not failed (default ``FEATURE_ANGLE``, 5°).
-        samples: points sampled along each edge (interior points: ends, where poles and
-            corners are, are not sampled).
+        samples: the floor of points sampled along each edge: equal steps, and both ends moved in
+            by ``END_INSET`` (poles and apexes are never evaluated); two more in every span between
+            knots of the edge's curve and of both faces' surfaces, and bisection where the edge turns
+            or a measure may cross its tolerance (``spiral_cad.cad.face_sampling``).
         units: for a file, the unit to read it in (None: the unit it declares); for a
             shape, the unit its numbers are in (default mm, build123d's).
         label: name shown in the report (default: the file's name).

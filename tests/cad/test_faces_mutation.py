@@ -95,7 +95,7 @@ def _border(edge, face) -> tuple[bool, bool] | None:
     """(the edge runs along v — it lies on u = const —, it is the first (not the last) u or v of the
     surface) when the edge is an isoparametric border of the face's B-spline surface; None otherwise."""
     surface = BRep_Tool.Surface_s(face, TopLoc_Location())
-    if not isinstance(surface, Geom_BSplineSurface) or surface.IsUPeriodic() or surface.IsVPeriodic():
+    if not isinstance(surface, Geom_BSplineSurface):
         return None
     curve = BRepAdaptor_Curve2d(edge, face)
     uv = gp_Pnt2d()
@@ -105,8 +105,9 @@ def _border(edge, face) -> tuple[bool, bool] | None:
         points.append((uv.X(), uv.Y()))
     u, v = np.array(points).T
     u0, u1, v0, v1 = surface.Bounds()
-    for along_v, values, (lo, hi) in ((True, u, (u0, u1)), (False, v, (v0, v1))):
-        if np.ptp(values) < 1e-9 * (hi - lo):
+    for along_v, values, (lo, hi), periodic in ((True, u, (u0, u1), surface.IsUPeriodic()),
+                                                (False, v, (v0, v1), surface.IsVPeriodic())):  # fmt: skip
+        if not periodic and np.ptp(values) < 1e-9 * (hi - lo):
             for first, end in ((True, lo), (False, hi)):
                 if abs(values[0] - end) < 1e-9 * (hi - lo):
                     return along_v, first
@@ -132,6 +133,9 @@ def plant(shape, edge_index: int, kind: str, rng: random.Random) -> tuple[object
     location = TopLoc_Location()
     surface = BRep_Tool.Surface_s(face, location).Copy()
     assert isinstance(surface, Geom_BSplineSurface)
+    for periodic, unset in ((surface.IsUPeriodic(), surface.SetUNotPeriodic), (surface.IsVPeriodic(), surface.SetVNotPeriodic)):
+        if periodic:
+            unset()  # the same surface and parameters, its poles in one row each
     # the defect's extent, by arc length along the edge, mapped to the surface's parameter along it
     curve = BRepAdaptor_Curve(edge)
     length = GCPnts_AbscissaPoint.Length_s(curve)
@@ -241,13 +245,28 @@ def planted_defects(name: str, count: int, seed: int = SEED):
     assert report.passes("G2"), report.table()
     rng = random.Random(f"{seed}-{name}")
     edges = [e.index + 1 for e in report.edges if e.level == "G2" and e.index >= 0 and not e.seam]
+    faces, indexed = _maps(base)
+    borders = [i for i in edges if any(_border(TopoDS.Edge_s(indexed.FindKey(i)), TopoDS.Face_s(faces.FindKey(f))) is not None
+                                      for f in _faces_of(base, i))]  # fmt: skip
+    assert borders, f"{name}: no G2 edge is an isoparametric border of a B-spline face"
     for kind in ("G0", "G1"):
-        made = 0
-        while made < count:
-            got = plant(base, rng.choice(edges), kind, rng)
-            if got is not None:
-                made += 1
-                yield got
+        for _ in range(count):
+            got = plant(base, rng.choice(borders), kind, rng)
+            assert got is not None
+            yield got
+
+
+def _faces_of(shape, edge_index: int) -> list[int]:
+    """The indices (1-based) of the faces holding edge ``edge_index``."""
+    faces, edges = _maps(shape)
+    edge = edges.FindKey(edge_index)
+    out = []
+    for i in range(1, faces.Extent() + 1):
+        own = TopTools_IndexedMapOfShape()
+        TopExp.MapShapes_s(faces.FindKey(i), TopAbs_EDGE, own)
+        if own.Contains(edge):
+            out.append(i)
+    return out
 
 
 def judged(report, planted: Planted) -> str:
