@@ -6,14 +6,17 @@ follow the geometry instead:
 
 * a **floor**: ``samples`` midpoints of equal parameter steps, and the two ends
   of the edge moved in by ``END_INSET`` of its range (near a vertex, where a
-  loft's faces turn tangent, without evaluating a pole or an apex);
+  loft's faces turn tangent, without evaluating a pole, an apex or a corner
+  patch's collapsed side);
 * **every polynomial span**: the knots of the edge's curve, of each face's
   pcurve, and the parameters where each pcurve crosses a knot line of its
   face's surface (any surface kind: B-spline, extrusion or revolution of a
-  B-spline curve, offset, trimmed — their breaks as OCCT's adaptors give
-  them) cut the edge into spans, and each span gets points at its quarters.
-  A local defect in a B-spline is bounded by knots, so it holds a span, and
-  inside a span every measure is one smooth (rational) function;
+  B-spline curve, offset, trimmed) cut the edge into spans, and each span
+  gets points at its quarters. A local defect in a B-spline is bounded by
+  knots, so it holds a span, and inside a span every measure is one smooth
+  (rational) function. The knots are read from the geometry itself
+  (``curve_knots``, ``surface_knots``): OCCT's adaptors list only the knots
+  below C3, and a defect inside a span of a degree-9 patch hides from them;
 * **refinement**: an interval is bisected (up to ``REFINE_ROUNDS`` times) where
   the edge or a face's normal turns by more than ``TURN`` between its ends,
   where a measure below its tolerance at both ends changes by enough to cross
@@ -36,6 +39,7 @@ from __future__ import annotations
 import math
 from collections.abc import Callable
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
@@ -52,9 +56,12 @@ from ..check.joints import norms
 #: Floats per sample and face: point (3), oriented unit normal (3), normal curvature across the edge.
 FACE_FLOATS = 7
 
-#: The ends of an edge are sampled this far inside its parameter range (relative): close enough to see a
-#: crease that starts at a vertex, far enough never to evaluate a pole or an apex exactly.
-END_INSET = 1e-6
+#: The ends of an edge are sampled this far inside its parameter range (relative): close enough to see
+#: faces that turn tangent towards a vertex (a loft's), far enough from a pole, an apex or the collapsed
+#: side of a corner patch, where the second fundamental form is ill-conditioned (on a ContinuousBox's
+#: corner patch the normal curvature read 1e-6 from such a vertex is off by 0.1 relative; at 1e-3 it agrees
+#: with its neighbour's within 3e-7).
+END_INSET = 1e-3
 
 #: An interval is bisected where the edge's tangent or a face's normal turns by more than this (radians).
 TURN = 0.4
@@ -87,15 +94,46 @@ def _values(count: int, fill: Callable[[TColStd_Array1OfReal], None]) -> list[fl
     return [array.Value(i) for i in range(1, count + 2)]
 
 
-def curve_breaks(curve: BRepAdaptor_Curve | BRepAdaptor_Curve2d) -> list[float]:
-    """The interior parameters where a curve's polynomial spans meet (any kind: B-spline, offset, …)."""
-    shape = GeomAbs_Shape.GeomAbs_CN
-    count = curve.NbIntervals(shape)
-    return _values(count, lambda a: curve.Intervals(a, shape))[1:-1] if count > 1 else []
+def curve_knots(curve: Any) -> list[float]:
+    """Every knot of a Geom or Geom2d curve's B-spline (through trimmed and offset curves); none for
+    other kinds (lines, conics, Bézier curves: one polynomial span)."""
+    from OCP.Geom import Geom_BSplineCurve, Geom_OffsetCurve, Geom_TrimmedCurve
+    from OCP.Geom2d import Geom2d_BSplineCurve, Geom2d_OffsetCurve, Geom2d_TrimmedCurve
+
+    while isinstance(curve, (Geom_TrimmedCurve, Geom2d_TrimmedCurve, Geom_OffsetCurve, Geom2d_OffsetCurve)):
+        curve = curve.BasisCurve()
+    if isinstance(curve, (Geom_BSplineCurve, Geom2d_BSplineCurve)):
+        return [curve.Knot(i) for i in range(1, curve.NbKnots() + 1)]
+    return []
 
 
-def surface_breaks(surface: BRepAdaptor_Surface, shape: GeomAbs_Shape = GeomAbs_Shape.GeomAbs_CN) -> tuple[list[float], list[float]]:
-    """The interior u and v values inside the face's bounds where the surface is less smooth than ``shape``:
+def surface_knots(surface: Any) -> tuple[list[float], list[float]]:
+    """Every u and every v knot of a Geom surface's B-spline: of a B-spline surface, of the B-spline curve
+    of an extrusion (u) or a revolution (v), through offset and trimmed surfaces. OCCT's adaptors list
+    only the knots below C3, and a defect inside a span of a high-degree surface hides from them."""
+    from OCP.Geom import (
+        Geom_BSplineSurface,
+        Geom_OffsetSurface,
+        Geom_RectangularTrimmedSurface,
+        Geom_SurfaceOfLinearExtrusion,
+        Geom_SurfaceOfRevolution,
+    )
+
+    while isinstance(surface, (Geom_RectangularTrimmedSurface, Geom_OffsetSurface)):
+        surface = surface.BasisSurface()
+    if isinstance(surface, Geom_BSplineSurface):
+        return ([surface.UKnot(i) for i in range(1, surface.NbUKnots() + 1)],
+                [surface.VKnot(i) for i in range(1, surface.NbVKnots() + 1)])  # fmt: skip
+    if isinstance(surface, Geom_SurfaceOfLinearExtrusion):
+        return curve_knots(surface.BasisCurve()), []
+    if isinstance(surface, Geom_SurfaceOfRevolution):
+        return [], curve_knots(surface.BasisCurve())
+    return [], []
+
+
+def surface_breaks(surface: BRepAdaptor_Surface, shape: GeomAbs_Shape) -> tuple[list[float], list[float]]:
+    """The interior u and v values inside the face's bounds where the surface is less smooth than ``shape``
+    (``GeomAbs_C2``: where a crease or a curvature jump may be), as OCCT's adaptor finds them for any kind:
     knot lines of a B-spline surface, of the B-spline curve of an extrusion or a revolution, of an offset's
     or a trimmed surface's basis."""
     nu, nv = surface.NbUIntervals(shape), surface.NbVIntervals(shape)
@@ -245,12 +283,15 @@ class EdgeLine(Line):
         self.pcurves = [BRepAdaptor_Curve2d(oriented, face) if BRep_Tool.CurveOnSurface_s(oriented, face, 0.0, 0.0) is not None
                         else None for _, face, oriented in sides]  # fmt: skip
         floor = floor_points(self.lo, self.hi, samples)
-        breaks = curve_breaks(self.curve)
+        breaks = curve_knots(BRep_Tool.Curve_s(edge, 0.0, 0.0)) if BRep_Tool.IsGeometric_s(edge) else []
         grid = np.unique(np.array(floor + breaks + [self.lo, self.hi]))
-        for (surface, _, _), pcurve in zip(sides, self.pcurves):
-            if pcurve is None:
-                continue
-            breaks += curve_breaks(pcurve) + _crossings(pcurve, grid, surface_breaks(surface))
+        for _, face, oriented in sides:
+            pcurve = BRep_Tool.CurveOnSurface_s(oriented, face, 0.0, 0.0)
+            if pcurve is not None:
+                breaks += curve_knots(pcurve)
+        for (_, face, _), pcurve in zip(sides, self.pcurves):
+            if pcurve is not None:
+                breaks += _crossings(pcurve, grid, surface_knots(BRep_Tool.Surface_s(face)))
         self.start = floor + span_points(self.lo, self.hi, breaks)
 
     def evaluate(self, params: list[float]) -> tuple[NDArray, NDArray]:
@@ -290,7 +331,7 @@ class KnotLine(Line):
         self.lo, self.hi = (v0, v1) if along_u else (u0, u1)
         low, high = (u0, u1) if along_u else (v0, v1)
         self.step = KNOT_STEP * (high - low)
-        us, vs = surface_breaks(surface)
+        us, vs = surface_knots(BRep_Tool.Surface_s(face))
         self.start = floor_points(self.lo, self.hi, samples) + span_points(self.lo, self.hi, vs if along_u else us)
         geom = BRep_Tool.Surface_s(face)  # located: the points come out where the face is
         self.bspline = geom if isinstance(geom, Geom_BSplineSurface) else None
