@@ -13,7 +13,6 @@ is asked to find it.
 
 from __future__ import annotations
 
-import math
 import random
 from dataclasses import dataclass
 
