@@ -46,6 +46,17 @@ from numpy.typing import NDArray
 from OCP.BRep import BRep_Tool
 from OCP.BRepAdaptor import BRepAdaptor_Curve, BRepAdaptor_Curve2d, BRepAdaptor_Surface
 from OCP.BRepTools import BRepTools
+from OCP.Geom import (
+    Geom_BSplineCurve,
+    Geom_BSplineSurface,
+    Geom_OffsetCurve,
+    Geom_OffsetSurface,
+    Geom_RectangularTrimmedSurface,
+    Geom_SurfaceOfLinearExtrusion,
+    Geom_SurfaceOfRevolution,
+    Geom_TrimmedCurve,
+)
+from OCP.Geom2d import Geom2d_BSplineCurve, Geom2d_OffsetCurve, Geom2d_TrimmedCurve
 from OCP.GeomAbs import GeomAbs_Shape
 from OCP.gp import gp_Pnt, gp_Pnt2d, gp_Vec
 from OCP.TColStd import TColStd_Array1OfReal
@@ -97,9 +108,6 @@ def _values(count: int, fill: Callable[[TColStd_Array1OfReal], None]) -> list[fl
 def curve_knots(curve: Any) -> list[float]:
     """Every knot of a Geom or Geom2d curve's B-spline (through trimmed and offset curves); none for
     other kinds (lines, conics, Bézier curves: one polynomial span)."""
-    from OCP.Geom import Geom_BSplineCurve, Geom_OffsetCurve, Geom_TrimmedCurve
-    from OCP.Geom2d import Geom2d_BSplineCurve, Geom2d_OffsetCurve, Geom2d_TrimmedCurve
-
     while isinstance(curve, (Geom_TrimmedCurve, Geom2d_TrimmedCurve, Geom_OffsetCurve, Geom2d_OffsetCurve)):
         curve = curve.BasisCurve()
     if isinstance(curve, (Geom_BSplineCurve, Geom2d_BSplineCurve)):
@@ -111,14 +119,6 @@ def surface_knots(surface: Any) -> tuple[list[float], list[float]]:
     """Every u and every v knot of a Geom surface's B-spline: of a B-spline surface, of the B-spline curve
     of an extrusion (u) or a revolution (v), through offset and trimmed surfaces. OCCT's adaptors list
     only the knots below C3, and a defect inside a span of a high-degree surface hides from them."""
-    from OCP.Geom import (
-        Geom_BSplineSurface,
-        Geom_OffsetSurface,
-        Geom_RectangularTrimmedSurface,
-        Geom_SurfaceOfLinearExtrusion,
-        Geom_SurfaceOfRevolution,
-    )
-
     while isinstance(surface, (Geom_RectangularTrimmedSurface, Geom_OffsetSurface)):
         surface = surface.BasisSurface()
     if isinstance(surface, Geom_BSplineSurface):
@@ -280,18 +280,15 @@ class EdgeLine(Line):
         self.edge, self.sides, self.signs = edge, sides, signs
         self.curve = BRepAdaptor_Curve(edge)
         self.lo, self.hi = self.curve.FirstParameter(), self.curve.LastParameter()
-        self.pcurves = [BRepAdaptor_Curve2d(oriented, face) if BRep_Tool.CurveOnSurface_s(oriented, face, 0.0, 0.0) is not None
-                        else None for _, face, oriented in sides]  # fmt: skip
+        self.curves_on_faces = [BRep_Tool.CurveOnSurface_s(oriented, face, 0.0, 0.0) for _, face, oriented in sides]
+        self.pcurves = [None if on_face is None else BRepAdaptor_Curve2d(oriented, face)
+                        for (_, face, oriented), on_face in zip(sides, self.curves_on_faces)]  # fmt: skip
         floor = floor_points(self.lo, self.hi, samples)
         breaks = curve_knots(BRep_Tool.Curve_s(edge, 0.0, 0.0)) if BRep_Tool.IsGeometric_s(edge) else []
         grid = np.unique(np.array(floor + breaks + [self.lo, self.hi]))
-        for _, face, oriented in sides:
-            pcurve = BRep_Tool.CurveOnSurface_s(oriented, face, 0.0, 0.0)
+        for (_, face, _), pcurve, on_face in zip(sides, self.pcurves, self.curves_on_faces):
             if pcurve is not None:
-                breaks += curve_knots(pcurve)
-        for (_, face, _), pcurve in zip(sides, self.pcurves):
-            if pcurve is not None:
-                breaks += _crossings(pcurve, grid, surface_knots(BRep_Tool.Surface_s(face)))
+                breaks += curve_knots(on_face) + _crossings(pcurve, grid, surface_knots(BRep_Tool.Surface_s(face)))
         self.start = floor + span_points(self.lo, self.hi, breaks)
 
     def evaluate(self, params: list[float]) -> tuple[NDArray, NDArray]:
@@ -324,8 +321,6 @@ class KnotLine(Line):
 
     def __init__(self, face: TopoDS_Face, surface: BRepAdaptor_Surface, along_u: bool, knot: float, sign: float,
                  samples: int) -> None:  # fmt: skip
-        from OCP.Geom import Geom_BSplineSurface
-
         self.surface, self.along_u, self.knot, self.signs = surface, along_u, knot, (sign, sign)
         u0, u1, v0, v1 = BRepTools.UVBounds_s(face)
         self.lo, self.hi = (v0, v1) if along_u else (u0, u1)
@@ -424,8 +419,10 @@ def sample_lines(lines: list[Line], tolerances: Tolerances) -> tuple[NDArray, li
 def _evaluate(lines: list[Line], owner: NDArray, params: NDArray) -> tuple[NDArray, NDArray]:
     """Rows (n × 2 × ``FACE_FLOATS``) and line tangents (n × 3) at ``params`` of the lines ``owner``."""
     raw, tangents, sign = np.empty((len(params), 2, 18)), np.empty((len(params), 3)), np.empty((len(params), 2))
-    for i in np.unique(owner).tolist():
-        at = np.nonzero(owner == i)[0]
+    order = np.argsort(owner, kind="stable")
+    ids, starts = np.unique(owner[order], return_index=True)
+    for i, a, b in zip(ids.tolist(), starts.tolist(), [*starts[1:].tolist(), len(order)]):
+        at = order[a:b]
         raw[at], tangents[at] = lines[i].evaluate(params[at].tolist())
         sign[at] = lines[i].signs
     rows = rows_of(raw.reshape(-1, 18), sign.reshape(-1), np.repeat(tangents, 2, axis=0))
