@@ -64,6 +64,9 @@ from OCP.TopoDS import TopoDS_Edge, TopoDS_Face
 
 from ..check.joints import norms
 
+__all__ = ["END_INSET", "FACE_FLOATS", "KNOT_STEP", "REFINE_ROUNDS", "TURN", "EdgeLine", "KnotLine", "Line", "Tolerances",
+           "curve_knots", "knot_lines", "measures", "sample_lines", "surface_knots"]  # fmt: skip
+
 #: Floats per sample and face: point (3), oriented unit normal (3), normal curvature across the edge.
 FACE_FLOATS = 7
 
