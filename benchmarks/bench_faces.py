@@ -4,7 +4,8 @@ Run: ``.venv/bin/python benchmarks/bench_faces.py [--quick] [--repeat R] [--boxe
 
 Each file is an array of build123d boxes (40 × 20 × 8) with their vertical edges filleted
 (10 faces, 8 G1 and 16 sharp edges each), written as one STEP compound. ``check_faces(path)``
-reads it in a child process and measures there (16 samples per edge); the peer is the same
+reads it in a child process and measures there (a floor of 16 samples and both ends per edge,
+more only at knots and where the geometry turns); the peer is the same
 measuring and classifying on the shape already in memory (no reader): the difference is the
 reader's share. The growth exponent of the time in the faces should be 1 (linear).
 
@@ -92,7 +93,7 @@ def main() -> None:
     print(machine())
     if args.out:
         write_markdown(args.out, "Face checker: time per face",
-                       f"Medians of {args.repeat} interleaved runs; 16 samples per edge. Growth exponent of the file "
+                       f"Medians of {args.repeat} interleaved runs; a floor of 16 samples per edge, adapted. Growth exponent of the file "
                        f"check in the faces: {exponent:.2f} (1: linear).", header, rows)  # fmt: skip
         with open(args.out, "a", encoding="utf-8") as fh:
             fh.write(

@@ -66,6 +66,7 @@ def outcome():
 #: module or by ``module::test`` name.
 SLOW = {
     "test_install.py",
+    "test_faces_mutation.py::test_every_planted_local_defect_in_a_continuous_box_is_found",
     "test_fit.py",
     "test_fuzz_readers.py",
     "test_examples.py",

@@ -1,9 +1,12 @@
 """G0/G1/G2 continuity of faces across every edge they share: the face-to-face checker.
 
 For every edge shared by two faces (and every seam edge, where a closed face
-meets itself) the edge is sampled at ``samples`` interior points. At each
-point both faces give, from their surface derivatives at the point's
-parameters on the edge's pcurve:
+meets itself) the edge is sampled where its geometry asks for it
+(``spiral_cad.cad.face_sampling``): a floor of ``samples`` points and both
+ends, every polynomial span between the knots of the edge's curve and of both
+faces' surfaces, and bisection where the edge turns or a measure may cross its
+tolerance between two samples. At each point both faces give, from their
+surface derivatives at the point's parameters on the edge's pcurve:
 
 * the surface point — the **gap** is the distance between the two;
 * the oriented unit normal (flipped for a face REVERSED in its shell) — the
@@ -29,13 +32,15 @@ What a file holds is not always one clean shell: faces written unstitched are
 sewn first (``SEW_TOL`` × size) and the stitches counted; two faces that use
 their edge in the same direction (an inconsistently oriented shell) are
 compared with one normal flipped and the row says so; at an edge of three or
-more faces every pair is judged; an internal knot line of a B-spline face
-whose multiplicity allows a crease or a curvature jump is judged as a
-pseudo-edge (index −1) between the two polynomial spans.
+more faces every pair is judged; an internal knot line of a face whose
+surface is less than C2 there — a B-spline surface, an extrusion or
+revolution of a B-spline curve, an offset or trimmed surface of one — is
+judged as a pseudo-edge (index −1) between the two polynomial spans.
 
 Files are read and measured in a child process (``spiral_cad.cad.readers``);
 only the measured numbers come back. The time is linear in the faces: one
-pass over the edge → faces map, a fixed number of evaluations per edge.
+pass over the edge → faces map, the floor of evaluations per edge and more
+only where knots or refinement ask for them.
 """
 
 from __future__ import annotations
@@ -50,13 +55,11 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-from numpy.typing import NDArray
 from OCP.Bnd import Bnd_Box
 from OCP.BRep import BRep_Tool
-from OCP.BRepAdaptor import BRepAdaptor_Curve, BRepAdaptor_Curve2d, BRepAdaptor_Surface
+from OCP.BRepAdaptor import BRepAdaptor_Curve, BRepAdaptor_Surface
 from OCP.BRepBndLib import BRepBndLib
 from OCP.GeomAbs import GeomAbs_SurfaceType
-from OCP.gp import gp_Pnt, gp_Pnt2d, gp_Vec
 from OCP.TopAbs import TopAbs_EDGE, TopAbs_FACE, TopAbs_FORWARD, TopAbs_REVERSED
 from OCP.TopExp import TopExp
 from OCP.TopoDS import TopoDS, TopoDS_Edge, TopoDS_Face, TopoDS_Shape
@@ -66,8 +69,9 @@ from OCP.TopTools import (
     TopTools_ListOfShape,
 )
 
-from ..check.joints import check_tolerances, norms
+from ..check.joints import check_tolerances
 from ..core.units import length_unit
+from .face_sampling import FACE_FLOATS, EdgeLine, Line, Tolerances, knot_lines, measures, sample_lines
 from .occ import as_occ_shape
 from .readers import IGES_SUFFIXES, STEP_SUFFIXES, read_file
 
@@ -83,9 +87,6 @@ FEATURE_ANGLE = math.radians(5.0)
 EDGE_CLASSES = ("unmeasurable", "gap", "crease", "G1", "G2", "sharp")
 _RANK = {"unmeasurable": 0, "gap": 0, "crease": 1, "G1": 2, "G2": 3}
 
-#: Floats per sample and face: point (3), oriented unit normal (3), normal curvature across the edge.
-_FACE_FLOATS = 7
-
 #: Free edges that coincide within this distance, relative to the model size, are sewn together
 #: before the faces are judged (faces written one by one: IGES surface exports, loose compounds).
 SEW_TOL = 1e-6
@@ -93,9 +94,10 @@ SEW_TOL = 1e-6
 #: What is measured of a shape, as plain data for the reader's child process:
 #: face count, per face its surface type, per checked pair (edge index, face a,
 #: face b, seam, note), the free edges (index, midpoint), the model size, the samples as
-#: float64 bytes (pairs × samples × 2 faces × ``_FACE_FLOATS``), and how many edges were sewn.
+#: float64 bytes (samples × 2 faces × ``FACE_FLOATS``, pair after pair), how many samples
+#: each pair got, and how many edges were sewn.
 Measured = tuple[int, list[str], list[tuple[int, int, int, bool, str]], list[tuple[int, tuple[float, float, float]]], float,
-                 bytes, int]  # fmt: skip
+                 bytes, list[int], int]  # fmt: skip
 
 
 # ------------------------------------------------------------ measuring
@@ -105,78 +107,6 @@ def _surface_name(kind: GeomAbs_SurfaceType) -> str:
     """``GeomAbs_BSplineSurface`` → ``"bspline"``, ``GeomAbs_SurfaceOfRevolution`` → ``"revolution"``."""
     name = kind.name.removeprefix("GeomAbs_").removesuffix("Surface").removeprefix("SurfaceOf")
     return name.lower() or "other"
-
-
-def _face_derivatives(surface: BRepAdaptor_Surface, face: TopoDS_Face, edge: TopoDS_Edge, params: NDArray, out: NDArray) -> None:
-    """Fill ``out`` (samples × 18) with the face's surface point and derivatives (P, Su, Sv, Suu,
-    Svv, Suv) at the pcurve's (u, v) at each edge parameter; where the edge has no pcurve on the
-    face (a file that left it out), at the (u, v) of the edge's points projected on the surface."""
-    uv, p = gp_Pnt2d(), gp_Pnt()
-    su, sv, suu, svv, suv = gp_Vec(), gp_Vec(), gp_Vec(), gp_Vec(), gp_Vec()
-    if BRep_Tool.CurveOnSurface_s(edge, face, 0.0, 0.0) is not None:
-        pcurve = BRepAdaptor_Curve2d(edge, face)
-        uvs = []
-        for t in params.tolist():
-            pcurve.D0(t, uv)
-            uvs.append((uv.X(), uv.Y()))
-    else:
-        uvs = _projected(edge, face, params)
-    for k, (u, v) in enumerate(uvs):
-        if not (math.isfinite(u) and math.isfinite(v)):
-            out[k] = math.nan
-            continue
-        surface.D2(u, v, p, su, sv, suu, svv, suv)
-        out[k] = (*p.Coord(), *su.Coord(), *sv.Coord(), *suu.Coord(), *svv.Coord(), *suv.Coord())
-
-
-def _projected(edge: TopoDS_Edge, face: TopoDS_Face, params: NDArray) -> list[tuple[float, float]]:
-    """(u, v) on the face's surface of the edge's points at ``params`` (``ShapeAnalysis_Surface``:
-    periodic and singular surfaces handled); NaN where no projection is found."""
-    from OCP.ShapeAnalysis import ShapeAnalysis_Surface
-
-    curve = BRepAdaptor_Curve(edge)
-    analysis = ShapeAnalysis_Surface(BRep_Tool.Surface_s(face))  # located, as the edge's points
-    tolerance = BRep_Tool.Tolerance_s(edge)
-    found = []
-    for t in params.tolist():
-        try:
-            uv = analysis.ValueOfUV(curve.Value(t), tolerance)
-            found.append((uv.X(), uv.Y()))
-        except Exception:  # noqa: BLE001 - OCCT's Standard_Failure: this sample is not measured
-            found.append((math.nan, math.nan))
-    return found
-
-
-def _samples(raw: NDArray, sign: NDArray, tangents: NDArray) -> NDArray:
-    """Point, oriented unit normal and normal curvature across the edge (d = n × t), rows of
-    ``_FACE_FLOATS``, from rows of surface derivatives — all samples of all edges in one pass."""
-    point, su, sv, suu, svv, suv = (raw[:, i : i + 3] for i in range(0, 18, 3))
-    with np.errstate(all="ignore"):
-        normal = np.cross(su, sv)
-        normal *= (sign / norms(normal))[:, None]  # sign −1 for a face REVERSED in its shell
-        across = np.cross(normal, tangents)  # d = n × t, in the tangent plane
-        e, f, g = (np.einsum("ij,ij->i", x, y) for x, y in ((su, su), (su, sv), (sv, sv)))
-        l_, m, n = (np.einsum("ij,ij->i", x, normal) for x in (suu, suv, svv))
-        du, dv = np.einsum("ij,ij->i", across, su), np.einsum("ij,ij->i", across, sv)
-        det = e * g - f * f
-        a, b = (g * du - f * dv) / det, (e * dv - f * du) / det  # d = a Su + b Sv
-        kappa = (l_ * a * a + 2.0 * m * a * b + n * b * b) / (e * a * a + 2.0 * f * a * b + g * b * b)
-    return np.column_stack([point, normal, kappa])
-
-
-def _edge_points(edge: TopoDS_Edge, samples: int, tangents: NDArray) -> NDArray:
-    """``samples`` interior parameters of the edge (midpoints of equal parameter steps: no end, so no
-    pole or corner); fills ``tangents`` with the unit tangent of the edge's 3-D curve there."""
-    curve = BRepAdaptor_Curve(edge)
-    u0, u1 = curve.FirstParameter(), curve.LastParameter()
-    params = u0 + (u1 - u0) * (np.arange(samples) + 0.5) / samples
-    p, d1 = gp_Pnt(), gp_Vec()
-    for k, t in enumerate(params.tolist()):
-        curve.D1(t, p, d1)
-        tangents[k] = d1.Coord()
-    with np.errstate(all="ignore"):
-        tangents /= norms(tangents)[:, None]
-    return params
 
 
 def _shapes(shapes: TopTools_ListOfShape) -> list[TopoDS_Shape]:
@@ -234,55 +164,8 @@ def _edge_uses(face: TopoDS_Face, edges: TopTools_IndexedMapOfShape) -> dict[int
     return uses
 
 
-def _knot_lines(face: TopoDS_Face, samples: int) -> list[tuple[str, NDArray, NDArray]]:
-    """The internal knot lines of a B-spline face where it may crease (knot multiplicity ≥ degree) or
-    its curvature may jump (≥ degree − 1): per line its name, the surface derivatives from either
-    side (samples × 2 × 18, the two spans' polynomials, ``LocalD2``) and the line's unit tangents.
-    The line is sampled across the face's (u, v) bounds, so a trimmed face's line may be sampled
-    a little beyond its trimming."""
-    from OCP.BRepTools import BRepTools
-    from OCP.Geom import Geom_BSplineSurface
-
-    surface = BRep_Tool.Surface_s(face)  # located: the points come out where the face is
-    if not isinstance(surface, Geom_BSplineSurface):
-        return []
-    u0, u1, v0, v1 = BRepTools.UVBounds_s(face)
-    p = gp_Pnt()
-    su, sv, suu, svv, suv = gp_Vec(), gp_Vec(), gp_Vec(), gp_Vec(), gp_Vec()
-    lines = []
-    for along_u in (True, False):
-        degree = surface.UDegree() if along_u else surface.VDegree()
-        first, last = (surface.FirstUKnotIndex(), surface.LastUKnotIndex()) if along_u else (
-            surface.FirstVKnotIndex(), surface.LastVKnotIndex())  # fmt: skip
-        knot = surface.UKnot if along_u else surface.VKnot
-        multiplicity = surface.UMultiplicity if along_u else surface.VMultiplicity
-        low, high = (u0, u1) if along_u else (v0, v1)
-        other_low, other_high = (v0, v1) if along_u else (u0, u1)
-        ofirst, olast = (surface.FirstVKnotIndex(), surface.LastVKnotIndex()) if along_u else (
-            surface.FirstUKnotIndex(), surface.LastUKnotIndex())  # fmt: skip
-        oknots = np.array([(surface.VKnot if along_u else surface.UKnot)(i) for i in range(ofirst, olast + 1)])
-        for i in range(first + 1, last):
-            k = knot(i)
-            if multiplicity(i) < max(1, degree - 1) or not low < k < high:
-                continue
-            others = other_low + (other_high - other_low) * (np.arange(samples) + 0.5) / samples
-            spans = ofirst + np.clip(np.searchsorted(oknots, others, side="right") - 1, 0, len(oknots) - 2)
-            raw = np.empty((samples, 2, 18))
-            for n, (t, j) in enumerate(zip(others.tolist(), spans.tolist())):
-                for side, (a, b) in enumerate(((i - 1, i), (i, i + 1))):
-                    if along_u:
-                        surface.LocalD2(k, t, a, b, j, j + 1, p, su, sv, suu, svv, suv)
-                    else:
-                        surface.LocalD2(t, k, j, j + 1, a, b, p, su, sv, suu, svv, suv)
-                    raw[n, side] = (*p.Coord(), *su.Coord(), *sv.Coord(), *suu.Coord(), *svv.Coord(), *suv.Coord())
-            tangents = raw[:, 0, 6:9] if along_u else raw[:, 0, 3:6]  # along the line: Sv on a u line, Su on a v line
-            with np.errstate(all="ignore"):
-                tangents = tangents / norms(tangents)[:, None]
-            lines.append((f"{'u' if along_u else 'v'} = {k:.6g} (knot of multiplicity {multiplicity(i)})", raw, tangents))
-    return lines
-
-
-def _measure(shape: TopoDS_Shape, samples: int) -> Measured:
+def _measure(shape: TopoDS_Shape, samples: int, gap_tol: float, angle_tol: float, curvature_tol: float,
+             feature_angle: float) -> Measured:  # fmt: skip
     """Everything ``check_faces`` needs of ``shape``, as plain data (see ``Measured``); runs in the
     reader's child process for a file. Faces that were written unstitched (coinciding free edges)
     are sewn first."""
@@ -301,10 +184,15 @@ def _measure(shape: TopoDS_Shape, samples: int) -> Measured:
     kinds: list[str] = []
     for i in range(1, faces.Extent() + 1):
         kinds.append(_surface_name(BRepAdaptor_Surface(TopoDS.Face_s(faces.FindKey(i)), False).GetType()))
+
+    def adaptor(face: TopoDS_Face) -> BRepAdaptor_Surface:
+        index = faces.FindIndex(face)
+        if index not in adaptors:
+            adaptors[index] = BRepAdaptor_Surface(face)
+        return adaptors[index]
+
     pairs: list[tuple[int, int, int, bool, str]] = []
-    raw: list[NDArray] = []  # surface derivatives per pair: samples × 2 sides × 18
-    tangents: list[NDArray] = []
-    sign: list[tuple[float, float]] = []
+    lines: list[Line] = []
     free: list[tuple[int, tuple[float, float, float]]] = []
     for i in range(1, ancestors.Extent() + 1):
         edge = TopoDS.Edge_s(ancestors.FindKey(i))
@@ -329,16 +217,7 @@ def _measure(shape: TopoDS_Shape, samples: int) -> Measured:
             free.append((index - 1, (middle.X(), middle.Y(), middle.Z())))
             continue
         for (fa, ea), (fb, eb), note in couples:
-            row_tangents = np.empty((samples, 3))
-            params = _edge_points(edge, samples, row_tangents)
-            row = np.empty((samples, 2, 18))
-            signs = []
-            for side, (face, oriented) in enumerate(((fa, ea), (fb, eb))):
-                face_index = faces.FindIndex(face)
-                if face_index not in adaptors:
-                    adaptors[face_index] = BRepAdaptor_Surface(face)
-                _face_derivatives(adaptors[face_index], face, oriented, params, row[:, side])
-                signs.append(-1.0 if face.Orientation() == TopAbs_REVERSED else 1.0)
+            signs = [-1.0 if face.Orientation() == TopAbs_REVERSED else 1.0 for face in (fa, fb)]
             if fa is not fb and not fa.IsSame(fb):
                 for face in (fa, fb):
                     if faces.FindIndex(face) not in uses:  # each face's edges explored once
@@ -353,25 +232,18 @@ def _measure(shape: TopoDS_Shape, samples: int) -> Measured:
                     if len(found) == 2:
                         note = "; ".join(filter(None, [note, "orientation: both faces use the edge in the same direction "
                                                        "(inconsistent shell); compared with one normal flipped"]))  # fmt: skip
-            raw.append(row)
-            tangents.append(row_tangents)
-            sign.append((signs[0], signs[1]))
+            sides = [(adaptor(fa), fa, ea), (adaptor(fb), fb, eb)]
+            lines.append(EdgeLine(edge, sides, (signs[0], signs[1]), samples))
             pairs.append((index - 1, faces.FindIndex(fa) - 1, faces.FindIndex(fb) - 1, len(found) == 1, note))
     for face_index in range(1, faces.Extent() + 1):
         face = TopoDS.Face_s(faces.FindKey(face_index))
-        for name, row, row_tangents in _knot_lines(face, samples):
-            raw.append(row)
-            tangents.append(row_tangents)
-            sign.append((-1.0, -1.0) if face.Orientation() == TopAbs_REVERSED else (1.0, 1.0))
-            pairs.append((-1, face_index - 1, face_index - 1, False, f"inside face {face_index - 1}, {name}"))
-    count = len(pairs)
-    if count:
-        flat = _samples(np.stack(raw).reshape(-1, 18), np.repeat(np.array(sign)[:, None, :], samples, axis=1).reshape(-1),
-                        np.repeat(np.stack(tangents)[:, :, None, :], 2, axis=2).reshape(-1, 3))  # fmt: skip
-    else:
-        flat = np.empty((0, _FACE_FLOATS))
-    data = flat.reshape(count, samples, 2, _FACE_FLOATS)
-    return faces.Extent(), kinds, pairs, free, size, data.tobytes(), stitched
+        sign = -1.0 if face.Orientation() == TopAbs_REVERSED else 1.0
+        for line in knot_lines(face, adaptor(face), sign, samples):
+            lines.append(line)
+            pairs.append((-1, face_index - 1, face_index - 1, False, f"inside face {face_index - 1}, {line.name}"))
+    tolerances = Tolerances(gap_tol * size, angle_tol, curvature_tol, feature_angle, size)
+    rows, counts = sample_lines(lines, tolerances)
+    return faces.Extent(), kinds, pairs, free, size, rows.tobytes(), counts, stitched
 
 
 # ------------------------------------------------------------ the report
@@ -400,6 +272,8 @@ class FaceEdge:
         note: what else was seen, e.g. ``"non-manifold: 3 faces"``, an orientation defect (the two
             faces use the edge in the same direction; compared with one normal flipped) or a
             partly tangent edge (angle below ``feature_angle`` at some samples, judged there).
+        samples: how many points of the edge were evaluated (the floor, the spans between knots, the
+            refinement: ``spiral_cad.cad.face_sampling``).
     """
 
     index: int
@@ -415,6 +289,7 @@ class FaceEdge:
     curvatures: tuple[float, float]
     level: str
     note: str = ""
+    samples: int = 0
 
     @property
     def tangent(self) -> bool:
@@ -435,13 +310,14 @@ class FaceReport:
         angle_tol: largest angle between normals of a tangent edge, radians.
         curvature_tol: largest relative jump of normal curvature of a G2 edge.
         feature_angle: normals further apart make an edge a sharp feature.
-        samples: points sampled along each edge.
+        samples: the floor of points sampled along each edge (more where the geometry asks for them).
         source: file name or shape description.
         units: the unit of every length (``""``: not known).
         seconds: how long the check took, reading included.
         stitched: edges where faces written unstitched were sewn together (within ``SEW_TOL`` × size)
             before being judged; face and edge indices then count in the sewn shape.
         free_at: the free edges left after sewing: (edge index, midpoint) each.
+        evaluated: how many points were evaluated on all edges and knot lines together.
     """
 
     edges: tuple[FaceEdge, ...]
@@ -458,6 +334,7 @@ class FaceReport:
     seconds: float = 0.0
     stitched: int = 0
     free_at: tuple[tuple[int, tuple[float, float, float]], ...] = ()
+    evaluated: int = 0
 
     @property
     def tangent_edges(self) -> list[FaceEdge]:
@@ -525,7 +402,8 @@ class FaceReport:
             f"{self.source or 'shape'}: {self.describe()}; worst tangent edge {self.worst}",
             f"  tolerances: gap {self.gap_tol:g} × size, angle {self.angle_tol:g} rad, curvature jump "
             f"{self.curvature_tol:g} relative, sharp above {math.degrees(self.feature_angle):g}°; "
-            f"{self.samples} samples per edge; model size {self.size:.6g}{unit}{sewn}",
+            f"at least {self.samples} samples per edge, more at knots and where the geometry turns "
+            f"({self.evaluated} in all); model size {self.size:.6g}{unit}{sewn}",
         ]
         order = sorted(self.edges, key=lambda e: (e.level == "sharp", _RANK.get(e.level, 9), -e.jump, e.index))
         names = [f"{e.surfaces[0]}/{e.surfaces[1]}" + (" seam" if e.seam else "") for e in order]
@@ -551,25 +429,20 @@ _FREE_LISTED = 20
 
 def _classify(measured: Measured, *, gap_tol: float, angle_tol: float, curvature_tol: float, feature_angle: float,
               samples: int, source: str, units: str, started: float) -> FaceReport:  # fmt: skip
-    """The report of the measured samples: worst values per edge (vectorised over all edges) and classes."""
-    count, kinds, pairs, free, size, data, stitched = measured
-    x = np.frombuffer(data, dtype=float).reshape(len(pairs), samples, 2, _FACE_FLOATS)
-    a, b = x[:, :, 0], x[:, :, 1]
-    with np.errstate(all="ignore"):
-        gap = norms((a[..., :3] - b[..., :3]).reshape(-1, 3)).reshape(len(pairs), samples)
-        dot = np.einsum("esi,esi->es", a[..., 3:6], b[..., 3:6])
-        cross = norms(np.cross(a[..., 3:6], b[..., 3:6]).reshape(-1, 3)).reshape(len(pairs), samples)
-        angle = np.arctan2(cross, dot)
-        ka, kb = a[..., 6], b[..., 6]
-        floor = 1.0 / size if size > 0.0 else 0.0
-        jump = np.abs(ka - kb) / np.maximum(np.maximum(np.abs(ka), np.abs(kb)), floor)
+    """The report of the measured samples: worst values per edge (measures vectorised over all samples) and classes."""
+    count, kinds, pairs, free, size, data, counts, stitched = measured
+    x = np.frombuffer(data, dtype=float).reshape(-1, 2, FACE_FLOATS)
+    gap, angle, jump = measures(x, size)
+    ends = np.cumsum([0, *counts])
     rows = []
     gap_limit = gap_tol * size
     for i, (edge, fa, fb, seam, note) in enumerate(pairs):
+        start, stop = int(ends[i]), int(ends[i + 1])
+        g_, an_, j_ = gap[start:stop], angle[start:stop], jump[start:stop]
         # NaN (a sample at a singular point of a surface) never decides a worst value
-        g, an, j = (int(np.nanargmax(v[i])) if np.isfinite(v[i]).any() else 0 for v in (gap, angle, jump))
-        worst_gap, worst_angle, worst_jump = float(gap[i, g]), float(angle[i, an]), float(jump[i, j])
-        least_angle = float(np.nanmin(angle[i])) if np.isfinite(angle[i]).any() else math.nan
+        g, an, j = (start + (int(np.nanargmax(v)) if np.isfinite(v).any() else 0) for v in (g_, an_, j_))
+        worst_gap, worst_angle, worst_jump = float(gap[g]), float(angle[an]), float(jump[j])
+        least_angle = float(np.nanmin(an_)) if np.isfinite(an_).any() else math.nan
         if not (math.isfinite(worst_gap) and math.isfinite(worst_angle)):
             level = "unmeasurable"  # no sample gave a point or a normal: never passed
         elif worst_gap > gap_limit:
@@ -586,13 +459,13 @@ def _classify(measured: Measured, *, gap_tol: float, angle_tol: float, curvature
         else:
             level = "G2"
 
-        def at(k: int, row: int = i) -> tuple[float, float, float]:
-            return (float(a[row, k, 0]), float(a[row, k, 1]), float(a[row, k, 2]))
+        def at(k: int) -> tuple[float, float, float]:
+            return (float(x[k, 0, 0]), float(x[k, 0, 1]), float(x[k, 0, 2]))
 
         rows.append(FaceEdge(edge, (fa, fb), (kinds[fa], kinds[fb]), seam, worst_gap, at(g), worst_angle, at(an),
-                             worst_jump, at(j), (float(ka[i, j]), float(kb[i, j])), level, note))  # fmt: skip
+                             worst_jump, at(j), (float(x[j, 0, 6]), float(x[j, 1, 6])), level, note, stop - start))  # fmt: skip
     return FaceReport(tuple(rows), count, len(free), size, gap_tol, angle_tol, curvature_tol, feature_angle, samples,
-                      source, units, time.perf_counter() - started, stitched, tuple(free))  # fmt: skip
+                      source, units, time.perf_counter() - started, stitched, tuple(free), int(ends[-1]))  # fmt: skip
 
 
 def check_faces(shape_or_path: Any, *, gap_tol: float = 1e-7, angle_tol: float = 1e-7, curvature_tol: float = 1e-4,
@@ -623,8 +496,10 @@ def check_faces(shape_or_path: Any, *, gap_tol: float = 1e-7, angle_tol: float =
             ``max(|κa|, |κb|, 1/size)``.
         feature_angle: normals further apart than this (radians) make an edge a sharp
             feature, listed and not failed (default ``FEATURE_ANGLE``, 5°).
-        samples: points sampled along each edge (interior points: ends, where poles and
-            corners are, are not sampled).
+        samples: the floor of points sampled along each edge: equal steps, and both ends moved in
+            by ``END_INSET`` (poles and apexes are never evaluated); two more in every span between
+            knots of the edge's curve and of both faces' surfaces, and bisection where the edge turns
+            or a measure may cross its tolerance (``spiral_cad.cad.face_sampling``).
         units: for a file, the unit to read it in (None: the unit it declares); for a
             shape, the unit its numbers are in (default mm, build123d's).
         label: name shown in the report (default: the file's name).
@@ -645,11 +520,11 @@ def check_faces(shape_or_path: Any, *, gap_tol: float = 1e-7, angle_tol: float =
     options: dict[str, Any] = dict(gap_tol=gap_tol, angle_tol=angle_tol, curvature_tol=curvature_tol,
                                    feature_angle=feature_angle, samples=samples)  # fmt: skip
     if isinstance(shape_or_path, (str, os.PathLike)):
-        unit, measured = read_file(shape_or_path, units, partial(_measure, samples=samples))
+        unit, measured = read_file(shape_or_path, units, partial(_measure, **options))
         source = label or os.path.basename(os.fspath(shape_or_path))
     else:
         unit = length_unit(units) if units is not None else ""
-        measured = _measure(as_occ_shape(shape_or_path), samples)
+        measured = _measure(as_occ_shape(shape_or_path), **options)
         source = label or type(shape_or_path).__name__
     return _classify(measured, source=source, units=unit, started=started, **options)
 

@@ -148,3 +148,21 @@ def test_a_failure_while_meshing_is_named_meshing_not_reading(files, monkeypatch
     monkeypatch.setattr(mesh, "read_file", timed_out)
     with pytest.raises(ValueError, match=r"^meshing for the picture: reading and meshing failed on 'box.step': it timed out"):
         mesh.face_mesh(files["box"])
+
+
+@pytest.mark.parametrize("suffix", [".step", ".igs"])
+def test_check_fails_g2_on_a_curvature_jump_over_five_percent_of_an_edge(tmp_path, capsys, suffix):
+    from face_reproducers import bump_join
+
+    path = tmp_path / f"bump{suffix}"
+    if suffix == ".step":
+        bd.export_step(bump_join(), str(path))
+    else:
+        Interface_Static.SetIVal_s("write.iges.brep.mode", 1)
+        writer = IGESControl_Writer("MM", 1)
+        writer.AddShape(bump_join().wrapped)
+        writer.ComputeModel()
+        assert writer.Write(str(path))
+    assert main(["check", str(path), "--require", "G2"]) == 1
+    assert "FAIL: worst tangent edge is G1, below the required G2" in capsys.readouterr().out
+    assert main(["check", str(path), "--require", "G1"]) == 0

@@ -16,6 +16,7 @@ from hypothesis import strategies as st
 pytest.importorskip("OCP")
 
 import build123d as bd  # noqa: E402
+from face_reproducers import bump_join, circle_square_circle_loft, quadratic_prism  # noqa: E402
 from helpers import freecad_lib  # noqa: E402
 from OCP.IGESControl import IGESControl_Writer  # noqa: E402
 from OCP.Interface import Interface_Static  # noqa: E402
@@ -265,7 +266,7 @@ def test_edges_without_pcurves_are_measured_by_projection(monkeypatch):
     from OCP.TopExp import TopExp_Explorer
     from OCP.TopoDS import TopoDS
 
-    import spiral_cad.cad.faces as faces
+    import spiral_cad.cad.face_sampling as sampling
 
     shape = filleted_box().wrapped
     builder, faces_found = BRep_Builder(), TopExp_Explorer(shape, TopAbs_FACE)
@@ -277,10 +278,12 @@ def test_edges_without_pcurves_are_measured_by_projection(monkeypatch):
             edges.Next()
         faces_found.Next()
     projected = []
-    original = faces._projected
-    monkeypatch.setattr(faces, "_projected", lambda *args: projected.append(args) or original(*args))
+    original = sampling.projected
+    monkeypatch.setattr(sampling, "projected", lambda *args: projected.append(args) or original(*args))
     assert_box_calibration(check_faces(shape))
-    assert len(projected) == 16  # the fillets' edges (a plane's pcurves OCCT computes itself)
+    # the fillets' edges, once each: nothing turns or changes along them, so no second round (a plane's
+    # pcurves OCCT computes itself)
+    assert len(projected) == 16
 
 
 def test_box_with_every_edge_filleted_is_g1_at_its_sphere_corners_too():
@@ -429,10 +432,15 @@ def bspline_face(heights: list[float]) -> bd.Face:
 def test_a_knot_line_inside_a_bspline_face_is_judged_as_a_pseudo_edge(heights, level):
     face = bspline_face(heights)
     for part, lines in ((face, 1), (bd.extrude(face, 1, dir=(0, 0, -1)), 2)):  # the slab: its top and bottom
-        inside = [e for e in check_faces(part).edges if e.index == -1]
+        inside = [e for e in check_faces(part).edges if e.index == -1 and "bspline" in e.surfaces]
         assert len(inside) == lines and {e.level for e in inside} == {level}
         assert all(e.note.startswith("inside face") and "u = 1 (knot of multiplicity 3)" in e.note for e in inside)
         assert all(e.jump_at[0] == pytest.approx(3.0) for e in inside)
+    # the slab's sides are extrusions of its edges, B-splines that bend at x = 3 within the planes y = 0 and
+    # y = 3: their knot lines are judged too, and a plane is G2 however its curve bends
+    slab = check_faces(bd.extrude(face, 1, dir=(0, 0, -1)))
+    sides = [e for e in slab.edges if e.index == -1 and e.surfaces == ("extrusion", "extrusion")]
+    assert len(sides) == 2 and all(e.level == "G2" and "extrusion surface's B-spline" in e.note for e in sides)
 
 
 def test_a_smooth_knot_line_stays_g2():
@@ -457,3 +465,134 @@ def test_table_columns_stay_in_line_with_long_surface_names():
     assert any(len(f"{e.surfaces[0]}/{e.surfaces[1]} seam") > 22 for e in check_faces(vase.part).edges if e.seam)
     start = lines[2].index("gap") + 3  # the gap column ends here in the header and in every row
     assert all(row[start - 1] != " " and row[start] == " " for row in rows)
+
+
+# ------------------------------------------------------------ defects a fixed set of samples missed
+
+
+def reproducer_file(tmp_path, part, suffix: str):
+    path = tmp_path / f"part{suffix}"
+    if suffix == ".step":
+        assert bd.export_step(part, str(path))
+    else:
+        write_iges(part, path)
+    return path
+
+
+@pytest.mark.parametrize("suffix", [".step", ".igs"])
+def test_a_curvature_jump_over_five_percent_of_an_edge_is_g1(tmp_path, suffix):
+    # 16 equally spaced samples fall at y = 0.906 and 0.969, either side of the bump
+    report = check_faces(reproducer_file(tmp_path, bump_join(), suffix))
+    (edge,) = report.edges
+    assert edge.level == "G1" and not report.passes("G2") and report.passes("G1")
+    assert 0.91 < edge.jump_at[1] < 0.96 and edge.jump == pytest.approx(1.0)  # 0 on the plane against 2·b(y)
+    assert edge.angle < 1e-9
+
+
+@pytest.mark.parametrize("where", [(0.01, 0.03), (0.5, 0.52), (0.97, 0.99)])
+def test_a_bump_over_two_percent_of_an_edge_is_found_wherever_it_is(where):
+    (edge,) = check_faces(bump_join(*where)).edges
+    assert edge.level == "G1" and where[0] < edge.jump_at[1] < where[1]
+
+
+def test_a_loft_whose_edges_turn_tangent_at_the_circles_has_creases_not_sharp_features():
+    report = check_faces(circle_square_circle_loft())
+    creases = [e for e in report.edges if e.level == "crease"]
+    assert len(creases) == 4 and all("partly tangent" in e.note for e in creases)
+    assert report.worst == "crease" and not report.passes("G1")
+
+
+def test_a_prism_on_a_c1_quadratic_bspline_has_g1_knot_lines_in_its_side():
+    report = check_faces(quadratic_prism())
+    inside = [e for e in report.edges if e.index == -1]
+    assert len(inside) == 3 and all(e.level == "G1" and e.surfaces == ("extrusion", "extrusion") for e in inside)
+    assert all("extrusion surface's B-spline" in e.note for e in inside)
+    assert len({(round(e.jump_at[0], 6), round(e.jump_at[1], 6)) for e in inside}) == 3  # three knots, three lines
+    assert not report.passes("G2")
+
+
+def test_extra_samples_go_where_the_geometry_is_not_where_it_is_plain():
+    plain = check_faces(bd.Box(10, 10, 10))
+    assert {e.samples for e in plain.edges} == {18}  # the floor of 16 and the two ends
+    (bump,) = check_faces(bump_join()).edges
+    assert bump.samples >= 18 + 2 * 6  # two in each of the six spans the bump's knots cut the edge into
+
+
+#: In FreeCAD: for each point, the edge through it sampled at 400 points (and 1e-6 from its ends), and at
+#: each the angle between the two faces' normals (``Face.normalAt``): the least and the largest.
+FREECAD_ALONG = textwrap.dedent(
+    """
+    import json, math, sys
+    sys.path.append(sys.argv[1])
+    import FreeCAD, Part
+    shape = Part.read(sys.argv[2])
+    out = []
+    for x, y, z in json.loads(sys.argv[3]):
+        vertex = Part.Vertex(FreeCAD.Vector(x, y, z))
+        edge = min(shape.Edges, key=lambda e: e.distToShape(vertex)[0])
+        faces = [f for f in shape.Faces if any(e.isSame(edge) for e in f.Edges)]
+        a, b = edge.FirstParameter, edge.LastParameter
+        ts = [a + 1e-6 * (b - a), b - 1e-6 * (b - a)] + [a + (b - a) * (k + 0.5) / 400 for k in range(400)]
+        angles = []
+        for t in ts:
+            p = edge.valueAt(t)
+            n = [f.normalAt(*f.Surface.parameter(p)) for f in faces]
+            angles.append(math.acos(max(-1.0, min(1.0, n[0].dot(n[1])))))
+        out.append([min(angles), max(angles)])
+    print(json.dumps(out))
+    """
+)
+
+
+def freecad(script: str, path, points) -> list:
+    run = subprocess.run(["/usr/bin/python3", "-c", script, FREECAD, str(path), json.dumps(points)],
+                         capture_output=True, text=True, timeout=600)  # fmt: skip
+    assert run.returncode == 0, run.stderr[-2000:]
+    return json.loads(run.stdout.splitlines()[-1])
+
+
+@pytest.mark.skipif(FREECAD is None, reason="FreeCAD is not installed (Debian/Ubuntu: apt-get install freecad-python3)")
+def test_freecad_agrees_on_the_reproducers(tmp_path):
+    # the bump: at the worst point FreeCAD's faces are tangent and their normal curvatures jump
+    bump = reproducer_file(tmp_path, bump_join(), ".step")
+    (edge,) = check_faces(bump).edges
+    ((a, b),) = freecad(FREECAD_SCRIPT, bump, [list(edge.jump_at)])
+    assert math.acos(min(1.0, float(np.dot(a[:3], b[:3])))) <= 1e-7
+    assert abs(a[3] - b[3]) / max(a[3], b[3]) > check_faces(bump).curvature_tol
+    assert sorted([a[3], b[3]]) == pytest.approx(sorted(abs(k) for k in edge.curvatures), abs=1e-9)
+    # the loft: FreeCAD finds the same edges tangent over part of their length (least angle below the
+    # feature angle, largest above), and the others sharp all along
+    path = tmp_path / "loft.step"
+    bd.export_step(circle_square_circle_loft(), str(path))
+    report = check_faces(path)
+    judged = [e for e in report.edges if e.level in ("crease", "sharp")]
+    for e, (least, most) in zip(judged, freecad(FREECAD_ALONG, path, [list(e.angle_at) for e in judged])):
+        assert (least < FEATURE_ANGLE < most) == (e.level == "crease"), (e.index, e.level, least, most)
+        assert least > FEATURE_ANGLE or e.level == "crease"
+    # the prism: FreeCAD's curvature either side of each knot line of the extruded B-spline differs
+    prism = tmp_path / "prism.step"
+    bd.export_step(quadratic_prism(), str(prism))
+    inside = [e for e in check_faces(prism).edges if e.index == -1]
+    assert len(inside) == 3
+    for ka, kb in freecad(FREECAD_KNOT, prism, [list(e.jump_at) for e in inside]):
+        assert abs(ka - kb) / max(abs(ka), abs(kb)) > 1e-2
+
+
+#: In FreeCAD: for each point on a knot line u = k of an extruded B-spline, the curvature of the face just
+#: before and just after the knot (``Surface.curvature``, the larger principal one, at u = k ∓ 1e-6).
+FREECAD_KNOT = textwrap.dedent(
+    """
+    import json, sys
+    sys.path.append(sys.argv[1])
+    import FreeCAD, Part
+    shape = Part.read(sys.argv[2])
+    out = []
+    for x, y, z in json.loads(sys.argv[3]):
+        p = FreeCAD.Vector(x, y, z)
+        vertex = Part.Vertex(p)
+        face = min((f for f in shape.Faces if f.Surface.TypeId != "Part::GeomPlane"), key=lambda f: f.distToShape(vertex)[0])
+        u, v = face.Surface.parameter(p)
+        out.append([face.Surface.curvature(u + h, v, "Max") + face.Surface.curvature(u + h, v, "Min") for h in (-1e-6, 1e-6)])
+    print(json.dumps(out))
+    """
+)
