@@ -826,7 +826,7 @@ def _make(segments: list[Segment], bound: float, closed: bool | None, shape: str
     if closed and "split" in kinds:  # start the open walk at a split
         cut = kinds.index("split")
         order = list(range(cut + 1, count)) + list(range(cut + 1))
-    for position, k in enumerate(order):
+    for k in order:
         piece = pieces[k]
         if current:
             joint = (k - 1) % count
