@@ -47,6 +47,7 @@ from ..core.shapes import SHAPE_CODES, TRANSITION_SHAPES, shape_code
 from ..core.space import PlaneFrame
 from ..core.spiral import BezierSpiral
 from ..core.units import DEFAULT_UNITS, length_unit
+from .fillets import _intersect
 from .rounding import _steepest_deflection, round_corners_batch
 
 __all__ = ["G2Joint", "G2Path", "make_g2"]
@@ -153,6 +154,10 @@ class _Piece:
     r: float = 0.0
     a0: float = 0.0
     sweep: float = 0.0
+    #: A tangent circle put into a corner next to an arc: how far it passes from the corner (else 0).
+    fillet: float = 0.0
+    #: How much of the bound a tangent circle beside this piece has used (its shift must leave it).
+    spent: float = 0.0
 
     @property
     def sense(self) -> float:
@@ -368,7 +373,7 @@ class _Group:
                 0, f"it is below what float64 resolves at these coordinates (8 ulp of {size:.6g} is {8.0 * EPS * size:.3g})", True
             )
         self.target = target
-        self.cap = [min(target, q_max * abs(p.r)) if need else 0.0 for p, need in zip(pieces, self.needs_shift)]
+        self.cap = [min(target - p.spent, q_max * abs(p.r)) if need else 0.0 for p, need in zip(pieces, self.needs_shift)]
         self.factor = [1.0] * n
 
     def shifts(self) -> list[float]:
@@ -572,9 +577,6 @@ def _solve(group: _Group) -> tuple[list[_Solved | None], list[float]]:
             if kind == "corner":
                 joint = solved[j]
                 assert joint is not None
-                if group.pieces[j].kind != "line" or group.pieces[(j + 1) % n].kind != "line":
-                    raise _Refusal(j, "a sharp corner next to an arc is not rounded by make_g2 yet: only corners "
-                                      "between two lines are; split the path there, or give the corner a tangent fillet", False)  # fmt: skip
                 raise _Refusal(j, joint.reason, joint.status == Status.UNVERIFIED)
             for k in (j, (j + 1) % n):
                 if group.needs_shift[k]:
@@ -643,14 +645,16 @@ def _deviation(group: _Group, solved: list[_Solved | None], s: list[float], used
     (every point of a concentric circle moves by it), and at each joint the spirals against the input
     pieces beside it, and the stretch of the input the joint replaced against the result."""
     n = len(group.pieces)
-    worst = max(s, default=0.0)
+    # A tangent circle put into a corner is itself ``fillet`` off the input: its shifts and joints add it.
+    worst = max((shift + p.fillet for shift, p in zip(s, group.pieces)), default=0.0)
     for j, joint in enumerate(solved):
         if joint is None:
             continue
         a, b = group.pieces[j], group.pieces[(j + 1) % n]
+        added = max(a.fillet, b.fillet)
         curve = np.vstack([_bezier(cp, SAMPLES) for cp in joint.spirals])
         there = np.minimum(_distance_to_piece(curve, a), _distance_to_piece(curve, b))
-        worst = max(worst, float(there.max()))
+        worst = max(worst, float(there.max()) + added)
         replaced = np.vstack([_piece_points(a, 0.0, used[j][1], SAMPLES, region="tail"),
                               _piece_points(b, used[(j + 1) % n][0], 0.0, SAMPLES, region="head")])  # fmt: skip
         near = np.min([_distance_to_bezier(replaced, cp) for cp in joint.spirals], axis=0)
@@ -658,7 +662,7 @@ def _deviation(group: _Group, solved: list[_Solved | None], s: list[float], used
             kept = _kept(piece, used[k], s[k])
             if kept is not None:
                 near = np.minimum(near, _distance_to_piece(replaced, kept))
-        worst = max(worst, float(near.max()))
+        worst = max(worst, float(near.max()) + added)
     return worst
 
 
@@ -851,6 +855,7 @@ def _make(segments: list[Segment], bound: float, closed: bool | None, shape: str
     deviation = 0.0
     for group_pieces, group_kinds, group_joints, group_closed in groups:
         try:
+            group_pieces, group_kinds, group_joints = _arc_corners(group_pieces, group_kinds, group_joints, group_closed, bound)
             group = _Group(group_pieces, group_kinds, group_closed, bound, shape, extent)
             solved, s = _solve(group)
             chain, measured = _assemble(group, solved, s, units, tolerance)
@@ -869,12 +874,149 @@ def _make(segments: list[Segment], bound: float, closed: bool | None, shape: str
         for j, (kind, solved_joint) in enumerate(zip(group_kinds, solved)):
             index = group_joints[j]
             a, b = group_pieces[j], group_pieces[(j + 1) % len(group_pieces)]
+            if a.fillet or b.fillet:
+                circle, shift = (a, s[j]) if a.fillet else (b, s[(j + 1) % len(group_pieces)])
+                moved = (f"corner rounded by a tangent circle of radius {abs(circle.r):.6g} passing {circle.fillet:.6g} from it, "
+                         f"shrunk by {shift:.6g} for its transitions")  # fmt: skip
+                joints[index] = G2Joint(index, "corner", tuple(pieces[index].end().tolist()), moved, circle.fillet + shift,
+                                        solved_joint.theta if solved_joint is not None else math.nan)  # fmt: skip
+                continue
             joints[index] = G2Joint(index, kind, tuple(pieces[index].end().tolist()), _moved(kind, a, b, s[j], s[(j + 1) % len(group_pieces)], solved_joint),
                                     _joint_shift(kind, s[j], s[(j + 1) % len(group_pieces)], group, solved_joint, a),
                                     solved_joint.theta if solved_joint is not None else math.nan)  # fmt: skip
     records = [joints[i] for i in sorted(joints)]
     splits = [j.index for j in records if j.kind == "split"]
     return G2Path(chains, deviation, records, splits, bool(closed) and not splits, bound, shape, units)
+
+
+def _arc_corners(pieces: list[_Piece], kinds: list[str], joints: list[int], closed: bool,
+                 bound: float) -> tuple[list[_Piece], list[str], list[int]]:  # fmt: skip
+    """Each sharp corner next to an arc given a tangent circle (a circular fillet) passing half the bound
+    from the corner point, so that the path is tangent there and its transitions do the rest."""
+    n = len(pieces)
+    corners = [j for j, kind in enumerate(kinds) if kind == "corner" and "arc" in (pieces[j].kind, pieces[(j + 1) % n].kind)]
+    if not corners:
+        return pieces, kinds, joints
+    pieces = [_Piece(p.kind, p.first, p.last, p.a.copy(), p.b.copy(), p.c.copy(), p.r, p.a0, p.sweep) for p in pieces]
+    sizes = [p.size for p in pieces]
+    both = [closed or 0 < k < n - 1 for k in range(n)]
+    circles: dict[int, _Piece] = {}
+    for j in corners:
+        a, b = pieces[j], pieces[(j + 1) % n]
+        room_a = (SHARED if both[j] else ALONE) * sizes[j]
+        room_b = (SHARED if both[(j + 1) % n] else ALONE) * sizes[(j + 1) % n]
+        made = _tangent_circle(a, b, 0.5 * bound, room_a, room_b)
+        if made is None:
+            raise _Refusal(j, "no tangent circle fits into this corner between its neighbours", False)
+        circle, end_a, start_b = made
+        _trim_end(a, end_a)
+        _trim_start(b, start_b)
+        a.spent = max(a.spent, circle.fillet)
+        b.spent = max(b.spent, circle.fillet)
+        circle.spent = circle.fillet
+        circles[j] = circle
+    out_pieces: list[_Piece] = []
+    out_kinds: list[str] = []
+    out_joints: list[int] = []
+    for k in range(n):
+        out_pieces.append(pieces[k])
+        if k >= len(kinds):
+            continue
+        if k in circles:
+            circle, after = circles[k], pieces[(k + 1) % n]
+            out_pieces.append(circle)
+            out_kinds += [_tangent_kind(pieces[k], circle), _tangent_kind(circle, after)]
+            out_joints += [joints[k], joints[k]]
+        else:
+            out_kinds.append(kinds[k])
+            out_joints.append(joints[k])
+    return out_pieces, out_kinds, out_joints
+
+
+def _tangent_kind(a: _Piece, b: _Piece) -> str:
+    if a.kind == "line" or b.kind == "line":
+        return "line-arc"
+    return "arc-arc-compound" if (a.r > 0) == (b.r > 0) else "arc-arc-reverse"
+
+
+def _tangent_circle(a: _Piece, b: _Piece, depth: float, room_a: float, room_b: float) -> tuple[_Piece, NDArray, NDArray] | None:
+    """The largest circle tangent to ``a`` and ``b`` inside their corner that passes at most ``depth`` from the
+    corner point and touches each within its room; (circle piece, touch on a, touch on b), None if none fits."""
+    corner = a.end()
+    turn = _turn(a, b)
+    sense = math.copysign(1.0, turn)
+
+    def attempt(rho: float) -> tuple[_Piece, NDArray, NDArray] | None:
+        loci = []
+        for piece, at_end in ((a, True), (b, False)):
+            if piece.kind == "line":
+                t = piece.tangent(True)
+                normal = np.array([-t[1], t[0]]) * sense
+                loci.append(("line", piece.a + rho * normal, t))
+            else:
+                distance = abs(piece.r) - rho if (piece.r > 0) == (sense > 0) else abs(piece.r) + rho
+                if not distance > 0.0:
+                    return None
+                loci.append(("circle", piece.c, distance))
+        centre = _intersect(loci[0], loci[1], corner)
+        if centre is None:
+            return None
+        touches = []
+        for piece in (a, b):
+            if piece.kind == "line":
+                t = piece.tangent(True)
+                touches.append(piece.a + float(np.dot(centre - piece.a, t)) * t)
+            else:
+                away = centre - piece.c
+                touches.append(piece.c + abs(piece.r) * away / math.hypot(*away))
+        used_a, used_b = _used(a, touches[0], True), _used(b, touches[1], False)
+        if not (0.0 < used_a <= room_a and 0.0 < used_b <= room_b):
+            return None
+        if not math.dist(centre, corner) - rho <= depth:
+            return None
+        start = math.atan2(touches[0][1] - centre[1], touches[0][0] - centre[0])
+        end = math.atan2(touches[1][1] - centre[1], touches[1][0] - centre[0])
+        sweep = (sense * (end - start)) % TAU
+        if not 0.0 < sweep < math.pi:
+            return None
+        circle = _Piece("arc", -1, -1, c=centre, r=sense * rho, a0=start, sweep=sweep, fillet=math.dist(centre, corner) - rho)
+        return circle, touches[0], touches[1]
+
+    half = abs(turn) / 2.0
+    rho = depth / max(1.0 / math.cos(half) - 1.0, 1e-300)
+    best = None
+    for _ in range(200):
+        best = attempt(rho)
+        if best is not None:
+            break
+        rho *= 0.5
+    if best is None:
+        return None
+    lo, hi = rho, 2.0 * rho
+    for _ in range(40):
+        mid = 0.5 * (lo + hi)
+        found = attempt(mid)
+        if found is not None:
+            lo, best = mid, found
+        else:
+            hi = mid
+    return best
+
+
+def _trim_end(piece: _Piece, point: NDArray) -> None:
+    if piece.kind == "line":
+        piece.b = point.copy()
+    else:
+        piece.sweep -= _used(piece, point, True)
+
+
+def _trim_start(piece: _Piece, point: NDArray) -> None:
+    if piece.kind == "line":
+        piece.a = point.copy()
+    else:
+        used = _used(piece, point, False)
+        piece.a0 += piece.sense * used
+        piece.sweep -= used
 
 
 def _moved(kind: str, a: _Piece, b: _Piece, sa: float, sb: float, solved: _Solved | None) -> str:
