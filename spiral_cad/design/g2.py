@@ -41,7 +41,7 @@ from ..core import _kernels as K
 from ..core import batch
 from ..core._inputs import as_float, as_points
 from ..core.chain import JOIN_TOLERANCE, Chain, g2_mismatch, join_tolerance
-from ..core.errors import NoSolutionError, Status
+from ..core.errors import JointError, NoSolutionError, Status
 from ..core.segments import TAU, Arc, Line, Segment
 from ..core.shapes import SHAPE_CODES, TRANSITION_SHAPES, shape_code
 from ..core.space import PlaneFrame
@@ -381,25 +381,25 @@ class _Group:
         more than the larger one by a step inside the nested band."""
         n = len(self.pieces)
         s = [c * f for c, f in zip(self.cap, self.factor)]
-        order = sorted((k for k in range(n) if self.needs_shift[k]), key=lambda k: abs(self.pieces[k].r))
-        for k in order:
-            for j in range(self.joint_count):
-                if self.kinds[j] != "arc-arc-compound":
-                    continue
+        pairs = []  # (small, big, band width) of every compound joint
+        for j in range(self.joint_count):
+            if self.kinds[j] == "arc-arc-compound":
                 a, b = j, (j + 1) % n
-                if k not in (a, b):
-                    continue
-                small = b if k == a else a
-                if abs(self.pieces[small].r) >= abs(self.pieces[k].r):
-                    continue  # k is the smaller circle here
-                s[k] = min(s[k], s[small] - self._band_step(small, k, s[small]))
+                small, big = (a, b) if abs(self.pieces[a].r) < abs(self.pieces[b].r) else (b, a)
+                pairs.append((small, big, self._band_width(small, big)))
+        pairs.sort(key=lambda pair: abs(self.pieces[pair[0]].r))
+        for _ in range(3):
+            for small, big, width in pairs:  # the larger circle shrinks less, by a step inside the band
+                s[big] = min(s[big], s[small] - min(0.5 * s[small], 0.5 * width))
+            for small, big, width in pairs[::-1]:  # ... and not by more than the band allows
+                s[small] = min(s[small], s[big] + 0.9 * width)
         return s
 
-    def _band_step(self, small: int, big: int, s_small: float) -> float:
+    def _band_width(self, small: int, big: int) -> float:
+        """How much more than the larger circle the smaller one may shrink: the nested band's width."""
         rs, rb = abs(self.pieces[small].r), abs(self.pieces[big].r)
         lower = K.nested_band_lower(rs / rb, SHAPE_CODES[self.shape])
-        width = (rb - rs) * (1.0 / lower - 1.0)
-        return min(0.5 * s_small, 0.5 * width)
+        return (rb - rs) * (1.0 / lower - 1.0)
 
     def solve_joints(self, s: list[float]) -> list[_Solved | None]:
         n = len(self.pieces)
@@ -566,10 +566,15 @@ def _solve(group: _Group) -> tuple[list[_Solved | None], list[float]]:
             if joint.status:
                 failed.append(j)
                 continue
+            # An overrun shrinks the shifts of this joint's circles (a smaller shift: a shorter transition).
+            worst = 1.0
             for k, used, end in ((j, joint.used_before, 1), ((j + 1) % n, joint.used_after, 0)):
                 room = group.allow[k][end]
                 if not (used <= room):
-                    over[k] = min(over.get(k, 1.0), (room / used) ** 2 * 0.8 if used > 0.0 and room > 0.0 else 0.25)
+                    worst = min(worst, (room / used) ** 2 * 0.8 if used > 0.0 and room > 0.0 else 0.25)
+            if worst < 1.0:
+                for k in _joint_circles(group, j):
+                    over[k] = min(over.get(k, 1.0), worst)
         if not over and not failed:
             return solved, s
         for j in failed:
@@ -578,22 +583,22 @@ def _solve(group: _Group) -> tuple[list[_Solved | None], list[float]]:
                 joint = solved[j]
                 assert joint is not None
                 raise _Refusal(j, joint.reason, joint.status == Status.UNVERIFIED)
-            for k in (j, (j + 1) % n):
-                if group.needs_shift[k]:
-                    over[k] = min(over.get(k, 1.0), 0.5)
+            for k in _joint_circles(group, j):
+                over[k] = min(over.get(k, 1.0), 0.5)
         for k, factor in over.items():
-            if group.pieces[k].kind == "arc":
-                group.factor[k] *= factor
-            else:  # a line overrun: the arcs beside it shrink less
-                for m in ((k - 1) % n, (k + 1) % n):
-                    if (group.closed or 0 <= m < n) and group.needs_shift[m]:
-                        group.factor[m] *= factor
+            group.factor[k] *= factor
     s = group.shifts()
     solved = group.solve_joints(s)
     for j, joint in enumerate(solved):
         if joint is not None and joint.status:
             raise _Refusal(j, joint.reason or describe_status(joint.status), True)
     raise _Refusal(0, "the transitions could not be fitted into the lines and arcs", True)
+
+
+def _joint_circles(group: _Group, j: int) -> list[int]:
+    """The pieces of joint ``j`` whose circles shift."""
+    n = len(group.pieces)
+    return [k for k in (j, (j + 1) % n) if group.needs_shift[k]]
 
 
 def describe_status(status: int) -> str:
@@ -609,12 +614,21 @@ def _assemble(group: _Group, solved: list[_Solved | None], s: list[float], units
             used[j][1] = joint.used_before
             used[(j + 1) % n][0] = joint.used_after
     segments: list[Segment] = []
+    owners: list[int] = []  # the joint each segment belongs to (a piece: the joint after it)
     for k, piece in enumerate(group.pieces):
-        segments += _trimmed(piece, used[k], s[k], solved, k, n, group.closed)
+        kept = _trimmed(piece, used[k], s[k], solved, k, n, group.closed)
+        segments += kept
+        owners += [min(k, len(solved) - 1)] * len(kept)
         joint = solved[k] if k < len(solved) else None
         if joint is not None:
             segments += [BezierSpiral._wrap(cp, group.shape) for cp in joint.spirals]
-    chain = Chain(segments, tolerance, units)
+            owners += [k] * len(joint.spirals)
+    try:
+        chain = Chain(segments, tolerance, units)
+    except JointError as error:
+        where = owners[error.joint + 1] if isinstance(segments[error.joint + 1], BezierSpiral) else owners[error.joint]
+        detail = str(error).split("): ", 1)[-1]
+        raise _Refusal(max(where, 0), f"float64 cannot hold its transition G2 at these coordinates and sizes ({detail})", True) from None
     if group.closed:
         problem = g2_mismatch(segments[-1], segments[0], chain.tolerance, units, len(segments) - 1)
         if problem:
@@ -948,7 +962,7 @@ def _tangent_circle(a: _Piece, b: _Piece, depth: float, room_a: float, room_b: f
 
     def attempt(rho: float) -> tuple[_Piece, NDArray, NDArray] | None:
         loci = []
-        for piece, at_end in ((a, True), (b, False)):
+        for piece in (a, b):
             if piece.kind == "line":
                 t = piece.tangent(True)
                 normal = np.array([-t[1], t[0]]) * sense
