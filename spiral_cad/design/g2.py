@@ -50,7 +50,7 @@ from ..core.units import DEFAULT_UNITS, length_unit
 from .fillets import _intersect
 from .rounding import _steepest_deflection, round_corners_batch
 
-__all__ = ["G2Joint", "G2Path", "make_g2"]
+__all__ = ["G2Joint", "G2Path", "make_g2", "smallest_max_deviation"]
 
 #: The shifts are aimed this much (relative) inside the bound.
 BOUND_MARGIN = 1e-6
@@ -740,6 +740,39 @@ def make_g2(
     return result
 
 
+def smallest_max_deviation(
+    path: Any, *, closed: bool | None = None, shape: str = "near-linear", units: str = DEFAULT_UNITS, tolerance: float = JOIN_TOLERANCE
+) -> float:
+    """The smallest ``max_deviation`` with which ``make_g2`` makes ``path`` G2 (what ``spiral-cad check``
+    tells of a G1 file).
+
+    Tangent joints need only a positive shift, so this is where float64 stops
+    holding the transitions at the path's coordinates and sizes. Found by
+    building: doubling from the coordinates' rounding, then bisecting, and
+    shown to 3 digits rounded up, that very number built again.
+
+    Args:
+        path, closed, shape, units, tolerance: as for ``make_g2``.
+
+    Raises:
+        NoSolutionError: no bound up to the path's size works (the first joint
+            that fails is named).
+        ValueError: malformed input.
+    """
+    shape_code(shape, TRANSITION_SHAPES)
+    units = length_unit(units)
+    tolerance = join_tolerance(tolerance)
+    segments, _ = _path_segments(path)
+    size = max(float(np.abs(np.array([p for s in segments for p in s.outline()])).max()), 1e-300)
+    floor = 8.0 * EPS * size
+    works = _smallest_bound(segments, floor, closed, shape, units, tolerance)
+    if works is None:
+        failed = _make(segments, 4.0 * size, closed, shape, units, tolerance)
+        reason = _refusal_message(failed, segments, 4.0 * size, closed, shape, units, tolerance) if isinstance(failed, _Refusal) else ""
+        raise NoSolutionError(f"no max_deviation up to the path's size makes it G2: {reason}")
+    return works
+
+
 def _placed_joint(joint: G2Joint, frame: PlaneFrame) -> G2Joint:
     point = tuple(float(v) for v in frame.point(np.array(joint.point)).tolist())
     return G2Joint(joint.index, joint.kind, point, joint.moved, joint.shift, joint.theta)
@@ -790,7 +823,7 @@ def _smallest_bound(segments: list[Segment], bound: float, closed: bool | None, 
     # The advice is shown to 3 digits: rounded up, and that very number built again.
     for _ in range(8):
         digits = 10.0 ** (math.floor(math.log10(hi)) - 2)
-        shown = math.ceil(hi / digits) * digits
+        shown = float(f"{math.ceil(hi / digits) * digits:.3g}")
         if not isinstance(_make(segments, shown, closed, shape, units, tolerance), _Refusal):
             return shown
         hi = 1.25 * shown

@@ -127,3 +127,31 @@ def test_refusal_passes_through():
         make_g2(fillet(Rectangle(10, 6).vertices(), 1).moved(build123d.Location((1e7, 1e7))), 1e-13)
     with pytest.raises(ValueError, match="planar Wire"):
         make_g2(build123d.Box(1, 1, 1), 0.1)
+
+
+def test_check_of_a_g1_file_says_the_smallest_bound_that_makes_it_g2(tmp_path, capsys):
+    """``spiral-cad check`` of a STEP file of a filleted rectangle (written by build123d, read back by
+    OCCT's STEP reader) names the smallest max_deviation that works; that bound then builds G2 and a
+    bound a tenth of it is refused."""
+    from build123d import export_step
+
+    from spiral_cad.app.cli import main
+    from spiral_cad.cad.fillet import planar_frame, wire_path
+    from spiral_cad.design import make_g2 as make_path_g2
+    from spiral_cad.design import smallest_max_deviation
+
+    path = tmp_path / "rounded.step"
+    wire = fillet(Rectangle(10, 6).vertices(), 1).faces()[0].outer_wire()
+    export_step(wire, str(path))
+    assert main(["check", str(path)]) == 0
+    out = capsys.readouterr().out
+    assert "worst G1" in out
+    line = next(x for x in out.splitlines() if x.startswith("make_g2:"))
+    assert "8 tangent joints" in line
+    bound = float(line.split("max_deviation ")[1].split(" ")[0])
+    segments, closed = wire_path(wire.wrapped, planar_frame(wire.wrapped))
+    assert smallest_max_deviation(segments, closed=closed) == bound
+    made = make_path_g2(segments, bound, closed=closed)
+    assert all(j.kind == "line-arc" for j in made.joints)
+    with pytest.raises(NoSolutionError, match="works"):
+        make_path_g2(segments, bound / 10.0, closed=closed)
