@@ -63,7 +63,7 @@ MAX_SHRINK = 0.5
 #: Passes of shrinking the shifts that overrun a line or an arc before a joint is refused.
 PASSES = 60
 #: Samples per spiral (and per replaced stretch of the input) when the deviation is measured.
-SAMPLES = 48
+SAMPLES = 32
 EPS = float(np.finfo(float).eps)
 
 JOINT_KINDS = ("line-arc", "arc-arc-compound", "arc-arc-reverse", "corner", "g2", "split")
@@ -375,6 +375,7 @@ class _Group:
         self.target = target
         self.cap = [min(target - p.spent, q_max * abs(p.r)) if need else 0.0 for p, need in zip(pieces, self.needs_shift)]
         self.factor = [1.0] * n
+        self._corners: dict[int, _Solved] = {}
 
     def shifts(self) -> list[float]:
         """Each arc's shrink: its cap times its factor, the smaller circle of a compound joint shrunk
@@ -402,50 +403,74 @@ class _Group:
         return (rb - rs) * (1.0 / lower - 1.0)
 
     def solve_joints(self, s: list[float]) -> list[_Solved | None]:
+        """Every joint's transition for the shifts ``s``: one batch solve per kind of joint."""
         n = len(self.pieces)
-        out: list[_Solved | None] = []
+        out: list[_Solved | None] = [None] * self.joint_count
+        by_kind: dict[str, list[int]] = {}
         for j in range(self.joint_count):
-            a, b = self.pieces[j], self.pieces[(j + 1) % n]
-            kind = self.kinds[j]
-            if kind == "line-arc":
-                out.append(self._line_arc(a, b, s[j], s[(j + 1) % n]))
-            elif kind in ("arc-arc-compound", "arc-arc-reverse"):
-                out.append(self._arc_arc(a, b, s[j], s[(j + 1) % n], kind))
-            elif kind == "corner":
-                out.append(self._corner(j, a, b))
-            else:
-                out.append(None)
+            by_kind.setdefault(self.kinds[j], []).append(j)
+        if by_kind.get("line-arc"):
+            self._lines_arcs(by_kind["line-arc"], s, out)
+        for kind in ("arc-arc-reverse", "arc-arc-compound"):
+            if by_kind.get(kind):
+                self._arcs_arcs(by_kind[kind], s, kind, out)
+        for j in by_kind.get("corner", []):  # a corner between lines does not depend on the shifts
+            if j not in self._corners:
+                self._corners[j] = self._corner(j, self.pieces[j], self.pieces[(j + 1) % n])
+            out[j] = self._corners[j]
         return out
 
-    def _line_arc(self, a: _Piece, b: _Piece, sa: float, sb: float) -> _Solved:
-        if a.kind == "line":
-            line, arc, shrink, reverse = a, b, sb, False
-            point, direction = a.b, a.tangent(True)
-        else:
-            line, arc, shrink, reverse = b, a, sa, True
-            point, direction = b.a, -b.tangent(False)
-        radius = abs(arc.r) - shrink
-        # Solved about the joint (where float64 holds a small transition far from the origin) and moved back.
-        origin = point.copy()
-        result = batch.line_to_circle(point - origin, direction, arc.c - origin, radius, shape=self.shape)
-        if not result.ok[0]:
-            return _Solved([], math.inf, math.inf, math.nan, int(result.status[0]), result.reason(0))
-        cp = result.spirals[0][0] + origin
-        if reverse:
-            cp = cp[::-1].copy()
-            return _Solved([cp], _used(arc, cp[0], True), _used(line, cp[3], False), float(result.theta[0]))
-        return _Solved([cp], _used(line, cp[0], True), _used(arc, cp[3], False), float(result.theta[0]))
+    def _lines_arcs(self, joints: list[int], s: list[float], out: list[_Solved | None]) -> None:
+        """Line → arc and arc → line joints (Theorem 4.1 onto the shrunk circle), solved about each joint
+        (where float64 holds a small transition far from the origin) and moved back."""
+        n = len(self.pieces)
+        origin, direction, centre, radius, reverse = [], [], [], [], []
+        for j in joints:
+            a, b = self.pieces[j], self.pieces[(j + 1) % n]
+            if a.kind == "line":
+                origin.append(a.b)
+                direction.append(a.tangent(True))
+                centre.append(b.c)
+                radius.append(abs(b.r) - s[(j + 1) % n])
+                reverse.append(False)
+            else:
+                origin.append(b.a)
+                direction.append(-b.tangent(False))
+                centre.append(a.c)
+                radius.append(abs(a.r) - s[j])
+                reverse.append(True)
+        points = np.array(origin)
+        result = batch.line_to_circle(
+            np.zeros_like(points), np.array(direction), np.array(centre) - points, np.array(radius), shape=self.shape
+        )
+        spirals = result.spirals[0] + points[:, None]
+        for m, j in enumerate(joints):
+            a, b = self.pieces[j], self.pieces[(j + 1) % n]
+            if not result.ok[m]:
+                out[j] = _Solved([], math.inf, math.inf, math.nan, int(result.status[m]), result.reason(m))
+                continue
+            cp = spirals[m][::-1].copy() if reverse[m] else spirals[m]
+            out[j] = _Solved([cp], _used(a, cp[0], True), _used(b, cp[3], False), float(result.theta[m]))
 
-    def _arc_arc(self, a: _Piece, b: _Piece, sa: float, sb: float, kind: str) -> _Solved:
-        ra = a.r - a.sense * sa
-        rb = b.r - b.sense * sb
+    def _arcs_arcs(self, joints: list[int], s: list[float], kind: str, out: list[_Solved | None]) -> None:
+        """Reverse (S) or compound (nested) joints between shrunk circles, solved about each joint."""
+        n = len(self.pieces)
+        before = [self.pieces[j] for j in joints]
+        after = [self.pieces[(j + 1) % n] for j in joints]
+        origin = np.array([a.end() for a in before])
+        c0 = np.array([a.c for a in before]) - origin
+        c1 = np.array([b.c for b in after]) - origin
+        r0 = np.array([a.r - a.sense * s[j] for a, j in zip(before, joints)])
+        r1 = np.array([b.r - b.sense * s[(j + 1) % n] for b, j in zip(after, joints)])
         solver = batch.circle_to_circle if kind == "arc-arc-reverse" else batch.circle_in_circle
-        origin = a.end()
-        result = solver(a.c - origin, ra, b.c - origin, rb, shape=self.shape)
-        if not result.ok[0]:
-            return _Solved([], math.inf, math.inf, math.nan, int(result.status[0]), result.reason(0))
-        spirals = [sp[0] + origin for sp in result.spirals]
-        return _Solved(spirals, _used(a, spirals[0][0], True), _used(b, spirals[-1][3], False), float(result.theta[0]))
+        result = solver(c0, r0, c1, r1, shape=self.shape)
+        moved = [sp + origin[:, None] for sp in result.spirals]
+        for m, j in enumerate(joints):
+            if not result.ok[m]:
+                out[j] = _Solved([], math.inf, math.inf, math.nan, int(result.status[m]), result.reason(m))
+                continue
+            spirals = [sp[m] for sp in moved]
+            out[j] = _Solved(spirals, _used(before[m], spirals[0][0], True), _used(after[m], spirals[-1][3], False), float(result.theta[m]))
 
     def _corner(self, j: int, a: _Piece, b: _Piece) -> _Solved:
         n = len(self.pieces)
@@ -657,27 +682,118 @@ def _trimmed(piece: _Piece, used: list[float], shrink: float, solved: list[_Solv
 def _deviation(group: _Group, solved: list[_Solved | None], s: list[float], used: list[list[float]]) -> float:
     """The Hausdorff distance between the input and the result, measured: the shrink of each arc
     (every point of a concentric circle moves by it), and at each joint the spirals against the input
-    pieces beside it, and the stretch of the input the joint replaced against the result."""
+    pieces beside it, and the stretch of the input the joint replaced against the result (all joints
+    at once, in blocks)."""
     n = len(group.pieces)
     # A tangent circle put into a corner is itself ``fillet`` off the input: its shifts and joints add it.
     worst = max((shift + p.fillet for shift, p in zip(s, group.pieces)), default=0.0)
-    for j, joint in enumerate(solved):
-        if joint is None:
-            continue
-        a, b = group.pieces[j], group.pieces[(j + 1) % n]
-        added = max(a.fillet, b.fillet)
-        curve = np.vstack([_bezier(cp, SAMPLES) for cp in joint.spirals])
-        there = np.minimum(_distance_to_piece(curve, a), _distance_to_piece(curve, b))
-        worst = max(worst, float(there.max()) + added)
-        replaced = np.vstack([_piece_points(a, 0.0, used[j][1], SAMPLES, region="tail"),
-                              _piece_points(b, used[(j + 1) % n][0], 0.0, SAMPLES, region="head")])  # fmt: skip
-        near = np.min([_distance_to_bezier(replaced, cp) for cp in joint.spirals], axis=0)
-        for piece, k in ((a, j), (b, (j + 1) % n)):
-            kept = _kept(piece, used[k], s[k])
-            if kept is not None:
-                near = np.minimum(near, _distance_to_piece(replaced, kept))
-        worst = max(worst, float(near.max()) + added)
+    index = [j for j, joint in enumerate(solved) if joint is not None]
+    for block in range(0, len(index), BLOCK):
+        joints = index[block : block + BLOCK]
+        before = [group.pieces[j] for j in joints]
+        after = [group.pieces[(j + 1) % n] for j in joints]
+        added = np.array([max(a.fillet, b.fillet) for a, b in zip(before, after)])
+        spirals = np.array([[cps[0], cps[-1]] for cps in (solved[j].spirals for j in joints)])  # type: ignore[union-attr]
+        rows_a, rows_b = _Rows(before), _Rows(after)
+        u = np.linspace(0.0, 1.0, SAMPLES)
+        curve = np.concatenate([_bezier_rows(spirals[:, 0], u), _bezier_rows(spirals[:, 1], u)], axis=1)
+        there = np.minimum(rows_a.distance(curve), rows_b.distance(curve))
+        worst = max(worst, float((there.max(axis=1) + added).max()))
+        tail = np.array([used[j][1] for j in joints])
+        head = np.array([used[(j + 1) % n][0] for j in joints])
+        replaced = np.concatenate(
+            [rows_a.points(rows_a.size - tail, rows_a.size, SAMPLES), rows_b.points(np.zeros(len(joints)), head, SAMPLES)], axis=1
+        )
+        near = np.minimum(_distance_to_bezier_rows(replaced, spirals[:, 0]), _distance_to_bezier_rows(replaced, spirals[:, 1]))
+        for pieces, ks in ((before, joints), (after, [(j + 1) % n for j in joints])):
+            kept = [_kept(piece, used[k], s[k]) for piece, k in zip(pieces, ks)]
+            present = np.array([k is not None for k in kept])
+            if present.any():
+                rows = _Rows([k if k is not None else pieces[i] for i, k in enumerate(kept)])
+                near = np.minimum(near, np.where(present[:, None], rows.distance(replaced), np.inf))
+        worst = max(worst, float((near.max(axis=1) + added).max()))
     return worst
+
+
+#: Joints measured at once (bounds the memory of the point-to-sample distances).
+BLOCK = 256
+#: Starting points of the nearest-point search on a spiral (its distance has one minimum per stretch
+#: this short: a spiral turns less than 90°), and the Newton steps that polish them.
+GUESSES = 17
+NEWTON_STEPS = 5
+
+
+class _Rows:
+    """Pieces as arrays: lines (a → b) and arcs (centre, radius, start angle, sweep), one row each."""
+
+    def __init__(self, pieces: list[_Piece]):
+        self.arc = np.array([p.kind == "arc" for p in pieces])
+        self.a = np.array([p.a for p in pieces])
+        self.b = np.array([p.b for p in pieces])
+        self.c = np.array([p.c for p in pieces])
+        self.r = np.array([abs(p.r) for p in pieces])
+        self.sense = np.array([p.sense for p in pieces])
+        self.a0 = np.array([p.a0 for p in pieces])
+        self.sweep = np.array([p.sweep for p in pieces])
+        self.size = np.where(self.arc, self.sweep, np.hypot(*(self.b - self.a).T))
+
+    def points(self, lo: NDArray, hi: NDArray, count: int) -> NDArray:
+        """(J, count, 2) points from ``lo`` to ``hi`` (length along a line, angle along an arc)."""
+        t = lo[:, None] + np.linspace(0.0, 1.0, count)[None] * (hi - lo)[:, None]
+        with np.errstate(invalid="ignore", divide="ignore"):
+            unit = (self.b - self.a) / np.where(self.arc, 1.0, self.size)[:, None]
+        line = self.a[:, None] + t[..., None] * unit[:, None]
+        angle = self.a0[:, None] + self.sense[:, None] * t
+        arc = self.c[:, None] + self.r[:, None, None] * np.stack([np.cos(angle), np.sin(angle)], axis=-1)
+        return np.where(self.arc[:, None, None], arc, line)
+
+    def distance(self, points: NDArray) -> NDArray:
+        """(J, M) exact distance of ``points`` (J, M, 2) to each row's line segment or arc."""
+        d = self.b - self.a
+        dd = np.einsum("ij,ij->i", d, d)
+        with np.errstate(invalid="ignore", divide="ignore"):
+            t = np.clip(np.einsum("jmk,jk->jm", points - self.a[:, None], d) / dd[:, None], 0.0, 1.0)
+        line = np.linalg.norm(points - self.a[:, None] - t[..., None] * d[:, None], axis=-1)
+        rel = points - self.c[:, None]
+        angle = np.arctan2(rel[..., 1], rel[..., 0])
+        inside = (self.sense[:, None] * (angle - self.a0[:, None])) % TAU <= self.sweep[:, None]
+        radial = np.abs(np.hypot(rel[..., 0], rel[..., 1]) - self.r[:, None])
+        end_angle = self.a0 + self.sense * self.sweep
+        start = self.c + self.r[:, None] * np.stack([np.cos(self.a0), np.sin(self.a0)], axis=-1)
+        end = self.c + self.r[:, None] * np.stack([np.cos(end_angle), np.sin(end_angle)], axis=-1)
+        ends = np.minimum(np.linalg.norm(points - start[:, None], axis=-1), np.linalg.norm(points - end[:, None], axis=-1))
+        arc = np.where(inside, np.minimum(radial, ends), ends)
+        return np.where(self.arc[:, None], arc, np.nan_to_num(line, nan=np.inf))
+
+
+def _bezier_rows(cp: NDArray, u: NDArray) -> NDArray:
+    """(J, len(u), 2) points of J cubic Béziers (J, 4, 2)."""
+    u = u[None, :, None] if u.ndim == 1 else u[..., None]
+    v = 1.0 - u
+    return v**3 * cp[:, None, 0] + 3 * v * v * u * cp[:, None, 1] + 3 * v * u * u * cp[:, None, 2] + u**3 * cp[:, None, 3]
+
+
+def _distance_to_bezier_rows(points: NDArray, cp: NDArray) -> NDArray:
+    """(J, M) distance of ``points`` (J, M, 2) to the cubic Béziers ``cp`` (J, 4, 2): the nearest of dense
+    samples, polished by Newton steps on (B(u) − p)·B'(u) = 0 (clamped to [0, 1])."""
+    grid = np.linspace(0.0, 1.0, GUESSES)
+    samples = _bezier_rows(cp, grid)  # (J, K, 2)
+    squared = (np.einsum("jmk,jmk->jm", points, points)[..., None] - 2.0 * np.einsum("jmk,jsk->jms", points, samples)
+               + np.einsum("jsk,jsk->js", samples, samples)[:, None])  # fmt: skip
+    best = grid[np.argmin(squared, axis=2)]  # (J, M)
+    d1 = 3.0 * np.diff(cp, axis=1)  # (J, 3, 2)
+    d2 = 2.0 * np.diff(d1, axis=1)  # (J, 2, 2)
+    for _ in range(NEWTON_STEPS):
+        off = _bezier_rows(cp, best) - points
+        v, w = (1.0 - best)[..., None], best[..., None]
+        first = v * v * d1[:, None, 0] + 2 * v * w * d1[:, None, 1] + w * w * d1[:, None, 2]
+        second = v * d2[:, None, 0] + w * d2[:, None, 1]
+        f = np.einsum("jmk,jmk->jm", off, first)
+        df = np.einsum("jmk,jmk->jm", first, first) + np.einsum("jmk,jmk->jm", off, second)
+        with np.errstate(invalid="ignore", divide="ignore"):
+            step = np.where(df > 0.0, f / df, 0.0)
+        best = np.clip(best - np.nan_to_num(step), 0.0, 1.0)
+    return np.linalg.norm(_bezier_rows(cp, best) - points, axis=-1)
 
 
 # ------------------------------------------------------------------ the front

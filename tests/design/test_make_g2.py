@@ -73,7 +73,8 @@ def hausdorff(segments, result: G2Path) -> float:
     fine = np.linspace(0.0, 1.0, 3000)
     for s in pieces:
         if isinstance(s, BezierSpiral):
-            near = np.linalg.norm(inputs - s.point(0.5), axis=1) <= s.length
+            # the spiral lies within its length of its start: only points it could bring nearer
+            near = np.linalg.norm(inputs - s.start, axis=1) - s.length < back
             if near.any():
                 back[near] = np.minimum(back[near], _distance_to_polyline(inputs[near], s.point(fine)))
     return max(there, float(back.max()))
