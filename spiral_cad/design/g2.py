@@ -39,7 +39,7 @@ from numpy.typing import NDArray
 
 from ..core import _kernels as K
 from ..core import batch
-from ..core._inputs import as_float, as_points
+from ..core._inputs import as_float, as_real_array
 from ..core.chain import JOIN_TOLERANCE, Chain, g2_mismatch, join_tolerance
 from ..core.errors import JointError, NoSolutionError, Status
 from ..core.segments import TAU, Arc, Line, Segment
@@ -214,13 +214,16 @@ def _path_segments(path: Any) -> tuple[list[Segment], PlaneFrame | None]:
         if all(s.dim == 2 for s in segments):
             return segments, None
         return _planar(segments)
-    points = as_points(path, "path")
+    points = as_real_array(path, "path")
     if points.ndim != 2 or len(points) < 2 or points.shape[1] not in (2, 3):
         raise ValueError(f"path must be lines and arcs, or (n ≥ 2, 2|3) points; got shape {points.shape}")
     for i, (a, b) in enumerate(zip(points[:-1], points[1:])):
         if np.array_equal(a, b):
             raise ValueError(f"path points {i} and {i + 1} coincide at {_shown_point(a.tolist())}")
     lines = [Line(a, b) for a, b in zip(points[:-1], points[1:])]
+    if not np.isfinite(points).all():
+        i = int(np.argmax(~np.isfinite(points).all(axis=1)))
+        raise ValueError(f"path points must be finite; point {i} is {points[i].tolist()}")
     if points.shape[1] == 2 or not points[:, 2].any():
         return [Line(a[:2], b[:2]) for a, b in zip(points[:-1], points[1:])], None
     return _planar(lines)
@@ -244,7 +247,7 @@ def _planar(segments: list[Segment]) -> tuple[list[Segment], PlaneFrame]:
         raise ValueError(f"make_g2 takes a path in one plane; this one leaves the best plane by {off:.3g}")
     x_dir = vt[0] - np.dot(vt[0], normal) * normal
     x_dir /= np.linalg.norm(x_dir)
-    frame = PlaneFrame(origin, x_dir, np.cross(normal, x_dir))
+    frame = PlaneFrame(origin, x_dir, normal)
     plane: list[Segment] = []
     for s in segments:
         if isinstance(s, Line):
@@ -252,9 +255,13 @@ def _planar(segments: list[Segment]) -> tuple[list[Segment], PlaneFrame]:
             plane.append(Line(a, b))
         else:
             assert isinstance(s, Arc)
-            start, end, middle = (np.asarray(frame.local([p if len(p) == 3 else (*p, 0.0)])[0]) for p in (s.start, s.end, s.point(0.5)))
+            start = frame.local([s.start if s.dim == 3 else (*s.start, 0.0)])[0]
             centre = frame.local([s.center if s.dim == 3 else (*s.center, 0.0)])[0]
-            sense = 1.0 if float(np.cross(np.subtract(middle, centre), np.subtract(end, middle))) > 0.0 else -1.0
+            tangent = s.tangent(0.0)
+            tangent3 = tangent if s.dim == 3 else np.append(tangent, 0.0)
+            tx, ty = float(np.dot(tangent3, frame.x_dir)), float(np.dot(tangent3, frame.y_dir))
+            u = np.subtract(start, centre)
+            sense = 1.0 if float(u[0] * ty - u[1] * tx) > 0.0 else -1.0
             start_angle = math.atan2(start[1] - centre[1], start[0] - centre[0])
             plane.append(Arc(centre, sense * abs(s.radius), start_angle, s.sweep))
     return plane, frame
@@ -444,9 +451,10 @@ class _Group:
             np.zeros_like(points), np.array(direction), np.array(centre) - points, np.array(radius), shape=self.shape
         )
         spirals = result.spirals[0] + points[:, None]
+        ok = result.ok
         for m, j in enumerate(joints):
             a, b = self.pieces[j], self.pieces[(j + 1) % n]
-            if not result.ok[m]:
+            if not ok[m]:
                 out[j] = _Solved([], math.inf, math.inf, math.nan, int(result.status[m]), result.reason(m))
                 continue
             cp = spirals[m][::-1].copy() if reverse[m] else spirals[m]
@@ -465,8 +473,9 @@ class _Group:
         solver = batch.circle_to_circle if kind == "arc-arc-reverse" else batch.circle_in_circle
         result = solver(c0, r0, c1, r1, shape=self.shape)
         moved = [sp + origin[:, None] for sp in result.spirals]
+        ok = result.ok
         for m, j in enumerate(joints):
-            if not result.ok[m]:
+            if not ok[m]:
                 out[j] = _Solved([], math.inf, math.inf, math.nan, int(result.status[m]), result.reason(m))
                 continue
             spirals = [sp[m] for sp in moved]

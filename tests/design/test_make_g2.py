@@ -355,3 +355,20 @@ def test_random_closed_filleted_polygons_become_g2(outcome, count, jitter, sprea
     assert result.closed
     assert_g2(segments, result, bound, closed=True)
     arcs_kept(segments, result)
+
+
+def test_a_planar_path_in_space_is_made_g2_in_its_plane():
+    from spiral_cad import PlaneFrame
+
+    frame = PlaneFrame((1.0, 2.0, 3.0), (1.0, 0.0, 1.0), (-1.0, 0.5, 1.0))
+    flat = filleted_rectangle()
+    tilted = make_g2([s.placed(frame) for s in flat], 0.01)
+    plane = make_g2(flat, 0.01)
+    assert tilted.chain.dim == 3 and tilted.closed
+    assert tilted.chain.length == pytest.approx(plane.chain.length, rel=1e-9)
+    assert tilted.deviation == pytest.approx(plane.deviation, rel=1e-6)
+    points = tilted.chain.sample(50)
+    off_plane = (points - np.array(frame.origin)) @ (np.asarray(frame.normal) / np.linalg.norm(frame.normal))
+    assert np.abs(off_plane).max() <= 1e-9
+    corner = make_g2([(0, 0, 0), (1, 0, 1), (1, 1, 1)], 0.01)
+    assert corner.chain.dim == 3 and [j.kind for j in corner.joints] == ["corner"]
