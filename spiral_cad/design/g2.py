@@ -220,7 +220,7 @@ def _path_segments(path: Any) -> tuple[list[Segment], PlaneFrame | None]:
     for i, (a, b) in enumerate(zip(points[:-1], points[1:])):
         if np.array_equal(a, b):
             raise ValueError(f"path points {i} and {i + 1} coincide at {_shown_point(a.tolist())}")
-    lines = [Line(a, b) for a, b in zip(points[:-1], points[1:])]
+    lines: list[Segment] = [Line(a, b) for a, b in zip(points[:-1], points[1:])]
     if not np.isfinite(points).all():
         i = int(np.argmax(~np.isfinite(points).all(axis=1)))
         raise ValueError(f"path points must be finite; point {i} is {points[i].tolist()}")
@@ -1119,7 +1119,7 @@ def _tangent_circle(a: _Piece, b: _Piece, depth: float, room_a: float, room_b: f
     sense = math.copysign(1.0, turn)
 
     def attempt(rho: float) -> tuple[_Piece, NDArray, NDArray] | None:
-        loci = []
+        loci: list[tuple[str, NDArray, Any]] = []
         for piece in (a, b):
             if piece.kind == "line":
                 t = piece.tangent(True)
