@@ -286,7 +286,7 @@ def _same_circle(a: _Piece, b: _Piece, scale: float) -> bool:
     return (a.r > 0) == (b.r > 0) and abs(a.r - b.r) <= 1e-9 * abs(a.r) and math.dist(a.c, b.c) <= 1e-9 * scale
 
 
-def _classify(a: _Piece, b: _Piece, scale: float, steepest: float) -> str:
+def _classify(a: _Piece, b: _Piece, scale: float, steepest: float, bound: float) -> str:
     """The joint from piece ``a`` to ``b``: ``g2``, ``line-arc``, ``arc-arc-…``, ``corner`` or ``split``."""
     turn = _turn(a, b)
     if abs(turn) > steepest:
@@ -294,7 +294,10 @@ def _classify(a: _Piece, b: _Piece, scale: float, steepest: float) -> str:
     if abs(turn) > TANGENT_TOL:
         return "corner"
     if a.kind == "line" and b.kind == "line":
-        return "g2"
+        # Merged into one line only when the joint point lies within a thousandth of the bound of it.
+        la, lb = a.size, b.size
+        drop = la * lb / (la + lb) * abs(math.sin(turn))
+        return "g2" if drop <= 1e-3 * bound else "corner"
     if a.kind == "arc" and b.kind == "arc":
         if _same_circle(a, b, scale):
             return "g2"
@@ -705,7 +708,7 @@ def _deviation(group: _Group, solved: list[_Solved | None], s: list[float], used
         spirals = np.array([[cps[0], cps[-1]] for cps in (solved[j].spirals for j in joints)])  # type: ignore[union-attr]
         rows_a, rows_b = _Rows(before), _Rows(after)
         u = np.linspace(0.0, 1.0, SAMPLES)
-        curve = np.concatenate([_bezier_rows(spirals[:, 0], u), _bezier_rows(spirals[:, 1], u)], axis=1)
+        curve = np.concatenate([_bezier_rows(spirals[:, 0], u), _bezier_rows(spirals[:, 1], u)], axis=1)  # a lone spiral twice
         there = np.minimum(rows_a.distance(curve), rows_b.distance(curve))
         worst = max(worst, float((there.max(axis=1) + added).max()))
         tail = np.array([used[j][1] for j in joints])
@@ -713,7 +716,10 @@ def _deviation(group: _Group, solved: list[_Solved | None], s: list[float], used
         replaced = np.concatenate(
             [rows_a.points(rows_a.size - tail, rows_a.size, SAMPLES), rows_b.points(np.zeros(len(joints)), head, SAMPLES)], axis=1
         )
-        near = np.minimum(_distance_to_bezier_rows(replaced, spirals[:, 0]), _distance_to_bezier_rows(replaced, spirals[:, 1]))
+        near = _distance_to_bezier_rows(replaced, spirals[:, 0])
+        pairs = np.flatnonzero([len(solved[j].spirals) == 2 for j in joints])  # type: ignore[union-attr]
+        if len(pairs):
+            near[pairs] = np.minimum(near[pairs], _distance_to_bezier_rows(replaced[pairs], spirals[pairs, 1]))
         for pieces, ks in ((before, joints), (after, [(j + 1) % n for j in joints])):
             kept = [_kept(piece, used[k], s[k]) for piece, k in zip(pieces, ks)]
             present = np.array([k is not None for k in kept])
@@ -981,7 +987,7 @@ def _make(segments: list[Segment], bound: float, closed: bool | None, shape: str
     steepest = _steepest_deflection(corner_shape)
     count = len(pieces)
     joint_count = count if closed else count - 1
-    kinds = [_classify(pieces[i], pieces[(i + 1) % count], extent, steepest) for i in range(joint_count)]
+    kinds = [_classify(pieces[i], pieces[(i + 1) % count], extent, steepest, bound) for i in range(joint_count)]
     joints: dict[int, G2Joint] = {}
     for i, kind in enumerate(kinds):
         if kind in ("g2", "split"):
