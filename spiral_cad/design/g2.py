@@ -365,7 +365,7 @@ class _Group:
         self.allow = [[(SHARED if all(act) else ALONE) * p.size if act[e] else 0.0 for e in range(2)] for p, act in zip(pieces, active)]
         self.needs_shift = [False] * n
         for j in range(self.joint_count):
-            if kinds[j] in ("line-arc", "arc-arc-compound", "arc-arc-reverse"):
+            if kinds[j] in ("line-arc", "arc-arc-compound", "arc-arc-reverse", "bridge"):
                 for k in (j, (j + 1) % n):
                     if pieces[k].kind == "arc":
                         self.needs_shift[k] = True
@@ -386,6 +386,8 @@ class _Group:
         self.cap = [min(target - p.spent, q_max * abs(p.r)) if need else 0.0 for p, need in zip(pieces, self.needs_shift)]
         self.factor = [1.0] * n
         self._corners: dict[int, _Solved] = {}
+        #: Short lines left out between two arcs (by joint): (the line, the input joint after it).
+        self.bridges: dict[int, tuple[_Piece, int]] = {}
 
     def shifts(self) -> list[float]:
         """Each arc's shrink: its cap times its factor, the smaller circle of a compound joint shrunk
@@ -421,7 +423,7 @@ class _Group:
             by_kind.setdefault(self.kinds[j], []).append(j)
         if by_kind.get("line-arc"):
             self._lines_arcs(by_kind["line-arc"], s, out)
-        for kind in ("arc-arc-reverse", "arc-arc-compound"):
+        for kind in ("arc-arc-reverse", "arc-arc-compound", "bridge"):
             if by_kind.get(kind):
                 self._arcs_arcs(by_kind[kind], s, kind, out)
         for j in by_kind.get("corner", []):  # a corner between lines does not depend on the shifts
@@ -473,7 +475,7 @@ class _Group:
         c1 = np.array([b.c for b in after]) - origin
         r0 = np.array([a.r - a.sense * s[j] for a, j in zip(before, joints)])
         r1 = np.array([b.r - b.sense * s[(j + 1) % n] for b, j in zip(after, joints)])
-        solver = batch.circle_to_circle if kind == "arc-arc-reverse" else batch.circle_in_circle
+        solver = batch.circle_in_circle if kind == "arc-arc-compound" else batch.circle_to_circle
         result = solver(c0, r0, c1, r1, shape=self.shape)
         moved = [sp + origin[:, None] for sp in result.spirals]
         ok = result.ok
@@ -707,9 +709,12 @@ def _deviation(group: _Group, solved: list[_Solved | None], s: list[float], used
         added = np.array([max(a.fillet, b.fillet) for a, b in zip(before, after)])
         spirals = np.array([[cps[0], cps[-1]] for cps in (solved[j].spirals for j in joints)])  # type: ignore[union-attr]
         rows_a, rows_b = _Rows(before), _Rows(after)
+        # A short line left out between two arcs is input the joint replaced (elsewhere: piece a again).
+        middle = [group.bridges[j][0] if j in group.bridges else a for j, a in zip(joints, before)]
+        rows_m = _Rows(middle)
         u = np.linspace(0.0, 1.0, SAMPLES)
         curve = np.concatenate([_bezier_rows(spirals[:, 0], u), _bezier_rows(spirals[:, 1], u)], axis=1)  # a lone spiral twice
-        there = np.minimum(rows_a.distance(curve), rows_b.distance(curve))
+        there = np.minimum(np.minimum(rows_a.distance(curve), rows_b.distance(curve)), rows_m.distance(curve))
         worst = max(worst, float((there.max(axis=1) + added).max()))
         tail = np.array([used[j][1] for j in joints])
         head = np.array([used[(j + 1) % n][0] for j in joints])
@@ -1034,7 +1039,10 @@ def _make(segments: list[Segment], bound: float, closed: bool | None, shape: str
     for group_pieces, group_kinds, group_joints, group_closed in groups:
         try:
             group_pieces, group_kinds, group_joints = _arc_corners(group_pieces, group_kinds, group_joints, group_closed, bound)
+            group_pieces, group_kinds, group_joints, bridges = _bridge_short_lines(group_pieces, group_kinds, group_joints,
+                                                                                   group_closed, bound)  # fmt: skip
             group = _Group(group_pieces, group_kinds, group_closed, bound, shape, extent)
+            group.bridges = bridges
             solved, s = _solve(group)
             chain, measured = _assemble(group, solved, s, units, tolerance)
         except _Refusal as refusal:
@@ -1052,6 +1060,14 @@ def _make(segments: list[Segment], bound: float, closed: bool | None, shape: str
         for j, (kind, solved_joint) in enumerate(zip(group_kinds, solved)):
             index = group_joints[j]
             a, b = group_pieces[j], group_pieces[(j + 1) % len(group_pieces)]
+            if kind == "bridge":
+                line, after = group.bridges[j]
+                moved = (f"line {line.first} ({line.size:.6g} long, too short for a transition at each end) joined across by "
+                         f"a {'C' if (a.r > 0) == (b.r > 0) else 'S'} spiral pair; {_moved('line-arc', a, b, s[j], s[(j + 1) % len(group_pieces)], solved_joint)}")  # fmt: skip
+                for where in (index, after):
+                    joints[where] = G2Joint(where, "line-arc", tuple(pieces[where].end().tolist()), moved,
+                                            max(s[j], s[(j + 1) % len(group_pieces)]), solved_joint.theta if solved_joint else math.nan)  # fmt: skip
+                continue
             if a.fillet or b.fillet:
                 circle, shift = (a, s[j]) if a.fillet else (b, s[(j + 1) % len(group_pieces)])
                 moved = (f"corner rounded by a tangent circle of radius {abs(circle.r):.6g} passing {circle.fillet:.6g} from it, "
@@ -1109,6 +1125,50 @@ def _arc_corners(pieces: list[_Piece], kinds: list[str], joints: list[int], clos
             out_kinds.append(kinds[k])
             out_joints.append(joints[k])
     return out_pieces, out_kinds, out_joints
+
+
+#: A line between two arcs is left out (the arcs joined by a C or S pair across it) when the shift
+#: its length allows a transition at each end is below this share of the bound.
+SHORT_LINE_SHIFT = 1e-4
+
+
+def _bridge_short_lines(pieces: list[_Piece], kinds: list[str], joints: list[int], closed: bool,
+                        bound: float) -> tuple[list[_Piece], list[str], list[int], dict[int, tuple[_Piece, int]]]:  # fmt: skip
+    """Lines between two tangent arcs too short for a transition at each end (the shift they allow,
+    about (0.45·ℓ)²/(6r), below ``SHORT_LINE_SHIFT`` of the bound) left out: the two arcs are joined
+    across the line by the paper's pair between circles (a C for the same sense, an S for opposite)."""
+    n = len(pieces)
+    joint_count = len(kinds)
+    short = set()
+    for k, piece in enumerate(pieces):
+        before, after = (k - 1) % n, k
+        if piece.kind != "line" or not (closed or 0 < k < n - 1) or after >= joint_count or before >= joint_count:
+            continue
+        if kinds[before] != "line-arc" or kinds[after] != "line-arc" or before in short or (k + 1) % n in short:
+            continue
+        radius = min(abs(pieces[before].r), abs(pieces[(k + 1) % n].r))
+        if (SHARED * piece.size) ** 2 / (6.0 * radius) < SHORT_LINE_SHIFT * bound:
+            short.add(k)
+    if not short or len(short) == n:
+        return pieces, kinds, joints, {}
+    out_pieces: list[_Piece] = []
+    out_kinds: list[str] = []
+    out_joints: list[int] = []
+    bridges: dict[int, tuple[_Piece, int]] = {}
+    order = list(range(n))
+    if closed and 0 in short:  # start after a kept piece so that no bridge wraps round the start
+        first = next(k for k in range(n) if k not in short)
+        order = order[first:] + order[:first]
+    for k in order:
+        if k in short:
+            bridges[len(out_kinds) - 1] = (pieces[k], joints[k])
+            out_kinds[-1] = "bridge"
+            continue
+        out_pieces.append(pieces[k])
+        if k < joint_count:
+            out_kinds.append(kinds[k])
+            out_joints.append(joints[k])
+    return out_pieces, out_kinds, out_joints, bridges
 
 
 def _tangent_kind(a: _Piece, b: _Piece) -> str:

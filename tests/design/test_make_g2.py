@@ -372,3 +372,17 @@ def test_a_planar_path_in_space_is_made_g2_in_its_plane():
     assert np.abs(off_plane).max() <= 1e-9
     corner = make_g2([(0, 0, 0), (1, 0, 1), (1, 1, 1)], 0.01)
     assert corner.chain.dim == 3 and [j.kind for j in corner.joints] == ["corner"]
+
+
+@pytest.mark.parametrize("length", [1e-2, 1e-3])
+@pytest.mark.parametrize("sense", [1.0, -1.0])
+def test_a_short_line_between_arcs_is_bridged_by_a_pair(length, sense):
+    """A line too short for a transition at each end (here 1e-2 and 1e-3 between arcs of radius 100)
+    is joined across by a C (same sense) or S pair: the arcs still shift by the whole bound."""
+    segments = _walk([("arc", 100.0, 0.3), ("line", length, 0.0), ("arc", sense * 100.0, 0.3)], 1.0, (0.0, 0.0))
+    result = make_g2(segments, 0.01)
+    assert_g2(segments, result, 0.01, closed=False)
+    arcs_kept(segments, result)
+    assert [j.kind for j in result.joints] == ["line-arc", "line-arc"]
+    assert "joined across" in result.joints[0].moved
+    assert result.joints[0].shift == pytest.approx(0.01, rel=1e-5)
