@@ -1,0 +1,147 @@
+"""make_g2's measure: the Hausdorff distance between the input and the result at every joint, for all
+joints at once (exact distances to lines and arcs, Newton-polished nearest points on the spirals)."""
+
+from __future__ import annotations
+
+import numpy as np
+from numpy.typing import NDArray
+
+from ..core.segments import TAU
+from ._g2_pieces import (
+    _kept,
+    _Piece,
+    _Solved,
+)
+from ._g2_solve import (
+    _Group,
+)
+
+#: Samples per spiral (and per replaced stretch of the input) when the deviation is measured.
+SAMPLES = 32
+
+
+def _deviation(group: _Group, solved: list[_Solved | None], s: list[float], used: list[list[float]]) -> float:
+    """The Hausdorff distance between the input and the result, measured: the shrink of each arc
+    (every point of a concentric circle moves by it), and at each joint the spirals against the input
+    pieces beside it, and the stretch of the input the joint replaced against the result (all joints
+    at once, in blocks)."""
+    n = len(group.pieces)
+    # A tangent circle put into a corner is itself ``fillet`` off the input: its shifts and joints add it.
+    worst = max((shift + p.fillet for shift, p in zip(s, group.pieces)), default=0.0)
+    index = [j for j, joint in enumerate(solved) if joint is not None]
+    for block in range(0, len(index), BLOCK):
+        joints = index[block : block + BLOCK]
+        before = [group.pieces[j] for j in joints]
+        after = [group.pieces[(j + 1) % n] for j in joints]
+        added = np.array([max(a.fillet, b.fillet) for a, b in zip(before, after)])
+        spirals = np.array([[cps[0], cps[-1]] for cps in (solved[j].spirals for j in joints)])  # type: ignore[union-attr]
+        rows_a, rows_b = _Rows(before), _Rows(after)
+        # A short line left out between two arcs is input the joint replaced (elsewhere: piece a again).
+        middle = [group.bridges[j][0] if j in group.bridges else a for j, a in zip(joints, before)]
+        rows_m = _Rows(middle)
+        u = np.linspace(0.0, 1.0, SAMPLES)
+        curve = np.concatenate([_bezier_rows(spirals[:, 0], u), _bezier_rows(spirals[:, 1], u)], axis=1)  # a lone spiral twice
+        there = np.minimum(np.minimum(rows_a.distance(curve), rows_b.distance(curve)), rows_m.distance(curve))
+        worst = max(worst, float((there.max(axis=1) + added).max()))
+        tail = np.array([used[j][1] for j in joints])
+        head = np.array([used[(j + 1) % n][0] for j in joints])
+        replaced = np.concatenate(
+            [rows_a.points(rows_a.size - tail, rows_a.size, SAMPLES), rows_b.points(np.zeros(len(joints)), head, SAMPLES)], axis=1
+        )
+        near = _distance_to_bezier_rows(replaced, spirals[:, 0])
+        pairs = np.flatnonzero([len(solved[j].spirals) == 2 for j in joints])  # type: ignore[union-attr]
+        if len(pairs):
+            near[pairs] = np.minimum(near[pairs], _distance_to_bezier_rows(replaced[pairs], spirals[pairs, 1]))
+        for pieces, ks in ((before, joints), (after, [(j + 1) % n for j in joints])):
+            kept = [_kept(piece, used[k], s[k]) for piece, k in zip(pieces, ks)]
+            present = np.array([k is not None for k in kept])
+            if present.any():
+                rows = _Rows([k if k is not None else pieces[i] for i, k in enumerate(kept)])
+                near = np.minimum(near, np.where(present[:, None], rows.distance(replaced), np.inf))
+        worst = max(worst, float((near.max(axis=1) + added).max()))
+    return worst
+
+
+#: Joints measured at once (bounds the memory of the point-to-sample distances).
+BLOCK = 256
+
+
+#: Starting points of the nearest-point search on a spiral (its distance has one minimum per stretch
+#: this short: a spiral turns less than 90°), and the Newton steps that polish them.
+GUESSES = 17
+
+
+NEWTON_STEPS = 5
+
+
+class _Rows:
+    """Pieces as arrays: lines (a → b) and arcs (centre, radius, start angle, sweep), one row each."""
+
+    def __init__(self, pieces: list[_Piece]):
+        self.arc = np.array([p.kind == "arc" for p in pieces])
+        self.a = np.array([p.a for p in pieces])
+        self.b = np.array([p.b for p in pieces])
+        self.c = np.array([p.c for p in pieces])
+        self.r = np.array([abs(p.r) for p in pieces])
+        self.sense = np.array([p.sense for p in pieces])
+        self.a0 = np.array([p.a0 for p in pieces])
+        self.sweep = np.array([p.sweep for p in pieces])
+        self.size = np.where(self.arc, self.sweep, np.hypot(*(self.b - self.a).T))
+
+    def points(self, lo: NDArray, hi: NDArray, count: int) -> NDArray:
+        """(J, count, 2) points from ``lo`` to ``hi`` (length along a line, angle along an arc)."""
+        t = lo[:, None] + np.linspace(0.0, 1.0, count)[None] * (hi - lo)[:, None]
+        with np.errstate(invalid="ignore", divide="ignore"):
+            unit = (self.b - self.a) / np.where(self.arc, 1.0, self.size)[:, None]
+        line = self.a[:, None] + t[..., None] * unit[:, None]
+        angle = self.a0[:, None] + self.sense[:, None] * t
+        arc = self.c[:, None] + self.r[:, None, None] * np.stack([np.cos(angle), np.sin(angle)], axis=-1)
+        return np.where(self.arc[:, None, None], arc, line)
+
+    def distance(self, points: NDArray) -> NDArray:
+        """(J, M) exact distance of ``points`` (J, M, 2) to each row's line segment or arc."""
+        d = self.b - self.a
+        dd = np.einsum("ij,ij->i", d, d)
+        with np.errstate(invalid="ignore", divide="ignore"):
+            t = np.clip(np.einsum("jmk,jk->jm", points - self.a[:, None], d) / dd[:, None], 0.0, 1.0)
+        line = np.linalg.norm(points - self.a[:, None] - t[..., None] * d[:, None], axis=-1)
+        rel = points - self.c[:, None]
+        angle = np.arctan2(rel[..., 1], rel[..., 0])
+        inside = (self.sense[:, None] * (angle - self.a0[:, None])) % TAU <= self.sweep[:, None]
+        radial = np.abs(np.hypot(rel[..., 0], rel[..., 1]) - self.r[:, None])
+        end_angle = self.a0 + self.sense * self.sweep
+        start = self.c + self.r[:, None] * np.stack([np.cos(self.a0), np.sin(self.a0)], axis=-1)
+        end = self.c + self.r[:, None] * np.stack([np.cos(end_angle), np.sin(end_angle)], axis=-1)
+        ends = np.minimum(np.linalg.norm(points - start[:, None], axis=-1), np.linalg.norm(points - end[:, None], axis=-1))
+        arc = np.where(inside, np.minimum(radial, ends), ends)
+        return np.where(self.arc[:, None], arc, np.nan_to_num(line, nan=np.inf))
+
+
+def _bezier_rows(cp: NDArray, u: NDArray) -> NDArray:
+    """(J, len(u), 2) points of J cubic Béziers (J, 4, 2)."""
+    u = u[None, :, None] if u.ndim == 1 else u[..., None]
+    v = 1.0 - u
+    return v**3 * cp[:, None, 0] + 3 * v * v * u * cp[:, None, 1] + 3 * v * u * u * cp[:, None, 2] + u**3 * cp[:, None, 3]
+
+
+def _distance_to_bezier_rows(points: NDArray, cp: NDArray) -> NDArray:
+    """(J, M) distance of ``points`` (J, M, 2) to the cubic Béziers ``cp`` (J, 4, 2): the nearest of dense
+    samples, polished by Newton steps on (B(u) − p)·B'(u) = 0 (clamped to [0, 1])."""
+    grid = np.linspace(0.0, 1.0, GUESSES)
+    samples = _bezier_rows(cp, grid)  # (J, K, 2)
+    squared = (np.einsum("jmk,jmk->jm", points, points)[..., None] - 2.0 * np.einsum("jmk,jsk->jms", points, samples)
+               + np.einsum("jsk,jsk->js", samples, samples)[:, None])  # fmt: skip
+    best = grid[np.argmin(squared, axis=2)]  # (J, M)
+    d1 = 3.0 * np.diff(cp, axis=1)  # (J, 3, 2)
+    d2 = 2.0 * np.diff(d1, axis=1)  # (J, 2, 2)
+    for _ in range(NEWTON_STEPS):
+        off = _bezier_rows(cp, best) - points
+        v, w = (1.0 - best)[..., None], best[..., None]
+        first = v * v * d1[:, None, 0] + 2 * v * w * d1[:, None, 1] + w * w * d1[:, None, 2]
+        second = v * d2[:, None, 0] + w * d2[:, None, 1]
+        f = np.einsum("jmk,jmk->jm", off, first)
+        df = np.einsum("jmk,jmk->jm", first, first) + np.einsum("jmk,jmk->jm", off, second)
+        with np.errstate(invalid="ignore", divide="ignore"):
+            step = np.where(df > 0.0, f / df, 0.0)
+        best = np.clip(best - np.nan_to_num(step), 0.0, 1.0)
+    return np.linalg.norm(_bezier_rows(cp, best) - points, axis=-1)
