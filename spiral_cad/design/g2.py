@@ -14,6 +14,10 @@ paper's transitions into those joints:
 * **arc → arc, compound (same sense)**: the smaller circle shrinks by a
   little more than the larger one, so it lies just inside it, in the band
   where the nested-circle spiral (the fifth case) exists.
+* **a line between two arcs too short for a transition at each end**: left
+  out, the arcs joined across it by a C (same sense) or S pair.
+* **sharp corners next to an arc**: a tangent circle passing half the bound
+  from the corner, then transitions as for every tangent joint.
 * **sharp corners between lines**: a spiral pair within the bound, as
   ``round_corners`` makes it (``round_corners_batch`` with ``max_deviation``).
 * **reversals (cusps)** and corners too sharp for a spiral pair: the path is
