@@ -244,6 +244,9 @@ def _walk(moves, scale: float, origin) -> list:
     heading = 0.0
     segments = []
     for kind, a, b in moves:
+        if kind == "turn":  # a sharp corner (or, at ±π, a reversal) before the next move
+            heading += a
+            continue
         if kind == "line":
             length = a * scale
             end = (x + length * math.cos(heading), y + length * math.sin(heading))
@@ -386,3 +389,32 @@ def test_a_short_line_between_arcs_is_bridged_by_a_pair(length, sense):
     assert [j.kind for j in result.joints] == ["line-arc", "line-arc"]
     assert "joined across" in result.joints[0].moved
     assert result.joints[0].shift == pytest.approx(0.01, rel=1e-5)
+
+
+_turn = st.tuples(st.just("turn"), st.one_of(st.floats(-2.8, -0.05), st.floats(0.05, 2.8), st.just(math.pi)), st.just(0.0))
+
+
+@settings(max_examples=60)
+@given(
+    moves=st.lists(st.one_of(_line, _arc, _turn), min_size=2, max_size=7),
+    scale_exp=st.floats(-3.0, 6.0),
+    bound_exp=st.floats(-6.0, -1.0),
+    shape=st.sampled_from(["near-linear", "walton-meek"]),
+)
+def test_random_paths_with_corners_and_reversals(outcome, moves, scale_exp, bound_exp, shape):
+    """Sharp corners between lines and arcs in any order, and reversals: rounded or split, G2 within the bound."""
+    moves = [m for i, m in enumerate(moves) if m[0] != "turn" or (i > 0 and moves[i - 1][0] != "turn")]
+    if not any(m[0] != "turn" for m in moves) or moves[0][0] == "turn" or moves[-1][0] == "turn":
+        return
+    scale = 10.0**scale_exp
+    segments = _walk(moves, scale, (scale, scale))
+    size = max(s.length for s in segments)
+    bound = 10.0**bound_exp * size
+    result = outcome(lambda: make_g2(segments, bound, shape=shape))
+    if result is None:
+        _suggested_bound_works(segments, bound, shape, closed=False)
+        return
+    assert_g2(segments, result, bound, closed=False)
+    arcs_kept(segments, result)
+    reversals = sum(1 for m in moves if m[0] == "turn" and m[1] == math.pi)
+    assert len(result.chains) >= 1 + reversals
