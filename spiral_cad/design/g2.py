@@ -55,6 +55,9 @@ from .rounding import _steepest_deflection
 
 __all__ = ["G2Joint", "G2Path", "make_g2", "smallest_max_deviation"]
 
+#: The largest gap between segments that make_g2 closes, as a share of the bound.
+GAP_SHARE = 0.1
+
 JOINT_KINDS = ("line-arc", "arc-arc-compound", "arc-arc-reverse", "corner", "g2", "split")
 
 
@@ -397,13 +400,14 @@ def _make(segments: list[Segment], bound: float, closed: bool | None, shape: str
     points = np.array([p for s in segments for p in s.outline()])
     scale = float(np.abs(points).max()) or 1.0
     extent = float(np.hypot(*(points.max(axis=0) - points.min(axis=0)))) or scale
-    gap_tol = max(1e-9 * extent, 64.0 * EPS * scale, 1e-3 * bound)
+    gap_tol = max(1e-9 * extent, 64.0 * EPS * scale, GAP_SHARE * bound)
     for i, (a, b) in enumerate(zip(pieces[:-1], pieces[1:])):
         gap = math.dist(a.end(), b.start())
         if gap > gap_tol:
             raise ValueError(
                 f"segments {i} and {i + 1} do not meet: segment {i} ends at {_shown_point(a.end().tolist())}, "
-                f"segment {i + 1} starts at {_shown_point(b.start().tolist())} ({gap:.3g} apart)"
+                f"segment {i + 1} starts at {_shown_point(b.start().tolist())} ({gap:.3g} apart; make_g2 closes gaps "
+                f"up to {GAP_SHARE:g} of max_deviation, {gap_tol:.3g})"
             )
     meets = math.dist(pieces[-1].end(), pieces[0].start()) <= gap_tol
     if closed is None:
@@ -418,6 +422,16 @@ def _make(segments: list[Segment], bound: float, closed: bool | None, shape: str
     count = len(pieces)
     joint_count = count if closed else count - 1
     kinds = [_classify(pieces[i], pieces[(i + 1) % count], extent, steepest, bound) for i in range(joint_count)]
+    # A small gap (arcs of a CNC program end off their circles by the program's rounding) is closed: a
+    # transition or tangent circle spans it by construction; two lines at a corner meet half-way. The
+    # shifts leave room for it and the deviation adds it.
+    gaps = [math.dist(pieces[i].end(), pieces[(i + 1) % count].start()) for i in range(joint_count)]
+    for i, gap in enumerate(gaps):
+        a, b = pieces[i], pieces[(i + 1) % count]
+        if gap > 0.0 and kinds[i] == "corner" and a.kind == "line" and b.kind == "line":
+            a.b = b.a = 0.5 * (a.b + b.a)
+    spanned = max(gaps, default=0.0) if max(gaps, default=0.0) > 64.0 * EPS * scale else 0.0
+    room = bound - spanned
     joints: dict[int, G2Joint] = {}
     for i, kind in enumerate(kinds):
         if kind in ("g2", "split"):
@@ -463,13 +477,14 @@ def _make(segments: list[Segment], bound: float, closed: bool | None, shape: str
     deviation = 0.0
     for group_pieces, group_kinds, group_joints, group_closed in groups:
         try:
-            group_pieces, group_kinds, group_joints = _arc_corners(group_pieces, group_kinds, group_joints, group_closed, bound)
+            group_pieces, group_kinds, group_joints = _arc_corners(group_pieces, group_kinds, group_joints, group_closed, room)
             group_pieces, group_kinds, group_joints, bridges = _bridge_short_lines(group_pieces, group_kinds, group_joints,
-                                                                                   group_closed, bound)  # fmt: skip
-            group = _Group(group_pieces, group_kinds, group_closed, bound, shape, extent)
+                                                                                   group_closed, room)  # fmt: skip
+            group = _Group(group_pieces, group_kinds, group_closed, room, shape, extent)
             group.bridges = bridges
             solved, s = _solve(group)
             chain, measured = _assemble(group, solved, s, units, tolerance)
+            measured += spanned
         except _Refusal as refusal:
             index = group_joints[refusal.joint] if group_joints else 0
             return _Located(index, tuple(pieces[index].end().tolist()), refusal.reason, refusal.larger_helps)

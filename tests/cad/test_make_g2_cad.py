@@ -137,6 +137,8 @@ def test_check_of_a_g1_file_says_the_smallest_bound_that_makes_it_g2(tmp_path, c
 
     from spiral_cad.app.cli import main
     from spiral_cad.cad.fillet import planar_frame, wire_path
+    from spiral_cad.cad.g2wire import _all_wires
+    from spiral_cad.cad.readers import read_shape
     from spiral_cad.design import make_g2 as make_path_g2
     from spiral_cad.design import smallest_max_deviation
 
@@ -149,7 +151,8 @@ def test_check_of_a_g1_file_says_the_smallest_bound_that_makes_it_g2(tmp_path, c
     line = next(x for x in out.splitlines() if x.startswith("make_g2:"))
     assert "8 tangent joints" in line
     bound = float(line.split("max_deviation ")[1].split(" ")[0])
-    segments, closed = wire_path(wire.wrapped, planar_frame(wire.wrapped))
+    read_back = _all_wires(read_shape(str(path)))[0]  # the curves as the file holds them
+    segments, closed = wire_path(read_back, planar_frame(read_back))
     assert smallest_max_deviation(segments, closed=closed) == bound
     made = make_path_g2(segments, bound, closed=closed)
     assert all(j.kind == "line-arc" for j in made.joints)
