@@ -158,6 +158,26 @@ def _used(piece: _Piece, point: NDArray, at_end: bool) -> float:
     return piece.sense * _wrap(angle - piece.a0)
 
 
+def _used_rows(pieces: list[_Piece], points: NDArray, at_end: bool) -> NDArray:
+    """``_used`` of many pieces at once: each piece's share between its point (rows of ``points``) and
+    its end (start)."""
+    line = np.array([p.kind == "line" for p in pieces])
+    a = np.array([p.a for p in pieces])
+    b = np.array([p.b for p in pieces])
+    c = np.array([p.c for p in pieces])
+    sense = np.array([p.sense for p in pieces])
+    a0 = np.array([p.a0 for p in pieces])
+    a1 = a0 + sense * np.array([p.sweep for p in pieces])
+    d = b - a
+    with np.errstate(invalid="ignore", divide="ignore"):
+        t = d / np.hypot(d[:, 0], d[:, 1])[:, None]
+    along = np.einsum("ij,ij->i", b - points, t) if at_end else np.einsum("ij,ij->i", points - a, t)
+    angle = np.arctan2(points[:, 1] - c[:, 1], points[:, 0] - c[:, 0])
+    turned = a1 - angle if at_end else angle - a0
+    around = sense * ((turned + math.pi) % TAU - math.pi)
+    return np.where(line, along, around)
+
+
 def _kept(piece: _Piece, used: list[float], shrink: float) -> _Piece | None:
     """What the transitions leave of ``piece`` (an arc on its shrunk circle), as a piece; None if nothing."""
     if piece.kind == "line":

@@ -23,6 +23,7 @@ from ._g2_pieces import (
     _Solved,
     _turn,
     _used,
+    _used_rows,
 )
 from .fillets import _intersect
 from .rounding import round_corners_batch
@@ -145,14 +146,19 @@ class _Group:
             np.zeros_like(points), np.array(direction), np.array(centre) - points, np.array(radius), shape=self.shape
         )
         spirals = result.spirals[0] + points[:, None]
-        ok = result.ok
+        flip = np.array(reverse)
+        spirals[flip] = spirals[flip, ::-1]
+        ok = result.ok.tolist()
+        before = [self.pieces[j] for j in joints]
+        after = [self.pieces[(j + 1) % n] for j in joints]
+        used_before = _used_rows(before, spirals[:, 0], True).tolist()
+        used_after = _used_rows(after, spirals[:, 3], False).tolist()
+        theta = result.theta.tolist()
         for m, j in enumerate(joints):
-            a, b = self.pieces[j], self.pieces[(j + 1) % n]
             if not ok[m]:
                 out[j] = _Solved([], math.inf, math.inf, math.nan, int(result.status[m]), result.reason(m))
                 continue
-            cp = spirals[m][::-1].copy() if reverse[m] else spirals[m]
-            out[j] = _Solved([cp], _used(a, cp[0], True), _used(b, cp[3], False), float(result.theta[m]))
+            out[j] = _Solved([spirals[m]], used_before[m], used_after[m], theta[m])
 
     def _arcs_arcs(self, joints: list[int], s: list[float], kind: str, out: list[_Solved | None]) -> None:
         """Reverse (S) or compound (nested) joints between shrunk circles, solved about each joint."""
@@ -167,13 +173,15 @@ class _Group:
         solver = batch.circle_in_circle if kind == "arc-arc-compound" else batch.circle_to_circle
         result = solver(c0, r0, c1, r1, shape=self.shape)
         moved = [sp + origin[:, None] for sp in result.spirals]
-        ok = result.ok
+        ok = result.ok.tolist()
+        used_before = _used_rows(before, moved[0][:, 0], True).tolist()
+        used_after = _used_rows(after, moved[-1][:, 3], False).tolist()
+        theta = result.theta.tolist()
         for m, j in enumerate(joints):
             if not ok[m]:
                 out[j] = _Solved([], math.inf, math.inf, math.nan, int(result.status[m]), result.reason(m))
                 continue
-            spirals = [sp[m] for sp in moved]
-            out[j] = _Solved(spirals, _used(before[m], spirals[0][0], True), _used(after[m], spirals[-1][3], False), float(result.theta[m]))
+            out[j] = _Solved([sp[m] for sp in moved], used_before[m], used_after[m], theta[m])
 
     def _corner(self, j: int, a: _Piece, b: _Piece) -> _Solved:
         n = len(self.pieces)
