@@ -63,7 +63,7 @@ def _deviation(group: _Group, solved: list[_Solved | None], s: list[float], used
 
 
 #: Joints measured at once (bounds the memory of the point-to-sample distances).
-BLOCK = 256
+BLOCK = 2048
 
 
 #: Starting points of the nearest-point search on a spiral (its distance has one minimum per stretch
@@ -100,28 +100,52 @@ class _Rows:
 
     def distance(self, points: NDArray) -> NDArray:
         """(J, M) exact distance of ``points`` (J, M, 2) to each row's line segment or arc."""
-        d = self.b - self.a
+        out = np.empty(points.shape[:2])
+        line = np.flatnonzero(~self.arc)
+        if len(line):
+            out[line] = self._line_distance(line, points[line])
+        arc = np.flatnonzero(self.arc)
+        if len(arc):
+            out[arc] = self._arc_distance(arc, points[arc])
+        return out
+
+    def _line_distance(self, rows: NDArray, points: NDArray) -> NDArray:
+        a = self.a[rows]
+        d = self.b[rows] - a
         dd = np.einsum("ij,ij->i", d, d)
+        rel = points - a[:, None]
         with np.errstate(invalid="ignore", divide="ignore"):
-            t = np.clip(np.einsum("jmk,jk->jm", points - self.a[:, None], d) / dd[:, None], 0.0, 1.0)
-        line = np.linalg.norm(points - self.a[:, None] - t[..., None] * d[:, None], axis=-1)
-        rel = points - self.c[:, None]
+            t = np.clip((rel @ d[:, :, None])[..., 0] / dd[:, None], 0.0, 1.0)
+        off = rel - t[..., None] * d[:, None]
+        return np.nan_to_num(np.hypot(off[..., 0], off[..., 1]), nan=np.inf)
+
+    def _arc_distance(self, rows: NDArray, points: NDArray) -> NDArray:
+        c, r, sense, a0, sweep = self.c[rows], self.r[rows], self.sense[rows], self.a0[rows], self.sweep[rows]
+        rel = points - c[:, None]
         angle = np.arctan2(rel[..., 1], rel[..., 0])
-        inside = (self.sense[:, None] * (angle - self.a0[:, None])) % TAU <= self.sweep[:, None]
-        radial = np.abs(np.hypot(rel[..., 0], rel[..., 1]) - self.r[:, None])
-        end_angle = self.a0 + self.sense * self.sweep
-        start = self.c + self.r[:, None] * np.stack([np.cos(self.a0), np.sin(self.a0)], axis=-1)
-        end = self.c + self.r[:, None] * np.stack([np.cos(end_angle), np.sin(end_angle)], axis=-1)
-        ends = np.minimum(np.linalg.norm(points - start[:, None], axis=-1), np.linalg.norm(points - end[:, None], axis=-1))
-        arc = np.where(inside, np.minimum(radial, ends), ends)
-        return np.where(self.arc[:, None], arc, np.nan_to_num(line, nan=np.inf))
+        inside = (sense[:, None] * (angle - a0[:, None])) % TAU <= sweep[:, None]
+        radial = np.abs(np.hypot(rel[..., 0], rel[..., 1]) - r[:, None])
+        end_angle = a0 + sense * sweep
+        start = r[:, None] * np.stack([np.cos(a0), np.sin(a0)], axis=-1)
+        end = r[:, None] * np.stack([np.cos(end_angle), np.sin(end_angle)], axis=-1)
+        to_start, to_end = rel - start[:, None], rel - end[:, None]
+        ends = np.minimum(np.hypot(to_start[..., 0], to_start[..., 1]), np.hypot(to_end[..., 0], to_end[..., 1]))
+        return np.where(inside, np.minimum(radial, ends), ends)
+
+
+def _bernstein(u: NDArray, degree: int) -> NDArray:
+    """The Bernstein basis of ``degree`` at ``u`` (any shape), on a new last axis."""
+    v = 1.0 - u
+    if degree == 3:
+        return np.stack([v * v * v, 3.0 * v * v * u, 3.0 * v * u * u, u * u * u], axis=-1)
+    if degree == 2:
+        return np.stack([v * v, 2.0 * v * u, u * u], axis=-1)
+    return np.stack([v, u], axis=-1)
 
 
 def _bezier_rows(cp: NDArray, u: NDArray) -> NDArray:
-    """(J, len(u), 2) points of J cubic Béziers (J, 4, 2)."""
-    u = u[None, :, None] if u.ndim == 1 else u[..., None]
-    v = 1.0 - u
-    return v**3 * cp[:, None, 0] + 3 * v * v * u * cp[:, None, 1] + 3 * v * u * u * cp[:, None, 2] + u**3 * cp[:, None, 3]
+    """(J, len(u), 2) points of J cubic Béziers (J, 4, 2) at the same ``u``, or (J, M, 2) at ``u`` (J, M)."""
+    return _bernstein(u, 3) @ cp
 
 
 def _distance_to_bezier_rows(points: NDArray, cp: NDArray) -> NDArray:
@@ -129,19 +153,18 @@ def _distance_to_bezier_rows(points: NDArray, cp: NDArray) -> NDArray:
     samples, polished by Newton steps on (B(u) − p)·B'(u) = 0 (clamped to [0, 1])."""
     grid = np.linspace(0.0, 1.0, GUESSES)
     samples = _bezier_rows(cp, grid)  # (J, K, 2)
-    squared = (np.einsum("jmk,jmk->jm", points, points)[..., None] - 2.0 * np.einsum("jmk,jsk->jms", points, samples)
-               + np.einsum("jsk,jsk->js", samples, samples)[:, None])  # fmt: skip
-    best = grid[np.argmin(squared, axis=2)]  # (J, M)
+    squared = np.einsum("jsk,jsk->js", samples, samples)[:, None] - 2.0 * (points @ samples.transpose(0, 2, 1))
+    best = grid[np.argmin(squared, axis=2)]  # (J, M); |p|² is the same for every sample
     d1 = 3.0 * np.diff(cp, axis=1)  # (J, 3, 2)
     d2 = 2.0 * np.diff(d1, axis=1)  # (J, 2, 2)
     for _ in range(NEWTON_STEPS):
         off = _bezier_rows(cp, best) - points
-        v, w = (1.0 - best)[..., None], best[..., None]
-        first = v * v * d1[:, None, 0] + 2 * v * w * d1[:, None, 1] + w * w * d1[:, None, 2]
-        second = v * d2[:, None, 0] + w * d2[:, None, 1]
+        first = _bernstein(best, 2) @ d1
+        second = _bernstein(best, 1) @ d2
         f = np.einsum("jmk,jmk->jm", off, first)
         df = np.einsum("jmk,jmk->jm", first, first) + np.einsum("jmk,jmk->jm", off, second)
         with np.errstate(invalid="ignore", divide="ignore"):
             step = np.where(df > 0.0, f / df, 0.0)
         best = np.clip(best - np.nan_to_num(step), 0.0, 1.0)
-    return np.linalg.norm(_bezier_rows(cp, best) - points, axis=-1)
+    off = _bezier_rows(cp, best) - points
+    return np.hypot(off[..., 0], off[..., 1])
