@@ -8,7 +8,6 @@ from numpy.typing import NDArray
 
 from ..core.segments import TAU
 from ._g2_pieces import (
-    _kept,
     _Piece,
     _Solved,
 )
@@ -28,36 +27,41 @@ def _deviation(group: _Group, solved: list[_Solved | None], s: list[float], used
     n = len(group.pieces)
     # A tangent circle put into a corner is itself ``fillet`` off the input: its shifts and joints add it.
     worst = max((shift + p.fillet for shift, p in zip(s, group.pieces)), default=0.0)
-    index = [j for j, joint in enumerate(solved) if joint is not None]
+    index = np.array([j for j, joint in enumerate(solved) if joint is not None], dtype=int)
+    rows_all = _Rows.of(group.pieces)
+    fillet = np.array([p.fillet for p in group.pieces])
+    shift = np.array(s, dtype=float)
+    used_lo, used_hi = np.array(used, dtype=float).reshape(-1, 2).T
     for block in range(0, len(index), BLOCK):
         joints = index[block : block + BLOCK]
-        before = [group.pieces[j] for j in joints]
-        after = [group.pieces[(j + 1) % n] for j in joints]
-        added = np.array([max(a.fillet, b.fillet) for a, b in zip(before, after)])
-        spirals = np.array([[cps[0], cps[-1]] for cps in (solved[j].spirals for j in joints)])  # type: ignore[union-attr]
-        rows_a, rows_b = _Rows(before), _Rows(after)
+        nexts = (joints + 1) % n
+        added = np.maximum(fillet[joints], fillet[nexts])
+        spirals = np.array([[cps[0], cps[-1]] for cps in (solved[j].spirals for j in joints.tolist())])  # type: ignore[union-attr]
+        rows_a, rows_b = rows_all.take(joints), rows_all.take(nexts)
         # A short line left out between two arcs is input the joint replaced (elsewhere: piece a again).
-        middle = [group.bridges[j][0] if j in group.bridges else a for j, a in zip(joints, before)]
-        rows_m = _Rows(middle)
+        bridged = np.array([j in group.bridges for j in joints.tolist()])
+        rows_m = rows_a
+        if bridged.any():
+            rows_m = _Rows.of([group.bridges[j][0] if j in group.bridges else group.pieces[j] for j in joints.tolist()])
         u = np.linspace(0.0, 1.0, SAMPLES)
         curve = np.concatenate([_bezier_rows(spirals[:, 0], u), _bezier_rows(spirals[:, 1], u)], axis=1)  # a lone spiral twice
-        there = np.minimum(np.minimum(rows_a.distance(curve), rows_b.distance(curve)), rows_m.distance(curve))
+        there = np.minimum(rows_a.distance(curve), rows_b.distance(curve))
+        if bridged.any():
+            there = np.minimum(there, rows_m.distance(curve))
         worst = max(worst, float((there.max(axis=1) + added).max()))
-        tail = np.array([used[j][1] for j in joints])
-        head = np.array([used[(j + 1) % n][0] for j in joints])
+        tail = used_hi[joints]
+        head = used_lo[nexts]
         replaced = np.concatenate(
             [rows_a.points(rows_a.size - tail, rows_a.size, SAMPLES), rows_b.points(np.zeros(len(joints)), head, SAMPLES)], axis=1
         )
         near = _distance_to_bezier_rows(replaced, spirals[:, 0])
-        pairs = np.flatnonzero([len(solved[j].spirals) == 2 for j in joints])  # type: ignore[union-attr]
+        pairs = np.flatnonzero([len(solved[j].spirals) == 2 for j in joints.tolist()])  # type: ignore[union-attr]
         if len(pairs):
             near[pairs] = np.minimum(near[pairs], _distance_to_bezier_rows(replaced[pairs], spirals[pairs, 1]))
-        for pieces, ks in ((before, joints), (after, [(j + 1) % n for j in joints])):
-            kept = [_kept(piece, used[k], s[k]) for piece, k in zip(pieces, ks)]
-            present = np.array([k is not None for k in kept])
+        for rows, ks in ((rows_a, joints), (rows_b, nexts)):
+            kept, present = rows.kept(used_lo[ks], used_hi[ks], shift[ks])
             if present.any():
-                rows = _Rows([k if k is not None else pieces[i] for i, k in enumerate(kept)])
-                near = np.minimum(near, np.where(present[:, None], rows.distance(replaced), np.inf))
+                near = np.minimum(near, np.where(present[:, None], kept.where(present, rows).distance(replaced), np.inf))
         worst = max(worst, float((near.max(axis=1) + added).max()))
     return worst
 
@@ -77,16 +81,52 @@ NEWTON_STEPS = 5
 class _Rows:
     """Pieces as arrays: lines (a → b) and arcs (centre, radius, start angle, sweep), one row each."""
 
-    def __init__(self, pieces: list[_Piece]):
-        self.arc = np.array([p.kind == "arc" for p in pieces])
-        self.a = np.array([p.a for p in pieces])
-        self.b = np.array([p.b for p in pieces])
-        self.c = np.array([p.c for p in pieces])
-        self.r = np.array([abs(p.r) for p in pieces])
-        self.sense = np.array([p.sense for p in pieces])
-        self.a0 = np.array([p.a0 for p in pieces])
-        self.sweep = np.array([p.sweep for p in pieces])
+    def __init__(self, arc: NDArray, a: NDArray, b: NDArray, c: NDArray, r: NDArray, sense: NDArray, a0: NDArray,
+                 sweep: NDArray):  # fmt: skip
+        self.arc, self.a, self.b, self.c, self.r, self.sense, self.a0, self.sweep = arc, a, b, c, r, sense, a0, sweep
         self.size = np.where(self.arc, self.sweep, np.hypot(*(self.b - self.a).T))
+
+    @classmethod
+    def of(cls, pieces: list[_Piece]) -> _Rows:
+        """The rows of ``pieces``."""
+        return cls(
+            np.array([p.kind == "arc" for p in pieces]),
+            np.array([p.a for p in pieces]).reshape(-1, 2),
+            np.array([p.b for p in pieces]).reshape(-1, 2),
+            np.array([p.c for p in pieces]).reshape(-1, 2),
+            np.array([abs(p.r) for p in pieces]),
+            np.array([p.sense for p in pieces]),
+            np.array([p.a0 for p in pieces]),
+            np.array([p.sweep for p in pieces]),
+        )
+
+    def take(self, rows: NDArray) -> _Rows:
+        """The rows ``rows`` (indices) of these."""
+        return _Rows(self.arc[rows], self.a[rows], self.b[rows], self.c[rows], self.r[rows], self.sense[rows], self.a0[rows],
+                     self.sweep[rows])  # fmt: skip
+
+    def where(self, mask: NDArray, other: _Rows) -> _Rows:
+        """These rows where ``mask``, else ``other``'s."""
+        pick = [np.where(mask[:, None] if x.ndim == 2 else mask, x, y) for x, y in
+                ((self.arc, other.arc), (self.a, other.a), (self.b, other.b), (self.c, other.c), (self.r, other.r),
+                 (self.sense, other.sense), (self.a0, other.a0), (self.sweep, other.sweep))]  # fmt: skip
+        return _Rows(*pick)
+
+    def kept(self, lo: NDArray, hi: NDArray, shrink: NDArray) -> tuple[_Rows, NDArray]:
+        """What transitions using ``lo`` at the start and ``hi`` at the end leave of each row (an arc on its
+        circle shrunk by ``shrink``), as ``_kept`` does for one piece, and whether anything is left."""
+        with np.errstate(invalid="ignore", divide="ignore"):
+            unit = (self.b - self.a) / np.where(self.arc, 1.0, self.size)[:, None]
+        left = self.size - lo - hi
+        a = self.a + lo[:, None] * unit
+        b = self.a + (self.size - hi)[:, None] * unit
+        a0 = self.a0 + self.sense * lo
+        r = np.abs(self.sense * self.r - self.sense * shrink)
+        line = ~self.arc
+        rows = _Rows(self.arc, np.where(line[:, None], a, self.a), np.where(line[:, None], b, self.b), self.c,
+                     np.where(self.arc, r, self.r), self.sense, np.where(self.arc, a0, self.a0),
+                     np.where(self.arc, left, self.sweep))  # fmt: skip
+        return rows, left > 0.0
 
     def points(self, lo: NDArray, hi: NDArray, count: int) -> NDArray:
         """(J, count, 2) points from ``lo`` to ``hi`` (length along a line, angle along an arc)."""

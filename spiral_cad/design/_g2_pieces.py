@@ -178,22 +178,6 @@ def _used_rows(pieces: list[_Piece], points: NDArray, at_end: bool) -> NDArray:
     return np.where(line, along, around)
 
 
-def _kept(piece: _Piece, used: list[float], shrink: float) -> _Piece | None:
-    """What the transitions leave of ``piece`` (an arc on its shrunk circle), as a piece; None if nothing."""
-    if piece.kind == "line":
-        t = piece.tangent(True)
-        length = piece.size - used[0] - used[1]
-        if not length > 0.0:
-            return None
-        return _Piece("line", piece.first, piece.last, a=piece.a + used[0] * t, b=piece.a + (piece.size - used[1]) * t)
-    sweep = piece.sweep - used[0] - used[1]
-    if not sweep > 0.0:
-        return None
-    return _Piece(
-        "arc", piece.first, piece.last, c=piece.c, r=piece.r - piece.sense * shrink, a0=piece.a0 + piece.sense * used[0], sweep=sweep
-    )
-
-
 class _Refusal(Exception):
     """A joint that cannot be made G2 within the bound (its index in the group and the reason)."""
 
