@@ -36,7 +36,7 @@ def _deviation(group: _Group, solved: list[_Solved | None], s: list[float], used
         joints = index[block : block + BLOCK]
         nexts = (joints + 1) % n
         added = np.maximum(fillet[joints], fillet[nexts])
-        spirals = np.array([[cps[0], cps[-1]] for cps in (solved[j].spirals for j in joints.tolist())])  # type: ignore[union-attr]
+        spirals = np.array([[cps[0], cps[-1]] for cps in (solved[j].spirals for j in joints.tolist())])
         rows_a, rows_b = rows_all.take(joints), rows_all.take(nexts)
         # A short line left out between two arcs is input the joint replaced (elsewhere: piece a again).
         bridged = np.array([j in group.bridges for j in joints.tolist()])
@@ -55,7 +55,7 @@ def _deviation(group: _Group, solved: list[_Solved | None], s: list[float], used
             [rows_a.points(rows_a.size - tail, rows_a.size, SAMPLES), rows_b.points(np.zeros(len(joints)), head, SAMPLES)], axis=1
         )
         near = _distance_to_bezier_rows(replaced, spirals[:, 0])
-        pairs = np.flatnonzero([len(solved[j].spirals) == 2 for j in joints.tolist()])  # type: ignore[union-attr]
+        pairs = np.flatnonzero([len(solved[j].spirals) == 2 for j in joints.tolist()])
         if len(pairs):
             near[pairs] = np.minimum(near[pairs], _distance_to_bezier_rows(replaced[pairs], spirals[pairs, 1]))
         for rows, ks in ((rows_a, joints), (rows_b, nexts)):

@@ -66,7 +66,7 @@ class _Group:
             q_max = 1.0 - 1.0 / K.shape_g1(code, math.sin(largest), math.cos(largest))
         else:
             q_max = MAX_SHRINK
-        size = max(float(np.abs(np.concatenate([p.start(), p.end(), p.c])).max()) for p in pieces)
+        size = _coordinate_size(pieces)
         target = bound * (1.0 - BOUND_MARGIN) - 8.0 * EPS * size
         if not target > 0.0:
             raise _Refusal(
@@ -196,6 +196,18 @@ class _Group:
         pair = result.control_points[0]
         return _Solved([pair[0].copy(), pair[1].copy()], _used(a, pair[0][0], True), _used(b, pair[1][3], False),
                        float(result.theta[0]))  # fmt: skip
+
+
+def _coordinate_size(pieces: list[_Piece]) -> float:
+    """The largest coordinate of the pieces' ends and centres (what float64 resolves them against)."""
+    arc = np.array([p.kind == "arc" for p in pieces])
+    c = np.array([p.c for p in pieces]).reshape(-1, 2)
+    r = np.abs(np.array([p.r for p in pieces]))[:, None]
+    a0 = np.array([p.a0 for p in pieces])
+    a1 = a0 + np.array([p.sense * p.sweep for p in pieces])
+    start = np.where(arc[:, None], c + r * np.stack([np.cos(a0), np.sin(a0)], axis=-1), np.array([p.a for p in pieces]).reshape(-1, 2))
+    end = np.where(arc[:, None], c + r * np.stack([np.cos(a1), np.sin(a1)], axis=-1), np.array([p.b for p in pieces]).reshape(-1, 2))
+    return float(max(np.abs(start).max(), np.abs(end).max(), np.abs(c).max()))
 
 
 def _solve(group: _Group) -> tuple[list[_Solved | None], list[float]]:

@@ -244,7 +244,9 @@ def _trimmed(piece: _Piece, used: list[float], shrink: float, solved: list[_Solv
     if not sweep > 0.0:
         return []
     radius = piece.r - piece.sense * shrink
-    return [Arc(piece.c, radius, piece.a0 + piece.sense * used[0], sweep)]
+    arc = Arc._of(piece.c.copy(), float(radius), float(piece.a0 + piece.sense * used[0]), float(sweep))
+    arc._check()  # the checks of Arc(...), without converting what is already float
+    return [arc]
 
 
 def make_g2(
