@@ -126,31 +126,24 @@ class _Group:
         """Line → arc and arc → line joints (Theorem 4.1 onto the shrunk circle), solved about each joint
         (where float64 holds a small transition far from the origin) and moved back."""
         n = len(self.pieces)
-        origin, direction, centre, radius, reverse = [], [], [], [], []
-        for j in joints:
-            a, b = self.pieces[j], self.pieces[(j + 1) % n]
-            if a.kind == "line":
-                origin.append(a.b)
-                direction.append(a.tangent(True))
-                centre.append(b.c)
-                radius.append(abs(b.r) - s[(j + 1) % n])
-                reverse.append(False)
-            else:
-                origin.append(b.a)
-                direction.append(-b.tangent(False))
-                centre.append(a.c)
-                radius.append(abs(a.r) - s[j])
-                reverse.append(True)
-        points = np.array(origin)
-        result = batch.line_to_circle(
-            np.zeros_like(points), np.array(direction), np.array(centre) - points, np.array(radius), shape=self.shape
-        )
-        spirals = result.spirals[0] + points[:, None]
-        flip = np.array(reverse)
-        spirals[flip] = spirals[flip, ::-1]
-        ok = result.ok.tolist()
         before = [self.pieces[j] for j in joints]
         after = [self.pieces[(j + 1) % n] for j in joints]
+        nexts = [(j + 1) % n for j in joints]
+        # The line's end and direction of travel away from the arc, the arc's circle shrunk: a line → arc
+        # joint as it is, an arc → line joint reversed.
+        flip = np.array([a.kind != "line" for a in before])
+        line_a = np.where(flip[:, None], np.array([b.b for b in after]), np.array([a.a for a in before]))
+        points = np.where(flip[:, None], np.array([b.a for b in after]), np.array([a.b for a in before]))
+        direction = points - line_a
+        direction /= np.hypot(direction[:, 0], direction[:, 1])[:, None]
+        centre = np.where(flip[:, None], np.array([a.c for a in before]), np.array([b.c for b in after]))
+        radius_after = np.array([abs(b.r) for b in after]) - np.array([s[k] for k in nexts])
+        radius_before = np.array([abs(a.r) for a in before]) - np.array([s[j] for j in joints])
+        radius = np.where(flip, radius_before, radius_after)
+        result = batch.line_to_circle(np.zeros_like(points), direction, centre - points, radius, shape=self.shape)
+        spirals = result.spirals[0] + points[:, None]
+        spirals[flip] = spirals[flip, ::-1]
+        ok = result.ok.tolist()
         used_before = _used_rows(before, spirals[:, 0], True).tolist()
         used_after = _used_rows(after, spirals[:, 3], False).tolist()
         theta = result.theta.tolist()
