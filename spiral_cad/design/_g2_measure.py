@@ -89,13 +89,14 @@ class _Rows:
     @classmethod
     def of(cls, pieces: list[_Piece]) -> _Rows:
         """The rows of ``pieces``."""
+        r = np.array([p.r for p in pieces])
         return cls(
             np.array([p.kind == "arc" for p in pieces]),
             np.array([p.a for p in pieces]).reshape(-1, 2),
             np.array([p.b for p in pieces]).reshape(-1, 2),
             np.array([p.c for p in pieces]).reshape(-1, 2),
-            np.array([abs(p.r) for p in pieces]),
-            np.array([p.sense for p in pieces]),
+            np.abs(r),
+            np.copysign(1.0, r),
             np.array([p.a0 for p in pieces]),
             np.array([p.sweep for p in pieces]),
         )

@@ -165,7 +165,7 @@ def _used_rows(pieces: list[_Piece], points: NDArray, at_end: bool) -> NDArray:
     a = np.array([p.a for p in pieces])
     b = np.array([p.b for p in pieces])
     c = np.array([p.c for p in pieces])
-    sense = np.array([p.sense for p in pieces])
+    sense = np.copysign(1.0, np.array([p.r for p in pieces]))
     a0 = np.array([p.a0 for p in pieces])
     a1 = a0 + sense * np.array([p.sweep for p in pieces])
     d = b - a
