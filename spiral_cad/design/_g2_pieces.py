@@ -88,6 +88,19 @@ def _piece_of(segment: Segment, index: int) -> _Piece:
     return _Piece("arc", index, index, c=segment.center[:2].copy(), r=segment.radius, a0=segment.start_angle, sweep=segment.sweep)
 
 
+def _piece_ends(pieces: list[_Piece]) -> tuple[NDArray, NDArray]:
+    """The start and end points of many pieces at once, (n, 2) each (``start()`` and ``end()`` of each)."""
+    arc = np.array([p.kind == "arc" for p in pieces])[:, None]
+    c = np.array([p.c for p in pieces]).reshape(-1, 2)
+    r = np.array([p.r for p in pieces])
+    a0 = np.array([p.a0 for p in pieces])
+    a1 = a0 + np.copysign(1.0, r) * np.array([p.sweep for p in pieces])
+    radius = np.abs(r)[:, None]
+    start = np.where(arc, c + radius * np.stack([np.cos(a0), np.sin(a0)], axis=-1), np.array([p.a for p in pieces]).reshape(-1, 2))
+    end = np.where(arc, c + radius * np.stack([np.cos(a1), np.sin(a1)], axis=-1), np.array([p.b for p in pieces]).reshape(-1, 2))
+    return start, end
+
+
 def _turn(a: _Piece, b: _Piece) -> float:
     ta, tb = a.tangent(True), b.tangent(False)
     return math.atan2(ta[0] * tb[1] - ta[1] * tb[0], float(np.dot(ta, tb)))

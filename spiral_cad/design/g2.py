@@ -51,7 +51,7 @@ from ..core.space import PlaneFrame
 from ..core.spiral import BezierSpiral
 from ..core.units import DEFAULT_UNITS, length_unit
 from ._g2_measure import _deviation
-from ._g2_pieces import EPS, _classify, _merge, _Piece, _piece_of, _Refusal, _shown_point, _Solved
+from ._g2_pieces import EPS, _classify, _merge, _Piece, _piece_ends, _piece_of, _Refusal, _shown_point, _Solved
 from ._g2_solve import _arc_corners, _bridge_short_lines, _Group, _solve
 from .rounding import _steepest_deflection
 
@@ -419,15 +419,18 @@ def _make(segments: list[Segment], bound: float, closed: bool | None, shape: str
     scale = float(np.abs(points).max()) or 1.0
     extent = float(np.hypot(*(points.max(axis=0) - points.min(axis=0)))) or scale
     gap_tol = max(1e-9 * extent, 64.0 * EPS * scale, GAP_SHARE * bound)
-    for i, (a, b) in enumerate(zip(pieces[:-1], pieces[1:])):
-        gap = math.dist(a.end(), b.start())
+    starts, ends = _piece_ends(pieces)
+    between = ends - np.roll(starts, -1, axis=0)  # each piece's end to the next one's start (the last: to the first)
+    distances = np.hypot(between[:, 0], between[:, 1])
+    for i in np.flatnonzero(distances[:-1] > gap_tol)[:1].tolist():
+        a, b, gap = pieces[i], pieces[i + 1], float(distances[i])
         if gap > gap_tol:
             raise ValueError(
                 f"segments {i} and {i + 1} do not meet: segment {i} ends at {_shown_point(a.end().tolist())}, "
                 f"segment {i + 1} starts at {_shown_point(b.start().tolist())} ({gap:.3g} apart; make_g2 closes gaps "
                 f"up to {GAP_SHARE:g} of max_deviation, {gap_tol:.3g})"
             )
-    meets = math.dist(pieces[-1].end(), pieces[0].start()) <= gap_tol
+    meets = bool(distances[-1] <= gap_tol)
     if closed is None:
         closed = meets and (len(pieces) > 1 or (pieces[0].kind == "arc" and pieces[0].sweep >= TAU - 1e-12))
     elif closed and not meets:
@@ -443,17 +446,18 @@ def _make(segments: list[Segment], bound: float, closed: bool | None, shape: str
     # A small gap (arcs of a CNC program end off their circles by the program's rounding) is closed: a
     # transition or tangent circle spans it by construction; two lines at a corner meet half-way. The
     # shifts leave room for it and the deviation adds it.
-    gaps = [math.dist(pieces[i].end(), pieces[(i + 1) % count].start()) for i in range(joint_count)]
+    gaps = distances[:joint_count].tolist()
     for i, gap in enumerate(gaps):
         a, b = pieces[i], pieces[(i + 1) % count]
         if gap > 0.0 and kinds[i] == "corner" and a.kind == "line" and b.kind == "line":
             a.b = b.a = 0.5 * (a.b + b.a)
     spanned = max(gaps, default=0.0) if max(gaps, default=0.0) > 64.0 * EPS * scale else 0.0
+    shown = [tuple(point) for point in _piece_ends(pieces)[1].tolist()]  # each joint's point (corners met half-way)
     room = bound - spanned
     joints: dict[int, G2Joint] = {}
     for i, kind in enumerate(kinds):
         if kind in ("g2", "split"):
-            joints[i] = G2Joint(i, kind, tuple(pieces[i].end().tolist()), "nothing" if kind == "g2" else "split here", 0.0)
+            joints[i] = G2Joint(i, kind, shown[i], "nothing" if kind == "g2" else "split here", 0.0)
     # Merge G2 neighbours; a closed path starts after a joint that is not G2 (if it has one).
     order = list(range(count))
     if closed:
@@ -505,13 +509,13 @@ def _make(segments: list[Segment], bound: float, closed: bool | None, shape: str
             measured += spanned
         except _Refusal as refusal:
             index = group_joints[refusal.joint] if group_joints else 0
-            return _Located(index, tuple(pieces[index].end().tolist()), refusal.reason, refusal.larger_helps)
+            return _Located(index, shown[index], refusal.reason, refusal.larger_helps)
         except ValueError as error:
             index = group_joints[0] if group_joints else 0
-            return _Located(index, tuple(pieces[index].end().tolist()), f"float64 cannot hold the result: {error}", True)
+            return _Located(index, shown[index], f"float64 cannot hold the result: {error}", True)
         if measured > bound:
             index = group_joints[0] if group_joints else 0
-            return _Located(index, tuple(pieces[index].end().tolist()),
+            return _Located(index, shown[index],
                             f"the result lies {measured:.6g} from the input, beyond the bound", True)  # fmt: skip
         chains.append(chain)
         deviation = max(deviation, measured)
@@ -523,17 +527,17 @@ def _make(segments: list[Segment], bound: float, closed: bool | None, shape: str
                 moved = (f"line {line.first} ({line.size:.6g} long, too short for a transition at each end) joined across by "
                          f"a {'C' if (a.r > 0) == (b.r > 0) else 'S'} spiral pair; {_moved('line-arc', a, b, s[j], s[(j + 1) % len(group_pieces)], solved_joint)}")  # fmt: skip
                 for where in (index, after):
-                    joints[where] = G2Joint(where, "line-arc", tuple(pieces[where].end().tolist()), moved,
+                    joints[where] = G2Joint(where, "line-arc", shown[where], moved,
                                             max(s[j], s[(j + 1) % len(group_pieces)]), solved_joint.theta if solved_joint else math.nan)  # fmt: skip
                 continue
             if a.fillet or b.fillet:
                 circle, shift = (a, s[j]) if a.fillet else (b, s[(j + 1) % len(group_pieces)])
                 moved = (f"corner rounded by a tangent circle of radius {abs(circle.r):.6g} passing {circle.fillet:.6g} from it, "
                          f"shrunk by {shift:.6g} for its transitions")  # fmt: skip
-                joints[index] = G2Joint(index, "corner", tuple(pieces[index].end().tolist()), moved, circle.fillet + shift,
+                joints[index] = G2Joint(index, "corner", shown[index], moved, circle.fillet + shift,
                                         solved_joint.theta if solved_joint is not None else math.nan)  # fmt: skip
                 continue
-            joints[index] = G2Joint(index, kind, tuple(pieces[index].end().tolist()), _moved(kind, a, b, s[j], s[(j + 1) % len(group_pieces)], solved_joint),
+            joints[index] = G2Joint(index, kind, shown[index], _moved(kind, a, b, s[j], s[(j + 1) % len(group_pieces)], solved_joint),
                                     _joint_shift(kind, s[j], s[(j + 1) % len(group_pieces)], group, solved_joint, a),
                                     solved_joint.theta if solved_joint is not None else math.nan)  # fmt: skip
     records = [joints[i] for i in sorted(joints)]
