@@ -77,10 +77,15 @@ def main() -> None:
                f"make_g2 takes {ours.median / chain.median:,.1f}× as long")  # fmt: skip
     report.section(
         "What bounds it",
-        "make_g2 solves every joint of a kind in one batch call, but walks the path in Python to classify joints, "
-        "share each line and arc between its joints, place the shifted arcs and build a segment object per piece, "
-        "and measures the deviation of every joint on sampled points (Newton-polished): those per-joint steps, "
-        "not the transition formulas, set its rate.",
+        "make_g2 solves every joint of a kind in one batch call and measures the deviation of all joints at once in "
+        "arrays (sampled spirals against exact distances to the lines and arcs, Newton-polished nearest points on the "
+        "spirals), with Python's cycle collector paused. What is left is per-joint Python: a piece record per input "
+        "segment and the classification of each joint, a result record per transition, a Line, Arc or BezierSpiral "
+        "object per piece of the result and the Chain's check of every joint, and a G2Joint record (with its "
+        "description) per joint. In a profile of 20,000 joints the measure takes about 40 %, the segment objects and "
+        "the Chain about 20 %, the solve around the batch call about 11 %, pieces and classification about 10 %, the "
+        "joint records and grouping the rest: the transition formulas are not the limit (the ratio above). 1 M "
+        "joints/s needs the result held as arrays until a Chain is asked for, and the measure in compiled code.",
     )
     report.finish(args)
 
