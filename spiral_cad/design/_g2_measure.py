@@ -78,6 +78,10 @@ GUESSES = 17
 NEWTON_STEPS = 5
 
 
+#: A Newton step in u this small leaves the distance unchanged to float64 (second order: ~1e-24 relative).
+SETTLED = 1e-12
+
+
 class _Rows:
     """Pieces as arrays: lines (a → b) and arcs (centre, radius, start angle, sweep), one row each."""
 
@@ -191,7 +195,12 @@ def _bezier_rows(cp: NDArray, u: NDArray) -> NDArray:
 
 def _distance_to_bezier_rows(points: NDArray, cp: NDArray) -> NDArray:
     """(J, M) distance of ``points`` (J, M, 2) to the cubic Béziers ``cp`` (J, 4, 2): the nearest of dense
-    samples, polished by Newton steps on (B(u) − p)·B'(u) = 0 (clamped to [0, 1])."""
+    samples, polished by Newton steps on (B(u) − p)·B'(u) = 0 (clamped to [0, 1]), at most ``NEWTON_STEPS``:
+    fewer once no u moves by more than ``SETTLED`` (near a nearest point the distance changes only to second
+    order in u, and any u gives a distance no smaller than the nearest one)."""
+    # About each spiral's start: far from the origin, |s|² − 2 p·s would lose the small distances.
+    points = points - cp[:, None, 0]
+    cp = cp - cp[:, None, 0]
     grid = np.linspace(0.0, 1.0, GUESSES)
     samples = _bezier_rows(cp, grid)  # (J, K, 2)
     squared = np.einsum("jsk,jsk->js", samples, samples)[:, None] - 2.0 * (points @ samples.transpose(0, 2, 1))
@@ -205,7 +214,11 @@ def _distance_to_bezier_rows(points: NDArray, cp: NDArray) -> NDArray:
         f = np.einsum("jmk,jmk->jm", off, first)
         df = np.einsum("jmk,jmk->jm", first, first) + np.einsum("jmk,jmk->jm", off, second)
         with np.errstate(invalid="ignore", divide="ignore"):
-            step = np.where(df > 0.0, f / df, 0.0)
-        best = np.clip(best - np.nan_to_num(step), 0.0, 1.0)
+            step = np.nan_to_num(np.where(df > 0.0, f / df, 0.0))
+        moved = np.clip(best - step, 0.0, 1.0)
+        settled = not np.abs(moved - best).max(initial=0.0) > SETTLED
+        best = moved
+        if settled:
+            break
     off = _bezier_rows(cp, best) - points
     return np.hypot(off[..., 0], off[..., 1])
