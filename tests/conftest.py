@@ -108,6 +108,9 @@ SLOW = {
     "test_points.py::test_a_million_rows_read_as_numpy_wrote_them",
     "test_ifc.py",
     "test_speed_guard.py::test_the_guard_fails_when_a_kernel_falls_back_to_plain_python",
+    "test_make_g2.py::test_random_g1_paths_become_g2_within_the_bound",
+    "test_make_g2.py::test_random_closed_filleted_polygons_become_g2",
+    "test_make_g2.py::test_random_paths_with_corners_and_reversals",
 }
 _CAD = re.compile(r"^\s*(?:from|import) (?:build123d|cadquery|OCP)\b|importorskip\([\"'](?:build123d|cadquery|OCP)", re.M)
 _SUBPROCESS = re.compile(r"\bsubprocess\b|sys\.executable")

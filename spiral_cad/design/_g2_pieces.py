@@ -1,0 +1,199 @@
+"""make_g2's pieces: the input's lines and arcs (merged with their G2 neighbours), how its joints are
+classified, and how much of a piece a transition uses."""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+
+import numpy as np
+from numpy.typing import NDArray
+
+from ..core.segments import TAU, Arc, Line, Segment
+
+#: The share of a line's length or an arc's sweep one joint may use when the other end has a joint too.
+SHARED = 0.45
+
+
+#: ... and when the other end is a free end of the path.
+ALONE = 0.9
+
+
+EPS = float(np.finfo(float).eps)
+
+
+def _shown_point(point: Sequence[float]) -> str:
+    return "(" + ", ".join(f"{v:.10g}" for v in point) + ")"
+
+
+@dataclass
+class _Piece:
+    """A line (a → b) or an arc (centre c, signed radius r, start angle a0, sweep) of the input, merged
+    with its G2 neighbours; ``first`` and ``last`` are the input segments it spans."""
+
+    kind: str
+    first: int
+    last: int
+    a: NDArray = field(default_factory=lambda: np.zeros(2))
+    b: NDArray = field(default_factory=lambda: np.zeros(2))
+    c: NDArray = field(default_factory=lambda: np.zeros(2))
+    r: float = 0.0
+    a0: float = 0.0
+    sweep: float = 0.0
+    #: A tangent circle put into a corner next to an arc: how far it passes from the corner (else 0).
+    fillet: float = 0.0
+    #: How much of the bound a tangent circle beside this piece has used (its shift must leave it).
+    spent: float = 0.0
+
+    @property
+    def sense(self) -> float:
+        return math.copysign(1.0, self.r)
+
+    @property
+    def a1(self) -> float:
+        return self.a0 + self.sense * self.sweep
+
+    def start(self) -> NDArray:
+        if self.kind == "line":
+            return self.a
+        return self.c + abs(self.r) * np.array([math.cos(self.a0), math.sin(self.a0)])
+
+    def end(self) -> NDArray:
+        if self.kind == "line":
+            return self.b
+        return self.c + abs(self.r) * np.array([math.cos(self.a1), math.sin(self.a1)])
+
+    def tangent(self, at_end: bool) -> NDArray:
+        if self.kind == "line":
+            d = self.b - self.a
+            return d / math.hypot(*d)
+        angle = self.a1 if at_end else self.a0
+        return self.sense * np.array([-math.sin(angle), math.cos(angle)])
+
+    def curvature(self) -> float:
+        return 0.0 if self.kind == "line" else 1.0 / self.r
+
+    @property
+    def size(self) -> float:
+        """Length of a line, sweep of an arc: what its joints share."""
+        return math.hypot(*(self.b - self.a)) if self.kind == "line" else self.sweep
+
+
+def _piece_of(segment: Segment, index: int) -> _Piece:
+    if isinstance(segment, Line):
+        (x0, y0, *_), (x1, y1, *_) = segment.ends
+        return _Piece("line", index, index, a=np.array([x0, y0]), b=np.array([x1, y1]))
+    assert isinstance(segment, Arc)
+    return _Piece("arc", index, index, c=segment.center[:2].copy(), r=segment.radius, a0=segment.start_angle, sweep=segment.sweep)
+
+
+def _piece_ends(pieces: list[_Piece]) -> tuple[NDArray, NDArray]:
+    """The start and end points of many pieces at once, (n, 2) each (``start()`` and ``end()`` of each)."""
+    arc = np.array([p.kind == "arc" for p in pieces])[:, None]
+    c = np.array([p.c for p in pieces]).reshape(-1, 2)
+    r = np.array([p.r for p in pieces])
+    a0 = np.array([p.a0 for p in pieces])
+    a1 = a0 + np.copysign(1.0, r) * np.array([p.sweep for p in pieces])
+    radius = np.abs(r)[:, None]
+    start = np.where(arc, c + radius * np.stack([np.cos(a0), np.sin(a0)], axis=-1), np.array([p.a for p in pieces]).reshape(-1, 2))
+    end = np.where(arc, c + radius * np.stack([np.cos(a1), np.sin(a1)], axis=-1), np.array([p.b for p in pieces]).reshape(-1, 2))
+    return start, end
+
+
+def _turn(a: _Piece, b: _Piece) -> float:
+    ta, tb = a.tangent(True), b.tangent(False)
+    return math.atan2(ta[0] * tb[1] - ta[1] * tb[0], float(np.dot(ta, tb)))
+
+
+def _same_circle(a: _Piece, b: _Piece, scale: float) -> bool:
+    return (a.r > 0) == (b.r > 0) and abs(a.r - b.r) <= 1e-9 * abs(a.r) and math.dist(a.c, b.c) <= 1e-9 * scale
+
+
+def _classify(a: _Piece, b: _Piece, scale: float, steepest: float, bound: float) -> str:
+    """The joint from piece ``a`` to ``b``: ``g2``, ``line-arc``, ``arc-arc-…``, ``corner`` or ``split``."""
+    turn = _turn(a, b)
+    if abs(turn) > steepest:
+        return "split"
+    if abs(turn) > TANGENT_TOL:
+        return "corner"
+    if a.kind == "line" and b.kind == "line":
+        # Merged into one line only when the joint point lies within a thousandth of the bound of it.
+        la, lb = a.size, b.size
+        drop = la * lb / (la + lb) * abs(math.sin(turn))
+        return "g2" if drop <= 1e-3 * bound else "corner"
+    if a.kind == "arc" and b.kind == "arc":
+        if _same_circle(a, b, scale):
+            return "g2"
+        return "arc-arc-compound" if (a.r > 0) == (b.r > 0) else "arc-arc-reverse"
+    return "line-arc"
+
+
+#: A joint whose tangent turns by less than this (radians) is tangent (G1).
+TANGENT_TOL = 1e-7
+
+
+def _merge(a: _Piece, b: _Piece) -> _Piece:
+    if a.kind == "line":
+        return _Piece("line", a.first, b.last, a=a.a, b=b.b)
+    return _Piece("arc", a.first, b.last, c=a.c, r=a.r, a0=a.a0, sweep=min(a.sweep + b.sweep, TAU))
+
+
+@dataclass
+class _Solved:
+    """One joint's transition: its spirals (control points in travel order), where they leave and
+    reach the pieces (the share of each piece used) and its θ."""
+
+    spirals: list[NDArray]
+    used_before: float
+    used_after: float
+    theta: float
+    status: int = 0
+    reason: str = ""
+
+
+def _angle_on(piece: _Piece, point: NDArray) -> float:
+    return math.atan2(point[1] - piece.c[1], point[0] - piece.c[0])
+
+
+def _wrap(angle: float) -> float:
+    return (angle + math.pi) % TAU - math.pi
+
+
+def _used(piece: _Piece, point: NDArray, at_end: bool) -> float:
+    """How much of ``piece`` (length of a line, sweep of an arc) lies between ``point`` and its end (start)."""
+    if piece.kind == "line":
+        t = piece.tangent(True)
+        return float(np.dot(piece.b - point, t)) if at_end else float(np.dot(point - piece.a, t))
+    angle = _angle_on(piece, point)
+    if at_end:
+        return piece.sense * _wrap(piece.a1 - angle)
+    return piece.sense * _wrap(angle - piece.a0)
+
+
+def _used_rows(pieces: list[_Piece], points: NDArray, at_end: bool) -> NDArray:
+    """``_used`` of many pieces at once: each piece's share between its point (rows of ``points``) and
+    its end (start)."""
+    line = np.array([p.kind == "line" for p in pieces])
+    a = np.array([p.a for p in pieces])
+    b = np.array([p.b for p in pieces])
+    c = np.array([p.c for p in pieces])
+    sense = np.copysign(1.0, np.array([p.r for p in pieces]))
+    a0 = np.array([p.a0 for p in pieces])
+    a1 = a0 + sense * np.array([p.sweep for p in pieces])
+    d = b - a
+    with np.errstate(invalid="ignore", divide="ignore"):
+        t = d / np.hypot(d[:, 0], d[:, 1])[:, None]
+    along = np.einsum("ij,ij->i", b - points, t) if at_end else np.einsum("ij,ij->i", points - a, t)
+    angle = np.arctan2(points[:, 1] - c[:, 1], points[:, 0] - c[:, 0])
+    turned = a1 - angle if at_end else angle - a0
+    around = sense * ((turned + math.pi) % TAU - math.pi)
+    return np.where(line, along, around)
+
+
+class _Refusal(Exception):
+    """A joint that cannot be made G2 within the bound (its index in the group and the reason)."""
+
+    def __init__(self, joint: int, reason: str, larger_helps: bool):
+        super().__init__(reason)
+        self.joint, self.reason, self.larger_helps = joint, reason, larger_helps

@@ -1,0 +1,430 @@
+"""make_g2's solve: the shift of every arc within the bound, the transitions at every joint (one batch
+per kind), tangent circles in corners next to arcs, and short lines between arcs bridged."""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from ..core import _kernels as K
+from ..core import batch
+from ..core.errors import Status
+from ..core.segments import TAU
+from ..core.shapes import SHAPE_CODES
+from ._g2_pieces import (
+    ALONE,
+    EPS,
+    SHARED,
+    _Piece,
+    _Refusal,
+    _Solved,
+    _turn,
+    _used,
+    _used_rows,
+)
+from .fillets import _intersect
+from .rounding import round_corners_batch
+
+#: The shifts are aimed this much (relative) inside the bound.
+BOUND_MARGIN = 1e-6
+
+
+#: Largest relative shrink s/r of an arc (Walton–Meek; near-linear stops at its largest angle).
+MAX_SHRINK = 0.5
+
+
+#: Passes of shrinking the shifts that overrun a line or an arc before a joint is refused.
+PASSES = 60
+
+
+class _Group:
+    """One part of the path (between splits), its pieces and joints, and the solve."""
+
+    def __init__(self, pieces: list[_Piece], kinds: list[str], closed: bool, bound: float, shape: str, scale: float):
+        self.pieces, self.kinds, self.closed, self.bound, self.shape = pieces, kinds, closed, bound, shape
+        self.scale = scale
+        n = len(pieces)
+        self.joint_count = n if closed else n - 1
+        active = [[False, False] for _ in range(n)]
+        for j in range(self.joint_count):
+            active[j][1] = True
+            active[(j + 1) % n][0] = True
+        self.allow = [[(SHARED if all(act) else ALONE) * p.size if act[e] else 0.0 for e in range(2)] for p, act in zip(pieces, active)]
+        self.needs_shift = [False] * n
+        for j in range(self.joint_count):
+            if kinds[j] in ("line-arc", "arc-arc-compound", "arc-arc-reverse", "bridge"):
+                for k in (j, (j + 1) % n):
+                    if pieces[k].kind == "arc":
+                        self.needs_shift[k] = True
+        code = SHAPE_CODES[shape]
+        theta_max = K.shape_max_theta(code)
+        if code == K.NEAR_LINEAR:
+            largest = 0.98 * theta_max
+            q_max = 1.0 - 1.0 / K.shape_g1(code, math.sin(largest), math.cos(largest))
+        else:
+            q_max = MAX_SHRINK
+        size = _coordinate_size(pieces)
+        target = bound * (1.0 - BOUND_MARGIN) - 8.0 * EPS * size
+        if not target > 0.0:
+            raise _Refusal(
+                0, f"it is below what float64 resolves at these coordinates (8 ulp of {size:.6g} is {8.0 * EPS * size:.3g})", True
+            )
+        self.target = target
+        self.cap = [min(target - p.spent, q_max * abs(p.r)) if need else 0.0 for p, need in zip(pieces, self.needs_shift)]
+        self.factor = [1.0] * n
+        self._corners: dict[int, _Solved] = {}
+        #: Short lines left out between two arcs (by joint): (the line, the input joint after it).
+        self.bridges: dict[int, tuple[_Piece, int]] = {}
+
+    def shifts(self) -> list[float]:
+        """Each arc's shrink: its cap times its factor, the smaller circle of a compound joint shrunk
+        more than the larger one by a step inside the nested band."""
+        n = len(self.pieces)
+        s = [c * f for c, f in zip(self.cap, self.factor)]
+        pairs = []  # (small, big, band width) of every compound joint
+        for j in range(self.joint_count):
+            if self.kinds[j] == "arc-arc-compound":
+                a, b = j, (j + 1) % n
+                small, big = (a, b) if abs(self.pieces[a].r) < abs(self.pieces[b].r) else (b, a)
+                pairs.append((small, big, self._band_width(small, big)))
+        pairs.sort(key=lambda pair: abs(self.pieces[pair[0]].r))
+        for _ in range(3):
+            for small, big, width in pairs:  # the larger circle shrinks less, by a step inside the band
+                s[big] = min(s[big], s[small] - min(0.5 * s[small], 0.5 * width))
+            for small, big, width in pairs[::-1]:  # ... and not by more than the band allows
+                s[small] = min(s[small], s[big] + 0.9 * width)
+        return s
+
+    def _band_width(self, small: int, big: int) -> float:
+        """How much more than the larger circle the smaller one may shrink: the nested band's width."""
+        rs, rb = abs(self.pieces[small].r), abs(self.pieces[big].r)
+        lower = K.nested_band_lower(rs / rb, SHAPE_CODES[self.shape])
+        return (rb - rs) * (1.0 / lower - 1.0)
+
+    def solve_joints(self, s: list[float]) -> list[_Solved | None]:
+        """Every joint's transition for the shifts ``s``: one batch solve per kind of joint."""
+        n = len(self.pieces)
+        out: list[_Solved | None] = [None] * self.joint_count
+        by_kind: dict[str, list[int]] = {}
+        for j in range(self.joint_count):
+            by_kind.setdefault(self.kinds[j], []).append(j)
+        if by_kind.get("line-arc"):
+            self._lines_arcs(by_kind["line-arc"], s, out)
+        for kind in ("arc-arc-reverse", "arc-arc-compound", "bridge"):
+            if by_kind.get(kind):
+                self._arcs_arcs(by_kind[kind], s, kind, out)
+        for j in by_kind.get("corner", []):  # a corner between lines does not depend on the shifts
+            if j not in self._corners:
+                self._corners[j] = self._corner(j, self.pieces[j], self.pieces[(j + 1) % n])
+            out[j] = self._corners[j]
+        return out
+
+    def _lines_arcs(self, joints: list[int], s: list[float], out: list[_Solved | None]) -> None:
+        """Line → arc and arc → line joints (Theorem 4.1 onto the shrunk circle), solved about each joint
+        (where float64 holds a small transition far from the origin) and moved back."""
+        n = len(self.pieces)
+        before = [self.pieces[j] for j in joints]
+        after = [self.pieces[(j + 1) % n] for j in joints]
+        nexts = [(j + 1) % n for j in joints]
+        # The line's end and direction of travel away from the arc, the arc's circle shrunk: a line → arc
+        # joint as it is, an arc → line joint reversed.
+        flip = np.array([a.kind != "line" for a in before])
+        line_a = np.where(flip[:, None], np.array([b.b for b in after]), np.array([a.a for a in before]))
+        points = np.where(flip[:, None], np.array([b.a for b in after]), np.array([a.b for a in before]))
+        direction = points - line_a
+        direction /= np.hypot(direction[:, 0], direction[:, 1])[:, None]
+        centre = np.where(flip[:, None], np.array([a.c for a in before]), np.array([b.c for b in after]))
+        radius_after = np.array([abs(b.r) for b in after]) - np.array([s[k] for k in nexts])
+        radius_before = np.array([abs(a.r) for a in before]) - np.array([s[j] for j in joints])
+        radius = np.where(flip, radius_before, radius_after)
+        result = batch.line_to_circle(np.zeros_like(points), direction, centre - points, radius, shape=self.shape)
+        spirals = result.spirals[0] + points[:, None]
+        spirals[flip] = spirals[flip, ::-1]
+        ok = result.ok.tolist()
+        used_before = _used_rows(before, spirals[:, 0], True).tolist()
+        used_after = _used_rows(after, spirals[:, 3], False).tolist()
+        theta = result.theta.tolist()
+        for m, j in enumerate(joints):
+            if not ok[m]:
+                out[j] = _Solved([], math.inf, math.inf, math.nan, int(result.status[m]), result.reason(m))
+                continue
+            out[j] = _Solved([spirals[m]], used_before[m], used_after[m], theta[m])
+
+    def _arcs_arcs(self, joints: list[int], s: list[float], kind: str, out: list[_Solved | None]) -> None:
+        """Reverse (S) or compound (nested) joints between shrunk circles, solved about each joint."""
+        n = len(self.pieces)
+        before = [self.pieces[j] for j in joints]
+        after = [self.pieces[(j + 1) % n] for j in joints]
+        origin = np.array([a.end() for a in before])
+        c0 = np.array([a.c for a in before]) - origin
+        c1 = np.array([b.c for b in after]) - origin
+        r0 = np.array([a.r - a.sense * s[j] for a, j in zip(before, joints)])
+        r1 = np.array([b.r - b.sense * s[(j + 1) % n] for b, j in zip(after, joints)])
+        solver = batch.circle_in_circle if kind == "arc-arc-compound" else batch.circle_to_circle
+        result = solver(c0, r0, c1, r1, shape=self.shape)
+        moved = [sp + origin[:, None] for sp in result.spirals]
+        ok = result.ok.tolist()
+        used_before = _used_rows(before, moved[0][:, 0], True).tolist()
+        used_after = _used_rows(after, moved[-1][:, 3], False).tolist()
+        theta = result.theta.tolist()
+        for m, j in enumerate(joints):
+            if not ok[m]:
+                out[j] = _Solved([], math.inf, math.inf, math.nan, int(result.status[m]), result.reason(m))
+                continue
+            out[j] = _Solved([sp[m] for sp in moved], used_before[m], used_after[m], theta[m])
+
+    def _corner(self, j: int, a: _Piece, b: _Piece) -> _Solved:
+        n = len(self.pieces)
+        if a.kind != "line" or b.kind != "line":
+            return _Solved([], math.inf, math.inf, math.nan, int(Status.OUTSIDE_SHAPE), "")
+        corner = a.b
+        p0 = corner - self.allow[j][1] * a.tangent(True)
+        p1 = corner + self.allow[(j + 1) % n][0] * b.tangent(False)
+        result = round_corners_batch(p0, corner, p1, max_deviation=self.target, shape=self.shape)
+        if not result.ok[0]:
+            return _Solved([], math.inf, math.inf, math.nan, int(result.status[0]), result.reason(0))
+        pair = result.control_points[0]
+        return _Solved([pair[0].copy(), pair[1].copy()], _used(a, pair[0][0], True), _used(b, pair[1][3], False),
+                       float(result.theta[0]))  # fmt: skip
+
+
+def _coordinate_size(pieces: list[_Piece]) -> float:
+    """The largest coordinate of the pieces' ends and centres (what float64 resolves them against)."""
+    arc = np.array([p.kind == "arc" for p in pieces])
+    c = np.array([p.c for p in pieces]).reshape(-1, 2)
+    r = np.abs(np.array([p.r for p in pieces]))[:, None]
+    a0 = np.array([p.a0 for p in pieces])
+    a1 = a0 + np.array([p.sense * p.sweep for p in pieces])
+    start = np.where(arc[:, None], c + r * np.stack([np.cos(a0), np.sin(a0)], axis=-1), np.array([p.a for p in pieces]).reshape(-1, 2))
+    end = np.where(arc[:, None], c + r * np.stack([np.cos(a1), np.sin(a1)], axis=-1), np.array([p.b for p in pieces]).reshape(-1, 2))
+    return float(max(np.abs(start).max(), np.abs(end).max(), np.abs(c).max()))
+
+
+def _solve(group: _Group) -> tuple[list[_Solved | None], list[float]]:
+    """The shifts and transitions of a group: shifts that overrun a piece shrink until every joint fits."""
+    n = len(group.pieces)
+    for _ in range(PASSES):
+        s = group.shifts()
+        solved = group.solve_joints(s)
+        over: dict[int, float] = {}
+        failed: list[int] = []
+        for j, joint in enumerate(solved):
+            if joint is None:
+                continue
+            if joint.status:
+                failed.append(j)
+                continue
+            # An overrun shrinks the shifts of this joint's circles (a smaller shift: a shorter transition).
+            worst = 1.0
+            for k, used, end in ((j, joint.used_before, 1), ((j + 1) % n, joint.used_after, 0)):
+                room = group.allow[k][end]
+                if not (used <= room):
+                    worst = min(worst, (room / used) ** 2 * 0.8 if used > 0.0 and room > 0.0 else 0.25)
+            if worst < 1.0:
+                for k in _joint_circles(group, j):
+                    over[k] = min(over.get(k, 1.0), worst)
+        if not over and not failed:
+            return solved, s
+        for j in failed:
+            kind = group.kinds[j]
+            if kind == "corner":
+                joint = solved[j]
+                assert joint is not None
+                raise _Refusal(j, joint.reason, joint.status == Status.UNVERIFIED)
+            for k in _joint_circles(group, j):
+                over[k] = min(over.get(k, 1.0), 0.5)
+        for k, factor in over.items():
+            group.factor[k] *= factor
+    s = group.shifts()
+    solved = group.solve_joints(s)
+    for j, joint in enumerate(solved):
+        if joint is not None and joint.status:
+            raise _Refusal(j, joint.reason or describe_status(joint.status), True)
+    raise _Refusal(0, "the transitions could not be fitted into the lines and arcs", True)
+
+
+def _joint_circles(group: _Group, j: int) -> list[int]:
+    """The pieces of joint ``j`` whose circles shift."""
+    n = len(group.pieces)
+    return [k for k in (j, (j + 1) % n) if group.needs_shift[k]]
+
+
+def describe_status(status: int) -> str:
+    return f"no transition ({Status(status).name})"
+
+
+def _arc_corners(pieces: list[_Piece], kinds: list[str], joints: list[int], closed: bool,
+                 bound: float) -> tuple[list[_Piece], list[str], list[int]]:  # fmt: skip
+    """Each sharp corner next to an arc given a tangent circle (a circular fillet) passing half the bound
+    from the corner point, so that the path is tangent there and its transitions do the rest."""
+    n = len(pieces)
+    corners = [j for j, kind in enumerate(kinds) if kind == "corner" and "arc" in (pieces[j].kind, pieces[(j + 1) % n].kind)]
+    if not corners:
+        return pieces, kinds, joints
+    pieces = [_Piece(p.kind, p.first, p.last, p.a.copy(), p.b.copy(), p.c.copy(), p.r, p.a0, p.sweep) for p in pieces]
+    sizes = [p.size for p in pieces]
+    both = [closed or 0 < k < n - 1 for k in range(n)]
+    circles: dict[int, _Piece] = {}
+    for j in corners:
+        a, b = pieces[j], pieces[(j + 1) % n]
+        room_a = (SHARED if both[j] else ALONE) * sizes[j]
+        room_b = (SHARED if both[(j + 1) % n] else ALONE) * sizes[(j + 1) % n]
+        made = _tangent_circle(a, b, 0.5 * bound, room_a, room_b)
+        if made is None:
+            raise _Refusal(j, "no tangent circle fits into this corner between its neighbours", False)
+        circle, end_a, start_b = made
+        _trim_end(a, end_a)
+        _trim_start(b, start_b)
+        a.spent = max(a.spent, circle.fillet)
+        b.spent = max(b.spent, circle.fillet)
+        circle.spent = circle.fillet
+        circles[j] = circle
+    out_pieces: list[_Piece] = []
+    out_kinds: list[str] = []
+    out_joints: list[int] = []
+    for k in range(n):
+        out_pieces.append(pieces[k])
+        if k >= len(kinds):
+            continue
+        if k in circles:
+            circle, after = circles[k], pieces[(k + 1) % n]
+            out_pieces.append(circle)
+            out_kinds += [_tangent_kind(pieces[k], circle), _tangent_kind(circle, after)]
+            out_joints += [joints[k], joints[k]]
+        else:
+            out_kinds.append(kinds[k])
+            out_joints.append(joints[k])
+    return out_pieces, out_kinds, out_joints
+
+
+#: A line between two arcs is left out (the arcs joined by a C or S pair across it) when the shift
+#: its length allows a transition at each end is below this share of the bound.
+SHORT_LINE_SHIFT = 1e-4
+
+
+def _bridge_short_lines(pieces: list[_Piece], kinds: list[str], joints: list[int], closed: bool,
+                        bound: float) -> tuple[list[_Piece], list[str], list[int], dict[int, tuple[_Piece, int]]]:  # fmt: skip
+    """Lines between two tangent arcs too short for a transition at each end (the shift they allow,
+    about (0.45·ℓ)²/(6r), below ``SHORT_LINE_SHIFT`` of the bound) left out: the two arcs are joined
+    across the line by the paper's pair between circles (a C for the same sense, an S for opposite)."""
+    n = len(pieces)
+    joint_count = len(kinds)
+    short = set()
+    for k, piece in enumerate(pieces):
+        before, after = (k - 1) % n, k
+        if piece.kind != "line" or not (closed or 0 < k < n - 1) or after >= joint_count or before >= joint_count:
+            continue
+        if kinds[before] != "line-arc" or kinds[after] != "line-arc" or before in short or (k + 1) % n in short:
+            continue
+        radius = min(abs(pieces[before].r), abs(pieces[(k + 1) % n].r))
+        if (SHARED * piece.size) ** 2 / (6.0 * radius) < SHORT_LINE_SHIFT * bound:
+            short.add(k)
+    if not short or len(short) == n:
+        return pieces, kinds, joints, {}
+    out_pieces: list[_Piece] = []
+    out_kinds: list[str] = []
+    out_joints: list[int] = []
+    bridges: dict[int, tuple[_Piece, int]] = {}
+    order = list(range(n))
+    if closed and 0 in short:  # start after a kept piece so that no bridge wraps round the start
+        first = next(k for k in range(n) if k not in short)
+        order = order[first:] + order[:first]
+    for k in order:
+        if k in short:
+            bridges[len(out_kinds) - 1] = (pieces[k], joints[k])
+            out_kinds[-1] = "bridge"
+            continue
+        out_pieces.append(pieces[k])
+        if k < joint_count:
+            out_kinds.append(kinds[k])
+            out_joints.append(joints[k])
+    return out_pieces, out_kinds, out_joints, bridges
+
+
+def _tangent_kind(a: _Piece, b: _Piece) -> str:
+    if a.kind == "line" or b.kind == "line":
+        return "line-arc"
+    return "arc-arc-compound" if (a.r > 0) == (b.r > 0) else "arc-arc-reverse"
+
+
+def _tangent_circle(a: _Piece, b: _Piece, depth: float, room_a: float, room_b: float) -> tuple[_Piece, NDArray, NDArray] | None:
+    """The largest circle tangent to ``a`` and ``b`` inside their corner that passes at most ``depth`` from the
+    corner point and touches each within its room; (circle piece, touch on a, touch on b), None if none fits."""
+    corner = a.end()
+    turn = _turn(a, b)
+    sense = math.copysign(1.0, turn)
+
+    def attempt(rho: float) -> tuple[_Piece, NDArray, NDArray] | None:
+        loci: list[tuple[str, NDArray, Any]] = []
+        for piece in (a, b):
+            if piece.kind == "line":
+                t = piece.tangent(True)
+                normal = np.array([-t[1], t[0]]) * sense
+                loci.append(("line", piece.a + rho * normal, t))
+            else:
+                distance = abs(piece.r) - rho if (piece.r > 0) == (sense > 0) else abs(piece.r) + rho
+                if not distance > 0.0:
+                    return None
+                loci.append(("circle", piece.c, distance))
+        centre = _intersect(loci[0], loci[1], corner)
+        if centre is None:
+            return None
+        touches = []
+        for piece in (a, b):
+            if piece.kind == "line":
+                t = piece.tangent(True)
+                touches.append(piece.a + float(np.dot(centre - piece.a, t)) * t)
+            else:
+                away = centre - piece.c
+                touches.append(piece.c + abs(piece.r) * away / math.hypot(*away))
+        used_a, used_b = _used(a, touches[0], True), _used(b, touches[1], False)
+        if not (0.0 < used_a <= room_a and 0.0 < used_b <= room_b):
+            return None
+        if not math.dist(centre, corner) - rho <= depth:
+            return None
+        start = math.atan2(touches[0][1] - centre[1], touches[0][0] - centre[0])
+        end = math.atan2(touches[1][1] - centre[1], touches[1][0] - centre[0])
+        sweep = (sense * (end - start)) % TAU
+        if not 0.0 < sweep < math.pi:
+            return None
+        circle = _Piece("arc", -1, -1, c=centre, r=sense * rho, a0=start, sweep=sweep, fillet=math.dist(centre, corner) - rho)
+        return circle, touches[0], touches[1]
+
+    half = abs(turn) / 2.0
+    rho = depth / max(1.0 / math.cos(half) - 1.0, 1e-300)
+    best = None
+    for _ in range(200):
+        best = attempt(rho)
+        if best is not None:
+            break
+        rho *= 0.5
+    if best is None:
+        return None
+    lo, hi = rho, 2.0 * rho
+    for _ in range(40):
+        mid = 0.5 * (lo + hi)
+        found = attempt(mid)
+        if found is not None:
+            lo, best = mid, found
+        else:
+            hi = mid
+    return best
+
+
+def _trim_end(piece: _Piece, point: NDArray) -> None:
+    if piece.kind == "line":
+        piece.b = point.copy()
+    else:
+        piece.sweep -= _used(piece, point, True)
+
+
+def _trim_start(piece: _Piece, point: NDArray) -> None:
+    if piece.kind == "line":
+        piece.a = point.copy()
+    else:
+        used = _used(piece, point, False)
+        piece.a0 += piece.sense * used
+        piece.sweep -= used
