@@ -97,8 +97,11 @@ def fd_curvature_continuous(chain: Chain, tol: float) -> None:
         kb = _fd_kappa(b, 0.0, h)
         scale = max(abs(ka), abs(kb), kappa)
         assert abs(ka - kb) <= (tol + 4 * h) * scale, f"joint {i}: κ {ka} before, {kb} after ({type(a).__name__} → {type(b).__name__})"
+        # a tangent from control points a piece's length apart, far from the origin, holds its direction
+        # only to about eps·size/length: float64's resolution, not a turn
         ta, tb = a.tangent(1.0), b.tangent(0.0)
-        assert abs(ta[0] * tb[1] - ta[1] * tb[0]) <= 1e-7 and float(ta @ tb) > 0, f"joint {i}: tangent turns"
+        turn_tol = max(1e-7, 16 * 2.2e-16 * size / length)
+        assert abs(ta[0] * tb[1] - ta[1] * tb[0]) <= turn_tol and float(ta @ tb) > 0, f"joint {i}: tangent turns"
 
 
 def _fd_kappa(segment, u0: float, h: float) -> float:
