@@ -163,7 +163,8 @@ def _planar(segments: list[Segment]) -> tuple[list[Segment], PlaneFrame]:
     origin = points[0]
     centred = points - origin
     size = float(np.abs(centred).max()) or 1.0
-    _, singular, vt = np.linalg.svd(centred / size, full_matrices=False)
+    # full matrices: a path of two points (a line) still gets a third direction, a normal to it
+    _, singular, vt = np.linalg.svd(centred / size, full_matrices=True)
     normal = vt[2]
     for s in segments:
         if isinstance(s, Arc) and s.dim == 3 and abs(abs(float(np.dot(s.normal, normal))) - 1.0) > 1e-9:

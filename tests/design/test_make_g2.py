@@ -380,6 +380,15 @@ def test_a_planar_path_in_space_is_made_g2_in_its_plane():
     assert corner.chain.dim == 3 and [j.kind for j in corner.joints] == ["corner"]
 
 
+@pytest.mark.parametrize("path", [[Line((0, 0, 1), (1, 0, 1))], [(0.0, 0.0, 1.0), (1.0, 0.0, 1.0)]])
+def test_a_single_line_in_space_is_already_g2(path):
+    # two outline points span no plane: any plane through the line will do
+    result = make_g2(path, 0.1)
+    assert result.deviation == 0.0 and result.chain.dim == 3
+    points = result.chain.sample(5)
+    assert np.allclose(points[:, 1:], 0.0 * points[:, 1:] + [0.0, 1.0]) and np.ptp(points[:, 0]) == pytest.approx(1.0)
+
+
 @pytest.mark.parametrize("length", [1e-2, 1e-3])
 @pytest.mark.parametrize("sense", [1.0, -1.0])
 def test_a_short_line_between_arcs_is_bridged_by_a_pair(length, sense):
