@@ -120,7 +120,7 @@ def wire_path(wire: TopoDS_Wire, frame: gp_Ax3, *, spirals: bool = False) -> tup
             pieces = _bezier_spans(curve, first, last)
             if pieces is None:
                 raise ValueError(
-                    f"g2 fillets round lines and circular arcs; edge {index} is a BSPLINE curve that is not joined cubic "
+                    f"a wire is read as lines, circular arcs and cubic spirals; edge {index} is a BSPLINE curve that is not joined cubic "
                     "Bézier spans (degree 3, non-rational, its whole knot range): pass "
                     "the continuous sketch object itself (not the builder's sketch) or its Chain"
                 )
@@ -131,7 +131,7 @@ def wire_path(wire: TopoDS_Wire, frame: gp_Ax3, *, spirals: bool = False) -> tup
                 segments.append(BezierSpiral.from_control_points(points))
         else:
             name = kind.name.removeprefix("GeomAbs_").removesuffix("Curve").upper()
-            raise ValueError(f"g2 fillets round lines and circular arcs; edge {index} is a {name} curve")
+            raise ValueError(f"a wire is read as lines, circular arcs and cubic spirals; edge {index} is a {name} curve")
         explorer.Next()
     if not segments:
         raise ValueError("the wire has no edges")
