@@ -50,7 +50,8 @@ def peak_mb() -> float:
 
 def child(job: str, moves: int) -> None:
     """One job in this process; prints its seconds and peak memory as JSON."""
-    from spiral_cad.io.gcode import parse_gcode, read_gcode, round_toolpath, round_toolpath_arrays
+    from spiral_cad.io.gcode import parse_gcode, read_gcode
+    from spiral_cad.io.toolpath_rounding import round_toolpath, round_toolpath_arrays
 
     warm = parse_gcode(program(50))  # compile the kernels first (one warm-up, as compare does)
     if job in ("chain", "write"):

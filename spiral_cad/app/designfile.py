@@ -438,7 +438,8 @@ def _rounded(d: RoundedPolylineDesign, where: str, units: str, base: Path | None
     if d.points is not None:  # the model holds points or gcode
         result = round_corners(d.points, shape=d.shape, units=units, **d.rounding())
     else:
-        from ..io.gcode import holds_splines, read_gcode, read_gcode_chain, round_toolpath
+        from ..io.gcode import holds_splines, read_gcode, read_gcode_chain
+        from ..io.toolpath_rounding import round_toolpath
 
         program = _own_file(str(d.gcode), base, f"{where}.gcode")
         if holds_splines(program):  # G5: the program states its curves (our own output reads back as its chain)
@@ -450,7 +451,7 @@ def _rounded(d: RoundedPolylineDesign, where: str, units: str, base: Path | None
             per_segment = None
         else:
             from ..core.units import MM_PER_UNIT
-            from ..io.gcode import segment_feeds
+            from ..io.toolpath_rounding import segment_feeds
             from ..io.gcode_write import PROGRAM_UNIT
 
             path = read_gcode(program)

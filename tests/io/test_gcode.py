@@ -8,7 +8,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from spiral_cad.io.gcode import parse_gcode, read_gcode, round_toolpath
+from spiral_cad.io.gcode import parse_gcode, read_gcode
+from spiral_cad.io.toolpath_rounding import round_toolpath
 
 HERE = Path(__file__).resolve().parents[1] / "gcode"
 

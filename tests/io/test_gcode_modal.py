@@ -116,7 +116,7 @@ def test_full_turns_and_radii_that_differ():
 
 def sliver_program(leftover: float) -> str:
     """Two right-angle corners whose roundings leave ``leftover`` of straight line between them (0.5 mm tolerance)."""
-    from spiral_cad.io.gcode import round_toolpath
+    from spiral_cad.io.toolpath_rounding import round_toolpath
 
     def text(side: float) -> str:
         return f"G21 G90\nG1 X0 Y0\nG1 X10 Y0\nG1 X10 Y{side:.17g}\nG1 X20 Y{side:.17g}\n"
@@ -126,7 +126,7 @@ def sliver_program(leftover: float) -> str:
 
 
 def test_a_sliver_between_corners_becomes_a_real_edge_and_pieces_keep_their_lines():
-    from spiral_cad.io.gcode import round_toolpath, segment_lines
+    from spiral_cad.io.toolpath_rounding import round_toolpath, segment_lines
 
     path = parse_gcode(sliver_program(4e-8), "sliver.nc")
     rounded = round_toolpath(path, max_deviation=0.5)  # the corners step back: the line between them is an edge
@@ -139,7 +139,7 @@ def test_a_sliver_between_corners_becomes_a_real_edge_and_pieces_keep_their_line
 
 
 def test_arrays_round_as_the_chain_does_and_name_lines():
-    from spiral_cad.io.gcode import round_toolpath, round_toolpath_arrays
+    from spiral_cad.io.toolpath_rounding import round_toolpath, round_toolpath_arrays
 
     text = "G21 G90 F1\nG1 X0 Y0 Z0\n" + "".join(f"G1 X{(i % 2) * 10 + i * 0.1:.4f} Y{i * 2:.4f} Z{-0.1 * i:.4f}\n" for i in range(1, 40))
     path = parse_gcode(text, "zigzag.nc")
