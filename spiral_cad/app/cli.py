@@ -175,7 +175,8 @@ def _build(args: argparse.Namespace) -> int:
         raise ValueError("give a design file or --from-gcode, not both")
     from ..io.gcode import reading_options
 
-    with reading_options(args.interpreter or "builtin", args.arc_tolerance, args.units or "mm"):
+    stated = args.units if args.units in ("mm", "in") else None  # the unit of a program that says neither G20 nor G21
+    with reading_options(args.interpreter or "builtin", args.arc_tolerance, args.units or "mm", program_units=stated):
         return _write_design(gcode_design(args), Path(args.out), plots=not args.no_plots)
 
 
@@ -457,12 +458,14 @@ def _parser() -> argparse.ArgumentParser:
                        help="LandXML: how the file counts directions: counter-clockwise from east or clockwise from north "
                             "(default auto: told from the file's own points)")  # fmt: skip
     gcode = build.add_argument_group(
-        "G-code", "round the straight moves (G0/G1) of a CNC program G2 and write STEP, IGES, DXF, samples, the\n"
-        "continuity report and NAME.ngc, the rounded program at the program's feed (never over the input; README: the\n"
-        "G-code subset; a program with G5 splines is read as the exact path it states; other codes are refused by\n"
-        "name and line)")  # fmt: skip
+        "G-code", "make a CNC program's path G2 and write STEP, IGES, DXF, samples, the continuity report and NAME.ngc,\n"
+        "the G2 program at the program's feed (never over the input). Lines stay lines and arcs (G2/G3, any plane)\n"
+        "true arcs; the path is split where it folds straight back (a plunge and its retract): one design NAME_1,\n"
+        "NAME_2, ... per G2 path. A program with G5 splines is read as the exact path it states; other codes are\n"
+        "refused by name and line (README: the G-code subset)")  # fmt: skip
     gcode.add_argument("--from-gcode", metavar="FILE.nc", help="the program to round (instead of a design file)")
-    gcode.add_argument("--max-deviation", type=float, help="the largest distance between a corner point and the path")
+    gcode.add_argument("--max-deviation", type=float,
+                       help="the largest distance between the program's path and the G2 path (at corners and tangent joints)")  # fmt: skip
     gcode.add_argument("--max-curvature", type=float, help="the curvature bound (1/unit)")
     gcode.add_argument("--shape", choices=["walton-meek", "near-linear", "g2cbs"], help="spiral shape (default walton-meek)")
     gcode.add_argument("--sample-step", type=float, help="samples at most this far apart along the path")
@@ -470,7 +473,8 @@ def _parser() -> argparse.ArgumentParser:
                        help="samples close enough that the path strays at most this far from their chords "
                             "(default: a tenth of --max-deviation, else 0.001)")  # fmt: skip
     gcode.add_argument("--units", choices=["mm", "cm", "m", "km", "in", "ft"],
-                       help="the unit of the outputs and of every length above (default mm; the program's G20/G21 is converted)")  # fmt: skip
+                       help="the unit of the outputs and of every length above (default mm; the program's G20/G21 is converted); "
+                            "mm or in also states the unit of a program that says neither G20 nor G21 (refused otherwise)")  # fmt: skip
     gcode.add_argument("--name", help="the design's name (default: the program's file name)")
     gcode.add_argument("--feed", type=float,
                        help="the F word of the rounded program NAME.ngc, in its unit per minute (default: the program's "
@@ -482,8 +486,10 @@ def _parser() -> argparse.ArgumentParser:
         "Debian package linuxcnc-uspace)",
     )
     gcode.add_argument(
-        "--arc-tolerance", type=float, help="read arcs G2/G3 as chords at most this far from the arc (default: arcs refused)"
-    )
+        "--arc-tolerance", type=float,
+        help="helical arcs (G2/G3 that also move along the plane's normal) become chords at most this far from them "
+             "(default a tenth of --max-deviation; the rest is the G2 path's); plane arcs stay arcs",
+    )  # fmt: skip
     fit = build.add_argument_group(
         "points", "fit lines, arcs and spirals G2 to measured or digitised points, every point within --tolerance; also\n"
         "writes NAME_residuals.csv and NAME_fit.png (--units, --name, --max-curvature, the samples as above; --shape\n"

@@ -52,6 +52,8 @@ class GcodeMoves:
         program_units: the program's own unit (G20/G21, or as stated for a program that says neither).
         source: the file's name, for messages.
         notes: what was read and is worth telling (a unit stated for the program, helices as chords).
+        chords: (n,) True where the segment is a chord of a helical arc (within ``helix_tolerance`` of it).
+        helix_tolerance: the chords' tolerance (None: the program has no helix).
     """
 
     segments: tuple[Line | Arc, ...]
@@ -62,6 +64,8 @@ class GcodeMoves:
     program_units: str
     source: str = "G-code"
     notes: tuple[str, ...] = ()
+    chords: NDArray | None = None
+    helix_tolerance: float | None = None
 
     def __len__(self) -> int:
         return len(self.segments)
@@ -162,6 +166,7 @@ def parse_gcode_moves(
     lines: list[int] = []
     rapid: list[bool] = []
     per_segment: list[float] = []
+    chords: list[bool] = []
     helices = 0
     for piece, feed in zip(pieces, feeds):
         kind, number, is_rapid, start = piece[:4]
@@ -172,9 +177,11 @@ def parse_gcode_moves(
                 made: list[Line | Arc] = [] if start == piece[4] else [_line(start, piece[4], factor, dim)]
             else:
                 made = _arc(start, *piece[4:], factor, dim, helix_tolerance)
-                helices += len(made) > 1 and isinstance(made[0], Line)
         except ValueError as error:
             raise ValueError(f"{source} line {number}: {error}") from None
+        helix = kind == "arc" and start[PLANES[piece[5]][2]] != piece[4][PLANES[piece[5]][2]]
+        helices += helix
+        chords += [helix] * len(made)
         segments += made
         lines += [number] * len(made)
         rapid += [bool(is_rapid)] * len(made)
@@ -184,7 +191,7 @@ def parse_gcode_moves(
     if helices:
         notes.append(f"{helices} helical arc(s) read as chords within {helix_tolerance:g} {target}")
     return GcodeMoves(tuple(segments), np.array(lines), np.array(rapid), np.array(per_segment, dtype=np.float64), target, unit,
-                      source, tuple(notes))  # fmt: skip
+                      source, tuple(notes), np.array(chords), helix_tolerance if helices else None)  # fmt: skip
 
 
 def read_gcode_moves(

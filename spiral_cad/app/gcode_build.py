@@ -1,0 +1,106 @@
+"""``build --from-gcode``: a program's moves made G2, one design per G2 path.
+
+The program is read as lines and arcs (``spiral_cad.io.gcode_paths``) and split where it folds
+straight back (a plunge and its retract): each part is its own G2 path. A part of straight moves
+only has its corners rounded as before (``round_toolpath``: the corner options of the design,
+the feed of every move kept); a part with arcs is made G2 by ``spiral_cad.design.make_g2`` within
+``max_deviation``, its arcs kept true arcs (make_g2 may split it further, at a reversal it finds).
+A helix's chords lie within a tenth of ``max_deviation`` of it (or the stated arc tolerance), and
+the part is made G2 within the rest, so every point stays within ``max_deviation`` of the program.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+from .designfile import BuiltRounded, DesignError, _program_feed
+from .schema import RoundedPolylineDesign
+
+#: The share of ``max_deviation`` a helix's chords take when no arc tolerance is stated.
+HELIX_SHARE = 0.1
+
+
+def toolpath_designs(d: RoundedPolylineDesign, where: str, units: str, program: Path) -> list[BuiltRounded]:
+    """The G2 paths of the G-code ``program`` of design ``d`` (in ``units``): one ``BuiltRounded`` each,
+    named ``NAME`` when there is one, else ``NAME_1``, ``NAME_2`` … in the program's order.
+
+    Raises:
+        DesignError: a part with arcs without one ``max_deviation``, or with corner options that apply
+            to straight moves only; what the reader, the rounding or ``make_g2`` refuse (named by line).
+    """
+    from ..core.units import MM_PER_UNIT
+    from ..io.gcode import reading_defaults
+    from ..io.gcode_paths import read_gcode_moves
+    from ..io.gcode_write import PROGRAM_UNIT
+    from ..io.toolpath import in_program_unit
+    from ..io.toolpath_rounding import round_toolpath, segment_feeds
+
+    deviation = d.max_deviation if isinstance(d.max_deviation, (int, float)) else None
+    _, arc_tolerance, arc_units, _ = reading_defaults()
+    helix = None
+    if arc_tolerance is not None:
+        helix = in_program_unit(arc_tolerance, arc_units, units)
+    elif deviation is not None:
+        helix = HELIX_SHARE * deviation
+    if helix is not None and deviation is not None and not helix < deviation:
+        raise DesignError(f"{where}: the arc tolerance {helix:g} {units} (a helix's chords) must be below max_deviation {deviation:g}")
+    moves = read_gcode_moves(program, units=units, helix_tolerance=helix)
+    feed = _program_feed(moves.program_feeds, moves.program_units, units)
+    to_program = MM_PER_UNIT[units] / MM_PER_UNIT[PROGRAM_UNIT[units]]
+    moves_to_units = MM_PER_UNIT[moves.program_units] / MM_PER_UNIT[units]  # feeds: program unit → units per minute
+    samples = None if d.samples is None else d.samples.options()
+    made: list[tuple[Any, Any, Any]] = []  # (chain, source, feeds per segment)
+    for first, stop in moves.parts():
+        chorded = moves.chords is not None and bool(moves.chords[first:stop].any())
+        bound = None if deviation is None else deviation - (helix or 0.0) * chorded
+        if stop - first == 1 and moves.straight(first, stop):  # one move between folds: a line, nothing to round
+            from ..core.chain import Chain
+            from ..design.rounding import RoundedPath
+
+            chain = Chain([moves.segments[first]], units=units)
+            made.append((chain, RoundedPath(chain, [], d.shape), moves.feeds[first : first + 1] * moves_to_units * to_program))
+            continue
+        if moves.straight(first, stop):
+            options = d.rounding() if not chorded else {**d.rounding(), "max_deviation": bound}
+            path = moves.toolpath(first, stop)
+            result = round_toolpath(path, shape=d.shape, **options)
+            per_segment = segment_feeds(result, path)
+            made.append((result.chain, result, None if per_segment is None else per_segment * to_program))
+            continue
+        line = int(moves.lines[first])
+        if bound is None:
+            raise DesignError(f"{where}: {moves.source} line {line}: a path with arcs is made G2 within one max_deviation "
+                              "(--max-deviation); give one number")  # fmt: skip
+        others = sorted(set(d.rounding()) - {"max_deviation"})
+        if others:
+            raise DesignError(f"{where}: {', '.join(others)}: corner options of straight moves; {moves.source} line {line} "
+                              "starts a path with arcs, made G2 within max_deviation alone")  # fmt: skip
+        made += _g2_parts(moves, first, stop, bound, d.shape, units)
+    notes = list(moves.notes)
+    folds = moves.folds()
+    if len(folds):
+        shown = ", ".join(str(int(moves.lines[j + 1])) for j in folds[:8]) + (" …" if len(folds) > 8 else "")
+        notes.append(f"split where the path folds straight back ({len(folds)}×), at the moves of lines {shown}")
+    built = []
+    for k, (chain, source, per_segment) in enumerate(made):
+        name = d.name if len(made) == 1 else f"{d.name}_{k + 1}"
+        built.append(BuiltRounded(name=name, chain=chain, source=source, samples=samples, inputs=(program,), program_feed=feed,
+                                  segment_feeds=per_segment, notes=tuple(notes) if k == 0 else ()))  # fmt: skip
+    return built
+
+
+def _g2_parts(moves: Any, first: int, stop: int, bound: float, shape: str, units: str) -> list[tuple[Any, Any, Any]]:
+    """The G2 chains ``make_g2`` makes of segments ``first`` to ``stop`` (a part with arcs), within ``bound``."""
+    from ..design import make_g2
+
+    try:
+        result = make_g2(list(moves.segments[first:stop]), bound, shape=_g2_shape(shape), units=units)
+    except ValueError as error:
+        raise type(error)(f"{moves.source} lines {int(moves.lines[first])}–{int(moves.lines[stop - 1])}: {error}") from None
+    return [(chain, result, None) for chain in result.chains]
+
+
+def _g2_shape(shape: str) -> str:
+    """The spiral shape ``make_g2`` takes for the design's corner shape (g2cbs rounds corners only)."""
+    return "near-linear" if shape == "g2cbs" else shape
