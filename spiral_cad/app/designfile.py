@@ -433,7 +433,7 @@ def _circle_chain(d: CircleChainDesign, where: str, units: str, base: Path | Non
     return BuiltCircleChain(name=d.name, chain=result.chain, source=result)
 
 
-def _rounded(d: RoundedPolylineDesign, where: str, units: str, base: Path | None) -> BuiltRounded | list[BuiltRounded]:
+def _rounded(d: RoundedPolylineDesign, where: str, units: str, base: Path | None) -> Built | list[Built]:
     from ..design import round_corners
 
     if d.points is not None:  # the model holds points or gcode
@@ -584,7 +584,16 @@ BUILDERS: dict[str, Callable[[Any, str, str, Path | None], Built | list[Built]]]
     "rounded_polyline": _rounded,
     "transition": _transition,
     "fit": _fit,
+    "g2_path": lambda d, where, units, base: _g2_path(d, units, base, where),
 }
+
+
+def _g2_path(d: Any, units: str, base: Path | None, where: str) -> list[Built]:
+    """A ``g2_path`` design: the lines and arcs of a DXF, LandXML or OpenDRIVE file made G2 (``g2_build``)."""
+    from .g2_build import g2_designs
+
+    source = _own_file(d.source, base, f"{where}.source")
+    return g2_designs(source, d.max_deviation, name=d.name, units=units, source_units=d.source_units, shape=d.spiral_shape)[1]
 
 
 def build(source: str | Path | dict, max_offset: float | None = None, directions: str = "auto") -> tuple[str, list[Built]]:
@@ -792,6 +801,11 @@ def _write_others(b: Built, stage: Path, units: str, missing: list[str], plots: 
                 names += _road_3d(b, profile, stage, units)
     if isinstance(b, BuiltLandXML):
         names += _landxml_report(b, stage)
+    elif getattr(b, "road", False):  # an alignment made G2 (build FILE.xml --g2): also its OpenDRIVE
+        from ..cad.export import export_opendrive
+
+        export_opendrive(b.chain, stage / f"{b.name}.xodr", name=b.name)
+        names.append("xodr")
     if "OCP" not in missing and len(b.chain) > LARGE_CHAIN_EDGES:
         names.append(f"no igs ({len(b.chain):,} edges, above {LARGE_CHAIN_EDGES:,}: the STEP file holds the same exact curves)")
     elif "OCP" not in missing:
@@ -900,7 +914,7 @@ def summary(built: list[Built], units: str) -> str:
     lines = fixed_columns(columns, rows)
     lines += [f"{b.name}: {b.road_3d}" for b in built if b.road_3d]
     lines += [f"{b.name}: {b.fit.line()}" for b in built if isinstance(b, BuiltFit | BuiltRoadFit)]
-    lines += [f"{b.name}: {note}" for b in built if isinstance(b, BuiltRounded) for note in b.notes]
+    lines += [f"{b.name}: {note}" for b in built for note in getattr(b, "notes", ())]
     lines += [f"{b.name}: {b.renamed}" for b in built if isinstance(b, BuiltLandXML) and b.renamed]
     lines += [f"{b.name}: {b.landxml_offset()}" for b in built if isinstance(b, BuiltLandXML) and b.run == 0]
     return "\n".join(lines)

@@ -493,9 +493,7 @@ class _Reader:
 
 
 #: How ``read_gcode`` reads when its caller does not say (set by ``reading_options``).
-_DEFAULTS: ContextVar[tuple[str, float | None, str | None, str | None]] = ContextVar(
-    "gcode_reading", default=("builtin", None, None, None)
-)
+_DEFAULTS: ContextVar[tuple[str, float | None, str | None, str | None]] = ContextVar("gcode_reading", default=("builtin", None, None, None))
 
 
 @contextmanager

@@ -176,7 +176,8 @@ def parse_gcode_moves(
             if kind == "line":
                 made: list[Line | Arc] = [] if start == piece[4] else [_line(start, piece[4], factor, dim)]
             else:
-                made = _arc(start, *piece[4:], factor, dim, helix_tolerance)
+                end, plane, ca, cb, rotation = piece[4:9]
+                made = _arc(start, end, plane, ca, cb, rotation, factor, dim, helix_tolerance)
         except ValueError as error:
             raise ValueError(f"{source} line {number}: {error}") from None
         helix = kind == "arc" and start[PLANES[piece[5]][2]] != piece[4][PLANES[piece[5]][2]]
