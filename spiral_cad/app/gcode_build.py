@@ -14,14 +14,14 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Any
 
-from .designfile import BuiltRounded, DesignError, _program_feed
+from .designfile import Built, BuiltRounded, DesignError, _program_feed
 from .schema import RoundedPolylineDesign
 
 #: The share of ``max_deviation`` a helix's chords take when no arc tolerance is stated.
 HELIX_SHARE = 0.1
 
 
-def toolpath_designs(d: RoundedPolylineDesign, where: str, units: str, program: Path) -> list[BuiltRounded]:
+def toolpath_designs(d: RoundedPolylineDesign, where: str, units: str, program: Path) -> list[Built]:
     """The G2 paths of the G-code ``program`` of design ``d`` (in ``units``): one ``BuiltRounded`` each,
     named ``NAME`` when there is one, else ``NAME_1``, ``NAME_2`` … in the program's order.
 
@@ -82,7 +82,7 @@ def toolpath_designs(d: RoundedPolylineDesign, where: str, units: str, program: 
     if len(folds):
         shown = ", ".join(str(int(moves.lines[j + 1])) for j in folds[:8]) + (" …" if len(folds) > 8 else "")
         notes.append(f"split where the path folds straight back ({len(folds)}×), at the moves of lines {shown}")
-    built = []
+    built: list[Built] = []
     for k, (chain, source, per_segment) in enumerate(made):
         name = d.name if len(made) == 1 else f"{d.name}_{k + 1}"
         built.append(BuiltRounded(name=name, chain=chain, source=source, samples=samples, inputs=(program,), program_feed=feed,

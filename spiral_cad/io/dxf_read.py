@@ -100,7 +100,7 @@ def read_dxf_paths(path: str | os.PathLike, *, units: str | None = None, drawing
         raise ValueError(f"join_tolerance must lie in (0, 1) (a share of the drawing's size); got {join_tolerance}")
     try:
         doc = ezdxf.readfile(name)
-    except (ezdxf.DXFError, UnicodeDecodeError) as error:
+    except (ezdxf.DXFError, UnicodeDecodeError, OSError) as error:  # ezdxf says "not a DXF file" with an OSError
         raise ValueError(f"{label}: not a DXF file ezdxf can read ({error})") from None
     target = None if units is None else length_unit(units)
     code = int(doc.header.get("$INSUNITS", 0))
