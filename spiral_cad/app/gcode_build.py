@@ -5,8 +5,10 @@ straight back (a plunge and its retract): each part is its own G2 path. A part o
 only has its corners rounded as before (``round_toolpath``: the corner options of the design,
 the feed of every move kept); a part with arcs is made G2 by ``spiral_cad.design.make_g2`` within
 ``max_deviation``, its arcs kept true arcs (make_g2 may split it further, at a reversal it finds).
-A helix's chords lie within a tenth of ``max_deviation`` of it (or the stated arc tolerance), and
-the part is made G2 within the rest, so every point stays within ``max_deviation`` of the program.
+A part with arcs in space is split further where it leaves its plane (a plunge onto a contour):
+``make_g2`` makes plane paths G2. A helix's chords lie within a tenth of ``max_deviation`` of it (or the
+stated arc tolerance), and the part is made G2 within the rest, so every point stays within
+``max_deviation`` of the program.
 """
 
 from __future__ import annotations
@@ -51,7 +53,9 @@ def toolpath_designs(d: RoundedPolylineDesign, where: str, units: str, program: 
     moves_to_units = MM_PER_UNIT[moves.program_units] / MM_PER_UNIT[units]  # feeds: program unit → units per minute
     samples = None if d.samples is None else d.samples.options()
     made: list[tuple[Any, Any, Any]] = []  # (chain, source, feeds per segment)
-    for first, stop in moves.parts():
+    pieces = [run for first, stop in moves.parts() for run in
+              ([(first, stop)] if moves.straight(first, stop) else moves.plane_runs(first, stop))]  # fmt: skip
+    for first, stop in pieces:
         chorded = moves.chords is not None and bool(moves.chords[first:stop].any())
         bound = None if deviation is None else deviation - (helix or 0.0) * chorded
         if stop - first == 1 and moves.straight(first, stop):  # one move between folds: a line, nothing to round
@@ -82,6 +86,8 @@ def toolpath_designs(d: RoundedPolylineDesign, where: str, units: str, program: 
     if len(folds):
         shown = ", ".join(str(int(moves.lines[j + 1])) for j in folds[:8]) + (" …" if len(folds) > 8 else "")
         notes.append(f"split where the path folds straight back ({len(folds)}×), at the moves of lines {shown}")
+    if len(pieces) > len(folds) + 1:
+        notes.append(f"split where a path with arcs leaves its plane ({len(pieces) - len(folds) - 1}×): make_g2 makes plane paths G2")
     built: list[Built] = []
     for k, (chain, source, per_segment) in enumerate(made):
         name = d.name if len(made) == 1 else f"{d.name}_{k + 1}"

@@ -33,10 +33,12 @@ from ..core.segments import Arc, Line
 from ..core.units import MM_PER_UNIT, length_unit
 from .toolpath import PLANES, GcodePath, arc_points, arc_sweep
 
-__all__ = ["FOLD_SINE", "GcodeMoves", "parse_gcode_moves", "read_gcode_moves"]
+__all__ = ["FOLD_SINE", "PLANE_TOLERANCE", "GcodeMoves", "parse_gcode_moves", "read_gcode_moves"]
 
 #: A joint where a curve (an arc) meets the next going back along it within this sine of the angle folds back.
 FOLD_SINE = 1e-9
+#: Points within this share of the path's size of a plane lie in it (``GcodeMoves.plane_runs``).
+PLANE_TOLERANCE = 1e-10
 
 
 @dataclass(frozen=True)
@@ -100,6 +102,29 @@ class GcodeMoves:
         """(first, stop) segment ranges of the path split where it folds straight back (``folds``)."""
         cuts = [0, *(int(j) + 1 for j in self.folds()), len(self.segments)]
         return list(zip(cuts[:-1], cuts[1:]))
+
+    def plane_runs(self, first: int, stop: int) -> list[tuple[int, int]]:
+        """(first, stop) ranges of segments ``first`` to ``stop`` that each lie in one plane, longest first in
+        travel order: a path in space (a plunge, then a contour) is split where it leaves its plane."""
+        if self.segments[first].dim == 2:
+            return [(first, stop)]
+        ends = np.array([p for s in self.segments[first:stop] for p in (s.start, s.end)])
+        tolerance = PLANE_TOLERANCE * max(float(np.abs(ends - ends[0]).max()), float(np.abs(ends).max()) * 1e-3)
+        runs, begin = [], first
+        points: list[NDArray] = []
+        normal: NDArray | None = None
+        for k in range(first, stop):
+            segment = self.segments[k]
+            new = [segment.start, segment.end] + ([segment.point(0.5)] if isinstance(segment, Arc) else [])
+            fits, found = _in_plane(points, normal, new, segment.normal if isinstance(segment, Arc) else None, tolerance)
+            if not fits:
+                runs.append((begin, k))
+                begin, points = k, []
+                fits, found = _in_plane([], None, new, segment.normal if isinstance(segment, Arc) else None, tolerance)
+            points += new
+            normal = found
+        runs.append((begin, stop))
+        return runs
 
     def straight(self, first: int, stop: int) -> bool:
         """Whether segments ``first`` to ``stop`` are all lines."""
@@ -213,6 +238,28 @@ def read_gcode_moves(
     return parse_gcode_moves(text, label, interpreter=interpreter or default_interpreter, units=units,
                              program_units=program_units or default_units, helix_tolerance=helix_tolerance,
                              folder=os.path.dirname(os.path.abspath(os.fspath(path))))  # fmt: skip
+
+
+def _in_plane(points: list[NDArray], normal: NDArray | None, new: list[NDArray], arc_normal: NDArray | None,
+              tolerance: float) -> tuple[bool, NDArray | None]:  # fmt: skip
+    """Whether ``points`` (in the plane of ``normal``, None while they are on one line) and ``new`` (with an arc's
+    ``arc_normal``) lie in one plane within ``tolerance``, and that plane's normal (None: still on one line)."""
+    every = np.array([*points, *new])
+    origin = every[0]
+    if normal is None and arc_normal is not None:
+        normal = np.asarray(arc_normal, dtype=np.float64)
+    if normal is None:  # lines only so far: the plane of the first point off their line, if any
+        direction = every[-1] - origin if not points else points[-1] - origin
+        direction = direction / (np.linalg.norm(direction) or 1.0)
+        off = (every - origin) - np.outer((every - origin) @ direction, direction)
+        far = int(np.argmax(np.linalg.norm(off, axis=1)))
+        if np.linalg.norm(off[far]) <= tolerance:
+            return True, None
+        normal = np.cross(direction, off[far])
+        normal = normal / np.linalg.norm(normal)
+    elif arc_normal is not None and abs(abs(float(np.dot(arc_normal, normal))) - 1.0) > 1e-9:
+        return False, normal
+    return bool(np.abs((every - origin) @ normal).max() <= tolerance), normal
 
 
 def _line(start: list[float], end: list[float], factor: float, dim: int) -> Line:
