@@ -1,4 +1,5 @@
-"""Design tools built on the core: horizontal and vertical alignments, superelevation, circle chains, corner rounding, G2 fillets.
+"""Design tools built on the core: horizontal and vertical alignments, superelevation, circle chains, corner rounding, G2 fillets,
+making paths of lines and tangent arcs G2 (``make_g2``).
 
 Pure numpy/numba: nothing here imports a CAD kernel.
 """
@@ -9,6 +10,7 @@ from .centerline import Centerline3D, centerline_3d
 from .circles import CircleChain, circle_chain
 from .criteria import CriteriaRow, RailCriteria, RoadCriteria
 from .fillets import FilletCorner, FilletedPath, fillet_path
+from .g2 import G2Joint, G2Path, make_g2
 from .profile import Profile, ProfileCriteria, VerticalCurve
 from .rounding import (
     CornerBatch,
@@ -34,6 +36,8 @@ __all__ = [
     "FilletCorner",
     "FilletedPath",
     "FilletedPolyline",
+    "G2Joint",
+    "G2Path",
     "Profile",
     "ProfileCriteria",
     "RailCriteria",
@@ -51,6 +55,7 @@ __all__ = [
     "fillet_path",
     "fillet_polyline",
     "fit_survey",
+    "make_g2",
     "peak_curvature_rate",
     "round_corners",
     "round_corners_batch",

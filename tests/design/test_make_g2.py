@@ -1,0 +1,229 @@
+"""make_g2: paths of lines and tangent arcs made G2 within a Hausdorff bound, arcs kept true arcs.
+
+Every built result is judged independently of the code under test: the joints by the chain's own
+check and by finite differences of dense samples (tangent turn and curvature from three points),
+the deviation by exact distances to the input's lines and arcs (dense samples of the result) and
+by the input's samples against the result's dense polyline.
+"""
+
+import math
+
+import numpy as np
+import pytest
+
+from spiral_cad import Arc, BezierSpiral, Chain, Line, NoSolutionError
+from spiral_cad.core.chain import g2_mismatch
+from spiral_cad.design import G2Path, make_g2
+
+# ---------------------------------------------------------------- independent measures
+
+
+def _distance_to_input(points: np.ndarray, segments) -> np.ndarray:
+    """Exact distance of points to the nearest input line segment or arc."""
+    best = np.full(len(points), np.inf)
+    for s in segments:
+        if isinstance(s, Line):
+            a, b = s.start, s.end
+            d = b - a
+            t = np.clip(((points - a) @ d) / float(d @ d), 0.0, 1.0)
+            dist = np.linalg.norm(points - a - t[:, None] * d, axis=1)
+        else:
+            rel = points - s.center
+            angle = np.arctan2(rel[:, 1], rel[:, 0])
+            inside = (math.copysign(1.0, s.radius) * (angle - s.start_angle)) % (2 * math.pi) <= s.sweep + 1e-12
+            radial = np.abs(np.linalg.norm(rel, axis=1) - abs(s.radius))
+            ends = np.minimum(np.linalg.norm(points - s.start, axis=1), np.linalg.norm(points - s.end, axis=1))
+            dist = np.where(inside, radial, ends)
+        best = np.minimum(best, dist)
+    return best
+
+
+def _dense(chain: Chain, per: int = 400) -> np.ndarray:
+    u = np.linspace(0.0, 1.0, per)
+    return np.vstack([s.point(u) for s in chain])
+
+
+def _distance_to_polyline(points: np.ndarray, poly: np.ndarray) -> np.ndarray:
+    best = np.full(len(points), np.inf)
+    a, d = poly[:-1], np.diff(poly, axis=0)
+    dd = np.einsum("ij,ij->i", d, d)
+    keep = dd > 0
+    a, d, dd = a[keep], d[keep], dd[keep]
+    for start in range(0, len(points), 256):
+        p = points[start : start + 256]
+        rel = p[:, None] - a[None]
+        t = np.clip(np.einsum("mkj,kj->mk", rel, d) / dd, 0.0, 1.0)
+        near = rel - t[..., None] * d[None]
+        best[start : start + 256] = np.sqrt(np.einsum("mkj,mkj->mk", near, near)).min(axis=1)
+    return best
+
+
+def hausdorff(segments, result: G2Path) -> float:
+    """Output → input exactly (dense samples of the output, exact distance to the input's primitives);
+    input → output exactly to the output's lines and arcs, and to each spiral's dense polyline
+    (its sag, under 1e-9 of the bound in these tests, is negligible)."""
+    out = np.vstack([_dense(c) for c in result.chains])
+    there = float(_distance_to_input(out, segments).max())
+    u = np.linspace(0.0, 1.0, 120)
+    inputs = np.vstack([s.point(u) for s in segments])
+    pieces = [s for c in result.chains for s in c]
+    back = _distance_to_input(inputs, [s for s in pieces if not isinstance(s, BezierSpiral)])
+    fine = np.linspace(0.0, 1.0, 3000)
+    for s in pieces:
+        if isinstance(s, BezierSpiral):
+            near = np.linalg.norm(inputs - s.point(0.5), axis=1) <= s.length
+            if near.any():
+                back[near] = np.minimum(back[near], _distance_to_polyline(inputs[near], s.point(fine)))
+    return max(there, float(back.max()))
+
+
+def fd_curvature_continuous(chain: Chain, tol: float) -> None:
+    """At every joint: curvature from finite differences just before and just after agree with the
+    curvatures the segments report, and those agree across the joint."""
+    segs = list(chain)
+    size = float(np.abs(chain.segment_ends).max())
+    for i, (a, b) in enumerate(zip(segs[:-1], segs[1:])):
+        # The stencil is wide enough that float64's rounding of the points (~eps·size) stays small
+        # against it; the curvature's own change across it is allowed for (≈ 4h of its scale).
+        h = min(max(1e-4, math.sqrt(2.2e-16 * size / 5e-3) / min(a.length, b.length)), 0.05)
+        ka = _fd_kappa(a, 1.0, h)
+        kb = _fd_kappa(b, 0.0, h)
+        own = [abs(float(s.curvature(u))) for s in (a, b) for u in (0.0, 1.0)]  # a spiral's peak: its own scale
+        scale = max(abs(ka), abs(kb), *own, 1.0 / max(a.length, b.length))
+        assert abs(ka - kb) <= (tol + 4 * h) * scale, f"joint {i}: κ {ka} before, {kb} after ({type(a).__name__} → {type(b).__name__})"
+        ta, tb = a.tangent(1.0), b.tangent(0.0)
+        assert abs(ta[0] * tb[1] - ta[1] * tb[0]) <= 1e-7 and float(ta @ tb) > 0, f"joint {i}: tangent turns"
+
+
+def _fd_kappa(segment, u0: float, h: float) -> float:
+    """Signed curvature from three points h of the segment's parameter apart at its end (a circle through them)."""
+    us = np.array([0.0, h, 2 * h]) if u0 == 0.0 else np.array([1.0 - 2 * h, 1.0 - h, 1.0])
+    p = segment.point(us)
+    a, b, c = p - p[0]
+    cross = (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0])
+    return 2.0 * cross / (np.linalg.norm(b - a) * np.linalg.norm(c - b) * np.linalg.norm(c - a))
+
+
+def assert_g2(segments, result: G2Path, bound: float, closed: bool) -> None:
+    for chain in result.chains:
+        Chain(list(chain), units=result.units)  # the chain's own check, again
+        fd_curvature_continuous(chain, 2e-2)
+    if closed and len(result.chains) == 1:
+        chain = result.chain
+        assert g2_mismatch(chain[-1], chain[0], 1e-9) is None
+    measured = hausdorff(segments, result)
+    assert measured <= bound * (1 + 1e-6) + 1e-9 * _size(segments), (measured, bound)
+    assert result.deviation <= bound
+    # The reported deviation is the measured one (within what sampling sees).
+    assert result.deviation >= 0.95 * measured - 1e-9 * _size(segments)
+
+
+def _size(segments) -> float:
+    return float(max(np.abs(np.vstack([s.point(np.linspace(0, 1, 5)) for s in segments])).max(), 1e-300))
+
+
+def arcs_kept(segments, result: G2Path) -> None:
+    """Every input arc's circle appears in the result as an Arc, concentric, radius within the bound."""
+    out_arcs = [s for c in result.chains for s in c if isinstance(s, Arc)]
+    for s in segments:
+        if isinstance(s, Arc):
+            same = [a for a in out_arcs if np.allclose(a.center, s.center, rtol=0, atol=1e-9 * _size(segments))
+                    and abs(abs(a.radius) - abs(s.radius)) <= result.max_deviation]  # fmt: skip
+            assert same, f"arc {s} has no true arc in the result"
+
+
+# ---------------------------------------------------------------- paths
+
+
+def filleted_rectangle(w=10.0, h=6.0, r=1.0, x=0.0, y=0.0):
+    return [
+        Line((x + r, y), (x + w - r, y)),
+        Arc((x + w - r, y + r), r, -math.pi / 2, math.pi / 2),
+        Line((x + w, y + r), (x + w, y + h - r)),
+        Arc((x + w - r, y + h - r), r, 0.0, math.pi / 2),
+        Line((x + w - r, y + h), (x + r, y + h)),
+        Arc((x + r, y + h - r), r, math.pi / 2, math.pi / 2),
+        Line((x, y + h - r), (x, y + r)),
+        Arc((x + r, y + r), r, math.pi, math.pi / 2),
+    ]
+
+
+def slot(length=8.0, r=1.5):
+    return [
+        Line((0.0, -r), (length, -r)),
+        Arc((length, 0.0), r, -math.pi / 2, math.pi),
+        Line((length, r), (0.0, r)),
+        Arc((0.0, 0.0), r, math.pi / 2, math.pi),
+    ]
+
+
+@pytest.mark.parametrize("shape", ["near-linear", "walton-meek"])
+@pytest.mark.parametrize("bound", [1e-1, 1e-3, 1e-6])
+def test_filleted_rectangle_becomes_g2_with_true_arcs(shape, bound):
+    segments = filleted_rectangle()
+    result = make_g2(segments, bound, shape=shape)
+    assert result.closed and len(result.chains) == 1
+    assert_g2(segments, result, bound, closed=True)
+    arcs_kept(segments, result)
+    assert [j.kind for j in result.joints] == ["line-arc"] * 8
+    assert all(0 < j.shift <= bound for j in result.joints)
+    assert sum(isinstance(s, BezierSpiral) for s in result.chain) == 8
+
+
+def test_slot_closed_and_deviation_is_the_shift():
+    segments = slot()
+    result = make_g2(segments, 0.01)
+    assert_g2(segments, result, 0.01, closed=True)
+    arcs_kept(segments, result)
+    # The shift is the bound (less its margin): the gentlest transitions the bound allows.
+    assert result.deviation == pytest.approx(0.01, rel=1e-5)
+
+
+def test_reverse_and_compound_curves():
+    reverse = [Line((0, 0), (5, 0)), Arc((5, 2), 2, -math.pi / 2, math.pi), Arc((5, 6), -2, -math.pi / 2, math.pi / 2)]
+    result = make_g2(reverse, 0.01)
+    assert [j.kind for j in result.joints] == ["line-arc", "arc-arc-reverse"]
+    assert_g2(reverse, result, 0.01, closed=False)
+    compound = [Line((0, 0), (5, 0)), Arc((5, 3), 3, -math.pi / 2, math.pi / 2), Arc((7, 3), 1, 0.0, math.pi / 2)]
+    result = make_g2(compound, 0.01)
+    assert [j.kind for j in result.joints] == ["line-arc", "arc-arc-compound"]
+    assert_g2(compound, result, 0.01, closed=False)
+    arcs_kept(compound, result)
+
+
+def test_corners_of_a_polyline_and_a_reversal_split():
+    square = make_g2([(0, 0), (1, 0), (1, 1), (0, 1)], 0.01)
+    assert [j.kind for j in square.joints] == ["corner", "corner"]
+    assert_g2([Line((0, 0), (1, 0)), Line((1, 0), (1, 1)), Line((1, 1), (0, 1))], square, 0.01, closed=False)
+    folded = make_g2([(0, 0), (1, 0), (0, 0), (0, 1)], 0.01)
+    assert folded.splits == [0] and len(folded.chains) == 2
+    with pytest.raises(ValueError, match=r"split into 2 parts at joint 0 at \(1, 0\)"):
+        _ = folded.chain
+
+
+def test_g2_joints_are_left_alone_and_a_circle_is_already_g2():
+    halves = [Arc((0, 0), 1.0, 0.0, math.pi), Arc((0, 0), 1.0, math.pi, math.pi)]
+    result = make_g2(halves, 0.01)
+    assert result.closed and result.deviation == 0.0
+    assert [j.kind for j in result.joints] == ["g2", "g2"]
+
+
+def test_refusal_names_the_joint_and_a_bound_that_works():
+    # A bound below what float64 resolves at these coordinates.
+    segments = filleted_rectangle(x=1e6, y=1e6)
+    with pytest.raises(NoSolutionError) as error:
+        make_g2(segments, 1e-12)
+    message = str(error.value)
+    assert "joint" in message and "works (built and checked)" in message
+    works = float(message.split("max_deviation ")[-1].split(" ")[0])
+    result = make_g2(segments, works)
+    assert_g2(segments, result, works, closed=True)
+
+
+def test_malformed_input_is_refused_by_name():
+    with pytest.raises(ValueError, match="do not meet"):
+        make_g2([Line((0, 0), (1, 0)), Line((2, 0), (3, 0))], 0.01)
+    with pytest.raises(ValueError, match="max_deviation"):
+        make_g2([(0, 0), (1, 0)], -1.0)
+    with pytest.raises(ValueError, match="shape"):
+        make_g2([(0, 0), (1, 0)], 0.1, shape="g2cbs")
