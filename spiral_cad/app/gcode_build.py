@@ -53,6 +53,7 @@ def toolpath_designs(d: RoundedPolylineDesign, where: str, units: str, program: 
     moves_to_units = MM_PER_UNIT[moves.program_units] / MM_PER_UNIT[units]  # feeds: program unit → units per minute
     samples = None if d.samples is None else d.samples.options()
     made: list[tuple[Any, Any, Any]] = []  # (chain, source, feeds per segment)
+    corners = 0  # splits at corners next to an arc
     pieces = [run for first, stop in moves.parts() for run in
               ([(first, stop)] if moves.straight(first, stop) else moves.plane_runs(first, stop))]  # fmt: skip
     for first, stop in pieces:
@@ -80,12 +81,16 @@ def toolpath_designs(d: RoundedPolylineDesign, where: str, units: str, program: 
         if others:
             raise DesignError(f"{where}: {', '.join(others)}: corner options of straight moves; {moves.source} line {line} "
                               "starts a path with arcs, made G2 within max_deviation alone")  # fmt: skip
-        made += _g2_parts(moves, first, stop, bound, d.shape, units)
+        parts, cut = _g2_parts(moves, first, stop, bound, d.shape, units)
+        made += parts
+        corners += cut
     notes = list(moves.notes)
     folds = moves.folds()
     if len(folds):
         shown = ", ".join(str(int(moves.lines[j + 1])) for j in folds[:8]) + (" …" if len(folds) > 8 else "")
         notes.append(f"split where the path folds straight back ({len(folds)}×), at the moves of lines {shown}")
+    if corners:
+        notes.append(f"split at {corners} corner(s) next to an arc (make_g2 rounds corners between lines)")
     if len(pieces) > len(folds) + 1:
         notes.append(f"split where a path with arcs leaves its plane ({len(pieces) - len(folds) - 1}×): make_g2 makes plane paths G2")
     built: list[Built] = []
@@ -96,15 +101,74 @@ def toolpath_designs(d: RoundedPolylineDesign, where: str, units: str, program: 
     return built
 
 
-def _g2_parts(moves: Any, first: int, stop: int, bound: float, shape: str, units: str) -> list[tuple[Any, Any, Any]]:
-    """The G2 chains ``make_g2`` makes of segments ``first`` to ``stop`` (a part with arcs), within ``bound``."""
+def _g2_parts(moves: Any, first: int, stop: int, bound: float, shape: str, units: str) -> tuple[list[tuple[Any, Any, Any]], int]:
+    """The G2 chains ``make_g2`` makes of segments ``first`` to ``stop`` (a part with arcs), within ``bound``, and at how
+    many corners next to an arc the part was split."""
     from ..design import make_g2
 
+    segments = list(moves.segments[first:stop])
+    frame = None
+    if segments[0].dim == 3:  # a plane run in space: made G2 in its plane's coordinates, then placed back
+        frame, segments = _in_frame(segments)
+    runs = [(0, len(segments))]
     try:
-        result = make_g2(list(moves.segments[first:stop]), bound, shape=_g2_shape(shape), units=units)
-    except ValueError as error:
-        raise type(error)(f"{moves.source} lines {int(moves.lines[first])}–{int(moves.lines[stop - 1])}: {error}") from None
-    return [(chain, result, None) for chain in result.chains]
+        results = [make_g2(segments, bound, shape=_g2_shape(shape), units=units)]
+    except ValueError as refused:
+        # a corner next to an arc that make_g2 does not round: the path is split at every such corner (a stop)
+        cuts = [0, *(j + 1 for j in _arc_corners(segments)), len(segments)]
+        runs = [(a, b) for a, b in zip(cuts[:-1], cuts[1:])]
+        if len(runs) == 1:
+            raise type(refused)(f"{moves.source} lines {int(moves.lines[first])}–{int(moves.lines[stop - 1])}: {refused}") from None
+        results = []
+        for a, b in runs:
+            try:
+                results.append(make_g2(segments[a:b], bound, shape=_g2_shape(shape), units=units))
+            except ValueError as error:
+                lines = f"{int(moves.lines[first + a])}–{int(moves.lines[first + b - 1])}"
+                raise type(error)(f"{moves.source} lines {lines}: {error}") from None
+    made = [(chain if frame is None else chain.placed(frame), result, None) for result in results for chain in result.chains]
+    return made, len(runs) - 1
+
+
+def _arc_corners(segments: list[Any]) -> list[int]:
+    """The joints (j: segment j ends) next to an arc that turn by more than ``make_g2``'s tangent tolerance."""
+    import numpy as np
+
+    from ..core.segments import Arc
+    from ..design.g2 import TANGENT_TOL
+
+    found = []
+    for j, (a, b) in enumerate(zip(segments[:-1], segments[1:])):
+        if isinstance(a, Arc) or isinstance(b, Arc):
+            t0, t1 = a.end_tangent, b.start_tangent
+            if abs(float(np.arctan2(t0[0] * t1[1] - t0[1] * t1[0], np.dot(t0, t1)))) > TANGENT_TOL:
+                found.append(j)
+    return found
+
+
+def _in_frame(segments: list[Any]) -> tuple[Any, list[Any]]:
+    """The frame of the plane of ``segments`` in space (an arc's normal; x along the world's x where it can) and the
+    segments in its coordinates (``Chain.placed(frame)`` puts them back)."""
+    import math
+
+    import numpy as np
+
+    from ..core.segments import Arc, Line
+    from ..core.space import PlaneFrame
+
+    normal = next(s.normal for s in segments if isinstance(s, Arc))
+    axis = np.eye(3)[int(np.argmin(np.abs(normal)))] if abs(normal[0]) > 0.9 else np.array([1.0, 0.0, 0.0])
+    x_dir = axis - np.dot(axis, normal) * normal
+    frame = PlaneFrame(normal * float(np.dot(segments[0].start, normal)), x_dir, normal)  # G17 at z: x, y as they are
+    plane: list[Any] = []
+    for s in segments:
+        if isinstance(s, Line):
+            plane.append(Line(*frame.local([s.start, s.end])))
+            continue
+        centre, start = frame.local([s.center, s.start])
+        sense = math.copysign(1.0, s.radius) * math.copysign(1.0, float(np.dot(s.normal, frame.normal)))
+        plane.append(Arc(centre, sense * abs(s.radius), math.atan2(start[1] - centre[1], start[0] - centre[0]), s.sweep))
+    return frame, plane
 
 
 def _g2_shape(shape: str) -> str:
