@@ -334,7 +334,7 @@ class _Reader:
                 )
         if motion is not None:
             self.motion = None if motion == 800 else motion
-        if target:
+        if target or centre and self.motion in (20, 30):  # an arc with no axis word: a full circle back to its start
             if self.motion is None:
                 reason = (
                     "after G80 (motion cancelled)" if motion == 800 or self.cancelled else "with no motion mode in effect (G0, G1, G2, G3)"
