@@ -97,16 +97,67 @@ def _dxf(source: Path, deviation: float, name: str | None, units: str | None, so
 
 def _made(segments: list, deviation: float, closed: bool, shape: str, units: str, where: str) -> list[tuple[Any, Any, list[str]]]:
     """(chain, G2Path, notes) of every G2 path ``make_g2`` makes of ``segments``."""
+    try:
+        results, splits = made_g2(segments, deviation, closed=closed, shape=shape, units=units, where=where)
+    except ValueError as error:
+        raise DesignError(str(error)) from None
+    worst = max(r.deviation for r in results)
+    notes = [f"within {worst:.3g} {units} of {where} (max_deviation {deviation:g})"]
+    if splits:
+        notes.append(f"split at {splits} corner(s) next to an arc (make_g2 rounds corners between lines)")
+    chains = [(chain, r) for r in results for chain in r.chains]
+    if len(chains) > len(results):
+        notes.append(f"split into {len(chains)} G2 paths where it folds back")
+    return [(chain, r, notes if k == 0 else []) for k, (chain, r) in enumerate(chains)]
+
+
+def made_g2(segments: list, bound: float, *, closed: bool | None = None, shape: str = "near-linear", units: str = "mm",
+            where: str = "path") -> tuple[list[Any], int]:  # fmt: skip
+    """``make_g2`` of ``segments``; where it refuses, the path split at every corner next to an arc (a corner
+    ``make_g2`` does not round: the machine or the reader stops there) and each part made G2 on its own.
+
+    Returns:
+        The ``G2Path`` of each part, and how many such corners split the path (0: made whole).
+
+    Raises:
+        ValueError, NoSolutionError: ``make_g2``'s refusal (of the whole path, or of a part), after ``where``.
+    """
     from ..design import make_g2
 
     try:
-        result = make_g2(segments, deviation, closed=closed, shape=shape, units=units)
-    except ValueError as error:
-        raise DesignError(f"{where}: {error}") from None
-    notes = [f"within {result.deviation:.3g} {units} of {where} (max_deviation {deviation:g})"]
-    if len(result.chains) > 1:
-        notes.append(f"split into {len(result.chains)} G2 paths where it folds back: {result.splits}")
-    return [(chain, result, notes if k == 0 else []) for k, chain in enumerate(result.chains)]
+        return [make_g2(segments, bound, closed=closed, shape=shape, units=units)], 0
+    except ValueError as refused:
+        corners = _arc_corners(segments, closed=bool(closed))
+        if not corners:
+            raise type(refused)(f"{where}: {refused}") from None
+    if closed:  # open the loop at the first such corner
+        first = corners[0] + 1
+        segments = segments[first:] + segments[:first]
+        corners = [(j - first) % len(segments) for j in corners[1:]] + [len(segments) - 1]
+    cuts = [0, *(j + 1 for j in corners if j + 1 < len(segments)), len(segments)]
+    results = []
+    for a, b in zip(cuts[:-1], cuts[1:]):
+        try:
+            results.append(make_g2(segments[a:b], bound, closed=False, shape=shape, units=units))
+        except ValueError as error:
+            raise type(error)(f"{where} (segments {a} to {b - 1}): {error}") from None
+    return results, len(corners)
+
+
+def _arc_corners(segments: list, closed: bool = False) -> list[int]:
+    """The joints (j: segment j ends) next to an arc that turn by more than ``make_g2``'s tangent tolerance."""
+    import numpy as np
+
+    from ..design.g2 import TANGENT_TOL
+
+    pairs = list(zip(segments, segments[1:] + (segments[:1] if closed else [])))
+    found = []
+    for j, (a, b) in enumerate(pairs):
+        if isinstance(a, Arc) or isinstance(b, Arc):
+            t0, t1 = a.end_tangent, b.start_tangent
+            if abs(float(np.arctan2(t0[0] * t1[1] - t0[1] * t1[0], np.dot(t0, t1)))) > TANGENT_TOL:
+                found.append(j)
+    return found
 
 
 def _named(made: list, stem: str, what: str, notes: tuple[str, ...] = (), road: bool = False) -> list[Built]:

@@ -104,46 +104,16 @@ def toolpath_designs(d: RoundedPolylineDesign, where: str, units: str, program: 
 def _g2_parts(moves: Any, first: int, stop: int, bound: float, shape: str, units: str) -> tuple[list[tuple[Any, Any, Any]], int]:
     """The G2 chains ``make_g2`` makes of segments ``first`` to ``stop`` (a part with arcs), within ``bound``, and at how
     many corners next to an arc the part was split."""
-    from ..design import make_g2
+    from .g2_build import made_g2
 
     segments = list(moves.segments[first:stop])
     frame = None
     if segments[0].dim == 3:  # a plane run in space: made G2 in its plane's coordinates, then placed back
         frame, segments = _in_frame(segments)
-    runs = [(0, len(segments))]
-    try:
-        results = [make_g2(segments, bound, shape=_g2_shape(shape), units=units)]
-    except ValueError as refused:
-        # a corner next to an arc that make_g2 does not round: the path is split at every such corner (a stop)
-        cuts = [0, *(j + 1 for j in _arc_corners(segments)), len(segments)]
-        runs = [(a, b) for a, b in zip(cuts[:-1], cuts[1:])]
-        if len(runs) == 1:
-            raise type(refused)(f"{moves.source} lines {int(moves.lines[first])}–{int(moves.lines[stop - 1])}: {refused}") from None
-        results = []
-        for a, b in runs:
-            try:
-                results.append(make_g2(segments[a:b], bound, shape=_g2_shape(shape), units=units))
-            except ValueError as error:
-                lines = f"{int(moves.lines[first + a])}–{int(moves.lines[first + b - 1])}"
-                raise type(error)(f"{moves.source} lines {lines}: {error}") from None
+    where = f"{moves.source} lines {int(moves.lines[first])}–{int(moves.lines[stop - 1])}"
+    results, splits = made_g2(segments, bound, shape=_g2_shape(shape), units=units, where=where)
     made = [(chain if frame is None else chain.placed(frame), result, None) for result in results for chain in result.chains]
-    return made, len(runs) - 1
-
-
-def _arc_corners(segments: list[Any]) -> list[int]:
-    """The joints (j: segment j ends) next to an arc that turn by more than ``make_g2``'s tangent tolerance."""
-    import numpy as np
-
-    from ..core.segments import Arc
-    from ..design.g2 import TANGENT_TOL
-
-    found = []
-    for j, (a, b) in enumerate(zip(segments[:-1], segments[1:])):
-        if isinstance(a, Arc) or isinstance(b, Arc):
-            t0, t1 = a.end_tangent, b.start_tangent
-            if abs(float(np.arctan2(t0[0] * t1[1] - t0[1] * t1[0], np.dot(t0, t1)))) > TANGENT_TOL:
-                found.append(j)
-    return found
+    return made, splits
 
 
 def _in_frame(segments: list[Any]) -> tuple[Any, list[Any]]:
