@@ -563,7 +563,7 @@ def _g2_source(value: Any) -> str:
 
 class G2PathDesign(_Model):
     """The lines and arcs of a DXF drawing, a LandXML alignment or an OpenDRIVE road made G2 within max_deviation
-    (``spiral_cad.make_g2``), arcs kept true arcs: one design per G2 path (NAME_1, NAME_2, … when there are several)."""
+    (``spiral_cad.design.make_g2``), arcs kept true arcs: one design per G2 path (NAME_1, NAME_2, … when there are several)."""
 
     name: Name = Field(description="Names the output files (see alignment).")
     type: Literal["g2_path"]
