@@ -9,7 +9,8 @@ where the tool goes):
 * ``G2``/``G3`` arcs in every plane LinuxCNC allows (``G17`` XY, ``G18`` ZX, ``G19`` YZ) are ``Arc`` s:
   true circles, never chords. An arc's centre is put on the bisector of its chord (LinuxCNC accepts
   end radii that differ slightly, and rs274 prints 4 decimals), so every arc ends where its move does;
-  a move of more than one turn (``P``) is one arc per turn;
+  a move of more than one turn (``P``) is one arc per turn; an arc of radius 0 (its ends at its centre: rs274
+  runs it as a plunge) is a straight move along the plane's normal;
 * a helical arc (``G2``/``G3`` that also moves along the plane's normal) is not a plane curve: it is
   read as chords within ``helix_tolerance`` (refused by name without it);
 * ``G5`` cubic splines are refused here: a program with them states its exact path
@@ -272,6 +273,9 @@ def _arc(start: list[float], end: list[float], plane: int, ca: float, cb: float,
          helix_tolerance: float | None) -> list[Line | Arc]:  # fmt: skip
     """The segments of one arc move: one ``Arc`` a turn, or a helix's chords."""
     first, second, normal = PLANES[plane]
+    if start[first] == ca and start[second] == cb and end[first] == ca and end[second] == cb:
+        # a helix of radius 0 (rs274 runs it: a hole as wide as the tool): a straight move along the normal
+        return [] if start == end else [_line(start, end, factor, dim)]
     if end[normal] != start[normal]:
         if helix_tolerance is None:
             raise ValueError("a helical arc (it also moves along the plane's normal) is not a plane arc: "

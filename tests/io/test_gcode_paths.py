@@ -145,3 +145,13 @@ def test_rs274_finds_subroutine_files_in_the_programs_folder(tmp_path):
     moves = read_gcode_moves(tmp_path / "main.ngc", interpreter="rs274")
     assert [type(s).__name__ for s in moves.segments] == ["Line", "Line", "Arc"]
     assert moves.lines[-1] == 3 and np.allclose(moves.segments[1].end, (5, 5))
+
+
+@needs_rs274
+def test_a_helix_of_radius_zero_is_a_plunge(tmp_path):
+    """rs274 runs a helical hole as wide as the tool (its ends at its centre) as ARC_FEED: read as the straight move."""
+    text = "G20 G90 F10\nG0 X1 Y1 Z0\nG3 X1 Y1 I0 J0 Z-0.1\nG1 X2\nM2\n"
+    assert canonical_arcs(text, tmp_path)[0][:4] == [1, 1, 1, 1]  # rs274's own call: centre at the ends
+    moves = parse_gcode_moves(text, interpreter="rs274", helix_tolerance=1e-4)
+    assert [type(s).__name__ for s in moves.segments] == ["Line", "Line", "Line"]
+    assert moves.segments[1].start.tolist() == [1, 1, 0] and moves.segments[1].end.tolist() == [1, 1, -0.1]
