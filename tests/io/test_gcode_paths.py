@@ -3,6 +3,7 @@
 import math
 import random
 import subprocess
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -149,9 +150,12 @@ def test_rs274_finds_subroutine_files_in_the_programs_folder(tmp_path):
 
 @needs_rs274
 def test_a_helix_of_radius_zero_is_a_plunge(tmp_path):
-    """rs274 runs a helical hole as wide as the tool (its ends at its centre) as ARC_FEED: read as the straight move."""
-    text = "G20 G90 F10\nG0 X1 Y1 Z0\nG3 X1 Y1 I0 J0 Z-0.1\nG1 X2\nM2\n"
-    assert canonical_arcs(text, tmp_path)[0][:4] == [1, 1, 1, 1]  # rs274's own call: centre at the ends
-    moves = parse_gcode_moves(text, interpreter="rs274", helix_tolerance=1e-4)
-    assert [type(s).__name__ for s in moves.segments] == ["Line", "Line", "Line"]
-    assert moves.segments[1].start.tolist() == [1, 1, 0] and moves.segments[1].end.tolist() == [1, 1, -0.1]
+    """LinuxCNC's useful-subroutines.ngc mills a hole as wide as the tool under cutter compensation: rs274 runs it as
+    arcs whose ends lie at their centre, descending (ARC_FEED(0, 0, 0, 0, 1, z)); read as the straight moves they make."""
+    program = Path(__file__).parents[1] / "data" / "gcode" / "linuxcnc_useful-subroutines.ngc"
+    theirs = canonical_arcs(program.read_text(), tmp_path)
+    zero = [a for a in theirs if a[:4] == [0, 0, 0, 0]]
+    assert len(zero) >= 4
+    moves = read_gcode_moves(program, interpreter="rs274", helix_tolerance=1e-4)
+    plunges = [s for s in moves.segments if isinstance(s, Line) and np.allclose(s.start[:2], 0) and np.allclose(s.end[:2], 0)]
+    assert sorted({round(float(s.end[2]), 4) for s in plunges} & {a[5] for a in zero}) == sorted({a[5] for a in zero})
