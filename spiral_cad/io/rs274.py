@@ -281,6 +281,6 @@ def _moves(calls: Iterable[str], source: str, arc_tolerance: float | None, arc_u
             progress(count)
     if not all(math.isfinite(v) for p in points for v in p):
         raise ValueError(f"{source}: rs274 printed a position that is not a finite number")
-    if len(points) < 2:
+    if len(points) < 2 and (exact is None or not exact[0]):  # as pieces, one move from the start is a path
         raise ValueError(f"{source}: rs274 executed {len(points)} move(s) to a new position; a path needs at least two")
     return GcodePath(np.array(points), np.array(lines), np.array(rapid), units, source)
