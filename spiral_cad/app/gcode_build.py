@@ -13,6 +13,7 @@ stated arc tolerance), and the part is made G2 within the rest, so every point s
 
 from __future__ import annotations
 
+import math
 from pathlib import Path
 from typing import Any
 
@@ -42,8 +43,10 @@ def toolpath_designs(d: RoundedPolylineDesign, where: str, units: str, program: 
     _, arc_tolerance, arc_units, _ = reading_defaults()
     helix = None
     if arc_tolerance is not None:
+        if not 0.0 < arc_tolerance < math.inf:
+            raise DesignError(f"{where}: arc_tolerance must be a positive finite length; got {arc_tolerance}")
         helix = in_program_unit(arc_tolerance, arc_units, units)
-    elif deviation is not None:
+    elif deviation is not None and HELIX_SHARE * deviation > 0.0:  # (a deviation below float64's reach is refused later)
         helix = HELIX_SHARE * deviation
     if helix is not None and deviation is not None and not helix < deviation:
         raise DesignError(f"{where}: the arc tolerance {helix:g} {units} (a helix's chords) must be below max_deviation {deviation:g}")

@@ -3,7 +3,8 @@
 Both readers give the same moves: the built-in one (``spiral_cad.io.gcode``) and LinuxCNC's ``rs274``
 (``spiral_cad.io.rs274``, run in the program's folder so that it finds the subroutine files the
 program calls). Every move to a new position is one segment, rapids (``G0``) included (the path is
-where the tool goes):
+where the tool goes); the path starts where the first move ends, as the built-in reader's polyline does
+(where the tool stood before it, the readers' 0, is not known):
 
 * ``G0``/``G1`` straight moves are ``Line`` s;
 * ``G2``/``G3`` arcs in every plane LinuxCNC allows (``G17`` XY, ``G18`` ZX, ``G19`` YZ) are ``Arc`` s:
@@ -118,10 +119,26 @@ class GcodeMoves:
             segment = self.segments[k]
             new = [segment.start, segment.end] + ([segment.point(0.5)] if isinstance(segment, Arc) else [])
             fits, found = _in_plane(points, normal, new, segment.normal if isinstance(segment, Arc) else None, tolerance)
-            if not fits:
-                runs.append((begin, k))
-                begin, points = k, []
-                fits, found = _in_plane([], None, new, segment.normal if isinstance(segment, Arc) else None, tolerance)
+            if not fits:  # a new plane: cut at the corner before the lines tangent to this segment, if they lie in it
+                cut = k
+                while cut - 1 > begin and isinstance(self.segments[cut - 1], Line) and _tangent(self.segments[cut - 1], self.segments[cut]):
+                    cut -= 1
+                points, found = [], None
+                for j in range(cut, k + 1):
+                    other = self.segments[j]
+                    extra = [other.start, other.end] + ([other.point(0.5)] if isinstance(other, Arc) else [])
+                    fits, found = _in_plane(points, found, extra, other.normal if isinstance(other, Arc) else None, tolerance)
+                    if not fits:
+                        break
+                    points += extra
+                if not fits or cut == k:
+                    cut, points = k, []
+                    fits, found = _in_plane([], None, new, segment.normal if isinstance(segment, Arc) else None, tolerance)
+                    points += new
+                runs.append((begin, cut))
+                begin = cut
+                normal = found
+                continue
             points += new
             normal = found
         runs.append((begin, stop))
@@ -194,6 +211,8 @@ def parse_gcode_moves(
     per_segment: list[float] = []
     chords: list[bool] = []
     helices = 0
+    moving = [k for k, p in enumerate(pieces) if p[3] != p[4]]
+    pieces, feeds = pieces[moving[0] + 1 :] if moving else [], feeds[moving[0] + 1 :] if moving else []  # see the docstring
     for piece, feed in zip(pieces, feeds):
         kind, number, is_rapid, start = piece[:4]
         try:
@@ -214,7 +233,8 @@ def parse_gcode_moves(
         rapid += [bool(is_rapid)] * len(made)
         per_segment += [feed] * len(made)
     if not segments:
-        raise ValueError(f"{source}: the program has no move to a new position; a path needs one")
+        raise ValueError(f"{source}: the program has fewer than two moves to a new position; a path starts where the "
+                         "first move ends and needs one more")  # fmt: skip
     if helices:
         notes.append(f"{helices} helical arc(s) read as chords within {helix_tolerance:g} {target}")
     return GcodeMoves(tuple(segments), np.array(lines), np.array(rapid), np.array(per_segment, dtype=np.float64), target, unit,
@@ -239,6 +259,12 @@ def read_gcode_moves(
     return parse_gcode_moves(text, label, interpreter=interpreter or default_interpreter, units=units,
                              program_units=program_units or default_units, helix_tolerance=helix_tolerance,
                              folder=os.path.dirname(os.path.abspath(os.fspath(path))))  # fmt: skip
+
+
+def _tangent(a: Line | Arc, b: Line | Arc) -> bool:
+    """Whether ``a`` ends in the direction ``b`` starts (within ``FOLD_SINE``)."""
+    t0, t1 = a.end_tangent, b.start_tangent
+    return float(np.dot(t0, t1)) > 0.0 and float(np.linalg.norm(np.cross(t0, t1))) <= FOLD_SINE
 
 
 def _in_plane(points: list[NDArray], normal: NDArray | None, new: list[NDArray], arc_normal: NDArray | None,

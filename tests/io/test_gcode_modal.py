@@ -175,19 +175,21 @@ def test_long_jobs_say_they_are_still_running(capsys):
     assert capsys.readouterr().err == ""  # a quick job says nothing
 
 
-def test_build_from_gcode_reads_arcs_with_an_arc_tolerance(tmp_path):
+def test_build_from_gcode_reads_arcs_as_arcs_and_splits_where_the_path_turns_back(tmp_path, capsys):
     from pathlib import Path
 
     from spiral_cad.app.cli import main
 
     program = Path(__file__).resolve().parents[1] / "gcode" / "with_arcs.nc"
     out = tmp_path / "out"
-    argv = ["build", "--from-gcode", str(program), "--max-deviation", "0.05", "--arc-tolerance", "0.005", "--no-plots", "--out", str(out)]
+    argv = ["build", "--from-gcode", str(program), "--max-deviation", "0.05", "--no-plots", "--out", str(out)]
     assert main(argv) == 0
-    table = np.loadtxt(out / "with_arcs_samples.csv", delimiter=",", skiprows=1)
-    # G2 from (20, 0) to (30, 10) about (20, 10) is clockwise: three quarters of a circle, by (10, 10) and (20, 20)
-    on_arc = (table[:, 1] < 19.0) & (table[:, 2] > 1.0)
-    assert on_arc.any() and np.abs(np.hypot(table[on_arc, 1] - 20, table[on_arc, 2] - 10) - 10).max() < 0.06
+    # G2 from (20, 0) to (30, 10) about (20, 10) is clockwise: it starts back along the line before it and ends
+    # against the line after it (cusps), so it is a path of its own: three quarters of a circle, by (10, 10) and (20, 20)
+    assert "split where the path folds straight back (2×), at the moves of lines 5, 6" in capsys.readouterr().out
+    table = np.loadtxt(out / "with_arcs_2_samples.csv", delimiter=",", skiprows=1)
+    assert np.abs(np.hypot(table[:, 1] - 20, table[:, 2] - 10) - 10).max() < 1e-9
+    assert table[:, 1].min() == pytest.approx(10, abs=1e-6) and table[:, 2].max() == pytest.approx(20, abs=1e-6)
 
 
 def test_g_and_m_codes_have_modal_groups_of_their_own_and_g80_yields_to_a_motion():

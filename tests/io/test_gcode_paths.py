@@ -18,6 +18,7 @@ needs_rs274 = pytest.mark.skipif(
 )
 
 PLANES = """G21 G90 F100
+G0 X5 Y5 Z0
 G0 X10 Y0 Z0
 G3 X0 Y10 I-10 J0
 G1 X0 Y10 Z3
@@ -49,7 +50,8 @@ def test_arcs_in_every_plane_are_true_arcs(interpreter):
     moves = parse_gcode_moves(PLANES, "planes.ngc", interpreter=interpreter)
     kinds = [type(s).__name__ for s in moves.segments]
     assert kinds == ["Line", "Arc", "Line", "Arc", "Arc", "Arc", "Arc", "Line"]  # P2: one arc a turn
-    assert moves.lines.tolist() == [2, 3, 4, 5, 6, 7, 7, 8] and moves.rapid.tolist() == [True] + [False] * 7
+    # the path starts where the first move ends (G0 X5 Y5: where the tool stood before it is not known)
+    assert moves.lines.tolist() == [3, 4, 5, 6, 7, 8, 8, 9] and moves.rapid.tolist() == [True] + [False] * 7
     xy, zx, yz, turn1, turn2 = (moves.segments[i] for i in (1, 3, 4, 5, 6))
     assert on_circle(xy, (0, 0, 0), 10) < 1e-12 and xy.sweep == pytest.approx(math.pi / 2)
     assert on_circle(zx, (0, 10, 6), 3) < 1e-12 and np.allclose(zx.end, (-3, 10, 6))
@@ -65,7 +67,7 @@ def test_arcs_in_every_plane_are_true_arcs(interpreter):
 def test_arc_centres_agree_with_rs274s_own_arcs(tmp_path):
     """rs274's canonical ARC_FEED (its centre, end and turn) against the arcs the built-in reader makes."""
     rng = random.Random(7)
-    lines, at = ["G21 G90 G17 F200", "G0 X0 Y0"], (0.0, 0.0)
+    lines, at = ["G21 G90 G17 F200", "G0 X5 Y5", "G0 X0 Y0"], (0.0, 0.0)
     for _ in range(30):
         i, j = round(rng.uniform(-20, 20), 4), round(rng.uniform(-20, 20), 4)
         radius, turn = math.hypot(i, j), rng.uniform(0.3, 5.5)
@@ -93,8 +95,8 @@ def test_the_two_readers_agree_segment_by_segment():
 
 @pytest.mark.parametrize("interpreter", ["builtin", pytest.param("rs274", marks=needs_rs274)])
 def test_a_helix_is_refused_by_name_or_read_as_chords_within_the_tolerance(interpreter):
-    text = "G21 G90 F100\nG0 X10 Y0 Z0\nG3 X-10 Y0 Z-4 I-10 J0\nM2\n"
-    with pytest.raises(ValueError, match=r"line 3: a helical arc .* \(helix_tolerance; build: --arc-tolerance\)"):
+    text = "G21 G90 F100\nG0 X5 Y5\nG0 X10 Y0 Z0\nG3 X-10 Y0 Z-4 I-10 J0\nM2\n"
+    with pytest.raises(ValueError, match=r"line 4: a helical arc .* \(helix_tolerance; build: --arc-tolerance\)"):
         parse_gcode_moves(text, "helix.ngc", interpreter=interpreter)
     moves = parse_gcode_moves(text, "helix.ngc", interpreter=interpreter, helix_tolerance=0.01)
     chords = moves.segments[1:]
@@ -107,21 +109,22 @@ def test_a_helix_is_refused_by_name_or_read_as_chords_within_the_tolerance(inter
 
 @pytest.mark.parametrize("interpreter", ["builtin", pytest.param("rs274", marks=needs_rs274)])
 def test_plunges_and_retracts_split_the_path(interpreter):
-    text = "G21 G90 F100\nG0 X0 Y0 Z5\nG1 Z-1\nG0 Z5\nG0 X10\nG1 Z-1\nG2 X20 Y0 I5 J0\nG3 X30 Y0 I5 J0\nG1 Z5\nM2\n"
+    text = "G21 G90 F100\nG0 X0 Y0 Z0\nG0 X0 Y0 Z5\nG1 Z-1\nG0 Z5\nG0 X10\nG1 Z-1\nG2 X20 Y0 I5 J0\nG3 X30 Y0 I5 J0\nG1 Z5\nM2\n"
     moves = parse_gcode_moves(text, interpreter=interpreter)
-    # up from 0, down (a fold), up again (a fold); along, down, an S of two tangent arcs, up (corners only)
-    assert [int(moves.lines[j + 1]) for j in moves.folds()] == [3, 4]
-    assert moves.parts() == [(0, 1), (1, 2), (2, 8)]
-    assert moves.straight(0, 2) and not moves.straight(2, 8)
+    # (the rapid up to Z5 is where the path starts) down, up again (a fold); along, down, an S of two tangent arcs,
+    # up (corners only)
+    assert [int(moves.lines[j + 1]) for j in moves.folds()] == [5]
+    assert moves.parts() == [(0, 1), (1, 7)]
+    assert moves.straight(0, 1) and not moves.straight(1, 7)
 
 
 def test_arcs_meeting_in_a_cusp_split_there():
-    text = "G21 G90 F100\nG1 X10 Y0\nG2 X20 Y0 I5 J0\nG3 X10 Y0 I-5 J0\nM2\n"  # the second arc turns back on the first
+    text = "G21 G90 F100\nG0 X-5\nG1 X10 Y0\nG2 X20 Y0 I5 J0\nG3 X10 Y0 I-5 J0\nM2\n"  # the second arc turns back on the first
     assert parse_gcode_moves(text).folds().tolist() == [1]
 
 
 def test_an_arc_folding_back_onto_a_line_splits_there():
-    text = "G21 G90 F100\nG1 X10 Y0\nG3 X10 Y0 I0 J5\nG1 X0 Y0\nM2\n"  # along, a full circle, straight back
+    text = "G21 G90 F100\nG0 X-5\nG1 X10 Y0\nG3 X10 Y0 I0 J5\nG1 X0 Y0\nM2\n"  # along, a full circle, straight back
     moves = parse_gcode_moves(text)
     assert moves.folds().tolist() == [1]  # the circle ends heading +x, the line runs -x
     assert [type(s).__name__ for s in moves.segments] == ["Line", "Arc", "Line"]
@@ -142,10 +145,10 @@ def test_a_program_without_a_unit_is_refused_unless_the_unit_is_stated(interpret
 @needs_rs274
 def test_rs274_finds_subroutine_files_in_the_programs_folder(tmp_path):
     (tmp_path / "square.ngc").write_text("o<square> sub\nG1 X#1\nG1 Y#1\no<square> endsub\nM2\n")
-    (tmp_path / "main.ngc").write_text("G21 G90 F100\no<square> call [5]\nG2 X0 Y5 I-2.5 J0\nM2\n")
+    (tmp_path / "main.ngc").write_text("G21 G90 F100\nG0 X-1\no<square> call [5]\nG2 X0 Y5 I-2.5 J0\nM2\n")
     moves = read_gcode_moves(tmp_path / "main.ngc", interpreter="rs274")
     assert [type(s).__name__ for s in moves.segments] == ["Line", "Line", "Arc"]
-    assert moves.lines[-1] == 3 and np.allclose(moves.segments[1].end, (5, 5))
+    assert moves.lines[-1] == 4 and np.allclose(moves.segments[1].end, (5, 5))
 
 
 @needs_rs274
