@@ -80,6 +80,56 @@ def solids_pictures() -> None:
     fig.savefig(IMAGES / "solids_zebra.png", bbox_inches="tight")
 
 
+def make_g2_picture() -> None:
+    """The make_g2 tutorial's picture: curvature against arc length round a build123d ``fillet()``ed
+    rectangle (it jumps 0 → 1/r at every tangent joint) and round the same outline after ``make_g2``
+    (continuous: a spiral at every joint, the arcs kept as arcs)."""
+    import build123d as bd
+    import numpy as np
+    from matplotlib.figure import Figure
+
+    from spiral_cad.cad.fillet import planar_frame, wire_path
+    from spiral_cad.design import make_g2
+
+    wire = bd.fillet(bd.Rectangle(40, 20).vertices(), 5).faces()[0].outer_wire()
+    segments, closed = wire_path(wire.wrapped, planar_frame(wire.wrapped))
+    result = make_g2(segments, 0.2, closed=closed)
+    fig = Figure(figsize=(11, 6.2), dpi=100)
+    ax_before, ax_after, ax_plan = fig.add_subplot(2, 2, 1), fig.add_subplot(2, 2, 3), fig.add_subplot(1, 2, 2)
+    station, s_in, k_in = 0.0, [], []
+    for segment in segments:  # the input is G1 only: its curvature, one segment at a time
+        u = np.linspace(0.0, 1.0, 60)
+        s_in += list(station + u * segment.length) + [np.nan]
+        k_in += list(np.broadcast_to(segment.curvature(u), u.shape)) + [np.nan]
+        station += segment.length
+    ax_before.plot(s_in, k_in, color="tab:red")
+    ax_before.set_title("fillet(Rectangle(40, 20), 5): κ jumps at 8 joints", fontsize=10)
+    chain = result.chain
+    s_out = np.linspace(0.0, chain.length, 4000)
+    ax_after.plot(s_out, chain.curvature_at(s_out), color="tab:blue")
+    ax_after.set_title(f"make_g2(…, 0.2): κ continuous; deviation {result.deviation:.3f} mm", fontsize=10)
+    for ax in (ax_before, ax_after):
+        ax.set_xlabel("arc length (mm)")
+        ax.set_ylabel("curvature (1/mm)")
+        ax.grid(alpha=0.3)
+    points = np.vstack([s.point(np.linspace(0.0, 1.0, 40)) for s in segments])
+    ax_plan.plot(points[:, 0], points[:, 1], color="tab:red", lw=2.5, alpha=0.5, label="input: lines and arcs (G1)")
+    for segment in chain:
+        p = segment.point(np.linspace(0.0, 1.0, 40))
+        kind = type(segment).__name__
+        color = {"Line": "black", "Arc": "tab:blue", "BezierSpiral": "tab:orange"}[kind]
+        ax_plan.plot(p[:, 0], p[:, 1], color=color, lw=1.2)
+    ax_plan.plot([], [], color="tab:blue", label="result: arcs (true circles, shifted 0.2 mm)")
+    ax_plan.plot([], [], color="tab:orange", label="result: spirals")
+    ax_plan.set_xlim(8, 21)
+    ax_plan.set_ylim(-11, 2)
+    ax_plan.set_aspect("equal")
+    ax_plan.set_title("one corner, close up (mm)", fontsize=10)
+    ax_plan.legend(loc="lower left", fontsize=8)
+    fig.tight_layout()
+    fig.savefig(IMAGES / "make_g2_curvature.png")
+
+
 def main() -> None:
     IMAGES.mkdir(parents=True, exist_ok=True)
     with tempfile.TemporaryDirectory() as tmp:
@@ -113,6 +163,7 @@ def main() -> None:
         first_curve()
         zebra_pictures()
         solids_pictures()
+        make_g2_picture()
     for path in sorted(IMAGES.iterdir()):
         print(path.relative_to(ROOT))
 

@@ -59,6 +59,7 @@ from OCP.TopoDS import TopoDS
 
 from .cad.corridor import Corridor, centerline_wire, corridor
 from .cad.fillet import fillet_face, fillet_wire, planar_frame
+from .cad.g2wire import g2_face, g2_wire
 from .cad.occ import chain_wire, plane_ax3, segment_edges
 from .cad.solids import Slab, continuous_box, fillet_prism_edges
 from .cad.solids import g2_slab as _slab
@@ -88,6 +89,7 @@ __all__ = [
     "curvature_comb",
     "g2_fillet",
     "g2_slab",
+    "make_g2",
 ]
 
 
@@ -765,3 +767,42 @@ def curvature_comb(shape_or_chain, scale: float | None = None, per_edge: int = 2
     from .cad.continuity import curvature_comb as comb
 
     return Compound(comb(shape_or_chain, scale=scale, per_edge=per_edge))
+
+
+def make_g2(target: Wire | Face | Sketch | Curve, max_deviation: float, shape: str = "near-linear") -> Wire | Face | Sketch | Curve:
+    """Operation: Make G2
+
+    Make a planar outline of lines and tangent arcs curvature-continuous (G2)
+    within ``max_deviation`` (``spiral_cad.design.make_g2``): every tangent
+    joint gets a spiral transition, its CIRCLE edges stay CIRCLE edges (shrunk
+    about their centres by the shift each transition needs), sharp corners
+    between lines get a spiral pair, and every point of the result lies within
+    ``max_deviation`` of the input and the input within it of the result. A
+    ``fillet()``ed rectangle or a ``SlotOverall`` becomes G2 this way.
+
+    Returns the same kind as given, every wire of it made G2 (a face's holes
+    included). A wire that reverses is split there into G2 parts that meet.
+
+    Args:
+        target: a planar ``Wire``, ``Face``, ``Sketch`` or ``Curve``.
+        max_deviation (float): the Hausdorff bound, in model units.
+        shape (str, optional): "near-linear" or "walton-meek". Defaults to "near-linear"
+
+    Raises:
+        ValueError: a solid, non-planar input, or edges other than lines and arcs.
+        NoSolutionError: a joint that cannot be made G2 within the bound (named,
+            with the smallest bound that works).
+    """
+    if not isinstance(target, Shape) or target.solids() or target.shells():
+        raise ValueError(f"make_g2 takes a planar Wire, Face, Sketch or Curve; got {type(target).__name__}")
+    if isinstance(target, Wire):
+        return Wire(g2_wire(target.wrapped, max_deviation, shape=shape)[0])
+    if isinstance(target, Face) and not isinstance(target, Sketch):
+        return Face(g2_face(target.wrapped, max_deviation, shape=shape))
+    faces, wires = target.faces(), [] if target.faces() else target.wires()
+    if faces:
+        return Sketch(Compound([Face(g2_face(f.wrapped, max_deviation, shape=shape)) for f in faces]).wrapped)
+    if not wires:
+        raise ValueError(f"make_g2 takes a planar Wire, Face, Sketch or Curve; this {type(target).__name__} has no wires")
+    frame = planar_frame(target.wrapped)
+    return Curve(Compound([Wire(g2_wire(w.wrapped, max_deviation, shape=shape, frame=frame)[0]) for w in wires]).wrapped)

@@ -11,10 +11,12 @@ Importing this module adds these methods to ``cadquery.Workplane``:
 * ``g2Polyline(points, radius=None, max_deviation=None)`` — a polyline (2-D or
   3-D points) whose corners are G2 spiral pairs, as one pending wire
 * ``g2Fillet(radius, transition=0.5)`` — G2 fillets on every corner of the pending wires
+* ``makeG2(maxDeviation)`` — the pending wires of lines and tangent arcs made G2 within a bound
 * ``continuousRect``, ``continuousPolygon``, ``continuousSlot2D`` — shapes with G2 corners
 
 and to ``cadquery.Sketch``: ``g2fillet(radius, transition=0.5)`` on the
-selected vertices (like ``Sketch.fillet``) and ``continuousRect``.
+selected vertices (like ``Sketch.fillet``), ``makeG2(maxDeviation)`` on its
+faces and ``continuousRect``.
 
 All coordinates are local to the workplane (``x`` along its ``xDir``, ``y``
 along ``zDir × xDir``, and for ``g2Polyline`` and chains in space ``z`` along
@@ -45,6 +47,7 @@ import cadquery as cq
 from OCP.gp import gp_Ax3
 
 from .cad.fillet import fillet_face, fillet_wire
+from .cad.g2wire import g2_face, g2_wire
 from .cad.occ import chain_wire, segment_edges
 from .cad.solids import continuous_box
 from .core.chain import Chain
@@ -65,6 +68,7 @@ __all__ = [
     "continuousSlot2D",
     "g2Fillet",
     "g2Polyline",
+    "makeG2",
     "plane_ax3",
     "spiralChain",
     "spiralCircleInCircle",
@@ -254,6 +258,30 @@ def g2Fillet(self: W, radius: float, transition: float = 0.5, same_sense: str = 
     return result
 
 
+def makeG2(self: W, maxDeviation: float, shape: str = "near-linear") -> W:
+    """Make the pending wires G2 within ``maxDeviation`` (``spiral_cad.design.make_g2``).
+
+    Lines and tangent arcs (e.g. a ``rect`` after ``.vertices().fillet2D``, or a
+    ``slot2D``) get spiral transitions at every tangent joint, their arcs kept
+    CIRCLE edges (shrunk about their centres by the shift each transition
+    needs), sharp corners between lines a spiral pair; every point moves by at
+    most ``maxDeviation``. The wires stay pending (e.g. for ``.extrude``).
+
+    Raises:
+        ValueError: no pending wires, non-planar wires or edges other than lines and arcs.
+        NoSolutionError: a joint that cannot be made G2 within the bound (named, with a bound that works).
+    """
+    wires = list(self.ctx.pendingWires)
+    if not wires:
+        raise ValueError("makeG2 makes the pending wires G2; there are none (draw a wire first)")
+    made = [cq.Wire(g2_wire(w.wrapped, maxDeviation, shape=shape)[0]) for w in wires]
+    self.ctx.pendingWires = []
+    result = self.newObject(made)
+    for wire in made:
+        result._addPendingWire(wire)
+    return result
+
+
 def _place_closed(self: W, path) -> W:
     """A closed chain built at the workplane origin, placed at every point on the stack (as ``rect``)."""
     wire = cq.Wire(chain_wire(path.segments))
@@ -308,6 +336,7 @@ METHODS = (
     spiralChain,
     g2Polyline,
     g2Fillet,
+    makeG2,
     continuousRect,
     continuousPolygon,
     continuousSlot2D,
@@ -342,7 +371,13 @@ def sketch_continuous_rect(self: S, w: float, h: float, radius: float, transitio
     return self.each(lambda location: face.located(location), mode, tag)
 
 
-SKETCH_METHODS = {"g2fillet": sketch_g2fillet, "continuousRect": sketch_continuous_rect}
+def sketch_make_g2(self: S, maxDeviation: float, shape: str = "near-linear") -> S:
+    """``cq.Sketch.makeG2``: every face of the sketch (holes included) made G2 within ``maxDeviation``."""
+    self._faces = cq.Compound.makeCompound(cq.Face(g2_face(face.wrapped, maxDeviation, shape=shape)) for face in self._faces.Faces())
+    return self
+
+
+SKETCH_METHODS = {"g2fillet": sketch_g2fillet, "makeG2": sketch_make_g2, "continuousRect": sketch_continuous_rect}
 
 for _name, _sketch_method in SKETCH_METHODS.items():
     setattr(cq.Sketch, _name, _sketch_method)

@@ -105,6 +105,8 @@ SLOW = {
     "test_fit_cli.py",
     "test_points.py::test_a_million_rows_read_as_numpy_wrote_them",
     "test_ifc.py",
+    "test_make_g2.py::test_random_g1_paths_become_g2_within_the_bound",
+    "test_make_g2.py::test_random_closed_filleted_polygons_become_g2",
 }
 _CAD = re.compile(r"^\s*(?:from|import) (?:build123d|cadquery|OCP)\b|importorskip\([\"'](?:build123d|cadquery|OCP)", re.M)
 _SUBPROCESS = re.compile(r"\bsubprocess\b|sys\.executable")

@@ -355,7 +355,19 @@ def _check_shape_file(args: argparse.Namespace) -> int:
     if comb is not None:
         comb_shape = curvature_comb(args.file, units=report.units)  # in the unit the report is in
         export_step(comb_shape, comb, name=f"{report.source} curvature comb", units=report.units)
-    return _print_report(report, args)
+    status = _print_report(report, args)
+    if report.min_level < Continuity.G2:
+        _print_g2_advice(args.file, report.units)
+    return status
+
+
+def _print_g2_advice(file: str, units: str) -> None:
+    """For a file below G2: the smallest max_deviation with which make_g2 makes each wire of lines and arcs G2."""
+    from ..cad.g2wire import g2_advice
+    from ..cad.readers import read_shape
+
+    for line in g2_advice(read_shape(file, units=units or None), units or "mm"):
+        print(line)
 
 
 def _comb_path(comb: str, checked: str) -> Path:

@@ -10,7 +10,7 @@ from .centerline import Centerline3D, centerline_3d
 from .circles import CircleChain, circle_chain
 from .criteria import CriteriaRow, RailCriteria, RoadCriteria
 from .fillets import FilletCorner, FilletedPath, fillet_path
-from .g2 import G2Joint, G2Path, make_g2
+from .g2 import G2Joint, G2Path, make_g2, smallest_max_deviation
 from .profile import Profile, ProfileCriteria, VerticalCurve
 from .rounding import (
     CornerBatch,
@@ -59,4 +59,5 @@ __all__ = [
     "peak_curvature_rate",
     "round_corners",
     "round_corners_batch",
+    "smallest_max_deviation",
 ]

@@ -10,6 +10,8 @@ import math
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from spiral_cad import Arc, BezierSpiral, Chain, Line, NoSolutionError
 from spiral_cad.core.chain import g2_mismatch
@@ -71,7 +73,8 @@ def hausdorff(segments, result: G2Path) -> float:
     fine = np.linspace(0.0, 1.0, 3000)
     for s in pieces:
         if isinstance(s, BezierSpiral):
-            near = np.linalg.norm(inputs - s.point(0.5), axis=1) <= s.length
+            # the spiral lies within its length of its start: only points it could bring nearer
+            near = np.linalg.norm(inputs - s.start, axis=1) - s.length < back
             if near.any():
                 back[near] = np.minimum(back[near], _distance_to_polyline(inputs[near], s.point(fine)))
     return max(there, float(back.max()))
@@ -83,13 +86,16 @@ def fd_curvature_continuous(chain: Chain, tol: float) -> None:
     segs = list(chain)
     size = float(np.abs(chain.segment_ends).max())
     for i, (a, b) in enumerate(zip(segs[:-1], segs[1:])):
-        # The stencil is wide enough that float64's rounding of the points (~eps·size) stays small
-        # against it; the curvature's own change across it is allowed for (≈ 4h of its scale).
-        h = min(max(1e-4, math.sqrt(2.2e-16 * size / 5e-3) / min(a.length, b.length)), 0.05)
+        # The stencil is wide enough that float64's rounding of the points (δ ≈ 4 eps·size) moves the
+        # curvature by under 1e-3 of its scale (δ/(hL)²); the curvature's own change across it is
+        # allowed for (≈ 4h of its scale).
+        own = [abs(float(s.curvature(u))) for s in (a, b) for u in (0.0, 1.0)]  # a spiral's peak: its own scale
+        length = min(a.length, b.length)
+        kappa = max(*own, 1.0 / max(a.length, b.length))
+        h = min(max(1e-4, math.sqrt(4 * 2.2e-16 * size / (1e-3 * kappa)) / length), 0.05)
         ka = _fd_kappa(a, 1.0, h)
         kb = _fd_kappa(b, 0.0, h)
-        own = [abs(float(s.curvature(u))) for s in (a, b) for u in (0.0, 1.0)]  # a spiral's peak: its own scale
-        scale = max(abs(ka), abs(kb), *own, 1.0 / max(a.length, b.length))
+        scale = max(abs(ka), abs(kb), kappa)
         assert abs(ka - kb) <= (tol + 4 * h) * scale, f"joint {i}: κ {ka} before, {kb} after ({type(a).__name__} → {type(b).__name__})"
         ta, tb = a.tangent(1.0), b.tangent(0.0)
         assert abs(ta[0] * tb[1] - ta[1] * tb[0]) <= 1e-7 and float(ta @ tb) > 0, f"joint {i}: tangent turns"
@@ -227,3 +233,156 @@ def test_malformed_input_is_refused_by_name():
         make_g2([(0, 0), (1, 0)], -1.0)
     with pytest.raises(ValueError, match="shape"):
         make_g2([(0, 0), (1, 0)], 0.1, shape="g2cbs")
+
+
+# ---------------------------------------------------------------- properties
+
+
+def _walk(moves, scale: float, origin) -> list:
+    """A G1 path from ``origin`` heading +x: each move a line (length) or a tangent arc (radius, sweep)."""
+    x, y = origin
+    heading = 0.0
+    segments = []
+    for kind, a, b in moves:
+        if kind == "line":
+            length = a * scale
+            end = (x + length * math.cos(heading), y + length * math.sin(heading))
+            segments.append(Line((x, y), end))
+            x, y = end
+        else:
+            radius, sweep = a * scale, b
+            # centre on the left for a positive radius
+            cx, cy = x - radius * math.sin(heading), y + radius * math.cos(heading)
+            start = math.atan2(y - cy, x - cx)
+            arc = Arc((cx, cy), radius, start, sweep)
+            segments.append(arc)
+            x, y = arc.end.tolist()
+            heading += math.copysign(sweep, radius)
+    return segments
+
+
+_line = st.tuples(st.just("line"), st.floats(0.2, 3.0), st.just(0.0))
+_arc = st.tuples(
+    st.just("arc"),
+    st.one_of(st.floats(0.01, 100.0), st.floats(-100.0, -0.01)),
+    st.floats(0.05, 2.5),
+)
+
+
+@settings(max_examples=100)
+@given(
+    moves=st.lists(st.one_of(_line, _arc), min_size=2, max_size=6),
+    scale_exp=st.floats(-3.0, 6.0),
+    offset_exp=st.floats(-3.0, 6.0),
+    bound_exp=st.floats(-6.0, -1.0),
+    shape=st.sampled_from(["near-linear", "walton-meek"]),
+)
+def test_random_g1_paths_become_g2_within_the_bound(outcome, moves, scale_exp, offset_exp, bound_exp, shape):
+    scale = 10.0**scale_exp
+    segments = _walk(moves, scale, (10.0**offset_exp, -(10.0**offset_exp)))
+    size = max(s.length for s in segments)
+    bound = 10.0**bound_exp * size
+    result = outcome(lambda: make_g2(segments, bound, shape=shape))
+    if result is None:
+        _suggested_bound_works(segments, bound, shape, closed=False)
+        return
+    assert_g2(segments, result, bound, closed=False)
+    arcs_kept(segments, result)
+
+
+def _suggested_bound_works(segments, bound, shape, closed) -> None:
+    """A refusal that names a bound: that bound then builds, G2 and within it."""
+    try:
+        make_g2(segments, bound, shape=shape)
+    except NoSolutionError as error:
+        message = str(error)
+        assert "joint" in message
+        if "works (built and checked)" in message:
+            works = float(message.split("max_deviation ")[-1].split(" ")[0])
+            assert works > bound
+            again = make_g2(segments, works, shape=shape)
+            assert_g2(segments, again, works, closed)
+
+
+def _filleted_polygon(points, radii) -> list:
+    """A closed G1 path: the polygon's corners replaced by tangent circular arcs (radii scaled down to fit)."""
+    pts = np.asarray(points, dtype=float)
+    n = len(pts)
+    t_in = [(pts[i] - pts[i - 1]) / np.linalg.norm(pts[i] - pts[i - 1]) for i in range(n)]
+    t_out = [(pts[(i + 1) % n] - pts[i]) / np.linalg.norm(pts[(i + 1) % n] - pts[i]) for i in range(n)]
+    turns = [math.atan2(a[0] * b[1] - a[1] * b[0], float(a @ b)) for a, b in zip(t_in, t_out)]
+    tangents = [r * math.tan(abs(d) / 2) for r, d in zip(radii, turns)]
+    edges = [np.linalg.norm(pts[(i + 1) % n] - pts[i]) for i in range(n)]
+    fit = min(0.9 * e / (tangents[i] + tangents[(i + 1) % n]) for i, e in enumerate(edges))
+    radii = [r * min(fit, 1.0) for r in radii]
+    segments = []
+    for i in range(n):
+        r, d = radii[i], turns[i]
+        t = r * math.tan(abs(d) / 2)
+        start, end = pts[i] - t * t_in[i], pts[i] + t * t_out[i]
+        normal = np.array([-t_in[i][1], t_in[i][0]]) * math.copysign(1.0, d)
+        centre = start + r * normal
+        arc = Arc(centre, math.copysign(r, d), math.atan2(*(start - centre)[::-1]), abs(d))
+        segments.append(arc)
+        nxt = pts[(i + 1) % n]
+        t_next = radii[(i + 1) % n] * math.tan(abs(turns[(i + 1) % n]) / 2)
+        segments.append(Line(end, nxt - t_next * t_out[i]))
+    return segments
+
+
+@settings(max_examples=50)
+@given(
+    count=st.integers(3, 7),
+    jitter=st.lists(st.floats(-0.3, 0.3), min_size=7, max_size=7),
+    spread=st.lists(st.floats(0.4, 1.0), min_size=7, max_size=7),
+    radii=st.lists(st.floats(0.01, 1.0), min_size=7, max_size=7),
+    scale_exp=st.floats(-3.0, 6.0),
+    bound_exp=st.floats(-6.0, -1.0),
+    shape=st.sampled_from(["near-linear", "walton-meek"]),
+)
+def test_random_closed_filleted_polygons_become_g2(outcome, count, jitter, spread, radii, scale_exp, bound_exp, shape):
+    """Star-shaped polygons (convex and concave corners: reverse curves between fillets of opposite sense)."""
+    angles = [2 * math.pi * (k + jitter[k]) / count for k in range(count)]
+    scale = 10.0**scale_exp
+    points = [(scale * spread[i] * math.cos(a), scale * spread[i] * math.sin(a)) for i, a in enumerate(angles)]
+    segments = _filleted_polygon(points, [r * scale for r in radii[:count]])
+    size = max(s.length for s in segments)
+    bound = 10.0**bound_exp * size
+    result = outcome(lambda: make_g2(segments, bound, shape=shape))
+    if result is None:
+        _suggested_bound_works(segments, bound, shape, closed=True)
+        return
+    assert result.closed
+    assert_g2(segments, result, bound, closed=True)
+    arcs_kept(segments, result)
+
+
+def test_a_planar_path_in_space_is_made_g2_in_its_plane():
+    from spiral_cad import PlaneFrame
+
+    frame = PlaneFrame((1.0, 2.0, 3.0), (1.0, 0.0, 1.0), (-1.0, 0.5, 1.0))
+    flat = filleted_rectangle()
+    tilted = make_g2([s.placed(frame) for s in flat], 0.01)
+    plane = make_g2(flat, 0.01)
+    assert tilted.chain.dim == 3 and tilted.closed
+    assert tilted.chain.length == pytest.approx(plane.chain.length, rel=1e-9)
+    assert tilted.deviation == pytest.approx(plane.deviation, rel=1e-6)
+    points = tilted.chain.sample(50)
+    off_plane = (points - np.array(frame.origin)) @ (np.asarray(frame.normal) / np.linalg.norm(frame.normal))
+    assert np.abs(off_plane).max() <= 1e-9
+    corner = make_g2([(0, 0, 0), (1, 0, 1), (1, 1, 1)], 0.01)
+    assert corner.chain.dim == 3 and [j.kind for j in corner.joints] == ["corner"]
+
+
+@pytest.mark.parametrize("length", [1e-2, 1e-3])
+@pytest.mark.parametrize("sense", [1.0, -1.0])
+def test_a_short_line_between_arcs_is_bridged_by_a_pair(length, sense):
+    """A line too short for a transition at each end (here 1e-2 and 1e-3 between arcs of radius 100)
+    is joined across by a C (same sense) or S pair: the arcs still shift by the whole bound."""
+    segments = _walk([("arc", 100.0, 0.3), ("line", length, 0.0), ("arc", sense * 100.0, 0.3)], 1.0, (0.0, 0.0))
+    result = make_g2(segments, 0.01)
+    assert_g2(segments, result, 0.01, closed=False)
+    arcs_kept(segments, result)
+    assert [j.kind for j in result.joints] == ["line-arc", "line-arc"]
+    assert "joined across" in result.joints[0].moved
+    assert result.joints[0].shift == pytest.approx(0.01, rel=1e-5)
