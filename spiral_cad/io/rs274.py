@@ -17,7 +17,8 @@ How the moves are read back:
 * ``ARC_FEED(first_end, second_end, first_centre, second_centre, rotation, normal_end, a, b, c)``
   in the plane of the last ``SELECT_PLANE`` (XY: first X, second Y; XZ: first Z, second X;
   YZ: first Y, second Z): chords within ``arc_tolerance`` (refused without it, as the built-in
-  reader does);
+  reader does) by ``run_rs274``; kept arcs by ``rs274_pieces`` (``spiral_cad.io.gcode_paths``);
+* ``SET_FEED_RATE`` and ``SET_FEED_MODE``: the feed of every piece (``rs274_pieces``);
 * ``USE_LENGTH_UNITS``: the unit (rs274 prints positions in the program's unit; its own
   default, before any G20/G21, is mm);
 * ``NURBS_FEED``, ``SPLINE_FEED``, ``STRAIGHT_PROBE``, ``RIGID_TAP`` and moves of the
@@ -25,7 +26,8 @@ How the moves are read back:
 
 The G-code line of every move: the program is handed to rs274 with its line number as the N
 word of each line (an N word only labels a line), and rs274 prints it with each call. Moves
-from a subroutine in another file keep the line of the call.
+from a subroutine in another file keep the last line printed before them (O-word lines carry no N
+word). ``folder`` runs rs274 in the program's folder, where it finds those subroutine files.
 
 Precision: rs274 prints 4 decimals, so positions agree with the program to 0.00005 of its unit
 (exactly, for programs written with at most 4 decimals in absolute coordinates).
