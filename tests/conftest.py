@@ -66,6 +66,9 @@ def outcome():
 #: module or by ``module::test`` name.
 SLOW = {
     "test_install.py",
+    "test_linuxcnc_programs.py::test_linuxcncs_programs_build_g2_and_read_back",
+    "test_g2_build.py::test_build_dxf_writes_every_output_and_refuses_by_name",
+    "test_g2_build.py::test_a_landxml_alignment_of_lines_and_arcs_is_made_g2",
     "test_fit.py",
     "test_fuzz_readers.py",
     "test_examples.py",
