@@ -69,7 +69,8 @@ def child(job: str, moves: int) -> None:
     if job == "build":
         build(moves)
         return
-    from spiral_cad.io.gcode import parse_gcode, read_gcode, round_toolpath, round_toolpath_arrays
+    from spiral_cad.io.gcode import parse_gcode, read_gcode
+    from spiral_cad.io.toolpath_rounding import round_toolpath, round_toolpath_arrays
 
     warm = parse_gcode(program(50))  # compile the kernels first (one warm-up, as compare does)
     if job in ("chain", "write"):

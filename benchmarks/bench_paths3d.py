@@ -128,7 +128,8 @@ def gcode_rows(sizes: dict, folder: Path) -> list[list[str]]:
     from build123d import Polyline
 
     from spiral_cad.cad.export import export_samples, export_step
-    from spiral_cad.io.gcode import read_gcode, round_toolpath
+    from spiral_cad.io.gcode import read_gcode
+    from spiral_cad.io.toolpath_rounding import round_toolpath
 
     program = folder / "finish.nc"
     program.write_text(gcode_program(sizes["moves"], np.random.default_rng(2)))

@@ -67,6 +67,9 @@ def outcome():
 SLOW = {
     "test_install.py",
     "test_faces_mutation.py::test_every_planted_local_defect_in_a_continuous_box_is_found",
+    "test_linuxcnc_programs.py::test_linuxcncs_programs_build_g2_and_read_back",
+    "test_g2_build.py::test_build_dxf_writes_every_output_and_refuses_by_name",
+    "test_g2_build.py::test_a_landxml_alignment_of_lines_and_arcs_is_made_g2",
     "test_fit.py",
     "test_fuzz_readers.py",
     "test_examples.py",

@@ -89,11 +89,11 @@ PIP_CAD = 'pip install "spiral_cad[cad]"'
 
 
 def _write_design(design: dict | str, out: Path, plots: bool, extra: Callable[[Path], None] | None = None,
-                  max_offset: float | None = None, directions: str = "auto") -> int:  # fmt: skip
+                  max_offset: float | None = None, directions: str = "auto", prebuilt: Callable[[], tuple] | None = None) -> int:  # fmt: skip
     from .designfile import build, criteria_tables, summary, write
 
     started = time.perf_counter()
-    units, built = build(design, max_offset=max_offset, directions=directions)
+    units, built = build(design, max_offset=max_offset, directions=directions) if prebuilt is None else prebuilt()
     print(f"built {len(built)} design(s); writing to {out}/", flush=True)
     try:
         written = write(built, out, units, progress=lambda line: print(line, flush=True), plots=plots, extra=extra)
@@ -159,6 +159,9 @@ GCODE_ONLY = ("max_deviation", "interpreter", "arc_tolerance", "feed")
 
 
 def _build(args: argparse.Namespace) -> int:
+    suffix = "" if args.design is None else Path(args.design).suffix.lower()
+    if args.g2 is not None or suffix in (".dxf", ".xodr"):
+        return _build_g2(args, suffix)
     landxml = [o for o, given in (("--max-offset", args.max_offset is not None), ("--directions", args.directions != "auto")) if given]
     if landxml and (args.design is None or Path(args.design).suffix.lower() != ".xml"):
         raise ValueError(f"{', '.join(landxml)}: only with a LandXML file (.xml)")
@@ -178,8 +181,52 @@ def _build(args: argparse.Namespace) -> int:
         raise ValueError("give a design file or --from-gcode, not both")
     from ..io.gcode import reading_options
 
-    with reading_options(args.interpreter or "builtin", args.arc_tolerance, args.units or "mm"):
+    stated = args.units if args.units in ("mm", "in") else None  # the unit of a program that says neither G20 nor G21
+    with reading_options(args.interpreter or "builtin", args.arc_tolerance, args.units or "mm", program_units=stated):
         return _write_design(gcode_design(args), Path(args.out), plots=not args.no_plots)
+
+
+#: ``build`` options a DXF drawing or ``--g2`` takes (the rest are refused by name).
+G2_OPTIONS = ("max_deviation", "units", "shape", "name")
+
+
+def _build_g2(args: argparse.Namespace, suffix: str) -> int:
+    """``build FILE.dxf --max-deviation D`` and ``build FILE.xml|.xodr --g2 D``: lines and arcs made G2 (``g2_build``)."""
+    from .g2_build import g2_designs
+
+    if suffix not in (".dxf", ".xml", ".xodr"):
+        raise ValueError("--g2: only with a DXF (.dxf), LandXML (.xml) or OpenDRIVE (.xodr) file")
+    if suffix == ".xodr" and args.g2 is None:
+        raise ValueError("an OpenDRIVE file is built with --g2 D (its lines and arcs made G2 within D); check it with spiral-cad check")
+    if args.g2 is not None and args.max_deviation is not None:
+        raise ValueError("give --g2 or --max-deviation (the same bound), not both")
+    deviation = args.g2 if args.g2 is not None else args.max_deviation
+    if deviation is None:
+        raise ValueError(
+            f"{Path(args.design).name}: give --max-deviation (the largest distance between the drawing's path and the G2 path)"
+        )
+    if not 0.0 < deviation < math.inf:
+        raise ValueError(f"--{'g2' if args.g2 is not None else 'max-deviation'} must be a positive finite number; got {deviation}")
+    others = [
+        f"--{o.replace('_', '-')}"
+        for o in (*GCODE_OPTIONS, *POINTS_OPTIONS)
+        if o not in G2_OPTIONS and getattr(args, o) not in (None, False)
+    ]
+    others += [o for o, given in (("--from-gcode", args.from_gcode), ("--from-points", args.from_points),
+                                  ("--max-offset", args.max_offset is not None), ("--directions", args.directions != "auto")) if given]  # fmt: skip
+    if others:
+        raise ValueError(f"{', '.join(others)}: not with a {'DXF drawing' if suffix == '.dxf' else '--g2 build'}")
+    if args.shape == "g2cbs":
+        raise ValueError("--shape g2cbs rounds corners; make_g2's spirals are near-linear (default) or walton-meek")
+    # the file's own unit unless --units is given (a DXF drawing is converted, a unitless one read in it)
+    return _write_design(
+        {},
+        Path(args.out),
+        plots=not args.no_plots,
+        prebuilt=lambda: g2_designs(
+            args.design, deviation, name=args.name, units=args.units, source_units=args.units, shape=args.shape or "near-linear"
+        ),
+    )
 
 
 def _check_numbers(args: argparse.Namespace, keys: tuple[str, ...]) -> None:
@@ -475,7 +522,7 @@ def _build_inputs(args: argparse.Namespace) -> int:
 
     designs: list[str] = args.design
     field, inputs = "design", designs
-    suffixes: tuple[str, ...] = (".json", ".xml")
+    suffixes: tuple[str, ...] = (".json", ".xml", ".dxf", ".xodr")
     for option, kinds in (("from_gcode", GCODE_SUFFIXES), ("from_points", (".csv", ".txt", ".xyz"))):
         first = getattr(args, option)
         if first is not None:
@@ -533,7 +580,9 @@ def _parser() -> argparse.ArgumentParser:
     build.add_argument(
         "design",
         nargs="*",
-        help="the design file (.json), or a LandXML file (.xml: every alignment); or --from-gcode or --from-points; "
+        help="the design file (.json), a LandXML file (.xml: every alignment), a DXF drawing (.dxf: its "
+        "lines and arcs chained into paths, made G2 within --max-deviation; --units for a unitless drawing) or an OpenDRIVE "
+        "file (.xodr, with --g2); or --from-gcode or --from-points; "
         "several files, folders or glob patterns are built in parallel, each into OUT/ its name (see --workers)",
     )
     build.add_argument("-o", "--out", default="out", help="output folder (default: out)")
@@ -541,16 +590,21 @@ def _parser() -> argparse.ArgumentParser:
     build.add_argument("--max-offset", type=float, metavar="LENGTH",
                        help="LandXML: the largest offset accepted between a file's element and ours, in the file's unit "
                             "(default: 5%% of each element's length; inf accepts any)")  # fmt: skip
+    build.add_argument("--g2", type=float, metavar="D",
+                       help="LandXML or OpenDRIVE: make every alignment of lines and arcs G2 within D (its unit; "
+                            "make_g2: arcs kept true arcs, spirals between), one design per alignment or road")  # fmt: skip
     build.add_argument("--directions", choices=["auto", "east-ccw", "north-cw"], default="auto",
                        help="LandXML: how the file counts directions: counter-clockwise from east or clockwise from north "
                             "(default auto: told from the file's own points)")  # fmt: skip
     gcode = build.add_argument_group(
-        "G-code", "round the straight moves (G0/G1) of a CNC program G2 and write STEP, IGES, DXF, samples, the\n"
-        "continuity report and NAME.ngc, the rounded program at the program's feed (never over the input; README: the\n"
-        "G-code subset; a program with G5 splines is read as the exact path it states; other codes are refused by\n"
-        "name and line)")  # fmt: skip
+        "G-code", "make a CNC program's path G2 and write STEP, IGES, DXF, samples, the continuity report and NAME.ngc,\n"
+        "the G2 program at the program's feed (never over the input). Lines stay lines and arcs (G2/G3, any plane)\n"
+        "true arcs; the path is split where it folds straight back (a plunge and its retract): one design NAME_1,\n"
+        "NAME_2, ... per G2 path. A program with G5 splines is read as the exact path it states; other codes are\n"
+        "refused by name and line (README: the G-code subset)")  # fmt: skip
     gcode.add_argument("--from-gcode", metavar="FILE.nc", help="the program to round (instead of a design file)")
-    gcode.add_argument("--max-deviation", type=float, help="the largest distance between a corner point and the path")
+    gcode.add_argument("--max-deviation", type=float,
+                       help="the largest distance between the program's path and the G2 path (at corners and tangent joints)")  # fmt: skip
     gcode.add_argument("--max-curvature", type=float, help="the curvature bound (1/unit)")
     gcode.add_argument("--shape", choices=["walton-meek", "near-linear", "g2cbs"], help="spiral shape (default walton-meek)")
     gcode.add_argument("--sample-step", type=float, help="samples at most this far apart along the path")
@@ -558,7 +612,8 @@ def _parser() -> argparse.ArgumentParser:
                        help="samples close enough that the path strays at most this far from their chords "
                             "(default: a tenth of --max-deviation, else 0.001)")  # fmt: skip
     gcode.add_argument("--units", choices=["mm", "cm", "m", "km", "in", "ft"],
-                       help="the unit of the outputs and of every length above (default mm; the program's G20/G21 is converted)")  # fmt: skip
+                       help="the unit of the outputs and of every length above (default mm; the program's G20/G21 is converted); "
+                            "mm or in also states the unit of a program that says neither G20 nor G21 (refused otherwise)")  # fmt: skip
     gcode.add_argument("--name", help="the design's name (default: the program's file name)")
     gcode.add_argument("--feed", type=float,
                        help="the F word of the rounded program NAME.ngc, in its unit per minute (default: the program's "
@@ -570,8 +625,10 @@ def _parser() -> argparse.ArgumentParser:
         "Debian package linuxcnc-uspace)",
     )
     gcode.add_argument(
-        "--arc-tolerance", type=float, help="read arcs G2/G3 as chords at most this far from the arc (default: arcs refused)"
-    )
+        "--arc-tolerance", type=float,
+        help="helical arcs (G2/G3 that also move along the plane's normal) become chords at most this far from them "
+             "(default a tenth of --max-deviation; the rest is the G2 path's); plane arcs stay arcs",
+    )  # fmt: skip
     fit = build.add_argument_group(
         "points", "fit lines, arcs and spirals G2 to measured or digitised points, every point within --tolerance; also\n"
         "writes NAME_residuals.csv and NAME_fit.png (--units, --name, --max-curvature, the samples as above; --shape\n"

@@ -125,6 +125,7 @@ class BuiltRounded(Built):
     """A rounded polyline or toolpath (``source``: the ``RoundedPath``), with its optional samples."""
 
     samples: dict[str, float] | None = None
+    notes: tuple[str, ...] = ()  # what the summary tells of how it was read (a G-code program split where it folds back)
 
     @property
     def kind(self) -> str:
@@ -432,38 +433,25 @@ def _circle_chain(d: CircleChainDesign, where: str, units: str, base: Path | Non
     return BuiltCircleChain(name=d.name, chain=result.chain, source=result)
 
 
-def _rounded(d: RoundedPolylineDesign, where: str, units: str, base: Path | None) -> BuiltRounded:
+def _rounded(d: RoundedPolylineDesign, where: str, units: str, base: Path | None) -> Built | list[Built]:
     from ..design import round_corners
 
     if d.points is not None:  # the model holds points or gcode
         result = round_corners(d.points, shape=d.shape, units=units, **d.rounding())
     else:
-        from ..io.gcode import holds_splines, read_gcode, read_gcode_chain, round_toolpath
+        from ..io.gcode import holds_splines, program_feeds, read_gcode_chain
 
         program = _own_file(str(d.gcode), base, f"{where}.gcode")
-        if holds_splines(program):  # G5: the program states its curves (our own output reads back as its chain)
-            from ..design.rounding import RoundedPath
-            from ..io.gcode import program_feeds
+        if not holds_splines(program):  # lines and arcs: one design per G2 path
+            from .gcode_build import toolpath_designs
 
-            result = RoundedPath(read_gcode_chain(program, units=units), [], d.shape)
-            feeds, program_units = program_feeds(program)
-            per_segment = None
-        else:
-            from ..core.units import MM_PER_UNIT
-            from ..io.gcode import segment_feeds
-            from ..io.gcode_write import PROGRAM_UNIT
+            return toolpath_designs(d, where, units, program)
+        from ..design.rounding import RoundedPath  # G5: the program states its curves (our own output reads back as its chain)
 
-            path = read_gcode(program)
-            feeds, program_units = path.feeds, path.units
-            moves = path.in_units(units)
-            result = round_toolpath(moves, shape=d.shape, **d.rounding())
-            per_segment = segment_feeds(result, moves)  # in units per minute: to the written program's unit
-            if per_segment is not None:
-                per_segment = per_segment * (MM_PER_UNIT[units] / MM_PER_UNIT[PROGRAM_UNIT[units]])
-        feed = _program_feed(feeds, program_units, units)
+        result = RoundedPath(read_gcode_chain(program, units=units), [], d.shape)
+        feed = _program_feed(*program_feeds(program), units)
         samples = None if d.samples is None else d.samples.options()
-        return BuiltRounded(name=d.name, chain=result.chain, source=result, samples=samples, inputs=(program,), program_feed=feed,
-                            segment_feeds=per_segment)  # fmt: skip
+        return BuiltRounded(name=d.name, chain=result.chain, source=result, samples=samples, inputs=(program,), program_feed=feed)
     samples = None if d.samples is None else d.samples.options()
     return BuiltRounded(name=d.name, chain=result.chain, source=result, samples=samples)
 
@@ -590,13 +578,22 @@ def _transition(d: Any, where: str, units: str, base: Path | None) -> BuiltTrans
     return BuiltTransition(name=d.name, chain=Chain(t.spirals, units=units), source=t)
 
 
-BUILDERS: dict[str, Callable[[Any, str, str, Path | None], Built]] = {
+BUILDERS: dict[str, Callable[[Any, str, str, Path | None], Built | list[Built]]] = {
     "alignment": _alignment,
     "circle_chain": _circle_chain,
     "rounded_polyline": _rounded,
     "transition": _transition,
     "fit": _fit,
+    "g2_path": lambda d, where, units, base: _g2_path(d, units, base, where),
 }
+
+
+def _g2_path(d: Any, units: str, base: Path | None, where: str) -> list[Built]:
+    """A ``g2_path`` design: the lines and arcs of a DXF, LandXML or OpenDRIVE file made G2 (``g2_build``)."""
+    from .g2_build import g2_designs
+
+    source = _own_file(d.source, base, f"{where}.source")
+    return g2_designs(source, d.max_deviation, name=d.name, units=units, source_units=d.source_units, shape=d.spiral_shape)[1]
 
 
 def build(source: str | Path | dict, max_offset: float | None = None, directions: str = "auto") -> tuple[str, list[Built]]:
@@ -620,14 +617,15 @@ def build(source: str | Path | dict, max_offset: float | None = None, directions
     for i, d in enumerate(design_file.designs):
         where = f"designs[{i}] ({d.name})"
         try:
-            b = BUILDERS[d.type](d, where, design_file.units, base)
-            if d.gcode_out is not None or isinstance(b, BuiltRounded):  # a path gets its program
-                b.gcode = {} if d.gcode_out is None else d.gcode_out.options()
-                if b.program_feed is not None and "feed" not in b.gcode:  # the program's own feeds, unless one is stated
-                    b.gcode["feed"] = b.program_feed
-                    if b.segment_feeds is not None:
-                        b.gcode["feeds"] = b.segment_feeds
-            built.append(b)
+            made = BUILDERS[d.type](d, where, design_file.units, base)
+            for b in made if isinstance(made, list) else [made]:  # a G-code program: one design per G2 path
+                if d.gcode_out is not None or isinstance(b, BuiltRounded):  # a path gets its program
+                    b.gcode = {} if d.gcode_out is None else d.gcode_out.options()
+                    if b.program_feed is not None and "feed" not in b.gcode:  # the program's own feeds, unless one is stated
+                        b.gcode["feed"] = b.program_feed
+                        if b.segment_feeds is not None:
+                            b.gcode["feeds"] = b.segment_feeds
+                built.append(b)
         except DesignError:
             raise
         except (NoSolutionError, ValueError) as e:
@@ -808,6 +806,11 @@ def _write_others(b: Built, stage: Path, units: str, missing: list[str], plots: 
                 names += _road_3d(b, profile, stage, units)
     if isinstance(b, BuiltLandXML):
         names += _landxml_report(b, stage)
+    elif getattr(b, "road", False):  # an alignment made G2 (build FILE.xml --g2): also its OpenDRIVE
+        from ..cad.export import export_opendrive
+
+        export_opendrive(b.chain, stage / f"{b.name}.xodr", name=b.name)
+        names.append("xodr")
     if "OCP" not in missing and len(b.chain) > LARGE_CHAIN_EDGES:
         names.append(f"no igs ({len(b.chain):,} edges, above {LARGE_CHAIN_EDGES:,}: the STEP file holds the same exact curves)")
     elif "OCP" not in missing:
@@ -916,6 +919,7 @@ def summary(built: list[Built], units: str) -> str:
     lines = fixed_columns(columns, rows)
     lines += [f"{b.name}: {b.road_3d}" for b in built if b.road_3d]
     lines += [f"{b.name}: {b.fit.line()}" for b in built if isinstance(b, BuiltFit | BuiltRoadFit)]
+    lines += [f"{b.name}: {note}" for b in built for note in getattr(b, "notes", ())]
     lines += [f"{b.name}: {b.renamed}" for b in built if isinstance(b, BuiltLandXML) and b.renamed]
     lines += [f"{b.name}: {b.landxml_offset()}" for b in built if isinstance(b, BuiltLandXML) and b.run == 0]
     return "\n".join(lines)

@@ -555,9 +555,31 @@ class LineToLine(_Transition):
     spiral_shape: CornerShape = Field("walton-meek", description="walton-meek, near-linear or g2cbs.")
 
 
+def _g2_source(value: Any) -> str:
+    if not isinstance(value, str) or not value or "\0" in value or not value.lower().endswith((".dxf", ".xml", ".xodr")):
+        raise _error(f"must be the path of a .dxf, .xml (LandXML) or .xodr (OpenDRIVE) file; got {_shown(value)}")
+    return value
+
+
+class G2PathDesign(_Model):
+    """The lines and arcs of a DXF drawing, a LandXML alignment or an OpenDRIVE road made G2 within max_deviation
+    (``spiral_cad.design.make_g2``), arcs kept true arcs: one design per G2 path (NAME_1, NAME_2, … when there are several)."""
+
+    name: Name = Field(description="Names the output files (see alignment).")
+    type: Literal["g2_path"]
+    source: Annotated[str, PlainValidator(_g2_source, json_schema_input_type=Annotated[str, Field(min_length=1)])] = Field(
+        description="A .dxf, LandXML .xml or OpenDRIVE .xodr file in the design file's folder (relative, without '..'); "
+        "a LandXML or OpenDRIVE file's unit must be the design file's.")  # fmt: skip
+    max_deviation: Positive = Field(description="The largest distance between the file's path and the G2 path.")
+    source_units: Units | None = Field(None, description="DXF: the unit of a unitless drawing (default: refused).")
+    spiral_shape: TransitionShape = Field("near-linear", description="near-linear (default) or walton-meek.")
+    gcode_out: GcodeOut | None = Field(None, description="Also write NAME.ngc, the path as G-code.")
+
+
 TransitionDesign = Annotated[LineToCircle | CircleToCircle | LineToLine | CircleInCircle, Field(discriminator="case")]
-Design = Annotated[AlignmentDesign | CircleChainDesign | RoundedPolylineDesign | TransitionDesign | FitDesign, Field(discriminator="type")]
-TYPES = ("alignment", "circle_chain", "rounded_polyline", "transition", "fit")
+Design = Annotated[AlignmentDesign | CircleChainDesign | RoundedPolylineDesign | TransitionDesign | FitDesign | G2PathDesign,
+                   Field(discriminator="type")]  # fmt: skip
+TYPES = ("alignment", "circle_chain", "rounded_polyline", "transition", "fit", "g2_path")
 CASES = ("line_to_circle", "circle_to_circle", "line_to_line", "circle_in_circle")
 
 

@@ -1,5 +1,5 @@
-"""File formats that need no CAD kernel: STEP text, SVG, DXF (through ezdxf), samples CSV,
-G-code in and out, point files in, OpenDRIVE model, writer, reader and checker, LandXML out and in
+"""File formats that need no CAD kernel: STEP text, SVG, DXF out and in (through ezdxf), samples CSV,
+G-code in (as a polyline, or as lines and arcs) and out, point files in, OpenDRIVE model, writer, reader and checker, LandXML out and in
 (``read_landxml``, loaded on first use), and all-or-nothing output staging.
 
 IGES and the STEP of solids go through OCCT and live in ``spiral_cad.cad``.

@@ -69,19 +69,16 @@ import re
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from contextvars import ContextVar
-from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
-from numpy.typing import NDArray
 
 from ..core import bezier
-from .progress import Progress, ticking
+from .progress import Progress
 from .toolpath import PLANES, GcodePath, arc_points, arc_sweep, in_program_unit, spline_points
 
 if TYPE_CHECKING:
     from ..core.chain import Chain
-    from ..design.rounding import RoundedPath
 
 #: Files larger than this are refused before reading (a full disk or a wrong file, not a program).
 MAX_BYTES = 1 << 30
@@ -177,6 +174,8 @@ class _Reader:
         self.end_at: int | None = None
         self.ended = False
         self.exact = False  # arcs and G5 splines kept as pieces (``pieces``), no chords needed
+        self.assumed_units: str | None = None  # the unit of a program that states none (None: refused)
+        self.piece_feeds: list[float] = []  # the F in force on each piece (NaN: a rapid, none, not G94)
         self.pieces: list[tuple[Any, ...]] = []  # (kind, line, rapid, start, data…) of every move (with ``exact``)
         self.spline_end: tuple[float, float] | None = None  # the last G5's (P, Q), while G5 moves follow each other
         self.feed: float | None = None  # the modal F (program unit per minute under G94)
@@ -335,14 +334,18 @@ class _Reader:
                 )
         if motion is not None:
             self.motion = None if motion == 800 else motion
-        if target:
+        if target or centre and self.motion in (20, 30):  # an arc with no axis word: a full circle back to its start
             if self.motion is None:
                 reason = (
                     "after G80 (motion cancelled)" if motion == 800 or self.cancelled else "with no motion mode in effect (G0, G1, G2, G3)"
                 )
                 raise self.error(number, f"coordinates {reason}; LinuxCNC: cannot use axis values without a G code that uses them")
             if self.units is None:
-                raise self.error(number, "the program sets no unit before its first move: add G21 (mm) or G20 (inch)")
+                if self.assumed_units is None:
+                    raise self.error(number, "the program sets no unit before its first move: add G21 (mm) or G20 (inch), "
+                                             "or state it (units='mm' or 'in'; build: --units mm or --units in)")  # fmt: skip
+                self.units = self.assumed_units
+                self.notes.append(f"line {number}: the program states no unit (G20/G21); read in {self.units} as stated")
             moved = list(self.position)
             for axis, value in target.items():
                 moved[axis] = value if self.absolute else moved[axis] + value
@@ -378,6 +381,8 @@ class _Reader:
             self.point_feeds.append(feed)
             self.lines.append(number)
             self.rapid.append(self.motion == 0)
+        if self.exact:  # every piece is followed by one add
+            self.piece_feeds.append(feed)
         if self.progress is not None:
             self.progress(len(self.points))
 
@@ -488,20 +493,27 @@ class _Reader:
 
 
 #: How ``read_gcode`` reads when its caller does not say (set by ``reading_options``).
-_DEFAULTS: ContextVar[tuple[str, float | None, str | None]] = ContextVar("gcode_reading", default=("builtin", None, None))
+_DEFAULTS: ContextVar[tuple[str, float | None, str | None, str | None]] = ContextVar("gcode_reading", default=("builtin", None, None, None))
 
 
 @contextmanager
 def reading_options(
-    interpreter: str = "builtin", arc_tolerance: float | None = None, arc_tolerance_units: str | None = None
-) -> Iterator[None]:
-    """Within the block, ``read_gcode`` calls that do not name them use this interpreter and arc
-    tolerance (how ``build --from-gcode --interpreter rs274`` reaches the design file's reader)."""
-    token = _DEFAULTS.set((interpreter, arc_tolerance, arc_tolerance_units))
+    interpreter: str = "builtin", arc_tolerance: float | None = None, arc_tolerance_units: str | None = None,
+    program_units: str | None = None,
+) -> Iterator[None]:  # fmt: skip
+    """Within the block, ``read_gcode`` and ``read_gcode_moves`` calls that do not name them use this
+    interpreter, arc tolerance and unit of a program that states none (``"mm"``, ``"in"``; None refuses
+    it): how ``build --from-gcode --interpreter rs274 --units in`` reaches the design file's reader."""
+    token = _DEFAULTS.set((interpreter, arc_tolerance, arc_tolerance_units, program_units))
     try:
         yield
     finally:
         _DEFAULTS.reset(token)
+
+
+def reading_defaults() -> tuple[str, float | None, str | None, str | None]:
+    """What ``reading_options`` set: (interpreter, arc tolerance, its unit, the unit of a program that states none)."""
+    return _DEFAULTS.get()
 
 
 def parse_gcode(
@@ -588,155 +600,10 @@ def read_gcode(
     """
     text, label = _program_text(path)
     if interpreter is None:  # neither given: what reading_options set (the built-in reader, arcs refused)
-        interpreter, default_tolerance, default_units = _DEFAULTS.get()
+        interpreter, default_tolerance, default_units, _ = _DEFAULTS.get()
         if arc_tolerance is None:
             arc_tolerance, arc_tolerance_units = default_tolerance, default_units
     return parse_gcode(text, label, arc_tolerance=arc_tolerance, interpreter=interpreter, arc_tolerance_units=arc_tolerance_units)
-
-
-#: OCCT's Precision::Confusion (model units): two points closer than this are one point, so no edge is shorter.
-OCCT_CONFUSION = 1e-7
-
-
-def segment_lines(rounded: RoundedPath, path: GcodePath) -> NDArray:
-    """The G-code line of every segment of ``rounded.chain`` (rounded from ``path``): a corner's
-    spirals take the line of the move that ends at the corner, a straight piece the line of its move."""
-    kind = np.asarray(rounded.chain.rows.kind)
-    corner_of = np.cumsum(kind != 0) - 1  # the spiral's number along the chain
-    index = np.array([c.index for c in rounded.corners], dtype=np.int64)
-    lines = np.empty(len(kind), dtype=np.int64)
-    spiral = kind != 0
-    if spiral.sum() == 2 * len(index):  # two spirals a corner, in order
-        lines[spiral] = path.lines[index[corner_of[spiral] // 2]]
-        # a straight piece runs from the previous corner to the next point: the move that ends there
-        after = np.searchsorted(np.flatnonzero(spiral), np.flatnonzero(~spiral))  # spirals before each straight piece
-        ahead = after // 2  # the corner the straight piece leads to (len(index) past the last corner)
-        ends = np.where(ahead < len(index), index[np.minimum(ahead, len(index) - 1)] if len(index) else 0, len(path) - 1)
-        lines[~spiral] = path.lines[ends]
-    else:  # another layout: the line of the nearest point to each segment's middle
-        middles = np.asarray(rounded.chain.segment_ends).mean(axis=1)
-        for i, middle in enumerate(middles):
-            lines[i] = path.lines[int(np.argmin(np.linalg.norm(path.points - middle, axis=1)))]
-    return lines
-
-
-def segment_feeds(rounded: RoundedPath, path: GcodePath) -> NDArray | None:
-    """The feed of every segment of ``rounded.chain`` (rounded from ``path``, its unit per minute): the F in force
-    on the move of the segment's line (``segment_lines``); NaN where that move has none, None when ``path`` has no
-    feeds (read by rs274)."""
-    if path.point_feeds is None or not len(path.point_feeds):
-        return None
-    lines = segment_lines(rounded, path)
-    at = np.clip(np.searchsorted(path.lines, lines, side="right") - 1, 0, len(path.lines) - 1)
-    feeds: NDArray = path.point_feeds[at]
-    return feeds
-
-
-def round_toolpath(path: GcodePath, *, for_occt: bool = True, **options) -> RoundedPath:
-    """The G2 rounding of a toolpath's polyline (``spiral_cad.design.round_corners`` with ``options``:
-    ``max_deviation``, ``max_curvature``, ``shape``, …) in the program's unit; an error names the
-    G-code line of the corner or point it is about. With ``for_occt`` (the default), a segment
-    shorter than OCCT's point tolerance (1e-7 model units, so never a STEP edge) is refused here,
-    naming the G-code line of its move (``segment_lines``), rather than later by OCCT by index only.
-
-    Raises:
-        ValueError, NoSolutionError: as ``round_corners``, with the line.
-    """
-    from ..design.rounding import round_corners
-
-    if "units" in options:
-        raise ValueError("units: the program's own (G20/G21); convert the path with GcodePath.in_units first")
-    try:
-        with ticking(f"rounding {path.source} ({len(path):,} points)"):
-            rounded = round_corners(path.points, units=path.units, **options)
-    except ValueError as error:
-        raise type(error)(f"{path.source}: {path.at_lines(str(error))}") from None
-    lengths = np.asarray(rounded.chain.lengths)
-    short: NDArray | tuple[int, ...] = np.flatnonzero(lengths <= OCCT_CONFUSION) if for_occt else ()
-    if len(short):
-        i = int(short[0])
-        kind = ("Line", "Arc", "BezierSpiral")[int(np.asarray(rounded.chain.rows.kind)[i])]
-        line = int(segment_lines(rounded, path)[i])
-        raise ValueError(
-            f"{path.source} line {line}: the rounded path's segment {i} ({kind}, length {lengths[i]:.3g} {path.units}) is shorter "
-            f"than OCCT's {OCCT_CONFUSION:g} and cannot be an OCCT edge ({len(short)} such segment(s)); "
-            "change the tolerance slightly, or move the corner's points"
-        )
-    return rounded
-
-
-@dataclass(frozen=True)
-class ToolpathCorners:
-    """The G2 rounding of a toolpath as arrays, one row per rounded corner (no object per move).
-
-    Between corners the path runs straight along the program's moves, so the corners and
-    ``points`` are the whole path; ``round_toolpath`` builds the same spirals as a ``Chain``
-    (for STEP, IGES, samples), at far higher cost in time and memory on long programs.
-
-    Attributes:
-        index: (k,) the point of ``path.points`` each corner is at.
-        lines: (k,) the G-code line of each corner (the move that ends there).
-        control_points: (k, 2, 4, 3) the corner's two Bézier spirals in travel order.
-        curvature: (k,) the pair's peak |κ| (1/unit).
-        deviation: (k,) the distance from the corner point to the path (unit).
-        units: the program's unit.
-        shape: the spiral shape.
-    """
-
-    index: NDArray
-    lines: NDArray
-    control_points: NDArray
-    curvature: NDArray
-    deviation: NDArray
-    units: str
-    shape: str
-
-    def __len__(self) -> int:
-        return len(self.index)
-
-
-def round_toolpath_arrays(
-    path: GcodePath,
-    *,
-    shape: str = "walton-meek",
-    max_deviation: float | None = None,
-    max_curvature: float | None = None,
-    curvature: float | None = None,
-    spiral_lengths: float | None = None,
-) -> ToolpathCorners:
-    """Round every corner of a toolpath G2 as ``round_toolpath`` does, into arrays (one value per
-    option for every corner): what a program of millions of moves needs.
-
-    Raises:
-        NoSolutionError: a corner that cannot be rounded as asked (its point, G-code line and numbers).
-        ValueError: malformed options or points (two moves to one point are one point: never here).
-    """
-    from ..core.errors import NoSolutionError, Status
-    from ..design.rounding import corner_legs, round_corners_batch
-
-    options = {"max_deviation": max_deviation, "max_curvature": max_curvature, "curvature": curvature,
-               "spiral_lengths": spiral_lengths}  # fmt: skip
-    for name, value in options.items():
-        if value is not None and not (isinstance(value, (int, float)) and 0.0 < value < math.inf):
-            raise ValueError(f"{name} must be one positive finite number here; got {value!r:.40}")
-    given: dict[str, Any] = {name: value for name, value in options.items() if value is not None}
-    with ticking(f"rounding {path.source} ({len(path):,} points)"):
-        try:
-            p0, corners, p1, index = corner_legs(path.points)
-        except ValueError as error:
-            raise ValueError(f"{path.source}: {path.at_lines(str(error))}") from None
-        result = round_corners_batch(p0, corners, p1, shape=shape, **given)
-    bad = np.flatnonzero(~result.ok)
-    if bad.size:
-        j = int(bad[0])
-        message = result.reason(j, label=f"corner {index[j]} (line {int(path.lines[index[j]])})")
-        refused = NoSolutionError if result.status[j] in (Status.LEGS_TOO_SHORT, Status.CORNER_REVERSAL, Status.UNVERIFIED,
-                                                           Status.OUTSIDE_SHAPE) else ValueError  # fmt: skip
-        raise refused(f"{path.source}: {message}" + (f" ({bad.size:,} corners fail)" if bad.size > 1 else ""))
-    control = result.control_points
-    if control.shape[-1] == 2:  # a flat program is rounded in its plane: back to x, y, z
-        control = np.concatenate([control, np.full(control.shape[:-1] + (1,), path.points[0, 2])], axis=-1)
-    return ToolpathCorners(index, path.lines[index], control, result.curvature, result.deviation, path.units, shape)
 
 
 #: A G5 word outside comments (spaces may stand inside words in RS274).
@@ -820,12 +687,14 @@ def parse_gcode_chain(text: str, source: str = "G-code", *, units: str | None = 
         raise ValueError(f"{source}: {error}") from None
 
 
-def _read_exact(text: str, source: str) -> _Reader:
-    """The built-in reader after reading ``text`` with arcs and splines kept as pieces."""
+def _read_exact(text: str, source: str, units: str | None = None) -> _Reader:
+    """The built-in reader after reading ``text`` with arcs and splines kept as pieces (``units``: the unit of a
+    program that states none, ``"mm"`` or ``"in"``; None refuses it)."""
     if not isinstance(text, str):
         raise ValueError(f"text must be the program as str; got {type(text).__name__}")
     reader = _Reader(source)
     reader.exact = True
+    reader.assumed_units = units
     for number, line in enumerate(text.replace("\r\n", "\n").replace("\r", "\n").split("\n"), 1):
         reader.read_line(number, line)
     return reader

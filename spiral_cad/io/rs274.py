@@ -17,7 +17,8 @@ How the moves are read back:
 * ``ARC_FEED(first_end, second_end, first_centre, second_centre, rotation, normal_end, a, b, c)``
   in the plane of the last ``SELECT_PLANE`` (XY: first X, second Y; XZ: first Z, second X;
   YZ: first Y, second Z): chords within ``arc_tolerance`` (refused without it, as the built-in
-  reader does);
+  reader does) by ``run_rs274``; kept arcs by ``rs274_pieces`` (``spiral_cad.io.gcode_paths``);
+* ``SET_FEED_RATE`` and ``SET_FEED_MODE``: the feed of every piece (``rs274_pieces``);
 * ``USE_LENGTH_UNITS``: the unit (rs274 prints positions in the program's unit; its own
   default, before any G20/G21, is mm);
 * ``NURBS_FEED``, ``SPLINE_FEED``, ``STRAIGHT_PROBE``, ``RIGID_TAP`` and moves of the
@@ -25,7 +26,8 @@ How the moves are read back:
 
 The G-code line of every move: the program is handed to rs274 with its line number as the N
 word of each line (an N word only labels a line), and rs274 prints it with each call. Moves
-from a subroutine in another file keep the line of the call.
+from a subroutine in another file keep the last line printed before them (O-word lines carry no N
+word). ``folder`` runs rs274 in the program's folder, where it finds those subroutine files.
 
 Precision: rs274 prints 4 decimals, so positions agree with the program to 0.00005 of its unit
 (exactly, for programs written with at most 4 decimals in absolute coordinates).
@@ -40,6 +42,9 @@ import shutil
 import subprocess
 import tempfile
 import time
+from collections.abc import Iterable, Iterator
+from contextlib import contextmanager
+from typing import IO, Any
 
 import numpy as np
 
@@ -92,9 +97,19 @@ _COMMENTS = re.compile(r"\([^()]*\)|;[^\n]*")
 
 def run_rs274(
     text: str, source: str = "G-code", *, arc_tolerance: float | None = None, timeout: float | None = None,
-    arc_tolerance_units: str | None = None,
+    arc_tolerance_units: str | None = None, folder: str | os.PathLike | None = None, units: str | None = None,
 ) -> GcodePath:  # fmt: skip
     """The moves of G-code ``text`` as LinuxCNC's interpreter ``rs274`` executes them.
+
+    Args:
+        text, source: the program and its name for messages.
+        arc_tolerance: arcs become chords at most this far from them (None: arcs refused).
+        timeout: seconds rs274 may run (default ``TIMEOUT``).
+        arc_tolerance_units: the unit of ``arc_tolerance`` (None: the program's).
+        folder: where rs274 runs, so it finds the subroutine files the program calls
+            (``o<name> call``): the program's own folder (None: none are found).
+        units: the unit of a program that says neither G20 nor G21, ``"mm"`` or ``"in"``
+            (None: such a program is refused).
 
     Raises:
         ValueError: rs274 is not installed (naming the package), rs274 refused the program
@@ -102,15 +117,47 @@ def run_rs274(
             an arc without ``arc_tolerance``, fewer than two moves, or rs274 still running after
             ``timeout`` seconds (default ``TIMEOUT``).
     """
+    with _canonical(text, source, timeout, folder, units) as (calls, assumed):
+        return _moves(calls, source, arc_tolerance, arc_tolerance_units, assumed)
+
+
+def rs274_pieces(
+    text: str, source: str = "G-code", *, timeout: float | None = None, folder: str | os.PathLike | None = None,
+    units: str | None = None,
+) -> tuple[list[tuple[Any, ...]], list[float], str]:  # fmt: skip
+    """The moves of G-code ``text`` as rs274 executes them, arcs kept as arcs: ``(pieces, feeds, unit)``.
+
+    ``pieces`` are the built-in reader's exact pieces (``("line", line, rapid, start, end)`` and
+    ``("arc", line, False, start, end, plane, centre_first, centre_second, rotation)``, as
+    ``spiral_cad.io.gcode_paths`` reads them), ``feeds`` the F in force on each (NaN: a rapid, or
+    not units per minute); the arguments are ``run_rs274``'s.
+
+    Raises:
+        ValueError: as ``run_rs274`` (arcs are read, never refused).
+    """
+    with _canonical(text, source, timeout, folder, units) as (calls, assumed):
+        pieces: list[tuple[Any, ...]] = []
+        feeds: list[float] = []
+        path = _moves(calls, source, None, None, assumed, (pieces, feeds))
+    return pieces, feeds, path.units
+
+
+@contextmanager
+def _canonical(text: str, source: str, timeout: float | None, run_in: str | os.PathLike | None,
+               units: str | None) -> Iterator[tuple[IO[str], str | None]]:  # fmt: skip
+    """rs274's canonical calls of ``text`` (an open file of its output) and the unit to read them in when the program
+    states none (``units``; None when it states one)."""
     executable = rs274_executable()
     if executable is None:
         raise ValueError(
             f"interpreter 'rs274' is not installed: it is LinuxCNC's, in the Debian package {PACKAGE} (apt-get install {PACKAGE}); or use the built-in reader"
         )
-    if not _UNIT_WORD.search(_COMMENTS.sub(" ", text)):
+    stated = _UNIT_WORD.search(_COMMENTS.sub(" ", text)) is not None
+    if not stated and units not in ("mm", "in"):
         raise ValueError(
             f"{source}: the program never says G20 (inches) or G21 (mm); rs274 would read it in mm, but a machine may "
-            "default to inches, and a path in the wrong unit is worse than none: add G20 or G21"
+            "default to inches, and a path in the wrong unit is worse than none: add G20 or G21, or state the unit "
+            "(units='mm' or 'in'; build: --units mm or --units in)"
         )
     with tempfile.TemporaryDirectory(prefix="spiral_cad_rs274_") as folder:
         program = os.path.join(folder, "program.ngc")
@@ -118,8 +165,9 @@ def run_rs274(
         with open(program, "w", encoding="utf-8") as file:
             file.write(numbered(text))
         limit = TIMEOUT if timeout is None else timeout
+        cwd = folder if run_in is None else os.fspath(run_in)
         with ticking(f"rs274 reading {source}"), open(os.path.join(folder, "errors.txt"), "w+") as errors:
-            process = subprocess.Popen([executable, "-g", program, output], cwd=folder, stdin=subprocess.DEVNULL,
+            process = subprocess.Popen([executable, "-g", program, output], cwd=cwd, stdin=subprocess.DEVNULL,
                                        stdout=subprocess.DEVNULL, stderr=errors)  # fmt: skip
             started = time.monotonic()
             try:
@@ -145,17 +193,20 @@ def run_rs274(
             said = messages[0] if messages else f"exit status {returncode}"
             raise ValueError(f"{source}{line}: rs274 refused the program: {said}")
         with open(output, encoding="utf-8", errors="replace") as file:
-            return _moves(file, source, arc_tolerance, arc_tolerance_units)
+            yield file, None if stated else units
 
 
-def _moves(calls, source: str, arc_tolerance: float | None, arc_units: str | None = None) -> GcodePath:
-    """The toolpath of rs274's canonical calls (an iterable of its output lines)."""
+def _moves(calls: Iterable[str], source: str, arc_tolerance: float | None, arc_units: str | None = None,
+           assumed: str | None = None, exact: tuple[list[tuple[Any, ...]], list[float]] | None = None) -> GcodePath:  # fmt: skip
+    """The toolpath of rs274's canonical calls (an iterable of its output lines); ``assumed``: the program's unit when
+    it states none; with ``exact`` (two lists), every move is also added to it as a piece and its feed."""
     progress = Progress(f"reading rs274's moves of {source}")
     points: list[list[float]] = []
     lines: list[int] = []
     rapid: list[bool] = []
     position = [0.0, 0.0, 0.0]
-    plane, units, line = 170, "mm", 0
+    plane, units, line = 170, assumed or "mm", 0
+    feed, feed_mode = math.nan, 0
 
     def error(text: str) -> ValueError:
         return ValueError(f"{source} line {line}: {text}")
@@ -178,8 +229,26 @@ def _moves(calls, source: str, arc_tolerance: float | None, arc_units: str | Non
             if any(values[3:6]):
                 raise error(f"{name} moves a rotary axis (A, B, C = {values[3]:g}, {values[4]:g}, {values[5]:g}); only X, Y, Z are read")
             point = values[:3]
+            if exact is not None and point != position:
+                exact[0].append(("line", line, name == "STRAIGHT_TRAVERSE", position, point))
+                exact[1].append(math.nan if name == "STRAIGHT_TRAVERSE" or feed_mode else feed)
             add(point, name == "STRAIGHT_TRAVERSE")
             position = point
+        elif name == "ARC_FEED" and exact is not None:
+            values = [float(v) for v in arguments.split(",")]
+            if any(values[6:9]):
+                raise error("ARC_FEED moves a rotary axis; only X, Y, Z are read")
+            first, second, normal = PLANES[plane]
+            end = [0.0, 0.0, 0.0]
+            end[first], end[second], end[normal] = values[0], values[1], values[5]
+            exact[0].append(("arc", line, False, position, end, plane, values[2], values[3], int(values[4])))
+            exact[1].append(math.nan if feed_mode else feed)
+            add(end, False)
+            position = end
+        elif name == "SET_FEED_RATE":
+            feed = float(arguments)
+        elif name == "SET_FEED_MODE":  # (spindle, mode): 0 units per minute, 1 inverse time, 2 per revolution
+            feed_mode = int(arguments.split(",")[-1])
         elif name == "ARC_FEED":
             values = [float(v) for v in arguments.split(",")]
             if arc_tolerance is None:
@@ -203,6 +272,8 @@ def _moves(calls, source: str, arc_tolerance: float | None, arc_units: str | Non
             unit = "in" if "INCH" in arguments else "mm" if "MM" in arguments else None
             if unit is None:
                 raise error(f"the unit {arguments.strip()} is not inch or mm")
+            if assumed is not None:  # rs274's own default (mm), printed for a program that states no unit
+                continue
             if points and unit != units:
                 raise error("the unit changes after the first move; one unit per program")
             units = unit
@@ -212,6 +283,6 @@ def _moves(calls, source: str, arc_tolerance: float | None, arc_units: str | Non
             progress(count)
     if not all(math.isfinite(v) for p in points for v in p):
         raise ValueError(f"{source}: rs274 printed a position that is not a finite number")
-    if len(points) < 2:
+    if len(points) < 2 and (exact is None or not exact[0]):  # as pieces, one move from the start is a path
         raise ValueError(f"{source}: rs274 executed {len(points)} move(s) to a new position; a path needs at least two")
     return GcodePath(np.array(points), np.array(lines), np.array(rapid), units, source)

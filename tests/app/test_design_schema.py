@@ -63,7 +63,7 @@ MALFORMED = [
     ({"units": "m", "designs": [{"name": "road", "type": "alignment"}]}, "designs[0] (road): missing field(s) pis, radii"),
     (
         {"units": "m", "designs": [{**ROAD, "type": "spline"}]},
-        "designs[0].type: must be one of alignment, circle_chain, rounded_polyline, transition, fit; got 'spline'",
+        "designs[0].type: must be one of alignment, circle_chain, rounded_polyline, transition, fit, g2_path; got 'spline'",
     ),
     (
         {"units": "m", "designs": [{"name": "road"}]},

@@ -116,7 +116,7 @@ def test_full_turns_and_radii_that_differ():
 
 def sliver_program(leftover: float) -> str:
     """Two right-angle corners whose roundings leave ``leftover`` of straight line between them (0.5 mm tolerance)."""
-    from spiral_cad.io.gcode import round_toolpath
+    from spiral_cad.io.toolpath_rounding import round_toolpath
 
     def text(side: float) -> str:
         return f"G21 G90\nG1 X0 Y0\nG1 X10 Y0\nG1 X10 Y{side:.17g}\nG1 X20 Y{side:.17g}\n"
@@ -126,7 +126,7 @@ def sliver_program(leftover: float) -> str:
 
 
 def test_a_sliver_between_corners_becomes_a_real_edge_and_pieces_keep_their_lines():
-    from spiral_cad.io.gcode import round_toolpath, segment_lines
+    from spiral_cad.io.toolpath_rounding import round_toolpath, segment_lines
 
     path = parse_gcode(sliver_program(4e-8), "sliver.nc")
     rounded = round_toolpath(path, max_deviation=0.5)  # the corners step back: the line between them is an edge
@@ -139,7 +139,7 @@ def test_a_sliver_between_corners_becomes_a_real_edge_and_pieces_keep_their_line
 
 
 def test_arrays_round_as_the_chain_does_and_name_lines():
-    from spiral_cad.io.gcode import round_toolpath, round_toolpath_arrays
+    from spiral_cad.io.toolpath_rounding import round_toolpath, round_toolpath_arrays
 
     text = "G21 G90 F1\nG1 X0 Y0 Z0\n" + "".join(f"G1 X{(i % 2) * 10 + i * 0.1:.4f} Y{i * 2:.4f} Z{-0.1 * i:.4f}\n" for i in range(1, 40))
     path = parse_gcode(text, "zigzag.nc")
@@ -175,19 +175,21 @@ def test_long_jobs_say_they_are_still_running(capsys):
     assert capsys.readouterr().err == ""  # a quick job says nothing
 
 
-def test_build_from_gcode_reads_arcs_with_an_arc_tolerance(tmp_path):
+def test_build_from_gcode_reads_arcs_as_arcs_and_splits_where_the_path_turns_back(tmp_path, capsys):
     from pathlib import Path
 
     from spiral_cad.app.cli import main
 
     program = Path(__file__).resolve().parents[1] / "gcode" / "with_arcs.nc"
     out = tmp_path / "out"
-    argv = ["build", "--from-gcode", str(program), "--max-deviation", "0.05", "--arc-tolerance", "0.005", "--no-plots", "--out", str(out)]
+    argv = ["build", "--from-gcode", str(program), "--max-deviation", "0.05", "--no-plots", "--out", str(out)]
     assert main(argv) == 0
-    table = np.loadtxt(out / "with_arcs_samples.csv", delimiter=",", skiprows=1)
-    # G2 from (20, 0) to (30, 10) about (20, 10) is clockwise: three quarters of a circle, by (10, 10) and (20, 20)
-    on_arc = (table[:, 1] < 19.0) & (table[:, 2] > 1.0)
-    assert on_arc.any() and np.abs(np.hypot(table[on_arc, 1] - 20, table[on_arc, 2] - 10) - 10).max() < 0.06
+    # G2 from (20, 0) to (30, 10) about (20, 10) is clockwise: it starts back along the line before it and ends
+    # against the line after it (cusps), so it is a path of its own: three quarters of a circle, by (10, 10) and (20, 20)
+    assert "split where the path folds straight back (2×), at the moves of lines 5, 6" in capsys.readouterr().out
+    table = np.loadtxt(out / "with_arcs_2_samples.csv", delimiter=",", skiprows=1)
+    assert np.abs(np.hypot(table[:, 1] - 20, table[:, 2] - 10) - 10).max() < 1e-9
+    assert table[:, 1].min() == pytest.approx(10, abs=1e-6) and table[:, 2].max() == pytest.approx(20, abs=1e-6)
 
 
 def test_g_and_m_codes_have_modal_groups_of_their_own_and_g80_yields_to_a_motion():

@@ -289,7 +289,8 @@ def test_rs274_reads_paths_in_space_within_the_stated_tolerances():
 def test_the_example_pocket_rounded_in_space_as_linuxcnc_reads_it(tmp_path):
     """examples/pocket.nc rounded G2: G5 at the corners in XY, G18/G19 biarcs where the tool plunges; LinuxCNC's
     interpreter library puts every point of it within the arc tolerance of the chain."""
-    from spiral_cad.io.gcode import read_gcode, round_toolpath
+    from spiral_cad.io.gcode import read_gcode
+    from spiral_cad.io.toolpath_rounding import round_toolpath
 
     chain = round_toolpath(read_gcode(Path(__file__).parents[2] / "examples" / "pocket.nc"), max_deviation=0.05).chain
     program = gcode_program(chain, arc_tolerance=0.002)

@@ -1,0 +1,337 @@
+"""G-code in as lines and arcs: a program's moves as true ``Line`` and ``Arc`` segments, split where it folds back.
+
+Both readers give the same moves: the built-in one (``spiral_cad.io.gcode``) and LinuxCNC's ``rs274``
+(``spiral_cad.io.rs274``, run in the program's folder so that it finds the subroutine files the
+program calls). Every move to a new position is one segment, rapids (``G0``) included (the path is
+where the tool goes); the path starts where the first move ends, as the built-in reader's polyline does
+(where the tool stood before it, the readers' 0, is not known):
+
+* ``G0``/``G1`` straight moves are ``Line`` s;
+* ``G2``/``G3`` arcs in every plane LinuxCNC allows (``G17`` XY, ``G18`` ZX, ``G19`` YZ) are ``Arc`` s:
+  true circles, never chords. An arc's centre is put on the bisector of its chord (LinuxCNC accepts
+  end radii that differ slightly, and rs274 prints 4 decimals), so every arc ends where its move does;
+  a move of more than one turn (``P``) is one arc per turn; an arc of radius 0 (its ends at its centre: rs274
+  runs it as a plunge) is a straight move along the plane's normal;
+* a helical arc (``G2``/``G3`` that also moves along the plane's normal) is not a plane curve: it is
+  read as chords within ``helix_tolerance`` (refused by name without it);
+* ``G5`` cubic splines are refused here: a program with them states its exact path
+  (``read_gcode_chain``).
+
+The path lies in the plane (x, y) when every position has z = 0 and every arc is in ``G17``, else in
+space. ``GcodeMoves.parts`` splits the moves where the path folds straight back (a plunge and its
+retract, a cut that returns along itself): a machine stops there, so each part is its own G2 path.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import NDArray
+
+from ..core.segments import Arc, Line
+from ..core.units import MM_PER_UNIT, length_unit
+from .toolpath import PLANES, GcodePath, arc_points, arc_sweep
+
+__all__ = ["FOLD_SINE", "PLANE_TOLERANCE", "GcodeMoves", "parse_gcode_moves", "read_gcode_moves"]
+
+#: A joint where a curve (an arc) meets the next going back along it within this sine of the angle folds back.
+FOLD_SINE = 1e-9
+#: Points within this share of the path's size of a plane lie in it (``GcodeMoves.plane_runs``).
+PLANE_TOLERANCE = 1e-10
+
+
+@dataclass(frozen=True)
+class GcodeMoves:
+    """The moves of a G-code program as lines and arcs.
+
+    Attributes:
+        segments: every move to a new position, in order (``Line`` or ``Arc``; a helix's chords are lines).
+        lines: (n,) the G-code line of each segment's move.
+        rapid: (n,) True where the move is a rapid (G0).
+        feeds: (n,) the feed in force (the program's unit per minute under G94; NaN: a rapid or none).
+        units: the segments' unit.
+        program_units: the program's own unit (G20/G21, or as stated for a program that says neither).
+        source: the file's name, for messages.
+        notes: what was read and is worth telling (a unit stated for the program, helices as chords).
+        chords: (n,) True where the segment is a chord of a helical arc (within ``helix_tolerance`` of it).
+        helix_tolerance: the chords' tolerance (None: the program has no helix).
+    """
+
+    segments: tuple[Line | Arc, ...]
+    lines: NDArray
+    rapid: NDArray
+    feeds: NDArray
+    units: str
+    program_units: str
+    source: str = "G-code"
+    notes: tuple[str, ...] = ()
+    chords: NDArray | None = None
+    helix_tolerance: float | None = None
+
+    def __len__(self) -> int:
+        return len(self.segments)
+
+    @property
+    def program_feeds(self) -> tuple[float, ...]:
+        """The distinct feeds of the feed moves (program unit per minute), in the order first used."""
+        return tuple(dict.fromkeys(float(f) for f in self.feeds[~self.rapid] if math.isfinite(f)))
+
+    def folds(self) -> NDArray:
+        """The joints (index j: segment j ends, j + 1 starts) where the path folds straight back."""
+        from ..design.rounding import straight_points
+
+        count = len(self.segments)
+        if count < 2:
+            return np.zeros(0, dtype=np.int64)
+        ends = np.array([s.end_tangent for s in self.segments[:-1]])
+        starts = np.array([s.start_tangent for s in self.segments[1:]])
+        dot = np.einsum("ij,ij->i", ends, starts)
+        sine = np.linalg.norm(ends[:, :, None] * starts[:, None, :] - ends[:, None, :] * starts[:, :, None], axis=(1, 2)) / math.sqrt(2)
+        fold = (dot < 0.0) & (sine <= FOLD_SINE)
+        straight = np.array([isinstance(s, Line) for s in self.segments])
+        both = np.flatnonzero(straight[:-1] & straight[1:])
+        if both.size:  # two lines: the rounding's own test (what float64 resolves at their coordinates)
+            before = np.array([self.segments[j].start for j in both])
+            corner = np.array([self.segments[j].end for j in both])
+            after = np.array([self.segments[j + 1].end for j in both])
+            fold[both] = straight_points(before, corner, after)[1]
+        return np.flatnonzero(fold)
+
+    def parts(self) -> list[tuple[int, int]]:
+        """(first, stop) segment ranges of the path split where it folds straight back (``folds``)."""
+        cuts = [0, *(int(j) + 1 for j in self.folds()), len(self.segments)]
+        return list(zip(cuts[:-1], cuts[1:]))
+
+    def plane_runs(self, first: int, stop: int) -> list[tuple[int, int]]:
+        """(first, stop) ranges of segments ``first`` to ``stop`` that each lie in one plane, longest first in
+        travel order: a path in space (a plunge, then a contour) is split where it leaves its plane."""
+        if self.segments[first].dim == 2:
+            return [(first, stop)]
+        ends = np.array([p for s in self.segments[first:stop] for p in (s.start, s.end)])
+        tolerance = PLANE_TOLERANCE * max(float(np.abs(ends - ends[0]).max()), float(np.abs(ends).max()) * 1e-3)
+        runs, begin = [], first
+        points: list[NDArray] = []
+        normal: NDArray | None = None
+        for k in range(first, stop):
+            segment = self.segments[k]
+            new = [segment.start, segment.end] + ([segment.point(0.5)] if isinstance(segment, Arc) else [])
+            fits, found = _in_plane(points, normal, new, segment.normal if isinstance(segment, Arc) else None, tolerance)
+            if not fits:  # a new plane: cut at the corner before the lines tangent to this segment, if they lie in it
+                cut = k
+                while cut - 1 > begin and isinstance(self.segments[cut - 1], Line) and _tangent(self.segments[cut - 1], self.segments[cut]):
+                    cut -= 1
+                points, found = [], None
+                for j in range(cut, k + 1):
+                    other = self.segments[j]
+                    extra = [other.start, other.end] + ([other.point(0.5)] if isinstance(other, Arc) else [])
+                    fits, found = _in_plane(points, found, extra, other.normal if isinstance(other, Arc) else None, tolerance)
+                    if not fits:
+                        break
+                    points += extra
+                if not fits or cut == k:
+                    cut, points = k, []
+                    fits, found = _in_plane([], None, new, segment.normal if isinstance(segment, Arc) else None, tolerance)
+                    points += new
+                runs.append((begin, cut))
+                begin = cut
+                normal = found
+                continue
+            points += new
+            normal = found
+        runs.append((begin, stop))
+        return runs
+
+    def straight(self, first: int, stop: int) -> bool:
+        """Whether segments ``first`` to ``stop`` are all lines."""
+        return all(isinstance(s, Line) for s in self.segments[first:stop])
+
+    def toolpath(self, first: int, stop: int) -> GcodePath:
+        """Straight segments ``first`` to ``stop`` as a ``GcodePath`` (x, y, z; what ``round_toolpath`` rounds)."""
+        segments = self.segments[first:stop]
+        points = np.array([segments[0].start, *(s.end for s in segments)], dtype=np.float64)
+        if points.shape[1] == 2:
+            points = np.column_stack([points, np.zeros(len(points))])
+        lines = np.concatenate([self.lines[first : first + 1], self.lines[first:stop]])
+        rapid = np.concatenate([self.rapid[first : first + 1], self.rapid[first:stop]])
+        factor = MM_PER_UNIT[self.program_units] / MM_PER_UNIT[self.units]
+        feeds = np.concatenate([[math.nan], self.feeds[first:stop]]) * factor
+        return GcodePath(points, lines, rapid, self.units, self.source, self.notes, (), feeds)
+
+
+def parse_gcode_moves(
+    text: str, source: str = "G-code", *, interpreter: str = "builtin", units: str | None = None,
+    program_units: str | None = None, helix_tolerance: float | None = None, folder: str | os.PathLike | None = None,
+) -> GcodeMoves:  # fmt: skip
+    """The moves of G-code ``text`` as lines and arcs (see the module docstring).
+
+    Args:
+        text: the program.
+        source: its name, for messages.
+        interpreter: ``"builtin"`` or ``"rs274"`` (LinuxCNC's own: parameters, subroutines, canned cycles).
+        units: the segments' unit (mm, cm, m, km, in, ft; default the program's).
+        program_units: the unit of a program that says neither G20 nor G21, ``"mm"`` or ``"in"``
+            (None: such a program is refused).
+        helix_tolerance: helical arcs become chords at most this far from them (in ``units``);
+            None refuses them.
+        folder: where rs274 looks for subroutine files (the program's folder).
+
+    Raises:
+        ValueError: what the reader refuses (naming the line and the word), a helical arc without
+            ``helix_tolerance``, a G5 spline, no move to a new position.
+    """
+    if program_units not in (None, "mm", "in"):
+        raise ValueError(f"program_units must be 'mm' or 'in' (G21 or G20); got {program_units!r}")
+    if helix_tolerance is not None and not 0.0 < helix_tolerance < math.inf:
+        raise ValueError(f"helix_tolerance must be a positive finite length; got {helix_tolerance}")
+    if interpreter == "rs274":
+        from .rs274 import rs274_pieces
+
+        pieces, feeds, unit = rs274_pieces(text, source, folder=folder, units=program_units)
+        notes: list[str] = []
+    elif interpreter == "builtin":
+        from .gcode import _read_exact
+
+        reader = _read_exact(text, source, program_units)
+        if reader.opened is not None and not reader.ended:
+            raise ValueError(f"{source}: the program opens with % (line {reader.opened}) but has no closing % or M2/M30; "
+                             "LinuxCNC refuses it (file ended with no percent sign)")  # fmt: skip
+        pieces, feeds, unit, notes = reader.pieces, reader.piece_feeds, reader.units or "mm", list(reader.notes)
+    else:
+        raise ValueError(f"interpreter must be 'builtin' or 'rs274'; got {interpreter!r}")
+    target = unit if units is None else length_unit(units)
+    factor = MM_PER_UNIT[unit] / MM_PER_UNIT[target]
+    flat = all(p[3][2] == 0.0 and p[4][2] == 0.0 and (p[0] != "arc" or p[5] == 170) for p in pieces if p[0] != "cubic")
+    dim = 2 if flat else 3
+    segments: list[Line | Arc] = []
+    lines: list[int] = []
+    rapid: list[bool] = []
+    per_segment: list[float] = []
+    chords: list[bool] = []
+    helices = 0
+    moving = [k for k, p in enumerate(pieces) if p[3] != p[4]]
+    pieces, feeds = pieces[moving[0] + 1 :] if moving else [], feeds[moving[0] + 1 :] if moving else []  # see the docstring
+    for piece, feed in zip(pieces, feeds):
+        kind, number, is_rapid, start = piece[:4]
+        try:
+            if kind == "cubic":
+                raise ValueError("a G5 cubic spline: a program with splines states its exact path (read_gcode_chain)")
+            if kind == "line":
+                made: list[Line | Arc] = [] if start == piece[4] else [_line(start, piece[4], factor, dim)]
+            else:
+                end, plane, ca, cb, rotation = piece[4:9]
+                made = _arc(start, end, plane, ca, cb, rotation, factor, dim, helix_tolerance)
+        except ValueError as error:
+            raise ValueError(f"{source} line {number}: {error}") from None
+        helix = kind == "arc" and start[PLANES[piece[5]][2]] != piece[4][PLANES[piece[5]][2]]
+        helices += helix
+        chords += [helix] * len(made)
+        segments += made
+        lines += [number] * len(made)
+        rapid += [bool(is_rapid)] * len(made)
+        per_segment += [feed] * len(made)
+    if not segments:
+        raise ValueError(f"{source}: the program has fewer than two moves to a new position; a path starts where the "
+                         "first move ends and needs one more")  # fmt: skip
+    if helices:
+        notes.append(f"{helices} helical arc(s) read as chords within {helix_tolerance:g} {target}")
+    return GcodeMoves(tuple(segments), np.array(lines), np.array(rapid), np.array(per_segment, dtype=np.float64), target, unit,
+                      source, tuple(notes), np.array(chords), helix_tolerance if helices else None)  # fmt: skip
+
+
+def read_gcode_moves(
+    path: str | os.PathLike, *, interpreter: str | None = None, units: str | None = None, program_units: str | None = None,
+    helix_tolerance: float | None = None,
+) -> GcodeMoves:  # fmt: skip
+    """The moves of a G-code file as lines and arcs (``parse_gcode_moves``; the file is checked as ``read_gcode``
+    checks it). ``interpreter`` and ``program_units`` default to what ``reading_options`` set.
+
+    Raises:
+        ValueError: as ``read_gcode`` and ``parse_gcode_moves``.
+        OSError: the file could not be read.
+    """
+    from .gcode import _program_text, reading_defaults
+
+    text, label = _program_text(path)
+    default_interpreter, _, _, default_units = reading_defaults()
+    return parse_gcode_moves(text, label, interpreter=interpreter or default_interpreter, units=units,
+                             program_units=program_units or default_units, helix_tolerance=helix_tolerance,
+                             folder=os.path.dirname(os.path.abspath(os.fspath(path))))  # fmt: skip
+
+
+def _tangent(a: Line | Arc, b: Line | Arc) -> bool:
+    """Whether ``a`` ends in the direction ``b`` starts (within ``FOLD_SINE``)."""
+    t0, t1 = a.end_tangent, b.start_tangent
+    return float(np.dot(t0, t1)) > 0.0 and float(np.linalg.norm(np.cross(t0, t1))) <= FOLD_SINE
+
+
+def _in_plane(points: list[NDArray], normal: NDArray | None, new: list[NDArray], arc_normal: NDArray | None,
+              tolerance: float) -> tuple[bool, NDArray | None]:  # fmt: skip
+    """Whether ``points`` (in the plane of ``normal``, None while they are on one line) and ``new`` (with an arc's
+    ``arc_normal``) lie in one plane within ``tolerance``, and that plane's normal (None: still on one line)."""
+    every = np.array([*points, *new])
+    origin = every[0]
+    if normal is None and arc_normal is not None:
+        normal = np.asarray(arc_normal, dtype=np.float64)
+    if normal is None:  # lines only so far: the plane of the first point off their line, if any
+        direction = every[-1] - origin if not points else points[-1] - origin
+        direction = direction / (np.linalg.norm(direction) or 1.0)
+        off = (every - origin) - np.outer((every - origin) @ direction, direction)
+        far = int(np.argmax(np.linalg.norm(off, axis=1)))
+        if np.linalg.norm(off[far]) <= tolerance:
+            return True, None
+        normal = np.cross(direction, off[far])
+        normal = normal / np.linalg.norm(normal)
+    elif arc_normal is not None and abs(abs(float(np.dot(arc_normal, normal))) - 1.0) > 1e-9:
+        return False, normal
+    return bool(np.abs((every - origin) @ normal).max() <= tolerance), normal
+
+
+def _line(start: list[float], end: list[float], factor: float, dim: int) -> Line:
+    """The line of a straight move (in space it stays in space at z = 0, as every segment of the path)."""
+    line = Line(np.array(start[:dim]) * factor, np.array(end[:dim]) * factor)
+    return Line._of(np.array(start) * factor, np.array(end) * factor) if line.dim != dim else line
+
+
+def _arc(start: list[float], end: list[float], plane: int, ca: float, cb: float, rotation: int, factor: float, dim: int,
+         helix_tolerance: float | None) -> list[Line | Arc]:  # fmt: skip
+    """The segments of one arc move: one ``Arc`` a turn, or a helix's chords."""
+    first, second, normal = PLANES[plane]
+    if start[first] == ca and start[second] == cb and end[first] == ca and end[second] == cb:
+        # a helix of radius 0 (rs274 runs it: a hole as wide as the tool): a straight move along the normal
+        return [] if start == end else [_line(start, end, factor, dim)]
+    if end[normal] != start[normal]:
+        if helix_tolerance is None:
+            raise ValueError("a helical arc (it also moves along the plane's normal) is not a plane arc: "
+                             "give a tolerance for its chords (helix_tolerance; build: --arc-tolerance)")  # fmt: skip
+        corners = [list(start), *arc_points(start, end, plane, ca, cb, rotation, helix_tolerance / factor)]
+        return [_line(a, b, factor, dim) for a, b in zip(corners[:-1], corners[1:]) if a != b]
+    a0, b0, a1, b1 = start[first], start[second], end[first], end[second]
+    chord = math.hypot(a1 - a0, b1 - b0)
+    if chord > 0.0:  # the centre on the chord's bisector: the arc ends where the move does
+        na, nb = -(b1 - b0) / chord, (a1 - a0) / chord
+        ma, mb = (a0 + a1) / 2, (b0 + b1) / 2
+        along = (ca - ma) * na + (cb - mb) * nb
+        ca, cb = ma + along * na, mb + along * nb
+    t0, sweep = arc_sweep(start, end, plane, ca, cb, rotation)
+    radius = math.hypot(a0 - ca, b0 - cb)
+    turns = max(1, math.ceil(abs(sweep) / (2 * math.pi) - 1e-12))
+    step = sweep / turns
+    out: list[Line | Arc] = []
+    for k in range(turns):
+        angle = t0 + k * step
+        if dim == 2:
+            out.append(Arc((ca * factor, cb * factor), math.copysign(radius * factor, step), angle, abs(step)))
+            continue
+        centre = np.array(start, dtype=np.float64)
+        centre[first], centre[second] = ca, cb
+        begin = centre.copy()
+        begin[first], begin[second] = ca + radius * math.cos(angle), cb + radius * math.sin(angle)
+        if k == 0:
+            begin = np.array(start, dtype=np.float64)
+        axis = np.zeros(3)
+        axis[normal] = 1.0
+        out.append(Arc.in_space(centre * factor, axis, begin * factor, step))
+    return out

@@ -1,0 +1,131 @@
+"""DXF in (spiral_cad.io.dxf_read): drawings written by ezdxf, R2010 and R12 (LINE/ARC only, as LibreCAD writes),
+read back as chained lines and arcs; ezdxf's own geometry is the judge."""
+
+import math
+
+import ezdxf
+import numpy as np
+import pytest
+from ezdxf.math import bulge_to_arc
+
+from spiral_cad.core.segments import Arc, Line
+from spiral_cad.io.dxf_read import read_dxf_paths
+
+
+def joined(path, closed: bool) -> float:
+    """The largest gap between consecutive segments of a path (and round its closing joint)."""
+    segments = list(path.segments) + ([path.segments[0]] if closed else [])
+    return max((float(np.abs(a.end - b.start).max()) for a, b in zip(segments[:-1], segments[1:])), default=0.0)
+
+
+def drawing(version: str = "R2010", insunits: int | None = 4):
+    doc = ezdxf.new(version)
+    if insunits is not None:
+        doc.header["$INSUNITS"] = insunits
+    return doc, doc.modelspace()
+
+
+def test_a_slot_drawn_in_any_order_and_direction_is_one_closed_path(tmp_path):
+    doc, msp = drawing()
+    msp.add_line((0, 0), (10, 0))
+    msp.add_line((0, 10), (10, 10))  # drawn against the travel
+    msp.add_arc((0, 5), 5, 90, 270)
+    msp.add_arc((10, 5), 5, 270, 90)
+    msp.add_text("a note")
+    doc.saveas(tmp_path / "slot.dxf")
+    read = read_dxf_paths(tmp_path / "slot.dxf")
+    assert read.units == "mm" and len(read) == 1 and read.notes == ("left out 1 TEXT",)
+    path = read.paths[0]
+    assert path.closed and joined(path, True) < 1e-12
+    assert [type(s).__name__ for s in path.segments] == ["Line", "Arc", "Line", "Arc"]
+    lengths = sorted(s.length for s in path.segments)
+    assert lengths == pytest.approx([10, 10, 5 * math.pi, 5 * math.pi])
+    assert all(s.radius > 0 for s in path.segments if isinstance(s, Arc))  # a counterclockwise outline
+
+
+def test_bulges_are_the_arcs_ezdxf_makes_of_them(tmp_path):
+    doc, msp = drawing()
+    vertices = [(0, 0, 0.3), (20, 0, -0.7), (30, 10, 1.5), (10, 25, 0.0), (0, 15, -0.2)]
+    msp.add_lwpolyline(vertices, format="xyb", close=True)
+    doc.saveas(tmp_path / "bulges.dxf")
+    path = read_dxf_paths(tmp_path / "bulges.dxf").paths[0]
+    assert path.closed and joined(path, True) < 1e-9
+    arcs = [s for s in path.segments if isinstance(s, Arc)]
+    ring = vertices + vertices[:1]
+    expected = [bulge_to_arc(a[:2], b[:2], a[2]) for a, b in zip(ring[:-1], ring[1:]) if a[2]]
+    assert len(arcs) == len(expected) == 4
+    for arc, (centre, _, _, radius) in zip(arcs, expected):
+        assert np.allclose(arc.center, (centre.x, centre.y), atol=1e-9) and abs(arc.radius) == pytest.approx(radius)
+    assert [math.copysign(1, a.radius) for a in arcs] == [1, -1, 1, -1]  # the bulge's sign is the sense
+
+
+def test_circles_and_mirrored_arcs(tmp_path):
+    doc, msp = drawing(insunits=1)
+    msp.add_circle((5, 5), 2)
+    msp.add_arc((20, 0), 3, 0, 90, dxfattribs={"extrusion": (0, 0, -1)})  # mirrored: clockwise in the world
+    doc.saveas(tmp_path / "mirror.dxf")
+    read = read_dxf_paths(tmp_path / "mirror.dxf", units="mm")
+    assert read.units == "mm" and len(read) == 2
+    circle, mirrored = (p.segments[0] for p in read.paths)
+    assert read.paths[0].closed and circle.sweep == pytest.approx(2 * math.pi) and circle.radius == pytest.approx(2 * 25.4)
+    arc = doc.modelspace().query("ARC")[0]
+    ends = np.array([arc.start_point, arc.end_point])[:, :2] * 25.4  # ezdxf's own world points of the OCS arc
+    assert mirrored.radius < 0 and not read.paths[1].closed
+    assert {tuple(np.round(mirrored.start, 9)), tuple(np.round(mirrored.end, 9))} == {tuple(np.round(p, 9)) for p in ends}
+
+
+def test_an_r12_drawing_of_lines_and_arcs_is_unitless_until_its_unit_is_stated(tmp_path):
+    doc, msp = drawing("R12", insunits=None)  # R12 has no $INSUNITS, as LibreCAD's R12 export
+    msp.add_line((0, 0), (40, 0))
+    msp.add_arc((40, 10), 10, 270, 0)
+    msp.add_line((50, 10), (50, 30))
+    msp.add_line((80, 80), (90, 80))  # a second, separate path
+    doc.saveas(tmp_path / "r12.dxf")
+    assert ezdxf.readfile(tmp_path / "r12.dxf").dxfversion == "AC1009"
+    with pytest.raises(ValueError, match=r"r12.dxf: the drawing is unitless .*--units mm"):
+        read_dxf_paths(tmp_path / "r12.dxf")
+    read = read_dxf_paths(tmp_path / "r12.dxf", drawing_units="in", units="mm")
+    assert read.units == "mm" and "the drawing is unitless: read in in as stated" in read.notes
+    first, second = read.paths
+    assert [type(s) for s in first.segments] == [Line, Arc, Line] and not first.closed and joined(first, False) < 1e-9
+    assert first.segments[-1].end.tolist() == pytest.approx([50 * 25.4, 30 * 25.4])
+    assert len(second.segments) == 1
+
+
+def test_refusals_name_the_entity(tmp_path):
+    doc, msp = drawing()
+    msp.add_line((0, 0), (1, 0))
+    spline = msp.add_spline([(0, 0), (1, 1), (2, 0), (3, 1)])
+    doc.saveas(tmp_path / "spline.dxf")
+    with pytest.raises(ValueError, match=rf"spline.dxf: entity {spline.dxf.handle} is a SPLINE .*only LINE, ARC, CIRCLE"):
+        read_dxf_paths(tmp_path / "spline.dxf")
+    doc, msp = drawing(insunits=3)  # miles
+    msp.add_line((0, 0), (1, 0))
+    doc.saveas(tmp_path / "miles.dxf")
+    with pytest.raises(ValueError, match=r"\$INSUNITS 3 is not a unit read here"):
+        read_dxf_paths(tmp_path / "miles.dxf")
+    (tmp_path / "text.dxf").write_text("not a drawing")
+    with pytest.raises(ValueError, match=r"text.dxf: not a DXF file"):
+        read_dxf_paths(tmp_path / "text.dxf")
+
+
+def test_a_branch_ends_every_path_through_it_and_near_ends_join(tmp_path):
+    doc, msp = drawing()
+    msp.add_line((0, 0), (10, 0))
+    msp.add_line((10, 0), (20, 0))
+    msp.add_line((10, 0), (10, 10))  # three ends meet at (10, 0)
+    msp.add_line((20, 1e-9), (30, 0))  # within the join tolerance of (20, 0)
+    doc.saveas(tmp_path / "tee.dxf")
+    read = read_dxf_paths(tmp_path / "tee.dxf")
+    assert sorted(len(p.segments) for p in read.paths) == [1, 1, 2]
+
+
+def test_3d_polylines_and_elevations_are_paths_in_space(tmp_path):
+    doc, msp = drawing()
+    msp.add_polyline3d([(0, 0, 0), (10, 0, 2), (10, 10, 4)])
+    msp.add_lwpolyline([(10, 10, 0.5), (20, 10, 0)], format="xyb", dxfattribs={"elevation": 4})
+    doc.saveas(tmp_path / "space.dxf")
+    read = read_dxf_paths(tmp_path / "space.dxf")
+    assert len(read) == 1 and read.paths[0].segments[0].dim == 3 and joined(read.paths[0], False) < 1e-9
+    arc = read.paths[0].segments[-1]
+    assert isinstance(arc, Arc) and np.allclose(arc.end, (20, 10, 4))
