@@ -51,11 +51,11 @@ from ..core.space import PlaneFrame
 from ..core.spiral import BezierSpiral
 from ..core.units import DEFAULT_UNITS, length_unit
 from ._g2_measure import _deviation
-from ._g2_pieces import EPS, _classify, _merge, _Piece, _piece_ends, _piece_of, _Refusal, _shown_point, _Solved
+from ._g2_pieces import EPS, TANGENT_TOL, _classify, _merge, _Piece, _piece_ends, _piece_of, _Refusal, _shown_point, _Solved
 from ._g2_solve import _arc_corners, _bridge_short_lines, _Group, _solve
 from .rounding import _steepest_deflection
 
-__all__ = ["G2Joint", "G2Path", "make_g2", "smallest_max_deviation"]
+__all__ = ["TANGENT_TOL", "G2Joint", "G2Path", "make_g2", "smallest_max_deviation"]
 
 #: The largest gap between segments that make_g2 closes, as a share of the bound.
 GAP_SHARE = 0.1
