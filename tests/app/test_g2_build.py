@@ -174,3 +174,14 @@ def test_the_design_type_g2_path(tmp_path):
     (tmp_path / "design.json").write_text(json.dumps(design))
     with pytest.raises(DesignError, match=r"source.*must be the path of a \.dxf"):
         build(tmp_path / "design.json")
+
+
+def test_a_bound_below_float64_is_refused_with_a_bound_that_builds(tmp_path, capsys):
+    # make_g2's refusal goes through the split-at-corners fallback; the message it ends with is make_g2's own
+    drawing = filleted_rectangle(tmp_path / "plate.dxf")
+    out = tmp_path / "out"
+    assert main(["build", str(drawing), "--max-deviation", "1e-14", "--no-plots", "--out", str(out)]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("error: ") and "internal error" not in err and "works (built and checked)" in err
+    advised = float(err.split("max_deviation ")[-1].split(" ")[0])
+    assert main(["build", str(drawing), "--max-deviation", repr(advised), "--no-plots", "--out", str(out)]) == 0
