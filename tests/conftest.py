@@ -1,24 +1,72 @@
-"""Shared test settings and helpers: the hypothesis profile sized for a 2-core CI machine, and
-``outcome``, the tally of property tests whose examples may be refused."""
+"""Shared test settings and helpers: the hypothesis profiles (the same random examples everywhere, failures
+kept in the repository's example database, a nightly size), ``outcome``, the tally of property tests whose
+examples may be refused, the markers, and the groups that keep an expensive fixture on one xdist worker."""
 
-import os
 import re
 from collections import Counter
+from collections.abc import Iterable
 from pathlib import Path
 
 import pytest
 from hypothesis import HealthCheck, event, settings
+from hypothesis.database import DirectoryBasedExampleDatabase, ExampleDatabase
 
-settings.register_profile(
-    "default",
-    max_examples=150,
-    deadline=None,
-    suppress_health_check=[HealthCheck.too_slow, HealthCheck.function_scoped_fixture],
-)
-settings.register_profile(
-    "ci", max_examples=150, deadline=None, derandomize=True, suppress_health_check=[HealthCheck.function_scoped_fixture]
-)
-settings.load_profile("ci" if os.environ.get("CI") else "default")
+#: The example database committed with the tests: every failing example hypothesis finds is saved here, so
+#: that whoever found it (a newcomer's first run, CI, the nightly run) can commit it and every later run
+#: replays it first.
+EXAMPLES = Path(__file__).resolve().parent / ".hypothesis-examples"
+#: How many times more examples each property test tries in the nightly run (``make nightly``).
+NIGHTLY_FACTOR = 10
+
+
+class RepositoryExamples(ExampleDatabase):
+    """Hypothesis's directory database, keeping only the failures, and keeping them once committed.
+
+    Failing examples (hypothesis's primary keys) are saved into ``path``; the secondary and pareto corpora
+    (examples shrunk past, targeting scores) are not kept, so a passing run writes nothing. An example is
+    deleted only by the process that saved it (while hypothesis shrinks it): one found earlier stays a
+    regression test after it passes. A read-only clone replays the examples and saves nothing (the directory
+    database ignores a failed write), and the xdist workers share the folder safely (each file is written
+    whole, then renamed into place).
+    """
+
+    def __init__(self, path: Path) -> None:
+        super().__init__()
+        self.store = DirectoryBasedExampleDatabase(path)
+        self.saved: set[tuple[bytes, bytes]] = set()
+
+    @staticmethod
+    def kept(key: bytes) -> bool:
+        return not key.endswith((b".secondary", b".pareto"))
+
+    def fetch(self, key: bytes) -> Iterable[bytes]:
+        return self.store.fetch(key) if self.kept(key) else ()
+
+    def save(self, key: bytes, value: bytes) -> None:
+        if self.kept(key):
+            self.store.save(key, value)
+            self.saved.add((key, value))
+
+    def delete(self, key: bytes, value: bytes) -> None:
+        if (key, value) in self.saved:
+            self.store.delete(key, value)
+            self.saved.discard((key, value))
+
+    def __repr__(self) -> str:
+        return f"RepositoryExamples({str(self.store.path)!r})"
+
+
+# One profile for everyone (CI included): random examples, so every run may find what a fixed seed hides.
+_SHARED = {
+    "deadline": None,
+    "database": RepositoryExamples(EXAMPLES),
+    "print_blob": True,
+    "suppress_health_check": [HealthCheck.too_slow, HealthCheck.function_scoped_fixture],
+}
+settings.register_profile("default", max_examples=150, **_SHARED)
+# ``make nightly`` (``--hypothesis-profile nightly``): every property test tries NIGHTLY_FACTOR times more examples.
+settings.register_profile("nightly", max_examples=150 * NIGHTLY_FACTOR, **_SHARED)
+settings.load_profile("default")
 
 #: Reprs that must never reach a message (plain numbers only).
 NUMPY_REPRS = ("np.", "array(", "dtype")
@@ -110,10 +158,15 @@ _CAD = re.compile(r"^\s*(?:from|import) (?:build123d|cadquery|OCP)\b|importorski
 _SUBPROCESS = re.compile(r"\bsubprocess\b|sys\.executable")
 
 
+@pytest.hookimpl(tryfirst=True)  # before xdist reads the groups
 def pytest_collection_modifyitems(config, items):
     """Markers by what a test module needs: ``cad`` (imports OCP, build123d or CadQuery, or lives in
-    tests/cad), ``subprocess`` (runs a program), ``install`` (tests/app/test_install.py), ``slow`` (``SLOW``)."""
+    tests/cad), ``subprocess`` (runs a program), ``install`` (tests/app/test_install.py), ``slow`` (``SLOW``);
+    the xdist groups of ``shared_fixture_group``; in the nightly profile, NIGHTLY_FACTOR times the examples a
+    property test asks for with its own ``@settings(max_examples=…)``."""
     texts: dict[Path, str] = {}
+    nightly = settings.get_current_profile_name() == "nightly"
+    scaled: set[int] = set()
     for item in items:
         path = Path(item.fspath)
         text = texts.setdefault(path, path.read_text(encoding="utf-8"))
@@ -125,6 +178,30 @@ def pytest_collection_modifyitems(config, items):
             item.add_marker(pytest.mark.install)
         if path.name in SLOW or f"{path.name}::{item.originalname}" in SLOW:
             item.add_marker(pytest.mark.slow)
+        group = shared_fixture_group(item)
+        if group and not item.get_closest_marker("xdist_group"):
+            item.add_marker(pytest.mark.xdist_group(group))
+        test = getattr(item, "obj", None)
+        chosen = getattr(test, "_hypothesis_internal_use_settings", None)
+        if nightly and chosen is not None and id(test) not in scaled:
+            scaled.add(id(test))
+            if chosen.max_examples < settings.default.max_examples:
+                test._hypothesis_internal_use_settings = settings(chosen, max_examples=chosen.max_examples * NIGHTLY_FACTOR)
+
+
+def shared_fixture_group(item) -> str | None:
+    """The module of a test that uses a module- or session-scoped fixture of its own module, or None.
+
+    Each xdist worker is a session of its own: the tests sharing such a fixture (a built site, a corridor, a
+    demo's files) go to one worker (``--dist loadgroup``), so it is built once, not once per worker.
+    """
+    info = getattr(item, "_fixtureinfo", None)
+    module = item.nodeid.split("::")[0]
+    for name in item.fixturenames if info is not None else ():
+        for definition in info.name2fixturedefs.get(name) or ():
+            if definition.scope in ("module", "session") and definition.baseid == module:
+                return module
+    return None
 
 
 @pytest.fixture(scope="session")
