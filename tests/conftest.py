@@ -2,6 +2,8 @@
 kept in the repository's example database, a nightly size), ``outcome``, the tally of property tests whose
 examples may be refused, the markers, and the groups that keep an expensive fixture on one xdist worker."""
 
+import ast
+import functools
 import re
 from collections import Counter
 from collections.abc import Iterable
@@ -15,6 +17,8 @@ from hypothesis.database import DirectoryBasedExampleDatabase, ExampleDatabase
 #: that whoever found it (a newcomer's first run, CI, the nightly run) can commit it and every later run
 #: replays it first.
 EXAMPLES = Path(__file__).resolve().parent / ".hypothesis-examples"
+#: Where pytest runs from (the test ids are relative to it).
+ROOTDIR = Path(__file__).resolve().parent.parent
 #: How many times more examples each property test tries in the nightly run (``make nightly``).
 NIGHTLY_FACTOR = 10
 
@@ -158,12 +162,11 @@ _CAD = re.compile(r"^\s*(?:from|import) (?:build123d|cadquery|OCP)\b|importorski
 _SUBPROCESS = re.compile(r"\bsubprocess\b|sys\.executable")
 
 
-@pytest.hookimpl(tryfirst=True)  # before xdist reads the groups
 def pytest_collection_modifyitems(config, items):
     """Markers by what a test module needs: ``cad`` (imports OCP, build123d or CadQuery, or lives in
     tests/cad), ``subprocess`` (runs a program), ``install`` (tests/app/test_install.py), ``slow`` (``SLOW``);
-    the xdist groups of ``shared_fixture_group``; in the nightly profile, NIGHTLY_FACTOR times the examples a
-    property test asks for with its own ``@settings(max_examples=…)``."""
+    in the nightly profile, NIGHTLY_FACTOR times the examples a property test asks for with its own
+    ``@settings(max_examples=…)``."""
     texts: dict[Path, str] = {}
     nightly = settings.get_current_profile_name() == "nightly"
     scaled: set[int] = set()
@@ -178,9 +181,6 @@ def pytest_collection_modifyitems(config, items):
             item.add_marker(pytest.mark.install)
         if path.name in SLOW or f"{path.name}::{item.originalname}" in SLOW:
             item.add_marker(pytest.mark.slow)
-        group = shared_fixture_group(item)
-        if group and not item.get_closest_marker("xdist_group"):
-            item.add_marker(pytest.mark.xdist_group(group))
         test = getattr(item, "obj", None)
         chosen = getattr(test, "_hypothesis_internal_use_settings", None)
         if nightly and chosen is not None and id(test) not in scaled:
@@ -189,19 +189,80 @@ def pytest_collection_modifyitems(config, items):
                 test._hypothesis_internal_use_settings = settings(chosen, max_examples=chosen.max_examples * NIGHTLY_FACTOR)
 
 
-def shared_fixture_group(item) -> str | None:
-    """The module of a test that uses a module- or session-scoped fixture of its own module, or None.
+# --- xdist: tests sharing an expensive fixture run on one worker -----------------------------------------
 
-    Each xdist worker is a session of its own: the tests sharing such a fixture (a built site, a corridor, a
-    demo's files) go to one worker (``--dist loadgroup``), so it is built once, not once per worker.
+
+def _decorator_call(node: ast.expr, *dotted: str) -> ast.Call | None:
+    """``node`` as a call of one of the ``dotted`` names (``pytest.fixture(...)``), or None."""
+    call = node if isinstance(node, ast.Call) else None
+    target = call.func if call else node
+    return (call or ast.Call(func=target, args=[], keywords=[])) if ast.unparse(target) in dotted else None
+
+
+@functools.cache
+def shared_groups(path: Path) -> dict[str, str]:
+    """The test functions of a test module that go to one xdist worker, with their group.
+
+    A test that uses, directly or through another fixture of its module, a module- or session-scoped
+    fixture of its module shares it with the other such tests (group: the module); a test marked
+    ``@pytest.mark.xdist_group("name")`` joins that group. Read from the source, so the controller, which
+    collects no tests, can group the test ids the workers send.
     """
-    info = getattr(item, "_fixtureinfo", None)
-    module = item.nodeid.split("::")[0]
-    for name in item.fixturenames if info is not None else ():
-        for definition in info.name2fixturedefs.get(name) or ():
-            if definition.scope in ("module", "session") and definition.baseid == module:
-                return module
-    return None
+    try:
+        tree = ast.parse(path.read_text(encoding="utf-8"))
+    except (OSError, SyntaxError, UnicodeDecodeError):
+        return {}
+    functions = [node for node in ast.walk(tree) if isinstance(node, ast.FunctionDef)]
+    needs: dict[str, set[str]] = {}  # fixture -> the fixtures it requests
+    shared: set[str] = set()
+    for function in functions:
+        for decorator in function.decorator_list:
+            if (call := _decorator_call(decorator, "pytest.fixture", "fixture")) is not None:
+                needs[function.name] = {argument.arg for argument in function.args.args}
+                scope = next((k.value for k in call.keywords if k.arg == "scope"), None)
+                if isinstance(scope, ast.Constant) and scope.value in ("module", "session"):
+                    shared.add(function.name)
+    grew = True
+    while grew:  # a fixture that requests a shared one is shared too
+        grew = False
+        for name, requested in needs.items():
+            if name not in shared and requested & shared:
+                shared.add(name)
+                grew = True
+    module = path.relative_to(ROOTDIR).as_posix() if path.is_relative_to(ROOTDIR) else path.as_posix()
+    groups = {}
+    for function in functions:
+        if not function.name.startswith("test"):
+            continue
+        for decorator in function.decorator_list:
+            call = _decorator_call(decorator, "pytest.mark.xdist_group")
+            if call is not None and call.args and isinstance(call.args[0], ast.Constant):
+                groups[function.name] = str(call.args[0].value)
+        if function.name not in groups and {argument.arg for argument in function.args.args} & shared:
+            groups[function.name] = module
+    return groups
+
+
+def xdist_scope(nodeid: str) -> str:
+    """The xdist work unit of a test id: its group (``shared_groups``), or the test alone."""
+    path, _, rest = nodeid.partition("::")
+    name = rest.split("::")[-1].split("[")[0]
+    return shared_groups(ROOTDIR / path).get(name, nodeid)
+
+
+@pytest.hookimpl(optionalhook=True)
+def pytest_xdist_make_scheduler(config, log):
+    """``--dist loadgroup``: like xdist's own, with the groups of ``shared_groups`` (xdist marks a group by
+    renaming the test ids, which pytest 9 no longer lets it do)."""
+    if config.getvalue("dist") != "loadgroup":
+        return None
+    from xdist.scheduler import LoadScopeScheduling
+
+    class SharedFixtureScheduling(LoadScopeScheduling):
+        def _split_scope(self, nodeid: str) -> str:
+            return xdist_scope(nodeid)
+
+    return SharedFixtureScheduling(config, log)
 
 
 @pytest.fixture(scope="session")
