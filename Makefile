@@ -3,12 +3,13 @@ PYTHON ?= python3
 VENV   := .venv
 BIN    := $(VENV)/bin
 STAMP  := $(VENV)/.installed
+DOCS_STAMP := $(VENV)/.docs-installed
 # OpenDRIVE validators (ASAM quality checker with the 1.8 XSD, pyxodr): they pin
 # numpy < 2, so they live in their own small environment, never in .venv.
 TOOLS       := .venv-tools
 TOOLS_STAMP := $(TOOLS)/.installed
 
-.PHONY: setup demo test check lint bench pictures clean rs274 freecad chromium
+.PHONY: setup demo test check nightly lint bench pictures clean rs274 freecad chromium
 
 $(STAMP): requirements.lock pyproject.toml
 	test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
@@ -49,13 +50,25 @@ chromium:
 	            || { apt-get update -q >/dev/null && DEBIAN_FRONTEND=noninteractive apt-get install -y -q --no-install-recommends chromium >/dev/null; }; }; } \
 	  || echo "Chromium not installed (apt-get install chromium): the rendered-site tests are skipped"
 
-# Everything CI runs: lint, the documentation site (--strict), then every test.
-test: $(STAMP) $(TOOLS_STAMP) rs274 freecad chromium lint docs
-	SPIRAL_CAD_XODR_TOOLS=$(abspath $(TOOLS))/bin/python $(BIN)/python -m pytest -q
+# pytest on every core (pytest-xdist); the tests sharing an expensive module fixture stay on one
+# worker (tests/conftest.py, shared_fixture_group). PYTEST_WORKERS=0 runs in one process.
+PYTEST_WORKERS ?= auto
+XDIST := -n $(PYTEST_WORKERS) --dist loadgroup
+
+# Everything CI runs: lint and the documentation site (--strict) side by side, then every test (the docs
+# tests reuse that site/). -O keeps each one's output in one piece.
+test: $(STAMP) $(TOOLS_STAMP) $(DOCS_STAMP) rs274 freecad chromium
+	$(MAKE) --no-print-directory -j2 -O lint docs
+	SPIRAL_CAD_XODR_TOOLS=$(abspath $(TOOLS))/bin/python $(BIN)/python -m pytest -q $(XDIST) --durations=30
 
 # The fast tier while working: no slow, install or subprocess-heavy tests.
 check: $(STAMP)
-	$(BIN)/python -m pytest -q -m "not slow and not install"
+	$(BIN)/python -m pytest -q $(XDIST) -m "not slow and not install"
+
+# The nightly size: every property test with ten times its examples (the "nightly" hypothesis profile,
+# tests/conftest.py). A failing example is saved in tests/.hypothesis-examples: commit it with the fix.
+nightly: $(STAMP) $(TOOLS_STAMP)
+	SPIRAL_CAD_XODR_TOOLS=$(abspath $(TOOLS))/bin/python $(BIN)/python -m pytest -q $(XDIST) -m hypothesis --hypothesis-profile=nightly
 
 # ruff (lint and format), mypy (strict for the numeric core), import-linter (layers point one way).
 lint: $(STAMP)
@@ -79,7 +92,6 @@ bench: $(STAMP)
 
 # The documentation site into site/: the pinned mkdocs toolchain on top of the
 # package's own set (shared packages keep requirements.lock's versions).
-DOCS_STAMP := $(VENV)/.docs-installed
 
 $(DOCS_STAMP): $(STAMP) requirements-docs.lock
 	$(BIN)/python -m pip install -q -r requirements-docs.lock -c requirements.lock
@@ -87,8 +99,12 @@ $(DOCS_STAMP): $(STAMP) requirements-docs.lock
 	touch $(DOCS_STAMP)
 
 .PHONY: docs
+# site/.strict-build marks a site built --strict; tests/app/test_docs.py reuses such a site while none
+# of its inputs changed (mkdocs keeps dot files in site/, hence the rm).
 docs: $(DOCS_STAMP)
+	rm -f site/.strict-build
 	NO_MKDOCS_2_WARNING=1 $(BIN)/python -m mkdocs build --strict
+	touch site/.strict-build
 
 pictures: $(STAMP)
 	$(BIN)/python docs/make_pictures.py

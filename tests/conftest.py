@@ -1,24 +1,76 @@
-"""Shared test settings and helpers: the hypothesis profile sized for a 2-core CI machine, and
-``outcome``, the tally of property tests whose examples may be refused."""
+"""Shared test settings and helpers: the hypothesis profiles (the same random examples everywhere, failures
+kept in the repository's example database, a nightly size), ``outcome``, the tally of property tests whose
+examples may be refused, the markers, and the groups that keep an expensive fixture on one xdist worker."""
 
-import os
+import ast
+import functools
 import re
 from collections import Counter
+from collections.abc import Iterable
 from pathlib import Path
 
 import pytest
 from hypothesis import HealthCheck, event, settings
+from hypothesis.database import DirectoryBasedExampleDatabase, ExampleDatabase
 
-settings.register_profile(
-    "default",
-    max_examples=150,
-    deadline=None,
-    suppress_health_check=[HealthCheck.too_slow, HealthCheck.function_scoped_fixture],
-)
-settings.register_profile(
-    "ci", max_examples=150, deadline=None, derandomize=True, suppress_health_check=[HealthCheck.function_scoped_fixture]
-)
-settings.load_profile("ci" if os.environ.get("CI") else "default")
+#: The example database committed with the tests: every failing example hypothesis finds is saved here, so
+#: that whoever found it (a newcomer's first run, CI, the nightly run) can commit it and every later run
+#: replays it first.
+EXAMPLES = Path(__file__).resolve().parent / ".hypothesis-examples"
+#: Where pytest runs from (the test ids are relative to it).
+ROOTDIR = Path(__file__).resolve().parent.parent
+#: How many times more examples each property test tries in the nightly run (``make nightly``).
+NIGHTLY_FACTOR = 10
+
+
+class RepositoryExamples(ExampleDatabase):
+    """Hypothesis's directory database, keeping only the failures, and keeping them once committed.
+
+    Failing examples (hypothesis's primary keys) are saved into ``path``; the secondary and pareto corpora
+    (examples shrunk past, targeting scores) are not kept, so a passing run writes nothing. An example is
+    deleted only by the process that saved it (while hypothesis shrinks it): one found earlier stays a
+    regression test after it passes. A read-only clone replays the examples and saves nothing (the directory
+    database ignores a failed write), and the xdist workers share the folder safely (each file is written
+    whole, then renamed into place).
+    """
+
+    def __init__(self, path: Path) -> None:
+        super().__init__()
+        self.store = DirectoryBasedExampleDatabase(path)
+        self.saved: set[tuple[bytes, bytes]] = set()
+
+    @staticmethod
+    def kept(key: bytes) -> bool:
+        return not key.endswith((b".secondary", b".pareto"))
+
+    def fetch(self, key: bytes) -> Iterable[bytes]:
+        return self.store.fetch(key) if self.kept(key) else ()
+
+    def save(self, key: bytes, value: bytes) -> None:
+        if self.kept(key):
+            self.store.save(key, value)
+            self.saved.add((key, value))
+
+    def delete(self, key: bytes, value: bytes) -> None:
+        if (key, value) in self.saved:
+            self.store.delete(key, value)
+            self.saved.discard((key, value))
+
+    def __repr__(self) -> str:
+        return f"RepositoryExamples({str(self.store.path)!r})"
+
+
+# One profile for everyone (CI included): random examples, so every run may find what a fixed seed hides.
+_SHARED = {
+    "deadline": None,
+    "database": RepositoryExamples(EXAMPLES),
+    "print_blob": True,
+    "suppress_health_check": [HealthCheck.too_slow, HealthCheck.function_scoped_fixture],
+}
+settings.register_profile("default", max_examples=150, **_SHARED)
+# ``make nightly`` (``--hypothesis-profile nightly``): every property test tries NIGHTLY_FACTOR times more examples.
+settings.register_profile("nightly", max_examples=150 * NIGHTLY_FACTOR, **_SHARED)
+settings.load_profile("default")
 
 #: Reprs that must never reach a message (plain numbers only).
 NUMPY_REPRS = ("np.", "array(", "dtype")
@@ -121,8 +173,12 @@ _SUBPROCESS = re.compile(r"\bsubprocess\b|sys\.executable")
 
 def pytest_collection_modifyitems(config, items):
     """Markers by what a test module needs: ``cad`` (imports OCP, build123d or CadQuery, or lives in
-    tests/cad), ``subprocess`` (runs a program), ``install`` (tests/app/test_install.py), ``slow`` (``SLOW``)."""
+    tests/cad), ``subprocess`` (runs a program), ``install`` (tests/app/test_install.py), ``slow`` (``SLOW``);
+    in the nightly profile, NIGHTLY_FACTOR times the examples a property test asks for with its own
+    ``@settings(max_examples=…)``."""
     texts: dict[Path, str] = {}
+    nightly = settings.get_current_profile_name() == "nightly"
+    scaled: set[int] = set()
     for item in items:
         path = Path(item.fspath)
         text = texts.setdefault(path, path.read_text(encoding="utf-8"))
@@ -134,6 +190,88 @@ def pytest_collection_modifyitems(config, items):
             item.add_marker(pytest.mark.install)
         if path.name in SLOW or f"{path.name}::{item.originalname}" in SLOW:
             item.add_marker(pytest.mark.slow)
+        test = getattr(item, "obj", None)
+        chosen = getattr(test, "_hypothesis_internal_use_settings", None)
+        if nightly and chosen is not None and id(test) not in scaled:
+            scaled.add(id(test))
+            if chosen.max_examples < settings.default.max_examples:
+                test._hypothesis_internal_use_settings = settings(chosen, max_examples=chosen.max_examples * NIGHTLY_FACTOR)
+
+
+# --- xdist: tests sharing an expensive fixture run on one worker -----------------------------------------
+
+
+def _decorator_call(node: ast.expr, *dotted: str) -> ast.Call | None:
+    """``node`` as a call of one of the ``dotted`` names (``pytest.fixture(...)``), or None."""
+    call = node if isinstance(node, ast.Call) else None
+    target = call.func if call else node
+    return (call or ast.Call(func=target, args=[], keywords=[])) if ast.unparse(target) in dotted else None
+
+
+@functools.cache
+def shared_groups(path: Path) -> dict[str, str]:
+    """The test functions of a test module that go to one xdist worker, with their group.
+
+    A test that uses, directly or through another fixture of its module, a module- or session-scoped
+    fixture of its module shares it with the other such tests (group: the module); a test marked
+    ``@pytest.mark.xdist_group("name")`` joins that group. Read from the source, so the controller, which
+    collects no tests, can group the test ids the workers send.
+    """
+    try:
+        tree = ast.parse(path.read_text(encoding="utf-8"))
+    except (OSError, SyntaxError, UnicodeDecodeError):
+        return {}
+    functions = [node for node in ast.walk(tree) if isinstance(node, ast.FunctionDef)]
+    needs: dict[str, set[str]] = {}  # fixture -> the fixtures it requests
+    shared: set[str] = set()
+    for function in functions:
+        for decorator in function.decorator_list:
+            if (call := _decorator_call(decorator, "pytest.fixture", "fixture")) is not None:
+                needs[function.name] = {argument.arg for argument in function.args.args}
+                scope = next((k.value for k in call.keywords if k.arg == "scope"), None)
+                if isinstance(scope, ast.Constant) and scope.value in ("module", "session"):
+                    shared.add(function.name)
+    grew = True
+    while grew:  # a fixture that requests a shared one is shared too
+        grew = False
+        for name, requested in needs.items():
+            if name not in shared and requested & shared:
+                shared.add(name)
+                grew = True
+    module = path.relative_to(ROOTDIR).as_posix() if path.is_relative_to(ROOTDIR) else path.as_posix()
+    groups = {}
+    for function in functions:
+        if not function.name.startswith("test"):
+            continue
+        for decorator in function.decorator_list:
+            call = _decorator_call(decorator, "pytest.mark.xdist_group")
+            if call is not None and call.args and isinstance(call.args[0], ast.Constant):
+                groups[function.name] = str(call.args[0].value)
+        if function.name not in groups and {argument.arg for argument in function.args.args} & shared:
+            groups[function.name] = module
+    return groups
+
+
+def xdist_scope(nodeid: str) -> str:
+    """The xdist work unit of a test id: its group (``shared_groups``), or the test alone."""
+    path, _, rest = nodeid.partition("::")
+    name = rest.split("::")[-1].split("[")[0]
+    return shared_groups(ROOTDIR / path).get(name, nodeid)
+
+
+@pytest.hookimpl(optionalhook=True)
+def pytest_xdist_make_scheduler(config, log):
+    """``--dist loadgroup``: like xdist's own, with the groups of ``shared_groups`` (xdist marks a group by
+    renaming the test ids, which pytest 9 no longer lets it do)."""
+    if config.getvalue("dist") != "loadgroup":
+        return None
+    from xdist.scheduler import LoadScopeScheduling
+
+    class SharedFixtureScheduling(LoadScopeScheduling):
+        def _split_scope(self, nodeid: str) -> str:
+            return xdist_scope(nodeid)
+
+    return SharedFixtureScheduling(config, log)
 
 
 @pytest.fixture(scope="session")

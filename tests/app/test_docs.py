@@ -6,7 +6,9 @@ is a temporary one. A block that cannot run by design is preceded by the line
 ``<!-- docs: skip (the reason) -->``; it is still compiled.
 
 The site test builds with ``mkdocs build --strict`` (the toolchain of
-``requirements-docs.lock``, which ``make docs`` installs) and opens pages in
+``requirements-docs.lock``, which ``make docs`` installs), or reuses the
+``site/`` that ``make docs`` built strictly after the last change to any of
+its inputs (``make test`` builds it just before pytest), and opens pages in
 headless Chromium served over HTTP: the title, the navigation, every request
 answered and no error on the console.
 """
@@ -127,17 +129,58 @@ def _chromium() -> str:
     pytest.skip("headless Chromium is not installed (Debian: apt-get install chromium)")
 
 
+#: Written into site/ by ``make docs`` once ``mkdocs build --strict`` succeeded (mkdocs keeps dot files).
+BUILT_MARK = ".strict-build"
+
+
+def _site_inputs() -> list[Path]:
+    """Every file the site is made from: its pages and assets, its configuration and hooks, the docstrings of
+    the API pages, the benchmark tables the results page gathers."""
+    return [
+        ROOT / "mkdocs.yml",
+        ROOT / "requirements-docs.lock",
+        *(path for path in DOCS.rglob("*") if path.is_file()),
+        *(ROOT / "spiral_cad").rglob("*.py"),
+        *(ROOT / "benchmarks").glob("results_*.md"),
+    ]
+
+
+def current_site(built: Path = ROOT / "site") -> Path | None:
+    """``built`` when ``make docs`` built it with ``--strict`` after the last change to any of its inputs."""
+    mark = built / BUILT_MARK
+    if not mark.is_file() or not (built / "index.html").is_file():
+        return None
+    made = mark.stat().st_mtime
+    return built if all(path.stat().st_mtime <= made for path in _site_inputs()) else None
+
+
+def test_a_site_is_reused_only_when_built_strictly_after_its_inputs(tmp_path):
+    assert current_site(tmp_path) is None
+    (tmp_path / "index.html").write_text("<title>spiral_cad</title>", encoding="utf-8")
+    assert current_site(tmp_path) is None  # no mark: the build failed or was not `make docs`
+    mark = tmp_path / BUILT_MARK
+    mark.touch()
+    newest = max(path.stat().st_mtime for path in _site_inputs())
+    os.utime(mark, (newest + 1, newest + 1))
+    assert current_site(tmp_path) == tmp_path
+    os.utime(mark, (newest - 1, newest - 1))
+    assert current_site(tmp_path) is None  # a page changed since
+
+
 @pytest.fixture(scope="module")
 def site(tmp_path_factory) -> Path:
+    """The site ``make docs`` built (``make test`` builds it before pytest) when it is current, else a strict build."""
     try:
         import mkdocs  # noqa: F401
         import mkdocstrings  # noqa: F401
     except ImportError:
         pytest.skip("the documentation toolchain is not installed here (make docs installs requirements-docs.lock)")
-    out = tmp_path_factory.mktemp("site")
-    env = {**os.environ, "PYTHONPATH": os.pathsep.join([str(ROOT), os.environ.get("PYTHONPATH", "")]), "NO_MKDOCS_2_WARNING": "1"}
     # API pages of faces this checkout does not have yet are left out, as the hook documents.
     missing = [name for name in ("check", "io", "cad", "app") if importlib.util.find_spec(f"spiral_cad.{name}") is None]
+    if not missing and (built := current_site()) is not None:
+        return built
+    out = tmp_path_factory.mktemp("site")
+    env = {**os.environ, "PYTHONPATH": os.pathsep.join([str(ROOT), os.environ.get("PYTHONPATH", "")]), "NO_MKDOCS_2_WARNING": "1"}
     if missing:
         env["SPIRAL_CAD_DOCS_SKIP_API"] = ",".join(missing)
     done = subprocess.run(

@@ -19,16 +19,32 @@ OUTPUTS = {
 }
 
 
+@pytest.fixture(scope="module")
+def example_outputs(tmp_path_factory):
+    """Runs an example script (the name) into a folder of its own once, however many tests read its outputs."""
+    folders: dict[str, Path] = {}
+
+    def run_once(script: str) -> Path:
+        if script not in folders:
+            folder = tmp_path_factory.mktemp(script.removesuffix(".py"))
+            target = folder / OUTPUTS[script][0] if script == "cadquery_plugin.py" else folder
+            run = subprocess.run([sys.executable, str(EXAMPLES / script), str(target)], capture_output=True, text=True,
+                                 timeout=300)  # fmt: skip
+            assert run.returncode == 0, run.stdout[-2000:] + run.stderr[-2000:]
+            folders[script] = folder
+        return folders[script]
+
+    return run_once
+
+
 @pytest.mark.parametrize("script", sorted(OUTPUTS))
-def test_example_runs(script, tmp_path):
-    target = tmp_path / OUTPUTS[script][0] if script == "cadquery_plugin.py" else tmp_path
-    run = subprocess.run([sys.executable, str(EXAMPLES / script), str(target)], capture_output=True, text=True, timeout=300)
-    assert run.returncode == 0, run.stdout[-2000:] + run.stderr[-2000:]
+def test_example_runs(script, example_outputs):
+    folder = example_outputs(script)
     for name in OUTPUTS[script]:
-        assert (tmp_path / name).stat().st_size > 0, name
+        assert (folder / name).stat().st_size > 0, name
 
 
-def test_the_road_example_writes_metres(tmp_path):
+def test_the_road_example_writes_metres(example_outputs):
     """road.step holds the design in metres: OCCT reading it into millimetres finds a road of about 900 m, not 0.9 m."""
     pytest.importorskip("OCP")
     from OCP.Bnd import Bnd_Box
@@ -37,9 +53,7 @@ def test_the_road_example_writes_metres(tmp_path):
     from OCP.GProp import GProp_GProps
     from OCP.STEPControl import STEPControl_Reader
 
-    run = subprocess.run([sys.executable, str(EXAMPLES / "build123d_road.py"), str(tmp_path)], capture_output=True,
-                         text=True, timeout=300)  # fmt: skip
-    assert run.returncode == 0, run.stdout[-2000:] + run.stderr[-2000:]
+    tmp_path = example_outputs("build123d_road.py")
     for name in ("road.step", "road_centreline.step"):
         reader = STEPControl_Reader()
         reader.ReadFile(str(tmp_path / name))

@@ -1,7 +1,7 @@
 """Single-byte mutations of the demo's STEP and IGES files: `spiral-cad check` reports or refuses, never crashes.
 
 Each mutated file is checked by ``spiral-cad check --require G2`` in a forked
-process of its own, so a crash is counted rather than fatal. The outcome must
+process of its own (one per core at a time), so a crash is counted rather than fatal. The outcome must
 be exit 0/1 with a complete report, or exit 2 with one ``error: …`` line —
 never a signal, a traceback or an "internal error".
 
@@ -54,11 +54,8 @@ def mutations(data: bytes, count: int, seed: int) -> list[bytes]:
     return out
 
 
-def check_in_child(path: Path) -> tuple[str, str, str]:
-    """``spiral-cad check PATH --require G2`` in a forked process: (outcome, stdout, stderr).
-
-    outcome is ``"exit N"``, ``"signal N"`` or ``"hang"``.
-    """
+def start_check(path: Path) -> int:
+    """Fork a child running ``spiral-cad check PATH --require G2`` (its output into PATH.out, PATH.err); its pid."""
     import spiral_cad.cad.continuity  # noqa: F401  (what `check` imports for STEP/IGES)
     from spiral_cad.app.cli import main  # imported here once, not in every child
 
@@ -75,18 +72,23 @@ def check_in_child(path: Path) -> tuple[str, str, str]:
             sys.stderr.flush()
         finally:
             os._exit(status)
-    deadline = time.monotonic() + HANG
-    while True:
-        done, status = os.waitpid(pid, os.WNOHANG)
-        if done:
-            break
-        if time.monotonic() > deadline:
-            os.kill(pid, signal.SIGKILL)
-            os.waitpid(pid, 0)
-            return "hang", "", ""
-        time.sleep(0.002)
+    return pid
+
+
+def finished(pid: int, path: Path, started: float) -> tuple[str, str, str] | None:
+    """(outcome, stdout, stderr) of the check ``start_check`` forked, or None while it runs.
+
+    outcome is ``"exit N"``, ``"signal N"`` or ``"hang"`` (killed after ``HANG`` seconds).
+    """
+    done, status = os.waitpid(pid, os.WNOHANG)
+    if not done:
+        if time.monotonic() - started <= HANG:
+            return None
+        os.kill(pid, signal.SIGKILL)
+        os.waitpid(pid, 0)
+        return "hang", "", ""
     outcome = f"signal {os.WTERMSIG(status)}" if os.WIFSIGNALED(status) else f"exit {os.WEXITSTATUS(status)}"
-    return outcome, out_file.read_text(errors="replace"), err_file.read_text(errors="replace")
+    return outcome, path.with_suffix(".out").read_text(errors="replace"), path.with_suffix(".err").read_text(errors="replace")
 
 
 def problem(name: str, outcome: str, out: str, err: str) -> str | None:
@@ -105,21 +107,36 @@ def problem(name: str, outcome: str, out: str, err: str) -> str | None:
     return outcome
 
 
-def campaign(files: list[Path], count: int, seed: int, folder: Path) -> tuple[Counter, list[str]]:
-    """Check ``count`` mutations of each file; (outcomes, problems found)."""
+def campaign(files: list[Path], count: int, seed: int, folder: Path, jobs: int | None = None) -> tuple[Counter, list[str]]:
+    """Check ``count`` mutations of each file, ``jobs`` children at a time (default: one per core);
+    (outcomes, problems found)."""
+    jobs = jobs or len(os.sched_getaffinity(0))
+    pending = [
+        (folder / f"m{n}-{k}{source.suffix}", data)
+        for n, source in enumerate(files)
+        for k, data in enumerate(mutations(source.read_bytes(), count, seed + n))
+    ]
+    pending.reverse()  # taken from the end, in order
+    running: dict[int, tuple[Path, bytes, float]] = {}
     outcomes: Counter = Counter()
     problems = []
-    for n, source in enumerate(files):
-        for k, data in enumerate(mutations(source.read_bytes(), count, seed + n)):
-            path = folder / f"m{k}{source.suffix}"
+    while pending or running:
+        while pending and len(running) < jobs:
+            path, data = pending.pop()
             path.write_bytes(data)
-            outcome, out, err = check_in_child(path)
+            running[start_check(path)] = (path, data, time.monotonic())
+        for pid, (path, data, started) in list(running.items()):
+            if (result := finished(pid, path, started)) is None:
+                continue
+            del running[pid]
+            outcome, out, err = result
             outcomes[outcome] += 1
             found = problem(path.name, outcome, out, err)
             if found:
-                kept = folder / f"problem-{len(problems)}{source.suffix}"
+                kept = folder / f"problem-{len(problems)}{path.suffix}"
                 kept.write_bytes(data)
                 problems.append(f"{kept}: {found}: {outcome} {err.strip()[:200]!r}")
+        time.sleep(0.002)
     return outcomes, problems
 
 
@@ -138,13 +155,14 @@ if __name__ == "__main__":
     parser = argparse.ArgumentParser(description="mutation campaign for `spiral-cad check` (see the module docstring)")
     parser.add_argument("--mutations", type=int, default=2500, help="per file (STEP and IGES)")
     parser.add_argument("--seed", type=int, default=SEED)
+    parser.add_argument("--jobs", type=int, help="checks at a time (default: one per core)")
     parser.add_argument("--keep", help="folder to keep the files that showed a problem (default: a temporary one)")
     options = parser.parse_args()
     with tempfile.TemporaryDirectory() as scratch:
         folder = Path(options.keep or scratch)
         folder.mkdir(parents=True, exist_ok=True)
         started = time.perf_counter()
-        outcomes, problems = campaign(demo_files(folder), options.mutations, options.seed, folder)
+        outcomes, problems = campaign(demo_files(folder), options.mutations, options.seed, folder, options.jobs)
         print(f"{sum(outcomes.values())} mutations in {time.perf_counter() - started:.0f} s: {dict(sorted(outcomes.items()))}")
         print(f"{len(problems)} problems")
         for line in problems[:20]:
