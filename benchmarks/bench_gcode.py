@@ -34,6 +34,8 @@ from timing import Report, Timing, arguments
 #: The modules whose code these numbers measure (stamped into the results: ``timing.code_stamp``).
 MEASURES = (
     "spiral_cad.io.gcode",
+    "spiral_cad.io.gcode_paths",
+    "spiral_cad.io.toolpath_rounding",
     "spiral_cad.io.toolpath",
     "spiral_cad.io.gcode_write",
     "spiral_cad.design.rounding",

@@ -20,6 +20,9 @@ from timing import Report, arguments, compare, per_second
 from spiral_cad import Arc, Chain, Line, batch
 from spiral_cad.design import make_g2
 
+#: The modules whose code these numbers measure (stamped into the results: ``timing.code_stamp``).
+MEASURES = ("spiral_cad.design.g2", "spiral_cad.design._g2_measure", "spiral_cad.design._g2_pieces", "spiral_cad.design._g2_solve")
+
 
 def random_g1_path(joints: int, rng: np.random.Generator) -> list:
     """Lines and tangent arcs alternating (``joints`` + 1 segments)."""

@@ -42,6 +42,9 @@ from spiral_cad import Chain, Line, line_to_line
 from spiral_cad.app.cli import main
 from spiral_cad.io.step import write_step
 
+#: The modules whose code these numbers measure (stamped into the results: ``timing.code_stamp``).
+MEASURES = ("spiral_cad.app.many",)
+
 
 def write_files(folder: Path, count: int) -> dict[str, str]:
     """``count`` STEP files in ``folder``; the verdict each should get (``ok``, or ``fail``: two pieces)."""

@@ -37,6 +37,7 @@ MEASURES = (
     "spiral_cad.core.space",
     "spiral_cad.core._chain_kernels",
     "spiral_cad.io.gcode",
+    "spiral_cad.io.toolpath_rounding",
     "spiral_cad.cad.export",
     "spiral_cad.build123d",
 )
