@@ -596,6 +596,8 @@ def _spiral_stations(cp: NDArray[np.float64], c1: NDArray[np.float64], c2: NDArr
     return out
 
 
+#: How many nearest samples chain_distances starts feet from (pieces already tried skipped).
+_NEIGHBOURS = 4
 #: Most samples chain_distances places along a chain (beside at least 8 per piece).
 _SAMPLES = 100_000
 
@@ -633,27 +635,34 @@ def chain_distances(chain: Chain, points: ArrayLike) -> tuple[NDArray[np.float64
     u_of = np.concatenate([np.linspace(0.0, 1.0, int(m)) for m in counts.tolist()])
     if not np.isfinite(samples).all():
         raise ValueError("chain_distances: the chain's points are not finite float64 numbers (coordinates beyond ±1e308)")
-    _, nearest = cKDTree(samples).query(p)
-    piece_of, u_guess = owner[nearest], u_of[nearest]
+    # The nearest few samples: where the chain passes near itself (closer than the samples' spacing)
+    # the nearest sample may lie on a piece other than the one that holds the foot.
+    _, nearest = cKDTree(samples).query(p, k=min(_NEIGHBOURS, len(samples)))
+    nearest = nearest.reshape(len(p), -1)
     best = np.full(len(p), np.inf)
     foot = np.zeros(len(p))
     ring = math.hypot(*(chain.end - chain.start)) <= 1e-9 * chain.size  # a closed chain: the ends are neighbours
-    order = np.argsort(piece_of, kind="stable")
-    bounds = np.flatnonzero(np.diff(piece_of[order])) + 1
-    for group in np.split(order, bounds):
-        if not len(group):
-            continue
-        k = int(piece_of[group[0]])
-        for j in (k - 1, k, k + 1):  # the neighbours too: a foot near a joint may lie on either side
-            if ring:
-                j %= len(pieces)
-            elif not 0 <= j < len(pieces):
+    tried = np.full((len(p), 0), -1)
+    for column in range(nearest.shape[1]):
+        piece_of, u_guess = owner[nearest[:, column]], u_of[nearest[:, column]]
+        fresh = np.flatnonzero(~(tried == piece_of[:, None]).any(axis=1))
+        tried = np.column_stack([tried, piece_of])
+        order = fresh[np.argsort(piece_of[fresh], kind="stable")]
+        bounds = np.flatnonzero(np.diff(piece_of[order])) + 1
+        for group in np.split(order, bounds):
+            if not len(group):
                 continue
-            guess = u_guess[group] if j == k else np.full(len(group), 1.0 if j == (k - 1) % len(pieces) else 0.0)
-            distance, along = _piece_distance(pieces[j], p[group], guess)
-            better = distance < best[group]
-            best[group[better]] = distance[better]
-            foot[group[better]] = stations[j] + along[better]
+            k = int(piece_of[group[0]])
+            for j in (k - 1, k, k + 1):  # the neighbours too: a foot near a joint may lie on either side
+                if ring:
+                    j %= len(pieces)
+                elif not 0 <= j < len(pieces):
+                    continue
+                guess = u_guess[group] if j == k else np.full(len(group), 1.0 if j == (k - 1) % len(pieces) else 0.0)
+                distance, along = _piece_distance(pieces[j], p[group], guess)
+                better = distance < best[group]
+                best[group[better]] = distance[better]
+                foot[group[better]] = stations[j] + along[better]
     return best, foot
 
 
@@ -774,6 +783,10 @@ def _reduce(pts: NDArray[np.float64], s: NDArray[np.float64], closed: bool) -> t
     return np.vstack([pts[:1], means, pts[-1:]]), np.concatenate([s[:1], means_s, s[-1:]])
 
 
+#: How far beyond the tolerance (as a factor) a join may miss the points when the runs are chosen.
+_SLACKS = (1.0, 16.0, 256.0)
+
+
 def _fit_chain(pts: NDArray[np.float64], tol: float, shape: str, units: str, closed: bool, kmax: float | None,
                report: ProgressCallback | None) -> tuple[Chain | None, NDArray[np.float64]]:  # fmt: skip
     """The chain of runs and transitions (not yet measured; None where the runs cannot be joined)
@@ -801,16 +814,25 @@ def _fit_chain(pts: NDArray[np.float64], tol: float, shape: str, units: str, clo
     chain = None
     # Runs too short for the transitions between them (sparse points round a tight smooth shape,
     # where every arc is short) cannot be joined: looser runs are longer, and fewer.
+    # A run's line or circle is a core tolerance off the design, and the spirals it decides several
+    # tolerances off until the chain is settled: the joins are first judged within the tolerance,
+    # then looser (the settled chain measured against the tolerance itself).
     for tau in sorted({core, min(2.0 * core, tol / 2.0), tol / 2.0}):
-        try:
-            prims = _segment(work, work_s, work_kappa, h, tau, kmax, closed)
-            report(3, _STEPS)
-            chain = _assemble(prims, work, tol, shape, units, closed)
-        except (ValueError, _Unfit):
-            continue
-        if tau == core or float(chain_distances(chain, pts)[0].max()) <= tol:
+        prims = None
+        for slack in _SLACKS:
+            try:
+                if prims is None:
+                    prims = _segment(work, work_s, work_kappa, h, tau, kmax, closed)
+                    report(3, _STEPS)
+                chain = _assemble(prims, work, tol, shape, units, closed, slack)
+            except (ValueError, _Unfit):
+                chain = None
+                continue
+            if not _loops(chain, pts, closed) and float(chain_distances(chain, pts)[0].max()) <= tol:
+                break
+            chain = None
+        if chain is not None:
             break
-        chain = None
     report(4, _STEPS)
     return chain, kappa
 
@@ -884,12 +906,14 @@ class _Gap:
 
 
 #: How many runs ahead a join may reach (the runs skipped between are left to its spirals).
-_REACH = 10
+_REACH = 64
 
 
-def _assemble(prims: list[_Primitive], pts: NDArray[np.float64], tol: float, shape: str, units: str, closed: bool) -> Chain:
+def _assemble(prims: list[_Primitive], pts: NDArray[np.float64], tol: float, shape: str, units: str, closed: bool,
+              slack: float = 1.0) -> Chain:  # fmt: skip
     """Choose the runs to keep, fewest pieces first (dynamic programming over the runs in order,
-    each join reaching up to ``_REACH`` runs ahead), and build the chain."""
+    each join reaching up to ``_REACH`` runs ahead, its points within ``slack`` tolerances), and build
+    the chain."""
     if not prims:
         raise _Unfit
     if len(prims) == 1:
@@ -909,7 +933,7 @@ def _assemble(prims: list[_Primitive], pts: NDArray[np.float64], tol: float, sha
 
     def usable(i: int, j: int) -> Transition | None:
         g = gap(i, j)
-        return g.transition if g.miss <= tol else None
+        return g.transition if g.miss <= slack * tol else None
 
     last = len(order) - 1
     best_cost, best_path = math.inf, None
@@ -931,10 +955,98 @@ def _assemble(prims: list[_Primitive], pts: NDArray[np.float64], tol: float, sha
         try:
             better = _build(*refined, pts, units, closed)
         except (ValueError, _Unfit):
-            return chain
-        if float(chain_distances(better, pts)[0].max()) <= tol:
-            return better
-    return chain
+            better = None
+        if better is not None and not _loops(better, pts, closed) and float(chain_distances(better, pts)[0].max()) <= float(chain_distances(chain, pts)[0].max()):
+            chain, kept = better, refined[0]
+    return _settled(chain, kept, pts, shape, tol, units, closed)
+
+
+#: Passes of refitting each kept line or circle to the points its own piece holds.
+_SETTLE_PASSES = 8
+
+
+def _settled(chain: Chain, kept: list[_Primitive], pts: NDArray[np.float64], shape: str, tol: float, units: str,
+             closed: bool) -> Chain:  # fmt: skip
+    """The chain with every kept line and circle refitted to the points its own piece of the chain
+    holds (the ends' tenth left out), the transitions solved again, while the largest miss drops.
+
+    A run grown within a core tolerance takes in points of the spirals beside it, and a spiral
+    between a line and a circle moves with the square root of their offset: a line or circle a
+    core tolerance off puts the spiral several tolerances off. Points the chain gives to a line or
+    an arc lie on the designed line or circle, and each pass takes fewer spiral points in."""
+    best, worst = chain, float(chain_distances(chain, pts)[0].max())
+    prims = list(kept)
+    for _ in range(_SETTLE_PASSES):
+        if worst <= 1e-3 * tol:
+            break
+        _, stations = chain_distances(best, pts)
+        owner = np.clip(np.searchsorted(best.stations, stations, side="right") - 1, 0, len(best) - 1)
+        moved = [_refitted(prim, best, owner, pts) for prim in prims]
+        try:
+            joins = []
+            for k in range(len(moved) if closed else len(moved) - 1):
+                p, q = moved[k], moved[(k + 1) % len(moved)]
+                lo, hi = (p.a + p.b) // 2, (q.a + q.b) // 2 + 1
+                between = pts[lo:hi] if hi > lo else np.vstack([pts[lo:], pts[:hi]])
+                t = _join(p, q, between[:: max(1, len(between) // 4000)], shape, tol, p.split_point(pts), q.split_point(pts))
+                if t is None:
+                    return best
+                joins.append(t)
+            trial = _build(moved, joins, pts, units, closed)
+        except (ValueError, _Unfit):
+            return best
+        miss = float(chain_distances(trial, pts)[0].max())
+        if not miss < worst or _loops(trial, pts, closed):
+            break
+        best, worst, prims = trial, miss, moved
+    return best
+
+
+def _loops(chain: Chain, pts: NDArray[np.float64], closed: bool) -> bool:
+    """The chain is much longer than the points' polyline: an arc goes round where the points do not
+    (every point is still near the chain, so the residuals alone do not tell)."""
+    travel = float(_arc_lengths(np.vstack([pts, pts[:1]]) if closed else pts)[-1])
+    return chain.length > 1.05 * travel
+
+
+def _refitted(prim: _Primitive, chain: Chain, owner: NDArray[np.int64], pts: NDArray[np.float64]) -> _Primitive:
+    """The primitive fitted again to the points on the chain's pieces of its kind that lie on it."""
+    mine = np.zeros(len(pts), dtype=bool)
+    for index, piece in enumerate(chain):
+        if prim.line and isinstance(piece, Line):
+            rel = 0.5 * (piece.start + piece.end) - prim.point
+            on = abs(float(prim.direction[0] * rel[1] - prim.direction[1] * rel[0]))
+            if on <= 1e-3 * max(piece.length, 1e-300) + 1e-9:
+                mine |= owner == index
+        elif not prim.line and isinstance(piece, Arc):
+            if math.hypot(*(piece.center - prim.center)) <= 1e-3 * abs(prim.radius) and abs(piece.radius - prim.radius) <= 1e-3 * abs(prim.radius):
+                mine |= owner == index
+    index = np.flatnonzero(mine)
+    if len(index) < 8:
+        return prim
+    # The ends' tenth left out of each stretch of the primitive's points.
+    breaks = np.flatnonzero(np.diff(index) > 1) + 1
+    inner = []
+    for stretch in np.split(index, breaks):
+        cut = max(1, len(stretch) // 10)
+        inner.append(stretch[cut:-cut])
+    chosen = pts[np.concatenate(inner)] if inner else pts[:0]
+    if len(chosen) < 5:
+        return prim
+    origin = chosen.mean(axis=0)
+    local = chosen - origin
+    if prim.line:
+        _, vectors = np.linalg.eigh(local.T @ local)
+        direction = vectors[:, 1]
+        if float(direction @ prim.direction) < 0.0:
+            direction = -direction
+        return _Primitive(prim.a, prim.b, True, origin, direction, origin, math.inf, prim.span, prim.split)
+    circle = _fit_circle(local)
+    if circle is None:
+        return prim
+    center, radius = circle
+    sense = 1.0 if prim.radius > 0 else -1.0
+    return _Primitive(prim.a, prim.b, False, prim.point, prim.direction, center + origin, sense * radius, prim.span, prim.split)
 
 
 #: Gauss–Newton iterations (scipy ``least_squares`` evaluations) per line or circle refined, and
