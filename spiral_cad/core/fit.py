@@ -50,6 +50,10 @@ __all__ = ["PointFit", "chain_distances", "curvature_estimate", "douglas_peucker
 #: ``progress(done, total)``: called as the fit's steps complete.
 ProgressCallback = Callable[[int, int], None]
 _STEPS = 5
+#: ``shape="auto"``: each transition in the spiral shape that holds the points best.
+_AUTO = "auto"
+#: The spiral shapes ``"auto"`` chooses from.
+_SHAPES = ("walton-meek", "near-linear")
 _TAU = 2.0 * math.pi
 #: Turn between chords 2·tolerance long above which the points double back.
 _DOUBLE_BACK = math.radians(150.0)
@@ -92,6 +96,11 @@ class PointFit:
     def pieces(self) -> int:
         """How many pieces (lines, arcs, spirals) the chain has."""
         return len(self.chain)
+
+    @property
+    def shapes(self) -> list[str | None]:
+        """Each piece's spiral shape (``"walton-meek"`` or ``"near-linear"``), None for a line or an arc."""
+        return [piece.shape if isinstance(piece, BezierSpiral) else None for piece in self.chain]
 
 
 # ------------------------------------------------------------------ input
@@ -427,7 +436,35 @@ def _foot(prim: _Primitive, point: NDArray[np.float64]) -> NDArray[np.float64]:
 def _join(p: _Primitive, q: _Primitive, points: NDArray[np.float64], shape: str, tolerance: float,
           p_from: NDArray[np.float64], q_to: NDArray[np.float64]) -> Transition | None:  # fmt: skip
     """The exact transition from ``p`` to ``q`` (None where none exists). Between two lines the
-    pair's peak curvature is the one whose spirals hold ``points`` best."""
+    pair's peak curvature is the one whose spirals hold ``points`` best; ``shape="auto"``: the shape
+    whose transition holds them best."""
+    if shape != _AUTO:
+        return _join_shaped(p, q, points, shape, p_from, q_to)
+    best: tuple[float, Transition | None] = (math.inf, None)
+    for each in _SHAPES:
+        t = _join_shaped(p, q, points, each, p_from, q_to)
+        if t is not None:
+            miss = _transition_miss(p, q, t, points)
+            if miss < best[0] or best[1] is None:
+                best = (miss, t)
+    return best[1]
+
+
+def _transition_miss(p: _Primitive, q: _Primitive, transition: Transition, local: NDArray[np.float64]) -> float:
+    """The largest distance of ``local`` to the transition with p's and q's line or circle clipped at its ends."""
+    if not len(local):
+        return 0.0
+    far = 2.0 * float(np.hypot(*(local.max(axis=0) - local.min(axis=0)))) + 1.0
+    try:
+        pieces: list[Segment] = [_clipped(p, transition.start, True, far), *transition.spirals, _clipped(q, transition.end, False, far)]
+    except ValueError:
+        return math.inf
+    return float(_nearest(pieces, local).max())
+
+
+def _join_shaped(p: _Primitive, q: _Primitive, points: NDArray[np.float64], shape: str, p_from: NDArray[np.float64],
+                 q_to: NDArray[np.float64]) -> Transition | None:  # fmt: skip
+    """The exact transition from ``p`` to ``q`` in one spiral shape (None where none exists)."""
     try:
         if p.line and q.line:
             return _corner(p, q, points, shape, p_from, q_to)
@@ -674,7 +711,7 @@ def fit_points(
     tolerance: float,
     *,
     closed: bool = False,
-    shape: str = "near-linear",
+    shape: str = _AUTO,
     units: str = "mm",
     max_curvature: float | None = None,
     progress: ProgressCallback | None = None,
@@ -688,8 +725,10 @@ def fit_points(
         closed: the points go round a closed shape: the chain closes on its
             start, G2 at the closing joint too (a last point repeating the
             first is dropped).
-        shape: the spiral shape (``"near-linear"``, the default, or
-            ``"walton-meek"``; ``spiral_cad.core.shapes``).
+        shape: the spiral shape: ``"auto"`` (the default: each transition in
+            the shape that holds the points best, so that fewer pieces are
+            needed; ``PointFit.shapes`` says which), ``"walton-meek"`` or
+            ``"near-linear"`` (``spiral_cad.core.shapes``).
         units: the length unit of the points (default mm).
         max_curvature: the largest curvature any arc may have (1/``units``);
             None: no bound.
@@ -709,7 +748,8 @@ def fit_points(
     """
     raw = _as_points(points)
     tol = _positive(tolerance, "tolerance")
-    shape_code(shape)
+    if shape != _AUTO:
+        shape_code(shape)
     units = length_unit(units)
     kmax = None if max_curvature is None else _positive(max_curvature, "max_curvature")
     report = progress or (lambda done, total: None)
@@ -745,7 +785,7 @@ def fit_points(
         chain, kappa = _fit_chain(pts, tol, shape, units, bool(closed), kmax, report if len(pts) <= _REDUCED else None)
         chain, residual, stations = _measured(chain, factor, raw_pts, raw_tol)
     if chain is None:
-        fallback, _, _ = _fallback(pts, tol, shape, units, bool(closed))
+        fallback, _, _ = _fallback(pts, tol, _SHAPES[1] if shape == _AUTO else shape, units, bool(closed))
         chain, residual, stations = _measured(fallback, factor, raw_pts, raw_tol)
         if chain is None:
             raise NoSolutionError(
@@ -950,22 +990,29 @@ def _assemble(prims: list[_Primitive], pts: NDArray[np.float64], tol: float, sha
         kept = kept[:-1]
     joins = [t for t in transitions if t is not None]
     chain = _build(kept, joins, pts, units, closed)
-    refined = _refine(kept, pts, shape, tol, closed)
+    # Each join keeps the shape the runs were chosen with ("auto" decided it there): a shape that
+    # switched between the refinement's steps would make its least squares jump.
+    shapes = [t.spirals[0].shape or shape for t in joins]
+    refined = _refine(kept, pts, shapes, tol, closed)
     if refined is not None:
         try:
             better = _build(*refined, pts, units, closed)
         except (ValueError, _Unfit):
             better = None
-        if better is not None and not _loops(better, pts, closed) and float(chain_distances(better, pts)[0].max()) <= float(chain_distances(chain, pts)[0].max()):
+        if (
+            better is not None
+            and not _loops(better, pts, closed)
+            and float(chain_distances(better, pts)[0].max()) <= float(chain_distances(chain, pts)[0].max())
+        ):
             chain, kept = better, refined[0]
-    return _settled(chain, kept, pts, shape, tol, units, closed)
+    return _settled(chain, kept, pts, shapes, tol, units, closed)
 
 
 #: Passes of refitting each kept line or circle to the points its own piece holds.
 _SETTLE_PASSES = 8
 
 
-def _settled(chain: Chain, kept: list[_Primitive], pts: NDArray[np.float64], shape: str, tol: float, units: str,
+def _settled(chain: Chain, kept: list[_Primitive], pts: NDArray[np.float64], shapes: list[str], tol: float, units: str,
              closed: bool) -> Chain:  # fmt: skip
     """The chain with every kept line and circle refitted to the points its own piece of the chain
     holds (the ends' tenth left out), the transitions solved again, while the largest miss drops.
@@ -988,7 +1035,7 @@ def _settled(chain: Chain, kept: list[_Primitive], pts: NDArray[np.float64], sha
                 p, q = moved[k], moved[(k + 1) % len(moved)]
                 lo, hi = (p.a + p.b) // 2, (q.a + q.b) // 2 + 1
                 between = pts[lo:hi] if hi > lo else np.vstack([pts[lo:], pts[:hi]])
-                t = _join(p, q, between[:: max(1, len(between) // 4000)], shape, tol, p.split_point(pts), q.split_point(pts))
+                t = _join(p, q, between[:: max(1, len(between) // 4000)], shapes[k], tol, p.split_point(pts), q.split_point(pts))
                 if t is None:
                     return best
                 joins.append(t)
@@ -1012,15 +1059,16 @@ def _loops(chain: Chain, pts: NDArray[np.float64], closed: bool) -> bool:
 def _refitted(prim: _Primitive, chain: Chain, owner: NDArray[np.int64], pts: NDArray[np.float64]) -> _Primitive:
     """The primitive fitted again to the points on the chain's pieces of its kind that lie on it."""
     mine = np.zeros(len(pts), dtype=bool)
-    for index, piece in enumerate(chain):
+    for number, piece in enumerate(chain):
         if prim.line and isinstance(piece, Line):
             rel = 0.5 * (piece.start + piece.end) - prim.point
             on = abs(float(prim.direction[0] * rel[1] - prim.direction[1] * rel[0]))
             if on <= 1e-3 * max(piece.length, 1e-300) + 1e-9:
-                mine |= owner == index
+                mine |= owner == number
         elif not prim.line and isinstance(piece, Arc):
-            if math.hypot(*(piece.center - prim.center)) <= 1e-3 * abs(prim.radius) and abs(piece.radius - prim.radius) <= 1e-3 * abs(prim.radius):
-                mine |= owner == index
+            near = 1e-3 * abs(prim.radius)
+            if math.hypot(*(piece.center - prim.center)) <= near and abs(piece.radius - prim.radius) <= near:
+                mine |= owner == number
     index = np.flatnonzero(mine)
     if len(index) < 8:
         return prim
@@ -1054,7 +1102,7 @@ def _refitted(prim: _Primitive, chain: Chain, owner: NDArray[np.int64], pts: NDA
 _REFINE_EVALUATIONS, _REFINE_SWEEPS = 20, 3
 
 
-def _refine(prims: list[_Primitive], pts: NDArray[np.float64], shape: str, tol: float, closed: bool
+def _refine(prims: list[_Primitive], pts: NDArray[np.float64], shapes: list[str], tol: float, closed: bool
             ) -> tuple[list[_Primitive], list[Transition]] | None:  # fmt: skip
     """The kept lines and circles adjusted, one at a time, to the least squares of every point of
     their run and of the spirals on either side (the spirals solved again at each step): a line or
@@ -1096,12 +1144,12 @@ def _refine(prims: list[_Primitive], pts: NDArray[np.float64], shape: str, tol: 
         pieces: list[Segment] = []
         try:
             if before is not None:
-                t = _join(before, prim, local, shape, tol, before.split_point(pts), prim.split_point(pts))
+                t = _join(before, prim, local, shapes[(k - 1) % count], tol, before.split_point(pts), prim.split_point(pts))
                 if t is None:
                     raise ValueError
                 pieces += [_clipped(before, t.start, True, far), *t.spirals, _clipped(prim, t.end, False, far)]
             if after is not None:
-                t = _join(prim, after, local, shape, tol, prim.split_point(pts), after.split_point(pts))
+                t = _join(prim, after, local, shapes[k], tol, prim.split_point(pts), after.split_point(pts))
                 if t is None:
                     raise ValueError
                 pieces += [_clipped(prim, t.start, True, far), *t.spirals, _clipped(after, t.end, False, far)]
@@ -1133,7 +1181,7 @@ def _refine(prims: list[_Primitive], pts: NDArray[np.float64], shape: str, tol: 
         # The points between the two runs' middles, as _evaluate gives them (round the ring's end too).
         lo, hi = (p.a + p.b) // 2, (q.a + q.b) // 2 + 1
         between = pts[lo:hi] if hi > lo else np.vstack([pts[lo:], pts[:hi]])
-        t = _join(p, q, between[:: max(1, len(between) // 4000)], shape, tol, p.split_point(pts), q.split_point(pts))
+        t = _join(p, q, between[:: max(1, len(between) // 4000)], shapes[k], tol, p.split_point(pts), q.split_point(pts))
         if t is None:
             return None
         joins.append(t)
@@ -1205,12 +1253,8 @@ def _evaluate(p: _Primitive, q: _Primitive, pts: NDArray[np.float64], shape: str
     transition = _join(p, q, local, shape, tol, p.split_point(pts), q.split_point(pts))
     if transition is None:
         return _Gap(None, math.inf)
-    far = 2.0 * float(np.hypot(*(local.max(axis=0) - local.min(axis=0)))) + 1.0
-    try:
-        pieces: list[Segment] = [_clipped(p, transition.start, True, far), *transition.spirals, _clipped(q, transition.end, False, far)]
-    except ValueError:
-        return _Gap(None, math.inf)
-    return _Gap(transition, float(_nearest(pieces, local).max()))
+    miss = _transition_miss(p, q, transition, local)
+    return _Gap(transition if math.isfinite(miss) else None, miss)
 
 
 def _ahead(prim: _Primitive, enter: NDArray[np.float64], leave: NDArray[np.float64]) -> bool:
