@@ -366,7 +366,7 @@ def solver_chain(kind: str, shape: str, radius: float, shift: float, turn: float
     return Chain.join([enter, leave], start=(-60.0, 0.0), end=tuple(leave.end + 80.0 * out))
 
 
-@settings(max_examples=5)
+@settings(max_examples=8)
 @given(
     kind=st.sampled_from(["curve", "corner"]),
     shape=st.sampled_from(["walton-meek", "near-linear"]),
