@@ -615,6 +615,13 @@ def fit_points(
     if chain is None:
         chain, kappa = _fit_chain(pts, tol, shape, units, bool(closed), kmax, report if len(pts) <= _REDUCED else None)
         chain, residual, stations = _measured(chain, factor, raw_pts, raw_tol)
+    for tighter in _TIGHTER:
+        # Runs chosen at a loose tolerance may not join where tighter ones do (their lines and
+        # circles take in more of the spirals): a fit within a tenth of the tolerance is within it.
+        if chain is not None or len(pts) > _REDUCED:
+            break
+        chain, _ = _fit_chain(pts, tol * tighter, shape, units, bool(closed), kmax, None)
+        chain, residual, stations = _measured(chain, factor, raw_pts, raw_tol)
     if chain is None:
         fallback, _, _ = _fallback(pts, tol, _SHAPES[1] if shape == _AUTO else shape, units, bool(closed))
         chain, residual, stations = _measured(fallback, factor, raw_pts, raw_tol)
@@ -635,6 +642,8 @@ def fit_points(
     return PointFit(chain, residual[slot], stations[slot], kappa[slot], tol, units)
 
 
+#: Tolerances (as fractions of the one asked for) tried before the fallback.
+_TIGHTER = (0.1,)
 #: Above this many points the fit works on block means of the points (about this many).
 _REDUCED = 20_000
 
