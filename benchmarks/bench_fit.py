@@ -80,6 +80,47 @@ def clothoid_samples(pieces, spacing: float) -> np.ndarray:
     return np.vstack(out)
 
 
+def readme_curve():
+    """The README's first curve: line, Walton–Meek spiral, arc, spiral, line (5 pieces, 826 mm)."""
+    from spiral_cad import Chain, line_to_circle
+
+    enter = line_to_circle((0, 0), (1, 0), (100, 60), 50.0)
+    leave = line_to_circle((300, 150), (-1, -1), (100, 60), 50.0).reversed()
+    return Chain.join([enter, leave], start=(-20, 0), end=(400, 250), units="mm")
+
+
+def own_design_table(quick: bool, with_build123d: bool) -> str:
+    """Pieces of 400 noise-free points of the README curve fitted in each spiral shape at tolerances
+    from 1e-9 to 1e-2 of its length; the interpolating peers pass through every point at any tolerance."""
+    curve = readme_curve()
+    points = curve.point_at(np.linspace(0.0, curve.length, 400))
+    interpolated = len(clothoid_spline(points))
+    relatives = (1e-4,) if quick else (1e-9, 1e-7, 1e-6, 1e-5, 1e-4, 1e-3, 1e-2)
+    shapes = ("walton-meek", "near-linear", "auto")
+    lines = [
+        f"400 points of the README's first curve ({len(curve)} pieces, Walton–Meek spirals, {curve.length:.0f} mm), no noise; "
+        "pieces of each fit (its time in s), and of the peers, which interpolate every point at any tolerance.",
+        "",
+        "| tolerance (of the length) | "
+        + " | ".join(f"fit_points `{shape}`" for shape in shapes)
+        + " | pyclothoids SolveG2 spline |"
+        + (" build123d Spline |" if with_build123d else ""),
+        "|---" * (len(shapes) + 2 + with_build123d) + "|",
+    ]
+    for relative in relatives:
+        cells = []
+        for shape in shapes:
+            started = time.perf_counter()
+            try:
+                fit = fit_points(points, relative * curve.length, shape=shape)
+                cells.append(f"{fit.pieces:,} ({time.perf_counter() - started:.1f})")
+            except ValueError:
+                cells.append(f"refused ({time.perf_counter() - started:.1f})")
+        peers = [f"{interpolated:,}"] + (["1"] if with_build123d else [])
+        lines.append(f"| {relative:g} | " + " | ".join(cells + peers) + " |")
+    return "\n".join(lines)
+
+
 def main() -> None:
     args = arguments(__doc__, points=(400, 80), sizes=([10_000, 100_000, 1_000_000], [2_000, 5_000]))
     truth = road().chain
@@ -118,6 +159,7 @@ def main() -> None:
         lines.append(f"| {name} | {count:,} | {residual:.3g} | {measures['deviation']:.3g} | {measures['sign changes']} | "
                      f"{measures['curvature step']:.3g} | {timings[name].median * 1e3:,.1f} |")  # fmt: skip
     report.section("Against interpolation through the same points", "\n".join(lines))
+    report.section("Our own design back, in each spiral shape", own_design_table(args.quick, "build123d Spline" in jobs))
     seconds = []
     for n in args.sizes:
         many = truth.point_at(np.linspace(0.0, truth.length, n)) + rng.normal(0.0, 0.05 * TOLERANCE, (n, 2))

@@ -36,9 +36,10 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from . import bezier
 from .chain import JOIN_TOLERANCE, Chain, g2_mismatch
 from .errors import NoSolutionError
+from .fit_distances import _as_points, _nearest, chain_distances
+from .fit_fallback import _fallback, douglas_peucker
 from .segments import Arc, Line, Segment
 from .shapes import shape_code
 from .spiral import BezierSpiral
@@ -50,6 +51,10 @@ __all__ = ["PointFit", "chain_distances", "curvature_estimate", "douglas_peucker
 #: ``progress(done, total)``: called as the fit's steps complete.
 ProgressCallback = Callable[[int, int], None]
 _STEPS = 5
+#: ``shape="auto"``: each transition in the spiral shape that holds the points best.
+_AUTO = "auto"
+#: The spiral shapes ``"auto"`` chooses from.
+_SHAPES = ("walton-meek", "near-linear")
 _TAU = 2.0 * math.pi
 #: Turn between chords 2·tolerance long above which the points double back.
 _DOUBLE_BACK = math.radians(150.0)
@@ -93,25 +98,13 @@ class PointFit:
         """How many pieces (lines, arcs, spirals) the chain has."""
         return len(self.chain)
 
+    @property
+    def shapes(self) -> list[str | None]:
+        """Each piece's spiral shape (``"walton-meek"`` or ``"near-linear"``), None for a line or an arc."""
+        return [piece.shape if isinstance(piece, BezierSpiral) else None for piece in self.chain]
+
 
 # ------------------------------------------------------------------ input
-
-
-def _as_points(points: Any) -> NDArray[np.float64]:
-    """``points`` as an (N, 2) float array; ValueError naming the first non-finite point."""
-    if isinstance(points, (str, bytes)):
-        raise ValueError(f"points must be an (N, 2) array of numbers; got {type(points).__name__}")
-    try:
-        array = np.array(points, dtype=float)
-    except (TypeError, ValueError) as error:
-        raise ValueError(f"points must be an (N, 2) array of numbers ({error})") from None
-    if array.ndim != 2 or array.shape[1] != 2:
-        raise ValueError(f"points must have shape (N, 2); got shape {array.shape}")
-    bad = ~np.isfinite(array).all(axis=1)
-    if bad.any():
-        i = int(np.flatnonzero(bad)[0])
-        raise ValueError(f"points[{i}] is not finite: ({float(array[i, 0])!r}, {float(array[i, 1])!r})")
-    return array
 
 
 def _positive(value: Any, name: str) -> float:
@@ -427,7 +420,35 @@ def _foot(prim: _Primitive, point: NDArray[np.float64]) -> NDArray[np.float64]:
 def _join(p: _Primitive, q: _Primitive, points: NDArray[np.float64], shape: str, tolerance: float,
           p_from: NDArray[np.float64], q_to: NDArray[np.float64]) -> Transition | None:  # fmt: skip
     """The exact transition from ``p`` to ``q`` (None where none exists). Between two lines the
-    pair's peak curvature is the one whose spirals hold ``points`` best."""
+    pair's peak curvature is the one whose spirals hold ``points`` best; ``shape="auto"``: the shape
+    whose transition holds them best."""
+    if shape != _AUTO:
+        return _join_shaped(p, q, points, shape, p_from, q_to)
+    best: tuple[float, Transition | None] = (math.inf, None)
+    for each in _SHAPES:
+        t = _join_shaped(p, q, points, each, p_from, q_to)
+        if t is not None:
+            miss = _transition_miss(p, q, t, points)
+            if miss < best[0] or best[1] is None:
+                best = (miss, t)
+    return best[1]
+
+
+def _transition_miss(p: _Primitive, q: _Primitive, transition: Transition, local: NDArray[np.float64]) -> float:
+    """The largest distance of ``local`` to the transition with p's and q's line or circle clipped at its ends."""
+    if not len(local):
+        return 0.0
+    far = 2.0 * float(np.hypot(*(local.max(axis=0) - local.min(axis=0)))) + 1.0
+    try:
+        pieces: list[Segment] = [_clipped(p, transition.start, True, far), *transition.spirals, _clipped(q, transition.end, False, far)]
+    except ValueError:
+        return math.inf
+    return float(_nearest(pieces, local).max())
+
+
+def _join_shaped(p: _Primitive, q: _Primitive, points: NDArray[np.float64], shape: str, p_from: NDArray[np.float64],
+                 q_to: NDArray[np.float64]) -> Transition | None:  # fmt: skip
+    """The exact transition from ``p`` to ``q`` in one spiral shape (None where none exists)."""
     try:
         if p.line and q.line:
             return _corner(p, q, points, shape, p_from, q_to)
@@ -513,150 +534,6 @@ def _clipped(prim: _Primitive, at: NDArray[np.float64], before: bool, far: float
     return Arc(tuple(prim.center.tolist()), prim.radius, angle - sense * math.pi if before else angle, math.pi)
 
 
-# ------------------------------------------------------------- distances
-
-
-def _nearest(pieces: list[Segment], points: NDArray[np.float64]) -> NDArray[np.float64]:
-    """Distance of each point to the nearest of ``pieces`` (each tried: few pieces)."""
-    best = np.full(len(points), np.inf)
-    for piece in pieces:
-        np.minimum(best, _piece_distance(piece, points, None, False)[0], out=best)
-    return best
-
-
-def _piece_distance(
-    piece: Segment, points: NDArray[np.float64], u0: NDArray[np.float64] | None, stations: bool = True
-) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-    """Distance of each point to ``piece`` and (``stations``) the arc length of its foot from the
-    piece's start (``u0``: a spiral's start guesses)."""
-    if isinstance(piece, Line):
-        a, b = piece.start, piece.end
-        d = b - a
-        length2 = float(d @ d)
-        t = np.clip(((points - a) @ d) / length2, 0.0, 1.0)
-        foot = a + t[:, None] * d
-        return np.hypot(*(points - foot).T), t * math.sqrt(length2)
-    if isinstance(piece, Arc):
-        c, r, a0, sweep = piece.center, piece.radius, piece.start_angle, piece.sweep
-        sense = 1.0 if r > 0 else -1.0
-        rel = points - c
-        phi = np.mod(sense * (np.arctan2(rel[:, 1], rel[:, 0]) - a0), _TAU)
-        outside = phi > sweep
-        # Beyond the sweep: the nearer end.
-        phi = np.where(outside & (phi - sweep > 0.5 * (_TAU - sweep)), 0.0, np.where(outside, sweep, phi))
-        angle = a0 + sense * phi
-        foot = c + abs(r) * np.stack([np.cos(angle), np.sin(angle)], axis=1)
-        return np.hypot(*(points - foot).T), phi * abs(r)
-    assert isinstance(piece, BezierSpiral)
-    cp = piece.control_points
-    # Power basis about B0 (the points moved by −B0 too, so survey coordinates keep their digits).
-    c1, c2, c3 = 3.0 * (cp[1] - cp[0]), 3.0 * (cp[0] - 2.0 * cp[1] + cp[2]), cp[3] - cp[0] + 3.0 * (cp[1] - cp[2])
-    rel = points - cp[0]
-    if u0 is None:
-        grid = np.linspace(0.0, 1.0, 17)
-        samples = ((c3 * grid[:, None] + c2) * grid[:, None] + c1) * grid[:, None]
-        gap = (rel[:, None, 0] - samples[None, :, 0]) ** 2 + (rel[:, None, 1] - samples[None, :, 1]) ** 2
-        u = grid[np.argmin(gap, axis=1)]
-    else:
-        u = u0.copy()
-    for _ in range(6):  # Newton on (B(u) − p)·B'(u) = 0
-        uu = u[:, None]
-        offset = ((c3 * uu + c2) * uu + c1) * uu - rel
-        d1 = (3.0 * c3 * uu + 2.0 * c2) * uu + c1
-        d2 = 6.0 * c3 * uu + 2.0 * c2
-        f = (offset * d1).sum(axis=1)
-        df = (d1 * d1).sum(axis=1) + (offset * d2).sum(axis=1)
-        u = np.clip(u - f / np.where(df > 0, df, 1.0), 0.0, 1.0)
-    uu = u[:, None]
-    offset = ((c3 * uu + c2) * uu + c1) * uu - rel
-    along = _spiral_stations(cp, c1, c2, c3, u) if stations else u
-    return np.hypot(offset[:, 0], offset[:, 1]), along
-
-
-#: Nodes of the arc length table a spiral's stations are interpolated from.
-_NODES = 129
-
-
-def _spiral_stations(cp: NDArray[np.float64], c1: NDArray[np.float64], c2: NDArray[np.float64], c3: NDArray[np.float64],
-                     u: NDArray[np.float64]) -> NDArray[np.float64]:  # fmt: skip
-    """Arc length from the spiral's start to each parameter ``u``: few points by quadrature, many
-    by cubic Hermite interpolation of a quadrature table with the speed |B'| as its slope (the
-    speed is smooth: the error is ~1e-12 of the length at 129 nodes)."""
-    if len(u) <= 4 * _NODES:
-        return np.asarray(bezier.arc_length(cp, u), dtype=float)
-    nodes = np.linspace(0.0, 1.0, _NODES)
-    table = np.asarray(bezier.arc_length(cp, nodes), dtype=float)
-    speed = np.hypot(*((3.0 * c3 * nodes[:, None] + 2.0 * c2) * nodes[:, None] + c1).T)
-    width = 1.0 / (_NODES - 1)
-    k = np.minimum((u / width).astype(np.int64), _NODES - 2)
-    t = u / width - k
-    t2, t3 = t * t, t * t * t
-    h00, h10, h01, h11 = 2 * t3 - 3 * t2 + 1, t3 - 2 * t2 + t, -2 * t3 + 3 * t2, t3 - t2
-    out: NDArray[np.float64] = h00 * table[k] + h10 * width * speed[k] + h01 * table[k + 1] + h11 * width * speed[k + 1]
-    return out
-
-
-#: Most samples chain_distances places along a chain (beside at least 8 per piece).
-_SAMPLES = 100_000
-
-
-def chain_distances(chain: Chain, points: ArrayLike) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-    """Distance of every point to a plane chain and the station (arc length) of its foot.
-
-    Each point is located at the nearest of samples along every piece (a k-d
-    tree, about two per point up to 100 000 samples), then its foot is solved on that piece
-    (lines and arcs in closed form, spirals by Newton's method) and on the
-    neighbouring pieces.
-
-    Args:
-        chain: a 2-D ``Chain``.
-        points: (N, 2) points.
-
-    Returns:
-        (distances, stations), each (N,).
-
-    Raises:
-        ValueError: a chain in space, or malformed points.
-    """
-    from scipy.spatial import cKDTree
-
-    if chain.dim != 2:
-        raise ValueError("chain_distances takes a plane chain")
-    p = _as_points(points)
-    lengths, stations = chain.lengths, chain.stations
-    # Samples enough to tell the pieces apart, not one per point: Newton finds each foot from there.
-    spacing = max(chain.length / min(max(2 * len(p), 1), _SAMPLES), 1e-300)
-    counts = np.clip(np.ceil(lengths / spacing).astype(np.int64), 8, 1_000_000)
-    pieces = list(chain)
-    samples = np.concatenate([piece.point(np.linspace(0.0, 1.0, int(m))) for piece, m in zip(pieces, counts.tolist())])
-    owner = np.repeat(np.arange(len(pieces)), counts)
-    u_of = np.concatenate([np.linspace(0.0, 1.0, int(m)) for m in counts.tolist()])
-    if not np.isfinite(samples).all():
-        raise ValueError("chain_distances: the chain's points are not finite float64 numbers (coordinates beyond ±1e308)")
-    _, nearest = cKDTree(samples).query(p)
-    piece_of, u_guess = owner[nearest], u_of[nearest]
-    best = np.full(len(p), np.inf)
-    foot = np.zeros(len(p))
-    ring = math.hypot(*(chain.end - chain.start)) <= 1e-9 * chain.size  # a closed chain: the ends are neighbours
-    order = np.argsort(piece_of, kind="stable")
-    bounds = np.flatnonzero(np.diff(piece_of[order])) + 1
-    for group in np.split(order, bounds):
-        if not len(group):
-            continue
-        k = int(piece_of[group[0]])
-        for j in (k - 1, k, k + 1):  # the neighbours too: a foot near a joint may lie on either side
-            if ring:
-                j %= len(pieces)
-            elif not 0 <= j < len(pieces):
-                continue
-            guess = u_guess[group] if j == k else np.full(len(group), 1.0 if j == (k - 1) % len(pieces) else 0.0)
-            distance, along = _piece_distance(pieces[j], p[group], guess)
-            better = distance < best[group]
-            best[group[better]] = distance[better]
-            foot[group[better]] = stations[j] + along[better]
-    return best, foot
-
-
 # ---------------------------------------------------------------- the fit
 
 
@@ -665,7 +542,7 @@ def fit_points(
     tolerance: float,
     *,
     closed: bool = False,
-    shape: str = "near-linear",
+    shape: str = _AUTO,
     units: str = "mm",
     max_curvature: float | None = None,
     progress: ProgressCallback | None = None,
@@ -679,8 +556,10 @@ def fit_points(
         closed: the points go round a closed shape: the chain closes on its
             start, G2 at the closing joint too (a last point repeating the
             first is dropped).
-        shape: the spiral shape (``"near-linear"``, the default, or
-            ``"walton-meek"``; ``spiral_cad.core.shapes``).
+        shape: the spiral shape: ``"auto"`` (the default: each transition in
+            the shape that holds the points best, so that fewer pieces are
+            needed; ``PointFit.shapes`` says which), ``"walton-meek"`` or
+            ``"near-linear"`` (``spiral_cad.core.shapes``).
         units: the length unit of the points (default mm).
         max_curvature: the largest curvature any arc may have (1/``units``);
             None: no bound.
@@ -700,7 +579,8 @@ def fit_points(
     """
     raw = _as_points(points)
     tol = _positive(tolerance, "tolerance")
-    shape_code(shape)
+    if shape != _AUTO:
+        shape_code(shape)
     units = length_unit(units)
     kmax = None if max_curvature is None else _positive(max_curvature, "max_curvature")
     report = progress or (lambda done, total: None)
@@ -735,8 +615,15 @@ def fit_points(
     if chain is None:
         chain, kappa = _fit_chain(pts, tol, shape, units, bool(closed), kmax, report if len(pts) <= _REDUCED else None)
         chain, residual, stations = _measured(chain, factor, raw_pts, raw_tol)
+    for tighter in _TIGHTER:
+        # Runs chosen at a loose tolerance may not join where tighter ones do (their lines and
+        # circles take in more of the spirals): a fit within a tenth of the tolerance is within it.
+        if chain is not None or len(pts) > _REDUCED:
+            break
+        chain, _ = _fit_chain(pts, tol * tighter, shape, units, bool(closed), kmax, None)
+        chain, residual, stations = _measured(chain, factor, raw_pts, raw_tol)
     if chain is None:
-        fallback, _, _ = _fallback(pts, tol, shape, units, bool(closed))
+        fallback, _, _ = _fallback(pts, tol, _SHAPES[1] if shape == _AUTO else shape, units, bool(closed))
         chain, residual, stations = _measured(fallback, factor, raw_pts, raw_tol)
         if chain is None:
             raise NoSolutionError(
@@ -755,6 +642,8 @@ def fit_points(
     return PointFit(chain, residual[slot], stations[slot], kappa[slot], tol, units)
 
 
+#: Tolerances (as fractions of the one asked for) tried before the fallback.
+_TIGHTER = (0.1,)
 #: Above this many points the fit works on block means of the points (about this many).
 _REDUCED = 20_000
 
@@ -772,6 +661,10 @@ def _reduce(pts: NDArray[np.float64], s: NDArray[np.float64], closed: bool) -> t
     if closed:
         return means, means_s
     return np.vstack([pts[:1], means, pts[-1:]]), np.concatenate([s[:1], means_s, s[-1:]])
+
+
+#: How far beyond the tolerance (as a factor) a join may miss the points when the runs are chosen.
+_SLACKS = (1.0, 16.0, 256.0)
 
 
 def _fit_chain(pts: NDArray[np.float64], tol: float, shape: str, units: str, closed: bool, kmax: float | None,
@@ -801,16 +694,25 @@ def _fit_chain(pts: NDArray[np.float64], tol: float, shape: str, units: str, clo
     chain = None
     # Runs too short for the transitions between them (sparse points round a tight smooth shape,
     # where every arc is short) cannot be joined: looser runs are longer, and fewer.
+    # A run's line or circle is a core tolerance off the design, and the spirals it decides several
+    # tolerances off until the chain is settled: the joins are first judged within the tolerance,
+    # then looser (the settled chain measured against the tolerance itself).
     for tau in sorted({core, min(2.0 * core, tol / 2.0), tol / 2.0}):
-        try:
-            prims = _segment(work, work_s, work_kappa, h, tau, kmax, closed)
-            report(3, _STEPS)
-            chain = _assemble(prims, work, tol, shape, units, closed)
-        except (ValueError, _Unfit):
-            continue
-        if tau == core or float(chain_distances(chain, pts)[0].max()) <= tol:
+        prims = None
+        for slack in _SLACKS:
+            try:
+                if prims is None:
+                    prims = _segment(work, work_s, work_kappa, h, tau, kmax, closed)
+                    report(3, _STEPS)
+                chain = _assemble(prims, work, tol, shape, units, closed, slack)
+            except (ValueError, _Unfit):
+                chain = None
+                continue
+            if not _loops(chain, pts, closed) and float(chain_distances(chain, pts)[0].max()) <= tol:
+                break
+            chain = None
+        if chain is not None:
             break
-        chain = None
     report(4, _STEPS)
     return chain, kappa
 
@@ -884,12 +786,14 @@ class _Gap:
 
 
 #: How many runs ahead a join may reach (the runs skipped between are left to its spirals).
-_REACH = 10
+_REACH = 64
 
 
-def _assemble(prims: list[_Primitive], pts: NDArray[np.float64], tol: float, shape: str, units: str, closed: bool) -> Chain:
+def _assemble(prims: list[_Primitive], pts: NDArray[np.float64], tol: float, shape: str, units: str, closed: bool,
+              slack: float = 1.0) -> Chain:  # fmt: skip
     """Choose the runs to keep, fewest pieces first (dynamic programming over the runs in order,
-    each join reaching up to ``_REACH`` runs ahead), and build the chain."""
+    each join reaching up to ``_REACH`` runs ahead, its points within ``slack`` tolerances), and build
+    the chain."""
     if not prims:
         raise _Unfit
     if len(prims) == 1:
@@ -909,7 +813,7 @@ def _assemble(prims: list[_Primitive], pts: NDArray[np.float64], tol: float, sha
 
     def usable(i: int, j: int) -> Transition | None:
         g = gap(i, j)
-        return g.transition if g.miss <= tol else None
+        return g.transition if g.miss <= slack * tol else None
 
     last = len(order) - 1
     best_cost, best_path = math.inf, None
@@ -926,15 +830,111 @@ def _assemble(prims: list[_Primitive], pts: NDArray[np.float64], tol: float, sha
         kept = kept[:-1]
     joins = [t for t in transitions if t is not None]
     chain = _build(kept, joins, pts, units, closed)
-    refined = _refine(kept, pts, shape, tol, closed)
+    # Each join keeps the shape the runs were chosen with ("auto" decided it there): a shape that
+    # switched between the refinement's steps would make its least squares jump.
+    shapes = [t.spirals[0].shape or shape for t in joins]
+    refined = _refine(kept, pts, shapes, tol, closed)
     if refined is not None:
         try:
             better = _build(*refined, pts, units, closed)
         except (ValueError, _Unfit):
-            return chain
-        if float(chain_distances(better, pts)[0].max()) <= tol:
-            return better
-    return chain
+            better = None
+        if (
+            better is not None
+            and not _loops(better, pts, closed)
+            and float(chain_distances(better, pts)[0].max()) <= float(chain_distances(chain, pts)[0].max())
+        ):
+            chain, kept = better, refined[0]
+    return _settled(chain, kept, pts, shapes, tol, units, closed)
+
+
+#: Passes of refitting each kept line or circle to the points its own piece holds.
+_SETTLE_PASSES = 8
+
+
+def _settled(chain: Chain, kept: list[_Primitive], pts: NDArray[np.float64], shapes: list[str], tol: float, units: str,
+             closed: bool) -> Chain:  # fmt: skip
+    """The chain with every kept line and circle refitted to the points its own piece of the chain
+    holds (the ends' tenth left out), the transitions solved again, while the largest miss drops.
+
+    A run grown within a core tolerance takes in points of the spirals beside it, and a spiral
+    between a line and a circle moves with the square root of their offset: a line or circle a
+    core tolerance off puts the spiral several tolerances off. Points the chain gives to a line or
+    an arc lie on the designed line or circle, and each pass takes fewer spiral points in."""
+    best, worst = chain, float(chain_distances(chain, pts)[0].max())
+    prims = list(kept)
+    for _ in range(_SETTLE_PASSES):
+        if worst <= 1e-3 * tol:
+            break
+        _, stations = chain_distances(best, pts)
+        owner = np.clip(np.searchsorted(best.stations, stations, side="right") - 1, 0, len(best) - 1)
+        moved = [_refitted(prim, best, owner, pts) for prim in prims]
+        try:
+            joins = []
+            for k in range(len(moved) if closed else len(moved) - 1):
+                p, q = moved[k], moved[(k + 1) % len(moved)]
+                lo, hi = (p.a + p.b) // 2, (q.a + q.b) // 2 + 1
+                between = pts[lo:hi] if hi > lo else np.vstack([pts[lo:], pts[:hi]])
+                t = _join(p, q, between[:: max(1, len(between) // 4000)], shapes[k], tol, p.split_point(pts), q.split_point(pts))
+                if t is None:
+                    return best
+                joins.append(t)
+            trial = _build(moved, joins, pts, units, closed)
+        except (ValueError, _Unfit):
+            return best
+        miss = float(chain_distances(trial, pts)[0].max())
+        if not miss < worst or _loops(trial, pts, closed):
+            break
+        best, worst, prims = trial, miss, moved
+    return best
+
+
+def _loops(chain: Chain, pts: NDArray[np.float64], closed: bool) -> bool:
+    """The chain is much longer than the points' polyline: an arc goes round where the points do not
+    (every point is still near the chain, so the residuals alone do not tell)."""
+    travel = float(_arc_lengths(np.vstack([pts, pts[:1]]) if closed else pts)[-1])
+    return chain.length > 1.05 * travel
+
+
+def _refitted(prim: _Primitive, chain: Chain, owner: NDArray[np.int64], pts: NDArray[np.float64]) -> _Primitive:
+    """The primitive fitted again to the points on the chain's pieces of its kind that lie on it."""
+    mine = np.zeros(len(pts), dtype=bool)
+    for number, piece in enumerate(chain):
+        if prim.line and isinstance(piece, Line):
+            rel = 0.5 * (piece.start + piece.end) - prim.point
+            on = abs(float(prim.direction[0] * rel[1] - prim.direction[1] * rel[0]))
+            if on <= 1e-3 * max(piece.length, 1e-300) + 1e-9:
+                mine |= owner == number
+        elif not prim.line and isinstance(piece, Arc):
+            near = 1e-3 * abs(prim.radius)
+            if math.hypot(*(piece.center - prim.center)) <= near and abs(piece.radius - prim.radius) <= near:
+                mine |= owner == number
+    index = np.flatnonzero(mine)
+    if len(index) < 8:
+        return prim
+    # The ends' tenth left out of each stretch of the primitive's points.
+    breaks = np.flatnonzero(np.diff(index) > 1) + 1
+    inner = []
+    for stretch in np.split(index, breaks):
+        cut = max(1, len(stretch) // 10)
+        inner.append(stretch[cut:-cut])
+    chosen = pts[np.concatenate(inner)] if inner else pts[:0]
+    if len(chosen) < 5:
+        return prim
+    origin = chosen.mean(axis=0)
+    local = chosen - origin
+    if prim.line:
+        _, vectors = np.linalg.eigh(local.T @ local)
+        direction = vectors[:, 1]
+        if float(direction @ prim.direction) < 0.0:
+            direction = -direction
+        return _Primitive(prim.a, prim.b, True, origin, direction, origin, math.inf, prim.span, prim.split)
+    circle = _fit_circle(local)
+    if circle is None:
+        return prim
+    center, radius = circle
+    sense = 1.0 if prim.radius > 0 else -1.0
+    return _Primitive(prim.a, prim.b, False, prim.point, prim.direction, center + origin, sense * radius, prim.span, prim.split)
 
 
 #: Gauss–Newton iterations (scipy ``least_squares`` evaluations) per line or circle refined, and
@@ -942,7 +942,7 @@ def _assemble(prims: list[_Primitive], pts: NDArray[np.float64], tol: float, sha
 _REFINE_EVALUATIONS, _REFINE_SWEEPS = 20, 3
 
 
-def _refine(prims: list[_Primitive], pts: NDArray[np.float64], shape: str, tol: float, closed: bool
+def _refine(prims: list[_Primitive], pts: NDArray[np.float64], shapes: list[str], tol: float, closed: bool
             ) -> tuple[list[_Primitive], list[Transition]] | None:  # fmt: skip
     """The kept lines and circles adjusted, one at a time, to the least squares of every point of
     their run and of the spirals on either side (the spirals solved again at each step): a line or
@@ -984,12 +984,12 @@ def _refine(prims: list[_Primitive], pts: NDArray[np.float64], shape: str, tol: 
         pieces: list[Segment] = []
         try:
             if before is not None:
-                t = _join(before, prim, local, shape, tol, before.split_point(pts), prim.split_point(pts))
+                t = _join(before, prim, local, shapes[(k - 1) % count], tol, before.split_point(pts), prim.split_point(pts))
                 if t is None:
                     raise ValueError
                 pieces += [_clipped(before, t.start, True, far), *t.spirals, _clipped(prim, t.end, False, far)]
             if after is not None:
-                t = _join(prim, after, local, shape, tol, prim.split_point(pts), after.split_point(pts))
+                t = _join(prim, after, local, shapes[k], tol, prim.split_point(pts), after.split_point(pts))
                 if t is None:
                     raise ValueError
                 pieces += [_clipped(prim, t.start, True, far), *t.spirals, _clipped(after, t.end, False, far)]
@@ -1021,7 +1021,7 @@ def _refine(prims: list[_Primitive], pts: NDArray[np.float64], shape: str, tol: 
         # The points between the two runs' middles, as _evaluate gives them (round the ring's end too).
         lo, hi = (p.a + p.b) // 2, (q.a + q.b) // 2 + 1
         between = pts[lo:hi] if hi > lo else np.vstack([pts[lo:], pts[:hi]])
-        t = _join(p, q, between[:: max(1, len(between) // 4000)], shape, tol, p.split_point(pts), q.split_point(pts))
+        t = _join(p, q, between[:: max(1, len(between) // 4000)], shapes[k], tol, p.split_point(pts), q.split_point(pts))
         if t is None:
             return None
         joins.append(t)
@@ -1093,12 +1093,8 @@ def _evaluate(p: _Primitive, q: _Primitive, pts: NDArray[np.float64], shape: str
     transition = _join(p, q, local, shape, tol, p.split_point(pts), q.split_point(pts))
     if transition is None:
         return _Gap(None, math.inf)
-    far = 2.0 * float(np.hypot(*(local.max(axis=0) - local.min(axis=0)))) + 1.0
-    try:
-        pieces: list[Segment] = [_clipped(p, transition.start, True, far), *transition.spirals, _clipped(q, transition.end, False, far)]
-    except ValueError:
-        return _Gap(None, math.inf)
-    return _Gap(transition, float(_nearest(pieces, local).max()))
+    miss = _transition_miss(p, q, transition, local)
+    return _Gap(transition if math.isfinite(miss) else None, miss)
 
 
 def _ahead(prim: _Primitive, enter: NDArray[np.float64], leave: NDArray[np.float64]) -> bool:
@@ -1169,98 +1165,3 @@ def _build(prims: list[_Primitive], transitions: list[Transition], pts: NDArray[
         if arc is not None:
             parts.append(arc)
     return Chain.join(parts, start=head_point, end=tail_point, units=units)
-
-
-# --------------------------------------------------------------- fallback
-
-
-def douglas_peucker(pts: NDArray[np.float64], epsilon: float, *, vertical: bool = False) -> NDArray[np.int64]:
-    """Douglas–Peucker: indices of a polyline through some of ``pts`` (n, 2) within ``epsilon`` of every point,
-    measured across each chord, or along y (``vertical``: elevations over increasing stations)."""
-    keep = np.zeros(len(pts), dtype=bool)
-    keep[0] = keep[-1] = True
-    stack = [(0, len(pts) - 1)]
-    while stack:
-        i, j = stack.pop()
-        if j - i < 2:
-            continue
-        a, b = pts[i], pts[j]
-        d = b - a
-        length = math.hypot(*d)
-        rel = pts[i + 1 : j] - a
-        if vertical:
-            off = np.abs(rel[:, 1] - rel[:, 0] * (d[1] / d[0]))
-        elif length > 0:
-            off = np.abs(rel[:, 0] * d[1] - rel[:, 1] * d[0]) / length
-        else:
-            off = np.hypot(*rel.T)
-        k = int(np.argmax(off))
-        if off[k] > epsilon:
-            m = i + 1 + k
-            keep[m] = True
-            stack.extend([(i, m), (m, j)])
-    return np.flatnonzero(keep)
-
-
-def _fallback(
-    pts: NDArray[np.float64], tol: float, shape: str, units: str, closed: bool
-) -> tuple[Chain, NDArray[np.float64], NDArray[np.float64]]:
-    """A polyline within half the tolerance, every corner rounded by a spiral pair that cuts it by
-    at most a quarter; tighter until every point is within the tolerance."""
-    worst = math.inf
-    for level in range(6):
-        epsilon = tol / 2.0 ** (level + 1)
-        ring = np.vstack([pts, pts[:1]]) if closed else pts
-        vertices = ring[douglas_peucker(ring, epsilon)]
-        if closed:
-            vertices = vertices[:-1]
-        try:
-            chain = _rounded(vertices, epsilon / 2.0, shape, units, closed)
-        except ValueError:
-            continue
-        residual, stations = chain_distances(chain, pts)
-        worst = min(worst, float(residual.max()))
-        if worst <= tol:
-            return chain, residual, stations
-    raise NoSolutionError(f"no G2 chain within tolerance {tol:g} was found (closest: {worst:.6g})")
-
-
-def _rounded(vertices: NDArray[np.float64], cut: float, shape: str, units: str, closed: bool) -> Chain:
-    """The polyline ``vertices`` with every corner rounded by a line_to_line pair cutting it by at most ``cut``."""
-    if closed:
-        if len(vertices) < 3:
-            raise ValueError("too few corners")
-        # Start half way along the first leg.
-        middle = 0.5 * (vertices[0] + vertices[1])
-        vertices = np.vstack([middle, vertices[1:], vertices[:1], middle])
-    vertices = _split_sharp(vertices, cut)
-    mids = 0.5 * (vertices[1:] + vertices[:-1])
-    parts: list[Transition | Segment] = []
-    for k in range(1, len(vertices) - 1):
-        p0 = vertices[0] if k == 1 else mids[k - 1]
-        p1 = vertices[-1] if k == len(vertices) - 2 else mids[k]
-        a, c, b = (tuple(v.tolist()) for v in (p0, vertices[k], p1))
-        try:
-            widest = line_to_line(a, c, b, None, shape)
-        except ValueError:
-            continue  # collinear: no corner
-        depth = float(np.hypot(*(np.asarray(widest.joint) - vertices[k])))
-        pair = widest if depth <= cut else line_to_line(a, c, b, abs(widest.spirals[0].end_curvature) * depth / cut, shape)
-        parts.append(pair)
-    start, end = tuple(vertices[0].tolist()), tuple(vertices[-1].tolist())
-    return Chain.join(parts, start=start, end=end, units=units)
-
-
-def _split_sharp(vertices: NDArray[np.float64], cut: float) -> NDArray[np.float64]:
-    """Corners turning by more than 90° become two corners ``cut`` from it along its legs (a chamfer)."""
-    out = [vertices[0]]
-    for k in range(1, len(vertices) - 1):
-        u, v = vertices[k] - vertices[k - 1], vertices[k + 1] - vertices[k]
-        lu, lv = math.hypot(*u), math.hypot(*v)
-        if float(u @ v) < 0.0:
-            t = min(cut, 0.25 * lu, 0.25 * lv)
-            out.extend([vertices[k] - t * u / lu, vertices[k] + t * v / lv])
-        else:
-            out.append(vertices[k])
-    out.append(vertices[-1])
-    return np.array(out)

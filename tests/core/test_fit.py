@@ -298,3 +298,97 @@ def test_a_noisy_road_leaves_residuals_like_the_noise(seed):
     assert kinds(fit.chain) == "LBABL"
     assert math.sqrt(float(np.mean(fit.residuals**2))) <= 2.0 * sigma
     assert chain_distances(fit.chain, clean)[0].max() <= 5.0 * sigma
+
+
+def readme_curve() -> Chain:
+    """The README's first curve: Line → spiral → arc → spiral → line, walton-meek (the core's default shape)."""
+    enter = line_to_circle((0, 0), (1, 0), (100, 60), 50.0)
+    leave = line_to_circle((300, 150), (-1, -1), (100, 60), 50.0).reversed()
+    return Chain.join([enter, leave], start=(-20, 0), end=(400, 250), units="mm")
+
+
+def farthest_point_distance(chain: Chain, points: np.ndarray) -> float:
+    """The largest distance of ``points`` to ``chain``, measured without the fit's own code: the
+    nearest of dense samples, then a golden-section search along the chain's stations around it."""
+    count = 20_000
+    stations = np.linspace(0.0, chain.length, count)
+    dense = chain.point_at(stations)
+    step = chain.length / (count - 1)
+    near = np.empty(len(points), dtype=np.int64)
+    for chunk in np.array_split(np.arange(len(points)), max(1, len(points) // 64)):
+        near[chunk] = np.argmin(((points[chunk, None, :] - dense[None]) ** 2).sum(axis=2), axis=1)
+    lo = np.clip(stations[near] - 2 * step, 0.0, chain.length)
+    hi = np.clip(stations[near] + 2 * step, 0.0, chain.length)
+
+    def gap(s: np.ndarray) -> np.ndarray:
+        return np.linalg.norm(chain.point_at(s) - points, axis=1)
+
+    ratio = (math.sqrt(5.0) - 1.0) / 2.0
+    for _ in range(60):
+        x1, x2 = hi - ratio * (hi - lo), lo + ratio * (hi - lo)
+        left = gap(x1) <= gap(x2)
+        hi, lo = np.where(left, x2, hi), np.where(left, lo, x1)
+    return float(np.minimum(gap(0.5 * (lo + hi)), np.sqrt(((points - dense[near]) ** 2).sum(axis=1))).max())
+
+
+@pytest.mark.parametrize("shape", ["walton-meek", "auto"])
+def test_the_readme_curve_comes_back_in_its_five_pieces_at_every_tolerance(shape):
+    """400 points of the README's first curve (5 pieces, walton-meek) come back in at most 5 pieces
+    from 1e-9 to 1e-2 of its length, never more as the tolerance loosens (they came back in 984,
+    808 and 699 pieces at 1e-6, 1e-5, 1e-4 when a join could reach only 10 runs ahead)."""
+    chain = readme_curve()
+    points = chain.point_at(np.linspace(0.0, chain.length, 400))
+    counts = []
+    for relative in (1e-9, 1e-7, 1e-5, 1e-3, 1e-2):
+        tolerance = relative * chain.length
+        fit = fit_points(points, tolerance, shape=shape)
+        assert fit.pieces <= 5, (relative, kinds(fit.chain))
+        assert farthest_point_distance(fit.chain, points) <= tolerance * (1 + 1e-6) + 1e-12
+        assert all(s == "walton-meek" for s in fit.shapes if s is not None)
+        assert abs(fit.chain.length - chain.length) <= 1e-3 * chain.length
+        counts.append(fit.pieces)
+    assert counts == sorted(counts, reverse=True)
+
+
+def solver_chain(kind: str, shape: str, radius: float, shift: float, turn: float) -> Chain:
+    """A chain of our solvers: line–spiral–arc–spiral–line (``kind="curve"``) or line–spiral pair–line (``"corner"``)."""
+    if kind == "corner":
+        d = np.array([math.cos(turn), math.sin(turn)])
+        corner = np.array([200.0, 0.0])
+        pair = line_to_line((0.0, 0.0), tuple(corner), tuple(corner + 200.0 * d), 1.0 / radius, shape)
+        return Chain.join([pair], start=(-40.0, 0.0), end=tuple(corner + 260.0 * d))
+    center = np.array([100.0, radius + shift])
+    enter = line_to_circle((0, 0), (1, 0), tuple(center), radius, shape)
+    total = turn + 2.0 * abs(enter.spirals[0].theta)
+    out = np.array([math.cos(total), math.sin(total)])
+    exit_point = center + (radius + shift) * np.array([math.sin(total), -math.cos(total)])
+    leave = line_to_circle(tuple(exit_point), tuple(-out), tuple(center), radius, shape).reversed()
+    return Chain.join([enter, leave], start=(-60.0, 0.0), end=tuple(leave.end + 80.0 * out))
+
+
+@settings(max_examples=8)
+@given(
+    kind=st.sampled_from(["curve", "corner"]),
+    shape=st.sampled_from(["walton-meek", "near-linear"]),
+    radius=st.floats(30.0, 120.0),
+    shift=st.floats(0.5, 6.0),
+    turn=st.floats(0.3, 1.5),
+    per_piece=st.integers(20, 60),
+    exponent=st.floats(-6.0, -3.0),
+)
+def test_solver_chains_come_back_within_their_own_pieces(outcome, kind, shape, radius, shift, turn, per_piece, exponent):
+    """Random chains of our solvers in either shape, sampled at a random density and fitted (in
+    their own shape) at a random tolerance and ten times it: never more pieces than their own, never
+    more at the looser tolerance, every point within the tolerance by an independent measure."""
+    outcome.minimum_built = 1.0  # each of them must come back
+    chain = outcome(lambda: solver_chain(kind, shape, radius, shift, turn))
+    if chain is None:
+        return
+    points = chain.point_at(np.linspace(0.0, chain.length, per_piece * len(chain)))
+    tolerance = 10.0**exponent * chain.size
+    fits = [fit_points(points, t, shape=shape) for t in (tolerance, 10.0 * tolerance)]
+    assert fits[0].pieces <= len(chain), (kinds(chain), kinds(fits[0].chain))
+    assert fits[1].pieces <= fits[0].pieces
+    for fit, t in zip(fits, (tolerance, 10.0 * tolerance)):
+        assert farthest_point_distance(fit.chain, points) <= t * (1 + 1e-6) + 1e-12
+        assert abs(fit.chain.length - chain.length) <= 0.01 * chain.length
