@@ -17,7 +17,7 @@ from pathlib import Path
 from typing import Any
 
 from ..core.segments import Arc, Line
-from .designfile import Built, DesignError
+from .built import Built, DesignError
 
 #: The suffixes of the files a ``g2_path`` reads, and what they are.
 SOURCES = {".dxf": "DXF drawing", ".xml": "LandXML file", ".xodr": "OpenDRIVE file"}

@@ -17,7 +17,7 @@ import math
 from pathlib import Path
 from typing import Any
 
-from .designfile import Built, BuiltRounded, DesignError, _program_feed
+from .built import Built, BuiltRounded, DesignError, program_feed
 from .schema import RoundedPolylineDesign
 
 #: The share of ``max_deviation`` a helix's chords take when no arc tolerance is stated.
@@ -51,7 +51,7 @@ def toolpath_designs(d: RoundedPolylineDesign, where: str, units: str, program: 
     if helix is not None and deviation is not None and not helix < deviation:
         raise DesignError(f"{where}: the arc tolerance {helix:g} {units} (a helix's chords) must be below max_deviation {deviation:g}")
     moves = read_gcode_moves(program, units=units, helix_tolerance=helix)
-    feed = _program_feed(moves.program_feeds, moves.program_units, units)
+    feed = program_feed(moves.program_feeds, moves.program_units, units)
     to_program = MM_PER_UNIT[units] / MM_PER_UNIT[PROGRAM_UNIT[units]]
     moves_to_units = MM_PER_UNIT[moves.program_units] / MM_PER_UNIT[units]  # feeds: program unit → units per minute
     samples = None if d.samples is None else d.samples.options()
