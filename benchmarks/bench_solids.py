@@ -22,14 +22,14 @@ from statistics import median
 import build123d as bd
 from timing import arguments, compare, machine, write_markdown
 
-import spiral_cad.cad.solids as solids
+import spiral_cad.cad.slabs as slabs
 from spiral_cad import Arc, Line
 from spiral_cad.build123d import ContinuousBox, g2_slab
 
 #: The modules whose code these numbers measure (stamped into the results: ``timing.code_stamp``).
-MEASURES = ("spiral_cad.build123d", "spiral_cad.cad.solids")
+MEASURES = ("spiral_cad.build123d", "spiral_cad.cad.slabs", "spiral_cad.cad.roll_surfaces")
 
-#: The steps of a slab, by the function of ``spiral_cad.cad.solids`` doing each.
+#: The steps of a slab, by the function doing each, as ``spiral_cad.cad.slabs`` calls it (timed there).
 STEPS = {
     "fit checks": "_roll_problem",
     "sweeps (s direction)": "_along",
@@ -45,7 +45,7 @@ STEPS = {
 def step_costs(make, rounds: int) -> dict[str, float]:
     """Median seconds per step of ``make()`` over ``rounds`` runs (the steps' functions timed in place)."""
     spent: dict[str, list[float]] = defaultdict(list)
-    originals = {name: getattr(solids, name) for name in STEPS.values()}
+    originals = {name: getattr(slabs, name) for name in STEPS.values()}
     this_run: dict[str, float] = {}
 
     def timed(name, function):
@@ -60,7 +60,7 @@ def step_costs(make, rounds: int) -> dict[str, float]:
 
     try:
         for name, function in originals.items():
-            setattr(solids, name, timed(name, function))
+            setattr(slabs, name, timed(name, function))
         for _ in range(rounds):
             this_run.clear()
             start = time.perf_counter()
@@ -70,7 +70,7 @@ def step_costs(make, rounds: int) -> dict[str, float]:
                 spent[name].append(value)
     finally:
         for name, function in originals.items():
-            setattr(solids, name, function)
+            setattr(slabs, name, function)
     return {name: median(values) for name, values in spent.items()}
 
 

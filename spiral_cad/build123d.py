@@ -61,8 +61,9 @@ from .cad.corridor import Corridor, centerline_wire, corridor
 from .cad.fillet import fillet_face, fillet_wire, planar_frame
 from .cad.g2wire import g2_face, g2_wire
 from .cad.occ import chain_wire, plane_ax3, segment_edges
-from .cad.solids import Slab, continuous_box, fillet_prism_edges
-from .cad.solids import g2_slab as _slab
+from .cad.prism_fillet import fillet_prism_edges
+from .cad.slabs import Slab, continuous_box
+from .cad.slabs import g2_slab as _slab
 from .core.chain import Chain
 from .core.segments import Segment
 from .core.shapes import DEFAULT_SHAPE
@@ -524,7 +525,7 @@ def g2_slab(
     smallest radius of curvature ``edge_radius``) is swept along the outline:
     exact over its lines and arcs, over spirals within ``tolerance`` (the
     measured deviation is the part's ``approximation`` attribute and goes into
-    the STEP description). See ``spiral_cad.cad.solids.g2_slab``.
+    the STEP description). See ``spiral_cad.cad.slabs.g2_slab``.
 
     Args:
         outline: a ``ContinuousRectangle``/``ContinuousPolygon``/``ContinuousSlot``, a

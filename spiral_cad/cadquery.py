@@ -49,7 +49,7 @@ from OCP.gp import gp_Ax3
 from .cad.fillet import fillet_face, fillet_wire
 from .cad.g2wire import g2_face, g2_wire
 from .cad.occ import chain_wire, segment_edges
-from .cad.solids import continuous_box
+from .cad.slabs import continuous_box
 from .core.chain import Chain
 from .core.segments import Segment
 from .core.shapes import DEFAULT_SHAPE

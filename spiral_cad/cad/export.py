@@ -108,7 +108,7 @@ def export_step(obj: Any, path: PathLike, *, name: str | None = None, units: str
     with real wires. A G2 solid (``ContinuousBox``, ``g2_slab``, ``g2_fillet``
     of edges) has the deviation of its approximated surfaces written into the
     header's FILE_DESCRIPTION; so has a part built of them (``BuildPart``, a
-    move, a boolean that keeps their surfaces: ``solids.recorded_approximation``
+    move, a boolean that keeps their surfaces: ``roll_surfaces.recorded_approximation``
     recognises their faces; not a scaled copy).
 
     Args:
@@ -130,7 +130,8 @@ def export_step(obj: Any, path: PathLike, *, name: str | None = None, units: str
         write_step(chains, path, label, unit, originating_system())
     else:
         from .occ import as_occ_shape
-        from .solids import approximation_note, recorded_approximation
+        from .roll_surfaces import recorded_approximation
+        from .slabs import approximation_note
         from .step_occ import write_shape_step
 
         approximation = getattr(obj, "approximation", None)  # G2 solids say how far any surface is from exact

@@ -1,0 +1,503 @@
+"""G2 slabs: a closed planar outline extruded with G2-rolled top and bottom edges, checked before it is returned.
+
+The input is checked first (the outline is closed, G2 and does not cross
+itself; the rolls fit inside it), then each outline piece gives a wall face
+and two roll faces (``roll_surfaces``); they are sewn with the two planar caps
+into one solid, which is checked valid and closed, and its faces' continuity
+verified, before anything is returned. ``continuous_box`` is the rectangle's case.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+from OCP.BRep import BRep_Tool
+from OCP.BRepBuilderAPI import (
+    BRepBuilderAPI_MakeSolid,
+    BRepBuilderAPI_Sewing,
+)
+from OCP.BRepCheck import BRepCheck_Analyzer
+from OCP.BRepGProp import BRepGProp
+from OCP.GeomAbs import GeomAbs_SurfaceType
+from OCP.GeomAdaptor import GeomAdaptor_Surface
+from OCP.gp import gp_Pln
+from OCP.GProp import GProp_GProps
+from OCP.TopAbs import TopAbs_FORWARD, TopAbs_REVERSED, TopAbs_SHELL, TopAbs_SOLID
+from OCP.TopExp import TopExp_Explorer
+from OCP.TopoDS import TopoDS, TopoDS_Face, TopoDS_Shape, TopoDS_Solid
+
+from ..core._inputs import as_float, shown
+from ..core.chain import JOIN_TOLERANCE, Chain, g2_mismatch
+from ..core.errors import NoSolutionError
+from ..core.segments import Arc, Segment
+from ..core.shapes import DEFAULT_SHAPE
+from ..core.units import DEFAULT_UNITS, length_unit
+from ..design.fillets import TANGENT_TOL, continuous_rectangle
+from .advice import advice, refusal
+from .roll_surfaces import _along, _along_spans, _cap, _faces_of, _record, _sections, _surface_face, roll_profile
+
+__all__ = [
+    "Slab",
+    "approximation_note",
+    "continuous_box",
+    "expected_level",
+    "forward_solid",
+    "g2_slab",
+    "outline_segments",
+    "verify_faces",
+    "verify_solid",
+]
+
+#: Relative slack on "the roll fits" comparisons (equality itself is decided by the construction).
+_FIT_SLACK = 1e-12
+#: A joint of the outline turning more than this (radians) is a corner no roll can follow.
+_CORNER_TOL = 1e-7
+
+
+@dataclass(frozen=True)
+class Slab:
+    """A G2 slab and what its construction guarantees.
+
+    Attributes:
+        shape: the solid (OCP ``TopoDS_Solid``), checked valid and closed.
+        approximation: the largest deviation of a non-exact patch (over a
+            spiral of the outline) from the true sweep, in the outline's unit;
+            0.0 when every patch is exact.
+        roll: the horizontal (= vertical) extent of the top and bottom rolls.
+        height: the slab's height.
+        units: the length unit of the numbers.
+    """
+
+    shape: TopoDS_Solid
+    approximation: float
+    roll: tuple[float, float]
+    height: float
+    units: str = DEFAULT_UNITS
+
+    @property
+    def description(self) -> str:
+        """One line for a file header: what is exact and the approximation's tolerance."""
+        return approximation_note(self.approximation, self.units)
+
+
+def approximation_note(approximation: float, units: str = DEFAULT_UNITS) -> str:
+    """The STEP description of a G2 solid whose non-exact surfaces deviate ``approximation`` from the exact ones."""
+    if approximation == 0.0:
+        return "spiral_cad G2 solid: every surface exact (extrusions, surfaces of revolution, planes)"
+    return (
+        f"spiral_cad G2 solid: sweeps over spirals approximated within {approximation:.3g} {units} "
+        "of the exact sweep; all other surfaces exact"
+    )
+
+
+# ------------------------------------------------------------------ input and fit
+
+
+def outline_segments(outline: Any) -> list[Segment]:
+    """The plane segments of a closed outline: a ``Chain``, a ``FilletedPath``, an object with ``.filleted``
+    (the continuous sketches) or segments in travel order.
+
+    Raises:
+        ValueError: anything else, segments in space, or an outline that does not close.
+    """
+    source = getattr(outline, "filleted", outline)
+    source = getattr(source, "segments", source)
+    if isinstance(source, Chain):
+        source = list(source)
+    if not isinstance(source, Sequence) or not source or not all(isinstance(s, Segment) for s in source):
+        raise ValueError(f"outline must be a closed Chain, a FilletedPath or segments in travel order; got {type(outline).__name__}")
+    segments = list(source)
+    if any(s.dim != 2 for s in segments):
+        raise ValueError("outline must lie in the plane (2-D segments)")
+    size = max(float(np.ptp(np.vstack([s.point(np.linspace(0, 1, 5)) for s in segments]), axis=0).max()), 1e-300)
+    gap = math.dist(segments[-1].end[:2], segments[0].start[:2])
+    if gap > 1e-9 * size:
+        raise ValueError(f"outline must be closed; its end is {gap:.3g} from its start")
+    for index, (a, b) in enumerate(zip(segments, [*segments[1:], segments[0]])):
+        (x, y, tx0, ty0, _), (_, _, tx1, ty1, _) = a.ends[1], b.ends[0]
+        turn = abs(math.atan2(tx0 * ty1 - ty0 * tx1, tx0 * tx1 + ty0 * ty1))
+        if turn > _CORNER_TOL:
+            raise ValueError(
+                f"outline must be tangent at every joint (a roll cannot follow a corner); the joint after segment "
+                f"{index} at ({x:.6g}, {y:.6g}) turns {turn:.3g} rad: round it first (g2_fillet, fillet_path)"
+            )
+    return segments
+
+
+def _samples(segments: list[Segment], count: int = 24) -> tuple[NDArray, NDArray, NDArray]:
+    """Points, left normals and curvatures at ``count`` parameters per segment (closing point excluded)."""
+    u = np.linspace(0.0, 1.0, count, endpoint=False)
+    points = np.vstack([s.point(u)[:, :2] for s in segments])
+    tangents = np.vstack([s.tangent(u)[:, :2] for s in segments])
+    curvatures = np.concatenate([np.broadcast_to(s.curvature(u), u.shape) for s in segments])
+    return points, np.stack([-tangents[:, 1], tangents[:, 0]], axis=1), curvatures
+
+
+def _crossing(polygon: NDArray[np.float64]) -> NDArray[np.float64] | None:
+    """A point where the closed polygon crosses itself (non-adjacent edges), or None."""
+    a, b = polygon, np.roll(polygon, -1, axis=0)
+    d = b - a
+    n = len(a)
+    i, j = np.triu_indices(n, 2)
+    keep = (j - i) < n - 1  # the last edge is adjacent to the first
+    i, j = i[keep], j[keep]
+    denom = d[i, 0] * d[j, 1] - d[i, 1] * d[j, 0]
+    diff = a[j] - a[i]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        t = (diff[:, 0] * d[j, 1] - diff[:, 1] * d[j, 0]) / denom
+        u = (diff[:, 0] * d[i, 1] - diff[:, 1] * d[i, 0]) / denom
+    hit = (denom != 0.0) & (t > 0.0) & (t < 1.0) & (u > 0.0) & (u < 1.0)
+    if not hit.any():
+        return None
+    k = int(np.argmax(hit))
+    result: NDArray[np.float64] = a[i[k]] + t[k] * d[i[k]]
+    return result
+
+
+def _fit_problem(segments: list[Segment], sigma: float, roll: float, given: Any, name: str) -> str | None:
+    """Why a roll ``roll`` wide does not fit inside the outline, or None: it must stay below every convex
+    radius of curvature (equal only on arcs: a clean pole) and its inner offset must not cross itself."""
+    for index, segment in enumerate(segments):
+        u = np.linspace(0.0, 1.0, 65)
+        bend = float(np.max(sigma * np.broadcast_to(segment.curvature(u), u.shape)))
+        if bend <= 0.0:
+            continue
+        product = roll * bend
+        exact_pole = isinstance(segment, Arc) and abs(product - 1.0) <= 1e-12
+        if product > 1.0 - _FIT_SLACK and not exact_pole:
+            return (
+                f"{name} {shown(given)} gives a roll {roll:.6g} wide, not below the outline's smallest convex radius "
+                f"of curvature {1.0 / bend:.6g} (segment {index}, a {type(segment).__name__}): the inner offset "
+                "would fold"
+            )
+    points, normals, _ = _samples(segments)
+    place = _crossing(points + sigma * roll * normals)
+    if place is not None:
+        return (
+            f"{name} {shown(given)} gives a roll {roll:.6g} wide whose inner offset crosses itself near "
+            f"({place[0]:.6g}, {place[1]:.6g}): the outline is too narrow there"
+        )
+    return None
+
+
+def _inward(segments: list[Segment]) -> float:
+    """+1 when the outline runs counterclockwise (its inward normal is the left one), else −1."""
+    points, _, _ = _samples(segments)
+    area = 0.5 * float(np.sum(points[:, 0] * np.roll(points[:, 1], -1) - np.roll(points[:, 0], -1) * points[:, 1]))
+    return 1.0 if area > 0.0 else -1.0
+
+
+def _roll_problem(segments: list[Segment], height: float, edge_radius: Any, given_height: Any, name: str,
+                  **options: Any) -> str | None:  # fmt: skip
+    """Why rolls of ``edge_radius`` (``options``: top, bottom, profile, transition, shape) do not fit the
+    outline and the height, or None."""
+    top, bottom = options.pop("top"), options.pop("bottom")
+    reach = float(roll_profile(float(edge_radius), **options)[-1].end[0])
+    d_top, d_bottom = (reach if top else 0.0), (reach if bottom else 0.0)
+    if d_top + d_bottom > height * (1.0 + _FIT_SLACK):
+        return (
+            f"{name} {shown(edge_radius)} gives rolls {reach:.6g} high; {'together they' if top and bottom else 'it'} "
+            f"exceed height {shown(given_height)}"
+        )
+    if max(d_top, d_bottom) == 0.0:
+        return None
+    return _fit_problem(segments, _inward(segments), min(max(d_top, d_bottom), height), edge_radius, name)
+
+
+# ------------------------------------------------------------------ the solid
+
+
+def _solid(faces: list[TopoDS_Face], tolerance: float, top: TopoDS_Face) -> TopoDS_Solid:
+    """The faces sewn into one closed shell and made a FORWARD solid facing out: the shell faces out
+    when the top cap (``top``, a plane z = height) does, as the construction knows (no volume needed)."""
+    sewing = BRepBuilderAPI_Sewing(tolerance)
+    for face in faces:
+        sewing.Add(face)
+    sewing.Perform()
+    sewn = sewing.SewedShape()
+    shells = TopExp_Explorer(sewn, TopAbs_SHELL)
+    count = 0
+    shell = None
+    while shells.More():
+        count += 1
+        shell = TopoDS.Shell_s(shells.Current())
+        shells.Next()
+    if count != 1 or shell is None or not BRep_Tool.IsClosed_s(shell):
+        raise NoSolutionError(f"the slab's {len(faces)} faces did not sew into one closed shell ({count} shell(s))")
+    sewn_top = sewing.Modified(top)
+    cap = next((f for f in _faces_of(shell) if f.IsSame(sewn_top)), None)
+    if cap is None or (plane := _plane(cap)) is None:
+        raise NoSolutionError("the slab's top cap is not a plane of the sewn shell")
+    up = plane.Axis().Direction().Z() * (-1.0 if cap.Orientation() == TopAbs_REVERSED else 1.0)
+    if up < 0.0:  # the shell faces in: the solid of the turned shell (a fresh solid is FORWARD)
+        shell = TopoDS.Shell_s(shell.Reversed())
+    return BRepBuilderAPI_MakeSolid(shell).Solid()
+
+
+def forward_solid(solid: TopoDS_Shape) -> TopoDS_Solid:
+    """The solid FORWARD: the same volume, usable in booleans.
+
+    ``BRepLib.OrientClosedSolid`` and ``Reversed`` may leave a solid REVERSED with a positive
+    volume; a fuse of a compound holding such a solid drops it (CadQuery's ``combine``). The
+    solid is made again from its shells as they face (orientations composed down from it)."""
+    if solid.Orientation() == TopAbs_FORWARD:
+        return TopoDS.Solid_s(solid)
+    maker = BRepBuilderAPI_MakeSolid()
+    shells = TopExp_Explorer(solid, TopAbs_SHELL)
+    while shells.More():
+        maker.Add(TopoDS.Shell_s(shells.Current()))
+        shells.Next()
+    return maker.Solid()
+
+
+def verify_solid(shape: TopoDS_Shape, what: str = "slab", facing_out: bool = False) -> None:
+    """NoSolutionError unless ``shape`` is one valid, closed, FORWARD solid with positive volume
+    (``BRepCheck_Analyzer``, which also finds a shell whose faces do not all face the same way;
+    ``facing_out``: the caller knows the shell faces out, so its volume is positive, unmeasured)."""
+    solids = TopExp_Explorer(shape, TopAbs_SOLID)
+    count = 0
+    while solids.More():
+        count += 1
+        solids.Next()
+    if count != 1:
+        raise NoSolutionError(f"the {what} is {count} solids, not one")
+    if _first_solid(shape).Orientation() != TopAbs_FORWARD:
+        raise NoSolutionError(f"the {what} is a {_first_solid(shape).Orientation().name} solid, not FORWARD (booleans drop it)")
+    if not BRepCheck_Analyzer(shape).IsValid():
+        raise NoSolutionError(f"the {what} is not a valid solid (BRepCheck_Analyzer)")
+    volume = 1.0 if facing_out else _volume(shape)
+    if not volume > 0.0:
+        raise NoSolutionError(f"the {what} encloses no volume ({volume:.3g})")
+
+
+def continuous_box(
+    length: float,
+    width: float,
+    height: float,
+    radius: float,
+    edge_radius: float | None = None,
+    *,
+    transition: float = 0.5,
+    shape: str = DEFAULT_SHAPE,
+    profile: str = "g2",
+    top: bool = True,
+    bottom: bool = True,
+    tolerance: float | None = None,
+    units: str = DEFAULT_UNITS,
+    _advise: bool = True,
+) -> Slab:
+    """A box with every edge and corner G2: ``g2_slab`` of a ``continuous_rectangle`` (centred on the origin,
+    z from 0 to ``height``). ``edge_radius`` None: the roll half as wide as the smaller of ``radius`` and
+    ``height``/2 allows. Other arguments and errors as ``g2_slab`` and ``continuous_rectangle``."""
+    for value, name in ((length, "length"), (width, "width"), (height, "height")):
+        if not as_float(value, name) > 0.0:
+            raise ValueError(f"{name} must be positive; got {shown(value)}")
+    try:
+        plan = continuous_rectangle(length, width, radius, transition, units=units, shape=shape)
+    except NoSolutionError as error:
+        if not _advise:
+            raise
+        raise _plan_refusal(error, length, width, height, as_float(radius, "radius"), edge_radius,
+                            dict(transition=transition, shape=shape, profile=profile, top=top, bottom=bottom),
+                            tolerance, units) from None  # fmt: skip
+    if edge_radius is None:  # the roll's extent is proportional to its radius
+        unit = float(roll_profile(1.0, profile=profile, transition=transition, shape=shape)[-1].end[0])
+        edge_radius = 0.5 * min(as_float(radius, "radius"), as_float(height, "height") / 2.0) / unit
+    return g2_slab(plan, height, edge_radius, top=top, bottom=bottom, profile=profile, transition=transition,
+                   shape=shape, tolerance=tolerance, units=units, _advise=_advise)  # fmt: skip
+
+
+def _plan_refusal(error: NoSolutionError, length: float, width: float, height: float, radius: float,
+                  edge_radius: float | None, options: dict[str, Any], tolerance: float | None,
+                  units: str) -> NoSolutionError:  # fmt: skip
+    """The refusal of plan corners too large for the box, with the largest ``radius`` that fits and builds
+    (with the given ``edge_radius``); when that roll fits no plan radius that fits, the largest plan radius
+    and the largest roll it holds, built together."""
+    transition, shape = options["transition"], options["shape"]
+
+    def plan_fits(r: float) -> bool:  # shrinking corners only ever fit better
+        try:
+            continuous_rectangle(length, width, r, transition, shape=shape)
+        except NoSolutionError:
+            return False
+        return True
+
+    def box(r: float) -> Slab:
+        return continuous_box(length, width, height, r, edge_radius, **options, tolerance=tolerance, units=units,
+                              _advise=False)  # fmt: skip
+
+    problem = f"{error} (the plan corners)"
+    fits = advice(plan_fits, box, radius)
+    if fits is not None or edge_radius is None:
+        return refusal(problem, "radius", fits)
+    corner = advice(plan_fits, lambda r: continuous_rectangle(length, width, r, transition, shape=shape), radius)
+    problem += f"; no radius fits with edge_radius {shown(edge_radius)}"
+    if corner is None:
+        return refusal(problem, "radius", None)
+    plan = outline_segments(continuous_rectangle(length, width, corner, transition, shape=shape))
+    slab_options = dict(options, profile=options["profile"])
+    roll = _slab_advice(plan, height, as_float(edge_radius, "edge_radius"), height, "edge_radius", slab_options,
+                        tolerance, units)  # fmt: skip
+    if roll is None:
+        return refusal(problem, "radius", None)
+    return NoSolutionError(f"{problem}; with radius {corner:.6g}, edge_radius up to {roll:.6g} fits")
+
+
+def expected_level(segments: Sequence[Segment], profile: str = "g2") -> str:
+    """The continuity the construction promises for tangent edges: ``"G2"`` for a G2 profile along an
+    outline whose tangent joints are all G2, else ``"G1"`` (circular profiles, circularly filleted outlines)."""
+    if profile != "g2":
+        return "G1"
+    for index, (a, b) in enumerate(zip(segments, [*segments[1:], segments[0]])):
+        if not _turns(a, b) and g2_mismatch(a, b, JOIN_TOLERANCE, index=index) is not None:
+            return "G1"
+    return "G2"
+
+
+def verify_faces(shape: TopoDS_Shape, level: str, what: str = "slab", units: str = DEFAULT_UNITS) -> None:
+    """NoSolutionError unless the face checker (``spiral_cad.cad.faces.check_faces``, default tolerances:
+    normals ≤ 1e-7 rad, normal-curvature jump ≤ 1e-4 relative, gaps ≤ 1e-7 × size) finds every tangent
+    edge at least ``level`` and no gap; sharp edges are features, listed there and not failed."""
+    from .faces import check_faces  # late: the checker reads files through this layer's readers
+
+    report = check_faces(shape, units=units)
+    if report.passes(level):
+        return
+    worst = min(report.edges, key=lambda e: (e.level == "sharp", e.level == level, -e.jump, -e.angle))
+    raise NoSolutionError(
+        f"the {what} is refused: the face checker finds edge {worst.index} ({worst.surfaces[0]}–{worst.surfaces[1]}) "
+        f"{worst.level}, not {level} (gap {worst.gap:.3g}, normal angle {worst.angle:.3g} rad, relative curvature "
+        f"jump {worst.jump:.3g} at {worst.jump_at}); {report.describe()}"
+    )
+
+
+def g2_slab(
+    outline: Any,
+    height: float,
+    edge_radius: float,
+    *,
+    top: bool = True,
+    bottom: bool = True,
+    profile: str = "g2",
+    transition: float = 0.5,
+    shape: str = DEFAULT_SHAPE,
+    tolerance: float | None = None,
+    units: str = DEFAULT_UNITS,
+    _name: str = "edge_radius",
+    _advise: bool = True,
+) -> Slab:
+    """A closed planar outline extruded by ``height`` with its top and bottom edges rolled (see the module docstring).
+
+    Args:
+        outline: a closed plane ``Chain`` of lines, arcs and spirals (G2 for a
+            G2 solid; tangent joints are swept as they are), a ``FilletedPath``
+            (``continuous_rectangle`` …) or its segments; convex or concave,
+            either sense. It lies in z = 0; the slab rises to z = ``height``.
+        height: the slab's height (> 0).
+        edge_radius: the roll profile's smallest radius of curvature (> 0).
+        top, bottom: roll the top / bottom edge (else the edge stays sharp).
+        profile: ``"g2"`` or ``"circular"`` (``roll_profile``).
+        transition, shape: of the G2 profile's spirals.
+        tolerance: the largest deviation allowed for the sweep over a spiral
+            (default 1e-7 × the outline's size).
+        units: the unit of the numbers (kept for the files written).
+
+    Returns:
+        The ``Slab``: the solid and the measured approximation. It is verified as returned: one valid
+        closed solid (``BRepCheck_Analyzer``), and the face checker finds every edge G2 (G1 for a
+        circular profile or an outline with G1 joints) or a sharp feature (unrolled edges).
+
+    Raises:
+        ValueError: malformed input.
+        NoSolutionError: the roll does not fit (it is as wide as it is high:
+            wider than the outline's smallest convex radius of curvature, an
+            inner offset that crosses itself, or both rolls higher than
+            ``height``) — the message names the value and what would fit.
+    """
+    units = length_unit(units)
+    segments = outline_segments(outline)
+    given_height, height = height, as_float(height, "height")
+    if not height > 0.0:
+        raise ValueError(f"height must be positive; got {shown(height)}")
+    options = dict(top=top, bottom=bottom, profile=profile, transition=transition, shape=shape)
+    radius = as_float(edge_radius, "edge_radius")
+    problem = _roll_problem(segments, height, edge_radius, given_height, _name, **options)
+    if problem is not None:
+        if not _advise:
+            raise NoSolutionError(problem)
+        raise refusal(problem, _name, _slab_advice(segments, height, radius, given_height, _name, options, tolerance, units))
+    try:
+        return _built_slab(segments, height, edge_radius, options, tolerance, units)
+    except NoSolutionError as error:  # fits, yet does not build: nearly singular (rolls meeting, an offset folding)
+        if not _advise:
+            raise
+        raise refusal(str(error), _name, _slab_advice(segments, height, radius, given_height, _name, options, tolerance, units)) from None
+
+
+def _slab_advice(segments: list[Segment], height: float, radius: float, given_height: Any, name: str,
+                 options: dict[str, Any], tolerance: float | None, units: str) -> float | None:  # fmt: skip
+    """The largest roll radius below ``radius`` a refusal may name: it fits with a margin and builds."""
+    return advice(
+        lambda r: _roll_problem(segments, height, r, given_height, name, **options) is None,
+        lambda r: g2_slab(segments, height, r, **options, tolerance=tolerance, units=units, _advise=False),
+        radius,
+    )
+
+
+def _built_slab(segments: list[Segment], height: float, edge_radius: float, options: dict[str, Any],
+                tolerance: float | None, units: str) -> Slab:  # fmt: skip
+    """The slab of rolls that fit, verified (``g2_slab`` after its fit checks)."""
+    top, bottom, profile, transition, shape = (options[k] for k in ("top", "bottom", "profile", "transition", "shape"))
+    roll = roll_profile(edge_radius, profile=profile, transition=transition, shape=shape)
+    reach = float(roll[-1].end[0])
+    d_top, d_bottom = (reach if top else 0.0), (reach if bottom else 0.0)
+    points, _, _ = _samples(segments)
+    size = float(np.ptp(points, axis=0).max())
+    if d_top + d_bottom > height - 1e-7 * size:  # a wall thinner than the sewing tolerance: the rolls meet
+        d_top, d_bottom = (height / 2.0, height / 2.0) if top and bottom else (d_top and height, d_bottom and height)
+    sigma = _inward(segments)
+    reach_max = max(d_top, d_bottom)
+    tol = 1e-7 * size if tolerance is None else as_float(tolerance, "tolerance")
+    if not tol > 0.0:
+        raise ValueError(f"tolerance must be positive; got {shown(tolerance)}")
+    alongs = [span for s in segments for span in _along_spans(_along(s, sigma, reach_max, tol))]
+    sections = _sections(roll, d_top, d_bottom, height)
+    degenerate = 1e-9 * size
+    made = [_surface_face(a, sec, degenerate) for a in alongs for sec in sections]
+    faces = [face for face, _ in made]
+    for k, (_, key) in enumerate(made):  # so export_step finds the note on parts built from this solid
+        _record(key, reach_max * alongs[k // len(sections)].deviation)
+    top_cap = _cap(alongs, d_top, height)
+    faces += [top_cap, _cap(alongs, d_bottom, 0.0)]
+    solid = _solid(faces, 1e-7 * size, top_cap)
+    verify_solid(solid, facing_out=True)
+    verify_faces(solid, expected_level(segments, profile), units=units)
+    approximation = reach_max * max(a.deviation for a in alongs)
+    return Slab(solid, approximation, (d_top, d_bottom), height, units)
+
+
+def _volume(shape: TopoDS_Shape) -> float:
+    props = GProp_GProps()
+    BRepGProp.VolumeProperties_s(shape, props)
+    return props.Mass()
+
+
+def _first_solid(shape: TopoDS_Shape) -> TopoDS_Solid:
+    explorer = TopExp_Explorer(shape, TopAbs_SOLID)
+    return TopoDS.Solid_s(explorer.Current())
+
+
+def _plane(face: TopoDS_Face) -> gp_Pln | None:
+    surface = GeomAdaptor_Surface(BRep_Tool.Surface_s(face))
+    return surface.Plane() if surface.GetType() == GeomAbs_SurfaceType.GeomAbs_Plane else None
+
+
+def _turns(before: Segment, after: Segment) -> bool:
+    """Whether the outline turns (a sharp corner) from ``before`` into ``after`` (tangent joints are left alone)."""
+    (tx0, ty0), (tx1, ty1) = before.ends[1][2:4], after.ends[0][2:4]
+    return abs(math.atan2(tx0 * ty1 - ty0 * tx1, tx0 * tx1 + ty0 * ty1)) > TANGENT_TOL
