@@ -24,7 +24,7 @@ from spiral_cad.core.fit import chain_distances
 from spiral_cad.design import Alignment
 
 #: The modules whose code these numbers measure (stamped into the results: ``timing.code_stamp``).
-MEASURES = ("spiral_cad.core.fit",)
+MEASURES = ("spiral_cad.core.fit", "spiral_cad.core._fit_runs", "spiral_cad.core._fit_joins")
 
 TOLERANCE = 0.05  # m
 

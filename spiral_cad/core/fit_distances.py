@@ -36,6 +36,11 @@ def _as_points(points: Any) -> NDArray[np.float64]:
     return array
 
 
+def _arc_lengths(points: NDArray[np.float64]) -> NDArray[np.float64]:
+    """The distance along the points' polyline to each point (0 at the first)."""
+    return np.concatenate([[0.0], np.cumsum(np.hypot(*np.diff(points, axis=0).T))])
+
+
 def _nearest(pieces: list[Segment], points: NDArray[np.float64]) -> NDArray[np.float64]:
     """Distance of each point to the nearest of ``pieces`` (each tried: few pieces)."""
     best = np.full(len(points), np.inf)
