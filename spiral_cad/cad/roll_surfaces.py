@@ -24,7 +24,7 @@ Each outline piece gives a wall face (the extrusion between the rolls) and
 a top and a bottom roll face; the top and bottom are planes bounded by the
 rolls' inner boundary curves (the same curves, so faces share edges). The
 faces are sewn, made a solid and checked (``BRepCheck_Analyzer``, one
-closed solid) before anything is returned.
+closed solid) in ``slabs`` before anything is returned.
 """
 
 from __future__ import annotations
