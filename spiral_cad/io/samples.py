@@ -93,10 +93,10 @@ class _Rows:
 
     def _polynomial(self, order: int, i: NDArray, t: NDArray) -> NDArray:
         """Derivative ``order`` (0: the point; 1, 2 on the scaled copies) of rows ``i`` at ``t``, by Horner."""
-        coefficients = self.coefficients[order]
-        acc = coefficients[i, -1]
+        coefficients = self.coefficients[order][i]  # gathered once: (n, k, d)
+        acc = coefficients[:, -1]
         for j in range(coefficients.shape[1] - 2, -1, -1):
-            acc = acc * t[:, None] + coefficients[i, j]
+            acc = acc * t[:, None] + coefficients[:, j]
         return acc
 
     def frames(self, owner: NDArray, u: NDArray, stations: bool = True) -> tuple[NDArray, NDArray, NDArray, NDArray]:
