@@ -122,6 +122,39 @@ def arc_length(cp: ArrayLike, u: ArrayLike = 1.0) -> NDArray[np.float64] | float
     return float(result) if result.ndim == 0 else result
 
 
+def arc_lengths_at(first: NDArray[np.float64], scale: NDArray[np.float64], u: NDArray[np.float64]) -> NDArray[np.float64]:
+    """Arc length from 0 to ``u[i]`` of curve i, many curves at once, by :func:`arc_length`'s rule.
+
+    The batch form of :func:`arc_length` for one parameter per curve: the
+    same composite Gauss–Legendre nodes, taken one node at a time over all
+    curves, so the temporaries stay a few arrays of the curves' size.
+
+    Args:
+        first: (n, 3, d) power coefficients of each curve's first derivative
+            (``_power_coefficients(cp, 1)``), each divided by its ``scale``.
+        scale: (n,) the factor (a power of two) each curve was divided by.
+        u: (n,) the end parameter of each curve.
+
+    Returns:
+        (n,) arc lengths.
+    """
+    u = np.asarray(u, dtype=float)
+    columns = [[np.ascontiguousarray(first[:, j, k]) for j in range(first.shape[1])] for k in range(first.shape[2])]
+    total = np.zeros(len(u))
+    for node, weight in zip(_U.tolist(), _W.tolist()):
+        t = u * node
+        square = np.zeros(len(u))
+        for c0, c1, c2 in columns:
+            value = c2 * t
+            value += c1
+            value *= t
+            value += c0
+            square += value * value
+        total += weight * np.sqrt(square)
+    result: NDArray[np.float64] = total * u * scale
+    return result
+
+
 def split(cp: NDArray[np.float64], t0: float, t1: float) -> NDArray[np.float64]:
     """Exact control points of the sub-curve on [t0, t1] (de Casteljau/blossom)."""
 

@@ -62,7 +62,7 @@ class _Rows:
     """Points, tangents and curvatures at parameters u of a chain's rows, vectorised per kind.
 
     Lines and arcs are parametrised by arc length; a spiral by its Bézier
-    parameter, its station found by quadrature (``bezier.arc_length``).
+    parameter, its station found by quadrature (``bezier.arc_lengths_at``).
     """
 
     def __init__(self, chain: Chain):
@@ -93,10 +93,10 @@ class _Rows:
 
     def _polynomial(self, order: int, i: NDArray, t: NDArray) -> NDArray:
         """Derivative ``order`` (0: the point; 1, 2 on the scaled copies) of rows ``i`` at ``t``, by Horner."""
-        coefficients = self.coefficients[order]
-        acc = coefficients[i, -1]
+        coefficients = self.coefficients[order][i]  # gathered once: (n, k, d)
+        acc = coefficients[:, -1]
         for j in range(coefficients.shape[1] - 2, -1, -1):
-            acc = acc * t[:, None] + coefficients[i, j]
+            acc = acc * t[:, None] + coefficients[:, j]
         return acc
 
     def frames(self, owner: NDArray, u: NDArray, stations: bool = True) -> tuple[NDArray, NDArray, NDArray, NDArray]:
@@ -122,8 +122,12 @@ class _Rows:
                 # the multi-curve form of BezierSpiral.curvature: (Q' × Q'')/|Q'|³, signed in the plane
                 cross = d1[:, 0] * d2[:, 1] - d1[:, 1] * d2[:, 0] if d == 2 else np.linalg.norm(np.cross(d1, d2), axis=1)
                 kappa[pick] = cross / speed**3 / self.scale[i]
-                s[pick] = self.stations[i] + np.minimum(bezier.arc_length(self.cp[i], t), self.lengths[i]) if stations else np.nan
+                s[pick] = self.stations[i] + np.minimum(self._arc_lengths(i, t), self.lengths[i]) if stations else np.nan
         return s, points, tangents, kappa
+
+    def _arc_lengths(self, i: NDArray, t: NDArray) -> NDArray:
+        """Arc length from 0 to ``t`` on spiral rows ``i`` (``bezier.arc_length``'s rule, one node at a time over all)."""
+        return bezier.arc_lengths_at(self.coefficients[1][i], self.scale[i], t)
 
     def _groups(self, owner: NDArray):
         kinds = self.kind[owner]
@@ -253,7 +257,8 @@ def write_samples(chain: Chain, path: str | os.PathLike, *, step: float | None =
     table = sample_path(chain, step=step, chord_tolerance=chord_tolerance)
     units = chain.units
     head = ",".join(f"{name} [{dimension.replace('L', units)}]" for name, dimension in COLUMNS)
-    body = "\n".join(",".join(map(repr, row)) for row in (table + 0.0).tolist())  # + 0.0: no -0.0
+    cells = map(repr, (table + 0.0).ravel().tolist())  # + 0.0: no -0.0
+    body = "\n".join(map(",".join, zip(*[cells] * len(COLUMNS))))  # rows of len(COLUMNS) cells, one join each
     with open(path, "w", encoding="utf-8", newline="") as handle:
         handle.write(f"{head}\n{body}\n")
     return len(table)
