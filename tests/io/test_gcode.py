@@ -208,7 +208,7 @@ def test_an_inch_program_is_converted_to_the_outputs_unit(tmp_path):
             r"max_curvature: corner options of straight moves; with_arcs.nc line 5 starts a path with arcs",
         ),
         (["--from-gcode", "pocket.nc"], r"--from-gcode needs --max-deviation"),
-        (["--from-gcode", "../data", "--max-deviation", "1"], r"the G-code file is a folder"),  # holds no program (else: all built)
+        (["--from-gcode", "../data/landxml", "--max-deviation", "1"], r"the G-code file is a folder"),  # holds no program (else: all built)
         (["--from-gcode", "pocket.nc", "--max-deviation", "nan"], r"--max-deviation must be a positive finite number; got nan"),
         (["--from-gcode", "pocket.nc", "--max-deviation=-1"], r"--max-deviation must be a positive finite number; got -1.0"),
         (["--from-gcode", "pocket.nc", "--max-deviation", "5e-324"], r"max_deviation 4.94066e-324 is below what float64 resolves"),
