@@ -986,8 +986,13 @@ def _resolved(result: CornerBatch, distance: NDArray, p0: NDArray, corners: NDAr
         if why is not None:
             raise _refusal(why, int(index[j]))
     arrays = {name: getattr(result, name).copy() for name in ("control_points", "distance", "curvature", "deviation")}
+    solved = {name: getattr(fixed, name) for name in arrays}
+    # The batch drops z when all of its rows lie in z = 0, so a space path's corners re-solved
+    # alone may come back as plane pairs: those lie in z = 0 and get their z back.
+    lost = result.control_points.shape[-1] - solved["control_points"].shape[-1]
+    solved["control_points"] = np.pad(solved["control_points"], ((0, 0), (0, 0), (0, 0), (0, lost)))
     for name, array in arrays.items():
-        array[changed] = getattr(fixed, name)
+        array[changed] = solved[name]
     return CornerBatch(result.shape, arrays["control_points"], result.theta, arrays["distance"], arrays["curvature"],
                        result.available, result.status, result.corners, result.requested, result.residual,
                        arrays["deviation"], result.max_deviation, result.max_curvature, result.spiral_length)  # fmt: skip

@@ -14,6 +14,11 @@ Two dialects (``dialect=``):
   spiral is biarcs (two tangent circular arcs per piece, split until the measured distance
   from the spiral is within ``arc_tolerance``).
 
+No arc is written with a radius below LinuxCNC's least radius (0.00005 in, 0.00127 mm; rs274
+refuses it as a zero-radius arc): such a piece of a biarc is a straight move, measured and fitted
+within ``arc_tolerance`` like every biarc, and such an arc of the chain is ``G1`` chords within
+``chord_tolerance``.
+
 The program states its unit with ``G21`` (mm) or ``G20`` (inch): a chain in mm or inches
 is written as it is, one in cm, m or km is converted to mm, one in feet to inches (said in
 the header). Every number is written with a fixed number of decimals (``decimals``; by
@@ -76,6 +81,9 @@ MAX_BIARCS = 1 << 14
 #: Tolerances below this times the largest coordinate are refused: float64 (about 2.2e-16 relative)
 #: cannot place points that finely, so the fit would halve without end.
 MIN_RELATIVE_TOLERANCE = 1e-13
+#: LinuxCNC's least arc radius (inches; 0.00127 mm in a G21 program): rs274 refuses an arc whose start or end
+#: lies closer to its centre as a "zero-radius arc", so a smaller arc is written as a straight move.
+LEAST_ARC_RADIUS_IN = 0.00005
 #: LinuxCNC's longest line (characters); header comments are cut to fit.
 MAX_LINE = 255
 #: The most characters of the name shown in the header.
@@ -194,9 +202,12 @@ def _distances(points: NDArray, start: NDArray, end: NDArray, centre: NDArray, r
     return np.where(line[:, None], to_line, np.where(angle <= sweep, on_circle, to_ends))
 
 
-def spirals_biarcs(control_points: NDArray, tolerance: float) -> list[tuple[list[Piece], float]]:
+def spirals_biarcs(control_points: NDArray, tolerance: float, least_radius: float = 0.0) -> list[tuple[list[Piece], float]]:
     """Biarcs within ``tolerance`` of plane cubics (``control_points`` (n, 4, 2)): for each, the pieces
     [(end, centre or None for a line, signed radius)] in travel order and the largest measured distance.
+
+    An arc of a biarc with radius below ``least_radius`` (a controller's least radius) is a line
+    between its ends instead, measured as a line: the halving goes on until it is within ``tolerance`` too.
 
     A biarc is two tangent arcs between two points of the cubic with its tangents there, with equal
     legs to their joint (the construction LinuxCNC uses for G5). Each cubic's parameter interval is
@@ -240,8 +251,8 @@ def spirals_biarcs(control_points: NDArray, tolerance: float) -> list[tuple[list
             q0, q1 = p0 + leg[:, None] * t0, p1 - leg[:, None] * t1
             joint = (q0 + q1) / 2.0
             middle = (q1 - q0) / np.linalg.norm(q1 - q0, axis=1, keepdims=True)
-            first = _arcs_through(p0, t0, joint)
-            second = _arcs_through(joint, middle, p1)
+            first = _straight_if_below(_arcs_through(p0, t0, joint), least_radius)
+            second = _straight_if_below(_arcs_through(joint, middle, p1), least_radius)
             error = np.minimum(_distances(probes, p0, joint, *first), _distances(probes, joint, p1, *second)).max(axis=1)
         good = (leg > 0.0) & np.isfinite(error) & (error <= tolerance)
         for k in np.flatnonzero(good):
@@ -261,6 +272,12 @@ def spirals_biarcs(control_points: NDArray, tolerance: float) -> list[tuple[list
     return [([piece for _, pieces in sorted(own, key=lambda f: f[0]) for piece in pieces], float(w)) for own, w in zip(found, worst)]
 
 
+def _straight_if_below(arcs: tuple[NDArray, NDArray, NDArray], least_radius: float) -> tuple[NDArray, NDArray, NDArray]:
+    """``_arcs_through``'s pieces with those of radius below ``least_radius`` made lines."""
+    centre, radius, line = arcs
+    return centre, radius, line | (np.abs(radius) < least_radius)
+
+
 def _resolvable(tolerance: float, extent: float, name: str, unit: str) -> None:
     """Refuse a tolerance float64 cannot resolve at coordinates up to ``extent`` (the smallest usable one named)."""
     smallest = MIN_RELATIVE_TOLERANCE * min(extent, MAX_COORDINATE)
@@ -269,13 +286,13 @@ def _resolvable(tolerance: float, extent: float, name: str, unit: str) -> None:
                          f"the smallest usable is {smallest:.2g}{unit} ({MIN_RELATIVE_TOLERANCE:g} of the largest coordinate)")  # fmt: skip
 
 
-def spiral_biarcs(control_points: NDArray, tolerance: float) -> tuple[list[Piece], float]:
+def spiral_biarcs(control_points: NDArray, tolerance: float, least_radius: float = 0.0) -> tuple[list[Piece], float]:
     """Biarcs within ``tolerance`` of one plane cubic (4, 2): ``spirals_biarcs`` of one.
 
     Raises:
         ValueError: as ``spirals_biarcs``.
     """
-    return spirals_biarcs(np.asarray(control_points, dtype=float)[None], tolerance)[0]
+    return spirals_biarcs(np.asarray(control_points, dtype=float)[None], tolerance, least_radius)[0]
 
 
 def gcode_program(
@@ -361,6 +378,8 @@ def gcode_program(
         if not 0.5 * 10.0**-decimals <= value <= MAX_COORDINATE:
             raise ValueError(f"feed {value:g} {program}/min cannot be printed with {decimals} decimals: it must be from "
                              f"{0.5 * 10.0**-decimals:g} to {MAX_COORDINATE:g}")  # fmt: skip
+    # rs274 measures an arc's radius from its printed centre and ends: a margin of their rounding on top
+    least_radius = (LEAST_ARC_RADIUS_IN * (25.4 if program == "mm" else 1.0) + 2.0 * printing) / factor
     plane_tol = 0.5 * 10.0**-decimals / factor if plane_tolerance is None else _positive(plane_tolerance, "plane_tolerance")
     if name is not None and ("(" in name or ")" in name or not name.isprintable()):
         raise ValueError(f"name {name!r:.60} cannot stand in a G-code comment (no parentheses, printable)")
@@ -382,7 +401,7 @@ def gcode_program(
         wanted = [i for i, plane in planes.items() if plane is not None and plane[0] == plane_name
                   and not (plane_name == "G17" and dialect == "linuxcnc")]  # fmt: skip
         if wanted:
-            fitted = spirals_biarcs(rows.geometry[wanted][:, :, [first, second]], arcs - printing / factor)
+            fitted = spirals_biarcs(rows.geometry[wanted][:, :, [first, second]], arcs - printing / factor, least_radius)
             fits.update(zip(wanted, fitted))
     in_force, feed_words = float(per_segment[0]) if len(chain) else feed, 0
     for i in range(len(chain)):
@@ -402,7 +421,7 @@ def gcode_program(
             normal = segment.normal
             ends = np.stack([segment.point(u) for u in np.linspace(0.0, 1.0, 5)])
             plane = _plane_of(np.pad(ends, ((0, 0), (0, 3 - chain.dim))), normal, plane_tol)
-            if plane is not None:
+            if plane is not None and abs(segment.radius) >= least_radius:  # a smaller arc: chords, below
                 ccw = (segment.radius > 0.0) == (normal[plane[3]] > 0.0)
                 centre = out.rounded(geometry[0])
                 out.arc(plane, centre, out.rounded(segment.end), ccw)
@@ -438,7 +457,7 @@ def gcode_program(
                         out.arc(plane, out.rounded(middle), target, radius > 0.0)
                 counts["biarcs"] += 1
                 continue
-        # a piece in a plane that is not a principal one: chords
+        # a piece in a plane that is not a principal one, or an arc below the least radius: chords
         piece = Chain([segment], units=chain.units)
         samples = sample_path(piece, chord_tolerance=chord - printing / factor)
         points = samples[:, 1:4]
@@ -464,6 +483,8 @@ def gcode_program(
         f"(biarcs within arc tolerance {arcs_p:g} {program}, measured {arc_error * factor:.3g}; {printed})",
         f"(pieces in space as G1 chords: {counts['chords']}, within chord tolerance {chord_p:g} {program}, "
         f"measured {chord_error * factor:.3g}; {printed})",
+        f"(arcs below LinuxCNC's least radius {LEAST_ARC_RADIUS_IN * (25.4 if program == 'mm' else 1.0):g} {program}: "
+        "straight moves within the tolerances above)",
         "(a plane path keeps the machine's Z)" if chain.dim == 2 else "(a path in space: X Y Z)",
     ]
     if dialect == "linuxcnc":

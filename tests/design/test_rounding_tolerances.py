@@ -289,3 +289,25 @@ def test_a_dense_polyline_whose_pairs_all_meet_opens_real_edges_instead_of_slive
 
     wire = chain_to_wire(path.chain)
     assert BRepCheck_Analyzer(wire.wrapped).IsValid() and len(wire.edges()) == len(path.chain)
+
+
+def test_a_space_path_whose_mended_corners_all_lie_in_z_0_keeps_them_in_space():
+    """LinuxCNC's flowsnake.ngc: a plunge from z = 1, then a flat path in z = 0 whose pairs leave slivers.
+    The corners beside a sliver, solved again on their own, all lie in z = 0 (the batch returns them as
+    plane pairs); the space path must take them back with z = 0 rather than fail on the shapes."""
+    flat = np.array([[3.7068, 1.0728], [3.6996, 1.085], [3.7065, 1.0973], [3.6924, 1.0971], [3.6852, 1.1093]])
+    points = np.vstack([[[3.7068, 1.5728, 1.0]], np.column_stack([flat, np.zeros(len(flat))])])
+    bound = 0.01
+    mended = round_corners(flat, max_deviation=bound)
+    assert min(_lines(mended)) >= 1e-6  # the plane path mends slivers: its corners moved (the case above)
+    path = round_corners(points, max_deviation=bound)
+    assert path.chain.dim == 3 and len(path.corners) == len(points) - 2
+    assert min(_lines(path)) >= 1e-6 and path.max_deviation <= bound
+    assert all(_path_distance(path.chain, points[c.index]) <= bound for c in path.corners)
+    for corner in path.corners[1:]:  # the flat corners: in z = 0, the plane path's pairs
+        spirals = np.array([s.control_points for s in corner.spirals])
+        assert np.all(spirals[..., 2] == 0.0)
+    plane = {c.index: np.array([s.control_points for s in c.spirals]) for c in mended.corners}
+    for corner in path.corners[1:]:
+        spirals = np.array([s.control_points for s in corner.spirals])[..., :2]
+        np.testing.assert_allclose(spirals, plane[corner.index - 1], rtol=0, atol=1e-12)

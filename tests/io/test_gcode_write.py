@@ -309,3 +309,40 @@ def test_a_mm_chain_as_an_inch_program_and_without_the_rapid():
     assert "converted from the chain's mm, times 0.0393701" in program.text
     back = parse_gcode_chain(program.text.replace("F30\n", "F30\nG0 X0 Y0\n"), units="mm")  # the machine starts at the start
     assert np.abs(back.rows.geometry - chain.rows.geometry).max() < 1e-11
+
+
+def _arc_radii(text: str) -> list[float]:
+    """The radius of every G2/G3 of a program we write: the length of its centre words (G91.1: from its start)."""
+    radii = []
+    for line in body(text):
+        if line.startswith(("G2 ", "G3 ")):
+            radii.append(float(np.hypot(*[float(w[1:]) for w in line.split()[1:] if w[0] in "IJK"])))
+    return radii
+
+
+@needs_rs274
+def test_no_arc_below_linuxcncs_least_radius_is_written_and_rs274_reads_the_program(tmp_path):
+    """A corner rounded within 0.0003 mm in the XZ plane (G18: biarcs) and a true arc of radius 0.001 mm in XY:
+    their biarcs and the arc would be G2/G3 of radius below 0.00005 in (0.00127 mm), which rs274 refuses as
+    zero-radius arcs (comp.ngc, lathe_g7x_quadrants.ngc); they are straight moves within the tolerances."""
+    least = 0.00005 * 25.4
+    corner = round_corners(np.array([[0, 0, 0], [1, 0, 0], [1, 0, 1.0], [2, 0, 1]]), max_deviation=0.0003).chain
+    spiral = np.asarray(corner[1].control_points)[:, [2, 0]]  # in G18's (Z, X) coordinates
+    unrestricted, _ = spiral_biarcs(spiral, 0.001)
+    assert any(about is not None and abs(radius) < least for _, about, radius in unrestricted)  # the case arises
+    pieces, error = spiral_biarcs(spiral, 0.001, least)
+    assert error <= 0.001 and not any(about is not None and abs(radius) < least for _, about, radius in pieces)
+    tiny_arc = Chain([Arc((0.0, 0.0), 0.001, 0.0, 2.0)], units="mm")
+    for chain in (corner, tiny_arc):
+        program = gcode_program(chain)
+        assert all(radius >= least for radius in _arc_radii(program.text))
+        assert "(arcs below LinuxCNC's least radius 0.00127 mm: straight moves within the tolerances above)" in program.text
+        assert program.arc_error <= 0.001 and program.chord_error <= 0.001
+        path = tmp_path / "tiny.ngc"
+        path.write_text(program.text)
+        done = subprocess.run([rs274.rs274_executable(), "-g", str(path), str(tmp_path / "canon.txt")], capture_output=True, text=True)
+        assert done.returncode == 0 and "error" not in done.stderr.lower() and "radius" not in done.stderr.lower(), done.stderr
+        moves = rs274.run_rs274(program.text, arc_tolerance=1e-4)
+        points = moves.points[~moves.rapid][:, : chain.dim]
+        assert distance_to_chain(chain, points, chain.length / 2000).max() <= 0.001 + 2e-4
+    assert gcode_program(tiny_arc).counts["chords"] == 1
