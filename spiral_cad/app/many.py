@@ -358,16 +358,24 @@ def run_many(task: Callable[[argparse.Namespace], int], files: Sequence[str], ch
             return future
 
         pending = as_completed([submit(index) for _, index in zip(range(window), waiting)])
+        died: list[int] = []  # files whose worker stopped: the file's doing, or another's on the same worker
         for future in pending:
             index = where.pop(future.key)
             try:
-                result = future.result()
-            except Exception as error:  # the worker died on this file
-                result = FileResult(files[index], 2, "", 0.0, "", (f"error: its worker stopped ({type(error).__name__}: {error})",))
-            results.add(index, result)
+                results.add(index, future.result())
+            except Exception:
+                died.append(index)
             for following in waiting:
                 pending.add(submit(following))
                 break
+        for index in died:  # each alone on the cluster: only a file that stops its worker by itself is its error
+            future = submit(index)
+            where.pop(future.key)
+            try:
+                result = future.result()
+            except Exception as error:
+                result = FileResult(files[index], 2, "", 0.0, "", (f"error: its worker stopped ({type(error).__name__}: {error})",))
+            results.add(index, result)
     finally:
         cluster = client.cluster
         client.close()

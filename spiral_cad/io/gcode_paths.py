@@ -211,8 +211,11 @@ def parse_gcode_moves(
     per_segment: list[float] = []
     chords: list[bool] = []
     helices = 0
-    moving = [k for k, p in enumerate(pieces) if p[3] != p[4]]
-    pieces, feeds = pieces[moving[0] + 1 :] if moving else [], feeds[moving[0] + 1 :] if moving else []  # see the docstring
+    # the first move's start is not known (see the docstring): its end is where the path starts. The built-in
+    # reader gives every move, so even one that lands on its 0 (G1 X0 Y0) states the start; rs274 prints
+    # no move that stays where it is, so its first move to a new position is that first move
+    first = 0 if interpreter == "builtin" else next((k for k, p in enumerate(pieces) if p[3] != p[4]), len(pieces))
+    pieces, feeds = pieces[first + 1 :], feeds[first + 1 :]
     for piece, feed in zip(pieces, feeds):
         kind, number, is_rapid, start = piece[:4]
         try:

@@ -154,7 +154,7 @@ def test_many_programs_build_each_into_its_own_folder_as_one_by_one(tmp_path, ca
     for shop in ("shop_a", "shop_b"):
         (tmp_path / "programs" / shop).mkdir(parents=True)
         (tmp_path / "programs" / shop / "pocket.nc").write_text(program.read_text(encoding="utf-8"), encoding="utf-8")
-    (tmp_path / "programs" / "shop_b" / "arc.nc").write_text("G21\nG0 X0 Y0\nG2 X10 Y0 I5 J0 F100\n", encoding="utf-8")
+    (tmp_path / "programs" / "shop_b" / "cycle.nc").write_text("G21\nG0 X0 Y0 Z5\nG81 X10 Y0 Z-1 R1 F100\n", encoding="utf-8")
     monkeypatch.chdir(tmp_path)
     options = ["--max-deviation", "0.05", "--no-plots"]
     status = main(["build", "--from-gcode", "programs/**/*.nc", *options, "-o", "many", "--workers", "2", "--summary", "built.csv"])
@@ -162,8 +162,8 @@ def test_many_programs_build_each_into_its_own_folder_as_one_by_one(tmp_path, ca
     assert status == 2 and "Traceback" not in err
     rows = {row["file"]: row for row in csv.DictReader(open("built.csv", encoding="utf-8"))}
     assert {f: (r["verdict"], r["worst_joint"]) for f, r in rows.items()} == {
-        "programs/shop_a/pocket.nc": ("ok", "G2"), "programs/shop_b/arc.nc": ("error", ""), "programs/shop_b/pocket.nc": ("ok", "G2")}  # fmt: skip
-    assert "error: programs/shop_b/arc.nc: " in err and "G2 (a clockwise arc) is refused" in err
+        "programs/shop_a/pocket.nc": ("ok", "G2"), "programs/shop_b/cycle.nc": ("error", ""), "programs/shop_b/pocket.nc": ("ok", "G2")}  # fmt: skip
+    assert "error: programs/shop_b/cycle.nc: " in err and "G81 is refused" in err
     assert main(["build", "--from-gcode", "programs/shop_a/pocket.nc", *options, "-o", "alone"]) == 0
     for shop in ("shop_a", "shop_b"):
         for name in ("pocket.ngc", "pocket_samples.csv", "pocket_continuity.txt"):

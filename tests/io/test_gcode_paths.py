@@ -109,11 +109,11 @@ def test_a_helix_is_refused_by_name_or_read_as_chords_within_the_tolerance(inter
 
 @pytest.mark.parametrize("interpreter", ["builtin", pytest.param("rs274", marks=needs_rs274)])
 def test_plunges_and_retracts_split_the_path(interpreter):
-    text = "G21 G90 F100\nG0 X0 Y0 Z0\nG0 X0 Y0 Z5\nG1 Z-1\nG0 Z5\nG0 X10\nG1 Z-1\nG2 X20 Y0 I5 J0\nG3 X30 Y0 I5 J0\nG1 Z5\nM2\n"
+    text = "G21 G90 F100\nG0 X0 Y0 Z5\nG1 Z-1\nG0 Z5\nG0 X10\nG1 Z-1\nG2 X20 Y0 I5 J0\nG3 X30 Y0 I5 J0\nG1 Z5\nM2\n"
     moves = parse_gcode_moves(text, interpreter=interpreter)
     # (the rapid up to Z5 is where the path starts) down, up again (a fold); along, down, an S of two tangent arcs,
     # up (corners only)
-    assert [int(moves.lines[j + 1]) for j in moves.folds()] == [5]
+    assert [int(moves.lines[j + 1]) for j in moves.folds()] == [4]
     assert moves.parts() == [(0, 1), (1, 7)]
     assert moves.straight(0, 1) and not moves.straight(1, 7)
 
