@@ -150,8 +150,9 @@ def test_check_of_a_g1_file_says_the_smallest_bound_that_makes_it_g2(tmp_path, c
     assert "worst G1" in out
     line = next(x for x in out.splitlines() if x.startswith("make_g2:"))
     assert "8 tangent joints" in line
-    bound = float(line.split("max_deviation ")[1].split(" ")[0])
-    read_back = _all_wires(read_shape(str(path)))[0]  # the curves as the file holds them
+    bound, unit = line.split("max_deviation ")[1].split(" ")[:2]
+    bound = float(bound)
+    read_back = _all_wires(read_shape(str(path), units=unit))[0]  # the curves as the file holds them, in the unit told
     segments, closed = wire_path(read_back, planar_frame(read_back))
     assert smallest_max_deviation(segments, closed=closed) == bound
     made = make_path_g2(segments, bound, closed=closed)
