@@ -358,10 +358,7 @@ def _check_shape_file(args: argparse.Namespace) -> int:
     if comb is not None:
         comb_shape = curvature_comb(args.file, units=report.units)  # in the unit the report is in
         export_step(comb_shape, comb, name=f"{report.source} curvature comb", units=report.units)
-    status = _print_report(report, args)
-    if report.min_level < Continuity.G2:
-        _print_g2_advice(args.file, report.units)
-    return status
+    return _print_report(report, args)
 
 
 def _print_g2_advice(file: str, units: str) -> None:
@@ -369,7 +366,12 @@ def _print_g2_advice(file: str, units: str) -> None:
     from ..cad.g2wire import g2_advice
     from ..cad.readers import read_shape
 
-    for line in g2_advice(read_shape(file, units=units or None), units or "mm"):
+    try:
+        shape = read_shape(file, units=units or None)
+    except ValueError as error:  # the check read the curves its own way; no advice must not fail it
+        print(f"make_g2: no advice: {error}")
+        return
+    for line in g2_advice(shape, units or "mm"):
         print(line)
 
 
@@ -391,6 +393,8 @@ def _print_report(report: ContinuityReport, args: argparse.Namespace) -> int:
     note_worst(str(report.min_level))
     if getattr(args, "timing", False) and report.timing is not None:
         print(report.timing_line())
+    if report.min_level < Continuity.G2:  # before the verdict, which stays the last line
+        _print_g2_advice(args.file, report.units)
     if not args.require:
         return 0
     expected = 1 if args.pieces is None else args.pieces

@@ -159,3 +159,23 @@ def test_check_of_a_g1_file_says_the_smallest_bound_that_makes_it_g2(tmp_path, c
     assert all(j.kind == "line-arc" for j in made.joints)
     with pytest.raises(NoSolutionError, match="works"):
         make_path_g2(segments, bound / 10.0, closed=closed)
+
+
+def test_check_advice_that_cannot_read_the_file_leaves_the_verdict_last(tmp_path, capsys, monkeypatch):
+    """The advice reads the file again its own way; when that read refuses, the check still ends with its
+    verdict (the last line) and its own status."""
+    from build123d import export_step
+
+    import spiral_cad.cad.readers as readers
+    from spiral_cad.app.cli import main
+
+    path = tmp_path / "rounded.step"
+    export_step(fillet(Rectangle(10, 6).vertices(), 1).faces()[0].outer_wire(), str(path))
+
+    def refuse(*args, **kwargs):
+        raise ValueError("the reader refuses it")
+
+    monkeypatch.setattr(readers, "read_shape", refuse)
+    assert main(["check", str(path), "--require", "G2"]) == 1
+    out = capsys.readouterr().out.splitlines()
+    assert "make_g2: no advice: the reader refuses it" in out and out[-1].startswith("FAIL: ")
