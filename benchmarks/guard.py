@@ -28,6 +28,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
+from bench_core import numpy_closed_form_line_to_circle as numpy_line_to_circle
 from timing import compare, machine, table
 
 #: Runs of each side per guard (the fastest counts).
@@ -91,23 +92,6 @@ def numpy_corners(p0: np.ndarray, corners: np.ndarray, p1: np.ndarray) -> np.nda
     d = np.minimum(lin, lout) * np.cos(half)
     legs = np.stack([corners - d[:, None] * tin, corners - 0.6 * d[:, None] * tin, corners, corners + 0.6 * d[:, None] * tout])
     return np.stack([legs, legs[::-1]], axis=1)
-
-
-def numpy_line_to_circle(p: np.ndarray, d: np.ndarray, centers: np.ndarray, r: np.ndarray) -> np.ndarray:
-    """Reference: MATH.md's closed form for line → circle in plain numpy (unverified)."""
-    t = d / np.linalg.norm(d, axis=1, keepdims=True)
-    v = centers - p
-    dist = t[:, 0] * v[:, 1] - t[:, 1] * v[:, 0]
-    rho = np.abs(dist) / r
-    cos_t = 10.0 / (9.0 * rho + np.sqrt(81.0 * rho * rho - 80.0))
-    sin_t = np.sqrt(1.0 - cos_t * cos_t)
-    g = 25.0 * sin_t * r / (54.0 * cos_t**2)
-    h = 5.0 * sin_t * r / (9.0 * cos_t)
-    a = np.einsum("ij,ij->i", v, t) - r * sin_t * (25.0 - 12.0 * cos_t**2) / (27.0 * cos_t**2)
-    n = np.stack([-t[:, 1], t[:, 0]], 1) * np.sign(dist)[:, None]
-    b0 = p + a[:, None] * t
-    end_dir = cos_t[:, None] * t + sin_t[:, None] * n
-    return np.stack([b0, b0 + g[:, None] * t, b0 + 2 * g[:, None] * t, b0 + 2 * g[:, None] * t + h[:, None] * end_dir], 1)
 
 
 def transitions(scale: float = 1.0) -> Guard:
