@@ -31,15 +31,15 @@ _TAU = 2.0 * math.pi
 
 
 def _join(p: _Primitive, q: _Primitive, points: NDArray[np.float64], shape: str, tolerance: float,
-          p_from: NDArray[np.float64], q_to: NDArray[np.float64]) -> Transition | None:  # fmt: skip
+          p_from: NDArray[np.float64], q_to: NDArray[np.float64], kmax: float | None = None) -> Transition | None:  # fmt: skip
     """The exact transition from ``p`` to ``q`` (None where none exists). Between two lines the
-    pair's peak curvature is the one whose spirals hold ``points`` best; ``shape="auto"``: the shape
-    whose transition holds them best."""
+    pair's peak curvature is the one whose spirals hold ``points`` best, at most ``kmax``;
+    ``shape="auto"``: the shape whose transition holds them best."""
     if shape != _AUTO:
-        return _join_shaped(p, q, points, shape, p_from, q_to)
+        return _join_shaped(p, q, points, shape, p_from, q_to, kmax)
     best: tuple[float, Transition | None] = (math.inf, None)
     for each in _SHAPES:
-        t = _join_shaped(p, q, points, each, p_from, q_to)
+        t = _join_shaped(p, q, points, each, p_from, q_to, kmax)
         if t is not None:
             miss = _transition_miss(p, q, t, points)
             if miss < best[0] or best[1] is None:
@@ -60,11 +60,11 @@ def _transition_miss(p: _Primitive, q: _Primitive, transition: Transition, local
 
 
 def _join_shaped(p: _Primitive, q: _Primitive, points: NDArray[np.float64], shape: str, p_from: NDArray[np.float64],
-                 q_to: NDArray[np.float64]) -> Transition | None:  # fmt: skip
+                 q_to: NDArray[np.float64], kmax: float | None = None) -> Transition | None:  # fmt: skip
     """The exact transition from ``p`` to ``q`` in one spiral shape (None where none exists)."""
     try:
         if p.line and q.line:
-            return _corner(p, q, points, shape, p_from, q_to)
+            return _corner(p, q, points, shape, p_from, q_to, kmax)
         if p.line:
             return line_to_circle(tuple(p.point.tolist()), tuple(p.direction.tolist()), tuple(q.center.tolist()), abs(q.radius), shape)
         if q.line:
@@ -79,9 +79,9 @@ def _join_shaped(p: _Primitive, q: _Primitive, points: NDArray[np.float64], shap
 
 
 def _corner(p: _Primitive, q: _Primitive, points: NDArray[np.float64], shape: str, p_from: NDArray[np.float64],
-            q_to: NDArray[np.float64]) -> Transition | None:  # fmt: skip
+            q_to: NDArray[np.float64], kmax: float | None = None) -> Transition | None:  # fmt: skip
     """line_to_line between two fitted lines, its curvature chosen (from the largest pair the runs
-    allow up to 1000× its curvature) to hold ``points`` best."""
+    allow up to 1000× its curvature, and up to ``kmax``) to hold ``points`` best."""
     cross = p.direction[0] * q.direction[1] - p.direction[1] * q.direction[0]
     if abs(cross) < 1e-12:
         return None
@@ -95,6 +95,11 @@ def _corner(p: _Primitive, q: _Primitive, points: NDArray[np.float64], shape: st
     except ValueError:
         return None
     lowest = abs(widest.spirals[0].end_curvature)
+    top = math.log(1000.0)
+    if kmax is not None:
+        if lowest > kmax * (1.0 + 1e-9):
+            return None  # even the widest pair the runs allow is too tight
+        top = min(top, math.log(max(kmax / lowest, 1.0)))
 
     def attempt(log_factor: float) -> tuple[float, Transition | None]:
         try:
@@ -104,11 +109,13 @@ def _corner(p: _Primitive, q: _Primitive, points: NDArray[np.float64], shape: st
         return _miss(trial.spirals, points), trial
 
     # The pair scales as 1/κ about the corner: the κ whose apex lies as near the corner as the
-    # nearest point does, then golden-section search on log κ around it.
+    # nearest point does is the first guess. Sparse points may sit well away from the apex, so the
+    # window around it walks downhill (doubling its step) until the least miss lies inside, then a
+    # golden-section search on log κ narrows it.
     apex = math.hypot(*(np.asarray(widest.joint) - corner))
     nearest = float(np.hypot(*(points - corner).T).min())
-    guess = math.log(max(apex / max(nearest, 1e-300), 1.0))
-    lo, hi = max(0.0, guess - 0.3), min(math.log(1000.0), guess + 0.3)
+    guess = min(math.log(max(apex / max(nearest, 1e-300), 1.0)), top)
+    lo, hi = _bracket(lambda x: attempt(x)[0], guess, 0.3, 0.0, top)
     ratio = (math.sqrt(5.0) - 1.0) / 2.0
     x1, x2 = hi - ratio * (hi - lo), lo + ratio * (hi - lo)
     f1, f2 = attempt(x1)[0], attempt(x2)[0]
@@ -123,6 +130,25 @@ def _corner(p: _Primitive, q: _Primitive, points: NDArray[np.float64], shape: st
             f2 = attempt(x2)[0]
     candidates = [(attempt(guess)[0], guess), (attempt(0.0)[0], 0.0), (f1, x1), (f2, x2)]
     return attempt(min(candidates)[1])[1]
+
+
+def _bracket(cost: Callable[[float], float], middle: float, step: float, low: float, high: float) -> tuple[float, float]:
+    """An interval of [low, high] around ``middle`` whose inner point costs no more than its ends:
+    the window moves towards the cheaper end, its step doubling, until it holds the least cost."""
+    fm = cost(middle)
+    left, right = max(low, middle - step), min(high, middle + step)
+    fl, fr = cost(left), cost(right)
+    while (fl < fm and left > low) or (fr < fm and right < high):
+        step *= 2.0
+        if fl < fr:
+            right, middle, fm = middle, left, fl
+            left = max(low, middle - step)
+            fl = cost(left)
+        else:
+            left, middle, fm = middle, right, fr
+            right = min(high, middle + step)
+            fr = cost(right)
+    return left, right
 
 
 def _miss(spirals: list[BezierSpiral], points: NDArray[np.float64]) -> float:
@@ -162,10 +188,10 @@ _REACH = 64
 
 
 def _assemble(prims: list[_Primitive], pts: NDArray[np.float64], tol: float, shape: str, units: str, closed: bool,
-              slack: float = 1.0) -> Chain:  # fmt: skip
+              slack: float = 1.0, kmax: float | None = None) -> Chain:  # fmt: skip
     """Choose the runs to keep, fewest pieces first (dynamic programming over the runs in order,
-    each join reaching up to ``_REACH`` runs ahead, its points within ``slack`` tolerances), and build
-    the chain."""
+    each join reaching up to ``_REACH`` runs ahead, its points within ``slack`` tolerances, no
+    corner's peak curvature over ``kmax``), and build the chain."""
     if not prims:
         raise _Unfit
     if len(prims) == 1:
@@ -180,7 +206,7 @@ def _assemble(prims: list[_Primitive], pts: NDArray[np.float64], tol: float, sha
 
     def gap(i: int, j: int) -> _Gap:
         if (i, j) not in gaps:
-            gaps[(i, j)] = _evaluate(order[i], order[j], pts, shape, tol)
+            gaps[(i, j)] = _evaluate(order[i], order[j], pts, shape, tol, kmax)
         return gaps[(i, j)]
 
     def usable(i: int, j: int) -> Transition | None:
@@ -205,7 +231,7 @@ def _assemble(prims: list[_Primitive], pts: NDArray[np.float64], tol: float, sha
     # Each join keeps the shape the runs were chosen with ("auto" decided it there): a shape that
     # switched between the refinement's steps would make its least squares jump.
     shapes = [t.spirals[0].shape or shape for t in joins]
-    refined = _refine(kept, pts, shapes, tol, closed)
+    refined = _refine(kept, pts, shapes, tol, closed, kmax)
     if refined is not None:
         try:
             better = _build(*refined, pts, units, closed)
@@ -217,7 +243,7 @@ def _assemble(prims: list[_Primitive], pts: NDArray[np.float64], tol: float, sha
             and float(chain_distances(better, pts)[0].max()) <= float(chain_distances(chain, pts)[0].max())
         ):
             chain, kept = better, refined[0]
-    return _settled(chain, kept, pts, shapes, tol, units, closed)
+    return _settled(chain, kept, pts, shapes, tol, units, closed, kmax)
 
 
 #: Passes of refitting each kept line or circle to the points its own piece holds.
@@ -225,7 +251,7 @@ _SETTLE_PASSES = 8
 
 
 def _settled(chain: Chain, kept: list[_Primitive], pts: NDArray[np.float64], shapes: list[str], tol: float, units: str,
-             closed: bool) -> Chain:  # fmt: skip
+             closed: bool, kmax: float | None = None) -> Chain:  # fmt: skip
     """The chain with every kept line and circle refitted to the points its own piece of the chain
     holds (the ends' tenth left out), the transitions solved again, while the largest miss drops.
 
@@ -247,7 +273,7 @@ def _settled(chain: Chain, kept: list[_Primitive], pts: NDArray[np.float64], sha
                 p, q = moved[k], moved[(k + 1) % len(moved)]
                 lo, hi = (p.a + p.b) // 2, (q.a + q.b) // 2 + 1
                 between = pts[lo:hi] if hi > lo else np.vstack([pts[lo:], pts[:hi]])
-                t = _join(p, q, between[:: max(1, len(between) // 4000)], shapes[k], tol, p.split_point(pts), q.split_point(pts))
+                t = _join(p, q, between[:: max(1, len(between) // 4000)], shapes[k], tol, p.split_point(pts), q.split_point(pts), kmax)
                 if t is None:
                     return best
                 joins.append(t)
@@ -314,8 +340,8 @@ def _refitted(prim: _Primitive, chain: Chain, owner: NDArray[np.int64], pts: NDA
 _REFINE_EVALUATIONS, _REFINE_SWEEPS = 20, 3
 
 
-def _refine(prims: list[_Primitive], pts: NDArray[np.float64], shapes: list[str], tol: float, closed: bool
-            ) -> tuple[list[_Primitive], list[Transition]] | None:  # fmt: skip
+def _refine(prims: list[_Primitive], pts: NDArray[np.float64], shapes: list[str], tol: float, closed: bool,
+            kmax: float | None = None) -> tuple[list[_Primitive], list[Transition]] | None:  # fmt: skip
     """The kept lines and circles adjusted, one at a time, to the least squares of every point of
     their run and of the spirals on either side (the spirals solved again at each step): a line or
     circle fitted to its run alone is pulled by the spiral points the run took in, and the spirals it
@@ -356,12 +382,12 @@ def _refine(prims: list[_Primitive], pts: NDArray[np.float64], shapes: list[str]
         pieces: list[Segment] = []
         try:
             if before is not None:
-                t = _join(before, prim, local, shapes[(k - 1) % count], tol, before.split_point(pts), prim.split_point(pts))
+                t = _join(before, prim, local, shapes[(k - 1) % count], tol, before.split_point(pts), prim.split_point(pts), kmax)
                 if t is None:
                     raise ValueError
                 pieces += [_clipped(before, t.start, True, far), *t.spirals, _clipped(prim, t.end, False, far)]
             if after is not None:
-                t = _join(prim, after, local, shapes[k], tol, prim.split_point(pts), after.split_point(pts))
+                t = _join(prim, after, local, shapes[k], tol, prim.split_point(pts), after.split_point(pts), kmax)
                 if t is None:
                     raise ValueError
                 pieces += [_clipped(prim, t.start, True, far), *t.spirals, _clipped(after, t.end, False, far)]
@@ -393,7 +419,7 @@ def _refine(prims: list[_Primitive], pts: NDArray[np.float64], shapes: list[str]
         # The points between the two runs' middles, as _evaluate gives them (round the ring's end too).
         lo, hi = (p.a + p.b) // 2, (q.a + q.b) // 2 + 1
         between = pts[lo:hi] if hi > lo else np.vstack([pts[lo:], pts[:hi]])
-        t = _join(p, q, between[:: max(1, len(between) // 4000)], shapes[k], tol, p.split_point(pts), q.split_point(pts))
+        t = _join(p, q, between[:: max(1, len(between) // 4000)], shapes[k], tol, p.split_point(pts), q.split_point(pts), kmax)
         if t is None:
             return None
         joins.append(t)
@@ -454,7 +480,7 @@ def _cheapest(order: list[_Primitive], pts: NDArray[np.float64], usable: Callabl
     return best, path[::-1]
 
 
-def _evaluate(p: _Primitive, q: _Primitive, pts: NDArray[np.float64], shape: str, tol: float) -> _Gap:
+def _evaluate(p: _Primitive, q: _Primitive, pts: NDArray[np.float64], shape: str, tol: float, kmax: float | None = None) -> _Gap:
     """The transition from run p to run q and the largest distance of the points between their
     middles to it, the runs' lines and circles clipped at its ends."""
     start, stop = (p.a + p.b) // 2, (q.a + q.b) // 2 + 1
@@ -462,7 +488,7 @@ def _evaluate(p: _Primitive, q: _Primitive, pts: NDArray[np.float64], shape: str
     # Choosing runs needs a gap's shape, not every point (the chain is measured at every point after).
     local = local[:: max(1, len(local) // 4000)]
     # A corner's spirals may reach the split point of either run, no further (the next corner owns the rest).
-    transition = _join(p, q, local, shape, tol, p.split_point(pts), q.split_point(pts))
+    transition = _join(p, q, local, shape, tol, p.split_point(pts), q.split_point(pts), kmax)
     if transition is None:
         return _Gap(None, math.inf)
     miss = _transition_miss(p, q, transition, local)

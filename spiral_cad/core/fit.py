@@ -380,7 +380,7 @@ def _fit_chain(pts: NDArray[np.float64], tol: float, shape: str, units: str, clo
                 if prims is None:
                     prims = _segment(work, work_s, work_kappa, h, tau, kmax, closed)
                     report(3, _STEPS)
-                chain = _assemble(prims, work, tol, shape, units, closed, slack)
+                chain = _assemble(prims, work, tol, shape, units, closed, slack, kmax)
             except (ValueError, _Unfit):
                 chain = None
                 continue
