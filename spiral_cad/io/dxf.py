@@ -44,8 +44,9 @@ def _xyz(point) -> tuple[float, float, float]:
     return x, y, (z[0] if z else 0.0)
 
 
-def _add(msp, seg: Segment, layer: str) -> None:
-    attribs = {"layer": layer}
+def _add(msp, seg: Segment, layer: str, attribs: dict | None = None) -> None:
+    """Add one segment to ``msp`` on ``layer``, with the other graphic attributes ``attribs`` (colour, linetype …)."""
+    attribs = {**(attribs or {}), "layer": layer}
     if isinstance(seg, Line):
         msp.add_line(_xyz(seg.start), _xyz(seg.end), dxfattribs=attribs)
     elif isinstance(seg, Arc) and seg.dim == 2:
