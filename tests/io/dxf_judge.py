@@ -14,7 +14,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-#: The G2 criteria of issue 40.
+#: The G2 criteria of issue 40: tangent angle, and curvature jump relative to the largest end curvature of the two pieces.
 ANGLE = 1e-6
 JUMP = 1e-5
 PATHS = ("LINE", "ARC", "CIRCLE", "SPLINE", "LWPOLYLINE", "POLYLINE", "ELLIPSE")
@@ -121,7 +121,8 @@ def judge(msp) -> Verdict:
         ta, ka = (ta, ka) if sa == 1 else (-ta, -ka)
         tb, kb = (tb, kb) if sb == 0 else (-tb, -kb)
         angle = abs(math.atan2(ta[0] * tb[1] - ta[1] * tb[0], float(ta @ tb)))
-        jump = abs(ka - kb) <= JUMP * max(abs(ka), abs(kb)) + 1e-12 / (size or 1.0)
+        scale = max(abs(k) for _, k in (*found[a].frames, *found[b].frames))  # the two pieces' curvature
+        jump = abs(ka - kb) <= JUMP * scale
         joint_of.append((a, angle <= ANGLE and jump))
     groups: dict[int, list[bool]] = {}
     for k in range(len(found)):
