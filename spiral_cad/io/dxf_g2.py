@@ -13,8 +13,9 @@ Every other entity is kept untouched: text, dimensions, hatches, points, ``SPLIN
 (counted in the notes: not made G2 here), and block references. A block reference (``INSERT``) whose
 block holds lines or arcs is exploded first (ezdxf's ``explode``, through its virtual entities), so its
 paths are made G2 too; the report names the blocks. The header (``$INSUNITS`` and the rest), the
-layers, linetypes, styles and blocks stay as they were. ezdxf's ``audit`` runs on the result before it
-is written; its errors refuse the write.
+layers, linetypes, styles and blocks stay as they were (ezdxf's ``audit`` is not run on them: an input's
+faults are kept, and named in the report). The result is written beside the target, read back by ezdxf
+without recover mode and audited; an issue the input did not have refuses the write.
 
 The bound is in the drawing's unit (``$INSUNITS``); ``units=`` states it in another unit. A unitless
 drawing takes the bound in drawing units (``units=`` then names them), and the report says so.
@@ -24,11 +25,13 @@ from __future__ import annotations
 
 import math
 import os
+import tempfile
 from collections import Counter
 from pathlib import Path
 
 import numpy as np
 
+from ..core.spiral import BezierSpiral
 from ..core.units import MM_PER_UNIT, length_unit
 from ..design import make_g2
 from .document_report import DocumentReport, PathReport
@@ -39,6 +42,8 @@ __all__ = ["ATTRIBUTES", "rewrite_dxf_g2"]
 
 #: The graphic attributes a G2 path takes from its path's first entity (besides the layer).
 ATTRIBUTES = ("color", "true_color", "linetype", "lineweight", "ltscale", "transparency", "invisible")
+#: The parts of a split path must meet within this share of the bound (else the path is kept whole).
+MEET = 1e-6
 #: Rounds of exploding block references that hold paths (blocks inside blocks).
 EXPLODE_DEPTH = 8
 
@@ -114,6 +119,44 @@ def _bound(doc, max_deviation: float, units: str | None, label: str) -> tuple[fl
     return bound, drawing, drawing, [f"max_deviation {max_deviation:g} {stated} is {bound:.6g} {drawing}, the drawing's unit"]
 
 
+def _audit(path: Path, recovered: bool):
+    """ezdxf's auditor of a freshly read file (the file itself is not changed)."""
+    import ezdxf
+    from ezdxf import recover
+
+    if recovered:
+        return recover.readfile(path)[1]
+    return ezdxf.readfile(path).audit()
+
+
+def _issues(path: Path, recovered: bool) -> tuple[Counter[int], str]:
+    """What ezdxf's audit fixes or finds in a file, counted by kind, and the first one's message."""
+    auditor = _audit(path, recovered)
+    items = (*auditor.errors, *auditor.fixes)
+    return Counter(int(item.code) for item in items), next((item.message for item in items), "")
+
+
+def _save(doc, target: Path, issues: Counter[int], label: str) -> None:
+    """Write the drawing beside ``target``, check that ezdxf reads it without recover mode and that its audit
+    finds nothing the input did not have, then move it onto ``target`` (else nothing is written)."""
+    import ezdxf
+
+    handle, temporary = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".dxf", dir=target.parent)
+    os.close(handle)
+    try:
+        doc.saveas(temporary)
+        auditor = ezdxf.readfile(temporary).audit()
+        found = Counter(int(item.code) for item in (*auditor.fixes, *auditor.errors))
+        new = found - issues
+        if new:
+            first = next(item.message for item in (*auditor.errors, *auditor.fixes) if int(item.code) in new)
+            raise ValueError(f"{label}: ezdxf's audit finds {sum(new.values())} new issue(s) in the result ({first}); nothing written")
+        os.replace(temporary, target)
+    finally:
+        if os.path.exists(temporary):
+            os.unlink(temporary)
+
+
 def _attributes(entity) -> dict:
     return {name: entity.dxf.get(name) for name in ATTRIBUTES if entity.dxf.hasattr(name)}
 
@@ -172,11 +215,10 @@ def rewrite_dxf_g2(source: Path, target: Path, max_deviation: float, *, units: s
     for kind in ("SPLINE", "ELLIPSE", "HELIX"):
         if kept[kind]:
             notes.append(f"{kept[kind]} {kind} entit{'y' if kept[kind] == 1 else 'ies'} not made G2 (only lines and arcs are)")
-    auditor = doc.audit()
-    if auditor.has_errors:
-        first = auditor.errors[0].message if auditor.errors else ""
-        raise ValueError(f"{label}: ezdxf's audit finds {len(auditor.errors)} error(s) in the result ({first}); nothing written")
-    doc.saveas(os.fspath(target))
+    issues, first = _issues(source, bool(recovered))
+    if issues:
+        notes.append(f"ezdxf's audit finds {sum(issues.values())} issue(s) in the input ({first}); kept as they were")
+    _save(doc, target, issues, label)
     return DocumentReport(label, target.name, "DXF drawing", unit_name, float(max_deviation) if units is None else bound,
                           tuple(reports), tuple(notes))  # fmt: skip
 
@@ -184,6 +226,8 @@ def rewrite_dxf_g2(source: Path, target: Path, max_deviation: float, *, units: s
 def _path(msp, pieces: list, owners: list, order: list[tuple[int, bool]], closed: bool, number: int, bound: float, units: str,
           shape: str, notes: list[str]) -> PathReport:  # fmt: skip
     """Make one chained path G2 and write it in place of its entities; its report."""
+    import ezdxf
+
     entities = [owners[index] for index, _ in order]
     first = entities[0]
     name = f"path {number} ({first.dxftype()} {first.dxf.handle}, layer {first.dxf.layer})"
@@ -194,22 +238,41 @@ def _path(msp, pieces: list, owners: list, order: list[tuple[int, bool]], closed
         segment = _segment(part, 1.0, 2 if flat else 3)
         segments.append(segment.reversed() if reverse else segment)
     joints = len(segments) - (0 if closed else 1)
+    if not joints:
+        return PathReport(name, joints, kept="one entity, no joint")
     try:
         result = make_g2(segments, bound, closed=closed, shape=shape, units=units)
     except ValueError as error:
         return PathReport(name, joints, kept=f"make_g2 refuses it: {error}")
     changed = sum(j.kind not in ("g2", "split") for j in result.joints)
-    if not changed and not result.splits:
-        return PathReport(name, joints, kept="G2 already")
+    splits = len(result.splits)
+    if not changed:
+        why = f"split at every joint ({splits}): corners too sharp for a spiral pair within the bound" if splits else "G2 already"
+        return PathReport(name, joints, splits=splits, kept=why)
+    gap = _split_gap(result.chains, closed)
+    if gap > MEET * bound:
+        return PathReport(name, joints, splits=splits, kept=f"make_g2 splits it at {splits} joint(s) and its parts no longer meet "
+                          f"there (a gap of {gap:.3g}): kept whole rather than opened")  # fmt: skip
+    if any(isinstance(s, BezierSpiral) for c in result.chains for s in c) and msp.doc.dxfversion < "AC1015":
+        return PathReport(name, joints, splits=splits, kept="an R12 drawing holds no SPLINE for its spirals (save it as R2000 or later)")
     attributes = _attributes(first)
     layers = {e.dxf.layer for e in entities}
     if len(layers) > 1 or any(_attributes(e) != attributes for e in entities):
         notes.append(f"{name}: its entities differ in layer, colour or linetype; its G2 path takes the first's")
-    count = 0
-    for chain in result.chains:
-        for segment in chain:
-            _add(msp, segment, first.dxf.layer, attributes)
-            count += 1
+    added = []
+    try:
+        for segment in (s for chain in result.chains for s in chain):
+            added.append(_add(msp, segment, first.dxf.layer, attributes))
+    except ezdxf.DXFError as error:  # e.g. a layer name ezdxf reads but will not give a new entity
+        for entity in added:
+            msp.delete_entity(entity)
+        return PathReport(name, joints, splits=splits, kept=f"ezdxf cannot write its G2 path ({error})")
     for entity in entities:
         msp.delete_entity(entity)
-    return PathReport(name, joints, changed, float(result.deviation), len(result.splits), pieces=count)
+    return PathReport(name, joints, changed, float(result.deviation), splits, pieces=len(added))
+
+
+def _split_gap(chains: list, closed: bool) -> float:
+    """The largest distance between the end of one part of a split path and the start of the next."""
+    pairs = list(zip(chains[:-1], chains[1:])) + ([(chains[-1], chains[0])] if closed and len(chains) > 1 else [])
+    return max((float(np.linalg.norm(a.end - b.start)) for a, b in pairs), default=0.0)

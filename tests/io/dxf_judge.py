@@ -38,11 +38,15 @@ def _curve(entity) -> _Curve | None:
     kind = entity.dxftype()
     if kind == "LINE":
         a, b = np.array(entity.dxf.start, dtype=float)[:2], np.array(entity.dxf.end, dtype=float)[:2]
+        if not np.hypot(*(b - a)) > 0.0:
+            return None  # a point drawn as a line: no curve
         t = (b - a) / np.hypot(*(b - a))
         return _Curve(a, b, ((t, 0.0), (t, 0.0)))
     if kind in ("ARC", "CIRCLE"):
         assert tuple(entity.dxf.extrusion) == (0.0, 0.0, 1.0), "the judge reads plane drawings"
         c, r = np.array(entity.dxf.center, dtype=float)[:2], float(entity.dxf.radius)
+        if not r > 0.0:
+            return None  # a point drawn as a circle: no curve
         a0 = math.radians(entity.dxf.start_angle) if kind == "ARC" else 0.0
         a1 = math.radians(entity.dxf.end_angle) if kind == "ARC" else 2 * math.pi
         ends = [c + r * np.array([math.cos(a), math.sin(a)]) for a in (a0, a1)]
