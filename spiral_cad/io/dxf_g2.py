@@ -28,6 +28,7 @@ import os
 import tempfile
 from collections import Counter
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -48,7 +49,7 @@ MEET = 1e-6
 EXPLODE_DEPTH = 8
 
 
-def _open(source: Path) -> tuple[object, str]:
+def _open(source: Path) -> tuple[Any, str]:
     """The drawing, and a note when only ezdxf's recover mode reads it."""
     import ezdxf
     from ezdxf import recover
@@ -95,7 +96,9 @@ def _explode(doc, msp) -> list[str]:
                 exploded[name] += 1
             except Exception as error:  # noqa: BLE001 - ezdxf raises several kinds; the reference is then kept
                 failed.append(f"INSERT {insert.dxf.handle} of block {name!r} kept: ezdxf cannot explode it ({error})")
-    notes = [f"exploded {n} INSERT(s) of block {name!r} (its lines and arcs made G2 in the model space)" for name, n in sorted(exploded.items())]
+    notes = [
+        f"exploded {n} INSERT(s) of block {name!r} (its lines and arcs made G2 in the model space)" for name, n in sorted(exploded.items())
+    ]
     return notes + failed
 
 
@@ -161,7 +164,9 @@ def _attributes(entity) -> dict:
     return {name: entity.dxf.get(name) for name in ATTRIBUTES if entity.dxf.hasattr(name)}
 
 
-def rewrite_dxf_g2(source: Path, target: Path, max_deviation: float, *, units: str | None = None, shape: str | None = None) -> DocumentReport:
+def rewrite_dxf_g2(
+    source: Path, target: Path, max_deviation: float, *, units: str | None = None, shape: str | None = None
+) -> DocumentReport:
     """Rewrite a DXF drawing with every path of lines and arcs made G2 within ``max_deviation`` (see the module docstring).
 
     Args:
@@ -208,8 +213,21 @@ def rewrite_dxf_g2(source: Path, target: Path, max_deviation: float, *, units: s
     if pieces:
         ends = np.array([p for parts, _ in pieces for part in (parts[0], parts[-1]) for p in (part[1], part[2])])
         size = float(np.linalg.norm(ends.max(axis=0) - ends.min(axis=0))) or 1.0
-        for number, (order, closed) in enumerate(_chains(pieces, JOIN_TOLERANCE * size), 1):
-            reports.append(_path(msp, pieces, owners, order, closed, number, bound, g2_units, shape or "near-linear", notes))
+        from scipy.spatial import cKDTree
+
+        tolerance = JOIN_TOLERANCE * size
+        tree = cKDTree(np.array([point for parts, _ in pieces for point in (parts[0][1], parts[-1][2])]))  # 2k, 2k + 1: piece k
+        for number, (order, closed) in enumerate(_chains(pieces, tolerance), 1):
+            touched = _touched(pieces, order, tree, tolerance)
+            if touched is not None:
+                first = owners[order[0][0]]
+                name = f"path {number} ({first.dxftype()} {first.dxf.handle}, layer {first.dxf.layer})"
+                where = ", ".join(f"{v:.6g}" for v in touched[:2])
+                reports.append(PathReport(name, sum(len(pieces[i][0]) for i, _ in order) - (0 if closed else 1),
+                                          kept=f"another entity ends at its vertex ({where}): rounding it would detach that entity"))  # fmt: skip
+                continue
+            branches = _branch_ends(pieces, order, tree, tolerance) if not closed else []
+            reports.append(_path(msp, pieces, owners, order, closed, number, bound, g2_units, shape or "near-linear", notes, branches))
     if kept:
         notes.append("kept as is: " + ", ".join(f"{n} {kind}" for kind, n in sorted(kept.items())))
     for kind in ("SPLINE", "ELLIPSE", "HELIX"):
@@ -224,7 +242,7 @@ def rewrite_dxf_g2(source: Path, target: Path, max_deviation: float, *, units: s
 
 
 def _path(msp, pieces: list, owners: list, order: list[tuple[int, bool]], closed: bool, number: int, bound: float, units: str,
-          shape: str, notes: list[str]) -> PathReport:  # fmt: skip
+          shape: str, notes: list[str], branches: list[np.ndarray]) -> PathReport:  # fmt: skip
     """Make one chained path G2 and write it in place of its entities; its report."""
     import ezdxf
 
@@ -253,6 +271,12 @@ def _path(msp, pieces: list, owners: list, order: list[tuple[int, bool]], closed
     if gap > MEET * bound:
         return PathReport(name, joints, splits=splits, kept=f"make_g2 splits it at {splits} joint(s) and its parts no longer meet "
                           f"there (a gap of {gap:.3g}): kept whole rather than opened")  # fmt: skip
+    for point in branches:  # an end where other entities meet stays where it was
+        moved = min(float(np.linalg.norm(np.asarray(end)[:2] - point[:2])) for end in (result.chains[0].start, result.chains[-1].end))
+        if moved > MEET * bound:
+            where = ", ".join(f"{v:.6g}" for v in point[:2])
+            return PathReport(name, joints, splits=splits, kept=f"its end at ({where}), where other entities meet it, would move by "
+                              f"{moved:.3g}: kept rather than detached")  # fmt: skip
     if any(isinstance(s, BezierSpiral) for c in result.chains for s in c) and msp.doc.dxfversion < "AC1015":
         return PathReport(name, joints, splits=splits, kept="an R12 drawing holds no SPLINE for its spirals (save it as R2000 or later)")
     attributes = _attributes(first)
@@ -261,8 +285,8 @@ def _path(msp, pieces: list, owners: list, order: list[tuple[int, bool]], closed
         notes.append(f"{name}: its entities differ in layer, colour or linetype; its G2 path takes the first's")
     added = []
     try:
-        for segment in (s for chain in result.chains for s in chain):
-            added.append(_add(msp, segment, first.dxf.layer, attributes))
+        for piece in (s for chain in result.chains for s in chain):
+            added.append(_add(msp, piece, first.dxf.layer, attributes))
     except ezdxf.DXFError as error:  # e.g. a layer name ezdxf reads but will not give a new entity
         for entity in added:
             msp.delete_entity(entity)
@@ -270,6 +294,27 @@ def _path(msp, pieces: list, owners: list, order: list[tuple[int, bool]], closed
     for entity in entities:
         msp.delete_entity(entity)
     return PathReport(name, joints, changed, float(result.deviation), splits, pieces=len(added))
+
+
+def _touched(pieces: list, order: list[tuple[int, bool]], tree: Any, tolerance: float) -> np.ndarray | None:
+    """A vertex inside one of the path's polylines where an end of another entity lies (None when there is none):
+    the drawing branches there, which the chaining (by entity ends) does not see."""
+    mine = {index for index, _ in order}
+    for index, _ in order:
+        parts = pieces[index][0]
+        for part in parts[:-1]:  # each inner vertex: a part's end that is not the entity's end
+            for j in tree.query_ball_point(part[2], tolerance):
+                if j // 2 not in mine:
+                    return np.asarray(part[2])
+    return None
+
+
+def _branch_ends(pieces: list, order: list[tuple[int, bool]], tree: Any, tolerance: float) -> list[np.ndarray]:
+    """The ends of an open path where other entities end too (a branch point: the chaining stopped there)."""
+    (head, head_reversed), (tail, tail_reversed) = order[0], order[-1]
+    start = pieces[head][0][-1][2] if head_reversed else pieces[head][0][0][1]
+    end = pieces[tail][0][0][1] if tail_reversed else pieces[tail][0][-1][2]
+    return [np.asarray(point) for point in (start, end) if len(tree.query_ball_point(point, tolerance)) > 1]
 
 
 def _split_gap(chains: list, closed: bool) -> float:

@@ -49,7 +49,7 @@ def _namespaces(source: Path) -> list[tuple[str, str]]:
     return found
 
 
-def _parse(source: Path) -> ET.ElementTree:
+def _parse(source: Path) -> ET.ElementTree[ET.Element]:
     for prefix, uri in _namespaces(source):
         try:
             ET.register_namespace(prefix, uri)
@@ -116,6 +116,8 @@ def rewrite_landxml_g2(source: Path, target: Path, max_deviation: float, *, shap
     except ET.ParseError as error:
         raise ValueError(f"{source.name}: not an XML document: {error}") from None
     root = tree.getroot()
+    if root is None:
+        raise ValueError(f"{source.name}: an empty XML document")
     try:
         read = read_landxml(source, shape=shape)
         reader = _Reader(root, shape)
