@@ -110,8 +110,10 @@ def judge(msp) -> Verdict:
 
     verdict = Verdict(others=others)
     joint_of: list[tuple[int, bool]] = []  # (curve, G2) per joint
+    close = np.hypot(*(points[:, None, :] - points[None, :, :]).transpose(2, 0, 1)) <= tol
+    np.fill_diagonal(close, False)
     for i in range(len(ends)):
-        near = [j for j in range(len(ends)) if j != i and np.hypot(*(points[j] - points[i])) <= tol]
+        near = np.flatnonzero(close[i]).tolist()
         if not near:
             verdict.open_ends += 1
             continue

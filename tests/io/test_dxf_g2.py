@@ -3,6 +3,7 @@
 
 import math
 from collections import Counter
+from pathlib import Path
 
 import ezdxf
 import pytest
@@ -119,3 +120,29 @@ def test_not_a_dxf_file_is_refused_by_name(tmp_path):
     with pytest.raises(ValueError, match="max_deviation"):
         plate(tmp_path / "p.dxf")
         rewrite_dxf_g2(tmp_path / "p.dxf", tmp_path / "y.dxf", -1.0)
+
+
+DATA = Path(__file__).resolve().parents[1] / "data" / "dxf"
+
+
+def test_a_public_drawing_of_rounded_polylines_comes_back_all_g2(tmp_path):
+    """ezdxf's own example drawing (tests/data/dxf/README.md): every joint G2 by ezdxf's reading, nothing lost."""
+    source = DATA / "ezdxf_forms.dxf"
+    report = rewrite_dxf_g2(source, tmp_path / "out.dxf", 0.01)
+    old, new = judge(ezdxf.readfile(source).modelspace()), judge(ezdxf.readfile(tmp_path / "out.dxf").modelspace())
+    assert old.g2 == 0 < old.joints and new.joints == 3 * old.joints and new.share == 1.0
+    assert new.open_ends == old.open_ends and new.others == old.others and new.paths == old.paths
+    assert 0.0 < report.worst <= 0.01 * (1 + 1e-9)
+    assert any("2 ELLIPSE entities not made G2" in n for n in report.notes)
+
+
+def test_a_drawing_only_recover_mode_reads_comes_back_plain(tmp_path):
+    source = DATA / "ezdxf_ac1003_line_example.dxf"
+    with pytest.raises(ezdxf.DXFError):
+        ezdxf.readfile(source)
+    report = rewrite_dxf_g2(source, tmp_path / "out.dxf", 0.01)
+    assert "recover mode" in report.notes[0]
+    after = ezdxf.readfile(tmp_path / "out.dxf")  # plain reader
+    assert not after.audit().has_errors
+    # an R12 drawing holds no SPLINE: a path that needs spirals is kept, and says why
+    assert any("R12" in p.kept for p in report.paths)
