@@ -24,6 +24,8 @@ class PathReport:
         splits: where the path was split (a reversal, a corner too sharp for the bound).
         kept: why the path was kept as it is ("" when it was made G2).
         pieces: how many pieces were written for it (lines, arcs, spirals).
+        g2: whether the path as written is G2 at every joint (made so, or G2 already: a circle, a lone entity,
+            clothoids between lines and arcs).
     """
 
     name: str
@@ -33,6 +35,7 @@ class PathReport:
     splits: int = 0
     kept: str = ""
     pieces: int = 0
+    g2: bool = False
 
     @property
     def made(self) -> bool:
@@ -82,6 +85,11 @@ class DocumentReport:
         return tuple(p for p in self.paths if not p.made)
 
     @property
+    def below_g2(self) -> tuple[PathReport, ...]:
+        """The paths left below G2 somewhere: kept as they were although not G2, or split (a command exits non-zero on them)."""
+        return tuple(p for p in self.paths if not p.g2 or p.splits)
+
+    @property
     def splits(self) -> int:
         """How many joints split a path, over the document."""
         return sum(p.splits for p in self.paths)
@@ -89,11 +97,12 @@ class DocumentReport:
     def lines(self) -> list[str]:
         """The short human report: a header, one line per path, the notes, and the verdict last."""
         made = len(self.paths) - len(self.kept)
+        already = sum(p.g2 and not p.made for p in self.paths)
         out = [f"{self.source} → {self.target} ({self.kind}), max deviation {self.max_deviation:g} {self.units}:"]
         out += [p.line(self.units) for p in self.paths]
         out += [f"  note: {n}" for n in self.notes]
         changed = sum(p.changed for p in self.paths)
         splits = f", {self.splits} split(s)" if self.splits else ""
         out.append(f"{made} of {len(self.paths)} path(s) made G2 (worst {self.worst:.3g} {self.units}, {changed} joint(s) changed"
-                   f"{splits}), {len(self.kept)} kept as is")  # fmt: skip
+                   f"{splits}), {already} G2 already, {len(self.below_g2)} left below G2")  # fmt: skip
         return out

@@ -257,7 +257,7 @@ def _path(msp, pieces: list, owners: list, order: list[tuple[int, bool]], closed
         segments.append(segment.reversed() if reverse else segment)
     joints = len(segments) - (0 if closed else 1)
     if not joints:
-        return PathReport(name, joints, kept="one entity, no joint")
+        return PathReport(name, joints, kept="one entity, no joint", g2=True)
     try:
         result = make_g2(segments, bound, closed=closed, shape=shape, units=units)
     except ValueError as error:
@@ -266,7 +266,7 @@ def _path(msp, pieces: list, owners: list, order: list[tuple[int, bool]], closed
     splits = len(result.splits)
     if not changed:
         why = f"split at every joint ({splits}): corners too sharp for a spiral pair within the bound" if splits else "G2 already"
-        return PathReport(name, joints, splits=splits, kept=why)
+        return PathReport(name, joints, splits=splits, kept=why, g2=not splits)
     gap = _split_gap(result.chains, closed)
     if gap > MEET * bound:
         return PathReport(name, joints, splits=splits, kept=f"make_g2 splits it at {splits} joint(s) and its parts no longer meet "
@@ -293,7 +293,7 @@ def _path(msp, pieces: list, owners: list, order: list[tuple[int, bool]], closed
         return PathReport(name, joints, splits=splits, kept=f"ezdxf cannot write its G2 path ({error})")
     for entity in entities:
         msp.delete_entity(entity)
-    return PathReport(name, joints, changed, float(result.deviation), splits, pieces=len(added))
+    return PathReport(name, joints, changed, float(result.deviation), splits, pieces=len(added), g2=True)
 
 
 def _touched(pieces: list, order: list[tuple[int, bool]], tree: Any, tolerance: float) -> np.ndarray | None:

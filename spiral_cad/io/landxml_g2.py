@@ -21,6 +21,7 @@ from __future__ import annotations
 
 import math
 import os
+import tempfile
 import xml.etree.ElementTree as ET
 from pathlib import Path
 
@@ -134,7 +135,7 @@ def rewrite_landxml_g2(source: Path, target: Path, max_deviation: float, *, shap
         if not all(isinstance(s, (Line, Arc)) for s in segments):
             why = ("G2 already (its spirals between the lines and arcs)" if len(alignment.chains) == 1
                    else f"it has spirals and is not G2 at {len(alignment.chains) - 1} joint(s) ({alignment.breaks[0]}); make_g2 takes lines and arcs")  # fmt: skip
-            reports.append(PathReport(name, joints, kept=why))
+            reports.append(PathReport(name, joints, kept=why, g2=len(alignment.chains) == 1))
             continue
         try:
             result = make_g2(segments, max_deviation, closed=False, shape=shape, units=alignment.units)
@@ -143,7 +144,7 @@ def rewrite_landxml_g2(source: Path, target: Path, max_deviation: float, *, shap
             continue
         changed = sum(j.kind not in ("g2", "split") for j in result.joints)
         if not changed and not result.splits:
-            reports.append(PathReport(name, joints, kept="G2 already"))
+            reports.append(PathReport(name, joints, kept="G2 already", g2=True))
             continue
         pieces, _ = straight_ends([s for c in result.chains for s in c])
         chain = Chain(pieces, tolerance=1e-6, units=alignment.units)
@@ -165,6 +166,13 @@ def rewrite_landxml_g2(source: Path, target: Path, max_deviation: float, *, shap
         shift = chain.length - sum(float(c.length) for c in alignment.chains)
         if alignment.profile is not None or _child(element, "Profile") is not None:
             notes.append(f"{name}: profile kept as it was; the alignment's end station moved by {shift * scale:.3g} {unit}")
-        reports.append(PathReport(name, joints, changed, float(result.deviation), len(result.splits), pieces=len(chain)))
-    tree.write(os.fspath(target), encoding="utf-8", xml_declaration=True)
+        reports.append(PathReport(name, joints, changed, float(result.deviation), len(result.splits), pieces=len(chain), g2=True))
+    handle, temporary = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".xml", dir=target.parent)
+    os.close(handle)
+    try:  # the whole file or none: an existing target (the source itself, in place) is replaced only by a complete one
+        tree.write(temporary, encoding="utf-8", xml_declaration=True)
+        os.replace(temporary, target)
+    finally:
+        if os.path.exists(temporary):
+            os.unlink(temporary)
     return DocumentReport(source.name, target.name, "LandXML file", unit, float(max_deviation), tuple(reports), tuple(notes))

@@ -76,6 +76,7 @@ def test_a_plate_comes_back_one_drawing_g2_with_everything_else_kept(tmp_path):
     splines = [e for e in outline if e.dxftype() == "SPLINE"]
     assert len(splines) == 8 and {s.dxf.degree for s in splines} == {3}
     assert report.lines()[-1].startswith("4 of 8 path(s) made G2")
+    assert report.lines()[-1].endswith("4 G2 already, 0 left below G2") and not report.below_g2
 
 
 def test_the_bound_is_in_the_drawings_unit_or_stated(tmp_path):
@@ -105,6 +106,7 @@ def test_a_path_make_g2_refuses_is_kept_and_named(tmp_path):
     doc.saveas(tmp_path / "fold.dxf")
     report = rewrite_dxf_g2(tmp_path / "fold.dxf", tmp_path / "out.dxf", 0.01)
     after = ezdxf.readfile(tmp_path / "out.dxf")
+    assert report.below_g2  # kept as is or split: told, for a command to exit non-zero
     if report.kept:
         assert report.kept[0].kept and len(after.modelspace().query("LWPOLYLINE")) == 1
     else:  # made G2 with a split at the fold: the pieces still meet there

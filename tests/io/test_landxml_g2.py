@@ -87,7 +87,7 @@ def _scale(alignment) -> float:
 @pytest.mark.parametrize("name", ["mdt_aplitop_alignment2.xml", "civil3d2020_a_kolu_asymmetric_s.xml", "novapoint_toi_y3.xml"])
 def test_an_alignment_that_is_g2_already_is_kept_as_it_was(tmp_path, name):
     report = rewrite_landxml_g2(DATA / name, tmp_path / name, 0.01)
-    assert all(p.kept.startswith("G2 already") for p in report.paths)
+    assert all(p.kept.startswith("G2 already") for p in report.paths) and not report.below_g2
     assert without_coordgeom(tmp_path / name, ()) == without_coordgeom(DATA / name, ())
     assert report.lines()[-1].startswith(f"0 of {len(report.paths)} path(s) made G2")
 
@@ -96,6 +96,7 @@ def test_an_alignment_make_g2_refuses_is_kept_and_the_reason_given(tmp_path):
     report = rewrite_landxml_g2(DATA / "freecad_sugar_grove_pi_curves.xml", tmp_path / "out.xml", 0.01)
     sugar = next(p for p in report.paths if p.name == "Sugar Grove Road")
     assert "do not meet" in sugar.kept and "848 apart" in sugar.kept
+    assert report.below_g2 == (sugar,)
     assert without_coordgeom(tmp_path / "out.xml", ()) == without_coordgeom(DATA / "freecad_sugar_grove_pi_curves.xml", ())
 
 
@@ -129,3 +130,11 @@ def test_not_landxml_is_refused(tmp_path):
         rewrite_landxml_g2(tmp_path / "x.xml", tmp_path / "y.xml", 0.01)
     with pytest.raises(ValueError, match="max_deviation"):
         rewrite_landxml_g2(DATA / "novapoint_toi_y3.xml", tmp_path / "y.xml", 0.0)
+
+
+def test_a_file_rewritten_onto_itself_is_whole(tmp_path):
+    target = tmp_path / "road.xml"
+    target.write_bytes((DATA / "openroads_indot_twin_branch.xml").read_bytes())
+    report = rewrite_landxml_g2(target, target, 0.01)
+    assert report.paths[0].made and read_landxml(target)[0].kinds.count("Spiral") == 2
+    assert [p.name for p in tmp_path.iterdir()] == ["road.xml"]  # no temporary left behind
