@@ -194,11 +194,13 @@ def rewrite_dxf_g2(
     msp = doc.modelspace()
     notes += _explode(doc, msp)
     pieces, owners = [], []
+    foreign: list[np.ndarray] = []  # the ends of the curves kept as they are (splines, ellipses): paths stay joined to them
     kept: Counter[str] = Counter()
     for entity in msp:
         kind = entity.dxftype()
         if kind not in READ or (kind == "POLYLINE" and not (entity.is_2d_polyline or entity.is_3d_polyline)):
             kept[kind] += 1
+            foreign += _curve_ends(entity, kind)
             continue
         try:
             parts = _entity_parts(entity, kind)
@@ -216,7 +218,8 @@ def rewrite_dxf_g2(
         from scipy.spatial import cKDTree
 
         tolerance = JOIN_TOLERANCE * size
-        tree = cKDTree(np.array([point for parts, _ in pieces for point in (parts[0][1], parts[-1][2])]))  # 2k, 2k + 1: piece k
+        own = [point for parts, _ in pieces for point in (parts[0][1], parts[-1][2])]  # 2k, 2k + 1: piece k
+        tree = cKDTree(np.array(own + foreign))  # then the ends of the curves kept as they are
         for number, (order, closed) in enumerate(_chains(pieces, tolerance), 1):
             touched = _touched(pieces, order, tree, tolerance)
             if touched is not None:
@@ -294,6 +297,21 @@ def _path(msp, pieces: list, owners: list, order: list[tuple[int, bool]], closed
     for entity in entities:
         msp.delete_entity(entity)
     return PathReport(name, joints, changed, float(result.deviation), splits, pieces=len(added), g2=True)
+
+
+def _curve_ends(entity, kind: str) -> list[np.ndarray]:
+    """The two ends of a curve entity that is kept as it is (none for other entities)."""
+    try:
+        if kind == "SPLINE":
+            tool = entity.construction_tool()
+            ends = [tool.point(0.0), tool.point(tool.max_t)]
+        elif kind == "ELLIPSE":
+            ends = [entity.start_point, entity.end_point]
+        else:
+            return []
+    except Exception:  # noqa: BLE001 - a malformed curve has no ends to keep joined
+        return []
+    return [np.array(tuple(point), dtype=float) for point in ends]
 
 
 def _touched(pieces: list, order: list[tuple[int, bool]], tree: Any, tolerance: float) -> np.ndarray | None:

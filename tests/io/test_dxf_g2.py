@@ -148,3 +148,27 @@ def test_a_drawing_only_recover_mode_reads_comes_back_plain(tmp_path):
     assert not after.audit().has_errors
     # an R12 drawing holds no SPLINE: a path that needs spirals is kept, and says why
     assert any("R12" in p.kept for p in report.paths)
+
+
+def test_a_drawing_rewritten_twice_changes_no_more(tmp_path):
+    plate(tmp_path / "plate.dxf")
+    rewrite_dxf_g2(tmp_path / "plate.dxf", tmp_path / "once.dxf", 0.05)
+    again = rewrite_dxf_g2(tmp_path / "once.dxf", tmp_path / "twice.dxf", 0.05)
+    assert not any(p.made for p in again.paths) and not again.below_g2
+    once, twice = (ezdxf.readfile(tmp_path / name).modelspace() for name in ("once.dxf", "twice.dxf"))
+    assert Counter((e.dxftype(), e.dxf.layer) for e in once) == Counter((e.dxftype(), e.dxf.layer) for e in twice)
+    assert judge(twice).share == 1.0
+
+
+def test_a_path_stays_joined_to_a_spline_it_meets(tmp_path):
+    doc = ezdxf.new("R2010")
+    doc.header["$INSUNITS"] = 4
+    msp = doc.modelspace()
+    msp.add_line((-10, 0), (0, 0))
+    msp.add_arc((0, 10), 10, 270, 360)  # line → arc, tangent: made G2, the arc shrinks about its centre
+    msp.add_spline([(10, 10), (10, 15), (15, 20), (20, 20)])  # a free-form curve from the arc's end
+    doc.saveas(tmp_path / "s.dxf")
+    report = rewrite_dxf_g2(tmp_path / "s.dxf", tmp_path / "out.dxf", 0.01)
+    (path,) = report.paths
+    assert "other entities meet it" in path.kept
+    assert report.below_g2 == (path,)
