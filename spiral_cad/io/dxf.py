@@ -44,26 +44,27 @@ def _xyz(point) -> tuple[float, float, float]:
     return x, y, (z[0] if z else 0.0)
 
 
-def _add(msp, seg: Segment, layer: str) -> None:
-    attribs = {"layer": layer}
+def _add(msp, seg: Segment, layer: str, attribs: dict | None = None):
+    """Add one segment to ``msp`` on ``layer``, with the other graphic attributes ``attribs`` (colour, linetype …); the entity."""
+    attribs = {**(attribs or {}), "layer": layer}
     if isinstance(seg, Line):
-        msp.add_line(_xyz(seg.start), _xyz(seg.end), dxfattribs=attribs)
-    elif isinstance(seg, Arc) and seg.dim == 2:
+        return msp.add_line(_xyz(seg.start), _xyz(seg.end), dxfattribs=attribs)
+    if isinstance(seg, Arc) and seg.dim == 2:
         # DXF arcs run counterclockwise: a clockwise arc is written from its end.
         a, b = math.degrees(seg.start_angle), math.degrees(seg.start_angle + math.copysign(seg.sweep, seg.radius))
         start, end = (a, b) if seg.radius > 0 else (b, a)
-        msp.add_arc(tuple(seg.center), abs(seg.radius), start, end, dxfattribs=attribs)
-    elif isinstance(seg, Arc):
-        _add_arc_in_space(msp, seg, attribs)
-    elif isinstance(seg, BezierSpiral):
+        return msp.add_arc(tuple(seg.center), abs(seg.radius), start, end, dxfattribs=attribs)
+    if isinstance(seg, Arc):
+        return _add_arc_in_space(msp, seg, attribs)
+    if isinstance(seg, BezierSpiral):
         points = [_xyz(p) for p in seg.control_points]
         spline = msp.add_open_spline(points, degree=3, knots=BEZIER_KNOTS, dxfattribs=attribs)
         spline.dxf.flags |= spline.PLANAR  # every spiral lies in one plane
-    else:
-        raise ValueError(f"segment must be a Line, Arc or BezierSpiral; got {seg!r}")
+        return spline
+    raise ValueError(f"segment must be a Line, Arc or BezierSpiral; got {seg!r}")
 
 
-def _add_arc_in_space(msp, arc: Arc, attribs: dict) -> None:
+def _add_arc_in_space(msp, arc: Arc, attribs: dict):
     """An ARC in the OCS whose extrusion is the arc's normal, turned for counterclockwise travel."""
     from ezdxf.math import OCS
 
@@ -71,7 +72,7 @@ def _add_arc_in_space(msp, arc: Arc, attribs: dict) -> None:
     ocs = OCS(extrusion)
     center, start = ocs.from_wcs(_xyz(arc.center)), ocs.from_wcs(_xyz(arc.start))
     a = math.degrees(math.atan2(start.y - center.y, start.x - center.x))
-    msp.add_arc((center.x, center.y, center.z), abs(arc.radius), a, a + math.degrees(arc.sweep),
+    return msp.add_arc((center.x, center.y, center.z), abs(arc.radius), a, a + math.degrees(arc.sweep),
                 dxfattribs={**attribs, "extrusion": extrusion})  # fmt: skip
 
 

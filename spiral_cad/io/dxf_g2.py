@@ -1,0 +1,341 @@
+"""A DXF drawing rewritten G2 in place: one drawing in, the same drawing out (``rewrite_dxf_g2``).
+
+The drawing is opened with ezdxf (``ezdxf.recover`` where the plain reader refuses it, as for LibreCAD's
+library drawings; the report says so). Its model space's ``LINE``, ``ARC``, ``CIRCLE``, ``LWPOLYLINE``
+and ``POLYLINE`` entities are chained into paths as ``spiral_cad.io.dxf_read`` chains them, and every
+path is made G2 by ``spiral_cad.design.make_g2`` within the bound, its arcs kept true arcs. The
+entities of a path made G2 are deleted and its G2 path written in their place: ``LINE``, ``ARC`` and one
+degree-3 ``SPLINE`` per spiral (its Bézier control points exact), on the layer and with the colour,
+linetype, lineweight and linetype scale of the path's first entity. A path that is G2 already (a lone
+circle) and a path ``make_g2`` refuses are kept as they are, and the report says why.
+
+Every other entity is kept untouched: text, dimensions, hatches, points, ``SPLINE`` and ``ELLIPSE``
+(counted in the notes: not made G2 here), and block references. A block reference (``INSERT``) whose
+block holds lines or arcs is exploded first (ezdxf's ``explode``, through its virtual entities), so its
+paths are made G2 too; the report names the blocks. The header (``$INSUNITS`` and the rest), the
+layers, linetypes, styles and blocks stay as they were (ezdxf's ``audit`` is not run on them: an input's
+faults are kept, and named in the report). The result is written beside the target, read back by ezdxf
+without recover mode and audited; an issue the input did not have refuses the write.
+
+The bound is in the drawing's unit (``$INSUNITS``); ``units=`` states it in another unit. A unitless
+drawing takes the bound in drawing units (``units=`` then names them), and the report says so.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import tempfile
+from collections import Counter
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from ..core.spiral import BezierSpiral
+from ..core.units import MM_PER_UNIT, length_unit
+from ..design import make_g2
+from .document_report import DocumentReport, PathReport
+from .dxf import _add
+from .dxf_read import DXF_UNITS, JOIN_TOLERANCE, READ, _chains, _entity_parts, _segment
+
+__all__ = ["ATTRIBUTES", "rewrite_dxf_g2"]
+
+#: The graphic attributes a G2 path takes from its path's first entity (besides the layer).
+ATTRIBUTES = ("color", "true_color", "linetype", "lineweight", "ltscale", "transparency", "invisible")
+#: The parts of a split path must meet within this share of the bound (else the path is kept whole).
+MEET = 1e-6
+#: Rounds of exploding block references that hold paths (blocks inside blocks).
+EXPLODE_DEPTH = 8
+
+
+def _open(source: Path) -> tuple[Any, str]:
+    """The drawing, and a note when only ezdxf's recover mode reads it."""
+    import ezdxf
+    from ezdxf import recover
+
+    if not source.is_file():
+        raise ValueError(f"{source.name}: the DXF file is {'a folder' if source.is_dir() else 'missing'}")
+    try:
+        return ezdxf.readfile(source), ""
+    except (ezdxf.DXFError, UnicodeDecodeError) as plain:
+        try:
+            doc, auditor = recover.readfile(source)
+        except (ezdxf.DXFError, UnicodeDecodeError, OSError) as error:
+            raise ValueError(f"{source.name}: not a DXF file ezdxf can read ({plain}; recover: {error})") from None
+        return doc, f"read with ezdxf's recover mode ({plain}; {len(auditor.fixes)} fix(es)); written as a plain DXF"
+    except OSError as error:  # ezdxf says "not a DXF file" with an OSError
+        raise ValueError(f"{source.name}: not a DXF file ezdxf can read ({error})") from None
+
+
+def _holds_paths(block, blocks, depth: int = 0) -> bool:
+    """Whether a block holds lines or arcs (itself, or through the blocks it references)."""
+    for entity in block:
+        kind = entity.dxftype()
+        if kind in READ:
+            return True
+        if kind == "INSERT" and depth < EXPLODE_DEPTH:
+            inner = blocks.get(entity.dxf.name)
+            if inner is not None and _holds_paths(inner, blocks, depth + 1):
+                return True
+    return False
+
+
+def _explode(doc, msp) -> list[str]:
+    """Explode every block reference of the model space whose block holds paths; notes naming the blocks."""
+    exploded: Counter[str] = Counter()
+    failed: list[str] = []
+    for _ in range(EXPLODE_DEPTH):
+        todo = [e for e in msp.query("INSERT") if (b := doc.blocks.get(e.dxf.name)) is not None and _holds_paths(b, doc.blocks)]
+        if not todo:
+            break
+        for insert in todo:
+            name = insert.dxf.name
+            try:
+                insert.explode()
+                exploded[name] += 1
+            except Exception as error:  # noqa: BLE001 - ezdxf raises several kinds; the reference is then kept
+                failed.append(f"INSERT {insert.dxf.handle} of block {name!r} kept: ezdxf cannot explode it ({error})")
+    notes = [
+        f"exploded {n} INSERT(s) of block {name!r} (its lines and arcs made G2 in the model space)" for name, n in sorted(exploded.items())
+    ]
+    return notes + failed
+
+
+def _bound(doc, max_deviation: float, units: str | None, label: str) -> tuple[float, str, str, list[str]]:
+    """The bound in drawing units, the report's unit name, the unit handed to make_g2, and notes."""
+    if not (isinstance(max_deviation, (int, float)) and math.isfinite(max_deviation) and max_deviation > 0.0):
+        raise ValueError(f"max_deviation must be a positive length; got {max_deviation!r}")
+    stated = None if units is None else length_unit(units)
+    code = int(doc.header.get("$INSUNITS", 0))
+    if code == 0:
+        if stated is None:
+            note = "the drawing is unitless ($INSUNITS 0 or missing): max_deviation taken in drawing units"
+            return float(max_deviation), "drawing units", "mm", [note]
+        return float(max_deviation), stated, stated, [f"the drawing is unitless: its units taken as {stated}, as stated"]
+    if code not in DXF_UNITS:
+        raise ValueError(f"{label}: $INSUNITS {code} is not a unit read here ({', '.join(f'{k} {u}' for k, u in DXF_UNITS.items())})")
+    drawing = DXF_UNITS[code]
+    if stated is None or stated == drawing:
+        return float(max_deviation), drawing, drawing, []
+    bound = float(max_deviation) * MM_PER_UNIT[stated] / MM_PER_UNIT[drawing]
+    return bound, drawing, drawing, [f"max_deviation {max_deviation:g} {stated} is {bound:.6g} {drawing}, the drawing's unit"]
+
+
+def _audit(path: Path, recovered: bool):
+    """ezdxf's auditor of a freshly read file (the file itself is not changed)."""
+    import ezdxf
+    from ezdxf import recover
+
+    if recovered:
+        return recover.readfile(path)[1]
+    return ezdxf.readfile(path).audit()
+
+
+def _issues(path: Path, recovered: bool) -> tuple[Counter[int], str]:
+    """What ezdxf's audit fixes or finds in a file, counted by kind, and the first one's message."""
+    auditor = _audit(path, recovered)
+    items = (*auditor.errors, *auditor.fixes)
+    return Counter(int(item.code) for item in items), next((item.message for item in items), "")
+
+
+def _save(doc, target: Path, issues: Counter[int], label: str) -> None:
+    """Write the drawing beside ``target``, check that ezdxf reads it without recover mode and that its audit
+    finds nothing the input did not have, then move it onto ``target`` (else nothing is written)."""
+    import ezdxf
+
+    handle, temporary = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".dxf", dir=target.parent)
+    os.close(handle)
+    try:
+        doc.saveas(temporary)
+        auditor = ezdxf.readfile(temporary).audit()
+        found = Counter(int(item.code) for item in (*auditor.fixes, *auditor.errors))
+        new = found - issues
+        if new:
+            first = next(item.message for item in (*auditor.errors, *auditor.fixes) if int(item.code) in new)
+            raise ValueError(f"{label}: ezdxf's audit finds {sum(new.values())} new issue(s) in the result ({first}); nothing written")
+        os.replace(temporary, target)
+    finally:
+        if os.path.exists(temporary):
+            os.unlink(temporary)
+
+
+def _attributes(entity) -> dict:
+    return {name: entity.dxf.get(name) for name in ATTRIBUTES if entity.dxf.hasattr(name)}
+
+
+def rewrite_dxf_g2(
+    source: Path, target: Path, max_deviation: float, *, units: str | None = None, shape: str | None = None
+) -> DocumentReport:
+    """Rewrite a DXF drawing with every path of lines and arcs made G2 within ``max_deviation`` (see the module docstring).
+
+    Args:
+        source: the drawing (.dxf).
+        target: the file to write (may be ``source``).
+        max_deviation: the largest distance between a path and its G2 path, in the drawing's unit (or ``units``).
+        units: the unit of ``max_deviation`` (default: the drawing's ``$INSUNITS``); for a unitless drawing, the
+            unit its numbers are in.
+        shape: the spiral shape (``"near-linear"``, the default, or ``"walton-meek"``).
+
+    Returns:
+        The report: per path its measured deviation, joints changed and splits, or why it was kept.
+
+    Raises:
+        ValueError: not a DXF file ezdxf reads, a bad bound or unit, an ``$INSUNITS`` not read here, or a result
+            ezdxf's audit finds errors in (nothing is written then).
+        OSError: the file could not be read or written.
+    """
+    source, target = Path(source), Path(target)
+    label = source.name
+    doc, recovered = _open(source)
+    bound, unit_name, g2_units, notes = _bound(doc, max_deviation, units, label)
+    if recovered:
+        notes.insert(0, recovered)
+    msp = doc.modelspace()
+    notes += _explode(doc, msp)
+    pieces, owners = [], []
+    foreign: list[np.ndarray] = []  # the ends of the curves kept as they are (splines, ellipses): paths stay joined to them
+    kept: Counter[str] = Counter()
+    for entity in msp:
+        kind = entity.dxftype()
+        if kind not in READ or (kind == "POLYLINE" and not (entity.is_2d_polyline or entity.is_3d_polyline)):
+            kept[kind] += 1
+            foreign += _curve_ends(entity, kind)
+            continue
+        try:
+            parts = _entity_parts(entity, kind)
+        except ValueError as error:
+            kept[kind] += 1
+            notes.append(f"{kind} {entity.dxf.handle} kept as is: {error}")
+            continue
+        if parts:
+            pieces.append((parts, str(entity.dxf.handle)))
+            owners.append(entity)
+    reports: list[PathReport] = []
+    if pieces:
+        ends = np.array([p for parts, _ in pieces for part in (parts[0], parts[-1]) for p in (part[1], part[2])])
+        size = float(np.linalg.norm(ends.max(axis=0) - ends.min(axis=0))) or 1.0
+        from scipy.spatial import cKDTree
+
+        tolerance = JOIN_TOLERANCE * size
+        own = [point for parts, _ in pieces for point in (parts[0][1], parts[-1][2])]  # 2k, 2k + 1: piece k
+        tree = cKDTree(np.array(own + foreign))  # then the ends of the curves kept as they are
+        for number, (order, closed) in enumerate(_chains(pieces, tolerance), 1):
+            touched = _touched(pieces, order, tree, tolerance)
+            if touched is not None:
+                first = owners[order[0][0]]
+                name = f"path {number} ({first.dxftype()} {first.dxf.handle}, layer {first.dxf.layer})"
+                where = ", ".join(f"{v:.6g}" for v in touched[:2])
+                reports.append(PathReport(name, sum(len(pieces[i][0]) for i, _ in order) - (0 if closed else 1),
+                                          kept=f"another entity ends at its vertex ({where}): rounding it would detach that entity"))  # fmt: skip
+                continue
+            branches = _branch_ends(pieces, order, tree, tolerance) if not closed else []
+            reports.append(_path(msp, pieces, owners, order, closed, number, bound, g2_units, shape or "near-linear", notes, branches))
+    if kept:
+        notes.append("kept as is: " + ", ".join(f"{n} {kind}" for kind, n in sorted(kept.items())))
+    for kind in ("SPLINE", "ELLIPSE", "HELIX"):
+        if kept[kind]:
+            notes.append(f"{kept[kind]} {kind} entit{'y' if kept[kind] == 1 else 'ies'} not made G2 (only lines and arcs are)")
+    issues, first = _issues(source, bool(recovered))
+    if issues:
+        notes.append(f"ezdxf's audit finds {sum(issues.values())} issue(s) in the input ({first}); kept as they were")
+    _save(doc, target, issues, label)
+    return DocumentReport(label, target.name, "DXF drawing", unit_name, float(max_deviation) if units is None else bound,
+                          tuple(reports), tuple(notes))  # fmt: skip
+
+
+def _path(msp, pieces: list, owners: list, order: list[tuple[int, bool]], closed: bool, number: int, bound: float, units: str,
+          shape: str, notes: list[str], branches: list[np.ndarray]) -> PathReport:  # fmt: skip
+    """Make one chained path G2 and write it in place of its entities; its report."""
+    import ezdxf
+
+    entities = [owners[index] for index, _ in order]
+    first = entities[0]
+    name = f"path {number} ({first.dxftype()} {first.dxf.handle}, layer {first.dxf.layer})"
+    parts = [(part, reverse) for index, reverse in order for part in (reversed(pieces[index][0]) if reverse else pieces[index][0])]
+    flat = all(p[1][2] == 0.0 and p[2][2] == 0.0 and (p[0] == "line" or abs(p[3][1][:2]).max() == 0.0) for p, _ in parts)
+    segments = []
+    for part, reverse in parts:
+        segment = _segment(part, 1.0, 2 if flat else 3)
+        segments.append(segment.reversed() if reverse else segment)
+    joints = len(segments) - (0 if closed else 1)
+    if not joints:
+        return PathReport(name, joints, kept="one entity, no joint", g2=True)
+    try:
+        result = make_g2(segments, bound, closed=closed, shape=shape, units=units)
+    except ValueError as error:
+        return PathReport(name, joints, kept=f"make_g2 refuses it: {error}")
+    changed = sum(j.kind not in ("g2", "split") for j in result.joints)
+    splits = len(result.splits)
+    if not changed:
+        why = f"split at every joint ({splits}): corners too sharp for a spiral pair within the bound" if splits else "G2 already"
+        return PathReport(name, joints, splits=splits, kept=why, g2=not splits)
+    gap = _split_gap(result.chains, closed)
+    if gap > MEET * bound:
+        return PathReport(name, joints, splits=splits, kept=f"make_g2 splits it at {splits} joint(s) and its parts no longer meet "
+                          f"there (a gap of {gap:.3g}): kept whole rather than opened")  # fmt: skip
+    for point in branches:  # an end where other entities meet stays where it was
+        moved = min(float(np.linalg.norm(np.asarray(end)[:2] - point[:2])) for end in (result.chains[0].start, result.chains[-1].end))
+        if moved > MEET * bound:
+            where = ", ".join(f"{v:.6g}" for v in point[:2])
+            return PathReport(name, joints, splits=splits, kept=f"its end at ({where}), where other entities meet it, would move by "
+                              f"{moved:.3g}: kept rather than detached")  # fmt: skip
+    if any(isinstance(s, BezierSpiral) for c in result.chains for s in c) and msp.doc.dxfversion < "AC1015":
+        return PathReport(name, joints, splits=splits, kept="an R12 drawing holds no SPLINE for its spirals (save it as R2000 or later)")
+    attributes = _attributes(first)
+    layers = {e.dxf.layer for e in entities}
+    if len(layers) > 1 or any(_attributes(e) != attributes for e in entities):
+        notes.append(f"{name}: its entities differ in layer, colour or linetype; its G2 path takes the first's")
+    added = []
+    try:
+        for piece in (s for chain in result.chains for s in chain):
+            added.append(_add(msp, piece, first.dxf.layer, attributes))
+    except ezdxf.DXFError as error:  # e.g. a layer name ezdxf reads but will not give a new entity
+        for entity in added:
+            msp.delete_entity(entity)
+        return PathReport(name, joints, splits=splits, kept=f"ezdxf cannot write its G2 path ({error})")
+    for entity in entities:
+        msp.delete_entity(entity)
+    return PathReport(name, joints, changed, float(result.deviation), splits, pieces=len(added), g2=True)
+
+
+def _curve_ends(entity, kind: str) -> list[np.ndarray]:
+    """The two ends of a curve entity that is kept as it is (none for other entities)."""
+    try:
+        if kind == "SPLINE":
+            tool = entity.construction_tool()
+            ends = [tool.point(0.0), tool.point(tool.max_t)]
+        elif kind == "ELLIPSE":
+            ends = [entity.start_point, entity.end_point]
+        else:
+            return []
+    except Exception:  # noqa: BLE001 - a malformed curve has no ends to keep joined
+        return []
+    return [np.array(tuple(point), dtype=float) for point in ends]
+
+
+def _touched(pieces: list, order: list[tuple[int, bool]], tree: Any, tolerance: float) -> np.ndarray | None:
+    """A vertex inside one of the path's polylines where an end of another entity lies (None when there is none):
+    the drawing branches there, which the chaining (by entity ends) does not see."""
+    mine = {index for index, _ in order}
+    for index, _ in order:
+        parts = pieces[index][0]
+        for part in parts[:-1]:  # each inner vertex: a part's end that is not the entity's end
+            for j in tree.query_ball_point(part[2], tolerance):
+                if j // 2 not in mine:
+                    return np.asarray(part[2])
+    return None
+
+
+def _branch_ends(pieces: list, order: list[tuple[int, bool]], tree: Any, tolerance: float) -> list[np.ndarray]:
+    """The ends of an open path where other entities end too (a branch point: the chaining stopped there)."""
+    (head, head_reversed), (tail, tail_reversed) = order[0], order[-1]
+    start = pieces[head][0][-1][2] if head_reversed else pieces[head][0][0][1]
+    end = pieces[tail][0][0][1] if tail_reversed else pieces[tail][0][-1][2]
+    return [np.asarray(point) for point in (start, end) if len(tree.query_ball_point(point, tolerance)) > 1]
+
+
+def _split_gap(chains: list, closed: bool) -> float:
+    """The largest distance between the end of one part of a split path and the start of the next."""
+    pairs = list(zip(chains[:-1], chains[1:])) + ([(chains[-1], chains[0])] if closed and len(chains) > 1 else [])
+    return max((float(np.linalg.norm(a.end - b.start)) for a, b in pairs), default=0.0)
