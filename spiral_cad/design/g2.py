@@ -51,8 +51,9 @@ from ..core.shapes import SHAPE_CODES, TRANSITION_SHAPES, shape_code
 from ..core.space import PlaneFrame
 from ..core.spiral import BezierSpiral
 from ..core.units import DEFAULT_UNITS, length_unit
+from ._g2_kept import _KeptRefusal, is_kept, make_kept
 from ._g2_measure import _deviation
-from ._g2_pieces import EPS, TANGENT_TOL, _circle_offset, _classify, _merge, _merge_error, _Piece, _piece_ends, _piece_of, _Refusal, _shown_point, _Solved
+from ._g2_pieces import EPS, TANGENT_TOL, _circle_offset, _classify, _merge, _merge_error, _Piece, _turn, _piece_ends, _piece_of, _Refusal, _shown_point, _Solved
 from ._g2_solve import _arc_corners, _bridge_short_lines, _Group, _solve
 from .rounding import _steepest_deflection
 
@@ -116,6 +117,20 @@ class G2Path:
     units: str = DEFAULT_UNITS
 
     @property
+    def split_joints(self) -> list[G2Joint]:
+        """The joints where the path was split (a reversal, or a corner sharper than a spiral pair
+        rounds): the parts meet there with a kink (G0); ``moved`` says why."""
+        return [j for j in self.joints if j.kind == "split"]
+
+    def describe_splits(self) -> str:
+        """The splits in words (empty when none): how many, and each joint, point and reason."""
+        splits = self.split_joints
+        if not splits:
+            return ""
+        named = "; ".join(f"joint {j.index} at {_shown_point(j.point)}: {j.moved.removeprefix('split here: ')}" for j in splits)
+        return f"split into {len(self.chains)} G2 parts at {len(splits)} joint(s), G0 there ({named})"
+
+    @property
     def chain(self) -> Chain:
         """The one chain of an unsplit path.
 
@@ -134,12 +149,12 @@ def _path_segments(path: Any) -> tuple[list[Segment], PlaneFrame | None]:
     if isinstance(path, Chain):
         path = list(path)
     if isinstance(path, Sequence) and path and all(isinstance(s, Segment) for s in path):
-        for i, s in enumerate(path):
-            if not isinstance(s, (Line, Arc)):
-                raise ValueError(f"make_g2 takes a path of lines and arcs; segment {i} is a {type(s).__name__}")
         segments = list(path)
         if all(s.dim == 2 for s in segments):
             return segments, None
+        for i, s in enumerate(segments):
+            if is_kept(s):
+                raise ValueError(f"make_g2 keeps spirals of a path in the plane (2-D); segment {i} is a {type(s).__name__} in space")
         return _planar(segments)
     points = as_real_array(path, "path")
     if points.ndim != 2 or len(points) < 2 or points.shape[1] not in (2, 3):
@@ -303,7 +318,7 @@ def make_g2(
     started = time.perf_counter()
     segments, frame = _path_segments(path)
     with _collector_paused():
-        result = _make(segments, bound, closed, shape, units, tolerance)
+        result = _build(segments, bound, closed, shape, units, tolerance)
         if isinstance(result, _Refusal):
             message = _refusal_message(result, segments, bound, closed, shape, units, tolerance, started + ADVICE_SECONDS)
     if isinstance(result, _Refusal):
@@ -341,7 +356,7 @@ def smallest_max_deviation(
     floor = 8.0 * EPS * size
     works = _smallest_bound(segments, floor, closed, shape, units, tolerance)
     if works is None:
-        failed = _make(segments, 4.0 * size, closed, shape, units, tolerance)
+        failed = _build(segments, 4.0 * size, closed, shape, units, tolerance)
         reason = _refusal_message(failed, segments, 4.0 * size, closed, shape, units, tolerance) if isinstance(failed, _Refusal) else ""
         raise NoSolutionError(f"no max_deviation up to the path's size makes it G2: {reason}")
     return works
@@ -376,7 +391,7 @@ class _Located(_Refusal):
 def _refusal_message(refusal: _Refusal, segments: list[Segment], bound: float, closed: bool | None, shape: str, units: str,
                      tolerance: float, deadline: float = math.inf) -> str:  # fmt: skip
     where = f"joint {refusal.joint}"
-    if isinstance(refusal, _Located):
+    if isinstance(refusal, (_Located, _KeptRefusal)):
         where += f" (between segments {refusal.joint} and {(refusal.joint + 1) % len(segments)}) at {_shown_point(refusal.point)}"
     message = f"{where}: cannot be made G2 within max_deviation {bound:.6g} {units}: {refusal.reason}"
     if not refusal.larger_helps:
@@ -415,7 +430,7 @@ def _advice(segments: list[Segment], joint: int, bound: float, closed: bool | No
             works = 4.0 * lo  # the window alone gives no advice: step on and let the whole path say
         if works > 4.0 * size:
             return None
-        made = _make(segments, works, closed, shape, units, tolerance)
+        made = _build(segments, works, closed, shape, units, tolerance)
         if not isinstance(made, _Refusal):
             return works
         if not made.larger_helps or time.perf_counter() > deadline:
@@ -437,7 +452,7 @@ def _smallest_bound(segments: list[Segment], bound: float, closed: bool | None, 
             return None
         if time.perf_counter() > deadline:
             return math.nan
-        made = _make(segments, hi, closed, shape, units, tolerance)
+        made = _build(segments, hi, closed, shape, units, tolerance)
         if not isinstance(made, _Refusal):
             break
         if not made.larger_helps:
@@ -447,7 +462,7 @@ def _smallest_bound(segments: list[Segment], bound: float, closed: bool | None, 
         if time.perf_counter() > deadline:
             break
         mid = math.sqrt(lo * hi)
-        if isinstance(_make(segments, mid, closed, shape, units, tolerance), _Refusal):
+        if isinstance(_build(segments, mid, closed, shape, units, tolerance), _Refusal):
             lo = mid
         else:
             hi = mid
@@ -455,14 +470,23 @@ def _smallest_bound(segments: list[Segment], bound: float, closed: bool | None, 
     for _ in range(8):
         digits = 10.0 ** (math.floor(math.log10(hi)) - 2)
         shown = float(f"{math.ceil(hi / digits) * digits:.3g}")
-        if not isinstance(_make(segments, shown, closed, shape, units, tolerance), _Refusal):
+        if not isinstance(_build(segments, shown, closed, shape, units, tolerance), _Refusal):
             return shown
         hi = 1.25 * shown
     return None
 
 
+def _build(segments: list[Segment], bound: float, closed: bool | None, shape: str, units: str, tolerance: float) -> G2Path | _Refusal:
+    """``make_g2`` of plane segments (spirals and other segments kept as they are), or the refusal of its
+    first joint that fails."""
+    if any(is_kept(s) for s in segments):
+        made: G2Path | _Refusal = make_kept(segments, bound, closed, shape, units, tolerance, _make, G2Path, G2Joint)
+        return made
+    return _make(segments, bound, closed, shape, units, tolerance)
+
+
 def _make(segments: list[Segment], bound: float, closed: bool | None, shape: str, units: str, tolerance: float) -> G2Path | _Refusal:
-    """``make_g2`` of plane segments, or the refusal of its first joint that fails."""
+    """``make_g2`` of plane lines and arcs, or the refusal of its first joint that fails."""
     pieces = [_piece_of(s, i) for i, s in enumerate(segments)]
     points = np.array([p for s in segments for p in s.outline()])
     scale = float(np.abs(points).max()) or 1.0
@@ -505,7 +529,8 @@ def _make(segments: list[Segment], bound: float, closed: bool | None, shape: str
     joints: dict[int, G2Joint] = {}
     for i, kind in enumerate(kinds):
         if kind in ("g2", "split"):
-            joints[i] = G2Joint(i, kind, shown[i], "nothing" if kind == "g2" else "split here", 0.0)
+            moved = "nothing" if kind == "g2" else _split_reason(pieces[i], pieces[(i + 1) % count], steepest)
+            joints[i] = G2Joint(i, kind, shown[i], moved, 0.0)
     # Merge G2 neighbours; a closed path starts after a joint that is not G2 (if it has one).
     order = list(range(count))
     if closed:
@@ -602,6 +627,7 @@ def _solve_group(pieces: list[_Piece], kinds: list[str], joints: list[int], clos
     refusal (located on the input) when none works."""
     first: _Located | None = None
     for share in (1.0, *RETRY_SHARES):
+        group_joints = joints
         try:
             group_pieces, group_kinds, group_joints = _arc_corners(pieces, kinds, joints, closed, share * room)
             group_pieces, group_kinds, group_joints, bridges = _bridge_short_lines(group_pieces, group_kinds, group_joints,
@@ -630,6 +656,15 @@ def _solve_group(pieces: list[_Piece], kinds: list[str], joints: list[int], clos
         return chain, measured, group, solved, s, group_pieces, group_kinds, group_joints
     assert first is not None
     return first
+
+
+def _split_reason(a: _Piece, b: _Piece, steepest: float) -> str:
+    """Why the path is split at the joint from ``a`` to ``b``, in words."""
+    turn = abs(_turn(a, b))
+    if turn > math.pi - 1e-6:
+        return f"split here: a reversal (the path turns back on itself, {math.degrees(turn):.6g}°)"
+    return (f"split here: a corner of {math.degrees(turn):.4g}°, sharper than the {math.degrees(steepest):.4g}° "
+            "a spiral pair rounds")  # fmt: skip
 
 
 def _moved(kind: str, a: _Piece, b: _Piece, sa: float, sb: float, solved: _Solved | None) -> str:
