@@ -58,12 +58,15 @@ def make_kept(segments: list[Segment], bound: float, closed: bool | None, shape:
     first = next(k for k, s in enumerate(segments) if is_kept(s)) if closed else 0
     order = list(range(first, n)) + list(range(first)) if closed else list(range(n))
     parts: list[list[Segment]] = [[]]
+    zero_at: int | None = None  # where the output of input segment 0 starts (a closed path is turned back to it)
     joints: dict[int, Any] = {}
     splits: list[int] = []
     deviation = 0.0
     k = 0
     while k < len(order):
         index = order[k]
+        if index == 0 and len(parts) == 1:
+            zero_at = len(parts[0])
         if is_kept(segments[index]):
             parts[-1].append(segments[index])
             k += 1
@@ -101,6 +104,8 @@ def make_kept(segments: list[Segment], bound: float, closed: bool | None, shape:
         if j not in joints:
             point = tuple(float(v) for v in segments[j].end[:2])
             joints[j] = joint_type(j, "g2", point, "nothing", 0.0)
+    if closed and not splits and zero_at:
+        parts[0] = parts[0][zero_at:] + parts[0][:zero_at]
     try:
         chains = [Chain(part, tolerance, units) for part in parts if part]
     except ValueError as error:

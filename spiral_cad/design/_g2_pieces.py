@@ -184,7 +184,7 @@ NESTED_SHARE = 0.25
 
 
 #: Arcs of one circle (to this share of the bound) are merged into one arc.
-MERGE_SHARE = 0.01
+MERGE_SHARE = 0.25
 
 
 def _merge_error(a: _Piece, b: _Piece) -> float:

@@ -580,6 +580,8 @@ def _make(segments: list[Segment], bound: float, closed: bool | None, shape: str
         groups.append((current, current_kinds, current_joints, closed and not open_path))
     spanned += merged_off
     room = bound - spanned
+    if not room > 0.0:
+        return _Located(0, shown[0], f"its gaps and the arcs of one circle merged move it {spanned:.3g}, the whole bound", True)
     chains: list[Chain] = []
     deviation = 0.0
     for group_pieces, group_kinds, group_joints, group_closed in groups:
