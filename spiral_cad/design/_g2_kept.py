@@ -15,7 +15,7 @@ from ..core.segments import Arc, Line, Segment
 from ._g2_pieces import _Refusal, _shown_point
 
 #: make_g2's result and refusal types, handed in by ``g2`` (which imports this module).
-Make = Callable[[list[Segment], float, "bool | None", str, str, float], Any]
+Make = Callable[[list[Segment], float, "bool | None", str, str, float, bool], Any]
 
 
 class _KeptRefusal(_Refusal):
@@ -32,7 +32,7 @@ def is_kept(segment: Segment) -> bool:
 
 
 def make_kept(segments: list[Segment], bound: float, closed: bool | None, shape: str, units: str, tolerance: float,
-              make: Make, result_type: Any, joint_type: Any) -> Any:  # fmt: skip
+              make: Make, result_type: Any, joint_type: Any, retry: bool = True) -> Any:  # fmt: skip
     """``make`` (make_g2 of lines and arcs) of each run of lines and arcs between the kept segments, the
     kept ones as they are; a G2Path (``result_type``) or a refusal located on the input.
 
@@ -75,7 +75,7 @@ def make_kept(segments: list[Segment], bound: float, closed: bool | None, shape:
         while k < len(order) and not is_kept(segments[order[k]]):
             run.append(order[k])
             k += 1
-        made = make([segments[i] for i in run], bound, False, shape, units, tolerance)
+        made = make([segments[i] for i in run], bound, False, shape, units, tolerance, retry)
         if isinstance(made, _Refusal):
             at = run[min(made.joint, len(run) - 1)]
             point = getattr(made, "point", tuple(segments[at].end[:2].tolist()))

@@ -264,6 +264,8 @@ def _used_rows(pieces: list[_Piece], points: NDArray, at_end: bool) -> NDArray:
 class _Refusal(Exception):
     """A joint that cannot be made G2 within the bound (its index in the group and the reason)."""
 
-    def __init__(self, joint: int, reason: str, larger_helps: bool):
+    def __init__(self, joint: int, reason: str, larger_helps: bool, smaller_helps: bool = True):
         super().__init__(reason)
         self.joint, self.reason, self.larger_helps = joint, reason, larger_helps
+        #: Whether a smaller share of the bound may work (not when the transitions are too small to hold G2).
+        self.smaller_helps = smaller_helps

@@ -452,7 +452,7 @@ def _smallest_bound(segments: list[Segment], bound: float, closed: bool | None, 
             return None
         if time.perf_counter() > deadline:
             return math.nan
-        made = _build(segments, hi, closed, shape, units, tolerance)
+        made = _build(segments, hi, closed, shape, units, tolerance, retry=False)
         if not isinstance(made, _Refusal):
             break
         if not made.larger_helps:
@@ -462,7 +462,7 @@ def _smallest_bound(segments: list[Segment], bound: float, closed: bool | None, 
         if time.perf_counter() > deadline:
             break
         mid = math.sqrt(lo * hi)
-        if isinstance(_build(segments, mid, closed, shape, units, tolerance), _Refusal):
+        if isinstance(_build(segments, mid, closed, shape, units, tolerance, retry=False), _Refusal):
             lo = mid
         else:
             hi = mid
@@ -476,17 +476,20 @@ def _smallest_bound(segments: list[Segment], bound: float, closed: bool | None, 
     return None
 
 
-def _build(segments: list[Segment], bound: float, closed: bool | None, shape: str, units: str, tolerance: float) -> G2Path | _Refusal:
+def _build(segments: list[Segment], bound: float, closed: bool | None, shape: str, units: str, tolerance: float,
+           retry: bool = True) -> G2Path | _Refusal:  # fmt: skip
     """``make_g2`` of plane segments (spirals and other segments kept as they are), or the refusal of its
     first joint that fails."""
     if any(is_kept(s) for s in segments):
-        made: G2Path | _Refusal = make_kept(segments, bound, closed, shape, units, tolerance, _make, G2Path, G2Joint)
+        made: G2Path | _Refusal = make_kept(segments, bound, closed, shape, units, tolerance, _make, G2Path, G2Joint, retry)
         return made
-    return _make(segments, bound, closed, shape, units, tolerance)
+    return _make(segments, bound, closed, shape, units, tolerance, retry)
 
 
-def _make(segments: list[Segment], bound: float, closed: bool | None, shape: str, units: str, tolerance: float) -> G2Path | _Refusal:
-    """``make_g2`` of plane lines and arcs, or the refusal of its first joint that fails."""
+def _make(segments: list[Segment], bound: float, closed: bool | None, shape: str, units: str, tolerance: float,
+          retry: bool = True) -> G2Path | _Refusal:  # fmt: skip
+    """``make_g2`` of plane lines and arcs, or the refusal of its first joint that fails (``retry``: a part
+    refused within the bound tried again within smaller shares of it; the advice's search goes without)."""
     pieces = [_piece_of(s, i) for i, s in enumerate(segments)]
     points = np.array([p for s in segments for p in s.outline()])
     scale = float(np.abs(points).max()) or 1.0
@@ -586,7 +589,7 @@ def _make(segments: list[Segment], bound: float, closed: bool | None, shape: str
     deviation = 0.0
     for group_pieces, group_kinds, group_joints, group_closed in groups:
         made = _solve_group(group_pieces, group_kinds, group_joints, group_closed, room, shape, extent, units, tolerance, spanned,
-                            bound, shown)  # fmt: skip
+                            bound, shown, RETRY_SHARES if retry else ())  # fmt: skip
         if isinstance(made, _Located):
             return made
         chain, measured, group, solved, s, group_pieces, group_kinds, group_joints = made
@@ -624,11 +627,12 @@ RETRY_SHARES = (0.25, 1.0 / 16.0, 1.0 / 64.0)
 
 
 def _solve_group(pieces: list[_Piece], kinds: list[str], joints: list[int], closed: bool, room: float, shape: str, extent: float,
-                 units: str, tolerance: float, spanned: float, bound: float, shown: list[tuple[float, ...]]) -> Any:  # fmt: skip
+                 units: str, tolerance: float, spanned: float, bound: float, shown: list[tuple[float, ...]],
+                 shares: tuple[float, ...] = RETRY_SHARES) -> Any:  # fmt: skip
     """One group (a part between splits) made G2 within ``room``, or else within a share of it; the first
     refusal (located on the input) when none works."""
     first: _Located | None = None
-    for share in (1.0, *RETRY_SHARES):
+    for share in (1.0, *shares):
         group_joints = joints
         try:
             group_pieces, group_kinds, group_joints = _arc_corners(pieces, kinds, joints, closed, share * room)
@@ -648,7 +652,7 @@ def _solve_group(pieces: list[_Piece], kinds: list[str], joints: list[int], clos
         except _Refusal as refusal:
             index = group_joints[refusal.joint] if group_joints and refusal.joint < len(group_joints) else joints[0] if joints else 0
             first = first or _Located(index, shown[index], refusal.reason, refusal.larger_helps)
-            if not refusal.larger_helps and share == 1.0 and "tangent circle" not in refusal.reason:
+            if not refusal.smaller_helps:
                 break
             continue
         except ValueError as error:
