@@ -106,7 +106,9 @@ def _dxf(source: Path, deviation: float, name: str | None, units: str | None, so
     return drawing.units, built
 
 
-def _made(segments: list, deviation: float, closed: bool, shape: str, units: str, where: str) -> list[tuple[Any, Any, list[str], tuple[str, ...]]]:
+def _made(
+    segments: list, deviation: float, closed: bool, shape: str, units: str, where: str
+) -> list[tuple[Any, Any, list[str], tuple[str, ...]]]:
     """(chain, G2Path, notes, splits named) of every G2 path ``make_g2`` makes of ``segments``."""
     named: list[str] = []
     try:

@@ -53,7 +53,21 @@ from ..core.spiral import BezierSpiral
 from ..core.units import DEFAULT_UNITS, length_unit
 from ._g2_kept import _KeptRefusal, is_kept, make_kept
 from ._g2_measure import _deviation
-from ._g2_pieces import EPS, TANGENT_TOL, _circle_offset, _classify, _merge, _merge_error, _Piece, _turn, _piece_ends, _piece_of, _Refusal, _shown_point, _Solved
+from ._g2_pieces import (
+    EPS,
+    TANGENT_TOL,
+    _circle_offset,
+    _classify,
+    _merge,
+    _merge_error,
+    _Piece,
+    _piece_ends,
+    _piece_of,
+    _Refusal,
+    _shown_point,
+    _Solved,
+    _turn,
+)
 from ._g2_solve import _arc_corners, _bridge_short_lines, _Group, _solve
 from .rounding import _steepest_deflection
 
@@ -544,11 +558,11 @@ def _make(segments: list[Segment], bound: float, closed: bool | None, shape: str
                 whole = _merge(whole, piece)
             if whole.kind != "arc" or whole.sweep < TAU - 1e-9:
                 return _Located(0, shown[0], "every joint is G2 but the pieces do not close into one circle", False)
-            moved = max(_circle_offset(whole, p) for p in pieces) + spanned
-            if moved > bound:
-                return _Located(0, shown[0], f"its arcs lie {moved:.3g} off one circle, beyond the bound", True)
+            off = max(_circle_offset(whole, p) for p in pieces) + spanned
+            if off > bound:
+                return _Located(0, shown[0], f"its arcs lie {off:.3g} off one circle, beyond the bound", True)
             circle = Arc._of(whole.c.copy(), float(whole.r), float(whole.a0), TAU)
-            return G2Path([Chain([circle], tolerance, units)], moved, [joints[i] for i in sorted(joints)], [], True, bound, shape, units)
+            return G2Path([Chain([circle], tolerance, units)], off, [joints[i] for i in sorted(joints)], [], True, bound, shape, units)
         order = order[cut + 1 :] + order[: cut + 1]
     groups: list[tuple[list[_Piece], list[str], list[int], bool]] = []
     current: list[_Piece] = []

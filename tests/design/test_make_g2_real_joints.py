@@ -57,7 +57,9 @@ def three_arcs(centre=(12.5, -7.25), radius=3.0, rounding=1e-4, spin=0.3) -> lis
     arcs = []
     start = np.array(centre) + radius * np.array([math.cos(spin), math.sin(spin)])
     for k in range(3):
-        exact_end = np.array(centre) + radius * np.array([math.cos(spin + (k + 1) * 2 * math.pi / 3), math.sin(spin + (k + 1) * 2 * math.pi / 3)])
+        exact_end = np.array(centre) + radius * np.array(
+            [math.cos(spin + (k + 1) * 2 * math.pi / 3), math.sin(spin + (k + 1) * 2 * math.pi / 3)]
+        )
         c = start + np.round((np.array(centre) - start) / rounding) * rounding
         a0 = math.atan2(start[1] - c[1], start[0] - c[0])
         a1 = math.atan2(exact_end[1] - c[1], exact_end[0] - c[0])
@@ -208,7 +210,17 @@ def board(count: int = 12, rounding: float = 1e-6, seed: int = 5) -> list:
 
 def _turns(segments) -> np.ndarray:
     pairs = zip(segments, segments[1:] + segments[:1])
-    return np.array([abs(math.atan2(float(a.end_tangent[0] * b.start_tangent[1] - a.end_tangent[1] * b.start_tangent[0]), float(a.end_tangent @ b.start_tangent))) for a, b in pairs])
+    return np.array(
+        [
+            abs(
+                math.atan2(
+                    float(a.end_tangent[0] * b.start_tangent[1] - a.end_tangent[1] * b.start_tangent[0]),
+                    float(a.end_tangent @ b.start_tangent),
+                )
+            )
+            for a, b in pairs
+        ]
+    )
 
 
 @pytest.mark.parametrize("rounding", [1e-6, 1e-4])
@@ -223,7 +235,12 @@ def test_a_kicad_like_board_outline_is_made_g2_whole(rounding):
 
 def test_a_refusal_names_the_true_reason_and_a_bound_that_builds_within_a_second():
     # A corner next to an arc whose lines are too short for its tangent circle at a small bound.
-    segments = [Line((0.0, 0.0), (10.0, 0.0)), Line((10.0, 0.0), (10.0, 1e-3)), Arc((9.0, 1e-3), 1.0, 0.0, math.pi / 2), Line((9.0, 1.001), (0.0, 1.001))]
+    segments = [
+        Line((0.0, 0.0), (10.0, 0.0)),
+        Line((10.0, 0.0), (10.0, 1e-3)),
+        Arc((9.0, 1e-3), 1.0, 0.0, math.pi / 2),
+        Line((9.0, 1.001), (0.0, 1.001)),
+    ]
     started = time.perf_counter()
     try:
         make_g2(segments, 0.5)
