@@ -307,6 +307,11 @@ def make_g2(
     Args:
         path: a sequence of ``Line`` and ``Arc`` meeting end to start (2-D, or
             3-D in one plane), a ``Chain`` of them, or (n, 2|3) polyline points.
+            Other segments (2-D ``BezierSpiral``, e.g. ``make_g2``'s own) are
+            kept as they are when their joints are G2: ``make_g2`` of its own
+            result changes nothing. Near-tangent joints (kinks whose circles
+            overlap by at most a tenth of the bound) are made G2 as tangent
+            ones; arcs of one circle (to a quarter of the bound) are merged.
         max_deviation: the Hausdorff bound: every point of the result lies
             within it of the input and every input point within it of the result.
         closed: whether the path closes (its closing joint is then treated like
@@ -321,8 +326,8 @@ def make_g2(
 
     Raises:
         NoSolutionError: a joint that cannot be made G2 within the bound; the
-            message names the joint, the numbers and the smallest bound that
-            works (built and checked) when a larger one helps.
+            message names the joint, the numbers and a bound that works (built
+            and checked) when a larger one helps, in under a second.
         ValueError: malformed input (segments that do not meet, a bad bound, …).
     """
     bound = _bound(max_deviation)
