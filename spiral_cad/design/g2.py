@@ -425,7 +425,7 @@ def _refusal_message(refusal: _Refusal, segments: list[Segment], bound: float, c
 
 #: The time a refusal may take, its advice included (a bound that works, found on the joint's
 #: neighbourhood and built on the whole path).
-ADVICE_SECONDS = 0.9
+ADVICE_SECONDS = 0.6
 
 
 def _advice(segments: list[Segment], joint: int, bound: float, closed: bool | None, shape: str, units: str,
