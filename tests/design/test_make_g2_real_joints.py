@@ -268,3 +268,20 @@ def test_splits_are_named_with_their_reason():
     sharp = make_g2([Line((0, 0), (5, 0)), Line((5, 0), (0, 0.2)), Line((0, 0.2), (0, 4))], 0.01)
     assert sharp.splits == [0] and "sharper than" in sharp.split_joints[0].moved
     assert make_g2(filleted_rectangle(), 0.01).describe_splits() == ""
+
+
+@settings(max_examples=20, deadline=None)
+@given(moves=st.lists(_move, min_size=2, max_size=5), kinks=st.lists(_kink, min_size=5, max_size=5), bound_exp=st.integers(-3, -1))
+def test_make_g2_of_a_random_result_changes_nothing(moves, kinks, bound_exp):
+    segments = _kinked_walk(moves, [0.0, *kinks[1:]])
+    bound = 10.0**bound_exp
+    try:
+        first = make_g2(segments, bound)
+    except NoSolutionError:
+        return
+    for chain in first.chains:
+        again = make_g2(chain, bound, closed=False)
+        assert again.deviation == 0.0 and {j.kind for j in again.joints} <= {"g2"}
+        assert [type(s) for s in again.chain] == [type(s) for s in chain]
+        u = np.linspace(0.0, 1.0, 5)
+        assert all(np.array_equal(a.point(u), b.point(u)) for a, b in zip(chain, again.chain))
