@@ -787,6 +787,9 @@ def make_g2(target: Wire | Face | Sketch | Curve, max_deviation: float, shape: s
 
     Returns the same kind as given, every wire of it made G2 (a face's holes
     included). A wire that reverses is split there into G2 parts that meet.
+    BEZIER edges whose joints are G2 (its own spirals, a ``ContinuousRectangle``)
+    are kept, so applying it twice changes nothing; near-tangent joints (kinks
+    of 1e-7 … 1e-3 rad, as exported drawings have) are made G2 too.
 
     Args:
         target: a planar ``Wire``, ``Face``, ``Sketch`` or ``Curve``.

@@ -89,7 +89,8 @@ PIP_CAD = 'pip install "spiral_cad[cad]"'
 
 
 def _write_design(design: dict | str, out: Path, plots: bool, extra: Callable[[Path], None] | None = None,
-                  max_offset: float | None = None, directions: str = "auto", prebuilt: Callable[[], tuple] | None = None) -> int:  # fmt: skip
+                  max_offset: float | None = None, directions: str = "auto", prebuilt: Callable[[], tuple] | None = None,
+                  allow_splits: bool = True) -> int:  # fmt: skip
     from .designfile import build, criteria_tables, summary, write
 
     started = time.perf_counter()
@@ -107,14 +108,22 @@ def _write_design(design: dict | str, out: Path, plots: bool, extra: Callable[[P
         if tables:
             print(tables + "\n")
         print(summary(built, units))
-        for b in built:  # "G2 (…)": the level the STEP file was checked at
-            note_worst((b.continuity or "").split(" ", 1)[0])
+        for b in built:  # "G2 (…)": the level the STEP file was checked at (G0: a part of a split path)
+            note_worst((getattr(b, "shown_continuity", None) or b.continuity or "").split(" ", 1)[0])
         print(f"\nwrote {len(written.files)} files to {out}/ in {time.perf_counter() - started:.1f} s")
     except KeyboardInterrupt:
         raise KeyboardInterrupt(f"every file had been written to {out}/") from None
     if written.skipped:
         print(f"error: not written: {'; '.join(written.skipped)}. Install the CAD extra: {PIP_CAD}", file=sys.stderr)
         return 2
+    split = list(dict.fromkeys(name for b in built for name in getattr(b, "split_at", ())))
+    if split:
+        print(f"\n{len(split)} split(s) left a kink (G0) where the parts meet:")
+        for name in split:
+            print(f"  {name}")
+        if not allow_splits:
+            print("FAIL: the path was split, so it is not G2 where the parts meet (pass --allow-splits to accept the parts)")
+            return 1
     return 0
 
 
@@ -226,6 +235,7 @@ def _build_g2(args: argparse.Namespace, suffix: str) -> int:
         prebuilt=lambda: g2_designs(
             args.design, deviation, name=args.name, units=args.units, source_units=args.units, shape=args.shape or "near-linear"
         ),
+        allow_splits=args.allow_splits,
     )
 
 
@@ -597,6 +607,9 @@ def _parser() -> argparse.ArgumentParser:
     build.add_argument("--g2", type=float, metavar="D",
                        help="LandXML or OpenDRIVE: make every alignment of lines and arcs G2 within D (its unit; "
                             "make_g2: arcs kept true arcs, spirals between), one design per alignment or road")  # fmt: skip
+    build.add_argument("--allow-splits", action="store_true",
+                       help="DXF, LandXML, OpenDRIVE (made G2): accept a path split into G2 parts (at a reversal or a corner "
+                            "too sharp; G0 where the parts meet) and exit 0; without it such a build exits 1")  # fmt: skip
     build.add_argument("--directions", choices=["auto", "east-ccw", "north-cw"], default="auto",
                        help="LandXML: how the file counts directions: counter-clockwise from east or clockwise from north "
                             "(default auto: told from the file's own points)")  # fmt: skip

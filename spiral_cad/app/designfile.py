@@ -771,7 +771,8 @@ def summary(built: list[Built], units: str) -> str:
     for b in built:
         peak = max(max(abs(seg.start_curvature), abs(seg.end_curvature)) for seg in b.chain)  # spirals are monotone
         shapes = sorted({seg.shape or "not stated" for seg in b.chain if isinstance(seg, BezierSpiral)}) or ["-"]
-        rows.append((b.name, b.kind, "+".join(shapes), len(b.chain), b.chain.length, peak, f" {b.continuity or '-'}"))
+        shown = getattr(b, "shown_continuity", None) or b.continuity or "-"  # a part of a split path: G0 at the splits
+        rows.append((b.name, b.kind, "+".join(shapes), len(b.chain), b.chain.length, peak, f" {shown}"))
     lines = fixed_columns(columns, rows)
     lines += [f"{b.name}: {b.road_3d}" for b in built if b.road_3d]
     lines += [f"{b.name}: {b.fit.line()}" for b in built if isinstance(b, BuiltFit | BuiltRoadFit)]

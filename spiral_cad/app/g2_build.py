@@ -34,10 +34,21 @@ class BuiltG2(Built):
     what: str
     notes: tuple[str, ...] = ()
     road: bool = False
+    #: The joints where the path this design is a part of was split (G0 there), in words; empty: made whole.
+    split_at: tuple[str, ...] = ()
 
     @property
     def kind(self) -> str:
-        return f"G2 path ({self.what})"
+        return f"G2 path ({self.what})" if not self.split_at else f"part of a split path ({self.what})"
+
+    @property
+    def shown_continuity(self) -> str:
+        """The continuity to print: the part's own, and G0 at the splits of its path (never "G2" alone for a
+        part whose path was split)."""
+        own = self.continuity or "-"
+        if not self.split_at:
+            return own
+        return f"G0 at {len(self.split_at)} split(s) of its path; this part {own}"
 
 
 def g2_designs(path: str | Path, max_deviation: float, *, name: str | None = None, units: str | None = None,
@@ -86,7 +97,7 @@ def _dxf(source: Path, deviation: float, name: str | None, units: str | None, so
 
     drawing = read_dxf_paths(source, units=units, drawing_units=source_units)
     stem = name or _stem(source.stem, "drawing")
-    made: list[tuple[Any, Any, list[str]]] = []
+    made: list[tuple[Any, Any, list[str], tuple[str, ...]]] = []
     for k, p in enumerate(drawing.paths):
         made += _made(
             list(p.segments), deviation, p.closed, shape, drawing.units, f"{drawing.source}: path {k + 1} (entity {p.handles[0]})"
@@ -95,26 +106,32 @@ def _dxf(source: Path, deviation: float, name: str | None, units: str | None, so
     return drawing.units, built
 
 
-def _made(segments: list, deviation: float, closed: bool, shape: str, units: str, where: str) -> list[tuple[Any, Any, list[str]]]:
-    """(chain, G2Path, notes) of every G2 path ``make_g2`` makes of ``segments``."""
+def _made(
+    segments: list, deviation: float, closed: bool, shape: str, units: str, where: str
+) -> list[tuple[Any, Any, list[str], tuple[str, ...]]]:
+    """(chain, G2Path, notes, splits named) of every G2 path ``make_g2`` makes of ``segments``."""
+    named: list[str] = []
     try:
-        results, splits = made_g2(segments, deviation, closed=closed, shape=shape, units=units, where=where)
+        results, splits = made_g2(segments, deviation, closed=closed, shape=shape, units=units, where=where, named=named)
     except ValueError as error:
         raise DesignError(str(error)) from None
     worst = max(r.deviation for r in results)
     notes = [f"within {worst:.3g} {units} of {where} (max_deviation {deviation:g})"]
-    if splits:
-        notes.append(f"split at {splits} corner(s) next to an arc (make_g2 rounds corners between lines)")
+    named += [f"{where}: {r.describe_splits()}" for r in results if r.split_joints]
+    notes += [f"SPLIT, G0 at the split: {name}" for name in named]
     chains = [(chain, r) for r in results for chain in r.chains]
-    if len(chains) > len(results):
-        notes.append(f"split into {len(chains)} G2 paths where it folds back")
-    return [(chain, r, notes if k == 0 else []) for k, (chain, r) in enumerate(chains)]
+    return [(chain, r, notes if k == 0 else [], tuple(named)) for k, (chain, r) in enumerate(chains)]
 
 
 def made_g2(segments: list, bound: float, *, closed: bool | None = None, shape: str = "near-linear", units: str = "mm",
-            where: str = "path") -> tuple[list[Any], int]:  # fmt: skip
+            where: str = "path", named: list[str] | None = None) -> tuple[list[Any], int]:  # fmt: skip
     """``make_g2`` of ``segments``; where it refuses, the path split at every corner next to an arc (a corner
     ``make_g2`` does not round: the machine or the reader stops there) and each part made G2 on its own.
+
+    Args:
+        segments, bound, closed, shape, units: as for ``make_g2``.
+        where: the path's name in messages.
+        named: if given, each such split is appended to it in words (joint, point and why).
 
     Returns:
         The ``G2Path`` of each part, and how many such corners split the path (0: made whole).
@@ -130,6 +147,10 @@ def made_g2(segments: list, bound: float, *, closed: bool | None = None, shape: 
         corners = _arc_corners(segments, closed=bool(closed))
         if not corners:
             raise type(refused)(f"{where}: {refused}") from None
+        why = str(refused)
+    if named is not None:
+        named += [f"{where}: joint {j} at ({segments[j].end[0]:.10g}, {segments[j].end[1]:.10g}), a corner next to an arc, "
+                  f"split because the whole path was refused ({why})" for j in corners]  # fmt: skip
     if closed:  # open the loop at the first such corner
         first = corners[0] + 1
         segments = segments[first:] + segments[:first]
@@ -163,9 +184,10 @@ def _arc_corners(segments: list, closed: bool = False) -> list[int]:
 def _named(made: list, stem: str, what: str, notes: tuple[str, ...] = (), road: bool = False) -> list[Built]:
     """One ``BuiltG2`` per chain, named ``stem`` or ``stem_1``, ``stem_2`` …"""
     built: list[Built] = []
-    for k, (chain, result, own) in enumerate(made):
+    for k, (chain, result, own, split_at) in enumerate(made):
         label = stem if len(made) == 1 else f"{stem}_{k + 1}"
-        built.append(BuiltG2(name=label, chain=chain, source=result, what=what, notes=(*(notes if k == 0 else ()), *own), road=road))
+        built.append(BuiltG2(name=label, chain=chain, source=result, what=what, notes=(*(notes if k == 0 else ()), *own), road=road,
+                             split_at=split_at))  # fmt: skip
     return built
 
 

@@ -34,15 +34,18 @@ def g2_wire(
     """The wire made G2 within ``max_deviation`` (``make_g2``), and the numeric result.
 
     A wire split at reversals stays one wire: its parts meet there (G0 at the
-    split, G2 everywhere else).
+    split, G2 everywhere else). Cubic Bézier edges (make_g2's own spirals, and a
+    builder's B-spline merges of them) are kept as they are: a wire made G2 is
+    returned unchanged by a second call.
 
     Raises:
-        ValueError: a non-planar wire or an edge that is not a line or arc.
+        ValueError: a non-planar wire, an edge that is not a line, arc or cubic
+            Bézier span, or a kept Bézier edge whose joints are not G2.
         NoSolutionError: a joint that cannot be made G2 within the bound (named,
             with a bound that works).
     """
     frame = planar_frame(wire) if frame is None else frame
-    segments, closed = wire_path(wire, frame)
+    segments, closed = wire_path(wire, frame, spirals=True)  # spirals (BEZIER edges, their B-spline merges) are kept
     result = make_g2(segments, max_deviation, closed=closed, shape=shape)
     pieces: list[Segment] = [s for chain in result.chains for s in chain]
     return chain_wire(pieces, frame), result

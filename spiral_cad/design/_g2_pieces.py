@@ -10,6 +10,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.typing import NDArray
 
+from ..core import _kernels as K
 from ..core.segments import TAU, Arc, Line, Segment
 
 #: The share of a line's length or an arc's sweep one joint may use when the other end has a joint too.
@@ -106,26 +107,63 @@ def _turn(a: _Piece, b: _Piece) -> float:
     return math.atan2(ta[0] * tb[1] - ta[1] * tb[0], float(np.dot(ta, tb)))
 
 
-def _same_circle(a: _Piece, b: _Piece, scale: float) -> bool:
-    return (a.r > 0) == (b.r > 0) and abs(a.r - b.r) <= 1e-9 * abs(a.r) and math.dist(a.c, b.c) <= 1e-9 * scale
+def _circle_offset(a: _Piece, b: _Piece) -> float:
+    """How far the circle of arc ``b`` lies from the circle of arc ``a`` (centres apart plus radii apart):
+    every point of ``b`` moves at most this far when it is taken onto ``a``'s circle."""
+    return math.dist(a.c, b.c) + abs(abs(a.r) - abs(b.r))
 
 
-def _classify(a: _Piece, b: _Piece, scale: float, steepest: float, bound: float) -> str:
+def _same_circle(a: _Piece, b: _Piece, scale: float, bound: float) -> bool:
+    """Whether arcs ``a`` and ``b`` turn the same way on one circle: to 1e-9 of the path's size, or to
+    ``MERGE_SHARE`` of the bound (a hole cut as arcs whose centres the program rounded)."""
+    if (a.r > 0) != (b.r > 0):
+        return False
+    return _circle_offset(a, b) <= max(1e-9 * max(abs(a.r), scale), MERGE_SHARE * bound)
+
+
+def _near_tangent(a: _Piece, b: _Piece, turn: float, bound: float) -> bool:
+    """Whether a joint that turns by ``turn`` is made G2 as a tangent joint: below ``TANGENT_TOL``, or a
+    small kink (as CAD and CAM files have, 1e-7 … 1e-3 rad) whose circles overlap by less than
+    ``NEAR_SHARE`` of the bound (r·turn²/2 for the largest radius beside it), so that the shifts of the
+    transition absorb it; the result's measured deviation includes it."""
+    if abs(turn) <= TANGENT_TOL:
+        return True
+    radius = max(abs(p.r) for p in (a, b) if p.kind == "arc")
+    return abs(turn) <= NEAR_MAX and 0.5 * radius * turn * turn <= NEAR_SHARE * bound
+
+
+def _nested_defect(a: _Piece, b: _Piece, shape: int) -> float:
+    """How far two arcs of the same sense are from touching inside each other (centres apart minus radii
+    apart), as a share of the band of the nested-circle spiral between them (0: touching; ≥ 1: no nested
+    spiral after any shift; equal radii: infinite)."""
+    rs, rb = sorted((abs(a.r), abs(b.r)))
+    if not rb - rs > 1e-12 * rb:
+        return math.inf
+    width = (rb - rs) * (1.0 / K.nested_band_lower(rs / rb, shape) - 1.0)
+    return abs(math.dist(a.c, b.c) - (rb - rs)) / width
+
+
+def _classify(a: _Piece, b: _Piece, scale: float, steepest: float, bound: float, shape: int = K.NEAR_LINEAR) -> str:
     """The joint from piece ``a`` to ``b``: ``g2``, ``line-arc``, ``arc-arc-…``, ``corner`` or ``split``."""
     turn = _turn(a, b)
     if abs(turn) > steepest:
         return "split"
-    if abs(turn) > TANGENT_TOL:
-        return "corner"
     if a.kind == "line" and b.kind == "line":
+        if abs(turn) > TANGENT_TOL:
+            return "corner"
         # Merged into one line only when the joint point lies within a thousandth of the bound of it.
         la, lb = a.size, b.size
         drop = la * lb / (la + lb) * abs(math.sin(turn))
         return "g2" if drop <= 1e-3 * bound else "corner"
+    if a.kind == "arc" and b.kind == "arc" and abs(turn) <= NEAR_MAX and _same_circle(a, b, scale, bound):
+        return "g2"
+    if not _near_tangent(a, b, turn, bound):
+        return "corner"
     if a.kind == "arc" and b.kind == "arc":
-        if _same_circle(a, b, scale):
-            return "g2"
-        return "arc-arc-compound" if (a.r > 0) == (b.r > 0) else "arc-arc-reverse"
+        if (a.r > 0) != (b.r > 0):
+            return "arc-arc-reverse"
+        # A kinked compound joint: its circles cross; the nested spiral needs them to touch (to a share of its band).
+        return "arc-arc-compound" if abs(turn) <= TANGENT_TOL or _nested_defect(a, b, shape) <= NESTED_SHARE else "corner"
     return "line-arc"
 
 
@@ -133,10 +171,42 @@ def _classify(a: _Piece, b: _Piece, scale: float, steepest: float, bound: float)
 TANGENT_TOL = 1e-7
 
 
+#: A kink up to this (radians) may be made G2 as a tangent joint (see ``_near_tangent``).
+NEAR_MAX = 0.02
+
+
+#: ... when the circles beside it overlap by at most this share of the bound.
+NEAR_SHARE = 0.1
+
+
+#: A kinked compound joint is made G2 as tangent when its circles touch to this share of the nested band.
+NESTED_SHARE = 0.25
+
+
+#: Arcs of one circle (to this share of the bound) are merged into one arc.
+MERGE_SHARE = 0.25
+
+
+def _merge_error(a: _Piece, b: _Piece) -> float:
+    """How far ``_merge(a, b)`` moves the points of ``a`` and ``b``: b's circle off a's, or the joint point off
+    the line from a's start to b's end."""
+    if a.kind != "line":
+        return _circle_offset(a, b)
+    d = b.b - a.a
+    length = math.hypot(*d)
+    return abs(float(d[0] * (a.b - a.a)[1] - d[1] * (a.b - a.a)[0])) / length if length > 0.0 else 0.0
+
+
 def _merge(a: _Piece, b: _Piece) -> _Piece:
+    """``a`` and its G2 neighbour ``b`` as one piece: a line from a's start to b's end, or an arc on a's
+    circle from a's start to b's end (b's points move by at most ``_circle_offset(a, b)``)."""
     if a.kind == "line":
-        return _Piece("line", a.first, b.last, a=a.a, b=b.b)
-    return _Piece("arc", a.first, b.last, c=a.c, r=a.r, a0=a.a0, sweep=min(a.sweep + b.sweep, TAU))
+        return _Piece("line", a.first, b.last, a=a.a, b=b.b, spent=max(a.spent, b.spent))
+    start, end = b.start(), b.end()
+    gap = a.sense * _wrap(math.atan2(start[1] - a.c[1], start[0] - a.c[0]) - a.a1)
+    drift = a.sense * _wrap(math.atan2(end[1] - a.c[1], end[0] - a.c[0]) - (a.a1 + a.sense * (gap + b.sweep)))
+    sweep = a.sweep + gap + b.sweep + drift
+    return _Piece("arc", a.first, b.last, c=a.c, r=a.r, a0=a.a0, sweep=min(max(sweep, 0.0), TAU), spent=max(a.spent, b.spent))
 
 
 @dataclass
@@ -194,6 +264,8 @@ def _used_rows(pieces: list[_Piece], points: NDArray, at_end: bool) -> NDArray:
 class _Refusal(Exception):
     """A joint that cannot be made G2 within the bound (its index in the group and the reason)."""
 
-    def __init__(self, joint: int, reason: str, larger_helps: bool):
+    def __init__(self, joint: int, reason: str, larger_helps: bool, smaller_helps: bool = True):
         super().__init__(reason)
         self.joint, self.reason, self.larger_helps = joint, reason, larger_helps
+        #: Whether a smaller share of the bound may work (not when the transitions are too small to hold G2).
+        self.smaller_helps = smaller_helps

@@ -36,6 +36,10 @@ BOUND_MARGIN = 1e-6
 MAX_SHRINK = 0.5
 
 
+#: A joint whose circles' shifts have shrunk below this share of their first try is refused.
+SMALLEST_FACTOR = 1e-6
+
+
 #: Passes of shrinking the shifts that overrun a line or an arc before a joint is refused.
 PASSES = 60
 
@@ -238,6 +242,8 @@ def _solve(group: _Group) -> tuple[list[_Solved | None], list[float]]:
                 over[k] = min(over.get(k, 1.0), 0.5)
         for k, factor in over.items():
             group.factor[k] *= factor
+        if failed and all(group.factor[k] < SMALLEST_FACTOR for j in failed for k in _joint_circles(group, j)):
+            break  # shifts this small find no transition either: the failing joint is refused now
     s = group.shifts()
     solved = group.solve_joints(s)
     for j, joint in enumerate(solved):

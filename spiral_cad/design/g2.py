@@ -35,6 +35,7 @@ from __future__ import annotations
 
 import gc
 import math
+import time
 from collections.abc import Iterator, Sequence
 from contextlib import contextmanager
 from dataclasses import dataclass, field
@@ -46,19 +47,34 @@ from ..core._inputs import as_float, as_real_array
 from ..core.chain import JOIN_TOLERANCE, Chain, g2_mismatch, join_tolerance
 from ..core.errors import JointError, NoSolutionError
 from ..core.segments import TAU, Arc, Line, Segment
-from ..core.shapes import TRANSITION_SHAPES, shape_code
+from ..core.shapes import SHAPE_CODES, TRANSITION_SHAPES, shape_code
 from ..core.space import PlaneFrame
 from ..core.spiral import BezierSpiral
 from ..core.units import DEFAULT_UNITS, length_unit
+from ._g2_kept import _KeptRefusal, is_kept, make_kept
 from ._g2_measure import _deviation
-from ._g2_pieces import EPS, TANGENT_TOL, _classify, _merge, _Piece, _piece_ends, _piece_of, _Refusal, _shown_point, _Solved
+from ._g2_pieces import (
+    EPS,
+    TANGENT_TOL,
+    _circle_offset,
+    _classify,
+    _merge,
+    _merge_error,
+    _Piece,
+    _piece_ends,
+    _piece_of,
+    _Refusal,
+    _shown_point,
+    _Solved,
+    _turn,
+)
 from ._g2_solve import _arc_corners, _bridge_short_lines, _Group, _solve
 from .rounding import _steepest_deflection
 
 __all__ = ["TANGENT_TOL", "G2Joint", "G2Path", "make_g2", "smallest_max_deviation"]
 
 #: The largest gap between segments that make_g2 closes, as a share of the bound.
-GAP_SHARE = 0.1
+GAP_SHARE = 0.5
 
 JOINT_KINDS = ("line-arc", "arc-arc-compound", "arc-arc-reverse", "corner", "g2", "split")
 
@@ -115,6 +131,20 @@ class G2Path:
     units: str = DEFAULT_UNITS
 
     @property
+    def split_joints(self) -> list[G2Joint]:
+        """The joints where the path was split (a reversal, or a corner sharper than a spiral pair
+        rounds): the parts meet there with a kink (G0); ``moved`` says why."""
+        return [j for j in self.joints if j.kind == "split"]
+
+    def describe_splits(self) -> str:
+        """The splits in words (empty when none): how many, and each joint, point and reason."""
+        splits = self.split_joints
+        if not splits:
+            return ""
+        named = "; ".join(f"joint {j.index} at {_shown_point(j.point)}: {j.moved.removeprefix('split here: ')}" for j in splits)
+        return f"split into {len(self.chains)} G2 parts at {len(splits)} joint(s), G0 there ({named})"
+
+    @property
     def chain(self) -> Chain:
         """The one chain of an unsplit path.
 
@@ -133,12 +163,12 @@ def _path_segments(path: Any) -> tuple[list[Segment], PlaneFrame | None]:
     if isinstance(path, Chain):
         path = list(path)
     if isinstance(path, Sequence) and path and all(isinstance(s, Segment) for s in path):
-        for i, s in enumerate(path):
-            if not isinstance(s, (Line, Arc)):
-                raise ValueError(f"make_g2 takes a path of lines and arcs; segment {i} is a {type(s).__name__}")
         segments = list(path)
         if all(s.dim == 2 for s in segments):
             return segments, None
+        for i, s in enumerate(segments):
+            if is_kept(s):
+                raise ValueError(f"make_g2 keeps spirals of a path in the plane (2-D); segment {i} is a {type(s).__name__} in space")
         return _planar(segments)
     points = as_real_array(path, "path")
     if points.ndim != 2 or len(points) < 2 or points.shape[1] not in (2, 3):
@@ -224,11 +254,11 @@ def _assemble(group: _Group, solved: list[_Solved | None], s: list[float], units
     except JointError as error:
         where = owners[error.joint + 1] if isinstance(segments[error.joint + 1], BezierSpiral) else owners[error.joint]
         detail = str(error).split("): ", 1)[-1]
-        raise _Refusal(max(where, 0), f"float64 cannot hold its transition G2 at these coordinates and sizes ({detail})", True) from None
+        raise _Refusal(max(where, 0), f"its transition does not join G2 ({detail})", True) from None
     if group.closed:
         problem = g2_mismatch(segments[-1], segments[0], chain.tolerance, units, len(segments) - 1)
         if problem:
-            raise _Refusal(n - 1, f"float64 cannot close the path G2: {problem}", True)
+            raise _Refusal(n - 1, f"the path does not close G2: {problem}", True)
     return chain, _deviation(group, solved, s, used)
 
 
@@ -277,6 +307,11 @@ def make_g2(
     Args:
         path: a sequence of ``Line`` and ``Arc`` meeting end to start (2-D, or
             3-D in one plane), a ``Chain`` of them, or (n, 2|3) polyline points.
+            Other segments (2-D ``BezierSpiral``, e.g. ``make_g2``'s own) are
+            kept as they are when their joints are G2: ``make_g2`` of its own
+            result changes nothing. Near-tangent joints (kinks whose circles
+            overlap by at most a tenth of the bound) are made G2 as tangent
+            ones; arcs of one circle (to a quarter of the bound) are merged.
         max_deviation: the Hausdorff bound: every point of the result lies
             within it of the input and every input point within it of the result.
         closed: whether the path closes (its closing joint is then treated like
@@ -291,19 +326,22 @@ def make_g2(
 
     Raises:
         NoSolutionError: a joint that cannot be made G2 within the bound; the
-            message names the joint, the numbers and the smallest bound that
-            works (built and checked) when a larger one helps.
+            message names the joint, the numbers and a bound that works (built
+            and checked) when a larger one helps, in under a second.
         ValueError: malformed input (segments that do not meet, a bad bound, …).
     """
     bound = _bound(max_deviation)
     shape_code(shape, TRANSITION_SHAPES)
     units = length_unit(units)
     tolerance = join_tolerance(tolerance)
+    started = time.perf_counter()
     segments, frame = _path_segments(path)
     with _collector_paused():
-        result = _make(segments, bound, closed, shape, units, tolerance)
+        result = _build(segments, bound, closed, shape, units, tolerance)
+        if isinstance(result, _Refusal):
+            message = _refusal_message(result, segments, bound, closed, shape, units, tolerance, started + ADVICE_SECONDS)
     if isinstance(result, _Refusal):
-        raise NoSolutionError(_refusal_message(result, segments, bound, closed, shape, units, tolerance)) from None
+        raise NoSolutionError(message) from None
     if frame is not None:
         result = G2Path([c.placed(frame) for c in result.chains], result.deviation,
                         [_placed_joint(j, frame) for j in result.joints], result.splits, result.closed, bound, shape, units)  # fmt: skip
@@ -337,7 +375,7 @@ def smallest_max_deviation(
     floor = 8.0 * EPS * size
     works = _smallest_bound(segments, floor, closed, shape, units, tolerance)
     if works is None:
-        failed = _make(segments, 4.0 * size, closed, shape, units, tolerance)
+        failed = _build(segments, 4.0 * size, closed, shape, units, tolerance)
         reason = _refusal_message(failed, segments, 4.0 * size, closed, shape, units, tolerance) if isinstance(failed, _Refusal) else ""
         raise NoSolutionError(f"no max_deviation up to the path's size makes it G2: {reason}")
     return works
@@ -370,36 +408,80 @@ class _Located(_Refusal):
 
 
 def _refusal_message(refusal: _Refusal, segments: list[Segment], bound: float, closed: bool | None, shape: str, units: str,
-                     tolerance: float) -> str:  # fmt: skip
+                     tolerance: float, deadline: float = math.inf) -> str:  # fmt: skip
     where = f"joint {refusal.joint}"
-    if isinstance(refusal, _Located):
+    if isinstance(refusal, (_Located, _KeptRefusal)):
         where += f" (between segments {refusal.joint} and {(refusal.joint + 1) % len(segments)}) at {_shown_point(refusal.point)}"
     message = f"{where}: cannot be made G2 within max_deviation {bound:.6g} {units}: {refusal.reason}"
     if not refusal.larger_helps:
         return message + "; no larger max_deviation helps"
-    works = _smallest_bound(segments, bound, closed, shape, units, tolerance)
+    works = _advice(segments, refusal.joint, bound, closed, shape, units, tolerance, deadline)
     if works is None:
         return message + "; no max_deviation up to the path's size helps"
+    if math.isnan(works):
+        return message + f"; no larger max_deviation was found to work within {ADVICE_SECONDS:g} s of search"
     return message + f"; max_deviation {works:.3g} {units} works (built and checked)"
 
 
-def _smallest_bound(segments: list[Segment], bound: float, closed: bool | None, shape: str, units: str, tolerance: float) -> float | None:
-    """The smallest bound (to a few per cent) with which the path is made G2, found by building it."""
+#: The time a refusal may take, its advice included (a bound that works, found on the joint's
+#: neighbourhood and built on the whole path).
+ADVICE_SECONDS = 0.6
+
+
+def _advice(segments: list[Segment], joint: int, bound: float, closed: bool | None, shape: str, units: str,
+            tolerance: float, deadline: float = math.inf) -> float | None:  # fmt: skip
+    """A bound larger than ``bound`` with which the whole path is made G2, shown to 3 digits and built with
+    that very number: searched on the few segments about the failing joint (cheap), then built whole; a
+    joint that still fails is searched next. None: none up to the path's size; NaN: none found in time."""
+    deadline = min(deadline, time.perf_counter() + ADVICE_SECONDS)
+    n = len(segments)
+    size = max(float(np.abs(np.array([p for s in segments for p in s.outline()])).max()), 1e-300)
+    ends = np.array([segments[-1].end[:2], segments[0].start[:2]], dtype=float)
+    wraps = closed is True or (closed is None and math.dist(*ends) <= 1e-9 * size)
+    lo = bound
+    for _ in range(8):
+        picks = list(range(joint - 2, joint + 4)) if wraps else list(range(max(joint - 2, 0), min(joint + 4, n)))
+        window = [segments[k % n] for k in picks] if n > len(picks) + 1 else segments
+        works = _smallest_bound(window, lo, False if window is not segments else closed, shape, units, tolerance, deadline)
+        if works is None or math.isnan(works):
+            if window is segments:
+                return works
+            works = 4.0 * lo  # the window alone gives no advice: step on and let the whole path say
+        if works > 4.0 * size:
+            return None
+        made = _build(segments, works, closed, shape, units, tolerance)
+        if not isinstance(made, _Refusal):
+            return works
+        if not made.larger_helps or time.perf_counter() > deadline:
+            return None if not made.larger_helps else math.nan
+        joint, lo = made.joint, works
+    return math.nan
+
+
+def _smallest_bound(segments: list[Segment], bound: float, closed: bool | None, shape: str, units: str, tolerance: float,
+                    deadline: float = math.inf) -> float | None:  # fmt: skip
+    """The smallest bound above ``bound`` (to a few per cent) with which the path is made G2, found by building
+    it, shown to 3 digits rounded up and that very number built; None: none up to the path's size; NaN:
+    ``deadline`` (``time.perf_counter()``) passed."""
     size = max(float(np.abs(np.array([p for s in segments for p in s.outline()])).max()), 1e-300)
     lo, hi = bound, bound
     while True:
         hi *= 4.0
         if hi > 4.0 * size:
             return None
-        made = _make(segments, hi, closed, shape, units, tolerance)
+        if time.perf_counter() > deadline:
+            return math.nan
+        made = _build(segments, hi, closed, shape, units, tolerance, retry=False)
         if not isinstance(made, _Refusal):
             break
         if not made.larger_helps:
             return None
         lo = hi
     for _ in range(6):
+        if time.perf_counter() > deadline:
+            break
         mid = math.sqrt(lo * hi)
-        if isinstance(_make(segments, mid, closed, shape, units, tolerance), _Refusal):
+        if isinstance(_build(segments, mid, closed, shape, units, tolerance, retry=False), _Refusal):
             lo = mid
         else:
             hi = mid
@@ -407,14 +489,26 @@ def _smallest_bound(segments: list[Segment], bound: float, closed: bool | None, 
     for _ in range(8):
         digits = 10.0 ** (math.floor(math.log10(hi)) - 2)
         shown = float(f"{math.ceil(hi / digits) * digits:.3g}")
-        if not isinstance(_make(segments, shown, closed, shape, units, tolerance), _Refusal):
+        if not isinstance(_build(segments, shown, closed, shape, units, tolerance), _Refusal):
             return shown
         hi = 1.25 * shown
     return None
 
 
-def _make(segments: list[Segment], bound: float, closed: bool | None, shape: str, units: str, tolerance: float) -> G2Path | _Refusal:
-    """``make_g2`` of plane segments, or the refusal of its first joint that fails."""
+def _build(segments: list[Segment], bound: float, closed: bool | None, shape: str, units: str, tolerance: float,
+           retry: bool = True) -> G2Path | _Refusal:  # fmt: skip
+    """``make_g2`` of plane segments (spirals and other segments kept as they are), or the refusal of its
+    first joint that fails."""
+    if any(is_kept(s) for s in segments):
+        made: G2Path | _Refusal = make_kept(segments, bound, closed, shape, units, tolerance, _make, G2Path, G2Joint, retry)
+        return made
+    return _make(segments, bound, closed, shape, units, tolerance, retry)
+
+
+def _make(segments: list[Segment], bound: float, closed: bool | None, shape: str, units: str, tolerance: float,
+          retry: bool = True) -> G2Path | _Refusal:  # fmt: skip
+    """``make_g2`` of plane lines and arcs, or the refusal of its first joint that fails (``retry``: a part
+    refused within the bound tried again within smaller shares of it; the advice's search goes without)."""
     pieces = [_piece_of(s, i) for i, s in enumerate(segments)]
     points = np.array([p for s in segments for p in s.outline()])
     scale = float(np.abs(points).max()) or 1.0
@@ -443,7 +537,7 @@ def _make(segments: list[Segment], bound: float, closed: bool | None, shape: str
     steepest = _steepest_deflection(corner_shape)
     count = len(pieces)
     joint_count = count if closed else count - 1
-    kinds = [_classify(pieces[i], pieces[(i + 1) % count], extent, steepest, bound) for i in range(joint_count)]
+    kinds = [_classify(pieces[i], pieces[(i + 1) % count], extent, steepest, bound, SHAPE_CODES[shape]) for i in range(joint_count)]
     # A small gap (arcs of a CNC program end off their circles by the program's rounding) is closed: a
     # transition or tangent circle spans it by construction; two lines at a corner meet half-way. The
     # shifts leave room for it and the deviation adds it.
@@ -454,23 +548,32 @@ def _make(segments: list[Segment], bound: float, closed: bool | None, shape: str
             a.b = b.a = 0.5 * (a.b + b.a)
     spanned = max(gaps, default=0.0) if max(gaps, default=0.0) > 64.0 * EPS * scale else 0.0
     shown = [tuple(point) for point in _piece_ends(pieces)[1].tolist()]  # each joint's point (corners met half-way)
-    room = bound - spanned
     joints: dict[int, G2Joint] = {}
     for i, kind in enumerate(kinds):
         if kind in ("g2", "split"):
-            joints[i] = G2Joint(i, kind, shown[i], "nothing" if kind == "g2" else "split here", 0.0)
+            moved = "nothing" if kind == "g2" else _split_reason(pieces[i], pieces[(i + 1) % count], steepest)
+            joints[i] = G2Joint(i, kind, shown[i], moved, 0.0)
     # Merge G2 neighbours; a closed path starts after a joint that is not G2 (if it has one).
     order = list(range(count))
     if closed:
         cut = next((i for i, k in enumerate(kinds) if k != "g2"), None)
-        if cut is None:  # every joint G2: a full circle or a closed line loop of one direction
-            chain = Chain(segments, tolerance, units)
-            return G2Path([chain], 0.0, [joints[i] for i in sorted(joints)], [], True, bound, shape, units)
+        if cut is None:  # every joint G2: a full circle (of arcs of one circle) or a closed line loop
+            whole = pieces[0]
+            for piece in pieces[1:]:
+                whole = _merge(whole, piece)
+            if whole.kind != "arc" or whole.sweep < TAU - 1e-9:
+                return _Located(0, shown[0], "every joint is G2 but the pieces do not close into one circle", False)
+            off = max(_circle_offset(whole, p) for p in pieces) + spanned
+            if off > bound:
+                return _Located(0, shown[0], f"its arcs lie {off:.3g} off one circle, beyond the bound", True)
+            circle = Arc._of(whole.c.copy(), float(whole.r), float(whole.a0), TAU)
+            return G2Path([Chain([circle], tolerance, units)], off, [joints[i] for i in sorted(joints)], [], True, bound, shape, units)
         order = order[cut + 1 :] + order[: cut + 1]
     groups: list[tuple[list[_Piece], list[str], list[int], bool]] = []
     current: list[_Piece] = []
     current_kinds: list[str] = []
     current_joints: list[int] = []
+    merged_off = 0.0  # how far merging G2 neighbours (arcs of one circle, lines in line) moves the input
     open_path = not closed or "split" in kinds
     if closed and "split" in kinds:  # start the open walk at a split
         cut = kinds.index("split")
@@ -481,6 +584,7 @@ def _make(segments: list[Segment], bound: float, closed: bool | None, shape: str
             joint = (k - 1) % count
             kind = kinds[joint]
             if kind == "g2":
+                merged_off = max(merged_off, _merge_error(current[-1], piece))
                 current[-1] = _merge(current[-1], piece)
                 continue
             if kind == "split":
@@ -496,28 +600,18 @@ def _make(segments: list[Segment], bound: float, closed: bool | None, shape: str
             current_kinds.append(kinds[last])
             current_joints.append(last)
         groups.append((current, current_kinds, current_joints, closed and not open_path))
+    spanned += merged_off
+    room = bound - spanned
+    if not room > 0.0:
+        return _Located(0, shown[0], f"its gaps and the arcs of one circle merged move it {spanned:.3g}, the whole bound", True)
     chains: list[Chain] = []
     deviation = 0.0
     for group_pieces, group_kinds, group_joints, group_closed in groups:
-        try:
-            group_pieces, group_kinds, group_joints = _arc_corners(group_pieces, group_kinds, group_joints, group_closed, room)
-            group_pieces, group_kinds, group_joints, bridges = _bridge_short_lines(group_pieces, group_kinds, group_joints,
-                                                                                   group_closed, room)  # fmt: skip
-            group = _Group(group_pieces, group_kinds, group_closed, room, shape, extent)
-            group.bridges = bridges
-            solved, s = _solve(group)
-            chain, measured = _assemble(group, solved, s, units, tolerance)
-            measured += spanned
-        except _Refusal as refusal:
-            index = group_joints[refusal.joint] if group_joints else 0
-            return _Located(index, shown[index], refusal.reason, refusal.larger_helps)
-        except ValueError as error:
-            index = group_joints[0] if group_joints else 0
-            return _Located(index, shown[index], f"float64 cannot hold the result: {error}", True)
-        if measured > bound:
-            index = group_joints[0] if group_joints else 0
-            return _Located(index, shown[index],
-                            f"the result lies {measured:.6g} from the input, beyond the bound", True)  # fmt: skip
+        made = _solve_group(group_pieces, group_kinds, group_joints, group_closed, room, shape, extent, units, tolerance, spanned,
+                            bound, shown, RETRY_SHARES if retry else ())  # fmt: skip
+        if isinstance(made, _Located):
+            return made
+        chain, measured, group, solved, s, group_pieces, group_kinds, group_joints = made
         chains.append(chain)
         deviation = max(deviation, measured)
         for j, (kind, solved_joint) in enumerate(zip(group_kinds, solved)):
@@ -544,6 +638,58 @@ def _make(segments: list[Segment], bound: float, closed: bool | None, shape: str
     records = [joints[i] for i in sorted(joints)]
     splits = [j.index for j in records if j.kind == "split"]
     return G2Path(chains, deviation, records, splits, bool(closed) and not splits, bound, shape, units)
+
+
+#: A group refused within the room is tried again within this share of it, ... (a result within a smaller
+#: bound is within the larger one: a bound that works stays working when it grows).
+RETRY_SHARES = (0.25, 1.0 / 16.0, 1.0 / 64.0)
+
+
+def _solve_group(pieces: list[_Piece], kinds: list[str], joints: list[int], closed: bool, room: float, shape: str, extent: float,
+                 units: str, tolerance: float, spanned: float, bound: float, shown: list[tuple[float, ...]],
+                 shares: tuple[float, ...] = RETRY_SHARES) -> Any:  # fmt: skip
+    """One group (a part between splits) made G2 within ``room``, or else within a share of it; the first
+    refusal (located on the input) when none works."""
+    first: _Located | None = None
+    for share in (1.0, *shares):
+        group_joints = joints
+        try:
+            group_pieces, group_kinds, group_joints = _arc_corners(pieces, kinds, joints, closed, share * room)
+            group_pieces, group_kinds, group_joints, bridges = _bridge_short_lines(group_pieces, group_kinds, group_joints,
+                                                                                   closed, share * room)  # fmt: skip
+            group = _Group(group_pieces, group_kinds, closed, share * room, shape, extent)
+            group.bridges = bridges
+            solved, s = _solve(group)
+            chain, measured = _assemble(group, solved, s, units, tolerance)
+            measured += spanned
+            if measured > bound:
+                index = group_joints[0] if group_joints else 0
+                raise _Located(index, shown[index], f"the result lies {measured:.6g} from the input, beyond the bound", True)
+        except _Located as refusal:
+            first = first or refusal
+            continue
+        except _Refusal as refusal:
+            index = group_joints[refusal.joint] if group_joints and refusal.joint < len(group_joints) else joints[0] if joints else 0
+            first = first or _Located(index, shown[index], refusal.reason, refusal.larger_helps)
+            if not refusal.smaller_helps:
+                break
+            continue
+        except ValueError as error:
+            index = joints[0] if joints else 0
+            first = first or _Located(index, shown[index], f"the transitions do not join G2: {error}", True)
+            continue
+        return chain, measured, group, solved, s, group_pieces, group_kinds, group_joints
+    assert first is not None
+    return first
+
+
+def _split_reason(a: _Piece, b: _Piece, steepest: float) -> str:
+    """Why the path is split at the joint from ``a`` to ``b``, in words."""
+    turn = abs(_turn(a, b))
+    if turn > math.pi - 1e-6:
+        return f"split here: a reversal (the path turns back on itself, {math.degrees(turn):.6g}°)"
+    return (f"split here: a corner of {math.degrees(turn):.4g}°, sharper than the {math.degrees(steepest):.4g}° "
+            "a spiral pair rounds")  # fmt: skip
 
 
 def _moved(kind: str, a: _Piece, b: _Piece, sa: float, sb: float, solved: _Solved | None) -> str:

@@ -185,3 +185,30 @@ def test_a_bound_below_float64_is_refused_with_a_bound_that_builds(tmp_path, cap
     assert err.startswith("error: ") and "internal error" not in err and "works (built and checked)" in err
     advised = float(err.split("max_deviation ")[-1].split(" ")[0])
     assert main(["build", str(drawing), "--max-deviation", repr(advised), "--no-plots", "--out", str(out)]) == 0
+
+
+def test_a_split_path_is_reported_plainly_and_fails_unless_splits_are_allowed(tmp_path, capsys):
+    """A drawing whose path turns sharper than a spiral pair rounds (a hairpin) is split there: the parts are
+    named as parts, the split is printed with its joint and reason, no part is shown as plain G2, and the
+    build exits 1 unless --allow-splits."""
+    doc = ezdxf.new("R2010")
+    doc.header["$INSUNITS"] = 4
+    msp = doc.modelspace()
+    msp.add_line((0, 0), (20, 0))
+    msp.add_arc((20, 3), 3, 270, 360)
+    msp.add_line((23, 3), (23, 10))
+    msp.add_line((23, 10), (22.9, 0.5))  # back down beside itself: a hairpin
+    path = tmp_path / "hairpin.dxf"
+    doc.saveas(path)
+    _, built = g2_designs(path, 0.01)
+    assert len(built) == 2 and all(b.split_at for b in built)
+    assert all(b.kind.startswith("part of a split path") for b in built)
+    assert "sharper than" in built[0].split_at[0]
+    status = main(["build", str(path), "--max-deviation", "0.01", "-o", str(tmp_path / "out"), "--no-plots"])
+    out = capsys.readouterr().out
+    assert status == 1
+    assert "1 split(s) left a kink (G0)" in out and "FAIL: the path was split" in out
+    rows = [line for line in out.splitlines() if line.startswith("hairpin_") and "part of a split path" in line]
+    assert len(rows) == 2 and all(" G0 at 1 split(s) of its path; this part G2" in row for row in rows)
+    status = main(["build", str(path), "--max-deviation", "0.01", "-o", str(tmp_path / "out2"), "--no-plots", "--allow-splits"])
+    assert status == 0 and "FAIL" not in capsys.readouterr().out

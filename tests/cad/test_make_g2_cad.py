@@ -111,6 +111,31 @@ def test_slot_wire_and_face_with_a_hole_keep_their_kind():
     assert isinstance(curve, Curve) and len(curve.edges()) == len(made_wire.edges())
 
 
+def _edge_points(shape) -> np.ndarray:
+    return np.array([tuple(e.position_at(t)) for e in shape.edges() for t in np.linspace(0.0, 1.0, 9)])
+
+
+def test_make_g2_twice_changes_nothing():
+    """make_g2 of its own output, and of a ContinuousRectangle (BEZIER spirals, CIRCLE arcs), keeps every edge."""
+    from spiral_cad.build123d import ContinuousRectangle
+
+    once = make_g2(fillet(Rectangle(10, 6).vertices(), 1), 0.01)
+    twice = make_g2(once, 0.01)
+    assert [e.geom_type for e in twice.edges()] == [e.geom_type for e in once.edges()]
+    assert np.abs(_edge_points(twice) - _edge_points(once)).max() < 1e-9
+    rectangle = ContinuousRectangle(40, 20, 5)
+    made = make_g2(rectangle, 0.1)
+    assert len(made.edges()) == len(rectangle.edges())
+    assert max(_wire_curvature_jumps(made.faces()[0].outer_wire())) < 1e-6
+    assert _hausdorff(made, rectangle) < 1e-9
+    # A kinked joint (a line turned by 1e-4 rad into the arc), as CAD exports have: made G2 too.
+    arc = build123d.CenterArc((10, 5), 5, -90 + math.degrees(1e-4), 90)
+    wire = Wire([build123d.Line((0, 0), arc.edges()[0].position_at(0)), arc.edges()[0]])
+    made_wire = make_g2(wire, 0.01)
+    assert [e.geom_type for e in made_wire.edges()] == [GeomType.LINE, GeomType.BEZIER, GeomType.CIRCLE]
+    assert _hausdorff(made_wire, wire) <= 0.01 * (1 + 1e-6)
+
+
 def test_cadquery_workplane_and_sketch():
     wp = cq.Workplane("XY").slot2D(10, 3).makeG2(0.01)
     solid = wp.extrude(2).val()

@@ -434,12 +434,14 @@ def test_random_paths_with_corners_and_reversals(outcome, moves, scale_exp, boun
 
 def test_small_gaps_are_closed_within_the_bound_and_larger_ones_refused():
     """Arcs whose ends miss their neighbours by a rounding (as a CNC program's arcs do) and lines that
-    miss at a corner: closed, still within the bound; a gap over a tenth of the bound is refused by name."""
+    miss at a corner: closed, still within the bound; a gap over half the bound is refused by name."""
     off = [s if isinstance(s, Line) else Arc(s.center, s.radius * (1 + 2e-4), s.start_angle, s.sweep) for s in filleted_rectangle()]
     result = make_g2(off, 0.01)
     assert_g2(off, result, 0.01, closed=True)
     square = [Line((0, 0), (1, 0)), Line((1, 0.0005), (1, 1)), Line((1, 1), (0, 1))]
     result = make_g2(square, 0.01)
     assert_g2(square, result, 0.01, closed=False)
+    result = make_g2(square, 0.001)  # a gap of half the bound is closed too
+    assert_g2(square, result, 0.001, closed=False)
     with pytest.raises(ValueError, match=r"segments 0 and 1 do not meet.*0\.0005 apart"):
-        make_g2(square, 0.001)
+        make_g2(square, 0.0009)
