@@ -115,10 +115,12 @@ def _circle_offset(a: _Piece, b: _Piece) -> float:
 
 def _same_circle(a: _Piece, b: _Piece, scale: float, bound: float) -> bool:
     """Whether arcs ``a`` and ``b`` turn the same way on one circle: to 1e-9 of the path's size, or to
-    ``MERGE_SHARE`` of the bound (a hole cut as arcs whose centres the program rounded)."""
+    ``MERGE_SHARE`` of the bound (a hole cut as arcs whose centres the program rounded) and within
+    ``MERGE_RELATIVE`` of the smaller radius (a loose bound never makes two different circles one)."""
     if (a.r > 0) != (b.r > 0):
         return False
-    return _circle_offset(a, b) <= max(1e-9 * max(abs(a.r), scale), MERGE_SHARE * bound)
+    offset = _circle_offset(a, b)
+    return offset <= 1e-9 * max(abs(a.r), scale) or offset <= min(MERGE_SHARE * bound, MERGE_RELATIVE * min(abs(a.r), abs(b.r)))
 
 
 def _near_tangent(a: _Piece, b: _Piece, turn: float, bound: float) -> bool:
@@ -171,6 +173,10 @@ def _classify(a: _Piece, b: _Piece, scale: float, steepest: float, bound: float,
 TANGENT_TOL = 1e-7
 
 
+#: A joint whose tangent turns by this much or more (radians) is a reversal: the path is split there.
+REVERSAL = math.pi - 1e-6
+
+
 #: A kink up to this (radians) may be made G2 as a tangent joint (see ``_near_tangent``).
 NEAR_MAX = 0.02
 
@@ -185,6 +191,10 @@ NESTED_SHARE = 0.25
 
 #: Arcs of one circle (to this share of the bound) are merged into one arc.
 MERGE_SHARE = 0.25
+
+
+#: ... and to this share of their smaller radius (a program rounds centres to ~1e-4 of a hole's radius).
+MERGE_RELATIVE = 1e-2
 
 
 def _merge_error(a: _Piece, b: _Piece) -> float:

@@ -263,11 +263,17 @@ def describe_status(status: int) -> str:
 
 
 def _arc_corners(pieces: list[_Piece], kinds: list[str], joints: list[int], closed: bool,
-                 bound: float) -> tuple[list[_Piece], list[str], list[int]]:  # fmt: skip
-    """Each sharp corner next to an arc given a tangent circle (a circular fillet) passing half the bound
-    from the corner point, so that the path is tangent there and its transitions do the rest."""
+                 bound: float, steepest: float = math.pi) -> tuple[list[_Piece], list[str], list[int]]:  # fmt: skip
+    """Each sharp corner next to an arc, or turning more than a spiral pair rounds (``steepest``), given a
+    tangent circle (a circular fillet) passing half the bound from the corner point, so that the path is
+    tangent there and its transitions do the rest."""
     n = len(pieces)
-    corners = [j for j, kind in enumerate(kinds) if kind == "corner" and "arc" in (pieces[j].kind, pieces[(j + 1) % n].kind)]
+    corners = [
+        j
+        for j, kind in enumerate(kinds)
+        if kind == "corner"
+        and ("arc" in (pieces[j].kind, pieces[(j + 1) % n].kind) or abs(_turn(pieces[j], pieces[(j + 1) % n])) > steepest)
+    ]
     if not corners:
         return pieces, kinds, joints
     pieces = [_Piece(p.kind, p.first, p.last, p.a.copy(), p.b.copy(), p.c.copy(), p.r, p.a0, p.sweep) for p in pieces]

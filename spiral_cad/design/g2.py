@@ -55,6 +55,7 @@ from ._g2_kept import _KeptRefusal, is_kept, make_kept
 from ._g2_measure import _deviation
 from ._g2_pieces import (
     EPS,
+    REVERSAL,
     TANGENT_TOL,
     _circle_offset,
     _classify,
@@ -132,8 +133,8 @@ class G2Path:
 
     @property
     def split_joints(self) -> list[G2Joint]:
-        """The joints where the path was split (a reversal, or a corner sharper than a spiral pair
-        rounds): the parts meet there with a kink (G0); ``moved`` says why."""
+        """The joints where the path was split (a reversal, or a sharp corner where no tangent circle
+        fits between its neighbours): the parts meet there with a kink (G0); ``moved`` says why."""
         return [j for j in self.joints if j.kind == "split"]
 
     def describe_splits(self) -> str:
@@ -297,8 +298,10 @@ def make_g2(
     circle shrunk about its centre by the shift the spiral needs; arc → arc:
     an S for a reverse curve, the nested-circle spiral for a compound one);
     sharp corners between lines get a spiral pair within the bound (as
-    ``round_corners`` with ``max_deviation``); at a reversal, or a corner
-    sharper than a spiral pair rounds, the path is split and each part made
+    ``round_corners`` with ``max_deviation``); a corner next to an arc, or
+    sharper than a spiral pair rounds, gets a tangent circle passing within
+    the bound and a transition on each side. At a reversal (or where no such
+    circle fits between its neighbours) the path is split and each part made
     G2 on its own. The shifts use the bound (gentlest transitions) as far as
     the arcs' sweeps and the lines' lengths allow (each joint may use up to
     45 % of a line or arc it shares with another joint). Arcs stay ``Arc``
@@ -506,9 +509,13 @@ def _build(segments: list[Segment], bound: float, closed: bool | None, shape: st
 
 
 def _make(segments: list[Segment], bound: float, closed: bool | None, shape: str, units: str, tolerance: float,
-          retry: bool = True) -> G2Path | _Refusal:  # fmt: skip
+          retry: bool = True, round_sharp: bool = True) -> G2Path | _Refusal:  # fmt: skip
     """``make_g2`` of plane lines and arcs, or the refusal of its first joint that fails (``retry``: a part
-    refused within the bound tried again within smaller shares of it; the advice's search goes without)."""
+    refused within the bound tried again within smaller shares of it; the advice's search goes without).
+
+    A corner sharper than a spiral pair rounds (but not a reversal) gets a tangent circle within the
+    bound and a transition on each side (``round_sharp``); where that fails, the path is made again
+    split at those corners, as before."""
     pieces = [_piece_of(s, i) for i, s in enumerate(segments)]
     points = np.array([p for s in segments for p in s.outline()])
     scale = float(np.abs(points).max()) or 1.0
@@ -538,6 +545,10 @@ def _make(segments: list[Segment], bound: float, closed: bool | None, shape: str
     count = len(pieces)
     joint_count = count if closed else count - 1
     kinds = [_classify(pieces[i], pieces[(i + 1) % count], extent, steepest, bound, SHAPE_CODES[shape]) for i in range(joint_count)]
+    sharp = [i for i, kind in enumerate(kinds) if kind == "split" and abs(_turn(pieces[i], pieces[(i + 1) % count])) < REVERSAL]
+    if round_sharp:
+        for i in sharp:
+            kinds[i] = "corner"
     # A small gap (arcs of a CNC program end off their circles by the program's rounding) is closed: a
     # transition or tangent circle spans it by construction; two lines at a corner meet half-way. The
     # shifts leave room for it and the deviation adds it.
@@ -608,8 +619,10 @@ def _make(segments: list[Segment], bound: float, closed: bool | None, shape: str
     deviation = 0.0
     for group_pieces, group_kinds, group_joints, group_closed in groups:
         made = _solve_group(group_pieces, group_kinds, group_joints, group_closed, room, shape, extent, units, tolerance, spanned,
-                            bound, shown, RETRY_SHARES if retry else ())  # fmt: skip
+                            bound, shown, steepest, RETRY_SHARES if retry else ())  # fmt: skip
         if isinstance(made, _Located):
+            if round_sharp and sharp:  # the tangent circles did not fit: split at those corners instead
+                return _make(segments, bound, closed, shape, units, tolerance, retry, round_sharp=False)
             return made
         chain, measured, group, solved, s, group_pieces, group_kinds, group_joints = made
         chains.append(chain)
@@ -646,7 +659,7 @@ RETRY_SHARES = (0.25, 1.0 / 16.0, 1.0 / 64.0)
 
 
 def _solve_group(pieces: list[_Piece], kinds: list[str], joints: list[int], closed: bool, room: float, shape: str, extent: float,
-                 units: str, tolerance: float, spanned: float, bound: float, shown: list[tuple[float, ...]],
+                 units: str, tolerance: float, spanned: float, bound: float, shown: list[tuple[float, ...]], steepest: float,
                  shares: tuple[float, ...] = RETRY_SHARES) -> Any:  # fmt: skip
     """One group (a part between splits) made G2 within ``room``, or else within a share of it; the first
     refusal (located on the input) when none works."""
@@ -654,7 +667,7 @@ def _solve_group(pieces: list[_Piece], kinds: list[str], joints: list[int], clos
     for share in (1.0, *shares):
         group_joints = joints
         try:
-            group_pieces, group_kinds, group_joints = _arc_corners(pieces, kinds, joints, closed, share * room)
+            group_pieces, group_kinds, group_joints = _arc_corners(pieces, kinds, joints, closed, share * room, steepest)
             group_pieces, group_kinds, group_joints, bridges = _bridge_short_lines(group_pieces, group_kinds, group_joints,
                                                                                    closed, share * room)  # fmt: skip
             group = _Group(group_pieces, group_kinds, closed, share * room, shape, extent)
@@ -686,7 +699,7 @@ def _solve_group(pieces: list[_Piece], kinds: list[str], joints: list[int], clos
 def _split_reason(a: _Piece, b: _Piece, steepest: float) -> str:
     """Why the path is split at the joint from ``a`` to ``b``, in words."""
     turn = abs(_turn(a, b))
-    if turn > math.pi - 1e-6:
+    if turn >= REVERSAL:
         return f"split here: a reversal (the path turns back on itself, {math.degrees(turn):.6g}°)"
     return (f"split here: a corner of {math.degrees(turn):.4g}°, sharper than the {math.degrees(steepest):.4g}° "
             "a spiral pair rounds")  # fmt: skip

@@ -188,7 +188,7 @@ def test_a_bound_below_float64_is_refused_with_a_bound_that_builds(tmp_path, cap
 
 
 def test_a_split_path_is_reported_plainly_and_fails_unless_splits_are_allowed(tmp_path, capsys):
-    """A drawing whose path turns sharper than a spiral pair rounds (a hairpin) is split there: the parts are
+    """A drawing whose path folds straight back (a reversal) is split there: the parts are
     named as parts, the split is printed with its joint and reason, no part is shown as plain G2, and the
     build exits 1 unless --allow-splits."""
     doc = ezdxf.new("R2010")
@@ -197,13 +197,13 @@ def test_a_split_path_is_reported_plainly_and_fails_unless_splits_are_allowed(tm
     msp.add_line((0, 0), (20, 0))
     msp.add_arc((20, 3), 3, 270, 360)
     msp.add_line((23, 3), (23, 10))
-    msp.add_line((23, 10), (22.9, 0.5))  # back down beside itself: a hairpin
+    msp.add_line((23, 10), (23, 4))  # straight back down over itself: a reversal (a sharp corner would be rounded)
     path = tmp_path / "hairpin.dxf"
     doc.saveas(path)
     _, built = g2_designs(path, 0.01)
     assert len(built) == 2 and all(b.split_at for b in built)
     assert all(b.kind.startswith("part of a split path") for b in built)
-    assert "sharper than" in built[0].split_at[0]
+    assert "reversal" in built[0].split_at[0]
     status = main(["build", str(path), "--max-deviation", "0.01", "-o", str(tmp_path / "out"), "--no-plots"])
     out = capsys.readouterr().out
     assert status == 1

@@ -12,6 +12,7 @@ from hypothesis import strategies as st
 from test_make_g2 import arcs_kept, assert_g2, filleted_rectangle
 
 from spiral_cad import Arc, BezierSpiral, Line, NoSolutionError
+from spiral_cad.core.chain import g2_mismatch
 from spiral_cad.design import make_g2
 
 
@@ -265,9 +266,24 @@ def test_splits_are_named_with_their_reason():
     assert "reversal" in folded.split_joints[0].moved
     text = folded.describe_splits()
     assert text.startswith("split into 2 G2 parts at 1 joint(s)") and "joint 0 at (5, 0)" in text
-    sharp = make_g2([Line((0, 0), (5, 0)), Line((5, 0), (0, 0.2)), Line((0, 0.2), (0, 4))], 0.01)
-    assert sharp.splits == [0] and "sharper than" in sharp.split_joints[0].moved
     assert make_g2(filleted_rectangle(), 0.01).describe_splits() == ""
+
+
+@pytest.mark.parametrize("turn", [100.0, 135.0, 170.0, 179.9])
+def test_a_corner_sharper_than_a_spiral_pair_rounds_gets_a_tangent_circle_not_a_split(turn):
+    """A drawing's 135° corner is rounded (spiral, arc, spiral) within the bound, not split with a kink."""
+    t = math.radians(turn)
+    segments = [Line((0, 0), (5, 0)), Line((5, 0), (5 + 5 * math.cos(t), 5 * math.sin(t)))]
+    made = make_g2(segments, 0.01)
+    assert made.splits == [] and len(made.chains) == 1
+    chain = made.chain
+    assert [type(piece).__name__ for piece in chain][1:-1].count("Arc") <= 1
+    assert made.deviation <= 0.01
+    for a, b in zip(chain, chain[1:]):
+        assert g2_mismatch(a, b, chain.tolerance) is None
+    # An independent measure of the deviation: the corner point's distance to the dense G2 path.
+    dense = chain.point_at(np.linspace(0.0, chain.length, 20_001))
+    assert float(np.hypot(*(dense - (5.0, 0.0)).T).min()) <= 0.01 * (1 + 1e-9)
 
 
 @settings(max_examples=20, deadline=None)

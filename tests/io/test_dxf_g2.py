@@ -101,7 +101,7 @@ def test_a_path_make_g2_refuses_is_kept_and_named(tmp_path):
     doc = ezdxf.new("R2010")
     doc.header["$INSUNITS"] = 4
     msp = doc.modelspace()
-    msp.add_lwpolyline([(0, 0), (10, 0), (0, 0.001)])  # folds back on itself: a cusp in the middle
+    msp.add_lwpolyline([(0, 0), (10, 0), (2, 0)])  # folds straight back on itself: a reversal in the middle
     msp.add_text("kept")
     doc.saveas(tmp_path / "fold.dxf")
     report = rewrite_dxf_g2(tmp_path / "fold.dxf", tmp_path / "out.dxf", 0.01)
