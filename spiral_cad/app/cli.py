@@ -569,7 +569,7 @@ def _add_g2(sub: argparse._SubParsersAction) -> None:
 def _g2(args: argparse.Namespace) -> int:
     from .g2_document import make_document_g2
 
-    options: dict[str, Any] = {"dialect": args.dialect}
+    options: dict[str, object] = {"dialect": args.dialect}
     if args.units:
         options["units"] = args.units
     report = make_document_g2(args.input, args.output, args.max_deviation, **options)

@@ -422,7 +422,7 @@ class _Rewriter:
         start, end = np.array(moves[0].start), np.array(moves[-1].end)
         size = max(float(np.abs(np.array([p for s in segments for p in s.outline()])).max()), 1.0)
         tiny = 1e-9 * size
-        closed = bool(np.linalg.norm(start - end) <= tiny)
+        closed = bool(np.linalg.norm(start - end) <= tiny) and _mid_line(segments[-1], segments[0])
         chains: list[Chain] | None = None
         made = None
         if closed:
@@ -475,6 +475,15 @@ class _Rewriter:
             return None
         run.deviation = deviation
         return out
+
+
+def _mid_line(last: Segment, first: Segment) -> bool:
+    """Whether a closed run's entry lies inside a straight side (its last and first moves lines of one direction):
+    only then can the run be made G2 all round and still start there."""
+    if not (isinstance(last, Line) and isinstance(first, Line)):
+        return False
+    a, b = np.asarray(last.end) - np.asarray(last.start), np.asarray(first.end) - np.asarray(first.start)
+    return bool(np.dot(a, b) > 0.0 and abs(a[0] * b[1] - a[1] * b[0]) <= 1e-12 * float(np.dot(a, a) + np.dot(b, b)))
 
 
 def _started_at(chain: Chain, point: Any, tiny: float) -> list[Chain] | None:
