@@ -170,7 +170,9 @@ def judge(input_text: str, output_text: str, bound: float, folder: str | None = 
     distance = 0.0
     if a.samples and b.samples:
         pa, pb = np.concatenate(a.samples), np.concatenate(b.samples)
-        distance = max(float(cKDTree(pb).query(pa)[0].max()), float(cKDTree(pa).query(pb)[0].max()))
+        far = 4.0 * bound  # nearer than this is measured; farther is reported as infinite (a fast query)
+        distance = max(float(cKDTree(pb).query(pa, distance_upper_bound=far)[0].max()),
+                       float(cKDTree(pa).query(pb, distance_upper_bound=far)[0].max()))  # fmt: skip
         if distance > bound + step:
             reasons.append(f"cutting paths {distance:.4g} apart, beyond {bound:g}")
     elif bool(a.samples) != bool(b.samples):

@@ -547,7 +547,8 @@ def _build_inputs(args: argparse.Namespace) -> int:
 
 def _add_g2(sub: argparse._SubParsersAction) -> None:
     g2 = sub.add_parser(
-        "g2", help="a document made G2 in place: the same document back (a CNC program: same lines, runs of cuts G2)",
+        "g2",
+        help="a document made G2 in place: the same document back (a CNC program: same lines, runs of cuts G2)",
         description="Make a document G2 in place within --max-deviation: one file in, one file out, kind by suffix "
         "(G-code .nc .ngc .gcode .tap; DXF and LandXML not yet). A CNC program keeps every line that is not a cutting "
         "move as it is (rapids, plunges, retracts, tool, spindle, coolant, dwells, stops, probes, comments); each run of "

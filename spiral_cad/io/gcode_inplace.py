@@ -45,7 +45,7 @@ import numpy as np
 
 from ..core.chain import Chain
 from ..core.errors import NoSolutionError
-from ..core.segments import Arc, Line, Segment
+from ..core.segments import Line, Segment
 from .gcode_paths import _arc
 from .gcode_write import DIALECTS, gcode_program
 from .progress import Progress
@@ -275,7 +275,7 @@ class _Rewriter:
             match = re.match(r"(\s*/?\s*(?:[Nn]\s*\d+)?\s*)", line)
             head = match.group(1) if match else ""
             code = motion
-            line = f"{head}G{code // 10}{'.' + str(code % 10) if code % 10 else ''} {line[len(head):]}"
+            line = f"{head}G{code // 10}{'.' + str(code % 10) if code % 10 else ''} {line[len(head) :]}"
             self.notes.append(f"a motion code put in front of a line that moved by the mode a rewritten run changed: {line.strip()}")
         self.out.append(line)
         if motion_codes or (has_axes and not non_modal):
