@@ -146,7 +146,7 @@ class GcodeG2Report:
                            f"{r.deviation:.3g} {unit}, {r.joints_changed} joints changed{split}")  # fmt: skip
             elif r.status == "kept":
                 out.append(f"{self.source} {where}: {r.moves} moves kept as they are: {r.reason}")
-        out += [f"{self.source}: kept {note}" for note in self.notes]
+        out += [f"{self.source}: {note}" for note in self.notes]
         made = sum(r.status == "G2" for r in self.runs)
         out.append(f"{self.source}: {made} of {len(self.runs)} runs made G2 within {self.max_deviation:g} {unit} "
                    f"(measured {self.deviation:.3g} {unit}), {len(self.kept)} kept for a reason, "

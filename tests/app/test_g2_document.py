@@ -135,3 +135,15 @@ def test_cli_strict_and_kinds_not_yet(tmp_path, capsys):
         rewriter_for("road.xml")
     with pytest.raises(ValueError, match="is the input"):
         make_document_g2(src, src, 0.01)
+
+
+def test_a_line_moving_by_the_modal_code_keeps_its_motion():
+    """A rewritten run may end with another motion code than the input's: a later line that moves by the
+    modal code gets the input's code in front (else it would run as the output's last code)."""
+    text = "G21 G90 G17\nG0 X0 Y0 Z0\nG1 X10 Y0 F100\nG3 X10 Y10 I0 J5\nX10 Y20 I0 J5 M8\nM2\n"
+    report = gcode_g2(text, 0.01)
+    assert report.runs[0].status == "G2"
+    assert "G3 X10 Y20 I0 J5 M8" in report.text.splitlines()
+    if rs274_judge.available():
+        verdict = rs274_judge.judge(text, report.text, 0.01)
+        assert verdict.passed, verdict.reasons
