@@ -130,7 +130,8 @@ def test_cli_strict_and_kinds_not_yet(tmp_path, capsys):
     assert main(["g2", str(src), "--max-deviation", "0.01", "-o", str(out), "--strict"]) == 1
     capsys.readouterr()
     assert main(["g2", str(tmp_path / "plate.dxf"), "--max-deviation", "0.01", "-o", str(tmp_path / "p.dxf")]) == 2
-    assert ".dxf" in capsys.readouterr().err and "not yet" in capsys.readouterr().err + "not yet"
+    err = capsys.readouterr().err
+    assert err.startswith("error: ") and ".dxf" in err and "not yet" in err
     with pytest.raises(ValueError, match="not yet"):
         rewriter_for("road.xml")
     with pytest.raises(ValueError, match="is the input"):
