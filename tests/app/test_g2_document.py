@@ -148,3 +148,16 @@ def test_a_line_moving_by_the_modal_code_keeps_its_motion():
     if rs274_judge.available():
         verdict = rs274_judge.judge(text, report.text, 0.01)
         assert verdict.passed, verdict.reasons
+
+
+def test_a_contour_entered_inside_a_side_is_made_g2_all_round():
+    """Entered half-way along a side, the closed contour is made G2 at all 8 joints and still starts there."""
+    text = CONTOUR.replace("G0 X5 Y0", "G0 X30 Y0").replace("G3 X5 Y0 I5 J0", "G3 X5 Y0 I5 J0\nG1 X30 Y0")
+    report = gcode_g2(text, 0.01)
+    assert report.runs[0].status == "G2" and report.runs[0].joints_changed == 8
+    lines = report.text.splitlines()
+    cut = [l for l in lines if re.match(r"G[1235] X", l)]
+    assert cut[-1] == "G1 X30 Y0" and cut[0].startswith("G1 X") and cut[0].endswith(" Y0")
+    if rs274_judge.available():
+        verdict = rs274_judge.judge(text, report.text, 0.01)
+        assert verdict.passed, verdict.reasons
