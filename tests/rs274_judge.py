@@ -124,6 +124,12 @@ def run(text: str, step: float, folder: str | None = None) -> Run:
             result.feeds.add(feed)
             result.feed_moves += 1
             position = end
+        elif name == "NURBS_FEED" and re.search(r"[Gg]\s*0*5\s*\.\s*3", lines[int(number) - 1]):  # G5.2 … G5.3
+            pts = nurbs_samples(lines, int(number) - 1, position, plane, step)
+            result.samples.append(pts)
+            result.feeds.add(feed)
+            result.feed_moves += 1
+            position = pts[-1].copy()
         elif name == "NURBS_FEED":  # a G5 cubic: from the program's words
             words = {k.upper(): float(x.replace(" ", "")) for k, x in WORD.findall(re.sub(r"\([^)]*\)|;.*", "", lines[int(number) - 1]))}
             end = position.copy()
@@ -144,6 +150,53 @@ def run(text: str, step: float, folder: str | None = None) -> Run:
         elif name in MACHINE:
             result.calls.append(f"{name}({args})")
     return result
+
+
+def nurbs_samples(lines: list[str], end_line: int, position: np.ndarray, plane: tuple[int, int, int], step: float) -> np.ndarray:
+    """Points of a LinuxCNC G5.2 … G5.3 NURBS ending on line ``end_line`` (0-based), from the program's words.
+
+    LinuxCNC's definition (``interp_convert.cc``, ``nurbs_additional_functions.cc``): the first control point is
+    where the tool stands (weight P of the G5.2 line when it names no point, else 1); every line naming both plane
+    axes adds a point with weight P; order L when above 3, else 3; knots 0 (k times), 1 … n − k + 1, n − k + 2 (k times).
+    """
+    first, second, normal = plane
+    names = "XYZ"
+    start = end_line
+    while not re.search(r"[Gg]\s*0*5\s*\.\s*2", re.sub(r"\([^)]*\)|;.*", "", lines[start])):
+        start -= 1
+    cps, weights, order = [[position[first], position[second]]], [1.0], 3
+    for k in range(start, end_line):
+        words = {a.upper(): float(x.replace(" ", "")) for a, x in WORD.findall(re.sub(r"\([^)]*\)|;.*", "", lines[k]))}
+        if k == start:
+            if words.get("L", 0) > 3:
+                order = int(words["L"])
+            if not (names[first] in words and names[second] in words) and words.get("P", 0) > 0:
+                weights[0] = words["P"]
+        if names[first] in words and names[second] in words:
+            cps.append([words[names[first]], words[names[second]]])
+            weights.append(words.get("P", 1.0))
+    p, w, kk = np.array(cps), np.array(weights), order
+    n = len(p) - 1
+    knots = np.array([0.0] * kk + list(range(1, n - kk + 2)) + [n - kk + 2.0] * kk)
+    size = float(np.linalg.norm(np.diff(p, axis=0), axis=1).sum())
+    u = np.linspace(0.0, knots[-1], max(2, math.ceil(size / step) * 4) + 1)
+    basis = np.zeros((len(u), len(knots) - 1))
+    for i in range(len(knots) - 1):  # order 1: half-open spans, the last one closed
+        last = knots[i + 1] == knots[-1] and knots[i] < knots[i + 1]
+        basis[:, i] = (u >= knots[i]) & ((u < knots[i + 1]) | (last & (u == knots[i + 1])))
+    for order_now in range(2, kk + 1):  # Cox–de Boor
+        nxt = np.zeros((len(u), len(knots) - order_now))
+        for i in range(len(knots) - order_now):
+            d0, d1 = knots[i + order_now - 1] - knots[i], knots[i + order_now] - knots[i + 1]
+            a = (u - knots[i]) / d0 * basis[:, i] if d0 > 0 else 0.0
+            b = (knots[i + order_now] - u) / d1 * basis[:, i + 1] if d1 > 0 else 0.0
+            nxt[:, i] = a + b
+        basis = nxt
+    weighted = basis * w
+    xy = (weighted @ p) / weighted.sum(axis=1, keepdims=True)
+    out = np.repeat(position[None], len(u), axis=0).astype(float)
+    out[:, first], out[:, second] = xy[:, 0], xy[:, 1]
+    return out
 
 
 @dataclass

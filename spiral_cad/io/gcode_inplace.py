@@ -22,7 +22,8 @@ mode, arc centre mode, feed mode, cutter compensation, motion mode, feed and pos
   the bound. A run ``make_g2`` splits (a reversal, a corner too sharp for the bound) is written part
   after part, its splits counted.
 
-From the first line that uses parameters, expressions, O-words, or text the reader cannot parse, the
+A LinuxCNC NURBS block (``G5.2`` … ``G5.3``) is kept as it is (not yet made G2); the tool ends on its last
+control point, so the cuts after it are rewritten. From the first line that uses parameters, expressions, O-words, or text the reader cannot parse, the
 rest of the program is kept verbatim (its positions are not known without an interpreter); a move of
 a rotary axis (``A``, ``B``, ``C``, ``U``, ``V``, ``W``) is never a cutting line.
 
@@ -66,7 +67,7 @@ _FULL_NGC = re.compile(r"[#\[<@^]|^\s*/?\s*(?:[Nn]\s*\d+\s*)?[Oo]")
 _ROTARY = set("ABCUVW")
 _CUTTING_WORDS = set("GNXYZIJRF")
 #: Motion codes (times ten) that leave the position unknown to this reader.
-_UNKNOWN_AFTER = {280, 300, 382, 383, 384, 385, 330, 331, 52, 53, 62, 730, 760, *range(810, 900, 10)}
+_UNKNOWN_AFTER = {280, 300, 382, 383, 384, 385, 330, 331, 62, 730, 760, *range(810, 900, 10)}
 _NON_MODAL_UNKNOWN = {280, 300, 100, 520, 530, 921, 922, 923}
 
 
@@ -217,6 +218,7 @@ class _Rewriter:
         self.emitted_feed: float = math.nan
         self.first_unit: str | None = units
         self.rotary: list[int] = []  # lines where a rotary axis moves
+        self.last_control: tuple[float, float] | None = None  # the last control point of a NURBS block being read
 
     # ---------------------------------------------------------------- reading
 
@@ -310,6 +312,8 @@ class _Rewriter:
         motion_codes = [c for c in g if c in (0, 10, 20, 30, 50, 51, 52, 53, 62, 800, 330, 331) or 382 <= c <= 385 or 730 <= c <= 890]
         if motion_codes:
             s.motion = motion_codes[-1] if motion_codes[-1] != 800 else None
+        if s.motion in (52, 53):  # a NURBS block (G5.2 … G5.3): kept as it is; the tool ends on its last control point
+            return self.nurbs(axes)
         non_modal = [c for c in g if c in (40, 100, 280, 300, 520, 530, 920, 921, 922, 923)]
         if any(c in _NON_MODAL_UNKNOWN for c in non_modal) or (s.motion in _UNKNOWN_AFTER and axes):
             s.position = [None, None, None]
@@ -355,6 +359,22 @@ class _Rewriter:
             segments = list(_arc([a[0], a[1], z], [b[0], b[1], z], 170, centre[0], centre[1], 1 if s.motion == 30 else -1, 1.0, 2, None))
         assert s.units is not None and s.motion is not None
         return _Move(number, segments, a, b, z, s.feed, s.feed_word, s.units, s.motion)
+
+    def nurbs(self, axes: dict[str, float]) -> None:
+        """Follow a G5.2 … G5.3 block (LinuxCNC: control points X Y of the XY plane; G5.3 moves to the last one)."""
+        s = self.state
+        if s.motion == 52 and "X" in axes and "Y" in axes:
+            self.last_control = (axes["X"], axes["Y"])
+        elif s.motion == 53:
+            s.motion = None  # LinuxCNC leaves no motion mode after G5.3
+            if s.plane == 170 and self.last_control is not None:
+                s.position = [self.last_control[0], self.last_control[1], s.position[2]]
+            else:
+                s.position = [None, None, None]
+            self.last_control = None
+        if s.motion == 52 and s.plane != 170:
+            s.position = [None, None, None]
+        return None
 
     @staticmethod
     def centre(a: tuple[float, float], b: tuple[float, float], other: dict[str, float], ccw: bool) -> tuple[float, float] | None:

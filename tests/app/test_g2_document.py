@@ -161,3 +161,31 @@ def test_a_contour_entered_inside_a_side_is_made_g2_all_round():
     if rs274_judge.available():
         verdict = rs274_judge.judge(text, report.text, 0.01)
         assert verdict.passed, verdict.reasons
+
+
+NURBS = """G21 G90 G17 G94
+G0 X10 Y0 Z1
+G1 Z0 F100
+G5.2 P1 L4
+    X10 Y0 P1
+    X20 Y20 P1
+    X12 Y8 P1
+    X10 Y20 P1
+G5.3
+G1 X30 Y20 F300
+G2 X40 Y10 I0 J-10
+G1 X40 Y0
+G0 Z1
+M2
+"""
+
+
+def test_a_nurbs_block_is_kept_and_the_cuts_after_it_are_rewritten():
+    """A G5.2 … G5.3 block (LinuxCNC's NURBS, adapted from its nc_files/nurbs/G5/trident-xy.ngc) is kept as it is;
+    the tool ends on its last control point, so the cuts after it are known and made G2."""
+    report = gcode_g2(NURBS, 0.01)
+    assert "\n".join(NURBS.splitlines()[3:9]) in report.text
+    assert [r.status for r in report.runs] == ["G2"] and report.runs[0].first == 10
+    if rs274_judge.available():  # the judge samples the NURBS from the words, as LinuxCNC defines it
+        verdict = rs274_judge.judge(NURBS, report.text, 0.01)
+        assert verdict.passed, verdict.reasons
