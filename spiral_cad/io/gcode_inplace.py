@@ -313,7 +313,8 @@ class _Rewriter:
         if motion_codes:
             s.motion = motion_codes[-1] if motion_codes[-1] != 800 else None
         if s.motion in (52, 53):  # a NURBS block (G5.2 … G5.3): kept as it is; the tool ends on its last control point
-            return self.nurbs(axes)
+            self.nurbs(axes)
+            return None
         non_modal = [c for c in g if c in (40, 100, 280, 300, 520, 530, 920, 921, 922, 923)]
         if any(c in _NON_MODAL_UNKNOWN for c in non_modal) or (s.motion in _UNKNOWN_AFTER and axes):
             s.position = [None, None, None]
@@ -374,7 +375,6 @@ class _Rewriter:
             self.last_control = None
         if s.motion == 52 and s.plane != 170:
             s.position = [None, None, None]
-        return None
 
     @staticmethod
     def centre(a: tuple[float, float], b: tuple[float, float], other: dict[str, float], ccw: bool) -> tuple[float, float] | None:
