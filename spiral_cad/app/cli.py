@@ -559,7 +559,7 @@ def _add_g2(sub: argparse._SubParsersAction) -> None:
     g2.add_argument("-o", "--output", required=True, help="the output document (same kind)")
     g2.add_argument("--max-deviation", type=float, required=True, metavar="D",
                     help="the largest distance between the input's path and the output's, in the document's unit (G20/G21)")  # fmt: skip
-    g2.add_argument("--dialect", choices=["linuxcnc", "generic"], default="linuxcnc",
+    g2.add_argument("--dialect", choices=["linuxcnc", "generic"],
                     help="G-code: linuxcnc (transitions as G5 cubics, exact; default) or generic (biarcs G2/G3: grbl, Klipper)")  # fmt: skip
     g2.add_argument("--units", choices=["mm", "in"], help="G-code: the unit of a program that says neither G20 nor G21")
     g2.add_argument("--strict", action="store_true",
@@ -570,7 +570,9 @@ def _add_g2(sub: argparse._SubParsersAction) -> None:
 def _g2(args: argparse.Namespace) -> int:
     from .g2_document import make_document_g2
 
-    options: dict[str, object] = {"dialect": args.dialect}
+    options: dict[str, object] = {}  # only what was given: each kind takes its own options
+    if args.dialect:
+        options["dialect"] = args.dialect
     if args.units:
         options["units"] = args.units
     report = make_document_g2(args.input, args.output, args.max_deviation, **options)

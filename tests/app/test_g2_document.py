@@ -189,3 +189,25 @@ def test_a_nurbs_block_is_kept_and_the_cuts_after_it_are_rewritten():
     if rs274_judge.available():  # the judge samples the NURBS from the words, as LinuxCNC defines it
         verdict = rs274_judge.judge(NURBS, report.text, 0.01)
         assert verdict.passed, verdict.reasons
+
+
+def test_another_kind_registers_by_suffix(tmp_path, monkeypatch):
+    """The suffix table takes the rewriters of other kinds (DXF and LandXML come next) without touching the verb."""
+    from spiral_cad.app import g2_document
+
+    monkeypatch.setattr(g2_document, "REWRITERS", dict(g2_document.REWRITERS))
+    seen = []
+
+    class Report:
+        kept: list = []
+        splits = 0
+
+        def lines(self):
+            return ["fake: 1 path made G2"]
+
+    g2_document.register_rewriter((".FAKE",), lambda src, dst, d, **o: seen.append((Path(src).name, d, o)) or Report())
+    (tmp_path / "a.fake").write_text("x")
+    assert main(["g2", str(tmp_path / "a.fake"), "--max-deviation", "0.5", "-o", str(tmp_path / "b.fake")]) == 0
+    assert seen == [("a.fake", 0.5, {})]
+    with pytest.raises(ValueError, match="suffix starts with a dot"):
+        g2_document.register_rewriter(("fake",), print)
