@@ -73,7 +73,8 @@ def run(text: str, step: float, folder: str | None = None) -> Run:
             f.write(program)
         done = subprocess.run(["rs274", "-g", path, os.path.join(tmp, "out")], cwd=folder or tmp, capture_output=True, text=True,
                               stdin=subprocess.DEVNULL, timeout=600)  # fmt: skip
-        said = [m for m in done.stderr.splitlines() if m.strip() and m.strip() != "executing"]
+        # (a parameter file it cannot update is said on stderr, and is no refusal of the program)
+        said = [m for m in done.stderr.splitlines() if m.strip() and m.strip() != "executing" and "variable file" not in m]
         if done.returncode or said:
             raise RuntimeError(f"rs274 refused it: {' / '.join(said[:2])}")
         with open(os.path.join(tmp, "out")) as f:
