@@ -15,6 +15,8 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
+from ..io.gcode_inplace import GCODE_SUFFIXES
+
 __all__ = ["REWRITERS", "make_document_g2", "register_rewriter", "rewriter_for"]
 
 Rewriter = Callable[..., Any]
@@ -44,7 +46,7 @@ def _gcode(src: str | os.PathLike, dst: str | os.PathLike, max_deviation: float,
     return rewrite_gcode_g2(src, dst, max_deviation, **options)
 
 
-register_rewriter((".nc", ".ngc", ".gcode", ".tap"), _gcode)
+register_rewriter(GCODE_SUFFIXES, _gcode)
 
 
 def rewriter_for(path: str | os.PathLike) -> Rewriter:
