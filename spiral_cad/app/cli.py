@@ -555,6 +555,43 @@ def _build_inputs(args: argparse.Namespace) -> int:
     return _run_many(args, _build, files, changes, "built")
 
 
+def _add_g2(sub: argparse._SubParsersAction) -> None:
+    g2 = sub.add_parser(
+        "g2",
+        help="a document made G2 in place: the same document back (a CNC program: same lines, runs of cuts G2)",
+        description="Make a document G2 in place within --max-deviation: one file in, one file out, kind by suffix "
+        "(G-code .nc .ngc .gcode .tap; DXF and LandXML not yet). A CNC program keeps every line that is not a cutting "
+        "move as it is (rapids, plunges, retracts, tool, spindle, coolant, dwells, stops, probes, comments); each run of "
+        "G1/G2/G3 cuts in XY at one Z and one feed is made G2 (make_g2: arcs kept), its first and last points and its "
+        "feed kept. A run that cannot be made G2 within the bound is kept as it is and named in the report.",
+    )
+    g2.add_argument("input", help="the document (.nc .ngc .gcode .tap)")
+    g2.add_argument("-o", "--output", required=True, help="the output document (same kind)")
+    g2.add_argument("--max-deviation", type=float, required=True, metavar="D",
+                    help="the largest distance between the input's path and the output's, in the document's unit (G20/G21)")  # fmt: skip
+    g2.add_argument("--dialect", choices=["linuxcnc", "generic"],
+                    help="G-code: linuxcnc (transitions as G5 cubics, exact; default) or generic (biarcs G2/G3: grbl, Klipper)")  # fmt: skip
+    g2.add_argument("--units", choices=["mm", "in"], help="G-code: the unit of a program that says neither G20 nor G21")
+    g2.add_argument("--strict", action="store_true",
+                    help="exit 1 when anything was kept below G2 for a reason (a run refused or beyond the bound, a split)")  # fmt: skip
+    g2.set_defaults(run=_g2)
+
+
+def _g2(args: argparse.Namespace) -> int:
+    from .g2_document import make_document_g2
+
+    options: dict[str, object] = {}  # only what was given: each kind takes its own options
+    if args.dialect:
+        options["dialect"] = args.dialect
+    if args.units:
+        options["units"] = args.units
+    report = make_document_g2(args.input, args.output, args.max_deviation, **options)
+    for line in report.lines():
+        print(line)
+    print(f"wrote {args.output}")
+    return 1 if args.strict and (report.kept or report.splits) else 0
+
+
 def _schema(args: argparse.Namespace) -> int:
     """``spiral-cad schema``: the JSON Schema of design files, the one description of the format."""
     from .schema import schema_text
@@ -573,6 +610,7 @@ def _parser() -> argparse.ArgumentParser:
             "  spiral-cad build examples/design.json      your own design file (spiral-cad schema prints the format)\n"
             "  spiral-cad build --from-gcode part.nc --max-deviation 0.01   a CNC program rounded G2: STEP and samples\n"
             "  spiral-cad build --from-points survey.csv --tolerance 0.05 --units m   lines, arcs and spirals within 5 cm\n"
+            "  spiral-cad g2 part.nc --max-deviation 0.01 -o part_g2.nc   the same program back, its cuts made G2\n"
             "  spiral-cad check out/highway.step --require G2   G0/G1/G2 at every joint; exit 1 below G2\n"
             "  spiral-cad check out/highway.xodr --require G2 --profiles C1 --links G1   every road, profile and link of an OpenDRIVE map"
         ),
@@ -663,6 +701,7 @@ def _parser() -> argparse.ArgumentParser:
     _add_many(build)
     build.set_defaults(run=_build_inputs)
     _add_check(sub)
+    _add_g2(sub)
     schema = sub.add_parser("schema", help="print the JSON Schema of design files (the format of build)")
     schema.set_defaults(run=_schema)
     return parser

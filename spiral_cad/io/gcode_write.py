@@ -102,6 +102,8 @@ class GcodeProgram:
         chord_error: the largest measured distance between a chorded piece and its chords
             (program unit; 0 when nothing was chorded).
         arc_error: the largest measured distance between a spiral and its biarcs (program unit).
+        moves: the program's move lines alone (no header, no first ``F``, no ``M2``): what a rewrite
+            in place puts into another program.
     """
 
     text: str
@@ -109,6 +111,7 @@ class GcodeProgram:
     counts: dict[str, int] = field(default_factory=dict)
     chord_error: float = 0.0
     arc_error: float = 0.0
+    moves: list[str] = field(default_factory=list)
 
 
 def _positive(value: object, name: str) -> float:
@@ -496,7 +499,7 @@ def gcode_program(
     head.append(f"F{out.number(round(float(per_segment[0]) if len(chain) else feed, decimals))}")
     head = [line if len(line) <= MAX_LINE else line[: MAX_LINE - 4] + "...)" for line in head]
     text = "\n".join(head + body + ["M2", ""])
-    return GcodeProgram(text, program, counts, chord_error * factor, arc_error * factor)
+    return GcodeProgram(text, program, counts, chord_error * factor, arc_error * factor, list(body))
 
 
 def _chord_error(points: NDArray, between: NDArray) -> float:

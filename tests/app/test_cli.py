@@ -104,7 +104,7 @@ def test_malformed_json_names_the_line(tmp_path, capsys):
 def test_help_lists_the_commands():
     run = subprocess.run([sys.executable, "-m", "spiral_cad.app.cli", "--help"], capture_output=True, text=True)
     assert run.returncode == 0
-    for word in ("demo", "build", "check"):
+    for word in ("demo", "build", "check", "g2"):
         assert word in run.stdout
 
 

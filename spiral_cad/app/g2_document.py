@@ -1,0 +1,87 @@
+"""``spiral-cad g2``: a user's document in, the same document out, made G2 (one file in, one file out).
+
+The document's kind is told by its suffix, through ``REWRITERS``: a table from suffix to the function
+that rewrites that kind of document in place, ``function(src, dst, max_deviation, **options) -> report``,
+where the report has ``lines()`` (the short report, one line per path) and ``kept`` (what was kept as
+it was for a reason: a strict run fails on it). G-code programs (``.nc .ngc .gcode .tap``) are
+registered here (``spiral_cad.io.gcode_inplace.rewrite_gcode_g2``); other kinds register with
+``register_rewriter`` (DXF and LandXML come next); any other suffix is an error naming it.
+"""
+
+from __future__ import annotations
+
+import os
+from collections.abc import Callable
+from pathlib import Path
+from typing import Any
+
+from ..io.gcode_inplace import GCODE_SUFFIXES
+
+__all__ = ["REWRITERS", "make_document_g2", "register_rewriter", "rewriter_for"]
+
+Rewriter = Callable[..., Any]
+
+#: Suffix (lower case, with its dot) → the function that makes such a document G2 in place.
+REWRITERS: dict[str, Rewriter] = {}
+#: Kinds of documents announced but not rewritten yet (suffix → what they are).
+NOT_YET = {".dxf": "DXF drawings", ".xml": "LandXML files", ".xodr": "OpenDRIVE files", ".step": "STEP wires",
+           ".stp": "STEP wires", ".igs": "IGES wires", ".iges": "IGES wires"}  # fmt: skip
+
+
+def register_rewriter(suffixes: tuple[str, ...], function: Rewriter) -> None:
+    """Make ``function(src, dst, max_deviation, **options)`` the rewriter of documents ending in ``suffixes``.
+
+    Raises:
+        ValueError: a suffix without its leading dot.
+    """
+    for suffix in suffixes:
+        if not suffix.startswith("."):
+            raise ValueError(f"a suffix starts with a dot; got {suffix!r}")
+        REWRITERS[suffix.lower()] = function
+
+
+def _gcode(src: str | os.PathLike, dst: str | os.PathLike, max_deviation: float, **options: Any) -> Any:
+    from ..io.gcode_inplace import rewrite_gcode_g2
+
+    return rewrite_gcode_g2(src, dst, max_deviation, **options)
+
+
+register_rewriter(GCODE_SUFFIXES, _gcode)
+
+
+def rewriter_for(path: str | os.PathLike) -> Rewriter:
+    """The rewriter of a document, by its suffix.
+
+    Raises:
+        ValueError: a suffix with no rewriter (naming it, and the suffixes that have one).
+    """
+    suffix = Path(path).suffix.lower()
+    if suffix in REWRITERS:
+        return REWRITERS[suffix]
+    known = " ".join(sorted(REWRITERS))
+    if suffix in NOT_YET:
+        raise ValueError(f"{Path(path).name}: {NOT_YET[suffix]} ({suffix}) are not yet made G2 in place; documents that are: {known}")
+    raise ValueError(f"{Path(path).name}: no document kind has the suffix {suffix or '(none)'!r}; documents made G2 in place: {known}")
+
+
+def make_document_g2(src: str | os.PathLike, dst: str | os.PathLike, max_deviation: float, **options: Any) -> Any:
+    """Make the document ``src`` G2 in place within ``max_deviation`` (the document's own unit) and write it to ``dst``.
+
+    Args:
+        src, dst: the input and output files (the output's suffix must be the input's kind).
+        max_deviation: the bound, in the document's unit (a G-code program's G20/G21).
+        options: the kind's own options (G-code: ``dialect``, ``shape``, ``units``).
+
+    Returns:
+        The kind's report (``lines()``: the short report; ``kept``: what was kept for a reason).
+
+    Raises:
+        ValueError: a suffix with no rewriter, an output of another kind, what the rewriter refuses.
+        OSError: a file could not be read or written.
+    """
+    function = rewriter_for(src)
+    if rewriter_for(dst) is not function:
+        raise ValueError(f"the output {Path(dst).name} is not the kind of document {Path(src).name} is")
+    if Path(src).resolve() == Path(dst).resolve():
+        raise ValueError(f"the output {Path(dst).name} is the input: write to another file")
+    return function(src, dst, max_deviation, **options)

@@ -1,0 +1,585 @@
+"""A CNC program made G2 in place: the same program back, its cutting runs G2 within a bound (as ArcWelder does for printers).
+
+``gcode_g2`` reads the program line by line, keeping LinuxCNC's modal state (unit, plane, distance
+mode, arc centre mode, feed mode, cutter compensation, motion mode, feed and position), and:
+
+* keeps every line that is not a cutting move **verbatim and in order**: comments, units, planes,
+  offsets, tool changes, spindle, coolant, dwells, stops, probes (``G38``), rapids (``G0``: the output
+  has exactly the input's rapids), plunges and retracts (a feed move that changes Z), splines;
+* makes each **run** of consecutive cutting lines G2 with ``spiral_cad.design.make_g2`` within
+  ``max_deviation`` (the program's own unit), arcs kept true arcs. A cutting line is a ``G1``, ``G2``
+  or ``G3`` move in the XY plane (``G17``) at constant Z under ``G90``, ``G91.1`` and ``G94``, without
+  cutter compensation, whose words are only ``G1``–``G3``, ``N``, ``X``, ``Y``, ``Z``, ``I``, ``J``,
+  ``R`` and ``F`` (no comment, no other code on the line); a run is such lines one after another at
+  one Z and one feed (a feed change starts a new run, so every move keeps its feed and no feed the
+  input does not use is written);
+* fixes each run's first and last points: the run starts where the input's does (the entry, after
+  the plunge) and ends where it does (before the retract). A closed run whose entry lies on a
+  straight part the transitions leave is made G2 all round and started there; otherwise the run is
+  made G2 as an open path and, when its last arc was shrunk, a straight step (no longer than the
+  arc's shift, so within the bound) returns to the input's end;
+* keeps a run verbatim, naming it and why, when ``make_g2`` refuses it or it cannot be written within
+  the bound. A run ``make_g2`` splits (a reversal, a corner too sharp for the bound) is written part
+  after part, its splits counted.
+
+A LinuxCNC NURBS block (``G5.2`` … ``G5.3``) is kept as it is (not yet made G2); the tool ends on its last
+control point, so the cuts after it are rewritten. From the first line that uses parameters, expressions, O-words, or text the reader cannot parse, the
+rest of the program is kept verbatim (its positions are not known without an interpreter); a move of
+a rotary axis (``A``, ``B``, ``C``, ``U``, ``V``, ``W``) is never a cutting line.
+
+The output dialect is ``spiral_cad.io.gcode_write``'s: ``"linuxcnc"`` (transitions as ``G5`` cubics,
+exact) or ``"generic"`` (biarcs ``G2``/``G3``, for grbl or Klipper, within a fifth of the bound; the
+transitions are then made within the rest). Header comments (after a first ``%``) state the bound,
+the measured deviation and the counts.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import re
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from ..core.chain import Chain
+from ..core.errors import NoSolutionError
+from ..core.segments import Line, Segment
+from .gcode_paths import _arc
+from .gcode_write import DIALECTS, gcode_program
+from .progress import Progress
+
+__all__ = ["GcodeG2Report", "GcodeRun", "gcode_g2", "rewrite_gcode_g2"]
+
+#: Suffixes of the G-code programs ``rewrite_gcode_g2`` takes.
+GCODE_SUFFIXES = (".nc", ".ngc", ".gcode", ".tap")
+#: The share of the bound left to biarcs in the generic dialect.
+BIARC_SHARE = 0.2
+#: Decimals of the numbers written (far below any bound a machine holds).
+DECIMALS = 10
+
+_WORD = re.compile(r"\s*([A-Za-z])\s*([+-]?\s*(?:\d+\.?\d*|\.\d+))", re.ASCII)
+_WORDS = re.compile(r"(?:\s*[A-Za-z]\s*[+-]?\s*(?:\d+\.?\d*|\.\d+))*\s*", re.ASCII)
+_COMMENT = re.compile(r"\([^()]*\)|;.*$")
+_FULL_NGC = re.compile(r"[#\[<@^]|^\s*/?\s*(?:[Nn]\s*\d+\s*)?[Oo]")
+_ROTARY = set("ABCUVW")
+_CUTTING_WORDS = set("GNXYZIJRF")
+#: Motion codes (times ten) that leave the position unknown to this reader.
+_UNKNOWN_AFTER = {280, 300, 382, 383, 384, 385, 330, 331, 62, 730, 760, *range(810, 900, 10)}
+_NON_MODAL_UNKNOWN = {280, 300, 100, 520, 530, 921, 922, 923}
+
+
+@dataclass
+class GcodeRun:
+    """One run of cutting lines and what became of it.
+
+    Attributes:
+        first, last: its first and last line (1-based).
+        moves: its moves.
+        status: ``"G2"`` (rewritten), ``"kept"`` (verbatim: see ``reason``) or ``"nothing to do"``
+            (one move, or every joint G2 already).
+        reason: why it was kept.
+        deviation: the measured distance between the input's path and the output's (both ways; program unit).
+        joints_changed: joints given a transition or rounded.
+        splits: joints ``make_g2`` split at (left as the corners they were).
+        lines_written: the lines written in its place.
+    """
+
+    first: int
+    last: int
+    moves: int
+    status: str = "kept"
+    reason: str = ""
+    deviation: float = 0.0
+    joints_changed: int = 0
+    splits: int = 0
+    lines_written: int = 0
+
+
+@dataclass
+class GcodeG2Report:
+    """What ``gcode_g2`` did to a program.
+
+    Attributes:
+        source: the program's name.
+        text: the output program.
+        max_deviation: the bound (program unit).
+        units: the program's unit.
+        dialect: the output dialect.
+        runs: every run of cutting lines, in order.
+        notes: what else was kept verbatim and why (e.g. lines after parameters).
+    """
+
+    source: str
+    text: str
+    max_deviation: float
+    units: str
+    dialect: str
+    runs: list[GcodeRun] = field(default_factory=list)
+    notes: list[str] = field(default_factory=list)
+
+    @property
+    def deviation(self) -> float:
+        """The largest measured deviation of a rewritten run (program unit)."""
+        return max((r.deviation for r in self.runs if r.status == "G2"), default=0.0)
+
+    @property
+    def kept(self) -> list[GcodeRun]:
+        """The runs kept verbatim for a reason (refused or not within the bound)."""
+        return [r for r in self.runs if r.status == "kept"]
+
+    @property
+    def splits(self) -> int:
+        """Joints left as corners where ``make_g2`` split a run."""
+        return sum(r.splits for r in self.runs)
+
+    def lines(self) -> list[str]:
+        """The short report: one line per run changed or kept, and the totals."""
+        unit = self.units
+        out = []
+        for r in self.runs:
+            where = f"lines {r.first}-{r.last}" if r.last != r.first else f"line {r.first}"
+            if r.status == "G2":
+                split = f", {r.splits} split(s) left as corners" if r.splits else ""
+                out.append(f"{self.source} {where}: {r.moves} moves made G2 ({r.lines_written} lines), deviation "
+                           f"{r.deviation:.3g} {unit}, {r.joints_changed} joints changed{split}")  # fmt: skip
+            elif r.status == "kept":
+                out.append(f"{self.source} {where}: {r.moves} moves kept as they are: {r.reason}")
+        out += [f"{self.source}: {note}" for note in self.notes]
+        made = sum(r.status == "G2" for r in self.runs)
+        out.append(f"{self.source}: {made} of {len(self.runs)} runs made G2 within {self.max_deviation:g} {unit} "
+                   f"(measured {self.deviation:.3g} {unit}), {len(self.kept)} kept for a reason, "
+                   f"{sum(r.status == 'nothing to do' for r in self.runs)} G2 already, {self.splits} splits")  # fmt: skip
+        return out
+
+
+@dataclass
+class _State:
+    units: str | None = None
+    plane: int = 170
+    absolute: bool = True
+    arc_absolute: bool = False
+    feed_mode: int = 940
+    comp: int = 400
+    motion: int | None = None
+    feed: float = math.nan
+    feed_word: str = ""
+    position: list[float | None] = field(default_factory=lambda: [0.0, 0.0, 0.0])
+
+
+@dataclass
+class _Move:
+    number: int
+    segments: list[Segment]
+    start: tuple[float, float]
+    end: tuple[float, float]
+    z: float
+    feed: float
+    feed_word: str
+    units: str
+    motion: int
+
+
+def _number(value: float) -> str:
+    text = f"{value:.{DECIMALS}f}".rstrip("0").rstrip(".")
+    return "0" if text in ("-0", "", "-") else text
+
+
+def _parse(line: str) -> tuple[list[tuple[str, float, str]], bool] | None:
+    """The words of a line (letter, value, as written) and whether it has a comment; None: not plain words."""
+    body = _COMMENT.sub(" ", line)
+    if "(" in body or ")" in body or _FULL_NGC.search(body):
+        return None
+    stripped = body.strip()
+    if stripped.startswith("/"):
+        stripped = stripped[1:]
+    if not _WORDS.fullmatch(stripped):
+        return None
+    words = [(m.group(1).upper(), float(m.group(2).replace(" ", "")), m.group(2).replace(" ", "")) for m in _WORD.finditer(stripped)]
+    return words, body != line
+
+
+def _code(value: float) -> int:
+    return int(round(value * 10))
+
+
+class _Rewriter:
+    def __init__(self, text: str, source: str, bound: float, dialect: str, shape: str, units: str | None):
+        self.source, self.bound, self.dialect, self.shape = source, bound, dialect, shape
+        self.raw = text.replace("\r\n", "\n").replace("\r", "\n").split("\n")
+        self.state = _State(units=units)
+        self.out: list[str] = []
+        self.runs: list[GcodeRun] = []
+        self.notes: list[str] = []
+        self.pending: list[tuple[str, _Move]] = []  # (raw line, move) of the run being gathered
+        self.emitted_motion: int | None = None
+        self.emitted_feed: float = math.nan
+        self.first_unit: str | None = units
+        self.rotary: list[int] = []  # lines where a rotary axis moves
+        self.last_control: tuple[float, float] | None = None  # the last control point of a NURBS block being read
+
+    # ---------------------------------------------------------------- reading
+
+    def run(self) -> None:
+        frozen = False
+        percent = 0
+        progress = Progress(f"g2 {self.source}: lines", len(self.raw))
+        for number, line in enumerate(self.raw, 1):
+            if not number & 0x3FFF:
+                progress(number)
+            if frozen:
+                self.out.append(line)
+                continue
+            if line.strip() == "%":
+                percent += 1
+                self.flush()
+                self.out.append(line)
+                if percent == 2:
+                    frozen = True
+                continue
+            parsed = _parse(line)
+            if parsed is None:
+                self.flush()
+                self.notes.append(f"lines {number}-{len(self.raw)} verbatim: line {number} uses parameters, expressions, "
+                                  "O-words or text that is not plain words (its positions need an interpreter)")  # fmt: skip
+                self.out.append(line)
+                frozen = True
+                continue
+            words, commented = parsed
+            move = self.read(number, words, commented, line.lstrip().startswith("/"))
+            if move is not None and self.pending and (move.feed != self.pending[-1][1].feed or move.z != self.pending[-1][1].z
+                                                      or move.units != self.pending[-1][1].units):  # fmt: skip
+                self.flush()
+            if move is not None:
+                self.pending.append((line, move))
+                continue
+            self.flush()
+            self.verbatim(line, words)
+        self.flush()
+        progress.done(len(self.raw))
+        if self.rotary:
+            shown = ", ".join(map(str, self.rotary[:5])) + (", …" if len(self.rotary) > 5 else "")
+            self.notes.append(f"{len(self.rotary)} line(s) where a rotary axis moves, as they are (line {shown})")
+
+    def verbatim(self, line: str, words: list[tuple[str, float, str]], move: _Move | None = None) -> None:
+        """Keep a line (``move``: a kept cutting line's move); put the input's motion code in front when it moves by the
+        modal code and the output's differs."""
+        motion = self.state.motion if move is None else move.motion
+        feed = self.state.feed if move is None else move.feed
+        g = {_code(v) for letter, v, _ in words if letter == "G"}
+        has_axes = any(letter in "XYZABCUVW" for letter, _, _ in words)
+        motion_codes = {c for c in g if c in (0, 10, 20, 30, 50, 51, 52, 53, 62, 382, 383, 384, 385, 330, 331, 800)
+                        or 730 <= c <= 890}  # fmt: skip
+        non_modal = g & {40, 100, 280, 300, 520, 530, 920}
+        if has_axes and not motion_codes and not non_modal and motion is not None and self.emitted_motion != motion:
+            match = re.match(r"(\s*/?\s*(?:[Nn]\s*\d+)?\s*)", line)
+            head = match.group(1) if match else ""
+            code = motion
+            line = f"{head}G{code // 10}{'.' + str(code % 10) if code % 10 else ''} {line[len(head) :]}"
+            self.notes.append(f"a motion code put in front of a line that moved by the mode a rewritten run changed: {line.strip()}")
+        self.out.append(line)
+        if motion_codes or (has_axes and not non_modal):
+            self.emitted_motion = motion
+        if any(letter == "F" for letter, _, _ in words):
+            self.emitted_feed = feed
+
+    def read(self, number: int, words: list[tuple[str, float, str]], commented: bool, deleted: bool) -> _Move | None:
+        """Update the state with a line; the line's move when it is a cutting line."""
+        s = self.state
+        g = [_code(v) for letter, v, _ in words if letter == "G"]
+        axes = {letter: v for letter, v, _ in words if letter in "XYZABCUVW"}
+        other = {letter: v for letter, v, _ in words if letter in "IJKRP"}
+        start = list(s.position)
+        for c in g:
+            if c in (200, 210):
+                s.units = "in" if c == 200 else "mm"
+                self.first_unit = self.first_unit or s.units
+            elif c in (170, 180, 190):
+                s.plane = c
+            elif c in (900, 910):
+                s.absolute = c == 900
+            elif c in (901, 911):
+                s.arc_absolute = c == 901
+            elif c in (930, 940, 950):
+                s.feed_mode = c
+            elif c in (400, 410, 411, 420, 421):
+                s.comp = c
+        for letter, v, written in words:
+            if letter == "F":
+                s.feed, s.feed_word = v, written
+        motion_codes = [c for c in g if c in (0, 10, 20, 30, 50, 51, 52, 53, 62, 800, 330, 331) or 382 <= c <= 385 or 730 <= c <= 890]
+        if motion_codes:
+            s.motion = motion_codes[-1] if motion_codes[-1] != 800 else None
+        if s.motion in (52, 53):  # a NURBS block (G5.2 … G5.3): kept as it is; the tool ends on its last control point
+            self.nurbs(axes)
+            return None
+        non_modal = [c for c in g if c in (40, 100, 280, 300, 520, 530, 920, 921, 922, 923)]
+        if any(c in _NON_MODAL_UNKNOWN for c in non_modal) or (s.motion in _UNKNOWN_AFTER and axes):
+            s.position = [None, None, None]
+            return None
+        if 920 in non_modal:
+            for k, letter in enumerate("XYZ"):
+                if letter in axes:
+                    s.position[k] = axes[letter]
+            return None
+        if 40 in non_modal or not axes or s.motion is None:
+            return None
+        end: list[float | None] = list(start)
+        for k, letter in enumerate("XYZ"):
+            if letter in axes:
+                if s.absolute:
+                    end[k] = axes[letter]
+                else:
+                    previous = start[k]
+                    end[k] = None if previous is None else previous + axes[letter]
+        s.position = end
+        if s.motion == 50 and s.absolute:  # a G5 cubic moves X and Y only
+            return None
+        cutting = (
+            s.motion in (10, 20, 30) and not commented and not deleted and s.plane == 170 and s.absolute and s.feed_mode == 940
+            and s.comp == 400 and s.units is not None and math.isfinite(s.feed) and s.feed > 0.0
+            and all(letter in _CUTTING_WORDS for letter, _, _ in words)
+            and all(c in (10, 20, 30) for c in g) and None not in start and None not in end and start[2] == end[2]
+        )  # fmt: skip
+        if any(letter in _ROTARY for letter in axes):
+            self.rotary.append(number)
+            return None
+        if not cutting:
+            return None
+        a = (float(start[0]), float(start[1]))  # type: ignore[arg-type]
+        b = (float(end[0]), float(end[1]))  # type: ignore[arg-type]
+        z = float(start[2])  # type: ignore[arg-type]
+        if s.motion == 10:
+            segments: list[Segment] = [] if a == b else [Line(a, b)]
+        else:
+            centre = self.centre(a, b, other, s.motion == 30)
+            if centre is None:
+                return None
+            segments = list(_arc([a[0], a[1], z], [b[0], b[1], z], 170, centre[0], centre[1], 1 if s.motion == 30 else -1, 1.0, 2, None))
+        assert s.units is not None and s.motion is not None
+        return _Move(number, segments, a, b, z, s.feed, s.feed_word, s.units, s.motion)
+
+    def nurbs(self, axes: dict[str, float]) -> None:
+        """Follow a G5.2 … G5.3 block (LinuxCNC: control points X Y of the XY plane; G5.3 moves to the last one)."""
+        s = self.state
+        if s.motion == 52 and "X" in axes and "Y" in axes:
+            self.last_control = (axes["X"], axes["Y"])
+        elif s.motion == 53:
+            s.motion = None  # LinuxCNC leaves no motion mode after G5.3
+            if s.plane == 170 and self.last_control is not None:
+                s.position = [self.last_control[0], self.last_control[1], s.position[2]]
+            else:
+                s.position = [None, None, None]
+            self.last_control = None
+        if s.motion == 52 and s.plane != 170:
+            s.position = [None, None, None]
+
+    @staticmethod
+    def centre(a: tuple[float, float], b: tuple[float, float], other: dict[str, float], ccw: bool) -> tuple[float, float] | None:
+        """An arc's centre from its I J offsets or its R (None: neither, or an R arc that cannot be)."""
+        if "R" in other:
+            if "I" in other or "J" in other:
+                return None
+            r = other["R"]
+            dx, dy = b[0] - a[0], b[1] - a[1]
+            d = math.hypot(dx, dy)
+            if d == 0.0 or abs(r) < d / 2:
+                return None
+            h = math.sqrt(max(r * r - d * d / 4, 0.0))
+            left = 1.0 if ccw else -1.0
+            if r < 0:
+                left = -left
+            return (a[0] + dx / 2 - left * h * dy / d, a[1] + dy / 2 + left * h * dx / d)
+        if "I" not in other and "J" not in other:
+            return None
+        return (a[0] + other.get("I", 0.0), a[1] + other.get("J", 0.0))
+
+    # ---------------------------------------------------------------- writing
+
+    def flush(self) -> None:
+        """Write the gathered run: made G2, or verbatim."""
+        if not self.pending:
+            return
+        lines = [line for line, _ in self.pending]
+        moves = [move for _, move in self.pending]
+        self.pending = []
+        run = GcodeRun(moves[0].number, moves[-1].number, len(moves))
+        self.runs.append(run)
+        segments = [s for m in moves for s in m.segments]
+        written: list[str] | None = None
+        if len(segments) < 2:
+            run.status = "nothing to do"
+        else:
+            try:
+                written = self.rewrite(run, moves, segments)
+            except (ValueError, NoSolutionError) as error:
+                run.reason = f"make_g2 or the writer refused it: {str(error)[:300]}"
+        if written is None:
+            for line, move in zip(lines, moves):
+                parsed = _parse(line)
+                assert parsed is not None
+                self.verbatim(line, parsed[0], move)
+            return
+        run.status = "G2"
+        run.lines_written = len(written)
+        feed = moves[0].feed
+        if feed != self.emitted_feed:
+            self.out.append(f"F{moves[0].feed_word}")
+        self.out += written
+        self.emitted_feed = feed
+        last = written[-1].split()[0] if written else ""
+        self.emitted_motion = {"G1": 10, "G2": 20, "G3": 30, "G5": 50}.get(last, self.emitted_motion)
+
+    def rewrite(self, run: GcodeRun, moves: list[_Move], segments: list[Segment]) -> list[str] | None:
+        """The lines of a run made G2, or None (``run.status``/``reason`` say why)."""
+        from ..design.g2 import make_g2
+
+        units = moves[0].units
+        bound = self.bound if self.first_unit in (None, units) else self.bound * (25.4 if self.first_unit == "in" else 1 / 25.4)
+        g2_bound = bound * (1.0 - BIARC_SHARE) if self.dialect == "generic" else bound
+        start, end = np.array(moves[0].start), np.array(moves[-1].end)
+        size = max(float(np.abs(np.array([p for s in segments for p in s.outline()])).max()), 1.0)
+        tiny = 1e-9 * size
+        closed = bool(np.linalg.norm(start - end) <= tiny) and _mid_line(segments[-1], segments[0])
+        chains: list[Chain] | None = None
+        made = None
+        if closed:
+            try:
+                made = make_g2(segments, g2_bound, closed=True, shape=self.shape, units=units)
+            except (ValueError, NoSolutionError):
+                made = None
+            if made is not None and len(made.chains) == 1:
+                chains = _started_at(made.chains[0], start, tiny)
+        if chains is None:
+            made = make_g2(segments, g2_bound, closed=False, shape=self.shape, units=units)
+            chains = list(made.chains)
+        assert made is not None
+        if all(j.kind == "g2" for j in made.joints):
+            run.status = "nothing to do"
+            return None
+        run.joints_changed = sum(j.kind not in ("g2", "split") for j in made.joints)
+        run.splits = len(made.splits)
+        # the run's ends fixed: a step from the input's entry and to its exit where the path's ends moved
+        pieces: list[list[Segment] | Chain] = []
+        position = start
+        steps = 0.0
+        for chain in chains:
+            gap = float(np.linalg.norm(np.asarray(chain.start) - position))
+            if gap > tiny:
+                pieces.append([Line(tuple(position), tuple(chain.start))])
+                steps = max(steps, gap)
+            pieces.append(chain)
+            position = np.asarray(chain.end)
+        gap = float(np.linalg.norm(end - position))
+        if gap > tiny:
+            pieces.append([Line(tuple(position), tuple(end))])
+            steps = max(steps, gap)
+        out: list[str] = []
+        arc_error = 0.0
+        printing = math.sqrt(2.0) * 10.0**-DECIMALS
+        for piece in pieces:
+            if isinstance(piece, Chain):
+                program = gcode_program(piece, dialect=self.dialect, feed=moves[0].feed, units=units, rapid_to_start=False,
+                                        arc_tolerance=bound * BIARC_SHARE, decimals=DECIMALS)  # fmt: skip
+                arc_error = max(arc_error, program.arc_error)
+                out += program.moves
+            else:
+                line = piece[0]
+                out.append(f"G1 X{_number(line.end[0])} Y{_number(line.end[1])}")
+        # the run ends exactly where the input's did, as the input wrote it
+        deviation = max(made.deviation, steps) + arc_error + printing  # a step lies within its length of the input's end
+        if deviation > bound:
+            run.reason = f"measured {deviation:.3g} {units} from the input, beyond the bound {bound:g} {units}"
+            return None
+        run.deviation = deviation
+        return out
+
+
+def _mid_line(last: Segment, first: Segment) -> bool:
+    """Whether a closed run's entry lies inside a straight side (its last and first moves lines of one direction):
+    only then can the run be made G2 all round and still start there."""
+    if not (isinstance(last, Line) and isinstance(first, Line)):
+        return False
+    a, b = np.asarray(last.end) - np.asarray(last.start), np.asarray(first.end) - np.asarray(first.start)
+    return bool(np.dot(a, b) > 0.0 and abs(a[0] * b[1] - a[1] * b[0]) <= 1e-12 * float(np.dot(a, a) + np.dot(b, b)))
+
+
+def _started_at(chain: Chain, point: Any, tiny: float) -> list[Chain] | None:
+    """A closed chain started at ``point`` when it lies on one of its lines (None: it does not)."""
+    segments = list(chain)
+    for k, s in enumerate(segments):
+        if not isinstance(s, Line):
+            continue
+        a, b = np.asarray(s.start), np.asarray(s.end)
+        d = b - a
+        t = float(np.dot(np.asarray(point) - a, d) / np.dot(d, d))
+        if not 0.0 <= t <= 1.0 or np.linalg.norm(a + t * d - point) > tiny:
+            continue
+        p = tuple(float(v) for v in point)
+        after = [] if np.linalg.norm(b - point) <= tiny else [Line(p, tuple(b))]
+        before = [] if np.linalg.norm(point - a) <= tiny else [Line(tuple(a), p)]
+        ordered = after + segments[k + 1 :] + segments[:k] + before
+        return [Chain(ordered, chain.tolerance, chain.units)]
+    return None
+
+
+def gcode_g2(
+    text: str, max_deviation: float, *, source: str = "G-code", dialect: str = "linuxcnc", shape: str = "near-linear",
+    units: str | None = None,
+) -> GcodeG2Report:  # fmt: skip
+    """A G-code program made G2 in place (see the module docstring): the output text and the report.
+
+    Args:
+        text: the program.
+        max_deviation: the bound, in the program's unit (its first G20/G21).
+        source: its name, for the report.
+        dialect: ``"linuxcnc"`` (G5 cubics) or ``"generic"`` (biarcs: grbl, Klipper).
+        shape: the transitions' shape (``make_g2``'s).
+        units: the unit of a program that states neither G20 nor G21 (``"mm"`` or ``"in"``); None:
+            such a program's runs are kept verbatim.
+
+    Raises:
+        ValueError: a bound that is not positive and finite, an unknown dialect or unit.
+    """
+    if isinstance(max_deviation, bool) or not isinstance(max_deviation, (int, float)) or not 0.0 < max_deviation < math.inf:
+        raise ValueError(f"max_deviation must be a positive finite length; got {max_deviation!r:.40}")
+    if dialect not in DIALECTS:
+        raise ValueError(f"dialect must be one of {', '.join(DIALECTS)}; got {dialect!r:.40}")
+    if units not in (None, "mm", "in"):
+        raise ValueError(f"units must be 'mm' or 'in' (G21 or G20); got {units!r:.40}")
+    rewriter = _Rewriter(text, source, float(max_deviation), dialect, shape, units)
+    rewriter.run()
+    unit = rewriter.first_unit or "mm"
+    report = GcodeG2Report(source, "", float(max_deviation), unit, dialect, rewriter.runs, rewriter.notes)
+    made = sum(r.status == "G2" for r in report.runs)
+    head = [
+        f"(spiral-cad g2: made G2 in place within max deviation {max_deviation:g} {unit}; measured {report.deviation:.3g} {unit})",
+        f"(spiral-cad g2: {made} of {len(report.runs)} runs of cutting moves rewritten, {len(report.kept)} kept as they were, "
+        f"dialect {dialect}; every other line as it was)",
+    ]
+    out = rewriter.out
+    at = 1 if out and out[0].strip() == "%" else 0
+    report.text = "\n".join(out[:at] + head + out[at:])
+    return report
+
+
+def rewrite_gcode_g2(
+    src: str | os.PathLike, dst: str | os.PathLike, max_deviation: float, *, dialect: str = "linuxcnc", shape: str = "near-linear",
+    units: str | None = None,
+) -> GcodeG2Report:  # fmt: skip
+    """Make the G-code program ``src`` G2 in place and write it to ``dst`` (``gcode_g2``): the report.
+
+    Raises:
+        ValueError: as ``gcode_g2``; a file that is not UTF-8 text.
+        OSError: a file could not be read or written.
+    """
+    path = Path(src)
+    try:
+        text = path.read_text(encoding="utf-8")
+    except UnicodeDecodeError as error:
+        raise ValueError(f"{path.name}: not UTF-8 text ({error.reason} at byte {error.start})") from None
+    report = gcode_g2(text, max_deviation, source=path.name, dialect=dialect, shape=shape, units=units)
+    Path(dst).write_text(report.text, encoding="utf-8")
+    return report

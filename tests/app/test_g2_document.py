@@ -1,0 +1,213 @@
+"""``spiral-cad g2`` and ``make_document_g2``: a CNC program comes back as the same program, its cuts made G2.
+
+The judge is LinuxCNC's own interpreter ``rs274`` (``tests/rs274_judge.py``, which shares no code with the
+rewriter): same rapids in the same order, same machine calls, only the input's feeds, and the cutting
+path within the bound both ways.
+"""
+
+from __future__ import annotations
+
+import re
+import sys
+from pathlib import Path
+
+import pytest
+
+from spiral_cad.app.cli import main
+from spiral_cad.app.g2_document import make_document_g2, rewriter_for
+from spiral_cad.io.gcode_inplace import gcode_g2
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+import rs274_judge  # noqa: E402
+
+DATA = Path(__file__).resolve().parents[1] / "data" / "gcode"
+needs_rs274 = pytest.mark.skipif(not rs274_judge.available(), reason="LinuxCNC's rs274 is not installed (make rs274)")
+
+#: The issue's 14-line plate contour: approach, plunge at F200, four lines and four G3 corners at F600, retract.
+CONTOUR = """G21 G90 G17
+G0 Z5
+G0 X5 Y0
+G1 Z-1 F200
+G1 X55 Y0 F600
+G3 X60 Y5 I0 J5
+G1 X60 Y35
+G3 X55 Y40 I-5 J0
+G1 X5 Y40
+G3 X0 Y35 I0 J-5
+G1 X0 Y5
+G3 X5 Y0 I5 J0
+G0 Z5
+M30
+"""
+CUT = re.compile(r"^\s*G[123]\s+X", re.I)
+
+
+def _kept_in_order(before: str, after: str) -> bool:
+    """Every line of ``before`` that is not a cutting move stands in ``after``, verbatim and in order."""
+    rest = iter(after.splitlines())
+    return all(any(line == other for other in rest) for line in before.splitlines() if not CUT.match(line) or "Z" in line)
+
+
+@pytest.mark.parametrize("dialect", ["linuxcnc", "generic"])
+def test_contour_comes_back_as_one_safe_program(dialect):
+    report = gcode_g2(CONTOUR, 0.01, source="contour.nc", dialect=dialect)
+    assert [r.status for r in report.runs] == ["G2"] and report.runs[0].joints_changed >= 7
+    assert 0.0 < report.deviation <= 0.01
+    text = report.text
+    assert _kept_in_order(CONTOUR, text)
+    assert "0.01 mm" in text.splitlines()[0] and "measured" in text.splitlines()[0]
+    # the G0 lines are the input's, and no feed the input does not use
+    assert [l for l in text.splitlines() if l.startswith("G0")] == [l for l in CONTOUR.splitlines() if l.startswith("G0")]
+    assert set(re.findall(r"F([\d.]+)", text)) <= {"200", "600"}
+    assert ("G5 " in text) == (dialect == "linuxcnc")
+
+
+@needs_rs274
+@pytest.mark.parametrize("dialect", ["linuxcnc", "generic"])
+def test_contour_judged_by_rs274(dialect):
+    report = gcode_g2(CONTOUR, 0.01, dialect=dialect)
+    verdict = rs274_judge.judge(CONTOUR, report.text, 0.01)
+    assert verdict.passed, verdict.reasons
+    assert verdict.distance > 0.005  # the path did change (the transitions use the bound)
+    assert verdict.feed_moves[1] > verdict.feed_moves[0]
+
+
+@needs_rs274
+@pytest.mark.parametrize("name", sorted(p.name for p in DATA.glob("*.ngc")))
+def test_linuxcnc_programs_judged_by_rs274(name):
+    path = DATA / name
+    text = path.read_text()
+    report = gcode_g2(text, 0.01, source=name)
+    verdict = rs274_judge.judge(text, report.text, 0.01, folder=str(DATA))
+    assert verdict.passed, (verdict.reasons, report.lines())
+    if name in ("linuxcnc_3dtest.ngc", "linuxcnc_comp.ngc"):  # plain programs: their cuts are rewritten
+        assert any(r.status == "G2" for r in report.runs)
+
+
+@needs_rs274
+def test_judge_sees_a_broken_program():
+    """The judge fails a program with a rapid at cutting depth and a path beyond the bound (what build wrote)."""
+    broken = CONTOUR.replace("G1 X55 Y0 F600", "G0 X55 Y0\nG1 F600").replace("G1 X60 Y35", "G1 X60.1 Y35")
+    verdict = rs274_judge.judge(CONTOUR, broken, 0.01)
+    assert not verdict.passed and any("rapids" in r for r in verdict.reasons)
+
+
+def test_what_is_kept_and_why():
+    text = "\n".join([
+        "G20 G90 G17", "G0 X0 Y0 Z1", "G1 Z0 F10",
+        "G1 X1 Y0", "G1 X2 Y0 A5", "G1 X3 Y1", "G1 X4 Y1 F20", "G1 X4 Y2", "G91", "G1 X1", "G1 Y1", "M2",
+    ])  # fmt: skip
+    report = gcode_g2(text, 0.001, source="t.ngc")
+    assert any("rotary axis" in n for n in report.notes)
+    assert report.units == "in"
+    out = report.text.splitlines()
+    for line in ("G1 X2 Y0 A5", "G91", "G1 X1", "G1 Y1", "G1 Z0 F10"):
+        assert line in out
+    # a feed change starts a new run: the F20 moves keep F20, the F10 ones F10
+    assert set(re.findall(r"F(\d+)", report.text)) <= {"10", "20"}
+
+
+def test_parameters_stop_the_rewrite_by_line():
+    report = gcode_g2("G21\n#1=5\nG0 X0 Y0\nG1 X#1 F100\nM2\n", 0.01)
+    assert report.runs == [] and "line 2" in report.notes[0]
+    assert report.text.endswith("G21\n#1=5\nG0 X0 Y0\nG1 X#1 F100\nM2\n")
+
+
+def test_cli_writes_the_program_and_reports(tmp_path, capsys):
+    src = tmp_path / "contour.nc"
+    src.write_text(CONTOUR)
+    assert main(["g2", str(src), "--max-deviation", "0.01", "-o", str(tmp_path / "out.ngc")]) == 0
+    said = capsys.readouterr().out
+    assert "lines 5-12: 8 moves made G2" in said and "joints changed" in said
+    assert (tmp_path / "out.ngc").read_text().count("\nG0 ") == 3
+
+
+def test_cli_strict_and_kinds_not_yet(tmp_path, capsys):
+    src = tmp_path / "back.nc"  # a cut that goes straight back along itself: split there, left a corner
+    src.write_text("G21\nG0 X0 Y0 Z0\nG1 X10 Y0 F100\nG3 X10 Y10 I0 J5\nG1 X0 Y10\nG1 X10 Y10\nM2\n")
+    out = tmp_path / "back_g2.nc"
+    assert main(["g2", str(src), "--max-deviation", "0.01", "-o", str(out)]) == 0
+    assert main(["g2", str(src), "--max-deviation", "0.01", "-o", str(out), "--strict"]) == 1
+    capsys.readouterr()
+    assert main(["g2", str(tmp_path / "plate.dxf"), "--max-deviation", "0.01", "-o", str(tmp_path / "p.dxf")]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("error: ") and ".dxf" in err and "not yet" in err
+    with pytest.raises(ValueError, match="not yet"):
+        rewriter_for("road.xml")
+    with pytest.raises(ValueError, match="is the input"):
+        make_document_g2(src, src, 0.01)
+
+
+def test_a_line_moving_by_the_modal_code_keeps_its_motion():
+    """A rewritten run may end with another motion code than the input's: a later line that moves by the
+    modal code gets the input's code in front (else it would run as the output's last code)."""
+    text = "G21 G90 G17\nG0 X0 Y0 Z0\nG1 X10 Y0 F100\nG3 X10 Y10 I0 J5\nX10 Y20 I0 J5 M8\nM2\n"
+    report = gcode_g2(text, 0.01)
+    assert report.runs[0].status == "G2"
+    assert "G3 X10 Y20 I0 J5 M8" in report.text.splitlines()
+    if rs274_judge.available():
+        verdict = rs274_judge.judge(text, report.text, 0.01)
+        assert verdict.passed, verdict.reasons
+
+
+def test_a_contour_entered_inside_a_side_is_made_g2_all_round():
+    """Entered half-way along a side, the closed contour is made G2 at all 8 joints and still starts there."""
+    text = CONTOUR.replace("G0 X5 Y0", "G0 X30 Y0").replace("G3 X5 Y0 I5 J0", "G3 X5 Y0 I5 J0\nG1 X30 Y0")
+    report = gcode_g2(text, 0.01)
+    assert report.runs[0].status == "G2" and report.runs[0].joints_changed == 8
+    lines = report.text.splitlines()
+    cut = [l for l in lines if re.match(r"G[1235] X", l)]
+    assert cut[-1] == "G1 X30 Y0" and cut[0].startswith("G1 X") and cut[0].endswith(" Y0")
+    if rs274_judge.available():
+        verdict = rs274_judge.judge(text, report.text, 0.01)
+        assert verdict.passed, verdict.reasons
+
+
+NURBS = """G21 G90 G17 G94
+G0 X10 Y0 Z1
+G1 Z0 F100
+G5.2 P1 L4
+    X10 Y0 P1
+    X20 Y20 P1
+    X12 Y8 P1
+    X10 Y20 P1
+G5.3
+G1 X30 Y20 F300
+G2 X40 Y10 I0 J-10
+G1 X40 Y0
+G0 Z1
+M2
+"""
+
+
+def test_a_nurbs_block_is_kept_and_the_cuts_after_it_are_rewritten():
+    """A G5.2 … G5.3 block (LinuxCNC's NURBS, adapted from its nc_files/nurbs/G5/trident-xy.ngc) is kept as it is;
+    the tool ends on its last control point, so the cuts after it are known and made G2."""
+    report = gcode_g2(NURBS, 0.01)
+    assert "\n".join(NURBS.splitlines()[3:9]) in report.text
+    assert [r.status for r in report.runs] == ["G2"] and report.runs[0].first == 10
+    if rs274_judge.available():  # the judge samples the NURBS from the words, as LinuxCNC defines it
+        verdict = rs274_judge.judge(NURBS, report.text, 0.01)
+        assert verdict.passed, verdict.reasons
+
+
+def test_another_kind_registers_by_suffix(tmp_path, monkeypatch):
+    """The suffix table takes the rewriters of other kinds (DXF and LandXML come next) without touching the verb."""
+    from spiral_cad.app import g2_document
+
+    monkeypatch.setattr(g2_document, "REWRITERS", dict(g2_document.REWRITERS))
+    seen = []
+
+    class Report:
+        kept: list = []
+        splits = 0
+
+        def lines(self):
+            return ["fake: 1 path made G2"]
+
+    g2_document.register_rewriter((".FAKE",), lambda src, dst, d, **o: seen.append((Path(src).name, d, o)) or Report())
+    (tmp_path / "a.fake").write_text("x")
+    assert main(["g2", str(tmp_path / "a.fake"), "--max-deviation", "0.5", "-o", str(tmp_path / "b.fake")]) == 0
+    assert seen == [("a.fake", 0.5, {})]
+    with pytest.raises(ValueError, match="suffix starts with a dot"):
+        g2_document.register_rewriter(("fake",), print)
