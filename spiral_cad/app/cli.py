@@ -560,20 +560,24 @@ def _add_g2(sub: argparse._SubParsersAction) -> None:
         "g2",
         help="a document made G2 in place: the same document back (a CNC program: same lines, runs of cuts G2)",
         description="Make a document G2 in place within --max-deviation: one file in, one file out, kind by suffix "
-        "(G-code .nc .ngc .gcode .tap; DXF and LandXML not yet). A CNC program keeps every line that is not a cutting "
+        "(G-code .nc .ngc .gcode .tap, DXF .dxf, LandXML .xml). A CNC program keeps every line that is not a cutting "
         "move as it is (rapids, plunges, retracts, tool, spindle, coolant, dwells, stops, probes, comments); each run of "
         "G1/G2/G3 cuts in XY at one Z and one feed is made G2 (make_g2: arcs kept), its first and last points and its "
-        "feed kept. A run that cannot be made G2 within the bound is kept as it is and named in the report.",
+        "feed kept. A run that cannot be made G2 within the bound is kept as it is and named in the report. A DXF "
+        "drawing's paths of lines and arcs are written back as LINE, ARC and exact SPLINE pieces on their own layers, every "
+        "other entity kept; a LandXML file's alignments of lines and arcs get spirals, stations recomputed, the rest kept.",
     )
-    g2.add_argument("input", help="the document (.nc .ngc .gcode .tap)")
+    g2.add_argument("input", help="the document (.nc .ngc .gcode .tap, .dxf, .xml)")
     g2.add_argument("-o", "--output", required=True, help="the output document (same kind)")
     g2.add_argument("--max-deviation", type=float, required=True, metavar="D",
                     help="the largest distance between the input's path and the output's, in the document's unit (G20/G21)")  # fmt: skip
     g2.add_argument("--dialect", choices=["linuxcnc", "generic"],
                     help="G-code: linuxcnc (transitions as G5 cubics, exact; default) or generic (biarcs G2/G3: grbl, Klipper)")  # fmt: skip
-    g2.add_argument("--units", choices=["mm", "in"], help="G-code: the unit of a program that says neither G20 nor G21")
+    g2.add_argument("--units", choices=["mm", "cm", "m", "in", "ft"],
+                    help="G-code (mm or in): the unit of a program that says neither G20 nor G21; DXF: the unit of "
+                         "--max-deviation (default the drawing's $INSUNITS; a unitless drawing: drawing units)")  # fmt: skip
     g2.add_argument("--strict", action="store_true",
-                    help="exit 1 when anything was kept below G2 for a reason (a run refused or beyond the bound, a split)")  # fmt: skip
+                    help="exit 1 when anything was left below G2 (a run or path refused or beyond the bound, a split)")  # fmt: skip
     g2.set_defaults(run=_g2)
 
 
@@ -589,7 +593,7 @@ def _g2(args: argparse.Namespace) -> int:
     for line in report.lines():
         print(line)
     print(f"wrote {args.output}")
-    return 1 if args.strict and (report.kept or report.splits) else 0
+    return 1 if args.strict and report.below_g2 else 0
 
 
 def _schema(args: argparse.Namespace) -> int:

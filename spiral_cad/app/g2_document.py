@@ -4,8 +4,9 @@ The document's kind is told by its suffix, through ``REWRITERS``: a table from s
 that rewrites that kind of document in place, ``function(src, dst, max_deviation, **options) -> report``,
 where the report has ``lines()`` (the short report, one line per path) and ``kept`` (what was kept as
 it was for a reason: a strict run fails on it). G-code programs (``.nc .ngc .gcode .tap``) are
-registered here (``spiral_cad.io.gcode_inplace.rewrite_gcode_g2``); other kinds register with
-``register_rewriter`` (DXF and LandXML come next); any other suffix is an error naming it.
+registered here (``spiral_cad.io.gcode_inplace.rewrite_gcode_g2``), and so are DXF drawings
+(``spiral_cad.io.dxf_g2.rewrite_dxf_g2``) and LandXML files (``spiral_cad.io.landxml_g2.rewrite_landxml_g2``);
+other kinds register with ``register_rewriter``; any other suffix is an error naming it.
 """
 
 from __future__ import annotations
@@ -24,8 +25,7 @@ Rewriter = Callable[..., Any]
 #: Suffix (lower case, with its dot) → the function that makes such a document G2 in place.
 REWRITERS: dict[str, Rewriter] = {}
 #: Kinds of documents announced but not rewritten yet (suffix → what they are).
-NOT_YET = {".dxf": "DXF drawings", ".xml": "LandXML files", ".xodr": "OpenDRIVE files", ".step": "STEP wires",
-           ".stp": "STEP wires", ".igs": "IGES wires", ".iges": "IGES wires"}  # fmt: skip
+NOT_YET = {".xodr": "OpenDRIVE files", ".step": "STEP wires", ".stp": "STEP wires", ".igs": "IGES wires", ".iges": "IGES wires"}
 
 
 def register_rewriter(suffixes: tuple[str, ...], function: Rewriter) -> None:
@@ -43,10 +43,35 @@ def register_rewriter(suffixes: tuple[str, ...], function: Rewriter) -> None:
 def _gcode(src: str | os.PathLike, dst: str | os.PathLike, max_deviation: float, **options: Any) -> Any:
     from ..io.gcode_inplace import rewrite_gcode_g2
 
+    if options.get("units", "mm") not in ("mm", "in"):
+        raise ValueError(f"{Path(src).name}: a G-code program is in mm (G21) or in (G20); got units={options['units']!r}")
     return rewrite_gcode_g2(src, dst, max_deviation, **options)
 
 
+def _refuse(src: str | os.PathLike, options: dict[str, Any], name: str, why: str) -> None:
+    """Refuse an option this kind of document does not take, by name."""
+    if name in options:
+        raise ValueError(f"{Path(src).name}: {name}={options[name]!r} does not apply ({why})")
+
+
+def _dxf(src: str | os.PathLike, dst: str | os.PathLike, max_deviation: float, **options: Any) -> Any:
+    from ..io.dxf_g2 import rewrite_dxf_g2
+
+    _refuse(src, options, "dialect", "a G-code option")
+    return rewrite_dxf_g2(Path(src), Path(dst), max_deviation, **options)
+
+
+def _landxml(src: str | os.PathLike, dst: str | os.PathLike, max_deviation: float, **options: Any) -> Any:
+    from ..io.landxml_g2 import rewrite_landxml_g2
+
+    _refuse(src, options, "units", "a LandXML file states its own unit, and max_deviation is in it")
+    _refuse(src, options, "dialect", "a G-code option")
+    return rewrite_landxml_g2(Path(src), Path(dst), max_deviation, **options)
+
+
 register_rewriter(GCODE_SUFFIXES, _gcode)
+register_rewriter((".dxf",), _dxf)
+register_rewriter((".xml",), _landxml)
 
 
 def rewriter_for(path: str | os.PathLike) -> Rewriter:

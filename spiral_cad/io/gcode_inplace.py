@@ -135,6 +135,11 @@ class GcodeG2Report:
         """Joints left as corners where ``make_g2`` split a run."""
         return sum(r.splits for r in self.runs)
 
+    @property
+    def below_g2(self) -> list[GcodeRun]:
+        """The runs left below G2 somewhere: kept verbatim for a reason, or split (``g2 --strict`` exits 1 on them)."""
+        return [r for r in self.runs if r.status == "kept" or r.splits]
+
     def lines(self) -> list[str]:
         """The short report: one line per run changed or kept, and the totals."""
         unit = self.units

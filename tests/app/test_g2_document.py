@@ -129,11 +129,11 @@ def test_cli_strict_and_kinds_not_yet(tmp_path, capsys):
     assert main(["g2", str(src), "--max-deviation", "0.01", "-o", str(out)]) == 0
     assert main(["g2", str(src), "--max-deviation", "0.01", "-o", str(out), "--strict"]) == 1
     capsys.readouterr()
-    assert main(["g2", str(tmp_path / "plate.dxf"), "--max-deviation", "0.01", "-o", str(tmp_path / "p.dxf")]) == 2
+    assert main(["g2", str(tmp_path / "road.xodr"), "--max-deviation", "0.01", "-o", str(tmp_path / "r.xodr")]) == 2
     err = capsys.readouterr().err
-    assert err.startswith("error: ") and ".dxf" in err and "not yet" in err
+    assert err.startswith("error: ") and ".xodr" in err and "not yet" in err
     with pytest.raises(ValueError, match="not yet"):
-        rewriter_for("road.xml")
+        rewriter_for("part.step")
     with pytest.raises(ValueError, match="is the input"):
         make_document_g2(src, src, 0.01)
 
@@ -211,3 +211,28 @@ def test_another_kind_registers_by_suffix(tmp_path, monkeypatch):
     assert seen == [("a.fake", 0.5, {})]
     with pytest.raises(ValueError, match="suffix starts with a dot"):
         g2_document.register_rewriter(("fake",), print)
+
+
+def test_a_drawing_and_a_road_file_come_back_whole_through_the_one_verb(tmp_path, capsys):
+    """``g2`` on a DXF and a LandXML file: one file in, one out, the report printed, options of other kinds refused by name."""
+    import ezdxf
+
+    doc = ezdxf.new("R2010")
+    doc.header["$INSUNITS"] = 4
+    msp = doc.modelspace()
+    msp.add_lwpolyline([(0, 0), (40, 0), (40, 20), (0, 20)], close=True, dxfattribs={"layer": "OUTLINE"})
+    msp.add_text("PLATE", dxfattribs={"layer": "NOTES"})
+    doc.saveas(tmp_path / "plate.dxf")
+    assert main(["g2", str(tmp_path / "plate.dxf"), "--max-deviation", "0.01", "-o", str(tmp_path / "out.dxf"), "--strict"]) == 0
+    said = capsys.readouterr().out
+    assert "4 of 4 joint(s) changed" in said and "0 left below G2" in said
+    back = ezdxf.readfile(tmp_path / "out.dxf").modelspace()
+    assert {e.dxftype() for e in back.query("*[layer=='OUTLINE']")} == {"LINE", "SPLINE"}
+    assert len(back.query("TEXT")) == 1
+    assert main(["g2", str(tmp_path / "plate.dxf"), "--max-deviation", "0.01", "-o", str(tmp_path / "o.dxf"), "--dialect", "generic"]) == 2
+    assert "dialect" in capsys.readouterr().err
+    road = next((DATA.parent / "landxml").glob("openroads_*.xml"))
+    assert main(["g2", str(road), "--max-deviation", "0.01", "-o", str(tmp_path / "road.xml")]) == 0
+    assert "made G2" in capsys.readouterr().out and (tmp_path / "road.xml").is_file()
+    assert main(["g2", str(road), "--max-deviation", "0.01", "-o", str(tmp_path / "r.xml"), "--units", "m"]) == 2
+    assert "units" in capsys.readouterr().err
