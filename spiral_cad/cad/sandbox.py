@@ -28,6 +28,8 @@ import warnings
 from collections.abc import Callable
 from typing import Any
 
+from ..io.signals import die_with_parent
+
 __all__ = ["MEMORY_LIMIT", "TIME_LIMIT", "Isolated", "run_isolated"]
 
 #: Seconds a reader may take before it is stopped.
@@ -197,6 +199,7 @@ def _child(task: Callable[..., Any], args: tuple, fd: int, memory: int) -> None:
     """Run ``task`` under the limits, write ``(kind, value)`` to ``fd`` and leave at once."""
     try:
         signal.signal(signal.SIGINT, signal.SIG_IGN)  # Ctrl-C: the parent stops the child
+        die_with_parent()  # a parent killed (a worker stopped by Ctrl-C) takes the child with it
         faulthandler.disable()  # a crash here is reported by the parent, not dumped on the terminal
         _limit_resources(memory)
         devnull = os.open(os.devnull, os.O_WRONLY)  # nothing the child prints reaches the terminal
