@@ -21,7 +21,7 @@ from ..design.tables import fixed_columns
 from ..io.opendrive_check import PROFILE_LEVELS, OpenDriveReport
 from ..io.signals import signals_handled
 from .many import PIP_MANY
-from .many_inputs import expand_inputs, output_collisions, wants_many
+from .many_inputs import escaping_streams, expand_inputs, output_collisions, wants_many
 from .many_task import note_worst
 
 
@@ -686,6 +686,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     ``error: terminated`` and 143 (nothing committed after the signal);
     Python warnings are not shown (what matters is an error or in the report).
     """
+    escaping_streams()  # a file name of any bytes is printed, escaped, never an encoding error
     with signals_handled(("SIGINT", "SIGTERM"), interrupt=True) as interrupted, warnings.catch_warnings():
         warnings.simplefilter("ignore")
         try:

@@ -10,11 +10,39 @@ for the terminal and the summary alike.
 
 from __future__ import annotations
 
+import codecs
+import contextlib
 import glob
+import io
 import os
+import sys
 from collections.abc import Iterator, Sequence
 
-__all__ = ["expand_inputs", "output_collisions", "shown", "wants_many"]
+__all__ = ["ESCAPE", "escaping_streams", "expand_inputs", "output_collisions", "shown", "wants_many"]
+
+#: The codec error handler that writes a name's undecodable byte as ``\xNN`` and any other character
+#: the stream cannot encode as ``\uNNNN``.
+ESCAPE = "spiral_cad.escape"
+
+
+def _escape(error: UnicodeError) -> tuple[str, int]:
+    if not isinstance(error, UnicodeEncodeError):
+        raise error
+    text = error.object[error.start : error.end]
+    escaped = (f"\\x{ord(c) - 0xDC00:02x}" if 0xDC80 <= ord(c) <= 0xDCFF else c.encode("ascii", "backslashreplace").decode() for c in text)
+    return "".join(escaped), error.end
+
+
+codecs.register_error(ESCAPE, _escape)
+
+
+def escaping_streams() -> None:
+    """Have ``sys.stdout`` and ``sys.stderr`` escape what they cannot encode (a file name of any bytes)
+    instead of failing on it."""
+    for stream in (sys.stdout, sys.stderr):
+        if isinstance(stream, io.TextIOWrapper):
+            with contextlib.suppress(ValueError, OSError):
+                stream.reconfigure(errors=ESCAPE)
 
 _GLOB_CHARACTERS = frozenset("*?[")
 
