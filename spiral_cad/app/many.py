@@ -349,8 +349,8 @@ def _dispatch(client: Any, task: Callable[[argparse.Namespace], int], files: Seq
                 alone.extend(waiting)
                 return False
             continue
-        index = in_flight.pop(future.key, None)
-        if index is None:
+        index = in_flight.pop(future.key, -1)
+        if index < 0:
             continue
         if future.status == "cancelled":  # we cancel nothing: the scheduler is gone
             return True

@@ -44,6 +44,7 @@ def escaping_streams() -> None:
             with contextlib.suppress(ValueError, OSError):
                 stream.reconfigure(errors=ESCAPE)
 
+
 _GLOB_CHARACTERS = frozenset("*?[")
 
 

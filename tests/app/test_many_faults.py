@@ -133,7 +133,6 @@ def test_no_worker_left_the_rest_run_here_and_the_run_ends(tmp_path, capsys, mon
 @pytest.mark.subprocess
 def test_a_lost_scheduler_reports_every_finished_file_and_names_the_rest_not_run(tmp_path):
     """An external scheduler killed mid-run (by the third file's task): exit 2, every file in the summary."""
-    import argparse
 
     environment = {**os.environ, "PYTHONPATH": os.pathsep.join(sys.path)}
     port = 20000 + os.getpid() % 20000
