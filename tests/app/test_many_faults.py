@@ -317,3 +317,29 @@ def _session(pid):
         return os.getsid(pid)
     except OSError:
         return None
+
+
+@pytest.mark.subprocess
+def test_a_reader_child_ends_with_the_worker_that_started_it():
+    """A worker killed (Ctrl-C, a crash) takes its reader child with it: no reader left running for minutes."""
+    import psutil
+
+    code = ("import time\nfrom spiral_cad.cad.sandbox import Isolated\n"
+            "child = Isolated(time.sleep, 600, what='the STEP reader', subject='slow.step')\n"
+            "print(child._pid, flush=True)\ntime.sleep(600)\n")  # fmt: skip
+    worker = subprocess.Popen([sys.executable, "-c", code], stdout=subprocess.PIPE, text=True)
+    assert worker.stdout is not None
+    reader = int(worker.stdout.readline())
+    assert psutil.pid_exists(reader)
+    worker.kill()
+    worker.wait()
+    deadline = time.monotonic() + 10
+    while time.monotonic() < deadline:
+        try:
+            if psutil.Process(reader).status() == psutil.STATUS_ZOMBIE:
+                break
+        except psutil.NoSuchProcess:
+            break
+        time.sleep(0.05)
+    else:
+        pytest.fail(f"the reader child {reader} still runs after its worker was killed")
