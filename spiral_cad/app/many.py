@@ -65,6 +65,9 @@ def _client(workers: int | None, scheduler: str | None, files: int) -> Any:
     # a task whose worker dies is not retried by dask: the command runs it again alone, in a fresh process of its own,
     # so only a file that stops a process by itself is its error, and no worker's death can hold the run
     dask.config.set({"distributed.scheduler.allowed-failures": 0, "distributed.admin.tick.limit": "1h"})
+    # dask's own log (a lost connection, a worker that died) is not the command's to print: every file's fate is reported
+    for name in ("distributed", "tornado", "asyncio"):
+        logging.getLogger(name).setLevel(logging.CRITICAL + 1)
     if scheduler is not None:
         try:
             return Client(scheduler, timeout="10s")
@@ -297,22 +300,28 @@ def _on_cluster(task: Callable[[argparse.Namespace], int], files: Sequence[str],
     cluster = client.cluster if scheduler is None else None
     alone: list[int] = []
     try:
-        _interrupts_released()  # a Ctrl-C during the start arrives here, where the cluster is closed
-        lost = _dispatch(client, task, files, changes, args, results, stop, alone)
+        try:
+            _interrupts_released()  # a Ctrl-C during the start arrives here, where the cluster is closed
+            lost = _dispatch(client, task, files, changes, args, results, stop, alone)
+        except BaseException:
+            _stop_workers(stop, cluster)
+            raise
+        finally:
+            _close(client, cluster)
+        if lost:
+            results.not_run("the dask scheduler was lost")
+            return
+        for index in alone:  # each alone: only a file that stops its process by itself is its error
+            results.add(index, run_alone(task, results.shown[index], args, changes[index], limit=ALONE_LIMIT, stop=stop))
     except BaseException:
-        _stop_workers(stop, cluster)
+        with contextlib.suppress(OSError):  # nothing more is committed (a process run alone was killed)
+            Path(stop).touch()
         raise
     finally:
-        _close(client, cluster)
         for index, result in enumerate(results.results):  # staging folders of workers that were stopped
             out = changes[index].get("out")
             if result is None and out is not None and os.path.isdir(out):
                 remove_stale(Path(out))
-    if lost:
-        results.not_run("the dask scheduler was lost")
-        return
-    for index in alone:  # each alone: only a file that stops its process by itself is its error
-        results.add(index, run_alone(task, results.shown[index], args, changes[index], limit=ALONE_LIMIT, stop=stop))
 
 
 def _dispatch(client: Any, task: Callable[[argparse.Namespace], int], files: Sequence[str], changes: Sequence[dict[str, Any]],
