@@ -74,8 +74,11 @@ def _client(workers: int | None, scheduler: str | None, files: int) -> Any:
         except (OSError, TimeoutError) as error:
             raise ValueError(f"--scheduler {scheduler!r}: no dask scheduler answered ({error})") from None
     count = workers if workers is not None else max(1, min(os.cpu_count() or 1, files))
-    cluster = LocalCluster(n_workers=count, threads_per_worker=1, processes=True, host="127.0.0.1",
-                           dashboard_address="127.0.0.1:0", silence_logs=logging.CRITICAL + 1)  # fmt: skip
+    try:
+        cluster = LocalCluster(n_workers=count, threads_per_worker=1, processes=True, host="127.0.0.1",
+                               dashboard_address="127.0.0.1:0", silence_logs=logging.CRITICAL + 1)  # fmt: skip
+    except (OSError, RuntimeError, TimeoutError) as error:  # a worker killed while it started, no process to spare
+        raise ValueError(f"the local dask cluster could not start ({type(error).__name__}: {error}); nothing was run") from None
     return Client(cluster)
 
 
