@@ -13,6 +13,7 @@ import contextlib
 import copy
 import io
 import multiprocessing
+import os
 import signal
 import sys
 import threading
@@ -170,12 +171,12 @@ def run_one(task: Callable[[argparse.Namespace], int], shown: str, args: argpars
 
 
 def _alone(send: Any, task: Callable[[argparse.Namespace], int], shown: str, args: argparse.Namespace, changes: dict[str, Any],
-           stop: str | None) -> None:  # fmt: skip
+           stop: str | None, parent: int) -> None:  # fmt: skip
     """The fresh process of ``run_alone``: Ctrl-C is the command's to answer; the result goes back on ``send``."""
     signal.signal(signal.SIGINT, signal.SIG_IGN)
     if hasattr(signal, "pthread_sigmask"):
         signal.pthread_sigmask(signal.SIG_UNBLOCK, {signal.SIGINT})
-    die_with_parent()
+    die_with_parent(parent)
     send.send(run_one(task, shown, args, changes, stop))
     send.close()
 
@@ -189,7 +190,7 @@ def run_alone(task: Callable[[argparse.Namespace], int], shown: str, args: argpa
     """
     context = multiprocessing.get_context("spawn")
     receive, send = context.Pipe(duplex=False)
-    process = context.Process(target=_alone, args=(send, task, shown, args, changes, stop), daemon=True)
+    process = context.Process(target=_alone, args=(send, task, shown, args, changes, stop, os.getpid()), daemon=True)
     masked = hasattr(signal, "pthread_sigmask")
     if masked:  # started with Ctrl-C blocked (it ignores Ctrl-C once running): the command stops it
         signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT})

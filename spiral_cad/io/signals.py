@@ -68,11 +68,12 @@ def stop_requested() -> bool:
     return _stop_file is not None and os.path.exists(_stop_file)
 
 
-def die_with_parent() -> None:
-    """Have this process killed when the process that started it ends (Linux; elsewhere nothing).
+def die_with_parent(parent: int) -> None:
+    """Have this process killed when ``parent``, the process that started it, ends (Linux; elsewhere nothing).
 
     A reader child of a worker that is killed (Ctrl-C, a crash) then stops at
-    once instead of running on with its memory until its own time limit.
+    once instead of running on with its memory until its own time limit. A
+    parent that ended before this call ends this process now.
     """
     if not sys.platform.startswith("linux"):
         return
@@ -82,4 +83,6 @@ def die_with_parent() -> None:
         libc = ctypes.CDLL(None, use_errno=True)
         libc.prctl(1, int(signal.SIGKILL))  # PR_SET_PDEATHSIG
     except (OSError, AttributeError):
-        pass
+        return
+    if os.getppid() != parent:  # the parent ended before the request was made
+        os.kill(os.getpid(), signal.SIGKILL)
