@@ -6,6 +6,7 @@ import argparse
 import math
 import os
 import re
+import signal
 import sys
 import time
 import warnings
@@ -19,7 +20,9 @@ from ..core.transitions import Transition
 from ..design.tables import fixed_columns
 from ..io.opendrive_check import PROFILE_LEVELS, OpenDriveReport
 from ..io.signals import signals_handled
-from .many import PIP_MANY, expand_inputs, note_worst, wants_many
+from .many import PIP_MANY
+from .many_inputs import escaping_streams, expand_inputs, output_collisions, wants_many
+from .many_task import note_worst
 
 
 def core_examples() -> list[tuple[str, Transition]]:
@@ -371,17 +374,27 @@ def _check_shape_file(args: argparse.Namespace) -> int:
     return _print_report(report, args)
 
 
-def _print_g2_advice(file: str, units: str) -> None:
-    """For a file below G2: the smallest max_deviation with which make_g2 makes each wire of lines and arcs G2."""
+def _advice_lines(file: str, units: str) -> list[str]:
     from ..cad.g2wire import g2_advice
     from ..cad.readers import read_shape
 
+    return g2_advice(read_shape(file, units=units or None), units or "mm")
+
+
+def _print_g2_advice(file: str, units: str) -> None:
+    """For a file below G2: the smallest max_deviation with which make_g2 makes each wire of lines and arcs G2.
+
+    Worked out in a child process under the readers' time limit (``cad.sandbox``): a polyline of
+    thousands of corners is stopped, not left holding the command or its worker.
+    """
+    from ..cad.sandbox import run_isolated
+
     try:
-        shape = read_shape(file, units=units or None)
+        lines = run_isolated(_advice_lines, file, units, what="make_g2's advice", subject=file)
     except ValueError as error:  # the check read the curves its own way; no advice must not fail it
         print(f"make_g2: no advice: {error}")
         return
-    for line in g2_advice(shape, units or "mm"):
+    for line in lines:
         print(line)
 
 
@@ -551,6 +564,7 @@ def _build_inputs(args: argparse.Namespace) -> int:
     where = os.path.abspath if args.scheduler else str
     top = os.path.commonpath([os.path.dirname(os.path.abspath(f)) for f in files])
     outs = [Path(args.out) / Path(os.path.relpath(os.path.abspath(f), top)).with_suffix("") for f in files]
+    output_collisions(files, outs)  # before anything runs
     changes = [{"design": None, field: where(f), "out": where(str(out))} for f, out in zip(files, outs)]
     return _run_many(args, _build, files, changes, "built")
 
@@ -711,15 +725,25 @@ def _parser() -> argparse.ArgumentParser:
     return parser
 
 
+def _interrupted(received: list[int], detail: str) -> int:
+    """The one line and the exit status of a command stopped by a signal: 130 Ctrl-C, 143 SIGTERM."""
+    number = received[0] if received else int(signal.SIGINT)  # also a KeyboardInterrupt raised without a signal
+    what = "terminated" if number == signal.SIGTERM else "interrupted"
+    print(f"error: {what}{f'; {detail}' if detail else ''}", file=sys.stderr)
+    return 128 + number
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     """Run the command line; returns the exit status (0 ok, 1 check failed, 2 error, 130 interrupted,
     141 output pipe closed early).
 
     Every error is printed as one ``error: …`` line on stderr, never as a
-    traceback; Ctrl-C at any moment gives ``error: interrupted`` and 130;
+    traceback; Ctrl-C at any moment gives ``error: interrupted`` and 130, SIGTERM
+    ``error: terminated`` and 143 (nothing committed after the signal);
     Python warnings are not shown (what matters is an error or in the report).
     """
-    with signals_handled(("SIGINT",), interrupt=True) as interrupted, warnings.catch_warnings():
+    escaping_streams()  # a file name of any bytes is printed, escaped, never an encoding error
+    with signals_handled(("SIGINT", "SIGTERM"), interrupt=True) as interrupted, warnings.catch_warnings():
         warnings.simplefilter("ignore")
         try:
             args = _parser().parse_args(argv)
@@ -733,12 +757,10 @@ def main(argv: Sequence[str] | None = None) -> int:
                 pass
             return CLOSED_PIPE
         except KeyboardInterrupt as interrupt:
-            print(f"error: interrupted{f'; {interrupt}' if str(interrupt) else ''}", file=sys.stderr)
-            return 130
+            return _interrupted(interrupted, str(interrupt))
         except Exception as error:
             if interrupted:  # Ctrl-C, wrapped by a library into another exception
-                print("error: interrupted", file=sys.stderr)
-                return 130
+                return _interrupted(interrupted, "")
             if isinstance(error, (ValueError, OSError)):  # DesignError, NoSolutionError, file system errors
                 print(f"error: {error}", file=sys.stderr)
             else:  # a bug: still no traceback, but say so

@@ -9,6 +9,15 @@ numbers, so no OCCT object is ever pickled. The results come back in the
 order of the files, whatever order the workers finish in, so the output is the
 one of running the files one by one.
 
+Nothing is lost and nothing hangs: a file whose worker died is run again
+alone in a fresh process (however often workers die, and also when no
+worker is left); a lost scheduler ends the run with every finished file
+reported and the others named "not run"; the ``--summary`` file is opened
+before anything runs and gets each row as its result arrives; Ctrl-C or
+SIGTERM commit nothing more, stop the workers and their children and remove
+their staging folders. The workers' own output (dask's log, tracebacks of a
+dying worker) never reaches the terminal.
+
 dask is imported only here and only when a run starts: a single file never
 starts a cluster and the command's cold start does not pay for dask.
 """
@@ -16,20 +25,22 @@ starts a cluster and the command's cold start does not pay for dask.
 from __future__ import annotations
 
 import contextlib
-import copy
 import csv
-import glob
-import io
+import logging
 import os
+import queue
+import shutil
 import signal
 import sys
-import threading
+import tempfile
 import time
-import warnings
 from collections.abc import Callable, Iterator, Sequence
-from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, TextIO
+
+from ..io.staging import remove_stale
+from .many_inputs import expand_inputs, shown, wants_many
+from .many_task import NOT_RUN, FileResult, note_worst, run_alone, run_one
 
 if TYPE_CHECKING:
     import argparse
@@ -37,173 +48,10 @@ if TYPE_CHECKING:
 __all__ = ["PIP_MANY", "FileResult", "expand_inputs", "note_worst", "run_many", "run_one", "wants_many"]
 
 PIP_MANY = 'pip install "spiral_cad[many]"'
-
-#: The rank of every level a checker reports, worst first (joints: unmeasurable < none < G0 < G1 < G2;
-#: faces: a gap is no G0 and a crease is G0 only).
-_RANK = {"unmeasurable": -1, "none": 0, "gap": 0, "crease": 1, "G0": 1, "G1": 2, "G2": 3}
-_GLOB_CHARACTERS = frozenset("*?[")
-
-
-@dataclass(frozen=True)
-class FileResult:
-    """What one file's run gave back from a worker: plain data only.
-
-    Attributes:
-        file: the file as the command line shows it.
-        status: the one-file exit status (0 ok, 1 below ``--require``, 2 error).
-        worst: the worst joint or edge the run reported (``"G2"``, ``"G1"``, ``"gap"`` …; ``""`` when
-            nothing was judged).
-        seconds: wall time of the run on its worker.
-        output: what the one-file run printed on stdout.
-        errors: its ``error: …`` lines (an exception's message, or what it printed on stderr).
-    """
-
-    file: str
-    status: int
-    worst: str
-    seconds: float
-    output: str
-    errors: tuple[str, ...]
-
-    @property
-    def verdict(self) -> str:
-        """``ok``, ``fail`` (below ``--require``) or ``error`` (not read, not built)."""
-        return {0: "ok", 1: "fail"}.get(self.status, "error")
-
-    def reason(self) -> str:
-        """Why the file did not pass, in one line (its error, else its ``FAIL:`` line)."""
-        if self.errors:
-            return "; ".join(line.removeprefix("error: ") for line in self.errors)
-        fails = [line.removeprefix("FAIL: ") for line in self.output.splitlines() if line.startswith("FAIL: ")]
-        return "; ".join(fails) or f"exit status {self.status}"
-
-
-def _is_pattern(text: str) -> bool:
-    return not Path(text).exists() and any(c in _GLOB_CHARACTERS for c in text)
-
-
-def _holds(folder: Path, suffixes: Sequence[str]) -> bool:
-    wanted = {suffix.lower() for suffix in suffixes}
-    return any(p.suffix.lower() in wanted and p.is_file() for p in folder.rglob("*"))
-
-
-def wants_many(inputs: Sequence[str], suffixes: Sequence[str]) -> bool:
-    """True when ``inputs`` name more than one file: several, a glob pattern, or a folder that holds
-    a file with one of ``suffixes`` (any other folder is refused as the one file it is not)."""
-    return len(inputs) > 1 or any(_is_pattern(text) or (Path(text).is_dir() and _holds(Path(text), suffixes)) for text in inputs)
-
-
-def expand_inputs(inputs: Sequence[str], suffixes: Sequence[str]) -> list[str]:
-    """The files ``inputs`` name, in order, each once: a file as given, a glob pattern's files
-    (``**`` reaches into subfolders), a folder's files with one of ``suffixes`` at any depth.
-
-    Raises:
-        ValueError: a pattern or folder that names no file.
-    """
-    files: dict[str, None] = {}
-    wanted = {suffix.lower() for suffix in suffixes}
-    for text in inputs:
-        path = Path(text)
-        if path.is_dir():
-            found = sorted(str(p) for p in path.rglob("*") if p.is_file() and p.suffix.lower() in wanted)
-            if not found:
-                raise ValueError(f"folder {text!r} holds no {', '.join(sorted(wanted))} file")
-        elif _is_pattern(text):
-            found = sorted(p for p in glob.glob(text, recursive=True) if Path(p).is_file())
-            if not found:
-                raise ValueError(f"no file matches {text!r}")
-        else:
-            found = [text]  # a missing file is that file's error, reported with the others
-        files.update(dict.fromkeys(found))
-    return list(files)
-
-
-class _Capture(threading.local):
-    """The streams and worst joint of the task running on this thread (None: not in a task)."""
-
-    out: io.StringIO | None = None
-    err: io.StringIO | None = None
-    worst: str = ""
-
-
-_capture = _Capture()
-
-
-class _ThreadStream(io.TextIOBase):
-    """A process's stdout or stderr that sends what a task prints to that task's buffer."""
-
-    def __init__(self, stream: TextIO, which: str) -> None:
-        self.stream, self.which = stream, which
-
-    def write(self, text: str) -> int:
-        buffer = getattr(_capture, self.which)
-        return (buffer if buffer is not None else self.stream).write(text)
-
-    def flush(self) -> None:
-        if getattr(_capture, self.which) is None:
-            self.stream.flush()
-
-    def fileno(self) -> int:
-        return self.stream.fileno()
-
-    def isatty(self) -> bool:
-        return getattr(_capture, self.which) is None and self.stream.isatty()
-
-    @property
-    def encoding(self) -> str:  # type: ignore[override]
-        return getattr(self.stream, "encoding", None) or "utf-8"
-
-
-_install_lock = threading.Lock()
-
-
-@contextlib.contextmanager
-def _captured() -> Iterator[_Capture]:
-    """What this thread prints goes to ``_capture.out``/``err`` (other threads print as before)."""
-    with _install_lock:
-        if not isinstance(sys.stdout, _ThreadStream):
-            sys.stdout = _ThreadStream(sys.stdout, "out")
-        if not isinstance(sys.stderr, _ThreadStream):
-            sys.stderr = _ThreadStream(sys.stderr, "err")
-    _capture.out, _capture.err, _capture.worst = io.StringIO(), io.StringIO(), ""
-    try:
-        yield _capture
-    finally:
-        _capture.out = _capture.err = None
-
-
-def note_worst(level: str) -> None:
-    """Record a level a run reported; a task keeps the worst (nothing happens outside a task)."""
-    if _capture.out is None or level not in _RANK:
-        return
-    if not _capture.worst or _RANK[level] < _RANK[_capture.worst]:
-        _capture.worst = level
-
-
-def run_one(task: Callable[[argparse.Namespace], int], shown: str, args: argparse.Namespace, changes: dict[str, Any]) -> FileResult:
-    """Run the one-file command ``task`` on a copy of ``args`` with ``changes`` (the file, its output
-    folder): what a worker runs for the file ``shown``.
-
-    Errors are caught as the command line catches them: a ``ValueError``/``OSError`` is an
-    ``error: …`` line, anything else an internal error; none escapes as a traceback.
-    """
-    warnings.simplefilter("ignore")  # as the command line: what matters is in the report
-    mine = copy.copy(args)
-    for name, value in changes.items():
-        setattr(mine, name, value)
-    started = time.perf_counter()
-    errors: list[str] = []
-    with _captured() as captured:
-        try:
-            status = task(mine)
-        except (ValueError, OSError) as error:
-            status, errors = 2, [f"error: {error}"]
-        except Exception as error:
-            status, errors = 2, [f"error: internal error ({type(error).__name__}: {error}); please report it"]
-        assert captured.out is not None and captured.err is not None
-        output, printed, worst = captured.out.getvalue(), captured.err.getvalue(), captured.worst
-    errors = [line for line in printed.splitlines() if line.strip()] + errors
-    return FileResult(shown, status, worst, time.perf_counter() - started, output, tuple(errors))
+#: Seconds with no worker on the cluster after which the files left run here, each alone in a fresh process.
+NO_WORKERS = 20.0
+#: Seconds a file may take when it runs alone in a fresh process (its worker died).
+ALONE_LIMIT = 600.0
 
 
 def _client(workers: int | None, scheduler: str | None, files: int) -> Any:
@@ -213,19 +61,24 @@ def _client(workers: int | None, scheduler: str | None, files: int) -> Any:
         from distributed import Client, LocalCluster
     except ImportError:
         raise ValueError(f"many files run on dask.distributed, which is not installed: {PIP_MANY}") from None
-    import logging
 
-    # a file that kills its worker (OCCT crashing outside the reader's sandbox) is that file's error after one retry (the
-    # retry spares a file that was only queued on the same worker), not after dask's default three
-    dask.config.set({"distributed.scheduler.allowed-failures": 1, "distributed.admin.tick.limit": "1h"})
+    # a task whose worker dies is not retried by dask: the command runs it again alone, in a fresh process of its own,
+    # so only a file that stops a process by itself is its error, and no worker's death can hold the run
+    dask.config.set({"distributed.scheduler.allowed-failures": 0, "distributed.admin.tick.limit": "1h"})
+    # dask's own log (a lost connection, a worker that died) is not the command's to print: every file's fate is reported
+    for name in ("distributed", "tornado", "asyncio"):
+        logging.getLogger(name).setLevel(logging.CRITICAL + 1)
     if scheduler is not None:
         try:
             return Client(scheduler, timeout="10s")
         except (OSError, TimeoutError) as error:
             raise ValueError(f"--scheduler {scheduler!r}: no dask scheduler answered ({error})") from None
     count = workers if workers is not None else max(1, min(os.cpu_count() or 1, files))
-    cluster = LocalCluster(n_workers=count, threads_per_worker=1, processes=True, host="127.0.0.1",
-                           dashboard_address="127.0.0.1:0", silence_logs=logging.ERROR)  # fmt: skip
+    try:
+        cluster = LocalCluster(n_workers=count, threads_per_worker=1, processes=True, host="127.0.0.1",
+                               dashboard_address="127.0.0.1:0", silence_logs=logging.CRITICAL + 1)  # fmt: skip
+    except (OSError, RuntimeError, TimeoutError) as error:  # a worker killed while it started, no process to spare
+        raise ValueError(f"the local dask cluster could not start ({type(error).__name__}: {error}); nothing was run") from None
     return Client(cluster)
 
 
@@ -259,6 +112,52 @@ def _interrupts_released() -> None:
         signal.pthread_sigmask(signal.SIG_UNBLOCK, _INTERRUPTS)
 
 
+def _on_descriptor(stream: TextIO, fd: int) -> bool:
+    try:
+        return stream.fileno() == fd
+    except (AttributeError, OSError, ValueError):
+        return False
+
+
+@contextlib.contextmanager
+def _children_quiet() -> Iterator[None]:
+    """Within the block, descriptors 1 and 2 lead to the null device — so the workers and the
+    processes they start, and dask's log, write nothing on the terminal — while this process's
+    ``sys.stdout`` and ``sys.stderr`` write where they did."""
+    try:
+        null = os.open(os.devnull, os.O_WRONLY)
+    except OSError:
+        yield
+        return
+    saved: dict[int, int] = {}
+    replaced: dict[str, TextIO] = {}
+    try:
+        for fd, name in ((1, "stdout"), (2, "stderr")):
+            stream = getattr(sys, name)
+            with contextlib.suppress(OSError, ValueError, AttributeError):
+                stream.flush()
+            saved[fd] = os.dup(fd)
+            if _on_descriptor(stream, fd):
+                mine = open(os.dup(saved[fd]), "w", encoding=stream.encoding, errors=stream.errors or "strict")  # noqa: SIM115
+                mine.reconfigure(line_buffering=getattr(stream, "line_buffering", False))
+                replaced[name] = stream
+                setattr(sys, name, mine)
+            os.dup2(null, fd)
+        yield
+    finally:
+        for name, stream in replaced.items():
+            mine = getattr(sys, name)
+            with contextlib.suppress(OSError, ValueError):
+                mine.flush()
+            setattr(sys, name, stream)
+            with contextlib.suppress(OSError, ValueError):
+                mine.close()
+        for fd, copy in saved.items():
+            os.dup2(copy, fd)
+            os.close(copy)
+        os.close(null)
+
+
 class _Progress:
     """``done/total files, failed, files/s`` on stderr, at most about once a second (and at the end)."""
 
@@ -276,47 +175,83 @@ class _Progress:
         print(f"{self.verb} {done}/{self.total} files, {failed} not passed, {rate:.1f} files/s{ending}", file=sys.stderr, flush=True)
 
 
-def _summary(path: str, results: Sequence[FileResult]) -> None:
-    """The CSV summary: one row per file (file, verdict, worst joint, seconds)."""
-    try:
-        with open(path, "w", newline="", encoding="utf-8") as handle:
-            writer = csv.writer(handle)
-            writer.writerow(["file", "verdict", "worst_joint", "seconds"])
-            for r in results:
-                writer.writerow([r.file, r.verdict, r.worst, f"{r.seconds:.4f}"])
-    except OSError as error:
-        raise ValueError(f"--summary {path!r}: cannot write it ({error.strerror or error})") from None
+class _Summary:
+    """The ``--summary`` CSV (file, verdict, worst joint, seconds): opened before the run, a row
+    written as each result arrives, so a run that ends early leaves every row it had."""
+
+    def __init__(self, path: str | None) -> None:
+        self.path, self.problem = path, ""
+        self.handle: TextIO | None = None
+        if path is None:
+            return
+        if Path(path).suffix.lower() != ".csv":
+            raise ValueError(f"--summary {shown(path)!r}: the summary is CSV; give a .csv file")
+        try:
+            self.handle = open(path, "w", newline="", encoding="utf-8")  # noqa: SIM115
+        except OSError as error:
+            raise ValueError(f"--summary {shown(path)!r}: cannot write it ({error.strerror or error}); nothing was run") from None
+        self.writer = csv.writer(self.handle)
+        self.row(["file", "verdict", "worst_joint", "seconds"])
+
+    def row(self, cells: Sequence[str]) -> None:
+        """Write one row now (a failure is kept for the end: the run goes on)."""
+        if self.handle is None or self.problem:
+            return
+        try:
+            self.writer.writerow(cells)
+            self.handle.flush()
+        except OSError as error:
+            self.problem = f"--summary {shown(self.path or '')!r}: cannot write it ({error.strerror or error}); its rows end early"
+
+    def close(self) -> None:
+        if self.handle is not None:
+            with contextlib.suppress(OSError):
+                self.handle.close()
+            self.handle = None
 
 
 class _Results:
-    """Results as they arrive, printed in the order of the files; progress on stderr."""
+    """Results as they arrive, printed in the order of the files; progress on stderr; summary rows."""
 
-    def __init__(self, files: Sequence[str], verb: str) -> None:
-        self.files = list(files)
+    def __init__(self, files: Sequence[str], verb: str, summary: _Summary) -> None:
+        self.shown = [shown(f) for f in files]
         self.results: list[FileResult | None] = [None] * len(files)
         self.printed = self.failed = self.done = 0
         self.progress = _Progress(len(files), verb)
+        self.summary = summary
 
-    def add(self, index: int, result: FileResult) -> None:
+    def add(self, index: int, result: FileResult, *, show: bool = True) -> None:
+        if self.results[index] is not None:
+            return
         self.results[index] = result
-        self.done += 1
-        self.failed += result.status != 0
+        self.summary.row([result.file, result.verdict, result.worst, f"{result.seconds:.4f}"])
+        if not show:
+            return
+        self.done += result.status != NOT_RUN
+        self.failed += result.status not in (0, NOT_RUN)
         while self.printed < len(self.results) and (ready := self.results[self.printed]) is not None:
-            ending = "" if ready.output.endswith("\n") else "\n"
-            print(f"== {ready.file}\n{ready.output}", end=ending, flush=True)
+            if ready.status != NOT_RUN:
+                ending = "" if ready.output.endswith("\n") else "\n"
+                print(f"== {ready.file}\n{ready.output}", end=ending, flush=True)
             self.printed += 1
         self.progress(self.done, self.failed)
 
-    def finish(self, summary: str | None) -> int:
-        """The last progress line, the summary, an ``error:`` line per file that did not pass; the exit status."""
+    def not_run(self, why: str, *, show: bool = True) -> None:
+        """Every file without a result is named "not run", for the reason ``why``."""
+        for index, result in enumerate(self.results):
+            if result is None:
+                self.add(index, FileResult.failed(self.shown[index], f"not run: {why}", NOT_RUN), show=show)
+
+    def finish(self) -> int:
+        """The last progress line, an ``error:`` line per file that did not pass; the exit status."""
         final = [r for r in self.results if r is not None]
         self.progress(self.done, self.failed, final=True)
-        if summary is not None:
-            _summary(summary, final)
         for r in final:
             if r.status != 0:
                 print(f"error: {r.file}: {r.reason()}", file=sys.stderr)
-        return 0 if self.failed == 0 else 2
+        if self.summary.problem:
+            print(f"error: {self.summary.problem}", file=sys.stderr)
+        return 0 if all(r.status == 0 for r in final) and not self.summary.problem else 2
 
 
 def run_many(task: Callable[[argparse.Namespace], int], files: Sequence[str], changes: Sequence[dict[str, Any]], args: argparse.Namespace,
@@ -328,57 +263,149 @@ def run_many(task: Callable[[argparse.Namespace], int], files: Sequence[str], ch
 
     Returns:
         0 when every file passed, else 2.
+
+    Raises:
+        ValueError: a bad option, or a ``summary`` that cannot be written (before anything runs).
+        KeyboardInterrupt: Ctrl-C or SIGTERM; the workers were stopped, nothing committed since.
     """
     if workers is not None and workers < 1:
         raise ValueError(f"--workers must be at least 1; got {workers}")
-    if summary is not None and Path(summary).suffix.lower() != ".csv":
-        raise ValueError(f"--summary {summary!r}: the summary is CSV; give a .csv file")
-    results = _Results(files, verb)
-    if len(files) == 1 and scheduler is None:
-        streams = sys.stdout, sys.stderr
+    sink = _Summary(summary)
+    try:
+        results = _Results(files, verb, sink)
+        if len(files) == 1 and scheduler is None:
+            streams = sys.stdout, sys.stderr
+            try:
+                result = run_one(task, results.shown[0], args, changes[0])
+            finally:
+                sys.stdout, sys.stderr = streams  # this process's own again
+            results.add(0, result)
+            return results.finish()
+        stop_folder = tempfile.mkdtemp(prefix="spiral-cad-stop-")
         try:
-            result = run_one(task, files[0], args, changes[0])
+            with _children_quiet():
+                _on_cluster(task, files, changes, args, results, workers, scheduler, os.path.join(stop_folder, "stop"))
+        except BaseException:
+            results.not_run("interrupted", show=False)
+            raise
         finally:
-            sys.stdout, sys.stderr = streams  # this process's own again
-        results.add(0, result)
-        return results.finish(summary)
+            shutil.rmtree(stop_folder, ignore_errors=True)
+        return results.finish()
+    finally:
+        sink.close()
+
+
+def _on_cluster(task: Callable[[argparse.Namespace], int], files: Sequence[str], changes: Sequence[dict[str, Any]],
+                args: argparse.Namespace, results: _Results, workers: int | None, scheduler: str | None, stop: str) -> None:  # fmt: skip
+    """The files on the cluster; those whose worker died each alone in a fresh process after."""
     with _interrupts_held():  # the workers start with Ctrl-C blocked: the command alone answers it
         client = _client(workers, scheduler, len(files))
+    cluster = client.cluster if scheduler is None else None
+    alone: list[int] = []
     try:
-        _interrupts_released()  # a Ctrl-C during the start arrives here, where the cluster is closed
-        from distributed import as_completed
-
-        window = max(64, 8 * sum(client.nthreads().values()))  # a bounded number of tasks in flight
-        waiting = iter(range(len(files)))
-        where: dict[str, int] = {}  # task key → file index
-
-        def submit(index: int) -> Any:
-            future = client.submit(run_one, task, files[index], args, changes[index], pure=False)
-            where[future.key] = index
-            return future
-
-        pending = as_completed([submit(index) for _, index in zip(range(window), waiting)])
-        died: list[int] = []  # files whose worker stopped: the file's doing, or another's on the same worker
-        for future in pending:
-            index = where.pop(future.key)
-            try:
-                results.add(index, future.result())
-            except Exception:
-                died.append(index)
-            for following in waiting:
-                pending.add(submit(following))
-                break
-        for index in died:  # each alone on the cluster: only a file that stops its worker by itself is its error
-            future = submit(index)
-            where.pop(future.key)
-            try:
-                result = future.result()
-            except Exception as error:
-                result = FileResult(files[index], 2, "", 0.0, "", (f"error: its worker stopped ({type(error).__name__}: {error})",))
-            results.add(index, result)
+        try:
+            _interrupts_released()  # a Ctrl-C during the start arrives here, where the cluster is closed
+            lost = _dispatch(client, task, files, changes, args, results, stop, alone)
+        except BaseException:
+            _stop_workers(stop, cluster)
+            raise
+        finally:
+            _close(client, cluster)
+        if lost:
+            results.not_run("the dask scheduler was lost")
+            return
+        for index in alone:  # each alone: only a file that stops its process by itself is its error
+            results.add(index, run_alone(task, results.shown[index], args, changes[index], limit=ALONE_LIMIT, stop=stop))
+    except BaseException:
+        with contextlib.suppress(OSError):  # nothing more is committed (a process run alone was killed)
+            Path(stop).touch()
+        raise
     finally:
-        cluster = client.cluster
-        client.close()
-        if cluster is not None and scheduler is None:
-            cluster.close()
-    return results.finish(summary)
+        for index, result in enumerate(results.results):  # staging folders of workers that were stopped
+            out = changes[index].get("out")
+            if result is None and out is not None and os.path.isdir(out):
+                remove_stale(Path(out))
+
+
+def _dispatch(client: Any, task: Callable[[argparse.Namespace], int], files: Sequence[str], changes: Sequence[dict[str, Any]],
+              args: argparse.Namespace, results: _Results, stop: str, alone: list[int]) -> bool:  # fmt: skip
+    """Run the files on the cluster, a bounded number in flight; the files whose worker died (or
+    all those left once no worker has been there for ``NO_WORKERS`` s) go into ``alone``.
+
+    Returns:
+        True when the scheduler was lost (its futures cancelled).
+    """
+    arrived: queue.Queue = queue.Queue()
+    window = max(64, 8 * _threads(client))
+    waiting = iter(range(len(files)))
+    in_flight: dict[Any, int] = {}  # task key → file index
+
+    def submit(index: int) -> None:
+        future = client.submit(run_one, task, results.shown[index], args, changes[index], stop, pure=False)
+        in_flight[future.key] = index
+        future.add_done_callback(arrived.put)
+
+    for _, index in zip(range(window), waiting):
+        submit(index)
+    idle_since: float | None = None
+    while in_flight:
+        try:
+            future = arrived.get(timeout=0.5)
+        except queue.Empty:
+            if _threads(client) > 0:
+                idle_since = None
+            elif idle_since is None:
+                idle_since = time.monotonic()
+            elif time.monotonic() - idle_since > NO_WORKERS:  # no worker comes back: the rest run here
+                alone.extend(sorted(in_flight.values()))
+                alone.extend(waiting)
+                return False
+            continue
+        index = in_flight.pop(future.key, -1)
+        if index < 0:
+            continue
+        if future.status == "cancelled":  # we cancel nothing: the scheduler is gone
+            return True
+        try:
+            results.add(index, future.result())
+        except Exception:  # its worker died (KilledWorker), or dask could not run it
+            alone.append(index)
+        for following in waiting:
+            submit(following)
+            break
+    return False
+
+
+def _threads(client: Any) -> int:
+    """The worker threads the cluster has now (1 when the scheduler cannot tell)."""
+    try:
+        return sum(client.nthreads().values())
+    except Exception:
+        return 1
+
+
+def _stop_workers(stop: str, cluster: Any) -> None:
+    """Interrupted: workers commit nothing more (the stop file), and a local cluster's are killed now."""
+    with contextlib.suppress(OSError):
+        Path(stop).touch()
+    for nanny in list(getattr(cluster, "workers", {}).values()):
+        pid = getattr(getattr(getattr(nanny, "process", None), "process", None), "pid", None)
+        if pid:
+            with contextlib.suppress(OSError):
+                os.kill(pid, signal.SIGKILL)  # its reader children end with it (die_with_parent)
+
+
+def _close(client: Any, cluster: Any) -> None:
+    """Close the client (and the local cluster), whatever state they are in, without a word."""
+    masked = hasattr(signal, "pthread_sigmask")
+    if masked:  # a second Ctrl-C does not cut the closing short (it arrives after)
+        signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT, signal.SIGTERM})
+    try:
+        with contextlib.suppress(Exception):
+            client.close(timeout=10)
+        if cluster is not None:
+            with contextlib.suppress(Exception):
+                cluster.close(timeout=20)
+    finally:
+        if masked:
+            signal.pthread_sigmask(signal.SIG_UNBLOCK, {signal.SIGINT, signal.SIGTERM})

@@ -41,7 +41,9 @@ import io
 import math
 import os
 import re
-from collections.abc import Callable
+import tempfile
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
 from functools import cache
 from pathlib import Path
 from typing import Any, cast
@@ -170,6 +172,22 @@ def _read_and_extract(path: Path, kind: str, units: str | None, extract: Callabl
     return unit, extract(shape)
 
 
+@contextmanager
+def _utf8_name(path: Path) -> Iterator[str]:
+    """A name of ``path`` that OCCT's readers take (UTF-8): the path itself, or for a name of other
+    bytes (``caf\xe9.step`` in Latin-1) a symbolic link to it in a temporary folder."""
+    name = str(path)
+    try:
+        name.encode("utf-8")
+    except UnicodeEncodeError:
+        with tempfile.TemporaryDirectory(prefix="spiral-cad-read-") as folder:
+            link = os.path.join(folder, f"input{path.suffix.encode('ascii', 'replace').decode()}")
+            os.symlink(os.path.abspath(path), link)
+            yield link
+        return
+    yield name
+
+
 def _read_whole(path: Path, kind: str, units: str | None) -> tuple[TopoDS_Shape, str]:
     """Read ``path`` with OCCT, check that it was read whole; (shape, unit read in)."""
     from OCP.IFSelect import IFSelect_RetDone
@@ -184,7 +202,8 @@ def _read_whole(path: Path, kind: str, units: str | None) -> tuple[TopoDS_Shape,
 
             IGESControl_Controller.Init_s()
             reader = IGESControl_Reader()
-        status = reader.ReadFile(str(path))
+        with _utf8_name(path) as readable:
+            status = reader.ReadFile(readable)
         name = _namer(path, kind, reader)
         failures = _reader_failures(reader.WS().ModelCheckList(), name) if status == IFSelect_RetDone else []
         if status == IFSelect_RetDone and not failures:

@@ -28,6 +28,8 @@ import warnings
 from collections.abc import Callable
 from typing import Any
 
+from ..io.signals import die_with_parent
+
 __all__ = ["MEMORY_LIMIT", "TIME_LIMIT", "Isolated", "run_isolated"]
 
 #: Seconds a reader may take before it is stopped.
@@ -97,6 +99,7 @@ class Isolated:
                 stream.flush()
             except (OSError, ValueError):
                 pass
+        parent = os.getpid()
         with warnings.catch_warnings():
             # Python ≥ 3.12 warns about forking with threads running (numpy's BLAS
             # pool): the child only runs ``task`` and leaves with os._exit.
@@ -110,7 +113,7 @@ class Isolated:
                 return
         if pid == 0:  # the child: never returns
             os.close(read_fd)
-            _child(task, args, write_fd, self._memory)
+            _child(task, args, write_fd, self._memory, parent)
         os.close(write_fd)
         self._pid, self._fd = pid, read_fd
 
@@ -193,10 +196,11 @@ def _receive(fd: int, deadline: float) -> bytes | None:
             chunks.append(chunk)
 
 
-def _child(task: Callable[..., Any], args: tuple, fd: int, memory: int) -> None:
+def _child(task: Callable[..., Any], args: tuple, fd: int, memory: int, parent: int) -> None:
     """Run ``task`` under the limits, write ``(kind, value)`` to ``fd`` and leave at once."""
     try:
         signal.signal(signal.SIGINT, signal.SIG_IGN)  # Ctrl-C: the parent stops the child
+        die_with_parent(parent)  # a parent killed (a worker stopped by Ctrl-C) takes the child with it
         faulthandler.disable()  # a crash here is reported by the parent, not dumped on the terminal
         _limit_resources(memory)
         devnull = os.open(os.devnull, os.O_WRONLY)  # nothing the child prints reaches the terminal

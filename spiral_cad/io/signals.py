@@ -1,13 +1,20 @@
-"""Signals during work that must finish or clean up: one helper for every command and writer."""
+"""Signals during work that must finish or clean up: one helper for every command and writer.
+
+Also the two ways a run of many files stops its helpers: a stop file that a
+worker looks for before it commits anything (``stop_requested``), and child
+processes that end with the process that started them (``die_with_parent``).
+"""
 
 from __future__ import annotations
 
+import os
 import signal
+import sys
 import threading
 from collections.abc import Iterator
 from contextlib import contextmanager
 
-__all__ = ["signals_handled"]
+__all__ = ["die_with_parent", "signals_handled", "stop_requested", "stopping_on"]
 
 
 @contextmanager
@@ -36,3 +43,46 @@ def signals_handled(names: tuple[str, ...], *, interrupt: bool) -> Iterator[list
     finally:
         for name, saved in previous.items():
             signal.signal(getattr(signal, name), saved)
+
+
+_stop_file: str | None = None
+
+
+@contextmanager
+def stopping_on(path: str | None) -> Iterator[None]:
+    """Within the block, ``stop_requested()`` is True once the file ``path`` exists (None: never).
+
+    A command that runs files on worker processes creates the file when it is
+    interrupted; a worker then commits nothing more.
+    """
+    global _stop_file
+    saved, _stop_file = _stop_file, path
+    try:
+        yield
+    finally:
+        _stop_file = saved
+
+
+def stop_requested() -> bool:
+    """True when the command this process works for was interrupted (see ``stopping_on``)."""
+    return _stop_file is not None and os.path.exists(_stop_file)
+
+
+def die_with_parent(parent: int) -> None:
+    """Have this process killed when ``parent``, the process that started it, ends (Linux; elsewhere nothing).
+
+    A reader child of a worker that is killed (Ctrl-C, a crash) then stops at
+    once instead of running on with its memory until its own time limit. A
+    parent that ended before this call ends this process now.
+    """
+    if not sys.platform.startswith("linux"):
+        return
+    try:
+        import ctypes
+
+        libc = ctypes.CDLL(None, use_errno=True)
+        libc.prctl(1, int(signal.SIGKILL))  # PR_SET_PDEATHSIG
+    except (OSError, AttributeError):
+        return
+    if os.getppid() != parent:  # the parent ended before the request was made
+        os.kill(os.getpid(), signal.SIGKILL)

@@ -28,7 +28,7 @@ import tempfile
 from pathlib import Path
 from types import TracebackType
 
-from .signals import signals_handled
+from .signals import signals_handled, stop_requested
 
 PREFIX = ".spiral-cad-build-"
 MARKER = ".spiral-cad-staging"
@@ -177,10 +177,13 @@ class Staging:
             OutputError: a destination is a folder, not a regular file, or
                 read-only (checked before anything is replaced).
             OSError: a move failed; every destination was restored.
-            KeyboardInterrupt: an interrupt arrived; every destination was
+            KeyboardInterrupt: an interrupt arrived (or the command this worker
+                runs for was interrupted, ``stop_requested``); every destination was
                 restored (or, if it came after the last move, every file is in
                 place and the exception says so).
         """
+        if stop_requested():  # the command was interrupted: nothing more is committed
+            raise KeyboardInterrupt
         staged = self.files()
         targets = [self.out / p.name for p in staged]
         problems = [p for p in map(destination_problem, targets) if p]
@@ -192,7 +195,7 @@ class Staging:
         with signals_handled(("SIGINT", "SIGTERM", "SIGHUP"), interrupt=False) as received:
             try:
                 for source, target in zip(staged, targets):
-                    if received:
+                    if received or stop_requested():
                         raise KeyboardInterrupt
                     saved = os.path.lexists(target)
                     if saved:
