@@ -195,8 +195,6 @@ def test_ctrl_c_in_the_terminal_stops_the_run_and_its_workers_in_one_line(tmp_pa
     import os
     import signal
 
-    import psutil
-
     for k in range(30):
         write_step([Chain(core_examples()[k % 10][1].spirals)], tmp_path / f"t{k:02d}.step", f"t{k}", "mm", "test")
     code = "import sys; from spiral_cad_launcher import main; sys.exit(main())"
@@ -210,18 +208,24 @@ def test_ctrl_c_in_the_terminal_stops_the_run_and_its_workers_in_one_line(tmp_pa
     _, err = process.communicate(timeout=120)
     assert process.returncode == 130 and "Traceback" not in err, err
     assert err.splitlines()[-1] == "error: interrupted"
-    left = [p for p in psutil.process_iter(["status"]) if _session(p.pid) == process.pid and p.info["status"] != psutil.STATUS_ZOMBIE]
-    _, alive = psutil.wait_procs(left, timeout=10)  # a worker may take a moment to finish stopping
+    assert_session_ended(process.pid)
+
+
+def assert_session_ended(leader: int) -> None:
+    """No process of the session ``leader`` started is still running (a worker may take a moment to finish stopping)."""
+    import os
+
+    import psutil
+
+    def session(pid):
+        try:
+            return os.getsid(pid)
+        except OSError:
+            return None
+
+    left = [p for p in psutil.process_iter(["status"]) if session(p.pid) == leader and p.info["status"] != psutil.STATUS_ZOMBIE]
+    _, alive = psutil.wait_procs(left, timeout=10)
     assert not alive, alive
-
-
-def _session(pid):
-    try:
-        import os
-
-        return os.getsid(pid)
-    except OSError:
-        return None
 
 
 def stop_the_process_on_a_bad_file(args) -> int:

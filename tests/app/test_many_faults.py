@@ -22,6 +22,9 @@ from spiral_cad.app.many import run_many
 from spiral_cad.app.many_inputs import expand_inputs
 from spiral_cad.io.step import write_step
 
+sys.path.insert(0, str(Path(__file__).parent))
+from test_many import assert_session_ended  # noqa: E402
+
 pytest.importorskip("distributed")
 LAUNCHER = "import sys; from spiral_cad_launcher import main; sys.exit(main())"
 PROGRESS = ("checked ", "built ")
@@ -286,7 +289,6 @@ def test_make_g2_advice_has_the_time_limit(tmp_path, capsys, monkeypatch):
 @pytest.mark.subprocess
 @pytest.mark.parametrize(("name", "status", "line"), [("SIGINT", 130, "error: interrupted"), ("SIGTERM", 143, "error: terminated")])
 def test_a_signal_during_build_commits_nothing_more_stops_every_process_and_removes_staging(tmp_path, name, status, line):
-    import psutil
 
     for k in range(12):
         (tmp_path / "programs").mkdir(exist_ok=True)
@@ -319,16 +321,7 @@ def test_a_signal_during_build_commits_nothing_more_stops_every_process_and_remo
     assert not [p for p in out.rglob(".spiral-cad-build-*")]  # no staging folder left
     rows = list(csv.DictReader(open(tmp_path / "built.csv", encoding="utf-8")))
     assert len(rows) == 12 and any(r["verdict"] == "ok" for r in rows) and any(r["verdict"] == "not run" for r in rows)
-    left = [p for p in psutil.process_iter(["status"]) if _session(p.pid) == process.pid and p.info["status"] != psutil.STATUS_ZOMBIE]
-    _, alive = psutil.wait_procs(left, timeout=10)
-    assert not alive, alive
-
-
-def _session(pid):
-    try:
-        return os.getsid(pid)
-    except OSError:
-        return None
+    assert_session_ended(process.pid)
 
 
 @pytest.mark.subprocess
