@@ -110,7 +110,6 @@ class _Group:
 
     def solve_joints(self, s: list[float]) -> list[_Solved | None]:
         """Every joint's transition for the shifts ``s``: one batch solve per kind of joint."""
-        n = len(self.pieces)
         out: list[_Solved | None] = [None] * self.joint_count
         by_kind: dict[str, list[int]] = {}
         for j in range(self.joint_count):
@@ -120,9 +119,9 @@ class _Group:
         for kind in ("arc-arc-reverse", "arc-arc-compound", "bridge"):
             if by_kind.get(kind):
                 self._arcs_arcs(by_kind[kind], s, kind, out)
-        for j in by_kind.get("corner", []):  # a corner between lines does not depend on the shifts
-            if j not in self._corners:
-                self._corners[j] = self._corner(j, self.pieces[j], self.pieces[(j + 1) % n])
+        corners = by_kind.get("corner", [])  # a corner between lines does not depend on the shifts: solved once
+        self._solve_corners([j for j in corners if j not in self._corners])
+        for j in corners:
             out[j] = self._corners[j]
         return out
 
@@ -180,19 +179,33 @@ class _Group:
                 continue
             out[j] = _Solved([sp[m] for sp in moved], used_before[m], used_after[m], theta[m])
 
-    def _corner(self, j: int, a: _Piece, b: _Piece) -> _Solved:
+    def _solve_corners(self, joints: list[int]) -> None:
+        """Corners between lines rounded by spiral pairs within the target, all in one batch
+        (``round_corners_batch``); a corner next to an arc has no pair (its tangent circle comes first)."""
         n = len(self.pieces)
-        if a.kind != "line" or b.kind != "line":
-            return _Solved([], math.inf, math.inf, math.nan, int(Status.OUTSIDE_SHAPE), "")
-        corner = a.b
-        p0 = corner - self.allow[j][1] * a.tangent(True)
-        p1 = corner + self.allow[(j + 1) % n][0] * b.tangent(False)
+        lines = []
+        for j in joints:
+            a, b = self.pieces[j], self.pieces[(j + 1) % n]
+            if a.kind != "line" or b.kind != "line":
+                self._corners[j] = _Solved([], math.inf, math.inf, math.nan, int(Status.OUTSIDE_SHAPE), "")
+            else:
+                lines.append(j)
+        if not lines:
+            return
+        before = [self.pieces[j] for j in lines]
+        after = [self.pieces[(j + 1) % n] for j in lines]
+        corner = np.array([a.b for a in before])
+        p0 = corner - np.array([self.allow[j][1] * a.tangent(True) for j, a in zip(lines, before)])
+        p1 = corner + np.array([self.allow[(j + 1) % n][0] * b.tangent(False) for j, b in zip(lines, after)])
         result = round_corners_batch(p0, corner, p1, max_deviation=self.target, shape=self.shape)
-        if not result.ok[0]:
-            return _Solved([], math.inf, math.inf, math.nan, int(result.status[0]), result.reason(0))
-        pair = result.control_points[0]
-        return _Solved([pair[0].copy(), pair[1].copy()], _used(a, pair[0][0], True), _used(b, pair[1][3], False),
-                       float(result.theta[0]))  # fmt: skip
+        ok, theta = result.ok.tolist(), result.theta.tolist()
+        for m, (j, a, b) in enumerate(zip(lines, before, after)):
+            if not ok[m]:
+                self._corners[j] = _Solved([], math.inf, math.inf, math.nan, int(result.status[m]), result.reason(m))
+                continue
+            pair = result.control_points[m]
+            self._corners[j] = _Solved([pair[0].copy(), pair[1].copy()], _used(a, pair[0][0], True), _used(b, pair[1][3], False),
+                                       theta[m])  # fmt: skip
 
 
 def _coordinate_size(pieces: list[_Piece]) -> float:
