@@ -62,3 +62,63 @@ def quadratic_prism() -> bd.Part:
                               _array(TColStd_Array1OfInteger, [3] + [1] * (spans - 1) + [3]), 2)  # fmt: skip
     edge = bd.Edge(BRepBuilderAPI_MakeEdge(curve).Edge())
     return bd.extrude(bd.make_face([edge, bd.Line(edge @ 1, edge @ 0)]), 5)
+
+
+def _cubic_basis(knots: list[float], t: float) -> list[float]:
+    """The cubic B-spline basis functions on ``knots`` at ``t`` (Cox–de Boor; t = the last knot counts in the last span)."""
+    last = len(knots) - 1
+    values = [1.0 if knots[i] <= t < knots[i + 1] or (t == knots[-1] and knots[i] < t == knots[i + 1]) else 0.0 for i in range(last)]
+    for degree in range(1, 4):
+        values = [((t - knots[i]) / (knots[i + degree] - knots[i]) * values[i] if knots[i + degree] > knots[i] else 0.0)
+                  + ((knots[i + degree + 1] - t) / (knots[i + degree + 1] - knots[i + 1]) * values[i + 1]
+                     if knots[i + degree + 1] > knots[i + 1] else 0.0) for i in range(last - degree)]  # fmt: skip
+    return values
+
+
+def knot_line_join(tilt: float = 1e-13, below: float = 0.25, above: float = 1.0):
+    """Two faces of one cubic B-spline surface z(y) (x = u, y = v) with a double knot at v = 0.5, meeting on
+    that knot line, tangent there, the curvature across it ``below`` on one side and ``above`` on the other
+    (a G1 join); one face's pcurve of the shared edge tilted by ``tilt`` out of the face's bounds, as a file
+    from another CAD system may have it. Returns the sewn shell (OCP)."""
+    import numpy as np
+    from OCP.BRep import BRep_Builder, BRep_Tool
+    from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeFace, BRepBuilderAPI_Sewing
+    from OCP.BRepTools import BRepTools
+    from OCP.Geom import Geom_BSplineSurface
+    from OCP.Geom2d import Geom2d_Line
+    from OCP.gp import gp_Dir2d, gp_Pnt
+    from OCP.TColgp import TColgp_Array2OfPnt
+    from OCP.TColStd import TColStd_Array1OfInteger, TColStd_Array1OfReal
+    from OCP.TopAbs import TopAbs_EDGE, TopAbs_FACE
+    from OCP.TopExp import TopExp
+    from OCP.TopoDS import TopoDS
+    from OCP.TopTools import TopTools_IndexedDataMapOfShapeListOfShape
+
+    flat = [0.0] * 4 + [0.5] * 2 + [1.0] * 4
+    ys = np.linspace(0.0, 1.0, 41)
+    zs = np.where(ys < 0.5, below / 2, above / 2) * (ys - 0.5) ** 2  # z'' = below, above: κ across the line
+    heights = np.linalg.lstsq(np.array([_cubic_basis(flat, y) for y in ys]), zs, rcond=None)[0]
+    poles = TColgp_Array2OfPnt(1, 2, 1, 6)
+    for i, x in enumerate((0.0, 1.0)):
+        for j in range(6):
+            poles.SetValue(i + 1, j + 1, gp_Pnt(x, sum(flat[j + 1 : j + 4]) / 3, heights[j]))  # y at the Greville points
+
+    def surface():  # one copy per face: each face gets its own pcurve of the shared edge
+        return Geom_BSplineSurface(poles, _array(TColStd_Array1OfReal, [0.0, 1.0]), _array(TColStd_Array1OfReal, [0.0, 0.5, 1.0]),
+                                   _array(TColStd_Array1OfInteger, [2, 2]), _array(TColStd_Array1OfInteger, [4, 2, 4]), 1, 3)  # fmt: skip
+
+    sewing = BRepBuilderAPI_Sewing(1e-6)
+    sewing.Add(BRepBuilderAPI_MakeFace(surface(), 0.0, 1.0, 0.0, 0.5, 1e-7).Face())
+    sewing.Add(BRepBuilderAPI_MakeFace(surface(), 0.0, 1.0, 0.5, 1.0, 1e-7).Face())
+    sewing.Perform()
+    shell = sewing.SewedShape()
+    ancestors = TopTools_IndexedDataMapOfShapeListOfShape()
+    TopExp.MapShapesAndAncestors_s(shell, TopAbs_EDGE, TopAbs_FACE, ancestors)
+    shared = next(i for i in range(1, ancestors.Extent() + 1) if ancestors.FindFromIndex(i).Extent() == 2)
+    edge, face = TopoDS.Edge_s(ancestors.FindKey(shared)), TopoDS.Face_s(ancestors.FindFromIndex(shared).First())
+    if tilt:
+        line = BRep_Tool.CurveOnSurface_s(edge, face, 0.0, 0.0).Lin2d()
+        outwards = 1.0 if BRepTools.UVBounds_s(face)[3] < 0.75 else -1.0  # the face below the line: tilt above it
+        d = line.Direction()
+        BRep_Builder().UpdateEdge(edge, Geom2d_Line(line.Location(), gp_Dir2d(d.X(), d.Y() + outwards * tilt * abs(d.X()))), face, 1e-7)
+    return shell

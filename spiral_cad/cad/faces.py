@@ -71,6 +71,7 @@ from OCP.TopTools import (
 
 from ..check.joints import check_tolerances
 from ..core.units import length_unit
+from .face_projection import FaceDomain
 from .face_sampling import FACE_FLOATS, EdgeLine, Line, Tolerances, knot_lines, measures, sample_lines
 from .occ import as_occ_shape
 from .readers import IGES_SUFFIXES, STEP_SUFFIXES, read_file
@@ -179,17 +180,17 @@ def _measure(shape: TopoDS_Shape, samples: int, gap_tol: float, angle_tol: float
     TopExp.MapShapes_s(shape, TopAbs_EDGE, edges)
     ancestors = TopTools_IndexedDataMapOfShapeListOfShape()
     TopExp.MapShapesAndAncestors_s(shape, TopAbs_EDGE, TopAbs_FACE, ancestors)
-    adaptors: dict[int, BRepAdaptor_Surface] = {}
+    domains: dict[int, FaceDomain] = {}
     uses: dict[int, dict[int, set[Any]]] = {}
     kinds: list[str] = []
     for i in range(1, faces.Extent() + 1):
         kinds.append(_surface_name(BRepAdaptor_Surface(TopoDS.Face_s(faces.FindKey(i)), False).GetType()))
 
-    def adaptor(face: TopoDS_Face) -> BRepAdaptor_Surface:
+    def domain(face: TopoDS_Face) -> FaceDomain:
         index = faces.FindIndex(face)
-        if index not in adaptors:
-            adaptors[index] = BRepAdaptor_Surface(face)
-        return adaptors[index]
+        if index not in domains:
+            domains[index] = FaceDomain(face, BRepAdaptor_Surface(face))
+        return domains[index]
 
     pairs: list[tuple[int, int, int, bool, str]] = []
     lines: list[Line] = []
@@ -232,13 +233,13 @@ def _measure(shape: TopoDS_Shape, samples: int, gap_tol: float, angle_tol: float
                     if len(found) == 2:
                         note = "; ".join(filter(None, [note, "orientation: both faces use the edge in the same direction "
                                                        "(inconsistent shell); compared with one normal flipped"]))  # fmt: skip
-            sides = [(adaptor(fa), fa, ea), (adaptor(fb), fb, eb)]
+            sides = [(domain(fa), ea), (domain(fb), eb)]
             lines.append(EdgeLine(edge, sides, (signs[0], signs[1]), samples))
             pairs.append((index - 1, faces.FindIndex(fa) - 1, faces.FindIndex(fb) - 1, len(found) == 1, note))
     for face_index in range(1, faces.Extent() + 1):
         face = TopoDS.Face_s(faces.FindKey(face_index))
         sign = -1.0 if face.Orientation() == TopAbs_REVERSED else 1.0
-        for line in knot_lines(face, adaptor(face), sign, samples):
+        for line in knot_lines(domain(face), sign, samples):
             lines.append(line)
             pairs.append((-1, face_index - 1, face_index - 1, False, f"inside face {face_index - 1}, {line.name}"))
     tolerances = Tolerances(gap_tol * size, angle_tol, curvature_tol, feature_angle, size)

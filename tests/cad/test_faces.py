@@ -596,3 +596,27 @@ FREECAD_KNOT = textwrap.dedent(
     print(json.dumps(out))
     """
 )
+
+
+@pytest.mark.parametrize("tilt", [0.0, 1e-13, -1e-13, 1e-9])
+def test_faces_meeting_on_a_knot_line_are_read_each_from_its_own_side(tilt):
+    # issue 39: a pcurve 1e-13 outside its face's bound, on the knot line where the face ends, read the
+    # neighbouring patch (a G1 join reported G2); each face is now evaluated from its own side of the line
+    from face_reproducers import knot_line_join
+    from OCP.BRepTools import BRepTools
+    from OCP.TopAbs import TopAbs_FACE
+    from OCP.TopExp import TopExp_Explorer
+    from OCP.TopoDS import TopoDS
+
+    shell = knot_line_join(tilt)
+    explorer, bounds = TopExp_Explorer(shell, TopAbs_FACE), []
+    while explorer.More():
+        bounds.append(BRepTools.UVBounds_s(TopoDS.Face_s(explorer.Current())))
+        explorer.Next()
+    if tilt > 0.0:  # the reproducer is what the issue describes: a face's bounds reach past the knot line
+        assert any(0.5 < v1 < 0.5 + 2 * tilt or 0.5 - 2 * tilt < v0 < 0.5 for _, _, v0, v1 in bounds)
+    report = check_faces(shell)
+    (edge,) = report.edges
+    assert edge.level == "G1" and not report.passes("G2")
+    assert sorted(abs(k) for k in edge.curvatures) == pytest.approx([0.25, 1.0], rel=1e-6)
+    assert edge.gap < 1e-12 and edge.angle < 1e-9
