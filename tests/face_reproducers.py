@@ -75,18 +75,20 @@ def _cubic_basis(knots: list[float], t: float) -> list[float]:
     return values
 
 
-def knot_line_join(tilt: float = 1e-13, below: float = 0.25, above: float = 1.0):
+def knot_line_join(tilt: float = 1e-13, below: float = 0.25, above: float = 1.0, shift: float = 0.0, apart: float = 0.0):
     """Two faces of one cubic B-spline surface z(y) (x = u, y = v) with a double knot at v = 0.5, meeting on
     that knot line, tangent there, the curvature across it ``below`` on one side and ``above`` on the other
     (a G1 join); one face's pcurve of the shared edge tilted by ``tilt`` out of the face's bounds, as a file
-    from another CAD system may have it. Returns the sewn shell (OCP)."""
+    from another CAD system may have it, or its parameter shifted by ``shift`` along the edge (the same
+    points, at other parameters); ``apart`` lifts the upper face by that much before the two are sewn (a
+    real gap, within the sewn edge's tolerance). Returns the sewn shell (OCP)."""
     import numpy as np
     from OCP.BRep import BRep_Builder, BRep_Tool
     from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeFace, BRepBuilderAPI_Sewing
     from OCP.BRepTools import BRepTools
     from OCP.Geom import Geom_BSplineSurface
     from OCP.Geom2d import Geom2d_Line
-    from OCP.gp import gp_Dir2d, gp_Pnt
+    from OCP.gp import gp_Dir2d, gp_Pnt, gp_Pnt2d, gp_Vec
     from OCP.TColgp import TColgp_Array2OfPnt
     from OCP.TColStd import TColStd_Array1OfInteger, TColStd_Array1OfReal
     from OCP.TopAbs import TopAbs_EDGE, TopAbs_FACE
@@ -107,9 +109,11 @@ def knot_line_join(tilt: float = 1e-13, below: float = 0.25, above: float = 1.0)
         return Geom_BSplineSurface(poles, _array(TColStd_Array1OfReal, [0.0, 1.0]), _array(TColStd_Array1OfReal, [0.0, 0.5, 1.0]),
                                    _array(TColStd_Array1OfInteger, [2, 2]), _array(TColStd_Array1OfInteger, [4, 2, 4]), 1, 3)  # fmt: skip
 
-    sewing = BRepBuilderAPI_Sewing(1e-6)
+    sewing = BRepBuilderAPI_Sewing(max(1e-6, 10 * apart))
+    upper = surface()
+    upper.Translate(gp_Vec(0.0, 0.0, apart))
     sewing.Add(BRepBuilderAPI_MakeFace(surface(), 0.0, 1.0, 0.0, 0.5, 1e-7).Face())
-    sewing.Add(BRepBuilderAPI_MakeFace(surface(), 0.0, 1.0, 0.5, 1.0, 1e-7).Face())
+    sewing.Add(BRepBuilderAPI_MakeFace(upper, 0.0, 1.0, 0.5, 1.0, 1e-7).Face())
     sewing.Perform()
     shell = sewing.SewedShape()
     ancestors = TopTools_IndexedDataMapOfShapeListOfShape()
@@ -121,4 +125,8 @@ def knot_line_join(tilt: float = 1e-13, below: float = 0.25, above: float = 1.0)
         outwards = 1.0 if BRepTools.UVBounds_s(face)[3] < 0.75 else -1.0  # the face below the line: tilt above it
         d = line.Direction()
         BRep_Builder().UpdateEdge(edge, Geom2d_Line(line.Location(), gp_Dir2d(d.X(), d.Y() + outwards * tilt * abs(d.X()))), face, 1e-7)
+    if shift:
+        line = BRep_Tool.CurveOnSurface_s(edge, face, 0.0, 0.0).Lin2d()
+        d, at = line.Direction(), line.Location()
+        BRep_Builder().UpdateEdge(edge, Geom2d_Line(gp_Pnt2d(at.X() + shift * d.X(), at.Y() + shift * d.Y()), d), face, 1e-7)
     return shell

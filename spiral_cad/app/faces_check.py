@@ -52,7 +52,7 @@ def check_face_file(file: str, *, require: str | None = None, gap_tol: float | N
                     curvature_map: str | None = None, timing: bool = False) -> int | None:  # fmt: skip
     """Judge the faces of ``file`` and print the table; draw the pictures asked for.
 
-    Tolerances left None take ``check_faces``'s defaults (gap 1e-7 × size, angle 1e-7 rad, curvature jump 1e-4). ``require`` "G2" or "G1" fails any
+    Tolerances left None take ``check_faces``'s defaults (gap: the file's stated precision and the edges' own tolerances, angle 1e-7 rad, curvature jump 1e-4). ``require`` "G2" or "G1" fails any
     tangent edge below it (and "G0" any gap); sharp features are listed, never failed. ``timing``
     also prints how long the check took.
 
@@ -65,7 +65,7 @@ def check_face_file(file: str, *, require: str | None = None, gap_tol: float | N
     zebra_png, map_png = _png("zebra", zebra), _png("curvature-map", curvature_map)
     report = check_faces(
         file,
-        gap_tol=1e-7 if gap_tol is None else gap_tol,
+        gap_tol=gap_tol,
         angle_tol=1e-7 if angle_tol is None else angle_tol,
         curvature_tol=1e-4 if curvature_tol is None else curvature_tol,
         feature_angle=FEATURE_ANGLE if feature_angle is None else feature_angle,

@@ -22,6 +22,7 @@ where the edge really is on it and as the face itself sees it:
 from __future__ import annotations
 
 import math
+from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
@@ -124,7 +125,7 @@ class FaceDomain:
                     (whole.UIntervals if axis == 0 else whole.VIntervals)(array, GeomAbs_Shape.GeomAbs_C2)
                     values = [array.Value(i) for i in range(2, count + 1)]
                 self.breaks.append(np.array(values))
-        self._classifier = None
+        self._classifier: Any = None  # OCCT's classifier of (u, v) in the face, made when first needed
 
     # ------------------------------------------------------------ one-sided evaluation
 

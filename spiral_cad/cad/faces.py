@@ -96,9 +96,10 @@ SEW_TOL = 1e-6
 #: face count, per face its surface type, per checked pair (edge index, face a,
 #: face b, seam, note), the free edges (index, midpoint), the model size, the samples as
 #: float64 bytes (samples × 2 faces × ``FACE_FLOATS``, pair after pair), how many samples
-#: each pair got, and how many edges were sewn.
+#: each pair got, how many edges were sewn, per pair the BRep tolerance of its edge (of its
+#: face for a knot line), and the precision the file states (0.0: none).
 Measured = tuple[int, list[str], list[tuple[int, int, int, bool, str]], list[tuple[int, tuple[float, float, float]]], float,
-                 bytes, list[int], int]  # fmt: skip
+                 bytes, list[int], int, list[float], float]  # fmt: skip
 
 
 # ------------------------------------------------------------ measuring
@@ -165,11 +166,11 @@ def _edge_uses(face: TopoDS_Face, edges: TopTools_IndexedMapOfShape) -> dict[int
     return uses
 
 
-def _measure(shape: TopoDS_Shape, samples: int, gap_tol: float, angle_tol: float, curvature_tol: float,
-             feature_angle: float) -> Measured:  # fmt: skip
+def _measure(shape: TopoDS_Shape, stated: float = 0.0, *, samples: int, gap_tol: float | None, angle_tol: float,
+             curvature_tol: float, feature_angle: float) -> Measured:  # fmt: skip
     """Everything ``check_faces`` needs of ``shape``, as plain data (see ``Measured``); runs in the
-    reader's child process for a file. Faces that were written unstitched (coinciding free edges)
-    are sewn first."""
+    reader's child process for a file (``stated``: the precision the file states). Faces that were
+    written unstitched (coinciding free edges) are sewn first."""
     box = Bnd_Box()
     BRepBndLib.Add_s(shape, box, False)
     size = 0.0 if box.IsVoid() else math.sqrt(box.SquareExtent())
@@ -193,6 +194,7 @@ def _measure(shape: TopoDS_Shape, samples: int, gap_tol: float, angle_tol: float
         return domains[index]
 
     pairs: list[tuple[int, int, int, bool, str]] = []
+    limits: list[float] = []
     lines: list[Line] = []
     free: list[tuple[int, tuple[float, float, float]]] = []
     for i in range(1, ancestors.Extent() + 1):
@@ -235,6 +237,7 @@ def _measure(shape: TopoDS_Shape, samples: int, gap_tol: float, angle_tol: float
                                                        "(inconsistent shell); compared with one normal flipped"]))  # fmt: skip
             sides = [(domain(fa), ea), (domain(fb), eb)]
             lines.append(EdgeLine(edge, sides, (signs[0], signs[1]), samples))
+            limits.append(BRep_Tool.Tolerance_s(edge))
             pairs.append((index - 1, faces.FindIndex(fa) - 1, faces.FindIndex(fb) - 1, len(found) == 1, note))
     for face_index in range(1, faces.Extent() + 1):
         face = TopoDS.Face_s(faces.FindKey(face_index))
@@ -242,9 +245,10 @@ def _measure(shape: TopoDS_Shape, samples: int, gap_tol: float, angle_tol: float
         for line in knot_lines(domain(face), sign, samples):
             lines.append(line)
             pairs.append((-1, face_index - 1, face_index - 1, False, f"inside face {face_index - 1}, {line.name}"))
-    tolerances = Tolerances(gap_tol * size, angle_tol, curvature_tol, feature_angle, size)
-    rows, counts = sample_lines(lines, tolerances)
-    return faces.Extent(), kinds, pairs, free, size, rows.tobytes(), counts, stitched
+            limits.append(BRep_Tool.Tolerance_s(face))
+    gap = gap_tol * size if gap_tol is not None else max([stated, *limits])  # what refinement watches
+    rows, counts = sample_lines(lines, Tolerances(gap, angle_tol, curvature_tol, feature_angle, size))
+    return faces.Extent(), kinds, pairs, free, size, rows.tobytes(), counts, stitched, limits, stated
 
 
 # ------------------------------------------------------------ the report
@@ -307,7 +311,8 @@ class FaceReport:
         faces: how many faces the shape holds.
         free_edges: edges that bound one face only (an open shell's border), not judged.
         size: the model size (diagonal of the bounding box), the scale of ``gap_tol`` and the curvature floor.
-        gap_tol: largest gap, relative to ``size``.
+        gap_tol: largest gap, relative to ``size``: as given, or (``gap_from`` the file) the largest limit
+            an edge was judged against, relative to ``size``.
         angle_tol: largest angle between normals of a tangent edge, radians.
         curvature_tol: largest relative jump of normal curvature of a G2 edge.
         feature_angle: normals further apart make an edge a sharp feature.
@@ -319,6 +324,9 @@ class FaceReport:
             before being judged; face and edge indices then count in the sewn shape.
         free_at: the free edges left after sewing: (edge index, midpoint) each.
         evaluated: how many points were evaluated on all edges and knot lines together.
+        gap_from: where the gap limit came from: ``"given"`` (``gap_tol`` × size), or the precision the file
+            states (``UNCERTAINTY_MEASURE_WITH_UNIT``) and each edge's own BRep tolerance, the larger of the two
+            per edge, e.g. ``"file: stated uncertainty 1e-07, edge tolerances 1e-07 to 2e-05"``.
     """
 
     edges: tuple[FaceEdge, ...]
@@ -336,6 +344,7 @@ class FaceReport:
     stitched: int = 0
     free_at: tuple[tuple[int, tuple[float, float, float]], ...] = ()
     evaluated: int = 0
+    gap_from: str = "given"
 
     @property
     def tangent_edges(self) -> list[FaceEdge]:
@@ -401,7 +410,7 @@ class FaceReport:
         sewn = f"; faces sewn within {SEW_TOL:g} × size" if self.stitched else ""
         out = [
             f"{self.source or 'shape'}: {self.describe()}; worst tangent edge {self.worst}",
-            f"  tolerances: gap {self.gap_tol:g} × size, angle {self.angle_tol:g} rad, curvature jump "
+            f"  tolerances: gap {self._gap_text()}, angle {self.angle_tol:g} rad, curvature jump "
             f"{self.curvature_tol:g} relative, sharp above {math.degrees(self.feature_angle):g}°; "
             f"at least {self.samples} samples per edge, more at knots and where the geometry turns "
             f"({self.evaluated} in all); model size {self.size:.6g}{unit}{sewn}",
@@ -423,20 +432,27 @@ class FaceReport:
                 out.append(f"  … and {len(self.free_at) - _FREE_LISTED} more")
         return "\n".join(out)
 
+    def _gap_text(self) -> str:
+        """The gap limit as the table states it."""
+        if self.gap_from == "given":
+            return f"{self.gap_tol:g} × size (given)"
+        return f"from the {self.gap_from} (at most {self.gap_tol * self.size:.3g}{' ' + self.units if self.units else ''})"
+
 
 #: Free edges listed by name in a table; the rest are counted.
 _FREE_LISTED = 20
 
 
-def _classify(measured: Measured, *, gap_tol: float, angle_tol: float, curvature_tol: float, feature_angle: float,
+def _classify(measured: Measured, *, gap_tol: float | None, angle_tol: float, curvature_tol: float, feature_angle: float,
               samples: int, source: str, units: str, started: float) -> FaceReport:  # fmt: skip
     """The report of the measured samples: worst values per edge (measures vectorised over all samples) and classes."""
-    count, kinds, pairs, free, size, data, counts, stitched = measured
+    count, kinds, pairs, free, size, data, counts, stitched, limits, stated = measured
     x = np.frombuffer(data, dtype=float).reshape(-1, 2, FACE_FLOATS)
     gap, angle, jump = measures(x, size)
     ends = np.cumsum([0, *counts])
     rows = []
-    gap_limit = gap_tol * size
+    given = gap_tol is not None
+    gap_limits = [gap_tol * size if gap_tol is not None else max(stated, limit) for limit in limits]
     for i, (edge, fa, fb, seam, note) in enumerate(pairs):
         start, stop = int(ends[i]), int(ends[i + 1])
         g_, an_, j_ = gap[start:stop], angle[start:stop], jump[start:stop]
@@ -446,7 +462,7 @@ def _classify(measured: Measured, *, gap_tol: float, angle_tol: float, curvature
         least_angle = float(np.nanmin(an_)) if np.isfinite(an_).any() else math.nan
         if not (math.isfinite(worst_gap) and math.isfinite(worst_angle)):
             level = "unmeasurable"  # no sample gave a point or a normal: never passed
-        elif worst_gap > gap_limit:
+        elif worst_gap > gap_limits[i]:
             level = "gap"
         elif least_angle > feature_angle:
             level = "sharp"  # sharp at every sample: a feature
@@ -465,11 +481,20 @@ def _classify(measured: Measured, *, gap_tol: float, angle_tol: float, curvature
 
         rows.append(FaceEdge(edge, (fa, fb), (kinds[fa], kinds[fb]), seam, worst_gap, at(g), worst_angle, at(an),
                              worst_jump, at(j), (float(x[j, 0, 6]), float(x[j, 1, 6])), level, note, stop - start))  # fmt: skip
-    return FaceReport(tuple(rows), count, len(free), size, gap_tol, angle_tol, curvature_tol, feature_angle, samples,
-                      source, units, time.perf_counter() - started, stitched, tuple(free), int(ends[-1]))  # fmt: skip
+    if given:
+        relative, gap_from = float(gap_tol or 0.0), "given"
+    else:
+        edge_limits = [limit for (edge, *_), limit in zip(pairs, limits) if edge >= 0] or [0.0]
+        relative = max([stated, *limits]) / size if size > 0.0 else 0.0
+        gap_from = (f"file: stated uncertainty {stated:.3g}, " if stated > 0.0 else "file: no stated uncertainty, ") + (
+            f"edge tolerances {min(edge_limits):.3g} to {max(edge_limits):.3g}"
+        )
+    return FaceReport(tuple(rows), count, len(free), size, relative, angle_tol, curvature_tol, feature_angle, samples,
+                      source, units, time.perf_counter() - started, stitched, tuple(free), int(ends[-1]),
+                      gap_from)  # fmt: skip
 
 
-def check_faces(shape_or_path: Any, *, gap_tol: float = 1e-7, angle_tol: float = 1e-7, curvature_tol: float = 1e-4,
+def check_faces(shape_or_path: Any, *, gap_tol: float | None = None, angle_tol: float = 1e-7, curvature_tol: float = 1e-4,
                 feature_angle: float = FEATURE_ANGLE, samples: int = 16, units: str | None = "mm",
                 label: str | None = None) -> FaceReport:  # fmt: skip
     """G0/G1/G2 continuity of the faces of a solid or shell across every edge they share.
@@ -491,7 +516,10 @@ def check_faces(shape_or_path: Any, *, gap_tol: float = 1e-7, angle_tol: float =
     Args:
         shape_or_path: a build123d or CadQuery shape, a ``TopoDS_Shape``, or a
             .step/.stp/.igs/.iges path.
-        gap_tol: largest distance between the two faces' points, relative to the model size.
+        gap_tol: largest distance between the two faces' points (each the projection of the edge's point
+            on its face), relative to the model size; None (default): per edge the larger of the precision
+            the file states (STEP's ``UNCERTAINTY_MEASURE_WITH_UNIT``, IGES's resolution) and the edge's
+            own BRep tolerance (``FaceReport.gap_from`` says which was used).
         angle_tol: largest angle between the oriented normals of a tangent edge, radians.
         curvature_tol: largest jump of the normal curvature across the edge, relative to
             ``max(|κa|, |κb|, 1/size)``.
@@ -513,7 +541,8 @@ def check_faces(shape_or_path: Any, *, gap_tol: float = 1e-7, angle_tol: float =
             ``feature_angle`` not within (``angle_tol``, π], ``samples`` not an integer ≥ 1.
     """
     started = time.perf_counter()
-    check_tolerances(gap_tol=gap_tol, angle_tol=angle_tol, curvature_tol=curvature_tol, feature_angle=feature_angle)
+    check_tolerances(gap_tol=0.0 if gap_tol is None else gap_tol, angle_tol=angle_tol, curvature_tol=curvature_tol,
+                     feature_angle=feature_angle)  # fmt: skip
     if not angle_tol < feature_angle <= math.pi:
         raise ValueError(f"feature_angle must be above angle_tol ({angle_tol:g}) and at most π; got {feature_angle!r}")
     if isinstance(samples, bool) or not isinstance(samples, int) or samples < 1:
@@ -521,7 +550,7 @@ def check_faces(shape_or_path: Any, *, gap_tol: float = 1e-7, angle_tol: float =
     options: dict[str, Any] = dict(gap_tol=gap_tol, angle_tol=angle_tol, curvature_tol=curvature_tol,
                                    feature_angle=feature_angle, samples=samples)  # fmt: skip
     if isinstance(shape_or_path, (str, os.PathLike)):
-        unit, measured = read_file(shape_or_path, units, partial(_measure, **options))
+        unit, measured = read_file(shape_or_path, units, partial(_measure, **options), stated=True)
         source = label or os.path.basename(os.fspath(shape_or_path))
     else:
         unit = length_unit(units) if units is not None else ""

@@ -106,23 +106,25 @@ def _shape_bytes(shape: TopoDS_Shape) -> bytes:
     return buffer.getvalue()
 
 
-def read_file(path: str | os.PathLike, units: str | None, extract: Callable[[TopoDS_Shape], Any]) -> tuple[str, Any]:
+def read_file(path: str | os.PathLike, units: str | None, extract: Callable[..., Any], *, stated: bool = False) -> tuple[str, Any]:
     """Read a STEP/IGES file in a child process and return ``(unit, extract(shape))``.
 
     ``extract`` runs in the child on the shape read (so evaluating its curves
     cannot harm the caller either) and must return plain data (``marshal``).
     ``unit`` is the unit the shape was read in: ``units``, or with None the
     unit the file declares (``"m"``), or ``"mm"`` for a unit spiral_cad does
-    not name.
+    not name. With ``stated``, ``extract(shape, uncertainty)`` is called with
+    the precision the file states (STEP's ``UNCERTAINTY_MEASURE_WITH_UNIT``,
+    IGES's minimum resolution), in the unit read in; 0.0 when it states none.
 
     Raises:
         ReadError, ValueError: as ``read_shape``.
     """
-    with start_reading(path, units, extract) as child:
+    with start_reading(path, units, extract, stated=stated) as child:
         return finish_reading(child)
 
 
-def start_reading(path: str | os.PathLike, units: str | None, extract: Callable[[TopoDS_Shape], Any]) -> Isolated:
+def start_reading(path: str | os.PathLike, units: str | None, extract: Callable[..., Any], *, stated: bool = False) -> Isolated:
     """``read_file`` started: the child reads while the caller goes on; ``finish_reading`` waits.
 
     Raises:
@@ -140,7 +142,7 @@ def start_reading(path: str | os.PathLike, units: str | None, extract: Callable[
     if kind == "IGES":
         _check_iges_sections(p)
     _load_readers()
-    return Isolated(_read_and_extract, p, kind, units, extract, what=f"the {kind} reader", subject=p.name)
+    return Isolated(_read_and_extract, p, kind, units, extract, stated, what=f"the {kind} reader", subject=p.name)
 
 
 def finish_reading(child: Isolated) -> tuple[str, Any]:
@@ -164,14 +166,16 @@ def _load_readers() -> None:
     IGESControl_Controller.Init_s()
 
 
-def _read_and_extract(path: Path, kind: str, units: str | None, extract: Callable[[TopoDS_Shape], Any]) -> tuple[str, Any]:
+def _read_and_extract(path: Path, kind: str, units: str | None, extract: Callable[..., Any], stated: bool = False) -> tuple[str, Any]:
     """The child's work: read the file whole, then extract what the caller needs."""
-    shape, unit = _read_whole(path, kind, units)
-    return unit, extract(shape)
+    precision: list[float] = []
+    shape, unit = _read_whole(path, kind, units, precision)
+    return unit, (extract(shape, precision[0] if precision else 0.0) if stated else extract(shape))
 
 
-def _read_whole(path: Path, kind: str, units: str | None) -> tuple[TopoDS_Shape, str]:
-    """Read ``path`` with OCCT, check that it was read whole; (shape, unit read in)."""
+def _read_whole(path: Path, kind: str, units: str | None, precision: list[float] | None = None) -> tuple[TopoDS_Shape, str]:
+    """Read ``path`` with OCCT, check that it was read whole; (shape, unit read in). The precision the
+    file states, in the unit read in, is appended to ``precision`` (when it states one)."""
     from OCP.IFSelect import IFSelect_RetDone
 
     with captured_messages() as printed:
@@ -189,6 +193,9 @@ def _read_whole(path: Path, kind: str, units: str | None) -> tuple[TopoDS_Shape,
         failures = _reader_failures(reader.WS().ModelCheckList(), name) if status == IFSelect_RetDone else []
         if status == IFSelect_RetDone and not failures:
             unit = _use_unit(reader, kind, units, path.name)
+            stated = _stated_precision(reader, kind) / MM_PER_UNIT[unit]
+            if precision is not None and math.isfinite(stated) and stated > 0.0:
+                precision.append(stated)
             curves = _step_curves(reader.StepModel()) if kind == "STEP" else _iges_curves(reader.IGESModel())
             nested = next((container for curve, container, _ in curves if curve is _NESTED), None)
             if nested is not None:
@@ -248,6 +255,24 @@ def _step_unit(reader: Any) -> float:
             if context.LengthDone():
                 return context.LengthFactor()
     return 1.0
+
+
+def _stated_precision(reader: Any, kind: str) -> float:
+    """The precision the file states, in mm (0.0: none): the first length ``UNCERTAINTY_MEASURE_WITH_UNIT``
+    of a STEP file's representation contexts (in its length unit), an IGES file's minimum resolution."""
+    if kind != "STEP":
+        return float(reader.IGESModel().GlobalSection().Resolution()) * _iges_unit(reader)
+    from OCP.STEPConstruct import STEPConstruct_UnitContext
+    from OCP.StepRepr import StepRepr_GlobalUncertaintyAssignedContext, StepRepr_RepresentationContext
+
+    for entity in _entities_of(reader.StepModel(), StepRepr_RepresentationContext):
+        if not isinstance(entity, StepRepr_GlobalUncertaintyAssignedContext):
+            entity = getattr(entity, "GlobalUncertaintyAssignedContext", lambda: None)()
+        if entity is not None:
+            context = STEPConstruct_UnitContext()
+            if context.ComputeTolerance(entity) == 0 and context.HasUncertainty():
+                return float(context.Uncertainty()) * _step_unit(reader)
+    return 0.0
 
 
 def _iges_unit(reader: Any) -> float:

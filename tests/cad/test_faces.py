@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import json
 import math
+import re
 import subprocess
 import textwrap
 
@@ -620,3 +621,47 @@ def test_faces_meeting_on_a_knot_line_are_read_each_from_its_own_side(tilt):
     assert edge.level == "G1" and not report.passes("G2")
     assert sorted(abs(k) for k in edge.curvatures) == pytest.approx([0.25, 1.0], rel=1e-6)
     assert edge.gap < 1e-12 and edge.angle < 1e-9
+
+
+def test_a_pcurve_with_a_shifted_parameter_is_not_a_gap():
+    # issue 39: the gap was measured between the two faces' pcurve points, so a pcurve whose parameter is
+    # shifted along the edge read as a gap where both surfaces contain the edge; now each face is read at
+    # the projection of the edge's 3-D point
+    from face_reproducers import knot_line_join
+
+    report = check_faces(knot_line_join(0.0, shift=0.02))
+    (edge,) = report.edges
+    assert edge.level == "G1" and edge.gap < 1e-12
+    assert sorted(abs(k) for k in edge.curvatures) == pytest.approx([0.25, 1.0], rel=1e-6)
+
+
+def test_the_gap_limit_comes_from_the_edges_tolerances_and_the_file_and_the_table_says_so(tmp_path):
+    # the faces are sewn 2e-5 apart: within the tolerance sewing gave their edge, beyond 1e-7 × size
+    from face_reproducers import knot_line_join
+    from OCP.BRep import BRep_Tool
+    from OCP.TopAbs import TopAbs_EDGE
+    from OCP.TopExp import TopExp_Explorer
+    from OCP.TopoDS import TopoDS
+
+    shell = knot_line_join(0.0, apart=2e-5)
+    explorer, tolerance = TopExp_Explorer(shell, TopAbs_EDGE), 0.0
+    while explorer.More():
+        tolerance = max(tolerance, BRep_Tool.Tolerance_s(TopoDS.Edge_s(explorer.Current())))
+        explorer.Next()
+    (edge,) = check_faces(shell).edges
+    assert 1e-5 < edge.gap <= tolerance and edge.level == "G1"
+    assert check_faces(shell, gap_tol=1e-7).edges[0].level == "gap"
+    report = check_faces(shell)
+    assert report.gap_from.startswith("file: no stated uncertainty, edge tolerances") and "(given)" not in report.table()
+    # a STEP file states its precision: a coarser one is used, and named
+    path = tmp_path / "join.step"
+    bd.export_step(bd.Shell(shell), str(path))
+    text, count = re.subn(r"UNCERTAINTY_MEASURE_WITH_UNIT\(LENGTH_MEASURE\([^)]*\)", "UNCERTAINTY_MEASURE_WITH_UNIT(LENGTH_MEASURE(0.01)",
+                          path.read_text())  # fmt: skip
+    assert count == 1
+    path.write_text(text)
+    report = check_faces(path)
+    assert "stated uncertainty 0.01" in report.gap_from and "stated uncertainty 0.01" in report.table()
+    assert report.gap_tol * report.size == pytest.approx(0.01)
+    given = check_faces(path, gap_tol=1e-7)
+    assert given.gap_from == "given" and "1e-07 × size (given)" in given.table() and given.edges[0].level == "gap"
