@@ -3,6 +3,8 @@ checker's tests and the CLI's."""
 
 from __future__ import annotations
 
+import math
+
 import build123d as bd
 
 
@@ -130,3 +132,19 @@ def knot_line_join(tilt: float = 1e-13, below: float = 0.25, above: float = 1.0,
         d, at = line.Direction(), line.Location()
         BRep_Builder().UpdateEdge(edge, Geom2d_Line(gp_Pnt2d(at.X() + shift * d.X(), at.Y() + shift * d.Y()), d), face, 1e-7)
     return shell
+
+
+def periodic_bspline_cylinder(start: float = 1.0, turn: float = 2 * math.pi, radius: float = 10.0, height: float = 10.0):
+    """A cylinder stored as a periodic rational B-spline (knots 0, 2π/3, 4π/3, 2π, each double: C0 in its
+    parameter, a circle in space) and one face of it over u in [start, start + turn]: past one period of
+    its knots when the face does not start at 0. Returns the face (OCP)."""
+    from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeFace
+    from OCP.Geom import Geom_CylindricalSurface, Geom_RectangularTrimmedSurface
+    from OCP.GeomConvert import GeomConvert
+    from OCP.gp import gp_Ax3
+
+    surface = GeomConvert.SurfaceToBSplineSurface_s(
+        Geom_RectangularTrimmedSurface(Geom_CylindricalSurface(gp_Ax3(), radius), 0.0, 2 * math.pi, 0.0, height)
+    )
+    surface.SetUPeriodic()
+    return BRepBuilderAPI_MakeFace(surface, start, start + turn, 0.0, height, 1e-7).Face()

@@ -484,11 +484,12 @@ def _classify(measured: Measured, *, gap_tol: float | None, angle_tol: float, cu
     if given:
         relative, gap_from = float(gap_tol or 0.0), "given"
     else:
-        edge_limits = [limit for (edge, *_), limit in zip(pairs, limits) if edge >= 0] or [0.0]
+        edge_limits = [limit for (edge, *_), limit in zip(pairs, limits) if edge >= 0]
         relative = max([stated, *limits]) / size if size > 0.0 else 0.0
-        gap_from = (f"file: stated uncertainty {stated:.3g}, " if stated > 0.0 else "file: no stated uncertainty, ") + (
-            f"edge tolerances {min(edge_limits):.3g} to {max(edge_limits):.3g}"
-        )
+        stated_text = f"stated uncertainty {stated:.3g}" if stated > 0.0 else "no stated uncertainty"
+        own = (f"edge tolerances {min(edge_limits):.3g} to {max(edge_limits):.3g}" if edge_limits
+               else f"face tolerances up to {max(limits, default=0.0):.3g}")  # fmt: skip
+        gap_from = f"file: {stated_text}, {own}"
     return FaceReport(tuple(rows), count, len(free), size, relative, angle_tol, curvature_tol, feature_angle, samples,
                       source, units, time.perf_counter() - started, stitched, tuple(free), int(ends[-1]),
                       gap_from)  # fmt: skip

@@ -695,3 +695,18 @@ def test_an_edge_without_pcurves_is_still_sampled_at_the_knots_of_its_faces(lo):
     tangent = [e for e in report.edges if e.index >= 0 and e.tangent]
     assert [e.level for e in tangent] == ["G1"] and lo < tangent[0].jump_at[1] < lo + 0.02
     assert report.counts == with_pcurves.counts
+
+
+@pytest.mark.parametrize(("start", "turn"), [(1.0, 2 * math.pi), (5.0, 4.0), (-7.0, 5.0)])
+def test_knot_lines_of_a_periodic_bspline_cylinder_past_one_period_are_g2_never_gaps(start, turn):
+    # issue 39: a knot line of the face one period on was evaluated from the spans of another knot:
+    # a cylinder read as a 10 mm gap at 60°
+    from face_reproducers import periodic_bspline_cylinder
+
+    report = check_faces(periodic_bspline_cylinder(start, turn))
+    inside = [e for e in report.edges if e.index == -1]
+    # every knot line the face crosses is judged (2π/3 apart), each a circle's curvature on both sides
+    assert len(inside) == sum(1 for k in range(-6, 9) if start < k * 2 * math.pi / 3 < start + turn)
+    assert inside and all(e.level == "G2" and e.gap < 1e-12 and e.angle < 1e-12 for e in inside)
+    assert all(k == pytest.approx(-0.1, rel=1e-9) for e in report.edges for k in e.curvatures)
+    assert report.worst == "G2"
