@@ -192,6 +192,8 @@ def _read_whole(path: Path, kind: str, units: str | None, precision: list[float]
         name = _namer(path, kind, reader)
         failures = _reader_failures(reader.WS().ModelCheckList(), name) if status == IFSelect_RetDone else []
         if status == IFSelect_RetDone and not failures:
+            if kind == "STEP" and (fault := _step_length_fault(reader)):
+                raise ReadError(f"cannot read {path.name!r}: {fault}")
             unit = _use_unit(reader, kind, units, path.name)
             stated = _stated_precision(reader, kind) / MM_PER_UNIT[unit]
             if precision is not None and math.isfinite(stated) and stated > 0.0:
@@ -255,6 +257,36 @@ def _step_unit(reader: Any) -> float:
             if context.LengthDone():
                 return context.LengthFactor()
     return 1.0
+
+
+def _step_length_fault(reader: Any) -> str:
+    """Why the global units of a STEP file give no length (its unit of length is a second, say), or ``""``:
+    a context that assigns units must assign a length unit among them."""
+    from OCP.StepRepr import StepRepr_GlobalUnitAssignedContext, StepRepr_RepresentationContext
+
+    for entity in _entities_of(reader.StepModel(), StepRepr_RepresentationContext):
+        if not isinstance(entity, StepRepr_GlobalUnitAssignedContext):
+            entity = getattr(entity, "GlobalUnitAssignedContext", lambda: None)()
+        if entity is None or not entity.NbUnits():
+            continue
+        units = [entity.UnitsValue(k) for k in range(1, entity.NbUnits() + 1)]
+        if any(unit is not None and "LengthUnit" in type(unit).__name__ for unit in units):
+            return ""
+        return "its units give no length: " + ", ".join(_unit_name(unit) for unit in units) + " (a length unit is required)"
+    return ""
+
+
+def _unit_name(unit: Any) -> str:
+    """``second (time unit)`` for a STEP named unit (SI or conversion based)."""
+    if unit is None:
+        return "a missing unit"
+    kind = re.sub(r"(?<!^)(?=[A-Z])", " ", type(unit).__name__.split("And")[-1]).lower()  # "SiUnitAndTimeUnit" → "time unit"
+    try:
+        name = unit.Name()
+    except Exception:  # noqa: BLE001 - a unit without a name
+        return kind
+    text = name.ToCString() if hasattr(name, "ToCString") else getattr(name, "name", str(name))
+    return f"{re.sub(r'^StepBasic_sun', '', str(text)).lower()} ({kind})"
 
 
 def _stated_precision(reader: Any, kind: str) -> float:

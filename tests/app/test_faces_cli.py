@@ -166,3 +166,24 @@ def test_check_fails_g2_on_a_curvature_jump_over_five_percent_of_an_edge(tmp_pat
     assert main(["check", str(path), "--require", "G2"]) == 1
     assert "FAIL: worst tangent edge is G1, below the required G2" in capsys.readouterr().out
     assert main(["check", str(path), "--require", "G1"]) == 0
+
+
+def test_a_step_file_whose_length_unit_is_a_second_is_refused_by_name(files, tmp_path, capsys):
+    # issue 39: read as metres, exit 0
+    text = files["box"].read_text()
+    length = "( LENGTH_UNIT() NAMED_UNIT(*) SI_UNIT(.MILLI.,.METRE.) )"
+    assert text.count(length) == 1
+    path = tmp_path / "second.step"
+    path.write_text(text.replace(length, "( NAMED_UNIT(*) SI_UNIT($,.SECOND.) TIME_UNIT() )"))
+    assert main(["check", str(path)]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("error: ") and "second (time unit)" in err and "no length" in err and "Traceback" not in err
+    assert main(["check", str(files["box"])]) == 0  # the same file with its length unit is read
+
+
+def test_the_table_says_where_the_gap_limit_came_from(files, capsys):
+    assert main(["check", str(files["box"])]) == 0
+    out = capsys.readouterr().out
+    assert "gap from the file: stated uncertainty" in out
+    assert main(["check", str(files["box"]), "--gap-tol", "1e-6"]) == 0
+    assert "gap 1e-06 × size (given)" in capsys.readouterr().out
