@@ -113,6 +113,8 @@ def _surface_name(kind: GeomAbs_SurfaceType) -> str:
 
 def _shapes(shapes: TopTools_ListOfShape) -> list[TopoDS_Shape]:
     """The shapes of an OCCT list (Python iteration over it costs ~0.3 ms a list; this a few µs)."""
+    if shapes.Extent() == 0:  # an edge of a loose wire, in no face
+        return []
     if shapes.Extent() <= 2:
         return [shapes.First(), shapes.Last()][: shapes.Extent()]
     found, rest = [], TopTools_ListOfShape()
@@ -133,7 +135,7 @@ def _free_edges(shape: TopoDS_Shape) -> list[TopoDS_Edge]:
         if BRep_Tool.Degenerated_s(edge) or not BRep_Tool.IsGeometric_s(edge):
             continue
         faces = _shapes(ancestors.FindFromIndex(i))
-        if all(f.IsSame(faces[0]) for f in faces) and not BRep_Tool.IsClosed_s(edge, TopoDS.Face_s(faces[0])):
+        if faces and all(f.IsSame(faces[0]) for f in faces) and not BRep_Tool.IsClosed_s(edge, TopoDS.Face_s(faces[0])):
             free.append(edge)
     return free
 
@@ -214,6 +216,8 @@ def _measure(shape: TopoDS_Shape, stated: float = 0.0, *, samples: int, gap_tol:
             # a non-manifold edge (three or more faces): every pair of its faces is judged
             note = f"non-manifold: {len(found)} faces" if len(found) > 2 else ""
             couples = [((a, edge), (b, edge), note) for k, a in enumerate(found) for b in found[k + 1 :]]
+        elif not found:  # an edge of a wire beside the faces (a centre line exported with its corridor): not a face's
+            continue
         else:
             point = BRepAdaptor_Curve(edge)
             middle = point.Value(0.5 * (point.FirstParameter() + point.LastParameter()))

@@ -710,3 +710,16 @@ def test_knot_lines_of_a_periodic_bspline_cylinder_past_one_period_are_g2_never_
     assert inside and all(e.level == "G2" and e.gap < 1e-12 and e.angle < 1e-12 for e in inside)
     assert all(k == pytest.approx(-0.1, rel=1e-9) for e in report.edges for k in e.curvatures)
     assert report.worst == "G2"
+
+
+def test_a_solid_exported_with_a_loose_wire_beside_it_is_judged(tmp_path):
+    # issue 39: the demo's highway_3d.step (the corridor with its centre line) failed with
+    # "Standard_NoSuchObject: NCollection_List::First": an edge in no face
+    box = filleted_box()
+    line = bd.Wire([bd.Edge.make_line((50, 0, 0), (60, 0, 0)), bd.Edge.make_line((60, 0, 0), (60, 10, 5))])
+    shape = bd.Compound([box, line])
+    path = tmp_path / "with_wire.step"
+    bd.export_step(shape, str(path))
+    for report in (check_faces(shape), check_faces(path)):
+        assert_box_calibration(report)
+        assert report.free_edges == 0
