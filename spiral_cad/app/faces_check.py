@@ -57,7 +57,8 @@ def check_face_file(file: str, *, require: str | None = None, gap_tol: float | N
     also prints how long the check took.
 
     Returns:
-        0 ok, 1 below ``require`` or no shared edge judged (loose faces that could not be sewn), None when the reader found no faces (the caller judges the wires).
+        0 ok, 1 below ``require``, None when the reader found no faces or one lone face (no
+        shared edge): the caller then judges the wires, the lone face's boundary among them.
 
     Raises:
         ValueError: an unreadable file or a bad option (printed as ``error: …`` by the CLI).
@@ -73,6 +74,10 @@ def check_face_file(file: str, *, require: str | None = None, gap_tol: float | N
     if report.faces == 0:
         return None
     print(report.table())
+    if report.faces == 1 and not report.edges:
+        # a lone face shares no edge: what can be judged is its boundary, the curve chain it is
+        print("a lone face shares no edge: its boundary is judged as the curve chain it is")
+        return None
     note_worst(report.worst)
     if timing:
         print(f"time {report.seconds:.3g} s for {report.faces} faces and {len(report.edges)} edges, reading included")

@@ -187,3 +187,16 @@ def test_the_table_says_where_the_gap_limit_came_from(files, capsys):
     assert "gap from the file: stated uncertainty" in out
     assert main(["check", str(files["box"]), "--gap-tol", "1e-6"]) == 0
     assert "gap 1e-06 × size (given)" in capsys.readouterr().out
+
+
+def test_a_lone_face_is_judged_by_its_boundary_as_a_curve_chain(tmp_path, capsys):
+    # issue 39: one face shares no edge, so "nothing shows G2"; its boundary is the curve chain to judge
+    smooth, square = tmp_path / "smooth.step", tmp_path / "square.step"
+    bd.export_step(bd.Face(ContinuousRectangle(40, 20, 5).wire()), str(smooth))
+    bd.export_step(bd.Face.make_rect(10, 10), str(square))
+    assert main(["check", str(smooth), "--require", "G2"]) == 0
+    out = capsys.readouterr().out
+    assert "its boundary is judged as the curve chain it is" in out and "1 wire of 16 edges" in out
+    assert out.rstrip().endswith("every joint at least G2")
+    assert main(["check", str(square), "--require", "G1"]) == 1  # a square's corners are G0
+    assert "1 wire of 4 edges" in capsys.readouterr().out
