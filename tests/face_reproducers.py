@@ -148,3 +148,65 @@ def periodic_bspline_cylinder(start: float = 1.0, turn: float = 2 * math.pi, rad
     )
     surface.SetUPeriodic()
     return BRepBuilderAPI_MakeFace(surface, start, start + turn, 0.0, height, 1e-7).Face()
+
+
+def surface_only_step(surfaces) -> str:
+    """The text of a surface-only STEP file (AP214, millimetres): each surface a ``B_SPLINE_SURFACE_WITH_KNOTS``
+    of one ``GEOMETRIC_SET``, no face, shell or solid. ``surfaces``: (poles as rows of (x, y, z) along u,
+    (u degree, v degree), (u knots, v knots), (u multiplicities, v multiplicities)) each."""
+    lines, n = [], [0]
+
+    def add(text):
+        n[0] += 1
+        lines.append(f"#{n[0]} = {text};")
+        return f"#{n[0]}"
+
+    ctx_len = add("( LENGTH_UNIT() NAMED_UNIT(*) SI_UNIT(.MILLI.,.METRE.) )")
+    ctx_ang = add("( NAMED_UNIT(*) PLANE_ANGLE_UNIT() SI_UNIT($,.RADIAN.) )")
+    ctx_sol = add("( NAMED_UNIT(*) SI_UNIT($,.STERADIAN.) SOLID_ANGLE_UNIT() )")
+    unc = add(f"UNCERTAINTY_MEASURE_WITH_UNIT(LENGTH_MEASURE(1.E-07),{ctx_len},'distance_accuracy_value','confusion accuracy')")
+    ctx = add(
+        f"( GEOMETRIC_REPRESENTATION_CONTEXT(3) GLOBAL_UNCERTAINTY_ASSIGNED_CONTEXT(({unc})) GLOBAL_UNIT_ASSIGNED_CONTEXT(({ctx_len},{ctx_ang},{ctx_sol})) REPRESENTATION_CONTEXT('Context #1','3D Context with UNIT and UNCERTAINTY') )"
+    )
+
+    def reals(values) -> str:
+        return "(" + ",".join(repr(float(a)) for a in values) + ")"
+
+    def ints(values) -> str:
+        return "(" + ",".join(str(int(a)) for a in values) + ")"
+
+    items = []
+    for poles, (du, dv), (ku, kv), (mu, mv) in surfaces:
+        rows = []
+        for row in poles:
+            rows.append("(" + ",".join(add(f"CARTESIAN_POINT('',({x!r},{y!r},{z!r}))") for x, y, z in row) + ")")
+        items.append(
+            add(
+                f"B_SPLINE_SURFACE_WITH_KNOTS('',{du},{dv},({','.join(rows)}),.UNSPECIFIED.,.F.,.F.,.F.,{ints(mu)},{ints(mv)},{reals(ku)},{reals(kv)},.UNSPECIFIED.)"
+            )
+        )
+    gset = add(f"GEOMETRIC_SET('',({','.join(items)}))")
+    app = add("APPLICATION_CONTEXT('core data for automotive mechanical design processes')")
+    add(f"APPLICATION_PROTOCOL_DEFINITION('international standard','automotive_design',2000,{app})")
+    pc = add(f"PRODUCT_CONTEXT('',{app},'mechanical')")
+    prod = add(f"PRODUCT('surfaces','surfaces','',({pc}))")
+    pdf = add(f"PRODUCT_DEFINITION_FORMATION('','',{prod})")
+    pdc = add(f"PRODUCT_DEFINITION_CONTEXT('part definition',{app},'design')")
+    pd = add(f"PRODUCT_DEFINITION('design','',{pdf},{pdc})")
+    pds = add(f"PRODUCT_DEFINITION_SHAPE('','',{pd})")
+    rep = add(f"GEOMETRICALLY_BOUNDED_SURFACE_SHAPE_REPRESENTATION('',({gset}),{ctx})")
+    add(f"SHAPE_DEFINITION_REPRESENTATION({pds},{rep})")
+    head = (
+        "ISO-10303-21;\nHEADER;\nFILE_DESCRIPTION(('surfaces only'),'2;1');\nFILE_NAME('s','2026-01-01T00:00:00',(''),(''),'','','');\n"
+        "FILE_SCHEMA(('AUTOMOTIVE_DESIGN { 1 0 10303 214 1 1 1 1 }'));\nENDSEC;\nDATA;\n"
+    )
+    return head + "\n".join(lines) + "\nENDSEC;\nEND-ISO-10303-21;\n"
+
+
+def tangent_patches_step() -> str:
+    """A surface-only STEP of two B-spline patches: the plane z = 0 (0 ≤ x ≤ 1) and z = (x − 1)² (1 ≤ x ≤ 2),
+    tangent along x = 1, the curvature across it 0 against 2 (a G1 join)."""
+    flat = [[(0.0, 0.0, 0.0), (0.0, 1.0, 0.0)], [(1.0, 0.0, 0.0), (1.0, 1.0, 0.0)]]
+    bent = [[(1.0, 0.0, 0.0), (1.0, 1.0, 0.0)], [(1.5, 0.0, 0.0), (1.5, 1.0, 0.0)], [(2.0, 0.0, 1.0), (2.0, 1.0, 1.0)]]
+    return surface_only_step([(flat, (1, 1), ((0, 1), (0, 1)), ((2, 2), (2, 2))),
+                              (bent, (2, 1), ((0, 1), (0, 1)), ((3, 3), (2, 2)))])  # fmt: skip

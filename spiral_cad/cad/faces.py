@@ -564,8 +564,10 @@ def check_faces(shape_or_path: Any, *, gap_tol: float | None = None, angle_tol: 
     return _classify(measured, source=source, units=unit, started=started, **options)
 
 
-#: STEP entities of a face (AP203/AP214/AP242 B-rep and surface models).
-_STEP_FACE = re.compile(rb"\b(?:ADVANCED_FACE|FACE_SURFACE|ORIENTED_FACE)\s*\(", re.IGNORECASE)
+#: STEP entities of a face (AP203/AP214/AP242 B-rep and surface models), and the bounded surfaces a
+#: surface-only file lists in a geometric set (OCCT makes a face of each).
+_STEP_FACE = re.compile(rb"\b(?:ADVANCED_FACE|FACE_SURFACE|ORIENTED_FACE|B_SPLINE_SURFACE\w*|BEZIER_SURFACE"
+                        rb"|RECTANGULAR_TRIMMED_SURFACE|CURVE_BOUNDED_SURFACE)\s*\(", re.IGNORECASE)  # fmt: skip
 #: IGES entity types OCCT makes faces of: surfaces (108 plane … 198 toroidal), bounded and trimmed
 #: surfaces (143, 144), faces, shells and solids (510, 514, 186). A file with none of them has no faces;
 #: one with them that still reads without faces is judged by its wires (``spiral-cad check``).
@@ -574,7 +576,8 @@ _IGES_FACES = {str(t).encode() for t in (108, 114, 118, 120, 122, 128, 140, 143,
 
 def holds_faces(path: str | os.PathLike) -> bool:
     """Whether a STEP/IGES file declares faces, from its text alone (no reader runs): a STEP face
-    entity, or an IGES directory entry of a surface, face, shell or solid (``_IGES_FACES``).
+    entity or bounded surface (a surface-only file), or an IGES directory entry of a surface, face, shell
+    or solid (``_IGES_FACES``).
 
     ``spiral-cad check`` judges faces when this is true and wires otherwise; False for a missing
     file or another suffix (the wire checker then names the problem).

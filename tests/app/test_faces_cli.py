@@ -200,3 +200,16 @@ def test_a_lone_face_is_judged_by_its_boundary_as_a_curve_chain(tmp_path, capsys
     assert out.rstrip().endswith("every joint at least G2")
     assert main(["check", str(square), "--require", "G1"]) == 1  # a square's corners are G0
     assert "1 wire of 4 edges" in capsys.readouterr().out
+
+
+def test_a_surface_only_step_file_is_judged_face_to_face(tmp_path, capsys):
+    # issue 39: B-spline surfaces in a geometric set, no face entity: judged as wires, worst joint G0
+    from face_reproducers import tangent_patches_step
+
+    path = tmp_path / "surfaces.step"
+    path.write_text(tangent_patches_step())
+    assert holds_faces(path)
+    assert main(["check", str(path), "--require", "G2"]) == 1
+    out = capsys.readouterr().out
+    assert "2 faces, 1 shared edges (1 G1)" in out and "wire" not in out
+    assert main(["check", str(path), "--require", "G1"]) == 0
