@@ -210,3 +210,25 @@ def tangent_patches_step() -> str:
     bent = [[(1.0, 0.0, 0.0), (1.0, 1.0, 0.0)], [(1.5, 0.0, 0.0), (1.5, 1.0, 0.0)], [(2.0, 0.0, 1.0), (2.0, 1.0, 1.0)]]
     return surface_only_step([(flat, (1, 1), ((0, 1), (0, 1)), ((2, 2), (2, 2))),
                               (bent, (2, 1), ((0, 1), (0, 1)), ((3, 3), (2, 2)))])  # fmt: skip
+
+
+def seam_torus(degree: int = 12, start: float = 1.0, major: float = 20.0, minor: float = 5.0):
+    """A torus-like periodic B-spline surface of ``degree`` in u and v, one span a period (knots 0 and 2π, each
+    of multiplicity ``degree``: C0 where the period closes, a kink of 2π/``degree`` through the pole there),
+    and one face of it over [start, start + 2π]² — across the surface's seam. Returns the face (OCP)."""
+    from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeFace
+    from OCP.Geom import Geom_BSplineSurface
+    from OCP.gp import gp_Pnt
+    from OCP.TColgp import TColgp_Array2OfPnt
+    from OCP.TColStd import TColStd_Array1OfInteger, TColStd_Array1OfReal
+
+    poles = TColgp_Array2OfPnt(1, degree, 1, degree)
+    for i in range(degree):
+        a = 2 * math.pi * i / degree
+        for j in range(degree):
+            b = 2 * math.pi * j / degree
+            ring = major + minor * math.cos(b)
+            poles.SetValue(i + 1, j + 1, gp_Pnt(ring * math.cos(a), ring * math.sin(a), minor * math.sin(b)))
+    knots, multiplicities = _array(TColStd_Array1OfReal, [0.0, 2 * math.pi]), _array(TColStd_Array1OfInteger, [degree, degree])
+    surface = Geom_BSplineSurface(poles, knots, knots, multiplicities, multiplicities, degree, degree, True, True)
+    return BRepBuilderAPI_MakeFace(surface, start, start + 2 * math.pi, start, start + 2 * math.pi, 1e-7).Face()

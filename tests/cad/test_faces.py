@@ -723,3 +723,24 @@ def test_a_solid_exported_with_a_loose_wire_beside_it_is_judged(tmp_path):
     for report in (check_faces(shape), check_faces(path)):
         assert_box_calibration(report)
         assert report.free_edges == 0
+
+
+@pytest.mark.parametrize("degree", [3, 12])
+def test_a_high_degree_periodic_surface_whose_face_crosses_the_seam_is_judged(tmp_path, degree):
+    # issue 39: an IGES torus of degree 12 crossing the seam gave "min() arg is an empty sequence"; its
+    # seam knot lines (C0 there: the surface turns by 2π/degree through the pole) are now judged
+    from face_reproducers import seam_torus
+
+    path = tmp_path / "torus.igs"
+    Interface_Static.SetIVal_s("write.iges.brep.mode", 1)
+    writer = IGESControl_Writer("MM", 1)
+    writer.AddShape(seam_torus(degree))
+    writer.ComputeModel()
+    assert writer.Write(str(path))
+    for report in (check_faces(seam_torus(degree)), check_faces(path)):
+        seams = [e for e in report.edges if e.seam]
+        inside = [e for e in report.edges if e.index == -1]
+        assert len(seams) == 2 and all(e.level == "G2" for e in seams)
+        assert len(inside) == 2 and all(e.gap < 1e-9 for e in report.edges)
+        # the kink through the pole: at most 2π/degree between the normals, reached somewhere along the line
+        assert all(0.5 * 2 * math.pi / degree < e.angle <= 2 * math.pi / degree + 1e-9 for e in inside)
