@@ -96,8 +96,9 @@ SEW_TOL = 1e-6
 #: face count, per face its surface type, per checked pair (edge index, face a,
 #: face b, seam, note), the free edges (index, midpoint), the model size, the samples as
 #: float64 bytes (samples × 2 faces × ``FACE_FLOATS``, pair after pair), how many samples
-#: each pair got, how many edges were sewn, per pair the BRep tolerance of its edge (of its
-#: face for a knot line), and the precision the file states (0.0: none).
+#: each pair got, how many edges were sewn, per pair twice the BRep tolerance of its edge (of its
+#: face for a knot line: each face lies within it, so the two within twice it), and the precision the
+#: file states (0.0: none).
 Measured = tuple[int, list[str], list[tuple[int, int, int, bool, str]], list[tuple[int, tuple[float, float, float]]], float,
                  bytes, list[int], int, list[float], float]  # fmt: skip
 
@@ -241,7 +242,7 @@ def _measure(shape: TopoDS_Shape, stated: float = 0.0, *, samples: int, gap_tol:
                                                        "(inconsistent shell); compared with one normal flipped"]))  # fmt: skip
             sides = [(domain(fa), ea), (domain(fb), eb)]
             lines.append(EdgeLine(edge, sides, (signs[0], signs[1]), samples))
-            limits.append(BRep_Tool.Tolerance_s(edge))
+            limits.append(2.0 * BRep_Tool.Tolerance_s(edge))  # each face within the tolerance of the edge
             pairs.append((index - 1, faces.FindIndex(fa) - 1, faces.FindIndex(fb) - 1, len(found) == 1, note))
     for face_index in range(1, faces.Extent() + 1):
         face = TopoDS.Face_s(faces.FindKey(face_index))
@@ -249,7 +250,7 @@ def _measure(shape: TopoDS_Shape, stated: float = 0.0, *, samples: int, gap_tol:
         for line in knot_lines(domain(face), sign, samples):
             lines.append(line)
             pairs.append((-1, face_index - 1, face_index - 1, False, f"inside face {face_index - 1}, {line.name}"))
-            limits.append(BRep_Tool.Tolerance_s(face))
+            limits.append(2.0 * BRep_Tool.Tolerance_s(face))
     gap = gap_tol * size if gap_tol is not None else max([stated, *limits])  # what refinement watches
     rows, counts = sample_lines(lines, Tolerances(gap, angle_tol, curvature_tol, feature_angle, size))
     return faces.Extent(), kinds, pairs, free, size, rows.tobytes(), counts, stitched, limits, stated
@@ -329,8 +330,8 @@ class FaceReport:
         free_at: the free edges left after sewing: (edge index, midpoint) each.
         evaluated: how many points were evaluated on all edges and knot lines together.
         gap_from: where the gap limit came from: ``"given"`` (``gap_tol`` × size), or the precision the file
-            states (``UNCERTAINTY_MEASURE_WITH_UNIT``) and each edge's own BRep tolerance, the larger of the two
-            per edge, e.g. ``"file: stated uncertainty 1e-07, edge tolerances 1e-07 to 2e-05"``.
+            states (``UNCERTAINTY_MEASURE_WITH_UNIT``) and twice each edge's own BRep tolerance, the larger of
+            the two per edge, e.g. ``"file: stated uncertainty 1e-07, twice the edge tolerances, 2e-07 to 4e-05"``.
     """
 
     edges: tuple[FaceEdge, ...]
@@ -491,8 +492,8 @@ def _classify(measured: Measured, *, gap_tol: float | None, angle_tol: float, cu
         edge_limits = [limit for (edge, *_), limit in zip(pairs, limits) if edge >= 0]
         relative = max([stated, *limits]) / size if size > 0.0 else 0.0
         stated_text = f"stated uncertainty {stated:.3g}" if stated > 0.0 else "no stated uncertainty"
-        own = (f"edge tolerances {min(edge_limits):.3g} to {max(edge_limits):.3g}" if edge_limits
-               else f"face tolerances up to {max(limits, default=0.0):.3g}")  # fmt: skip
+        own = (f"twice the edge tolerances, {min(edge_limits):.3g} to {max(edge_limits):.3g}" if edge_limits
+               else f"twice the face tolerances, up to {max(limits, default=0.0):.3g}")  # fmt: skip
         gap_from = f"file: {stated_text}, {own}"
     return FaceReport(tuple(rows), count, len(free), size, relative, angle_tol, curvature_tol, feature_angle, samples,
                       source, units, time.perf_counter() - started, stitched, tuple(free), int(ends[-1]),
@@ -523,8 +524,8 @@ def check_faces(shape_or_path: Any, *, gap_tol: float | None = None, angle_tol: 
             .step/.stp/.igs/.iges path.
         gap_tol: largest distance between the two faces' points (each the projection of the edge's point
             on its face), relative to the model size; None (default): per edge the larger of the precision
-            the file states (STEP's ``UNCERTAINTY_MEASURE_WITH_UNIT``, IGES's resolution) and the edge's
-            own BRep tolerance (``FaceReport.gap_from`` says which was used).
+            the file states (STEP's ``UNCERTAINTY_MEASURE_WITH_UNIT``, IGES's resolution) and twice the edge's
+            own BRep tolerance (each face lies within it of the edge; ``FaceReport.gap_from`` says which was used).
         angle_tol: largest angle between the oriented normals of a tangent edge, radians.
         curvature_tol: largest jump of the normal curvature across the edge, relative to
             ``max(|κa|, |κb|, 1/size)``.

@@ -652,7 +652,7 @@ def test_the_gap_limit_comes_from_the_edges_tolerances_and_the_file_and_the_tabl
     assert 1e-5 < edge.gap <= tolerance and edge.level == "G1"
     assert check_faces(shell, gap_tol=1e-7).edges[0].level == "gap"
     report = check_faces(shell)
-    assert report.gap_from.startswith("file: no stated uncertainty, edge tolerances") and "(given)" not in report.table()
+    assert report.gap_from.startswith("file: no stated uncertainty, twice the edge tolerances") and "(given)" not in report.table()
     # a STEP file states its precision: a coarser one is used, and named
     path = tmp_path / "join.step"
     bd.export_step(bd.Shell(shell), str(path))
