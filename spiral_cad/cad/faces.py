@@ -6,7 +6,9 @@ meets itself) the edge is sampled where its geometry asks for it
 ends, every polynomial span between the knots of the edge's curve and of both
 faces' surfaces, and bisection where the edge turns or a measure may cross its
 tolerance between two samples. At each point both faces give, from their
-surface derivatives at the point's parameters on the edge's pcurve:
+surface derivatives where the edge's 3-D point projects onto each, read from
+inside each face's own domain (``spiral_cad.cad.face_projection``; the pcurve
+is only the starting guess):
 
 * the surface point — the **gap** is the distance between the two;
 * the oriented unit normal (flipped for a face REVERSED in its shell) — the
@@ -20,7 +22,7 @@ surface derivatives at the point's parameters on the edge's pcurve:
 
 The worst value of each along the edge, and where it was, give the edge's
 class (``EDGE_CLASSES``): ``"unmeasurable"`` (no sample gave a point or a normal), ``"gap"`` (the faces do not meet: gap above
-``gap_tol`` × model size), ``"sharp"`` (normals further apart than
+the gap limit: ``gap_tol`` × model size, or by default the file's precision or twice the edge's tolerance), ``"sharp"`` (normals further apart than
 ``feature_angle``: a feature — a box's edge — listed, never failed),
 ``"crease"`` (an angle above ``angle_tol`` but below ``feature_angle``: a
 near-tangent kink, a defect), ``"G1"`` (tangent, the curvature jumps),
