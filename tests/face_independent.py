@@ -21,7 +21,7 @@ from OCP.TopExp import TopExp
 from OCP.TopoDS import TopoDS
 from OCP.TopTools import TopTools_IndexedDataMapOfShapeListOfShape, TopTools_IndexedMapOfShape
 
-INSIDE = 1e-6  # relative to the face's parameter range: how far inside the face the curvature is read
+INSIDE = 1e-9  # relative to the face's parameter range: how far inside the face the normal and curvature are read
 
 
 def _side(face, surface, u: float, v: float, across: np.ndarray, bounds, sign: float, inward: list[float]):
@@ -98,7 +98,7 @@ def measure_edges(shape, samples: int = 32, angle_tol: float = 1e-7, curvature_t
             for face, inward in zip(faces, inwards):
                 surface = BRep_Tool.Surface_s(face)
                 bounds = BRepTools.UVBounds_s(face)
-                projection = GeomAPI_ProjectPointOnSurf(p, surface)
+                projection = GeomAPI_ProjectPointOnSurf(p, surface, *bounds)  # within the face's bounds
                 if not projection.NbPoints():
                     break
                 u, v = projection.LowerDistanceParameters()
@@ -113,7 +113,7 @@ def measure_edges(shape, samples: int = 32, angle_tol: float = 1e-7, curvature_t
                 side = _side(face, surface, u, v, across, bounds, sign, inward)
                 if side is None:
                     break
-                sides.append((sign * np.array([n.X(), n.Y(), n.Z()]), side[1], across))  # the normal on the edge
+                sides.append((side[0], side[1], across))
             if len(sides) != 2:
                 continue
             (na, ka, across), (nb, kb, _) = sides
