@@ -77,6 +77,28 @@ def _cubic_basis(knots: list[float], t: float) -> list[float]:
     return values
 
 
+def knot_surface(below: float = 0.25, above: float = 1.0):
+    """A cubic B-spline surface z(y) (x = u, y = v, both 0…1) with a double knot at v = 0.5, tangent across
+    it, its curvature across the line ``below`` for v < 0.5 and ``above`` for v > 0.5 (OCP)."""
+    import numpy as np
+    from OCP.Geom import Geom_BSplineSurface
+    from OCP.gp import gp_Pnt
+    from OCP.TColgp import TColgp_Array2OfPnt
+    from OCP.TColStd import TColStd_Array1OfInteger, TColStd_Array1OfReal
+
+    flat = [0.0] * 4 + [0.5] * 2 + [1.0] * 4
+    ys = np.linspace(0.0, 1.0, 41)
+    zs = np.where(ys < 0.5, below / 2, above / 2) * (ys - 0.5) ** 2  # z'' = below, above: κ across the line
+    heights = np.linalg.lstsq(np.array([_cubic_basis(flat, y) for y in ys]), zs, rcond=None)[0]
+    poles = TColgp_Array2OfPnt(1, 2, 1, 6)
+    for i, x in enumerate((0.0, 1.0)):
+        for j in range(6):
+            poles.SetValue(i + 1, j + 1, gp_Pnt(x, sum(flat[j + 1 : j + 4]) / 3, heights[j]))  # y at the Greville points
+
+    return Geom_BSplineSurface(poles, _array(TColStd_Array1OfReal, [0.0, 1.0]), _array(TColStd_Array1OfReal, [0.0, 0.5, 1.0]),
+                               _array(TColStd_Array1OfInteger, [2, 2]), _array(TColStd_Array1OfInteger, [4, 2, 4]), 1, 3)  # fmt: skip
+
+
 def knot_line_join(tilt: float = 1e-13, below: float = 0.25, above: float = 1.0, shift: float = 0.0, apart: float = 0.0):
     """Two faces of one cubic B-spline surface z(y) (x = u, y = v) with a double knot at v = 0.5, meeting on
     that knot line, tangent there, the curvature across it ``below`` on one side and ``above`` on the other
@@ -98,18 +120,8 @@ def knot_line_join(tilt: float = 1e-13, below: float = 0.25, above: float = 1.0,
     from OCP.TopoDS import TopoDS
     from OCP.TopTools import TopTools_IndexedDataMapOfShapeListOfShape
 
-    flat = [0.0] * 4 + [0.5] * 2 + [1.0] * 4
-    ys = np.linspace(0.0, 1.0, 41)
-    zs = np.where(ys < 0.5, below / 2, above / 2) * (ys - 0.5) ** 2  # z'' = below, above: κ across the line
-    heights = np.linalg.lstsq(np.array([_cubic_basis(flat, y) for y in ys]), zs, rcond=None)[0]
-    poles = TColgp_Array2OfPnt(1, 2, 1, 6)
-    for i, x in enumerate((0.0, 1.0)):
-        for j in range(6):
-            poles.SetValue(i + 1, j + 1, gp_Pnt(x, sum(flat[j + 1 : j + 4]) / 3, heights[j]))  # y at the Greville points
-
     def surface():  # one copy per face: each face gets its own pcurve of the shared edge
-        return Geom_BSplineSurface(poles, _array(TColStd_Array1OfReal, [0.0, 1.0]), _array(TColStd_Array1OfReal, [0.0, 0.5, 1.0]),
-                                   _array(TColStd_Array1OfInteger, [2, 2]), _array(TColStd_Array1OfInteger, [4, 2, 4]), 1, 3)  # fmt: skip
+        return knot_surface(below, above)
 
     sewing = BRepBuilderAPI_Sewing(max(1e-6, 10 * apart))
     upper = surface()
@@ -232,3 +244,24 @@ def seam_torus(degree: int = 12, start: float = 1.0, major: float = 20.0, minor:
     knots, multiplicities = _array(TColStd_Array1OfReal, [0.0, 2 * math.pi]), _array(TColStd_Array1OfInteger, [degree, degree])
     surface = Geom_BSplineSurface(poles, knots, knots, multiplicities, multiplicities, degree, degree, True, True)
     return BRepBuilderAPI_MakeFace(surface, start, start + 2 * math.pi, start, start + 2 * math.pi, 1e-7).Face()
+
+
+def plug_on_knot_line(below: float = 0.25, above: float = 1.0):
+    """One face of ``knot_surface`` over the whole square with a rectangular hole [0.25, 0.75] × [0.5, 0.8] in
+    (u, v), and the plug filling the hole, on the same surface: the hole's lower edge lies on the knot line
+    v = 0.5, inside the bounds of the face with the hole (whose side there is below the line: curvature
+    ``below``) and on the border of the plug (above: ``above``). Returns the shell of the two (OCP)."""
+    from OCP.BRep import BRep_Builder
+    from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeFace
+    from OCP.BRepTools import BRepTools
+    from OCP.TopoDS import TopoDS, TopoDS_Shell
+
+    surface = knot_surface(below, above)
+    plug = BRepBuilderAPI_MakeFace(surface, 0.25, 0.75, 0.5, 0.8, 1e-7).Face()
+    outer = BRepBuilderAPI_MakeFace(surface, 0.0, 1.0, 0.0, 1.0, 1e-7)
+    outer.Add(TopoDS.Wire_s(BRepTools.OuterWire_s(plug).Reversed()))  # the same edges: shared, on the same surface
+    shell, builder = TopoDS_Shell(), BRep_Builder()
+    builder.MakeShell(shell)
+    builder.Add(shell, outer.Face())
+    builder.Add(shell, plug)
+    return shell

@@ -745,3 +745,16 @@ def test_a_high_degree_periodic_surface_whose_face_crosses_the_seam_is_judged(tm
         assert len(inside) in knot_lines and all(e.level != "gap" and e.gap < 1e-6 for e in report.edges)
         # the kink through the pole: at most 2π/degree between the normals, reached somewhere along the line
         assert all(0.5 * 2 * math.pi / degree < e.angle <= 2 * math.pi / degree + 1e-9 for e in inside)
+
+
+def test_an_edge_on_a_knot_line_inside_its_faces_bounds_is_read_from_the_faces_side():
+    # the hole's lower edge lies on the knot line v = 0.5 inside the bounds of the face with the hole: its
+    # side there (below the line) is found by OCCT's classifier, not by its bounds; read from above, the
+    # join was G2 (κ 1 against 1)
+    from face_reproducers import plug_on_knot_line
+
+    report = check_faces(plug_on_knot_line())
+    shared = sorted((e for e in report.edges if e.index >= 0), key=lambda e: e.jump)
+    assert [e.level for e in shared] == ["G2", "G2", "G2", "G1"]
+    assert shared[-1].curvatures == pytest.approx((0.25, 1.0), rel=1e-6)  # the holed face's, then the plug's
+    assert shared[-1].jump_at[1] == pytest.approx(0.5)
