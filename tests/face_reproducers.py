@@ -106,15 +106,11 @@ def knot_line_join(tilt: float = 1e-13, below: float = 0.25, above: float = 1.0,
     from another CAD system may have it, or its parameter shifted by ``shift`` along the edge (the same
     points, at other parameters); ``apart`` lifts the upper face by that much before the two are sewn (a
     real gap, within the sewn edge's tolerance). Returns the sewn shell (OCP)."""
-    import numpy as np
     from OCP.BRep import BRep_Builder, BRep_Tool
     from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeFace, BRepBuilderAPI_Sewing
     from OCP.BRepTools import BRepTools
-    from OCP.Geom import Geom_BSplineSurface
     from OCP.Geom2d import Geom2d_Line
-    from OCP.gp import gp_Dir2d, gp_Pnt, gp_Pnt2d, gp_Vec
-    from OCP.TColgp import TColgp_Array2OfPnt
-    from OCP.TColStd import TColStd_Array1OfInteger, TColStd_Array1OfReal
+    from OCP.gp import gp_Dir2d, gp_Pnt2d, gp_Vec
     from OCP.TopAbs import TopAbs_EDGE, TopAbs_FACE
     from OCP.TopExp import TopExp
     from OCP.TopoDS import TopoDS
