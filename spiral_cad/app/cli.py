@@ -490,7 +490,12 @@ def _add_check(sub: argparse._SubParsersAction) -> None:
                        help="also write the curvature comb of every edge as STEP (STEP/IGES input; never the checked file)")  # fmt: skip
     check.add_argument("--timing", action="store_true",
                        help="also print where the check spent its time: the reader's share, and whether it limits the check")  # fmt: skip
-    check.add_argument("--gap-tol", type=float, help="G0 gap, absolute model units (default 1e-7; faces: relative to the model size, 1e-7)")
+    check.add_argument(
+        "--gap-tol",
+        type=float,
+        help="G0 gap, absolute model units (default 1e-7; faces: relative to the model size, "
+        "default per edge the file's stated uncertainty or the edge's own tolerance, the larger)",
+    )
     check.add_argument("--angle-tol", type=float, help="G1 tangent angle, radians (default 1e-7; faces: between the normals)")
     check.add_argument("--curvature-tol", type=float,
                        help="G2 curvature jump, relative (default 1e-6; faces: normal curvature across the edge, 1e-4)")  # fmt: skip

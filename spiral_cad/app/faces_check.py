@@ -52,12 +52,13 @@ def check_face_file(file: str, *, require: str | None = None, gap_tol: float | N
                     curvature_map: str | None = None, timing: bool = False) -> int | None:  # fmt: skip
     """Judge the faces of ``file`` and print the table; draw the pictures asked for.
 
-    Tolerances left None take ``check_faces``'s defaults (gap 1e-7 × size, angle 1e-7 rad, curvature jump 1e-4). ``require`` "G2" or "G1" fails any
+    Tolerances left None take ``check_faces``'s defaults (gap: the file's stated precision and the edges' own tolerances, angle 1e-7 rad, curvature jump 1e-4). ``require`` "G2" or "G1" fails any
     tangent edge below it (and "G0" any gap); sharp features are listed, never failed. ``timing``
     also prints how long the check took.
 
     Returns:
-        0 ok, 1 below ``require`` or no shared edge judged (loose faces that could not be sewn), None when the reader found no faces (the caller judges the wires).
+        0 ok, 1 below ``require``, None when the reader found no faces or one lone face (no
+        shared edge): the caller then judges the wires, the lone face's boundary among them.
 
     Raises:
         ValueError: an unreadable file or a bad option (printed as ``error: …`` by the CLI).
@@ -65,7 +66,7 @@ def check_face_file(file: str, *, require: str | None = None, gap_tol: float | N
     zebra_png, map_png = _png("zebra", zebra), _png("curvature-map", curvature_map)
     report = check_faces(
         file,
-        gap_tol=1e-7 if gap_tol is None else gap_tol,
+        gap_tol=gap_tol,
         angle_tol=1e-7 if angle_tol is None else angle_tol,
         curvature_tol=1e-4 if curvature_tol is None else curvature_tol,
         feature_angle=FEATURE_ANGLE if feature_angle is None else feature_angle,
@@ -73,6 +74,10 @@ def check_face_file(file: str, *, require: str | None = None, gap_tol: float | N
     if report.faces == 0:
         return None
     print(report.table())
+    if report.faces == 1 and not report.edges:
+        # a lone face shares no edge: what can be judged is its boundary, the curve chain it is
+        print("a lone face shares no edge: its boundary is judged as the curve chain it is")
+        return None
     note_worst(report.worst)
     if timing:
         print(f"time {report.seconds:.3g} s for {report.faces} faces and {len(report.edges)} edges, reading included")

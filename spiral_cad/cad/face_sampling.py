@@ -39,6 +39,7 @@ from __future__ import annotations
 import math
 from collections.abc import Callable
 from dataclasses import dataclass
+from functools import partial
 from typing import Any
 
 import numpy as np
@@ -63,6 +64,7 @@ from OCP.TColStd import TColStd_Array1OfReal
 from OCP.TopoDS import TopoDS_Edge, TopoDS_Face
 
 from ..check.joints import norms
+from .face_projection import KNOT_STEP, FaceDomain, evaluate_on_faces
 
 __all__ = ["END_INSET", "FACE_FLOATS", "KNOT_STEP", "REFINE_ROUNDS", "TURN", "EdgeLine", "KnotLine", "Line", "Tolerances",
            "curve_knots", "knot_lines", "measures", "sample_lines", "surface_knots"]  # fmt: skip
@@ -82,10 +84,6 @@ TURN = 0.4
 
 #: Rounds of bisection at most; each halves the intervals it touches.
 REFINE_ROUNDS = 6
-
-#: Where no one-sided evaluation exists, a knot line's two sides are evaluated this far from it (relative to
-#: the face's parameter range) and moved back onto it to first order.
-KNOT_STEP = 1e-9
 
 
 @dataclass(frozen=True)
@@ -165,16 +163,13 @@ def floor_points(lo: float, hi: float, samples: int) -> list[float]:
     return [lo + END_INSET * width, *mids, hi - END_INSET * width]
 
 
-def _crossings(pcurve: BRepAdaptor_Curve2d, grid: NDArray, knots: tuple[list[float], list[float]]) -> list[float]:
-    """Edge parameters where the pcurve crosses a knot value of its surface (u = k or v = k), from the sign
-    changes on ``grid``, each refined by a few secant steps (exact at once for a straight pcurve)."""
+def _crossings(uv_of: Callable[[list[float]], NDArray], grid: NDArray, knots: tuple[list[float], list[float]]) -> list[float]:
+    """Edge parameters where the edge's (u, v) on a face (``uv_of``: its pcurve, or the projections of its
+    points) crosses a knot value of the face's surface (u = k or v = k), from the sign changes on ``grid``,
+    each refined by a few secant steps (exact at once for a straight pcurve)."""
     if not knots[0] and not knots[1]:
         return []
-    uv = gp_Pnt2d()
-    values = np.empty((len(grid), 2))
-    for k, t in enumerate(grid.tolist()):
-        pcurve.D0(t, uv)
-        values[k] = uv.X(), uv.Y()
+    values = uv_of(grid.tolist())
     found = []
     for axis in (0, 1):
         for knot in knots[axis]:
@@ -184,9 +179,8 @@ def _crossings(pcurve: BRepAdaptor_Curve2d, grid: NDArray, knots: tuple[list[flo
                 t = a
                 for _ in range(4):
                     t = a - fa * (b - a) / (fb - fa)
-                    pcurve.D0(t, uv)
-                    ft = (uv.X(), uv.Y())[axis] - knot
-                    if abs(ft) <= 1e-14 * max(1.0, abs(knot)):
+                    ft = float(uv_of([t])[0, axis]) - knot
+                    if not math.isfinite(ft) or abs(ft) <= 1e-14 * max(1.0, abs(knot)):
                         break
                     a, fa = (t, ft) if (ft < 0) == (fa < 0) else (a, fa)
                     b, fb = (t, ft) if (ft < 0) == (fb < 0) else (b, fb)
@@ -194,19 +188,17 @@ def _crossings(pcurve: BRepAdaptor_Curve2d, grid: NDArray, knots: tuple[list[flo
     return found
 
 
+def _pcurve_points(pcurve: BRepAdaptor_Curve2d, params: list[float]) -> NDArray:
+    """The pcurve's (u, v) at ``params`` (n × 2)."""
+    uv = gp_Pnt2d()
+    out = np.empty((len(params), 2))
+    for k, t in enumerate(params):
+        pcurve.D0(t, uv)
+        out[k] = uv.X(), uv.Y()
+    return out
+
+
 # ------------------------------------------------------------ evaluating
-
-
-def face_derivatives(surface: BRepAdaptor_Surface, uvs: list[tuple[float, float]], out: NDArray) -> None:
-    """Fill ``out`` (samples × 18) with the surface point and derivatives (P, Su, Sv, Suu, Svv, Suv) at each (u, v)."""
-    p = gp_Pnt()
-    su, sv, suu, svv, suv = gp_Vec(), gp_Vec(), gp_Vec(), gp_Vec(), gp_Vec()
-    for k, (u, v) in enumerate(uvs):
-        if not (math.isfinite(u) and math.isfinite(v)):
-            out[k] = math.nan
-            continue
-        surface.D2(u, v, p, su, sv, suu, svv, suv)
-        out[k] = (*p.Coord(), *su.Coord(), *sv.Coord(), *suu.Coord(), *svv.Coord(), *suv.Coord())
 
 
 def projected(edge: TopoDS_Edge, face: TopoDS_Face, params: list[float]) -> list[tuple[float, float]]:
@@ -276,104 +268,95 @@ class Line:
 
 
 class EdgeLine(Line):
-    """An edge shared by two faces (or a seam: one face twice, the edge used both ways)."""
+    """An edge shared by two faces (or a seam: one face twice, the edge used both ways).
 
-    def __init__(self, edge: TopoDS_Edge, sides: list[tuple[BRepAdaptor_Surface, TopoDS_Face, TopoDS_Edge]],
-                 signs: tuple[float, float], samples: int) -> None:  # fmt: skip
+    Each face is evaluated at the projection of the edge's 3-D point onto its surface, inside its own
+    domain (``spiral_cad.cad.face_projection``); its pcurve, where there is one, is the starting guess.
+    """
+
+    def __init__(self, edge: TopoDS_Edge, sides: list[tuple[FaceDomain, TopoDS_Edge]], signs: tuple[float, float],
+                 samples: int) -> None:  # fmt: skip
         self.edge, self.sides, self.signs = edge, sides, signs
         self.curve = BRepAdaptor_Curve(edge)
+        self.tolerance = BRep_Tool.Tolerance_s(edge)
         self.lo, self.hi = self.curve.FirstParameter(), self.curve.LastParameter()
-        self.curves_on_faces = [BRep_Tool.CurveOnSurface_s(oriented, face, 0.0, 0.0) for _, face, oriented in sides]
-        self.pcurves = [None if on_face is None else BRepAdaptor_Curve2d(oriented, face)
-                        for (_, face, oriented), on_face in zip(sides, self.curves_on_faces)]  # fmt: skip
+        self.curves_on_faces = [BRep_Tool.CurveOnSurface_s(oriented, domain.face, 0.0, 0.0) for domain, oriented in sides]
+        self.pcurves = [None if on_face is None else BRepAdaptor_Curve2d(oriented, domain.face)
+                        for (domain, oriented), on_face in zip(sides, self.curves_on_faces)]  # fmt: skip
         floor = floor_points(self.lo, self.hi, samples)
         breaks = curve_knots(BRep_Tool.Curve_s(edge, 0.0, 0.0)) if BRep_Tool.IsGeometric_s(edge) else []
         grid = np.unique(np.array(floor + breaks + [self.lo, self.hi]))
-        for (_, face, _), pcurve, on_face in zip(sides, self.pcurves, self.curves_on_faces):
+        for (domain, oriented), pcurve, on_face in zip(sides, self.pcurves, self.curves_on_faces):
+            # where the knot lines of the face's surface cross the edge, in both directions, pcurve or not
+            knots = surface_knots(BRep_Tool.Surface_s(domain.face))
             if pcurve is not None:
-                breaks += curve_knots(on_face) + _crossings(pcurve, grid, surface_knots(BRep_Tool.Surface_s(face)))
+                breaks += curve_knots(on_face) + _crossings(partial(_pcurve_points, pcurve), grid, knots)
+            else:
+                uv_of = partial(_projected_points, oriented, domain.face)
+                breaks += _crossings(uv_of, grid, knots)
         self.start = floor + span_points(self.lo, self.hi, breaks)
 
-    def evaluate(self, params: list[float]) -> tuple[NDArray, NDArray]:
-        """Both faces' derivatives at the pcurves' (u, v) (or the projections of the edge's points), and the
-        unit tangents of the edge's 3-D curve."""
-        tangents = np.empty((len(params), 3))
+    def locate(self, params: list[float]) -> tuple[NDArray, NDArray, list[NDArray]]:
+        """The edge's points (n × 3) and unit tangents (n × 3) at ``params``, and per face the (u, v) to start
+        its projection from: its pcurve's, or OCCT's projection where it has none."""
+        tangents, points = np.empty((len(params), 3)), np.empty((len(params), 3))
         p, d1 = gp_Pnt(), gp_Vec()
         for k, t in enumerate(params):
             self.curve.D1(t, p, d1)
-            tangents[k] = d1.Coord()
+            tangents[k], points[k] = d1.Coord(), p.Coord()
         with np.errstate(all="ignore"):
             tangents /= norms(tangents)[:, None]
+        starts = [_pcurve_points(pcurve, params) if pcurve is not None else _projected_points(oriented, domain.face, params)
+                  for (domain, oriented), pcurve in zip(self.sides, self.pcurves)]  # fmt: skip
+        return points, tangents, starts
+
+    def evaluate(self, params: list[float]) -> tuple[NDArray, NDArray]:
+        """Both faces' derivatives at the projections of the edge's points (from the pcurves' (u, v), or
+        OCCT's projection without one), and the unit tangents of the edge's 3-D curve."""
+        points, tangents, starts = self.locate(params)
         raw = np.empty((len(params), 2, 18))
-        uv = gp_Pnt2d()
-        for side, ((surface, face, oriented), pcurve) in enumerate(zip(self.sides, self.pcurves)):
-            if pcurve is not None:
-                uvs = []
-                for t in params:
-                    pcurve.D0(t, uv)
-                    uvs.append((uv.X(), uv.Y()))
-            else:
-                uvs = projected(oriented, face, params)
-            face_derivatives(surface, uvs, raw[:, side])
+        for side, ((domain, _), start) in enumerate(zip(self.sides, starts)):
+            domain.evaluate_at(points, start, raw[:, side], self.tolerance)
         return raw, tangents
+
+
+def _projected_points(edge: TopoDS_Edge, face: TopoDS_Face, params: list[float]) -> NDArray:
+    return np.array(projected(edge, face, params), dtype=float).reshape(-1, 2)
 
 
 class KnotLine(Line):
     """A knot line u = k (``along_u``) or v = k inside one face, across the face's (u, v) bounds (a
     trimmed face's line may be sampled a little beyond its trimming)."""
 
-    def __init__(self, face: TopoDS_Face, surface: BRepAdaptor_Surface, along_u: bool, knot: float, sign: float,
-                 samples: int) -> None:  # fmt: skip
-        self.surface, self.along_u, self.knot, self.signs = surface, along_u, knot, (sign, sign)
+    def __init__(self, domain: FaceDomain, along_u: bool, knot: float, sign: float, samples: int) -> None:
+        self.domain, self.along_u, self.knot, self.signs = domain, along_u, knot, (sign, sign)
+        face = domain.face
         u0, u1, v0, v1 = BRepTools.UVBounds_s(face)
         self.lo, self.hi = (v0, v1) if along_u else (u0, u1)
-        low, high = (u0, u1) if along_u else (v0, v1)
-        self.step = KNOT_STEP * (high - low)
         us, vs = surface_knots(BRep_Tool.Surface_s(face))
         self.start = floor_points(self.lo, self.hi, samples) + span_points(self.lo, self.hi, vs if along_u else us)
-        geom = BRep_Tool.Surface_s(face)  # located: the points come out where the face is
-        self.bspline = geom if isinstance(geom, Geom_BSplineSurface) else None
         self.name = f"{'u' if along_u else 'v'} = {knot:.6g}"
-        if self.bspline is not None:
-            s = self.bspline
-            first, last = (s.FirstUKnotIndex(), s.LastUKnotIndex()) if along_u else (s.FirstVKnotIndex(), s.LastVKnotIndex())
-            knot_at = s.UKnot if along_u else s.VKnot
-            self.index = min(range(first + 1, last), key=lambda i: abs(knot_at(i) - knot))
-            multiplicity = (s.UMultiplicity if along_u else s.VMultiplicity)(self.index)
+        s = domain.bspline
+        if s is not None:
+            axis = 0 if along_u else 1
+            ks = domain.knots[axis]
+            period = domain.periods[axis]
+            reduced = ks[0] + (knot - ks[0]) % period if period > 0.0 else knot
+            index = int(np.argmin(np.abs(ks - reduced))) + 1
+            multiplicity = (s.UMultiplicity if along_u else s.VMultiplicity)(index)
             self.name += f" (knot of multiplicity {multiplicity})"
-            ofirst, olast = (s.FirstVKnotIndex(), s.LastVKnotIndex()) if along_u else (s.FirstUKnotIndex(), s.LastUKnotIndex())
-            self.ofirst = ofirst
-            self.oknots = np.array([(s.VKnot if along_u else s.UKnot)(i) for i in range(ofirst, olast + 1)])
         else:
-            self.name += f" (a knot of the {_kind(surface)} surface's B-spline, below C2)"
+            self.name += f" (a knot of the {_kind(domain.adaptor)} surface's B-spline, below C2)"
 
     def evaluate(self, params: list[float]) -> tuple[NDArray, NDArray]:
         """The two sides' derivatives on the line: the two spans' polynomials of a B-spline surface, else
         ``KNOT_STEP`` either side moved back onto the line to first order."""
-        p = gp_Pnt()
-        su, sv, suu, svv, suv = gp_Vec(), gp_Vec(), gp_Vec(), gp_Vec(), gp_Vec()
         raw = np.empty((len(params), 2, 18))
-        k = self.knot
-        if self.bspline is not None:
-            s, i = self.bspline, self.index
-            spans = self.ofirst + np.clip(np.searchsorted(self.oknots, params, side="right") - 1, 0, len(self.oknots) - 2)
-            for n, (t, j) in enumerate(zip(params, spans.tolist())):
-                for side, (a, b) in enumerate(((i - 1, i), (i, i + 1))):
-                    if self.along_u:
-                        s.LocalD2(k, t, a, b, j, j + 1, p, su, sv, suu, svv, suv)
-                    else:
-                        s.LocalD2(t, k, j, j + 1, a, b, p, su, sv, suu, svv, suv)
-                    raw[n, side] = (*p.Coord(), *su.Coord(), *sv.Coord(), *suu.Coord(), *svv.Coord(), *suv.Coord())
-        else:
-            for side, h in enumerate((-self.step, self.step)):
-                uvs = [(k + h, t) if self.along_u else (t, k + h) for t in params]
-                face_derivatives(self.surface, uvs, raw[:, side])
-                # back onto the line, to first order in h (x the direction across it): P −= h·S_x,
-                # S_u −= h·S_ux, S_v −= h·S_vx
-                x, ux, vx = (3, 9, 15) if self.along_u else (6, 15, 12)
-                found = raw[:, side].copy()
-                for target, derivative in ((0, x), (3, ux), (6, vx)):
-                    raw[:, side, target : target + 3] -= h * found[:, derivative : derivative + 3]
+        axis = 0 if self.along_u else 1
+        uvs = np.empty((len(params), 2))
+        uvs[:, axis], uvs[:, 1 - axis] = self.knot, params
+        for side, sign in enumerate((-1.0, 1.0)):
+            self.domain.one_sided(uvs, axis, np.full(len(params), sign), raw[:, side])
         tangents = raw[:, 0, 6:9] if self.along_u else raw[:, 0, 3:6]  # along the line: Sv on a u line, Su on a v line
         with np.errstate(all="ignore"):
             return raw, tangents / norms(tangents)[:, None]
@@ -384,12 +367,12 @@ def _kind(surface: BRepAdaptor_Surface) -> str:
     return name.lower() or "other"
 
 
-def knot_lines(face: TopoDS_Face, surface: BRepAdaptor_Surface, sign: float, samples: int) -> list[KnotLine]:
-    """The knot lines inside ``face`` where its surface is less than C2 (a crease or a curvature jump may
+def knot_lines(domain: FaceDomain, sign: float, samples: int) -> list[KnotLine]:
+    """The knot lines inside a face where its surface is less than C2 (a crease or a curvature jump may
     be there): of a B-spline surface, of the B-spline curve of an extrusion or a revolution, of an offset's
     or a trimmed surface's basis."""
-    us, vs = surface_breaks(surface, GeomAbs_Shape.GeomAbs_C2)
-    return [KnotLine(face, surface, along_u, k, sign, samples) for along_u, ks in ((True, us), (False, vs)) for k in ks]
+    us, vs = surface_breaks(domain.adaptor, GeomAbs_Shape.GeomAbs_C2)
+    return [KnotLine(domain, along_u, k, sign, samples) for along_u, ks in ((True, us), (False, vs)) for k in ks]
 
 
 # ------------------------------------------------------------ sampling in rounds
@@ -420,14 +403,36 @@ def sample_lines(lines: list[Line], tolerances: Tolerances) -> tuple[NDArray, li
 
 
 def _evaluate(lines: list[Line], owner: NDArray, params: NDArray) -> tuple[NDArray, NDArray]:
-    """Rows (n × 2 × ``FACE_FLOATS``) and line tangents (n × 3) at ``params`` of the lines ``owner``."""
+    """Rows (n × 2 × ``FACE_FLOATS``) and line tangents (n × 3) at ``params`` of the lines ``owner``; the
+    faces along every edge are projected on all at once (``evaluate_on_faces``)."""
     raw, tangents, sign = np.empty((len(params), 2, 18)), np.empty((len(params), 3)), np.empty((len(params), 2))
     order = np.argsort(owner, kind="stable")
     ids, starts = np.unique(owner[order], return_index=True)
+    domains: dict[int, int] = {}  # id of a face's domain → its place in ``listed``
+    listed: list[FaceDomain] = []
+    on_edges: list[tuple[NDArray, NDArray, list[NDArray], list[int], float]] = []
     for i, a, b in zip(ids.tolist(), starts.tolist(), [*starts[1:].tolist(), len(order)]):
-        at = order[a:b]
-        raw[at], tangents[at] = lines[i].evaluate(params[at].tolist())
-        sign[at] = lines[i].signs
+        at, line = order[a:b], lines[i]
+        sign[at] = line.signs
+        if isinstance(line, EdgeLine):
+            points, tangents[at], uvs = line.locate(params[at].tolist())
+            for domain, _ in line.sides:
+                if id(domain) not in domains:
+                    domains[id(domain)] = len(listed)
+                    listed.append(domain)
+            which = [domains[id(domain)] for domain, _ in line.sides]
+            on_edges.append((at, points, uvs, which, line.tolerance))
+        else:
+            raw[at], tangents[at] = line.evaluate(params[at].tolist())
+    if on_edges:
+        for side in (0, 1):
+            rows = np.concatenate([at for at, *_ in on_edges])
+            face_of = np.concatenate([np.full(len(at), which[side]) for at, _, _, which, _ in on_edges])
+            found = np.empty((len(rows), 18))
+            evaluate_on_faces(listed, face_of, np.concatenate([points for _, points, *_ in on_edges]),
+                              np.concatenate([uvs[side] for _, _, uvs, _, _ in on_edges]),
+                              np.concatenate([np.full(len(at), tol) for at, *_, tol in on_edges]), found)  # fmt: skip
+            raw[rows, side] = found
     rows = rows_of(raw.reshape(-1, 18), sign.reshape(-1), np.repeat(tangents, 2, axis=0))
     return rows.reshape(-1, 2, FACE_FLOATS), tangents
 

@@ -6,7 +6,9 @@ meets itself) the edge is sampled where its geometry asks for it
 ends, every polynomial span between the knots of the edge's curve and of both
 faces' surfaces, and bisection where the edge turns or a measure may cross its
 tolerance between two samples. At each point both faces give, from their
-surface derivatives at the point's parameters on the edge's pcurve:
+surface derivatives where the edge's 3-D point projects onto each, read from
+inside each face's own domain (``spiral_cad.cad.face_projection``; the pcurve
+is only the starting guess):
 
 * the surface point — the **gap** is the distance between the two;
 * the oriented unit normal (flipped for a face REVERSED in its shell) — the
@@ -20,7 +22,7 @@ surface derivatives at the point's parameters on the edge's pcurve:
 
 The worst value of each along the edge, and where it was, give the edge's
 class (``EDGE_CLASSES``): ``"unmeasurable"`` (no sample gave a point or a normal), ``"gap"`` (the faces do not meet: gap above
-``gap_tol`` × model size), ``"sharp"`` (normals further apart than
+the gap limit: ``gap_tol`` × model size, or by default the file's precision or twice the edge's tolerance), ``"sharp"`` (normals further apart than
 ``feature_angle``: a feature — a box's edge — listed, never failed),
 ``"crease"`` (an angle above ``angle_tol`` but below ``feature_angle``: a
 near-tangent kink, a defect), ``"G1"`` (tangent, the curvature jumps),
@@ -71,6 +73,7 @@ from OCP.TopTools import (
 
 from ..check.joints import check_tolerances
 from ..core.units import length_unit
+from .face_projection import FaceDomain
 from .face_sampling import FACE_FLOATS, EdgeLine, Line, Tolerances, knot_lines, measures, sample_lines
 from .occ import as_occ_shape
 from .readers import IGES_SUFFIXES, STEP_SUFFIXES, read_file
@@ -95,9 +98,11 @@ SEW_TOL = 1e-6
 #: face count, per face its surface type, per checked pair (edge index, face a,
 #: face b, seam, note), the free edges (index, midpoint), the model size, the samples as
 #: float64 bytes (samples × 2 faces × ``FACE_FLOATS``, pair after pair), how many samples
-#: each pair got, and how many edges were sewn.
+#: each pair got, how many edges were sewn, per pair twice the BRep tolerance of its edge (of its
+#: face for a knot line: each face lies within it, so the two within twice it), and the precision the
+#: file states (0.0: none).
 Measured = tuple[int, list[str], list[tuple[int, int, int, bool, str]], list[tuple[int, tuple[float, float, float]]], float,
-                 bytes, list[int], int]  # fmt: skip
+                 bytes, list[int], int, list[float], float]  # fmt: skip
 
 
 # ------------------------------------------------------------ measuring
@@ -111,6 +116,8 @@ def _surface_name(kind: GeomAbs_SurfaceType) -> str:
 
 def _shapes(shapes: TopTools_ListOfShape) -> list[TopoDS_Shape]:
     """The shapes of an OCCT list (Python iteration over it costs ~0.3 ms a list; this a few µs)."""
+    if shapes.Extent() == 0:  # an edge of a loose wire, in no face
+        return []
     if shapes.Extent() <= 2:
         return [shapes.First(), shapes.Last()][: shapes.Extent()]
     found, rest = [], TopTools_ListOfShape()
@@ -131,7 +138,7 @@ def _free_edges(shape: TopoDS_Shape) -> list[TopoDS_Edge]:
         if BRep_Tool.Degenerated_s(edge) or not BRep_Tool.IsGeometric_s(edge):
             continue
         faces = _shapes(ancestors.FindFromIndex(i))
-        if all(f.IsSame(faces[0]) for f in faces) and not BRep_Tool.IsClosed_s(edge, TopoDS.Face_s(faces[0])):
+        if faces and all(f.IsSame(faces[0]) for f in faces) and not BRep_Tool.IsClosed_s(edge, TopoDS.Face_s(faces[0])):
             free.append(edge)
     return free
 
@@ -164,11 +171,11 @@ def _edge_uses(face: TopoDS_Face, edges: TopTools_IndexedMapOfShape) -> dict[int
     return uses
 
 
-def _measure(shape: TopoDS_Shape, samples: int, gap_tol: float, angle_tol: float, curvature_tol: float,
-             feature_angle: float) -> Measured:  # fmt: skip
+def _measure(shape: TopoDS_Shape, stated: float = 0.0, *, samples: int, gap_tol: float | None, angle_tol: float,
+             curvature_tol: float, feature_angle: float) -> Measured:  # fmt: skip
     """Everything ``check_faces`` needs of ``shape``, as plain data (see ``Measured``); runs in the
-    reader's child process for a file. Faces that were written unstitched (coinciding free edges)
-    are sewn first."""
+    reader's child process for a file (``stated``: the precision the file states). Faces that were
+    written unstitched (coinciding free edges) are sewn first."""
     box = Bnd_Box()
     BRepBndLib.Add_s(shape, box, False)
     size = 0.0 if box.IsVoid() else math.sqrt(box.SquareExtent())
@@ -179,19 +186,20 @@ def _measure(shape: TopoDS_Shape, samples: int, gap_tol: float, angle_tol: float
     TopExp.MapShapes_s(shape, TopAbs_EDGE, edges)
     ancestors = TopTools_IndexedDataMapOfShapeListOfShape()
     TopExp.MapShapesAndAncestors_s(shape, TopAbs_EDGE, TopAbs_FACE, ancestors)
-    adaptors: dict[int, BRepAdaptor_Surface] = {}
+    domains: dict[int, FaceDomain] = {}
     uses: dict[int, dict[int, set[Any]]] = {}
     kinds: list[str] = []
     for i in range(1, faces.Extent() + 1):
         kinds.append(_surface_name(BRepAdaptor_Surface(TopoDS.Face_s(faces.FindKey(i)), False).GetType()))
 
-    def adaptor(face: TopoDS_Face) -> BRepAdaptor_Surface:
+    def domain(face: TopoDS_Face) -> FaceDomain:
         index = faces.FindIndex(face)
-        if index not in adaptors:
-            adaptors[index] = BRepAdaptor_Surface(face)
-        return adaptors[index]
+        if index not in domains:
+            domains[index] = FaceDomain(face, BRepAdaptor_Surface(face))
+        return domains[index]
 
     pairs: list[tuple[int, int, int, bool, str]] = []
+    limits: list[float] = []
     lines: list[Line] = []
     free: list[tuple[int, tuple[float, float, float]]] = []
     for i in range(1, ancestors.Extent() + 1):
@@ -211,6 +219,8 @@ def _measure(shape: TopoDS_Shape, samples: int, gap_tol: float, angle_tol: float
             # a non-manifold edge (three or more faces): every pair of its faces is judged
             note = f"non-manifold: {len(found)} faces" if len(found) > 2 else ""
             couples = [((a, edge), (b, edge), note) for k, a in enumerate(found) for b in found[k + 1 :]]
+        elif not found:  # an edge of a wire beside the faces (a centre line exported with its corridor): not a face's
+            continue
         else:
             point = BRepAdaptor_Curve(edge)
             middle = point.Value(0.5 * (point.FirstParameter() + point.LastParameter()))
@@ -232,18 +242,20 @@ def _measure(shape: TopoDS_Shape, samples: int, gap_tol: float, angle_tol: float
                     if len(found) == 2:
                         note = "; ".join(filter(None, [note, "orientation: both faces use the edge in the same direction "
                                                        "(inconsistent shell); compared with one normal flipped"]))  # fmt: skip
-            sides = [(adaptor(fa), fa, ea), (adaptor(fb), fb, eb)]
+            sides = [(domain(fa), ea), (domain(fb), eb)]
             lines.append(EdgeLine(edge, sides, (signs[0], signs[1]), samples))
+            limits.append(2.0 * BRep_Tool.Tolerance_s(edge))  # each face within the tolerance of the edge
             pairs.append((index - 1, faces.FindIndex(fa) - 1, faces.FindIndex(fb) - 1, len(found) == 1, note))
     for face_index in range(1, faces.Extent() + 1):
         face = TopoDS.Face_s(faces.FindKey(face_index))
         sign = -1.0 if face.Orientation() == TopAbs_REVERSED else 1.0
-        for line in knot_lines(face, adaptor(face), sign, samples):
+        for line in knot_lines(domain(face), sign, samples):
             lines.append(line)
             pairs.append((-1, face_index - 1, face_index - 1, False, f"inside face {face_index - 1}, {line.name}"))
-    tolerances = Tolerances(gap_tol * size, angle_tol, curvature_tol, feature_angle, size)
-    rows, counts = sample_lines(lines, tolerances)
-    return faces.Extent(), kinds, pairs, free, size, rows.tobytes(), counts, stitched
+            limits.append(2.0 * BRep_Tool.Tolerance_s(face))
+    gap = gap_tol * size if gap_tol is not None else max([stated, *limits])  # what refinement watches
+    rows, counts = sample_lines(lines, Tolerances(gap, angle_tol, curvature_tol, feature_angle, size))
+    return faces.Extent(), kinds, pairs, free, size, rows.tobytes(), counts, stitched, limits, stated
 
 
 # ------------------------------------------------------------ the report
@@ -306,7 +318,8 @@ class FaceReport:
         faces: how many faces the shape holds.
         free_edges: edges that bound one face only (an open shell's border), not judged.
         size: the model size (diagonal of the bounding box), the scale of ``gap_tol`` and the curvature floor.
-        gap_tol: largest gap, relative to ``size``.
+        gap_tol: largest gap, relative to ``size``: as given, or (``gap_from`` the file) the largest limit
+            an edge was judged against, relative to ``size``.
         angle_tol: largest angle between normals of a tangent edge, radians.
         curvature_tol: largest relative jump of normal curvature of a G2 edge.
         feature_angle: normals further apart make an edge a sharp feature.
@@ -318,6 +331,9 @@ class FaceReport:
             before being judged; face and edge indices then count in the sewn shape.
         free_at: the free edges left after sewing: (edge index, midpoint) each.
         evaluated: how many points were evaluated on all edges and knot lines together.
+        gap_from: where the gap limit came from: ``"given"`` (``gap_tol`` × size), or the precision the file
+            states (``UNCERTAINTY_MEASURE_WITH_UNIT``) and twice each edge's own BRep tolerance, the larger of
+            the two per edge, e.g. ``"file: stated uncertainty 1e-07, twice the edge tolerances, 2e-07 to 4e-05"``.
     """
 
     edges: tuple[FaceEdge, ...]
@@ -335,6 +351,7 @@ class FaceReport:
     stitched: int = 0
     free_at: tuple[tuple[int, tuple[float, float, float]], ...] = ()
     evaluated: int = 0
+    gap_from: str = "given"
 
     @property
     def tangent_edges(self) -> list[FaceEdge]:
@@ -400,7 +417,7 @@ class FaceReport:
         sewn = f"; faces sewn within {SEW_TOL:g} × size" if self.stitched else ""
         out = [
             f"{self.source or 'shape'}: {self.describe()}; worst tangent edge {self.worst}",
-            f"  tolerances: gap {self.gap_tol:g} × size, angle {self.angle_tol:g} rad, curvature jump "
+            f"  tolerances: gap {self._gap_text()}, angle {self.angle_tol:g} rad, curvature jump "
             f"{self.curvature_tol:g} relative, sharp above {math.degrees(self.feature_angle):g}°; "
             f"at least {self.samples} samples per edge, more at knots and where the geometry turns "
             f"({self.evaluated} in all); model size {self.size:.6g}{unit}{sewn}",
@@ -422,20 +439,27 @@ class FaceReport:
                 out.append(f"  … and {len(self.free_at) - _FREE_LISTED} more")
         return "\n".join(out)
 
+    def _gap_text(self) -> str:
+        """The gap limit as the table states it."""
+        if self.gap_from == "given":
+            return f"{self.gap_tol:g} × size (given)"
+        return f"from the {self.gap_from} (at most {self.gap_tol * self.size:.3g}{' ' + self.units if self.units else ''})"
+
 
 #: Free edges listed by name in a table; the rest are counted.
 _FREE_LISTED = 20
 
 
-def _classify(measured: Measured, *, gap_tol: float, angle_tol: float, curvature_tol: float, feature_angle: float,
+def _classify(measured: Measured, *, gap_tol: float | None, angle_tol: float, curvature_tol: float, feature_angle: float,
               samples: int, source: str, units: str, started: float) -> FaceReport:  # fmt: skip
     """The report of the measured samples: worst values per edge (measures vectorised over all samples) and classes."""
-    count, kinds, pairs, free, size, data, counts, stitched = measured
+    count, kinds, pairs, free, size, data, counts, stitched, limits, stated = measured
     x = np.frombuffer(data, dtype=float).reshape(-1, 2, FACE_FLOATS)
     gap, angle, jump = measures(x, size)
     ends = np.cumsum([0, *counts])
     rows = []
-    gap_limit = gap_tol * size
+    given = gap_tol is not None
+    gap_limits = [gap_tol * size if gap_tol is not None else max(stated, limit) for limit in limits]
     for i, (edge, fa, fb, seam, note) in enumerate(pairs):
         start, stop = int(ends[i]), int(ends[i + 1])
         g_, an_, j_ = gap[start:stop], angle[start:stop], jump[start:stop]
@@ -445,7 +469,7 @@ def _classify(measured: Measured, *, gap_tol: float, angle_tol: float, curvature
         least_angle = float(np.nanmin(an_)) if np.isfinite(an_).any() else math.nan
         if not (math.isfinite(worst_gap) and math.isfinite(worst_angle)):
             level = "unmeasurable"  # no sample gave a point or a normal: never passed
-        elif worst_gap > gap_limit:
+        elif worst_gap > gap_limits[i]:
             level = "gap"
         elif least_angle > feature_angle:
             level = "sharp"  # sharp at every sample: a feature
@@ -464,11 +488,21 @@ def _classify(measured: Measured, *, gap_tol: float, angle_tol: float, curvature
 
         rows.append(FaceEdge(edge, (fa, fb), (kinds[fa], kinds[fb]), seam, worst_gap, at(g), worst_angle, at(an),
                              worst_jump, at(j), (float(x[j, 0, 6]), float(x[j, 1, 6])), level, note, stop - start))  # fmt: skip
-    return FaceReport(tuple(rows), count, len(free), size, gap_tol, angle_tol, curvature_tol, feature_angle, samples,
-                      source, units, time.perf_counter() - started, stitched, tuple(free), int(ends[-1]))  # fmt: skip
+    if given:
+        relative, gap_from = float(gap_tol or 0.0), "given"
+    else:
+        edge_limits = [limit for (edge, *_), limit in zip(pairs, limits) if edge >= 0]
+        relative = max([stated, *limits]) / size if size > 0.0 else 0.0
+        stated_text = f"stated uncertainty {stated:.3g}" if stated > 0.0 else "no stated uncertainty"
+        own = (f"twice the edge tolerances, {min(edge_limits):.3g} to {max(edge_limits):.3g}" if edge_limits
+               else f"twice the face tolerances, up to {max(limits, default=0.0):.3g}")  # fmt: skip
+        gap_from = f"file: {stated_text}, {own}"
+    return FaceReport(tuple(rows), count, len(free), size, relative, angle_tol, curvature_tol, feature_angle, samples,
+                      source, units, time.perf_counter() - started, stitched, tuple(free), int(ends[-1]),
+                      gap_from)  # fmt: skip
 
 
-def check_faces(shape_or_path: Any, *, gap_tol: float = 1e-7, angle_tol: float = 1e-7, curvature_tol: float = 1e-4,
+def check_faces(shape_or_path: Any, *, gap_tol: float | None = None, angle_tol: float = 1e-7, curvature_tol: float = 1e-4,
                 feature_angle: float = FEATURE_ANGLE, samples: int = 16, units: str | None = "mm",
                 label: str | None = None) -> FaceReport:  # fmt: skip
     """G0/G1/G2 continuity of the faces of a solid or shell across every edge they share.
@@ -490,7 +524,10 @@ def check_faces(shape_or_path: Any, *, gap_tol: float = 1e-7, angle_tol: float =
     Args:
         shape_or_path: a build123d or CadQuery shape, a ``TopoDS_Shape``, or a
             .step/.stp/.igs/.iges path.
-        gap_tol: largest distance between the two faces' points, relative to the model size.
+        gap_tol: largest distance between the two faces' points (each the projection of the edge's point
+            on its face), relative to the model size; None (default): per edge the larger of the precision
+            the file states (STEP's ``UNCERTAINTY_MEASURE_WITH_UNIT``, IGES's resolution) and twice the edge's
+            own BRep tolerance (each face lies within it of the edge; ``FaceReport.gap_from`` says which was used).
         angle_tol: largest angle between the oriented normals of a tangent edge, radians.
         curvature_tol: largest jump of the normal curvature across the edge, relative to
             ``max(|κa|, |κb|, 1/size)``.
@@ -512,7 +549,8 @@ def check_faces(shape_or_path: Any, *, gap_tol: float = 1e-7, angle_tol: float =
             ``feature_angle`` not within (``angle_tol``, π], ``samples`` not an integer ≥ 1.
     """
     started = time.perf_counter()
-    check_tolerances(gap_tol=gap_tol, angle_tol=angle_tol, curvature_tol=curvature_tol, feature_angle=feature_angle)
+    check_tolerances(gap_tol=0.0 if gap_tol is None else gap_tol, angle_tol=angle_tol, curvature_tol=curvature_tol,
+                     feature_angle=feature_angle)  # fmt: skip
     if not angle_tol < feature_angle <= math.pi:
         raise ValueError(f"feature_angle must be above angle_tol ({angle_tol:g}) and at most π; got {feature_angle!r}")
     if isinstance(samples, bool) or not isinstance(samples, int) or samples < 1:
@@ -520,7 +558,7 @@ def check_faces(shape_or_path: Any, *, gap_tol: float = 1e-7, angle_tol: float =
     options: dict[str, Any] = dict(gap_tol=gap_tol, angle_tol=angle_tol, curvature_tol=curvature_tol,
                                    feature_angle=feature_angle, samples=samples)  # fmt: skip
     if isinstance(shape_or_path, (str, os.PathLike)):
-        unit, measured = read_file(shape_or_path, units, partial(_measure, **options))
+        unit, measured = read_file(shape_or_path, units, partial(_measure, **options), stated=True)
         source = label or os.path.basename(os.fspath(shape_or_path))
     else:
         unit = length_unit(units) if units is not None else ""
@@ -529,8 +567,10 @@ def check_faces(shape_or_path: Any, *, gap_tol: float = 1e-7, angle_tol: float =
     return _classify(measured, source=source, units=unit, started=started, **options)
 
 
-#: STEP entities of a face (AP203/AP214/AP242 B-rep and surface models).
-_STEP_FACE = re.compile(rb"\b(?:ADVANCED_FACE|FACE_SURFACE|ORIENTED_FACE)\s*\(", re.IGNORECASE)
+#: STEP entities of a face (AP203/AP214/AP242 B-rep and surface models), and the bounded surfaces a
+#: surface-only file lists in a geometric set (OCCT makes a face of each).
+_STEP_FACE = re.compile(rb"\b(?:ADVANCED_FACE|FACE_SURFACE|ORIENTED_FACE|B_SPLINE_SURFACE\w*|BEZIER_SURFACE"
+                        rb"|RECTANGULAR_TRIMMED_SURFACE|CURVE_BOUNDED_SURFACE)\s*\(", re.IGNORECASE)  # fmt: skip
 #: IGES entity types OCCT makes faces of: surfaces (108 plane … 198 toroidal), bounded and trimmed
 #: surfaces (143, 144), faces, shells and solids (510, 514, 186). A file with none of them has no faces;
 #: one with them that still reads without faces is judged by its wires (``spiral-cad check``).
@@ -539,7 +579,8 @@ _IGES_FACES = {str(t).encode() for t in (108, 114, 118, 120, 122, 128, 140, 143,
 
 def holds_faces(path: str | os.PathLike) -> bool:
     """Whether a STEP/IGES file declares faces, from its text alone (no reader runs): a STEP face
-    entity, or an IGES directory entry of a surface, face, shell or solid (``_IGES_FACES``).
+    entity or bounded surface (a surface-only file), or an IGES directory entry of a surface, face, shell
+    or solid (``_IGES_FACES``).
 
     ``spiral-cad check`` judges faces when this is true and wires otherwise; False for a missing
     file or another suffix (the wire checker then names the problem).

@@ -108,23 +108,25 @@ def _shape_bytes(shape: TopoDS_Shape) -> bytes:
     return buffer.getvalue()
 
 
-def read_file(path: str | os.PathLike, units: str | None, extract: Callable[[TopoDS_Shape], Any]) -> tuple[str, Any]:
+def read_file(path: str | os.PathLike, units: str | None, extract: Callable[..., Any], *, stated: bool = False) -> tuple[str, Any]:
     """Read a STEP/IGES file in a child process and return ``(unit, extract(shape))``.
 
     ``extract`` runs in the child on the shape read (so evaluating its curves
     cannot harm the caller either) and must return plain data (``marshal``).
     ``unit`` is the unit the shape was read in: ``units``, or with None the
     unit the file declares (``"m"``), or ``"mm"`` for a unit spiral_cad does
-    not name.
+    not name. With ``stated``, ``extract(shape, uncertainty)`` is called with
+    the precision the file states (STEP's ``UNCERTAINTY_MEASURE_WITH_UNIT``,
+    IGES's minimum resolution), in the unit read in; 0.0 when it states none.
 
     Raises:
         ReadError, ValueError: as ``read_shape``.
     """
-    with start_reading(path, units, extract) as child:
+    with start_reading(path, units, extract, stated=stated) as child:
         return finish_reading(child)
 
 
-def start_reading(path: str | os.PathLike, units: str | None, extract: Callable[[TopoDS_Shape], Any]) -> Isolated:
+def start_reading(path: str | os.PathLike, units: str | None, extract: Callable[..., Any], *, stated: bool = False) -> Isolated:
     """``read_file`` started: the child reads while the caller goes on; ``finish_reading`` waits.
 
     Raises:
@@ -142,7 +144,7 @@ def start_reading(path: str | os.PathLike, units: str | None, extract: Callable[
     if kind == "IGES":
         _check_iges_sections(p)
     _load_readers()
-    return Isolated(_read_and_extract, p, kind, units, extract, what=f"the {kind} reader", subject=p.name)
+    return Isolated(_read_and_extract, p, kind, units, extract, stated, what=f"the {kind} reader", subject=p.name)
 
 
 def finish_reading(child: Isolated) -> tuple[str, Any]:
@@ -166,10 +168,11 @@ def _load_readers() -> None:
     IGESControl_Controller.Init_s()
 
 
-def _read_and_extract(path: Path, kind: str, units: str | None, extract: Callable[[TopoDS_Shape], Any]) -> tuple[str, Any]:
+def _read_and_extract(path: Path, kind: str, units: str | None, extract: Callable[..., Any], stated: bool = False) -> tuple[str, Any]:
     """The child's work: read the file whole, then extract what the caller needs."""
-    shape, unit = _read_whole(path, kind, units)
-    return unit, extract(shape)
+    precision: list[float] = []
+    shape, unit = _read_whole(path, kind, units, precision)
+    return unit, (extract(shape, precision[0] if precision else 0.0) if stated else extract(shape))
 
 
 @contextmanager
@@ -188,8 +191,9 @@ def _utf8_name(path: Path) -> Iterator[str]:
     yield name
 
 
-def _read_whole(path: Path, kind: str, units: str | None) -> tuple[TopoDS_Shape, str]:
-    """Read ``path`` with OCCT, check that it was read whole; (shape, unit read in)."""
+def _read_whole(path: Path, kind: str, units: str | None, precision: list[float] | None = None) -> tuple[TopoDS_Shape, str]:
+    """Read ``path`` with OCCT, check that it was read whole; (shape, unit read in). The precision the
+    file states, in the unit read in, is appended to ``precision`` (when it states one)."""
     from OCP.IFSelect import IFSelect_RetDone
 
     with captured_messages() as printed:
@@ -207,7 +211,12 @@ def _read_whole(path: Path, kind: str, units: str | None) -> tuple[TopoDS_Shape,
         name = _namer(path, kind, reader)
         failures = _reader_failures(reader.WS().ModelCheckList(), name) if status == IFSelect_RetDone else []
         if status == IFSelect_RetDone and not failures:
+            if kind == "STEP" and (fault := _step_length_fault(reader)):
+                raise ReadError(f"cannot read {path.name!r}: {fault}")
             unit = _use_unit(reader, kind, units, path.name)
+            stated = _stated_precision(reader, kind) / MM_PER_UNIT[unit]
+            if precision is not None and math.isfinite(stated) and stated > 0.0:
+                precision.append(stated)
             curves = _step_curves(reader.StepModel()) if kind == "STEP" else _iges_curves(reader.IGESModel())
             nested = next((container for curve, container, _ in curves if curve is _NESTED), None)
             if nested is not None:
@@ -267,6 +276,54 @@ def _step_unit(reader: Any) -> float:
             if context.LengthDone():
                 return context.LengthFactor()
     return 1.0
+
+
+def _step_length_fault(reader: Any) -> str:
+    """Why the global units of a STEP file give no length (its unit of length is a second, say), or ``""``:
+    a context that assigns units must assign a length unit among them."""
+    from OCP.StepRepr import StepRepr_GlobalUnitAssignedContext, StepRepr_RepresentationContext
+
+    for entity in _entities_of(reader.StepModel(), StepRepr_RepresentationContext):
+        if not isinstance(entity, StepRepr_GlobalUnitAssignedContext):
+            entity = getattr(entity, "GlobalUnitAssignedContext", lambda: None)()
+        if entity is None or not entity.NbUnits():
+            continue
+        units = [entity.UnitsValue(k) for k in range(1, entity.NbUnits() + 1)]
+        if any(unit is not None and "LengthUnit" in type(unit).__name__ for unit in units):
+            return ""
+        return "its units give no length: " + ", ".join(_unit_name(unit) for unit in units) + " (a length unit is required)"
+    return ""
+
+
+def _unit_name(unit: Any) -> str:
+    """``second (time unit)`` for a STEP named unit (SI or conversion based)."""
+    if unit is None:
+        return "a missing unit"
+    kind = re.sub(r"(?<!^)(?=[A-Z])", " ", type(unit).__name__.split("And")[-1]).lower()  # "SiUnitAndTimeUnit" → "time unit"
+    try:
+        name = unit.Name()
+    except Exception:  # noqa: BLE001 - a unit without a name
+        return kind
+    text = name.ToCString() if hasattr(name, "ToCString") else getattr(name, "name", str(name))
+    return f"{re.sub(r'^StepBasic_sun', '', str(text)).lower()} ({kind})"
+
+
+def _stated_precision(reader: Any, kind: str) -> float:
+    """The precision the file states, in mm (0.0: none): the first length ``UNCERTAINTY_MEASURE_WITH_UNIT``
+    of a STEP file's representation contexts (in its length unit), an IGES file's minimum resolution."""
+    if kind != "STEP":
+        return float(reader.IGESModel().GlobalSection().Resolution()) * _iges_unit(reader)
+    from OCP.STEPConstruct import STEPConstruct_UnitContext
+    from OCP.StepRepr import StepRepr_GlobalUncertaintyAssignedContext, StepRepr_RepresentationContext
+
+    for entity in _entities_of(reader.StepModel(), StepRepr_RepresentationContext):
+        if not isinstance(entity, StepRepr_GlobalUncertaintyAssignedContext):
+            entity = getattr(entity, "GlobalUncertaintyAssignedContext", lambda: None)()
+        if entity is not None:
+            context = STEPConstruct_UnitContext()
+            if context.ComputeTolerance(entity) == 0 and context.HasUncertainty():
+                return float(context.Uncertainty()) * _step_unit(reader)
+    return 0.0
 
 
 def _iges_unit(reader: Any) -> float:

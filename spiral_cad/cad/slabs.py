@@ -361,7 +361,7 @@ def expected_level(segments: Sequence[Segment], profile: str = "g2") -> str:
 
 def verify_faces(shape: TopoDS_Shape, level: str, what: str = "slab", units: str = DEFAULT_UNITS) -> None:
     """NoSolutionError unless the face checker (``spiral_cad.cad.faces.check_faces``, default tolerances:
-    normals ≤ 1e-7 rad, normal-curvature jump ≤ 1e-4 relative, gaps ≤ 1e-7 × size) finds every tangent
+    normals ≤ 1e-7 rad, normal-curvature jump ≤ 1e-4 relative, gaps ≤ twice the edges' tolerances) finds every tangent
     edge at least ``level`` and no gap; sharp edges are features, listed there and not failed."""
     from .faces import check_faces  # late: the checker reads files through this layer's readers
 

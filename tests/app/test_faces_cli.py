@@ -166,3 +166,50 @@ def test_check_fails_g2_on_a_curvature_jump_over_five_percent_of_an_edge(tmp_pat
     assert main(["check", str(path), "--require", "G2"]) == 1
     assert "FAIL: worst tangent edge is G1, below the required G2" in capsys.readouterr().out
     assert main(["check", str(path), "--require", "G1"]) == 0
+
+
+def test_a_step_file_whose_length_unit_is_a_second_is_refused_by_name(files, tmp_path, capsys):
+    # issue 39: read as metres, exit 0
+    text = files["box"].read_text()
+    length = "( LENGTH_UNIT() NAMED_UNIT(*) SI_UNIT(.MILLI.,.METRE.) )"
+    assert text.count(length) == 1
+    path = tmp_path / "second.step"
+    path.write_text(text.replace(length, "( NAMED_UNIT(*) SI_UNIT($,.SECOND.) TIME_UNIT() )"))
+    assert main(["check", str(path)]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("error: ") and "second (time unit)" in err and "no length" in err and "Traceback" not in err
+    assert main(["check", str(files["box"])]) == 0  # the same file with its length unit is read
+
+
+def test_the_table_says_where_the_gap_limit_came_from(files, capsys):
+    assert main(["check", str(files["box"])]) == 0
+    out = capsys.readouterr().out
+    assert "gap from the file: stated uncertainty" in out
+    assert main(["check", str(files["box"]), "--gap-tol", "1e-6"]) == 0
+    assert "gap 1e-06 × size (given)" in capsys.readouterr().out
+
+
+def test_a_lone_face_is_judged_by_its_boundary_as_a_curve_chain(tmp_path, capsys):
+    # issue 39: one face shares no edge, so "nothing shows G2"; its boundary is the curve chain to judge
+    smooth, square = tmp_path / "smooth.step", tmp_path / "square.step"
+    bd.export_step(bd.Face(ContinuousRectangle(40, 20, 5).wire()), str(smooth))
+    bd.export_step(bd.Face.make_rect(10, 10), str(square))
+    assert main(["check", str(smooth), "--require", "G2"]) == 0
+    out = capsys.readouterr().out
+    assert "its boundary is judged as the curve chain it is" in out and "1 wire of 16 edges" in out
+    assert out.rstrip().endswith("every joint at least G2")
+    assert main(["check", str(square), "--require", "G1"]) == 1  # a square's corners are G0
+    assert "1 wire of 4 edges" in capsys.readouterr().out
+
+
+def test_a_surface_only_step_file_is_judged_face_to_face(tmp_path, capsys):
+    # issue 39: B-spline surfaces in a geometric set, no face entity: judged as wires, worst joint G0
+    from face_reproducers import tangent_patches_step
+
+    path = tmp_path / "surfaces.step"
+    path.write_text(tangent_patches_step())
+    assert holds_faces(path)
+    assert main(["check", str(path), "--require", "G2"]) == 1
+    out = capsys.readouterr().out
+    assert "2 faces, 1 shared edges (1 G1)" in out and "wire" not in out
+    assert main(["check", str(path), "--require", "G1"]) == 0

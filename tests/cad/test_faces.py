@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import json
 import math
+import re
 import subprocess
 import textwrap
 
@@ -596,3 +597,164 @@ FREECAD_KNOT = textwrap.dedent(
     print(json.dumps(out))
     """
 )
+
+
+@pytest.mark.parametrize("tilt", [0.0, 1e-13, -1e-13, 1e-9])
+def test_faces_meeting_on_a_knot_line_are_read_each_from_its_own_side(tilt):
+    # issue 39: a pcurve 1e-13 outside its face's bound, on the knot line where the face ends, read the
+    # neighbouring patch (a G1 join reported G2); each face is now evaluated from its own side of the line
+    from face_reproducers import knot_line_join
+    from OCP.BRepTools import BRepTools
+    from OCP.TopAbs import TopAbs_FACE
+    from OCP.TopExp import TopExp_Explorer
+    from OCP.TopoDS import TopoDS
+
+    shell = knot_line_join(tilt)
+    explorer, bounds = TopExp_Explorer(shell, TopAbs_FACE), []
+    while explorer.More():
+        bounds.append(BRepTools.UVBounds_s(TopoDS.Face_s(explorer.Current())))
+        explorer.Next()
+    if tilt > 0.0:  # the reproducer is what the issue describes: a face's bounds reach past the knot line
+        assert any(0.5 < v1 < 0.5 + 2 * tilt or 0.5 - 2 * tilt < v0 < 0.5 for _, _, v0, v1 in bounds)
+    report = check_faces(shell)
+    (edge,) = report.edges
+    assert edge.level == "G1" and not report.passes("G2")
+    assert sorted(abs(k) for k in edge.curvatures) == pytest.approx([0.25, 1.0], rel=1e-6)
+    assert edge.gap < 1e-12 and edge.angle < 1e-9
+
+
+def test_a_pcurve_with_a_shifted_parameter_is_not_a_gap():
+    # issue 39: the gap was measured between the two faces' pcurve points, so a pcurve whose parameter is
+    # shifted along the edge read as a gap where both surfaces contain the edge; now each face is read at
+    # the projection of the edge's 3-D point
+    from face_reproducers import knot_line_join
+
+    report = check_faces(knot_line_join(0.0, shift=0.02))
+    (edge,) = report.edges
+    assert edge.level == "G1" and edge.gap < 1e-12
+    assert sorted(abs(k) for k in edge.curvatures) == pytest.approx([0.25, 1.0], rel=1e-6)
+
+
+def test_the_gap_limit_comes_from_the_edges_tolerances_and_the_file_and_the_table_says_so(tmp_path):
+    # the faces are sewn 2e-5 apart: within the tolerance sewing gave their edge, beyond 1e-7 × size
+    from face_reproducers import knot_line_join
+    from OCP.BRep import BRep_Tool
+    from OCP.TopAbs import TopAbs_EDGE
+    from OCP.TopExp import TopExp_Explorer
+    from OCP.TopoDS import TopoDS
+
+    shell = knot_line_join(0.0, apart=2e-5)
+    explorer, tolerance = TopExp_Explorer(shell, TopAbs_EDGE), 0.0
+    while explorer.More():
+        tolerance = max(tolerance, BRep_Tool.Tolerance_s(TopoDS.Edge_s(explorer.Current())))
+        explorer.Next()
+    (edge,) = check_faces(shell).edges
+    assert 1e-5 < edge.gap <= tolerance and edge.level == "G1"
+    assert check_faces(shell, gap_tol=1e-7).edges[0].level == "gap"
+    report = check_faces(shell)
+    assert report.gap_from.startswith("file: no stated uncertainty, twice the edge tolerances") and "(given)" not in report.table()
+    # a STEP file states its precision: a coarser one is used, and named
+    path = tmp_path / "join.step"
+    bd.export_step(bd.Shell(shell), str(path))
+    text, count = re.subn(r"UNCERTAINTY_MEASURE_WITH_UNIT\(LENGTH_MEASURE\([^)]*\)", "UNCERTAINTY_MEASURE_WITH_UNIT(LENGTH_MEASURE(0.01)",
+                          path.read_text())  # fmt: skip
+    assert count == 1
+    path.write_text(text)
+    report = check_faces(path)
+    assert "stated uncertainty 0.01" in report.gap_from and "stated uncertainty 0.01" in report.table()
+    assert report.gap_tol * report.size == pytest.approx(0.01)
+    given = check_faces(path, gap_tol=1e-7)
+    assert given.gap_from == "given" and "1e-07 × size (given)" in given.table() and given.edges[0].level == "gap"
+
+
+def _without_pcurves(shape):
+    """``shape`` with every edge's pcurves dropped (a file may leave them out; a plane's OCCT computes itself)."""
+    from OCP.BRep import BRep_Builder
+    from OCP.TopAbs import TopAbs_EDGE, TopAbs_FACE
+    from OCP.TopExp import TopExp_Explorer
+    from OCP.TopoDS import TopoDS
+
+    builder, faces_found = BRep_Builder(), TopExp_Explorer(shape, TopAbs_FACE)
+    while faces_found.More():
+        face = TopoDS.Face_s(faces_found.Current())
+        edges = TopExp_Explorer(face, TopAbs_EDGE)
+        while edges.More():
+            builder.UpdateEdge(TopoDS.Edge_s(edges.Current()), None, face, 1e-7)
+            edges.Next()
+        faces_found.Next()
+    return shape
+
+
+@pytest.mark.parametrize("lo", [0.11, 0.47, 0.91])
+def test_an_edge_without_pcurves_is_still_sampled_at_the_knots_of_its_faces(lo):
+    # issue 39: without pcurves the knot lines crossing the edge were not found (16 floor samples left):
+    # a curvature bump between two knots over 2 % of the edge was missed between them
+    shell = bump_join(lo, lo + 0.02).wrapped
+    with_pcurves = check_faces(shell)
+    report = check_faces(_without_pcurves(shell))
+    tangent = [e for e in report.edges if e.index >= 0 and e.tangent]
+    assert [e.level for e in tangent] == ["G1"] and lo < tangent[0].jump_at[1] < lo + 0.02
+    assert report.counts == with_pcurves.counts
+
+
+@pytest.mark.parametrize(("start", "turn"), [(1.0, 2 * math.pi), (5.0, 4.0), (-7.0, 5.0)])
+def test_knot_lines_of_a_periodic_bspline_cylinder_past_one_period_are_g2_never_gaps(start, turn):
+    # issue 39: a knot line of the face one period on was evaluated from the spans of another knot:
+    # a cylinder read as a 10 mm gap at 60°
+    from face_reproducers import periodic_bspline_cylinder
+
+    report = check_faces(periodic_bspline_cylinder(start, turn))
+    inside = [e for e in report.edges if e.index == -1]
+    # every knot line the face crosses is judged (2π/3 apart), each a circle's curvature on both sides
+    assert len(inside) == sum(1 for k in range(-6, 9) if start < k * 2 * math.pi / 3 < start + turn)
+    assert inside and all(e.level == "G2" and e.gap < 1e-12 and e.angle < 1e-12 for e in inside)
+    assert all(k == pytest.approx(-0.1, rel=1e-9) for e in report.edges for k in e.curvatures)
+    assert report.worst == "G2"
+
+
+def test_a_solid_exported_with_a_loose_wire_beside_it_is_judged(tmp_path):
+    # issue 39: the demo's highway_3d.step (the corridor with its centre line) failed with
+    # "Standard_NoSuchObject: NCollection_List::First": an edge in no face
+    box = filleted_box()
+    line = bd.Wire([bd.Edge.make_line((50, 0, 0), (60, 0, 0)), bd.Edge.make_line((60, 0, 0), (60, 10, 5))])
+    shape = bd.Compound([box, line])
+    path = tmp_path / "with_wire.step"
+    bd.export_step(shape, str(path))
+    for report in (check_faces(shape), check_faces(path)):
+        assert_box_calibration(report)
+        assert report.free_edges == 0
+
+
+@pytest.mark.parametrize("degree", [3, 12])
+def test_a_high_degree_periodic_surface_whose_face_crosses_the_seam_is_judged(tmp_path, degree):
+    # issue 39: an IGES torus of degree 12 crossing the seam gave "min() arg is an empty sequence"; its
+    # seam knot lines (C0 there: the surface turns by 2π/degree through the pole) are now judged
+    from face_reproducers import seam_torus
+
+    path = tmp_path / "torus.igs"
+    Interface_Static.SetIVal_s("write.iges.brep.mode", 1)
+    writer = IGESControl_Writer("MM", 1)
+    writer.AddShape(seam_torus(degree))
+    writer.ComputeModel()
+    assert writer.Write(str(path))
+    # OCCT's IGES round trip may trim the face onto one knot line: the other stays inside it
+    for report, knot_lines in ((check_faces(seam_torus(degree)), {2}), (check_faces(path), {1, 2})):
+        seams = [e for e in report.edges if e.seam]
+        inside = [e for e in report.edges if e.index == -1]
+        assert seams and all(e.level == "G2" for e in seams)  # two seams, sewn into one from the IGES file
+        assert len(inside) in knot_lines and all(e.level != "gap" and e.gap < 1e-6 for e in report.edges)
+        # the kink through the pole: at most 2π/degree between the normals, reached somewhere along the line
+        assert all(0.5 * 2 * math.pi / degree < e.angle <= 2 * math.pi / degree + 1e-9 for e in inside)
+
+
+def test_an_edge_on_a_knot_line_inside_its_faces_bounds_is_read_from_the_faces_side():
+    # the hole's lower edge lies on the knot line v = 0.5 inside the bounds of the face with the hole: its
+    # side there (below the line) is found by OCCT's classifier, not by its bounds; read from above, the
+    # join was G2 (κ 1 against 1)
+    from face_reproducers import plug_on_knot_line
+
+    report = check_faces(plug_on_knot_line())
+    shared = sorted((e for e in report.edges if e.index >= 0), key=lambda e: e.jump)
+    assert [e.level for e in shared] == ["G2", "G2", "G2", "G1"]
+    assert shared[-1].curvatures == pytest.approx((0.25, 1.0), rel=1e-6)  # the holed face's, then the plug's
+    assert shared[-1].jump_at[1] == pytest.approx(0.5)
