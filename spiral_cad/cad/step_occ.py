@@ -89,6 +89,7 @@ def write_shape_step(
     placeholder = f"SPIRALCADNAME{secrets.token_hex(12).upper()}"
     STEPControl_Writer()  # registers the write.step.* parameters (a new model reads them when made)
     assembly = Interface_Static.IVal_s("write.step.assembly")
+    unit, product = Interface_Static.CVal_s("write.step.unit"), Interface_Static.CVal_s("write.step.product.name")
     Interface_Static.SetIVal_s("write.step.assembly", 0)  # one product, never an assembly of its members
     Interface_Static.SetCVal_s("write.step.unit", _STEP_UNIT[units])
     Interface_Static.SetCVal_s("write.step.product.name", placeholder)
@@ -97,8 +98,10 @@ def write_shape_step(
         writer.Model().SetLocalLengthUnit(MM_PER_UNIT[units])  # the shape is in the file unit: no rescaling
         with captured_messages():
             status = writer.Transfer(solids, STEPControl_AsIs)
-    finally:  # other writers in this process (build123d's, CadQuery's) keep their own setting
+    finally:  # other writers in this process (build123d's, CadQuery's) keep their own settings: the unit above all
         Interface_Static.SetIVal_s("write.step.assembly", assembly)
+        Interface_Static.SetCVal_s("write.step.unit", unit)
+        Interface_Static.SetCVal_s("write.step.product.name", product)
     if status != IFSelect_ReturnStatus.IFSelect_RetDone:
         raise OSError(f"STEP transfer failed for {name!r}")
     header = APIHeaderSection_MakeHeader(writer.Model())

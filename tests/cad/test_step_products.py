@@ -237,3 +237,16 @@ def test_shapes_step_can_not_hold_nothing_or_loose_vertices(tmp_path):
         export_step(Compound([]), tmp_path / "empty.step")
     with pytest.raises(ValueError, match="loose vertices"):
         export_step(Compound([Vertex(1, 2, 3)]), tmp_path / "vertex.step")
+
+
+def test_our_step_writer_leaves_the_unit_of_other_writers_in_the_process_as_it_was(tmp_path):
+    """OCCT's ``write.step.unit`` is process-wide: after a part written in inches, build123d's own
+    ``export_step`` of a millimetre part still declares millimetres (a test run found it in the wrong unit)."""
+    import build123d as bd
+
+    from spiral_cad.cad.step_occ import write_shape_step
+
+    write_shape_step(bd.Box(1, 1, 1), tmp_path / "inch.step", "inch", "in", "test")
+    assert "SI_UNIT(.MILLI.,.METRE.)" not in (tmp_path / "inch.step").read_text()
+    bd.export_step(bd.Box(10, 10, 10), str(tmp_path / "mm.step"))
+    assert (tmp_path / "mm.step").read_text().count("SI_UNIT(.MILLI.,.METRE.)") == 1
