@@ -399,8 +399,10 @@ def g2_fillet(
     convex or concave, each end meeting a cap perpendicular to it) become
     exact extrusions of the 2-D G2 corner; when every edge of a cap is chosen
     too, the cap's edge is rolled by the G2 profile of the same radius
-    (``g2_slab``). Side and cap edges chosen together (``box.edges()``) get
-    one radius as the smallest radius of curvature of every edge: the rolls
+    (``g2_slab``); a cap's holes (a plate drilled through) are rims of their
+    own, rolled the other way, each chosen whole or left sharp. Side and cap
+    edges chosen together (``box.edges()``) get one radius as the smallest
+    radius of curvature of every edge: the rolls
     are of ``radius`` and the side corners of ``plan_radius(radius)`` (1.25 ×
     the roll's reach, 1.571 × radius), wide enough to hold the roll. Inside
     ``BuildPart`` the builder's part is replaced.
@@ -422,8 +424,9 @@ def g2_fillet(
             ``fillet`` on its edges), non-planar input, edges other than lines
             and arcs, or edges that belong to no wire or face.
         NoSolutionError: a corner that cannot be rounded (named, with numbers);
-            solid edges that are not a prism's straight side edges or whole caps
-            (named by edge and point: a vertex blend is a later step).
+            solid edges that are not a prism's straight side edges or whole rims of its caps (outline or
+            hole), rolls meeting across a thin wall, pockets, bosses and steps along the axis (named by edge
+            and point, with the largest radius that builds where one does).
     """
     context: Builder | None = Builder._get_context("g2_fillet")
     if isinstance(target, Iterable) and not isinstance(target, (Shape, str, bytes)):
@@ -548,10 +551,9 @@ def g2_slab(
         if len(outline.faces()) != 1:
             raise ValueError(f"g2_slab takes a sketch of one face; this one has {len(outline.faces())}")
         outline = outline.faces()[0]
-    holes: list[list[Segment]] = []
-    if isinstance(outline, Face) and not hasattr(outline, "filleted"):
-        holes = [_plane_outline(w) for w in outline.inner_wires()]
-        outline = outline.outer_wire()
+    face = isinstance(outline, Face) and not hasattr(outline, "filleted")
+    holes = [_plane_outline(w) for w in outline.inner_wires()] if face else []
+    outline = outline.outer_wire() if face else outline
     if isinstance(outline, (Face, Wire)) and not hasattr(outline, "filleted"):
         outline = _plane_outline(outline)
     slab = _slab(outline, height, edge_radius, top=top, bottom=bottom, profile=profile, transition=transition,

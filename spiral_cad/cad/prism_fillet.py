@@ -238,6 +238,7 @@ def fillet_prism_edges(
         plane = _plane(face)
         if plane is not None and any(any(e.IsSame(h) for h in _edges_of(face)) for e in edges):
             candidates.append(plane.Axis().Direction())
+    candidates = [c for k, c in enumerate(candidates) if not any(c.IsParallel(d, 1e-12) for d in candidates[:k])]
     ranked, failed = [], []
     for candidate in candidates:
         try:
@@ -355,8 +356,20 @@ def fillet_prism_edges(
                         "not chosen: choose it too (a roll cannot turn a sharp corner), or leave that rim sharp"
                     )
         try:  # with chosen side edges the plan changes with the radius: a suggestion is built from the start
-            slab = g2_slab(planned[0], prism.height, radius, holes=planned[1:], _rolled=rolled, transition=transition,
-                           shape=shape, tolerance=tolerance, _name="radius", _at=at, _advise=False)  # fmt: skip
+            slab = g2_slab(
+                planned[0],
+                prism.height,
+                radius,
+                holes=planned[1:],
+                _rolled=rolled,
+                transition=transition,
+                shape=shape,
+                tolerance=tolerance,
+                _name="radius",
+                _at=at,
+                _advise=False,
+                _verify=False,
+            )  # fmt: skip  (verified below, as placed and returned)
         except NoSolutionError as error:
             if not _advise:
                 raise
@@ -405,7 +418,10 @@ def _rolled_plan(segments: list[Segment], chosen: list[int], height: float, radi
                  at: Callable[[float, float], str] | None = None) -> list[Segment]:  # fmt: skip
     """The cap outline with the chosen corners rounded by ``plan_radius(radius)``, or NoSolutionError naming
     what does not fit and the largest radius that does (side corners, rolls and height together)."""
-    options = dict(top=caps["top"], bottom=caps["bottom"], profile="g2", transition=transition, shape=shape)
+    options: dict[str, Any] = dict(top=caps["top"], bottom=caps["bottom"], profile="g2", transition=transition,
+                                   shape=shape)  # fmt: skip
+    if at is not None:
+        options["at"] = at
 
     def attempt(r: float) -> tuple[list[Segment] | None, str | None]:
         corner = plan_radius(r, transition=transition, shape=shape)
@@ -415,8 +431,7 @@ def _rolled_plan(segments: list[Segment], chosen: list[int], height: float, radi
         except NoSolutionError as error:
             return None, f"radius {shown(r)} rounds the side edges with the plan radius {corner:.6g} ({error})"
         plan = list(path.segments)
-        where = {} if at is None else {"at": at}
-        return plan, _roll_problem(plan, height, r, height, "radius", **dict(options), **where)
+        return plan, _roll_problem(plan, height, r, height, "radius", **dict(options))
 
     plan, problem = attempt(radius)
     if problem is None and plan is not None:

@@ -474,6 +474,7 @@ def g2_slab(
     holes: Sequence[Any] = (),
     _rolled: Sequence[tuple[bool, bool]] | None = None,
     _at: Callable[[float, float], str] = _plain,
+    _verify: bool = True,
     _name: str = "edge_radius",
     _advise: bool = True,
 ) -> Slab:
@@ -529,6 +530,7 @@ def g2_slab(
                                    holes=hole_loops, rolled=_rolled, at=_at)  # fmt: skip
     radius = as_float(edge_radius, "edge_radius")
     problem = _roll_problem(segments, height, edge_radius, given_height, _name, **options)
+    options["verify"] = _verify
     if problem is not None:
         if not _advise:
             raise NoSolutionError(problem)
@@ -545,7 +547,7 @@ def _slab_advice(segments: list[Segment], height: float, radius: float, given_he
                  options: dict[str, Any], tolerance: float | None, units: str) -> float | None:  # fmt: skip
     """The largest roll radius below ``radius`` a refusal may name: it fits with a margin and builds."""
     return advice(
-        lambda r: _roll_problem(segments, height, r, given_height, name, **options) is None,
+        lambda r: _roll_problem(segments, height, r, given_height, name, **_fit_options(options)) is None,
         lambda r: g2_slab(segments, height, r, **_slab_options(options), tolerance=tolerance, units=units, _advise=False),
         radius,
     )
@@ -553,8 +555,13 @@ def _slab_advice(segments: list[Segment], height: float, radius: float, given_he
 
 def _slab_options(options: dict[str, Any]) -> dict[str, Any]:
     """``g2_slab``'s keyword arguments from the fit checks' ``options``."""
-    rest = {k: v for k, v in options.items() if k not in ("holes", "rolled", "at")}
+    rest = {k: v for k, v in options.items() if k not in ("holes", "rolled", "at", "verify")}
     return dict(rest, holes=options.get("holes", ()), _rolled=options.get("rolled"), _at=options.get("at", _plain))
+
+
+def _fit_options(options: dict[str, Any]) -> dict[str, Any]:
+    """The fit checks' ``options`` without what only the construction reads."""
+    return {k: v for k, v in options.items() if k != "verify"}
 
 
 def _built_slab(segments: list[Segment], height: float, edge_radius: float, options: dict[str, Any],
@@ -589,9 +596,10 @@ def _built_slab(segments: list[Segment], height: float, edge_radius: float, opti
     top_cap = _cap([(a, d) for a, d, _ in rims], height)
     faces = [*sides, top_cap, _cap([(a, d) for a, _, d in rims], 0.0)]
     solid = _solid(faces, 1e-7 * size, top_cap)
-    verify_solid(solid, facing_out=True)
-    levels = [expected_level(loop, profile) for loop in loops]
-    verify_faces(solid, "G1" if "G1" in levels else "G2", units=units)
+    if options.get("verify", True):  # a caller that moves the solid verifies it where it is returned
+        verify_solid(solid, facing_out=True)
+        levels = [expected_level(loop, profile) for loop in loops]
+        verify_faces(solid, "G1" if "G1" in levels else "G2", units=units)
     return Slab(solid, approximation, reaches, height, units)
 
 

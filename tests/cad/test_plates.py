@@ -14,7 +14,7 @@ import subprocess
 import textwrap
 
 import pytest
-from build123d import Axis, Box, BuildSketch, Circle, Cylinder, GeomType, Locations, Mode, Pos, Rectangle, fillet
+from build123d import Axis, Box, BuildSketch, Circle, Cylinder, GeomType, Locations, Mode, Pos, fillet
 from helpers import freecad_lib
 from OCP.BRepCheck import BRepCheck_Analyzer
 from OCP.TopAbs import TopAbs_FORWARD, TopAbs_SOLID
@@ -205,3 +205,17 @@ def test_build123d_circular_fillet_of_the_same_edges_is_only_g1():  # the baseli
     circular = fillet(plate.edges(), 1.5)
     report = check_faces(circular.wrapped)
     assert report.counts["G1"] > 0 and not report.passes("G2")
+
+
+def test_cadquery_g2_fillet_of_a_plates_edges_is_the_build123d_part():
+    import cadquery as cq
+
+    import spiral_cad.cadquery  # noqa: F401  (registers the methods)
+
+    plate = cq.Workplane("XY").box(100, 60, 10).faces(">Z").workplane().center(20, 0).hole(10)
+    rounded = plate.edges().g2Fillet(1.5).val()
+    assert rounded.isValid() and len(rounded.Solids()) == 1
+    ours = g2_fillet((Box(100, 60, 10) - Pos(20, 0, 0) * Cylinder(5, 10)).edges(), 1.5)
+    assert rounded.Volume() == pytest.approx(ours.volume, rel=1e-9)
+    with pytest.raises(NoSolutionError, match=r"3 levels"):
+        cq.Workplane("XY").box(100, 60, 10).faces(">Z").workplane().rect(40, 20).cutBlind(-4).edges().g2Fillet(1.5)
