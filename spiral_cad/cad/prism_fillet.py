@@ -310,16 +310,19 @@ def fillet_prism_edges(
     def plans(r: float) -> list[list[Segment]]:
         """Each loop with its chosen corners rounded (with the plan radius on rolled loops), or NoSolutionError."""
         made = []
-        for segments, corners, (top, bottom) in zip(loops, chosen, rolled):
-            if corners and (top or bottom):
-                caps_here = {"top": top, "bottom": bottom}
-                made.append(_rolled_plan(segments, corners, prism.height, r, caps_here, transition, same_sense, shape, None,
-                                         at))  # fmt: skip
-            elif corners:
-                made.append(list(fillet_path(segments, r, transition=transition, vertices=corners, closed=True,
-                                             same_sense=same_sense, shape=shape).segments))  # fmt: skip
-            else:
-                made.append(segments)
+        for index, (segments, corners, (top, bottom)) in enumerate(zip(loops, chosen, rolled)):
+            try:
+                if corners and (top or bottom):
+                    caps_here = {"top": top, "bottom": bottom}
+                    made.append(_rolled_plan(segments, corners, prism.height, r, caps_here, transition, same_sense,
+                                             shape, None, at))  # fmt: skip
+                elif corners:
+                    made.append(list(fillet_path(segments, r, transition=transition, vertices=corners, closed=True,
+                                                 same_sense=same_sense, shape=shape).segments))  # fmt: skip
+                else:
+                    made.append(segments)
+            except NoSolutionError as error:
+                raise NoSolutionError(f"on the {_rim_name(index)} (near {at(*segments[0].start[:2])}): {error}") from None
         return made
 
     def fits(r: float) -> bool:

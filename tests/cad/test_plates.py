@@ -16,6 +16,8 @@ import textwrap
 import pytest
 from build123d import Axis, Box, BuildSketch, Circle, Cylinder, GeomType, Locations, Mode, Pos, fillet
 from helpers import freecad_lib
+from hypothesis import given, settings
+from hypothesis import strategies as st
 from OCP.BRepCheck import BRepCheck_Analyzer
 from OCP.TopAbs import TopAbs_FORWARD, TopAbs_SOLID
 from OCP.TopExp import TopExp_Explorer
@@ -219,3 +221,40 @@ def test_cadquery_g2_fillet_of_a_plates_edges_is_the_build123d_part():
     assert rounded.Volume() == pytest.approx(ours.volume, rel=1e-9)
     with pytest.raises(NoSolutionError, match=r"3 levels"):
         cq.Workplane("XY").box(100, 60, 10).faces(">Z").workplane().rect(40, 20).cutBlind(-4).edges().g2Fillet(1.5)
+
+
+@pytest.mark.slow
+def test_a_square_hole_too_small_for_the_plan_corners_is_refused_on_its_rim_with_a_radius_that_builds():
+    plate = Box(60, 40, 8) - Box(4, 4, 8)
+    with pytest.raises(NoSolutionError, match=r"on the rim of hole 0 \(near \(-?2, -?2, -4\)\): radius 1.5 rounds") as error:
+        g2_fillet(plate.edges(), 1.5)
+    radius = _suggested(error)
+    assert plan_radius(radius) < 2.0  # two plan corners fit along the 4 mm side
+    built = g2_fillet(plate.edges(), radius)
+    _one_forward_valid_solid(built.wrapped)
+    _all_g2(built.wrapped)
+
+
+@pytest.mark.slow
+@settings(max_examples=5, deadline=None)
+@given(
+    st.lists(st.tuples(st.integers(0, 3), st.integers(0, 1), st.floats(0.5, 6.0)), max_size=4, unique_by=lambda h: h[:2]),
+    st.floats(0.2, 2.5),
+    st.floats(4.0, 12.0),
+)
+def test_property_random_plates_with_holes_round_g2_or_name_a_radius_that_builds(holes, radius, height):
+    plate = Box(100, 44, height)
+    for i, j, r in holes:  # on a 25 × 25 grid: apart and inside the plate, walls from 3.5 mm up
+        plate = plate - Pos(-37.5 + 25 * i, -12.5 + 25 * j, 0) * Cylinder(r, height)
+    try:
+        rounded = g2_fillet(plate.edges(), radius)
+    except NoSolutionError as error:
+        found = re.search(r"radius up to ([0-9.e+-]+) fits", str(error))
+        assert found or "no radius fits" in str(error), str(error)
+        if found:
+            rounded = g2_fillet(plate.edges(), float(found.group(1)))
+        else:
+            return
+    _one_forward_valid_solid(rounded.wrapped)
+    _all_g2(rounded.wrapped)
+    assert 0.8 * plate.volume < rounded.volume < plate.volume
