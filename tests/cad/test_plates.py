@@ -98,7 +98,7 @@ def test_holes_that_cross_the_outline_or_each_other_are_malformed():
         occ_slab(plan, 8, 1, holes=[[Arc((0, 0), 4, 0, 2 * math.pi)], [Arc((3, 0), 4, 0, 2 * math.pi)]])
 
 
-def test_the_plate_with_a_hole_from_the_issue_is_rounded_g2_on_every_edge():
+def test_the_plate_with_a_hole_from_the_issue_is_rounded_g2_on_every_edge(tmp_path):
     plate = Box(100, 60, 10) - Pos(20, 0, 0) * Cylinder(5, 10)
     rounded = g2_fillet(plate.edges(), 1.5)
     _one_forward_valid_solid(rounded.wrapped)
@@ -107,6 +107,10 @@ def test_the_plate_with_a_hole_from_the_issue_is_rounded_g2_on_every_edge():
     corners = plan_radius(1.5)
     rims = (2 * (100 + 60) + 2 * math.pi * (5 + reach)) * 2 * reach**2  # each roll takes less than reach² per length
     assert plate.volume - 10 * 4 * corners**2 - rims < rounded.volume < plate.volume
+    from spiral_cad.cad.export import export_step
+
+    export_step(rounded, tmp_path / "plate.step")  # the approximation of the sweeps over the plan's spirals, noted
+    assert "sweeps over spirals approximated within" in (tmp_path / "plate.step").read_text()
     bb = rounded.bounding_box()
     assert (bb.min.X, bb.max.X, bb.min.Z, bb.max.Z) == pytest.approx((-50, 50, -5, 5), abs=1e-6)
 
@@ -120,6 +124,9 @@ def test_only_the_chosen_rims_are_rolled_and_the_rest_stays_sharp():
     rounded = g2_fillet(plate.edges().filter_by(GeomType.CIRCLE), 1.5)
     _one_forward_valid_solid(rounded.wrapped)
     _all_g2(rounded.wrapped, sharp=True)  # the box's 12 edges, unchosen
+    for edge in check_faces(rounded.wrapped).edges:  # and only those: every sharp edge lies on the box's sides
+        x, y, _ = edge.angle_at
+        assert edge.level != "sharp" or abs(abs(x) - 50) < 1e-6 or abs(abs(y) - 30) < 1e-6, edge
     roll = roll_profile(1.5)
     assert rounded.volume == pytest.approx(plate.volume - 8 * _rolled_away(2 * math.pi * 5, roll, True), rel=1e-9)
     top_rims = plate.edges().filter_by(GeomType.CIRCLE).group_by(Axis.Z)[-1]
