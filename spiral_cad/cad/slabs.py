@@ -252,6 +252,8 @@ def _placement_problem(loops: list[list[Segment]], widths: Sequence[float]) -> t
                 return i, j, place
             if (i == 0) != _inside(offsets[j][0], offsets[i]):
                 return i, j, offsets[j][0]
+            if i > 0 and _inside(offsets[i][0], offsets[j]):  # a hole inside a later one
+                return i, j, offsets[i][0]
     return None
 
 

@@ -96,6 +96,10 @@ def test_holes_that_cross_the_outline_or_each_other_are_malformed():
         occ_slab(plan, 8, 1, holes=[[Arc((29, 0), 4, 0, 2 * math.pi)]])
     with pytest.raises(ValueError, match=r"hole 0's rim and hole 1's rim cross or nest"):
         occ_slab(plan, 8, 1, holes=[[Arc((0, 0), 4, 0, 2 * math.pi)], [Arc((3, 0), 4, 0, 2 * math.pi)]])
+    for inner, outer in ((0, 1), (1, 0)):  # a hole inside another, either order
+        nested = [[Arc((0, 0), 2, 0, 2 * math.pi)], [Arc((0, 0), 6, 0, 2 * math.pi)]]
+        with pytest.raises(ValueError, match=r"cross or nest"):
+            occ_slab(plan, 8, 1, holes=[nested[inner], nested[outer]])
 
 
 def test_the_plate_with_a_hole_from_the_issue_is_rounded_g2_on_every_edge(tmp_path):
