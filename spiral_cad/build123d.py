@@ -399,8 +399,10 @@ def g2_fillet(
     convex or concave, each end meeting a cap perpendicular to it) become
     exact extrusions of the 2-D G2 corner; when every edge of a cap is chosen
     too, the cap's edge is rolled by the G2 profile of the same radius
-    (``g2_slab``). Side and cap edges chosen together (``box.edges()``) get
-    one radius as the smallest radius of curvature of every edge: the rolls
+    (``g2_slab``); a cap's holes (a plate drilled through) are rims of their
+    own, rolled the other way, each chosen whole or left sharp. Side and cap
+    edges chosen together (``box.edges()``) get one radius as the smallest
+    radius of curvature of every edge: the rolls
     are of ``radius`` and the side corners of ``plan_radius(radius)`` (1.25 ×
     the roll's reach, 1.571 × radius), wide enough to hold the roll. Inside
     ``BuildPart`` the builder's part is replaced.
@@ -422,8 +424,9 @@ def g2_fillet(
             ``fillet`` on its edges), non-planar input, edges other than lines
             and arcs, or edges that belong to no wire or face.
         NoSolutionError: a corner that cannot be rounded (named, with numbers);
-            solid edges that are not a prism's straight side edges or whole caps
-            (named by edge and point: a vertex blend is a later step).
+            solid edges that are not a prism's straight side edges or whole rims of its caps (outline or
+            hole), rolls meeting across a thin wall, pockets, bosses and steps along the axis (named by edge
+            and point, with the largest radius that builds where one does).
     """
     context: Builder | None = Builder._get_context("g2_fillet")
     if isinstance(target, Iterable) and not isinstance(target, (Shape, str, bytes)):
@@ -532,6 +535,7 @@ def g2_slab(
             closed ``Chain``, a ``FilletedPath`` or segments (in the XY plane), or a
             planar face, one-face sketch or closed wire of lines, arcs and cubic Bézier
             spirals (``g2_fillet`` output; a builder's cubic B-spline edges are read as their Bézier spans) lying in the XY plane.
+            A face's holes (inner wires) become through holes whose rims are rolled the same way.
         height: the part's height.
         edge_radius: the roll's smallest radius of curvature.
         top, bottom: roll the top / bottom edge. Default True.
@@ -540,31 +544,27 @@ def g2_slab(
         tolerance: the largest deviation of a sweep over a spiral (default 1e-7 × size).
 
     Raises:
-        ValueError: malformed input, or a face with holes (one outline is rolled; cut holes afterwards).
+        ValueError: malformed input, or holes that cross the outline or each other.
         NoSolutionError: the roll does not fit (named, with what would fit).
     """
     if isinstance(outline, Sketch) and not hasattr(outline, "filleted"):
         if len(outline.faces()) != 1:
             raise ValueError(f"g2_slab takes a sketch of one face; this one has {len(outline.faces())}")
         outline = outline.faces()[0]
+    face = isinstance(outline, Face) and not hasattr(outline, "filleted")
+    holes = [_plane_outline(w) for w in outline.inner_wires()] if face else []
+    outline = outline.outer_wire() if face else outline
     if isinstance(outline, (Face, Wire)) and not hasattr(outline, "filleted"):
         outline = _plane_outline(outline)
     slab = _slab(outline, height, edge_radius, top=top, bottom=bottom, profile=profile, transition=transition,
-                 shape=shape, tolerance=tolerance)  # fmt: skip
+                 shape=shape, tolerance=tolerance, holes=holes)  # fmt: skip
     return _part(slab)
 
 
-def _plane_outline(shape: Face | Wire) -> list[Segment]:
-    """The outline of a face without holes (or of a closed wire) in the XY plane as segments."""
+def _plane_outline(wire: Wire) -> list[Segment]:
+    """A closed wire in the XY plane as segments."""
     from .cad.fillet import wire_path
 
-    holes = len(shape.inner_wires()) if isinstance(shape, Face) else 0
-    if holes:  # the solid would silently be the outer outline's: a different volume
-        raise ValueError(
-            f"the face has {holes} hole{'s' if holes > 1 else ''}; g2_slab rolls one outline: make the slab of the "
-            "outer outline and cut the holes from it afterwards (their rims stay sharp)"
-        )
-    wire = shape.outer_wire() if isinstance(shape, Face) else shape
     if any(abs(v.Z) > 1e-9 * max(1.0, wire.bounding_box().diagonal) for v in wire.vertices()):
         raise ValueError("g2_slab takes an outline in the XY plane (z = 0)")
     segments, closed = wire_path(wire.wrapped, gp_Ax3(), spirals=True)

@@ -10,7 +10,8 @@ Importing this module adds these methods to ``cadquery.Workplane``:
 * ``spiralChain(chain)`` — a whole ``spiral_cad.Chain`` as one wire
 * ``g2Polyline(points, radius=None, max_deviation=None)`` — a polyline (2-D or
   3-D points) whose corners are G2 spiral pairs, as one pending wire
-* ``g2Fillet(radius, transition=0.5)`` — G2 fillets on every corner of the pending wires
+* ``g2Fillet(radius, transition=0.5)`` — G2 fillets on every corner of the pending wires, or on the
+  selected edges of a solid (``.edges().g2Fillet(r)``: a right prism's side edges and cap rims, holes too)
 * ``makeG2(maxDeviation)`` — the pending wires of lines and tangent arcs made G2 within a bound
 * ``continuousRect``, ``continuousPolygon``, ``continuousSlot2D`` — shapes with G2 corners
 
@@ -49,6 +50,7 @@ from OCP.gp import gp_Ax3
 from .cad.fillet import fillet_face, fillet_wire
 from .cad.g2wire import g2_face, g2_wire
 from .cad.occ import chain_wire, segment_edges
+from .cad.prism_fillet import fillet_prism_edges
 from .cad.slabs import continuous_box
 from .core.chain import Chain
 from .core.segments import Segment
@@ -240,13 +242,23 @@ def g2Fillet(self: W, radius: float, transition: float = 0.5, same_sense: str = 
     """Round every corner of the pending wires with G2 fillets (``spiral_cad.design.fillets``).
 
     Each corner becomes transition → arc of ``radius`` → transition, curvature
-    continuous; the wires stay pending (e.g. for ``.extrude``).
+    continuous; the wires stay pending (e.g. for ``.extrude``). With no pending
+    wires and edges of a solid selected (``.edges()``, as CadQuery's ``fillet``
+    takes them), the solid is rounded as ``spiral_cad.build123d.g2_fillet``
+    rounds a part's edges (``fillet_prism_edges``) and replaces it on the stack.
 
     Raises:
-        ValueError: no pending wires, non-planar wires or edges other than lines and arcs.
-        NoSolutionError: a corner that cannot be rounded (named, with numbers).
+        ValueError: no pending wires and no selected edges of a solid, non-planar wires or edges other than
+            lines and arcs.
+        NoSolutionError: a corner or edge that cannot be rounded (named, with numbers).
     """
     wires = list(self.ctx.pendingWires)
+    edges = [e for e in self.objects if isinstance(e, cq.Edge)]
+    if not wires and edges:
+        solid = self.findSolid()
+        slab = fillet_prism_edges(solid.wrapped, [e.wrapped for e in edges], radius, transition=transition,
+                                  same_sense=same_sense, shape=shape)  # fmt: skip
+        return self.newObject([cq.Solid(slab.shape)])
     if not wires:
         raise ValueError("g2Fillet rounds the pending wires; there are none (draw a closed wire first)")
     options: dict[str, Any] = dict(transition=transition, same_sense=same_sense, shape=shape)

@@ -21,7 +21,7 @@ from OCP.BRepGProp import BRepGProp
 from OCP.BRepPrimAPI import BRepPrimAPI_MakePrism
 from OCP.BRepTools import BRepTools
 from OCP.GeomAbs import GeomAbs_CurveType, GeomAbs_SurfaceType
-from OCP.gp import gp_Ax3, gp_Dir, gp_Pnt, gp_Trsf, gp_Vec
+from OCP.gp import gp_Ax3, gp_Dir, gp_Pln, gp_Pnt, gp_Trsf, gp_Vec
 from OCP.GProp import GProp_GProps
 from OCP.TopAbs import TopAbs_EDGE, TopAbs_FACE, TopAbs_SOLID, TopAbs_WIRE
 from OCP.TopExp import TopExp, TopExp_Explorer
@@ -41,6 +41,7 @@ from .roll_surfaces import _faces_of, roll_profile
 from .slabs import (
     Slab,
     _first_solid,
+    _loops,
     _plane,
     _roll_problem,
     _turns,
@@ -93,10 +94,20 @@ def _area(shape: TopoDS_Shape) -> float:
 def _prism(solid: TopoDS_Shape, direction: gp_Dir, edge_name: str) -> _Prism:
     """The solid as a right prism along ``direction``, or NoSolutionError naming what is not."""
     caps = [f for f in _faces_of(solid) if (p := _plane(f)) is not None and p.Axis().Direction().IsParallel(direction, 1e-12)]
+    levels = sorted({round(gp_Vec(direction).Dot(gp_Vec(_plane(f).Location().XYZ())), 9) for f in caps})  # type: ignore[union-attr]
+    if len(levels) > 2:
+        shown_levels = ", ".join(f"{level:.6g}" for level in levels)
+        raise NoSolutionError(
+            f"g2_fillet rounds right prisms (two parallel planar caps; through holes allowed); {edge_name}: the part "
+            f"has planar faces at {len(levels)} levels along ({direction.X():.6g}, {direction.Y():.6g}, "
+            f"{direction.Z():.6g}) — {shown_levels} — as a pocket, a boss or a step makes, which g2_fillet does not "
+            "round: round the plain prism first and cut the pocket (or add the boss) afterwards, or use build123d's "
+            "fillet on those edges"
+        )
     if len(caps) != 2:
         raise NoSolutionError(
             f"g2_fillet rounds solid edges of right prisms (two parallel planar caps, side faces along the edges); "
-            f"{edge_name}: the part has {len(caps)} planar face(s) perpendicular to it, not 2 (a vertex blend is a later step)"
+            f"{edge_name}: the part has {len(caps)} planar face(s) perpendicular to it, not 2: it is no right prism"
         )
     for index, face in enumerate(_faces_of(solid)):
         if any(face.IsSame(cap) for cap in caps):
@@ -227,18 +238,20 @@ def fillet_prism_edges(
         plane = _plane(face)
         if plane is not None and any(any(e.IsSame(h) for h in _edges_of(face)) for e in edges):
             candidates.append(plane.Axis().Direction())
-    ranked, leaning = [], []
+    candidates = [c for k, c in enumerate(candidates) if not any(c.IsParallel(d, 1e-12) for d in candidates[:k])]
+    ranked, failed = [], []
     for candidate in candidates:
         try:
             ranked.append((_fit(solid, edges, candidate, named), candidate))
-        except NoSolutionError as error:
-            leaning += [error] if " leans " in str(error) else []
-    if not ranked and leaning:
-        raise leaning[0]
+        except NoSolutionError as error:  # the most telling first: levels (nearest z first), then a leaning side
+            failed.append(((" levels " not in str(error), " leans " not in str(error), -abs(candidate.Z())), str(error)))
+    if not ranked and failed:
+        raise NoSolutionError(min(failed)[1])
     if not ranked:
         raise NoSolutionError(
             f"g2_fillet rounds a solid's straight edges when each end meets a face perpendicular to it (prism side "
-            f"edges) and whole caps of right prisms; {named[0]} is neither (a vertex blend is a later step)"
+            f"edges) and the rims of right prisms' caps; {named[0]} is neither (it is curved, slanted or on a "
+            "curved face)"
         )
     axis = min(ranked, key=lambda row: row[0])[1]
     sides, caps, side_names = [], [], []
@@ -250,90 +263,126 @@ def fillet_prism_edges(
         else:
             caps.append((k, edge, named[k]))
     prism = _prism(solid, axis, f"edge {position[0]}")
-    by_cap = {"bottom": _edges_of(prism.bottom), "top": _edges_of(prism.top)}
-    chosen_caps = {}
-    for which, cap_edges in by_cap.items():
-        picked = [c for c in caps if any(c[1].IsSame(e) for e in cap_edges)]
-        if picked and len(picked) != len(cap_edges):
-            missing = next(e for e in cap_edges if not any(c[1].IsSame(e) for c in picked))
-            where = _where(BRepAdaptor_Curve(missing).Value(BRepAdaptor_Curve(missing).FirstParameter()))
-            raise NoSolutionError(
-                f"g2_fillet rounds a prism's {which} edges all together (a slab); the {which} cap's edge at {where} "
-                "is not chosen, and a vertex blend where rounded and sharp edges meet is a later step"
-            )
-        chosen_caps[which] = bool(picked)
-        for c in picked:
-            caps.remove(c)
+    frame = prism.frame
+    loops = _cap_loops(prism)
+    flags = [[False, False] for _ in loops]  # each loop's (top, bottom) rim chosen
+    for which, face in (("top", prism.top), ("bottom", prism.bottom)):
+        for wire in _wires_of(face):
+            wire_edges = _edges_of(wire)
+            picked = [c for c in caps if any(c[1].IsSame(e) for e in wire_edges)]
+            if not picked:
+                continue
+            loop = _loop_of(loops, frame, _start(wire_edges[0]), size)
+            missing = [e for e in wire_edges if not any(c[1].IsSame(e) for c in picked)]
+            if missing:
+                raise NoSolutionError(
+                    f"g2_fillet rolls each rim of a cap whole; on the {which} cap's {_rim_name(loop)} the edge at "
+                    f"{_where(_start(missing[0]))} is not chosen while other edges of that rim are: choose every "
+                    "edge of the rim, or none (it then stays sharp)"
+                )
+            flags[loop][0 if which == "top" else 1] = True
+            for c in picked:
+                caps.remove(c)
     if caps:
         raise NoSolutionError(f"g2_fillet cannot round {caps[0][2]}: neither a side edge nor a cap edge of the prism")
-    frame = prism.frame
-    if BRepTools.OuterWire_s(prism.bottom).IsNull() or len(_wires_of(prism.bottom)) != 1:
-        raise NoSolutionError("g2_fillet rounds prisms whose caps have one boundary (no holes)")
-    segments, _ = wire_path(BRepTools.OuterWire_s(prism.bottom), frame, spirals=True)
-    feet = [BRepAdaptor_Curve(e).Value(BRepAdaptor_Curve(e).FirstParameter()) for e in sides]
-    feet += [BRepAdaptor_Curve(e).Value(BRepAdaptor_Curve(e).LastParameter()) for e in sides]
+    feet = [_start(e) for e in sides] + [_end(e) for e in sides]
     for name, edge in zip(side_names, sides):
-        ends = [BRepAdaptor_Curve(edge).Value(BRepAdaptor_Curve(edge).FirstParameter()),
-                BRepAdaptor_Curve(edge).Value(BRepAdaptor_Curve(edge).LastParameter())]  # fmt: skip
-        for i in _corner_vertices(segments, frame, ends, size):
-            before, after = segments[i - 1], segments[i]
-            mismatch = None if _turns(before, after) else g2_mismatch(before, after, JOIN_TOLERANCE, index=i)
-            if mismatch is not None:
-                jump = (float(np.ravel(before.curvature(1.0))[0]), float(np.ravel(after.curvature(0.0))[0]))
-                raise NoSolutionError(
-                    f"g2_fillet rounds corners; {name} is a tangent joint, not a corner: the outline's curvature "
-                    f"jumps from {jump[0]:.6g} to {jump[1]:.6g} there, so its faces meet G1; making tangent joints G2 "
-                    "is a separate feature: leave the edge out of the selection"
-                )
-    chosen = [i for i in _corner_vertices(segments, frame, feet, size) if _turns(segments[i - 1], segments[i])]
-    rolled = any(chosen_caps.values())
+        for segments in loops:
+            for i in _corner_vertices(segments, frame, [_start(edge), _end(edge)], size):
+                before, after = segments[i - 1], segments[i]
+                mismatch = None if _turns(before, after) else g2_mismatch(before, after, JOIN_TOLERANCE, index=i)
+                if mismatch is not None:
+                    jump = (float(np.ravel(before.curvature(1.0))[0]), float(np.ravel(after.curvature(0.0))[0]))
+                    raise NoSolutionError(
+                        f"g2_fillet rounds corners; {name} is a tangent joint, not a corner: the outline's curvature "
+                        f"jumps from {jump[0]:.6g} to {jump[1]:.6g} there, so its faces meet G1; making tangent joints "
+                        "G2 is a separate feature: leave the edge out of the selection"
+                    )
+    chosen = [[i for i in _corner_vertices(s, frame, feet, size) if _turns(s[i - 1], s[i])] for s in loops]
+    rolled = [(f[0], f[1]) for f in flags]
+    at = lambda x, y: _where(gp_Pnt(x, y, 0.0).Transformed(_to_global(frame)))  # noqa: E731  (plan → the part's place)
     options: dict[str, Any] = dict(transition=transition, same_sense=same_sense, shape=shape, tolerance=tolerance)
+    both = any(c and any(f) for c, f in zip(chosen, rolled))  # side and cap edges chosen on one loop
 
     def builds(r: float) -> Slab:  # the same edges rounded with ``r``: what a refusal may suggest
         return fillet_prism_edges(solid, edges, r, **options, _advise=False)
 
-    outline = segments
-    if chosen and rolled:  # one radius for all: the roll's, the plan corners wide enough to hold it
-        segments = _rolled_plan(outline, chosen, prism.height, radius, chosen_caps, transition, same_sense, shape,
-                                builds if _advise else None)  # fmt: skip
-    elif chosen:
-        plan_options = dict(transition=transition, vertices=chosen, closed=True, same_sense=same_sense, shape=shape)
+    def plans(r: float) -> list[list[Segment]]:
+        """Each loop with its chosen corners rounded (with the plan radius on rolled loops), or NoSolutionError."""
+        made = []
+        for index, (segments, corners, (top, bottom)) in enumerate(zip(loops, chosen, rolled)):
+            try:
+                if corners and (top or bottom):
+                    caps_here = {"top": top, "bottom": bottom}
+                    made.append(_rolled_plan(segments, corners, prism.height, r, caps_here, transition, same_sense,
+                                             shape, None, at))  # fmt: skip
+                elif corners:
+                    made.append(list(fillet_path(segments, r, transition=transition, vertices=corners, closed=True,
+                                                 same_sense=same_sense, shape=shape).segments))  # fmt: skip
+                else:
+                    made.append(segments)
+            except NoSolutionError as error:
+                raise NoSolutionError(f"on the {_rim_name(index)} (near {at(*segments[0].start[:2])}): {error}") from None
+        return made
+
+    def fits(r: float) -> bool:
         try:
-            path = fillet_path(segments, radius, **plan_options)  # type: ignore[arg-type]
-        except NoSolutionError as error:
-            if not _advise:
-                raise
-            fits = advice(lambda r: _succeeds(lambda: fillet_path(segments, r, **plan_options)), builds, as_float(radius, "radius"))  # type: ignore[arg-type]
-            raise refusal(str(error), "radius", fits) from None
-        segments = list(path.segments)
-    if not rolled:
-        local = _extrusion(segments, prism.height)
+            plan = plans(r)
+        except NoSolutionError:
+            return False
+        return not any(any(f) for f in rolled) or _roll_problem(
+            plan[0], prism.height, r, prism.height, "radius", holes=plan[1:], rolled=rolled, top=True, bottom=True,
+            profile="g2", transition=transition, shape=shape, at=at) is None  # fmt: skip
+
+    def refused(error: NoSolutionError) -> NoSolutionError:
+        note = (f" (side and cap edges chosen together: the side edges get the plan radius {PLAN_OVER_REACH:g} × "
+                "the roll's reach)") if both and "plan radius" not in str(error) and " meet near " not in str(error) else ""  # fmt: skip
+        return refusal(f"{error}{note}", "radius", advice(fits, builds, as_float(radius, "radius")))
+
+    try:
+        planned = plans(radius)
+    except NoSolutionError as error:
+        if not _advise:
+            raise
+        raise refused(error) from None
+    if not any(any(f) for f in rolled):
+        local = _extrusion(planned, prism.height)
         approximation = 0.0
         roll = (0.0, 0.0)
     else:
-        for a, b in zip(segments, segments[1:] + segments[:1]):
-            if _turns(a, b):
-                corner = gp_Pnt(*a.end[:2], 0.0).Transformed(_to_global(frame))
-                raise NoSolutionError(
-                    f"g2_fillet rolls the cap edges along a smooth outline; the side edge at {_where(corner)} is sharp "
-                    "and not chosen (choose it too: a vertex blend of sharp and rounded edges is a later step)"
-                )
+        for segments, loop_rolled in zip(planned, rolled):
+            for a, b in zip(segments, segments[1:] + segments[:1]):
+                if any(loop_rolled) and _turns(a, b):
+                    corner = gp_Pnt(*a.end[:2], 0.0).Transformed(_to_global(frame))
+                    raise NoSolutionError(
+                        f"g2_fillet rolls a rim along a smooth outline; the side edge at {_where(corner)} is sharp and "
+                        "not chosen: choose it too (a roll cannot turn a sharp corner), or leave that rim sharp"
+                    )
         try:  # with chosen side edges the plan changes with the radius: a suggestion is built from the start
-            slab = g2_slab(segments, prism.height, radius, top=chosen_caps["top"], bottom=chosen_caps["bottom"],
-                           transition=transition, shape=shape, tolerance=tolerance, _name="radius",
-                           _advise=_advise and not chosen)  # fmt: skip
+            slab = g2_slab(
+                planned[0],
+                prism.height,
+                radius,
+                holes=planned[1:],
+                _rolled=rolled,
+                transition=transition,
+                shape=shape,
+                tolerance=tolerance,
+                _name="radius",
+                _at=at,
+                _advise=False,
+                _verify=False,
+            )  # fmt: skip  (verified below, as placed and returned)
         except NoSolutionError as error:
-            if not (_advise and chosen):
+            if not _advise:
                 raise
-            plan_fits = lambda r: _succeeds(  # noqa: E731
-                lambda: _rolled_plan(outline, chosen, prism.height, r, chosen_caps, transition, same_sense, shape, None)
-            )
-            raise refusal(str(error), "radius", advice(plan_fits, builds, as_float(radius, "radius"))) from None
+            raise refused(error) from None
         local, approximation, roll = slab.shape, slab.approximation, slab.roll
     placed = BRepBuilderAPI_Transform(local, _to_global(frame), True).Shape()
     result = forward_solid(TopoDS.Solid_s(placed) if placed.ShapeType() == TopAbs_SOLID else _first_solid(placed))
     verify_solid(result, "rounded part")
-    verify_faces(result, expected_level(segments), "rounded part")
+    levels = [expected_level(segments) for segments in planned]
+    verify_faces(result, "G1" if "G1" in levels else "G2", "rounded part")
     return Slab(result, approximation, roll, prism.height)
 
 
@@ -368,10 +417,14 @@ def _succeeds(make: Callable[[], object]) -> bool:
 
 def _rolled_plan(segments: list[Segment], chosen: list[int], height: float, radius: float, caps: dict[str, bool],
                  transition: float, same_sense: str, shape: str,
-                 builds: Callable[[float], object] | None) -> list[Segment]:  # fmt: skip
+                 builds: Callable[[float], object] | None,
+                 at: Callable[[float, float], str] | None = None) -> list[Segment]:  # fmt: skip
     """The cap outline with the chosen corners rounded by ``plan_radius(radius)``, or NoSolutionError naming
     what does not fit and the largest radius that does (side corners, rolls and height together)."""
-    options = dict(top=caps["top"], bottom=caps["bottom"], profile="g2", transition=transition, shape=shape)
+    options: dict[str, Any] = dict(top=caps["top"], bottom=caps["bottom"], profile="g2", transition=transition,
+                                   shape=shape)  # fmt: skip
+    if at is not None:
+        options["at"] = at
 
     def attempt(r: float) -> tuple[list[Segment] | None, str | None]:
         corner = plan_radius(r, transition=transition, shape=shape)
@@ -439,9 +492,48 @@ def _corner_vertices(segments: list[Segment], frame: gp_Ax3, feet: list[gp_Pnt],
     return chosen
 
 
-def _extrusion(segments: list[Segment], height: float) -> TopoDS_Shape:
-    face = BRepBuilderAPI_MakeFace(chain_wire(segments), True).Face()
-    solid = BRepPrimAPI_MakePrism(face, gp_Vec(0.0, 0.0, height)).Shape()
+def _extrusion(loops: list[list[Segment]], height: float) -> TopoDS_Shape:
+    """The plane region inside the first loop and outside the others, extruded by ``height``."""
+    oriented = _loops(loops[0], loops[1:])
+    maker = BRepBuilderAPI_MakeFace(gp_Pln(gp_Pnt(0.0, 0.0, 0.0), gp_Dir(0.0, 0.0, 1.0)), chain_wire(oriented[0]))
+    for hole in oriented[1:]:
+        maker.Add(chain_wire(hole))
+    solid = BRepPrimAPI_MakePrism(maker.Face(), gp_Vec(0.0, 0.0, height)).Shape()
     explorer = TopExp_Explorer(solid, TopAbs_SOLID)
     result = TopoDS.Solid_s(explorer.Current())
     return forward_solid(TopoDS.Solid_s(result.Reversed()) if _volume(result) < 0.0 else result)
+
+
+def _start(edge: TopoDS_Edge) -> gp_Pnt:
+    curve = BRepAdaptor_Curve(edge)
+    return curve.Value(curve.FirstParameter())
+
+
+def _end(edge: TopoDS_Edge) -> gp_Pnt:
+    curve = BRepAdaptor_Curve(edge)
+    return curve.Value(curve.LastParameter())
+
+
+def _cap_loops(prism: _Prism) -> list[list[Segment]]:
+    """The bottom cap's boundary loops in the prism's frame: the outer one first, then its holes."""
+    outer = BRepTools.OuterWire_s(prism.bottom)
+    if outer.IsNull():
+        raise NoSolutionError("g2_fillet rounds prisms whose caps have an outer boundary; this cap has none")
+    inner = [TopoDS.Wire_s(w) for w in _wires_of(prism.bottom) if not w.IsSame(outer)]
+    return [wire_path(w, prism.frame, spirals=True)[0] for w in [outer, *inner]]
+
+
+def _loop_of(loops: list[list[Segment]], frame: gp_Ax3, point: gp_Pnt, size: float) -> int:
+    """The index of the loop passing (in plan) through ``point``, a vertex of a cap's wire."""
+    back = gp_Trsf()
+    back.SetTransformation(frame)
+    local = point.Transformed(back)
+    distances = [min(math.hypot(local.X() - s.start[0], local.Y() - s.start[1]) for s in loop) for loop in loops]
+    best = int(np.argmin(distances))
+    if distances[best] > 1e-7 * size:
+        raise NoSolutionError(f"g2_fillet found no rim of the bottom cap under the cap edge at {_where(point)}")
+    return best
+
+
+def _rim_name(loop: int) -> str:
+    return "outer rim" if loop == 0 else f"rim of hole {loop - 1}"

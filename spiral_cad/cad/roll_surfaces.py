@@ -302,15 +302,23 @@ def _boundary_edge(along: _Along, w: float, z: float):
     return BRepBuilderAPI_MakeEdge(curve).Edge()
 
 
-def _cap(alongs: list[_Along], w: float, z: float) -> TopoDS_Face:
-    wire = BRepBuilderAPI_MakeWire()
-    for along in alongs:
-        edge = _boundary_edge(along, w, z)
-        if edge is not None:
-            wire.Add(edge)
-    if not wire.IsDone():
-        raise NoSolutionError(f"the cap at z = {z:.6g} has no closed boundary (the roll closes the outline)")
-    return BRepBuilderAPI_MakeFace(gp_Pln(gp_Pnt(0.0, 0.0, z), gp_Dir(0.0, 0.0, 1.0)), wire.Wire()).Face()
+def _cap(rims: Sequence[tuple[list[_Along], float]], z: float) -> TopoDS_Face:
+    """The plane z bounded by each rim's iso-curve at its roll's width: the first rim (counterclockwise)
+    outside, the others (clockwise) holes in it."""
+    wires = []
+    for alongs, w in rims:
+        wire = BRepBuilderAPI_MakeWire()
+        for along in alongs:
+            edge = _boundary_edge(along, w, z)
+            if edge is not None:
+                wire.Add(edge)
+        if not wire.IsDone():
+            raise NoSolutionError(f"the cap at z = {z:.6g} has no closed boundary (the roll closes the outline)")
+        wires.append(wire.Wire())
+    face = BRepBuilderAPI_MakeFace(gp_Pln(gp_Pnt(0.0, 0.0, z), gp_Dir(0.0, 0.0, 1.0)), wires[0])
+    for hole in wires[1:]:
+        face.Add(hole)
+    return face.Face()
 
 
 # ------------------------------------------------------------------ what parts made of slabs carry

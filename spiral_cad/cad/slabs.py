@@ -10,7 +10,7 @@ verified, before anything is returned. ``continuous_box`` is the rectangle's cas
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from typing import Any
 
@@ -98,12 +98,13 @@ def approximation_note(approximation: float, units: str = DEFAULT_UNITS) -> str:
 # ------------------------------------------------------------------ input and fit
 
 
-def outline_segments(outline: Any) -> list[Segment]:
+def outline_segments(outline: Any, *, corners: bool = False) -> list[Segment]:
     """The plane segments of a closed outline: a ``Chain``, a ``FilletedPath``, an object with ``.filleted``
-    (the continuous sketches) or segments in travel order.
+    (the continuous sketches) or segments in travel order; tangent at every joint unless ``corners``
+    (an outline left sharp, whose walls meet at its corners).
 
     Raises:
-        ValueError: anything else, segments in space, or an outline that does not close.
+        ValueError: anything else, segments in space, an outline that does not close, or a corner.
     """
     source = getattr(outline, "filleted", outline)
     source = getattr(source, "segments", source)
@@ -118,7 +119,7 @@ def outline_segments(outline: Any) -> list[Segment]:
     gap = math.dist(segments[-1].end[:2], segments[0].start[:2])
     if gap > 1e-9 * size:
         raise ValueError(f"outline must be closed; its end is {gap:.3g} from its start")
-    for index, (a, b) in enumerate(zip(segments, [*segments[1:], segments[0]])):
+    for index, (a, b) in enumerate(zip(segments, [*segments[1:], segments[0]]) if not corners else ()):
         (x, y, tx0, ty0, _), (_, _, tx1, ty1, _) = a.ends[1], b.ends[0]
         turn = abs(math.atan2(tx0 * ty1 - ty0 * tx1, tx0 * tx1 + ty0 * ty1))
         if turn > _CORNER_TOL:
@@ -159,7 +160,12 @@ def _crossing(polygon: NDArray[np.float64]) -> NDArray[np.float64] | None:
     return result
 
 
-def _fit_problem(segments: list[Segment], sigma: float, roll: float, given: Any, name: str) -> str | None:
+def _plain(x: float, y: float) -> str:
+    return f"({x:.6g}, {y:.6g})"
+
+
+def _fit_problem(segments: list[Segment], sigma: float, roll: float, given: Any, name: str,
+                 at: Callable[[float, float], str] = _plain) -> str | None:  # fmt: skip
     """Why a roll ``roll`` wide does not fit inside the outline, or None: it must stay below every convex
     radius of curvature (equal only on arcs: a clean pole) and its inner offset must not cross itself."""
     for index, segment in enumerate(segments):
@@ -180,7 +186,7 @@ def _fit_problem(segments: list[Segment], sigma: float, roll: float, given: Any,
     if place is not None:
         return (
             f"{name} {shown(given)} gives a roll {roll:.6g} wide whose inner offset crosses itself near "
-            f"({place[0]:.6g}, {place[1]:.6g}): the outline is too narrow there"
+            f"{at(place[0], place[1])}: the outline is too narrow there"
         )
     return None
 
@@ -192,21 +198,100 @@ def _inward(segments: list[Segment]) -> float:
     return 1.0 if area > 0.0 else -1.0
 
 
+def _reverse(segments: list[Segment]) -> list[Segment]:
+    return [s.reversed() for s in reversed(segments)]
+
+
+def _loops(segments: list[Segment], holes: Sequence[list[Segment]] = ()) -> list[list[Segment]]:
+    """The outline counterclockwise and each hole clockwise: the material on every loop's left."""
+    outer = segments if _inward(segments) > 0.0 else _reverse(segments)
+    return [outer] + [h if _inward(h) < 0.0 else _reverse(h) for h in holes]
+
+
+def _rim(index: int) -> str:
+    return "the outline's rim" if index == 0 else f"hole {index - 1}'s rim"
+
+
+def _inside(point: NDArray[np.float64], polygon: NDArray[np.float64]) -> bool:
+    """Whether ``point`` lies inside the closed ``polygon`` (even–odd rule)."""
+    a, b = polygon, np.roll(polygon, -1, axis=0)
+    straddle = (a[:, 1] > point[1]) != (b[:, 1] > point[1])
+    with np.errstate(divide="ignore", invalid="ignore"):
+        x = a[:, 0] + (point[1] - a[:, 1]) * (b[:, 0] - a[:, 0]) / (b[:, 1] - a[:, 1])
+    return bool(np.count_nonzero(straddle & (x > point[0])) % 2)
+
+
+def _between(p: NDArray[np.float64], q: NDArray[np.float64]) -> NDArray[np.float64] | None:
+    """A point where the closed polygons ``p`` and ``q`` cross, or None."""
+    a, d = p, np.roll(p, -1, axis=0) - p
+    c, e = q, np.roll(q, -1, axis=0) - q
+    denom = d[:, None, 0] * e[None, :, 1] - d[:, None, 1] * e[None, :, 0]
+    diff = c[None, :, :] - a[:, None, :]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        t = (diff[..., 0] * e[None, :, 1] - diff[..., 1] * e[None, :, 0]) / denom
+        u = (diff[..., 0] * d[:, None, 1] - diff[..., 1] * d[:, None, 0]) / denom
+    hit = (denom != 0.0) & (t >= 0.0) & (t <= 1.0) & (u >= 0.0) & (u <= 1.0)
+    if not hit.any():
+        return None
+    i, j = np.unravel_index(int(np.argmax(hit)), hit.shape)
+    result: NDArray[np.float64] = a[i] + t[i, j] * d[i]
+    return result
+
+
+def _placement_problem(loops: list[list[Segment]], widths: Sequence[float]) -> tuple[int, int, NDArray] | None:
+    """Loops ``i``, ``j`` whose inner offsets by ``widths`` cross or nest wrongly (a hole outside the
+    outline, or inside another hole), with a point there; None when every loop keeps its place."""
+    offsets = []
+    for loop, width in zip(loops, widths):
+        points, normals, _ = _samples(loop)
+        offsets.append(points + width * normals)
+    for i in range(len(loops)):
+        for j in range(i + 1, len(loops)):
+            place = _between(offsets[i], offsets[j])
+            if place is not None:
+                return i, j, place
+            if (i == 0) != _inside(offsets[j][0], offsets[i]):
+                return i, j, offsets[j][0]
+            if i > 0 and _inside(offsets[i][0], offsets[j]):  # a hole inside a later one
+                return i, j, offsets[i][0]
+    return None
+
+
 def _roll_problem(segments: list[Segment], height: float, edge_radius: Any, given_height: Any, name: str,
+                  holes: Sequence[list[Segment]] = (), rolled: Sequence[tuple[bool, bool]] | None = None,
+                  at: Callable[[float, float], str] = _plain,
                   **options: Any) -> str | None:  # fmt: skip
     """Why rolls of ``edge_radius`` (``options``: top, bottom, profile, transition, shape) do not fit the
-    outline and the height, or None."""
+    outline, its ``holes`` (``rolled``: each loop's top and bottom flags) and the height, or None."""
     top, bottom = options.pop("top"), options.pop("bottom")
     reach = float(roll_profile(float(edge_radius), **options)[-1].end[0])
-    d_top, d_bottom = (reach if top else 0.0), (reach if bottom else 0.0)
-    if d_top + d_bottom > height * (1.0 + _FIT_SLACK):
+    loops = _loops(segments, holes)
+    flags = list(rolled) if rolled is not None else [(top, bottom)] * len(loops)
+    widths = []
+    for index, (loop_top, loop_bottom) in enumerate(flags):
+        d_top, d_bottom = (reach if loop_top else 0.0), (reach if loop_bottom else 0.0)
+        if d_top + d_bottom > height * (1.0 + _FIT_SLACK):
+            where = "" if not holes else f" at {_rim(index)}"
+            return (
+                f"{name} {shown(edge_radius)} gives rolls {reach:.6g} high{where}; "
+                f"{'together they' if loop_top and loop_bottom else 'it'} exceed height {shown(given_height)}"
+            )
+        widths.append(min(max(d_top, d_bottom), height))
+    for index, (loop, width) in enumerate(zip(loops, widths)):
+        if width == 0.0:
+            continue
+        problem = _fit_problem(loop, 1.0, width, edge_radius, name, at)
+        if problem is not None:
+            return problem if not holes else f"{problem} ({_rim(index)})"
+    meeting = _placement_problem(loops, widths) if len(loops) > 1 else None
+    if meeting is not None:
+        i, j, place = meeting
         return (
-            f"{name} {shown(edge_radius)} gives rolls {reach:.6g} high; {'together they' if top and bottom else 'it'} "
-            f"exceed height {shown(given_height)}"
+            f"{name} {shown(edge_radius)} gives rolls {reach:.6g} wide; those of {_rim(i)} and {_rim(j)} meet near "
+            f"{at(place[0], place[1])}: the wall between them is narrower than the two rolls "
+            f"({widths[i] + widths[j]:.6g})"
         )
-    if max(d_top, d_bottom) == 0.0:
-        return None
-    return _fit_problem(segments, _inward(segments), min(max(d_top, d_bottom), height), edge_radius, name)
+    return None
 
 
 # ------------------------------------------------------------------ the solid
@@ -388,6 +473,10 @@ def g2_slab(
     shape: str = DEFAULT_SHAPE,
     tolerance: float | None = None,
     units: str = DEFAULT_UNITS,
+    holes: Sequence[Any] = (),
+    _rolled: Sequence[tuple[bool, bool]] | None = None,
+    _at: Callable[[float, float], str] = _plain,
+    _verify: bool = True,
     _name: str = "edge_radius",
     _advise: bool = True,
 ) -> Slab:
@@ -406,6 +495,10 @@ def g2_slab(
         tolerance: the largest deviation allowed for the sweep over a spiral
             (default 1e-7 × the outline's size).
         units: the unit of the numbers (kept for the files written).
+        holes: closed outlines inside ``outline`` (as ``outline``, either
+            sense), through holes of the slab: each hole's rim is rolled with
+            the same profile, turning the other way (concave in plan), top and
+            bottom as ``top`` and ``bottom`` say.
 
     Returns:
         The ``Slab``: the solid and the measured approximation. It is verified as returned: one valid
@@ -416,17 +509,30 @@ def g2_slab(
         ValueError: malformed input.
         NoSolutionError: the roll does not fit (it is as wide as it is high:
             wider than the outline's smallest convex radius of curvature, an
-            inner offset that crosses itself, or both rolls higher than
+            inner offset that crosses itself, the rolls of two rims meeting
+            across a wall thinner than both, or both rolls higher than
             ``height``) — the message names the value and what would fit.
     """
     units = length_unit(units)
-    segments = outline_segments(outline)
+    if _rolled is not None and len(_rolled) != 1 + len(holes):
+        raise ValueError(f"_rolled needs one (top, bottom) pair per loop; got {len(_rolled)} for {1 + len(holes)}")
+    sharp = [not any(f) for f in _rolled] if _rolled is not None else [not (top or bottom)] * (1 + len(holes))
+    segments = outline_segments(outline, corners=sharp[0])
+    hole_loops = [outline_segments(h, corners=c) for h, c in zip(holes, sharp[1:])]
+    if hole_loops and (misplaced := _placement_problem(_loops(segments, hole_loops), [0.0] * (1 + len(hole_loops)))):
+        i, j, place = misplaced
+        raise ValueError(
+            f"holes must lie inside the outline and apart from each other; {_rim(i)} and {_rim(j)} cross or nest "
+            f"near ({place[0]:.6g}, {place[1]:.6g})"
+        )
     given_height, height = height, as_float(height, "height")
     if not height > 0.0:
         raise ValueError(f"height must be positive; got {shown(height)}")
-    options = dict(top=top, bottom=bottom, profile=profile, transition=transition, shape=shape)
+    options: dict[str, Any] = dict(top=top, bottom=bottom, profile=profile, transition=transition, shape=shape,
+                                   holes=hole_loops, rolled=_rolled, at=_at)  # fmt: skip
     radius = as_float(edge_radius, "edge_radius")
     problem = _roll_problem(segments, height, edge_radius, given_height, _name, **options)
+    options["verify"] = _verify
     if problem is not None:
         if not _advise:
             raise NoSolutionError(problem)
@@ -443,42 +549,60 @@ def _slab_advice(segments: list[Segment], height: float, radius: float, given_he
                  options: dict[str, Any], tolerance: float | None, units: str) -> float | None:  # fmt: skip
     """The largest roll radius below ``radius`` a refusal may name: it fits with a margin and builds."""
     return advice(
-        lambda r: _roll_problem(segments, height, r, given_height, name, **options) is None,
-        lambda r: g2_slab(segments, height, r, **options, tolerance=tolerance, units=units, _advise=False),
+        lambda r: _roll_problem(segments, height, r, given_height, name, **_fit_options(options)) is None,
+        lambda r: g2_slab(segments, height, r, **_slab_options(options), tolerance=tolerance, units=units, _advise=False),
         radius,
     )
+
+
+def _slab_options(options: dict[str, Any]) -> dict[str, Any]:
+    """``g2_slab``'s keyword arguments from the fit checks' ``options``."""
+    rest = {k: v for k, v in options.items() if k not in ("holes", "rolled", "at", "verify")}
+    return dict(rest, holes=options.get("holes", ()), _rolled=options.get("rolled"), _at=options.get("at", _plain))
+
+
+def _fit_options(options: dict[str, Any]) -> dict[str, Any]:
+    """The fit checks' ``options`` without what only the construction reads."""
+    return {k: v for k, v in options.items() if k != "verify"}
 
 
 def _built_slab(segments: list[Segment], height: float, edge_radius: float, options: dict[str, Any],
                 tolerance: float | None, units: str) -> Slab:  # fmt: skip
     """The slab of rolls that fit, verified (``g2_slab`` after its fit checks)."""
     top, bottom, profile, transition, shape = (options[k] for k in ("top", "bottom", "profile", "transition", "shape"))
+    loops = _loops(segments, options.get("holes", ()))
+    flags = options.get("rolled") or [(top, bottom)] * len(loops)
     roll = roll_profile(edge_radius, profile=profile, transition=transition, shape=shape)
     reach = float(roll[-1].end[0])
-    d_top, d_bottom = (reach if top else 0.0), (reach if bottom else 0.0)
     points, _, _ = _samples(segments)
     size = float(np.ptp(points, axis=0).max())
-    if d_top + d_bottom > height - 1e-7 * size:  # a wall thinner than the sewing tolerance: the rolls meet
-        d_top, d_bottom = (height / 2.0, height / 2.0) if top and bottom else (d_top and height, d_bottom and height)
-    sigma = _inward(segments)
-    reach_max = max(d_top, d_bottom)
     tol = 1e-7 * size if tolerance is None else as_float(tolerance, "tolerance")
     if not tol > 0.0:
         raise ValueError(f"tolerance must be positive; got {shown(tolerance)}")
-    alongs = [span for s in segments for span in _along_spans(_along(s, sigma, reach_max, tol))]
-    sections = _sections(roll, d_top, d_bottom, height)
-    degenerate = 1e-9 * size
-    made = [_surface_face(a, sec, degenerate) for a in alongs for sec in sections]
-    faces = [face for face, _ in made]
-    for k, (_, key) in enumerate(made):  # so export_step finds the note on parts built from this solid
-        _record(key, reach_max * alongs[k // len(sections)].deviation)
-    top_cap = _cap(alongs, d_top, height)
-    faces += [top_cap, _cap(alongs, d_bottom, 0.0)]
+    sides: list[TopoDS_Face] = []
+    rims, approximation, reaches = [], 0.0, (0.0, 0.0)
+    for loop, (loop_top, loop_bottom) in zip(loops, flags):
+        d_top, d_bottom = (reach if loop_top else 0.0), (reach if loop_bottom else 0.0)
+        if d_top + d_bottom > height - 1e-7 * size:  # a wall thinner than the sewing tolerance: the rolls meet
+            d_top, d_bottom = (height / 2.0, height / 2.0) if loop_top and loop_bottom else (d_top and height, d_bottom and height)
+        reach_max = max(d_top, d_bottom)
+        alongs = [span for s in loop for span in _along_spans(_along(s, 1.0, reach_max, tol))]
+        sections = _sections(roll, d_top, d_bottom, height)
+        made = [_surface_face(a, sec, 1e-9 * size) for a in alongs for sec in sections]
+        sides += [face for face, _ in made]
+        for k, (_, key) in enumerate(made):  # so export_step finds the note on parts built from this solid
+            _record(key, reach_max * alongs[k // len(sections)].deviation)
+        rims.append((alongs, d_top, d_bottom))
+        approximation = max(approximation, reach_max * max(a.deviation for a in alongs))
+        reaches = (max(reaches[0], d_top), max(reaches[1], d_bottom))
+    top_cap = _cap([(a, d) for a, d, _ in rims], height)
+    faces = [*sides, top_cap, _cap([(a, d) for a, _, d in rims], 0.0)]
     solid = _solid(faces, 1e-7 * size, top_cap)
-    verify_solid(solid, facing_out=True)
-    verify_faces(solid, expected_level(segments, profile), units=units)
-    approximation = reach_max * max(a.deviation for a in alongs)
-    return Slab(solid, approximation, (d_top, d_bottom), height, units)
+    if options.get("verify", True):  # a caller that moves the solid verifies it where it is returned
+        verify_solid(solid, facing_out=True)
+        levels = [expected_level(loop, profile) for loop in loops]
+        verify_faces(solid, "G1" if "G1" in levels else "G2", units=units)
+    return Slab(solid, approximation, reaches, height, units)
 
 
 def _volume(shape: TopoDS_Shape) -> float:

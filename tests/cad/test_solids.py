@@ -506,16 +506,16 @@ def test_side_edges_of_a_concave_prism_round_to_the_extruded_2d_g2_corners():
     assert _props(rounded.wrapped)[0] == pytest.approx(6 * area, rel=1e-9)
 
 
-def test_a_face_with_a_hole_is_refused_by_name_not_rolled_without_it():
+def test_a_face_with_a_hole_is_rolled_with_its_hole():
     with BuildSketch() as sketch:
         Rectangle(40, 20)
         Rectangle(20, 4, mode=Mode.SUBTRACT)
     face = g2_fillet(sketch.sketch, 1)
     assert len(face.faces()[0].inner_wires()) == 1
-    with pytest.raises(ValueError, match=r"the face has 1 hole; g2_slab rolls one outline"):
-        g2_slab(face, 5, 0.5)
-    with pytest.raises(ValueError, match=r"has 1 hole"):
-        g2_slab(face.faces()[0], 5, 0.5)
+    slab = g2_slab(face, 5, 0.5)  # the hole's rims rolled too (tests/cad/test_plates.py checks them)
+    _assert_one_valid_solid(slab.wrapped)
+    assert slab.volume < face.faces()[0].area * 5
+    assert g2_slab(face.faces()[0], 5, 0.5).volume == pytest.approx(slab.volume, rel=1e-12)
 
 
 def test_a_builder_sketch_whose_spiral_pairs_were_merged_into_b_splines_makes_the_same_slab():
