@@ -210,6 +210,7 @@ def _read_whole(path: Path, kind: str, units: str | None, precision: list[float]
             status = reader.ReadFile(readable)
         name = _namer(path, kind, reader)
         failures = _reader_failures(reader.WS().ModelCheckList(), name) if status == IFSelect_RetDone else []
+        failures = [text for text in failures if not _PRESENTATION.match(text)]
         if status == IFSelect_RetDone and not failures:
             if kind == "STEP" and (fault := _step_length_fault(reader)):
                 raise ReadError(f"cannot read {path.name!r}: {fault}")
@@ -564,6 +565,14 @@ def _class_name(entity: Any) -> str:
     return type(entity).__name__.split("_", 1)[-1]
 
 
+#: a reader's complaint about an entity that only says how a part looks (a style, colour, font, marker,
+#: layer or annotation; "#1159 SURFACE_STYLE_RENDERING_WITH_PROPERTIES: …", "CurveStyle: …"): no geometry is
+#: lost with it, so the file is still read whole (Inventor 2021 writes an enumeration OCCT does not take)
+_PRESENTATION = re.compile(
+    r"(?:#\d+\s+)?\w*(?:STYLE|COLOU?R|PRESENTATION|DRAUGHTING|FONT|MARKER|RENDERING|FILL_?AREA|INVISIBILITY|"
+    r"ANNOTATION|LAYER)\w*\s*:",
+    re.I,
+)
 _STEP_TOKEN = re.compile(rb"'(?:[^']|'')*'|/\*.*?\*/|#(\d+)\s*=\s*([A-Za-z0-9_]*)", re.S)
 
 
