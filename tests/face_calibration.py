@@ -82,19 +82,27 @@ def _sewn(shape, tolerance: float = 1e-6):
     return sewing.SewedShape() if sewing.NbContigousEdges() + sewing.NbMultipleEdges() else shape
 
 
-def _independent(shape, stated: float, samples: int) -> dict[int, dict]:
-    return {i: {"level": m["level"]} for i, m in measure_edges(_sewn(shape), samples=samples, stated=stated).items()}
+def _independent(shape, stated: float, samples: int, dense: int, ours: dict[int, str]) -> dict[int, dict]:
+    """The measure's class of every shared edge; where it differs from ``ours`` (the checker's), measured
+    again at ``dense`` points (a gap or a tangent stretch between its ``samples`` points is then seen)."""
+    shape = _sewn(shape)
+    found = {i: m["level"] for i, m in measure_edges(shape, samples=samples, stated=stated).items()}
+    disputed = {i for i, level in found.items() if ours.get(i, level) != level}
+    if disputed:
+        found.update({i: m["level"] for i, m in measure_edges(shape, dense, stated=stated, only=disputed).items()})
+    return {i: {"level": level, "dense": i in disputed} for i, level in found.items()}
 
 
-def compare_file(path: str | Path, samples: int = 12) -> dict:
+def compare_file(path: str | Path, samples: int = 12, dense: int = 200) -> dict:
     """Both verdicts on every shared edge of the file at ``path``: counts of edges, agreements, false
     passes (the checker's verdict ranks above the measure's, ``RANK``), false failures (below), the
-    disagreements themselves and the checker's time per face."""
+    disagreements themselves (edges where the two differ at ``samples`` points are measured again at
+    ``dense``), the edges the measure could not judge, and the checker's time per face."""
     started = time.perf_counter()
     report = check_faces(path)
     seconds = time.perf_counter() - started
     ours = {e.index: e.level for e in report.edges if e.index >= 0 and not e.seam}
-    _, theirs = read_file(path, "mm", partial(_independent, samples=samples), stated=True)
+    _, theirs = read_file(path, "mm", partial(_independent, samples=samples, dense=dense, ours=ours), stated=True)
     shared = sorted(set(ours) & set(theirs))
     rows = [(i, ours[i], theirs[i]["level"]) for i in shared]
     return {
@@ -103,7 +111,9 @@ def compare_file(path: str | Path, samples: int = 12) -> dict:
         "only_checker": len(set(ours) - set(theirs)),
         "only_measure": len(set(theirs) - set(ours)),
         "agree": sum(a == b for _, a, b in rows),
-        "false_pass": [r for r in rows if RANK[r[1]] > RANK[r[2]]],
+        "remeasured": sum(theirs[i]["dense"] for i in shared),
+        "unmeasurable": [r for r in rows if r[2] == "unmeasurable" and r[1] != "unmeasurable"],
+        "false_pass": [r for r in rows if RANK[r[1]] > RANK[r[2]] and r[2] != "unmeasurable"],
         "false_fail": [r for r in rows if RANK[r[1]] < RANK[r[2]]],
         "other": [r for r in rows if r[1] != r[2] and RANK[r[1]] == RANK[r[2]]],
         "seconds": seconds,

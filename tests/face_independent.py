@@ -69,11 +69,24 @@ def _side(face, surface, u: float, v: float, across: np.ndarray, bounds, sign: f
     return normal, sign * (k1 * c * c + k2 * (1.0 - c * c))
 
 
+def _direction_in(face, edge):
+    """The orientation of ``edge`` as ``face`` (with the face's own orientation) runs it."""
+    from OCP.TopExp import TopExp_Explorer
+
+    explorer = TopExp_Explorer(face, TopAbs_EDGE)
+    while explorer.More():
+        if explorer.Current().IsSame(edge):
+            return explorer.Current().Orientation()
+        explorer.Next()
+    return None
+
+
 def measure_edges(shape, samples: int = 32, angle_tol: float = 1e-7, curvature_tol: float = 1e-4,
-                  feature_angle: float = math.radians(5.0), stated: float = 0.0) -> dict[int, dict]:  # fmt: skip
+                  feature_angle: float = math.radians(5.0), stated: float = 0.0,
+                  only: set[int] | None = None) -> dict[int, dict]:  # fmt: skip
     """Per edge shared by two distinct faces (0-based index in ``TopExp.MapShapes`` order): the worst gap,
     angle and relative curvature jump at ``samples`` equally spaced points and two ``END`` from the vertices,
-    and the class, by the checker's own rules."""
+    and the class, by the checker's own rules; ``only``: just the edges of these indices."""
     from OCP.Bnd import Bnd_Box
     from OCP.BRepBndLib import BRepBndLib
 
@@ -88,12 +101,17 @@ def measure_edges(shape, samples: int = 32, angle_tol: float = 1e-7, curvature_t
         edge = TopoDS.Edge_s(ancestors.FindKey(i))
         if BRep_Tool.Degenerated_s(edge) or not BRep_Tool.IsGeometric_s(edge):
             continue
+        if only is not None and edges.FindIndex(edge) - 1 not in only:
+            continue
         listed = ancestors.FindFromIndex(i)
         faces = []
         for face in (listed.First(), listed.Last()) if listed.Extent() == 2 else ():
             faces.append(TopoDS.Face_s(face))
         if len(faces) != 2 or faces[0].IsSame(faces[1]):
             continue
+        # faces oriented alike run a shared edge in opposite directions; the same direction in both: one is
+        # reversed (decided by the topology, so that a fold of 177° stays a fold and is not read as a crease)
+        flip = _direction_in(faces[0], edge) == _direction_in(faces[1], edge)
         curve = BRepAdaptor_Curve(edge)
         t0, t1 = curve.FirstParameter(), curve.LastParameter()
         gaps, angles, jumps = [], [], []
@@ -127,7 +145,7 @@ def measure_edges(shape, samples: int = 32, angle_tol: float = 1e-7, curvature_t
             if len(sides) != 2:
                 continue
             (na, ka, across), (nb, kb, _) = sides
-            if na @ nb < 0.0:  # the faces disagree on their outside: compared with one flipped
+            if flip:  # the faces disagree on their outside: compared with one flipped
                 nb, kb = -nb, -kb
             # both curvatures along the same direction across the edge (d = n × t of the first face)
             gaps.append(float(np.linalg.norm(points[0] - points[1])))
