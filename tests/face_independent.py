@@ -21,20 +21,28 @@ from OCP.TopExp import TopExp
 from OCP.TopoDS import TopoDS
 from OCP.TopTools import TopTools_IndexedDataMapOfShapeListOfShape, TopTools_IndexedMapOfShape
 
-INSIDE = 1e-9  # relative to the face's parameter range: how far inside the face the normal and curvature are read
+#: how far inside the face the normal and curvature are read, in 3-D, relative to the smaller of the model size and
+#: the surface's smallest radius of curvature there (so the normal turns by at most 1e-9 rad on the way: a step
+#: relative to the parameter range turned a small cylinder's normal by 1e-6 rad on a 6.7 m Pro/ENGINEER model)
+INSIDE = 1e-9
+END = 1e-3  # the samples next to the vertices, this far in (relative to the edge's parameter range)
 
 
-def _side(face, surface, u: float, v: float, across: np.ndarray, bounds, sign: float, inward: list[float]):
-    """Normal, and normal curvature along ``across`` (3-D), read ``INSIDE`` into the face from (u, v);
+def _side(face, surface, u: float, v: float, across: np.ndarray, bounds, sign: float, inward: list[float], size: float):
+    """Normal, and normal curvature along ``across`` (3-D), read ``INSIDE`` × ``size`` (or × the smallest radius
+    of curvature, if smaller) into the face from (u, v);
     ``inward`` holds the side found inside the face along ``across`` (classified once per edge and face)."""
     props = GeomLProp_SLProps(surface, u, v, 2, 1e-9)
     if not props.IsNormalDefined():
         return None
     su, sv = props.D1U(), props.D1V()
     a = np.array([[su.X(), sv.X()], [su.Y(), sv.Y()], [su.Z(), sv.Z()]])
-    step = np.linalg.lstsq(a, across, rcond=None)[0]
-    step /= np.linalg.norm(step) or 1.0
+    along = np.linalg.lstsq(a, across, rcond=None)[0]  # (u, v) per unit length across the edge
+    along /= np.linalg.norm(a @ along) or 1.0
+    step = along / (np.linalg.norm(along) or 1.0)
     width = max(bounds[1] - bounds[0], bounds[3] - bounds[2])
+    bend = max(abs(props.MaxCurvature()), abs(props.MinCurvature())) if props.IsCurvatureDefined() else 0.0
+    reach = INSIDE * min(size, 1.0 / bend if bend > 0.0 else size)
     if not inward:
         classifier = BRepClass_FaceClassifier()
         for direction in (1.0, -1.0, 0.0):
@@ -43,7 +51,7 @@ def _side(face, surface, u: float, v: float, across: np.ndarray, bounds, sign: f
             if direction == 0.0 or classifier.State() == TopAbs_IN:
                 inward.append(direction)
                 break
-    uu, vv = u + inward[0] * INSIDE * width * step[0], v + inward[0] * INSIDE * width * step[1]
+    uu, vv = u + inward[0] * reach * along[0], v + inward[0] * reach * along[1]
     props = GeomLProp_SLProps(surface, uu, vv, 2, 1e-9)
     if not props.IsNormalDefined():
         return None
@@ -61,10 +69,24 @@ def _side(face, surface, u: float, v: float, across: np.ndarray, bounds, sign: f
     return normal, sign * (k1 * c * c + k2 * (1.0 - c * c))
 
 
+def _direction_in(face, edge):
+    """The orientation of ``edge`` as ``face`` (with the face's own orientation) runs it."""
+    from OCP.TopExp import TopExp_Explorer
+
+    explorer = TopExp_Explorer(face, TopAbs_EDGE)
+    while explorer.More():
+        if explorer.Current().IsSame(edge):
+            return explorer.Current().Orientation()
+        explorer.Next()
+    return None
+
+
 def measure_edges(shape, samples: int = 32, angle_tol: float = 1e-7, curvature_tol: float = 1e-4,
-                  feature_angle: float = math.radians(5.0), stated: float = 0.0) -> dict[int, dict]:  # fmt: skip
+                  feature_angle: float = math.radians(5.0), stated: float = 0.0,
+                  only: set[int] | None = None) -> dict[int, dict]:  # fmt: skip
     """Per edge shared by two distinct faces (0-based index in ``TopExp.MapShapes`` order): the worst gap,
-    angle and relative curvature jump at ``samples`` points and the class, by the checker's own rules."""
+    angle and relative curvature jump at ``samples`` equally spaced points and two ``END`` from the vertices,
+    and the class, by the checker's own rules; ``only``: just the edges of these indices."""
     from OCP.Bnd import Bnd_Box
     from OCP.BRepBndLib import BRepBndLib
 
@@ -79,17 +101,23 @@ def measure_edges(shape, samples: int = 32, angle_tol: float = 1e-7, curvature_t
         edge = TopoDS.Edge_s(ancestors.FindKey(i))
         if BRep_Tool.Degenerated_s(edge) or not BRep_Tool.IsGeometric_s(edge):
             continue
+        if only is not None and edges.FindIndex(edge) - 1 not in only:
+            continue
         listed = ancestors.FindFromIndex(i)
         faces = []
         for face in (listed.First(), listed.Last()) if listed.Extent() == 2 else ():
             faces.append(TopoDS.Face_s(face))
         if len(faces) != 2 or faces[0].IsSame(faces[1]):
             continue
+        # faces oriented alike run a shared edge in opposite directions; the same direction in both: one is
+        # reversed (decided by the topology, so that a fold of 177° stays a fold and is not read as a crease)
+        flip = _direction_in(faces[0], edge) == _direction_in(faces[1], edge)
         curve = BRepAdaptor_Curve(edge)
         t0, t1 = curve.FirstParameter(), curve.LastParameter()
         gaps, angles, jumps = [], [], []
         inwards: list[list[float]] = [[], []]
-        for t in np.linspace(t0, t1, samples + 2)[1:-1] * 1.0:
+        ends = [t0 + END * (t1 - t0), t1 - END * (t1 - t0)]  # where faces may turn tangent, near the vertices
+        for t in [*np.linspace(t0, t1, samples + 2)[1:-1], *ends]:
             p, d1 = gp_Pnt(), gp_Vec()
             curve.D1(float(t), p, d1)
             tangent = np.array([d1.X(), d1.Y(), d1.Z()])
@@ -110,14 +138,14 @@ def measure_edges(shape, samples: int = 32, angle_tol: float = 1e-7, curvature_t
                 n = props.Normal()
                 sign = -1.0 if face.Orientation() == TopAbs_REVERSED else 1.0
                 across = np.cross(sign * np.array([n.X(), n.Y(), n.Z()]), tangent)
-                side = _side(face, surface, u, v, across, bounds, sign, inward)
+                side = _side(face, surface, u, v, across, bounds, sign, inward, size)
                 if side is None:
                     break
                 sides.append((side[0], side[1], across))
             if len(sides) != 2:
                 continue
             (na, ka, across), (nb, kb, _) = sides
-            if na @ nb < 0.0:  # the faces disagree on their outside: compared with one flipped
+            if flip:  # the faces disagree on their outside: compared with one flipped
                 nb, kb = -nb, -kb
             # both curvatures along the same direction across the edge (d = n × t of the first face)
             gaps.append(float(np.linalg.norm(points[0] - points[1])))

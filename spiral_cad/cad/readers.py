@@ -210,6 +210,7 @@ def _read_whole(path: Path, kind: str, units: str | None, precision: list[float]
             status = reader.ReadFile(readable)
         name = _namer(path, kind, reader)
         failures = _reader_failures(reader.WS().ModelCheckList(), name) if status == IFSelect_RetDone else []
+        failures = [text for text in failures if not _about_looks(text)]
         if status == IFSelect_RetDone and not failures:
             if kind == "STEP" and (fault := _step_length_fault(reader)):
                 raise ReadError(f"cannot read {path.name!r}: {fault}")
@@ -562,6 +563,25 @@ def _step_namer(path: Path, model: Any) -> Callable[[Any], str]:
 
 def _class_name(entity: Any) -> str:
     return type(entity).__name__.split("_", 1)[-1]
+
+
+#: the words of an entity that only says how a part looks (a style, colour, font, marker, layer or annotation)
+_LOOKS = {"STYLE", "COLOUR", "COLOR", "DRAUGHTING", "FONT", "MARKER", "RENDERING", "FILL", "INVISIBILITY",
+          "ANNOTATION", "LAYER"}  # fmt: skip
+#: a complaint's entity ("#1159 SURFACE_STYLE_RENDERING_WITH_PROPERTIES: …", "CurveStyle: …") and the parameter
+#: it names ("Parameter n0.2 (curve_font) …", an attribute of a style another entity refers to)
+_COMPLAINT = re.compile(r"(?:#\d+\s+)?(\w+)\s*:(?:.*?\(([a-z_.]+)\))?")
+
+
+def _about_looks(text: str) -> bool:
+    """A reader's complaint only about how a part looks, with which no geometry is lost (Inventor 2021 leaves
+    a rendering method unset; other writers a curve font or marker OCCT does not take)."""
+    found = _COMPLAINT.match(text)
+    if not found:
+        return False
+    words = set(re.sub(r"(?<=[a-z])(?=[A-Z])", "_", found.group(1)).upper().split("_"))
+    named = set(re.split(r"[_.]", (found.group(2) or "").upper()))
+    return bool(words & _LOOKS) or bool(named & _LOOKS)
 
 
 _STEP_TOKEN = re.compile(rb"'(?:[^']|'')*'|/\*.*?\*/|#(\d+)\s*=\s*([A-Za-z0-9_]*)", re.S)

@@ -21,6 +21,8 @@ PARTS = {
     "knot line, pcurve parameter shifted": lambda: knot_line_join(0.0, shift=0.02),
     "faces sewn 2e-5 apart": lambda: knot_line_join(0.0, apart=2e-5),
     "filleted cylinder": lambda: bd.fillet(bd.Cylinder(10, 20).edges(), 3).wrapped,
+    # a wedge whose two long faces fold back by 177°: sharp, not a crease of 3° (normals nearly opposite)
+    "wedge folded by 177°": lambda: bd.extrude(bd.Polygon((0, 0), (40, 1), (40, -1), align=None), 5).wrapped,
 }
 
 

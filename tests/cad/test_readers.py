@@ -340,3 +340,26 @@ def test_a_control_point_at_1e300_is_measured_with_no_word_of_snap(files, tmp_pa
     assert main(["check", str(path), "--require", "G2"]) == 1
     out, err = capfd.readouterr()
     assert err == "" and re.search(r"model size [0-9.]+e\+(299|300) m", out) and "FAIL: worst joint is none" in out
+
+
+def test_a_style_the_reader_cannot_decode_loses_no_geometry(tmp_path):
+    # Inventor 2021 writes SURFACE_STYLE_RENDERING_WITH_PROPERTIES with its rendering method left unset
+    # ($): OCCT's STEP reader fails that entity, a colour, and the part was refused (FreeCAD reads it)
+    bd = pytest.importorskip("build123d")
+    path = tmp_path / "styled.step"
+    export_step(bd.Box(1, 2, 3), path)
+    text = path.read_text()
+    item = re.search(r"#(\d+)\s*=\s*MANIFOLD_SOLID_BREP", text).group(1)
+    style = (
+        f"#9001=STYLED_ITEM('',(#9002),#{item});\n#9002=PRESENTATION_STYLE_ASSIGNMENT((#9003));\n"
+        "#9003=SURFACE_STYLE_USAGE(.BOTH.,#9004);\n#9004=SURFACE_SIDE_STYLE('',(#9005));\n"
+        "#9005=SURFACE_STYLE_RENDERING_WITH_PROPERTIES($,#9006,(#9007));\n"
+        "#9006=COLOUR_RGB('',0.75,0.75,0.75);\n#9007=SURFACE_STYLE_TRANSPARENT(0.);\n"
+    )
+    path.write_text(text.replace("ENDSEC;\nEND-ISO", style + "ENDSEC;\nEND-ISO"))
+    assert "#9005=" in path.read_text()
+    assert bd.Solid(read_shape(path)).volume == pytest.approx(6.0, rel=1e-9)
+    broken = tmp_path / "broken.step"  # a defect in the geometry itself is still refused
+    broken.write_text(path.read_text().replace("MANIFOLD_SOLID_BREP('',", "MANIFOLD_SOLID_BREP('',1.0,"))
+    with pytest.raises(ValueError, match="MANIFOLD_SOLID_BREP"):
+        read_shape(broken)
