@@ -180,15 +180,81 @@ M2
 """
 
 
-def test_a_nurbs_block_is_kept_and_the_cuts_after_it_are_rewritten():
-    """A G5.2 … G5.3 block (LinuxCNC's NURBS, adapted from its nc_files/nurbs/G5/trident-xy.ngc) is kept as it is;
-    the tool ends on its last control point, so the cuts after it are known and made G2."""
-    report = gcode_g2(NURBS, 0.01)
-    assert "\n".join(NURBS.splitlines()[3:9]) in report.text
-    assert [r.status for r in report.runs] == ["G2"] and report.runs[0].first == 10
-    if rs274_judge.available():  # the judge samples the NURBS from the words, as LinuxCNC defines it
-        verdict = rs274_judge.judge(NURBS, report.text, 0.01)
+@pytest.mark.parametrize("dialect", ["linuxcnc", "generic"])
+def test_a_nurbs_block_is_made_g2_and_the_cuts_after_it_too(dialect):
+    """A G5.2 … G5.3 block (LinuxCNC's NURBS, adapted from its nc_files/nurbs/G5/trident-xy.ngc) is made G2 within
+    the bound from its first point to its last, at its own feed; the cuts after it are made G2 too. The judge samples
+    the input's NURBS from its words, as LinuxCNC defines it, and the output's G5 cubics from theirs."""
+    report = gcode_g2(NURBS, 0.01, dialect=dialect)
+    assert [(r.status, r.nurbs) for r in report.runs] == [("G2", True), ("G2", False)]
+    assert report.runs[0].first == 4 and report.runs[0].last == 9 and 0.0 < report.runs[0].deviation <= 0.01
+    text = report.text
+    assert "G5.2" not in text and "G5.3" not in text and ("G5 " in text) == (dialect == "linuxcnc")
+    assert set(re.findall(r"F([\d.]+)", text)) <= {"100", "300"}
+    assert "NURBS block made G2" in "\n".join(report.lines())
+    if rs274_judge.available():
+        verdict = rs274_judge.judge(NURBS, text, 0.01)
         assert verdict.passed, verdict.reasons
+        assert verdict.distance > 1e-4  # the path did change
+
+
+def test_a_nurbs_block_the_reader_does_not_take_is_kept_and_the_cuts_after_it_are_rewritten():
+    """A NURBS block with a comment inside is kept as it is (named); the tool ends on its last control point."""
+    commented = NURBS.replace("X20 Y20 P1", "X20 Y20 P1 (a comment)")
+    report = gcode_g2(commented, 0.01)
+    assert "\n".join(commented.splitlines()[3:9]) in report.text
+    assert [r.status for r in report.runs] == ["kept", "G2"] and "comment" in report.runs[0].reason
+    if rs274_judge.available():
+        verdict = rs274_judge.judge(commented, report.text, 0.01)
+        assert verdict.passed, verdict.reasons
+
+
+@needs_rs274
+def test_linuxcnc_nurbs_program_judged_by_rs274():
+    """LinuxCNC's own nc_files/nurbs/G5/leto-xy.ngc (a weighted order-3 NURBS), made G2 and judged by rs274."""
+    text = (DATA / "linuxcnc_leto-xy.ngc").read_text()
+    report = gcode_g2(text, 0.01, source="leto-xy.ngc")
+    assert [(r.status, r.nurbs) for r in report.runs] == [("G2", True)]
+    verdict = rs274_judge.judge(text, report.text, 0.01)
+    assert verdict.passed, verdict.reasons
+
+
+#: A run whose far corners float64 cannot round within 1e-8 mm at a million millimetres, its near ones it can.
+FAR = """G21 G90 G17
+G0 X0 Y0
+G1 Z-1 F100
+G1 X10 Y0 F600
+G1 X10 Y10
+G1 X20 Y10
+G1 X20 Y20
+G1 X1000000 Y20
+G1 X1000000 Y30
+G1 X1000010 Y30
+G0 Z5
+M2
+"""
+
+
+def test_a_refused_joint_splits_the_run_and_the_rest_is_made_g2():
+    """Where make_g2 refuses a joint, the run is split there: that joint is left as it was (named with its line,
+    point and reason), and the parts on either side are made G2 on their own."""
+    report = gcode_g2(FAR, 1e-8)
+    (run,) = report.runs
+    assert run.status == "G2" and run.joints_changed >= 1 and len(run.refused) >= 2
+    assert any(r.startswith("line 8 (X1000000 Y20): joint") for r in run.refused)
+    assert any(r.startswith("line 9 (X1000000 Y30): joint") for r in run.refused)
+    assert all("cannot be made G2" in r for r in run.refused)
+    text = report.text.splitlines()
+    assert "G1 X1000000 Y30" in text and "G1 X1000010 Y30" in text  # the refused corners' moves as they were
+    assert text.index("G1 X1000000 Y30") < text.index("G1 X1000010 Y30")
+    assert any(line.startswith("G5 ") for line in text)  # the near corners rounded
+    assert "G1 X10 Y0 F600" not in text
+    assert run in report.below_g2
+    shown = "\n".join(report.lines())
+    assert "refused joint(s) left as they were" in shown and "joint at line 9 (X1000000 Y30)" in shown
+    # the near part's ends are the input's: its last point is the refused joint's
+    i = text.index("G1 X1000000 Y30")
+    assert "X1000000 Y20" in text[i - 1]
 
 
 def test_another_kind_registers_by_suffix(tmp_path, monkeypatch):
