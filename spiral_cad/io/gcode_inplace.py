@@ -18,12 +18,14 @@ mode, arc centre mode, feed mode, cutter compensation, motion mode, feed and pos
   straight part the transitions leave is made G2 all round and started there; otherwise the run is
   made G2 as an open path and, when its last arc was shrunk, a straight step (no longer than the
   arc's shift, so within the bound) returns to the input's end;
-* keeps a run verbatim, naming it and why, when ``make_g2`` refuses it or it cannot be written within
-  the bound. A run ``make_g2`` splits (a reversal, a corner too sharp for the bound) is written part
-  after part, its splits counted.
+* splits a run at a joint ``make_g2`` refuses: that joint is left as it was (named in ``GcodeRun.refused``
+  by its line, point and reason) and the parts on either side are made G2 on their own; keeps a part
+  verbatim, naming why, when it cannot be written within the bound. A run ``make_g2`` splits (a
+  reversal, a corner too sharp for the bound) is written part after part, its splits counted.
 
-A LinuxCNC NURBS block (``G5.2`` … ``G5.3``) is kept as it is (not yet made G2); the tool ends on its last
-control point, so the cuts after it are rewritten. From the first line that uses parameters, expressions, O-words, or text the reader cannot parse, the
+A LinuxCNC NURBS block (``G5.2`` … ``G5.3``) in G17, G90, G94 and G40 whose lines hold only plain words is
+made G2 within the bound (``gcode_nurbs.nurbs_g2``) from its first point to its last, at its feed; another
+is kept as it is (named), and the tool ends on its last control point, so the cuts after it are rewritten. From the first line that uses parameters, expressions, O-words, or text the reader cannot parse, the
 rest of the program is kept verbatim (its positions are not known without an interpreter); a move of
 a rotary axis (``A``, ``B``, ``C``, ``U``, ``V``, ``W``) is never a cutting line.
 

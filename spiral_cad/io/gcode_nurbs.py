@@ -145,7 +145,7 @@ def nurbs_biarcs(controls: NDArray[np.float64], weights: NDArray[np.float64], or
             error = np.minimum(_distances(probes, p0, joint, *first), _distances(probes, joint, p1, *second)).max(axis=1)
         good = (leg > 0.0) & np.isfinite(error) & (error <= tolerance)
         for k in np.flatnonzero(good):
-            pieces = [_piece(p0[k], joint[k], first, k), _piece(joint[k], p1[k], second, k)]
+            pieces = [_piece(p0[k], joint[k], first, int(k)), _piece(joint[k], p1[k], second, int(k))]
             found.append((float(u0[k]), [piece for piece in pieces if piece is not None]))
         bad = ~good
         half = (u0[bad] + u1[bad]) / 2.0
