@@ -59,6 +59,8 @@ __all__ = ["GcodeG2Report", "GcodeRun", "gcode_g2", "rewrite_gcode_g2"]
 GCODE_SUFFIXES = (".nc", ".ngc", ".gcode", ".tap")
 #: The share of the bound left to biarcs in the generic dialect.
 BIARC_SHARE = 0.2
+#: The most joints a run is split at where ``make_g2`` refuses them (each costs a build of the rest); the rest is kept.
+MAX_REFUSED = 20
 #: Decimals of the numbers written (far below any bound a machine holds).
 DECIMALS = 10
 
@@ -573,8 +575,9 @@ class _Rewriter:
             ends = list(np.cumsum([len(m.segments) for m in moves]))
             joint = int(found.group(1)) if found else -1
             at = ends.index(joint + 1) if joint + 1 in ends[:-1] else -1
-            if at < 0:  # not a joint between two moves of the run: the whole run kept
-                run.reason = run.reason or f"make_g2 refused it: {str(error)[:300]}"
+            if at < 0 or len(run.refused) >= MAX_REFUSED:  # not a joint between two moves, or too many: the part kept
+                many = f"more than {MAX_REFUSED} joints refused; " if at >= 0 else ""
+                run.reason = run.reason or f"make_g2 refused it: {many}{str(error)[:300]}"
                 return [(lines, moves, None)]
             x, y = moves[at].end
             run.refused.append(f"line {moves[at].number} (X{_number(x)} Y{_number(y)}): {str(error)[:300]}")
