@@ -40,6 +40,7 @@ from __future__ import annotations
 import math
 import os
 import re
+import time
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -61,6 +62,8 @@ GCODE_SUFFIXES = (".nc", ".ngc", ".gcode", ".tap")
 BIARC_SHARE = 0.2
 #: The most joints a run is split at where ``make_g2`` refuses them (each costs a build of the rest); the rest is kept.
 MAX_REFUSED = 20
+#: The least time the splits of one run may take (seconds; else twice its first build).
+SPLIT_SECONDS = 5.0
 #: Decimals of the numbers written (far below any bound a machine holds).
 DECIMALS = 10
 
@@ -253,6 +256,7 @@ class _Rewriter:
         self.rotary: list[int] = []  # lines where a rotary axis moves
         self.last_control: tuple[float, float] | None = None  # the last control point of a NURBS block being read
         self.block: _Block | None = None  # the NURBS block being read
+        self.started = self.deadline = 0.0  # when the run being written started, and its splits' deadline
 
     # ---------------------------------------------------------------- reading
 
@@ -538,6 +542,7 @@ class _Rewriter:
         self.pending = []
         run = GcodeRun(moves[0].number, moves[-1].number, len(moves))
         self.runs.append(run)
+        self.started, self.deadline = time.perf_counter(), math.inf
         parts = self.parts(run, moves, lines)
         if any(written is not None for _, _, written in parts):
             run.status = "G2"
@@ -575,8 +580,11 @@ class _Rewriter:
             ends = list(np.cumsum([len(m.segments) for m in moves]))
             joint = int(found.group(1)) if found else -1
             at = ends.index(joint + 1) if joint + 1 in ends[:-1] else -1
-            if at < 0 or len(run.refused) >= MAX_REFUSED:  # not a joint between two moves, or too many: the part kept
-                many = f"more than {MAX_REFUSED} joints refused; " if at >= 0 else ""
+            now = time.perf_counter()
+            if self.deadline == math.inf:  # the splits may take twice the first build (at least SPLIT_SECONDS)
+                self.deadline = now + max(SPLIT_SECONDS, 2.0 * (now - self.started))
+            if at < 0 or len(run.refused) >= MAX_REFUSED or now > self.deadline:  # the part kept
+                many = f"more than {MAX_REFUSED} joints refused or out of time; " if at >= 0 else ""
                 run.reason = run.reason or f"make_g2 refused it: {many}{str(error)[:300]}"
                 return [(lines, moves, None)]
             x, y = moves[at].end
