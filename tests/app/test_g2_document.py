@@ -82,6 +82,8 @@ def test_linuxcnc_programs_judged_by_rs274(name):
     assert verdict.passed, (verdict.reasons, report.lines())
     if name in ("linuxcnc_3dtest.ngc", "linuxcnc_comp.ngc"):  # plain programs: their cuts are rewritten
         assert any(r.status == "G2" for r in report.runs)
+    if name == "linuxcnc_leto-xy.ngc":  # a weighted order-3 NURBS block, made G2
+        assert [(r.status, r.nurbs) for r in report.runs] == [("G2", True)]
 
 
 @needs_rs274
@@ -207,16 +209,6 @@ def test_a_nurbs_block_the_reader_does_not_take_is_kept_and_the_cuts_after_it_ar
     if rs274_judge.available():
         verdict = rs274_judge.judge(commented, report.text, 0.01)
         assert verdict.passed, verdict.reasons
-
-
-@needs_rs274
-def test_linuxcnc_nurbs_program_judged_by_rs274():
-    """LinuxCNC's own nc_files/nurbs/G5/leto-xy.ngc (a weighted order-3 NURBS), made G2 and judged by rs274."""
-    text = (DATA / "linuxcnc_leto-xy.ngc").read_text()
-    report = gcode_g2(text, 0.01, source="leto-xy.ngc")
-    assert [(r.status, r.nurbs) for r in report.runs] == [("G2", True)]
-    verdict = rs274_judge.judge(text, report.text, 0.01)
-    assert verdict.passed, verdict.reasons
 
 
 #: A run whose far corners float64 cannot round within 1e-8 mm at a million millimetres, its near ones it can.
