@@ -18,12 +18,14 @@ mode, arc centre mode, feed mode, cutter compensation, motion mode, feed and pos
   straight part the transitions leave is made G2 all round and started there; otherwise the run is
   made G2 as an open path and, when its last arc was shrunk, a straight step (no longer than the
   arc's shift, so within the bound) returns to the input's end;
-* keeps a run verbatim, naming it and why, when ``make_g2`` refuses it or it cannot be written within
-  the bound. A run ``make_g2`` splits (a reversal, a corner too sharp for the bound) is written part
-  after part, its splits counted.
+* splits a run at a joint ``make_g2`` refuses: that joint is left as it was (named in ``GcodeRun.refused``
+  by its line, point and reason) and the parts on either side are made G2 on their own; keeps a part
+  verbatim, naming why, when it cannot be written within the bound. A run ``make_g2`` splits (a
+  reversal, a corner too sharp for the bound) is written part after part, its splits counted.
 
-A LinuxCNC NURBS block (``G5.2`` … ``G5.3``) is kept as it is (not yet made G2); the tool ends on its last
-control point, so the cuts after it are rewritten. From the first line that uses parameters, expressions, O-words, or text the reader cannot parse, the
+A LinuxCNC NURBS block (``G5.2`` … ``G5.3``) in G17, G90, G94 and G40 whose lines hold only plain words is
+made G2 within the bound (``gcode_nurbs.nurbs_g2``) from its first point to its last, at its feed; another
+is kept as it is (named), and the tool ends on its last control point, so the cuts after it are rewritten. From the first line that uses parameters, expressions, O-words, or text the reader cannot parse, the
 rest of the program is kept verbatim (its positions are not known without an interpreter); a move of
 a rotary axis (``A``, ``B``, ``C``, ``U``, ``V``, ``W``) is never a cutting line.
 
@@ -38,6 +40,7 @@ from __future__ import annotations
 import math
 import os
 import re
+import time
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -57,6 +60,10 @@ __all__ = ["GcodeG2Report", "GcodeRun", "gcode_g2", "rewrite_gcode_g2"]
 GCODE_SUFFIXES = (".nc", ".ngc", ".gcode", ".tap")
 #: The share of the bound left to biarcs in the generic dialect.
 BIARC_SHARE = 0.2
+#: The most joints a run is split at where ``make_g2`` refuses them (each costs a build of the rest); the rest is kept.
+MAX_REFUSED = 20
+#: The least time the splits of one run may take (seconds; else twice its first build).
+SPLIT_SECONDS = 5.0
 #: Decimals of the numbers written (far below any bound a machine holds).
 DECIMALS = 10
 
@@ -78,13 +85,16 @@ class GcodeRun:
     Attributes:
         first, last: its first and last line (1-based).
         moves: its moves.
-        status: ``"G2"`` (rewritten), ``"kept"`` (verbatim: see ``reason``) or ``"nothing to do"``
-            (one move, or every joint G2 already).
-        reason: why it was kept.
+        status: ``"G2"`` (rewritten, whole or in parts), ``"kept"`` (verbatim: see ``reason``) or
+            ``"nothing to do"`` (one move, or every joint G2 already).
+        reason: why it (or a part of it) was kept verbatim.
+        refused: the joints ``make_g2`` refused, each left as it was (the run split there and each side
+            made G2 on its own): the line ending at the joint, its point and ``make_g2``'s reason.
         deviation: the measured distance between the input's path and the output's (both ways; program unit).
         joints_changed: joints given a transition or rounded.
         splits: joints ``make_g2`` split at (left as the corners they were).
         lines_written: the lines written in its place.
+        nurbs: it is a LinuxCNC NURBS block (``G5.2`` … ``G5.3``), not a run of moves.
     """
 
     first: int
@@ -92,10 +102,12 @@ class GcodeRun:
     moves: int
     status: str = "kept"
     reason: str = ""
+    refused: list[str] = field(default_factory=list)
     deviation: float = 0.0
     joints_changed: int = 0
     splits: int = 0
     lines_written: int = 0
+    nurbs: bool = False
 
 
 @dataclass
@@ -138,7 +150,7 @@ class GcodeG2Report:
     @property
     def below_g2(self) -> list[GcodeRun]:
         """The runs left below G2 somewhere: kept verbatim for a reason, or split (``g2 --strict`` exits 1 on them)."""
-        return [r for r in self.runs if r.status == "kept" or r.splits]
+        return [r for r in self.runs if r.status == "kept" or r.splits or r.refused]
 
     def lines(self) -> list[str]:
         """The short report: one line per run changed or kept, and the totals."""
@@ -146,12 +158,19 @@ class GcodeG2Report:
         out = []
         for r in self.runs:
             where = f"lines {r.first}-{r.last}" if r.last != r.first else f"line {r.first}"
-            if r.status == "G2":
+            if r.status == "G2" and r.nurbs:
+                out.append(f"{self.source} {where}: NURBS block made G2 ({r.lines_written} lines), deviation {r.deviation:.3g} {unit}")
+            elif r.status == "G2":
                 split = f", {r.splits} split(s) left as corners" if r.splits else ""
+                refused = f", {len(r.refused)} refused joint(s) left as they were" if r.refused else ""
                 out.append(f"{self.source} {where}: {r.moves} moves made G2 ({r.lines_written} lines), deviation "
-                           f"{r.deviation:.3g} {unit}, {r.joints_changed} joints changed{split}")  # fmt: skip
+                           f"{r.deviation:.3g} {unit}, {r.joints_changed} joints changed{split}{refused}")  # fmt: skip
+                out += [f"{self.source} {where}: joint at {joint}" for joint in r.refused]
+                if r.reason:
+                    out.append(f"{self.source} {where}: a part kept as it was: {r.reason}")
             elif r.status == "kept":
                 out.append(f"{self.source} {where}: {r.moves} moves kept as they are: {r.reason}")
+                out += [f"{self.source} {where}: joint at {joint}" for joint in r.refused[1:]]
         out += [f"{self.source}: {note}" for note in self.notes]
         made = sum(r.status == "G2" for r in self.runs)
         out.append(f"{self.source}: {made} of {len(self.runs)} runs made G2 within {self.max_deviation:g} {unit} "
@@ -172,6 +191,18 @@ class _State:
     feed: float = math.nan
     feed_word: str = ""
     position: list[float | None] = field(default_factory=lambda: [0.0, 0.0, 0.0])
+
+
+@dataclass
+class _Block:
+    """A NURBS block (``G5.2`` … ``G5.3``) being read: where it starts, whether its modes allow a rewrite, its lines."""
+
+    start: list[float | None]
+    plain: bool
+    feed: float
+    feed_word: str
+    units: str | None
+    lines: list[tuple[int, str, list[tuple[str, float, str]], bool]] = field(default_factory=list)
 
 
 @dataclass
@@ -224,6 +255,8 @@ class _Rewriter:
         self.first_unit: str | None = units
         self.rotary: list[int] = []  # lines where a rotary axis moves
         self.last_control: tuple[float, float] | None = None  # the last control point of a NURBS block being read
+        self.block: _Block | None = None  # the NURBS block being read
+        self.started = self.deadline = 0.0  # when the run being written started, and its splits' deadline
 
     # ---------------------------------------------------------------- reading
 
@@ -240,6 +273,7 @@ class _Rewriter:
             if line.strip() == "%":
                 percent += 1
                 self.flush()
+                self.drop_block()
                 self.out.append(line)
                 if percent == 2:
                     frozen = True
@@ -247,6 +281,7 @@ class _Rewriter:
             parsed = _parse(line)
             if parsed is None:
                 self.flush()
+                self.drop_block()
                 self.notes.append(f"lines {number}-{len(self.raw)} verbatim: line {number} uses parameters, expressions, "
                                   "O-words or text that is not plain words (its positions need an interpreter)")  # fmt: skip
                 self.out.append(line)
@@ -254,6 +289,12 @@ class _Rewriter:
                 continue
             words, commented = parsed
             move = self.read(number, words, commented, line.lstrip().startswith("/"))
+            if self.block is not None:
+                self.flush()
+                self.block.lines.append((number, line, words, commented or line.lstrip().startswith("/")))
+                if self.state.motion != 52:  # G5.3 (or a block left another way) ends it
+                    self.finish_block()
+                continue
             if move is not None and self.pending and (move.feed != self.pending[-1][1].feed or move.z != self.pending[-1][1].z
                                                       or move.units != self.pending[-1][1].units):  # fmt: skip
                 self.flush()
@@ -263,6 +304,7 @@ class _Rewriter:
             self.flush()
             self.verbatim(line, words)
         self.flush()
+        self.drop_block()
         progress.done(len(self.raw))
         if self.rotary:
             shown = ", ".join(map(str, self.rotary[:5])) + (", …" if len(self.rotary) > 5 else "")
@@ -369,6 +411,9 @@ class _Rewriter:
     def nurbs(self, axes: dict[str, float]) -> None:
         """Follow a G5.2 … G5.3 block (LinuxCNC: control points X Y of the XY plane; G5.3 moves to the last one)."""
         s = self.state
+        if s.motion == 52 and self.block is None:
+            self.block = _Block(list(s.position), s.plane == 170 and s.absolute and s.feed_mode == 940 and s.comp == 400
+                                and s.units is not None and math.isfinite(s.feed) and s.feed > 0.0, s.feed, s.feed_word, s.units)  # fmt: skip
         if s.motion == 52 and "X" in axes and "Y" in axes:
             self.last_control = (axes["X"], axes["Y"])
         elif s.motion == 53:
@@ -380,6 +425,91 @@ class _Rewriter:
             self.last_control = None
         if s.motion == 52 and s.plane != 170:
             s.position = [None, None, None]
+
+    def drop_block(self) -> None:
+        """Keep an unfinished NURBS block's lines as they are (a line the reader cannot follow, or the program's end)."""
+        if self.block is not None:
+            self.out += [line for _, line, _, _ in self.block.lines]
+            self.block = None
+
+    def finish_block(self) -> None:
+        """Write a NURBS block just read: made G2 within the bound (``gcode_nurbs``), or verbatim (the report says why)."""
+        block, self.block = self.block, None
+        assert block is not None
+        first, last = block.lines[0][0], block.lines[-1][0]
+        run = GcodeRun(first, last, 1, nurbs=True)
+        self.runs.append(run)
+        written: list[str] | None = None
+        try:
+            written = self.block_g2(block, run)
+        except ValueError as error:
+            run.reason = f"NURBS block kept as it is: {str(error)[:300]}"
+        if written is None:
+            motion = self.state.motion
+            for _, line, words, _ in block.lines:
+                self.state.motion = 52
+                self.verbatim(line, words)
+            self.state.motion = motion
+            self.emitted_motion = None
+            return
+        run.status, run.lines_written = "G2", len(written)
+        if block.feed != self.emitted_feed:
+            self.out.append(f"F{block.feed_word}")
+            self.emitted_feed = block.feed
+        self.out += written
+        last_code = written[-1].split()[0] if written else ""
+        self.emitted_motion = {"G1": 10, "G2": 20, "G3": 30, "G5": 50}.get(last_code, self.emitted_motion)
+
+    def block_g2(self, block: _Block, run: GcodeRun) -> list[str] | None:
+        """The lines of a NURBS block made G2 (see ``gcode_nurbs``).
+
+        Raises:
+            ValueError: a block this reader does not take (words other than the plain ones, a comment, another
+                plane or mode), or one ``nurbs_g2`` refuses; the message says which.
+        """
+        from .gcode_nurbs import nurbs_g2
+
+        if not block.plain or None in block.start[:2] or block.units is None:
+            raise ValueError("not in G17 G90 G94 G40 with a known unit, feed and position")
+        controls = [(float(block.start[0]), float(block.start[1]))]  # type: ignore[arg-type]
+        weights = [1.0]
+        order = 3
+        for k, (number, _, words, commented) in enumerate(block.lines):
+            letters = {letter for letter, _, _ in words}
+            values = {letter: v for letter, v, _ in words}
+            codes = [_code(v) for letter, v, _ in words if letter == "G"]
+            allowed = ("GXYPLFN" if k == 0 else "GN") if k in (0, len(block.lines) - 1) else "XYPN"
+            if commented or not letters <= set(allowed) or codes != ([52] if k == 0 else [53] if k == len(block.lines) - 1 else []):
+                raise ValueError(f"line {number} holds words other than G5.2/G5.3, X, Y, P, L, F, N, or a comment")
+            if k == 0 and values.get("L", 0.0) > 3:
+                order = int(values["L"])
+            if ("X" in letters) != ("Y" in letters):
+                raise ValueError(f"line {number} names one of X and Y only")
+            if "X" in letters:
+                controls.append((values["X"], values["Y"]))
+                weights.append(values.get("P", 1.0))
+            elif k == 0 and values.get("P", 0.0) > 0.0:
+                weights[0] = values["P"]
+        units = block.units
+        bound = self.bound if self.first_unit in (None, units) else self.bound * (25.4 if self.first_unit == "in" else 1 / 25.4)
+        curve_bound = bound * (1.0 - BIARC_SHARE) if self.dialect == "generic" else bound
+        made = nurbs_g2(np.array(controls), np.array(weights), order, curve_bound, units=units, shape=self.shape)
+        out: list[str] = []
+        arc_error = 0.0
+        for piece in made.pieces:
+            if isinstance(piece, Chain):
+                program = gcode_program(piece, dialect=self.dialect, feed=block.feed, units=units, rapid_to_start=False,
+                                        arc_tolerance=bound * BIARC_SHARE, decimals=DECIMALS)  # fmt: skip
+                arc_error = max(arc_error, program.arc_error)
+                out += program.moves
+            else:
+                out.append(f"G1 X{_number(piece.end[0])} Y{_number(piece.end[1])}")
+        deviation = made.deviation + arc_error + math.sqrt(2.0) * 10.0**-DECIMALS
+        if deviation > bound:
+            raise ValueError(f"measured {deviation:.3g} {units} from the NURBS, beyond the bound {bound:g} {units}")
+        run.deviation = deviation
+        run.joints_changed = made.joints
+        return out
 
     @staticmethod
     def centre(a: tuple[float, float], b: tuple[float, float], other: dict[str, float], ccw: bool) -> tuple[float, float] | None:
@@ -404,7 +534,7 @@ class _Rewriter:
     # ---------------------------------------------------------------- writing
 
     def flush(self) -> None:
-        """Write the gathered run: made G2, or verbatim."""
+        """Write the gathered run: made G2 part by part (split at the joints ``make_g2`` refuses), or verbatim."""
         if not self.pending:
             return
         lines = [line for line, _ in self.pending]
@@ -412,38 +542,72 @@ class _Rewriter:
         self.pending = []
         run = GcodeRun(moves[0].number, moves[-1].number, len(moves))
         self.runs.append(run)
-        segments = [s for m in moves for s in m.segments]
-        written: list[str] | None = None
-        if len(segments) < 2:
-            run.status = "nothing to do"
+        self.started, self.deadline = time.perf_counter(), math.inf
+        parts = self.parts(run, moves, lines)
+        if any(written is not None for _, _, written in parts):
+            run.status = "G2"
+        elif run.reason or run.refused:
+            run.status, run.reason = "kept", run.reason or "; ".join(run.refused)
         else:
-            try:
-                written = self.rewrite(run, moves, segments)
-            except (ValueError, NoSolutionError) as error:
-                run.reason = f"make_g2 or the writer refused it: {str(error)[:300]}"
-        if written is None:
-            for line, move in zip(lines, moves):
-                parsed = _parse(line)
-                assert parsed is not None
-                self.verbatim(line, parsed[0], move)
-            return
-        run.status = "G2"
-        run.lines_written = len(written)
-        feed = moves[0].feed
-        if feed != self.emitted_feed:
-            self.out.append(f"F{moves[0].feed_word}")
-        self.out += written
-        self.emitted_feed = feed
-        last = written[-1].split()[0] if written else ""
-        self.emitted_motion = {"G1": 10, "G2": 20, "G3": 30, "G5": 50}.get(last, self.emitted_motion)
+            run.status = "nothing to do"
+        for part_lines, part_moves, written in parts:
+            if written is None:
+                for line, move in zip(part_lines, part_moves):
+                    parsed = _parse(line)
+                    assert parsed is not None
+                    self.verbatim(line, parsed[0], move)
+                continue
+            run.lines_written += len(written)
+            feed = part_moves[0].feed
+            if feed != self.emitted_feed:
+                self.out.append(f"F{part_moves[0].feed_word}")
+            self.out += written
+            self.emitted_feed = feed
+            last = written[-1].split()[0] if written else ""
+            self.emitted_motion = {"G1": 10, "G2": 20, "G3": 30, "G5": 50}.get(last, self.emitted_motion)
+
+    def parts(self, run: GcodeRun, moves: list[_Move], lines: list[str]) -> list[tuple[list[str], list[_Move], list[str] | None]]:
+        """A run's parts, each with its lines written in its place (None: kept verbatim): the run made G2 whole, or, where
+        ``make_g2`` refuses a joint between two moves, split there (the joint left as it was, named in ``run.refused``) and
+        each side made G2 on its own."""
+        segments = [s for m in moves for s in m.segments]
+        if len(segments) < 2:
+            return [(lines, moves, None)]
+        try:
+            written = self.rewrite(run, moves, segments)
+        except NoSolutionError as error:
+            found = re.search(r"joint (\d+)", str(error))
+            ends = list(np.cumsum([len(m.segments) for m in moves]))
+            joint = int(found.group(1)) if found else -1
+            at = ends.index(joint + 1) if joint + 1 in ends[:-1] else -1
+            now = time.perf_counter()
+            if self.deadline == math.inf:  # the splits may take twice the first build (at least SPLIT_SECONDS)
+                self.deadline = now + max(SPLIT_SECONDS, 2.0 * (now - self.started))
+            if at < 0 or len(run.refused) >= MAX_REFUSED or now > self.deadline:  # the part kept
+                many = f"more than {MAX_REFUSED} joints refused or out of time; " if at >= 0 else ""
+                run.reason = run.reason or f"make_g2 refused it: {many}{str(error)[:300]}"
+                return [(lines, moves, None)]
+            x, y = moves[at].end
+            run.refused.append(f"line {moves[at].number} (X{_number(x)} Y{_number(y)}): {str(error)[:300]}")
+            return self.parts(run, moves[: at + 1], lines[: at + 1]) + self.parts(run, moves[at + 1 :], lines[at + 1 :])
+        except ValueError as error:
+            run.reason = run.reason or f"make_g2 or the writer refused it: {str(error)[:300]}"
+            return [(lines, moves, None)]
+        return [(lines, moves, written)]
 
     def rewrite(self, run: GcodeRun, moves: list[_Move], segments: list[Segment]) -> list[str] | None:
-        """The lines of a run made G2, or None (``run.status``/``reason`` say why)."""
+        """The lines of a run (or part of one) made G2, or None: every joint G2 already, or beyond the bound
+        (``run.reason`` says so).
+
+        Raises:
+            NoSolutionError: ``make_g2`` refused a joint (its message names it).
+        """
         from ..design.g2 import make_g2
 
         units = moves[0].units
         bound = self.bound if self.first_unit in (None, units) else self.bound * (25.4 if self.first_unit == "in" else 1 / 25.4)
-        g2_bound = bound * (1.0 - BIARC_SHARE) if self.dialect == "generic" else bound
+        printing = math.sqrt(2.0) * 10.0**-DECIMALS  # the written numbers' rounding, left out of make_g2's share
+        g2_bound = (bound * (1.0 - BIARC_SHARE) if self.dialect == "generic" else bound) - 2.0 * printing
         start, end = np.array(moves[0].start), np.array(moves[-1].end)
         size = max(float(np.abs(np.array([p for s in segments for p in s.outline()])).max()), 1.0)
         tiny = 1e-9 * size
@@ -462,10 +626,8 @@ class _Rewriter:
             chains = list(made.chains)
         assert made is not None
         if all(j.kind == "g2" for j in made.joints):
-            run.status = "nothing to do"
             return None
-        run.joints_changed = sum(j.kind not in ("g2", "split") for j in made.joints)
-        run.splits = len(made.splits)
+        joints_changed = sum(j.kind not in ("g2", "split") for j in made.joints)
         # the run's ends fixed: a step from the input's entry and to its exit where the path's ends moved
         pieces: list[list[Segment] | Chain] = []
         position = start
@@ -496,9 +658,11 @@ class _Rewriter:
         # the run ends exactly where the input's did, as the input wrote it
         deviation = max(made.deviation, steps) + arc_error + printing  # a step lies within its length of the input's end
         if deviation > bound:
-            run.reason = f"measured {deviation:.3g} {units} from the input, beyond the bound {bound:g} {units}"
+            run.reason = run.reason or f"measured {deviation:.3g} {units} from the input, beyond the bound {bound:g} {units}"
             return None
-        run.deviation = deviation
+        run.deviation = max(run.deviation, deviation)
+        run.joints_changed += joints_changed
+        run.splits += len(made.splits)
         return out
 
 

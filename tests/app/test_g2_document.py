@@ -82,6 +82,8 @@ def test_linuxcnc_programs_judged_by_rs274(name):
     assert verdict.passed, (verdict.reasons, report.lines())
     if name in ("linuxcnc_3dtest.ngc", "linuxcnc_comp.ngc"):  # plain programs: their cuts are rewritten
         assert any(r.status == "G2" for r in report.runs)
+    if name == "linuxcnc_leto-xy.ngc":  # a weighted order-3 NURBS block, made G2
+        assert [(r.status, r.nurbs) for r in report.runs] == [("G2", True)]
 
 
 @needs_rs274
@@ -180,15 +182,71 @@ M2
 """
 
 
-def test_a_nurbs_block_is_kept_and_the_cuts_after_it_are_rewritten():
-    """A G5.2 … G5.3 block (LinuxCNC's NURBS, adapted from its nc_files/nurbs/G5/trident-xy.ngc) is kept as it is;
-    the tool ends on its last control point, so the cuts after it are known and made G2."""
-    report = gcode_g2(NURBS, 0.01)
-    assert "\n".join(NURBS.splitlines()[3:9]) in report.text
-    assert [r.status for r in report.runs] == ["G2"] and report.runs[0].first == 10
-    if rs274_judge.available():  # the judge samples the NURBS from the words, as LinuxCNC defines it
-        verdict = rs274_judge.judge(NURBS, report.text, 0.01)
+@pytest.mark.parametrize("dialect", ["linuxcnc", "generic"])
+def test_a_nurbs_block_is_made_g2_and_the_cuts_after_it_too(dialect):
+    """A G5.2 … G5.3 block (LinuxCNC's NURBS, adapted from its nc_files/nurbs/G5/trident-xy.ngc) is made G2 within
+    the bound from its first point to its last, at its own feed; the cuts after it are made G2 too. The judge samples
+    the input's NURBS from its words, as LinuxCNC defines it, and the output's G5 cubics from theirs."""
+    report = gcode_g2(NURBS, 0.01, dialect=dialect)
+    assert [(r.status, r.nurbs) for r in report.runs] == [("G2", True), ("G2", False)]
+    assert report.runs[0].first == 4 and report.runs[0].last == 9 and 0.0 < report.runs[0].deviation <= 0.01
+    text = report.text
+    assert "G5.2" not in text and "G5.3" not in text and ("G5 " in text) == (dialect == "linuxcnc")
+    assert set(re.findall(r"F([\d.]+)", text)) <= {"100", "300"}
+    assert "NURBS block made G2" in "\n".join(report.lines())
+    if rs274_judge.available():
+        verdict = rs274_judge.judge(NURBS, text, 0.01)
         assert verdict.passed, verdict.reasons
+        assert verdict.distance > 1e-4  # the path did change
+
+
+def test_a_nurbs_block_the_reader_does_not_take_is_kept_and_the_cuts_after_it_are_rewritten():
+    """A NURBS block with a comment inside is kept as it is (named); the tool ends on its last control point."""
+    commented = NURBS.replace("X20 Y20 P1", "X20 Y20 P1 (a comment)")
+    report = gcode_g2(commented, 0.01)
+    assert "\n".join(commented.splitlines()[3:9]) in report.text
+    assert [r.status for r in report.runs] == ["kept", "G2"] and "comment" in report.runs[0].reason
+    if rs274_judge.available():
+        verdict = rs274_judge.judge(commented, report.text, 0.01)
+        assert verdict.passed, verdict.reasons
+
+
+#: A run whose far corners float64 cannot round within 1e-8 mm at a million millimetres, its near ones it can.
+FAR = """G21 G90 G17
+G0 X0 Y0
+G1 Z-1 F100
+G1 X10 Y0 F600
+G1 X10 Y10
+G1 X20 Y10
+G1 X20 Y20
+G1 X1000000 Y20
+G1 X1000000 Y30
+G1 X1000010 Y30
+G0 Z5
+M2
+"""
+
+
+def test_a_refused_joint_splits_the_run_and_the_rest_is_made_g2():
+    """Where make_g2 refuses a joint, the run is split there: that joint is left as it was (named with its line,
+    point and reason), and the parts on either side are made G2 on their own."""
+    report = gcode_g2(FAR, 1e-8)
+    (run,) = report.runs
+    assert run.status == "G2" and run.joints_changed >= 1 and len(run.refused) >= 2
+    assert any(r.startswith("line 8 (X1000000 Y20): joint") for r in run.refused)
+    assert any(r.startswith("line 9 (X1000000 Y30): joint") for r in run.refused)
+    assert all("cannot be made G2" in r for r in run.refused)
+    text = report.text.splitlines()
+    assert "G1 X1000000 Y30" in text and "G1 X1000010 Y30" in text  # the refused corners' moves as they were
+    assert text.index("G1 X1000000 Y30") < text.index("G1 X1000010 Y30")
+    assert any(line.startswith("G5 ") for line in text)  # the near corners rounded
+    assert "G1 X10 Y0 F600" not in text
+    assert run in report.below_g2
+    shown = "\n".join(report.lines())
+    assert "refused joint(s) left as they were" in shown and "joint at line 9 (X1000000 Y30)" in shown
+    # the near part's ends are the input's: its last point is the refused joint's
+    i = text.index("G1 X1000000 Y30")
+    assert "X1000000 Y20" in text[i - 1]
 
 
 def test_another_kind_registers_by_suffix(tmp_path, monkeypatch):
@@ -236,3 +294,21 @@ def test_a_drawing_and_a_road_file_come_back_whole_through_the_one_verb(tmp_path
     assert "made G2" in capsys.readouterr().out and (tmp_path / "road.xml").is_file()
     assert main(["g2", str(road), "--max-deviation", "0.01", "-o", str(tmp_path / "r.xml"), "--units", "m"]) == 2
     assert "units" in capsys.readouterr().err
+
+
+def test_nurbs_points_follow_the_judges_reading_of_linuxcnc():
+    """Our NURBS (scipy's B-spline in homogeneous coordinates) against the judge's own Cox–de Boor sampler of the same
+    words (LinuxCNC's definition: weights, order 4, the first control point where the tool stands)."""
+    import numpy as np
+    from scipy.spatial import cKDTree
+
+    from spiral_cad.io.gcode_nurbs import nurbs_points
+
+    lines = ["G5.2 P1 L4", "X20 Y20 P3", "X12 Y8 P0.5", "X5 Y25 P1", "X10 Y20 P2", "G5.3"]
+    theirs = rs274_judge.nurbs_samples(lines, 5, np.array([10.0, 0.0, 1.0]), (0, 1, 2), 0.005)[:, :2]
+    ours = nurbs_points(np.array([[10, 0], [20, 20], [12, 8], [5, 25], [10, 20]]), np.array([1, 3, 0.5, 1, 2]), 4, 0.005)
+    gap = max(cKDTree(ours).query(theirs)[0].max(), cKDTree(theirs).query(ours)[0].max())
+    assert gap < 0.005
+    assert np.allclose(ours[0], [10, 0]) and np.allclose(ours[-1], [10, 20])
+    with pytest.raises(ValueError, match="order 4 needs at least 4"):
+        nurbs_points(np.array([[0, 0], [1, 1], [2, 0]]), np.ones(3), 4, 0.01)

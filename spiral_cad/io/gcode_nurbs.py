@@ -1,0 +1,219 @@
+"""A LinuxCNC NURBS block (``G5.2`` … ``G5.3``) made G2 within a bound: its points, and a G2 chain along it.
+
+LinuxCNC's definition (``interp_convert.cc``, ``nurbs_additional_functions.cc``): the first control point is where
+the tool stands (its weight is the ``P`` of the ``G5.2`` line when that line names no point, else 1); every line of
+the block naming both X and Y adds a control point with weight ``P`` (default 1); the order is ``L`` when above 3,
+else 3; the knots are clamped and uniform: 0 (order times), 1 … n − order + 1, n − order + 2 (order times), for
+control points 0 … n. The curve starts on the first control point and ends on the last.
+
+``nurbs_g2`` approximates the curve by biarcs (two tangent arcs between two points of the curve with its tangents
+there, equal legs, as ``gcode_write`` fits them to cubics; the parameter interval halved until each lies within a
+share of the bound), makes that G1 path of arcs G2 with ``spiral_cad.design.make_g2`` within the rest (its ends
+fixed: a straight step from the block's first point and to its last where the G2 path's ends moved), and
+measures the result against dense samples of the NURBS both ways.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import NDArray
+from scipy.interpolate import BSpline
+from scipy.spatial import cKDTree
+
+from ..core.chain import Chain
+from ..core.segments import Arc, Line, Segment
+from .gcode_write import _arcs_through, _distances
+
+__all__ = ["NurbsG2", "nurbs_g2", "nurbs_points"]
+
+#: The share of the bound the biarcs may use (``make_g2`` uses the rest).
+BIARC_SHARE = 0.3
+#: The spacing of the samples the result is measured on, as a share of the bound.
+MEASURE_SHARE = 0.05
+#: The most samples taken of a block, and the most biarcs (a longer curve is kept as it is).
+MAX_SAMPLES = 400_000
+MAX_BIARCS = 20_000
+#: Points probed between a biarc's ends.
+PROBES = 9
+
+
+@dataclass
+class NurbsG2:
+    """A NURBS block made G2.
+
+    Attributes:
+        pieces: the G2 chains and the straight steps that fix the ends, in travel order.
+        deviation: the measured distance between the NURBS and the result, both ways (an upper bound).
+        joints: joints of the biarcs made G2.
+    """
+
+    pieces: list[Chain | Segment]
+    deviation: float
+    joints: int
+
+
+def _curve(controls: NDArray[np.float64], weights: NDArray[np.float64], order: int) -> BSpline:
+    """The NURBS as a B-spline in homogeneous coordinates (w x, w y, w)."""
+    p = np.asarray(controls, dtype=float)
+    w = np.asarray(weights, dtype=float)
+    n = len(p) - 1
+    if order < 2 or n + 1 < order:
+        raise ValueError(f"a NURBS of order {order} needs at least {order} control points; got {n + 1}")
+    if not np.all(w > 0.0):
+        raise ValueError(f"NURBS weights must be positive; got {w.min():g}")
+    knots = np.array([0.0] * order + list(range(1, n - order + 2)) + [float(n - order + 2)] * order)
+    return BSpline(knots, np.column_stack([p * w[:, None], w]), order - 1)
+
+
+def _at(curve: BSpline, u: NDArray[np.float64]) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """Points and unit tangents of the NURBS at parameters ``u`` (where the derivative vanishes, as at a repeated
+    control point, the tangent a millionth of a knot span inwards)."""
+    u = np.asarray(u, dtype=float)
+    h = curve(u)
+    point = h[..., :2] / h[..., 2:]
+    last = float(curve.t[-1])
+    inward = np.where(u < last / 2.0, 1.0, -1.0)
+    nudged = [u, u + 1e-6 * inward, u + 1e-4 * inward]
+    tangent = np.full(point.shape, np.nan)
+    for v in nudged:
+        hv, dh = curve(v), curve.derivative()(v)
+        t = (dh[..., :2] * hv[..., 2:] - hv[..., :2] * dh[..., 2:]) / hv[..., 2:] ** 2
+        norm = np.linalg.norm(t, axis=-1, keepdims=True)
+        usable = (norm > 1e-12 * max(1.0, float(np.abs(point).max()))) & np.isnan(tangent[..., :1])
+        with np.errstate(invalid="ignore", divide="ignore"):
+            tangent = np.where(usable, t / norm, tangent)
+    return point, tangent
+
+
+def nurbs_points(
+    controls: NDArray[np.float64], weights: NDArray[np.float64], order: int, spacing: float
+) -> NDArray[np.float64]:  # fmt: skip
+    """Points of a LinuxCNC NURBS (control points (n + 1, 2), their weights, its order), at most about ``spacing``
+    apart, first and last on the first and last control points.
+
+    Raises:
+        ValueError: fewer control points than the order, a weight that is not positive, a spacing that is not,
+            more than ``MAX_SAMPLES`` points.
+    """
+    if not spacing > 0.0:
+        raise ValueError(f"spacing must be positive; got {spacing:g}")
+    curve = _curve(controls, weights, order)
+    p = np.asarray(controls, dtype=float)
+    u = np.linspace(0.0, curve.t[-1], 64 * len(p) + 1)
+    rough = curve(u)
+    xy = rough[:, :2] / rough[:, 2:]
+    length = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(xy, axis=0), axis=1))])
+    count = max(2, math.ceil(length[-1] / spacing) + 1)
+    if count > MAX_SAMPLES:
+        raise ValueError(f"a NURBS {length[-1]:.6g} long needs {count} samples at spacing {spacing:.3g}; at most {MAX_SAMPLES}")
+    dense = curve(np.interp(np.linspace(0.0, length[-1], count), length, u))  # about even in arc length
+    out = dense[:, :2] / dense[:, 2:]
+    out[0], out[-1] = p[0], p[-1]
+    return out
+
+
+def nurbs_biarcs(controls: NDArray[np.float64], weights: NDArray[np.float64], order: int, tolerance: float) -> list[Segment]:
+    """Biarcs (lines where straight) within ``tolerance`` of a LinuxCNC NURBS, tangent to it at their ends.
+
+    Raises:
+        ValueError: as ``nurbs_points``; more than ``MAX_BIARCS`` biarcs.
+    """
+    curve = _curve(controls, weights, order)
+    knots = np.unique(curve.t)
+    u0, u1 = knots[:-1], knots[1:]
+    inside = np.linspace(0.0, 1.0, PROBES + 2)[1:-1]
+    found: list[tuple[float, list[Segment]]] = []
+    while len(u0):
+        if len(found) + len(u0) > MAX_BIARCS:
+            raise ValueError(f"the NURBS needs more than {MAX_BIARCS} biarcs within {tolerance:.3g}")
+        ends, tangents = _at(curve, np.stack([u0, u1], axis=1))
+        probes, _ = _at(curve, u0[:, None] + (u1 - u0)[:, None] * inside)
+        p0, p1, t0, t1 = ends[:, 0], ends[:, 1], tangents[:, 0], tangents[:, 1]
+        chord = p1 - p0
+        a = 2.0 * (np.einsum("ij,ij->i", t0, t1) - 1.0)
+        b = -2.0 * np.einsum("ij,ij->i", chord, t0 + t1)
+        c = np.einsum("ij,ij->i", chord, chord)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            leg = np.where(np.abs(a) < 1e-12, c / -b, (-b - np.sqrt(np.maximum(b * b - 4.0 * a * c, 0.0))) / (2.0 * a))
+            q0, q1 = p0 + leg[:, None] * t0, p1 - leg[:, None] * t1
+            joint = (q0 + q1) / 2.0
+            middle = (q1 - q0) / np.linalg.norm(q1 - q0, axis=1, keepdims=True)
+            first, second = _arcs_through(p0, t0, joint), _arcs_through(joint, middle, p1)
+            error = np.minimum(_distances(probes, p0, joint, *first), _distances(probes, joint, p1, *second)).max(axis=1)
+        good = (leg > 0.0) & np.isfinite(error) & (error <= tolerance)
+        for k in np.flatnonzero(good):
+            pieces = [_piece(p0[k], joint[k], first, int(k)), _piece(joint[k], p1[k], second, int(k))]
+            found.append((float(u0[k]), [piece for piece in pieces if piece is not None]))
+        bad = ~good
+        half = (u0[bad] + u1[bad]) / 2.0
+        u0, u1 = np.ravel(np.stack([u0[bad], half], axis=1)), np.ravel(np.stack([half, u1[bad]], axis=1))
+    return [piece for _, pieces in sorted(found, key=lambda f: f[0]) for piece in pieces]
+
+
+def _piece(start: NDArray[np.float64], end: NDArray[np.float64], arcs: tuple[NDArray, NDArray, NDArray], k: int) -> Segment | None:
+    """One piece of a biarc: a line, or the arc about its centre from ``start`` to ``end`` (None: no length)."""
+    centre, radius, line = arcs[0][k], float(arcs[1][k]), bool(arcs[2][k])
+    if float(np.linalg.norm(end - start)) <= 1e-12 * max(1.0, float(np.abs(start).max())):
+        return None
+    if line:
+        return Line(tuple(start), tuple(end))
+    a0 = math.atan2(start[1] - centre[1], start[0] - centre[0])
+    a1 = math.atan2(end[1] - centre[1], end[0] - centre[0])
+    sweep = ((a1 - a0) if radius > 0 else (a0 - a1)) % (2.0 * math.pi)
+    return Arc(tuple(centre), radius, a0, sweep if sweep > 0.0 else 2.0 * math.pi)
+
+
+def nurbs_g2(
+    controls: NDArray[np.float64], weights: NDArray[np.float64], order: int, bound: float, *, units: str = "mm",
+    shape: str = "near-linear",
+) -> NurbsG2:  # fmt: skip
+    """A LinuxCNC NURBS made G2 within ``bound``, from its first control point to its last.
+
+    Args:
+        controls: its control points, (n + 1, 2), the first where the tool stands.
+        weights: their weights.
+        order: its order (degree + 1).
+        bound: the largest distance allowed between the NURBS and the result, both ways.
+        units: the length unit.
+        shape: the transitions' shape (``make_g2``'s).
+
+    Raises:
+        ValueError: a NURBS that cannot be read (``nurbs_points``), biarcs ``make_g2`` refuses, or a result
+            measured beyond the bound.
+    """
+    from ..design.g2 import make_g2
+
+    biarcs = nurbs_biarcs(controls, weights, order, bound * BIARC_SHARE)
+    start, end = np.asarray(controls[0], dtype=float), np.asarray(controls[-1], dtype=float)
+    spacing = bound * MEASURE_SHARE
+    curve = nurbs_points(controls, weights, order, spacing)
+    if len(biarcs) < 2:
+        raise ValueError("a NURBS that is one arc or line: nothing to make G2")
+    made = make_g2(biarcs, bound * (1.0 - BIARC_SHARE) - spacing, closed=False, shape=shape, units=units)
+    pieces: list[Chain | Segment] = []
+    position = start
+    tiny = 1e-9 * max(1.0, float(np.abs(curve).max()))
+    for chain in made.chains:
+        if float(np.linalg.norm(np.asarray(chain.start) - position)) > tiny:
+            pieces.append(Line(tuple(position), tuple(chain.start)))
+        pieces.append(chain)
+        position = np.asarray(chain.end)
+    if float(np.linalg.norm(end - position)) > tiny:
+        pieces.append(Line(tuple(position), tuple(end)))
+    # measured both ways on dense samples of each: a point's distance to the other's nearest sample bounds its
+    # distance to the other; half the spacing covers the points between samples
+    result = np.vstack([_samples(piece, spacing) for piece in pieces])
+    deviation = max(float(cKDTree(result).query(curve)[0].max()), float(cKDTree(curve).query(result)[0].max())) + spacing / 2.0
+    if deviation > bound:
+        raise ValueError(f"the NURBS made G2 measures {deviation:.3g} {units} from it, beyond the bound {bound:g} {units}")
+    return NurbsG2(pieces, deviation, sum(j.kind not in ("g2", "split") for j in made.joints))
+
+
+def _samples(piece: Chain | Segment, spacing: float) -> NDArray[np.float64]:
+    """Points of a chain or segment at most ``spacing`` apart along it."""
+    segments = list(piece) if isinstance(piece, Chain) else [piece]
+    out = [np.asarray(s.point(np.linspace(0.0, 1.0, max(2, math.ceil(s.length / spacing) + 1))))[:, :2] for s in segments]
+    return np.vstack(out)
