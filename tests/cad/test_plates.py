@@ -192,7 +192,7 @@ READ = textwrap.dedent(
     """
     import sys
     sys.path.append(sys.argv[1])
-    import Part
+    import FreeCAD, Part  # Part alone, without FreeCAD's application first, crashes on reading (SIGSEGV)
     shape = Part.read(sys.argv[2])
     print(len(shape.Solids), shape.isValid(), repr(shape.Volume))
     """
