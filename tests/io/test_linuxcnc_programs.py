@@ -23,8 +23,11 @@ CANON_PLANES = {"CANON_PLANE_XY": (0, 1, 2), "CANON_PLANE_XZ": (2, 0, 1), "CANON
 
 def canonical_ends(program: Path, folder: Path) -> np.ndarray:
     """The end of every feed move and rapid (x, y, z, in the program's unit) as rs274 executes ``program``."""
-    done = subprocess.run([rs274.rs274_executable(), "-g", str(program), str(folder / "canon.txt")], capture_output=True,
-                          text=True, cwd=program.parent)  # fmt: skip
+    for _ in range(3):  # rs274 itself dies now and then by SIGBUS beside another rs274 (seen on good programs): run it again
+        done = subprocess.run([rs274.rs274_executable(), "-g", str(program), str(folder / "canon.txt")], capture_output=True,
+                              text=True, cwd=program.parent)  # fmt: skip
+        if done.returncode >= 0:
+            break
     assert done.returncode == 0 and "error" not in done.stderr.lower(), done.stderr
     plane, ends = (0, 1, 2), []
     for name, arguments in re.findall(
