@@ -1,9 +1,12 @@
 """Face checker on STEP files of ~100, ~300 and ~1 000 faces: time per face, linear in the faces.
 
-Run: ``.venv/bin/python benchmarks/bench_faces.py [--quick] [--repeat R] [--boxes N N N] [--picture-boxes N N] [--out FILE]``.
+Run: ``.venv/bin/python benchmarks/bench_faces.py [--quick] [--repeat R] [--boxes N N N] [--g2-boxes N N]
+[--picture-boxes N N] [--out FILE]``.
 
 Each file is an array of build123d boxes (40 × 20 × 8) with their vertical edges filleted
-(10 faces, 8 G1 and 16 sharp edges each), written as one STEP compound. ``check_faces(path)``
+(10 faces, 8 G1 and 16 sharp edges each: planes and cylinders bounded by lines and circles), written as
+one STEP compound; ``--g2-boxes`` adds arrays of ``ContinuousBox(40, 20, 8, 3)`` (B-spline faces and
+edges, every edge G2). ``check_faces(path)``
 reads it in a child process and measures there (a floor of 16 samples and both ends per edge,
 more only at knots and where the geometry turns); the peer is the same
 measuring and classifying on the shape already in memory (no reader): the difference is the
@@ -25,15 +28,25 @@ from pathlib import Path
 import build123d as bd
 from timing import arguments, compare, growth_exponent, machine, table, write_markdown
 
+from spiral_cad.build123d import ContinuousBox
 from spiral_cad.cad.faces import check_faces
 
 #: The modules whose code these numbers measure (stamped into the results: ``timing.code_stamp``).
-MEASURES = ("spiral_cad.cad.faces", "spiral_cad.cad.mesh", "spiral_cad.app.zebra")
+MEASURES = (
+    "spiral_cad.cad.faces",
+    "spiral_cad.cad.face_sampling",
+    "spiral_cad.cad.face_projection",
+    "spiral_cad.cad.batch_geometry",
+    "spiral_cad.cad.readers",
+    "spiral_cad.cad.mesh",
+    "spiral_cad.app.zebra",
+)
 
 
-def boxes(count: int) -> bd.Compound:
-    """``count`` filleted boxes on a grid, one compound."""
-    box = bd.fillet(bd.Box(40, 20, 8).edges().filter_by(bd.Axis.Z), 2)
+def boxes(count: int, g2: bool = False) -> bd.Compound:
+    """``count`` filleted boxes on a grid, one compound: build123d's circular fillets (planes and cylinders
+    bounded by lines and circles), or with ``g2`` ContinuousBoxes (mostly B-spline faces and edges)."""
+    box = ContinuousBox(40, 20, 8, 3) if g2 else bd.fillet(bd.Box(40, 20, 8).edges().filter_by(bd.Axis.Z), 2)
     return bd.Compound([box.moved(bd.Location((50 * (i % 10), 30 * (i // 10), 0))) for i in range(count)])
 
 
@@ -58,20 +71,26 @@ def picture(path: Path) -> dict[str, float]:
 
 
 def main() -> None:
-    args = arguments(__doc__, repeat=(5, 1), boxes=([10, 30, 100], [2, 6]), picture_boxes=([10, 100], [2]))
+    args = arguments(__doc__, repeat=(5, 1), boxes=([10, 30, 100], [2, 6]), picture_boxes=([10, 100], [2]),
+                     g2_boxes=([4, 12], [1]))  # fmt: skip
     rows, faces, seconds = [], [], []
     with tempfile.TemporaryDirectory() as folder:
-        for count in args.boxes:
-            part = boxes(count)
-            path = Path(folder) / f"boxes_{count}.step"
+        for count, g2 in [(count, False) for count in args.boxes] + [(count, True) for count in args.g2_boxes]:
+            part = boxes(count, g2)
+            path = Path(folder) / f"boxes_{count}{'_g2' if g2 else ''}.step"
             bd.export_step(part, str(path))
             report = check_faces(path)
-            assert report.counts["G1"] == 8 * count and report.counts["sharp"] == 16 * count, report.describe()
+            if g2:
+                assert report.passes("G2"), report.describe()
+            else:
+                assert report.counts["G1"] == 8 * count and report.counts["sharp"] == 16 * count, report.describe()
             best = compare({"file": lambda: check_faces(path), "shape": lambda: check_faces(part)}, args.repeat)
             ours, shape = best["file"].median, best["shape"].median
-            faces.append(report.faces)
-            seconds.append(ours)
-            rows.append((f"{report.faces:,} faces, {len(report.edges):,} edges", f"{ours * 1000:,.0f} ms",
+            if not g2:  # the growth exponent is of one kind of part
+                faces.append(report.faces)
+                seconds.append(ours)
+            kind = "ContinuousBox" if g2 else "filleted box"
+            rows.append((f"{count} × {kind}: {report.faces:,} faces, {len(report.edges):,} edges", f"{ours * 1000:,.0f} ms",
                          f"{ours / report.faces * 1e6:,.0f} µs", f"{shape * 1000:,.0f} ms",
                          f"{shape / report.faces * 1e6:,.0f} µs", f"{1 - shape / ours:.0%}"))  # fmt: skip
         pictures = []

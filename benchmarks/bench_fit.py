@@ -122,7 +122,7 @@ def own_design_table(quick: bool, with_build123d: bool) -> str:
 
 
 def main() -> None:
-    args = arguments(__doc__, points=(400, 80), sizes=([10_000, 100_000, 1_000_000], [2_000, 5_000]))
+    args = arguments(__doc__, points=(400, 80), sizes=([10_000, 100_000, 1_000_000], [2_000]))
     truth = road().chain
     rng = np.random.default_rng(3)
     points = truth.point_at(np.linspace(0.0, truth.length, args.points)) + rng.normal(0.0, 0.05 * TOLERANCE, (args.points, 2))

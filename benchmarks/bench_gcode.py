@@ -163,7 +163,7 @@ def main() -> None:
     if len(sys.argv) == 4 and sys.argv[1] == "--child":
         child(sys.argv[2], int(sys.argv[3]))
         return
-    args = arguments(__doc__, sizes=([10_000, 100_000, 1_000_000], [300, 2_000]), chain_max=(100_000, 2_000), write_max=(10_000, 300),
+    args = arguments(__doc__, sizes=([10_000, 100_000, 1_000_000], [300]), chain_max=(100_000, 2_000), write_max=(10_000, 300),
                      build_max=(10_000, 300))  # fmt: skip
     report = Report("G-code benchmark", f"Generated pocketing programs, max_deviation {MAX_DEVIATION} mm; one run per job, "
                                         "each in its own process (peak = that process's maximum resident set).")  # fmt: skip

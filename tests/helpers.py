@@ -15,6 +15,7 @@ from pathlib import Path
 import mpmath as mp
 import numpy as np
 import pytest
+from scipy.spatial import cKDTree
 
 import spiral_cad as sc
 from spiral_cad import Arc, Chain, Circle, Line, circle_in_circle, circle_to_circle, line_to_circle, line_to_line
@@ -323,15 +324,29 @@ def distance_to_chain(chain: Chain, points: np.ndarray, spacing: float) -> np.nd
     points = np.asarray(points, dtype=float)[:, : polyline.shape[1]]
     a, d = polyline[:-1], np.diff(polyline, axis=0)
     length2 = np.einsum("ij,ij->i", d, d)
-    nearest, station = np.empty(len(points)), np.empty(len(points))
-    for i, p in enumerate(points):
-        t = np.clip(np.einsum("ij,ij->i", p - a, d) / length2, 0.0, 1.0)
-        gaps = np.einsum("ij,ij->i", p - a - t[:, None] * d, p - a - t[:, None] * d)
-        k = int(np.argmin(gaps))
-        nearest[i], station[i] = math.sqrt(gaps[k]), s[k] + t[k] * (s[k + 1] - s[k])
+    # only segments with an end within (nearest vertex + longest segment) of a point can hold its nearest point
+    tree = cKDTree(polyline)
+    reach = tree.query(points)[0] + math.sqrt(float(length2.max()))
+    near = tree.query_ball_point(points, reach)
+    vertex = np.concatenate([np.asarray(v, dtype=int) for v in near])
+    owner = np.repeat(np.arange(len(points)), [len(v) for v in near])
+    segment, owner = np.clip(np.concatenate([vertex, vertex - 1]), 0, len(a) - 1), np.concatenate([owner, owner])
+    offset = points[owner] - a[segment]
+    t = np.clip(np.einsum("ij,ij->i", offset, d[segment]) / length2[segment], 0.0, 1.0)
+    foot = offset - t[:, None] * d[segment]
+    gaps = np.einsum("ij,ij->i", foot, foot)
+    order = np.lexsort((gaps, owner))
+    best = order[np.searchsorted(owner[order], np.arange(len(points)))]  # each point's least gap
+    k = segment[best]
+    nearest, station = np.sqrt(gaps[best]), s[k] + t[best] * (s[k + 1] - s[k])
+    moving = np.arange(len(points))
     for _ in range(8):  # then the foot of the perpendicular on the chain itself: s ← s + (p − C(s))·T(s)
-        step = np.einsum("ij,ij->i", points - chain.point_at(station), chain.tangent_at(station))
-        station = np.clip(station + step, 0.0, chain.length)
+        at = station[moving]
+        step = np.einsum("ij,ij->i", points[moving] - chain.point_at(at), chain.tangent_at(at))
+        station[moving] = np.clip(at + step, 0.0, chain.length)
+        moving = moving[np.abs(station[moving] - at) > 1e-13 * chain.length]  # settled ones stay
+        if not len(moving):
+            break
     out = np.minimum(nearest, np.linalg.norm(points - chain.point_at(station), axis=1))
     return out
 

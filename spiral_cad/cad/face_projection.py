@@ -29,7 +29,17 @@ from numpy.typing import NDArray
 from OCP.BRep import BRep_Tool
 from OCP.BRepAdaptor import BRepAdaptor_Surface
 from OCP.BRepTools import BRepTools
-from OCP.Geom import Geom_BSplineSurface, Geom_RectangularTrimmedSurface
+from OCP.Geom import (
+    Geom_BSplineCurve,
+    Geom_BSplineSurface,
+    Geom_OffsetCurve,
+    Geom_OffsetSurface,
+    Geom_RectangularTrimmedSurface,
+    Geom_SurfaceOfLinearExtrusion,
+    Geom_SurfaceOfRevolution,
+    Geom_TrimmedCurve,
+)
+from OCP.Geom2d import Geom2d_BSplineCurve, Geom2d_OffsetCurve, Geom2d_TrimmedCurve
 from OCP.GeomAbs import GeomAbs_Shape
 from OCP.GeomAdaptor import GeomAdaptor_Surface
 from OCP.gp import gp_Pnt, gp_Pnt2d, gp_Vec
@@ -37,7 +47,19 @@ from OCP.TColStd import TColStd_Array1OfReal
 from OCP.TopAbs import TopAbs_IN
 from OCP.TopoDS import TopoDS_Face
 
-__all__ = ["KNOT_STEP", "NEAR_KNOT", "SETTLED", "FaceDomain", "derivatives", "evaluate_on_faces", "shifted_back"]
+from spiral_cad.cad.batch_geometry import surface_derivatives, surface_frame
+
+__all__ = [
+    "KNOT_STEP",
+    "NEAR_KNOT",
+    "SETTLED",
+    "FaceDomain",
+    "curve_knots",
+    "derivatives",
+    "evaluate_on_faces",
+    "shifted_back",
+    "surface_knots",
+]
 
 #: Where no one-sided evaluation exists, a knot line's side is evaluated this far from it (relative to the
 #: face's parameter range) and moved back onto it to first order.
@@ -75,6 +97,32 @@ def shifted_back(raw: NDArray, axis: int, h: float | NDArray) -> None:
         raw[:, target : target + 3] -= h * found[:, derivative : derivative + 3]
 
 
+def curve_knots(curve: Any) -> list[float]:
+    """Every knot of a Geom or Geom2d curve's B-spline (through trimmed and offset curves); none for
+    other kinds (lines, conics, Bézier curves: one polynomial span)."""
+    while isinstance(curve, (Geom_TrimmedCurve, Geom2d_TrimmedCurve, Geom_OffsetCurve, Geom2d_OffsetCurve)):
+        curve = curve.BasisCurve()
+    if isinstance(curve, (Geom_BSplineCurve, Geom2d_BSplineCurve)):
+        return [curve.Knot(i) for i in range(1, curve.NbKnots() + 1)]
+    return []
+
+
+def surface_knots(surface: Any) -> tuple[list[float], list[float]]:
+    """Every u and every v knot of a Geom surface's B-spline: of a B-spline surface, of the B-spline curve
+    of an extrusion (u) or a revolution (v), through offset and trimmed surfaces. OCCT's adaptors list
+    only the knots below C3, and a defect inside a span of a high-degree surface hides from them."""
+    while isinstance(surface, (Geom_RectangularTrimmedSurface, Geom_OffsetSurface)):
+        surface = surface.BasisSurface()
+    if isinstance(surface, Geom_BSplineSurface):
+        return ([surface.UKnot(i) for i in range(1, surface.NbUKnots() + 1)],
+                [surface.VKnot(i) for i in range(1, surface.NbVKnots() + 1)])  # fmt: skip
+    if isinstance(surface, Geom_SurfaceOfLinearExtrusion):
+        return curve_knots(surface.BasisCurve()), []
+    if isinstance(surface, Geom_SurfaceOfRevolution):
+        return [], curve_knots(surface.BasisCurve())
+    return [], []
+
+
 def _knots(surface: Geom_BSplineSurface, axis: int) -> NDArray:
     count = surface.NbUKnots() if axis == 0 else surface.NbVKnots()
     knot = surface.UKnot if axis == 0 else surface.VKnot
@@ -91,11 +139,15 @@ class FaceDomain:
         breaks: per direction, the knot values where the surface is below C2 (over its whole domain; a
             periodic surface's values within one period).
         bspline: the located B-spline surface (through a rectangular trim), or None.
+        surface_knots: every u and v knot of the surface's B-spline (``surface_knots``).
+        frame: a plane's, cylinder's, cone's, sphere's or torus's numbers (``batch_geometry.surface_frame``), or None.
     """
 
     def __init__(self, face: TopoDS_Face, adaptor: BRepAdaptor_Surface) -> None:
         self.face, self.adaptor = face, adaptor
+        self.frame = surface_frame(adaptor)  # an elementary surface's numbers (evaluated in closed form), or None
         geom = BRep_Tool.Surface_s(face)  # located: its points are where the face is
+        self.surface_knots = surface_knots(geom)
         u0, u1, v0, v1 = BRepTools.UVBounds_s(face)
         self.lo, self.hi = np.array([u0, v0]), np.array([u1, v1])
         self.width = np.maximum(self.hi - self.lo, 1e-300)
@@ -242,30 +294,45 @@ def _clamp(uvs: NDArray, lo: NDArray, hi: NDArray, periods: NDArray) -> NDArray:
     return np.clip(np.where(better, moved, uvs), lo, hi)
 
 
-def _derivatives_of(domains: list[FaceDomain], owner: NDArray, uvs: NDArray) -> NDArray:
-    """Derivatives (n × 18) at ``uvs``, each on the face ``domains[owner]``."""
-    out = np.empty((len(uvs), 18))
-    p = gp_Pnt()
-    su, sv, suu, svv, suv = gp_Vec(), gp_Vec(), gp_Vec(), gp_Vec(), gp_Vec()
-    adaptors = [d.adaptor for d in domains]
-    for k, (f, (u, v)) in enumerate(zip(owner.tolist(), uvs.tolist())):
-        if not (math.isfinite(u) and math.isfinite(v)):
-            out[k] = math.nan
-            continue
-        adaptors[f].D2(u, v, p, su, sv, suu, svv, suv)
-        out[k] = (*p.Coord(), *su.Coord(), *sv.Coord(), *suu.Coord(), *svv.Coord(), *suv.Coord())
-    return out
+class FaceTable:
+    """Faces' domains as arrays (one row per face), built once for many evaluations of the same faces."""
+
+    def __init__(self, domains: list[FaceDomain]) -> None:
+        self.domains = domains
+        self.lo, self.hi = np.array([d.lo for d in domains]), np.array([d.hi for d in domains])
+        self.width, self.periods = np.array([d.width for d in domains]), np.array([d.periods for d in domains])
+        self.closed = np.array([d.frame is not None for d in domains])
+        self.frames = np.array([np.zeros(17) if d.frame is None else d.frame for d in domains])
+
+    def derivatives(self, owner: NDArray, uvs: NDArray) -> NDArray:
+        """Derivatives (n × 18) at ``uvs``, each on the face ``owner``: elementary surfaces all at once in
+        closed form, the others point by point through OCCT."""
+        out = np.empty((len(uvs), 18))
+        closed = self.closed[owner]
+        if closed.any():
+            out[closed] = surface_derivatives(self.frames[owner[closed]], uvs[closed])
+        rest = np.flatnonzero(~closed)
+        p = gp_Pnt()
+        su, sv, suu, svv, suv = gp_Vec(), gp_Vec(), gp_Vec(), gp_Vec(), gp_Vec()
+        for k, f, (u, v) in zip(rest.tolist(), owner[rest].tolist(), uvs[rest].tolist()):
+            if not (math.isfinite(u) and math.isfinite(v)):
+                out[k] = math.nan
+                continue
+            self.domains[f].adaptor.D2(u, v, p, su, sv, suu, svv, suv)
+            out[k] = (*p.Coord(), *su.Coord(), *sv.Coord(), *suu.Coord(), *svv.Coord(), *suv.Coord())
+        return out
 
 
-def evaluate_on_faces(domains: list[FaceDomain], owner: NDArray, points: NDArray, starts: NDArray, tolerances: NDArray,
-                      out: NDArray) -> None:  # fmt: skip
-    """Fill ``out`` (n × 18) with the derivatives of face ``domains[owner[k]]`` at the projection of
+def evaluate_on_faces(faces: list[FaceDomain] | FaceTable, owner: NDArray, points: NDArray, starts: NDArray,
+                      tolerances: NDArray, out: NDArray) -> None:  # fmt: skip
+    """Fill ``out`` (n × 18) with the derivatives of face ``faces[owner[k]]`` at the projection of
     ``points[k]`` on its surface, from ``starts[k]`` (the pcurve's (u, v); NaN: OCCT's projection within
     ``tolerances[k]``), inside the face's own domain: Gauss–Newton steps (below ``SETTLED`` taken to first
     order), clamped into the face's bounds, one-sided on a knot line below C2 (see the module)."""
+    table = faces if isinstance(faces, FaceTable) else FaceTable(faces)
+    domains = table.domains
     n = len(points)
-    lo, hi = np.array([d.lo for d in domains])[owner], np.array([d.hi for d in domains])[owner]
-    width, periods = np.array([d.width for d in domains])[owner], np.array([d.periods for d in domains])[owner]
+    lo, hi, width, periods = table.lo[owner], table.hi[owner], table.width[owner], table.periods[owner]
     uvs = np.array(starts, dtype=float).reshape(n, 2)
 
     def fallback(rows: NDArray) -> None:
@@ -281,7 +348,7 @@ def evaluate_on_faces(domains: list[FaceDomain], owner: NDArray, points: NDArray
         if step == _STEPS:  # the steps did not settle: from OCCT's projection once more
             fallback(todo)
             uvs[todo] = _clamp(uvs[todo], lo[todo], hi[todo], periods[todo])
-        raw = _derivatives_of(domains, owner[todo], uvs[todo])
+        raw = table.derivatives(owner[todo], uvs[todo])
         delta = _gauss_newton(raw, points[todo])
         target = _clamp(uvs[todo] + np.nan_to_num(delta), lo[todo], hi[todo], periods[todo])
         move = target - uvs[todo]

@@ -40,34 +40,23 @@ import math
 from collections.abc import Callable
 from dataclasses import dataclass
 from functools import partial
-from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
 from OCP.BRep import BRep_Tool
 from OCP.BRepAdaptor import BRepAdaptor_Curve, BRepAdaptor_Curve2d, BRepAdaptor_Surface
 from OCP.BRepTools import BRepTools
-from OCP.Geom import (
-    Geom_BSplineCurve,
-    Geom_BSplineSurface,
-    Geom_OffsetCurve,
-    Geom_OffsetSurface,
-    Geom_RectangularTrimmedSurface,
-    Geom_SurfaceOfLinearExtrusion,
-    Geom_SurfaceOfRevolution,
-    Geom_TrimmedCurve,
-)
-from OCP.Geom2d import Geom2d_BSplineCurve, Geom2d_OffsetCurve, Geom2d_TrimmedCurve
 from OCP.GeomAbs import GeomAbs_Shape
 from OCP.gp import gp_Pnt, gp_Pnt2d, gp_Vec
 from OCP.TColStd import TColStd_Array1OfReal
 from OCP.TopoDS import TopoDS_Edge, TopoDS_Face
 
 from ..check.joints import norms
-from .face_projection import KNOT_STEP, FaceDomain, evaluate_on_faces
+from .batch_geometry import curve_frame, curve_points
+from .face_projection import KNOT_STEP, FaceDomain, FaceTable, curve_knots, evaluate_on_faces
 
 __all__ = ["END_INSET", "FACE_FLOATS", "KNOT_STEP", "REFINE_ROUNDS", "TURN", "EdgeLine", "KnotLine", "Line", "Tolerances",
-           "curve_knots", "knot_lines", "measures", "sample_lines", "surface_knots"]  # fmt: skip
+           "knot_lines", "measures", "sample_lines"]  # fmt: skip
 
 #: Floats per sample and face: point (3), oriented unit normal (3), normal curvature across the edge.
 FACE_FLOATS = 7
@@ -104,32 +93,6 @@ def _values(count: int, fill: Callable[[TColStd_Array1OfReal], None]) -> list[fl
     array = TColStd_Array1OfReal(1, count + 1)
     fill(array)
     return [array.Value(i) for i in range(1, count + 2)]
-
-
-def curve_knots(curve: Any) -> list[float]:
-    """Every knot of a Geom or Geom2d curve's B-spline (through trimmed and offset curves); none for
-    other kinds (lines, conics, Bézier curves: one polynomial span)."""
-    while isinstance(curve, (Geom_TrimmedCurve, Geom2d_TrimmedCurve, Geom_OffsetCurve, Geom2d_OffsetCurve)):
-        curve = curve.BasisCurve()
-    if isinstance(curve, (Geom_BSplineCurve, Geom2d_BSplineCurve)):
-        return [curve.Knot(i) for i in range(1, curve.NbKnots() + 1)]
-    return []
-
-
-def surface_knots(surface: Any) -> tuple[list[float], list[float]]:
-    """Every u and every v knot of a Geom surface's B-spline: of a B-spline surface, of the B-spline curve
-    of an extrusion (u) or a revolution (v), through offset and trimmed surfaces. OCCT's adaptors list
-    only the knots below C3, and a defect inside a span of a high-degree surface hides from them."""
-    while isinstance(surface, (Geom_RectangularTrimmedSurface, Geom_OffsetSurface)):
-        surface = surface.BasisSurface()
-    if isinstance(surface, Geom_BSplineSurface):
-        return ([surface.UKnot(i) for i in range(1, surface.NbUKnots() + 1)],
-                [surface.VKnot(i) for i in range(1, surface.NbVKnots() + 1)])  # fmt: skip
-    if isinstance(surface, Geom_SurfaceOfLinearExtrusion):
-        return curve_knots(surface.BasisCurve()), []
-    if isinstance(surface, Geom_SurfaceOfRevolution):
-        return [], curve_knots(surface.BasisCurve())
-    return [], []
 
 
 def surface_breaks(surface: BRepAdaptor_Surface, shape: GeomAbs_Shape) -> tuple[list[float], list[float]]:
@@ -283,31 +246,46 @@ class EdgeLine(Line):
         self.curves_on_faces = [BRep_Tool.CurveOnSurface_s(oriented, domain.face, 0.0, 0.0) for domain, oriented in sides]
         self.pcurves = [None if on_face is None else BRepAdaptor_Curve2d(oriented, domain.face)
                         for (domain, oriented), on_face in zip(sides, self.curves_on_faces)]  # fmt: skip
+        frames = [curve_frame(self.curve), *(None if pcurve is None else curve_frame(pcurve) for pcurve in self.pcurves)]
+        # the edge and both pcurves lines, circles or ellipses: located in closed form, with other such edges
+        self.closed: NDArray | None = None if any(frame is None for frame in frames) else np.concatenate(frames)  # type: ignore[arg-type]
+        # else each curve in closed form where it can be, point by point where not
+        self.batch = [None if frame is None else partial(curve_points, frame) for frame in frames]
         floor = floor_points(self.lo, self.hi, samples)
         breaks = curve_knots(BRep_Tool.Curve_s(edge, 0.0, 0.0)) if BRep_Tool.IsGeometric_s(edge) else []
-        grid = np.unique(np.array(floor + breaks + [self.lo, self.hi]))
+        grid, own = None, list(breaks)
         for (domain, oriented), pcurve, on_face in zip(sides, self.pcurves, self.curves_on_faces):
             # where the knot lines of the face's surface cross the edge, in both directions, pcurve or not
-            knots = surface_knots(BRep_Tool.Surface_s(domain.face))
             if pcurve is not None:
-                breaks += curve_knots(on_face) + _crossings(partial(_pcurve_points, pcurve), grid, knots)
-            else:
-                uv_of = partial(_projected_points, oriented, domain.face)
-                breaks += _crossings(uv_of, grid, knots)
+                breaks += curve_knots(on_face)
+            if not any(domain.surface_knots):
+                continue
+            if grid is None:
+                grid = np.unique(np.array(floor + own + [self.lo, self.hi]))
+            uv_of = (partial(_pcurve_points, pcurve) if pcurve is not None
+                     else partial(_projected_points, oriented, domain.face))  # fmt: skip
+            breaks += _crossings(uv_of, grid, domain.surface_knots)
         self.start = floor + span_points(self.lo, self.hi, breaks)
 
     def locate(self, params: list[float]) -> tuple[NDArray, NDArray, list[NDArray]]:
         """The edge's points (n × 3) and unit tangents (n × 3) at ``params``, and per face the (u, v) to start
         its projection from: its pcurve's, or OCCT's projection where it has none."""
-        tangents, points = np.empty((len(params), 3)), np.empty((len(params), 3))
-        p, d1 = gp_Pnt(), gp_Vec()
-        for k, t in enumerate(params):
-            self.curve.D1(t, p, d1)
-            tangents[k], points[k] = d1.Coord(), p.Coord()
+        if self.closed is not None:
+            return located(np.broadcast_to(self.closed, (len(params), len(self.closed))), np.asarray(params, dtype=float))
+        edge, *on_faces = self.batch
+        if edge is not None:
+            points, tangents = edge(np.asarray(params, dtype=float))
+        else:
+            tangents, points = np.empty((len(params), 3)), np.empty((len(params), 3))
+            p, d1 = gp_Pnt(), gp_Vec()
+            for k, t in enumerate(params):
+                self.curve.D1(t, p, d1)
+                tangents[k], points[k] = d1.Coord(), p.Coord()
         with np.errstate(all="ignore"):
-            tangents /= norms(tangents)[:, None]
-        starts = [_pcurve_points(pcurve, params) if pcurve is not None else _projected_points(oriented, domain.face, params)
-                  for (domain, oriented), pcurve in zip(self.sides, self.pcurves)]  # fmt: skip
+            tangents = tangents / norms(tangents)[:, None]
+        starts = [_projected_points(oriented, domain.face, params) if pcurve is None
+                  else _pcurve_points(pcurve, params) if batch is None else batch(np.asarray(params, dtype=float))[0]
+                  for (domain, oriented), pcurve, batch in zip(self.sides, self.pcurves, on_faces)]  # fmt: skip
         return points, tangents, starts
 
     def evaluate(self, params: list[float]) -> tuple[NDArray, NDArray]:
@@ -318,6 +296,15 @@ class EdgeLine(Line):
         for side, ((domain, _), start) in enumerate(zip(self.sides, starts)):
             domain.evaluate_at(points, start, raw[:, side], self.tolerance)
         return raw, tangents
+
+
+def located(frames: NDArray, params: NDArray) -> tuple[NDArray, NDArray, list[NDArray]]:
+    """``EdgeLine.locate`` of edges whose curve and pcurves are lines, circles or ellipses, one row per
+    parameter: ``frames`` (n × 30) the curve's 12 numbers and each pcurve's 9 (``batch_geometry.curve_frame``)."""
+    points, tangents = curve_points(frames[:, :12], params)
+    with np.errstate(all="ignore"):
+        tangents /= norms(tangents)[:, None]
+    return points, tangents, [curve_points(frames[:, 12:21], params)[0], curve_points(frames[:, 21:], params)[0]]
 
 
 def _projected_points(edge: TopoDS_Edge, face: TopoDS_Face, params: list[float]) -> NDArray:
@@ -333,7 +320,7 @@ class KnotLine(Line):
         face = domain.face
         u0, u1, v0, v1 = BRepTools.UVBounds_s(face)
         self.lo, self.hi = (v0, v1) if along_u else (u0, u1)
-        us, vs = surface_knots(BRep_Tool.Surface_s(face))
+        us, vs = domain.surface_knots
         self.start = floor_points(self.lo, self.hi, samples) + span_points(self.lo, self.hi, vs if along_u else us)
         self.name = f"{'u' if along_u else 'v'} = {knot:.6g}"
         s = domain.bspline
@@ -384,9 +371,10 @@ def sample_lines(lines: list[Line], tolerances: Tolerances) -> tuple[NDArray, li
     or a measure may cross its tolerance between two samples (see the module's description)."""
     if not lines:
         return np.empty((0, 2, FACE_FLOATS)), []
+    table = _LineTable(lines)
     owner = np.concatenate([np.full(len(line.start), i) for i, line in enumerate(lines)])
     params = np.concatenate([np.asarray(line.start, dtype=float) for line in lines])
-    rows, tangents = _evaluate(lines, owner, params)
+    rows, tangents = table.evaluate(owner, params)
     width = np.array([line.hi - line.lo for line in lines])
     for _ in range(REFINE_ROUNDS):
         order = np.lexsort((params, owner))
@@ -395,46 +383,68 @@ def sample_lines(lines: list[Line], tolerances: Tolerances) -> tuple[NDArray, li
         if not mids.any():
             break
         new_owner, new_params = owner[:-1][mids], 0.5 * (params[:-1][mids] + params[1:][mids])
-        new_rows, new_tangents = _evaluate(lines, new_owner, new_params)
+        new_rows, new_tangents = table.evaluate(new_owner, new_params)
         owner, params = np.concatenate([owner, new_owner]), np.concatenate([params, new_params])
         rows, tangents = np.concatenate([rows, new_rows]), np.concatenate([tangents, new_tangents])
     order = np.lexsort((params, owner))
     return rows[order], np.bincount(owner, minlength=len(lines)).tolist()
 
 
-def _evaluate(lines: list[Line], owner: NDArray, params: NDArray) -> tuple[NDArray, NDArray]:
-    """Rows (n × 2 × ``FACE_FLOATS``) and line tangents (n × 3) at ``params`` of the lines ``owner``; the
-    faces along every edge are projected on all at once (``evaluate_on_faces``)."""
-    raw, tangents, sign = np.empty((len(params), 2, 18)), np.empty((len(params), 3)), np.empty((len(params), 2))
-    order = np.argsort(owner, kind="stable")
-    ids, starts = np.unique(owner[order], return_index=True)
-    domains: dict[int, int] = {}  # id of a face's domain → its place in ``listed``
-    listed: list[FaceDomain] = []
-    on_edges: list[tuple[NDArray, NDArray, list[NDArray], list[int], float]] = []
-    for i, a, b in zip(ids.tolist(), starts.tolist(), [*starts[1:].tolist(), len(order)]):
-        at, line = order[a:b], lines[i]
-        sign[at] = line.signs
-        if isinstance(line, EdgeLine):
-            points, tangents[at], uvs = line.locate(params[at].tolist())
-            for domain, _ in line.sides:
-                if id(domain) not in domains:
-                    domains[id(domain)] = len(listed)
-                    listed.append(domain)
-            which = [domains[id(domain)] for domain, _ in line.sides]
-            on_edges.append((at, points, uvs, which, line.tolerance))
-        else:
-            raw[at], tangents[at] = line.evaluate(params[at].tolist())
-    if on_edges:
-        for side in (0, 1):
-            rows = np.concatenate([at for at, *_ in on_edges])
-            face_of = np.concatenate([np.full(len(at), which[side]) for at, _, _, which, _ in on_edges])
+class _LineTable:
+    """What ``sample_lines`` needs of every line as arrays (one row per line), so that each round
+    evaluates all samples together: the faces along every edge are projected on all at once
+    (``evaluate_on_faces``), and edges whose curve and pcurves are lines, circles or ellipses are located
+    all at once (``located``)."""
+
+    def __init__(self, lines: list[Line]) -> None:
+        self.lines = lines
+        self.signs = np.array([line.signs for line in lines])
+        self.on_edge = np.array([isinstance(line, EdgeLine) for line in lines])
+        self.closed = np.array([isinstance(line, EdgeLine) and line.closed is not None for line in lines])
+        self.tolerance = np.array([line.tolerance if isinstance(line, EdgeLine) else 0.0 for line in lines])
+        self.frames = np.zeros((len(lines), 30))
+        self.face_of = np.zeros((len(lines), 2), dtype=int)
+        places: dict[int, int] = {}  # id of a face's domain → its place in ``domains``
+        self.domains: list[FaceDomain] = []
+        for i, line in enumerate(lines):
+            if not isinstance(line, EdgeLine):
+                continue
+            if line.closed is not None:
+                self.frames[i] = line.closed
+            for side, (domain, _) in enumerate(line.sides):
+                if id(domain) not in places:
+                    places[id(domain)] = len(self.domains)
+                    self.domains.append(domain)
+                self.face_of[i, side] = places[id(domain)]
+        self.faces = FaceTable(self.domains)
+
+    def evaluate(self, owner: NDArray, params: NDArray) -> tuple[NDArray, NDArray]:
+        """Rows (n × 2 × ``FACE_FLOATS``) and line tangents (n × 3) at ``params`` of the lines ``owner``."""
+        n = len(params)
+        raw, tangents = np.empty((n, 2, 18)), np.empty((n, 3))
+        points, uvs = np.empty((n, 3)), np.empty((2, n, 2))
+        closed = self.closed[owner]
+        if closed.any():
+            at = np.flatnonzero(closed)
+            points[at], tangents[at], (uvs[0, at], uvs[1, at]) = located(self.frames[owner[at]], params[at])
+        rest = np.flatnonzero(~closed)
+        order = rest[np.argsort(owner[rest], kind="stable")]
+        ids, starts = np.unique(owner[order], return_index=True)
+        for i, a, b in zip(ids.tolist(), starts.tolist(), [*starts[1:].tolist(), len(order)]):
+            at, line = order[a:b], self.lines[i]
+            if isinstance(line, EdgeLine):
+                points[at], tangents[at], (uvs[0, at], uvs[1, at]) = line.locate(params[at].tolist())
+            else:
+                raw[at], tangents[at] = line.evaluate(params[at].tolist())
+        rows = np.flatnonzero(self.on_edge[owner])
+        for side in (0, 1) if len(rows) else ():
             found = np.empty((len(rows), 18))
-            evaluate_on_faces(listed, face_of, np.concatenate([points for _, points, *_ in on_edges]),
-                              np.concatenate([uvs[side] for _, _, uvs, _, _ in on_edges]),
-                              np.concatenate([np.full(len(at), tol) for at, *_, tol in on_edges]), found)  # fmt: skip
+            evaluate_on_faces(self.faces, self.face_of[owner[rows], side], points[rows], uvs[side, rows],
+                              self.tolerance[owner[rows]], found)  # fmt: skip
             raw[rows, side] = found
-    rows = rows_of(raw.reshape(-1, 18), sign.reshape(-1), np.repeat(tangents, 2, axis=0))
-    return rows.reshape(-1, 2, FACE_FLOATS), tangents
+        sign = self.signs[owner]
+        found = rows_of(raw.reshape(-1, 18), sign.reshape(-1), np.repeat(tangents, 2, axis=0))
+        return found.reshape(-1, 2, FACE_FLOATS), tangents
 
 
 def _to_bisect(owner: NDArray, params: NDArray, rows: NDArray, tangents: NDArray, width: NDArray,

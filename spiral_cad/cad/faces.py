@@ -57,6 +57,7 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
+from numpy.typing import NDArray
 from OCP.Bnd import Bnd_Box
 from OCP.BRep import BRep_Tool
 from OCP.BRepAdaptor import BRepAdaptor_Curve, BRepAdaptor_Surface
@@ -450,6 +451,16 @@ class FaceReport:
 _FREE_LISTED = 20
 
 
+def _worst_of_each(values: NDArray, ends: NDArray) -> NDArray:
+    """Per line (samples ``ends[i]`` to ``ends[i + 1]``, none empty), the index of its largest value, the
+    first of equals; NaN (a sample at a singular point of a surface) never decides it (all NaN: the first)."""
+    finite = np.where(np.isnan(values), -np.inf, values)
+    line = np.repeat(np.arange(len(ends) - 1), np.diff(ends))
+    order = np.lexsort((-np.arange(len(values)), finite, line))  # by line, then value, then the first index last
+    found = order[ends[1:] - 1]
+    return np.where(np.isnan(values[found]), ends[:-1], found)
+
+
 def _classify(measured: Measured, *, gap_tol: float | None, angle_tol: float, curvature_tol: float, feature_angle: float,
               samples: int, source: str, units: str, started: float) -> FaceReport:  # fmt: skip
     """The report of the measured samples: worst values per edge (measures vectorised over all samples) and classes."""
@@ -460,13 +471,13 @@ def _classify(measured: Measured, *, gap_tol: float | None, angle_tol: float, cu
     rows = []
     given = gap_tol is not None
     gap_limits = [gap_tol * size if gap_tol is not None else max(stated, limit) for limit in limits]
+    worst = [_worst_of_each(v, ends).tolist() for v in (gap, angle, jump)]
+    least = np.fmin.reduceat(angle, ends[:-1]).tolist() if len(angle) else []
     for i, (edge, fa, fb, seam, note) in enumerate(pairs):
         start, stop = int(ends[i]), int(ends[i + 1])
-        g_, an_, j_ = gap[start:stop], angle[start:stop], jump[start:stop]
-        # NaN (a sample at a singular point of a surface) never decides a worst value
-        g, an, j = (start + (int(np.nanargmax(v)) if np.isfinite(v).any() else 0) for v in (g_, an_, j_))
+        g, an, j = worst[0][i], worst[1][i], worst[2][i]
         worst_gap, worst_angle, worst_jump = float(gap[g]), float(angle[an]), float(jump[j])
-        least_angle = float(np.nanmin(an_)) if np.isfinite(an_).any() else math.nan
+        least_angle = least[i]
         if not (math.isfinite(worst_gap) and math.isfinite(worst_angle)):
             level = "unmeasurable"  # no sample gave a point or a normal: never passed
         elif worst_gap > gap_limits[i]:

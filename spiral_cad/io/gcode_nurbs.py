@@ -25,7 +25,7 @@ from scipy.spatial import cKDTree
 
 from ..core.chain import Chain
 from ..core.segments import Arc, Line, Segment
-from .gcode_write import _arcs_through, _distances
+from .gcode_write import _arcs_through, _distances, _equal_legs
 
 __all__ = ["NurbsG2", "nurbs_g2", "nurbs_points"]
 
@@ -132,15 +132,8 @@ def nurbs_biarcs(controls: NDArray[np.float64], weights: NDArray[np.float64], or
         ends, tangents = _at(curve, np.stack([u0, u1], axis=1))
         probes, _ = _at(curve, u0[:, None] + (u1 - u0)[:, None] * inside)
         p0, p1, t0, t1 = ends[:, 0], ends[:, 1], tangents[:, 0], tangents[:, 1]
-        chord = p1 - p0
-        a = 2.0 * (np.einsum("ij,ij->i", t0, t1) - 1.0)
-        b = -2.0 * np.einsum("ij,ij->i", chord, t0 + t1)
-        c = np.einsum("ij,ij->i", chord, chord)
+        leg, joint, middle = _equal_legs(p0, p1, t0, t1)
         with np.errstate(divide="ignore", invalid="ignore"):
-            leg = np.where(np.abs(a) < 1e-12, c / -b, (-b - np.sqrt(np.maximum(b * b - 4.0 * a * c, 0.0))) / (2.0 * a))
-            q0, q1 = p0 + leg[:, None] * t0, p1 - leg[:, None] * t1
-            joint = (q0 + q1) / 2.0
-            middle = (q1 - q0) / np.linalg.norm(q1 - q0, axis=1, keepdims=True)
             first, second = _arcs_through(p0, t0, joint), _arcs_through(joint, middle, p1)
             error = np.minimum(_distances(probes, p0, joint, *first), _distances(probes, joint, p1, *second)).max(axis=1)
         good = (leg > 0.0) & np.isfinite(error) & (error <= tolerance)

@@ -176,6 +176,21 @@ def _plane_of(points: NDArray, normal: NDArray | None, tolerance: float) -> tupl
 Piece = tuple[NDArray, NDArray | None, float]
 
 
+def _equal_legs(p0: NDArray, p1: NDArray, t0: NDArray, t1: NDArray) -> tuple[NDArray, NDArray, NDArray]:
+    """The biarc of equal legs between each ``p0`` (unit tangent ``t0``) and ``p1`` (``t1``): the leg length
+    (not positive where none exists), the joint point and the unit tangent there, rows of arrays."""
+    chord = p1 - p0
+    a = 2.0 * (np.einsum("ij,ij->i", t0, t1) - 1.0)
+    b = -2.0 * np.einsum("ij,ij->i", chord, t0 + t1)
+    c = np.einsum("ij,ij->i", chord, chord)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        root = (-b - np.sqrt(np.maximum(b * b - 4.0 * a * c, 0.0))) / (2.0 * a)  # the positive root (a < 0 < c)
+        leg = np.where(np.abs(a) < 1e-12, c / -b, root)
+        q0, q1 = p0 + leg[:, None] * t0, p1 - leg[:, None] * t1
+        middle = (q1 - q0) / np.linalg.norm(q1 - q0, axis=1, keepdims=True)
+    return leg, (q0 + q1) / 2.0, middle
+
+
 def _arcs_through(start: NDArray, tangent: NDArray, end: NDArray) -> tuple[NDArray, NDArray, NDArray]:
     """The circles leaving each ``start`` (m, 2) along ``tangent`` through ``end``: (centres, signed radii,
     positive counterclockwise, and whether the piece is a line: ``end`` on the tangent)."""
@@ -244,16 +259,8 @@ def spirals_biarcs(control_points: NDArray, tolerance: float, least_radius: floa
         tangents = bezier.tangent(curves, np.stack([u0, u1], axis=1))
         probes = bezier.point(curves, u0[:, None] + (u1 - u0)[:, None] * inside)
         p0, p1, t0, t1 = ends[:, 0], ends[:, 1], tangents[:, 0], tangents[:, 1]
-        chord = p1 - p0
-        a = 2.0 * (np.einsum("ij,ij->i", t0, t1) - 1.0)
-        b = -2.0 * np.einsum("ij,ij->i", chord, t0 + t1)
-        c = np.einsum("ij,ij->i", chord, chord)
+        leg, joint, middle = _equal_legs(p0, p1, t0, t1)
         with np.errstate(divide="ignore", invalid="ignore"):
-            root = (-b - np.sqrt(np.maximum(b * b - 4.0 * a * c, 0.0))) / (2.0 * a)  # the positive root (a < 0 < c)
-            leg = np.where(np.abs(a) < 1e-12, c / -b, root)
-            q0, q1 = p0 + leg[:, None] * t0, p1 - leg[:, None] * t1
-            joint = (q0 + q1) / 2.0
-            middle = (q1 - q0) / np.linalg.norm(q1 - q0, axis=1, keepdims=True)
             first = _straight_if_below(_arcs_through(p0, t0, joint), least_radius)
             second = _straight_if_below(_arcs_through(joint, middle, p1), least_radius)
             error = np.minimum(_distances(probes, p0, joint, *first), _distances(probes, joint, p1, *second)).max(axis=1)

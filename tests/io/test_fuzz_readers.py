@@ -144,9 +144,13 @@ def test_mutated_demo_files_are_reported_or_refused_never_a_crash(tmp_path):
     import pytest
 
     pytest.importorskip("OCP")
+    from conftest import NIGHTLY_FACTOR
+    from hypothesis import settings
+
     files = demo_files(tmp_path)
-    outcomes, problems = campaign(files, 125, SEED, tmp_path)
-    assert sum(outcomes.values()) == 250
+    count = 60 * (NIGHTLY_FACTOR if settings.get_current_profile_name() == "nightly" else 1)  # `make nightly`: 600 a file
+    outcomes, problems = campaign(files, count, SEED, tmp_path)
+    assert sum(outcomes.values()) == 2 * count
     assert problems == [], "\n".join(problems[:10])
     assert outcomes["exit 2"] > 0 and outcomes["exit 0"] + outcomes["exit 1"] > 0  # both kinds of mutation occur
 
