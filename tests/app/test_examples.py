@@ -1,10 +1,10 @@
-"""Every example script runs from plain Python and writes what it promises."""
+"""Every example script runs from plain Python (a process of its own, as ``python SCRIPT FOLDER``) and
+writes what it promises."""
 
-import subprocess
-import sys
 from pathlib import Path
 
 import pytest
+from helpers import Block, run_blocks
 
 EXAMPLES = Path(__file__).resolve().parents[2] / "examples"
 OUTPUTS = {
@@ -28,9 +28,8 @@ def example_outputs(tmp_path_factory):
         if script not in folders:
             folder = tmp_path_factory.mktemp(script.removesuffix(".py"))
             target = folder / OUTPUTS[script][0] if script == "cadquery_plugin.py" else folder
-            run = subprocess.run([sys.executable, str(EXAMPLES / script), str(target)], capture_output=True, text=True,
-                                 timeout=300)  # fmt: skip
-            assert run.returncode == 0, run.stdout[-2000:] + run.stderr[-2000:]
+            path = EXAMPLES / script
+            run_blocks(path, [Block(1, path.read_text(encoding="utf-8"), None)], folder, 300, [str(path), str(target)])
             folders[script] = folder
         return folders[script]
 
