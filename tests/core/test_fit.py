@@ -129,7 +129,7 @@ def test_a_closed_circle_is_one_arc(noise):
 
 @pytest.mark.parametrize("noise", [0.0, 0.05])
 def test_an_ellipse_closes_g2(noise):
-    angle = np.linspace(0.0, 2 * math.pi, 1500, endpoint=False)
+    angle = np.linspace(0.0, 2 * math.pi, 500, endpoint=False)
     points = np.c_[80 * np.cos(angle), 40 * np.sin(angle)]
     points += np.random.default_rng(2).normal(0.0, noise * 0.05, points.shape)
     fit = fit_points(points, 0.05, closed=True)
