@@ -583,8 +583,8 @@ def _add_g2(sub: argparse._SubParsersAction) -> None:
         "move as it is (rapids, plunges, retracts, tool, spindle, coolant, dwells, stops, probes, comments); each run of "
         "G1/G2/G3 cuts in XY at one Z and one feed is made G2 (make_g2: arcs kept), its first and last points and its "
         "feed kept. A run that cannot be made G2 within the bound is kept as it is and named in the report. A DXF "
-        "drawing's paths of lines and arcs are written back as LINE, ARC and exact SPLINE pieces on their own layers, every "
-        "other entity kept; a LandXML file's alignments of lines and arcs get spirals, stations recomputed, the rest kept.",
+        "drawing's paths of lines and arcs (and the splines and ellipses in them, read as biarcs within 0.3 of the bound) "
+        "are written back as LINE, ARC and exact SPLINE pieces on their own layers, every other entity kept; a LandXML file's alignments of lines and arcs get spirals, stations recomputed, the rest kept.",
     )
     g2.add_argument("input", help="the document (.nc .ngc .gcode .tap, .dxf, .xml)")
     g2.add_argument("-o", "--output", required=True, help="the output document (same kind)")

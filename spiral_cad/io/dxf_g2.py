@@ -35,8 +35,10 @@ import numpy as np
 from ..core.spiral import BezierSpiral
 from ..core.units import MM_PER_UNIT, length_unit
 from ..design import make_g2
+from .curve_biarcs import BIARC_SHARE
 from .document_report import DocumentReport, PathReport
 from .dxf import _add
+from .dxf_curves import CURVES, curve_parts
 from .dxf_read import DXF_UNITS, JOIN_TOLERANCE, READ, _chains, _entity_parts, _segment
 
 __all__ = ["ATTRIBUTES", "rewrite_dxf_g2"]
@@ -193,11 +195,25 @@ def rewrite_dxf_g2(
         notes.insert(0, recovered)
     msp = doc.modelspace()
     notes += _explode(doc, msp)
-    pieces, owners = [], []
+    pieces: list[tuple[list[tuple], str]] = []
+    owners: list[Any] = []
     foreign: list[np.ndarray] = []  # the ends of the curves kept as they are (splines, ellipses): paths stay joined to them
     kept: Counter[str] = Counter()
+    curved: set[int] = set()  # the pieces that are biarcs along a SPLINE or ELLIPSE
+    alone = 0  # of them, those that make a path on their own (kept as drawn)
     for entity in msp:
         kind = entity.dxftype()
+        if kind in CURVES:
+            try:
+                along = curve_parts(entity, kind, BIARC_SHARE * bound)
+            except ValueError as error:
+                along = None
+                notes.append(f"{kind} {entity.dxf.handle} kept as is: {error}")
+            if along:
+                curved.add(len(pieces))
+                pieces.append((along, str(entity.dxf.handle)))
+                owners.append(entity)
+                continue
         if kind not in READ or (kind == "POLYLINE" and not (entity.is_2d_polyline or entity.is_3d_polyline)):
             kept[kind] += 1
             foreign += _curve_ends(entity, kind)
@@ -229,13 +245,25 @@ def rewrite_dxf_g2(
                 reports.append(PathReport(name, sum(len(pieces[i][0]) for i, _ in order) - (0 if closed else 1),
                                           kept=f"another entity ends at its vertex ({where}): rounding it would detach that entity"))  # fmt: skip
                 continue
+            if len(order) == 1 and order[0][0] in curved:  # a SPLINE or ELLIPSE alone: smooth as drawn, kept exact
+                curved.discard(order[0][0])
+                alone += 1
+                continue
             branches = _branch_ends(pieces, order, tree, tolerance) if not closed else []
-            reports.append(_path(msp, pieces, owners, order, closed, number, bound, g2_units, shape or "near-linear", notes, branches))
+            share = BIARC_SHARE if any(index in curved for index, _ in order) else 0.0
+            reports.append(_path(msp, pieces, owners, order, closed, number, bound, g2_units, shape or "near-linear", notes, branches,
+                                 share))  # fmt: skip
     if kept:
         notes.append("kept as is: " + ", ".join(f"{n} {kind}" for kind, n in sorted(kept.items())))
-    for kind in ("SPLINE", "ELLIPSE", "HELIX"):
+    if alone:
+        notes.append(f"{alone} SPLINE or ELLIPSE entit{'y' if alone == 1 else 'ies'} meeting no other path kept as drawn")
+    if curved:
+        notes.append(f"{len(curved)} SPLINE or ELLIPSE entit{'y' if len(curved) == 1 else 'ies'} read as biarcs within "
+                     f"{BIARC_SHARE:g} of the bound, their paths made G2 within the rest")  # fmt: skip
+    for kind, why in (("SPLINE", "one cubic Bézier span, or out of the plane z = 0"), ("ELLIPSE", "out of the plane z = 0"),
+                      ("HELIX", "a curve in space")):  # fmt: skip
         if kept[kind]:
-            notes.append(f"{kept[kind]} {kind} entit{'y' if kept[kind] == 1 else 'ies'} not made G2 (only lines and arcs are)")
+            notes.append(f"{kept[kind]} {kind} entit{'y' if kept[kind] == 1 else 'ies'} not made G2 ({why})")
     issues, first = _issues(source, bool(recovered))
     if issues:
         notes.append(f"ezdxf's audit finds {sum(issues.values())} issue(s) in the input ({first}); kept as they were")
@@ -245,8 +273,9 @@ def rewrite_dxf_g2(
 
 
 def _path(msp, pieces: list, owners: list, order: list[tuple[int, bool]], closed: bool, number: int, bound: float, units: str,
-          shape: str, notes: list[str], branches: list[np.ndarray]) -> PathReport:  # fmt: skip
-    """Make one chained path G2 and write it in place of its entities; its report."""
+          shape: str, notes: list[str], branches: list[np.ndarray], share: float = 0.0) -> PathReport:  # fmt: skip
+    """Make one chained path G2 and write it in place of its entities; its report. ``share`` of the bound is
+    taken by biarcs along its curves already (``make_g2`` gets the rest; the deviation reported includes it)."""
     import ezdxf
 
     entities = [owners[index] for index, _ in order]
@@ -262,7 +291,7 @@ def _path(msp, pieces: list, owners: list, order: list[tuple[int, bool]], closed
     if not joints:
         return PathReport(name, joints, kept="one entity, no joint", g2=True)
     try:
-        result = make_g2(segments, bound, closed=closed, shape=shape, units=units)
+        result = make_g2(segments, bound * (1.0 - share), closed=closed, shape=shape, units=units)
     except ValueError as error:
         return PathReport(name, joints, kept=f"make_g2 refuses it: {error}")
     changed = sum(j.kind not in ("g2", "split") for j in result.joints)
@@ -296,7 +325,7 @@ def _path(msp, pieces: list, owners: list, order: list[tuple[int, bool]], closed
         return PathReport(name, joints, splits=splits, kept=f"ezdxf cannot write its G2 path ({error})")
     for entity in entities:
         msp.delete_entity(entity)
-    return PathReport(name, joints, changed, float(result.deviation), splits, pieces=len(added), g2=True)
+    return PathReport(name, joints, changed, float(result.deviation) + share * bound, splits, pieces=len(added), g2=True)
 
 
 def _curve_ends(entity, kind: str) -> list[np.ndarray]:

@@ -6,9 +6,7 @@ the block naming both X and Y adds a control point with weight ``P`` (default 1)
 else 3; the knots are clamped and uniform: 0 (order times), 1 … n − order + 1, n − order + 2 (order times), for
 control points 0 … n. The curve starts on the first control point and ends on the last.
 
-``nurbs_g2`` approximates the curve by biarcs (two tangent arcs between two points of the curve with its tangents
-there, equal legs, as ``gcode_write`` fits them to cubics; the parameter interval halved until each lies within a
-share of the bound), makes that G1 path of arcs G2 with ``spiral_cad.design.make_g2`` within the rest (its ends
+``nurbs_g2`` approximates the curve by biarcs (``spiral_cad.io.curve_biarcs``, within a share of the bound), makes that G1 path of arcs G2 with ``spiral_cad.design.make_g2`` within the rest (its ends
 fixed: a straight step from the block's first point and to its last where the G2 path's ends moved), and
 measures the result against dense samples of the NURBS both ways.
 """
@@ -17,6 +15,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from functools import partial
 
 import numpy as np
 from numpy.typing import NDArray
@@ -24,20 +23,15 @@ from scipy.interpolate import BSpline
 from scipy.spatial import cKDTree
 
 from ..core.chain import Chain
-from ..core.segments import Arc, Line, Segment
-from .gcode_write import _arcs_through, _distances, _equal_legs
+from ..core.segments import Line, Segment
+from .curve_biarcs import BIARC_SHARE, curve_biarcs
 
 __all__ = ["NurbsG2", "nurbs_g2", "nurbs_points"]
 
-#: The share of the bound the biarcs may use (``make_g2`` uses the rest).
-BIARC_SHARE = 0.3
 #: The spacing of the samples the result is measured on, as a share of the bound.
 MEASURE_SHARE = 0.05
-#: The most samples taken of a block, and the most biarcs (a longer curve is kept as it is).
+#: The most samples taken of a block (a longer curve is kept as it is).
 MAX_SAMPLES = 400_000
-MAX_BIARCS = 20_000
-#: Points probed between a biarc's ends.
-PROBES = 9
 
 
 @dataclass
@@ -115,50 +109,6 @@ def nurbs_points(
     return out
 
 
-def nurbs_biarcs(controls: NDArray[np.float64], weights: NDArray[np.float64], order: int, tolerance: float) -> list[Segment]:
-    """Biarcs (lines where straight) within ``tolerance`` of a LinuxCNC NURBS, tangent to it at their ends.
-
-    Raises:
-        ValueError: as ``nurbs_points``; more than ``MAX_BIARCS`` biarcs.
-    """
-    curve = _curve(controls, weights, order)
-    knots = np.unique(curve.t)
-    u0, u1 = knots[:-1], knots[1:]
-    inside = np.linspace(0.0, 1.0, PROBES + 2)[1:-1]
-    found: list[tuple[float, list[Segment]]] = []
-    while len(u0):
-        if len(found) + len(u0) > MAX_BIARCS:
-            raise ValueError(f"the NURBS needs more than {MAX_BIARCS} biarcs within {tolerance:.3g}")
-        ends, tangents = _at(curve, np.stack([u0, u1], axis=1))
-        probes, _ = _at(curve, u0[:, None] + (u1 - u0)[:, None] * inside)
-        p0, p1, t0, t1 = ends[:, 0], ends[:, 1], tangents[:, 0], tangents[:, 1]
-        leg, joint, middle = _equal_legs(p0, p1, t0, t1)
-        with np.errstate(divide="ignore", invalid="ignore"):
-            first, second = _arcs_through(p0, t0, joint), _arcs_through(joint, middle, p1)
-            error = np.minimum(_distances(probes, p0, joint, *first), _distances(probes, joint, p1, *second)).max(axis=1)
-        good = (leg > 0.0) & np.isfinite(error) & (error <= tolerance)
-        for k in np.flatnonzero(good):
-            pieces = [_piece(p0[k], joint[k], first, int(k)), _piece(joint[k], p1[k], second, int(k))]
-            found.append((float(u0[k]), [piece for piece in pieces if piece is not None]))
-        bad = ~good
-        half = (u0[bad] + u1[bad]) / 2.0
-        u0, u1 = np.ravel(np.stack([u0[bad], half], axis=1)), np.ravel(np.stack([half, u1[bad]], axis=1))
-    return [piece for _, pieces in sorted(found, key=lambda f: f[0]) for piece in pieces]
-
-
-def _piece(start: NDArray[np.float64], end: NDArray[np.float64], arcs: tuple[NDArray, NDArray, NDArray], k: int) -> Segment | None:
-    """One piece of a biarc: a line, or the arc about its centre from ``start`` to ``end`` (None: no length)."""
-    centre, radius, line = arcs[0][k], float(arcs[1][k]), bool(arcs[2][k])
-    if float(np.linalg.norm(end - start)) <= 1e-12 * max(1.0, float(np.abs(start).max())):
-        return None
-    if line:
-        return Line(tuple(start), tuple(end))
-    a0 = math.atan2(start[1] - centre[1], start[0] - centre[0])
-    a1 = math.atan2(end[1] - centre[1], end[0] - centre[0])
-    sweep = ((a1 - a0) if radius > 0 else (a0 - a1)) % (2.0 * math.pi)
-    return Arc(tuple(centre), radius, a0, sweep if sweep > 0.0 else 2.0 * math.pi)
-
-
 def nurbs_g2(
     controls: NDArray[np.float64], weights: NDArray[np.float64], order: int, bound: float, *, units: str = "mm",
     shape: str = "near-linear",
@@ -179,7 +129,8 @@ def nurbs_g2(
     """
     from ..design.g2 import make_g2
 
-    biarcs = nurbs_biarcs(controls, weights, order, bound * BIARC_SHARE)
+    curve_of = _curve(controls, weights, order)
+    biarcs = curve_biarcs(partial(_at, curve_of), np.unique(curve_of.t), bound * BIARC_SHARE)
     start, end = np.asarray(controls[0], dtype=float), np.asarray(controls[-1], dtype=float)
     spacing = bound * MEASURE_SHARE
     curve = nurbs_points(controls, weights, order, spacing)
