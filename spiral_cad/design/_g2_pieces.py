@@ -203,8 +203,9 @@ def _classify(a: _Piece, b: _Piece, scale: float, steepest: float, bound: float,
         return "g2" if drop <= 1e-3 * bound else "corner"
     if a.kind == "arc" and b.kind == "arc" and abs(turn) <= NEAR_MAX and _same_circle(a, b, scale, bound):
         return "g2"
-    if a.kind == "arc" and b.kind == "arc" and (a.r > 0) == (b.r > 0) and turn * a.sense < 0.0 and c_pair and _c_pair(a, b, turn):
-        return "arc-arc-c"  # turning against both arcs: the C pair lies at the joint, whatever the kink and the bound
+    if (a.kind == "arc" and b.kind == "arc" and (a.r > 0) == (b.r > 0) and turn * a.sense < 0.0 and abs(turn) <= NEAR_MAX and c_pair
+            and _c_pair(a, b, turn)):  # fmt: skip
+        return "arc-arc-c"  # a small kink against both arcs: the C pair lies at the joint, whatever the bound
     if not _near_tangent(a, b, turn, bound):
         return "corner"
     if a.kind == "arc" and b.kind == "arc":

@@ -513,7 +513,7 @@ def _build(segments: list[Segment], bound: float, closed: bool | None, shape: st
 
 
 def _make(segments: list[Segment], bound: float, closed: bool | None, shape: str, units: str, tolerance: float,
-          retry: bool = True, round_sharp: bool = True, no_c: frozenset[int] = frozenset()) -> G2Path | _Refusal:  # fmt: skip
+          retry: bool = True, round_sharp: bool = True, no_c: frozenset[int] = frozenset(), retried: int = 0) -> G2Path | _Refusal:  # fmt: skip
     """``make_g2`` of plane lines and arcs, or the refusal of its first joint that fails (``retry``: a part
     refused within the bound tried again within smaller shares of it; the advice's search goes without).
 
@@ -632,10 +632,10 @@ def _make(segments: list[Segment], bound: float, closed: bool | None, shape: str
         made = _solve_group(group_pieces, group_kinds, group_joints, group_closed, room, shape, extent, units, tolerance, spanned,
                             bound, shown, steepest, RETRY_SHARES if retry else ())  # fmt: skip
         if isinstance(made, _Located):
-            if made.joint < joint_count and kinds[made.joint] == "arc-arc-c" and len(no_c) < C_RETRIES:
-                return _make(segments, bound, closed, shape, units, tolerance, retry, round_sharp, no_c | {made.joint})
+            if made.joint < joint_count and kinds[made.joint] == "arc-arc-c" and retried < C_RETRIES:
+                return _make(segments, bound, closed, shape, units, tolerance, retry, round_sharp, no_c | {made.joint}, retried + 1)
             if round_sharp and sharp:  # the tangent circles did not fit: split at those corners instead
-                return _make(segments, bound, closed, shape, units, tolerance, retry, round_sharp=False, no_c=no_c)
+                return _make(segments, bound, closed, shape, units, tolerance, retry, False, no_c, retried)
             return made
         chain, measured, group, solved, s, group_pieces, group_kinds, group_joints = made
         chains.append(chain)
