@@ -164,8 +164,9 @@ def _c_window(a: _Piece, b: _Piece) -> tuple[int, int, float, float] | None:
         return None
     m, dr = math.sqrt(m2), abs(ra - rb)
     small, big = (0, 1) if ra <= rb else (1, 0)
-    # At most twice as far past touching as the circles are, or must be: their crossing (and the pair) stays near.
-    lo = dr - m
+    # Between half and twice as far past touching as the circles are (or must be): their crossing, and the
+    # pair, stay near the joint.
+    lo = max(dr - m, -0.5 * (d - dr))
     base = max(lo, 0.0)
     return small, big, lo, base + (d - abs(dr - base))
 
@@ -250,7 +251,7 @@ C_HOLD = 5e-10
 
 
 #: ... and the shifts make it cross at this many times the least such angle.
-C_MARGIN = 2.0
+C_MARGIN = 1.0
 
 
 #: Arcs of one circle (to this share of the bound) are merged into one arc.
