@@ -179,13 +179,17 @@ def _c_pair(a: _Piece, b: _Piece, turn: float) -> bool:
     them, at the circles' other crossing: the lens between must fit in the arcs."""
     if not abs(turn) > TANGENT_TOL or _c_window(a, b) is None:
         return False
-    if turn * a.sense > 0.0:
-        d = math.dist(a.c, b.c)
-        # each crossing's angle at a centre, from the line of centres (the smaller circle: from its far side)
-        at = [math.acos(min(max((p.r * p.r + d * d - q.r * q.r) / (2.0 * abs(p.r) * d), -1.0), 1.0)) for p, q in ((a, b), (b, a))]
-        if 2.0 * max(min(t, math.pi - t) for t in at) > SHARED * min(a.sweep, b.sweep):
-            return False
-    return True
+    return turn * a.sense < 0.0 or _lens_fits(a, b)
+
+
+def _lens_fits(a: _Piece, b: _Piece) -> bool:
+    """Whether the lens between the two crossings of the circles of arcs ``a`` and ``b`` (the joint at one of
+    them) spans at most the share of each arc a joint may use: a transition placed at the other crossing,
+    or where the circles come nearest, fits."""
+    d = math.dist(a.c, b.c)
+    # each crossing's angle at a centre, from the line of centres (the smaller circle: from its far side)
+    at = [math.acos(min(max((p.r * p.r + d * d - q.r * q.r) / (2.0 * abs(p.r) * d), -1.0), 1.0)) for p, q in ((a, b), (b, a))]
+    return 2.0 * max(min(t, math.pi - t) for t in at) <= SHARED * min(a.sweep, b.sweep)
 
 
 def _classify(a: _Piece, b: _Piece, scale: float, steepest: float, bound: float, shape: int = K.NEAR_LINEAR,
