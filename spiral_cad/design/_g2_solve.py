@@ -301,7 +301,7 @@ def _solve(group: _Group) -> tuple[list[_Solved | None], list[float]]:
                 if not (used <= room):
                     worst = min(worst, (room / used) ** 2 * 0.8 if used > 0.0 and room > 0.0 else 0.25)
             if worst < 1.0:
-                if group.kinds[j] == "arc-arc-c" or not _joint_circles(group, j):  # a C pair's use hardly depends on the shifts
+                if group.kinds[j] == "arc-arc-c":  # a C pair's use hardly depends on the shifts: nothing to shrink
                     raise _Refusal(j, "its C spiral pair between the crossing circles needs more of the arcs than they have", False,
                                    False)  # fmt: skip
                 for k in _joint_circles(group, j):
