@@ -193,9 +193,10 @@ def _lens_fits(a: _Piece, b: _Piece) -> bool:
 
 
 def _classify(a: _Piece, b: _Piece, scale: float, steepest: float, bound: float, shape: int = K.NEAR_LINEAR,
-              c_pair: bool = True) -> str:  # fmt: skip
+              c_pair: bool = True, loose: bool = True) -> str:  # fmt: skip
     """The joint from piece ``a`` to ``b``: ``g2``, ``line-arc``, ``arc-arc-…`` (``arc-arc-c``: a C pair between
-    crossing circles of the same sense, unless not ``c_pair``), ``corner`` or ``split``."""
+    crossing circles of the same sense, unless not ``c_pair``), ``corner`` or ``split``; arcs of one circle to a
+    share of the bound are ``g2`` (merged) when ``loose``, else only to float64's resolution."""
     turn = _turn(a, b)
     if abs(turn) > steepest:
         return "split"
@@ -206,7 +207,7 @@ def _classify(a: _Piece, b: _Piece, scale: float, steepest: float, bound: float,
         la, lb = a.size, b.size
         drop = la * lb / (la + lb) * abs(math.sin(turn))
         return "g2" if drop <= 1e-3 * bound else "corner"
-    if a.kind == "arc" and b.kind == "arc" and abs(turn) <= NEAR_MAX and _same_circle(a, b, scale, bound):
+    if a.kind == "arc" and b.kind == "arc" and abs(turn) <= NEAR_MAX and _same_circle(a, b, scale, bound if loose else 0.0):
         return "g2"
     if (a.kind == "arc" and b.kind == "arc" and (a.r > 0) == (b.r > 0) and turn * a.sense < 0.0 and abs(turn) <= NEAR_MAX and c_pair
             and _c_pair(a, b, turn)):  # fmt: skip

@@ -513,14 +513,17 @@ def _build(segments: list[Segment], bound: float, closed: bool | None, shape: st
 
 
 def _make(segments: list[Segment], bound: float, closed: bool | None, shape: str, units: str, tolerance: float,
-          retry: bool = True, round_sharp: bool = True, no_c: frozenset[int] = frozenset(), retried: int = 0) -> G2Path | _Refusal:  # fmt: skip
+          retry: bool = True, round_sharp: bool = True, no_c: frozenset[int] = frozenset(), retried: int = 0,
+          loose: bool = True) -> G2Path | _Refusal:  # fmt: skip
     """``make_g2`` of plane lines and arcs, or the refusal of its first joint that fails (``retry``: a part
     refused within the bound tried again within smaller shares of it; the advice's search goes without).
 
     A corner sharper than a spiral pair rounds (but not a reversal) gets a tangent circle within the
     bound and a transition on each side (``round_sharp``); where that fails, the path is made again
     split at those corners, as before. A joint between crossing circles whose C pair is refused is made
-    again as a compound joint or a corner (``no_c``: those joints)."""
+    again as a compound joint or a corner (``no_c``: those joints). Arcs merged as arcs of one circle to a share
+    of the bound (``loose``) move the ends of their neighbours: where that fails, the path is made again with
+    only arcs of one circle to float64's resolution merged (a bound that works keeps working when it grows)."""
     pieces = [_piece_of(s, i) for i, s in enumerate(segments)]
     points = np.array([p for s in segments for p in s.outline()])
     scale = float(np.abs(points).max()) or 1.0
@@ -549,13 +552,13 @@ def _make(segments: list[Segment], bound: float, closed: bool | None, shape: str
     steepest = _steepest_deflection(corner_shape)
     count = len(pieces)
     joint_count = count if closed else count - 1
-    kinds = [_classify(pieces[i], pieces[(i + 1) % count], extent, steepest, bound, SHAPE_CODES[shape], i not in no_c)
+    kinds = [_classify(pieces[i], pieces[(i + 1) % count], extent, steepest, bound, SHAPE_CODES[shape], i not in no_c, loose)
              for i in range(joint_count)]  # fmt: skip
     unfit = _c_unfit(pieces, kinds, shape)
     if unfit:  # C pairs that do not fit beside the joint: those joints made compound or corners
         no_c = no_c | frozenset(unfit)
         for i in unfit:
-            kinds[i] = _classify(pieces[i], pieces[(i + 1) % count], extent, steepest, bound, SHAPE_CODES[shape], False)
+            kinds[i] = _classify(pieces[i], pieces[(i + 1) % count], extent, steepest, bound, SHAPE_CODES[shape], False, loose)
     sharp = [i for i, kind in enumerate(kinds) if kind == "split" and abs(_turn(pieces[i], pieces[(i + 1) % count])) < REVERSAL]
     if round_sharp:
         for i in sharp:
@@ -596,6 +599,7 @@ def _make(segments: list[Segment], bound: float, closed: bool | None, shape: str
     current_kinds: list[str] = []
     current_joints: list[int] = []
     merged_off = 0.0  # how far merging G2 neighbours (arcs of one circle, lines in line) moves the input
+    arcs_merged = False  # whether arcs of nearly one circle were merged
     open_path = not closed or "split" in kinds
     if closed and "split" in kinds:  # start the open walk at a split
         cut = kinds.index("split")
@@ -607,6 +611,7 @@ def _make(segments: list[Segment], bound: float, closed: bool | None, shape: str
             kind = kinds[joint]
             if kind == "g2":
                 merged_off = max(merged_off, _merge_error(current[-1], piece))
+                arcs_merged = arcs_merged or (piece.kind == "arc" and _merge_error(current[-1], piece) > 0.0)
                 current[-1] = _merge(current[-1], piece)
                 continue
             if kind == "split":
@@ -633,9 +638,13 @@ def _make(segments: list[Segment], bound: float, closed: bool | None, shape: str
                             bound, shown, steepest, RETRY_SHARES if retry else ())  # fmt: skip
         if isinstance(made, _Located):
             if made.joint < joint_count and kinds[made.joint] == "arc-arc-c" and retried < C_RETRIES:
-                return _make(segments, bound, closed, shape, units, tolerance, retry, round_sharp, no_c | {made.joint}, retried + 1)
+                return _make(segments, bound, closed, shape, units, tolerance, retry, round_sharp, no_c | {made.joint}, retried + 1, loose)
+            if loose and arcs_merged:  # arcs of nearly one circle merged: made again, joined by transitions
+                again = _make(segments, bound, closed, shape, units, tolerance, retry, round_sharp, no_c, retried, False)
+                if not isinstance(again, _Refusal):
+                    return again
             if round_sharp and sharp:  # the tangent circles did not fit: split at those corners instead
-                return _make(segments, bound, closed, shape, units, tolerance, retry, False, no_c, retried)
+                return _make(segments, bound, closed, shape, units, tolerance, retry, False, no_c, retried, loose)
             return made
         chain, measured, group, solved, s, group_pieces, group_kinds, group_joints = made
         chains.append(chain)

@@ -11,7 +11,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from test_make_g2 import arcs_kept, assert_g2
 
-from spiral_cad import Arc, NoSolutionError
+from spiral_cad import Arc, Line, NoSolutionError
 from spiral_cad.design import make_g2
 
 
@@ -160,4 +160,22 @@ def test_random_same_sense_arcs_are_made_g2_or_refused_by_joint(radii, nearly, k
     except NoSolutionError as error:
         assert "cannot be made G2 within max_deviation" in str(error) and "between segments" in str(error)
         return
+    assert_g2(arcs, result, bound, closed=False)
+
+
+@pytest.mark.parametrize("bound", [0.01, 0.03, 0.1])
+def test_arcs_of_nearly_one_circle_before_a_short_line_stay_g2_when_the_bound_grows(bound):
+    """Two arcs of radius 19 kinked by 1.4e-4 rad (their circles 2.6e-3 apart), then a 0.5 line: within 0.01 a
+    C pair joins them; a larger bound would merge them as arcs of one circle, which moves the line's start off
+    the arc, so they are joined as within 0.01 (a bound that works keeps working)."""
+    first = Arc((0.0, 0.0), -19.0, 0.5, 1.0)
+    heading = 0.5 - math.pi / 2 - 1.0 + 1.38e-4  # the end tangent of the clockwise arc, kinked
+    end = np.asarray(first.end, dtype=float)
+    centre = end - 19.0 * np.array([-math.sin(heading), math.cos(heading)])
+    second = Arc(tuple(centre), -19.0, math.atan2(end[1] - centre[1], end[0] - centre[0]), 1.0)
+    tail = np.asarray(second.end, dtype=float)
+    out = heading - 1.0
+    arcs = [first, second, Line(tuple(tail), tuple(tail + 0.5 * np.array([math.cos(out), math.sin(out)])))]
+    result = make_g2(arcs, bound)
+    assert [j.kind for j in result.joints] == ["arc-arc-compound", "line-arc"]
     assert_g2(arcs, result, bound, closed=False)
