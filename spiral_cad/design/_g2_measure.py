@@ -49,8 +49,11 @@ def _deviation(group: _Group, solved: list[_Solved | None], s: list[float], used
         if bridged.any():
             there = np.minimum(there, rows_m.distance(curve))
         worst = max(worst, float((there.max(axis=1) + added).max()))
-        tail = used_hi[joints]
-        head = used_lo[nexts]
+        # A C pair beyond an arc's end (or before its start) extends that arc on its circle: the input there
+        # is the other piece, against which the extension is measured; the stretch replaced is the rest.
+        tail = np.maximum(used_hi[joints], 0.0)
+        head = np.maximum(used_lo[nexts], 0.0)
+        worst = max(worst, _extensions(rows_a, rows_b, joints, nexts, used_lo, used_hi, shift, added))
         replaced = np.concatenate(
             [rows_a.points(rows_a.size - tail, rows_a.size, SAMPLES), rows_b.points(np.zeros(len(joints)), head, SAMPLES)], axis=1
         )
@@ -63,6 +66,25 @@ def _deviation(group: _Group, solved: list[_Solved | None], s: list[float], used
             if present.any():
                 near = np.minimum(near, np.where(present[:, None], kept.where(present, rows).distance(replaced), np.inf))
         worst = max(worst, float((near.max(axis=1) + added).max()))
+    return worst
+
+
+def _extensions(rows_a: _Rows, rows_b: _Rows, joints: NDArray, nexts: NDArray, used_lo: NDArray, used_hi: NDArray,
+                shift: NDArray, added: NDArray) -> float:  # fmt: skip
+    """How far the result's arcs extended past a joint (a transition that leaves an arc after its end, or
+    reaches one before its start: ``used`` < 0) lie from the input pieces beside the joint."""
+    worst = 0.0
+    for rows, ks, at_end in ((rows_a, joints, True), (rows_b, nexts, False)):
+        over = -(used_hi[ks] if at_end else used_lo[ks])
+        pick = np.flatnonzero(over > 0.0)
+        if not len(pick):
+            continue
+        kept, _ = rows.take(pick).kept(used_lo[ks[pick]], used_hi[ks[pick]], shift[ks[pick]])
+        left = kept.size
+        lo, hi = (left - over[pick], left) if at_end else (np.zeros(len(pick)), over[pick])
+        points = kept.points(lo, hi, SAMPLES)
+        near = np.minimum(rows_a.take(pick).distance(points), rows_b.take(pick).distance(points))
+        worst = max(worst, float((near.max(axis=1) + added[pick]).max()))
     return worst
 
 

@@ -145,8 +145,58 @@ def _nested_defect(a: _Piece, b: _Piece, shape: int) -> float:
     return abs(math.dist(a.c, b.c) - (rb - rs)) / width
 
 
-def _classify(a: _Piece, b: _Piece, scale: float, steepest: float, bound: float, shape: int = K.NEAR_LINEAR) -> str:
-    """The joint from piece ``a`` to ``b``: ``g2``, ``line-arc``, ``arc-arc-…``, ``corner`` or ``split``."""
+def _c_window(a: _Piece, b: _Piece) -> tuple[int, int, float, float] | None:
+    """The C pair between the circles of two arcs of the same sense, as the shifts must leave it: (the smaller
+    piece's side, 0 for ``a``, 1 for ``b``; the larger's; lo, hi) such that the larger circle shrinking by δ more
+    than the smaller, lo ≤ δ ≤ hi, leaves them crossing at an angle whose C pair float64 holds G2 (its spirals
+    turn about that angle: r·angle² ≥ ``C_HOLD`` of the coordinates, with a margin), not much further past
+    touching than they are (the crossing, and the pair, stay near the joint); None when no shift does
+    (circles nearly concentric)."""
+    ra, rb = abs(a.r), abs(b.r)
+    d = math.dist(a.c, b.c)
+    size = max(float(np.abs(a.end()).max()), float(np.abs(a.c).max()), float(np.abs(b.c).max()), ra, rb)
+    angle = C_MARGIN * math.sqrt(C_HOLD * size / min(ra, rb))
+    if not angle < 0.5:
+        return None
+    # Circles of radii r0, r1 whose centres lie d apart cross at the angle α when (r0 − r1)² = d² − 4 r0 r1 sin²(α/2).
+    m2 = d * d - 4.0 * ra * rb * math.sin(0.5 * angle) ** 2
+    if not m2 > 0.0:
+        return None
+    m, dr = math.sqrt(m2), abs(ra - rb)
+    small, big = (0, 1) if ra <= rb else (1, 0)
+    # Between half and twice as far past touching as the circles are (or must be): their crossing, and the
+    # pair, stay near the joint.
+    lo = max(dr - m, -0.5 * (d - dr))
+    base = max(lo, 0.0)
+    return small, big, lo, base + (d - abs(dr - base))
+
+
+def _c_pair(a: _Piece, b: _Piece, turn: float) -> bool:
+    """Whether a kinked joint of two arcs of the same sense is joined by the broken-back C pair between their
+    circles (Theorem 4.2; every kinked joint of two circles lies on circles that cross), both arcs kept or
+    shrunk about their centres (``_c_window``). A spiral cut as arcs of slowly changing radius, each starting
+    where the last ends, has such joints. Turning against the arcs, the pair lies at the joint; turning with
+    them, at the circles' other crossing: the lens between must fit in the arcs."""
+    if not abs(turn) > TANGENT_TOL or _c_window(a, b) is None:
+        return False
+    return turn * a.sense < 0.0 or _lens_fits(a, b)
+
+
+def _lens_fits(a: _Piece, b: _Piece) -> bool:
+    """Whether the lens between the two crossings of the circles of arcs ``a`` and ``b`` (the joint at one of
+    them) spans at most the share of each arc a joint may use: a transition placed at the other crossing,
+    or where the circles come nearest, fits."""
+    d = math.dist(a.c, b.c)
+    # each crossing's angle at a centre, from the line of centres (the smaller circle: from its far side)
+    at = [math.acos(min(max((p.r * p.r + d * d - q.r * q.r) / (2.0 * abs(p.r) * d), -1.0), 1.0)) for p, q in ((a, b), (b, a))]
+    return 2.0 * max(min(t, math.pi - t) for t in at) <= SHARED * min(a.sweep, b.sweep)
+
+
+def _classify(a: _Piece, b: _Piece, scale: float, steepest: float, bound: float, shape: int = K.NEAR_LINEAR,
+              c_pair: bool = True, loose: bool = True) -> str:  # fmt: skip
+    """The joint from piece ``a`` to ``b``: ``g2``, ``line-arc``, ``arc-arc-…`` (``arc-arc-c``: a C pair between
+    crossing circles of the same sense, unless not ``c_pair``), ``corner`` or ``split``; arcs of one circle to a
+    share of the bound are ``g2`` (merged) when ``loose``, else only to float64's resolution."""
     turn = _turn(a, b)
     if abs(turn) > steepest:
         return "split"
@@ -157,15 +207,21 @@ def _classify(a: _Piece, b: _Piece, scale: float, steepest: float, bound: float,
         la, lb = a.size, b.size
         drop = la * lb / (la + lb) * abs(math.sin(turn))
         return "g2" if drop <= 1e-3 * bound else "corner"
-    if a.kind == "arc" and b.kind == "arc" and abs(turn) <= NEAR_MAX and _same_circle(a, b, scale, bound):
+    if a.kind == "arc" and b.kind == "arc" and abs(turn) <= NEAR_MAX and _same_circle(a, b, scale, bound if loose else 0.0):
         return "g2"
+    if (a.kind == "arc" and b.kind == "arc" and (a.r > 0) == (b.r > 0) and turn * a.sense < 0.0 and abs(turn) <= NEAR_MAX and c_pair
+            and _c_pair(a, b, turn)):  # fmt: skip
+        return "arc-arc-c"  # a small kink against both arcs: the C pair lies at the joint, whatever the bound
     if not _near_tangent(a, b, turn, bound):
         return "corner"
     if a.kind == "arc" and b.kind == "arc":
         if (a.r > 0) != (b.r > 0):
             return "arc-arc-reverse"
+        if c_pair and _c_pair(a, b, turn):
+            return "arc-arc-c"
         # A kinked compound joint: its circles cross; the nested spiral needs them to touch (to a share of its band).
-        return "arc-arc-compound" if abs(turn) <= TANGENT_TOL or _nested_defect(a, b, shape) <= NESTED_SHARE else "corner"
+        share = NESTED_AGAINST if turn * a.sense < 0.0 else NESTED_SHARE
+        return "arc-arc-compound" if abs(turn) <= TANGENT_TOL or _nested_defect(a, b, shape) <= share else "corner"
     return "line-arc"
 
 
@@ -187,6 +243,20 @@ NEAR_SHARE = 0.1
 
 #: A kinked compound joint is made G2 as tangent when its circles touch to this share of the nested band.
 NESTED_SHARE = 0.25
+
+
+#: ... or to this share when the kink turns against the arcs (the nested spiral then lies at the joint): the
+#: smaller circle shrinks past the crossing into the band.
+NESTED_AGAINST = 64.0
+
+
+#: The C pair of a kinked joint between circles of the same sense needs r·angle² of at least this share of its
+#: coordinates (the angle at which the circles cross; smaller pairs are beyond float64's G2).
+C_HOLD = 5e-10
+
+
+#: ... and the shifts make it cross at this many times the least such angle.
+C_MARGIN = 1.0
 
 
 #: Arcs of one circle (to this share of the bound) are merged into one arc.

@@ -18,6 +18,7 @@ from ._g2_pieces import (
     ALONE,
     EPS,
     SHARED,
+    _c_window,
     _Piece,
     _Refusal,
     _Solved,
@@ -38,6 +39,18 @@ MAX_SHRINK = 0.5
 
 #: A joint whose circles' shifts have shrunk below this share of their first try is refused.
 SMALLEST_FACTOR = 1e-6
+
+
+#: Sweeps (forward and back along the path) that pass the shifts' constraints through runs of C pairs.
+SWEEPS = 6
+
+
+#: A C pair is tried where, between the circles as they are, it needs at most this much of its arcs' share.
+C_ROOM = 0.8
+
+
+#: An arc that shifts only to follow its neighbours across C pairs shrinks by at most this share of its radius.
+C_FOLLOW = 0.02
 
 
 #: Passes of shrinking the shifts that overrun a line or an arc before a joint is refused.
@@ -63,6 +76,27 @@ class _Group:
                 for k in (j, (j + 1) % n):
                     if pieces[k].kind == "arc":
                         self.needs_shift[k] = True
+        # A C pair between circles of the same sense: the larger circle shrinks by δ more than the smaller,
+        # lo ≤ δ ≤ hi (they cross, at an angle float64 holds); it shifts when lo > 0, and the arcs joined by C
+        # pairs all may shift when one of them does (for another joint).
+        self.c_pairs: list[tuple[int, int, int, float, float]] = []  # (joint, small, big, lo, hi)
+        self._compound: list[tuple[int, int, int, float, float]] | None = None
+        for j in range(self.joint_count):
+            if kinds[j] == "arc-arc-c":
+                ends = (j, (j + 1) % n)
+                window = _c_window(pieces[ends[0]], pieces[ends[1]])
+                if window is None:
+                    raise _Refusal(j, "its arcs lie on circles too nearly concentric for a C spiral pair", False, False)
+                small, big, lo, hi = window
+                self.c_pairs.append((j, ends[small], ends[big], lo, hi))
+                if lo > 0.0:
+                    self.needs_shift[ends[big]] = True
+        following = [False] * n  # shifting only to follow a neighbour across C pairs (by a little: the pairs stay put)
+        for members in _c_groups(kinds, self.joint_count, n):
+            if any(self.needs_shift[k] for k in members):
+                for k in members:
+                    following[k] = not self.needs_shift[k]
+                    self.needs_shift[k] = True
         code = SHAPE_CODES[shape]
         theta_max = K.shape_max_theta(code)
         if code == K.NEAR_LINEAR:
@@ -77,7 +111,8 @@ class _Group:
                 0, f"it is below what float64 resolves at these coordinates (8 ulp of {size:.6g} is {8.0 * EPS * size:.3g})", True
             )
         self.target = target
-        self.cap = [min(target - p.spent, q_max * abs(p.r)) if need else 0.0 for p, need in zip(pieces, self.needs_shift)]
+        self.cap = [min(target - p.spent, (C_FOLLOW if follow else q_max) * abs(p.r)) if need else 0.0
+                    for p, need, follow in zip(pieces, self.needs_shift, following)]  # fmt: skip
         self.factor = [1.0] * n
         self._corners: dict[int, _Solved] = {}
         #: Short lines left out between two arcs (by joint): (the line, the input joint after it).
@@ -85,22 +120,47 @@ class _Group:
 
     def shifts(self) -> list[float]:
         """Each arc's shrink: its cap times its factor, the smaller circle of a compound joint shrunk
-        more than the larger one by a step inside the nested band."""
-        n = len(self.pieces)
+        more than the larger one by a step inside the nested band (past the crossing of circles that
+        cross), the circles of a C pair shrunk so that they still cross (``c_pairs``)."""
         s = [c * f for c, f in zip(self.cap, self.factor)]
-        pairs = []  # (small, big, band width) of every compound joint
-        for j in range(self.joint_count):
-            if self.kinds[j] == "arc-arc-compound":
-                a, b = j, (j + 1) % n
-                small, big = (a, b) if abs(self.pieces[a].r) < abs(self.pieces[b].r) else (b, a)
-                pairs.append((small, big, self._band_width(small, big)))
-        pairs.sort(key=lambda pair: abs(self.pieces[pair[0]].r))
+        pairs = self._pairs()
         for _ in range(3):
-            for small, big, width in pairs:  # the larger circle shrinks less, by a step inside the band
-                s[big] = min(s[big], s[small] - min(0.5 * s[small], 0.5 * width))
-            for small, big, width in pairs[::-1]:  # ... and not by more than the band allows
-                s[small] = min(s[small], s[big] + 0.9 * width)
-        return s
+            for _, small, big, cross, width in pairs:  # the larger circle shrinks less, by a step inside the band
+                s[big] = min(s[big], s[small] - cross - min(0.5 * (s[small] - cross), 0.5 * width))
+            for _, small, big, cross, width in pairs[::-1]:  # ... and not by more than the band allows
+                s[small] = min(s[small], s[big] + cross + 0.9 * width)
+        if self.c_pairs:  # the constraints passed along the path (runs of C pairs between compound joints), both ways
+            chain = sorted([(j, "compound", small, big, cross, width) for j, small, big, cross, width in pairs]
+                           + [(j, "c", small, big, lo, hi) for j, small, big, lo, hi in self.c_pairs])  # fmt: skip
+            for _ in range(SWEEPS):
+                before = list(s)
+                for order in (chain, chain[::-1]):
+                    for _, kind, small, big, x, y in order:
+                        if kind == "c":  # still crossing, steeply enough: lo ≤ s[big] − s[small] ≤ hi
+                            s[big] = min(s[big], s[small] + y)
+                            s[small] = min(s[small], s[big] - x)
+                        else:
+                            s[big] = min(s[big], s[small] - x - min(0.5 * (s[small] - x), 0.5 * y))
+                            s[small] = min(s[small], s[big] + x + 0.9 * y)
+                if s == before:
+                    break
+        return [max(v, 0.0) for v in s]
+
+    def _pairs(self) -> list[tuple[int, int, int, float, float]]:
+        """(joint, small, big, how far the circles cross, band width) of every compound joint, smaller circles first."""
+        if self._compound is None:
+            n = len(self.pieces)
+            pairs = []
+            for j in range(self.joint_count):
+                if self.kinds[j] == "arc-arc-compound":
+                    a, b = j, (j + 1) % n
+                    small, big = (a, b) if abs(self.pieces[a].r) < abs(self.pieces[b].r) else (b, a)
+                    pa, pb = self.pieces[small], self.pieces[big]
+                    cross = max(math.dist(pa.c, pb.c) - (abs(pb.r) - abs(pa.r)), 0.0)
+                    pairs.append((j, small, big, cross, self._band_width(small, big)))
+            pairs.sort(key=lambda pair: abs(self.pieces[pair[1]].r))
+            self._compound = pairs
+        return self._compound
 
     def _band_width(self, small: int, big: int) -> float:
         """How much more than the larger circle the smaller one may shrink: the nested band's width."""
@@ -116,7 +176,7 @@ class _Group:
             by_kind.setdefault(self.kinds[j], []).append(j)
         if by_kind.get("line-arc"):
             self._lines_arcs(by_kind["line-arc"], s, out)
-        for kind in ("arc-arc-reverse", "arc-arc-compound", "bridge"):
+        for kind in ("arc-arc-reverse", "arc-arc-compound", "arc-arc-c", "bridge"):
             if by_kind.get(kind):
                 self._arcs_arcs(by_kind[kind], s, kind, out)
         corners = by_kind.get("corner", [])  # a corner between lines does not depend on the shifts: solved once
@@ -157,7 +217,7 @@ class _Group:
             out[j] = _Solved([spirals[m]], used_before[m], used_after[m], theta[m])
 
     def _arcs_arcs(self, joints: list[int], s: list[float], kind: str, out: list[_Solved | None]) -> None:
-        """Reverse (S) or compound (nested) joints between shrunk circles, solved about each joint."""
+        """Reverse (S), compound (nested) or C joints between shrunk circles, solved about each joint."""
         n = len(self.pieces)
         before = [self.pieces[j] for j in joints]
         after = [self.pieces[(j + 1) % n] for j in joints]
@@ -241,6 +301,9 @@ def _solve(group: _Group) -> tuple[list[_Solved | None], list[float]]:
                 if not (used <= room):
                     worst = min(worst, (room / used) ** 2 * 0.8 if used > 0.0 and room > 0.0 else 0.25)
             if worst < 1.0:
+                if group.kinds[j] == "arc-arc-c":  # a C pair's use hardly depends on the shifts: nothing to shrink
+                    raise _Refusal(j, "its C spiral pair between the crossing circles needs more of the arcs than they have", False,
+                                   False)  # fmt: skip
                 for k in _joint_circles(group, j):
                     over[k] = min(over.get(k, 1.0), worst)
         if not over and not failed:
@@ -263,6 +326,52 @@ def _solve(group: _Group) -> tuple[list[_Solved | None], list[float]]:
         if joint is not None and joint.status:
             raise _Refusal(j, joint.reason or describe_status(joint.status), True)
     raise _Refusal(0, "the transitions could not be fitted into the lines and arcs", True)
+
+
+def _c_unfit(pieces: list[_Piece], kinds: list[str], shape: str) -> list[int]:
+    """The C joints (``arc-arc-c``) whose pair, between the circles as they are (the larger shrunk by the least
+    δ of ``_c_window``), is not found or needs more than ``C_ROOM`` of the share (``SHARED``) of an arc beside it
+    (the shifts move it a little): made otherwise."""
+    n = len(pieces)
+    joints = [j for j, kind in enumerate(kinds) if kind == "arc-arc-c"]
+    if not joints:
+        return []
+    before = [pieces[j] for j in joints]
+    after = [pieces[(j + 1) % n] for j in joints]
+    shrink = np.zeros((len(joints), 2))
+    for m, (a, b) in enumerate(zip(before, after)):
+        window = _c_window(a, b)
+        if window is not None:
+            shrink[m, window[1]] = max(window[2], 0.0)
+    origin = np.array([a.end() for a in before])
+    r0 = np.array([a.r - a.sense * shrink[m, 0] for m, a in enumerate(before)])
+    r1 = np.array([b.r - b.sense * shrink[m, 1] for m, b in enumerate(after)])
+    result = batch.circle_to_circle(np.array([a.c for a in before]) - origin, r0, np.array([b.c for b in after]) - origin, r1,
+                                    shape=shape)  # fmt: skip
+    moved = [sp + origin[:, None] for sp in result.spirals]
+    with np.errstate(invalid="ignore"):
+        used_before = _used_rows(before, moved[0][:, 0], True)
+        used_after = _used_rows(after, moved[-1][:, 3], False)
+    room_before = np.array([C_ROOM * SHARED * a.sweep for a in before])
+    room_after = np.array([C_ROOM * SHARED * b.sweep for b in after])
+    fits = result.ok & (used_before <= room_before) & (used_after <= room_after)
+    return [j for j, ok in zip(joints, fits.tolist()) if not ok]
+
+
+def _c_groups(kinds: list[str], joint_count: int, n: int) -> list[list[int]]:
+    """The runs of pieces joined by C pairs (``arc-arc-c`` joints), each as its piece indices."""
+    groups: list[list[int]] = []
+    for j in range(joint_count):
+        if kinds[j] != "arc-arc-c":
+            continue
+        k = (j + 1) % n
+        if groups and groups[-1][-1] == j:
+            groups[-1].append(k)
+        else:
+            groups.append([j, k])
+    if len(groups) > 1 and groups[-1][-1] == groups[0][0]:  # a closed path: the last run goes on into the first
+        groups[0] = groups.pop()[:-1] + groups[0]
+    return [sorted(set(members)) for members in groups]
 
 
 def _joint_circles(group: _Group, j: int) -> list[int]:

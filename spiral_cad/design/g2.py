@@ -69,7 +69,7 @@ from ._g2_pieces import (
     _Solved,
     _turn,
 )
-from ._g2_solve import _arc_corners, _bridge_short_lines, _Group, _solve
+from ._g2_solve import _arc_corners, _bridge_short_lines, _c_unfit, _Group, _solve
 from .rounding import _steepest_deflection
 
 __all__ = ["TANGENT_TOL", "G2Joint", "G2Path", "make_g2", "smallest_max_deviation"]
@@ -78,6 +78,10 @@ __all__ = ["TANGENT_TOL", "G2Joint", "G2Path", "make_g2", "smallest_max_deviatio
 GAP_SHARE = 0.5
 
 JOINT_KINDS = ("line-arc", "arc-arc-compound", "arc-arc-reverse", "corner", "g2", "split")
+
+#: The joints solved in ways the result does not name apart: a C pair between crossing circles of the same
+#: sense is a compound joint (its ``moved`` says which).
+PUBLIC_KINDS = {"arc-arc-c": "arc-arc-compound"}
 
 
 @dataclass(frozen=True)
@@ -509,13 +513,17 @@ def _build(segments: list[Segment], bound: float, closed: bool | None, shape: st
 
 
 def _make(segments: list[Segment], bound: float, closed: bool | None, shape: str, units: str, tolerance: float,
-          retry: bool = True, round_sharp: bool = True) -> G2Path | _Refusal:  # fmt: skip
+          retry: bool = True, round_sharp: bool = True, no_c: frozenset[int] = frozenset(), retried: int = 0,
+          loose: bool = True) -> G2Path | _Refusal:  # fmt: skip
     """``make_g2`` of plane lines and arcs, or the refusal of its first joint that fails (``retry``: a part
     refused within the bound tried again within smaller shares of it; the advice's search goes without).
 
     A corner sharper than a spiral pair rounds (but not a reversal) gets a tangent circle within the
     bound and a transition on each side (``round_sharp``); where that fails, the path is made again
-    split at those corners, as before."""
+    split at those corners, as before. A joint between crossing circles whose C pair is refused is made
+    again as a compound joint or a corner (``no_c``: those joints). Arcs merged as arcs of one circle to a share
+    of the bound (``loose``) move the ends of their neighbours: where that fails, the path is made again with
+    only arcs of one circle to float64's resolution merged (a bound that works keeps working when it grows)."""
     pieces = [_piece_of(s, i) for i, s in enumerate(segments)]
     points = np.array([p for s in segments for p in s.outline()])
     scale = float(np.abs(points).max()) or 1.0
@@ -544,7 +552,13 @@ def _make(segments: list[Segment], bound: float, closed: bool | None, shape: str
     steepest = _steepest_deflection(corner_shape)
     count = len(pieces)
     joint_count = count if closed else count - 1
-    kinds = [_classify(pieces[i], pieces[(i + 1) % count], extent, steepest, bound, SHAPE_CODES[shape]) for i in range(joint_count)]
+    kinds = [_classify(pieces[i], pieces[(i + 1) % count], extent, steepest, bound, SHAPE_CODES[shape], i not in no_c, loose)
+             for i in range(joint_count)]  # fmt: skip
+    unfit = _c_unfit(pieces, kinds, shape)
+    if unfit:  # C pairs that do not fit beside the joint: those joints made compound or corners
+        no_c = no_c | frozenset(unfit)
+        for i in unfit:
+            kinds[i] = _classify(pieces[i], pieces[(i + 1) % count], extent, steepest, bound, SHAPE_CODES[shape], False, loose)
     sharp = [i for i, kind in enumerate(kinds) if kind == "split" and abs(_turn(pieces[i], pieces[(i + 1) % count])) < REVERSAL]
     if round_sharp:
         for i in sharp:
@@ -585,6 +599,7 @@ def _make(segments: list[Segment], bound: float, closed: bool | None, shape: str
     current_kinds: list[str] = []
     current_joints: list[int] = []
     merged_off = 0.0  # how far merging G2 neighbours (arcs of one circle, lines in line) moves the input
+    arcs_merged = False  # whether arcs of nearly one circle were merged
     open_path = not closed or "split" in kinds
     if closed and "split" in kinds:  # start the open walk at a split
         cut = kinds.index("split")
@@ -596,6 +611,7 @@ def _make(segments: list[Segment], bound: float, closed: bool | None, shape: str
             kind = kinds[joint]
             if kind == "g2":
                 merged_off = max(merged_off, _merge_error(current[-1], piece))
+                arcs_merged = arcs_merged or (piece.kind == "arc" and _merge_error(current[-1], piece) > 0.0)
                 current[-1] = _merge(current[-1], piece)
                 continue
             if kind == "split":
@@ -621,8 +637,14 @@ def _make(segments: list[Segment], bound: float, closed: bool | None, shape: str
         made = _solve_group(group_pieces, group_kinds, group_joints, group_closed, room, shape, extent, units, tolerance, spanned,
                             bound, shown, steepest, RETRY_SHARES if retry else ())  # fmt: skip
         if isinstance(made, _Located):
+            if made.joint < joint_count and kinds[made.joint] == "arc-arc-c" and retried < C_RETRIES:
+                return _make(segments, bound, closed, shape, units, tolerance, retry, round_sharp, no_c | {made.joint}, retried + 1, loose)
+            if loose and arcs_merged:  # arcs of nearly one circle merged: made again, joined by transitions
+                again = _make(segments, bound, closed, shape, units, tolerance, retry, round_sharp, no_c, retried, False)
+                if not isinstance(again, _Refusal):
+                    return again
             if round_sharp and sharp:  # the tangent circles did not fit: split at those corners instead
-                return _make(segments, bound, closed, shape, units, tolerance, retry, round_sharp=False)
+                return _make(segments, bound, closed, shape, units, tolerance, retry, False, no_c, retried, loose)
             return made
         chain, measured, group, solved, s, group_pieces, group_kinds, group_joints = made
         chains.append(chain)
@@ -645,12 +667,17 @@ def _make(segments: list[Segment], bound: float, closed: bool | None, shape: str
                 joints[index] = G2Joint(index, "corner", shown[index], moved, circle.fillet + shift,
                                         solved_joint.theta if solved_joint is not None else math.nan)  # fmt: skip
                 continue
-            joints[index] = G2Joint(index, kind, shown[index], _moved(kind, a, b, s[j], s[(j + 1) % len(group_pieces)], solved_joint),
+            joints[index] = G2Joint(index, PUBLIC_KINDS.get(kind, kind), shown[index],
+                                    _moved(kind, a, b, s[j], s[(j + 1) % len(group_pieces)], solved_joint),
                                     _joint_shift(kind, s[j], s[(j + 1) % len(group_pieces)], group, solved_joint, a),
                                     solved_joint.theta if solved_joint is not None else math.nan)  # fmt: skip
     records = [joints[i] for i in sorted(joints)]
     splits = [j.index for j in records if j.kind == "split"]
     return G2Path(chains, deviation, records, splits, bool(closed) and not splits, bound, shape, units)
+
+
+#: The most joints between crossing circles whose C pair is refused and made again otherwise (each a new solve).
+C_RETRIES = 8
 
 
 #: A group refused within the room is tried again within this share of it, ... (a result within a smaller
@@ -712,6 +739,8 @@ def _moved(kind: str, a: _Piece, b: _Piece, sa: float, sb: float, solved: _Solve
     if kind == "corner":
         return "corner rounded by a spiral pair"
     parts = [arc(p, s) for p, s in ((a, sa), (b, sb)) if p.kind == "arc"]
+    if kind == "arc-arc-c":
+        parts.insert(0, "a C spiral pair between the crossing circles")
     return "; ".join(parts)
 
 

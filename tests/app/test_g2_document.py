@@ -72,8 +72,14 @@ def test_contour_judged_by_rs274(dialect):
     assert verdict.feed_moves[1] > verdict.feed_moves[0]
 
 
+#: Programs whose rewriting takes more than a few seconds.
+SLOW_PROGRAMS = {"linuxcnc_arcspiral.ngc"}
+
+
 @needs_rs274
-@pytest.mark.parametrize("name", sorted(p.name for p in DATA.glob("*.ngc")))
+@pytest.mark.parametrize(
+    "name", [pytest.param(p.name, marks=[pytest.mark.slow] if p.name in SLOW_PROGRAMS else []) for p in sorted(DATA.glob("*.ngc"))]
+)
 def test_linuxcnc_programs_judged_by_rs274(name):
     path = DATA / name
     text = path.read_text()
@@ -312,3 +318,39 @@ def test_nurbs_points_follow_the_judges_reading_of_linuxcnc():
     assert np.allclose(ours[0], [10, 0]) and np.allclose(ours[-1], [10, 20])
     with pytest.raises(ValueError, match="order 4 needs at least 4"):
         nurbs_points(np.array([[0, 0], [1, 1], [2, 0]]), np.ones(3), 4, 0.01)
+
+
+ARCSPIRAL = DATA / "linuxcnc_arcspiral.ngc"
+
+
+def test_arcspirals_outer_turns_come_back_g2_through_the_cli(tmp_path, capsys):
+    """LinuxCNC's arcspiral.ngc, its first 300 arcs (same-sense joints of radii 0.1 % apart, kinked by the
+    program's rounding): the run is rewritten, every joint between arcs made G2 (C pairs between the crossing
+    circles), the arcs kept as they are."""
+    lines = ARCSPIRAL.read_text().splitlines()
+    src = tmp_path / "arcspiral300.ngc"
+    src.write_text("\n".join(lines[:307] + lines[-2:]) + "\n")  # the header, 300 arcs, the retract and M2
+    out = tmp_path / "out.ngc"
+    assert main(["g2", str(src), "--max-deviation", "0.01", "-o", str(out), "--strict"]) == 0
+    said = capsys.readouterr().out
+    assert "lines 7-307: 301 moves made G2" in said and "299 joints changed" in said and "refused" not in said
+    assert "1 of 1 runs made G2" in said
+    # the arcs kept as they are: the C pairs lie between the circles where they cross
+    assert float(re.search(r"deviation ([0-9.e+-]+) in", said).group(1)) < 1e-6
+    if rs274_judge.available():
+        verdict = rs274_judge.judge(src.read_text(), out.read_text(), 0.01)
+        assert verdict.passed, verdict.reasons
+
+
+@pytest.mark.slow
+def test_arcspiral_comes_back_g2_but_for_its_innermost_joints():
+    """The whole program: its run rewritten, all but a few of its 998 joints made G2 (the innermost arcs, radii
+    of 0.002 … 0.026 in with kinks up to 0.6 rad, may be left as they were, named); judged by rs274."""
+    text = ARCSPIRAL.read_text()
+    report = gcode_g2(text, 0.01, source=ARCSPIRAL.name)
+    [run] = report.runs
+    assert run.status == "G2" and run.joints_changed >= 990 and len(run.refused) <= 5, report.lines()
+    assert 0.0 < report.deviation <= 0.01
+    if rs274_judge.available():
+        verdict = rs274_judge.judge(text, report.text, 0.01)
+        assert verdict.passed, verdict.reasons
