@@ -826,13 +826,21 @@ CURVATURES = textwrap.dedent(
     shape = Part.read(sys.argv[2])
     size = shape.BoundBox.DiagonalLength
     out = []
+
+    def near(shapes, p):  # those whose bounding box holds p (a margin of 1e-4 of the part): the others are far
+        for item in shapes:
+            box = item.BoundBox
+            box.enlarge(1e-4 * size)
+            if box.isInside(p):
+                yield item
+
     for x, y, z in json.loads(sys.argv[3]):
         p = FreeCAD.Vector(x, y, z)
         vertex = Part.Vertex(p)
-        edge = min(shape.Edges, key=lambda e: e.distToShape(vertex)[0])
+        edge = min(near(shape.Edges, p), key=lambda e: e.distToShape(vertex)[0])
         t = edge.tangentAt(edge.Curve.parameter(p))
         found = []
-        for face in shape.Faces:
+        for face in near(shape.Faces, p):
             if face.distToShape(vertex)[0] > 1e-6:
                 continue
             u, v = face.Surface.parameter(p)
