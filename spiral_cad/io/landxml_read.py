@@ -581,7 +581,9 @@ def _alignment(r: _Reader, a: ET.Element, label: str) -> LandXMLAlignment:
     k1 = np.array([i.k1 for i in items])
     file = (np.array(starts), np.array(headings), bend, k1, size)
     # a sliver's limit is that of an element of SLIVER × the alignment's length: its own would be below rounding
-    limits = MAX_OFFSET_FRACTION * np.maximum(size, SLIVER * size.sum()) if r.max_offset is None else np.full(len(size), r.max_offset)
+    largest = float(size.max()) if len(size) else 0.0  # the length summed relative to the longest: lengths near 1e308 do not overflow
+    sliver = SLIVER * float((size / largest).sum()) * largest if largest > 0.0 else 0.0
+    limits = MAX_OFFSET_FRACTION * np.maximum(size, sliver) if r.max_offset is None else np.full(len(size), r.max_offset)
     tried: list[tuple[NDArray[np.float64], NDArray[np.int64]]] = []
     for kink in (ABSORBED_KINK, 0.0):  # small kinks absorbed where the offsets allow it, else G2 runs apart there
         runs, breaks, joints, continued = _joints(items, starts, headings, ends, r.units, kink)

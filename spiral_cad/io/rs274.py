@@ -39,6 +39,7 @@ import math
 import os
 import re
 import shutil
+import signal
 import subprocess
 import tempfile
 import time
@@ -88,6 +89,10 @@ def numbered(text: str) -> str:
 MAX_OUTPUT = 4 << 30
 #: How long rs274 may run (seconds) before the program is taken for one that never ends (an O-word loop).
 TIMEOUT = 600.0
+
+#: Runs of rs274 at most when it dies by a signal saying nothing (LinuxCNC's interpreter sometimes dies by
+#: SIGBUS beside another rs274, on programs it reads on the next run).
+SIGNAL_RUNS = 3
 
 
 #: A G20 or G21 word (spaces may stand inside words in RS274), and comments, which hide words.
@@ -166,27 +171,33 @@ def _canonical(text: str, source: str, timeout: float | None, run_in: str | os.P
             file.write(numbered(text))
         limit = TIMEOUT if timeout is None else timeout
         cwd = folder if run_in is None else os.fspath(run_in)
-        with ticking(f"rs274 reading {source}"), open(os.path.join(folder, "errors.txt"), "w+") as errors:
-            process = subprocess.Popen([executable, "-g", program, output], cwd=cwd, stdin=subprocess.DEVNULL,
-                                       stdout=subprocess.DEVNULL, stderr=errors)  # fmt: skip
-            started = time.monotonic()
-            try:
-                while process.poll() is None:  # a loop that never ends would fill the disk: watch time and size
-                    time.sleep(0.05)
-                    if time.monotonic() - started > limit:
-                        raise ValueError(f"{source}: rs274 was still running after {limit:g} s (a loop that never ends?); stopped")
-                    if os.path.exists(output) and os.path.getsize(output) > MAX_OUTPUT:
-                        raise ValueError(
-                            f"{source}: rs274 printed more than {MAX_OUTPUT / 1e6:,.0f} MB of moves (a loop that never ends?); stopped"
-                        )
-            finally:
-                if process.poll() is None:
-                    process.kill()
-                    process.wait()
-            errors.seek(0)
-            stderr = errors.read()
-        returncode = process.returncode
-        messages = [m for m in stderr.splitlines() if m.strip() and m.strip() != "executing"]
+        for _ in range(SIGNAL_RUNS):
+            with ticking(f"rs274 reading {source}"), open(os.path.join(folder, "errors.txt"), "w+") as errors:
+                process = subprocess.Popen([executable, "-g", program, output], cwd=cwd, stdin=subprocess.DEVNULL,
+                                           stdout=subprocess.DEVNULL, stderr=errors)  # fmt: skip
+                started = time.monotonic()
+                try:
+                    while process.poll() is None:  # a loop that never ends would fill the disk: watch time and size
+                        time.sleep(0.05)
+                        if time.monotonic() - started > limit:
+                            raise ValueError(f"{source}: rs274 was still running after {limit:g} s (a loop that never ends?); stopped")
+                        if os.path.exists(output) and os.path.getsize(output) > MAX_OUTPUT:
+                            raise ValueError(
+                                f"{source}: rs274 printed more than {MAX_OUTPUT / 1e6:,.0f} MB of moves (a loop that never ends?); stopped"
+                            )
+                finally:
+                    if process.poll() is None:
+                        process.kill()
+                        process.wait()
+                errors.seek(0)
+                stderr = errors.read()
+            returncode = process.returncode
+            messages = [m for m in stderr.splitlines() if m.strip() and m.strip() != "executing"]
+            if not (returncode < 0 and not messages):
+                break  # done, or refused in its own words; killed by a signal with nothing said: run it again
+        if returncode < 0 and not messages:
+            name = signal.Signals(-returncode).name if -returncode in signal.valid_signals() else f"signal {-returncode}"
+            raise ValueError(f"{source}: rs274 died by {name} {SIGNAL_RUNS} times, saying nothing (LinuxCNC's interpreter crashed)")
         if returncode != 0 or messages:
             where = _N_WORD.match(messages[1]) if len(messages) > 1 else None
             line = f" line {where.group(0).strip(' /Nn')}" if where else ""

@@ -167,3 +167,25 @@ def test_a_program_that_never_names_its_unit_is_refused_as_by_the_built_in_reade
     with pytest.raises(ValueError, match=r"never says G20 \(inches\) or G21 \(mm\)"):
         parse_gcode(text, interpreter="rs274")
     assert parse_gcode("G 2 1 G90 F10\nG1 X1 Y0\nX2 Y1\nM30\n", interpreter="rs274").units == "mm"
+
+
+@pytest.mark.parametrize("deaths", [1, 2, 3])
+def test_rs274_dying_by_a_signal_is_run_again_and_named_when_it_keeps_dying(tmp_path, monkeypatch, deaths):
+    """LinuxCNC's rs274 sometimes dies by SIGBUS on a program it reads on the next run: run again (3 runs at most), and
+    when it keeps dying say so by the signal's name, not as the program refused."""
+    real = rs274.rs274_executable()
+    if real is None:
+        pytest.skip(f"LinuxCNC's rs274 is not installed ({rs274.PACKAGE})")
+    count = tmp_path / "runs"
+    fake = tmp_path / "rs274"
+    fake.write_text(f'#!/bin/sh\necho x >> {count}\n[ "$(wc -l < {count})" -le {deaths} ] && kill -BUS $$\nexec {real} "$@"\n')
+    fake.chmod(0o755)
+    monkeypatch.setattr(rs274, "rs274_executable", lambda: str(fake))
+    program = "G21 G90 G17\nG0 X0 Y0\nG1 X10 Y0 F100\nG1 X10 Y5\nM2\n"
+    if deaths < rs274.SIGNAL_RUNS:
+        path = rs274.run_rs274(program)
+        assert np.allclose(path.points[-1][:2], (10, 5)) and count.read_text().count("x") == deaths + 1
+    else:
+        with pytest.raises(ValueError, match=r"rs274 died by SIGBUS 3 times, saying nothing"):
+            rs274.run_rs274(program)
+        assert count.read_text().count("x") == rs274.SIGNAL_RUNS

@@ -284,3 +284,18 @@ def test_any_mutated_export_reads_or_is_refused_with_a_value_error(data):
             assert all(np.isfinite(c.length) for c in r.chains) and np.isfinite(r.offsets).all()
     except ValueError:
         pass
+
+
+@pytest.mark.filterwarnings("error")
+def test_lengths_near_the_largest_float_do_not_overflow_the_offset_limits():
+    """Found by the test above: two Line starts at 1e308 made the alignment's length overflow (a RuntimeWarning)."""
+    text = (DATA / "openroads_indot_twin_branch.xml").read_text(encoding="utf-8-sig")
+    for start in (1540, 879):  # the x of two Line starts (the test's own numbering of the file's numbers)
+        number = re.compile(r"-?\d+\.?\d*(?:e-?\d+)?").match(text, start)
+        assert number is not None and number.group(0).startswith("6"), text[start : start + 20]
+        text = text[:start] + "1e308" + text[number.end() :]
+    try:
+        for r in read_landxml(text):
+            assert all(np.isfinite(c.length) for c in r.chains) and np.isfinite(r.offsets).all()
+    except ValueError:
+        pass
