@@ -25,7 +25,11 @@ EXPECTED = {
 
 
 #: Smaller still than --quick where a script's quick run would take over 10 s (the test asks only that it runs).
-SMALLEST = {"bench_many": ["--files", "6", "--sample", "1"], "bench_faces": ["--boxes", "2", "--picture-boxes", "2"]}
+SMALLEST = {
+    "bench_many": ["--files", "6", "--sample", "1"],
+    "bench_faces": ["--boxes", "2", "--picture-boxes", "2"],
+    "bench_fit": ["--points", "40", "--sizes", "500"],
+}
 
 
 def run_quick(script: Path, out: Path, monkeypatch: pytest.MonkeyPatch) -> None:
