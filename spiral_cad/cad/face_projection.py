@@ -312,14 +312,11 @@ class FaceTable:
         if closed.any():
             out[closed] = surface_derivatives(self.frames[owner[closed]], uvs[closed])
         rest = np.flatnonzero(~closed)
-        p = gp_Pnt()
-        su, sv, suu, svv, suv = gp_Vec(), gp_Vec(), gp_Vec(), gp_Vec(), gp_Vec()
-        for k, f, (u, v) in zip(rest.tolist(), owner[rest].tolist(), uvs[rest].tolist()):
-            if not (math.isfinite(u) and math.isfinite(v)):
-                out[k] = math.nan
-                continue
-            self.domains[f].adaptor.D2(u, v, p, su, sv, suu, svv, suv)
-            out[k] = (*p.Coord(), *su.Coord(), *sv.Coord(), *suu.Coord(), *svv.Coord(), *suv.Coord())
+        for f in np.unique(owner[rest]).tolist():
+            rows = rest[owner[rest] == f]
+            found = np.empty((len(rows), 18))
+            derivatives(self.domains[f].adaptor, uvs[rows], found)
+            out[rows] = found
         return out
 
 

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable
+from typing import TYPE_CHECKING
 
 import numpy as np
 from numpy.typing import NDArray
@@ -18,7 +19,10 @@ from numpy.typing import NDArray
 from ..core.segments import Arc, Line, Segment
 from .gcode_write import _arcs_through, _distances, _equal_legs
 
-__all__ = ["BIARC_SHARE", "MAX_BIARCS", "PROBES", "curve_biarcs"]
+if TYPE_CHECKING:
+    from scipy.interpolate import BSpline
+
+__all__ = ["BIARC_SHARE", "MAX_BIARCS", "PROBES", "curve_biarcs", "rational_spline_at"]
 
 #: The share of a document's bound its biarcs may use (``make_g2`` uses the rest).
 BIARC_SHARE = 0.3
@@ -63,6 +67,28 @@ def curve_biarcs(at: Evaluator, breaks: NDArray[np.float64], tolerance: float) -
         half = (u0[bad] + u1[bad]) / 2.0
         u0, u1 = np.ravel(np.stack([u0[bad], half], axis=1)), np.ravel(np.stack([half, u1[bad]], axis=1))
     return [piece for _, pieces in sorted(found, key=lambda f: f[0]) for piece in pieces]
+
+
+def rational_spline_at(curve: BSpline, u: NDArray[np.float64]) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """Points and unit tangents at ``u`` of a plane rational B-spline held in homogeneous coordinates (w x, w y, w)
+    (where the derivative vanishes, as at a repeated control point, the tangent a millionth of the parameter range
+    inwards, then a ten-thousandth)."""
+    u = np.asarray(u, dtype=float)
+    h = curve(u)
+    point = h[..., :2] / h[..., 2:]
+    k = curve.k
+    lo, hi = float(curve.t[k]), float(curve.t[len(curve.t) - k - 1])
+    inward = np.where(u < (lo + hi) / 2.0, 1.0, -1.0) * (hi - lo)
+    slope = curve.derivative()
+    tangent = np.full(point.shape, np.nan)
+    for v in (u, u + 1e-6 * inward, u + 1e-4 * inward):
+        hv, dh = curve(v), slope(v)
+        t = (dh[..., :2] * hv[..., 2:] - hv[..., :2] * dh[..., 2:]) / hv[..., 2:] ** 2
+        norm = np.linalg.norm(t, axis=-1, keepdims=True)
+        usable = (norm > 1e-12 * max(1.0, float(np.abs(point).max()))) & np.isnan(tangent[..., :1])
+        with np.errstate(invalid="ignore", divide="ignore"):
+            tangent = np.where(usable, t / norm, tangent)
+    return point, tangent
 
 
 def _piece(start: NDArray[np.float64], end: NDArray[np.float64], arcs: tuple[NDArray, NDArray, NDArray], k: int) -> Segment | None:

@@ -10,6 +10,7 @@ each spiral) is not turned into biarcs: it is kept as the exact curve it is.
 from __future__ import annotations
 
 import math
+from functools import partial
 from typing import Any
 
 import numpy as np
@@ -17,7 +18,7 @@ from numpy.typing import NDArray
 from scipy.interpolate import BSpline
 
 from ..core.segments import Arc, Segment
-from .curve_biarcs import curve_biarcs
+from .curve_biarcs import curve_biarcs, rational_spline_at
 
 __all__ = ["CURVES", "curve_parts"]
 
@@ -67,23 +68,9 @@ def _spline(entity: Any) -> tuple[Any, NDArray[np.float64]] | None:
     if degree == 3 and len(controls) == 4 and not tool.is_rational:
         return None  # one cubic Bézier span: exact as it is
     curve = BSpline(knots, np.column_stack([controls[:, :2] * weights[:, None], weights]), degree)
-    slope = curve.derivative()
     lo, hi = float(knots[degree]), float(knots[len(knots) - degree - 1])
-    span = hi - lo
-
-    def at(u: NDArray[np.float64]) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-        h, dh = curve(u), slope(u)
-        point = h[:, :2] / h[:, 2:]
-        tangent = _unit(dh[:, :2] * h[:, 2:] - h[:, :2] * dh[:, 2:])
-        stalled = ~np.isfinite(tangent).all(axis=1)  # a repeated control point: the tangent just inside
-        if stalled.any():
-            inward = np.where(u[stalled] < lo + span / 2.0, 1.0, -1.0) * 1e-6 * span
-            hs, dhs = curve(u[stalled] + inward), slope(u[stalled] + inward)
-            tangent[stalled] = _unit(dhs[:, :2] * hs[:, 2:] - hs[:, :2] * dhs[:, 2:])
-        return point, tangent
-
     breaks = np.unique(knots[(knots >= lo) & (knots <= hi)])
-    return at, breaks
+    return partial(rational_spline_at, curve), breaks
 
 
 def _ellipse(entity: Any) -> tuple[Any, NDArray[np.float64]] | None:

@@ -24,7 +24,7 @@ from scipy.spatial import cKDTree
 
 from ..core.chain import Chain
 from ..core.segments import Line, Segment
-from .curve_biarcs import BIARC_SHARE, curve_biarcs
+from .curve_biarcs import BIARC_SHARE, curve_biarcs, rational_spline_at
 
 __all__ = ["NurbsG2", "nurbs_g2", "nurbs_points"]
 
@@ -60,26 +60,6 @@ def _curve(controls: NDArray[np.float64], weights: NDArray[np.float64], order: i
         raise ValueError(f"NURBS weights must be positive; got {w.min():g}")
     knots = np.array([0.0] * order + list(range(1, n - order + 2)) + [float(n - order + 2)] * order)
     return BSpline(knots, np.column_stack([p * w[:, None], w]), order - 1)
-
-
-def _at(curve: BSpline, u: NDArray[np.float64]) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-    """Points and unit tangents of the NURBS at parameters ``u`` (where the derivative vanishes, as at a repeated
-    control point, the tangent a millionth of a knot span inwards)."""
-    u = np.asarray(u, dtype=float)
-    h = curve(u)
-    point = h[..., :2] / h[..., 2:]
-    last = float(curve.t[-1])
-    inward = np.where(u < last / 2.0, 1.0, -1.0)
-    nudged = [u, u + 1e-6 * inward, u + 1e-4 * inward]
-    tangent = np.full(point.shape, np.nan)
-    for v in nudged:
-        hv, dh = curve(v), curve.derivative()(v)
-        t = (dh[..., :2] * hv[..., 2:] - hv[..., :2] * dh[..., 2:]) / hv[..., 2:] ** 2
-        norm = np.linalg.norm(t, axis=-1, keepdims=True)
-        usable = (norm > 1e-12 * max(1.0, float(np.abs(point).max()))) & np.isnan(tangent[..., :1])
-        with np.errstate(invalid="ignore", divide="ignore"):
-            tangent = np.where(usable, t / norm, tangent)
-    return point, tangent
 
 
 def nurbs_points(
@@ -130,7 +110,7 @@ def nurbs_g2(
     from ..design.g2 import make_g2
 
     curve_of = _curve(controls, weights, order)
-    biarcs = curve_biarcs(partial(_at, curve_of), np.unique(curve_of.t), bound * BIARC_SHARE)
+    biarcs = curve_biarcs(partial(rational_spline_at, curve_of), np.unique(curve_of.t), bound * BIARC_SHARE)
     start, end = np.asarray(controls[0], dtype=float), np.asarray(controls[-1], dtype=float)
     spacing = bound * MEASURE_SHARE
     curve = nurbs_points(controls, weights, order, spacing)
