@@ -2,8 +2,8 @@
 
 The document's kind is told by its suffix, through ``REWRITERS``: a table from suffix to the function
 that rewrites that kind of document in place, ``function(src, dst, max_deviation, **options) -> report``,
-where the report has ``lines()`` (the short report, one line per path) and ``kept`` (what was kept as
-it was for a reason: a strict run fails on it). G-code programs (``.nc .ngc .gcode .tap``) are
+where the report has ``lines()`` (the short report, one line per path) and ``below_g2`` (what was left
+below G2: split, or kept as it was for a reason; the command exits 1 on it unless splits are allowed). G-code programs (``.nc .ngc .gcode .tap``) are
 registered here (``spiral_cad.io.gcode_inplace.rewrite_gcode_g2``), and so are DXF drawings
 (``spiral_cad.io.dxf_g2.rewrite_dxf_g2``) and LandXML files (``spiral_cad.io.landxml_g2.rewrite_landxml_g2``);
 other kinds register with ``register_rewriter``; any other suffix is an error naming it.
@@ -98,7 +98,8 @@ def make_document_g2(src: str | os.PathLike, dst: str | os.PathLike, max_deviati
         options: the kind's own options (G-code: ``dialect``, ``shape``, ``units``).
 
     Returns:
-        The kind's report (``lines()``: the short report; ``kept``: what was kept for a reason).
+        The kind's report (``lines()``: the short report; ``below_g2``: what was left below G2, split or kept
+        as it was for a reason).
 
     Raises:
         ValueError: a suffix with no rewriter, an output of another kind, what the rewriter refuses.
@@ -109,4 +110,6 @@ def make_document_g2(src: str | os.PathLike, dst: str | os.PathLike, max_deviati
         raise ValueError(f"the output {Path(dst).name} is not the kind of document {Path(src).name} is")
     if Path(src).resolve() == Path(dst).resolve():
         raise ValueError(f"the output {Path(dst).name} is the input: write to another file")
+    if not Path(dst).parent.is_dir():
+        raise ValueError(f"the output's folder {str(Path(dst).parent)!r} does not exist")
     return function(src, dst, max_deviation, **options)

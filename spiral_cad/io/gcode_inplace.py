@@ -149,7 +149,7 @@ class GcodeG2Report:
 
     @property
     def below_g2(self) -> list[GcodeRun]:
-        """The runs left below G2 somewhere: kept verbatim for a reason, or split (``g2 --strict`` exits 1 on them)."""
+        """The runs left below G2 somewhere: kept verbatim for a reason, or split (``spiral-cad g2`` exits 1 on them without ``--allow-splits``)."""
         return [r for r in self.runs if r.status == "kept" or r.splits or r.refused]
 
     def lines(self) -> list[str]:

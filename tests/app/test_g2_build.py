@@ -212,3 +212,14 @@ def test_a_split_path_is_reported_plainly_and_fails_unless_splits_are_allowed(tm
     assert len(rows) == 2 and all(" G0 at 1 split(s) of its path; this part G2" in row for row in rows)
     status = main(["build", str(path), "--max-deviation", "0.01", "-o", str(tmp_path / "out2"), "--no-plots", "--allow-splits"])
     assert status == 0 and "FAIL" not in capsys.readouterr().out
+
+
+def test_allow_splits_is_refused_where_it_means_nothing(tmp_path, capsys):
+    """A G-code build splits a program's path where it folds back by design: --allow-splits there is told, not ignored."""
+    program = tmp_path / "p.nc"
+    program.write_text("G21\nG0 X0 Y0 Z1\nG1 Z-1 F100\nG1 X10\nG1 Y10\nG0 Z1\nM2\n")
+    argv = ["build", "--from-gcode", str(program), "--max-deviation", "0.01", "-o", str(tmp_path / "out"), "--allow-splits"]
+    assert main(argv) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("error: --allow-splits: only with a path made G2") and "spiral-cad g2" in err
+    assert not (tmp_path / "out").exists()

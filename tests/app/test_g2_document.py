@@ -130,12 +130,13 @@ def test_cli_writes_the_program_and_reports(tmp_path, capsys):
     assert (tmp_path / "out.ngc").read_text().count("\nG0 ") == 3
 
 
-def test_cli_strict_and_kinds_not_yet(tmp_path, capsys):
+def test_cli_exits_1_on_a_split_unless_allowed_and_kinds_not_yet(tmp_path, capsys):
     src = tmp_path / "back.nc"  # a cut that goes straight back along itself: split there, left a corner
     src.write_text("G21\nG0 X0 Y0 Z0\nG1 X10 Y0 F100\nG3 X10 Y10 I0 J5\nG1 X0 Y10\nG1 X10 Y10\nM2\n")
     out = tmp_path / "back_g2.nc"
-    assert main(["g2", str(src), "--max-deviation", "0.01", "-o", str(out)]) == 0
-    assert main(["g2", str(src), "--max-deviation", "0.01", "-o", str(out), "--strict"]) == 1
+    assert main(["g2", str(src), "--max-deviation", "0.01", "-o", str(out)]) == 1  # written, but a split is told by the exit
+    assert "FAIL: 1 left below G2" in capsys.readouterr().out and out.read_text().count("\nG0 ") == 1
+    assert main(["g2", str(src), "--max-deviation", "0.01", "-o", str(out), "--allow-splits"]) == 0
     capsys.readouterr()
     assert main(["g2", str(tmp_path / "road.xodr"), "--max-deviation", "0.01", "-o", str(tmp_path / "r.xodr")]) == 2
     err = capsys.readouterr().err
@@ -144,6 +145,8 @@ def test_cli_strict_and_kinds_not_yet(tmp_path, capsys):
         rewriter_for("part.step")
     with pytest.raises(ValueError, match="is the input"):
         make_document_g2(src, src, 0.01)
+    assert main(["g2", str(src), "--max-deviation", "0.01", "-o", str(tmp_path / "no" / "such" / "out.nc")]) == 2
+    assert capsys.readouterr().err.startswith("error: the output's folder ") and not (tmp_path / "no").exists()
 
 
 def test_a_line_moving_by_the_modal_code_keeps_its_motion():
@@ -263,8 +266,7 @@ def test_another_kind_registers_by_suffix(tmp_path, monkeypatch):
     seen = []
 
     class Report:
-        kept: list = []
-        splits = 0
+        below_g2: list = []
 
         def lines(self):
             return ["fake: 1 path made G2"]
@@ -287,7 +289,7 @@ def test_a_drawing_and_a_road_file_come_back_whole_through_the_one_verb(tmp_path
     msp.add_lwpolyline([(0, 0), (40, 0), (40, 20), (0, 20)], close=True, dxfattribs={"layer": "OUTLINE"})
     msp.add_text("PLATE", dxfattribs={"layer": "NOTES"})
     doc.saveas(tmp_path / "plate.dxf")
-    assert main(["g2", str(tmp_path / "plate.dxf"), "--max-deviation", "0.01", "-o", str(tmp_path / "out.dxf"), "--strict"]) == 0
+    assert main(["g2", str(tmp_path / "plate.dxf"), "--max-deviation", "0.01", "-o", str(tmp_path / "out.dxf")]) == 0
     said = capsys.readouterr().out
     assert "4 of 4 joint(s) changed" in said and "0 left below G2" in said
     back = ezdxf.readfile(tmp_path / "out.dxf").modelspace()
@@ -331,7 +333,7 @@ def test_arcspirals_outer_turns_come_back_g2_through_the_cli(tmp_path, capsys):
     src = tmp_path / "arcspiral300.ngc"
     src.write_text("\n".join(lines[:307] + lines[-2:]) + "\n")  # the header, 300 arcs, the retract and M2
     out = tmp_path / "out.ngc"
-    assert main(["g2", str(src), "--max-deviation", "0.01", "-o", str(out), "--strict"]) == 0
+    assert main(["g2", str(src), "--max-deviation", "0.01", "-o", str(out)]) == 0
     said = capsys.readouterr().out
     assert "lines 7-307: 301 moves made G2" in said and "299 joints changed" in said and "refused" not in said
     assert "1 of 1 runs made G2" in said
