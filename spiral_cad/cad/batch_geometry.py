@@ -74,14 +74,14 @@ def surface_derivatives(frames: NDArray, uvs: NDArray) -> NDArray:
     return out
 
 
-def curve_frame(curve: BRepAdaptor_Curve | BRepAdaptor_Curve2d) -> NDArray | None:
+def curve_frame(curve: BRepAdaptor_Curve | BRepAdaptor_Curve2d) -> list[float] | None:
     """The numbers of a line, circle or ellipse (O, X, Y, l, a, b; 2 or 3 coordinates each, located as the
-    adaptor's edge), or None for any other curve."""
+    adaptor's edge), or None for any other curve. A list: many frames become one array at once."""
     kind = curve.GetType()
     if kind == GeomAbs_CurveType.GeomAbs_Line:
         line = curve.Line()
-        o, x = _xyz(line.Location()), _xyz(line.Direction())
-        return np.array([*o, *x, *([0.0] * len(o)), 1.0, 0.0, 0.0])
+        o = line.Location().Coord()
+        return [*o, *line.Direction().Coord(), *(0.0,) * len(o), 1.0, 0.0, 0.0]
     if kind == GeomAbs_CurveType.GeomAbs_Circle:
         conic = curve.Circle()
         a = b = conic.Radius()
@@ -90,13 +90,13 @@ def curve_frame(curve: BRepAdaptor_Curve | BRepAdaptor_Curve2d) -> NDArray | Non
         a, b = conic.MajorRadius(), conic.MinorRadius()
     else:
         return None
-    return np.array([*_xyz(conic.Location()), *_xyz(conic.XAxis().Direction()), *_xyz(conic.YAxis().Direction()), 0.0, a, b])
+    return [*conic.Location().Coord(), *conic.XAxis().Direction().Coord(), *conic.YAxis().Direction().Coord(), 0.0, a, b]
 
 
-def curve_points(frames: NDArray, ts: NDArray) -> tuple[NDArray, NDArray]:
+def curve_points(frames: NDArray | list[float], ts: NDArray) -> tuple[NDArray, NDArray]:
     """Points and first derivatives (n × d each) at ``ts`` (n) of the curve ``frames`` (from ``curve_frame``;
     one for all, or one row per parameter)."""
-    frames = np.atleast_2d(frames)
+    frames = np.atleast_2d(np.asarray(frames, dtype=float))
     d = (frames.shape[1] - 3) // 3
     o, x, y = frames[:, :d], frames[:, d : 2 * d], frames[:, 2 * d : 3 * d]
     l, a, b = (frames[:, i : i + 1] for i in range(3 * d, 3 * d + 3))

@@ -79,12 +79,14 @@ def derivatives(surface: BRepAdaptor_Surface, uvs: NDArray, out: NDArray) -> Non
     """Fill ``out`` (n × 18) with the point and derivatives (P, Su, Sv, Suu, Svv, Suv) at each (u, v) row."""
     p = gp_Pnt()
     su, sv, suu, svv, suv = gp_Vec(), gp_Vec(), gp_Vec(), gp_Vec(), gp_Vec()
-    for k, (u, v) in enumerate(uvs.tolist()):
+    rows, nan = [], (math.nan,) * 18
+    for u, v in uvs.tolist():
         if not (math.isfinite(u) and math.isfinite(v)):
-            out[k] = math.nan
+            rows.append(nan)
             continue
         surface.D2(u, v, p, su, sv, suu, svv, suv)
-        out[k] = (*p.Coord(), *su.Coord(), *sv.Coord(), *suu.Coord(), *svv.Coord(), *suv.Coord())
+        rows.append((*p.Coord(), *su.Coord(), *sv.Coord(), *suu.Coord(), *svv.Coord(), *suv.Coord()))
+    out[:] = np.array(rows, dtype=float).reshape(-1, 18)
 
 
 def shifted_back(raw: NDArray, axis: int, h: float | NDArray) -> None:

@@ -122,8 +122,7 @@ def span_points(lo: float, hi: float, breaks: list[float]) -> list[float]:
 def floor_points(lo: float, hi: float, samples: int) -> list[float]:
     """``samples`` midpoints of equal steps and the two ends moved in by ``END_INSET``."""
     width = hi - lo
-    mids = (lo + width * (np.arange(samples) + 0.5) / samples).tolist()
-    return [lo + END_INSET * width, *mids, hi - END_INSET * width]
+    return [lo + END_INSET * width, *(lo + width * (k + 0.5) / samples for k in range(samples)), hi - END_INSET * width]
 
 
 def _crossings(uv_of: Callable[[list[float]], NDArray], grid: NDArray, knots: tuple[list[float], list[float]]) -> list[float]:
@@ -153,12 +152,11 @@ def _crossings(uv_of: Callable[[list[float]], NDArray], grid: NDArray, knots: tu
 
 def _pcurve_points(pcurve: BRepAdaptor_Curve2d, params: list[float]) -> NDArray:
     """The pcurve's (u, v) at ``params`` (n × 2)."""
-    uv = gp_Pnt2d()
-    out = np.empty((len(params), 2))
-    for k, t in enumerate(params):
+    uv, found = gp_Pnt2d(), []
+    for t in params:
         pcurve.D0(t, uv)
-        out[k] = uv.X(), uv.Y()
-    return out
+        found.append(uv.Coord())
+    return np.array(found, dtype=float).reshape(-1, 2)
 
 
 # ------------------------------------------------------------ evaluating
@@ -248,9 +246,9 @@ class EdgeLine(Line):
                         for (domain, oriented), on_face in zip(sides, self.curves_on_faces)]  # fmt: skip
         frames = [curve_frame(self.curve), *(None if pcurve is None else curve_frame(pcurve) for pcurve in self.pcurves)]
         # the edge and both pcurves lines, circles or ellipses: located in closed form, with other such edges
-        self.closed: NDArray | None = None if any(frame is None for frame in frames) else np.concatenate(frames)  # type: ignore[arg-type]
+        self.closed: list[float] | None = None if any(frame is None for frame in frames) else sum(frames, [])  # type: ignore[arg-type]
         # else each curve in closed form where it can be, point by point where not
-        self.batch = [None if frame is None else partial(curve_points, frame) for frame in frames]
+        self.batch = [None if frame is None else partial(curve_points, np.array(frame)) for frame in frames]
         floor = floor_points(self.lo, self.hi, samples)
         breaks = curve_knots(BRep_Tool.Curve_s(edge, 0.0, 0.0)) if BRep_Tool.IsGeometric_s(edge) else []
         grid, own = None, list(breaks)
@@ -271,16 +269,17 @@ class EdgeLine(Line):
         """The edge's points (n × 3) and unit tangents (n × 3) at ``params``, and per face the (u, v) to start
         its projection from: its pcurve's, or OCCT's projection where it has none."""
         if self.closed is not None:
-            return located(np.broadcast_to(self.closed, (len(params), len(self.closed))), np.asarray(params, dtype=float))
+            return located(np.broadcast_to(np.array(self.closed), (len(params), len(self.closed))), np.asarray(params, dtype=float))
         edge, *on_faces = self.batch
         if edge is not None:
             points, tangents = edge(np.asarray(params, dtype=float))
         else:
-            tangents, points = np.empty((len(params), 3)), np.empty((len(params), 3))
-            p, d1 = gp_Pnt(), gp_Vec()
-            for k, t in enumerate(params):
+            p, d1, found = gp_Pnt(), gp_Vec(), []
+            for t in params:
                 self.curve.D1(t, p, d1)
-                tangents[k], points[k] = d1.Coord(), p.Coord()
+                found.append((*p.Coord(), *d1.Coord()))
+            both = np.array(found, dtype=float).reshape(-1, 6)
+            points, tangents = both[:, :3], both[:, 3:]
         with np.errstate(all="ignore"):
             tangents = tangents / norms(tangents)[:, None]
         starts = [_projected_points(oriented, domain.face, params) if pcurve is None
@@ -402,15 +401,14 @@ class _LineTable:
         self.on_edge = np.array([isinstance(line, EdgeLine) for line in lines])
         self.closed = np.array([isinstance(line, EdgeLine) and line.closed is not None for line in lines])
         self.tolerance = np.array([line.tolerance if isinstance(line, EdgeLine) else 0.0 for line in lines])
-        self.frames = np.zeros((len(lines), 30))
+        none = [0.0] * 30
+        self.frames = np.array([line.closed if isinstance(line, EdgeLine) and line.closed is not None else none for line in lines])
         self.face_of = np.zeros((len(lines), 2), dtype=int)
         places: dict[int, int] = {}  # id of a face's domain → its place in ``domains``
         self.domains: list[FaceDomain] = []
         for i, line in enumerate(lines):
             if not isinstance(line, EdgeLine):
                 continue
-            if line.closed is not None:
-                self.frames[i] = line.closed
             for side, (domain, _) in enumerate(line.sides):
                 if id(domain) not in places:
                     places[id(domain)] = len(self.domains)
