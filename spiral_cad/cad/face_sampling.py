@@ -246,7 +246,9 @@ class EdgeLine(Line):
                         for (domain, oriented), on_face in zip(sides, self.curves_on_faces)]  # fmt: skip
         frames = [curve_frame(self.curve), *(None if pcurve is None else curve_frame(pcurve) for pcurve in self.pcurves)]
         # the edge and both pcurves lines, circles or ellipses: located in closed form, with other such edges
-        self.closed: list[float] | None = None if any(frame is None for frame in frames) else sum(frames, [])  # type: ignore[arg-type]
+        self.closed: list[float] | None = None
+        if all(frame is not None for frame in frames):
+            self.closed = [x for frame in frames for x in frame or ()]
         # else each curve in closed form where it can be, point by point where not
         self.batch = [None if frame is None else partial(curve_points, np.array(frame)) for frame in frames]
         floor = floor_points(self.lo, self.hi, samples)
