@@ -7,7 +7,6 @@ import shutil
 import subprocess
 import sys
 import tempfile
-from functools import partial
 from pathlib import Path
 
 import cadquery as cq
@@ -45,17 +44,14 @@ def zebra_pictures() -> None:
         "circular fillets, r = 5: G1": face_mesh(bd.fillet(bd.Box(40, 20, 8).edges().filter_by(bd.Axis.Z), 5)),
         "continuous rectangle, extruded: G2": face_mesh(bd.extrude(ContinuousRectangle(40, 20, 5), 8)),
     }
-    view = (1.0, -0.9, 0.45)
-    for name, draw in (("zebra_boxes.png", partial(plot_zebra, stripes=5)), ("zebra_curvature.png", plot_curvature_map)):
-        fig = Figure(figsize=(12, 3.6), dpi=110)
+    for name, draw in (("zebra_boxes.png", plot_zebra), ("zebra_curvature.png", plot_curvature_map)):
+        fig = Figure(figsize=(14, 4.2), dpi=110)
         for ax, (title, mesh) in zip(fig.subplots(1, 2), parts.items()):
-            draw(mesh, ax=ax, title=title, view=view)
+            draw(mesh, ax=ax, title=title)
         fig.savefig(IMAGES / name, bbox_inches="tight")
     # every edge filleted: stripes cross the cylinder/sphere edges (G1) and kink there
-    fig = Figure(figsize=(6, 4.5), dpi=110)
     rounded = bd.fillet(bd.Box(40, 20, 16).edges(), 6)
-    plot_zebra(rounded, ax=fig.add_subplot(), view=(1.0, -1.3, 1.0), stripes=6, across=(0.3, 0.2, 1.0))
-    fig.savefig(IMAGES / "zebra_corners.png", bbox_inches="tight")
+    plot_zebra(rounded, view=(1.0, -1.3, 1.0), pixels=700).savefig(IMAGES / "zebra_corners.png", bbox_inches="tight")
 
 
 def solids_pictures() -> None:
@@ -74,9 +70,9 @@ def solids_pictures() -> None:
         "build123d Box + fillet (6, then 1.5): G1": face_mesh(circular),
         "ContinuousBox(40, 20, 8, 6, edge_radius=1.5): G2": face_mesh(ContinuousBox(40, 20, 8, 6, edge_radius=1.5)),
     }
-    fig = Figure(figsize=(11, 3.6), dpi=110)
+    fig = Figure(figsize=(14, 4.6), dpi=110)
     for ax, (title, mesh) in zip(fig.subplots(1, 2), parts.items()):
-        plot_zebra(mesh, ax=ax, title=title, view=(1.0, -0.9, 0.7), stripes=6)
+        plot_zebra(mesh, ax=ax, title=title, view=(1.0, -0.9, 0.7))
     fig.savefig(IMAGES / "solids_zebra.png", bbox_inches="tight")
 
 

@@ -329,12 +329,13 @@ def _check(args: argparse.Namespace) -> int:
         return 2
     from ..cad.faces import holds_faces
 
+    picture = _picture_options(args)  # refused before anything is read
     if holds_faces(args.file):
         from .faces_check import check_face_file
 
         status = check_face_file(args.file, require=args.require, gap_tol=args.gap_tol, angle_tol=args.angle_tol,
                                  curvature_tol=args.curvature_tol, feature_angle=args.feature_angle, zebra=args.zebra,
-                                 curvature_map=args.curvature_map, timing=args.timing)  # fmt: skip
+                                 curvature_map=args.curvature_map, timing=args.timing, picture=picture)  # fmt: skip
         if status is not None:  # None: the reader found no faces after all, so the wires are judged
             if args.comb:  # the comb of every edge of the part, in mm as build123d and FreeCAD read
                 from ..cad.continuity import curvature_comb
@@ -507,6 +508,13 @@ def _add_check(sub: argparse._SubParsersAction) -> None:
                        help="faces: normals further apart (radians) make a sharp feature, listed and not failed (default 5°)")  # fmt: skip
     check.add_argument("--zebra", metavar="OUT.png", help="faces: also draw zebra stripes (reflection lines) of the part as PNG")
     check.add_argument("--curvature-map", metavar="OUT.png", help="faces: also draw the mean curvature of the part as PNG")
+    check.add_argument(
+        "--view", metavar="X,Y,Z", help="the pictures: direction towards the viewer (default 1,-0.9,0.45: front right, a little above)"
+    )
+    check.add_argument(
+        "--stripes", type=int, metavar="N", help="the zebra picture: stripe pairs (default 24; more for a finer look at small fillets)"
+    )
+    check.add_argument("--pixels", type=int, metavar="N", help="the pictures: their longer side in pixels (default 1000)")
     _add_many(check)
     check.set_defaults(run=_check_inputs)
 
@@ -533,6 +541,30 @@ def _run_many(args: argparse.Namespace, task: Callable[[argparse.Namespace], int
     from .many import run_many
 
     return run_many(task, files, changes, args, verb=verb, workers=args.workers, scheduler=args.scheduler, summary=args.summary)
+
+
+def _picture_options(args: argparse.Namespace) -> dict:
+    """``--view``, ``--stripes`` and ``--pixels`` as the pictures' keyword arguments (only those given)."""
+    options: dict = {}
+    if args.view is not None:
+        try:
+            view = tuple(float(x) for x in args.view.split(","))
+        except ValueError:
+            view = ()
+        if len(view) != 3 or not all(map(math.isfinite, view)) or not any(view):
+            raise ValueError(f"--view must be three numbers X,Y,Z, not all zero (a direction towards the viewer); got {args.view!r}")
+        options["view"] = view
+    if args.stripes is not None:
+        options["stripes"] = args.stripes
+    if args.pixels is not None:
+        options["pixels"] = args.pixels
+    if options and not (args.zebra or args.curvature_map):
+        raise ValueError(f"{', '.join('--' + k for k in options)}: only with --zebra or --curvature-map")
+    if options:
+        from .zebra import check_picture_options
+
+        check_picture_options(**options)
+    return options
 
 
 def _check_inputs(args: argparse.Namespace) -> int:

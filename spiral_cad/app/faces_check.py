@@ -41,7 +41,7 @@ def _picture(draw: Callable[[], Figure], path: Path, what: str) -> None:
     for warning in caught:
         print(f"warning: {what}: {warning.message}")
     try:
-        fig.savefig(path, dpi=120, bbox_inches="tight")
+        fig.savefig(path, dpi=100, bbox_inches="tight")  # the picture pixel for pixel
     except OSError as error:
         raise ValueError(f"cannot write the {what} to {str(path)!r}: {error.strerror or error}") from None
     print(f"{what} written to {path}")
@@ -49,12 +49,13 @@ def _picture(draw: Callable[[], Figure], path: Path, what: str) -> None:
 
 def check_face_file(file: str, *, require: str | None = None, gap_tol: float | None = None, angle_tol: float | None = None,
                     curvature_tol: float | None = None, feature_angle: float | None = None, zebra: str | None = None,
-                    curvature_map: str | None = None, timing: bool = False) -> int | None:  # fmt: skip
+                    curvature_map: str | None = None, timing: bool = False, picture: dict | None = None) -> int | None:  # fmt: skip
     """Judge the faces of ``file`` and print the table; draw the pictures asked for.
 
     Tolerances left None take ``check_faces``'s defaults (gap: the file's stated precision and the edges' own tolerances, angle 1e-7 rad, curvature jump 1e-4). ``require`` "G2" or "G1" fails any
     tangent edge below it (and "G0" any gap); sharp features are listed, never failed. ``timing``
-    also prints how long the check took.
+    also prints how long the check took. ``picture`` holds the pictures' options (``view``, ``pixels``;
+    the zebra's ``stripes``), as ``plot_zebra`` and ``plot_curvature_map`` take them.
 
     Returns:
         0 ok, 1 below ``require``, None when the reader found no faces or one lone face (no
@@ -85,11 +86,13 @@ def check_face_file(file: str, *, require: str | None = None, gap_tol: float | N
         from ..cad.mesh import face_mesh
         from .zebra import plot_curvature_map, plot_zebra
 
-        mesh = face_mesh(file, units=report.units)
+        options = dict(picture or {})
+        stripes = {"stripes": options.pop("stripes")} if "stripes" in options else {}
+        mesh = face_mesh(file, units=report.units, **{k: v for k, v in options.items() if k == "pixels"})
         if zebra_png is not None:
-            _picture(lambda: plot_zebra(mesh, title=f"{report.source}: zebra"), zebra_png, "zebra stripes")
+            _picture(lambda: plot_zebra(mesh, title=f"{report.source}: zebra", **options, **stripes), zebra_png, "zebra stripes")
         if map_png is not None:
-            _picture(lambda: plot_curvature_map(mesh, title=f"{report.source}: mean curvature"), map_png, "curvature map")
+            _picture(lambda: plot_curvature_map(mesh, title=f"{report.source}: mean curvature", **options), map_png, "curvature map")
     if not require:
         return 0
     if not report.edges:

@@ -3,13 +3,21 @@
 How surfaces are judged by eye: a part under a room of parallel light tubes. The stripes are
 the reflections of the tubes, so they follow the normals: across a G0 edge they break, across a
 G1 edge (normals agree, curvature jumps) they stay joined but **kink**, across a G2 edge they
-bend smoothly. Here the mesh comes from ``spiral_cad.cad.mesh.face_mesh`` (the surfaces' exact
-normals at each vertex, a separate vertex per face along an edge), the view is orthographic, the
-reflected view vector r = 2 (n·v) n − v is computed from the surface normals interpolated over
-each pixel, and the stripes are bands of ``asin(r·e)`` for a fixed direction e across the tubes.
-The triangles are rasterised with a depth buffer into one image of ``spiral_cad.cad.mesh.PIXELS`` pixels a side
-(numpy, in passes of bounded size), so time and memory follow the picture, not the mesh; a face
-seen from behind (an open shell) is drawn with its normal turned towards the viewer.
+bend smoothly. As in CAD zebra tools the tubes hang in the viewer's room (fixed to the view, at
+``angle`` in the picture), and the part is seen from a point at a finite ``distance``: each pixel's
+ray from the eye is reflected about the surface normal there, r = d − 2 (d·n) n, so a flat face
+reflects a fan of directions and carries stripes too, and those stripes run on across its edges
+into the fillets — straight on through a G2 edge, with a kink at a G1 one. The stripes are bands
+of ``asin(r·e)`` for the direction e across the tubes, their borders smoothed over a pixel
+(anti-aliased from the bands' own slope in the picture).
+
+The mesh comes from ``spiral_cad.cad.mesh.face_mesh``: the surfaces' exact normals at each vertex, a
+separate vertex per face along an edge, and triangles split where the normal's rate of turn
+changes (where a spiral's curvature grows from zero), so that the interpolated normals do not kink
+where the surface does not. The image is orthographic: the triangles are rasterised with a depth
+buffer into one image of ``spiral_cad.cad.mesh.PIXELS`` pixels a side (numpy, in passes of bounded
+size), so time and memory follow the picture, not the mesh; a face seen from behind (an open shell)
+is drawn with its normal turned towards the viewer.
 
 Figures are ``matplotlib.figure.Figure`` (Agg, no pyplot state), as ``spiral_cad.app.plots``.
 """
@@ -20,6 +28,7 @@ import math
 import warnings
 from collections.abc import Callable, Iterator, Sequence
 from dataclasses import dataclass
+from functools import partial
 from typing import Any
 
 import numpy as np
@@ -32,12 +41,16 @@ from numpy.typing import NDArray
 
 from ..cad.mesh import PIXELS, FaceMesh, face_mesh
 
-__all__ = ["ACROSS", "VIEW", "plot_curvature_map", "plot_zebra"]
+__all__ = ["DISTANCE", "STRIPES", "VIEW", "check_picture_options", "plot_curvature_map", "plot_zebra"]
 
-#: Default direction towards the viewer: from the front right, above.
-VIEW = (1.0, -1.6, 1.2)
-#: Default direction across the light tubes: tilted, so that stripes cross vertical and horizontal faces alike.
-ACROSS = (1.0, 0.5, 0.3)
+#: Default direction towards the viewer: from the front right, a little above (low enough that the stripes on
+#: the sides run across their vertical edges).
+VIEW = (1.0, -0.9, 0.45)
+#: Default stripe pairs over the half-turn of reflected directions.
+STRIPES = 24
+#: Default distance of the eye from the part's centre, in part sizes (bounding-box diagonals): near enough
+#: that a flat face reflects a fan of directions (about 45°) and so carries stripes into its fillets.
+DISTANCE = 1.2
 
 
 def _frame(view: Sequence[float]) -> tuple[NDArray, NDArray, NDArray]:
@@ -136,35 +149,42 @@ def _batches(counts: NDArray) -> Iterator[NDArray]:
         first = last
 
 
-def _draw(mesh: FaceMesh, values: NDArray | Callable[[NDArray], NDArray], view: Sequence[float], ax: Axes | None,
+def _draw(mesh: FaceMesh, values: NDArray | Callable[[NDArray, NDArray], NDArray], view: Sequence[float], ax: Axes | None,
           title: str, pixels: int, **style: Any) -> tuple[Figure, Axes, AxesImage]:  # fmt: skip
     """Draw the part as one image: each pixel takes the nearest triangle's value there.
 
     A pixel's value is interpolated linearly from the corners' ``values``, or, when ``values`` is
-    a function of unit normals, is that function of the normal interpolated to the pixel,
+    a function of unit normals and points, is that function of the normal interpolated to the pixel,
     renormalised and turned towards the viewer (Phong's normals: a stripe border follows the
-    surface, not the triangles; a face seen from behind shows its other side).
+    surface, not the triangles; a face seen from behind shows its other side), and of the point
+    there, and ``style["finish"]``, if given, maps the whole image of those values to what is shown.
 
     Warns:
         UserWarning: no pixel shows a face (a part seen exactly edge-on).
     """
     v = _frame(view)[0]
-    if ax is None:
-        fig = Figure(figsize=(6.4, 4.8), dpi=100)
-        ax = fig.add_subplot()
+    raster = _raster(mesh, view, pixels)
+    if ax is None:  # a figure pixel (at its 100 dpi) per picture pixel, and room above for the title
+        inches = np.array(raster.owner.shape[::-1]) / 100.0
+        above = 0.4 if title else 0.0
+        fig = Figure(figsize=(inches[0], inches[1] + above), dpi=100)
+        ax = fig.add_axes((0.0, 0.0, 1.0, inches[1] / (inches[1] + above)))
     else:
         fig = ax.figure.get_figure(root=True)
-    raster = _raster(mesh, view, pixels)
     seen = raster.owner >= 0
     corners = mesh.triangles[raster.owner[seen]]  # (k, 3)
     w = raster.weights[seen]
     image = np.full(raster.owner.shape, np.nan)
     if callable(values):
         normals = np.einsum("kc,kcd->kd", w, mesh.normals[corners])
+        points = np.einsum("kc,kcd->kd", w, mesh.points[corners])
         with np.errstate(all="ignore"):
             normals /= np.linalg.norm(normals, axis=1)[:, None]
             normals *= np.where(normals @ v < 0.0, -1.0, 1.0)[:, None]  # the side facing the viewer
-            image[seen] = np.nan_to_num(values(normals))
+        image[seen] = values(normals, points)
+        finish = style.pop("finish", np.nan_to_num)  # the whole picture's values at once (stripes: smoothed borders)
+        image = finish(image)
+        image[~seen] = np.nan
     else:
         image[seen] = np.einsum("kc,kc->k", w, values[corners])
     if not seen.any():
@@ -183,20 +203,49 @@ def _mesh_of(part: Any, units: str | None, pixels: int) -> FaceMesh:
     return part if isinstance(part, FaceMesh) else face_mesh(part, units=units, pixels=pixels)
 
 
-def _check_pixels(pixels: int) -> None:
+def check_picture_options(*, view: Sequence[float] = VIEW, stripes: int = STRIPES, pixels: int = PIXELS) -> None:
+    """Refuse a picture's options before anything is drawn.
+
+    Raises:
+        ValueError: ``view`` not a non-zero 3-D direction, ``stripes`` not an integer from 1 to 200, or
+            ``pixels`` not an integer from 16 to 8000 (each named with the value given).
+    """
+    _frame(view)
+    if isinstance(stripes, bool) or not isinstance(stripes, int) or not 1 <= stripes <= 200:
+        raise ValueError(f"stripes must be an integer from 1 to 200; got {stripes!r:.40}")
     if isinstance(pixels, bool) or not isinstance(pixels, int) or not 16 <= pixels <= 8000:
         raise ValueError(f"pixels must be an integer from 16 to 8000; got {pixels!r:.40}")
 
 
-def plot_zebra(part: Any, *, view: Sequence[float] = VIEW, stripes: int = 14, across: Sequence[float] = ACROSS,
+def _stripes(phase: NDArray, dark: float) -> NDArray:
+    """Grey levels in [0, 1] of stripes at ``phase`` (in periods; the first ``dark`` share of each period
+    dark), each border ramped over one pixel by the phase's own slope in the picture (as a shader's
+    ``fwidth``): anti-aliased without drawing the picture larger."""
+    with np.errstate(all="ignore"):
+        # (a picture one pixel thin, a face seen edge-on: no slope, hard borders)
+        slope = np.nan_to_num(np.hypot(*np.gradient(phase)), nan=0.0, posinf=0.0) if min(phase.shape) > 1 else np.zeros_like(phase)
+        fraction = phase - np.floor(phase)
+        # signed distance (in periods) to the nearer border of the dark band: positive inside it
+        distance = np.where(fraction < dark, np.minimum(fraction, dark - fraction), -np.minimum(fraction - dark, 1.0 - fraction))
+        shade = np.clip(0.5 + distance / np.maximum(slope, 1e-12), 0.0, 1.0)
+    return np.nan_to_num(1.0 - shade)
+
+
+def plot_zebra(part: Any, *, view: Sequence[float] = VIEW, stripes: int = STRIPES, width: float = 0.5,
+               angle: float = 0.0, distance: float = DISTANCE, across: Sequence[float] | None = None,
                ax: Axes | None = None, title: str = "", units: str | None = "mm", pixels: int = PIXELS) -> Figure:  # fmt: skip
-    """Zebra stripes (reflection lines of parallel light tubes) on a part, orthographic view.
+    """Zebra stripes (reflection lines of parallel light tubes) on a part: they kink at a G1 edge and
+    run smoothly through a G2 one.
 
     Args:
         part: a ``FaceMesh``, a build123d/CadQuery/OCCT shape, or a STEP/IGES path.
-        view: direction towards the viewer.
-        stripes: stripe pairs over the half-turn of reflected directions.
-        across: direction across the light tubes (default vertical: horizontal tubes).
+        view: direction towards the viewer (the picture is an orthographic view along it).
+        stripes: dark-and-light stripe pairs over the half-turn of reflected directions.
+        width: the dark share of each pair, in (0, 1).
+        angle: the tubes' direction in the picture, degrees counter-clockwise from horizontal.
+        distance: how far the eye is from the part's centre, in part sizes (bounding-box diagonals);
+            ``math.inf`` reflects parallel rays (a flat face then shows one colour).
+        across: a direction across the tubes fixed to the part instead of the view (overrides ``angle``).
         ax: draw into these axes (default: a new figure).
         title: axes title.
         units: the unit to read a file in (as ``face_mesh``).
@@ -206,28 +255,43 @@ def plot_zebra(part: Any, *, view: Sequence[float] = VIEW, stripes: int = 14, ac
         The figure (``fig.savefig("zebra.png")``).
 
     Raises:
-        ValueError: a bad ``view``/``across`` direction, ``stripes`` or ``pixels`` count, or a part without faces.
+        ValueError: a bad ``view``/``across`` direction, ``stripes``, ``width``, ``angle``, ``distance`` or
+            ``pixels``, or a part without faces.
 
     Warns:
         UserWarning: nothing is visible from ``view``.
     """
-    if isinstance(stripes, bool) or not isinstance(stripes, int) or not 1 <= stripes <= 64:
-        raise ValueError(f"stripes must be an integer from 1 to 64; got {stripes!r:.40}")
-    _check_pixels(pixels)
-    e = np.asarray(across, dtype=float)
-    if e.shape != (3,) or not np.isfinite(e).all() or not np.linalg.norm(e) > 0:
-        raise ValueError(f"across must be a non-zero 3-D direction; got {across!r}")
+    check_picture_options(view=view, stripes=stripes, pixels=pixels)
+    for name, value, ok in (("width", width, lambda x: 0.0 < x < 1.0), ("angle", angle, math.isfinite),
+                            ("distance", distance, lambda x: x > 0.0)):  # fmt: skip
+        if isinstance(value, bool) or not isinstance(value, (int, float)) or math.isnan(value) or not ok(value):
+            raise ValueError(f"{name} must be {'in (0, 1)' if name == 'width' else 'a positive number' if name == 'distance' else 'a finite number'}; "
+                             f"got {value!r:.40}")  # fmt: skip
+    v, right, up = _frame(view)
+    if across is None:
+        e = math.cos(math.radians(angle)) * up - math.sin(math.radians(angle)) * right
+    else:
+        e = np.asarray(across, dtype=float)
+        if e.shape != (3,) or not np.isfinite(e).all() or not np.linalg.norm(e) > 0:
+            raise ValueError(f"across must be a non-zero 3-D direction; got {across!r}")
+        e = e / np.linalg.norm(e)
     mesh = _mesh_of(part, units, pixels)
-    v = _frame(view)[0]
-    e = e / np.linalg.norm(e)
+    centre = 0.5 * (mesh.points.min(axis=0) + mesh.points.max(axis=0))
+    eye = centre + distance * max(mesh.size, 1e-300) * v if math.isfinite(distance) else None
 
-    def phase(n: NDArray) -> NDArray:
-        """The reflected view vector's elevation above the tubes' plane, cut into 2·stripes bands by the colours."""
-        reflected = 2.0 * (n @ v)[:, None] * n - v
-        return np.arcsin(np.clip(reflected @ e, -1.0, 1.0))
+    def phase(n: NDArray, p: NDArray) -> NDArray:
+        """Stripe periods of the reflected ray's elevation above the tubes' plane (the dark band first)."""
+        if eye is None:
+            d = np.broadcast_to(-v, n.shape)
+        else:
+            d = p - eye
+            d = d / np.linalg.norm(d, axis=1)[:, None]
+        reflected = d - 2.0 * np.einsum("ij,ij->i", d, n)[:, None] * n
+        elevation = np.arcsin(np.clip(reflected @ e, -1.0, 1.0))
+        return (elevation / math.pi + 0.5) * stripes
 
-    bands = ListedColormap(["0.08", "0.97"] * stripes)
-    style = dict(cmap=bands, norm=Normalize(-math.pi / 2, math.pi / 2))
+    grey = ListedColormap(np.linspace(0.08, 0.97, 256)[:, None].repeat(3, axis=1))
+    style = dict(cmap=grey, norm=Normalize(0.0, 1.0), finish=partial(_stripes, dark=width))
     return _draw(mesh, phase, view, ax, title, pixels, **style)[0]
 
 
@@ -257,7 +321,7 @@ def plot_curvature_map(part: Any, *, view: Sequence[float] = VIEW, kind: str = "
     """
     if kind not in ("mean", "gaussian"):
         raise ValueError(f"kind must be 'mean' or 'gaussian'; got {kind!r}")
-    _check_pixels(pixels)
+    check_picture_options(view=view, pixels=pixels)
     mesh = _mesh_of(part, units, pixels)
     values = np.nan_to_num(mesh.mean_curvature if kind == "mean" else mesh.gaussian_curvature)
     peak = float(np.abs(values).max()) or 1.0

@@ -24,7 +24,7 @@ from OCP.BRep import BRep_Tool
 from OCP.BRepAdaptor import BRepAdaptor_Surface
 from OCP.BRepBndLib import BRepBndLib
 from OCP.BRepMesh import BRepMesh_IncrementalMesh
-from OCP.gp import gp_Pnt, gp_Vec
+from OCP.GeomAbs import GeomAbs_SurfaceType
 from OCP.IMeshTools import IMeshTools_Parameters
 from OCP.TopAbs import TopAbs_FACE, TopAbs_REVERSED
 from OCP.TopExp import TopExp, TopExp_Explorer
@@ -34,10 +34,11 @@ from OCP.TopTools import TopTools_IndexedMapOfShape
 
 from ..check.joints import norms
 from ..core.units import length_unit
+from .face_projection import derivatives
 from .occ import as_occ_shape
 from .readers import read_file
 
-__all__ = ["ANGULAR", "DEFLECTION", "MAX_TRIANGLES", "PIXELS", "FaceMesh", "face_mesh"]
+__all__ = ["ANGULAR", "DEFLECTION", "MAX_TRIANGLES", "PIXELS", "REFINED", "RELATIVE", "SLOPE", "FaceMesh", "face_mesh"]
 
 #: Pixels along the longer side of the picture a mesh is made for (``spiral_cad.app.zebra``).
 PIXELS = 1000
@@ -107,8 +108,7 @@ def _mesh(shape: TopoDS_Shape, deflection: float | None, angle: float, pixels: i
         BRepTools.Clean_s(shape)
         linear, angular = 2.0 * linear, min(2.0 * angular, coarsest)
     points, triangles, values, owners = [], [], [], []
-    p, su, sv, suu, svv, suv = gp_Pnt(), gp_Vec(), gp_Vec(), gp_Vec(), gp_Vec(), gp_Vec()
-    offset, index = 0, 0
+    offset, index, budget = 0, 0, max_triangles
     explorer = TopExp_Explorer(shape, TopAbs_FACE)
     while explorer.More():
         face = TopoDS.Face_s(explorer.Current())
@@ -119,12 +119,13 @@ def _mesh(shape: TopoDS_Shape, deflection: float | None, angle: float, pixels: i
             index += 1
             continue
         surface = BRepAdaptor_Surface(face)  # located: the points come out where the face is
-        raw = np.empty((mesh.NbNodes(), 18))
-        for k in range(1, mesh.NbNodes() + 1):
-            uv = mesh.UVNode(k)
-            surface.D2(uv.X(), uv.Y(), p, su, sv, suu, svv, suv)
-            raw[k - 1] = (*p.Coord(), *su.Coord(), *sv.Coord(), *suu.Coord(), *svv.Coord(), *suv.Coord())
+        uvs = np.array([mesh.UVNode(k).Coord() for k in range(1, mesh.NbNodes() + 1)], dtype=float)
+        raw = np.empty((len(uvs), 18))
+        derivatives(surface, uvs, raw)
         tri = np.array([mesh.Triangle(k).Get() for k in range(1, mesh.NbTriangles() + 1)], dtype=np.int64) - 1
+        room = min(budget, REFINED * len(tri) + 2_000) if surface.GetType() not in _EVEN else 0
+        raw, tri = _refined(surface, uvs, raw, tri, slope=SLOPE / size, shortest=size / (2.0 * pixels), budget=room)
+        budget -= len(tri)
         reversed_ = face.Orientation() == TopAbs_REVERSED
         if reversed_:
             tri = tri[:, ::-1]
@@ -148,6 +149,97 @@ def _mesh(shape: TopoDS_Shape, deflection: float | None, angle: float, pixels: i
 
 #: The coarsest angular limit the triangle cap may push a mesh to, radians.
 _COARSEST = 0.5
+#: How far the normal's rate of turn along a triangle edge may differ from the rate the triangle
+#: interpolates, in radians per model size, before the edge is split (``_refined``).
+SLOPE = 0.02
+#: ... or by more than this share of the surface's own rate there (where the normal turns fast anyway, a small
+#: change of rate does not show).
+RELATIVE = 0.5
+#: Surfaces whose normal turns at one rate everywhere along any direction: never split.
+_EVEN = (GeomAbs_SurfaceType.GeomAbs_Plane, GeomAbs_SurfaceType.GeomAbs_Cylinder, GeomAbs_SurfaceType.GeomAbs_Sphere)
+#: A face's triangles may grow this many times over by splitting (the worst edges first).
+REFINED = 3
+#: Rounds of splitting.
+_ROUNDS = 8
+
+
+def _normal_slopes(raw: NDArray) -> tuple[NDArray, NDArray, NDArray]:
+    """Unit normals and their derivatives along u and v (n × 3 each), from rows of surface derivatives."""
+    su, sv, suu, svv, suv = (raw[:, i : i + 3] for i in range(3, 18, 3))
+    with np.errstate(all="ignore"):
+        big = np.cross(su, sv)
+        length = norms(big)[:, None]
+        normal = big / length
+        turns = []
+        for d in (np.cross(suu, sv) + np.cross(su, suv), np.cross(suv, sv) + np.cross(su, svv)):
+            turns.append((d - normal * np.einsum("ij,ij->i", normal, d)[:, None]) / length)
+    return normal, turns[0], turns[1]
+
+
+def _refined(surface: BRepAdaptor_Surface, uvs: NDArray, raw: NDArray, tri: NDArray, *, slope: float, shortest: float,
+             budget: int) -> tuple[NDArray, NDArray]:  # fmt: skip
+    """The face's triangles split where a picture's normals, interpolated linearly over a triangle, would
+    turn at another rate than the surface's: the normal turns at a constant rate across a triangle, so
+    where curvature grows from zero (a G2 spiral leaving a plane) a coarse triangle starts it with a jump,
+    and zebra stripes drawn from it would kink where the surface has none. An edge is split at its
+    parameter midpoint (the surface evaluated there) while the surface's rate of turn at either end
+    differs from the edge's by more than ``slope`` (radians per unit length) and the edge is longer than
+    ``shortest``, for ``_ROUNDS`` rounds or until ``budget`` triangles. Returns (raw, triangles)."""
+    normal, nu, nv = _normal_slopes(raw)
+    for _ in range(_ROUNDS):
+        if len(tri) >= budget:
+            break
+        ends = np.sort(np.concatenate([tri[:, [0, 1]], tri[:, [1, 2]], tri[:, [2, 0]]]), axis=1)
+        keys, which = np.unique(ends[:, 0] * len(uvs) + ends[:, 1], return_inverse=True)
+        a, b = keys // len(uvs), keys % len(uvs)
+        step = uvs[b] - uvs[a]
+        chord = normal[b] - normal[a]  # what a triangle interpolates along the edge (per unit of its parameter)
+        with np.errstate(all="ignore"):
+            length = norms(raw[b, :3] - raw[a, :3])
+            excess = np.zeros(len(keys))
+            for end in (a, b):
+                exact = nu[end] * step[:, :1] + nv[end] * step[:, 1:]  # the surface's turn over the edge, at this end's rate
+                excess = np.fmax(excess, norms(exact - chord) / (slope * length + RELATIVE * norms(exact)))
+            excess[~(length > 2.0 * shortest)] = 0.0  # NaN too
+        split = excess > 1.0
+        room = (budget - len(tri)) // 2  # a split edge adds a triangle on each side
+        if split.sum() > room:  # the worst first
+            split[np.argsort(excess)[: len(excess) - room]] = False
+        if not split.any():
+            break
+        mids = 0.5 * (uvs[a[split]] + uvs[b[split]])
+        found = np.empty((len(mids), 18))
+        derivatives(surface, mids, found)
+        new_index = np.full(len(keys), -1)
+        new_index[split] = len(uvs) + np.arange(int(split.sum()))
+        uvs, raw = np.vstack([uvs, mids]), np.vstack([raw, found])
+        normal, nu, nv = (np.vstack([x, y]) for x, y in zip((normal, nu, nv), _normal_slopes(found)))
+        tri = _split(tri, new_index[which.reshape(3, -1).T])
+    return raw, tri
+
+
+#: How a triangle is split, by which of its edges 01, 12, 20 hold a midpoint (bit 1, 2, 4): the new
+#: triangles as positions in its ring (corner 0, midpoint 01, corner 1, midpoint 12, corner 2, midpoint 20),
+#: fanned from a midpoint so that each keeps the triangle's orientation.
+_SPLITS = {
+    0: [(0, 2, 4)],
+    1: [(1, 2, 4), (1, 4, 0)],
+    2: [(3, 4, 0), (3, 0, 2)],
+    4: [(5, 0, 2), (5, 2, 4)],
+    3: [(1, 2, 3), (1, 3, 4), (1, 4, 0)],
+    6: [(3, 4, 5), (3, 5, 0), (3, 0, 2)],
+    5: [(1, 2, 4), (1, 4, 5), (1, 5, 0)],
+    7: [(0, 1, 5), (1, 2, 3), (5, 3, 4), (1, 3, 5)],
+}
+
+
+def _split(tri: NDArray, mid: NDArray) -> NDArray:
+    """Triangles with the midpoints ``mid`` (m × 3: of edges 01, 12, 20; -1: not split) put in, each split
+    into 2, 3 or 4 (``_SPLITS``)."""
+    ring = np.column_stack([tri[:, 0], mid[:, 0], tri[:, 1], mid[:, 1], tri[:, 2], mid[:, 2]])
+    code = (mid >= 0) @ np.array([1, 2, 4])
+    out = [ring[code == c][:, np.array(shape)].reshape(-1, 3) for c, shape in _SPLITS.items()]
+    return np.vstack(out).astype(np.int64)
 
 
 def _triangles(shape: TopoDS_Shape) -> int:

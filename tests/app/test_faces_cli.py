@@ -91,7 +91,24 @@ def test_zebra_and_curvature_pictures_are_written_and_tell_g1_from_g2(files, tmp
     box, slab = pictures["box"], pictures["slab"]
     dark = [(p < 0.2).all(axis=2).mean() for p in (box, slab)]
     assert min(dark) > 0.02 and box.std() > 0.1  # stripes drawn, not a blank page
-    assert box.shape == slab.shape and np.abs(box - slab).mean() > 0.01  # G1 and G2 stripes differ
+    rows, columns = min(box.shape[0], slab.shape[0]), min(box.shape[1], slab.shape[1])  # each picture sized by its part
+    assert np.abs(box[:rows, :columns] - slab[:rows, :columns]).mean() > 0.01  # G1 and G2 stripes differ
+
+
+def test_picture_options_size_and_aim_the_pictures_and_are_refused_by_name(files, tmp_path, capsys):
+    zebra = tmp_path / "z.png"
+    argv = ["check", str(files["box"]), "--zebra", str(zebra)]
+    assert main([*argv, "--pixels", "300", "--stripes", "40", "--view", "0,-1,0.3"]) == 0
+    assert 280 <= max(_picture(zebra).shape[:2]) <= 320  # the picture pixel for pixel
+    capsys.readouterr()
+    for extra, named in ((["--stripes", "0"], "stripes must be an integer from 1 to 200; got 0"),
+                         (["--pixels", "9"], "pixels must be an integer from 16 to 8000; got 9"),
+                         (["--view", "1,2"], "--view must be three numbers"), (["--view", "0,0,0"], "--view must be three numbers")):  # fmt: skip
+        assert main([*argv, *extra]) == 2
+        err = capsys.readouterr().err
+        assert err.startswith("error: ") and named in err, err
+    assert main(["check", str(files["box"]), "--stripes", "30"]) == 2
+    assert "--stripes: only with --zebra or --curvature-map" in capsys.readouterr().err
 
 
 def test_bad_picture_paths_are_errors_not_tracebacks(files, tmp_path, capsys):

@@ -12,7 +12,7 @@ import build123d as bd  # noqa: E402
 import numpy as np  # noqa: E402
 from matplotlib.backends.backend_agg import FigureCanvasAgg  # noqa: E402
 
-from spiral_cad.app.zebra import plot_curvature_map, plot_zebra  # noqa: E402
+from spiral_cad.app.zebra import VIEW, plot_curvature_map, plot_zebra  # noqa: E402
 from spiral_cad.cad.mesh import face_mesh  # noqa: E402
 
 
@@ -75,3 +75,62 @@ def test_curvature_map_is_one_image_whatever_the_mesh(sphere):
     fig = plot_curvature_map(sphere, pixels=200)
     assert len(fig.axes[0].images) == 1 and not fig.axes[0].collections
     assert max(fig.axes[0].images[0].get_array().shape) == 200
+
+
+def _stripe_kinks(part, view=VIEW) -> list[float]:
+    """The jump, in degrees, of the stripe borders' direction across each visible vertical edge of a
+    prism, measured on the drawn picture: the borders' direction (structure tensor of the grey levels'
+    Sobel gradient) in strips 1–2 and 3–4 pixels each side of the edge, extrapolated to the edge."""
+    from scipy import ndimage
+
+    fig = plot_zebra(part, view=view)
+    image = fig.axes[0].images[0]
+    grey = np.nan_to_num(np.asarray(image.get_array(), dtype=float), nan=1.0)
+    height, width = grey.shape
+    left, right_, bottom, top = image.get_extent()
+    v = np.asarray(view, dtype=float) / np.linalg.norm(view)
+    right = np.cross((0.0, 0.0, 1.0), v)
+    right /= np.linalg.norm(right)
+    up = np.cross(v, right)  # the picture's axes: orthographic along the view, z up
+
+    def pixel(p):
+        return np.array([(p @ right - left) / (right_ - left) * width - 0.5, (p @ up - bottom) / (top - bottom) * height - 0.5])
+
+    gx, gy = ndimage.sobel(grey, axis=1), ndimage.sobel(grey, axis=0)
+    kinks = []
+    for edge in part.edges().filter_by(bd.Axis.Z):
+        middle = edge.center()
+        if min(np.array(tuple(f.normal_at(middle))) @ v for f in part.faces() if any(edge == e for e in f.edges())) < 0.15:
+            continue  # not seen, or seen at a grazing angle
+        a, b = (pixel(np.array(tuple(edge.position_at(t)))) for t in (0.15, 0.85))
+        along = (b - a) / np.linalg.norm(b - a)
+        normal = np.array([-along[1], along[0]])
+        steps = np.linspace(0.0, 1.0, int(np.linalg.norm(b - a)))[:, None]
+
+        def direction(side, offsets):
+            at = np.vstack([a + steps * (b - a) + side * o * normal for o in offsets])
+            j, i = np.rint(at).astype(int).T
+            x, y = gx[i, j], gy[i, j]
+            return 0.5 * math.atan2(2.0 * (x * y).sum(), (x * x).sum() - (y * y).sum())
+
+        def wrapped(angle):
+            return (angle + math.pi / 2) % math.pi - math.pi / 2
+
+        at_edge = []
+        for side in (-1.0, 1.0):
+            near, far = direction(side, (1, 2)), direction(side, (3, 4))
+            at_edge.append(near - 0.75 * wrapped(far - near))  # strips centred 1.5 and 3.5 px out: on to 0
+        kinks.append(abs(math.degrees(wrapped(at_edge[1] - at_edge[0]))))
+    return kinks
+
+
+def test_zebra_stripes_kink_at_a_g1_edge_and_not_at_a_g2_one():
+    """The picture's job, measured on its pixels: across each visible edge where a side meets a circular
+    fillet (G1) the stripe borders turn by 20° or more at once, and across each edge of the same box
+    with G2 corners (ContinuousRectangle: plane–spiral–arc–spiral) by under 8°."""
+    from spiral_cad.build123d import ContinuousRectangle
+
+    g1 = _stripe_kinks(bd.fillet(bd.Box(60, 40, 10).edges().filter_by(bd.Axis.Z), 12))
+    g2 = _stripe_kinks(bd.extrude(ContinuousRectangle(60, 40, 12), 10))
+    assert len(g1) >= 3 and len(g2) >= 6
+    assert min(g1) >= 20.0 and max(g2) < 8.0, (g1, g2)
