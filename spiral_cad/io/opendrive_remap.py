@@ -8,10 +8,12 @@ the old point at ``s`` (``spiral_cad.core.fit_distances.chain_distances``: exact
 spirals), kept in order (a map that never runs backwards), 0 to 0 and the old end to the new end.
 
 ``remap_road`` applies it to a road element's subtree outside its ``planView``: every ``s`` (and ``sStart``,
-``sEnd``) attribute is moved; the cubics of ``elevation``, ``superelevation``, ``shape`` and ``laneOffset``
-records (a + b·ds + c·ds² + d·ds³ from their own ``s``) are rescaled to their new intervals, so each record
-gives the same value at its start and at its next record's start as before. Offsets inside a lane section
-(``sOffset``) are relative to it and kept.
+``sEnd``) attribute is moved (by less than ``STILL`` it keeps its text); the cubics of ``elevation``,
+``superelevation`` and ``laneOffset`` records and of lanes' ``width`` and ``border`` records (a + b·ds + c·ds² + d·ds³ from their own start) are
+rescaled to their new intervals, so each record gives the same value at its start and at its interval's end
+as before. An ``sOffset`` inside a lane section (widths, borders, road marks, speeds …) is taken as the road
+position it stands for (the section's ``s`` plus it), moved like the others, and written back from the
+section's new ``s``. A ``shape`` record's cross-section polynomial (in t) is moved with its ``s``, not stretched.
 """
 
 from __future__ import annotations
@@ -31,10 +33,12 @@ from .decimals import shortest_decimal
 
 __all__ = ["RemapReport", "new_stations", "old_points", "remap_road"]
 
+#: A position that moves less than this (m) is kept as written (the feet's rounding on an unchanged stretch).
+STILL = 1e-9
 #: The attributes that hold a road position.
 POSITIONS = ("s", "sStart", "sEnd")
 #: Records holding a cubic in ds from their own ``s`` (their coefficients rescaled with their interval).
-CUBICS = ("elevation", "superelevation", "shape", "laneOffset")
+CUBICS = ("elevation", "superelevation", "laneOffset", "width", "border")
 
 
 def old_points(segments: Sequence[Segment], starts: Sequence[float], s: NDArray) -> NDArray:
@@ -94,6 +98,44 @@ def _local(tag: object) -> str:
     return tag.rsplit("}", 1)[-1] if isinstance(tag, str) else ""
 
 
+@dataclass
+class _Position:
+    element: ET.Element
+    name: str
+    old: float  # the road position (a lane section's start added to an sOffset)
+    base: int = -1  # for an sOffset: the position of its lane section's s
+
+
+def _number(element: ET.Element, name: str, road: str) -> float:
+    text = element.attrib[name]
+    try:
+        value = float(text)
+    except ValueError:
+        value = math.nan
+    if not math.isfinite(value):
+        raise ValueError(f"road {road}: <{_local(element.tag)}> {name}={text!r:.40} is not a finite number")
+    return value
+
+
+def _positions(road: ET.Element) -> list[_Position]:
+    """Every road position of the road's subtree outside its planView (lane sections' sOffsets as road positions)."""
+    label = str(road.get("id"))
+    found: list[_Position] = []
+    for child in road:
+        if _local(child.tag) == "planView":
+            continue
+        for element in child.iter():
+            for name in POSITIONS:
+                if name in element.attrib:
+                    found.append(_Position(element, name, _number(element, name, label)))
+            if _local(element.tag) == "laneSection" and "s" in element.attrib:
+                base = len(found) - 1
+                for inner in element.iter():
+                    if inner is not element and "sOffset" in inner.attrib:
+                        found.append(_Position(inner, "sOffset", found[base].old + _number(inner, "sOffset", label), base))
+    return found
+
+
 def remap_road(road: ET.Element, segments: Sequence[Segment], starts: Sequence[float], old_length: float,
                parts: Sequence[Chain]) -> RemapReport:  # fmt: skip
     """Move every road position of ``road`` outside its planView from the old reference line to the new one (see the module docstring).
@@ -108,69 +150,65 @@ def remap_road(road: ET.Element, segments: Sequence[Segment], starts: Sequence[f
         ValueError: a position that is not a finite number (naming the element and attribute).
     """
     new_length = sum(p.length for p in parts)
-    found: list[tuple[ET.Element, str, float]] = []
-    for child in road:
-        if _local(child.tag) == "planView":
-            continue
-        for element in child.iter():
-            for name in POSITIONS:
-                if name in element.attrib:
-                    text = element.attrib[name]
-                    try:
-                        value = float(text)
-                    except ValueError:
-                        value = math.nan
-                    if not math.isfinite(value):
-                        raise ValueError(f"road {road.get('id')}: <{_local(element.tag)}> {name}={text!r:.40} is not a finite number")
-                    found.append((element, name, value))
+    found = _positions(road)
     if not found:
         return RemapReport(0, 0, 0.0, 0, 0)
-    values = np.array([v for _, _, v in found])
+    values = np.array([p.old for p in found])
     clamped = int(np.count_nonzero(values > old_length * (1.0 + 1e-12)))
     grid = np.unique(np.concatenate([np.clip(values, 0.0, old_length), [0.0, old_length]]))
     stations, _ = new_stations(parts, old_points(segments, starts, grid))
     stations = np.clip(np.maximum.accumulate(stations), 0.0, new_length)
     stations[0], stations[-1] = (0.0 if grid[0] == 0.0 else stations[0]), new_length  # the ends are fixed
-    mapped = np.interp(np.clip(values, 0.0, old_length), grid, stations)
-    mapped[values <= 0.0] = values[values <= 0.0]  # 0 stays 0
-    rescaled = _rescale(road, found, values, mapped, old_length, new_length)
+
+    def mapped(s: NDArray) -> NDArray:
+        out = np.interp(np.clip(s, 0.0, old_length), grid, stations)
+        return np.where(s <= 0.0, s, out)  # 0 stays 0
+
+    new = mapped(values)
+    new = np.where(np.abs(new - values) < STILL, values, new)
+    rescaled = _rescale(road, found, new, (old_length, float(mapped(np.array([old_length]))[0])))
     moved = 0
-    for (element, name, old), value in zip(found, mapped.tolist()):
+    for position, value in zip(found, new.tolist()):
+        old = position.old
+        if position.base >= 0:  # an sOffset: from its lane section's new start
+            old, value = old - found[position.base].old, value - float(new[position.base])
         if value != old:  # a position that does not move keeps its text
-            element.set(name, shortest_decimal(value, "OpenDRIVE"))
+            position.element.set(position.name, shortest_decimal(value, "OpenDRIVE"))
             moved += 1
-    largest = float(np.max(np.abs(mapped - values)))
+    largest = float(np.max(np.abs(new - values)))
     return RemapReport(len(found), moved, largest, clamped, rescaled)
 
 
-def _rescale(road: ET.Element, found: list[tuple[ET.Element, str, float]], old: NDArray, new: NDArray, old_length: float,
-             new_length: float) -> int:  # fmt: skip
-    """Rescale each cubic record's b, c, d by its interval's stretch (old span over new span); how many were."""
-    where = {id(element): k for k, (element, name, _) in enumerate(found) if name == "s"}
+def _rescale(road: ET.Element, found: list[_Position], new: NDArray, road_end: tuple[float, float]) -> int:
+    """Rescale each cubic record's b, c, d by its interval's stretch (old span over new span); how many were.
+
+    A record's interval ends at the next record of its kind in the same parent, else at its lane section's
+    end (the next lane section, or the road's end) for lane records, else at the road's end."""
+    where = {id(p.element): k for k, p in enumerate(found) if p.name in ("s", "sOffset")}
+    sections = [k for k, p in enumerate(found) if _local(p.element.tag) == "laneSection" and p.name == "s"]
+    section_end = {a: (found[b].old, float(new[b])) for a, b in zip(sections, sections[1:])}
     count = 0
     for parent in road.iter():
         records = [e for e in parent if _local(e.tag) in CUBICS and id(e) in where]
-        for kind in {_local(e.tag) for e in records}:
+        for kind in sorted({_local(e.tag) for e in records}):
             mine = [e for e in records if _local(e.tag) == kind]
-            if kind == "shape":  # shapes are cross-section polynomials in t at one s: moved, not stretched
-                continue
             for k, element in enumerate(mine):
                 i = where[id(element)]
                 if k + 1 < len(mine):
                     j = where[id(mine[k + 1])]
-                    old_span, new_span = old[j] - old[i], new[j] - new[i]
+                    old_span, new_span = found[j].old - found[i].old, float(new[j] - new[i])
                 else:
-                    old_span, new_span = old_length - old[i], new_length - new[i]
+                    end_old, end_new = section_end.get(found[i].base, road_end)
+                    old_span, new_span = end_old - found[i].old, end_new - float(new[i])
                 if not (old_span > 0.0 and new_span > 0.0) or old_span == new_span:
                     continue
                 stretch = old_span / new_span
+                changed = False
                 for power, name in ((1, "b"), (2, "c"), (3, "d")):
                     if name in element.attrib:
-                        try:
-                            value = float(element.attrib[name])
-                        except ValueError:
-                            raise ValueError(f"road {road.get('id')}: <{kind}> {name}={element.attrib[name]!r:.40} is not a number") from None
+                        value = _number(element, name, str(road.get("id")))
                         if value:
                             element.set(name, shortest_decimal(value * stretch**power, "OpenDRIVE"))
-                count += 1
+                            changed = True
+                count += changed
     return count
