@@ -12,8 +12,8 @@ spirals), kept in order (a map that never runs backwards), 0 to 0 and the old en
 ``superelevation`` and ``laneOffset`` records and of lanes' ``width`` and ``border`` records (a + b·ds + c·ds² + d·ds³ from their own start) are
 rescaled to their new intervals, so each record gives the same value at its start and at its interval's end
 as before. An ``sOffset`` inside a lane section (widths, borders, road marks, speeds …) is taken as the road
-position it stands for (the section's ``s`` plus it), moved like the others, and written back from the
-section's new ``s``. A ``shape`` record's cross-section polynomial (in t) is moved with its ``s``, not stretched.
+position it stands for (its nearest positioned ancestor's: a lane section's ``s``, a road mark's
+``sOffset``, plus it), moved like the others, and written back from that ancestor's new position. A ``shape`` record's cross-section polynomial (in t) is moved with its ``s``, not stretched.
 """
 
 from __future__ import annotations
@@ -103,7 +103,7 @@ class _Position:
     element: ET.Element
     name: str
     old: float  # the road position (a lane section's start added to an sOffset)
-    base: int = -1  # for an sOffset: the position of its lane section's s
+    base: int = -1  # for an sOffset: the position it is measured from
 
 
 def _number(element: ET.Element, name: str, road: str) -> float:
@@ -118,21 +118,26 @@ def _number(element: ET.Element, name: str, road: str) -> float:
 
 
 def _positions(road: ET.Element) -> list[_Position]:
-    """Every road position of the road's subtree outside its planView (lane sections' sOffsets as road positions)."""
+    """Every road position of the road's subtree outside its planView; an ``sOffset`` as the road position it
+    stands for: its nearest positioned ancestor's (a lane section's ``s``, a road mark's ``sOffset``) plus it."""
     label = str(road.get("id"))
     found: list[_Position] = []
+
+    def walk(element: ET.Element, base: int) -> None:
+        own = base
+        for name in POSITIONS:
+            if name in element.attrib:
+                found.append(_Position(element, name, _number(element, name, label)))
+                own = len(found) - 1 if name == "s" else own
+        if "sOffset" in element.attrib and base >= 0:
+            found.append(_Position(element, "sOffset", found[base].old + _number(element, "sOffset", label), base))
+            own = len(found) - 1
+        for child in element:
+            walk(child, own)
+
     for child in road:
-        if _local(child.tag) == "planView":
-            continue
-        for element in child.iter():
-            for name in POSITIONS:
-                if name in element.attrib:
-                    found.append(_Position(element, name, _number(element, name, label)))
-            if _local(element.tag) == "laneSection" and "s" in element.attrib:
-                base = len(found) - 1
-                for inner in element.iter():
-                    if inner is not element and "sOffset" in inner.attrib:
-                        found.append(_Position(inner, "sOffset", found[base].old + _number(inner, "sOffset", label), base))
+        if _local(child.tag) != "planView":
+            walk(child, -1)
     return found
 
 
