@@ -53,8 +53,8 @@ __all__ = ["END_ANGLE", "END_GAP", "rewrite_opendrive_g2"]
 END_GAP = 1e-9
 #: … and its heading turns at most this much (rad).
 END_ANGLE = 1e-9
-#: The file's joints are judged G2 with ``check_opendrive``'s default tolerances (gap m, angle rad, relative curvature jump).
-JOINT_TOLERANCES = {"gap_tol": 1e-7, "angle_tol": 1e-7, "curvature_tol": 1e-6}
+#: The file's joints are judged G2 with ``check_opendrive``'s default tolerances: gap (m), angle (rad), relative curvature jump.
+GAP_TOL, ANGLE_TOL, CURVATURE_TOL = 1e-7, 1e-7, 1e-6
 #: Samples per piece where the deviation between the old and the new reference line is measured (both ways).
 SAMPLES = 65
 #: The planView kinds make_g2 takes (a paramPoly3 as the Bézier cubic it is).
@@ -68,8 +68,16 @@ def _local(tag: object) -> str:
 def _breaks(road: Road) -> list[str]:
     """The road's planView joints that are not G2, in words (index and what jumps)."""
     frames = road.plan.frames[:, :2, :]
-    size = max(model_size(road.plan.frames[:, :, :3].reshape(-1, 3).tolist()), 1.0)
-    report = classify_pieces([("road", frames.tolist(), False, road.id)], size, **JOINT_TOLERANCES, element="geometry", units="m")
+    size = max(model_size(road.plan.frames[:, :, :3].reshape(-1, 3)), 1.0)
+    report = classify_pieces(
+        [("road", frames.tolist(), False, road.id)],
+        size,
+        gap_tol=GAP_TOL,
+        angle_tol=ANGLE_TOL,
+        curvature_tol=CURVATURE_TOL,
+        element="geometry",
+        units="m",
+    )
     out = []
     for joint in report.wires[0].joints:
         if joint.level < Continuity.G2:
@@ -172,7 +180,9 @@ def _road_g2(road: Road, element: ET.Element, bound: float, shape: str, notes: l
                                                  "for its links")  # fmt: skip
     deviation = max(_deviation(segments, parts), float(result.deviation))
     if deviation > bound * (1.0 + 1e-9):
-        return PathReport(name, joints, kept=f"its G2 reference line measures {deviation:.3g} m from the file's, beyond the bound {bound:g} m")
+        return PathReport(
+            name, joints, kept=f"its G2 reference line measures {deviation:.3g} m from the file's, beyond the bound {bound:g} m"
+        )
     plan_view = next(e for e in element if _local(e.tag) == "planView")
     first_s = float(road.plan.head["s"][0])
     lost = _replace_geometries(plan_view, _planview(parts, first_s))

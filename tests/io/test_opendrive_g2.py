@@ -267,6 +267,7 @@ def test_s_positions_move_onto_the_new_line_and_none_lies_past_its_end(made):
     # the object 1 m before the old end is 1 m before the new end: the last line is kept up to the end
     (o3,) = [o for o in new.iter() if o.get("id") == "o3"]
     assert float(o3.get("s")) == pytest.approx(new_length - 1.0, abs=1e-9)
+
     # a cubic past a transition is rescaled to its interval: the same elevation at its interval's ends
     def elevation(road, s):
         rows = sorted((float(e.get("s")), *(float(e.get(k)) for k in "abcd")) for e in road.iter() if local(e.tag) == "elevation")
