@@ -137,9 +137,9 @@ def test_cli_strict_and_kinds_not_yet(tmp_path, capsys):
     assert main(["g2", str(src), "--max-deviation", "0.01", "-o", str(out)]) == 0
     assert main(["g2", str(src), "--max-deviation", "0.01", "-o", str(out), "--strict"]) == 1
     capsys.readouterr()
-    assert main(["g2", str(tmp_path / "road.xodr"), "--max-deviation", "0.01", "-o", str(tmp_path / "r.xodr")]) == 2
+    assert main(["g2", str(tmp_path / "part.step"), "--max-deviation", "0.01", "-o", str(tmp_path / "p.step")]) == 2
     err = capsys.readouterr().err
-    assert err.startswith("error: ") and ".xodr" in err and "not yet" in err
+    assert err.startswith("error: ") and ".step" in err and "not yet" in err and ".xodr" in err  # .xodr is made G2 in place
     with pytest.raises(ValueError, match="not yet"):
         rewriter_for("part.step")
     with pytest.raises(ValueError, match="is the input"):
