@@ -44,6 +44,7 @@ from .document_report import DocumentReport, PathReport
 from .g2_ends import straight_ends
 from .landxml_g2 import parse_keeping, write_tree
 from .opendrive import _plan_view, plan_records
+from .opendrive_ends import fixed_ends
 from .opendrive_read import Road, read_network
 from .opendrive_remap import new_stations, remap_road
 
@@ -168,6 +169,14 @@ def _road_g2(road: Road, element: ET.Element, bound: float, shape: str, notes: l
         if gap > END_GAP:
             return PathReport(name, joints, kept=f"make_g2 splits it ({result.describe_splits()}) and its parts {k} and {k + 1} are "
                                                  f"{gap:.3g} m apart")  # fmt: skip
+    ends_fixed: list[str] = []
+    if len(parts) == 1:
+        fixed, ends_fixed = fixed_ends(segments, list(parts[0]), shape)
+        if ends_fixed:
+            try:
+                parts = [Chain(fixed, tolerance=1e-6, units="m")]
+            except ValueError as error:  # a joint the splice did not make G2: the ends stay as make_g2 left them (named below)
+                ends_fixed = [f"no end arc turned ({error})"]
     old_start, old_end = segments[0].ends[0], segments[-1].ends[1]
     new_start, new_end = parts[0].segments[0].ends[0], parts[-1].segments[-1].ends[1]
     for which, was, now in (("start", old_start, new_start), ("end", old_end, new_end)):
@@ -190,6 +199,7 @@ def _road_g2(road: Road, element: ET.Element, bound: float, shape: str, notes: l
     remapped = remap_road(element, segments, road.plan.head["s"].tolist(), road.length, parts)
     element.set("length", repr(float(new_length)))
     notes.append(remapped.note(name, road.length, new_length))
+    notes += [f"{name}: {done}" for done in ends_fixed]
     if lost:
         notes.append(f"{name}: {lost} child element(s) of its old planView geometries (userData …) went with them")
     curvature = [(w, a[4], b[4]) for w, a, b in (("start", old_start, new_start), ("end", old_end, new_end)) if abs(a[4] - b[4]) > 1e-12]

@@ -127,11 +127,13 @@ def _place(pieces):
 
 MAIN = [("line", 100.0), ("arc", 100.0, 1 / 200), ("line", 80.0), ("arc", 60.0, -1 / 150), ("line", 60.0)]
 ENDS_ON_ARC = [("line", 40.0), ("arc", 30.0, 1 / 60)]
+LOOP_END = [("line", 20.0), ("arc", 200.0, 1 / 50)]  # a loop ramp: its end arc turns 4 rad
 
 
 def network() -> str:
     main_plan, main_length, (ex, ey, eh) = _place(MAIN)
     arc_plan, arc_length, _ = _place(ENDS_ON_ARC)
+    short_plan, short_length, _ = _place(LOOP_END)
     return f"""<?xml version="1.0" encoding="UTF-8"?>
 <OpenDRIVE>
   <!-- a comment the file keeps -->
@@ -193,6 +195,17 @@ def network() -> str:
   <road name="ends on an arc" length="{arc_length!r}" id="3" junction="-1">
     <planView>
       {arc_plan}
+    </planView>
+  </road>
+  <road name="loop ramp" length="{short_length!r}" id="4" junction="-1">
+    <planView>
+      {short_plan}
+    </planView>
+  </road>
+  <road name="clothoid after a line" length="50.0" id="5" junction="-1">
+    <planView>
+      <geometry s="0.0" x="0.0" y="-50.0" hdg="0.0" length="30.0"><line/></geometry>
+      <geometry s="30.0" x="30.0" y="-50.0" hdg="0.0" length="20.0"><spiral curvStart="0.01" curvEnd="0.02"/></geometry>
     </planView>
   </road>
   <junction id="100" name="j">
@@ -302,20 +315,38 @@ def test_everything_outside_the_planview_is_kept(made):
     source, target, report = made
     assert without(source) == without(target)
     # the roads not made G2 are kept exactly, geometries and all
-    for road in ("2", "3"):
+    for road in ("2", "5"):
         assert ET.tostring(roads(source)[road]) == ET.tostring(roads(target)[road])
     text = target.read_text(encoding="utf-8")
     assert "<!-- a comment the file keeps -->" in text and 'vendor:flag="kept"' in text and "urn:vendor" in text
 
 
-def test_a_road_whose_end_would_move_is_kept_and_named_with_its_numbers(made):
+@pytest.mark.parametrize("road", ["3", "4"])  # an arc of 0.5 rad, a loop of 4 rad
+def test_a_road_ending_on_an_arc_keeps_its_end_point_and_heading(made, road):
+    source, target, report = made
+    (path,) = [p for p in report.paths if p.name.startswith(f"road {road} ")]
+    assert path.made and path.changed == 1 and path.deviation <= 0.05
+    old, new = roads(source)[road], roads(target)[road]
+    items = geometries(new)
+    for a, b in zip(items, items[1:]):
+        (pa, ha, ka), (pb, hb, kb) = geometry_frames(a, np.array([1.0])), geometry_frames(b, np.array([0.0]))
+        assert np.hypot(*(pa[0] - pb[0])) < 1e-7 and abs(math.remainder(ha[0] - hb[0], 2 * math.pi)) < 1e-8 and abs(ka[0] - kb[0]) < 1e-7
+    (a, ha, ka), (b, hb, kb) = (geometry_frames(geometries(r)[-1], np.array([1.0])) for r in (old, new))
+    assert np.hypot(*(a[0] - b[0])) < 1e-9 and abs(math.remainder(ha[0] - hb[0], 2 * math.pi)) < 1e-9
+    assert ka[0] < kb[0] < 1.25 * ka[0]  # the end arc turned about the end point, a little tighter
+    (p_old, _), (p_new, _) = dense(old), dense(new)
+    assert max(polyline_distance(p_old, p_new).max(), polyline_distance(p_new, p_old).max()) <= 0.05 + SAG
+    assert any(n.startswith(f"road {road} ") and "turned about the end point" in n for n in report.notes)
+
+
+def test_a_road_make_g2_cannot_take_is_kept_and_named_with_its_numbers(made):
     _, _, report = made
     (connector,) = [p for p in report.paths if p.name.startswith("road 2 ")]
-    (arc_end,) = [p for p in report.paths if p.name.startswith("road 3 ")]
+    (clothoid,) = [p for p in report.paths if p.name.startswith("road 5 ")]
     assert connector.kept and connector.g2  # one geometry
-    assert arc_end.kept and not arc_end.g2 and "end would move" in arc_end.kept and "arc" in arc_end.kept
-    assert float(arc_end.kept.split("move ")[1].split(" m")[0]) > 0.0
-    assert report.below_g2 == (arc_end,)
+    assert clothoid.kept and not clothoid.g2 and "spiral" in clothoid.kept and "joint 0 (line → spiral)" in clothoid.kept
+    assert "curvature jump 0.01 1/m" in clothoid.kept
+    assert report.below_g2 == (clothoid,)
 
 
 def test_a_public_road_esmini_comes_back_g2_with_its_road_marks(tmp_path):
@@ -338,7 +369,7 @@ def test_the_command_rewrites_reports_and_refuses_by_road(tmp_path, capsys):
     source.write_text(network(), encoding="utf-8")
     assert main(["g2", str(source), "--max-deviation", "0.05", "-o", str(target)]) == 0
     out = capsys.readouterr().out
-    assert "road 1 (main): G2 within" in out and "road 3 (ends on an arc): kept as is" in out and "1 left below G2" in out
+    assert "road 1 (main): G2 within" in out and "road 5 (clothoid after a line): kept as is" in out and "1 left below G2" in out
     assert main(["g2", str(source), "--max-deviation", "0.05", "-o", str(target), "--strict"]) == 1
     capsys.readouterr()
     assert main(["g2", str(source), "--max-deviation", "0.05", "-o", str(target), "--units", "mm"]) == 2
