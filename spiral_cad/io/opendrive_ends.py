@@ -29,6 +29,8 @@ __all__ = ["SHIFT_SHARES", "fixed_ends"]
 
 #: The shares of make_g2's shift tried in turn for the end arc (the first whose transition fits).
 SHIFT_SHARES = (1.0, 0.7, 0.5, 0.35, 0.25)
+#: Arcs after the end arc whose curvature is within this share of its own are one arc with it (make_g2 merges them).
+MERGED = 1e-6
 #: The end arc's radius may shrink to this share of its own at most (its curvature then grows by a quarter).
 SMALLEST_RADIUS = 0.8
 
@@ -39,18 +41,34 @@ def _carrier(segment: Segment) -> Carrier:
     return Carrier(np.array([x, y]), math.atan2(ty, tx), float(k) if isinstance(segment, Arc) else 0.0, segment.length)
 
 
-def _fixed_start(old: Segment, made: list[Segment], shape: str) -> list[Segment] | None:
-    """``made`` with its first arc turned about the old start (see the module docstring), or None."""
-    if not (isinstance(old, Arc) and isinstance(made[0], Arc)):
+def _end_arc(old: Sequence[Segment]) -> tuple[Segment, float] | None:
+    """The old line's first arc and the length of the run of arcs of its circle it starts (make_g2 merges them:
+    files split one curve into many arcs), or None when it starts on something else."""
+    first = old[0]
+    if not isinstance(first, Arc):
         return None
+    k0, length = first.ends[0][4], 0.0
+    for segment in old:
+        if not (isinstance(segment, Arc) and abs(segment.ends[0][4] - k0) <= MERGED * abs(k0)):
+            break
+        length += segment.length
+    return first, length
+
+
+def _fixed_start(old: Sequence[Segment], made: list[Segment], shape: str) -> list[Segment] | None:
+    """``made`` with its first arc turned about the old start (see the module docstring), or None."""
+    found = _end_arc(old)
+    if found is None or not isinstance(made[0], Arc):
+        return None
+    first, length = found
     spirals = 1
     while spirals < len(made) and isinstance(made[spirals], BezierSpiral):
         spirals += 1
     if spirals == 1 or spirals == len(made) or spirals > 3:
         return None
     after = made[spirals]  # the neighbour make_g2 placed: a line, or an arc as shifted
-    (x0, y0, tx0, ty0, k0), _ = old.ends
-    radius, sweep = 1.0 / abs(k0), abs(k0) * old.length
+    (x0, y0, tx0, ty0, k0), _ = first.ends
+    radius, sweep = 1.0 / abs(k0), abs(k0) * length
     shift = radius - 1.0 / abs(made[0].ends[0][4])
     if not (shift > 0.0 and sweep > 0.0):
         return None
@@ -60,7 +78,7 @@ def _fixed_start(old: Segment, made: list[Segment], shape: str) -> list[Segment]
         smaller = radius - share * shift / spread
         if not smaller > SMALLEST_RADIUS * radius:
             continue
-        entry = Carrier(np.array([x0, y0]), math.atan2(ty0, tx0), math.copysign(1.0 / smaller, k0), old.length)  # read around its middle
+        entry = Carrier(np.array([x0, y0]), math.atan2(ty0, tx0), math.copysign(1.0 / smaller, k0), length)  # read around its middle
         curvatures = [entry.curvature, *([0.0] if spirals == 3 else []), exit_.curvature]
         try:
             _, solved = solve_run(entry, exit_, curvatures, shape)
@@ -86,9 +104,9 @@ def fixed_ends(old: Sequence[Segment], made: Sequence[Segment], shape: str) -> t
     out, done = list(made), []
     for which in ("start", "end"):
         flip = which == "end"
-        first_old = old[-1].reversed() if flip else old[0]
+        first_old = _reversed(old) if flip else list(old)
         current = _reversed(out) if flip else out
-        a, b = first_old.ends[0], current[0].ends[0]
+        a, b = first_old[0].ends[0], current[0].ends[0]
         if math.hypot(b[0] - a[0], b[1] - a[1]) == 0.0:
             continue
         fixed = _fixed_start(first_old, current, shape)
@@ -96,5 +114,5 @@ def fixed_ends(old: Sequence[Segment], made: Sequence[Segment], shape: str) -> t
             continue
         out = _reversed(fixed) if flip else fixed
         k = abs(fixed[0].ends[0][4])
-        done.append(f"its {which} arc turned about the {which} point (radius {1.0 / abs(first_old.ends[0][4]):.6g} → {1.0 / k:.6g} m)")
+        done.append(f"its {which} arc turned about the {which} point (radius {1.0 / abs(first_old[0].ends[0][4]):.6g} → {1.0 / k:.6g} m)")
     return out, done
