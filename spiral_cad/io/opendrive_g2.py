@@ -10,8 +10,11 @@ road's first ``s`` and the road's ``length`` is the new one.
 
 The road's ends are fixed: its first and last point and heading stay as they were, so its links and
 junction connections stay valid. make_g2 keeps a road's first and last line where they are (it shortens
-them at their inner ends); an arc at an end is shifted about its centre, which moves the end across the
-road — such a road is kept as it is and the report says by how much its end would move.
+them at their inner ends); an arc at an end is shifted about its centre, which would move the end across
+the road, so it is turned about the end point instead (``spiral_cad.io.opendrive_ends``: the arc through
+the end, along its heading, a little tighter, and its transition solved again; the report names the new
+radius). Where that finds no transition the road is kept as it is and the report says by how much its end
+would move.
 
 Everything placed along a road by ``s`` outside its planView (lane sections, lane offsets, elevation,
 superelevation and shape records, objects, signals and their references, road types) is carried to the
@@ -52,8 +55,8 @@ __all__ = ["END_ANGLE", "END_GAP", "rewrite_opendrive_g2"]
 
 #: A road end counts as kept when it moves at most this far (m) …
 END_GAP = 1e-9
-#: … and its heading turns at most this much (rad).
-END_ANGLE = 1e-9
+#: … and its heading turns at most this much (rad; a tenth of ``check_opendrive``'s angle tolerance).
+END_ANGLE = 1e-8
 #: The file's joints are judged G2 with ``check_opendrive``'s default tolerances: gap (m), angle (rad), relative curvature jump.
 GAP_TOL, ANGLE_TOL, CURVATURE_TOL = 1e-7, 1e-7, 1e-6
 #: Samples per piece where the deviation between the old and the new reference line is measured (both ways).
