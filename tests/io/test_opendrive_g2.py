@@ -128,12 +128,15 @@ def _place(pieces):
 MAIN = [("line", 100.0), ("arc", 100.0, 1 / 200), ("line", 80.0), ("arc", 60.0, -1 / 150), ("line", 60.0)]
 ENDS_ON_ARC = [("line", 40.0), ("arc", 30.0, 1 / 60)]
 LOOP_END = [("line", 20.0), ("arc", 200.0, 1 / 50)]  # a loop ramp: its end arc turns 4 rad
+# CARLA Town06's road 77: a compound curve of two nearly equal radii from its start: no tighter start arc nests in the next
+COMPOUND_START = [("arc", 8.283, 1 / 50.6), ("arc", 29.686, 1 / 50.94), ("line", 11.52)]
 
 
 def network() -> str:
     main_plan, main_length, (ex, ey, eh) = _place(MAIN)
     arc_plan, arc_length, _ = _place(ENDS_ON_ARC)
     short_plan, short_length, _ = _place(LOOP_END)
+    compound_plan, compound_length, _ = _place(COMPOUND_START)
     return f"""<?xml version="1.0" encoding="UTF-8"?>
 <OpenDRIVE>
   <!-- a comment the file keeps -->
@@ -206,6 +209,11 @@ def network() -> str:
     <planView>
       <geometry s="0.0" x="0.0" y="-50.0" hdg="0.0" length="30.0"><line/></geometry>
       <geometry s="30.0" x="30.0" y="-50.0" hdg="0.0" length="20.0"><spiral curvStart="0.01" curvEnd="0.02"/></geometry>
+    </planView>
+  </road>
+  <road name="compound start" length="{compound_length!r}" id="6" junction="-1">
+    <planView>
+      {compound_plan}
     </planView>
   </road>
   <junction id="100" name="j">
@@ -315,7 +323,7 @@ def test_everything_outside_the_planview_is_kept(made):
     source, target, report = made
     assert without(source) == without(target)
     # the roads not made G2 are kept exactly, geometries and all
-    for road in ("2", "5"):
+    for road in ("2", "5", "6"):
         assert ET.tostring(roads(source)[road]) == ET.tostring(roads(target)[road])
     text = target.read_text(encoding="utf-8")
     assert "<!-- a comment the file keeps -->" in text and 'vendor:flag="kept"' in text and "urn:vendor" in text
@@ -339,14 +347,17 @@ def test_a_road_ending_on_an_arc_keeps_its_end_point_and_heading(made, road):
     assert any(n.startswith(f"road {road} ") and "turned about the end point" in n for n in report.notes)
 
 
-def test_a_road_make_g2_cannot_take_is_kept_and_named_with_its_numbers(made):
+def test_a_road_make_g2_cannot_take_or_whose_start_would_move_is_kept_and_named_with_its_numbers(made):
     _, _, report = made
     (connector,) = [p for p in report.paths if p.name.startswith("road 2 ")]
     (clothoid,) = [p for p in report.paths if p.name.startswith("road 5 ")]
     assert connector.kept and connector.g2  # one geometry
     assert clothoid.kept and not clothoid.g2 and "spiral" in clothoid.kept and "joint 0 (line → spiral)" in clothoid.kept
     assert "curvature jump 0.01 1/m" in clothoid.kept
-    assert report.below_g2 == (clothoid,)
+    (compound,) = [p for p in report.paths if p.name.startswith("road 6 ")]
+    assert compound.kept and not compound.g2 and "its start would move" in compound.kept and "geometry 0" in compound.kept
+    assert 0.0 < float(compound.kept.split("move ")[1].split(" m")[0]) <= 0.05
+    assert report.below_g2 == (clothoid, compound)
 
 
 def test_a_public_road_esmini_comes_back_g2_with_its_road_marks(tmp_path):
@@ -369,7 +380,7 @@ def test_the_command_rewrites_reports_and_refuses_by_road(tmp_path, capsys):
     source.write_text(network(), encoding="utf-8")
     assert main(["g2", str(source), "--max-deviation", "0.05", "-o", str(target)]) == 0
     out = capsys.readouterr().out
-    assert "road 1 (main): G2 within" in out and "road 5 (clothoid after a line): kept as is" in out and "1 left below G2" in out
+    assert "road 1 (main): G2 within" in out and "road 5 (clothoid after a line): kept as is" in out and "2 left below G2" in out
     assert main(["g2", str(source), "--max-deviation", "0.05", "-o", str(target), "--strict"]) == 1
     capsys.readouterr()
     assert main(["g2", str(source), "--max-deviation", "0.05", "-o", str(target), "--units", "mm"]) == 2
