@@ -285,6 +285,28 @@ def test_s_positions_move_onto_the_new_line_and_none_lies_past_its_end(made):
         assert 0.0 <= s_new <= new_length
         # the point at the new s lies within the bound of the old point at the old s (nearest-point mapping)
         assert np.hypot(*(point_at(old, s_old) - point_at(new, s_new))) <= 0.05 + SAG, (a.tag, a.attrib)
+
+    # an sOffset stands for its parent's position plus it (a lane section's s, a road mark's sOffset): that
+    # road position moves onto the new line too
+    def offsets(road):
+        out = []
+        for section in road.iter():
+            if local(section.tag) == "laneSection":
+                for lane in section.iter():
+                    for mark in lane:
+                        if "sOffset" in mark.attrib:
+                            at = float(section.get("s")) + float(mark.get("sOffset"))
+                            out.append(at)
+                            out += [
+                                at + float(inner.get("sOffset")) for inner in mark.iter() if inner is not mark and "sOffset" in inner.attrib
+                            ]
+        return out
+
+    moved = 0
+    for s_old, s_new in zip(offsets(old), offsets(new), strict=True):
+        assert 0.0 <= s_new <= new_length and np.hypot(*(point_at(old, s_old) - point_at(new, s_new))) <= 0.05 + SAG
+        moved += s_new != s_old
+    assert moved >= 3
     # the object 1 m before the old end is 1 m before the new end: the last line is kept up to the end
     (o3,) = [o for o in new.iter() if o.get("id") == "o3"]
     assert float(o3.get("s")) == pytest.approx(new_length - 1.0, abs=1e-9)
@@ -399,3 +421,12 @@ def test_a_file_that_is_g2_already_is_written_back_unchanged_in_its_roads(tmp_pa
     assert not any(p.made for p in report.paths)
     for road_id, road in roads(source).items():
         assert ET.tostring(road) == ET.tostring(roads(target)[road_id])
+
+
+def test_a_file_rewritten_onto_itself_is_whole(tmp_path):
+    source, other = tmp_path / "net.xodr", tmp_path / "other.xodr"
+    source.write_text(network(), encoding="utf-8")
+    rewrite_opendrive_g2(source, other, 0.05)
+    report = rewrite_opendrive_g2(source, source, 0.05)
+    assert source.read_bytes() == other.read_bytes() and any(p.made for p in report.paths)
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["net.xodr", "other.xodr"]  # no temporary file left
