@@ -5,7 +5,8 @@ that rewrites that kind of document in place, ``function(src, dst, max_deviation
 where the report has ``lines()`` (the short report, one line per path) and ``below_g2`` (what was left
 below G2: split, or kept as it was for a reason; the command exits 1 on it unless splits are allowed). G-code programs (``.nc .ngc .gcode .tap``) are
 registered here (``spiral_cad.io.gcode_inplace.rewrite_gcode_g2``), and so are DXF drawings
-(``spiral_cad.io.dxf_g2.rewrite_dxf_g2``) and LandXML files (``spiral_cad.io.landxml_g2.rewrite_landxml_g2``);
+(``spiral_cad.io.dxf_g2.rewrite_dxf_g2``), LandXML files (``spiral_cad.io.landxml_g2.rewrite_landxml_g2``)
+and OpenDRIVE files (``spiral_cad.io.opendrive_g2.rewrite_opendrive_g2``);
 other kinds register with ``register_rewriter``; any other suffix is an error naming it.
 """
 
@@ -25,7 +26,7 @@ Rewriter = Callable[..., Any]
 #: Suffix (lower case, with its dot) → the function that makes such a document G2 in place.
 REWRITERS: dict[str, Rewriter] = {}
 #: Kinds of documents announced but not rewritten yet (suffix → what they are).
-NOT_YET = {".xodr": "OpenDRIVE files", ".step": "STEP wires", ".stp": "STEP wires", ".igs": "IGES wires", ".iges": "IGES wires"}
+NOT_YET = {".step": "STEP wires", ".stp": "STEP wires", ".igs": "IGES wires", ".iges": "IGES wires"}
 
 
 def register_rewriter(suffixes: tuple[str, ...], function: Rewriter) -> None:
@@ -69,9 +70,18 @@ def _landxml(src: str | os.PathLike, dst: str | os.PathLike, max_deviation: floa
     return rewrite_landxml_g2(Path(src), Path(dst), max_deviation, **options)
 
 
+def _opendrive(src: str | os.PathLike, dst: str | os.PathLike, max_deviation: float, **options: Any) -> Any:
+    from ..io.opendrive_g2 import rewrite_opendrive_g2
+
+    _refuse(src, options, "units", "an OpenDRIVE file is in metres, and max_deviation is in metres")
+    _refuse(src, options, "dialect", "a G-code option")
+    return rewrite_opendrive_g2(Path(src), Path(dst), max_deviation, **options)
+
+
 register_rewriter(GCODE_SUFFIXES, _gcode)
 register_rewriter((".dxf",), _dxf)
 register_rewriter((".xml",), _landxml)
+register_rewriter((".xodr",), _opendrive)
 
 
 def rewriter_for(path: str | os.PathLike) -> Rewriter:

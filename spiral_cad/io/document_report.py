@@ -1,6 +1,6 @@
 """What rewriting a document G2 did: per path its measured deviation, joints changed, splits, or why it was kept.
 
-``rewrite_dxf_g2`` and ``rewrite_landxml_g2`` return a :class:`DocumentReport`; ``lines()`` is the short
+``rewrite_dxf_g2``, ``rewrite_landxml_g2`` and ``rewrite_opendrive_g2`` return a :class:`DocumentReport`; ``lines()`` is the short
 report a command prints (the last line is the verdict).
 """
 
@@ -58,7 +58,7 @@ class DocumentReport:
     Attributes:
         source: the input file's name.
         target: the output file's name.
-        kind: ``"DXF drawing"`` or ``"LandXML file"``.
+        kind: ``"DXF drawing"``, ``"LandXML file"`` or ``"OpenDRIVE file"``.
         units: the unit of ``max_deviation`` and of the deviations (the document's own; ``"drawing units"``
             for a unitless drawing).
         max_deviation: the bound asked for, in ``units``.

@@ -33,7 +33,7 @@ from .g2_ends import straight_ends
 from .landxml import _coord_geom, _text
 from .landxml_read import _child, _children, _local, _Reader, read_landxml
 
-__all__ = ["GEOMETRY", "rewrite_landxml_g2"]
+__all__ = ["GEOMETRY", "parse_keeping", "rewrite_landxml_g2", "write_tree"]
 
 #: The CoordGeom children that are the alignment's geometry (replaced); the others (``Feature``) are kept.
 GEOMETRY = ("Line", "IrregularLine", "Curve", "Spiral", "Chain")
@@ -50,7 +50,8 @@ def _namespaces(source: Path) -> list[tuple[str, str]]:
     return found
 
 
-def _parse(source: Path) -> ET.ElementTree[ET.Element]:
+def parse_keeping(source: Path) -> ET.ElementTree[ET.Element]:
+    """An XML document with its comments and processing instructions, its namespace prefixes registered to be written back."""
     for prefix, uri in _namespaces(source):
         try:
             ET.register_namespace(prefix, uri)
@@ -58,6 +59,19 @@ def _parse(source: Path) -> ET.ElementTree[ET.Element]:
             pass
     parser = ET.XMLParser(target=ET.TreeBuilder(insert_comments=True, insert_pis=True))
     return ET.parse(source, parser)
+
+
+def write_tree(tree: ET.ElementTree[ET.Element], target: Path) -> None:
+    """Write an XML document whole or not at all: an existing target (the source itself, in place) is replaced
+    only by a complete file (UTF-8, with an XML declaration)."""
+    handle, temporary = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".tmp", dir=target.parent)
+    os.close(handle)
+    try:
+        tree.write(temporary, encoding="utf-8", xml_declaration=True)
+        os.replace(temporary, target)
+    finally:
+        if os.path.exists(temporary):
+            os.unlink(temporary)
 
 
 def _direction_text(degrees: float, unit: str, convention: str) -> str:
@@ -113,7 +127,7 @@ def rewrite_landxml_g2(source: Path, target: Path, max_deviation: float, *, shap
         raise ValueError(f"max_deviation must be a positive length; got {max_deviation!r}")
     shape = shape or "near-linear"
     try:
-        tree = _parse(source)
+        tree = parse_keeping(source)
     except ET.ParseError as error:
         raise ValueError(f"{source.name}: not an XML document: {error}") from None
     root = tree.getroot()
@@ -167,12 +181,5 @@ def rewrite_landxml_g2(source: Path, target: Path, max_deviation: float, *, shap
         if alignment.profile is not None or _child(element, "Profile") is not None:
             notes.append(f"{name}: profile kept as it was; the alignment's end station moved by {shift * scale:.3g} {unit}")
         reports.append(PathReport(name, joints, changed, float(result.deviation), len(result.splits), pieces=len(chain), g2=True))
-    handle, temporary = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".xml", dir=target.parent)
-    os.close(handle)
-    try:  # the whole file or none: an existing target (the source itself, in place) is replaced only by a complete one
-        tree.write(temporary, encoding="utf-8", xml_declaration=True)
-        os.replace(temporary, target)
-    finally:
-        if os.path.exists(temporary):
-            os.unlink(temporary)
+    write_tree(tree, target)
     return DocumentReport(source.name, target.name, "LandXML file", unit, float(max_deviation), tuple(reports), tuple(notes))

@@ -138,9 +138,9 @@ def test_cli_exits_1_on_a_split_unless_allowed_and_kinds_not_yet(tmp_path, capsy
     assert "FAIL: 1 left below G2" in capsys.readouterr().out and out.read_text().count("\nG0 ") == 1
     assert main(["g2", str(src), "--max-deviation", "0.01", "-o", str(out), "--allow-splits"]) == 0
     capsys.readouterr()
-    assert main(["g2", str(tmp_path / "road.xodr"), "--max-deviation", "0.01", "-o", str(tmp_path / "r.xodr")]) == 2
+    assert main(["g2", str(tmp_path / "part.step"), "--max-deviation", "0.01", "-o", str(tmp_path / "p.step")]) == 2
     err = capsys.readouterr().err
-    assert err.startswith("error: ") and ".xodr" in err and "not yet" in err
+    assert err.startswith("error: ") and ".step" in err and "not yet" in err and ".xodr" in err  # .xodr is made G2 in place
     with pytest.raises(ValueError, match="not yet"):
         rewriter_for("part.step")
     with pytest.raises(ValueError, match="is the input"):
