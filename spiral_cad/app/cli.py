@@ -311,7 +311,17 @@ def _check(args: argparse.Namespace) -> int:
     (Non-finite measures are graded "unmeasurable" on purpose; ``main`` keeps
     numpy's warnings about them off the terminal.)
     """
-    if Path(args.file).suffix.lower() == ".xodr":
+    suffix = Path(args.file).suffix.lower()
+    if suffix not in CHECK_SUFFIXES and Path(args.file).exists():
+        from ..io.gcode import SUFFIXES as GCODE_SUFFIXES
+
+        documents = {".dxf": "a DXF drawing", ".xml": "a LandXML file", **dict.fromkeys(GCODE_SUFFIXES, "a CNC program")}
+        kind = (
+            f"{documents[suffix]}: spiral-cad g2 makes it G2 in place and reports every path left below G2" if suffix in documents else ""
+        )
+        raise ValueError(f"{Path(args.file).name}: check judges STEP/IGES (.step .stp .igs .iges) and OpenDRIVE (.xodr) files"
+                         + (f"; for {kind}" if kind else ""))  # fmt: skip
+    if suffix == ".xodr":
         _wire_tolerances(args)
         if args.comb:
             print("error: --comb draws STEP/IGES edges; it does not apply to OpenDRIVE", file=sys.stderr)
@@ -592,6 +602,9 @@ def _build_inputs(args: argparse.Namespace) -> int:
     field, inputs = "design", designs
     suffixes: tuple[str, ...] = (".json", ".xml", ".dxf", ".xodr")
     for option, kinds in (("from_gcode", GCODE_SUFFIXES), ("from_points", (".csv", ".txt", ".xyz"))):
+        if designs and args.from_gcode is None and args.from_points is None and all(Path(d).suffix.lower() in kinds for d in designs):
+            setattr(args, option, designs[0])  # the kind from the suffix: build part.nc is build --from-gcode part.nc
+            designs = designs[1:]
         first = getattr(args, option)
         if first is not None:
             expanded = bool(designs) and all(Path(d).suffix.lower() in kinds for d in designs)
@@ -699,7 +712,7 @@ def _parser() -> argparse.ArgumentParser:
         nargs="*",
         help="the design file (.json), a LandXML file (.xml: every alignment), a DXF drawing (.dxf: its "
         "lines and arcs chained into paths, made G2 within --max-deviation; --units for a unitless drawing) or an OpenDRIVE "
-        "file (.xodr, with --g2); or --from-gcode or --from-points; "
+        "file (.xodr, with --g2), a CNC program (.nc .ngc .gcode .tap: as --from-gcode) or points (.csv .txt .xyz: as --from-points); "
         "several files, folders or glob patterns are built in parallel, each into OUT/ its name (see --workers)",
     )
     build.add_argument("-o", "--out", default="out", help="output folder (default: out)")

@@ -79,8 +79,9 @@ def g2_designs(path: str | Path, max_deviation: float, *, name: str | None = Non
         if source_units is not None:
             raise DesignError(f"{source.name}: source_units (--units for a unitless drawing) is for DXF files")
         paths = _landxml(source) if suffix == ".xml" else _opendrive(source)
-    except (OSError, ValueError) as error:
-        raise DesignError(f"{source.name}: {error}") from None
+    except (OSError, ValueError) as error:  # named once: the readers' messages may start with the file's name
+        message = str(error)
+        raise DesignError(message if message.startswith(f"{source.name}:") else f"{source.name}: {message}") from None
     own = paths[0][3] if paths else "m"
     if units is not None and units != own:
         raise DesignError(f"{source.name}: the file's alignments are in {own}; the designs' unit must be the same (got {units})")

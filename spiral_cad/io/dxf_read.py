@@ -108,7 +108,7 @@ def read_dxf_paths(path: str | os.PathLike, *, units: str | None = None, drawing
         stated = drawing_units or target
         if stated is None:
             raise ValueError(f"{label}: the drawing is unitless ($INSUNITS 0 or missing, as in R12); state its unit "
-                             "(drawing_units='mm', …; build: --units mm)")  # fmt: skip
+                             "(spiral-cad: --units mm; Python: drawing_units=\"mm\")")  # fmt: skip
         drawing = length_unit(stated)
     elif code in DXF_UNITS:
         drawing = DXF_UNITS[code]

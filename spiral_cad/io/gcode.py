@@ -392,7 +392,7 @@ class _Reader:
         if self.arc_tolerance is None and not self.exact:
             raise self.error(
                 number,
-                f"{name} is refused: only straight moves (G0, G1) are read unless arc_tolerance is given (arcs become chords within it); have the CAM write straight moves, or linearise the arcs first",
+                f"{name} is refused: only straight moves (G0, G1) are read unless arc_tolerance is given (arcs become chords within it); or read the program with read_gcode_chain (arcs as true arcs, G5 splines exact)",
             )
         first, second, _ = PLANES[self.plane]
         offsets = {170: "IJ", 180: "KI", 190: "JK"}[self.plane]

@@ -1,0 +1,49 @@
+"""What a newcomer types first: the kind of input told by its suffix, and refusals that name the right door."""
+
+from __future__ import annotations
+
+import ezdxf
+import pytest
+
+from spiral_cad.app.cli import main
+from spiral_cad.io.gcode import read_gcode
+
+PROGRAM = "G21\nG0 X0 Y0 Z1\nG1 Z-1 F100\nG1 X10 F300\nG3 X20 Y10 I0 J10\nG0 Z1\nM2\n"
+
+
+def test_build_takes_a_program_or_points_by_their_suffix(tmp_path, capsys):
+    program = tmp_path / "plate.nc"
+    program.write_text(PROGRAM)
+    assert main(["build", str(program), "--max-deviation", "0.01", "-o", str(tmp_path / "out"), "--no-plots"]) == 0
+    assert "plate" in capsys.readouterr().out and any((tmp_path / "out").glob("plate*.ngc"))
+    points = tmp_path / "survey.csv"
+    points.write_text("0,0\n10,0\n20,1\n30,3\n40,6\n")
+    assert main(["build", str(points), "--tolerance", "0.5", "-o", str(tmp_path / "fit"), "--no-plots"]) == 0
+    assert any((tmp_path / "fit").glob("survey*.step"))
+
+
+@pytest.mark.parametrize(("name", "kind"), [("plate.nc", "a CNC program"), ("plan.dxf", "a DXF drawing"), ("road.xml", "a LandXML file")])
+def test_check_names_what_it_judges_and_the_verb_for_other_documents(tmp_path, capsys, name, kind):
+    path = tmp_path / name
+    path.write_text(PROGRAM if name.endswith(".nc") else "x")
+    assert main(["check", str(path)]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith(f"error: {name}: check judges STEP/IGES") and ".xodr" in err
+    assert f"for {kind}: spiral-cad g2" in err
+
+
+def test_a_unitless_drawing_is_named_once_and_told_the_flag(tmp_path, capsys):
+    doc = ezdxf.new("R2010")
+    doc.header["$INSUNITS"] = 0
+    doc.modelspace().add_lwpolyline([(0, 0), (10, 0), (10, 10)])
+    doc.saveas(tmp_path / "unitless.dxf")
+    assert main(["build", str(tmp_path / "unitless.dxf"), "--max-deviation", "0.01", "-o", str(tmp_path / "out")]) == 2
+    err = capsys.readouterr().err
+    assert err.count("unitless.dxf") == 1 and "--units mm" in err
+
+
+def test_the_straight_move_reader_names_the_reader_of_arcs(tmp_path):
+    program = tmp_path / "arcs.nc"
+    program.write_text(PROGRAM)
+    with pytest.raises(ValueError, match=r"arcs.nc line 5: G3 .* read_gcode_chain"):
+        read_gcode(program)
