@@ -420,8 +420,8 @@ def g2_fillet(
             "near-linear" (curvature almost linear in arc length). Defaults to "walton-meek"
 
     Raises:
-        ValueError: a solid or shell (round one of its faces, or use build123d's
-            ``fillet`` on its edges), non-planar input, edges other than lines
+        ValueError: a solid or shell itself (give its edges, ``part.edges()``, or one
+            of its faces), non-planar input, edges other than lines
             and arcs, or edges that belong to no wire or face.
         NoSolutionError: a corner that cannot be rounded (named, with numbers);
             solid edges that are not a prism's straight side edges or whole rims of its caps (outline or
@@ -449,9 +449,9 @@ def g2_fillet(
     solids = target.solids() or target.shells()
     if solids or getattr(target, "_dim", None) == 3:
         raise ValueError(
-            f"g2_fillet rounds planar wires, faces and sketches; got a {type(target).__name__} with "
-            f"{len(target.solids())} solid(s) and {len(target.shells())} shell(s): round one of its faces, or use "
-            "build123d's fillet on its edges"
+            f"g2_fillet rounds planar wires, faces and sketches, or a part's edges; got a {type(target).__name__} "
+            f"with {len(target.solids())} solid(s) and {len(target.shells())} shell(s): give the edges to round, "
+            f"g2_fillet(part.edges(), {radius!r}) (or some of them: part.edges().filter_by(Axis.Z)), or one of its faces"
         )
     in_space = _lines_in_space(target) if isinstance(target, Wire) else None
     if in_space is not None:

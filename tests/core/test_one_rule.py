@@ -334,8 +334,9 @@ def test_g2_fillet_of_the_issue():
     assert check_continuity(big).passes("G2") and len(big.edges()) == 16
     with pytest.raises(sc.NoSolutionError, match=r"corner 0 at \(1000000000, 1000000000\): .*float64"):
         g2_fillet(bd.Polyline((1e9, 1e9), (1e9 + 10, 1e9), (1e9 + 5, 1e9 + 8), close=True), 1)  # was a G0 joint
-    with pytest.raises(ValueError, match=r"g2_fillet rounds planar wires, faces and sketches; got a Box with 1 solid"):
+    with pytest.raises(ValueError, match=r"got a Box with 1 solid.*give the edges to round, g2_fillet\(part.edges\(\), 0.2\)"):
         g2_fillet(bd.Box(1, 2, 3), 0.2)
+    assert g2_fillet(bd.Box(1, 2, 3).edges(), 0.2).is_valid  # the advice builds
     with bd.BuildLine() as line:
         bd.Polyline((0, 0), (1, 0), (1, 1), (0, 1), close=True)
         bd.Polyline((3, 0), (4, 0), (4, 1), (3, 1), close=True)
