@@ -10,6 +10,8 @@ wires, holes included. build123d's ``make_g2`` and the CadQuery plugin call it.
 
 from __future__ import annotations
 
+import math
+
 from OCP.BRep import BRep_Tool
 from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeFace
 from OCP.BRepTools import BRepTools
@@ -114,9 +116,28 @@ def g2_advice(shape: TopoDS_Shape, units: str = "mm", shape_name: str = "near-li
             continue
         tangent = sum(kind.startswith(("line-arc", "arc-arc")) for kind in kinds)
         corners = kinds.count("corner")
+        use = _suggested(segments, closed, works, shape_name, units, made.chains[0].size)
         lines.append(
             f"make_g2: piece {index} ({len(segments)} lines and arcs; {tangent} tangent joints, {corners} corners) becomes G2 "
-            f"with max_deviation {works:.3g} {units} or more (the smallest that works, built and checked; a larger bound "
+            f"with max_deviation {use:.3g} {units} (built and checked; any bound from {works:.3g} {units} works, a larger one "
             "gives gentler transitions)"
         )
     return lines
+
+
+#: The bound ``g2_advice`` suggests: this share of the piece's size, when it builds (else the smallest that works).
+SUGGESTED_SHARE = 1e-3
+
+
+def _suggested(segments: list, closed: bool, works: float, shape: str, units: str, size: float) -> float:
+    """A bound to use: ``SUGGESTED_SHARE`` of the piece's size, rounded down to one significant figure,
+    if it builds (checked here), else ``works`` (the smallest that works)."""
+    share = SUGGESTED_SHARE * size
+    if not (math.isfinite(share) and share > works):
+        return works
+    rounded = float(f"{share:.0e}")
+    try:
+        make_g2(segments, rounded, closed=closed, shape=shape, units=units)
+    except ValueError:
+        return works
+    return rounded

@@ -47,3 +47,26 @@ def test_the_straight_move_reader_names_the_reader_of_arcs(tmp_path):
     program.write_text(PROGRAM)
     with pytest.raises(ValueError, match=r"arcs.nc line 5: G3 .* read_gcode_chain"):
         read_gcode(program)
+
+
+def test_check_advises_a_bound_to_use_and_it_builds(tmp_path, capsys):
+    """The make_g2 advice of check is a value to use (a thousandth of the piece's size), in the file's
+    unit, beside the smallest that works; the advised bound makes the wire G2 within it."""
+    bd = pytest.importorskip("build123d")
+    import re
+
+    from spiral_cad.cad.fillet import planar_frame, wire_path
+    from spiral_cad.design import make_g2
+
+    wire = bd.FilletPolyline((0, 0), (40, 0), (40, 20), (0, 20), radius=5, close=True)
+    path = tmp_path / "plate.step"
+    bd.export_step(wire, str(path))
+    assert main(["check", str(path)]) == 0
+    advice = capsys.readouterr().out.splitlines()[-1]
+    found = re.search(r"becomes G2 with max_deviation (\S+) mm \(built and checked; any bound from (\S+) mm works", advice)
+    assert found, advice
+    use, smallest = float(found[1]), float(found[2])
+    assert use == pytest.approx(0.04) and smallest < use  # a thousandth of the 44.7 mm diagonal, one figure
+    segments, closed = wire_path(wire.wrapped, planar_frame(wire.wrapped))
+    made = make_g2(segments, use, closed=closed)
+    assert made.deviation <= use and all(j.kind != "split" for j in made.joints)
