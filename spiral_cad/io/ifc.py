@@ -56,6 +56,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ..core._chain_kernels import ARC, LINE, SPIRAL
+from ..core.chain import Chain
 from ..core.units import length_unit, to_metres
 from .names import check_name
 from .opendrive import plan_records
@@ -347,8 +348,6 @@ def _horizontal(w: _Step, chain: Any, scale: float, tolerance: float) -> tuple[l
 
 def _halved(chain: Any, spirals: NDArray) -> Any:
     """``chain`` with the segments ``spirals`` (indices of spirals) each split into its two halves of arc length."""
-    from ..core.chain import Chain
-
     segments = list(chain.segments)
     for k in sorted(spirals.tolist(), reverse=True):
         spiral = segments[k]
@@ -440,15 +439,25 @@ def ifc_file(
     return ifcopenshell.file.from_string(text)
 
 
+@dataclass(frozen=True)
+class _Stationed:
+    """A chain written as an alignment: what ``_ifc_text`` reads of an ``Alignment``."""
+
+    chain: Chain
+    start_station: float
+    end_station: float
+
+
 def _ifc_text(alignments: Any, *, units: str | None, profile: Any, names: Sequence[str] | None, project: str, application: str,
               file_name: str = "") -> str:  # fmt: skip
     """The STEP text of ``ifc_file``: the project, units, contexts and site made by ifcopenshell's API, the
     alignments' entities appended as text (``_Step``)."""
     from ..design.alignment import Alignment
 
-    items = [alignments] if isinstance(alignments, Alignment) else list(alignments)
-    if not items or not all(isinstance(a, Alignment) for a in items):
-        raise ValueError("alignments must be an Alignment or a non-empty list of them")
+    items = [alignments] if isinstance(alignments, (Alignment, Chain)) else list(alignments)
+    if not items or not all(isinstance(a, (Alignment, Chain)) for a in items):
+        raise ValueError("alignments must be an Alignment or a plane Chain, or a non-empty list of them")
+    items = [_Stationed(a, 0.0, a.length) if isinstance(a, Chain) else a for a in items]  # a chain: stations from 0
     profiles = list(profile) if isinstance(profile, (list, tuple)) else [profile] * len(items)
     if len(profiles) != len(items):
         raise ValueError(f"profile: give one profile (or None) per alignment ({len(items)}); got {len(profiles)}")
@@ -519,7 +528,7 @@ def write_ifc(
     """Write IFC 4.3 alignments (see the module docstring for the mapping).
 
     Args:
-        alignments: an ``Alignment`` or a list of them (one unit).
+        alignments: an ``Alignment`` or a plane ``Chain`` (stations from 0), or a list of them (one unit).
         path: the .ifc file to write (STEP physical file, ISO 10303-21).
         units: the file's length unit (default: the alignments'); mm, cm,
             m and km are SI units, ft and in conversion-based units.

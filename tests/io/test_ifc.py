@@ -443,3 +443,19 @@ def test_global_ids_are_ifc_compressed_version_4_uuids_and_unique():
     for g in made[:200]:
         expanded = ifcopenshell.guid.expand(g)  # ifcopenshell's own decoding, back and forth
         assert ifcopenshell.guid.compress(expanded) == g and expanded[12] == "4" and expanded[16] in "89ab"
+
+
+def test_a_plane_chain_is_written_as_write_landxml_takes_it(tmp_path):
+    """``write_ifc(chain)`` as ``write_landxml(chain)``: one alignment, stations from 0, read by ifcopenshell
+    with its layout segments ending where the chain's pieces end."""
+    import spiral_cad as sc
+
+    enter = sc.line_to_circle((0, 0), (1, 0), (100, 60), 50.0)
+    leave = sc.line_to_circle((300, 150), (-1, -1), (100, 60), 50.0).reversed()
+    chain = sc.Chain.join([enter, leave], start=(-20, 0), end=(400, 250), units="m")
+    model = ifcopenshell.open(str(write_ifc(chain, tmp_path / "chain.ifc")))
+    assert len(model.by_type("IfcAlignment")) == 1
+    segments = [s.DesignParameters for s in model.by_type("IfcAlignmentSegment")]
+    assert math.isclose(sum(s.SegmentLength for s in segments), chain.length, rel_tol=1e-9)
+    with pytest.raises(ValueError, match="an Alignment or a plane Chain"):
+        write_ifc([chain, "road"], tmp_path / "bad.ifc")
