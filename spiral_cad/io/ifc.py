@@ -454,10 +454,10 @@ def _ifc_text(alignments: Any, *, units: str | None, profile: Any, names: Sequen
     alignments' entities appended as text (``_Step``)."""
     from ..design.alignment import Alignment
 
-    items = [alignments] if isinstance(alignments, (Alignment, Chain)) else list(alignments)
-    if not items or not all(isinstance(a, (Alignment, Chain)) for a in items):
+    given = [alignments] if isinstance(alignments, (Alignment, Chain)) else list(alignments)
+    if not given or not all(isinstance(a, (Alignment, Chain)) for a in given):
         raise ValueError("alignments must be an Alignment or a plane Chain, or a non-empty list of them")
-    items = [_Stationed(a, 0.0, a.length) if isinstance(a, Chain) else a for a in items]  # a chain: stations from 0
+    items: list[Alignment | _Stationed] = [_Stationed(a, 0.0, a.length) if isinstance(a, Chain) else a for a in given]
     profiles = list(profile) if isinstance(profile, (list, tuple)) else [profile] * len(items)
     if len(profiles) != len(items):
         raise ValueError(f"profile: give one profile (or None) per alignment ({len(items)}); got {len(profiles)}")
