@@ -220,10 +220,11 @@ class Line(Segment):
     def __init__(self, start: Any, end: Any):
         a, b = as_point(start, "start"), as_point(end, "end")
         dim = max(len(a), len(b))
-        self._set(np.array(lifted(a, dim)), np.array(lifted(b, dim)))
-        if np.array_equal(self._a, self._b):
+        a, b = lifted(a, dim), lifted(b, dim)
+        self._set(np.array(a), np.array(b))
+        if a == b:
             raise ValueError(f"Line needs distinct end points; both are {tuple(self._a.tolist())}")
-        if not math.isfinite(self.length):
+        if max(map(abs, a + b)) > 1e300 and not math.isfinite(self.length):  # below, the length is finite
             raise ValueError(f"Line end points {tuple(self._a.tolist())} and {tuple(self._b.tolist())} are too far apart for float64")
 
     def _set(self, a: NDArray[np.float64], b: NDArray[np.float64]) -> None:

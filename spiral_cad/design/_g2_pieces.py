@@ -316,10 +316,10 @@ def _used(piece: _Piece, point: NDArray, at_end: bool) -> float:
     return _used_xy(piece, float(point[0]), float(point[1]), at_end)
 
 
-def _used_xy(piece: _Piece, x: float, y: float, at_end: bool) -> float:
-    """``_used`` of the point (x, y), in plain floats."""
+def _used_xy(piece: _Piece, x: float, y: float, at_end: bool, direction: tuple[float, float] | None = None) -> float:
+    """``_used`` of the point (x, y), in plain floats (``direction``: a line's, when known)."""
     if piece.kind == "line":
-        tx, ty = piece.direction()
+        tx, ty = piece.direction() if direction is None else direction
         if at_end:
             return float(piece.b[0] - x) * tx + float(piece.b[1] - y) * ty
         return float(x - piece.a[0]) * tx + float(y - piece.a[1]) * ty

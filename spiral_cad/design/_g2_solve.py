@@ -523,7 +523,7 @@ def _tangent_circle(a: _Piece, b: _Piece, depth: float, room_a: float, room_b: f
                 awayx, awayy = ox - px, oy - py
                 length = math.hypot(awayx, awayy)
                 touches.append((px + radius * awayx / length, py + radius * awayy / length))
-        used_a, used_b = _used_xy(a, *touches[0], True), _used_xy(b, *touches[1], False)
+        used_a, used_b = _used_xy(a, *touches[0], True, fixed[0][3:5]), _used_xy(b, *touches[1], False, fixed[1][3:5])
         if not (0.0 < used_a <= room_a and 0.0 < used_b <= room_b):
             return None
         if not math.dist(centre, (cx, cy)) - rho <= depth:

@@ -429,8 +429,11 @@ def gcode_program(
         if kind == ARC:
             assert isinstance(segment, Arc)
             normal = segment.normal
-            ends = np.stack([segment.point(u) for u in np.linspace(0.0, 1.0, 5)])
-            plane = _plane_of(np.pad(ends, ((0, 0), (0, 3 - chain.dim))), normal, plane_tol)
+            if chain.dim == 2:  # a plane arc lies in its plane (z = 0): its points need not be computed
+                ends = np.zeros((1, 3))
+            else:
+                ends = np.stack([segment.point(u) for u in np.linspace(0.0, 1.0, 5)])
+            plane = _plane_of(ends, normal, plane_tol)
             if plane is not None and abs(segment.radius) >= least_radius:  # a smaller arc: chords, below
                 ccw = (segment.radius > 0.0) == (normal[plane[3]] > 0.0)
                 centre = out.rounded(geometry[0])
