@@ -131,8 +131,9 @@ class _Writer:
 
     def rounded(self, point: NDArray) -> list[float]:
         """A chain point in the program's unit, rounded to the printed decimals."""
-        values = [round(float(v) * self.factor, self.decimals) for v in point[: self.dim]]
-        if not all(math.isfinite(v) and abs(v) <= MAX_COORDINATE for v in values):
+        factor, decimals = self.factor, self.decimals
+        values = [round(v * factor, decimals) for v in np.asarray(point, dtype=float)[: self.dim].tolist()]
+        if not all(abs(v) <= MAX_COORDINATE for v in values):  # NaN fails too; infinity is beyond
             raise ValueError(f"the point {tuple(point.tolist())} is beyond {MAX_COORDINATE:g} program units or not finite; "
                              "G-code writes fixed decimals")  # fmt: skip
         return values + [self.position[2]] * (3 - self.dim)
@@ -164,11 +165,22 @@ class _Writer:
 
 def _plane_of(points: NDArray, normal: NDArray | None, tolerance: float) -> tuple[str, int, int, int] | None:
     """The principal plane the piece lies in (its points within ``tolerance`` of one plane normal to an axis)."""
+    return _plane_of_spread(np.ptp(points[:, :3], axis=0).tolist(), normal, tolerance)
+
+
+def _planes_of(points: NDArray, tolerance: float) -> list[tuple[str, int, int, int] | None]:
+    """``_plane_of`` of many pieces at once (points (m, k, 3)), without normals."""
+    return [_plane_of_spread(spread, None, tolerance) for spread in np.ptp(points, axis=1).tolist()]
+
+
+def _plane_of_spread(spread: list[float], normal: NDArray | None, tolerance: float) -> tuple[str, int, int, int] | None:
+    """The first principal plane whose normal axis the points spread along by at most ``tolerance`` (and, given a
+    normal, that it is)."""
     for plane in PLANES:
         axis = plane[3]
         if normal is not None and abs(abs(float(normal[axis])) - 1.0) > 1e-12:
             continue
-        if float(np.ptp(points[:, axis])) <= tolerance:
+        if spread[axis] <= tolerance:
             return plane
     return None
 
@@ -405,7 +417,8 @@ def gcode_program(
         out.position = out.rounded(chain.start)
     kinds = np.asarray(rows.kind)
     # the principal plane of every spiral, and the biarcs of those G5 cannot carry, fitted at once per plane
-    planes = {int(i): _plane_of(rows.geometry[i, :, :3], None, plane_tol) for i in np.flatnonzero(kinds == SPIRAL)}
+    spirals = np.flatnonzero(kinds == SPIRAL)
+    planes = dict(zip(spirals.tolist(), _planes_of(rows.geometry[spirals, :, :3], plane_tol)))
     fits: dict[int, tuple[list[Piece], float]] = {}
     for plane_name, first, second, _ in PLANES:
         wanted = [i for i, plane in planes.items() if plane is not None and plane[0] == plane_name
