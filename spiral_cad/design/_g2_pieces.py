@@ -88,6 +88,8 @@ class _Piece:
 
 def _piece_of(segment: Segment, index: int) -> _Piece:
     if isinstance(segment, Line):
+        if segment.dim == 2:  # its end points as its frames hold them (copied from its row), without computing the frames
+            return _Piece("line", index, index, a=segment._a.copy(), b=segment._b.copy())
         (x0, y0, *_), (x1, y1, *_) = segment.ends
         return _Piece("line", index, index, a=np.array([x0, y0]), b=np.array([x1, y1]))
     assert isinstance(segment, Arc)
