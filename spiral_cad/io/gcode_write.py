@@ -129,12 +129,13 @@ class _Writer:
         self.position: list[float] = [0.0, 0.0, 0.0]
         self.plane = "G17"
 
-    def rounded(self, point: NDArray) -> list[float]:
-        """A chain point in the program's unit, rounded to the printed decimals."""
+    def rounded(self, point: NDArray | list[float]) -> list[float]:
+        """A chain point (its first ``dim`` coordinates) in the program's unit, rounded to the printed decimals."""
         factor, decimals = self.factor, self.decimals
-        values = [round(v * factor, decimals) for v in np.asarray(point, dtype=float)[: self.dim].tolist()]
+        coordinates = point[: self.dim] if isinstance(point, list) else np.asarray(point, dtype=float)[: self.dim].tolist()
+        values = [round(v * factor, decimals) for v in coordinates]
         if not all(abs(v) <= MAX_COORDINATE for v in values):  # NaN fails too; infinity is beyond
-            raise ValueError(f"the point {tuple(point.tolist())} is beyond {MAX_COORDINATE:g} program units or not finite; "
+            raise ValueError(f"the point {tuple(coordinates)} is beyond {MAX_COORDINATE:g} program units or not finite; "
                              "G-code writes fixed decimals")  # fmt: skip
         return values + [self.position[2]] * (3 - self.dim)
 
@@ -427,15 +428,15 @@ def gcode_program(
             fitted = spirals_biarcs(rows.geometry[wanted][:, :, [first, second]], arcs - printing / factor, least_radius)
             fits.update(zip(wanted, fitted))
     in_force, feed_words = float(per_segment[0]) if len(chain) else feed, 0
-    for i in range(len(chain)):
-        kind = int(kinds[i])
+    listed = rows.geometry.tolist()  # every row's points as floats at once (each is rounded to text one by one)
+    for i, (kind, segment_feed) in enumerate(zip(kinds.tolist(), per_segment.tolist())):
         geometry = rows.geometry[i]
-        if per_segment[i] != in_force:  # the program's own feed changes here
-            in_force = float(per_segment[i])
+        if segment_feed != in_force:  # the program's own feed changes here
+            in_force = segment_feed
             body.append(f"F{out.number(round(in_force, decimals))}")
             feed_words += 1
         if kind == LINE:
-            out.line(out.rounded(geometry[1]))
+            out.line(out.rounded(listed[i][1]))
             counts["line"] += 1
             continue
         segment = chain[i]
@@ -458,7 +459,7 @@ def gcode_program(
             plane = planes[i]
             if plane is not None and i not in fits:  # G5: XY, LinuxCNC
                 out.set_plane("G17")
-                p = [out.rounded(point) for point in cp]
+                p = [out.rounded(point) for point in listed[i]]
                 start = out.position
                 words = (f"I{out.number(p[1][0] - start[0])} J{out.number(p[1][1] - start[1])} "
                          f"P{out.number(p[2][0] - p[3][0])} Q{out.number(p[2][1] - p[3][1])}")  # fmt: skip
