@@ -500,7 +500,8 @@ def _tangent_circle(a: _Piece, b: _Piece, depth: float, room_a: float, room_b: f
         else:
             fixed.append((False, float(piece.c[0]), float(piece.c[1]), 0.0, 0.0, 0.0, 0.0, abs(piece.r)))
 
-    def attempt(rho: float) -> tuple[_Piece, NDArray, NDArray] | None:
+    def attempt(rho: float) -> tuple[float, tuple[float, float], list[tuple[float, float]], float, float, float] | None:
+        """The circle of radius ``rho`` (radius, centre, touches, start angle, sweep, distance from the corner), or None."""
         loci: list[tuple[str, tuple[float, float], Any]] = []
         for piece, (line, px, py, tx, ty, nx, ny, radius) in zip((a, b), fixed):
             if line:
@@ -526,16 +527,15 @@ def _tangent_circle(a: _Piece, b: _Piece, depth: float, room_a: float, room_b: f
         used_a, used_b = _used_xy(a, *touches[0], True, fixed[0][3:5]), _used_xy(b, *touches[1], False, fixed[1][3:5])
         if not (0.0 < used_a <= room_a and 0.0 < used_b <= room_b):
             return None
-        if not math.dist(centre, (cx, cy)) - rho <= depth:
+        fillet = math.dist(centre, (cx, cy)) - rho
+        if not fillet <= depth:
             return None
         start = math.atan2(touches[0][1] - oy, touches[0][0] - ox)
         end = math.atan2(touches[1][1] - oy, touches[1][0] - ox)
         sweep = (sense * (end - start)) % TAU
         if not 0.0 < sweep < math.pi:
             return None
-        circle = _Piece("arc", -1, -1, c=np.array(centre), r=sense * rho, a0=start, sweep=sweep,
-                        fillet=math.dist(centre, (cx, cy)) - rho)  # fmt: skip
-        return circle, np.array(touches[0]), np.array(touches[1])
+        return rho, centre, touches, start, sweep, fillet
 
     half = abs(turn) / 2.0
     rho = depth / max(1.0 / math.cos(half) - 1.0, 1e-300)
@@ -555,7 +555,9 @@ def _tangent_circle(a: _Piece, b: _Piece, depth: float, room_a: float, room_b: f
             lo, best = mid, found
         else:
             hi = mid
-    return best
+    rho, centre, touches, start, sweep, fillet = best
+    circle = _Piece("arc", -1, -1, c=np.array(centre), r=sense * rho, a0=start, sweep=sweep, fillet=fillet)
+    return circle, np.array(touches[0]), np.array(touches[1])
 
 
 def _trim_end(piece: _Piece, point: NDArray) -> None:
