@@ -301,6 +301,8 @@ class Circle:
 
 #: The plane basis of plane arcs (the x and y axes).
 _XY_BASIS = np.array([[1.0, 0.0, 0.0], [0.0, 1.0, 0.0]])
+#: The normal of a plane arc (``Arc.normal`` of the XY plane): e1 × e2 of ``_XY_BASIS``.
+_XY_NORMAL = np.cross(_XY_BASIS[0], _XY_BASIS[1])
 _XY_BASIS.flags.writeable = False
 
 
@@ -444,7 +446,9 @@ class Arc(Segment):
     @property
     def normal(self) -> NDArray[np.float64]:
         """Unit normal (3,) of the arc's plane: (0, 0, 1) in the plane; positive radius turns counterclockwise about it."""
-        e1, e2 = _XY_BASIS if self._basis is None else self._basis
+        if self._basis is None:
+            return _XY_NORMAL.copy()
+        e1, e2 = self._basis
         return np.cross(e1, e2)
 
     @property

@@ -134,9 +134,10 @@ class _Writer:
         factor, decimals = self.factor, self.decimals
         coordinates = point[: self.dim] if isinstance(point, list) else np.asarray(point, dtype=float)[: self.dim].tolist()
         values = [round(v * factor, decimals) for v in coordinates]
-        if not all(abs(v) <= MAX_COORDINATE for v in values):  # NaN fails too; infinity is beyond
-            raise ValueError(f"the point {tuple(coordinates)} is beyond {MAX_COORDINATE:g} program units or not finite; "
-                             "G-code writes fixed decimals")  # fmt: skip
+        for v in values:
+            if not abs(v) <= MAX_COORDINATE:  # NaN fails too; infinity is beyond
+                raise ValueError(f"the point {tuple(coordinates)} is beyond {MAX_COORDINATE:g} program units or not finite; "
+                                 "G-code writes fixed decimals")  # fmt: skip
         return values + [self.position[2]] * (3 - self.dim)
 
     def number(self, value: float) -> str:
@@ -439,8 +440,8 @@ def gcode_program(
             out.line(out.rounded(listed[i][1]))
             counts["line"] += 1
             continue
-        segment = chain[i]
         if kind == ARC:
+            segment = chain[i]
             assert isinstance(segment, Arc)
             normal = segment.normal
             if chain.dim == 2:  # a plane arc lies in its plane (z = 0): its points need not be computed
@@ -485,7 +486,7 @@ def gcode_program(
                 counts["biarcs"] += 1
                 continue
         # a piece in a plane that is not a principal one, or an arc below the least radius: chords
-        piece = Chain([segment], units=chain.units)
+        piece = Chain([chain[i]], units=chain.units)
         samples = sample_path(piece, chord_tolerance=chord - printing / factor)
         points = samples[:, 1:4]
         between = piece.point_at((samples[1:, 0] + samples[:-1, 0]) / 2.0)
