@@ -12,10 +12,14 @@ moves' plan (x, y after the plunge) rounded as a Chain and written as G-code (``
 LinuxCNC with exact G5, and generic with biarcs within 0.001 mm), and the LinuxCNC program
 read back as the same chain (``parse_gcode_chain``); and, up to ``--build-max`` moves, the whole
 command ``spiral-cad build --from-gcode FILE --max-deviation 0.01 --no-plots`` (read, round, write
-STEP, G-code, samples and DXF; peak = the larger of the command's process and its children). One run per job (a minute-long
+STEP, G-code, samples and DXF; peak = the larger of the command's process and its children); and, up to ``--g2-max``
+moves, the in-place rewrite ``spiral-cad g2 FILE --max-deviation 0.01 -o OUT`` of a pocketing and contouring
+program of as many moves (``contour_program``: pockets of G1 rows, rounded-rectangle contours of G1 lines and G3
+corners, bosses cut as G1 chords with R-word arcs, each entered by a rapid and a plunge, at their own feeds; the
+command as a user runs it, its progress lines on stderr kept). One run per job (a minute-long
 job on a shared machine: the spread is not measured); the peer of the arrays is the
 Chain at the same size. Goals: 100 000 moves read and rounded in ≤ 60 s and ≤ 1.5 GB;
-1 M moves rounded in ≤ 20 s and ≤ 3 GB; ``build --from-gcode`` of 100 000 moves in ≤ 30 s and ≤ 1 GB.
+1 M moves rounded in ≤ 20 s and ≤ 3 GB; ``build --from-gcode`` and ``g2`` of 100 000 moves each in ≤ 30 s and ≤ 1 GB.
 """
 
 from __future__ import annotations
@@ -45,6 +49,15 @@ MEASURES = (
     "spiral_cad.io.samples",
     "spiral_cad.io.step",
     "spiral_cad.core.bezier",
+    "spiral_cad.io.gcode_inplace",
+    "spiral_cad.app.g2_document",
+    "spiral_cad.design.g2",
+    "spiral_cad.design._g2_pieces",
+    "spiral_cad.design._g2_solve",
+    "spiral_cad.design._g2_measure",
+    "spiral_cad.design._g2_kept",
+    "spiral_cad.design.fillets",
+    "spiral_cad.core.segments",
 )
 
 MAX_DEVIATION = 0.01  # mm at every corner
@@ -62,6 +75,41 @@ def program(moves: int) -> str:
     return f"%\n(pocket, {moves} moves)\nG21 G90 G17 G40 G49 G80\nT1 M6\nS12000 M3\nG0 X0 Y0 Z5\nG1 Z-1 F800\n{body}\nG0 Z5\nM30\n%\n"
 
 
+def contour_program(moves: int) -> str:
+    """A program of about ``moves`` moves, part after part: a pocket of G1 rows (jittered ends, F1000), a rounded
+    rectangle of G1 sides and G3 corners (F800), and a boss cut as G1 chords of a circle (F600) with two R-word
+    arcs (a reversal) after it; each entered by a rapid and a plunge (F200) and left by a rapid retract."""
+    rng = np.random.default_rng(7)
+    out = ["%", f"(pocket and contour, {moves} moves)", "G21 G90 G17 G40 G49 G80 G94", "T1 M6", "S12000 M3", "M8"]
+    count = part = 0
+    while count < moves:
+        ox, oy, depth = (part % 10) * 60.0, (part // 10 % 10) * 50.0, -1.0 - (part // 100) * 0.5
+        rows = int(rng.integers(20, 60))
+        out += ["G0 Z5", f"G0 X{ox + 2:.4f} Y{oy + 2:.4f}", f"G1 Z{depth:.4f} F200"]
+        for r in range(rows):
+            y = oy + 2 + r * 0.8
+            x0, x1 = ox + 2 + rng.uniform(-0.05, 0.05), ox + 38 + rng.uniform(-0.05, 0.05)
+            b = x0 if r % 2 else x1
+            out += [f"G1 X{b:.4f} Y{y:.4f}" + (" F1000" if r == 0 else ""), f"X{b:.4f} Y{y + 0.8:.4f}"]
+        w, h, c = 40.0, rows * 0.8 + 4, 3.0
+        out += ["G0 Z5", f"G0 X{ox + c:.4f} Y{oy:.4f}", f"G1 Z{depth:.4f} F200",
+                f"G1 X{ox + w - c:.4f} Y{oy:.4f} F800", f"G3 X{ox + w:.4f} Y{oy + c:.4f} I0 J{c:.4f}",
+                f"G1 Y{oy + h - c:.4f}", f"G3 X{ox + w - c:.4f} Y{oy + h:.4f} I{-c:.4f} J0",
+                f"G1 X{ox + c:.4f}", f"G3 X{ox:.4f} Y{oy + h - c:.4f} I0 J{-c:.4f}",
+                f"G1 Y{oy + c:.4f}", f"G3 X{ox + c:.4f} Y{oy:.4f} I{c:.4f} J0"]  # fmt: skip
+        cx, cy, radius = ox + 20, oy + h / 2, 5 + rng.uniform(0, 1)
+        n = int(rng.integers(40, 120))
+        t = np.linspace(0, 2 * np.pi, n + 1)
+        out += ["G0 Z5", f"G0 X{cx + radius:.4f} Y{cy:.4f}", f"G1 Z{depth:.4f} F200",
+                f"G1 X{cx + radius * np.cos(t[1]):.4f} Y{cy + radius * np.sin(t[1]):.4f} F600"]  # fmt: skip
+        out += [f"X{cx + radius * np.cos(a):.4f} Y{cy + radius * np.sin(a):.4f}" for a in t[2:]]
+        out += [f"G2 X{cx + radius - 4:.4f} Y{cy:.4f} R2", f"G3 X{cx + radius - 8:.4f} Y{cy:.4f} R2",
+                f"G1 X{cx + radius - 9:.4f} Y{cy + 1:.4f}", "G0 Z5"]  # fmt: skip
+        count += 2 * rows + n + 22
+        part += 1
+    return "\n".join(out + ["M9", "M5", "G0 Z25", "M30", "%", ""])
+
+
 def peak_mb() -> float:
     return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0
 
@@ -70,6 +118,9 @@ def child(job: str, moves: int) -> None:
     """One job in this process; prints its seconds and peak memory as JSON."""
     if job == "build":
         build(moves)
+        return
+    if job == "g2":
+        g2(moves)
         return
     from spiral_cad.io.gcode import parse_gcode, read_gcode
     from spiral_cad.io.toolpath_rounding import round_toolpath, round_toolpath_arrays
@@ -152,6 +203,26 @@ def build(moves: int) -> None:
     print(json.dumps({"build": seconds, "peak_mb": max(peak_mb(), children)}))
 
 
+def g2(moves: int) -> None:
+    """``spiral-cad g2`` of a ``contour_program`` of ``moves`` moves, as the command runs it (its stderr kept)."""
+    from spiral_cad.app.cli import main
+
+    with tempfile.TemporaryDirectory() as folder:
+        file = os.path.join(folder, f"contour{moves}.ngc")
+        with open(file, "w", encoding="ascii") as handle:
+            handle.write(contour_program(moves))
+        started = time.perf_counter()
+        with open(os.devnull, "w") as quiet:
+            stdout, sys.stdout = sys.stdout, quiet
+            try:
+                code = main(["g2", file, "--max-deviation", str(MAX_DEVIATION), "-o", os.path.join(folder, "out.ngc")])
+            finally:
+                sys.stdout = stdout
+        seconds = time.perf_counter() - started
+    assert code == 0, code
+    print(json.dumps({"g2": seconds, "peak_mb": peak_mb()}))
+
+
 def run(job: str, moves: int) -> dict:
     done = subprocess.run([sys.executable, __file__, "--child", job, str(moves)], capture_output=True, text=True, check=False)
     if done.returncode != 0:
@@ -164,7 +235,7 @@ def main() -> None:
         child(sys.argv[2], int(sys.argv[3]))
         return
     args = arguments(__doc__, sizes=([10_000, 100_000, 1_000_000], [300]), chain_max=(100_000, 2_000), write_max=(10_000, 300),
-                     build_max=(10_000, 300))  # fmt: skip
+                     build_max=(10_000, 300), g2_max=(100_000, 300))  # fmt: skip
     report = Report("G-code benchmark", f"Generated pocketing programs, max_deviation {MAX_DEVIATION} mm; one run per job, "
                                         "each in its own process (peak = that process's maximum resident set).")  # fmt: skip
     rows = []
@@ -200,6 +271,13 @@ def main() -> None:
                 goal = f"≤ 30 s, ≤ 1 GB: {'met' if built['build'] <= 30 and built['peak_mb'] <= 1024 else 'missed'}"
             report.add(f"spiral-cad build --from-gcode, {moves:,} moves", built["build"], "s", Timing((built["build"],)),
                        f"peak {built['peak_mb']:,.0f} MB", goal=goal)  # fmt: skip
+        if moves <= args.g2_max:
+            made = run("g2", moves)
+            goal = ""
+            if moves == 100_000:
+                goal = f"≤ 30 s, ≤ 1 GB: {'met' if made['g2'] <= 30 and made['peak_mb'] <= 1024 else 'missed'}"
+            report.add(f"spiral-cad g2 (in place), {moves:,} moves", made["g2"], "s", Timing((made["g2"],)),
+                       f"peak {made['peak_mb']:,.0f} MB", goal=goal)  # fmt: skip
         rows.append(f"| {moves:,} | {read['read']:.2f} s, {read['peak_mb']:,.0f} MB | "
                     + (f"{chain['round']:.2f} s, {chain['peak_mb']:,.0f} MB" if chain else "not run (above --chain-max)")
                     + f" | {arrays['round']:.2f} s, {arrays['peak_mb']:,.0f} MB |")  # fmt: skip

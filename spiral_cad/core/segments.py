@@ -220,10 +220,11 @@ class Line(Segment):
     def __init__(self, start: Any, end: Any):
         a, b = as_point(start, "start"), as_point(end, "end")
         dim = max(len(a), len(b))
-        self._set(np.array(lifted(a, dim)), np.array(lifted(b, dim)))
-        if np.array_equal(self._a, self._b):
+        a, b = lifted(a, dim), lifted(b, dim)
+        self._set(np.array(a), np.array(b))
+        if a == b:
             raise ValueError(f"Line needs distinct end points; both are {tuple(self._a.tolist())}")
-        if not math.isfinite(self.length):
+        if max(map(abs, a + b)) > 1e300 and not math.isfinite(self.length):  # below, the length is finite
             raise ValueError(f"Line end points {tuple(self._a.tolist())} and {tuple(self._b.tolist())} are too far apart for float64")
 
     def _set(self, a: NDArray[np.float64], b: NDArray[np.float64]) -> None:
@@ -300,6 +301,8 @@ class Circle:
 
 #: The plane basis of plane arcs (the x and y axes).
 _XY_BASIS = np.array([[1.0, 0.0, 0.0], [0.0, 1.0, 0.0]])
+#: The normal of a plane arc (``Arc.normal`` of the XY plane): e1 × e2 of ``_XY_BASIS``.
+_XY_NORMAL = np.cross(_XY_BASIS[0], _XY_BASIS[1])
 _XY_BASIS.flags.writeable = False
 
 
@@ -443,7 +446,9 @@ class Arc(Segment):
     @property
     def normal(self) -> NDArray[np.float64]:
         """Unit normal (3,) of the arc's plane: (0, 0, 1) in the plane; positive radius turns counterclockwise about it."""
-        e1, e2 = _XY_BASIS if self._basis is None else self._basis
+        if self._basis is None:
+            return _XY_NORMAL.copy()
+        e1, e2 = self._basis
         return np.cross(e1, e2)
 
     @property

@@ -65,10 +65,15 @@ class _Piece:
             return self.b
         return self.c + abs(self.r) * np.array([math.cos(self.a1), math.sin(self.a1)])
 
+    def direction(self) -> tuple[float, float]:
+        """A line's unit direction, as plain floats (``tangent`` of a line)."""
+        dx, dy = float(self.b[0] - self.a[0]), float(self.b[1] - self.a[1])
+        length = math.hypot(dx, dy)
+        return dx / length, dy / length
+
     def tangent(self, at_end: bool) -> NDArray:
         if self.kind == "line":
-            d = self.b - self.a
-            return d / math.hypot(*d)
+            return np.array(self.direction())
         angle = self.a1 if at_end else self.a0
         return self.sense * np.array([-math.sin(angle), math.cos(angle)])
 
@@ -83,6 +88,8 @@ class _Piece:
 
 def _piece_of(segment: Segment, index: int) -> _Piece:
     if isinstance(segment, Line):
+        if segment.dim == 2:  # its end points as its frames hold them (copied from its row), without computing the frames
+            return _Piece("line", index, index, a=segment._a.copy(), b=segment._b.copy())
         (x0, y0, *_), (x1, y1, *_) = segment.ends
         return _Piece("line", index, index, a=np.array([x0, y0]), b=np.array([x1, y1]))
     assert isinstance(segment, Arc)
@@ -302,20 +309,23 @@ class _Solved:
     reason: str = ""
 
 
-def _angle_on(piece: _Piece, point: NDArray) -> float:
-    return math.atan2(point[1] - piece.c[1], point[0] - piece.c[0])
-
-
 def _wrap(angle: float) -> float:
     return (angle + math.pi) % TAU - math.pi
 
 
 def _used(piece: _Piece, point: NDArray, at_end: bool) -> float:
     """How much of ``piece`` (length of a line, sweep of an arc) lies between ``point`` and its end (start)."""
+    return _used_xy(piece, float(point[0]), float(point[1]), at_end)
+
+
+def _used_xy(piece: _Piece, x: float, y: float, at_end: bool, direction: tuple[float, float] | None = None) -> float:
+    """``_used`` of the point (x, y), in plain floats (``direction``: a line's, when known)."""
     if piece.kind == "line":
-        t = piece.tangent(True)
-        return float(np.dot(piece.b - point, t)) if at_end else float(np.dot(point - piece.a, t))
-    angle = _angle_on(piece, point)
+        tx, ty = piece.direction() if direction is None else direction
+        if at_end:
+            return float(piece.b[0] - x) * tx + float(piece.b[1] - y) * ty
+        return float(x - piece.a[0]) * tx + float(y - piece.a[1]) * ty
+    angle = math.atan2(y - float(piece.c[1]), x - float(piece.c[0]))
     if at_end:
         return piece.sense * _wrap(piece.a1 - angle)
     return piece.sense * _wrap(angle - piece.a0)

@@ -25,8 +25,9 @@ from ._g2_pieces import (
     _turn,
     _used,
     _used_rows,
+    _used_xy,
 )
-from .fillets import _intersect
+from .fillets import _intersect_xy
 from .rounding import round_corners_batch
 
 #: The shifts are aimed this much (relative) inside the bound.
@@ -487,45 +488,54 @@ def _tangent_kind(a: _Piece, b: _Piece) -> str:
 def _tangent_circle(a: _Piece, b: _Piece, depth: float, room_a: float, room_b: float) -> tuple[_Piece, NDArray, NDArray] | None:
     """The largest circle tangent to ``a`` and ``b`` inside their corner that passes at most ``depth`` from the
     corner point and touches each within its room; (circle piece, touch on a, touch on b), None if none fits."""
-    corner = a.end()
+    cx, cy = (float(v) for v in a.end())
     turn = _turn(a, b)
     sense = math.copysign(1.0, turn)
+    # what does not change with the radius, in plain floats (each attempt is a few hundred float operations)
+    fixed = []
+    for piece in (a, b):
+        if piece.kind == "line":
+            tx, ty = piece.direction()
+            fixed.append((True, float(piece.a[0]), float(piece.a[1]), tx, ty, -ty * sense, tx * sense, 0.0))
+        else:
+            fixed.append((False, float(piece.c[0]), float(piece.c[1]), 0.0, 0.0, 0.0, 0.0, abs(piece.r)))
 
-    def attempt(rho: float) -> tuple[_Piece, NDArray, NDArray] | None:
-        loci: list[tuple[str, NDArray, Any]] = []
-        for piece in (a, b):
-            if piece.kind == "line":
-                t = piece.tangent(True)
-                normal = np.array([-t[1], t[0]]) * sense
-                loci.append(("line", piece.a + rho * normal, t))
+    def attempt(rho: float) -> tuple[float, tuple[float, float], list[tuple[float, float]], float, float, float] | None:
+        """The circle of radius ``rho`` (radius, centre, touches, start angle, sweep, distance from the corner), or None."""
+        loci: list[tuple[str, tuple[float, float], Any]] = []
+        for piece, (line, px, py, tx, ty, nx, ny, radius) in zip((a, b), fixed):
+            if line:
+                loci.append(("line", (px + rho * nx, py + rho * ny), (tx, ty)))
             else:
-                distance = abs(piece.r) - rho if (piece.r > 0) == (sense > 0) else abs(piece.r) + rho
+                distance = radius - rho if (piece.r > 0) == (sense > 0) else radius + rho
                 if not distance > 0.0:
                     return None
-                loci.append(("circle", piece.c, distance))
-        centre = _intersect(loci[0], loci[1], corner)
+                loci.append(("circle", (px, py), distance))
+        centre = _intersect_xy(loci[0], loci[1], (cx, cy))
         if centre is None:
             return None
+        ox, oy = centre
         touches = []
-        for piece in (a, b):
-            if piece.kind == "line":
-                t = piece.tangent(True)
-                touches.append(piece.a + float(np.dot(centre - piece.a, t)) * t)
+        for line, px, py, tx, ty, _, _, radius in fixed:
+            if line:
+                along = (ox - px) * tx + (oy - py) * ty
+                touches.append((px + along * tx, py + along * ty))
             else:
-                away = centre - piece.c
-                touches.append(piece.c + abs(piece.r) * away / math.hypot(*away))
-        used_a, used_b = _used(a, touches[0], True), _used(b, touches[1], False)
+                awayx, awayy = ox - px, oy - py
+                length = math.hypot(awayx, awayy)
+                touches.append((px + radius * awayx / length, py + radius * awayy / length))
+        used_a, used_b = _used_xy(a, *touches[0], True, fixed[0][3:5]), _used_xy(b, *touches[1], False, fixed[1][3:5])
         if not (0.0 < used_a <= room_a and 0.0 < used_b <= room_b):
             return None
-        if not math.dist(centre, corner) - rho <= depth:
+        fillet = math.dist(centre, (cx, cy)) - rho
+        if not fillet <= depth:
             return None
-        start = math.atan2(touches[0][1] - centre[1], touches[0][0] - centre[0])
-        end = math.atan2(touches[1][1] - centre[1], touches[1][0] - centre[0])
+        start = math.atan2(touches[0][1] - oy, touches[0][0] - ox)
+        end = math.atan2(touches[1][1] - oy, touches[1][0] - ox)
         sweep = (sense * (end - start)) % TAU
         if not 0.0 < sweep < math.pi:
             return None
-        circle = _Piece("arc", -1, -1, c=centre, r=sense * rho, a0=start, sweep=sweep, fillet=math.dist(centre, corner) - rho)
-        return circle, touches[0], touches[1]
+        return rho, centre, touches, start, sweep, fillet
 
     half = abs(turn) / 2.0
     rho = depth / max(1.0 / math.cos(half) - 1.0, 1e-300)
@@ -545,7 +555,9 @@ def _tangent_circle(a: _Piece, b: _Piece, depth: float, room_a: float, room_b: f
             lo, best = mid, found
         else:
             hi = mid
-    return best
+    rho, centre, touches, start, sweep, fillet = best
+    circle = _Piece("arc", -1, -1, c=np.array(centre), r=sense * rho, a0=start, sweep=sweep, fillet=fillet)
+    return circle, np.array(touches[0]), np.array(touches[1])
 
 
 def _trim_end(piece: _Piece, point: NDArray) -> None:

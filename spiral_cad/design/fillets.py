@@ -195,54 +195,75 @@ def _locus(kind: str, geometry: Any, theta: float, r: float, turn: float, same_s
 
 
 def _intersect(a, b, near: NDArray) -> NDArray | None:
-    """The intersection of two loci nearest ``near`` (None when they do not meet).
+    """The intersection of two loci nearest ``near`` (None when they do not meet): ``_intersect_xy`` of arrays.
+
+    A locus is ``("line", point, direction)`` or ``("circle", centre, radius)``.
+    """
+    local = [(kind, (float(point[0]), float(point[1])), (float(other[0]), float(other[1])) if kind == "line" else float(other))
+             for kind, point, other in (a, b)]  # fmt: skip
+    root = _intersect_xy(local[0], local[1], (float(near[0]), float(near[1])))
+    return None if root is None else np.array(root)
+
+
+def _ldexp(x: float, exponent: int) -> float:
+    """``x·2^exponent`` as ``np.ldexp`` gives it (an overflow: infinity of x's sign)."""
+    try:
+        return math.ldexp(x, exponent)
+    except OverflowError:
+        return math.copysign(math.inf, x)
+
+
+def _intersect_xy(a, b, near: tuple[float, float]) -> tuple[float, float] | None:
+    """The intersection of two loci nearest ``near`` (None when they do not meet), in plain floats (points as (x, y)).
 
     Solved relative to ``near`` and scaled by a power of two (exact), so the
     squares of distances neither overflow nor underflow at any magnitude.
     """
-    offsets = [float(np.abs(point - near).max()) for _, point, _ in (a, b)]
+    nx, ny = near
+    offsets = [max(abs(point[0] - nx), abs(point[1] - ny)) for _, point, _ in (a, b)]
     size = max(offsets + [abs(distance) for kind, _, distance in (a, b) if kind == "circle"])
     exponent = math.frexp(size)[1] if math.isfinite(size) else 0
-    local = [(kind, np.ldexp(point - near, -exponent), other if kind == "line" else math.ldexp(other, -exponent))
-             for kind, point, other in (a, b)]  # fmt: skip
+    local = [(kind, (_ldexp(point[0] - nx, -exponent), _ldexp(point[1] - ny, -exponent)),
+              other if kind == "line" else _ldexp(other, -exponent)) for kind, point, other in (a, b)]  # fmt: skip
     root = _nearest_intersection(*local)
-    if root is None or not np.isfinite(root).all():
+    if root is None or not (math.isfinite(root[0]) and math.isfinite(root[1])):
         return None
-    return near + np.ldexp(root, exponent)
+    return nx + _ldexp(root[0], exponent), ny + _ldexp(root[1], exponent)
 
 
-def _nearest_intersection(a, b) -> NDArray | None:
-    """The intersection of two loci nearest the origin (None when they do not meet)."""
+def _nearest_intersection(a, b) -> tuple[float, float] | None:
+    """The intersection of two loci nearest the origin (None when they do not meet), in plain floats."""
     if a[0] == "circle" and b[0] == "line":
         a, b = b, a
     if a[0] == "line" and b[0] == "line":
-        (_, p, u), (_, q, v) = a, b
-        det = u[0] * v[1] - u[1] * v[0]
+        (_, (px, py), (ux, uy)), (_, (qx, qy), (vx, vy)) = a, b
+        det = ux * vy - uy * vx
         if abs(det) <= 1e-15:
             return None
-        w = q - p
-        return p + u * (w[0] * v[1] - w[1] * v[0]) / det
+        wx, wy = qx - px, qy - py
+        along = wx * vy - wy * vx
+        return px + ux * along / det, py + uy * along / det
     if a[0] == "line":
-        (_, p, u), (_, c, radius) = a, b
-        w = p - c
-        along = float(np.dot(w, u))
-        disc = along * along - (float(np.dot(w, w)) - radius * radius)
+        (_, (px, py), (ux, uy)), (_, (cx, cy), radius) = a, b
+        wx, wy = px - cx, py - cy
+        along = wx * ux + wy * uy
+        disc = along * along - ((wx * wx + wy * wy) - radius * radius)
         if disc < 0.0:
             return None
-        roots = [p + u * (-along + sign * math.sqrt(disc)) for sign in (1.0, -1.0)]
+        root = math.sqrt(disc)
+        roots = [(px + ux * (-along + step), py + uy * (-along + step)) for step in (root, -root)]
     else:
-        (_, c0, r0), (_, c1, r1) = a, b
-        offset = c1 - c0
-        d = float(np.hypot(*offset))
+        (_, (x0, y0), r0), (_, (x1, y1), r1) = a, b
+        ox, oy = x1 - x0, y1 - y0
+        d = float(np.hypot(ox, oy))
         if d == 0.0 or d > r0 + r1 or d < abs(r0 - r1):
             return None
         along = (r0 * r0 - r1 * r1 + d * d) / (2.0 * d)
         h = math.sqrt(max(r0 * r0 - along * along, 0.0))
-        unit = offset / d
-        base = c0 + along * unit
-        normal = np.array([-unit[1], unit[0]])
-        roots = [base + h * normal, base - h * normal]
-    return min(roots, key=lambda x: float(np.hypot(*x)))
+        ex, ey = ox / d, oy / d
+        bx, by = x0 + along * ex, y0 + along * ey
+        roots = [(bx + h * -ey, by + h * ex), (bx - h * -ey, by - h * ex)]
+    return min(roots, key=lambda x: float(np.hypot(x[0], x[1])))
 
 
 def _transition_onto(kind: str, geometry: Any, center: NDArray, r: float, same_sense: str, shape: str) -> Transition:

@@ -265,7 +265,7 @@ class _Rewriter:
         percent = 0
         progress = Progress(f"g2 {self.source}: lines", len(self.raw))
         for number, line in enumerate(self.raw, 1):
-            if not number & 0x3FFF:
+            if not number & 0x3FF:  # a look at the clock every 1 024 lines (Progress prints at most every 2 s)
                 progress(number)
             if frozen:
                 self.out.append(line)

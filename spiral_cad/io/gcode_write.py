@@ -129,12 +129,15 @@ class _Writer:
         self.position: list[float] = [0.0, 0.0, 0.0]
         self.plane = "G17"
 
-    def rounded(self, point: NDArray) -> list[float]:
-        """A chain point in the program's unit, rounded to the printed decimals."""
-        values = [round(float(v) * self.factor, self.decimals) for v in point[: self.dim]]
-        if not all(math.isfinite(v) and abs(v) <= MAX_COORDINATE for v in values):
-            raise ValueError(f"the point {tuple(point.tolist())} is beyond {MAX_COORDINATE:g} program units or not finite; "
-                             "G-code writes fixed decimals")  # fmt: skip
+    def rounded(self, point: NDArray | list[float]) -> list[float]:
+        """A chain point (its first ``dim`` coordinates) in the program's unit, rounded to the printed decimals."""
+        factor, decimals = self.factor, self.decimals
+        coordinates = point[: self.dim] if isinstance(point, list) else np.asarray(point, dtype=float)[: self.dim].tolist()
+        values = [round(v * factor, decimals) for v in coordinates]
+        for v in values:
+            if not abs(v) <= MAX_COORDINATE:  # NaN fails too; infinity is beyond
+                raise ValueError(f"the point {tuple(coordinates)} is beyond {MAX_COORDINATE:g} program units or not finite; "
+                                 "G-code writes fixed decimals")  # fmt: skip
         return values + [self.position[2]] * (3 - self.dim)
 
     def number(self, value: float) -> str:
@@ -164,11 +167,22 @@ class _Writer:
 
 def _plane_of(points: NDArray, normal: NDArray | None, tolerance: float) -> tuple[str, int, int, int] | None:
     """The principal plane the piece lies in (its points within ``tolerance`` of one plane normal to an axis)."""
+    return _plane_of_spread(np.ptp(points[:, :3], axis=0).tolist(), normal, tolerance)
+
+
+def _planes_of(points: NDArray, tolerance: float) -> list[tuple[str, int, int, int] | None]:
+    """``_plane_of`` of many pieces at once (points (m, k, 3)), without normals."""
+    return [_plane_of_spread(spread, None, tolerance) for spread in np.ptp(points, axis=1).tolist()]
+
+
+def _plane_of_spread(spread: list[float], normal: NDArray | None, tolerance: float) -> tuple[str, int, int, int] | None:
+    """The first principal plane whose normal axis the points spread along by at most ``tolerance`` (and, given a
+    normal, that it is)."""
     for plane in PLANES:
         axis = plane[3]
         if normal is not None and abs(abs(float(normal[axis])) - 1.0) > 1e-12:
             continue
-        if float(np.ptp(points[:, axis])) <= tolerance:
+        if spread[axis] <= tolerance:
             return plane
     return None
 
@@ -405,7 +419,8 @@ def gcode_program(
         out.position = out.rounded(chain.start)
     kinds = np.asarray(rows.kind)
     # the principal plane of every spiral, and the biarcs of those G5 cannot carry, fitted at once per plane
-    planes = {int(i): _plane_of(rows.geometry[i, :, :3], None, plane_tol) for i in np.flatnonzero(kinds == SPIRAL)}
+    spirals = np.flatnonzero(kinds == SPIRAL)
+    planes = dict(zip(spirals.tolist(), _planes_of(rows.geometry[spirals, :, :3], plane_tol)))
     fits: dict[int, tuple[list[Piece], float]] = {}
     for plane_name, first, second, _ in PLANES:
         wanted = [i for i, plane in planes.items() if plane is not None and plane[0] == plane_name
@@ -414,23 +429,26 @@ def gcode_program(
             fitted = spirals_biarcs(rows.geometry[wanted][:, :, [first, second]], arcs - printing / factor, least_radius)
             fits.update(zip(wanted, fitted))
     in_force, feed_words = float(per_segment[0]) if len(chain) else feed, 0
-    for i in range(len(chain)):
-        kind = int(kinds[i])
+    listed = rows.geometry.tolist()  # every row's points as floats at once (each is rounded to text one by one)
+    for i, (kind, segment_feed) in enumerate(zip(kinds.tolist(), per_segment.tolist())):
         geometry = rows.geometry[i]
-        if per_segment[i] != in_force:  # the program's own feed changes here
-            in_force = float(per_segment[i])
+        if segment_feed != in_force:  # the program's own feed changes here
+            in_force = segment_feed
             body.append(f"F{out.number(round(in_force, decimals))}")
             feed_words += 1
         if kind == LINE:
-            out.line(out.rounded(geometry[1]))
+            out.line(out.rounded(listed[i][1]))
             counts["line"] += 1
             continue
-        segment = chain[i]
         if kind == ARC:
+            segment = chain[i]
             assert isinstance(segment, Arc)
             normal = segment.normal
-            ends = np.stack([segment.point(u) for u in np.linspace(0.0, 1.0, 5)])
-            plane = _plane_of(np.pad(ends, ((0, 0), (0, 3 - chain.dim))), normal, plane_tol)
+            if chain.dim == 2:  # a plane arc lies in its plane (z = 0): its points need not be computed
+                ends = np.zeros((1, 3))
+            else:
+                ends = np.stack([segment.point(u) for u in np.linspace(0.0, 1.0, 5)])
+            plane = _plane_of(ends, normal, plane_tol)
             if plane is not None and abs(segment.radius) >= least_radius:  # a smaller arc: chords, below
                 ccw = (segment.radius > 0.0) == (normal[plane[3]] > 0.0)
                 centre = out.rounded(geometry[0])
@@ -442,7 +460,7 @@ def gcode_program(
             plane = planes[i]
             if plane is not None and i not in fits:  # G5: XY, LinuxCNC
                 out.set_plane("G17")
-                p = [out.rounded(point) for point in cp]
+                p = [out.rounded(point) for point in listed[i]]
                 start = out.position
                 words = (f"I{out.number(p[1][0] - start[0])} J{out.number(p[1][1] - start[1])} "
                          f"P{out.number(p[2][0] - p[3][0])} Q{out.number(p[2][1] - p[3][1])}")  # fmt: skip
@@ -468,7 +486,7 @@ def gcode_program(
                 counts["biarcs"] += 1
                 continue
         # a piece in a plane that is not a principal one, or an arc below the least radius: chords
-        piece = Chain([segment], units=chain.units)
+        piece = Chain([chain[i]], units=chain.units)
         samples = sample_path(piece, chord_tolerance=chord - printing / factor)
         points = samples[:, 1:4]
         between = piece.point_at((samples[1:, 0] + samples[:-1, 0]) / 2.0)

@@ -18,6 +18,7 @@ BENCH = Path(__file__).resolve().parents[2] / "benchmarks"
 SCRIPTS = sorted(BENCH.glob("bench_*.py"))
 #: What a script's quick table must say beside its numbers (every job ran; the solids it built are valid).
 EXPECTED = {
+    "bench_gcode": ("spiral-cad build --from-gcode", "spiral-cad g2 (in place)"),
     "bench_paths3d": ("3-D batch", "G-code", "valid True", "per-corner"),
     "bench_roads3d": ("corridor", "valid", "growth exponent"),
     "bench_solids": ("ContinuousBox", "valid True", "build123d fillet"),
