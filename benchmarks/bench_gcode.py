@@ -31,6 +31,7 @@ import subprocess
 import sys
 import tempfile
 import time
+from collections.abc import Callable
 
 import numpy as np
 from timing import Report, Timing, arguments
@@ -171,55 +172,39 @@ def child(job: str, moves: int) -> None:
     print(json.dumps({"read": read, "round": rounded, "peak_mb": peak_mb(), "before_mb": before, "moves": len(path)}))
 
 
-def build(moves: int) -> None:
-    """``spiral-cad build --from-gcode`` of a program of ``moves`` moves, as the command runs it (its stderr kept)."""
+def _command(name: str, text: str, argv: Callable[[str, str], list[str]]) -> float:
+    """Seconds that ``spiral-cad`` with ``argv(file, folder)`` takes on ``text`` written to ``name`` in a
+    fresh folder, as the command runs it (its stdout dropped, its stderr kept); a failure stops the job."""
     from spiral_cad.app.cli import main
 
     with tempfile.TemporaryDirectory() as folder:
-        file = os.path.join(folder, f"pocket{moves}.nc")
+        file = os.path.join(folder, name)
         with open(file, "w", encoding="ascii") as handle:
-            handle.write(program(moves))
+            handle.write(text)
         started = time.perf_counter()
         with open(os.devnull, "w") as quiet:
             stdout, sys.stdout = sys.stdout, quiet
             try:
-                code = main(
-                    [
-                        "build",
-                        "--from-gcode",
-                        file,
-                        "--max-deviation",
-                        str(MAX_DEVIATION),
-                        "--out",
-                        os.path.join(folder, "out"),
-                        "--no-plots",
-                    ]
-                )
+                code = main(argv(file, folder))
             finally:
                 sys.stdout = stdout
         seconds = time.perf_counter() - started
-    children = resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss / 1024.0
     assert code == 0, code
+    return seconds
+
+
+def build(moves: int) -> None:
+    """``spiral-cad build --from-gcode`` of a program of ``moves`` moves."""
+    seconds = _command(f"pocket{moves}.nc", program(moves), lambda file, folder: [
+        "build", "--from-gcode", file, "--max-deviation", str(MAX_DEVIATION), "--out", os.path.join(folder, "out"), "--no-plots"])  # fmt: skip
+    children = resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss / 1024.0
     print(json.dumps({"build": seconds, "peak_mb": max(peak_mb(), children)}))
 
 
 def g2(moves: int) -> None:
-    """``spiral-cad g2`` of a ``contour_program`` of ``moves`` moves, as the command runs it (its stderr kept)."""
-    from spiral_cad.app.cli import main
-
-    with tempfile.TemporaryDirectory() as folder:
-        file = os.path.join(folder, f"contour{moves}.ngc")
-        with open(file, "w", encoding="ascii") as handle:
-            handle.write(contour_program(moves))
-        started = time.perf_counter()
-        with open(os.devnull, "w") as quiet:
-            stdout, sys.stdout = sys.stdout, quiet
-            try:
-                code = main(["g2", file, "--max-deviation", str(MAX_DEVIATION), "-o", os.path.join(folder, "out.ngc")])
-            finally:
-                sys.stdout = stdout
-        seconds = time.perf_counter() - started
-    assert code == 0, code
+    """``spiral-cad g2`` of a ``contour_program`` of ``moves`` moves (its reversals split: allowed)."""
+    seconds = _command(f"contour{moves}.ngc", contour_program(moves), lambda file, folder: [
+        "g2", file, "--max-deviation", str(MAX_DEVIATION), "-o", os.path.join(folder, "out.ngc"), "--allow-splits"])  # fmt: skip
     print(json.dumps({"g2": seconds, "peak_mb": peak_mb()}))
 
 
