@@ -249,20 +249,16 @@ def main() -> None:
             report.add(f"gcode_program (generic, biarcs), {moves:,} moves", written["generic"], "s", Timing((written["generic"],)),
                        f"LinuxCNC {written['linuxcnc']:.2f} s", written["linuxcnc"] / written["generic"])  # fmt: skip
             report.add(f"parse_gcode_chain of it (the same chain), {moves:,} moves", written["back"], "s", Timing((written["back"],)))
-        if moves <= args.build_max:
-            built = run("build", moves)
-            goal = ""
-            if moves == 100_000:
-                goal = f"≤ 30 s, ≤ 1 GB: {'met' if built['build'] <= 30 and built['peak_mb'] <= 1024 else 'missed'}"
-            report.add(f"spiral-cad build --from-gcode, {moves:,} moves", built["build"], "s", Timing((built["build"],)),
-                       f"peak {built['peak_mb']:,.0f} MB", goal=goal)  # fmt: skip
-        if moves <= args.g2_max:
-            made = run("g2", moves)
-            goal = ""
-            if moves == 100_000:
-                goal = f"≤ 30 s, ≤ 1 GB: {'met' if made['g2'] <= 30 and made['peak_mb'] <= 1024 else 'missed'}"
-            report.add(f"spiral-cad g2 (in place), {moves:,} moves", made["g2"], "s", Timing((made["g2"],)),
-                       f"peak {made['peak_mb']:,.0f} MB", goal=goal)  # fmt: skip
+        for job, limit, label in (
+            ("build", args.build_max, "spiral-cad build --from-gcode"),
+            ("g2", args.g2_max, "spiral-cad g2 (in place)"),
+        ):
+            if moves <= limit:
+                done = run(job, moves)
+                goal = ""
+                if moves == 100_000:
+                    goal = f"≤ 30 s, ≤ 1 GB: {'met' if done[job] <= 30 and done['peak_mb'] <= 1024 else 'missed'}"
+                report.add(f"{label}, {moves:,} moves", done[job], "s", Timing((done[job],)), f"peak {done['peak_mb']:,.0f} MB", goal=goal)
         rows.append(f"| {moves:,} | {read['read']:.2f} s, {read['peak_mb']:,.0f} MB | "
                     + (f"{chain['round']:.2f} s, {chain['peak_mb']:,.0f} MB" if chain else "not run (above --chain-max)")
                     + f" | {arrays['round']:.2f} s, {arrays['peak_mb']:,.0f} MB |")  # fmt: skip
