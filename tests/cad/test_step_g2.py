@@ -2,19 +2,16 @@
 
 from __future__ import annotations
 
-import math
 import os
 import re
 import subprocess
-import sys
 from pathlib import Path
 
 import build123d as bd
 import pytest
-from OCP.BRep import BRep_Tool
 from OCP.BRepAdaptor import BRepAdaptor_Curve
-from OCP.BRepExtrema import BRepExtrema_DistShapeShape
 from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeVertex
+from OCP.BRepExtrema import BRepExtrema_DistShapeShape
 from OCP.BRepTools import BRepTools_WireExplorer
 from OCP.gp import gp_Pnt, gp_Vec
 from OCP.IFSelect import IFSelect_RetDone
