@@ -28,6 +28,8 @@ from __future__ import annotations
 import math
 import os
 import tempfile
+from collections.abc import Iterator
+from contextlib import contextmanager
 from pathlib import Path
 from typing import Any
 
@@ -116,11 +118,47 @@ def _nothing(shape: TopoDS_Shape) -> int:
 
 def _rewrite_document(source: str, target: str, kind: str, unit: str, bound: float, spiral: str) -> tuple[list, list[str]]:
     """The child's work: read the file into an XCAF document, make its wires G2, write it; the report as plain data."""
+    settings: dict[str, int | str] = {"write.iges.unit": _UNIT_NAME[unit]}
+    if kind == "STEP":  # names of solids and other sub-shapes kept too, and written in the file's unit
+        settings = {"read.stepcaf.subshapes.name": 1, "write.stepcaf.subshapes.name": 1, "write.step.unit": _UNIT_NAME[unit]}
+    with _settings(kind, settings):
+        doc = _read_document(source, kind, unit)
+        paths, notes = _rewrite_wires(doc, bound, spiral, unit)
+        notes.append("names, colours and layers kept through OCCT's XDE"
+                     + (" (a PRODUCT's id is written as its name); wires written as curve sets (readers chain their edges)"
+                        if kind == "STEP" else "; wires written as composite curves"))  # fmt: skip
+        _write_document(doc, Path(target), kind)
+    return paths, notes
+
+
+@contextmanager
+def _settings(kind: str, values: dict[str, int | str]) -> Iterator[None]:
+    """OCCT's reader and writer parameters set to ``values`` for the block, then put back as they were."""
     from OCP.Interface import Interface_Static
+
+    if kind == "STEP":
+        from OCP.STEPCAFControl import STEPCAFControl_Reader, STEPCAFControl_Writer
+
+        STEPCAFControl_Reader(), STEPCAFControl_Writer()  # register their parameters
+    else:
+        from OCP.IGESCAFControl import IGESCAFControl_Writer
+
+        IGESCAFControl_Writer()
+    before = {name: Interface_Static.CVal_s(name) for name in values}
+    for name, value in values.items():
+        Interface_Static.SetCVal_s(name, str(value))
+    try:
+        yield
+    finally:
+        for name, value in before.items():
+            Interface_Static.SetCVal_s(name, value)
+
+
+def _rewrite_wires(doc: Any, bound: float, spiral: str, unit: str) -> tuple[list[tuple], list[str]]:
+    """Every wire of every shape of the document that is not G2 made G2 in place; (report rows, notes)."""
     from OCP.TDF import TDF_LabelSequence
     from OCP.XCAFDoc import XCAFDoc_DocumentTool
 
-    doc = _read_document(source, kind, unit)
     tool = XCAFDoc_DocumentTool.ShapeTool_s(doc.Main())
     labels = TDF_LabelSequence()
     tool.GetShapes(labels)
@@ -142,18 +180,8 @@ def _rewrite_document(source: str, target: str, kind: str, unit: str, bound: flo
     faces = ", ".join(f"{count} {word}(s)" for word, count in kept.items() if count)
     if faces:
         notes.append(f"{faces} kept as they are (a part's faces are not this command's job; g2_face and g2_fillet make them G2)")
-    notes.append("product and shape names, colours and layers kept through OCCT's XDE; wires are written "
-                 + ("as curve sets (readers chain their edges)" if kind == "STEP" else "as composite curves"))  # fmt: skip
     if not paths:
         notes.append("the file holds no wires or loose edges")
-    name = _UNIT_NAME[unit]
-    setting = "write.step.unit" if kind == "STEP" else "write.iges.unit"
-    before = Interface_Static.CVal_s(setting)
-    Interface_Static.SetCVal_s(setting, name)
-    try:
-        _write_document(doc, Path(target), kind)
-    finally:
-        Interface_Static.SetCVal_s(setting, before)
     return paths, notes
 
 

@@ -256,3 +256,53 @@ def test_refusals(tmp_path: Path, capsys) -> None:
     broken.write_text("ISO-10303-21;\nHEADER;\n")
     assert main(["g2", str(broken), "--max-deviation", "0.01", "-o", str(tmp_path / "o.step")]) == 2
     assert not (tmp_path / "o.step").exists()
+
+
+def _names_and_colours(path: Path) -> dict[str, tuple[str, list]]:
+    """Every shape label's name → (shape type, its colours), as OCCT's XDE reads the file."""
+    from OCP.Quantity import Quantity_Color
+    from OCP.STEPCAFControl import STEPCAFControl_Reader
+    from OCP.TCollection import TCollection_ExtendedString
+    from OCP.TDataStd import TDataStd_Name
+    from OCP.TDF import TDF_LabelSequence
+    from OCP.TDocStd import TDocStd_Document
+    from OCP.XCAFApp import XCAFApp_Application
+    from OCP.XCAFDoc import XCAFDoc_ColorType, XCAFDoc_DocumentTool
+
+    doc = TDocStd_Document(TCollection_ExtendedString("MDTV-XCAF"))
+    XCAFApp_Application.GetApplication_s().InitDocument(doc)
+    reader = STEPCAFControl_Reader()
+    reader.SetColorMode(True)
+    reader.SetNameMode(True)
+    assert reader.ReadFile(str(path)) == IFSelect_RetDone and reader.Transfer(doc)
+    shapes, colours = XCAFDoc_DocumentTool.ShapeTool_s(doc.Main()), XCAFDoc_DocumentTool.ColorTool_s(doc.Main())
+    labels = TDF_LabelSequence()
+    shapes.GetShapes(labels)
+    found = {}
+    for i in range(1, labels.Length() + 1):
+        label, name = labels.Value(i), TDataStd_Name()
+        assert label.FindAttribute(TDataStd_Name.GetID_s(), name)
+        shape, its = shapes.GetShape_s(label), []
+        for kind in (XCAFDoc_ColorType.XCAFDoc_ColorGen, XCAFDoc_ColorType.XCAFDoc_ColorSurf, XCAFDoc_ColorType.XCAFDoc_ColorCurv):
+            colour = Quantity_Color()
+            if colours.GetColor(shape, kind, colour):
+                its.append((round(colour.Red(), 3), round(colour.Green(), 3), round(colour.Blue(), 3)))
+        found[name.Get().ToExtString()] = (shape.ShapeType().name, its)
+    return found
+
+
+def test_assembly_names_and_colours_kept(tmp_path: Path) -> None:
+    """A CadQuery assembly: a blue block and a red contour, each a named product; the contour is made G2 in place."""
+    import cadquery as cq
+
+    contour = bd.FilletPolyline((0, 0), (40, 0), (40, 20), (0, 20), radius=5, close=True)
+    assembly = cq.Assembly(name="plate")
+    assembly.add(cq.Workplane().box(10, 10, 10).translate((100, 0, 0)), name="block", color=cq.Color("blue"))
+    assembly.add(cq.Shape.cast(contour.wrapped), name="contour", color=cq.Color("red"))
+    source, target = tmp_path / "plate.step", tmp_path / "plate_g2.step"
+    assembly.export(str(source))
+    report = make_document_g2(source, target, 0.01)
+    assert [(p.name.split(",")[0], p.changed) for p in report.paths] == [("contour", 8)]
+    before, after = _names_and_colours(source), _names_and_colours(target)
+    assert after == before and after["block"][1] == [(0.0, 0.0, 1.0)] and after["contour"][1] == [(1.0, 0.0, 0.0)]
+    assert _judge(source, target, 0.01, 1.0, 1000.0) == 1
