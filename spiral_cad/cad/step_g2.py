@@ -33,6 +33,7 @@ from contextlib import contextmanager
 from pathlib import Path
 from typing import Any
 
+import numpy as np
 from OCP.BRep import BRep_Builder
 from OCP.BRepAdaptor import BRepAdaptor_Curve
 from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeEdge, BRepBuilderAPI_MakeWire
@@ -45,6 +46,7 @@ from OCP.TopAbs import TopAbs_COMPOUND, TopAbs_EDGE, TopAbs_FACE, TopAbs_REVERSE
 from OCP.TopExp import TopExp_Explorer
 from OCP.TopoDS import TopoDS, TopoDS_Compound, TopoDS_Edge, TopoDS_Iterator, TopoDS_Shape, TopoDS_Wire
 from OCP.TopTools import TopTools_HSequenceOfShape
+from scipy.spatial import cKDTree
 
 from ..check.joints import Continuity
 from ..core.units import MM_PER_UNIT
@@ -118,7 +120,11 @@ def _nothing(shape: TopoDS_Shape) -> int:
 
 def _rewrite_document(source: str, target: str, kind: str, unit: str, bound: float, spiral: str) -> tuple[list, list[str]]:
     """The child's work: read the file into an XCAF document, make its wires G2, write it; the report as plain data."""
-    settings: dict[str, int | str] = {"write.iges.unit": _UNIT_NAME[unit]}
+    # an IGES file of BRep solids (186, shells 514) is written in BRep mode, so its solids stay solids
+    settings: dict[str, int | str] = {
+        "write.iges.unit": _UNIT_NAME[unit],
+        "write.iges.brep.mode": int(kind == "IGES" and _iges_brep(source)),
+    }
     if kind == "STEP":  # names of solids and other sub-shapes kept too, and written in the file's unit
         settings = {"read.stepcaf.subshapes.name": 1, "write.stepcaf.subshapes.name": 1, "write.step.unit": _UNIT_NAME[unit]}
     with _settings(kind, settings):
@@ -129,6 +135,15 @@ def _rewrite_document(source: str, target: str, kind: str, unit: str, bound: flo
                         if kind == "STEP" else "; wires written as composite curves"))  # fmt: skip
         _write_document(doc, Path(target), kind)
     return paths, notes
+
+
+def _iges_brep(source: str) -> bool:
+    """Whether an IGES file holds BRep solids or shells (entities 186, 514): its directory entries say."""
+    with open(source, "rb") as handle:
+        for record in handle:
+            if len(record) >= 73 and record[72:73] == b"D" and record[:8].strip() in (b"186", b"514"):
+                return True
+    return False
 
 
 @contextmanager
@@ -279,27 +294,41 @@ def _free_wires(shape: TopoDS_Shape) -> list[tuple[TopoDS_Wire, list[TopoDS_Shap
         explorer.Next()
     if not loose:
         return found
-    middles = [_middle(e) for e in loose]
-    size = max((abs(c) for p in middles for c in p), default=1.0)
+    middles = np.array([_middle(e) for e in loose])
+    size = float(np.abs(middles).max(initial=1.0))
+    tree = cKDTree(middles)
     sequence = TopTools_HSequenceOfShape()
     for edge in loose:
         sequence.Append(edge)
     joined = TopTools_HSequenceOfShape()
     ShapeAnalysis_FreeBounds.ConnectEdgesToWires_s(sequence, max(1e-7, CHAIN_TOLERANCE * size), False, joined)
-    unused = set(range(len(loose)))
+    used = np.zeros(len(loose), dtype=bool)
     for k in range(1, joined.Length() + 1):
         wire = TopoDS.Wire_s(joined.Value(k))
         originals = []
         explorer = TopExp_Explorer(wire, TopAbs_EDGE)
         while explorer.More():  # the chained edges are copies: each is found by its middle point
-            middle = _middle(TopoDS.Edge_s(explorer.Current()))
-            best = min(unused, key=lambda i: math.dist(middles[i], middle), default=None)
+            best = _nearest_unused(tree, _middle(TopoDS.Edge_s(explorer.Current())), used)
             if best is not None:
-                unused.discard(best)
+                used[best] = True
                 originals.append(loose[best])
             explorer.Next()
-        found.append((wire, list(originals)))
+        found.append((wire, originals))
     return found
+
+
+def _nearest_unused(tree: cKDTree, point: tuple[float, float, float], used: np.ndarray) -> int | None:
+    """The index of the unused point of ``tree`` nearest to ``point`` (None: all are used)."""
+    count = 4
+    while True:
+        k = min(count, tree.n)
+        _, found = tree.query(point, k=k)
+        for i in np.atleast_1d(found).tolist():
+            if i < tree.n and not used[i]:
+                return int(i)
+        if k == tree.n:
+            return None
+        count *= 4
 
 
 def _middle(edge: TopoDS_Edge) -> tuple[float, float, float]:

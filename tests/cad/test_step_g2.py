@@ -201,15 +201,17 @@ def test_iges_in_inches(tmp_path: Path) -> None:
     contour = bd.FilletPolyline((0, 0), (4, 0), (4, 2), (0, 2), radius=0.5, close=True)
     square = bd.Polyline((5, 0), (6, 0), (6, 1), (5, 1), close=True)
     source, target = tmp_path / "plate.igs", tmp_path / "plate_g2.igs"
-    export_iges(bd.Compound([contour, square]), source, units="in")
+    export_iges(bd.Compound([contour, square, bd.Box(1, 1, 1).moved(bd.Location((10, 0, 0)))]), source, units="in")
     report = make_document_g2(source, target, 0.001)
     assert report.units == "in" and len(report.paths) == 2 and not report.below_g2
+    (solid_in,), (solid_out,) = _solids(_occt_read(source, 1.0)), _solids(_occt_read(target, 1.0))  # a BRep solid stays one
+    assert solid_out.volume == pytest.approx(solid_in.volume, rel=1e-12) and solid_in.volume == pytest.approx(25.4**3)  # in mm
     assert 0 < report.worst <= 0.001
     assert b"4HINCH" in target.read_bytes()
     assert _judge(source, target, 0.001, 25.4, 1.0) == 2  # written in inches, read in mm
     fc_in, fc_out = _freecad(source), _freecad(target)
     if fc_in is not None:
-        assert fc_out[0] == fc_in[0] == 2
+        assert (fc_out[0], fc_out[2]) == (fc_in[0], fc_in[2]) == (8, 1)  # the two wires and the box's six faces' wires
 
 
 def test_step_in_inches_of_connected_edge_sets(tmp_path: Path) -> None:
