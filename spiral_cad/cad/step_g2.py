@@ -408,7 +408,7 @@ def _rewrite_shape(shape: TopoDS_Shape, name: str, bound: float, spiral: str, un
             paths.append((label, joints, 0, math.nan, 0, "G2 already", 0, True))
             continue
         try:
-            new, result = g2_wire(_analytic_wire(wire), bound, shape=spiral)
+            new, result = g2_wire(_analytic_wire(wire), bound, shape=spiral, units=unit)
         except ValueError as error:  # NoSolutionError too: the wire is kept, named, with the reason
             paths.append((label, joints, 0, math.nan, 0, f"not made G2: {error}", 0, False))
             continue
