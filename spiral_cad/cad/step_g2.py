@@ -230,28 +230,37 @@ def _read_document(source: str, kind: str, unit: str) -> Any:
 
 
 def _write_document(doc: Any, target: Path, kind: str) -> None:
-    """Write the document whole or not at all (a temporary file in the target's folder, then renamed)."""
-    from OCP.IFSelect import IFSelect_RetDone
-
+    """Write the document whole or not at all (a temporary file in the target's folder, then renamed), its reals
+    with 17 significant digits (``print_model``: OCCT prints 9 or 13, which moves a short spiral's inner control
+    points enough to break G2 at its ends)."""
     from .console import captured_messages
+    from .occ import print_model
 
     handle, temporary = tempfile.mkstemp(prefix=f".{target.name}.", suffix=target.suffix, dir=target.parent)
     os.close(handle)
     try:
         with captured_messages():
             if kind == "STEP":
+                from OCP.StepAP214 import StepAP214
                 from OCP.STEPCAFControl import STEPCAFControl_Writer
                 from OCP.STEPControl import STEPControl_AsIs
+                from OCP.StepData import StepData_StepWriter
 
                 writer: Any = STEPCAFControl_Writer()
-                done = writer.Transfer(doc, STEPControl_AsIs) and writer.Write(temporary) == IFSelect_RetDone
+                done = writer.Transfer(doc, STEPControl_AsIs)
+                printer, protocol = StepData_StepWriter(writer.ChangeWriter().Model()), StepAP214.Protocol_s()
             else:
                 from OCP.IGESCAFControl import IGESCAFControl_Writer
+                from OCP.IGESData import IGESData_IGESWriter
+                from OCP.IGESSelect import IGESSelect_WorkLibrary
 
                 writer = IGESCAFControl_Writer()
-                done = writer.Transfer(doc) and writer.Write(temporary)
+                done = writer.Transfer(doc)
+                writer.ComputeModel()
+                printer, protocol = IGESData_IGESWriter(writer.Model()), IGESSelect_WorkLibrary.DefineProtocol_s()
         if not done:
-            raise OSError(f"OCCT's {kind} writer could not write {target.name}")
+            raise OSError(f"OCCT's {kind} writer could not transfer the document for {target.name}")
+        print_model(printer, protocol, temporary, kind)
         os.replace(temporary, target)
     finally:
         if os.path.exists(temporary):

@@ -308,3 +308,14 @@ def test_assembly_names_and_colours_kept(tmp_path: Path) -> None:
     before, after = _names_and_colours(source), _names_and_colours(target)
     assert after == before and after["block"][1] == [(0.0, 0.0, 1.0)] and after["contour"][1] == [(1.0, 0.0, 0.0)]
     assert _judge(source, target, 0.01, 1.0, 1000.0) == 1
+
+
+def test_short_spirals_stay_g2_through_the_written_digits(tmp_path: Path) -> None:
+    """An arrow of sharp corners in inches: its spiral pairs are short, so OCCT's 9-digit IGES reals would break G2
+    at their ends (a curvature jump of 0.006); the file is printed with 17 digits."""
+    arrow = bd.Polyline((0, 0), (4, 0), (4, -0.3), (4.6, 0.25), (4, 0.8), (4, 0.5), (0, 0.5), close=True)
+    source, target = tmp_path / "arrow.igs", tmp_path / "arrow_g2.igs"
+    export_iges(arrow, source, units="in")
+    report = make_document_g2(source, target, 0.01)
+    assert [p.changed for p in report.paths] == [7]
+    assert _judge(source, target, 0.01, 25.4, 1.0) == 1
