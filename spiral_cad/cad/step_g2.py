@@ -34,7 +34,7 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-from OCP.BRep import BRep_Builder
+from OCP.BRep import BRep_Builder, BRep_Tool
 from OCP.BRepAdaptor import BRepAdaptor_Curve
 from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeEdge, BRepBuilderAPI_MakeWire
 from OCP.BRepTools import BRepTools_ReShape, BRepTools_WireExplorer
@@ -43,15 +43,16 @@ from OCP.gce import gce_MakeCirc, gce_MakeLin
 from OCP.GeomAbs import GeomAbs_CurveType
 from OCP.ShapeAnalysis import ShapeAnalysis_FreeBounds
 from OCP.TopAbs import TopAbs_COMPOUND, TopAbs_EDGE, TopAbs_FACE, TopAbs_REVERSED, TopAbs_SHELL, TopAbs_SOLID, TopAbs_WIRE
-from OCP.TopExp import TopExp_Explorer
+from OCP.TopExp import TopExp, TopExp_Explorer
 from OCP.TopoDS import TopoDS, TopoDS_Compound, TopoDS_Edge, TopoDS_Iterator, TopoDS_Shape, TopoDS_Wire
 from OCP.TopTools import TopTools_HSequenceOfShape
 from scipy.spatial import cKDTree
 
 from ..check.joints import Continuity
 from ..core.units import MM_PER_UNIT
+from ..design.g2 import GAP_SHARE
 from ..io.document_report import DocumentReport, PathReport
-from .continuity import check_continuity
+from .continuity import SNAP_FRACTION, check_continuity
 from .g2wire import g2_wire
 from .readers import IGES_SUFFIXES, STEP_SUFFIXES, read_file
 from .sandbox import run_isolated
@@ -119,7 +120,8 @@ def _nothing(shape: TopoDS_Shape) -> int:
 
 
 def _rewrite_document(source: str, target: str, kind: str, unit: str, bound: float, spiral: str) -> tuple[list, list[str]]:
-    """The child's work: read the file into an XCAF document, make its wires G2, write it; the report as plain data."""
+    """The child's work: read the file into an XCAF document, make its wires G2, write it; the report as plain data.
+    Loose edges whose ends lie within ``GAP_SHARE`` of the bound (the gaps make_g2 closes) are chained."""
     # an IGES file of BRep solids (186, shells 514) is written in BRep mode, so its solids stay solids
     settings: dict[str, int | str] = {
         "write.iges.unit": _UNIT_NAME[unit],
@@ -129,7 +131,7 @@ def _rewrite_document(source: str, target: str, kind: str, unit: str, bound: flo
         settings = {"read.stepcaf.subshapes.name": 1, "write.stepcaf.subshapes.name": 1, "write.step.unit": _UNIT_NAME[unit]}
     with _settings(kind, settings):
         doc = _read_document(source, kind, unit)
-        paths, notes = _rewrite_wires(doc, bound, spiral, unit)
+        paths, notes = _rewrite_wires(doc, bound, spiral, unit, GAP_SHARE * bound)
         notes.append("names, colours and layers kept through OCCT's XDE"
                      + (" (a PRODUCT's id is written as its name); wires written as curve sets (readers chain their edges)"
                         if kind == "STEP" else "; wires written as composite curves"))  # fmt: skip
@@ -169,7 +171,7 @@ def _settings(kind: str, values: dict[str, int | str]) -> Iterator[None]:
             Interface_Static.SetCVal_s(name, value)
 
 
-def _rewrite_wires(doc: Any, bound: float, spiral: str, unit: str) -> tuple[list[tuple], list[str]]:
+def _rewrite_wires(doc: Any, bound: float, spiral: str, unit: str, reach: float) -> tuple[list[tuple], list[str]]:
     """Every wire of every shape of the document that is not G2 made G2 in place; (report rows, notes)."""
     from OCP.TDF import TDF_LabelSequence
     from OCP.XCAFDoc import XCAFDoc_DocumentTool
@@ -188,7 +190,7 @@ def _rewrite_wires(doc: Any, bound: float, spiral: str, unit: str) -> tuple[list
         for word, found in _counts(old).items():
             kept[word] += found
         name = _label_name(label) or f"shape {i}"
-        new = _rewrite_shape(old, name, bound, spiral, unit, paths)
+        new = _rewrite_shape(old, name, bound, spiral, unit, reach, paths, notes)
         if new is not None:
             tool.SetShape(label, new)
     tool.UpdateAssemblies()
@@ -287,9 +289,10 @@ def _counts(shape: TopoDS_Shape) -> dict[str, int]:
     return found
 
 
-def _free_wires(shape: TopoDS_Shape) -> list[tuple[TopoDS_Wire, list[TopoDS_Shape]]]:
-    """Each wire of ``shape`` that bounds no face, and each chain of its loose edges joined into a wire; with
-    the shapes of the document it replaces (the wire itself, or the loose edges it was chained from)."""
+def _free_wires(shape: TopoDS_Shape, reach: float = 0.0) -> list[tuple[TopoDS_Wire, list[TopoDS_Shape]]]:
+    """Each wire of ``shape`` that bounds no face, and each chain of its loose edges joined into a wire (ends within
+    ``reach``, at least 1e-7 and ``CHAIN_TOLERANCE`` of the size, are joined); with the shapes of the document it
+    replaces (the wire itself, or the loose edges it was chained from)."""
     found: list[tuple[TopoDS_Wire, list[TopoDS_Shape]]] = []
     explorer = TopExp_Explorer(shape, TopAbs_WIRE, TopAbs_FACE)
     while explorer.More():
@@ -310,7 +313,7 @@ def _free_wires(shape: TopoDS_Shape) -> list[tuple[TopoDS_Wire, list[TopoDS_Shap
     for edge in loose:
         sequence.Append(edge)
     joined = TopTools_HSequenceOfShape()
-    ShapeAnalysis_FreeBounds.ConnectEdgesToWires_s(sequence, max(1e-7, CHAIN_TOLERANCE * size), False, joined)
+    ShapeAnalysis_FreeBounds.ConnectEdgesToWires_s(sequence, max(1e-7, CHAIN_TOLERANCE * size, reach), False, joined)
     used = np.zeros(len(loose), dtype=bool)
     for k in range(1, joined.Length() + 1):
         wire = TopoDS.Wire_s(joined.Value(k))
@@ -338,6 +341,52 @@ def _nearest_unused(tree: cKDTree, point: tuple[float, float, float], used: np.n
         if k == tree.n:
             return None
         count *= 4
+
+
+def _size(shape: TopoDS_Shape) -> float:
+    """The diagonal of the shape's bounding box (1 for an empty or unbounded one)."""
+    from OCP.Bnd import Bnd_Box
+    from OCP.BRepBndLib import BRepBndLib
+
+    box = Bnd_Box()
+    BRepBndLib.Add_s(shape, box)
+    if box.IsVoid():
+        return 1.0
+    size = box.CornerMin().Distance(box.CornerMax())
+    return size if math.isfinite(size) and size > 0.0 else 1.0
+
+
+def _gaps(wires: list[TopoDS_Wire], size: float, unit: str) -> list[str]:
+    """The open ends of ``wires`` that lie closer together than ``SNAP_FRACTION`` of the model ``size`` without meeting
+    (wider than the gaps chained and closed by make_g2): gaps the file has, left as they are (``spiral-cad check``
+    chains such ends and reports a G0 failure there), in words."""
+    ends: list[tuple[int, tuple[float, float, float]]] = []
+    for number, wire in enumerate(wires, 1):
+        first, last = TopExp.FirstVertex_s(_first_edge(wire, True), True), TopExp.LastVertex_s(_first_edge(wire, False), True)
+        if first.IsNull() or last.IsNull() or first.IsSame(last):
+            continue
+        ends += [(number, BRep_Tool.Pnt_s(first).Coord()), (number, BRep_Tool.Pnt_s(last).Coord())]
+    if len(ends) < 2:
+        return []
+    points = np.array([p for _, p in ends])
+    found = []
+    for i, j in sorted(cKDTree(points).query_pairs(SNAP_FRACTION * size)):
+        gap = float(np.linalg.norm(points[i] - points[j]))
+        if gap > 1e-7:
+            a, b = ends[i][0], ends[j][0]
+            which = f"the two ends of wire {a}" if a == b else f"an end of wire {a} and one of wire {b}"
+            found.append(f"{which} are {gap:.3g} {unit} apart, more than half the bound: a gap in the file")
+    return found
+
+
+def _first_edge(wire: TopoDS_Wire, first: bool) -> TopoDS_Edge:
+    """The first (or last) edge of the wire in connection order."""
+    explorer = BRepTools_WireExplorer(wire)
+    edge = TopoDS.Edge_s(explorer.Current())
+    while not first and explorer.More():
+        edge = TopoDS.Edge_s(explorer.Current())
+        explorer.Next()
+    return edge
 
 
 def _middle(edge: TopoDS_Edge) -> tuple[float, float, float]:
@@ -401,11 +450,14 @@ def _as_line_or_arc(edge: TopoDS_Edge) -> TopoDS_Edge | None:
     return None
 
 
-def _rewrite_shape(shape: TopoDS_Shape, name: str, bound: float, spiral: str, unit: str, paths: list[tuple]) -> TopoDS_Shape | None:
-    """``shape`` with its wires that are not G2 made G2 (None: nothing changed); one report row per wire added to ``paths``."""
+def _rewrite_shape(shape: TopoDS_Shape, name: str, bound: float, spiral: str, unit: str, reach: float, paths: list[tuple],
+                   notes: list[str]) -> TopoDS_Shape | None:  # fmt: skip
+    """``shape`` with its wires that are not G2 made G2 (None: nothing changed); one report row per wire added to
+    ``paths``, ends of wires that nearly meet (a gap left as it is) in ``notes``."""
     reshape = BRepTools_ReShape()
     made: list[TopoDS_Wire] = []
-    wires = _free_wires(shape)
+    wires = _free_wires(shape, reach)
+    gaps = _gaps([wire for wire, _ in wires], _size(shape), unit)
     for number, (wire, originals) in enumerate(wires, 1):
         label = f"{name}, wire {number}" if len(wires) > 1 else f"{name}, wire"
         report = check_continuity(wire, units=unit)
@@ -427,6 +479,8 @@ def _rewrite_shape(shape: TopoDS_Shape, name: str, bound: float, spiral: str, un
         made.append(new)
         pieces = sum(len(c) for c in result.chains)
         paths.append((label, joints, changed, float(result.deviation), len(result.splits), "", pieces, True))
+    for gap in gaps:  # an input joint left below G0: counted and named
+        paths.append((f"{name}, a gap", 1, 0, math.nan, 0, gap, 0, False))
     if not made:
         return None
     if shape.ShapeType() in (TopAbs_WIRE, TopAbs_EDGE) and len(made) == 1:

@@ -319,3 +319,21 @@ def test_short_spirals_stay_g2_through_the_written_digits(tmp_path: Path) -> Non
     report = make_document_g2(source, target, 0.01)
     assert [p.changed for p in report.paths] == [7]
     assert _judge(source, target, 0.01, 25.4, 1.0) == 1
+
+
+def test_gaps_closed_within_half_the_bound_and_wider_ones_named(tmp_path: Path, capsys) -> None:
+    """Loose edges that almost meet: gaps up to half the bound are closed (one closed G2 wire, as `check` chains them);
+    a wider gap, as `check` would call a G0 failure, is named and counted below G2."""
+    near = bd.Compound([bd.Polyline((0, 0), (10, 0), (10, 10)), bd.Polyline((10.001, 10), (0, 10), (0, 0.0005))])
+    source, target = tmp_path / "near.step", tmp_path / "near_g2.step"
+    bd.export_step(near, source)
+    report = make_document_g2(source, target, 0.01)
+    assert [(p.changed, p.joints) for p in report.paths] == [(4, 4)] and not report.below_g2
+    (wire,) = _wires(_occt_read(target, 1.0))
+    assert len(_joints(wire)) == 12 and all(angle <= 1e-6 and jump <= 1e-5 for angle, jump in _joints(wire))  # closed
+    apart = bd.Compound([bd.Polyline((0, 0), (10, 0), (10, 10)), bd.Polyline((10.05, 10), (0, 10), (0, 0))])
+    source = tmp_path / "apart.step"
+    bd.export_step(apart, source)
+    assert main(["g2", str(source), "--max-deviation", "0.01", "-o", str(tmp_path / "apart_g2.step")]) == 1
+    out = capsys.readouterr().out
+    assert "a gap: kept as is (the two ends of wire 1 are 0.05 mm apart" in out and "FAIL: 1 left below G2" in out
