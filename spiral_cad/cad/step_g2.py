@@ -4,12 +4,14 @@ The file is first read whole by our reader (``spiral_cad.cad.readers``: every cu
 the unit it declares), then read again through OCCT's XDE (``STEPCAFControl_Reader`` /
 ``IGESCAFControl_Reader``) into an XCAF document in that same unit, so that the products, their names,
 colours and layers come along. Every wire of every shape in the document — a wire that is no face's
-boundary, or loose edges chained end to end into wires as ``spiral-cad check`` chains them — is measured
+boundary, or loose edges chained end to end into wires (ends within half the bound, a gap ``make_g2``
+closes; a wider gap that ``spiral-cad check`` would chain is named and counted below G2) — is measured
 (``check_continuity``: G2 when every joint is); a wire that is not G2 is made G2 within the bound by
 ``spiral_cad.design.make_g2`` (``g2_wire``: lines and arcs kept true lines and arcs, spirals between
 them, its own cubic Bézier spirals kept). The made wire takes the place of the old one in its shape
 (``XCAFDoc_ShapeTool.SetShape`` on the shape's label), and the document is written back in the same
-format and unit by ``STEPCAFControl_Writer`` / ``IGESCAFControl_Writer``, whole or not at all.
+format and unit by ``STEPCAFControl_Writer`` / ``IGESCAFControl_Writer``, whole or not at all, its reals
+with 17 significant digits (``occ.print_model``) and an IGES file's BRep solids in BRep mode.
 
 Solids, shells and faces are kept as they are: a part's faces are not this verb's job (``g2_face`` and
 ``g2_fillet`` make faces G2). A wire that is G2 already, one that is not planar or holds curves other
@@ -190,7 +192,7 @@ def _rewrite_wires(doc: Any, bound: float, spiral: str, unit: str, reach: float)
         for word, found in _counts(old).items():
             kept[word] += found
         name = _label_name(label) or f"shape {i}"
-        new = _rewrite_shape(old, name, bound, spiral, unit, reach, paths, notes)
+        new = _rewrite_shape(old, name, bound, spiral, unit, reach, paths)
         if new is not None:
             tool.SetShape(label, new)
     tool.UpdateAssemblies()
@@ -450,10 +452,10 @@ def _as_line_or_arc(edge: TopoDS_Edge) -> TopoDS_Edge | None:
     return None
 
 
-def _rewrite_shape(shape: TopoDS_Shape, name: str, bound: float, spiral: str, unit: str, reach: float, paths: list[tuple],
-                   notes: list[str]) -> TopoDS_Shape | None:  # fmt: skip
+def _rewrite_shape(shape: TopoDS_Shape, name: str, bound: float, spiral: str, unit: str, reach: float,
+                   paths: list[tuple]) -> TopoDS_Shape | None:  # fmt: skip
     """``shape`` with its wires that are not G2 made G2 (None: nothing changed); one report row per wire added to
-    ``paths``, ends of wires that nearly meet (a gap left as it is) in ``notes``."""
+    ``paths``, and one per gap between wire ends that nearly meet (left as it is, below G2)."""
     reshape = BRepTools_ReShape()
     made: list[TopoDS_Wire] = []
     wires = _free_wires(shape, reach)
