@@ -30,7 +30,7 @@ from __future__ import annotations
 import math
 import os
 import tempfile
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from pathlib import Path
 from typing import Any
@@ -133,11 +133,11 @@ def _rewrite_document(source: str, target: str, kind: str, unit: str, bound: flo
         settings = {"read.stepcaf.subshapes.name": 1, "write.stepcaf.subshapes.name": 1, "write.step.unit": _UNIT_NAME[unit]}
     with _settings(kind, settings):
         doc = _read_document(source, kind, unit)
-        paths, notes = _rewrite_wires(doc, bound, spiral, unit, GAP_SHARE * bound)
+        paths, notes, gained = _rewrite_wires(doc, bound, spiral, unit, GAP_SHARE * bound)
         notes.append("names, colours and layers kept through OCCT's XDE"
                      + (" (a PRODUCT's id is written as its name); wires written as curve sets (readers chain their edges)"
                         if kind == "STEP" else "; wires written as composite curves"))  # fmt: skip
-        _write_document(doc, Path(target), kind)
+        _write_document(doc, Path(target), kind, lambda written: _check_written(source, written, kind, unit, gained))
     return paths, notes
 
 
@@ -173,8 +173,9 @@ def _settings(kind: str, values: dict[str, int | str]) -> Iterator[None]:
             Interface_Static.SetCVal_s(name, value)
 
 
-def _rewrite_wires(doc: Any, bound: float, spiral: str, unit: str, reach: float) -> tuple[list[tuple], list[str]]:
-    """Every wire of every shape of the document that is not G2 made G2 in place; (report rows, notes)."""
+def _rewrite_wires(doc: Any, bound: float, spiral: str, unit: str, reach: float) -> tuple[list[tuple], list[str], int]:
+    """Every wire of every shape of the document that is not G2 made G2 in place; (report rows, notes, how many edges
+    the written file gains: each changed shape's new edges less its old ones, times the times it is placed)."""
     from OCP.TDF import TDF_LabelSequence
     from OCP.XCAFDoc import XCAFDoc_DocumentTool
 
@@ -184,6 +185,7 @@ def _rewrite_wires(doc: Any, bound: float, spiral: str, unit: str, reach: float)
     paths: list[tuple] = []
     notes: list[str] = []
     kept = {"solid": 0, "shell": 0, "face": 0}
+    whole, gained = _placed(tool), 0
     for i in range(1, labels.Length() + 1):
         label = labels.Value(i)
         if tool.IsAssembly_s(label) or tool.IsReference_s(label):
@@ -194,6 +196,7 @@ def _rewrite_wires(doc: Any, bound: float, spiral: str, unit: str, reach: float)
         name = _label_name(label) or f"shape {i}"
         new = _rewrite_shape(old, name, bound, spiral, unit, reach, paths)
         if new is not None:
+            gained += _occurrences(whole, old) * (_edge_total(new) - _edge_total(old))
             tool.SetShape(label, new)
     tool.UpdateAssemblies()
     faces = ", ".join(f"{count} {word}(s)" for word, count in kept.items() if count)
@@ -201,7 +204,56 @@ def _rewrite_wires(doc: Any, bound: float, spiral: str, unit: str, reach: float)
         notes.append(f"{faces} kept as they are (a part's faces are not this command's job; g2_face and g2_fillet make them G2)")
     if not paths:
         notes.append("the file holds no wires or loose edges")
-    return paths, notes
+    return paths, notes, gained
+
+
+def _placed(tool: Any) -> TopoDS_Shape:
+    """Every free shape of the document, placed (a compound): what a reader of the file gets."""
+    from OCP.TDF import TDF_LabelSequence
+
+    free = TDF_LabelSequence()
+    tool.GetFreeShapes(free)
+    builder, compound = BRep_Builder(), TopoDS_Compound()
+    builder.MakeCompound(compound)
+    for i in range(1, free.Length() + 1):
+        builder.Add(compound, tool.GetShape_s(free.Value(i)))
+    return compound
+
+
+def _occurrences(whole: TopoDS_Shape, shape: TopoDS_Shape) -> int:
+    """How many times ``shape`` is placed in ``whole`` (a part instanced four times: 4; at least 1)."""
+    count, explorer = 0, TopExp_Explorer(whole, shape.ShapeType())
+    while explorer.More():
+        count += explorer.Current().IsPartner(shape)
+        explorer.Next()
+    return max(count, 1)
+
+
+def _edge_total(shape: TopoDS_Shape) -> int:
+    from .readers import _edge_count
+
+    return _edge_count(shape)[0]
+
+
+def _check_written(source: str, written: str, kind: str, unit: str, gained: int) -> None:
+    """Refuse a written file that does not hold the input's edges plus those gained: OCCT's XDE writer can drop a
+    placed copy (IGES subfigure instances with a scale), and nothing may be lost in silence.
+
+    Raises:
+        ValueError: the counts differ (nothing is written).
+    """
+    from .readers import _edge_count, _read_whole
+
+    before = _edge_count(_read_whole(Path(source), kind, unit)[0])[0]
+    try:
+        after = _edge_count(_read_whole(Path(written), kind, unit)[0])[0]
+    except ValueError as error:  # our reader's verdict on what OCCT's writer made
+        reason = str(error).split(": ", 1)[-1]
+        raise ValueError(f"{Path(source).name}: OCCT's {kind} writer (XDE) made a file that does not read back whole "
+                         f"({reason}); nothing written") from None  # fmt: skip
+    if after != before + gained:
+        raise ValueError(f"{Path(source).name}: OCCT's {kind} writer (XDE) would not write the document whole: it holds "
+                         f"{after} edges, {before + gained} expected ({before} read, {gained:+d} made); nothing written")  # fmt: skip
 
 
 def _read_document(source: str, kind: str, unit: str) -> Any:
@@ -233,7 +285,7 @@ def _read_document(source: str, kind: str, unit: str) -> Any:
     return doc
 
 
-def _write_document(doc: Any, target: Path, kind: str) -> None:
+def _write_document(doc: Any, target: Path, kind: str, check: Callable[[str], None]) -> None:
     """Write the document whole or not at all (a temporary file in the target's folder, then renamed), its reals
     with 17 significant digits (``print_model``: OCCT prints 9 or 13, which moves a short spiral's inner control
     points enough to break G2 at its ends)."""
@@ -265,6 +317,7 @@ def _write_document(doc: Any, target: Path, kind: str) -> None:
         if not done:
             raise OSError(f"OCCT's {kind} writer could not transfer the document for {target.name}")
         print_model(printer, protocol, temporary, kind)
+        check(temporary)
         os.replace(temporary, target)
     finally:
         if os.path.exists(temporary):
