@@ -411,7 +411,7 @@ def _size(shape: TopoDS_Shape) -> float:
     return size if math.isfinite(size) and size > 0.0 else 1.0
 
 
-def _gaps(wires: list[TopoDS_Wire], size: float, unit: str) -> list[str]:
+def _gaps(wires: list[TopoDS_Wire], size: float, reach: float, unit: str) -> list[str]:
     """The open ends of ``wires`` that lie closer together than ``SNAP_FRACTION`` of the model ``size`` without meeting
     (wider than the gaps chained and closed by make_g2): gaps the file has, left as they are (``spiral-cad check``
     chains such ends and reports a G0 failure there), in words."""
@@ -427,7 +427,7 @@ def _gaps(wires: list[TopoDS_Wire], size: float, unit: str) -> list[str]:
     found = []
     for i, j in sorted(cKDTree(points).query_pairs(SNAP_FRACTION * size)):
         gap = float(np.linalg.norm(points[i] - points[j]))
-        if gap > 1e-7:
+        if gap > max(reach, 1e-7):  # (a wire whose ends lie within reach is closed by make_g2)
             a, b = ends[i][0], ends[j][0]
             which = f"the two ends of wire {a}" if a == b else f"an end of wire {a} and one of wire {b}"
             found.append(f"{which} are {gap:.3g} {unit} apart, more than half the bound: a gap in the file")
@@ -512,7 +512,7 @@ def _rewrite_shape(shape: TopoDS_Shape, name: str, bound: float, spiral: str, un
     reshape = BRepTools_ReShape()
     made: list[TopoDS_Wire] = []
     wires = _free_wires(shape, reach)
-    gaps = _gaps([wire for wire, _ in wires], _size(shape), unit)
+    gaps = _gaps([wire for wire, _ in wires], _size(shape), reach, unit)
     for number, (wire, originals) in enumerate(wires, 1):
         label = f"{name}, wire {number}" if len(wires) > 1 else f"{name}, wire"
         report = check_continuity(wire, units=unit)
