@@ -628,19 +628,19 @@ def _add_g2(sub: argparse._SubParsersAction) -> None:
         "g2",
         help="a document made G2 in place: the same document back (a CNC program: same lines, runs of cuts G2)",
         description="Make a document G2 in place within --max-deviation: one file in, one file out, kind by suffix "
-        "(G-code .nc .ngc .gcode .tap, DXF .dxf, LandXML .xml, OpenDRIVE .xodr). A CNC program keeps every line that is not a cutting "
+        "(G-code .nc .ngc .gcode .tap, DXF .dxf, LandXML .xml, OpenDRIVE .xodr, STEP .step .stp, IGES .igs .iges). A CNC program keeps every line that is not a cutting "
         "move as it is (rapids, plunges, retracts, tool, spindle, coolant, dwells, stops, probes, comments); each run of "
         "G1/G2/G3 cuts in XY at one Z and one feed is made G2 (make_g2: arcs kept), its first and last points and its "
         "feed kept. A run that cannot be made G2 within the bound is kept as it is and named in the report. A DXF "
         "drawing's paths of lines and arcs (and the splines and ellipses in them, read as biarcs within 0.3 of the bound) "
         "are written back as LINE, ARC and exact SPLINE pieces on their own layers, every other entity kept; a LandXML file's alignments of lines and arcs get spirals, stations recomputed, the rest kept; "
-        "an OpenDRIVE file's roads of lines and arcs get spirals (paramPoly3), their ends fixed, their length and every s "
-        "position along them (lanes, elevation, objects, signals) carried to the new reference line, the rest kept.",
+        "an OpenDRIVE file's roads of lines and arcs get spirals (paramPoly3), their ends fixed, their length and every s position "
+        "along them (lanes, elevation, objects, signals) carried to the new reference line, the rest kept; a STEP or IGES file's wires that are not G2 get spirals (lines and arcs kept), its solids, faces, names, colours and layers kept.",
     )
-    g2.add_argument("input", help="the document (.nc .ngc .gcode .tap, .dxf, .xml, .xodr)")
+    g2.add_argument("input", help="the document (.nc .ngc .gcode .tap, .dxf, .xml, .xodr, .step .stp, .igs .iges)")
     g2.add_argument("-o", "--output", required=True, help="the output document (same kind)")
     g2.add_argument("--max-deviation", type=float, required=True, metavar="D",
-                    help="the largest distance between the input's path and the output's, in the document's unit (G20/G21; OpenDRIVE: m)")  # fmt: skip
+                    help="the largest distance between the input's path and the output's, in the document's unit (G20/G21; OpenDRIVE: m; STEP/IGES: the file's)")  # fmt: skip
     g2.add_argument("--dialect", choices=["linuxcnc", "generic"],
                     help="G-code: linuxcnc (transitions as G5 cubics, exact; default) or generic (biarcs G2/G3: grbl, Klipper)")  # fmt: skip
     g2.add_argument("--units", choices=["mm", "cm", "m", "in", "ft"],

@@ -6,7 +6,8 @@ where the report has ``lines()`` (the short report, one line per path) and ``bel
 below G2: split, or kept as it was for a reason; the command exits 1 on it unless splits are allowed). G-code programs (``.nc .ngc .gcode .tap``) are
 registered here (``spiral_cad.io.gcode_inplace.rewrite_gcode_g2``), and so are DXF drawings
 (``spiral_cad.io.dxf_g2.rewrite_dxf_g2``), LandXML files (``spiral_cad.io.landxml_g2.rewrite_landxml_g2``)
-and OpenDRIVE files (``spiral_cad.io.opendrive_g2.rewrite_opendrive_g2``);
+OpenDRIVE files (``spiral_cad.io.opendrive_g2.rewrite_opendrive_g2``) and the wires of STEP and IGES
+files (``spiral_cad.cad.step_g2.rewrite_step_g2``, ``rewrite_iges_g2``);
 other kinds register with ``register_rewriter``; any other suffix is an error naming it.
 """
 
@@ -25,8 +26,6 @@ Rewriter = Callable[..., Any]
 
 #: Suffix (lower case, with its dot) → the function that makes such a document G2 in place.
 REWRITERS: dict[str, Rewriter] = {}
-#: Kinds of documents announced but not rewritten yet (suffix → what they are).
-NOT_YET = {".step": "STEP wires", ".stp": "STEP wires", ".igs": "IGES wires", ".iges": "IGES wires"}
 
 
 def register_rewriter(suffixes: tuple[str, ...], function: Rewriter) -> None:
@@ -78,10 +77,28 @@ def _opendrive(src: str | os.PathLike, dst: str | os.PathLike, max_deviation: fl
     return rewrite_opendrive_g2(Path(src), Path(dst), max_deviation, **options)
 
 
+def _step(src: str | os.PathLike, dst: str | os.PathLike, max_deviation: float, **options: Any) -> Any:
+    from ..cad.step_g2 import rewrite_step_g2
+
+    _refuse(src, options, "units", "a STEP file states its own unit, and max_deviation is in it")
+    _refuse(src, options, "dialect", "a G-code option")
+    return rewrite_step_g2(src, dst, max_deviation, **options)
+
+
+def _iges(src: str | os.PathLike, dst: str | os.PathLike, max_deviation: float, **options: Any) -> Any:
+    from ..cad.step_g2 import rewrite_iges_g2
+
+    _refuse(src, options, "units", "an IGES file states its own unit, and max_deviation is in it")
+    _refuse(src, options, "dialect", "a G-code option")
+    return rewrite_iges_g2(src, dst, max_deviation, **options)
+
+
 register_rewriter(GCODE_SUFFIXES, _gcode)
 register_rewriter((".dxf",), _dxf)
 register_rewriter((".xml",), _landxml)
 register_rewriter((".xodr",), _opendrive)
+register_rewriter((".step", ".stp"), _step)
+register_rewriter((".igs", ".iges"), _iges)
 
 
 def rewriter_for(path: str | os.PathLike) -> Rewriter:
@@ -94,8 +111,6 @@ def rewriter_for(path: str | os.PathLike) -> Rewriter:
     if suffix in REWRITERS:
         return REWRITERS[suffix]
     known = " ".join(sorted(REWRITERS))
-    if suffix in NOT_YET:
-        raise ValueError(f"{Path(path).name}: {NOT_YET[suffix]} ({suffix}) are not yet made G2 in place; documents that are: {known}")
     raise ValueError(f"{Path(path).name}: no document kind has the suffix {suffix or '(none)'!r}; documents made G2 in place: {known}")
 
 

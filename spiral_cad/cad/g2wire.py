@@ -23,6 +23,7 @@ from OCP.TopoDS import TopoDS, TopoDS_Face, TopoDS_Shape, TopoDS_Wire
 from OCP.TopTools import TopTools_HSequenceOfShape, TopTools_IndexedMapOfShape
 
 from ..core.segments import Segment
+from ..core.units import DEFAULT_UNITS
 from ..design.g2 import G2Path, make_g2, smallest_max_deviation
 from .fillet import _wires, planar_frame, wire_path
 from .occ import chain_wire
@@ -31,9 +32,10 @@ __all__ = ["g2_advice", "g2_face", "g2_wire"]
 
 
 def g2_wire(
-    wire: TopoDS_Wire, max_deviation: float, *, shape: str = "near-linear", frame: gp_Ax3 | None = None
+    wire: TopoDS_Wire, max_deviation: float, *, shape: str = "near-linear", frame: gp_Ax3 | None = None, units: str = DEFAULT_UNITS
 ) -> tuple[TopoDS_Wire, G2Path]:
-    """The wire made G2 within ``max_deviation`` (``make_g2``), and the numeric result.
+    """The wire made G2 within ``max_deviation`` (``make_g2``), and the numeric result (``units``: the wire's length unit,
+    for the result and make_g2's messages).
 
     A wire split at reversals stays one wire: its parts meet there (G0 at the
     split, G2 everywhere else). Cubic Bézier edges (make_g2's own spirals, and a
@@ -48,7 +50,7 @@ def g2_wire(
     """
     frame = planar_frame(wire) if frame is None else frame
     segments, closed = wire_path(wire, frame, spirals=True)  # spirals (BEZIER edges, their B-spline merges) are kept
-    result = make_g2(segments, max_deviation, closed=closed, shape=shape)
+    result = make_g2(segments, max_deviation, closed=closed, shape=shape, units=units)
     pieces: list[Segment] = [s for chain in result.chains for s in chain]
     return chain_wire(pieces, frame), result
 

@@ -130,7 +130,7 @@ def test_cli_writes_the_program_and_reports(tmp_path, capsys):
     assert (tmp_path / "out.ngc").read_text().count("\nG0 ") == 3
 
 
-def test_cli_exits_1_on_a_split_unless_allowed_and_kinds_not_yet(tmp_path, capsys):
+def test_cli_exits_1_on_a_split_unless_allowed_and_unknown_kinds(tmp_path, capsys):
     src = tmp_path / "back.nc"  # a cut that goes straight back along itself: split there, left a corner
     src.write_text("G21\nG0 X0 Y0 Z0\nG1 X10 Y0 F100\nG3 X10 Y10 I0 J5\nG1 X0 Y10\nG1 X10 Y10\nM2\n")
     out = tmp_path / "back_g2.nc"
@@ -138,11 +138,12 @@ def test_cli_exits_1_on_a_split_unless_allowed_and_kinds_not_yet(tmp_path, capsy
     assert "FAIL: 1 left below G2" in capsys.readouterr().out and out.read_text().count("\nG0 ") == 1
     assert main(["g2", str(src), "--max-deviation", "0.01", "-o", str(out), "--allow-splits"]) == 0
     capsys.readouterr()
-    assert main(["g2", str(tmp_path / "part.step"), "--max-deviation", "0.01", "-o", str(tmp_path / "p.step")]) == 2
+    assert main(["g2", str(tmp_path / "part.3mf"), "--max-deviation", "0.01", "-o", str(tmp_path / "p.3mf")]) == 2
     err = capsys.readouterr().err
-    assert err.startswith("error: ") and ".step" in err and "not yet" in err and ".xodr" in err  # .xodr is made G2 in place
-    with pytest.raises(ValueError, match="not yet"):
-        rewriter_for("part.step")
+    assert err.startswith("error: ") and ".3mf" in err and ".step" in err and ".xodr" in err  # the kinds made G2 in place are listed
+    with pytest.raises(ValueError, match="no document kind"):
+        rewriter_for("part.3mf")
+    assert rewriter_for("PART.STP") is rewriter_for("part.step") and rewriter_for("p.igs") is rewriter_for("p.iges")
     with pytest.raises(ValueError, match="is the input"):
         make_document_g2(src, src, 0.01)
     assert main(["g2", str(src), "--max-deviation", "0.01", "-o", str(tmp_path / "no" / "such" / "out.nc")]) == 2
