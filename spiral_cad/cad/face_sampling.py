@@ -252,11 +252,12 @@ class EdgeLine(Line):
         # else each curve in closed form where it can be, point by point where not
         self.batch = [None if frame is None else partial(curve_points, np.array(frame)) for frame in frames]
         floor = floor_points(self.lo, self.hi, samples)
-        breaks = curve_knots(BRep_Tool.Curve_s(edge, 0.0, 0.0)) if BRep_Tool.IsGeometric_s(edge) else []
+        # (a line, circle or ellipse, as ``curve_frame`` found, has no knots)
+        breaks = curve_knots(BRep_Tool.Curve_s(edge, 0.0, 0.0)) if frames[0] is None and BRep_Tool.IsGeometric_s(edge) else []
         grid, own = None, list(breaks)
-        for (domain, oriented), pcurve, on_face in zip(sides, self.pcurves, self.curves_on_faces):
+        for (domain, oriented), pcurve, on_face, frame in zip(sides, self.pcurves, self.curves_on_faces, frames[1:]):
             # where the knot lines of the face's surface cross the edge, in both directions, pcurve or not
-            if pcurve is not None:
+            if pcurve is not None and frame is None:
                 breaks += curve_knots(on_face)
             if not any(domain.surface_knots):
                 continue
