@@ -50,6 +50,7 @@ import numpy as np
 from ..core.chain import Chain
 from ..core.errors import NoSolutionError
 from ..core.segments import Line, Segment
+from .gcode import exponent_word
 from .gcode_paths import _arc
 from .gcode_write import DIALECTS, gcode_program
 from .progress import Progress
@@ -278,6 +279,9 @@ class _Rewriter:
                 if percent == 2:
                     frozen = True
                 continue
+            exponent = exponent_word(line)
+            if exponent is not None:
+                raise ValueError(f"{self.source} line {number}: {exponent}")
             parsed = _parse(line)
             if parsed is None:
                 self.flush()
