@@ -29,6 +29,8 @@ MACHINE = {"CHANGE_TOOL", "SELECT_TOOL", "CHANGE_TOOL_NUMBER", "START_SPINDLE_CL
            "STOP_SPINDLE_TURNING", "SET_SPINDLE_SPEED", "FLOOD_ON", "FLOOD_OFF", "MIST_ON", "MIST_OFF", "DWELL",
            "PROGRAM_STOP", "OPTIONAL_PROGRAM_STOP", "PROGRAM_END", "PALLET_SHUTTLE", "STRAIGHT_PROBE", "USE_TOOL_LENGTH_OFFSET",
            "SET_G5X_OFFSET", "SET_G92_OFFSET", "MESSAGE", "USE_LENGTH_UNITS", "RIGID_TAP"}  # fmt: skip
+#: Runs of rs274 at most when it dies by a signal saying nothing (as spiral_cad.io.rs274 does).
+SIGNAL_RUNS = 5
 PLANE_AXES = {"CANON_PLANE_XY": (0, 1, 2), "CANON_PLANE_XZ": (2, 0, 1), "CANON_PLANE_YZ": (1, 2, 0)}
 
 
@@ -71,12 +73,15 @@ def run(text: str, step: float, folder: str | None = None) -> Run:
         path = os.path.join(tmp, "p.ngc")
         with open(path, "w") as f:
             f.write(program)
-        done = subprocess.run(["rs274", "-g", path, os.path.join(tmp, "out")], cwd=folder or tmp, capture_output=True, text=True,
-                              stdin=subprocess.DEVNULL, timeout=600)  # fmt: skip
-        # (a parameter file it cannot update is said on stderr, and is no refusal of the program)
-        said = [m for m in done.stderr.splitlines() if m.strip() and m.strip() != "executing" and "variable file" not in m]
+        for _ in range(SIGNAL_RUNS):  # LinuxCNC's rs274 now and then dies by a signal saying nothing: run it again
+            done = subprocess.run(["rs274", "-g", path, os.path.join(tmp, "out")], cwd=folder or tmp, capture_output=True, text=True,
+                                  stdin=subprocess.DEVNULL, timeout=600)  # fmt: skip
+            # (a parameter file it cannot update is said on stderr, and is no refusal of the program)
+            said = [m for m in done.stderr.splitlines() if m.strip() and m.strip() != "executing" and "variable file" not in m]
+            if not (done.returncode < 0 and not said):
+                break
         if done.returncode or said:
-            raise RuntimeError(f"rs274 refused it: {' / '.join(said[:2])}")
+            raise RuntimeError(f"rs274 refused it: {' / '.join(said[:2]) or f'exit status {done.returncode}'}")
         with open(os.path.join(tmp, "out")) as f:
             calls = f.read().splitlines()
     result = Run()
