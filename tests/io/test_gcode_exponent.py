@@ -32,7 +32,9 @@ def test_both_readers_refuse_an_exponent_by_line_and_word(cut, word, meant):
     text = _program(cut)
     for read in (lambda: gcode_g2(text, 0.01, source="plate.nc"), lambda: parse_gcode(text, "plate.nc"),
                  lambda: parse_gcode_chain(text, "plate.nc")):  # fmt: skip
-        with pytest.raises(ValueError, match=rf"plate\.nc line 4: {word.replace('.', '[.]').replace('+', '[+]')} is a number with an exponent") as info:
+        with pytest.raises(
+            ValueError, match=rf"plate\.nc line 4: {word.replace('.', '[.]').replace('+', '[+]')} is a number with an exponent"
+        ) as info:
             read()
         assert f"write {meant}" in str(info.value)
 
