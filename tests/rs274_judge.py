@@ -4,7 +4,7 @@
 machine would do: the rapid moves (same, in the same order, as rs274 prints them), the tool, spindle,
 coolant, dwell, stop and probe calls (same, in order), the feed rates of the feed moves (the output's
 among the input's), and the cutting path (every feed move, sampled): every sample of each within
-``bound`` of the other's path (plus the sampling step). rs274 prints no control points for a ``G5``
+``bound`` of the other's path (plus the sampling step and rs274's printing, ``PRINTED``). rs274 prints no control points for a ``G5``
 cubic (``NURBS_FEED(4, ...)``), so a ``G5`` is sampled from the program's own words (each line is given
 its line number as N word, which rs274 prints with each call; absolute ``G90`` and ``G17`` assumed).
 """
@@ -29,6 +29,9 @@ MACHINE = {"CHANGE_TOOL", "SELECT_TOOL", "CHANGE_TOOL_NUMBER", "START_SPINDLE_CL
            "STOP_SPINDLE_TURNING", "SET_SPINDLE_SPEED", "FLOOD_ON", "FLOOD_OFF", "MIST_ON", "MIST_OFF", "DWELL",
            "PROGRAM_STOP", "OPTIONAL_PROGRAM_STOP", "PROGRAM_END", "PALLET_SHUTTLE", "STRAIGHT_PROBE", "USE_TOOL_LENGTH_OFFSET",
            "SET_G5X_OFFSET", "SET_G92_OFFSET", "MESSAGE", "USE_LENGTH_UNITS", "RIGID_TAP"}  # fmt: skip
+#: What rs274's printing (4 decimals in the program's unit: 0.1 µm in mm, 2.5 µm in inch) may put between two points
+#: of the same place, one printed from each program: each rounded by half a unit in up to 3 coordinates.
+PRINTED = 2.0 * math.sqrt(3.0) * 0.5e-4
 #: Runs of rs274 at most when it dies by a signal saying nothing (as spiral_cad.io.rs274 does).
 SIGNAL_RUNS = 5
 PLANE_AXES = {"CANON_PLANE_XY": (0, 1, 2), "CANON_PLANE_XZ": (2, 0, 1), "CANON_PLANE_YZ": (1, 2, 0)}
@@ -232,7 +235,7 @@ def judge(input_text: str, output_text: str, bound: float, folder: str | None = 
         far = 4.0 * bound  # nearer than this is measured; farther is reported as infinite (a fast query)
         distance = max(float(cKDTree(pb).query(pa, distance_upper_bound=far)[0].max()),
                        float(cKDTree(pa).query(pb, distance_upper_bound=far)[0].max()))  # fmt: skip
-        if distance > bound + step:
+        if distance > bound + step + PRINTED:
             reasons.append(f"cutting paths {distance:.4g} apart, beyond {bound:g}")
     elif bool(a.samples) != bool(b.samples):
         reasons.append("one program cuts, the other does not")
