@@ -91,11 +91,16 @@ def run(text: str, step: float, folder: str | None = None) -> Run:
     position = np.zeros(3)
     plane = PLANE_AXES["CANON_PLANE_XY"]
     feed = math.nan
+    written: dict[str, float] = {}  # the X, Y, Z words last written on a move's line (G90 assumed), to the digit
     for raw in calls:
         m = CALL.match(raw)
         if not m:
             continue
         number, name, args = m.group(1), m.group(2), m.group(3)
+        before = dict(written)
+        if name in ("STRAIGHT_TRAVERSE", "STRAIGHT_FEED", "ARC_FEED") and number:
+            code = re.sub(r"\([^)]*\)|;.*", "", lines[int(number) - 1])
+            written.update({k.upper(): float(x.replace(" ", "")) for k, x in WORD.findall(code) if k.upper() in "XYZ"})
         if name == "STRAIGHT_TRAVERSE":
             result.rapids.append(args)
             position = np.array([float(v) for v in args.split(",")[:3]])
@@ -116,7 +121,13 @@ def run(text: str, step: float, folder: str | None = None) -> Run:
             a0 = math.atan2(position[second] - cy, position[first] - cx)
             a1 = math.atan2(end[second] - cy, end[first] - cx)
             sweep = a1 - a0
-            if rotation > 0:
+            names = "XYZ"[first] + "XYZ"[second]
+            if (abs(rotation) == 1 and np.abs(end[[first, second]] - position[[first, second]]).max() <= 1.5e-4
+                    and all(k in before and k in written for k in names)
+                    and max(abs(written[k] - before[k]) for k in names) > 1e-12):  # fmt: skip
+                # printed ends equal to rs274's 4 decimals, written ends not: an arc shorter than the printing, no full turn
+                sweep = math.copysign(abs(math.remainder(sweep, 2 * math.pi)), rotation)
+            elif rotation > 0:
                 sweep = (sweep if sweep > 0 else sweep + 2 * math.pi) + 2 * math.pi * (rotation - 1)
             else:
                 sweep = (sweep if sweep < 0 else sweep - 2 * math.pi) - 2 * math.pi * (-rotation - 1)

@@ -39,3 +39,17 @@ def test_an_inch_slot_comes_back_within_the_bound_by_rs274():
     assert verdict.passed, verdict.reasons
     # the judge sees the paths through rs274's 4 printed decimals: never farther apart than the bound and that printing
     assert verdict.distance <= 0.0005 + 0.0005 / 20 + rs274_judge.PRINTED
+
+
+def _arcs(tail: str) -> str:
+    return f"G20 G90 G17 G94\nG0 X0 Y1 Z0.1\nG1 Z-0.1 F10\nG1 X1 Y1 F20\n{tail}G1 X2 Y1\nG0 Z0.1\nM2\n"
+
+
+@pytest.mark.skipif(not rs274_judge.available(), reason="LinuxCNC's rs274 is not installed")
+def test_the_judge_reads_an_arc_shorter_than_the_printing_as_short_and_a_full_circle_as_full():
+    """rs274 prints 4 decimals: an arc of 0.00005 in prints with its end on its start, as a full circle does; the judge
+    tells them apart by the line's own words (biarcs for grbl hold such arcs)."""
+    tiny = _arcs("G3 X0.99995 Y0.9999999988 I0 J-1\nG1 X1 Y1\n")
+    assert rs274_judge.judge(tiny, _arcs(""), 0.0005).passed
+    full = _arcs("G3 X1 Y1 I0 J-1\n")
+    assert not rs274_judge.judge(full, _arcs(""), 0.0005).passed  # a whole turn of radius 1 is no short arc
