@@ -4,7 +4,7 @@
 machine would do: the rapid moves (same, in the same order, as rs274 prints them), the tool, spindle,
 coolant, dwell, stop and probe calls (same, in order), the feed rates of the feed moves (the output's
 among the input's), and the cutting path (every feed move, sampled): every sample of each within
-``bound`` of the other's path (plus the sampling step). rs274 prints no control points for a ``G5``
+``bound`` of the other's path (plus the sampling step and rs274's printing, ``PRINTED``). rs274 prints no control points for a ``G5``
 cubic (``NURBS_FEED(4, ...)``), so a ``G5`` is sampled from the program's own words (each line is given
 its line number as N word, which rs274 prints with each call; absolute ``G90`` and ``G17`` assumed).
 """
@@ -29,6 +29,11 @@ MACHINE = {"CHANGE_TOOL", "SELECT_TOOL", "CHANGE_TOOL_NUMBER", "START_SPINDLE_CL
            "STOP_SPINDLE_TURNING", "SET_SPINDLE_SPEED", "FLOOD_ON", "FLOOD_OFF", "MIST_ON", "MIST_OFF", "DWELL",
            "PROGRAM_STOP", "OPTIONAL_PROGRAM_STOP", "PROGRAM_END", "PALLET_SHUTTLE", "STRAIGHT_PROBE", "USE_TOOL_LENGTH_OFFSET",
            "SET_G5X_OFFSET", "SET_G92_OFFSET", "MESSAGE", "USE_LENGTH_UNITS", "RIGID_TAP"}  # fmt: skip
+#: What rs274's printing (4 decimals in the program's unit: 0.1 µm in mm, 2.5 µm in inch) may put between two points
+#: of the same place, one printed from each program: each rounded by half a unit in up to 3 coordinates.
+PRINTED = 2.0 * math.sqrt(3.0) * 0.5e-4
+#: Runs of rs274 at most when it dies by a signal saying nothing (as spiral_cad.io.rs274 does).
+SIGNAL_RUNS = 5
 PLANE_AXES = {"CANON_PLANE_XY": (0, 1, 2), "CANON_PLANE_XZ": (2, 0, 1), "CANON_PLANE_YZ": (1, 2, 0)}
 
 
@@ -71,23 +76,31 @@ def run(text: str, step: float, folder: str | None = None) -> Run:
         path = os.path.join(tmp, "p.ngc")
         with open(path, "w") as f:
             f.write(program)
-        done = subprocess.run(["rs274", "-g", path, os.path.join(tmp, "out")], cwd=folder or tmp, capture_output=True, text=True,
-                              stdin=subprocess.DEVNULL, timeout=600)  # fmt: skip
-        # (a parameter file it cannot update is said on stderr, and is no refusal of the program)
-        said = [m for m in done.stderr.splitlines() if m.strip() and m.strip() != "executing" and "variable file" not in m]
+        for _ in range(SIGNAL_RUNS):  # LinuxCNC's rs274 now and then dies by a signal saying nothing: run it again
+            done = subprocess.run(["rs274", "-g", path, os.path.join(tmp, "out")], cwd=folder or tmp, capture_output=True, text=True,
+                                  stdin=subprocess.DEVNULL, timeout=600)  # fmt: skip
+            # (a parameter file it cannot update is said on stderr, and is no refusal of the program)
+            said = [m for m in done.stderr.splitlines() if m.strip() and m.strip() != "executing" and "variable file" not in m]
+            if not (done.returncode < 0 and not said):
+                break
         if done.returncode or said:
-            raise RuntimeError(f"rs274 refused it: {' / '.join(said[:2])}")
+            raise RuntimeError(f"rs274 refused it: {' / '.join(said[:2]) or f'exit status {done.returncode}'}")
         with open(os.path.join(tmp, "out")) as f:
             calls = f.read().splitlines()
     result = Run()
     position = np.zeros(3)
     plane = PLANE_AXES["CANON_PLANE_XY"]
     feed = math.nan
+    written: dict[str, float] = {}  # the X, Y, Z words last written on a move's line (G90 assumed), to the digit
     for raw in calls:
         m = CALL.match(raw)
         if not m:
             continue
         number, name, args = m.group(1), m.group(2), m.group(3)
+        before = dict(written)
+        if name in ("STRAIGHT_TRAVERSE", "STRAIGHT_FEED", "ARC_FEED") and number:
+            code = re.sub(r"\([^)]*\)|;.*", "", lines[int(number) - 1])
+            written.update({k.upper(): float(x.replace(" ", "")) for k, x in WORD.findall(code) if k.upper() in "XYZ"})
         if name == "STRAIGHT_TRAVERSE":
             result.rapids.append(args)
             position = np.array([float(v) for v in args.split(",")[:3]])
@@ -108,7 +121,13 @@ def run(text: str, step: float, folder: str | None = None) -> Run:
             a0 = math.atan2(position[second] - cy, position[first] - cx)
             a1 = math.atan2(end[second] - cy, end[first] - cx)
             sweep = a1 - a0
-            if rotation > 0:
+            names = "XYZ"[first] + "XYZ"[second]
+            if (abs(rotation) == 1 and np.abs(end[[first, second]] - position[[first, second]]).max() <= 1.5e-4
+                    and all(k in before and k in written for k in names)
+                    and max(abs(written[k] - before[k]) for k in names) > 1e-12):  # fmt: skip
+                # printed ends equal to rs274's 4 decimals, written ends not: an arc shorter than the printing, no full turn
+                sweep = math.copysign(abs(math.remainder(sweep, 2 * math.pi)), rotation)
+            elif rotation > 0:
                 sweep = (sweep if sweep > 0 else sweep + 2 * math.pi) + 2 * math.pi * (rotation - 1)
             else:
                 sweep = (sweep if sweep < 0 else sweep - 2 * math.pi) - 2 * math.pi * (-rotation - 1)
@@ -227,7 +246,7 @@ def judge(input_text: str, output_text: str, bound: float, folder: str | None = 
         far = 4.0 * bound  # nearer than this is measured; farther is reported as infinite (a fast query)
         distance = max(float(cKDTree(pb).query(pa, distance_upper_bound=far)[0].max()),
                        float(cKDTree(pa).query(pb, distance_upper_bound=far)[0].max()))  # fmt: skip
-        if distance > bound + step:
+        if distance > bound + step + PRINTED:
             reasons.append(f"cutting paths {distance:.4g} apart, beyond {bound:g}")
     elif bool(a.samples) != bool(b.samples):
         reasons.append("one program cuts, the other does not")

@@ -147,6 +147,30 @@ _CONTROL = re.compile("[\x00-\x08\x0b-\x1f\x7f-\x9f\u2028\u2029]")
 _CODE = re.compile(r"[0-9]{1,4}(?:\.[0-9]?0*)?")
 #: A whole comment, or a parenthesis or semicolon that starts or ends none.
 _COMMENT = re.compile(r"\([^()]*\)|[;()]")
+#: A number written with an exponent (``X1e3``, ``Y.5E-2``): G-code numbers have none.
+_EXPONENT = re.compile(r"([A-Za-z])\s*([+-]?\s*(?:\d+\.?\d*|\.\d+))([eE]\s*[+-]?\s*\d+)", re.ASCII)
+
+
+def exponent_word(text: str) -> str | None:
+    """Why a line of G-code is refused for a number written with an exponent (comments aside); None when it has none.
+
+    LinuxCNC reads ``X1e3`` as ``X1`` and a word ``E3`` (and refuses the E word), a printer as ``X1`` and an
+    extrusion ``E3``: read as 1000 it would be a path neither machine cuts, read as 1 a silent misreading.
+
+    Args:
+        text: one line of a program.
+    """
+    if "e" not in text and "E" not in text:
+        return None
+    match = _EXPONENT.search(_COMMENTS.sub(" ", text))
+    if match is None:
+        return None
+    letter, number, exponent = match.group(1), match.group(2).replace(" ", ""), match.group(3).replace(" ", "")
+    value = float(number + exponent)
+    shown = f"{value:.10f}".rstrip("0").rstrip(".") if math.isfinite(value) and abs(value) < 1e15 else None
+    return (f"{letter}{number}{exponent} is a number with an exponent, which G-code numbers do not have "
+            f"(LinuxCNC reads it as {letter.upper()}{number} and a word {exponent.upper()}, a printer as an extrusion)"
+            + (f"; write {letter.upper()}{shown}" if shown else ""))  # fmt: skip
 
 
 class _Reader:
@@ -205,6 +229,9 @@ class _Reader:
             kept.append(" ")
         kept.append(text[at:])
         text = "".join(kept)
+        exponent = exponent_word(text)
+        if exponent is not None:
+            raise self.error(number, exponent)
         found: list[tuple[str, float, str]] = []
         at = 0
         stripped = text.rstrip()

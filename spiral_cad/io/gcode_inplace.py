@@ -50,6 +50,7 @@ import numpy as np
 from ..core.chain import Chain
 from ..core.errors import NoSolutionError
 from ..core.segments import Line, Segment
+from .gcode import exponent_word
 from .gcode_paths import _arc
 from .gcode_write import DIALECTS, gcode_program
 from .progress import Progress
@@ -254,6 +255,7 @@ class _Rewriter:
         self.emitted_feed: float = math.nan
         self.first_unit: str | None = units
         self.rotary: list[int] = []  # lines where a rotary axis moves
+        self.unitless: list[int] = []  # feed moves in XY read before any G20/G21 (their unit unknown: kept as they are)
         self.last_control: tuple[float, float] | None = None  # the last control point of a NURBS block being read
         self.block: _Block | None = None  # the NURBS block being read
         self.started = self.deadline = 0.0  # when the run being written started, and its splits' deadline
@@ -278,6 +280,9 @@ class _Rewriter:
                 if percent == 2:
                     frozen = True
                 continue
+            exponent = exponent_word(line)
+            if exponent is not None:
+                raise ValueError(f"{self.source} line {number}: {exponent}")
             parsed = _parse(line)
             if parsed is None:
                 self.flush()
@@ -306,6 +311,9 @@ class _Rewriter:
         self.flush()
         self.drop_block()
         progress.done(len(self.raw))
+        if self.unitless:
+            self.notes.append(f"{len(self.unitless)} feed move(s) before any G20 or G21 (first on line {self.unitless[0]}) kept as they "
+                              "are: the program does not say its unit; give units ('mm' or 'in'; --units) to make them G2")  # fmt: skip
         if self.rotary:
             shown = ", ".join(map(str, self.rotary[:5])) + (", …" if len(self.rotary) > 5 else "")
             self.notes.append(f"{len(self.rotary)} line(s) where a rotary axis moves, as they are (line {shown})")
@@ -393,6 +401,8 @@ class _Rewriter:
         if any(letter in _ROTARY for letter in axes):
             self.rotary.append(number)
             return None
+        if s.units is None and s.motion in (10, 20, 30) and s.plane == 170:
+            self.unitless.append(number)
         if not cutting:
             return None
         a = (float(start[0]), float(start[1]))  # type: ignore[arg-type]

@@ -50,7 +50,7 @@ def test_arcs_are_refused_by_name_with_their_line():
         ("G21 G1 X1\nG20\nX2\n", r"line 2: G20 changes the unit after the first move"),
         ("G21\nG0 G1 X1\n", r"line 2: G0 and G1 are both in modal group 1 \(motion\)"),
         ("G21\nG1 X1 X2\n", r"line 2: X is given twice"),
-        ("G21\nG1 X1e3\n", r"line 2: the word E3"),
+        ("G21\nG1 X1e3\n", r"line 2: X1e3 is a number with an exponent"),
         ("G21\nG1 X--1\n", r"line 2: 'X--1' is not a G-code word"),
         ("G21\nG1 X" + "9" * 400 + "\n", r"line 2: X9+… is not a finite number"),
         ("G21\nG1 X1 (open comment\n", r"line 2: a comment is not closed"),
