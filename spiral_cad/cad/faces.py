@@ -129,10 +129,15 @@ def _shapes(shapes: TopTools_ListOfShape) -> list[TopoDS_Shape]:
     return found
 
 
-def _free_edges(shape: TopoDS_Shape) -> list[TopoDS_Edge]:
-    """The edges of ``shape`` that bound one face only and are not its seam (degenerate edges left out)."""
+def _edge_faces(shape: TopoDS_Shape) -> TopTools_IndexedDataMapOfShapeListOfShape:
+    """Each edge of ``shape`` with the faces it bounds."""
     ancestors = TopTools_IndexedDataMapOfShapeListOfShape()
     TopExp.MapShapesAndAncestors_s(shape, TopAbs_EDGE, TopAbs_FACE, ancestors)
+    return ancestors
+
+
+def _free_edges(ancestors: TopTools_IndexedDataMapOfShapeListOfShape) -> list[TopoDS_Edge]:
+    """The edges (of ``_edge_faces``) that bound one face only and are not its seam (degenerate edges left out)."""
     free = []
     for i in range(1, ancestors.Extent() + 1):
         edge = TopoDS.Edge_s(ancestors.FindKey(i))
@@ -144,12 +149,12 @@ def _free_edges(shape: TopoDS_Shape) -> list[TopoDS_Edge]:
     return free
 
 
-def _sewn(shape: TopoDS_Shape, size: float) -> tuple[TopoDS_Shape, int]:
+def _sewn(shape: TopoDS_Shape, size: float, ancestors: TopTools_IndexedDataMapOfShapeListOfShape) -> tuple[TopoDS_Shape, int]:
     """``shape`` with its coinciding free edges sewn (``SEW_TOL`` × ``size``), and how many edges were
-    stitched; ``shape`` itself when it has no free edges or none could be joined."""
+    stitched; ``shape`` itself when it has no free edges (``ancestors``: its ``_edge_faces``) or none could be joined."""
     from OCP.BRepBuilderAPI import BRepBuilderAPI_Sewing
 
-    if size <= 0.0 or not _free_edges(shape):
+    if size <= 0.0 or not _free_edges(ancestors):
         return shape, 0
     sewing = BRepBuilderAPI_Sewing(SEW_TOL * size)
     sewing.SetNonManifoldMode(True)  # an edge where three faces meet is sewn to all three
@@ -180,13 +185,14 @@ def _measure(shape: TopoDS_Shape, stated: float = 0.0, *, samples: int, gap_tol:
     box = Bnd_Box()
     BRepBndLib.Add_s(shape, box, False)
     size = 0.0 if box.IsVoid() else math.sqrt(box.SquareExtent())
-    shape, stitched = _sewn(shape, size)
+    ancestors = _edge_faces(shape)
+    shape, stitched = _sewn(shape, size, ancestors)
+    if stitched:
+        ancestors = _edge_faces(shape)
     faces = TopTools_IndexedMapOfShape()
     TopExp.MapShapes_s(shape, TopAbs_FACE, faces)
     edges = TopTools_IndexedMapOfShape()
     TopExp.MapShapes_s(shape, TopAbs_EDGE, edges)
-    ancestors = TopTools_IndexedDataMapOfShapeListOfShape()
-    TopExp.MapShapesAndAncestors_s(shape, TopAbs_EDGE, TopAbs_FACE, ancestors)
     domains: dict[int, FaceDomain] = {}
     uses: dict[int, dict[int, set[Any]]] = {}
     kinds: list[str] = []

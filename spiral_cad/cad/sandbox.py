@@ -17,6 +17,7 @@ task runs in the calling process.
 from __future__ import annotations
 
 import faulthandler
+import gc
 import marshal
 import math
 import os
@@ -207,6 +208,9 @@ def _child(task: Callable[..., Any], args: tuple, fd: int, memory: int, parent: 
         os.dup2(devnull, 1)
         os.dup2(devnull, 2)
         sys.stdout = sys.stderr = open(devnull, "w", closefd=False)
+        # what the parent made is never garbage here: the collector leaves it alone (no full passes over the
+        # imported modules while a big part is read and measured, and their pages stay shared with the parent)
+        gc.freeze()
         try:
             result: tuple[str, Any] = ("ok", task(*args))
         except ValueError as error:
