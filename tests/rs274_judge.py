@@ -52,16 +52,20 @@ class Run:
     feed_moves: int = 0
 
 
+#: A line's own N word.
+LABEL = re.compile(r"^[Nn]\s*\d+\s*")
+
+
 def numbered(text: str) -> tuple[str, list[str]]:
     lines = text.replace("\r\n", "\n").split("\n")
     out = []
     for k, line in enumerate(lines, 1):
         head = line.lstrip(" \t/")
-        if not head or head[0] in "%Oo" or re.match(r"\s*/?\s*[Nn]\s*\d", line):
+        if not head or head[0] in "%Oo":
             out.append(line)
-        else:
+        else:  # a line's own N word (a label the interpreter ignores) is replaced: rs274 prints the N number
             slash = line[: len(line) - len(head)]
-            out.append(f"{slash}N{k} {head}")
+            out.append(f"{slash}N{k} {LABEL.sub('', head)}")
     return "\n".join(out), lines
 
 
