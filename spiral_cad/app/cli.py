@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import logging
 import math
 import os
 import re
@@ -800,8 +801,10 @@ def main(argv: Sequence[str] | None = None) -> int:
     Every error is printed as one ``error: …`` line on stderr, never as a
     traceback; Ctrl-C at any moment gives ``error: interrupted`` and 130, SIGTERM
     ``error: terminated`` and 143 (nothing committed after the signal);
-    Python warnings are not shown (what matters is an error or in the report).
+    Python warnings and libraries' log messages are not shown (what matters is an error or in the report:
+    ezdxf's "non-unique entity handle" is in the report as its audit's finding).
     """
+    logging.getLogger("ezdxf").setLevel(logging.CRITICAL)
     escaping_streams()  # a file name of any bytes is printed, escaped, never an encoding error
     with signals_handled(("SIGINT", "SIGTERM"), interrupt=True) as interrupted, warnings.catch_warnings():
         warnings.simplefilter("ignore")

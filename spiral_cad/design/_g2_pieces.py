@@ -200,10 +200,11 @@ def _lens_fits(a: _Piece, b: _Piece) -> bool:
 
 
 def _classify(a: _Piece, b: _Piece, scale: float, steepest: float, bound: float, shape: int = K.NEAR_LINEAR,
-              c_pair: bool = True, loose: bool = True) -> str:  # fmt: skip
+              c_pair: bool = True, loose: bool = True, near: bool = True) -> str:  # fmt: skip
     """The joint from piece ``a`` to ``b``: ``g2``, ``line-arc``, ``arc-arc-…`` (``arc-arc-c``: a C pair between
     crossing circles of the same sense, unless not ``c_pair``), ``corner`` or ``split``; arcs of one circle to a
-    share of the bound are ``g2`` (merged) when ``loose``, else only to float64's resolution."""
+    share of the bound are ``g2`` (merged) when ``loose``, else only to float64's resolution; a small kink is
+    made G2 as a tangent joint when ``near`` (``_near_tangent``), else rounded as the corner it is."""
     turn = _turn(a, b)
     if abs(turn) > steepest:
         return "split"
@@ -219,7 +220,7 @@ def _classify(a: _Piece, b: _Piece, scale: float, steepest: float, bound: float,
     if (a.kind == "arc" and b.kind == "arc" and (a.r > 0) == (b.r > 0) and turn * a.sense < 0.0 and abs(turn) <= NEAR_MAX and c_pair
             and _c_pair(a, b, turn)):  # fmt: skip
         return "arc-arc-c"  # a small kink against both arcs: the C pair lies at the joint, whatever the bound
-    if not _near_tangent(a, b, turn, bound):
+    if not (_near_tangent(a, b, turn, bound) if near else abs(turn) <= TANGENT_TOL):
         return "corner"
     if a.kind == "arc" and b.kind == "arc":
         if (a.r > 0) != (b.r > 0):
@@ -246,6 +247,28 @@ NEAR_MAX = 0.02
 
 #: ... when the circles beside it overlap by at most this share of the bound.
 NEAR_SHARE = 0.1
+
+
+#: An arc whose chord lies within this share of the bound of it may be made a line where a joint beside it has a
+#: kink that its sweep leaves no room to absorb (a CAM program's short arc): its joints become corners.
+CHORD_SHARE = 0.25
+
+
+def _sagitta(piece: _Piece) -> float:
+    """How far an arc lies from its chord (the farthest point of the arc from the segment between its ends)."""
+    return abs(piece.r) * (1.0 - math.cos(0.5 * piece.sweep))
+
+
+def _flat_arcs(pieces: list[_Piece], kinds: list[str], bound: float) -> frozenset[int]:
+    """The arcs beside a joint with a kink (not tangent, not a split) that lie within ``CHORD_SHARE`` of
+    ``bound`` of their chords."""
+    n = len(pieces)
+    flat: set[int] = set()
+    for j, kind in enumerate(kinds):
+        a, b = pieces[j], pieces[(j + 1) % n]
+        if kind not in ("g2", "split") and abs(_turn(a, b)) > TANGENT_TOL:
+            flat.update(k for k in (j, (j + 1) % n) if pieces[k].kind == "arc" and _sagitta(pieces[k]) <= CHORD_SHARE * bound)
+    return frozenset(flat)
 
 
 #: A kinked compound joint is made G2 as tangent when its circles touch to this share of the nested band.

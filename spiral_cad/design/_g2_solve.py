@@ -18,6 +18,7 @@ from ._g2_pieces import (
     ALONE,
     EPS,
     SHARED,
+    TANGENT_TOL,
     _c_window,
     _Piece,
     _Refusal,
@@ -52,6 +53,11 @@ C_ROOM = 0.8
 
 #: An arc that shifts only to follow its neighbours across C pairs shrinks by at most this share of its radius.
 C_FOLLOW = 0.02
+
+
+#: A kinked line → arc joint's spiral lands at least this far (radians) past where the arc's tangent is the
+#: line's and past the arc's start (its circle then lies clear of the line by a margin float64 resolves).
+LANDING_MARGIN = 1e-5
 
 
 #: Passes of shrinking the shifts that overrun a line or an arc before a joint is refused.
@@ -114,6 +120,7 @@ class _Group:
         self.target = target
         self.cap = [min(target - p.spent, (C_FOLLOW if follow else q_max) * abs(p.r)) if need else 0.0
                     for p, need, follow in zip(pieces, self.needs_shift, following)]  # fmt: skip
+        self.floor = self._floors(code)
         self.factor = [1.0] * n
         self._corners: dict[int, _Solved] = {}
         #: Short lines left out between two arcs (by joint): (the line, the input joint after it).
@@ -145,7 +152,27 @@ class _Group:
                             s[small] = min(s[small], s[big] + x + 0.9 * y)
                 if s == before:
                     break
-        return [max(v, 0.0) for v in s]
+        return [max(v, 0.0, f) for v, f in zip(s, self.floor)]
+
+    def _floors(self, code: int) -> list[float]:
+        """Each arc's least shrink: where a line meets it with a small kink (``line-arc``, a near-tangent joint),
+        its circle crosses the line or is tangent to it before the arc starts, so the spiral needs the circle
+        shrunk at least until it lands on the arc itself (Theorem 4.1: the centre lies r·g1(θ) off the line);
+        shrinking the shifts to fit the room must not pass below that."""
+        n = len(self.pieces)
+        floor = [0.0] * n
+        for j in range(self.joint_count):
+            a, b = self.pieces[j], self.pieces[(j + 1) % n]
+            if self.kinds[j] != "line-arc" or not abs(turn := _turn(a, b)) > TANGENT_TOL:
+                continue
+            k, line = (j + 1) % n if a.kind == "line" else j, a if a.kind == "line" else b
+            arc = self.pieces[k]
+            kink = turn * arc.sense  # > 0: the arc starts turned past the line's direction (reversing keeps the sign)
+            ux, uy = line.direction()
+            offset = abs(ux * (arc.c[1] - line.a[1]) - uy * (arc.c[0] - line.a[0]))  # the centre off the line
+            theta = max(kink, 0.0) + LANDING_MARGIN
+            floor[k] = max(floor[k], abs(arc.r) - offset / K.shape_g1(code, math.sin(theta), math.cos(theta)))
+        return floor
 
     def _pairs(self) -> list[tuple[int, int, int, float, float]]:
         """(joint, small, big, how far the circles cross, band width) of every compound joint, smaller circles first."""
@@ -284,11 +311,13 @@ def _coordinate_size(pieces: list[_Piece]) -> float:
 def _solve(group: _Group) -> tuple[list[_Solved | None], list[float]]:
     """The shifts and transitions of a group: shifts that overrun a piece shrink until every joint fits."""
     n = len(group.pieces)
+    tightest = (1.0, 0)  # the joint whose transitions overran their room most in the last pass, and by how much
     for _ in range(PASSES):
         s = group.shifts()
         solved = group.solve_joints(s)
         over: dict[int, float] = {}
         failed: list[int] = []
+        tightest = (1.0, 0)
         for j, joint in enumerate(solved):
             if joint is None:
                 continue
@@ -302,6 +331,7 @@ def _solve(group: _Group) -> tuple[list[_Solved | None], list[float]]:
                 if not (used <= room):
                     worst = min(worst, (room / used) ** 2 * 0.8 if used > 0.0 and room > 0.0 else 0.25)
             if worst < 1.0:
+                tightest = min(tightest, (worst, j))
                 if group.kinds[j] == "arc-arc-c":  # a C pair's use hardly depends on the shifts: nothing to shrink
                     raise _Refusal(j, "its C spiral pair between the crossing circles needs more of the arcs than they have", False,
                                    False)  # fmt: skip
@@ -326,7 +356,7 @@ def _solve(group: _Group) -> tuple[list[_Solved | None], list[float]]:
     for j, joint in enumerate(solved):
         if joint is not None and joint.status:
             raise _Refusal(j, joint.reason or describe_status(joint.status), True)
-    raise _Refusal(0, "the transitions could not be fitted into the lines and arcs", True)
+    raise _Refusal(tightest[1], "its transitions could not be fitted into the lines and arcs beside it", True)
 
 
 def _c_unfit(pieces: list[_Piece], kinds: list[str], shape: str) -> list[int]:

@@ -59,12 +59,14 @@ from ._g2_pieces import (
     TANGENT_TOL,
     _circle_offset,
     _classify,
+    _flat_arcs,
     _merge,
     _merge_error,
     _Piece,
     _piece_ends,
     _piece_of,
     _Refusal,
+    _sagitta,
     _shown_point,
     _Solved,
     _turn,
@@ -295,6 +297,7 @@ def make_g2(
     shape: str = "near-linear",
     units: str = DEFAULT_UNITS,
     tolerance: float = JOIN_TOLERANCE,
+    advise: bool = True,
 ) -> G2Path:
     """Make a path of lines and tangent arcs G2 within ``max_deviation``, keeping its arcs true arcs.
 
@@ -318,7 +321,9 @@ def make_g2(
             kept as they are when their joints are G2: ``make_g2`` of its own
             result changes nothing. Near-tangent joints (kinks whose circles
             overlap by at most a tenth of the bound) are made G2 as tangent
-            ones; arcs of one circle (to a quarter of the bound) are merged.
+            ones; arcs of one circle (to a quarter of the bound) are merged. An arc too short
+            for transitions that absorb a kinked joint beside it, lying within a quarter of the bound
+            of its chord (a CAM program's short arc), is cut as its chord, its joints rounded as corners.
         max_deviation: the Hausdorff bound: every point of the result lies
             within it of the input and every input point within it of the result.
         closed: whether the path closes (its closing joint is then treated like
@@ -327,6 +332,8 @@ def make_g2(
             length) or ``"walton-meek"``.
         units: the length unit (default mm).
         tolerance: the chains' relative join tolerance.
+        advise: whether a refusal searches for a bound that works (up to ``ADVICE_SECONDS``); False for a
+            caller that only needs the joint refused and its reason (it splits there and goes on).
 
     Returns:
         A :class:`G2Path`: the chains, the measured deviation and what was done at every joint.
@@ -346,7 +353,8 @@ def make_g2(
     with _collector_paused():
         result = _build(segments, bound, closed, shape, units, tolerance)
         if isinstance(result, _Refusal):
-            message = _refusal_message(result, segments, bound, closed, shape, units, tolerance, started + ADVICE_SECONDS)
+            deadline = started + ADVICE_SECONDS if advise else -math.inf
+            message = _refusal_message(result, segments, bound, closed, shape, units, tolerance, deadline)
     if isinstance(result, _Refusal):
         raise NoSolutionError(message) from None
     if frame is not None:
@@ -422,6 +430,8 @@ def _refusal_message(refusal: _Refusal, segments: list[Segment], bound: float, c
     message = f"{where}: cannot be made G2 within max_deviation {bound:.6g} {units}: {refusal.reason}"
     if not refusal.larger_helps:
         return message + "; no larger max_deviation helps"
+    if deadline == -math.inf:
+        return message + "; a larger max_deviation may help"
     works = _advice(segments, refusal.joint, bound, closed, shape, units, tolerance, deadline)
     if works is None:
         return message + "; no max_deviation up to the path's size helps"
@@ -514,7 +524,7 @@ def _build(segments: list[Segment], bound: float, closed: bool | None, shape: st
 
 def _make(segments: list[Segment], bound: float, closed: bool | None, shape: str, units: str, tolerance: float,
           retry: bool = True, round_sharp: bool = True, no_c: frozenset[int] = frozenset(), retried: int = 0,
-          loose: bool = True) -> G2Path | _Refusal:  # fmt: skip
+          loose: bool = True, chorded: frozenset[int] = frozenset(), near: bool = True) -> G2Path | _Refusal:  # fmt: skip
     """``make_g2`` of plane lines and arcs, or the refusal of its first joint that fails (``retry``: a part
     refused within the bound tried again within smaller shares of it; the advice's search goes without).
 
@@ -523,8 +533,15 @@ def _make(segments: list[Segment], bound: float, closed: bool | None, shape: str
     split at those corners, as before. A joint between crossing circles whose C pair is refused is made
     again as a compound joint or a corner (``no_c``: those joints). Arcs merged as arcs of one circle to a share
     of the bound (``loose``) move the ends of their neighbours: where that fails, the path is made again with
-    only arcs of one circle to float64's resolution merged (a bound that works keeps working when it grows)."""
+    only arcs of one circle to float64's resolution merged (a bound that works keeps working when it grows).
+    Where that fails, short arcs beside the kinked joint refused are made again as their chords (``chorded``:
+    those segments; each moves the path by its sagitta), their joints corners; then small kinks are rounded as the
+    corners they are rather than absorbed by the shifts of the arcs beside them (not ``near``)."""
     pieces = [_piece_of(s, i) for i, s in enumerate(segments)]
+    chord_off = 0.0
+    for i in chorded:
+        chord_off = max(chord_off, _sagitta(pieces[i]))
+        pieces[i] = _Piece("line", i, i, a=pieces[i].start(), b=pieces[i].end())
     points = np.array([p for s in segments for p in s.outline()])
     scale = float(np.abs(points).max()) or 1.0
     extent = float(np.hypot(*(points.max(axis=0) - points.min(axis=0)))) or scale
@@ -552,13 +569,13 @@ def _make(segments: list[Segment], bound: float, closed: bool | None, shape: str
     steepest = _steepest_deflection(corner_shape)
     count = len(pieces)
     joint_count = count if closed else count - 1
-    kinds = [_classify(pieces[i], pieces[(i + 1) % count], extent, steepest, bound, SHAPE_CODES[shape], i not in no_c, loose)
+    kinds = [_classify(pieces[i], pieces[(i + 1) % count], extent, steepest, bound, SHAPE_CODES[shape], i not in no_c, loose, near)
              for i in range(joint_count)]  # fmt: skip
     unfit = _c_unfit(pieces, kinds, shape)
     if unfit:  # C pairs that do not fit beside the joint: those joints made compound or corners
         no_c = no_c | frozenset(unfit)
         for i in unfit:
-            kinds[i] = _classify(pieces[i], pieces[(i + 1) % count], extent, steepest, bound, SHAPE_CODES[shape], False, loose)
+            kinds[i] = _classify(pieces[i], pieces[(i + 1) % count], extent, steepest, bound, SHAPE_CODES[shape], False, loose, near)
     sharp = [i for i, kind in enumerate(kinds) if kind == "split" and abs(_turn(pieces[i], pieces[(i + 1) % count])) < REVERSAL]
     if round_sharp:
         for i in sharp:
@@ -627,7 +644,7 @@ def _make(segments: list[Segment], bound: float, closed: bool | None, shape: str
             current_kinds.append(kinds[last])
             current_joints.append(last)
         groups.append((current, current_kinds, current_joints, closed and not open_path))
-    spanned += merged_off
+    spanned += merged_off + chord_off
     room = bound - spanned
     if not room > 0.0:
         return _Located(0, shown[0], f"its gaps and the arcs of one circle merged move it {spanned:.3g}, the whole bound", True)
@@ -638,13 +655,25 @@ def _make(segments: list[Segment], bound: float, closed: bool | None, shape: str
                             bound, shown, steepest, RETRY_SHARES if retry else ())  # fmt: skip
         if isinstance(made, _Located):
             if made.joint < joint_count and kinds[made.joint] == "arc-arc-c" and retried < C_RETRIES:
-                return _make(segments, bound, closed, shape, units, tolerance, retry, round_sharp, no_c | {made.joint}, retried + 1, loose)
+                return _make(segments, bound, closed, shape, units, tolerance, retry, round_sharp, no_c | {made.joint}, retried + 1, loose,
+                             chorded, near)  # fmt: skip
             if loose and arcs_merged:  # arcs of nearly one circle merged: made again, joined by transitions
-                again = _make(segments, bound, closed, shape, units, tolerance, retry, round_sharp, no_c, retried, False)
+                again = _make(segments, bound, closed, shape, units, tolerance, retry, round_sharp, no_c, retried, False, chorded, near)
+                if not isinstance(again, _Refusal):
+                    return again
+            flat = _flat_arcs(pieces, kinds, room) & {made.joint, (made.joint + 1) % count} - chorded
+            if flat:  # short arcs beside the kinked joint refused made their chords
+                again = _make(segments, bound, closed, shape, units, tolerance, retry, round_sharp, no_c, retried, loose, chorded | flat,
+                              near)  # fmt: skip
+                if not isinstance(again, _Refusal):
+                    return again
+            if near and any(kind != "corner" and abs(_turn(pieces[i], pieces[(i + 1) % count])) > TANGENT_TOL
+                            for i, kind in enumerate(kinds) if kind not in ("g2", "split")):  # fmt: skip
+                again = _make(segments, bound, closed, shape, units, tolerance, retry, round_sharp, no_c, retried, loose, chorded, False)
                 if not isinstance(again, _Refusal):
                     return again
             if round_sharp and sharp:  # the tangent circles did not fit: split at those corners instead
-                return _make(segments, bound, closed, shape, units, tolerance, retry, False, no_c, retried, loose)
+                return _make(segments, bound, closed, shape, units, tolerance, retry, False, no_c, retried, loose, chorded, near)
             return made
         chain, measured, group, solved, s, group_pieces, group_kinds, group_joints = made
         chains.append(chain)

@@ -25,6 +25,7 @@ from __future__ import annotations
 
 import math
 import os
+import re
 import tempfile
 from collections import Counter
 from pathlib import Path
@@ -68,6 +69,37 @@ def _open(source: Path) -> tuple[Any, str]:
         return doc, f"read with ezdxf's recover mode ({plain}; {len(auditor.fixes)} fix(es)); written as a plain DXF"
     except OSError as error:  # ezdxf says "not a DXF file" with an OSError
         raise ValueError(f"{source.name}: not a DXF file ezdxf can read ({error})") from None
+
+
+def _as_r2000(doc, label: str, notes: list[str]) -> Any:
+    """An R12 drawing holding paths as the same drawing in DXF R2000 (R12 has no SPLINE for the spirals):
+    its tables, blocks, model and paper space imported by ezdxf's ``Importer``, its header variables
+    copied (a unit it does not state is not stated); the drawing as it is when not every entity comes along."""
+    import ezdxf
+    from ezdxf.addons import Importer
+
+    if doc.dxfversion >= "AC1015" or not any(entity.dxftype() in READ for entity in doc.modelspace()):
+        return doc
+    new = ezdxf.new("R2000", setup=False)
+    importer = Importer(doc, new)
+    importer.import_tables()
+    importer.import_blocks([block.name for block in doc.blocks if not block.is_any_layout])
+    importer.import_modelspace()
+    importer.import_paperspace_layouts()
+    importer.finalize()
+    for name in doc.header.varnames():
+        try:
+            new.header[name] = doc.header[name]
+        except (ezdxf.DXFError, ValueError, TypeError):  # a variable R2000 does not have ($BLIPMODE …)
+            pass
+    for name in ("$INSUNITS", "$MEASUREMENT"):
+        if name not in doc.header and name in new.header:
+            del new.header[name]
+    if _contents(new.modelspace()) != _contents(doc.modelspace()):
+        return doc
+    notes.append("a DXF R12 drawing (R12 holds no SPLINE for the spirals): written as DXF R2000, every entity, "
+                 "table, block and header variable taken along")  # fmt: skip
+    return new
 
 
 def _holds_paths(block, blocks, depth: int = 0) -> bool:
@@ -134,28 +166,75 @@ def _audit(path: Path, recovered: bool):
     return ezdxf.readfile(path).audit()
 
 
-def _issues(path: Path, recovered: bool) -> tuple[Counter[int], str]:
-    """What ezdxf's audit fixes or finds in a file, counted by kind, and the first one's message."""
+def _issues(path: Path, recovered: bool) -> tuple[set[tuple[int, str]], int, str]:
+    """What ezdxf's audit fixes or finds in a file: its kinds (``_issue_kinds``), how many, the first one's message."""
     auditor = _audit(path, recovered)
     items = (*auditor.errors, *auditor.fixes)
-    return Counter(int(item.code) for item in items), next((item.message for item in items), "")
+    return _issue_kinds(items), len(items), next((item.message for item in items), "")
 
 
-def _save(doc, target: Path, issues: Counter[int], label: str) -> None:
-    """Write the drawing beside ``target``, check that ezdxf reads it without recover mode and that its audit
-    finds nothing the input did not have, then move it onto ``target`` (else nothing is written)."""
+def _issue_kinds(items) -> set[tuple[int, str]]:
+    """Audit issues as (code, message without the entities it names): an issue of a kind the input has, on an
+    entity written in a path's place (a layer name ezdxf does not accept, on the new spline), is not new."""
+    return {(int(item.code), _ENTITY.sub("", item.message)) for item in items}
+
+
+#: An entity named in an audit message: ``LINE(#35)``.
+_ENTITY = re.compile(r"\s*\b[A-Z_0-9]+\(#[0-9A-Fa-f]+\)")
+
+
+def _unique_handles(doc, notes: list[str]) -> None:
+    """Give a new handle to each model space entity whose handle another entity has (the database keeps one of
+    them: ezdxf would write only that one, or none)."""
+    renamed = 0
+    for entity in doc.modelspace():
+        if doc.entitydb.get(entity.dxf.handle) is not entity:
+            entity.update_handle(doc.entitydb.next_handle())
+            doc.entitydb.add(entity)
+            renamed += 1
+    if renamed:
+        notes.append(f"{renamed} entit{'y' if renamed == 1 else 'ies'} whose handle another entity has given a new handle")
+
+
+def _contents(msp) -> Counter[tuple[str, str]]:
+    return Counter((entity.dxftype(), str(entity.dxf.layer)) for entity in msp)
+
+
+def _save(doc, target: Path, issues: set[tuple[int, str]], label: str, notes: list[str]) -> None:
+    """Write the drawing beside ``target``, check that ezdxf reads it without recover mode, that it holds every
+    entity of the model space and that its audit finds nothing the input did not have, then move it onto
+    ``target`` (else nothing is written). A drawing ezdxf cannot write as read (a dictionary entry pointing at
+    nothing) is written after ezdxf's audit has fixed it, and the report says so."""
     import ezdxf
 
+    _unique_handles(doc, notes)
+    expected = _contents(doc.modelspace())
     handle, temporary = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".dxf", dir=target.parent)
     os.close(handle)
     try:
-        doc.saveas(temporary)
-        auditor = ezdxf.readfile(temporary).audit()
-        found = Counter(int(item.code) for item in (*auditor.fixes, *auditor.errors))
-        new = found - issues
+        try:
+            doc.saveas(temporary)
+        except Exception as error:  # noqa: BLE001 - any fault ezdxf's writer meets is the input's; its audit may fix it
+            fixed = doc.audit()
+            items = (*fixed.fixes, *fixed.errors)
+            if not items:
+                raise ValueError(f"{label}: ezdxf cannot write the drawing ({type(error).__name__}: {error}); nothing written") from None
+            notes.append(f"ezdxf cannot write the drawing as read ({type(error).__name__}: {error}); written after its audit "
+                         f"fixed {len(items)} issue(s) ({items[0].message})")  # fmt: skip
+            issues = issues | _issue_kinds(items)
+            expected = _contents(doc.modelspace())
+            doc.saveas(temporary)
+        written = ezdxf.readfile(temporary)
+        lost = expected - _contents(written.modelspace())
+        if lost:
+            what = ", ".join(f"{n} {kind} on layer {layer}" for (kind, layer), n in sorted(lost.items()))
+            why = " (a DXF R12 drawing holds no SPLINE)" if "SPLINE" in what and doc.dxfversion < "AC1015" else ""
+            raise ValueError(f"{label}: ezdxf would not write {what}{why}; nothing written")
+        auditor = written.audit()
+        items = (*auditor.errors, *auditor.fixes)
+        new = [item for item in items if (int(item.code), _ENTITY.sub("", item.message)) not in issues]
         if new:
-            first = next(item.message for item in (*auditor.errors, *auditor.fixes) if int(item.code) in new)
-            raise ValueError(f"{label}: ezdxf's audit finds {sum(new.values())} new issue(s) in the result ({first}); nothing written")
+            raise ValueError(f"{label}: ezdxf's audit finds {len(new)} new issue(s) in the result ({new[0].message}); nothing written")
         os.replace(temporary, target)
     finally:
         if os.path.exists(temporary):
@@ -193,6 +272,7 @@ def rewrite_dxf_g2(
     bound, unit_name, g2_units, notes = _bound(doc, max_deviation, units, label)
     if recovered:
         notes.insert(0, recovered)
+    doc = _as_r2000(doc, label, notes)
     msp = doc.modelspace()
     notes += _explode(doc, msp)
     pieces: list[tuple[list[tuple], str]] = []
@@ -264,10 +344,10 @@ def rewrite_dxf_g2(
                       ("HELIX", "a curve in space")):  # fmt: skip
         if kept[kind]:
             notes.append(f"{kept[kind]} {kind} entit{'y' if kept[kind] == 1 else 'ies'} not made G2 ({why})")
-    issues, first = _issues(source, bool(recovered))
-    if issues:
-        notes.append(f"ezdxf's audit finds {sum(issues.values())} issue(s) in the input ({first}); kept as they were")
-    _save(doc, target, issues, label)
+    issues, count, first = _issues(source, bool(recovered))
+    if count:
+        notes.append(f"ezdxf's audit finds {count} issue(s) in the input ({first}); kept as they were")
+    _save(doc, target, issues, label, notes)
     return DocumentReport(label, target.name, "DXF drawing", unit_name, float(max_deviation) if units is None else bound,
                           tuple(reports), tuple(notes))  # fmt: skip
 
@@ -318,14 +398,27 @@ def _path(msp, pieces: list, owners: list, order: list[tuple[int, bool]], closed
     added = []
     try:
         for piece in (s for chain in result.chains for s in chain):
-            added.append(_add(msp, piece, first.dxf.layer, attributes))
-    except ezdxf.DXFError as error:  # e.g. a layer name ezdxf reads but will not give a new entity
+            added.append(_add_on_layer(msp, piece, first.dxf.layer, attributes))
+    except ezdxf.DXFError as error:
         for entity in added:
             msp.delete_entity(entity)
         return PathReport(name, joints, splits=splits, kept=f"ezdxf cannot write its G2 path ({error})")
     for entity in entities:
         msp.delete_entity(entity)
     return PathReport(name, joints, changed, float(result.deviation) + share * bound, splits, pieces=len(added), g2=True)
+
+
+def _add_on_layer(msp, piece, layer: str, attributes: dict):
+    """``_add`` on the path's own layer, also one whose name ezdxf reads but will not give a new entity
+    (``MILL: 1``, as dxf2gcode names layers): the entity is made on layer 0 and moved there."""
+    import ezdxf
+
+    try:
+        return _add(msp, piece, layer, attributes)
+    except ezdxf.DXFValueError:
+        entity = _add(msp, piece, "0", attributes)
+        entity.dxf.unprotected_set("layer", layer)
+        return entity
 
 
 def _curve_ends(entity, kind: str) -> list[np.ndarray]:

@@ -174,7 +174,12 @@ class GcodeG2Report:
                 out += [f"{self.source} {where}: joint at {joint}" for joint in r.refused[1:]]
         out += [f"{self.source}: {note}" for note in self.notes]
         made = sum(r.status == "G2" for r in self.runs)
-        out.append(f"{self.source}: {made} of {len(self.runs)} runs made G2 within {self.max_deviation:g} {unit} "
+        left = sum(len(r.refused) for r in self.runs if r.status == "G2")
+        parts = sum(r.status == "G2" and bool(r.reason) for r in self.runs)
+        also = (f", {left} joint(s) in them refused and left as they were" if left else "") + (
+            f", a part of {parts} of them kept as it was" if parts else ""
+        )
+        out.append(f"{self.source}: {made} of {len(self.runs)} runs made G2 within {self.max_deviation:g} {unit}{also} "
                    f"(measured {self.deviation:.3g} {unit}), {len(self.kept)} kept for a reason, "
                    f"{sum(r.status == 'nothing to do' for r in self.runs)} G2 already, {self.splits} splits")  # fmt: skip
         return out
@@ -626,13 +631,13 @@ class _Rewriter:
         made = None
         if closed:
             try:
-                made = make_g2(segments, g2_bound, closed=True, shape=self.shape, units=units)
+                made = make_g2(segments, g2_bound, closed=True, shape=self.shape, units=units, advise=False)
             except (ValueError, NoSolutionError):
                 made = None
             if made is not None and len(made.chains) == 1:
                 chains = _started_at(made.chains[0], start, tiny)
         if chains is None:
-            made = make_g2(segments, g2_bound, closed=False, shape=self.shape, units=units)
+            made = make_g2(segments, g2_bound, closed=False, shape=self.shape, units=units, advise=False)
             chains = list(made.chains)
         assert made is not None
         if all(j.kind == "g2" for j in made.joints):

@@ -254,6 +254,7 @@ def test_a_refused_joint_splits_the_run_and_the_rest_is_made_g2():
     assert run in report.below_g2
     shown = "\n".join(report.lines())
     assert "refused joint(s) left as they were" in shown and "joint at line 9 (X1000000 Y30)" in shown
+    assert f"1 of 1 runs made G2 within 1e-08 mm, {len(run.refused)} joint(s) in them refused and left as they were" in shown
     # the near part's ends are the input's: its last point is the refused joint's
     i = text.index("G1 X1000000 Y30")
     assert "X1000000 Y20" in text[i - 1]

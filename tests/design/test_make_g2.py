@@ -227,6 +227,10 @@ def test_refusal_names_the_joint_and_a_bound_that_works():
     works = float(message.split("max_deviation ")[-1].split(" ")[0])
     result = make_g2(segments, works)
     assert_g2(segments, result, works, closed=True)
+    # A caller that splits where make_g2 refuses and goes on (a program made G2 in place) asks for no advice.
+    with pytest.raises(NoSolutionError) as error:
+        make_g2(segments, 1e-12, advise=False)
+    assert str(error.value) == message.split("; max_deviation")[0] + "; a larger max_deviation may help"
 
 
 def test_malformed_input_is_refused_by_name():

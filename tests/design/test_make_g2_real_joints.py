@@ -42,6 +42,66 @@ def test_a_line_arc_joint_with_a_small_kink_is_made_g2(kink, bound):
     arcs_kept(segments, result)
 
 
+def line_short_arc_line(radius: float, length: float, kink: float) -> list:
+    """A 50-long line, an arc ``length`` long whose start tangent is turned by ``kink`` from the line's, and a
+    line leaving it tangent: the short arcs between lines a CAM program writes."""
+    heading = kink
+    centre = np.array([50.0 - radius * math.sin(heading), radius * math.cos(heading)])
+    arc = Arc(tuple(centre), radius, heading - math.pi / 2, length / radius)
+    end, out = np.asarray(arc.end), heading + length / radius
+    return [Line((0.0, 0.0), (50.0, 0.0)), arc, Line(tuple(end), tuple(end + 30.0 * np.array([math.cos(out), math.sin(out)])))]
+
+
+@pytest.mark.parametrize("kink", [3.5e-5, -3.5e-5, 1e-3, -1e-3])
+@pytest.mark.parametrize(("radius", "length"), [(5.0, 0.006), (50.0, 0.006), (50.0, 0.06), (500.0, 0.02), (500.0, 0.6)])
+def test_a_short_arc_between_kinked_lines_is_made_g2_not_refused(radius, length, kink):
+    # Its sweep is too small for transitions that absorb the kink: kept as an arc where they fit, else
+    # made its chord (it lies within a quarter of the bound of it) with the corners either side rounded.
+    segments = line_short_arc_line(radius, length, kink)
+    result = make_g2(segments, 0.01)
+    assert len(result.chains) == 1 and not result.splits
+    assert_g2(segments, result, 0.01, closed=False)
+
+
+#: Moves of Fusion 360 programs (public CAM output) that make_g2 refused: short arcs with sub-degree kinks,
+#: a short line at a corner next to an arc; each G-code line's words as the reader reads them.
+FUSION_JOINTS = {
+    "a 0.018 mm arc between a line and a reverse arc": [
+        Line((88.994, 54.716), (81.808, 47.235)),
+        Arc((80.67863324477065, 48.35136675522997), -1.587999999999991, -0.7796094735403694, 0.011577379714705294),
+        Arc((84.40667936785756, 44.65359584965546), 3.662999999999992, 2.364548450249159, 0.6617454652928854),
+    ],
+    "a 0.054 mm arc, then one of its radius 0.095 mm off": [
+        Line((34.901, 84.334), (69.753, 84.621)),
+        Arc((69.90197806154211, 78.03468467675748), -6.588000000000001, 1.5934118036742808, 0.008198149622574036),
+        Arc((69.8068100517511, 78.03400000273834), -6.587999999999999, 1.570767494334525, 0.4617438385003996),
+    ],
+    "a 0.03 mm arc after an arc, 0.23° apart": [
+        Arc((20.90752608838311, 44.130000030656866), 3.6630000000000007, 0.1413382365134722, 1.4293287122802747),
+        Arc((20.893, 44.13103072104639), 3.661999999999999, 1.566700193003017, 0.008192267583759127),
+    ],
+    "an R239 arc over 0.33° between an arc and a reverse arc": [
+        Arc((9.711132693112951, 12.583681303233467), -10.743658905255957, -2.3198856803867463, 0.1302647758592319),
+        Arc((185.61179414262634, 158.38402038257158), -239.21418336815992, -2.449518721644207, 0.005844379619078577),
+        Arc((-0.0026828945897720865, 6.362000577079909), 0.7096142610206096, 0.686904225849053, 1.7714238703032175),
+    ],
+    "a 0.012 mm line at a 14° corner, a short line onto an arc": [
+        Line((9.397, 53.005), (9.4, 52.993)),
+        Line((9.4, 52.993), (9.4, 52.856)),
+        Arc((15.99995655260405, 52.85603042347857), 6.599956552674171, -3.141588043941483, 1.919813285127091),
+        Line((18.257, 46.654), (23.153, 48.484)),
+    ],
+}
+
+
+@pytest.mark.parametrize("name", list(FUSION_JOINTS))
+def test_short_arcs_and_lines_of_cam_programs_are_made_g2_whole(name):
+    segments = FUSION_JOINTS[name]
+    result = make_g2(segments, 0.01)
+    assert len(result.chains) == 1 and not result.splits
+    assert_g2(segments, result, 0.01, closed=False)
+
+
 @pytest.mark.parametrize("kink", [2e-7, 1e-5, 1e-3, -1e-5, -1e-3])
 @pytest.mark.parametrize(("r0", "r1"), [(5.0, -8.0), (5.0, 8.0), (8.0, 5.0)])
 def test_an_arc_arc_joint_with_a_small_kink_is_made_g2(kink, r0, r1):

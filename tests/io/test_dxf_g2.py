@@ -147,8 +147,9 @@ def test_a_drawing_only_recover_mode_reads_comes_back_plain(tmp_path):
     assert "recover mode" in report.notes[0]
     after = ezdxf.readfile(tmp_path / "out.dxf")  # plain reader
     assert not after.audit().has_errors
-    # an R12 drawing holds no SPLINE: a path that needs spirals is kept, and says why
-    assert any("R12" in p.kept for p in report.paths)
+    # an R12 drawing holds no SPLINE: it comes back as R2000, its paths made G2
+    assert after.dxfversion == "AC1015" and any("written as DXF R2000" in n for n in report.notes)
+    assert any(p.g2 and p.changed for p in report.paths)
 
 
 def test_a_drawing_rewritten_twice_changes_no_more(tmp_path):
@@ -219,3 +220,80 @@ def test_splines_and_ellipses_in_a_path_are_made_g2_within_the_bound(tmp_path):
     apart = max(cKDTree(new).query(old)[0].max(), cKDTree(old).query(new)[0].max())
     assert apart <= bound + spacing, apart
     assert apart <= report.worst + spacing  # the deviation reported bounds the measured one
+
+
+def _r12_board(path, layer: str = "Edge.Cuts") -> None:
+    """A board outline as KiCad exports it: DXF R12, no $INSUNITS, lines and arcs of a rounded rectangle, a text."""
+    doc = ezdxf.new("R12")
+    msp = doc.modelspace()
+    a = {"layer": layer}
+    msp.add_line((3, 0), (47, 0), dxfattribs=a)
+    msp.add_arc((47, 3), 3, 270, 360, dxfattribs=a)
+    msp.add_line((50, 3), (50, 27), dxfattribs=a)
+    msp.add_arc((47, 27), 3, 0, 90, dxfattribs=a)
+    msp.add_line((47, 30), (3, 30), dxfattribs=a)
+    msp.add_arc((3, 27), 3, 90, 180, dxfattribs=a)
+    msp.add_line((0, 27), (0, 3), dxfattribs=a)
+    msp.add_arc((3, 3), 3, 180, 270, dxfattribs=a)
+    msp.add_text("REV A", dxfattribs={"layer": "Notes", "height": 2}).set_placement((5, 35))
+    doc.saveas(path)
+    text = Path(path).read_text()
+    assert "$INSUNITS" not in text
+
+
+def test_an_r12_drawing_comes_back_g2_as_r2000_with_everything_else_and_no_unit_invented(tmp_path):
+    _r12_board(tmp_path / "board.dxf")
+    report = rewrite_dxf_g2(tmp_path / "board.dxf", tmp_path / "out.dxf", 0.01, units="mm")
+    after = ezdxf.readfile(tmp_path / "out.dxf")
+    assert after.dxfversion == "AC1015" and "$INSUNITS" not in after.header
+    assert any("written as DXF R2000" in n for n in report.notes)
+    new = judge(after.modelspace())
+    assert new.share == 1.0 and new.open_ends == 0
+    assert new.others == judge(ezdxf.readfile(tmp_path / "board.dxf").modelspace()).others  # the text
+    assert {e.dxf.layer for e in after.modelspace() if e.dxftype() != "TEXT"} == {"Edge.Cuts"}
+
+
+def test_a_path_on_a_layer_whose_name_ezdxf_will_not_give_a_new_entity_is_written_on_it(tmp_path):
+    # dxf2gcode names layers "MILL: 1"; ezdxf reads them, but refuses them for a new entity.
+    _r12_board(tmp_path / "board.dxf", layer="MILL_1")
+    (tmp_path / "board.dxf").write_text((tmp_path / "board.dxf").read_text().replace("MILL_1", "MILL: 1"))
+    report = rewrite_dxf_g2(tmp_path / "board.dxf", tmp_path / "out.dxf", 0.01, units="mm")
+    after = ezdxf.readfile(tmp_path / "out.dxf")
+    assert {e.dxf.layer for e in after.modelspace() if e.dxftype() != "TEXT"} == {"MILL: 1"}
+    assert judge(after.modelspace()).share == 1.0 and not report.below_g2
+
+
+def test_a_drawing_ezdxf_cannot_write_as_read_is_written_after_its_audit(tmp_path):
+    # Its current material and its material dictionary's "ByLayer" point at nothing (as a Visio export's do):
+    # ezdxf's writer fails on it.
+    doc = ezdxf.new("R2010")
+    msp = doc.modelspace()
+    msp.add_line((0, 0), (10, 0))
+    msp.add_line((10, 0), (10, 10))
+    doc.saveas(tmp_path / "ok.dxf")
+    handle = doc.materials.get("ByLayer").dxf.handle
+    text = (tmp_path / "ok.dxf").read_text()
+    dangling = text.replace(f"ByLayer\n350\n{handle}\n", "ByLayer\n350\nFFFFF\n").replace(f"$CMATERIAL\n347\n{handle}\n",
+                                                                                         "$CMATERIAL\n347\nFFFFE\n")  # fmt: skip
+    assert dangling.count("FFFF") == 2
+    (tmp_path / "in.dxf").write_text(dangling)
+    report = rewrite_dxf_g2(tmp_path / "in.dxf", tmp_path / "out.dxf", 0.01)
+    assert any("written after its audit fixed" in n for n in report.notes)
+    assert judge(ezdxf.readfile(tmp_path / "out.dxf").modelspace()).share == 1.0
+
+
+def test_a_drawing_whose_entities_ezdxf_would_drop_is_refused_and_not_written(tmp_path):
+    # An R12 file holding a SPLINE and no path (Inkscape writes SPLINEs into R12): ezdxf writes no SPLINE to R12.
+    doc = ezdxf.new("R12")
+    doc.modelspace().add_text("A")
+    doc.saveas(tmp_path / "r12.dxf")
+    spline = ezdxf.new("R2000")
+    spline.modelspace().add_spline([(60, 0), (65, 5), (70, 0), (75, 5)])
+    spline.saveas(tmp_path / "s.dxf")
+    entity = (tmp_path / "s.dxf").read_text().split("ENTITIES\n")[1].split("  0\nENDSEC")[0]
+    text = (tmp_path / "r12.dxf").read_text()
+    (tmp_path / "in.dxf").write_text(text.replace("ENTITIES\n", "ENTITIES\n" + entity, 1))
+    assert len(ezdxf.readfile(tmp_path / "in.dxf").modelspace().query("SPLINE")) == 1
+    with pytest.raises(ValueError, match=r"would not write 1 SPLINE .*R12 drawing holds no SPLINE.*nothing written"):
+        rewrite_dxf_g2(tmp_path / "in.dxf", tmp_path / "out.dxf", 0.01, units="mm")
+    assert not (tmp_path / "out.dxf").exists()
