@@ -14,8 +14,10 @@ Every other entity is kept untouched: text, dimensions, hatches, points, ``SPLIN
 block holds lines or arcs is exploded first (ezdxf's ``explode``, through its virtual entities), so its
 paths are made G2 too; the report names the blocks. The header (``$INSUNITS`` and the rest), the
 layers, linetypes, styles and blocks stay as they were (ezdxf's ``audit`` is not run on them: an input's
-faults are kept, and named in the report). The result is written beside the target, read back by ezdxf
-without recover mode and audited; an issue the input did not have refuses the write.
+faults are kept, and named in the report; one ezdxf's writer cannot write is fixed by its audit first,
+and named). The result is written beside the target, read back by ezdxf without recover mode and audited;
+an issue the input did not have, or an entity of the model space missing, refuses the write. An R12
+drawing holding paths is written as R2000 (R12 has no ``SPLINE`` for the spirals).
 
 The bound is in the drawing's unit (``$INSUNITS``); ``units=`` states it in another unit. A unitless
 drawing takes the bound in drawing units (``units=`` then names them), and the report says so.

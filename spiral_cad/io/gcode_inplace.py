@@ -261,6 +261,7 @@ class _Rewriter:
         self.first_unit: str | None = units
         self.rotary: list[int] = []  # lines where a rotary axis moves
         self.unitless: list[int] = []  # feed moves in XY read before any G20/G21 (their unit unknown: kept as they are)
+        self.other_words: dict[str, list[int]] = {}  # feed moves in XY kept for a word a cutting move does not have (K …)
         self.last_control: tuple[float, float] | None = None  # the last control point of a NURBS block being read
         self.block: _Block | None = None  # the NURBS block being read
         self.started = self.deadline = 0.0  # when the run being written started, and its splits' deadline
@@ -322,6 +323,10 @@ class _Rewriter:
         if self.rotary:
             shown = ", ".join(map(str, self.rotary[:5])) + (", …" if len(self.rotary) > 5 else "")
             self.notes.append(f"{len(self.rotary)} line(s) where a rotary axis moves, as they are (line {shown})")
+        for letters, numbers in self.other_words.items():
+            shown = ", ".join(map(str, numbers[:5])) + (", …" if len(numbers) > 5 else "")
+            self.notes.append(f"{len(numbers)} feed move(s) with the word(s) {letters} kept as they are (line {shown})"
+                              + (": LinuxCNC refuses K on an arc in the XY plane" if "K" in letters else ""))  # fmt: skip
 
     def verbatim(self, line: str, words: list[tuple[str, float, str]], move: _Move | None = None) -> None:
         """Keep a line (``move``: a kept cutting line's move); put the input's motion code in front when it moves by the
@@ -409,6 +414,9 @@ class _Rewriter:
         if s.units is None and s.motion in (10, 20, 30) and s.plane == 170:
             self.unitless.append(number)
         if not cutting:
+            extra = sorted({letter for letter, _, _ in words} - _CUTTING_WORDS)
+            if s.motion in (10, 20, 30) and s.plane == 170 and extra and not commented and not deleted:
+                self.other_words.setdefault(" ".join(extra), []).append(number)
             return None
         a = (float(start[0]), float(start[1]))  # type: ignore[arg-type]
         b = (float(end[0]), float(end[1]))  # type: ignore[arg-type]

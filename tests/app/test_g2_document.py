@@ -115,6 +115,16 @@ def test_what_is_kept_and_why():
     assert set(re.findall(r"F(\d+)", report.text)) <= {"10", "20"}
 
 
+def test_a_feed_move_with_a_word_a_cut_does_not_have_is_kept_and_named():
+    # FreeCAD's grbl post writes K0.000 on XY arcs (LinuxCNC refuses it; the line is kept as it is, and said)
+    text = "\n".join(["G21 G17 G90", "G0 X0 Y0 Z5", "G1 Z-1 F100", "G1 X10 Y0", "G1 X10 Y10", "G3 X0 Y20 I-10 J0 K0.000",
+                      "G1 X-10 Y20", "G1 X-10 Y30", "G0 Z5", "M2"])  # fmt: skip
+    report = gcode_g2(text, 0.01, source="k.ngc")
+    assert "G3 X0 Y20 I-10 J0 K0.000" in report.text.splitlines()
+    assert any(n.startswith("1 feed move(s) with the word(s) K kept as they are (line 6)") and "LinuxCNC" in n for n in report.notes)
+    assert [r.status for r in report.runs] == ["G2", "G2"]
+
+
 def test_parameters_stop_the_rewrite_by_line():
     report = gcode_g2("G21\n#1=5\nG0 X0 Y0\nG1 X#1 F100\nM2\n", 0.01)
     assert report.runs == [] and "line 2" in report.notes[0]
