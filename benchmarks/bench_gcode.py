@@ -16,7 +16,8 @@ STEP, G-code, samples and DXF; peak = the larger of the command's process and it
 moves, the in-place rewrite ``spiral-cad g2 FILE --max-deviation 0.01 -o OUT`` of a pocketing and contouring
 program of as many moves (``contour_program``: pockets of G1 rows, rounded-rectangle contours of G1 lines and G3
 corners, bosses cut as G1 chords with R-word arcs, each entered by a rapid and a plunge, at their own feeds; the
-command as a user runs it, its progress lines on stderr kept). One run per job (a minute-long
+command as a user runs it, its progress lines on stderr kept; from 20 000 moves its runs are made G2 in one forked
+process per core: its peak is given as the command's plus each process's). One run per job (a minute-long
 job on a shared machine: the spread is not measured); the peer of the arrays is the
 Chain at the same size. Goals: 100 000 moves read and rounded in ≤ 60 s and ≤ 1.5 GB;
 1 M moves rounded in ≤ 20 s and ≤ 3 GB; ``build --from-gcode`` and ``g2`` of 100 000 moves each in ≤ 30 s and ≤ 1 GB.
@@ -35,6 +36,8 @@ from collections.abc import Callable
 
 import numpy as np
 from timing import Report, Timing, arguments
+
+from spiral_cad.io.gcode_inplace import MAX_PROCESSES
 
 #: The modules whose code these numbers measure (stamped into the results: ``timing.code_stamp``).
 MEASURES = (
@@ -205,7 +208,8 @@ def g2(moves: int) -> None:
     """``spiral-cad g2`` of a ``contour_program`` of ``moves`` moves (its reversals split: allowed)."""
     seconds = _command(f"contour{moves}.ngc", contour_program(moves), lambda file, folder: [
         "g2", file, "--max-deviation", str(MAX_DEVIATION), "-o", os.path.join(folder, "out.ngc"), "--allow-splits"])  # fmt: skip
-    print(json.dumps({"g2": seconds, "peak_mb": peak_mb()}))
+    children = resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss / 1024.0  # the processes sharing the runs, if any
+    print(json.dumps({"g2": seconds, "peak_mb": peak_mb(), "child_mb": children}))
 
 
 def run(job: str, moves: int) -> dict:
@@ -256,9 +260,12 @@ def main() -> None:
             if moves <= limit:
                 done = run(job, moves)
                 goal = ""
+                processes = min(len(os.sched_getaffinity(0)), MAX_PROCESSES) if done.get("child_mb") else 0
+                memory = done["peak_mb"] + processes * done.get("child_mb", 0.0)  # a bound: forked pages are shared
                 if moves == 100_000:
-                    goal = f"≤ 30 s, ≤ 1 GB: {'met' if done[job] <= 30 and done['peak_mb'] <= 1024 else 'missed'}"
-                report.add(f"{label}, {moves:,} moves", done[job], "s", Timing((done[job],)), f"peak {done['peak_mb']:,.0f} MB", goal=goal)
+                    goal = f"≤ 30 s, ≤ 1 GB: {'met' if done[job] <= 30 and memory <= 1024 else 'missed'}"
+                peak = f"peak {done['peak_mb']:,.0f} MB" + (f" + {processes} × {done['child_mb']:,.0f} MB" if processes else "")
+                report.add(f"{label}, {moves:,} moves", done[job], "s", Timing((done[job],)), peak, goal=goal)
         rows.append(f"| {moves:,} | {read['read']:.2f} s, {read['peak_mb']:,.0f} MB | "
                     + (f"{chain['round']:.2f} s, {chain['peak_mb']:,.0f} MB" if chain else "not run (above --chain-max)")
                     + f" | {arrays['round']:.2f} s, {arrays['peak_mb']:,.0f} MB |")  # fmt: skip

@@ -38,6 +38,7 @@ the measured deviation and the counts.
 from __future__ import annotations
 
 import math
+import multiprocessing
 import os
 import re
 import time
@@ -67,6 +68,11 @@ MAX_REFUSED = 20
 SPLIT_SECONDS = 5.0
 #: Decimals of the numbers written (far below any bound a machine holds).
 DECIMALS = 10
+#: A program of at least this many cutting moves has its runs made G2 in several processes at once (one per
+#: core, forked; the output is the same as made in one).
+PARALLEL_MOVES = 20_000
+#: ... in at most this many.
+MAX_PROCESSES = 8
 
 _WORD = re.compile(r"\s*([A-Za-z])\s*([+-]?\s*(?:\d+\.?\d*|\.\d+))", re.ASCII)
 _WORDS = re.compile(r"(?:\s*[A-Za-z]\s*[+-]?\s*(?:\d+\.?\d*|\.\d+))*\s*", re.ASCII)
@@ -248,8 +254,15 @@ def _code(value: float) -> int:
 
 
 class _Rewriter:
-    def __init__(self, text: str, source: str, bound: float, dialect: str, shape: str, units: str | None):
+    def __init__(self, text: str, source: str, bound: float, dialect: str, shape: str, units: str | None, gathering: bool = False):
         self.source, self.bound, self.dialect, self.shape = source, bound, dialect, shape
+        self.config = (text, source, bound, dialect, shape, units)
+        #: Only reading, to gather the runs (``made_apart``): no run is made G2.
+        self.gathering = gathering
+        self.gathered: list[tuple[list[str], list[_Move]]] = []
+        #: Runs made G2 in other processes, by their order in the program: the run, and each part's length and lines.
+        self.made: dict[int, tuple[GcodeRun, list[tuple[int, list[str] | None]]]] = {}
+        self.flushed = 0
         self.raw = text.replace("\r\n", "\n").replace("\r", "\n").split("\n")
         self.state = _State(units=units)
         self.out: list[str] = []
@@ -269,9 +282,13 @@ class _Rewriter:
     # ---------------------------------------------------------------- reading
 
     def run(self) -> None:
+        if not self.gathering:
+            self.made = self.made_apart()
         frozen = False
         percent = 0
-        progress = Progress(f"g2 {self.source}: lines", len(self.raw))
+        progress = Progress(
+            f"g2 {self.source}: lines", len(self.raw) if not self.gathering else 0, after=math.inf if self.gathering else 3.0
+        )
         for number, line in enumerate(self.raw, 1):
             if not number & 0x3FF:  # a look at the clock every 1 024 lines (Progress prints at most every 2 s)
                 progress(number)
@@ -459,6 +476,8 @@ class _Rewriter:
         """Write a NURBS block just read: made G2 within the bound (``gcode_nurbs``), or verbatim (the report says why)."""
         block, self.block = self.block, None
         assert block is not None
+        if self.gathering:
+            return
         first, last = block.lines[0][0], block.lines[-1][0]
         run = GcodeRun(first, last, 1, nurbs=True)
         self.runs.append(run)
@@ -563,10 +582,20 @@ class _Rewriter:
         lines = [line for line, _ in self.pending]
         moves = [move for _, move in self.pending]
         self.pending = []
-        run = GcodeRun(moves[0].number, moves[-1].number, len(moves))
+        if self.gathering:
+            self.gathered.append((lines, moves))
+            return
+        made = self.made.pop(self.flushed, None)
+        self.flushed += 1
+        if made is not None and (made[0].first, made[0].last) == (moves[0].number, moves[-1].number):
+            run, at, parts = made[0], 0, []
+            for count, part in made[1]:
+                parts.append((lines[at : at + count], moves[at : at + count], part))
+                at += count
+        else:
+            run = GcodeRun(moves[0].number, moves[-1].number, len(moves))
+            parts = self.made_g2(run, moves, lines)
         self.runs.append(run)
-        self.started, self.deadline = time.perf_counter(), math.inf
-        parts = self.parts(run, moves, lines)
         if any(written is not None for _, _, written in parts):
             run.status = "G2"
         elif run.reason or run.refused:
@@ -588,6 +617,35 @@ class _Rewriter:
             self.emitted_feed = feed
             last = written[-1].split()[0] if written else ""
             self.emitted_motion = {"G1": 10, "G2": 20, "G3": 30, "G5": 50}.get(last, self.emitted_motion)
+
+    def made_g2(self, run: GcodeRun, moves: list[_Move], lines: list[str]) -> list[tuple[list[str], list[_Move], list[str] | None]]:
+        """A run's parts, each with its lines written in its place (``parts``), timed from now."""
+        self.started, self.deadline = time.perf_counter(), math.inf
+        return self.parts(run, moves, lines)
+
+    def made_apart(self) -> dict[int, tuple[GcodeRun, list[tuple[int, list[str] | None]]]]:
+        """The runs of a long program made G2 in one process per core (forked: each holds the runs read), by their
+        order; none when the program is short, there is one core, or the system cannot fork."""
+        processes = min(len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count() or 1, MAX_PROCESSES)
+        if processes < 2 or "fork" not in multiprocessing.get_all_start_methods():
+            return {}
+        global _GATHERED
+        gatherer = _Rewriter(*self.config, gathering=True)
+        gatherer.run()
+        if sum(len(moves) for _, moves in gatherer.gathered) < PARALLEL_MOVES:
+            return {}
+        made: dict[int, tuple[GcodeRun, list[tuple[int, list[str] | None]]]] = {}
+        progress = Progress(f"g2 {self.source}: runs made G2", len(gatherer.gathered))
+        _GATHERED = gatherer
+        try:
+            with multiprocessing.get_context("fork").Pool(processes) as pool:
+                for k, result in enumerate(pool.imap(_made_g2, range(len(gatherer.gathered)), chunksize=8)):
+                    made[k] = result
+                    progress(k + 1)
+        finally:
+            _GATHERED = None
+        progress.done(len(made))
+        return made
 
     def parts(self, run: GcodeRun, moves: list[_Move], lines: list[str]) -> list[tuple[list[str], list[_Move], list[str] | None]]:
         """A run's parts, each with its lines written in its place (None: kept verbatim): the run made G2 whole, or, where
@@ -687,6 +745,19 @@ class _Rewriter:
         run.joints_changed += joints_changed
         run.splits += len(made.splits)
         return out
+
+
+#: The runs a forked process makes G2 (``_Rewriter.made_apart``).
+_GATHERED: _Rewriter | None = None
+
+
+def _made_g2(index: int) -> tuple[GcodeRun, list[tuple[int, list[str] | None]]]:
+    """Run ``index`` of the program gathered before the fork made G2: the run, and each part's length and lines."""
+    assert _GATHERED is not None
+    lines, moves = _GATHERED.gathered[index]
+    run = GcodeRun(moves[0].number, moves[-1].number, len(moves))
+    parts = _GATHERED.made_g2(run, moves, lines)
+    return run, [(len(part_lines), written) for part_lines, _, written in parts]
 
 
 def _mid_line(last: Segment, first: Segment) -> bool:

@@ -7,6 +7,7 @@ path within the bound both ways.
 
 from __future__ import annotations
 
+import os
 import re
 import sys
 from pathlib import Path
@@ -268,6 +269,27 @@ def test_a_refused_joint_splits_the_run_and_the_rest_is_made_g2():
     # the near part's ends are the input's: its last point is the refused joint's
     i = text.index("G1 X1000000 Y30")
     assert "X1000000 Y20" in text[i - 1]
+
+
+@pytest.mark.skipif(
+    len(os.sched_getaffinity(0)) < 2 if hasattr(os, "sched_getaffinity") else True, reason="one core: no processes to share"
+)
+def test_a_long_programs_runs_made_in_several_processes_come_back_as_made_in_one(monkeypatch):
+    """Runs made G2 in forked processes (a long program) give the very program and report one process gives: NURBS
+    blocks, feeds and kept lines in their places."""
+    import spiral_cad.io.gcode_inplace as inplace
+
+    program = "\n".join([CONTOUR, NURBS.replace("M2", ""), FAR.replace("G21 G90 G17", ""), CONTOUR.replace("G21 G90 G17", "")])
+    apart = []
+    made_apart = inplace._Rewriter.made_apart
+    monkeypatch.setattr(inplace._Rewriter, "made_apart", lambda self: apart.append(dict(made_apart(self))) or dict(apart[-1]))
+    monkeypatch.setattr(inplace, "PARALLEL_MOVES", 0)
+    forked = gcode_g2(program, 0.01, source="long.ngc")
+    monkeypatch.setattr(inplace, "PARALLEL_MOVES", 10**12)
+    alone = gcode_g2(program, 0.01, source="long.ngc")
+    assert len(apart[0]) == sum(not r.nurbs for r in forked.runs) >= 4 and apart[1] == {}
+    assert forked.text == alone.text and forked.lines() == alone.lines()
+    assert any(r.nurbs and r.status == "G2" for r in forked.runs) and sum(r.status == "G2" for r in forked.runs) >= 5
 
 
 def test_another_kind_registers_by_suffix(tmp_path, monkeypatch):
