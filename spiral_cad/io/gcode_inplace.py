@@ -41,6 +41,7 @@ import math
 import multiprocessing
 import os
 import re
+import signal
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -638,7 +639,7 @@ class _Rewriter:
         progress = Progress(f"g2 {self.source}: runs made G2", len(gatherer.gathered))
         _GATHERED = gatherer
         try:
-            with multiprocessing.get_context("fork").Pool(processes) as pool:
+            with multiprocessing.get_context("fork").Pool(processes, _quiet) as pool:
                 for k, result in enumerate(pool.imap(_made_g2, range(len(gatherer.gathered)), chunksize=8)):
                     made[k] = result
                     progress(k + 1)
@@ -749,6 +750,12 @@ class _Rewriter:
 
 #: The runs a forked process makes G2 (``_Rewriter.made_apart``).
 _GATHERED: _Rewriter | None = None
+
+
+def _quiet() -> None:
+    """A forked process leaves Ctrl-C and SIGTERM to the command: it is ended with the pool, saying nothing."""
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    signal.signal(signal.SIGTERM, signal.SIG_DFL)
 
 
 def _made_g2(index: int) -> tuple[GcodeRun, list[tuple[int, list[str] | None]]]:

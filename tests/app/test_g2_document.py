@@ -7,11 +7,13 @@ path within the bound both ways.
 
 from __future__ import annotations
 
+import math
 import os
 import re
 import sys
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 from spiral_cad.app.cli import main
@@ -390,3 +392,47 @@ def test_arcspiral_comes_back_g2_but_for_its_innermost_joints():
     if rs274_judge.available():
         verdict = rs274_judge.judge(text, report.text, 0.01)
         assert verdict.passed, verdict.reasons
+
+
+@pytest.mark.skipif(
+    len(os.sched_getaffinity(0)) < 2 if hasattr(os, "sched_getaffinity") else True, reason="one core: no processes to share"
+)
+def test_ctrl_c_while_processes_make_the_runs_g2_is_one_line_130_and_no_file(tmp_path):
+    """Ctrl-C in a terminal reaches the command and its forked processes: the command says so in one line, the
+    processes end with it, and no program is written."""
+    import signal
+    import subprocess
+    import time
+
+    from spiral_cad.io.gcode_inplace import PARALLEL_MOVES
+
+    parts = []
+    for k in range(PARALLEL_MOVES // 20 + 1):  # rounded rectangles of G1 chords, 24 moves each
+        x, y = (k % 40) * 30.0, (k // 40) * 30.0
+        chords = " ".join(f"X{x + 10 + 8 * math.cos(a):.4f} Y{y + 10 + 8 * math.sin(a):.4f}" for a in np.linspace(0, 6.2, 24))
+        parts += [
+            f"G0 X{x + 18:.4f} Y{y + 10:.4f}",
+            "G1 Z-1 F200",
+            "G1 F600",
+            *[f"G1 {w}" for w in re.findall(r"X\S+ Y\S+", chords)],
+            "G0 Z5",
+        ]
+    program = tmp_path / "long.ngc"
+    program.write_text("G21 G90 G17\n" + "\n".join(parts) + "\nM2\n")
+    out = tmp_path / "long_g2.ngc"
+    process = subprocess.Popen([sys.executable, "-m", "spiral_cad.app.cli", "g2", str(program), "--max-deviation", "0.01", "-o", str(out)],
+                               stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True, start_new_session=True)  # fmt: skip
+    seen = []
+    for line in process.stderr:
+        seen.append(line)
+        if "runs made G2:" in line:  # the processes are at work
+            break
+    os.killpg(process.pid, signal.SIGINT)  # as a terminal sends it: to the whole group
+    err = "".join(seen) + process.stderr.read()
+    assert process.wait(timeout=60) == 130, err
+    said = [line for line in err.splitlines() if not re.match(r"g2 long\.ngc: (runs made G2|lines): ", line)]
+    assert said == ["error: interrupted"], err
+    assert not out.exists()
+    time.sleep(0.5)
+    with pytest.raises(ProcessLookupError):  # no process of the command is left
+        os.killpg(process.pid, 0)
