@@ -129,8 +129,11 @@ def run(text: str, step: float, folder: str | None = None) -> Run:
             if (abs(rotation) == 1 and np.abs(end[[first, second]] - position[[first, second]]).max() <= 1.5e-4
                     and all(k in before and k in written for k in names)
                     and max(abs(written[k] - before[k]) for k in names) > 1e-12):  # fmt: skip
-                # printed ends equal to rs274's 4 decimals, written ends not: an arc shorter than the printing, no full turn
-                sweep = math.copysign(abs(math.remainder(sweep, 2 * math.pi)), rotation)
+                # printed ends equal to rs274's 4 decimals, written ends not: the sweep from the written ends (an arc shorter
+                # than the printing, or a turn short of a full one by less than it)
+                w0 = math.atan2(before[names[1]] - cy, before[names[0]] - cx)
+                w1 = math.atan2(written[names[1]] - cy, written[names[0]] - cx)
+                sweep = (w1 - w0) % (2 * math.pi) if rotation > 0 else -((w0 - w1) % (2 * math.pi))
             elif rotation > 0:
                 sweep = (sweep if sweep > 0 else sweep + 2 * math.pi) + 2 * math.pi * (rotation - 1)
             else:
