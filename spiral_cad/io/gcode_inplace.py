@@ -275,7 +275,7 @@ class _Rewriter:
         self.first_unit: str | None = units
         self.rotary: list[int] = []  # lines where a rotary axis moves
         self.unitless: list[int] = []  # feed moves in XY read before any G20/G21 (their unit unknown: kept as they are)
-        self.other_words: dict[str, list[int]] = {}  # feed moves in XY kept for a word a cutting move does not have (K …)
+        self.kept_moves: dict[str, list[int]] = {}  # feed moves in XY kept as they are, by why (a word a cut does not have …)
         self.last_control: tuple[float, float] | None = None  # the last control point of a NURBS block being read
         self.block: _Block | None = None  # the NURBS block being read
         self.started = self.deadline = 0.0  # when the run being written started, and its splits' deadline
@@ -341,10 +341,10 @@ class _Rewriter:
         if self.rotary:
             shown = ", ".join(map(str, self.rotary[:5])) + (", …" if len(self.rotary) > 5 else "")
             self.notes.append(f"{len(self.rotary)} line(s) where a rotary axis moves, as they are (line {shown})")
-        for letters, numbers in self.other_words.items():
+        for why, numbers in self.kept_moves.items():
             shown = ", ".join(map(str, numbers[:5])) + (", …" if len(numbers) > 5 else "")
-            self.notes.append(f"{len(numbers)} feed move(s) with the word(s) {letters} kept as they are (line {shown})"
-                              + (": LinuxCNC refuses K on an arc in the XY plane" if "K" in letters else ""))  # fmt: skip
+            self.notes.append(f"{len(numbers)} feed move(s) {why} kept as they are (line {shown})"
+                              + (": LinuxCNC refuses K on an arc in the XY plane" if " K" in why else ""))  # fmt: skip
 
     def verbatim(self, line: str, words: list[tuple[str, float, str]], move: _Move | None = None) -> None:
         """Keep a line (``move``: a kept cutting line's move); put the input's motion code in front when it moves by the
@@ -433,8 +433,9 @@ class _Rewriter:
             self.unitless.append(number)
         if not cutting:
             extra = sorted({letter for letter, _, _ in words} - _CUTTING_WORDS)
-            if s.motion in (10, 20, 30) and s.plane == 170 and extra and not commented and not deleted:
-                self.other_words.setdefault(" ".join(extra), []).append(number)
+            if s.motion in (10, 20, 30) and s.plane == 170 and not commented and not deleted and (extra or not s.absolute):
+                why = f"with the word(s) {' '.join(extra)}" if extra else "in incremental mode (G91)"
+                self.kept_moves.setdefault(why, []).append(number)
             return None
         a = (float(start[0]), float(start[1]))  # type: ignore[arg-type]
         b = (float(end[0]), float(end[1]))  # type: ignore[arg-type]

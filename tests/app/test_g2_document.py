@@ -110,6 +110,7 @@ def test_what_is_kept_and_why():
     ])  # fmt: skip
     report = gcode_g2(text, 0.001, source="t.ngc")
     assert any("rotary axis" in n for n in report.notes)
+    assert "2 feed move(s) in incremental mode (G91) kept as they are (line 10, 11)" in report.notes
     assert report.units == "in"
     out = report.text.splitlines()
     for line in ("G1 X2 Y0 A5", "G91", "G1 X1", "G1 Y1", "G1 Z0 F10"):
