@@ -3,7 +3,8 @@
 The drawing is opened with ezdxf (``ezdxf.recover`` where the plain reader refuses it, as for LibreCAD's
 library drawings; the report says so). Its model space's ``LINE``, ``ARC``, ``CIRCLE``, ``LWPOLYLINE``
 and ``POLYLINE`` entities are chained into paths as ``spiral_cad.io.dxf_read`` chains them, and every
-path is made G2 by ``spiral_cad.design.make_g2`` within the bound, its arcs kept true arcs. The
+path is made G2 by ``spiral_cad.design.make_g2`` within the bound, its arcs kept true arcs (its runs of lines
+drawn as fewer lines within ``FEWER_SHARE`` of the bound first: a curve plotted as micrometre chords). The
 entities of a path made G2 are deleted and its G2 path written in their place: ``LINE``, ``ARC`` and one
 degree-3 ``SPLINE`` per spiral (its Bézier control points exact), on the layer and with the colour,
 linetype, lineweight and linetype scale of the path's first entity. A path that is G2 already (a lone
@@ -35,6 +36,8 @@ from typing import Any
 
 import numpy as np
 
+from ..core.fit import douglas_peucker
+from ..core.segments import Line
 from ..core.spiral import BezierSpiral
 from ..core.units import MM_PER_UNIT, length_unit
 from ..design import make_g2
@@ -48,6 +51,10 @@ __all__ = ["ATTRIBUTES", "rewrite_dxf_g2"]
 
 #: The graphic attributes a G2 path takes from its path's first entity (besides the layer).
 ATTRIBUTES = ("color", "true_color", "linetype", "lineweight", "ltscale", "transparency", "invisible")
+#: A run of lines is drawn as fewer lines within this share of the bound before it is made G2 (a curve a program
+#: plotted as chords a few micrometres long, as KiCad does: spirals at its micrometre corners would be so short that
+#: float64's rounding of their control points shows in their curvature).
+FEWER_SHARE = 0.2
 #: The parts of a split path must meet within this share of the bound (else the path is kept whole).
 MEET = 1e-6
 #: Rounds of exploding block references that hold paths (blocks inside blocks).
@@ -372,6 +379,10 @@ def _path(msp, pieces: list, owners: list, order: list[tuple[int, bool]], closed
     joints = len(segments) - (0 if closed else 1)
     if not joints:
         return PathReport(name, joints, kept="one entity, no joint", g2=True)
+    fewer = _fewer_lines(segments, FEWER_SHARE * bound) if flat else segments
+    if len(fewer) < len(segments):  # a curve plotted as chords a few micrometres long: its spirals float64 holds
+        share += FEWER_SHARE
+        segments = fewer
     try:
         result = make_g2(segments, bound * (1.0 - share), closed=closed, shape=shape, units=units)
     except ValueError as error:
@@ -408,6 +419,41 @@ def _path(msp, pieces: list, owners: list, order: list[tuple[int, bool]], closed
     for entity in entities:
         msp.delete_entity(entity)
     return PathReport(name, joints, changed, float(result.deviation) + share * bound, splits, pieces=len(added), g2=True)
+
+
+def _fewer_lines(segments: list, tolerance: float) -> list:
+    """Each run of consecutive lines as fewer lines through some of its vertices (Douglas–Peucker), when every
+    vertex left out lies within ``tolerance`` of its new line and projects inside it, in order: the two then lie
+    within ``tolerance`` of each other both ways. A run where that fails stays as it is."""
+    out: list = []
+    run: list[Line] = []
+
+    def close_run() -> None:
+        if len(run) >= 2:
+            points = np.array([run[0].start] + [line.end for line in run], dtype=float)
+            keep = douglas_peucker(points, tolerance)
+            if len(keep) < len(points) and all(_inside_in_order(points[i : j + 1]) for i, j in zip(keep[:-1], keep[1:])):
+                out.extend(Line(tuple(points[i]), tuple(points[j])) for i, j in zip(keep[:-1], keep[1:]))
+                run.clear()
+                return
+        out.extend(run)
+        run.clear()
+
+    for segment in segments:
+        if isinstance(segment, Line):
+            run.append(segment)
+            continue
+        close_run()
+        out.append(segment)
+    close_run()
+    return out
+
+
+def _inside_in_order(points: np.ndarray) -> bool:
+    """Whether the inner points project onto the chord from the first to the last inside it, in order."""
+    chord = points[-1] - points[0]
+    t = (points - points[0]) @ chord / float(chord @ chord)
+    return float(chord @ chord) > 0.0 and bool(np.all(np.diff(t) >= 0.0))
 
 
 def _add_on_layer(msp, piece, layer: str, attributes: dict):

@@ -297,3 +297,30 @@ def test_a_drawing_whose_entities_ezdxf_would_drop_is_refused_and_not_written(tm
     with pytest.raises(ValueError, match=r"would not write 1 SPLINE .*R12 drawing holds no SPLINE.*nothing written"):
         rewrite_dxf_g2(tmp_path / "in.dxf", tmp_path / "out.dxf", 0.01, units="mm")
     assert not (tmp_path / "out.dxf").exists()
+
+
+def test_a_curve_plotted_as_micrometre_chords_comes_back_with_spirals_float64_holds(tmp_path):
+    # KiCad plots a board's rounded corners as chords a few micrometres long (R12, no unit). A spiral pair at each
+    # micrometre corner would be so short that float64's rounding of its control points shows: the line end of a
+    # spiral curving 1e-6 per unit. The chords are drawn as fewer lines within a fifth of the bound first.
+    doc = ezdxf.new("R12")
+    msp = doc.modelspace()
+    corners = [((47.0, 3.0), -90.0), ((47.0, 27.0), 0.0), ((3.0, 27.0), 90.0), ((3.0, 3.0), 180.0)]
+    points = []
+    for (cx, cy), start in corners:
+        a = np.radians(np.linspace(start, start + 90.0, int(np.radians(90.0) * 3.0 / 0.007) + 1))  # 7 µm chords
+        points += list(zip(cx + 3.0 * np.cos(a), cy + 3.0 * np.sin(a)))
+    for p, q in zip(points, points[1:] + points[:1]):
+        if p != q:
+            msp.add_line(p, q, dxfattribs={"layer": "Edge.Cuts"})
+    doc.saveas(tmp_path / "board.dxf")
+    report = rewrite_dxf_g2(tmp_path / "board.dxf", tmp_path / "out.dxf", 0.01)
+    after = ezdxf.readfile(tmp_path / "out.dxf")
+    assert judge(after.modelspace()).share == 1.0 and report.worst <= 0.01
+    splines = after.modelspace().query("SPLINE")
+    assert 0 < len(splines) < len(points) / 10
+    for spline in splines:  # each spiral leaves a line with no curvature, to 1e-8 per unit
+        curve = spline.construction_tool()
+        ends = [curve.derivative(t, 2) for t in (0.0, curve.max_t)]
+        bends = [abs(d1.x * d2.y - d1.y * d2.x) / d1.magnitude**3 for _, d1, d2 in ends]
+        assert min(bends) <= 1e-8, bends
