@@ -173,8 +173,8 @@ GCODE_ONLY = ("max_deviation", "interpreter", "arc_tolerance", "feed")
 
 def _build(args: argparse.Namespace) -> int:
     suffix = "" if args.design is None else Path(args.design).suffix.lower()
-    if args.g2 is not None or suffix in (".dxf", ".xodr"):
-        return _build_g2(args, suffix)
+    if args.g2 is not None or suffix in (".dxf", ".xodr") or (suffix == ".xml" and args.max_deviation is not None):
+        return _build_g2(args, suffix)  # --g2 and --max-deviation: one bound, either name
     landxml = [o for o, given in (("--max-offset", args.max_offset is not None), ("--directions", args.directions != "auto")) if given]
     if landxml and (args.design is None or Path(args.design).suffix.lower() != ".xml"):
         raise ValueError(f"{', '.join(landxml)}: only with a LandXML file (.xml)")
@@ -213,8 +213,9 @@ def _build_g2(args: argparse.Namespace, suffix: str) -> int:
 
     if suffix not in (".dxf", ".xml", ".xodr"):
         raise ValueError("--g2: only with a DXF (.dxf), LandXML (.xml) or OpenDRIVE (.xodr) file")
-    if suffix == ".xodr" and args.g2 is None:
-        raise ValueError("an OpenDRIVE file is built with --g2 D (its lines and arcs made G2 within D); check it with spiral-cad check")
+    if suffix == ".xodr" and args.g2 is None and args.max_deviation is None:
+        raise ValueError("an OpenDRIVE file is built with --g2 D or --max-deviation D (its lines and arcs made G2 within D); "
+                         "check it with spiral-cad check")  # fmt: skip
     if args.g2 is not None and args.max_deviation is not None:
         raise ValueError("give --g2 or --max-deviation (the same bound), not both")
     deviation = args.g2 if args.g2 is not None else args.max_deviation
@@ -723,7 +724,8 @@ def _parser() -> argparse.ArgumentParser:
                             "(default: 5%% of each element's length; inf accepts any)")  # fmt: skip
     build.add_argument("--g2", type=float, metavar="D",
                        help="LandXML or OpenDRIVE: make every alignment of lines and arcs G2 within D (its unit; "
-                            "make_g2: arcs kept true arcs, spirals between), one design per alignment or road")  # fmt: skip
+                            "make_g2: arcs kept true arcs, spirals between), one design per alignment or road; "
+                            "--max-deviation D is the same bound")  # fmt: skip
     build.add_argument("--allow-splits", action="store_true",
                        help="DXF, LandXML, OpenDRIVE (made G2): accept a path split into G2 parts (at a reversal or a corner "
                             "too sharp; G0 where the parts meet) and exit 0; without it such a build exits 1")  # fmt: skip

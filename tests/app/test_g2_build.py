@@ -130,6 +130,9 @@ def test_a_landxml_alignment_of_lines_and_arcs_is_made_g2(tmp_path, capsys):
     assert (out / f"{built[0].name}.xodr").exists() and (out / f"{built[0].name}.step").exists()
     assert main(["build", str(source), "--g2", "0.1", "--max-deviation", "0.1", "--out", str(out)]) == 2
     assert "give --g2 or --max-deviation" in capsys.readouterr().err
+    again = tmp_path / "again"  # one bound by either name
+    assert main(["build", str(source), "--max-deviation", "0.1", "--no-plots", "--out", str(again)]) == 0
+    assert (again / f"{built[0].name}.xodr").read_bytes() == (out / f"{built[0].name}.xodr").read_bytes()
 
 
 def test_opendrive_roads_of_lines_and_arcs_are_made_g2_and_spirals_refused(tmp_path, capsys):
@@ -156,7 +159,8 @@ def test_opendrive_roads_of_lines_and_arcs_are_made_g2_and_spirals_refused(tmp_p
     assert main(["build", str(DATA / "esmini_lane_offset_junction.xodr"), "--g2", "0.05", "--out", str(tmp_path / "x")]) == 2
     assert "has spiral geometries: --g2 makes roads of lines and arcs G2" in capsys.readouterr().err
     assert main(["build", str(tmp_path / "g1.xodr"), "--out", str(tmp_path / "x")]) == 2
-    assert "an OpenDRIVE file is built with --g2 D" in capsys.readouterr().err
+    assert "an OpenDRIVE file is built with --g2 D or --max-deviation D" in capsys.readouterr().err
+    assert main(["build", str(tmp_path / "g1.xodr"), "--max-deviation", "0.05", "--no-plots", "--out", str(tmp_path / "y")]) == 0
 
 
 def test_the_design_type_g2_path(tmp_path):
