@@ -38,7 +38,7 @@ import math
 import time
 from collections.abc import Iterator, Sequence
 from contextlib import contextmanager
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Any
 
 import numpy as np
@@ -522,21 +522,38 @@ def _build(segments: list[Segment], bound: float, closed: bool | None, shape: st
     return _make(segments, bound, closed, shape, units, tolerance, retry)
 
 
-def _make(segments: list[Segment], bound: float, closed: bool | None, shape: str, units: str, tolerance: float,
-          retry: bool = True, round_sharp: bool = True, no_c: frozenset[int] = frozenset(), retried: int = 0,
-          loose: bool = True, chorded: frozenset[int] = frozenset(), near: bool = True) -> G2Path | _Refusal:  # fmt: skip
-    """``make_g2`` of plane lines and arcs, or the refusal of its first joint that fails (``retry``: a part
-    refused within the bound tried again within smaller shares of it; the advice's search goes without).
+@dataclass(frozen=True)
+class _Attempt:
+    """How ``_make`` makes a path; each way it is made again after a refusal changes one of these.
 
-    A corner sharper than a spiral pair rounds (but not a reversal) gets a tangent circle within the
-    bound and a transition on each side (``round_sharp``); where that fails, the path is made again
-    split at those corners, as before. A joint between crossing circles whose C pair is refused is made
-    again as a compound joint or a corner (``no_c``: those joints). Arcs merged as arcs of one circle to a share
-    of the bound (``loose``) move the ends of their neighbours: where that fails, the path is made again with
-    only arcs of one circle to float64's resolution merged (a bound that works keeps working when it grows).
-    Where that fails, short arcs beside the kinked joint refused are made again as their chords (``chorded``:
-    those segments; each moves the path by its sagitta), their joints corners; then small kinks are rounded as the
-    corners they are rather than absorbed by the shifts of the arcs beside them (not ``near``)."""
+    Attributes:
+        round_sharp: a corner sharper than a spiral pair rounds (not a reversal) gets a tangent circle within
+            the bound and a transition on each side; where that fails, the path is made again split there.
+        no_c: joints between crossing circles whose C pair was refused, made as compound joints or corners.
+        retried: how many times ``no_c`` has grown.
+        loose: arcs of one circle to a share of the bound are merged (they move their neighbours' ends);
+            where that fails, only arcs of one circle to float64's resolution (a bound that works keeps working
+            when it grows).
+        chorded: short arcs beside a kinked joint refused, made their chords (each moves the path by its
+            sagitta), their joints corners.
+        near: small kinks are absorbed by the shifts of the arcs beside them; where that fails, rounded as the
+            corners they are.
+    """
+
+    round_sharp: bool = True
+    no_c: frozenset[int] = frozenset()
+    retried: int = 0
+    loose: bool = True
+    chorded: frozenset[int] = frozenset()
+    near: bool = True
+
+
+def _make(segments: list[Segment], bound: float, closed: bool | None, shape: str, units: str, tolerance: float,
+          retry: bool = True, attempt: _Attempt = _Attempt()) -> G2Path | _Refusal:  # fmt: skip
+    """``make_g2`` of plane lines and arcs, or the refusal of its first joint that fails (``retry``: a part
+    refused within the bound tried again within smaller shares of it; the advice's search goes without),
+    made as ``attempt`` says, and again in the next way where that is refused."""
+    round_sharp, no_c, loose, chorded, near = attempt.round_sharp, attempt.no_c, attempt.loose, attempt.chorded, attempt.near
     pieces = [_piece_of(s, i) for i, s in enumerate(segments)]
     chord_off = 0.0
     for i in chorded:
@@ -654,26 +671,23 @@ def _make(segments: list[Segment], bound: float, closed: bool | None, shape: str
         made = _solve_group(group_pieces, group_kinds, group_joints, group_closed, room, shape, extent, units, tolerance, spanned,
                             bound, shown, steepest, RETRY_SHARES if retry else ())  # fmt: skip
         if isinstance(made, _Located):
-            if made.joint < joint_count and kinds[made.joint] == "arc-arc-c" and retried < C_RETRIES:
-                return _make(segments, bound, closed, shape, units, tolerance, retry, round_sharp, no_c | {made.joint}, retried + 1, loose,
-                             chorded, near)  # fmt: skip
-            if loose and arcs_merged:  # arcs of nearly one circle merged: made again, joined by transitions
-                again = _make(segments, bound, closed, shape, units, tolerance, retry, round_sharp, no_c, retried, False, chorded, near)
-                if not isinstance(again, _Refusal):
-                    return again
+            tried = replace(attempt, no_c=no_c)
+            if made.joint < joint_count and kinds[made.joint] == "arc-arc-c" and attempt.retried < C_RETRIES:
+                return _make(segments, bound, closed, shape, units, tolerance, retry,
+                             replace(tried, no_c=no_c | {made.joint}, retried=attempt.retried + 1))  # fmt: skip
             flat = _flat_arcs(pieces, kinds, room) & {made.joint, (made.joint + 1) % count} - chorded
-            if flat:  # short arcs beside the kinked joint refused made their chords
-                again = _make(segments, bound, closed, shape, units, tolerance, retry, round_sharp, no_c, retried, loose, chorded | flat,
-                              near)  # fmt: skip
-                if not isinstance(again, _Refusal):
-                    return again
-            if near and any(kind != "corner" and abs(_turn(pieces[i], pieces[(i + 1) % count])) > TANGENT_TOL
-                            for i, kind in enumerate(kinds) if kind not in ("g2", "split")):  # fmt: skip
-                again = _make(segments, bound, closed, shape, units, tolerance, retry, round_sharp, no_c, retried, loose, chorded, False)
-                if not isinstance(again, _Refusal):
-                    return again
+            kinked = near and any(kind != "corner" and abs(_turn(pieces[i], pieces[(i + 1) % count])) > TANGENT_TOL
+                                  for i, kind in enumerate(kinds) if kind not in ("g2", "split"))  # fmt: skip
+            for again in (
+                replace(tried, loose=False) if loose and arcs_merged else None,  # arcs of nearly one circle: joined by transitions
+                replace(tried, chorded=chorded | flat) if flat else None,  # short arcs beside the kinked joint refused: chords
+                replace(tried, near=False) if kinked else None,  # small kinks rounded as corners
+            ):
+                remade = _make(segments, bound, closed, shape, units, tolerance, retry, again) if again else None
+                if remade is not None and not isinstance(remade, _Refusal):
+                    return remade
             if round_sharp and sharp:  # the tangent circles did not fit: split at those corners instead
-                return _make(segments, bound, closed, shape, units, tolerance, retry, False, no_c, retried, loose, chorded, near)
+                return _make(segments, bound, closed, shape, units, tolerance, retry, replace(tried, round_sharp=False))
             return made
         chain, measured, group, solved, s, group_pieces, group_kinds, group_joints = made
         chains.append(chain)
