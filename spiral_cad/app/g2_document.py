@@ -133,8 +133,8 @@ def make_document_g2(src: str | os.PathLike, dst: str | os.PathLike, max_deviati
     function = rewriter_for(src)
     if rewriter_for(dst) is not function:
         raise ValueError(f"the output {Path(dst).name} is not the kind of document {Path(src).name} is")
-    if Path(src).resolve() == Path(dst).resolve():
-        raise ValueError(f"the output {Path(dst).name} is the input: write to another file")
+    if Path(src).resolve() == Path(dst).resolve() or (Path(src).exists() and Path(dst).exists() and os.path.samefile(src, dst)):
+        raise ValueError(f"the output {Path(dst).name} is the input: write to another file")  # (a link to it, too)
     if not Path(dst).parent.is_dir():
         raise ValueError(f"the output's folder {str(Path(dst).parent)!r} does not exist")
     return function(src, dst, max_deviation, **options)

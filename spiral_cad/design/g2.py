@@ -353,7 +353,9 @@ def make_g2(
     with _collector_paused():
         result = _build(segments, bound, closed, shape, units, tolerance)
         if isinstance(result, _Refusal):
-            deadline = started + ADVICE_SECONDS if advise else -math.inf
+            # no search where one build of the whole path takes longer than the search may take
+            cheap = time.perf_counter() - started <= ADVICE_SECONDS
+            deadline = started + ADVICE_SECONDS if advise and cheap else -math.inf
             message = _refusal_message(result, segments, bound, closed, shape, units, tolerance, deadline)
     if isinstance(result, _Refusal):
         raise NoSolutionError(message) from None
@@ -504,6 +506,8 @@ def _smallest_bound(segments: list[Segment], bound: float, closed: bool | None, 
             hi = mid
     # The advice is shown to 3 digits: rounded up, and that very number built again.
     for _ in range(8):
+        if time.perf_counter() > deadline:
+            return math.nan
         digits = 10.0 ** (math.floor(math.log10(hi)) - 2)
         shown = float(f"{math.ceil(hi / digits) * digits:.3g}")
         if not isinstance(_build(segments, shown, closed, shape, units, tolerance), _Refusal):

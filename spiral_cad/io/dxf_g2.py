@@ -80,22 +80,34 @@ def _open(source: Path) -> tuple[Any, str]:
         raise ValueError(f"{source.name}: not a DXF file ezdxf can read ({error})") from None
 
 
-def _as_r2000(doc, label: str, notes: list[str]) -> Any:
-    """An R12 drawing holding paths as the same drawing in DXF R2000 (R12 has no SPLINE for the spirals):
-    its tables, blocks, model and paper space imported by ezdxf's ``Importer``, its header variables
-    copied (a unit it does not state is not stated); the drawing as it is when not every entity comes along."""
+def _as_r2000(doc, issues: set[tuple[int, str]], notes: list[str]) -> Any:
+    """An R12 drawing holding paths as the same drawing in DXF R2000 (R12 has no SPLINE for the spirals): its
+    tables, blocks, model and paper space imported by ezdxf's ``Importer``, the entities' XDATA and their
+    application names, the header variables copied (a unit it does not state is not stated). The drawing as it
+    is (its paths then kept, named) when not every entity comes along, a block entity has XDATA, or ezdxf's
+    audit finds an issue in the R2000 drawing that the drawing has not (``issues``)."""
     import ezdxf
     from ezdxf.addons import Importer
 
     if doc.dxfversion >= "AC1015" or not any(entity.dxftype() in READ for entity in doc.modelspace()):
+        return doc
+    if any(entity.xdata for block in doc.blocks if not block.is_any_layout for entity in block):
         return doc
     new = ezdxf.new("R2000", setup=False)
     importer = Importer(doc, new)
     importer.import_tables()
     importer.import_blocks([block.name for block in doc.blocks if not block.is_any_layout])
     importer.import_modelspace()
-    importer.import_paperspace_layouts()
+    importer.import_entities(doc.paperspace(), new.paperspace())
     importer.finalize()
+    for space, into in ((doc.modelspace(), new.modelspace()), (doc.paperspace(), new.paperspace())):
+        if [e.dxftype() for e in space] != [e.dxftype() for e in into]:
+            return doc
+        for entity, imported in zip(space, into):  # the Importer leaves XDATA behind
+            for name, tags in entity.xdata.data.items() if entity.xdata else ():
+                if name not in new.appids:
+                    new.appids.new(name)
+                imported.set_xdata(name, list(tags))
     for name in doc.header.varnames():
         try:
             new.header[name] = doc.header[name]
@@ -104,10 +116,18 @@ def _as_r2000(doc, label: str, notes: list[str]) -> Any:
     for name in ("$INSUNITS", "$MEASUREMENT"):
         if name not in doc.header and name in new.header:
             del new.header[name]
-    if _contents(new.modelspace()) != _contents(doc.modelspace()):
+    handle, temporary = tempfile.mkstemp(suffix=".dxf")
+    os.close(handle)
+    try:
+        new.saveas(temporary)
+        written = ezdxf.readfile(temporary)
+        found = written.audit()
+    finally:
+        os.unlink(temporary)
+    if _contents(written.modelspace()) != _contents(doc.modelspace()) or _issue_kinds((*found.errors, *found.fixes)) - issues:
         return doc
     notes.append("a DXF R12 drawing (R12 holds no SPLINE for the spirals): written as DXF R2000, every entity, "
-                 "table, block and header variable taken along")  # fmt: skip
+                 "table, block, XDATA and header variable taken along")  # fmt: skip
     return new
 
 
@@ -281,7 +301,8 @@ def rewrite_dxf_g2(
     bound, unit_name, g2_units, notes = _bound(doc, max_deviation, units, label)
     if recovered:
         notes.insert(0, recovered)
-    doc = _as_r2000(doc, label, notes)
+    issues, count, first = _issues(source, bool(recovered))
+    doc = _as_r2000(doc, issues, notes)
     msp = doc.modelspace()
     notes += _explode(doc, msp)
     pieces: list[tuple[list[tuple], str]] = []
@@ -353,7 +374,6 @@ def rewrite_dxf_g2(
                       ("HELIX", "a curve in space")):  # fmt: skip
         if kept[kind]:
             notes.append(f"{kept[kind]} {kind} entit{'y' if kept[kind] == 1 else 'ies'} not made G2 ({why})")
-    issues, count, first = _issues(source, bool(recovered))
     if count:
         notes.append(f"ezdxf's audit finds {count} issue(s) in the input ({first}); kept as they were")
     _save(doc, target, issues, label, notes)

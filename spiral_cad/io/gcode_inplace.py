@@ -629,8 +629,8 @@ class _Rewriter:
         """The runs of a long program made G2 in one process per core (forked: each holds the runs read), by their
         order; none when the program is short, there is one core, or the system cannot fork."""
         processes = min(len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count() or 1, MAX_PROCESSES)
-        if processes < 2 or "fork" not in multiprocessing.get_all_start_methods():
-            return {}
+        if processes < 2 or "fork" not in multiprocessing.get_all_start_methods() or multiprocessing.current_process().daemon:
+            return {}  # (a pool's own process may start none)
         global _GATHERED
         gatherer = _Rewriter(*self.config, gathering=True)
         gatherer.run()

@@ -452,3 +452,29 @@ def test_a_bores_circle_comes_back_a_turn_short_of_full_and_the_judge_reads_it_s
     verdict = rs274_judge.judge(text, report.text, 0.01)
     assert verdict.passed, verdict.reasons
     assert verdict.distance > 1e-3  # the circle did shrink: the judge measured a full turn, not a short arc
+
+
+def test_an_output_that_is_a_link_to_the_input_is_refused(tmp_path):
+    source = tmp_path / "contour.nc"
+    source.write_text(CONTOUR)
+    os.link(source, tmp_path / "link.nc")
+    with pytest.raises(ValueError, match="is the input"):
+        make_document_g2(source, tmp_path / "link.nc", 0.01)
+    assert source.read_text() == CONTOUR
+
+
+def _in_a_pool_process(text: str) -> str:
+    return gcode_g2(text, 0.01).text
+
+
+def test_a_program_made_g2_inside_a_pools_process_is_made_in_that_process(monkeypatch):
+    """A pool's own process may start none (daemonic): the runs are made in it, as in one process."""
+    import multiprocessing
+
+    import spiral_cad.io.gcode_inplace as inplace
+
+    monkeypatch.setattr(inplace, "PARALLEL_MOVES", 0)  # every program "long" (forked into the pool's process too)
+    with multiprocessing.get_context("fork").Pool(1) as pool:
+        text = pool.apply(_in_a_pool_process, (CONTOUR,))
+    monkeypatch.setattr(inplace, "PARALLEL_MOVES", 10**12)
+    assert text == gcode_g2(CONTOUR, 0.01).text

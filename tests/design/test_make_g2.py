@@ -217,7 +217,7 @@ def test_g2_joints_are_left_alone_and_a_circle_is_already_g2():
     assert [j.kind for j in result.joints] == ["g2", "g2"]
 
 
-def test_refusal_names_the_joint_and_a_bound_that_works():
+def test_refusal_names_the_joint_and_a_bound_that_works(monkeypatch):
     # A bound below what float64 resolves at these coordinates.
     segments = filleted_rectangle(x=1e6, y=1e6)
     with pytest.raises(NoSolutionError) as error:
@@ -227,6 +227,13 @@ def test_refusal_names_the_joint_and_a_bound_that_works():
     works = float(message.split("max_deviation ")[-1].split(" ")[0])
     result = make_g2(segments, works)
     assert_g2(segments, result, works, closed=True)
+    # A path whose one build takes a good share of the search's time gets no search (it would overrun it).
+    import spiral_cad.design.g2 as g2
+
+    monkeypatch.setattr(g2, "ADVICE_SECONDS", 1e-9)
+    with pytest.raises(NoSolutionError, match="a larger max_deviation may help$"):
+        make_g2(segments, 1e-12)
+    monkeypatch.undo()
     # A caller that splits where make_g2 refuses and goes on (a program made G2 in place) asks for no advice.
     with pytest.raises(NoSolutionError) as error:
         make_g2(segments, 1e-12, advise=False)

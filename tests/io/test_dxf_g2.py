@@ -253,6 +253,27 @@ def test_an_r12_drawing_comes_back_g2_as_r2000_with_everything_else_and_no_unit_
     assert {e.dxf.layer for e in after.modelspace() if e.dxftype() != "TEXT"} == {"Edge.Cuts"}
 
 
+def test_an_r12_drawings_xdata_and_paper_space_come_along_and_one_that_cannot_is_kept_r12(tmp_path):
+    _r12_board(tmp_path / "board.dxf")
+    doc = ezdxf.readfile(tmp_path / "board.dxf")
+    doc.appids.new("MYAPP")
+    doc.modelspace().query("TEXT")[0].set_xdata("MYAPP", [(1000, "on the text"), (1040, 3.5)])
+    doc.paperspace().add_line((0, 0), (100, 0))
+    doc.saveas(tmp_path / "board.dxf")
+    rewrite_dxf_g2(tmp_path / "board.dxf", tmp_path / "out.dxf", 0.01, units="mm")
+    after = ezdxf.readfile(tmp_path / "out.dxf")
+    assert after.dxfversion == "AC1015" and "MYAPP" in after.appids
+    assert after.modelspace().query("TEXT")[0].get_xdata("MYAPP") == [(1000, "on the text"), (1040, 3.5)]
+    assert after.layout_names() == ["Model", "Layout1"] and [e.dxftype() for e in after.paperspace()] == ["LINE"]
+    # a block entity's XDATA the Importer would leave behind: the drawing stays R12, its paths kept and named
+    block = doc.blocks.new("TAG")
+    block.add_text("X").set_xdata("MYAPP", [(1000, "in a block")])
+    doc.saveas(tmp_path / "tagged.dxf")
+    report = rewrite_dxf_g2(tmp_path / "tagged.dxf", tmp_path / "out2.dxf", 0.01, units="mm")
+    assert ezdxf.readfile(tmp_path / "out2.dxf").dxfversion == "AC1009"
+    assert report.below_g2 and all("R12" in p.kept for p in report.paths if not p.g2)
+
+
 def test_a_path_on_a_layer_whose_name_ezdxf_will_not_give_a_new_entity_is_written_on_it(tmp_path):
     # dxf2gcode names layers "MILL: 1"; ezdxf reads them, but refuses them for a new entity.
     _r12_board(tmp_path / "board.dxf", layer="MILL_1")
