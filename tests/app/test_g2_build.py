@@ -3,6 +3,7 @@ made G2 by make_g2, arcs kept true arcs, the input within the bound (measured he
 
 import json
 import math
+import re
 from pathlib import Path
 
 import ezdxf
@@ -132,7 +133,8 @@ def test_a_landxml_alignment_of_lines_and_arcs_is_made_g2(tmp_path, capsys):
     assert "give --g2 or --max-deviation" in capsys.readouterr().err
     again = tmp_path / "again"  # one bound by either name
     assert main(["build", str(source), "--max-deviation", "0.1", "--no-plots", "--out", str(again)]) == 0
-    assert (again / f"{built[0].name}.xodr").read_bytes() == (out / f"{built[0].name}.xodr").read_bytes()
+    undated = [re.sub(r' date="[^"]*"', "", (folder / f"{built[0].name}.xodr").read_text()) for folder in (again, out)]
+    assert undated[0] == undated[1]  # the same file, but for the time it was written
 
 
 def test_opendrive_roads_of_lines_and_arcs_are_made_g2_and_spirals_refused(tmp_path, capsys):
