@@ -120,11 +120,10 @@ def _as_r2000(doc, issues: set[tuple[int, str]], notes: list[str]) -> Any:
     os.close(handle)
     try:
         new.saveas(temporary)
-        written = ezdxf.readfile(temporary)
-        found = written.audit()
+        contents, found = _read_back(temporary)
     finally:
         os.unlink(temporary)
-    if _contents(written.modelspace()) != _contents(doc.modelspace()) or _issue_kinds((*found.errors, *found.fixes)) - issues:
+    if contents != _contents(doc.modelspace()) or _issue_kinds(found) - issues:
         return doc
     notes.append("a DXF R12 drawing (R12 holds no SPLINE for the spirals): written as DXF R2000, every entity, "
                  "table, block, XDATA and header variable taken along")  # fmt: skip
@@ -205,7 +204,11 @@ def _issues(path: Path, recovered: bool) -> tuple[set[tuple[int, str]], int, str
 def _issue_kinds(items) -> set[tuple[int, str]]:
     """Audit issues as (code, message without the entities it names): an issue of a kind the input has, on an
     entity written in a path's place (a layer name ezdxf does not accept, on the new spline), is not new."""
-    return {(int(item.code), _ENTITY.sub("", item.message)) for item in items}
+    return {_issue_kind(item) for item in items}
+
+
+def _issue_kind(item) -> tuple[int, str]:
+    return int(item.code), _ENTITY.sub("", item.message)
 
 
 #: An entity named in an audit message: ``LINE(#35)``.
@@ -229,12 +232,22 @@ def _contents(msp) -> Counter[tuple[str, str]]:
     return Counter((entity.dxftype(), str(entity.dxf.layer)) for entity in msp)
 
 
+def _read_back(path: str) -> tuple[Counter[tuple[str, str]], list]:
+    """A written drawing as ezdxf reads it without recover mode: what its model space holds (``_contents``), and
+    what ezdxf's audit then finds in it."""
+    import ezdxf
+
+    written = ezdxf.readfile(path)
+    contents = _contents(written.modelspace())
+    auditor = written.audit()
+    return contents, [*auditor.errors, *auditor.fixes]
+
+
 def _save(doc, target: Path, issues: set[tuple[int, str]], label: str, notes: list[str]) -> None:
     """Write the drawing beside ``target``, check that ezdxf reads it without recover mode, that it holds every
     entity of the model space and that its audit finds nothing the input did not have, then move it onto
     ``target`` (else nothing is written). A drawing ezdxf cannot write as read (a dictionary entry pointing at
     nothing) is written after ezdxf's audit has fixed it, and the report says so."""
-    import ezdxf
 
     _unique_handles(doc, notes)
     expected = _contents(doc.modelspace())
@@ -253,15 +266,13 @@ def _save(doc, target: Path, issues: set[tuple[int, str]], label: str, notes: li
             issues = issues | _issue_kinds(items)
             expected = _contents(doc.modelspace())
             doc.saveas(temporary)
-        written = ezdxf.readfile(temporary)
-        lost = expected - _contents(written.modelspace())
+        contents, items = _read_back(temporary)
+        lost = expected - contents
         if lost:
             what = ", ".join(f"{n} {kind} on layer {layer}" for (kind, layer), n in sorted(lost.items()))
             why = " (a DXF R12 drawing holds no SPLINE)" if "SPLINE" in what and doc.dxfversion < "AC1015" else ""
             raise ValueError(f"{label}: ezdxf would not write {what}{why}; nothing written")
-        auditor = written.audit()
-        items = (*auditor.errors, *auditor.fixes)
-        new = [item for item in items if (int(item.code), _ENTITY.sub("", item.message)) not in issues]
+        new = [item for item in items if _issue_kind(item) not in issues]
         if new:
             raise ValueError(f"{label}: ezdxf's audit finds {len(new)} new issue(s) in the result ({new[0].message}); nothing written")
         os.replace(temporary, target)
