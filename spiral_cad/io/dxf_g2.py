@@ -258,12 +258,12 @@ def _save(doc, target: Path, issues: set[tuple[int, str]], label: str, notes: li
             doc.saveas(temporary)
         except Exception as error:  # noqa: BLE001 - any fault ezdxf's writer meets is the input's; its audit may fix it
             fixed = doc.audit()
-            items = (*fixed.fixes, *fixed.errors)
-            if not items:
+            repairs = [*fixed.fixes, *fixed.errors]
+            if not repairs:
                 raise ValueError(f"{label}: ezdxf cannot write the drawing ({type(error).__name__}: {error}); nothing written") from None
             notes.append(f"ezdxf cannot write the drawing as read ({type(error).__name__}: {error}); written after its audit "
-                         f"fixed {len(items)} issue(s) ({items[0].message})")  # fmt: skip
-            issues = issues | _issue_kinds(items)
+                         f"fixed {len(repairs)} issue(s) ({repairs[0].message})")  # fmt: skip
+            issues = issues | _issue_kinds(repairs)
             expected = _contents(doc.modelspace())
             doc.saveas(temporary)
         contents, items = _read_back(temporary)

@@ -38,10 +38,8 @@ the measured deviation and the counts.
 from __future__ import annotations
 
 import math
-import multiprocessing
 import os
 import re
-import signal
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -54,10 +52,12 @@ from ..core.errors import NoSolutionError
 from ..core.segments import Line, Segment
 from .gcode import exponent_word
 from .gcode_paths import _arc
+from .gcode_processes import PARALLEL_MOVES, in_processes, processes
+from .gcode_report import GcodeG2Report, GcodeRun
 from .gcode_write import DIALECTS, gcode_program
 from .progress import Progress
 
-__all__ = ["GcodeG2Report", "GcodeRun", "gcode_g2", "rewrite_gcode_g2"]
+__all__ = ["gcode_g2", "rewrite_gcode_g2"]
 
 #: Suffixes of the G-code programs ``rewrite_gcode_g2`` takes.
 GCODE_SUFFIXES = (".nc", ".ngc", ".gcode", ".tap")
@@ -69,11 +69,6 @@ MAX_REFUSED = 20
 SPLIT_SECONDS = 5.0
 #: Decimals of the numbers written (far below any bound a machine holds).
 DECIMALS = 10
-#: A program of at least this many cutting moves has its runs made G2 in several processes at once (one per
-#: core, forked; the output is the same as made in one).
-PARALLEL_MOVES = 20_000
-#: ... in at most this many.
-MAX_PROCESSES = 8
 
 _WORD = re.compile(r"\s*([A-Za-z])\s*([+-]?\s*(?:\d+\.?\d*|\.\d+))", re.ASCII)
 _WORDS = re.compile(r"(?:\s*[A-Za-z]\s*[+-]?\s*(?:\d+\.?\d*|\.\d+))*\s*", re.ASCII)
@@ -84,112 +79,6 @@ _CUTTING_WORDS = set("GNXYZIJRF")
 #: Motion codes (times ten) that leave the position unknown to this reader.
 _UNKNOWN_AFTER = {280, 300, 382, 383, 384, 385, 330, 331, 62, 730, 760, *range(810, 900, 10)}
 _NON_MODAL_UNKNOWN = {280, 300, 100, 520, 530, 921, 922, 923}
-
-
-@dataclass
-class GcodeRun:
-    """One run of cutting lines and what became of it.
-
-    Attributes:
-        first, last: its first and last line (1-based).
-        moves: its moves.
-        status: ``"G2"`` (rewritten, whole or in parts), ``"kept"`` (verbatim: see ``reason``) or
-            ``"nothing to do"`` (one move, or every joint G2 already).
-        reason: why it (or a part of it) was kept verbatim.
-        refused: the joints ``make_g2`` refused, each left as it was (the run split there and each side
-            made G2 on its own): the line ending at the joint, its point and ``make_g2``'s reason.
-        deviation: the measured distance between the input's path and the output's (both ways; program unit).
-        joints_changed: joints given a transition or rounded.
-        splits: joints ``make_g2`` split at (left as the corners they were).
-        lines_written: the lines written in its place.
-        nurbs: it is a LinuxCNC NURBS block (``G5.2`` … ``G5.3``), not a run of moves.
-    """
-
-    first: int
-    last: int
-    moves: int
-    status: str = "kept"
-    reason: str = ""
-    refused: list[str] = field(default_factory=list)
-    deviation: float = 0.0
-    joints_changed: int = 0
-    splits: int = 0
-    lines_written: int = 0
-    nurbs: bool = False
-
-
-@dataclass
-class GcodeG2Report:
-    """What ``gcode_g2`` did to a program.
-
-    Attributes:
-        source: the program's name.
-        text: the output program.
-        max_deviation: the bound (program unit).
-        units: the program's unit.
-        dialect: the output dialect.
-        runs: every run of cutting lines, in order.
-        notes: what else was kept verbatim and why (e.g. lines after parameters).
-    """
-
-    source: str
-    text: str
-    max_deviation: float
-    units: str
-    dialect: str
-    runs: list[GcodeRun] = field(default_factory=list)
-    notes: list[str] = field(default_factory=list)
-
-    @property
-    def deviation(self) -> float:
-        """The largest measured deviation of a rewritten run (program unit)."""
-        return max((r.deviation for r in self.runs if r.status == "G2"), default=0.0)
-
-    @property
-    def kept(self) -> list[GcodeRun]:
-        """The runs kept verbatim for a reason (refused or not within the bound)."""
-        return [r for r in self.runs if r.status == "kept"]
-
-    @property
-    def splits(self) -> int:
-        """Joints left as corners where ``make_g2`` split a run."""
-        return sum(r.splits for r in self.runs)
-
-    @property
-    def below_g2(self) -> list[GcodeRun]:
-        """The runs left below G2 somewhere: kept verbatim for a reason, or split (``spiral-cad g2`` exits 1 on them without ``--allow-splits``)."""
-        return [r for r in self.runs if r.status == "kept" or r.splits or r.refused]
-
-    def lines(self) -> list[str]:
-        """The short report: one line per run changed or kept, and the totals."""
-        unit = self.units
-        out = []
-        for r in self.runs:
-            where = f"lines {r.first}-{r.last}" if r.last != r.first else f"line {r.first}"
-            if r.status == "G2" and r.nurbs:
-                out.append(f"{self.source} {where}: NURBS block made G2 ({r.lines_written} lines), deviation {r.deviation:.3g} {unit}")
-            elif r.status == "G2":
-                split = f", {r.splits} split(s) left as corners" if r.splits else ""
-                refused = f", {len(r.refused)} refused joint(s) left as they were" if r.refused else ""
-                out.append(f"{self.source} {where}: {r.moves} moves made G2 ({r.lines_written} lines), deviation "
-                           f"{r.deviation:.3g} {unit}, {r.joints_changed} joints changed{split}{refused}")  # fmt: skip
-                out += [f"{self.source} {where}: joint at {joint}" for joint in r.refused]
-                if r.reason:
-                    out.append(f"{self.source} {where}: a part kept as it was: {r.reason}")
-            elif r.status == "kept":
-                out.append(f"{self.source} {where}: {r.moves} moves kept as they are: {r.reason}")
-                out += [f"{self.source} {where}: joint at {joint}" for joint in r.refused[1:]]
-        out += [f"{self.source}: {note}" for note in self.notes]
-        made = sum(r.status == "G2" for r in self.runs)
-        left = sum(len(r.refused) for r in self.runs if r.status == "G2")
-        parts = sum(r.status == "G2" and bool(r.reason) for r in self.runs)
-        also = (f", {left} joint(s) in them refused and left as they were" if left else "") + (
-            f", a part of {parts} of them kept as it was" if parts else ""
-        )
-        out.append(f"{self.source}: {made} of {len(self.runs)} runs made G2 within {self.max_deviation:g} {unit}{also} "
-                   f"(measured {self.deviation:.3g} {unit}), {len(self.kept)} kept for a reason, "
-                   f"{sum(r.status == 'nothing to do' for r in self.runs)} G2 already, {self.splits} splits")  # fmt: skip
-        return out
 
 
 @dataclass
@@ -626,28 +515,22 @@ class _Rewriter:
         return self.parts(run, moves, lines)
 
     def made_apart(self) -> dict[int, tuple[GcodeRun, list[tuple[int, list[str] | None]]]]:
-        """The runs of a long program made G2 in one process per core (forked: each holds the runs read), by their
-        order; none when the program is short, there is one core, or the system cannot fork."""
-        processes = min(len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count() or 1, MAX_PROCESSES)
-        if processes < 2 or "fork" not in multiprocessing.get_all_start_methods() or multiprocessing.current_process().daemon:
-            return {}  # (a pool's own process may start none)
-        global _GATHERED
+        """The runs of a long program made G2 in one process per core (``gcode_processes``: forked, each holds the
+        runs read), by their order; none when the program is short or there is one process to make them in."""
+        if processes() < 2:
+            return {}
         gatherer = _Rewriter(*self.config, gathering=True)
         gatherer.run()
         if sum(len(moves) for _, moves in gatherer.gathered) < PARALLEL_MOVES:
             return {}
-        made: dict[int, tuple[GcodeRun, list[tuple[int, list[str] | None]]]] = {}
-        progress = Progress(f"g2 {self.source}: runs made G2", len(gatherer.gathered))
-        _GATHERED = gatherer
-        try:
-            with multiprocessing.get_context("fork").Pool(processes, _quiet) as pool:
-                for k, result in enumerate(pool.imap(_made_g2, range(len(gatherer.gathered)), chunksize=8)):
-                    made[k] = result
-                    progress(k + 1)
-        finally:
-            _GATHERED = None
-        progress.done(len(made))
-        return made
+        return in_processes(gatherer.made_run, len(gatherer.gathered), f"g2 {self.source}: runs made G2")
+
+    def made_run(self, index: int) -> tuple[GcodeRun, list[tuple[int, list[str] | None]]]:
+        """Gathered run ``index`` made G2: the run, and each part's length and lines."""
+        lines, moves = self.gathered[index]
+        run = GcodeRun(moves[0].number, moves[-1].number, len(moves))
+        parts = self.made_g2(run, moves, lines)
+        return run, [(len(part_lines), written) for part_lines, _, written in parts]
 
     def parts(self, run: GcodeRun, moves: list[_Move], lines: list[str]) -> list[tuple[list[str], list[_Move], list[str] | None]]:
         """A run's parts, each with its lines written in its place (None: kept verbatim): the run made G2 whole, or, where
@@ -747,25 +630,6 @@ class _Rewriter:
         run.joints_changed += joints_changed
         run.splits += len(made.splits)
         return out
-
-
-#: The runs a forked process makes G2 (``_Rewriter.made_apart``).
-_GATHERED: _Rewriter | None = None
-
-
-def _quiet() -> None:
-    """A forked process leaves Ctrl-C and SIGTERM to the command: it is ended with the pool, saying nothing."""
-    signal.signal(signal.SIGINT, signal.SIG_IGN)
-    signal.signal(signal.SIGTERM, signal.SIG_DFL)
-
-
-def _made_g2(index: int) -> tuple[GcodeRun, list[tuple[int, list[str] | None]]]:
-    """Run ``index`` of the program gathered before the fork made G2: the run, and each part's length and lines."""
-    assert _GATHERED is not None
-    lines, moves = _GATHERED.gathered[index]
-    run = GcodeRun(moves[0].number, moves[-1].number, len(moves))
-    parts = _GATHERED.made_g2(run, moves, lines)
-    return run, [(len(part_lines), written) for part_lines, _, written in parts]
 
 
 def _mid_line(last: Segment, first: Segment) -> bool:
