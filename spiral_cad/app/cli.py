@@ -814,6 +814,8 @@ def main(argv: Sequence[str] | None = None) -> int:
             args = _parser().parse_args(argv)
             status = args.run(args)
             sys.stdout.flush()
+            if interrupted:  # its KeyboardInterrupt was swallowed (raised in a __del__): still stopped
+                return _interrupted(interrupted, "")
             return status
         except BrokenPipeError:
             try:  # the interpreter's last flush must not fail again

@@ -38,6 +38,7 @@ from collections.abc import Callable, Iterator, Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, TextIO
 
+from ..io.signals import raise_if_interrupted
 from ..io.staging import remove_stale
 from .many_inputs import expand_inputs, shown, wants_many
 from .many_task import NOT_RUN, FileResult, note_worst, run_alone, run_one
@@ -349,6 +350,7 @@ def _dispatch(client: Any, task: Callable[[argparse.Namespace], int], files: Seq
         submit(index)
     idle_since: float | None = None
     while in_flight:
+        raise_if_interrupted()  # a Ctrl-C whose KeyboardInterrupt dask's callbacks swallowed
         try:
             future = arrived.get(timeout=0.5)
         except queue.Empty:

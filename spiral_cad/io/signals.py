@@ -14,7 +14,12 @@ import threading
 from collections.abc import Iterator
 from contextlib import contextmanager
 
-__all__ = ["die_with_parent", "signals_handled", "stop_requested", "stopping_on"]
+__all__ = ["die_with_parent", "raise_if_interrupted", "signals_handled", "stop_requested", "stopping_on"]
+
+#: The records of the interrupting blocks now active. A signal stays in its record after its
+#: KeyboardInterrupt was raised, also when the interpreter swallowed it ("Exception ignored in"
+#: a ``__del__`` or a callback), so the command still stops.
+_interrupting: list[list[int]] = []
 
 
 @contextmanager
@@ -25,7 +30,9 @@ def signals_handled(names: tuple[str, ...], *, interrupt: bool) -> Iterator[list
 
     The record also tells an interrupt that a library turned into another exception (OCP's
     "ImportError: initialization failed" during a long import). Outside the main thread signals
-    cannot arrive, and nothing changes.
+    cannot arrive, and nothing changes. A signal that reached an interrupting block is
+    remembered until the block ends: ``stop_requested`` is True from then on, and
+    ``raise_if_interrupted`` raises again an interrupt that was swallowed.
     """
     received: list[int] = []
     if threading.current_thread() is not threading.main_thread():
@@ -38,11 +45,25 @@ def signals_handled(names: tuple[str, ...], *, interrupt: bool) -> Iterator[list
             raise KeyboardInterrupt
 
     previous = {name: signal.signal(getattr(signal, name), handler) for name in names if hasattr(signal, name)}
+    if interrupt:
+        _interrupting.append(received)
     try:
         yield received
     finally:
         for name, saved in previous.items():
             signal.signal(getattr(signal, name), saved)
+        if interrupt:
+            _interrupting.remove(received)
+
+
+def raise_if_interrupted() -> None:
+    """Raise KeyboardInterrupt when an interrupting ``signals_handled`` block got a signal.
+
+    Called where a long wait loops, so that an interrupt raised where the interpreter
+    ignores exceptions (a ``__del__`` run by the garbage collector) still stops the work.
+    """
+    if any(_interrupting):
+        raise KeyboardInterrupt
 
 
 _stop_file: str | None = None
@@ -64,8 +85,9 @@ def stopping_on(path: str | None) -> Iterator[None]:
 
 
 def stop_requested() -> bool:
-    """True when the command this process works for was interrupted (see ``stopping_on``)."""
-    return _stop_file is not None and os.path.exists(_stop_file)
+    """True when the command this process works for was interrupted (see ``stopping_on``), or
+    this process got a signal in an interrupting ``signals_handled`` block."""
+    return any(_interrupting) or (_stop_file is not None and os.path.exists(_stop_file))
 
 
 def die_with_parent(parent: int) -> None:

@@ -192,6 +192,36 @@ def test_an_interrupt_a_library_turned_into_another_exception_is_still_an_interr
     assert not (tmp_path / "out").exists()
 
 
+class _InterruptedWhileCollected:
+    """An object whose ``__del__`` gets the Ctrl-C: the interpreter prints "Exception ignored" and goes on."""
+
+    def __del__(self):
+        import os
+        import signal
+
+        os.kill(os.getpid(), signal.SIGINT)  # its handler runs inside this call, its KeyboardInterrupt is swallowed
+
+
+@pytest.mark.filterwarnings("ignore::pytest.PytestUnraisableExceptionWarning")
+def test_an_interrupt_the_interpreter_swallowed_still_stops_the_build_with_130(tmp_path, capsys, monkeypatch):
+    """dask's Future.__del__ got a Ctrl-C this way: the run went on to the end and exited 0."""
+    import gc
+
+    from spiral_cad.app import designfile
+
+    real = designfile._write_design
+
+    def collected_then_written(*args, **kwargs):
+        _InterruptedWhileCollected()
+        gc.collect()
+        return real(*args, **kwargs)
+
+    monkeypatch.setattr(designfile, "_write_design", collected_then_written)
+    assert main(["build", str(EXAMPLES / "design.json"), "--out", str(tmp_path / "out"), "--no-plots"]) == 130
+    assert capsys.readouterr().err == f"error: interrupted; nothing in {tmp_path / 'out'}/ was changed\n"
+    assert not (tmp_path / "out").exists()
+
+
 def test_warnings_never_reach_the_terminal(tmp_path, capsys, monkeypatch, recwarn):
     import warnings
 

@@ -106,6 +106,32 @@ def test_an_interrupt_during_the_moves_restores_every_destination(out, monkeypat
     assert signal.getsignal(signal.SIGINT) is handler
 
 
+@pytest.mark.filterwarnings("ignore::pytest.PytestUnraisableExceptionWarning")
+def test_an_interrupt_the_interpreter_swallowed_stops_the_commit_until_its_block_ends(out):
+    """A KeyboardInterrupt raised in a ``__del__`` is only printed; the command's record still stops it."""
+    import gc
+
+    from spiral_cad.io.signals import raise_if_interrupted, signals_handled, stop_requested
+
+    class InterruptedWhileCollected:
+        def __del__(self):
+            os.kill(os.getpid(), signal.SIGINT)
+
+    before = contents(out)
+    with signals_handled(("SIGINT",), interrupt=True) as received:
+        InterruptedWhileCollected()
+        gc.collect()
+        assert received == [signal.SIGINT] and stop_requested()
+        with pytest.raises(KeyboardInterrupt):
+            raise_if_interrupted()
+        with pytest.raises(KeyboardInterrupt), Staging(out) as stage:
+            stage_new_files(stage)
+            stage.commit()
+    assert contents(out) == before
+    assert not stop_requested()
+    raise_if_interrupted()  # the block ended: nothing pending
+
+
 def test_a_failed_restore_keeps_the_backups_and_names_them(out, monkeypatch):
     def break_down(n):
         if n >= 4:  # from the new b.svg on every move fails, the restores too
