@@ -76,6 +76,23 @@ def solids_pictures() -> None:
     fig.savefig(IMAGES / "solids_zebra.png", bbox_inches="tight")
 
 
+def gallery_pictures() -> None:
+    """The solids tutorial's gallery: each 2.5-D part rounded by build123d's circular ``fillet`` (the
+    stripes kink where the fillets meet the faces) beside ``g2_fillet`` of the same edges (they do not)."""
+    from matplotlib.figure import Figure
+
+    from spiral_cad.app.gallery import GALLERY, gallery_part
+    from spiral_cad.app.zebra import plot_zebra
+
+    fig = Figure(figsize=(12, 4.0 * len(GALLERY)), dpi=100)
+    axes = fig.subplots(len(GALLERY), 2)
+    for row, (name, (_, radius)) in zip(axes, GALLERY.items()):
+        for ax, g2 in zip(row, (False, True)):
+            title = f"{name.replace('_', ' ')}: {'g2_fillet' if g2 else 'build123d fillet'}, r = {radius:g}: {'G2' if g2 else 'G1'}"
+            plot_zebra(gallery_part(name, g2=g2), ax=ax, title=title, view=(1.0, -1.1, 0.8), stripes=10, pixels=900)
+    fig.savefig(IMAGES / "solids_gallery.png", bbox_inches="tight")
+
+
 def make_g2_picture() -> None:
     """The make_g2 tutorial's picture: curvature against arc length round a build123d ``fillet()``ed
     rectangle (it jumps 0 → 1/r at every tangent joint) and round the same outline after ``make_g2``
@@ -159,6 +176,7 @@ def main() -> None:
         first_curve()
         zebra_pictures()
         solids_pictures()
+        gallery_pictures()
         make_g2_picture()
     for path in sorted(IMAGES.iterdir()):
         print(path.relative_to(ROOT))

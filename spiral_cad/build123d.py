@@ -61,9 +61,9 @@ from .cad.corridor import Corridor, centerline_wire, corridor
 from .cad.fillet import fillet_face, fillet_wire, planar_frame
 from .cad.g2wire import g2_face, g2_wire
 from .cad.occ import chain_wire, plane_ax3, segment_edges
-from .cad.prism_fillet import fillet_prism_edges
 from .cad.slabs import Slab, continuous_box
 from .cad.slabs import g2_slab as _slab
+from .cad.stack_fillet import fillet_part_edges
 from .core.chain import Chain
 from .core.segments import Segment
 from .core.shapes import DEFAULT_SHAPE
@@ -404,8 +404,12 @@ def g2_fillet(
     edges chosen together (``box.edges()``) get one radius as the smallest
     radius of curvature of every edge: the rolls
     are of ``radius`` and the side corners of ``plan_radius(radius)`` (1.25 ×
-    the roll's reach, 1.571 × radius), wide enough to hold the roll. Inside
-    ``BuildPart`` the builder's part is replaced.
+    the roll's reach, 1.571 × radius), wide enough to hold the roll. A 2.5-D
+    part — a stack of prisms along one axis: pockets with floors, bosses,
+    steps, counterbores — is rounded the same way wall by wall; a rim where a
+    face rises on the open side (a pocket's floor, the face a boss stands on)
+    gets the roll turned over, a concave G2 fillet. Inside ``BuildPart`` the
+    builder's part is replaced.
 
     Args:
         target: the shape to round, the vertices to round in a builder, or
@@ -424,9 +428,10 @@ def g2_fillet(
             of its faces), non-planar input, edges other than lines
             and arcs, or edges that belong to no wire or face.
         NoSolutionError: a corner that cannot be rounded (named, with numbers);
-            solid edges that are not a prism's straight side edges or whole rims of its caps (outline or
-            hole), rolls meeting across a thin wall, pockets, bosses and steps along the axis (named by edge
-            and point, with the largest radius that builds where one does).
+            solid edges that are not a 2.5-D part's vertical edges or whole rims of its walls (outline,
+            hole, pocket, boss), rolls meeting across thin material, a face neither horizontal nor vertical,
+            walls of different heights meeting on one rim (a slot reaching the side) — named by edge and
+            point, with the largest radius that builds where one does.
     """
     context: Builder | None = Builder._get_context("g2_fillet")
     if isinstance(target, Iterable) and not isinstance(target, (Shape, str, bytes)):
@@ -496,7 +501,7 @@ def _fillet_edges(edges: list[Edge], radius: float, context: Builder | None, **o
         raise ValueError("g2_fillet of edges needs edges of a part (from part.edges(), or inside BuildPart)")
     if len(part.solids()) != 1:
         raise ValueError(f"g2_fillet of edges rounds one solid; the part has {len(part.solids())}")
-    slab = fillet_prism_edges(part.solids()[0].wrapped, [e.wrapped for e in edges], radius, **options)
+    slab = fillet_part_edges(part.solids()[0].wrapped, [e.wrapped for e in edges], radius, **options)
     result = _part(slab)
     if isinstance(context, BuildPart):
         context._add_to_context(result, mode=Mode.REPLACE)

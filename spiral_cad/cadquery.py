@@ -50,8 +50,8 @@ from OCP.gp import gp_Ax3
 from .cad.fillet import fillet_face, fillet_wire
 from .cad.g2wire import g2_face, g2_wire
 from .cad.occ import chain_wire, segment_edges
-from .cad.prism_fillet import fillet_prism_edges
 from .cad.slabs import continuous_box
+from .cad.stack_fillet import fillet_part_edges
 from .core.chain import Chain
 from .core.segments import Segment
 from .core.shapes import DEFAULT_SHAPE
@@ -245,7 +245,7 @@ def g2Fillet(self: W, radius: float, transition: float = 0.5, same_sense: str = 
     continuous; the wires stay pending (e.g. for ``.extrude``). With no pending
     wires and edges of a solid selected (``.edges()``, as CadQuery's ``fillet``
     takes them), the solid is rounded as ``spiral_cad.build123d.g2_fillet``
-    rounds a part's edges (``fillet_prism_edges``) and replaces it on the stack.
+    rounds a part's edges (``fillet_part_edges``: prisms and 2.5-D parts) and replaces it on the stack.
 
     Raises:
         ValueError: no pending wires and no selected edges of a solid, non-planar wires or edges other than
@@ -256,7 +256,7 @@ def g2Fillet(self: W, radius: float, transition: float = 0.5, same_sense: str = 
     edges = [e for e in self.objects if isinstance(e, cq.Edge)]
     if not wires and edges:
         solid = self.findSolid()
-        slab = fillet_prism_edges(solid.wrapped, [e.wrapped for e in edges], radius, transition=transition,
+        slab = fillet_part_edges(solid.wrapped, [e.wrapped for e in edges], radius, transition=transition,
                                   same_sense=same_sense, shape=shape)  # fmt: skip
         return self.newObject([cq.Solid(slab.shape)])
     if not wires:

@@ -7,6 +7,8 @@ from __future__ import annotations
 import io
 import json
 import math
+import multiprocessing
+import multiprocessing.context
 import os
 import re
 import subprocess
@@ -255,69 +257,77 @@ def python_blocks(text: str, marker: str, name: str = "page") -> list[Block]:
     return blocks
 
 
+def _pages() -> multiprocessing.context.ForkServerContext:
+    """Where pages run: processes forked from a server that imported spiral_cad, numpy and (where
+    installed) build123d once and ran nothing else. Never forked from a test's process: once OCCT's
+    thread pool has threads there (a boolean ran), a child forked from it that runs a boolean waits
+    for threads it does not have, for ever."""
+    global _PAGES
+    if _PAGES is None:
+        _PAGES = multiprocessing.get_context("forkserver")
+        _PAGES.set_forkserver_preload(["numpy", "spiral_cad", "build123d"])  # one missing is skipped
+    return _PAGES
+
+
+_PAGES: multiprocessing.context.ForkServerContext | None = None
+
+
+def _run_page(page: str, runnable: list[tuple[int, str]], cwd: str, argv: list[str] | None, err: str) -> None:
+    """The page's own process: its blocks in one fresh ``__main__`` namespace; stderr into ``err``."""
+    import sys
+
+    status = 1
+    try:
+        os.chdir(cwd)
+        sys.argv = argv or ["-c"]
+        sys.path[0:0] = [str(Path(argv[0]).resolve().parent) if argv else cwd]  # as Python puts it first
+        os.environ["MPLBACKEND"] = "Agg"
+        if "matplotlib" in sys.modules:
+            sys.modules["matplotlib"].use("Agg", force=True)
+        os.dup2(os.open(os.devnull, os.O_WRONLY), 1)
+        os.dup2(os.open(err, os.O_WRONLY), 2)
+        sys.stdout = io.TextIOWrapper(open(1, "wb", closefd=False), line_buffering=True)
+        sys.stderr = io.TextIOWrapper(open(2, "wb", closefd=False), line_buffering=True)
+        namespace = {"__name__": "__main__"}
+        for first_line, code in runnable:
+            exec(compile("\n" * (first_line - 1) + code, page, "exec"), namespace)
+        status = 0
+    except SystemExit as stop:  # as the interpreter would end
+        status = stop.code if isinstance(stop.code, int) else (0 if stop.code is None else 1)
+    except BaseException:  # noqa: BLE001 - the page's error, reported by the test
+        import traceback
+
+        traceback.print_exc()
+    finally:
+        sys.stdout.flush()
+        sys.stderr.flush()
+        os._exit(status)
+
+
 #: Runs blocks as one Python session (one namespace), each compiled at its own line of the page.
 def run_blocks(page: Path, blocks: list[Block], cwd: Path, timeout: float, argv: list[str] | None = None) -> None:
     """Run a page's blocks that are not marked skip, top to bottom in one fresh Python process in
     ``cwd`` with a fresh ``__main__`` namespace; fail the test with the process's stderr. With ``argv``
     the page is a script run as ``python *argv`` (its folder first on the path), else as ``python -c``.
 
-    The process is forked from this one once spiral_cad, numpy and (where installed) build123d are
-    imported here, so a page does not pay for importing them again (about 3 s a page); what it
+    The process is forked from a server that imported spiral_cad, numpy and build123d once
+    (``_pages``), so a page does not pay for importing them again (about 3 s a page); what it
     defines, changes or breaks stays in its own process."""
-    import signal
-    import sys
     import tempfile
 
-    import spiral_cad  # noqa: F401  (imported once here, shared by every page forked below)
-
-    try:
-        import build123d  # noqa: F401
-    except ImportError:
-        pass
     runnable = [(b.first_line, b.code) for b in blocks if b.skip_reason is None]
-    with tempfile.TemporaryFile() as err:
-        for stream in (sys.stdout, sys.stderr):
-            stream.flush()
-        pid = os.fork()
-        if pid == 0:  # the page's own process: never returns
-            status = 1
-            try:
-                os.chdir(cwd)
-                sys.argv = argv or ["-c"]
-                sys.path[0:0] = [str(Path(argv[0]).resolve().parent) if argv else str(cwd)]  # as Python puts it first
-                os.environ["MPLBACKEND"] = "Agg"
-                if "matplotlib" in sys.modules:
-                    sys.modules["matplotlib"].use("Agg", force=True)
-                os.dup2(os.open(os.devnull, os.O_WRONLY), 1)
-                os.dup2(err.fileno(), 2)
-                sys.stdout = io.TextIOWrapper(open(1, "wb", closefd=False), line_buffering=True)  # not pytest's capture
-                sys.stderr = io.TextIOWrapper(open(2, "wb", closefd=False), line_buffering=True)
-                namespace = {"__name__": "__main__"}
-                for first_line, code in runnable:
-                    exec(compile("\n" * (first_line - 1) + code, str(page), "exec"), namespace)
-                status = 0
-            except SystemExit as stop:  # as the interpreter would end
-                status = stop.code if isinstance(stop.code, int) else (0 if stop.code is None else 1)
-            except BaseException:  # noqa: BLE001 - the page's error, reported by the test below
-                import traceback
-
-                traceback.print_exc()
-            finally:
-                sys.stdout.flush()
-                sys.stderr.flush()
-                os._exit(status)
-        deadline = time.monotonic() + timeout
-        while (done := os.waitpid(pid, os.WNOHANG))[0] == 0:
-            if time.monotonic() > deadline:
-                os.kill(pid, signal.SIGKILL)
-                os.waitpid(pid, 0)
-                pytest.fail(f"{page}: still running after {timeout:g} s", pytrace=False)
-            time.sleep(0.01)
-        status = done[1]
-        if status != 0:
+    with tempfile.NamedTemporaryFile() as err:
+        process = _pages().Process(target=_run_page, args=(str(page), runnable, str(cwd), argv, err.name))
+        process.start()
+        process.join(timeout)
+        if process.is_alive():
+            process.kill()
+            process.join()
+            pytest.fail(f"{page}: still running after {timeout:g} s", pytrace=False)
+        if process.exitcode != 0:
             err.seek(0)
             text = err.read().decode("utf-8", "replace")
-            pytest.fail((text[-4000:] or f"{page}: exit status {status}"), pytrace=False)
+            pytest.fail((text[-4000:] or f"{page}: exit status {process.exitcode}"), pytrace=False)
 
 
 def unresolved(dotted: str) -> str | None:

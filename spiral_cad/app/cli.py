@@ -12,6 +12,7 @@ import sys
 import time
 import warnings
 from collections.abc import Callable, Sequence
+from functools import partial
 from importlib.util import find_spec
 from pathlib import Path
 
@@ -135,13 +136,18 @@ def _demo(args: argparse.Namespace) -> int:
     print("The five transitions of Walton & Meek (1996), one instance each with each spiral shape:\n")
     print(transition_table(core_examples()))
     print()
-    return _write_design(DEMO_DESIGN, Path(args.out), plots=not args.no_plots, extra=None if args.no_plots else _paper_plots)
+    return _write_design(DEMO_DESIGN, Path(args.out), plots=not args.no_plots, extra=partial(_demo_extras, plots=not args.no_plots))
 
 
-def _paper_plots(folder: Path) -> None:
-    """The paper's Fig. 6 family beside the near-linear one, and both spirals against a clothoid,
-    written into ``folder`` (nothing without matplotlib: the missing plots are reported with the rest)."""
-    if find_spec("matplotlib") is None:
+def _demo_extras(folder: Path, plots: bool) -> None:
+    """The gallery's G2 parts as STEP files (with the CAD extra) and, with ``plots``, the paper's
+    Fig. 6 family beside the near-linear one and both spirals against a clothoid, written into
+    ``folder`` (what needs a missing extra is reported with the rest)."""
+    if find_spec("build123d") is not None:
+        from .gallery import write_gallery
+
+        write_gallery(folder)
+    if not plots or find_spec("matplotlib") is None:
         return
     from .plots import plot_fig6_shapes, plot_vs_clothoid
 

@@ -79,7 +79,12 @@ LARGE_CHAIN_EDGES = 50_000
 #: Design files larger than this are refused before they are read.
 MAX_DESIGN_BYTES = 10_000_000
 #: The packages of the ``cad`` extra and what needs them.
-CAD_EXTRA = {"OCP": "IGES, the 3-D STEP of roads and the continuity check", "ezdxf": "DXF", "matplotlib": "plots", "ifcopenshell": "IFC"}
+CAD_EXTRA = {
+    "OCP": "IGES, the 3-D STEP of roads, the demo's gallery of G2 parts and the continuity check",
+    "ezdxf": "DXF",
+    "matplotlib": "plots",
+    "ifcopenshell": "IFC",
+}
 
 
 def build_landxml(path: str | Path, max_offset: float | None = None, directions: str = "auto") -> tuple[str, list[Built]]:

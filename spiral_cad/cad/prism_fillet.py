@@ -42,7 +42,6 @@ from .slabs import (
     Slab,
     _first_solid,
     _loops,
-    _plane,
     _roll_problem,
     _turns,
     _volume,
@@ -52,8 +51,18 @@ from .slabs import (
     verify_faces,
     verify_solid,
 )
+from .stacks import _plane
 
-__all__ = ["PLAN_OVER_REACH", "fillet_prism_edges", "plan_radius"]
+__all__ = ["PLAN_OVER_REACH", "StackedPart", "fillet_prism_edges", "plan_radius"]
+
+
+class StackedPart(NoSolutionError):
+    """The part has planar faces at more than two levels along ``axis``: no prism, maybe a 2.5-D part
+    (``stack_fillet``)."""
+
+    def __init__(self, message: str, axis: gp_Dir) -> None:
+        super().__init__(message)
+        self.axis = axis
 
 
 @dataclass(frozen=True)
@@ -97,12 +106,13 @@ def _prism(solid: TopoDS_Shape, direction: gp_Dir, edge_name: str) -> _Prism:
     levels = sorted({round(gp_Vec(direction).Dot(gp_Vec(_plane(f).Location().XYZ())), 9) for f in caps})  # type: ignore[union-attr]
     if len(levels) > 2:
         shown_levels = ", ".join(f"{level:.6g}" for level in levels)
-        raise NoSolutionError(
+        raise StackedPart(
             f"g2_fillet rounds right prisms (two parallel planar caps; through holes allowed); {edge_name}: the part "
             f"has planar faces at {len(levels)} levels along ({direction.X():.6g}, {direction.Y():.6g}, "
             f"{direction.Z():.6g}) — {shown_levels} — as a pocket, a boss or a step makes, which g2_fillet does not "
             "round: round the plain prism first and cut the pocket (or add the boss) afterwards, or use build123d's "
-            "fillet on those edges"
+            "fillet on those edges",
+            direction,
         )
     if len(caps) != 2:
         raise NoSolutionError(
@@ -244,9 +254,9 @@ def fillet_prism_edges(
         try:
             ranked.append((_fit(solid, edges, candidate, named), candidate))
         except NoSolutionError as error:  # the most telling first: levels (nearest z first), then a leaning side
-            failed.append(((" levels " not in str(error), " leans " not in str(error), -abs(candidate.Z())), str(error)))
+            failed.append(((" levels " not in str(error), " leans " not in str(error), -abs(candidate.Z())), error))
     if not ranked and failed:
-        raise NoSolutionError(min(failed)[1])
+        raise min(failed, key=lambda row: row[0])[1]
     if not ranked:
         raise NoSolutionError(
             f"g2_fillet rounds a solid's straight edges when each end meets a face perpendicular to it (prism side "

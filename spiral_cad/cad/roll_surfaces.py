@@ -48,7 +48,7 @@ from OCP.TColStd import TColStd_Array1OfInteger, TColStd_Array1OfReal, TColStd_A
 from OCP.TopAbs import TopAbs_FACE
 from OCP.TopExp import TopExp_Explorer
 from OCP.TopLoc import TopLoc_Location
-from OCP.TopoDS import TopoDS, TopoDS_Face, TopoDS_Shape
+from OCP.TopoDS import TopoDS, TopoDS_Face, TopoDS_Shape, TopoDS_Wire
 
 from ..core import bezier
 from ..core._inputs import as_float, shown
@@ -251,21 +251,24 @@ def _along_spans(along: _Along) -> list[_Along]:
     ]
 
 
-def _sections(roll: list[Segment], top: float, bottom: float, height: float) -> list[_Section]:
-    """The Bézier spans of the bottom roll, the wall and the top roll (those of non-zero extent), in the (w, z) plane."""
+def _sections(roll: list[Segment], top: float, bottom: float, low: float, high: float, *, foot: bool = False) -> list[_Section]:
+    """The Bézier spans of the bottom roll, the wall and the top roll (those of non-zero extent) of a wall from
+    z ``low`` to ``high``, in the (w, z) plane. ``foot``: the bottom is a concave fillet onto a face rising on
+    the open side (w < 0: a pocket's floor, the face a boss stands on), the bottom roll turned over."""
     curve = chain_to_nurbs(roll) if roll else None
     ends = np.array([0.0, 1.0]), np.array([4, 4])
     sections = []
     if bottom > 0.0 and curve is not None:
         scale = bottom / float(curve.control_points[-1, 0])
-        points = curve.control_points * scale * np.array([1.0, -1.0])  # mirrored: the wall at (0, d) down to (d, 0)
+        flip = np.array([-1.0 if foot else 1.0, -1.0])  # mirrored: the wall at (0, d) down to (±d, 0)
+        points = curve.control_points * scale * flip + np.array([0.0, low])
         sections += [_Section(3, *ends, w, p) for w, p in _spans(3, curve.weights, points)]
-    if height - top - bottom > 0.0:
-        wall = np.array([[0.0, bottom], [0.0, height - top]])
+    if high - low - top - bottom > 0.0:
+        wall = np.array([[0.0, low + bottom], [0.0, high - top]])
         sections.append(_Section(1, np.array([0.0, 1.0]), np.array([2, 2]), np.ones(2), wall))
     if top > 0.0 and curve is not None:
         scale = top / float(curve.control_points[-1, 0])
-        points = curve.control_points * scale + np.array([0.0, height])
+        points = curve.control_points * scale + np.array([0.0, high])
         sections += [_Section(3, *ends, w, p) for w, p in _spans(3, curve.weights, points)]
     return sections
 
@@ -302,21 +305,23 @@ def _boundary_edge(along: _Along, w: float, z: float):
     return BRepBuilderAPI_MakeEdge(curve).Edge()
 
 
-def _cap(rims: Sequence[tuple[list[_Along], float]], z: float) -> TopoDS_Face:
-    """The plane z bounded by each rim's iso-curve at its roll's width: the first rim (counterclockwise)
-    outside, the others (clockwise) holes in it."""
-    wires = []
-    for alongs, w in rims:
-        wire = BRepBuilderAPI_MakeWire()
-        for along in alongs:
-            edge = _boundary_edge(along, w, z)
-            if edge is not None:
-                wire.Add(edge)
-        if not wire.IsDone():
-            raise NoSolutionError(f"the cap at z = {z:.6g} has no closed boundary (the roll closes the outline)")
-        wires.append(wire.Wire())
-    face = BRepBuilderAPI_MakeFace(gp_Pln(gp_Pnt(0.0, 0.0, z), gp_Dir(0.0, 0.0, 1.0)), wires[0])
-    for hole in wires[1:]:
+def _rim_wire(alongs: Sequence[_Along], w: float, z: float, *, reverse: bool = False) -> TopoDS_Wire:
+    """The closed wire of the rim's iso-curves C + w·Ñ at height z (``reverse``: run backwards)."""
+    wire = BRepBuilderAPI_MakeWire()
+    for along in alongs:
+        edge = _boundary_edge(along, w, z)
+        if edge is not None:
+            wire.Add(edge)
+    if not wire.IsDone():
+        raise NoSolutionError(f"the face at z = {z:.6g} has no closed boundary (the roll closes the outline)")
+    made = wire.Wire()
+    return TopoDS.Wire_s(made.Reversed()) if reverse else made
+
+
+def _plane_face(z: float, outer: TopoDS_Wire, holes: Sequence[TopoDS_Wire] = ()) -> TopoDS_Face:
+    """The plane z inside ``outer`` (counterclockwise) and outside each of ``holes`` (clockwise)."""
+    face = BRepBuilderAPI_MakeFace(gp_Pln(gp_Pnt(0.0, 0.0, z), gp_Dir(0.0, 0.0, 1.0)), outer)
+    for hole in holes:
         face.Add(hole)
     return face.Face()
 

@@ -16,30 +16,24 @@ from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
-from OCP.BRep import BRep_Tool
-from OCP.BRepBuilderAPI import (
-    BRepBuilderAPI_MakeSolid,
-    BRepBuilderAPI_Sewing,
-)
+from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeSolid
 from OCP.BRepCheck import BRepCheck_Analyzer
 from OCP.BRepGProp import BRepGProp
-from OCP.GeomAbs import GeomAbs_SurfaceType
-from OCP.GeomAdaptor import GeomAdaptor_Surface
-from OCP.gp import gp_Pln
 from OCP.GProp import GProp_GProps
-from OCP.TopAbs import TopAbs_FORWARD, TopAbs_REVERSED, TopAbs_SHELL, TopAbs_SOLID
+from OCP.TopAbs import TopAbs_FORWARD, TopAbs_SHELL, TopAbs_SOLID
 from OCP.TopExp import TopExp_Explorer
-from OCP.TopoDS import TopoDS, TopoDS_Face, TopoDS_Shape, TopoDS_Solid
+from OCP.TopoDS import TopoDS, TopoDS_Shape, TopoDS_Solid
 
 from ..core._inputs import as_float, shown
 from ..core.chain import JOIN_TOLERANCE, Chain, g2_mismatch
 from ..core.errors import NoSolutionError
-from ..core.segments import Arc, Segment
+from ..core.segments import Segment
 from ..core.shapes import DEFAULT_SHAPE
 from ..core.units import DEFAULT_UNITS, length_unit
 from ..design.fillets import TANGENT_TOL, continuous_rectangle
 from .advice import advice, refusal
-from .roll_surfaces import _along, _along_spans, _cap, _faces_of, _record, _sections, _surface_face, roll_profile
+from .roll_surfaces import roll_profile
+from .stacks import _FIT_SLACK, Wall, _between, _fit_problem, _inside, _plain, _samples, stack_solid
 
 __all__ = [
     "Slab",
@@ -53,8 +47,6 @@ __all__ = [
     "verify_solid",
 ]
 
-#: Relative slack on "the roll fits" comparisons (equality itself is decided by the construction).
-_FIT_SLACK = 1e-12
 #: A joint of the outline turning more than this (radians) is a corner no roll can follow.
 _CORNER_TOL = 1e-7
 
@@ -130,67 +122,6 @@ def outline_segments(outline: Any, *, corners: bool = False) -> list[Segment]:
     return segments
 
 
-def _samples(segments: list[Segment], count: int = 24) -> tuple[NDArray, NDArray, NDArray]:
-    """Points, left normals and curvatures at ``count`` parameters per segment (closing point excluded)."""
-    u = np.linspace(0.0, 1.0, count, endpoint=False)
-    points = np.vstack([s.point(u)[:, :2] for s in segments])
-    tangents = np.vstack([s.tangent(u)[:, :2] for s in segments])
-    curvatures = np.concatenate([np.broadcast_to(s.curvature(u), u.shape) for s in segments])
-    return points, np.stack([-tangents[:, 1], tangents[:, 0]], axis=1), curvatures
-
-
-def _crossing(polygon: NDArray[np.float64]) -> NDArray[np.float64] | None:
-    """A point where the closed polygon crosses itself (non-adjacent edges), or None."""
-    a, b = polygon, np.roll(polygon, -1, axis=0)
-    d = b - a
-    n = len(a)
-    i, j = np.triu_indices(n, 2)
-    keep = (j - i) < n - 1  # the last edge is adjacent to the first
-    i, j = i[keep], j[keep]
-    denom = d[i, 0] * d[j, 1] - d[i, 1] * d[j, 0]
-    diff = a[j] - a[i]
-    with np.errstate(divide="ignore", invalid="ignore"):
-        t = (diff[:, 0] * d[j, 1] - diff[:, 1] * d[j, 0]) / denom
-        u = (diff[:, 0] * d[i, 1] - diff[:, 1] * d[i, 0]) / denom
-    hit = (denom != 0.0) & (t > 0.0) & (t < 1.0) & (u > 0.0) & (u < 1.0)
-    if not hit.any():
-        return None
-    k = int(np.argmax(hit))
-    result: NDArray[np.float64] = a[i[k]] + t[k] * d[i[k]]
-    return result
-
-
-def _plain(x: float, y: float) -> str:
-    return f"({x:.6g}, {y:.6g})"
-
-
-def _fit_problem(segments: list[Segment], sigma: float, roll: float, given: Any, name: str,
-                 at: Callable[[float, float], str] = _plain) -> str | None:  # fmt: skip
-    """Why a roll ``roll`` wide does not fit inside the outline, or None: it must stay below every convex
-    radius of curvature (equal only on arcs: a clean pole) and its inner offset must not cross itself."""
-    for index, segment in enumerate(segments):
-        u = np.linspace(0.0, 1.0, 65)
-        bend = float(np.max(sigma * np.broadcast_to(segment.curvature(u), u.shape)))
-        if bend <= 0.0:
-            continue
-        product = roll * bend
-        exact_pole = isinstance(segment, Arc) and abs(product - 1.0) <= 1e-12
-        if product > 1.0 - _FIT_SLACK and not exact_pole:
-            return (
-                f"{name} {shown(given)} gives a roll {roll:.6g} wide, not below the outline's smallest convex radius "
-                f"of curvature {1.0 / bend:.6g} (segment {index}, a {type(segment).__name__}): the inner offset "
-                "would fold"
-            )
-    points, normals, _ = _samples(segments)
-    place = _crossing(points + sigma * roll * normals)
-    if place is not None:
-        return (
-            f"{name} {shown(given)} gives a roll {roll:.6g} wide whose inner offset crosses itself near "
-            f"{at(place[0], place[1])}: the outline is too narrow there"
-        )
-    return None
-
-
 def _inward(segments: list[Segment]) -> float:
     """+1 when the outline runs counterclockwise (its inward normal is the left one), else −1."""
     points, _, _ = _samples(segments)
@@ -210,32 +141,6 @@ def _loops(segments: list[Segment], holes: Sequence[list[Segment]] = ()) -> list
 
 def _rim(index: int) -> str:
     return "the outline's rim" if index == 0 else f"hole {index - 1}'s rim"
-
-
-def _inside(point: NDArray[np.float64], polygon: NDArray[np.float64]) -> bool:
-    """Whether ``point`` lies inside the closed ``polygon`` (even–odd rule)."""
-    a, b = polygon, np.roll(polygon, -1, axis=0)
-    straddle = (a[:, 1] > point[1]) != (b[:, 1] > point[1])
-    with np.errstate(divide="ignore", invalid="ignore"):
-        x = a[:, 0] + (point[1] - a[:, 1]) * (b[:, 0] - a[:, 0]) / (b[:, 1] - a[:, 1])
-    return bool(np.count_nonzero(straddle & (x > point[0])) % 2)
-
-
-def _between(p: NDArray[np.float64], q: NDArray[np.float64]) -> NDArray[np.float64] | None:
-    """A point where the closed polygons ``p`` and ``q`` cross, or None."""
-    a, d = p, np.roll(p, -1, axis=0) - p
-    c, e = q, np.roll(q, -1, axis=0) - q
-    denom = d[:, None, 0] * e[None, :, 1] - d[:, None, 1] * e[None, :, 0]
-    diff = c[None, :, :] - a[:, None, :]
-    with np.errstate(divide="ignore", invalid="ignore"):
-        t = (diff[..., 0] * e[None, :, 1] - diff[..., 1] * e[None, :, 0]) / denom
-        u = (diff[..., 0] * d[:, None, 1] - diff[..., 1] * d[:, None, 0]) / denom
-    hit = (denom != 0.0) & (t >= 0.0) & (t <= 1.0) & (u >= 0.0) & (u <= 1.0)
-    if not hit.any():
-        return None
-    i, j = np.unravel_index(int(np.argmax(hit)), hit.shape)
-    result: NDArray[np.float64] = a[i] + t[i, j] * d[i]
-    return result
 
 
 def _placement_problem(loops: list[list[Segment]], widths: Sequence[float]) -> tuple[int, int, NDArray] | None:
@@ -295,33 +200,6 @@ def _roll_problem(segments: list[Segment], height: float, edge_radius: Any, give
 
 
 # ------------------------------------------------------------------ the solid
-
-
-def _solid(faces: list[TopoDS_Face], tolerance: float, top: TopoDS_Face) -> TopoDS_Solid:
-    """The faces sewn into one closed shell and made a FORWARD solid facing out: the shell faces out
-    when the top cap (``top``, a plane z = height) does, as the construction knows (no volume needed)."""
-    sewing = BRepBuilderAPI_Sewing(tolerance)
-    for face in faces:
-        sewing.Add(face)
-    sewing.Perform()
-    sewn = sewing.SewedShape()
-    shells = TopExp_Explorer(sewn, TopAbs_SHELL)
-    count = 0
-    shell = None
-    while shells.More():
-        count += 1
-        shell = TopoDS.Shell_s(shells.Current())
-        shells.Next()
-    if count != 1 or shell is None or not BRep_Tool.IsClosed_s(shell):
-        raise NoSolutionError(f"the slab's {len(faces)} faces did not sew into one closed shell ({count} shell(s))")
-    sewn_top = sewing.Modified(top)
-    cap = next((f for f in _faces_of(shell) if f.IsSame(sewn_top)), None)
-    if cap is None or (plane := _plane(cap)) is None:
-        raise NoSolutionError("the slab's top cap is not a plane of the sewn shell")
-    up = plane.Axis().Direction().Z() * (-1.0 if cap.Orientation() == TopAbs_REVERSED else 1.0)
-    if up < 0.0:  # the shell faces in: the solid of the turned shell (a fresh solid is FORWARD)
-        shell = TopoDS.Shell_s(shell.Reversed())
-    return BRepBuilderAPI_MakeSolid(shell).Solid()
 
 
 def forward_solid(solid: TopoDS_Shape) -> TopoDS_Solid:
@@ -579,30 +457,15 @@ def _built_slab(segments: list[Segment], height: float, edge_radius: float, opti
     tol = 1e-7 * size if tolerance is None else as_float(tolerance, "tolerance")
     if not tol > 0.0:
         raise ValueError(f"tolerance must be positive; got {shown(tolerance)}")
-    sides: list[TopoDS_Face] = []
-    rims, approximation, reaches = [], 0.0, (0.0, 0.0)
-    for loop, (loop_top, loop_bottom) in zip(loops, flags):
-        d_top, d_bottom = (reach if loop_top else 0.0), (reach if loop_bottom else 0.0)
-        if d_top + d_bottom > height - 1e-7 * size:  # a wall thinner than the sewing tolerance: the rolls meet
-            d_top, d_bottom = (height / 2.0, height / 2.0) if loop_top and loop_bottom else (d_top and height, d_bottom and height)
-        reach_max = max(d_top, d_bottom)
-        alongs = [span for s in loop for span in _along_spans(_along(s, 1.0, reach_max, tol))]
-        sections = _sections(roll, d_top, d_bottom, height)
-        made = [_surface_face(a, sec, 1e-9 * size) for a in alongs for sec in sections]
-        sides += [face for face, _ in made]
-        for k, (_, key) in enumerate(made):  # so export_step finds the note on parts built from this solid
-            _record(key, reach_max * alongs[k // len(sections)].deviation)
-        rims.append((alongs, d_top, d_bottom))
-        approximation = max(approximation, reach_max * max(a.deviation for a in alongs))
-        reaches = (max(reaches[0], d_top), max(reaches[1], d_bottom))
-    top_cap = _cap([(a, d) for a, d, _ in rims], height)
-    faces = [*sides, top_cap, _cap([(a, d) for a, _, d in rims], 0.0)]
-    solid = _solid(faces, 1e-7 * size, top_cap)
+    walls = [Wall(loop, 0.0, height, reach if loop_top else 0.0, reach if loop_bottom else 0.0, name=_rim(index))
+             for index, (loop, (loop_top, loop_bottom)) in enumerate(zip(loops, flags))]  # fmt: skip
+    solid, approximation = stack_solid(walls, roll, tol, size)
+    reaches = tuple(min(max((getattr(w, side) for w in walls), default=0.0), height) for side in ("top", "bottom"))
     if options.get("verify", True):  # a caller that moves the solid verifies it where it is returned
         verify_solid(solid, facing_out=True)
         levels = [expected_level(loop, profile) for loop in loops]
         verify_faces(solid, "G1" if "G1" in levels else "G2", units=units)
-    return Slab(solid, approximation, reaches, height, units)
+    return Slab(solid, approximation, (reaches[0], reaches[1]), height, units)
 
 
 def _volume(shape: TopoDS_Shape) -> float:
@@ -614,11 +477,6 @@ def _volume(shape: TopoDS_Shape) -> float:
 def _first_solid(shape: TopoDS_Shape) -> TopoDS_Solid:
     explorer = TopExp_Explorer(shape, TopAbs_SOLID)
     return TopoDS.Solid_s(explorer.Current())
-
-
-def _plane(face: TopoDS_Face) -> gp_Pln | None:
-    surface = GeomAdaptor_Surface(BRep_Tool.Surface_s(face))
-    return surface.Plane() if surface.GetType() == GeomAbs_SurfaceType.GeomAbs_Plane else None
 
 
 def _turns(before: Segment, after: Segment) -> bool:

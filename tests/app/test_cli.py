@@ -25,8 +25,14 @@ def test_demo_writes_every_output(tmp_path, capsys):
     (count,) = map(int, re.findall(r"wrote (\d+) files", text))
     progress = re.findall(r"^  \S.* → (.*?)(?: \(\d+\.\d s\))?$", text, re.MULTILINE)
     listed = sum(len(files.split(", ")) for files in progress)
-    assert count == listed == len(names) == 31
+    assert count == listed == len(names) == 35
     assert "robot.ngc" in names  # the robot path's program
+    from spiral_cad.app.gallery import GALLERY
+    from spiral_cad.cad.faces import check_faces
+
+    for part in GALLERY:  # the gallery's G2 parts, as OCCT reads them back
+        report = check_faces(tmp_path / f"gallery_{part}.step")
+        assert report.passes("G2") and report.counts["sharp"] == 0, report.describe()
     for csv_file in ("highway_stations.csv", "highway_criteria.csv", "highway_profile.csv"):
         assert_plain_csv(tmp_path / csv_file)
     assert "np.float64" not in text

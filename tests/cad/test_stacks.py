@@ -1,0 +1,212 @@
+"""G2 fillets of 2.5-D parts (issue 41): pockets, bosses, steps and counterbores rounded by ``g2_fillet``,
+every chosen rim rolled (convex on tops and the underside, concave at a pocket's floor or a boss's foot).
+
+Volumes are checked against the offset (Steiner) formula: each wall's plan area times its height, less what
+each roll takes and plus what each foot adds, from the segments' and the roll's own formulas integrated by
+mpmath (``test_solids``). Continuity by the face checker; where FreeCAD is installed, the STEP by its reader.
+"""
+
+from __future__ import annotations
+
+import math
+import re
+import subprocess
+
+import pytest
+from build123d import Axis, Box, Cylinder, Pos, fillet
+from helpers import freecad_lib
+from hypothesis import given, settings
+from hypothesis import strategies as st
+from test_plates import READ, _all_g2, _one_forward_valid_solid
+from test_solids import _outline_integrals, _profile_integrals
+
+from spiral_cad import Arc
+from spiral_cad.build123d import g2_fillet
+from spiral_cad.cad.faces import check_faces
+from spiral_cad.cad.prism_fillet import plan_radius
+from spiral_cad.cad.solids import roll_profile
+from spiral_cad.core.errors import NoSolutionError
+from spiral_cad.design.fillets import fillet_path
+
+BASE = Box(100, 60, 10)  # z from −5 to 5
+
+
+def _rectangle(width: float, height: float, x: float, y: float, radius: float) -> list:
+    """A box's plan with its vertical corners as ``g2_fillet`` rounds them with ``radius`` (the rims rolled too)."""
+    a, b = width / 2.0, height / 2.0
+    corners = [(x - a, y - b), (x + a, y - b), (x + a, y + b), (x - a, y + b), (x - a, y - b)]
+    return list(fillet_path(corners, plan_radius(radius)).segments)
+
+
+def _circle(r: float, x: float, y: float) -> list:
+    return [Arc((x, y), r, 0.0, 2.0 * math.pi)]
+
+
+def _expected_volume(walls, radius: float) -> float:
+    """Walls as (plan, low, high, material inside, bottom is a foot), every rim rolled: the stack of plan
+    areas less each roll's strip (L·∫w dz − τ/2·∫w² dz, τ the loop's turning with the material on its left)
+    plus each foot's (L·∫w dz + τ/2·∫w² dz)."""
+    w_dz, w2_dz, _, _ = _profile_integrals(roll_profile(radius))
+    total = 0.0
+    for plan, low, high, inside, foot in walls:
+        area, length = _outline_integrals(plan)
+        sign = 1.0 if inside else -1.0
+        half_turn = sign * math.pi
+        total += sign * area * (high - low)
+        total -= length * w_dz - half_turn * w2_dz  # the top roll
+        total += (length * w_dz + half_turn * w2_dz) if foot else -(length * w_dz - half_turn * w2_dz)
+    return total
+
+
+R = 1.0
+PARTS = {
+    "pocket": (BASE - Pos(0, 0, 3) * Box(40, 20, 4),
+               [(_rectangle(100, 60, 0, 0, R), -5, 5, True, False), (_rectangle(40, 20, 0, 0, R), 1, 5, False, True)]),
+    "boss": (BASE + Pos(20, 0, 10) * Box(30, 20, 10),
+             [(_rectangle(100, 60, 0, 0, R), -5, 5, True, False), (_rectangle(30, 20, 20, 0, R), 5, 15, True, True)]),
+    "round boss with a hole": (BASE + Pos(20, 0, 10) * Cylinder(12, 10) - Pos(20, 0, 10) * Cylinder(5, 10),
+                               [(_rectangle(100, 60, 0, 0, R), -5, 5, True, False), (_circle(12, 20, 0), 5, 15, True, True),
+                                (_circle(5, 20, 0), 5, 15, False, True)]),
+    "three steps": (Box(60, 60, 10) + Pos(0, 0, 10) * Box(40, 40, 10) + Pos(0, 0, 20) * Box(20, 20, 10),
+                    [(_rectangle(60, 60, 0, 0, R), -5, 5, True, False), (_rectangle(40, 40, 0, 0, R), 5, 15, True, True),
+                     (_rectangle(20, 20, 0, 0, R), 15, 25, True, True)]),
+    "counterbore": (BASE - Pos(0, 0, 3) * Cylinder(8, 4) - Cylinder(4, 10),
+                    [(_rectangle(100, 60, 0, 0, R), -5, 5, True, False), (_circle(8, 0, 0), 1, 5, False, True),
+                     (_circle(4, 0, 0), -5, 1, False, False)]),
+}  # fmt: skip
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("name", list(PARTS))
+def test_every_edge_of_a_2_5_d_part_rounds_g2_with_the_offset_formulas_volume(name):
+    part, walls = PARTS[name]
+    rounded = g2_fillet(part.edges(), R)
+    _one_forward_valid_solid(rounded.wrapped)
+    _all_g2(rounded.wrapped)
+    assert rounded.volume == pytest.approx(_expected_volume(walls, R), rel=1e-9)
+    bb, sharp = rounded.bounding_box(), part.bounding_box()
+    assert (bb.min.X, bb.max.X, bb.min.Z, bb.max.Z) == pytest.approx((sharp.min.X, sharp.max.X, sharp.min.Z, sharp.max.Z), abs=1e-6)
+
+
+def test_the_pocket_from_the_issue_rounds_g2_and_the_circular_fillet_does_not(tmp_path):
+    pocket = BASE - Pos(0, 0, 3) * Box(40, 20, 4)
+    rounded = g2_fillet(pocket.edges(), 1.5)
+    _one_forward_valid_solid(rounded.wrapped)
+    _all_g2(rounded.wrapped)
+    assert not check_faces(fillet(pocket.edges(), 1.5).wrapped).passes("G2")  # build123d's: G1 where faces meet
+    from spiral_cad.cad.export import export_step
+
+    export_step(rounded, tmp_path / "pocket.step")
+    assert "sweeps over spirals approximated within" in (tmp_path / "pocket.step").read_text()
+
+
+def test_only_the_chosen_rims_and_corners_are_rounded():
+    pocket = BASE - Pos(0, 0, 3) * Box(40, 20, 4)
+    upright = g2_fillet(pocket.edges().filter_by(Axis.Z), 1.5)  # the vertical corners only: rims stay sharp
+    _one_forward_valid_solid(upright.wrapped)
+    report = check_faces(upright.wrapped)
+    rims, pieces = 4, 4 + 4 * 3  # outline top and bottom, pocket rim and floor; 4 sides, 4 corners of 3 pieces
+    assert report.counts["sharp"] == rims * pieces
+    assert report.passes("G2")
+    inner = [e for e in pocket.edges() if abs(e.center().X) <= 20 + 1e-9 and abs(e.center().Y) <= 10 + 1e-9]
+    only_pocket = g2_fillet(inner, 1.5)
+    _all_g2(only_pocket.wrapped, sharp=True)  # the outline's 12 edges stay sharp
+    assert check_faces(only_pocket.wrapped).counts["sharp"] == 12
+
+
+def _suggested(error: pytest.ExceptionInfo) -> float:
+    found = re.search(r"radius up to ([0-9.e+-]+) fits", str(error.value))
+    assert found, str(error.value)
+    return float(found.group(1))
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize(
+    "part, radius, problem",
+    [
+        (BASE - Pos(0, 0, 3) * Box(40, 20, 4), 3.0, r"rolls 3.77\d* high at pocket 0's rim; together they exceed its height 4"),
+        (BASE - Pos(0, 0, 3) * Box(40, 3, 4), 1.5, r"on pocket 0's rim: corner \d and corner \d both claim"),
+        (BASE - Pos(40, 0, 0) * Cylinder(9, 10) - Pos(40, 0, 3) * Box(4, 4, 4) + Pos(-20, 0, 6) * Box(10, 10, 2), 1.2,
+         r"gives rolls .* high at boss 0's rim"),
+    ],
+)  # fmt: skip
+def test_what_does_not_fit_is_refused_by_name_with_a_radius_that_builds(part, radius, problem):
+    with pytest.raises(NoSolutionError, match=problem) as error:
+        g2_fillet(part.edges(), radius)
+    built = g2_fillet(part.edges(), _suggested(error))
+    _one_forward_valid_solid(built.wrapped)
+    _all_g2(built.wrapped)
+
+
+def test_what_is_not_a_stack_of_whole_walls_is_refused_where_it_is():
+    slot = BASE - Pos(40, 0, 3) * Box(40, 20, 4)  # open to the side: the rim of its floor ends on the outline's wall
+    with pytest.raises(NoSolutionError, match=r"at \(20, 10, 1\) walls of different heights meet \(a step, slot"):
+        g2_fillet(slot.edges(), 1)
+    pocket = BASE - Pos(0, 0, 3) * Box(40, 20, 4)
+    rim = [e for e in pocket.edges() if abs(e.center().Z - 5) < 1e-9 and abs(e.center().X) <= 20 + 1e-9 and abs(e.center().Y) <= 10 + 1e-9]
+    with pytest.raises(NoSolutionError, match=r"the vertical edge of pocket 0's rim at \(-?20, -?10, 1\) is sharp and not chosen"):
+        g2_fillet(rim, 1)  # the rim rolled round corners nobody chose
+    with pytest.raises(NoSolutionError, match=r"on pocket 0's rim \(top\) the edge at .* is not chosen"):
+        g2_fillet(rim[:3] + pocket.edges().filter_by(Axis.Z)[:], 1)
+
+
+def test_cadquery_rounds_a_blind_pocket_as_build123d_does():
+    import cadquery as cq
+
+    import spiral_cad.cadquery  # noqa: F401  (registers the methods)
+
+    part = cq.Workplane("XY").box(100, 60, 10).faces(">Z").workplane().rect(40, 20).cutBlind(-4)
+    rounded = part.edges().g2Fillet(1.5).val()
+    assert rounded.isValid() and len(rounded.Solids()) == 1
+    ours = g2_fillet((BASE - Pos(0, 0, 3) * Box(40, 20, 4)).edges(), 1.5)
+    assert rounded.Volume() == pytest.approx(ours.volume, rel=1e-9)
+
+
+FREECAD = freecad_lib()
+
+
+@pytest.mark.skipif(FREECAD is None, reason="FreeCAD is not installed (Debian/Ubuntu: apt-get install freecad-python3)")
+def test_freecad_reads_a_plate_with_holes_a_pocket_and_a_boss_as_one_valid_solid(tmp_path):
+    from spiral_cad.cad.export import export_step
+
+    part = BASE - Pos(0, 0, 3) * Box(40, 20, 4) + Pos(35, 15, 10) * Cylinder(6, 10)
+    part = part - [Pos(x, y, 0) * Cylinder(3, 10) for x in (-40, 40) for y in (-22,)]
+    rounded = g2_fillet(part.edges(), 1.0)
+    _all_g2(rounded.wrapped)
+    path = tmp_path / "part.step"
+    export_step(rounded, path)
+    run = subprocess.run(["/usr/bin/python3", "-c", READ, FREECAD, str(path)], capture_output=True, text=True, timeout=600)
+    assert run.returncode == 0, run.stderr[-2000:]
+    solids, valid, volume = run.stdout.split()[-3:]
+    assert (solids, valid) == ("1", "True")
+    assert float(volume) == pytest.approx(rounded.volume, rel=1e-9)
+
+
+@pytest.mark.slow
+@settings(max_examples=6, deadline=None)
+@given(
+    st.lists(st.tuples(st.integers(0, 3), st.integers(0, 1), st.sampled_from(["hole", "pocket", "boss", "round boss"]),
+                       st.floats(3.0, 9.0), st.floats(1.0, 8.0)), max_size=4, unique_by=lambda f: f[:2]),
+    st.floats(0.3, 2.0),
+)  # fmt: skip
+def test_property_random_2_5_d_parts_round_g2_or_name_a_radius_that_builds(features, radius):
+    part = Box(100, 50, 10)
+    for i, j, kind, size, depth in features:  # on a 25 × 25 grid: apart and inside the base
+        place = (-37.5 + 25 * i, -12.5 + 25 * j)
+        if kind == "hole":
+            part = part - Pos(*place, 0) * Cylinder(size, 10)
+        elif kind == "pocket":
+            part = part - Pos(*place, 5 - depth / 2) * Box(2 * size, 2 * size, min(depth, 8))
+        elif kind == "boss":
+            part = part + Pos(*place, 5 + depth / 2) * Box(2 * size, 2 * size, depth)
+        else:
+            part = part + Pos(*place, 5 + depth / 2) * Cylinder(size, depth)
+    try:
+        rounded = g2_fillet(part.edges(), radius)
+    except NoSolutionError as error:
+        found = re.search(r"radius up to ([0-9.e+-]+) fits", str(error))
+        assert found, str(error)
+        rounded = g2_fillet(part.edges(), float(found.group(1)))
+    _one_forward_valid_solid(rounded.wrapped)
+    _all_g2(rounded.wrapped)
+    assert rounded.volume < part.volume + sum(8 * s * s * 2 for *_, s, _ in features)  # a foot adds < its ring
