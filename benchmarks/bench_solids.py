@@ -10,6 +10,9 @@ G1, unchecked). Second pair: the sphere-octant box both ways — ``g2_slab`` of 
 rounded rectangle with a circular roll of 3 against ``fillet(Box.edges(), 3)``. Third pair (issue 30's):
 ``ContinuousBox(60, 40, 12, 8, edge_radius=3)`` against ``fillet(Box(60, 40, 12).edges(), 3)``, with what
 each step of ours costs (median over the runs: fit checks, sweeps, faces, sewing, BRepCheck, face check).
+Fourth pair (issue 41's): the gallery's plate with four holes and a pocket, every edge rounded by
+``g2_fillet`` against build123d's ``fillet`` of the same edges (the sharp part made once, outside the
+timing), with its steps too.
 """
 
 from __future__ import annotations
@@ -23,29 +26,40 @@ import build123d as bd
 from timing import arguments, compare, machine, write_markdown
 
 import spiral_cad.cad.slabs as slabs
+import spiral_cad.cad.stack_fillet as stack_fillet
+import spiral_cad.cad.stacks as stacks
 from spiral_cad import Arc, Line
-from spiral_cad.build123d import ContinuousBox, g2_slab
+from spiral_cad.app.gallery import GALLERY
+from spiral_cad.build123d import ContinuousBox, g2_fillet, g2_slab
 
 #: The modules whose code these numbers measure (stamped into the results: ``timing.code_stamp``).
-MEASURES = ("spiral_cad.build123d", "spiral_cad.cad.slabs", "spiral_cad.cad.roll_surfaces")
+MEASURES = ("spiral_cad.build123d", "spiral_cad.cad.slabs", "spiral_cad.cad.roll_surfaces", "spiral_cad.cad.stacks",
+            "spiral_cad.cad.stack_fillet", "spiral_cad.cad.prism_fillet")  # fmt: skip
 
-#: The steps of a slab, by the function doing each, as ``spiral_cad.cad.slabs`` calls it (timed there).
-STEPS = {
-    "fit checks": "_roll_problem",
-    "sweeps (s direction)": "_along",
-    "surfaces and faces": "_surface_face",
-    "STEP-note fingerprints": "_record",
-    "caps": "_cap",
-    "sewing and solid": "_solid",
-    "BRepCheck": "verify_solid",
-    "face check": "verify_faces",
+#: The steps shared by slabs and 2.5-D parts, by the module and function doing each (timed there).
+_BUILD = {
+    "sweeps (s direction)": (stacks, "_along"),
+    "surfaces and faces": (stacks, "_surface_face"),
+    "STEP-note fingerprints": (stacks, "_record"),
+    "plane faces": (stacks, "_level_faces"),
+    "sewing and solid": (stacks, "_solid"),
+}
+#: The steps of a slab (``ContinuousBox``).
+STEPS = {"fit checks": (slabs, "_roll_problem"), **_BUILD, "BRepCheck": (slabs, "verify_solid"), "face check": (slabs, "verify_faces")}
+#: The steps of ``g2_fillet`` on a 2.5-D part.
+PART_STEPS = {
+    "reading the walls": (stack_fillet, "_walls"),
+    "fit checks": (stack_fillet, "stack_problem"),
+    **_BUILD,
+    "BRepCheck": (stack_fillet, "verify_solid"),
+    "face check": (stack_fillet, "verify_faces"),
 }
 
 
-def step_costs(make, rounds: int) -> dict[str, float]:
+def step_costs(make, rounds: int, steps: dict = STEPS) -> dict[str, float]:
     """Median seconds per step of ``make()`` over ``rounds`` runs (the steps' functions timed in place)."""
     spent: dict[str, list[float]] = defaultdict(list)
-    originals = {name: getattr(slabs, name) for name in STEPS.values()}
+    originals = {step: getattr(module, name) for step, (module, name) in steps.items()}
     this_run: dict[str, float] = {}
 
     def timed(name, function):
@@ -59,8 +73,9 @@ def step_costs(make, rounds: int) -> dict[str, float]:
         return run
 
     try:
-        for name, function in originals.items():
-            setattr(slabs, name, timed(name, function))
+        for step, function in originals.items():
+            module, name = steps[step]
+            setattr(module, name, timed(step, function))
         for _ in range(rounds):
             this_run.clear()
             start = time.perf_counter()
@@ -69,8 +84,9 @@ def step_costs(make, rounds: int) -> dict[str, float]:
             for name, value in this_run.items():
                 spent[name].append(value)
     finally:
-        for name, function in originals.items():
-            setattr(slabs, name, function)
+        for step, function in originals.items():
+            module, name = steps[step]
+            setattr(module, name, function)
     return {name: median(values) for name, values in spent.items()}
 
 
@@ -89,6 +105,8 @@ def rounded_rectangle(length: float, width: float, r: float) -> list:
 
 def main() -> None:
     args = arguments(__doc__, repeat=(7, 2))
+    make, plate_radius = GALLERY["plate_pocket_holes"]
+    plate = make()  # the sharp part, made once
     jobs = {
         "ContinuousBox": lambda: ContinuousBox(40, 20, 8, 6, edge_radius=1.5),
         "build123d fillet": peer_box,
@@ -96,12 +114,15 @@ def main() -> None:
         "build123d fillet all": lambda: bd.fillet(bd.Box(40, 20, 8).edges(), 3),
         "ContinuousBox 60×40×12": lambda: ContinuousBox(60, 40, 12, 8, edge_radius=3),
         "build123d fillet 60×40×12": lambda: bd.fillet(bd.Box(60, 40, 12).edges(), 3),
+        "g2_fillet plate, 4 holes + pocket": lambda: g2_fillet(plate.edges(), plate_radius),
+        "build123d fillet plate, 4 holes + pocket": lambda: bd.fillet(plate.edges(), plate_radius),
     }
     best = compare(jobs, args.repeat)
     ours, theirs = ContinuousBox(40, 20, 8, 6, edge_radius=1.5), peer_box()
     rows = []
     pairs = (("ContinuousBox", "build123d fillet"), ("g2_slab circular", "build123d fillet all"),
-             ("ContinuousBox 60×40×12", "build123d fillet 60×40×12"))  # fmt: skip
+             ("ContinuousBox 60×40×12", "build123d fillet 60×40×12"),
+             ("g2_fillet plate, 4 holes + pocket", "build123d fillet plate, 4 holes + pocket"))  # fmt: skip
     for name, peer in pairs:
         shape, other = jobs[name](), jobs[peer]()
         ratio = best[peer].median / best[name].median
@@ -116,12 +137,16 @@ def main() -> None:
             f"Volumes: ours {ours.volume:.6g}, peer {theirs.volume:.6g} mm³ (different shapes: G2 vs circular).")  # fmt: skip
     costs = step_costs(jobs["ContinuousBox 60×40×12"], args.repeat)
     total = costs.pop("total")
-    steps = ", ".join(f"{step} {costs.get(function, 0.0) * 1000:.0f} ms" for step, function in STEPS.items())
+    steps = ", ".join(f"{step} {costs.get(step, 0.0) * 1000:.0f} ms" for step in STEPS)
     note += f" ContinuousBox(60, 40, 12, 8, edge_radius=3) step by step (total {total * 1000:.0f} ms): {steps}."
+    costs = step_costs(jobs["g2_fillet plate, 4 holes + pocket"], args.repeat, PART_STEPS)
+    total = costs.pop("total")
+    steps = ", ".join(f"{step} {costs.get(step, 0.0) * 1000:.0f} ms" for step in PART_STEPS)
+    note += f" The plate with 4 holes and a pocket step by step (total {total * 1000:.0f} ms): {steps}."
     print(note)
     print(machine())
     if args.out:
-        write_markdown(args.out, "G2 solids: ContinuousBox beside build123d's fillet", note, header, rows)
+        write_markdown(args.out, "G2 solids: ContinuousBox and 2.5-D parts beside build123d's fillet", note, header, rows)
 
 
 if __name__ == "__main__":

@@ -604,13 +604,16 @@ class ContinuousBox(BasePartObject):
         bottom (bool, optional): roll the bottom edge. Defaults to True
         tolerance (float, optional): largest deviation of the sweep over spirals; None: 1e-7 × size.
             Defaults to None
+        holes (Iterable, optional): through holes: closed plane outlines (a ``Chain``, a continuous
+            sketch, segments such as ``[Arc((x, y), r, 0, 2π)]``) in the box's plan, centred on the
+            box; each rim rolled like the outline's, turning the other way (``g2_slab``). Defaults to ()
         rotation (RotationLike, optional): angles to rotate about axes. Defaults to (0, 0, 0)
         align (Align | tuple[Align, Align, Align] | None, optional): align MIN, CENTER,
             or MAX of object. Defaults to (Align.CENTER, Align.CENTER, Align.CENTER)
         mode (Mode, optional): combine mode. Defaults to Mode.ADD
 
     Raises:
-        ValueError: malformed input.
+        ValueError: malformed input (a hole crossing the outline or another hole).
         NoSolutionError: plan corners or rolls that do not fit (named, with what would fit).
     """
 
@@ -618,12 +621,13 @@ class ContinuousBox(BasePartObject):
 
     def __init__(self, length: float, width: float, height: float, radius: float, edge_radius: float | None = None,
                  transition: float = 0.5, shape: str = DEFAULT_SHAPE, profile: str = "g2", top: bool = True,
-                 bottom: bool = True, tolerance: float | None = None, rotation: RotationLike = (0, 0, 0),
+                 bottom: bool = True, tolerance: float | None = None, holes: Iterable[Any] = (),
+                 rotation: RotationLike = (0, 0, 0),
                  align: Align | tuple[Align, Align, Align] | None = (Align.CENTER, Align.CENTER, Align.CENTER),
                  mode: Mode = Mode.ADD):  # fmt: skip
         self.length, self.width, self.box_height = length, width, height
         self.slab = continuous_box(length, width, height, radius, edge_radius, transition=transition, shape=shape,
-                                   profile=profile, top=top, bottom=bottom, tolerance=tolerance)  # fmt: skip
+                                   profile=profile, top=top, bottom=bottom, tolerance=tolerance, holes=list(holes))  # fmt: skip
         self.approximation = self.slab.approximation
         solid = Solid(self.slab.shape)
         if align is not None:  # the box's extent is known: OCCT's optimal bounding box of the sweeps costs seconds

@@ -252,11 +252,13 @@ def continuous_box(
     bottom: bool = True,
     tolerance: float | None = None,
     units: str = DEFAULT_UNITS,
+    holes: Sequence[Any] = (),
     _advise: bool = True,
 ) -> Slab:
     """A box with every edge and corner G2: ``g2_slab`` of a ``continuous_rectangle`` (centred on the origin,
     z from 0 to ``height``). ``edge_radius`` None: the roll half as wide as the smaller of ``radius`` and
-    ``height``/2 allows. Other arguments and errors as ``g2_slab`` and ``continuous_rectangle``."""
+    ``height``/2 allows; ``holes``: through holes in the box's plan, centred like it. Other arguments and
+    errors as ``g2_slab`` and ``continuous_rectangle``."""
     for value, name in ((length, "length"), (width, "width"), (height, "height")):
         if not as_float(value, name) > 0.0:
             raise ValueError(f"{name} must be positive; got {shown(value)}")
@@ -266,13 +268,13 @@ def continuous_box(
         if not _advise:
             raise
         raise _plan_refusal(error, length, width, height, as_float(radius, "radius"), edge_radius,
-                            dict(transition=transition, shape=shape, profile=profile, top=top, bottom=bottom),
+                            dict(transition=transition, shape=shape, profile=profile, top=top, bottom=bottom, holes=holes),
                             tolerance, units) from None  # fmt: skip
     if edge_radius is None:  # the roll's extent is proportional to its radius
         unit = float(roll_profile(1.0, profile=profile, transition=transition, shape=shape)[-1].end[0])
         edge_radius = 0.5 * min(as_float(radius, "radius"), as_float(height, "height") / 2.0) / unit
     return g2_slab(plan, height, edge_radius, top=top, bottom=bottom, profile=profile, transition=transition,
-                   shape=shape, tolerance=tolerance, units=units, _advise=_advise)  # fmt: skip
+                   shape=shape, tolerance=tolerance, units=units, holes=holes, _advise=_advise)  # fmt: skip
 
 
 def _plan_refusal(error: NoSolutionError, length: float, width: float, height: float, radius: float,

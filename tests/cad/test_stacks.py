@@ -210,3 +210,17 @@ def test_property_random_2_5_d_parts_round_g2_or_name_a_radius_that_builds(featu
     _one_forward_valid_solid(rounded.wrapped)
     _all_g2(rounded.wrapped)
     assert rounded.volume < part.volume + sum(8 * s * s * 2 for *_, s, _ in features)  # a foot adds < its ring
+
+
+def test_a_continuous_box_with_holes_rolls_every_rim_and_advises_a_radius_with_them():
+    from spiral_cad.build123d import ContinuousBox
+
+    holes = [_circle(4, x, 0) for x in (-12, 12)]
+    box = ContinuousBox(50, 30, 8, 6, edge_radius=1, holes=holes)
+    _one_forward_valid_solid(box.wrapped)
+    _all_g2(box.wrapped)
+    solid = ContinuousBox(50, 30, 8, 6, edge_radius=1)
+    assert box.volume == pytest.approx(solid.volume - 2 * 8 * math.pi * 16, abs=2 * 2 * math.pi * 5 * 1.3**2)
+    with pytest.raises(NoSolutionError, match=r"those of the outline's rim and hole 0's rim meet") as error:
+        ContinuousBox(50, 30, 8, 6, edge_radius=3, holes=[_circle(4, 18, 0)])  # a 3 mm wall: too thin for two rolls
+    ContinuousBox(50, 30, 8, 6, edge_radius=_suggested(error), holes=[_circle(4, 18, 0)])
