@@ -12,7 +12,6 @@ import multiprocessing.context
 import os
 import re
 import subprocess
-import time
 from dataclasses import dataclass
 from pathlib import Path
 
