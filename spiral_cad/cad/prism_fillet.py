@@ -63,6 +63,7 @@ class StackedPart(NoSolutionError):
     def __init__(self, message: str, axis: gp_Dir) -> None:
         super().__init__(message)
         self.axis = axis
+        self.axes = [axis]  # every direction the part has planar faces at more than two levels along
 
 
 @dataclass(frozen=True)
@@ -256,7 +257,10 @@ def fillet_prism_edges(
         except NoSolutionError as error:  # the most telling first: levels (nearest z first), then a leaning side
             failed.append(((" levels " not in str(error), " leans " not in str(error), -abs(candidate.Z())), error))
     if not ranked and failed:
-        raise min(failed, key=lambda row: row[0])[1]
+        first = min(failed, key=lambda row: row[0])[1]
+        if isinstance(first, StackedPart):
+            first.axes = [e.axis for _, e in sorted(failed, key=lambda row: row[0]) if isinstance(e, StackedPart)]
+        raise first
     if not ranked:
         raise NoSolutionError(
             f"g2_fillet rounds a solid's straight edges when each end meets a face perpendicular to it (prism side "

@@ -251,10 +251,12 @@ def _along_spans(along: _Along) -> list[_Along]:
     ]
 
 
-def _sections(roll: list[Segment], top: float, bottom: float, low: float, high: float, *, foot: bool = False) -> list[_Section]:
+def _sections(roll: list[Segment], top: float, bottom: float, low: float, high: float, *, foot: bool = False,
+              head: bool = False) -> list[_Section]:  # fmt: skip
     """The Bézier spans of the bottom roll, the wall and the top roll (those of non-zero extent) of a wall from
     z ``low`` to ``high``, in the (w, z) plane. ``foot``: the bottom is a concave fillet onto a face rising on
-    the open side (w < 0: a pocket's floor, the face a boss stands on), the bottom roll turned over."""
+    the open side (w < 0: a pocket's floor, the face a boss stands on), the bottom roll turned over; ``head``:
+    the top is one onto a face hanging over the open side."""
     curve = chain_to_nurbs(roll) if roll else None
     ends = np.array([0.0, 1.0]), np.array([4, 4])
     sections = []
@@ -268,7 +270,7 @@ def _sections(roll: list[Segment], top: float, bottom: float, low: float, high: 
         sections.append(_Section(1, np.array([0.0, 1.0]), np.array([2, 2]), np.ones(2), wall))
     if top > 0.0 and curve is not None:
         scale = top / float(curve.control_points[-1, 0])
-        points = curve.control_points * scale + np.array([0.0, high])
+        points = curve.control_points * scale * np.array([-1.0 if head else 1.0, 1.0]) + np.array([0.0, high])
         sections += [_Section(3, *ends, w, p) for w, p in _spans(3, curve.weights, points)]
     return sections
 

@@ -33,7 +33,7 @@ from ..core.units import DEFAULT_UNITS, length_unit
 from ..design.fillets import TANGENT_TOL, continuous_rectangle
 from .advice import advice, refusal
 from .roll_surfaces import roll_profile
-from .stacks import _FIT_SLACK, Wall, _between, _fit_problem, _inside, _plain, _samples, stack_solid
+from .stacks import _FIT_SLACK, Wall, _between, _fit_problem, _inside, _plain, _samples, meeting_problem, stack_solid
 
 __all__ = [
     "Slab",
@@ -188,15 +188,8 @@ def _roll_problem(segments: list[Segment], height: float, edge_radius: Any, give
         problem = _fit_problem(loop, 1.0, width, edge_radius, name, at)
         if problem is not None:
             return problem if not holes else f"{problem} ({_rim(index)})"
-    meeting = _placement_problem(loops, widths) if len(loops) > 1 else None
-    if meeting is not None:
-        i, j, place = meeting
-        return (
-            f"{name} {shown(edge_radius)} gives rolls {reach:.6g} wide; those of {_rim(i)} and {_rim(j)} meet near "
-            f"{at(place[0], place[1])}: the wall between them is narrower than the two rolls "
-            f"({widths[i] + widths[j]:.6g})"
-        )
-    return None
+    walls = [Wall(loop, 0.0, height, width, name=_rim(index)) for index, (loop, width) in enumerate(zip(loops, widths))]
+    return meeting_problem(walls, edge_radius, name, lambda x, y, z: at(x, y)) if len(loops) > 1 else None
 
 
 # ------------------------------------------------------------------ the solid

@@ -11,6 +11,7 @@ in plan. The solid is made again (``stacks.stack_solid``) and verified as return
 
 from __future__ import annotations
 
+import math
 from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Any
@@ -26,9 +27,10 @@ from OCP.TopoDS import TopoDS, TopoDS_Edge, TopoDS_Face, TopoDS_Shape, TopoDS_Wi
 from OCP.TopTools import TopTools_IndexedDataMapOfShapeListOfShape
 
 from ..core._inputs import as_float
+from ..core.chain import JOIN_TOLERANCE, g2_mismatch
 from ..core.errors import NoSolutionError
 from ..core.segments import Segment
-from ..core.shapes import DEFAULT_SHAPE
+from ..core.shapes import DEFAULT_SHAPE, shape_code
 from ..design.fillets import fillet_path
 from .advice import advice, refusal
 from .fillet import wire_path
@@ -55,11 +57,38 @@ __all__ = ["fillet_part_edges"]
 def fillet_part_edges(solid: TopoDS_Shape, edges: Sequence[TopoDS_Edge], radius: float, **options: Any) -> Slab:
     """Round a solid's straight edges and rims with G2 fillets: a right prism as ``fillet_prism_edges``
     does, a 2.5-D part (horizontal faces at more than two levels: pockets, bosses, steps) as
-    ``fillet_stack_edges`` does. Arguments, result and errors as ``fillet_prism_edges``."""
+    ``fillet_stack_edges`` does along the axis its walls stand on. Arguments, result and errors as
+    ``fillet_prism_edges``."""
+    _checked_options(radius, options)
+    stacked = None
     try:
         return fillet_prism_edges(solid, edges, radius, **options)
-    except StackedPart as stacked:
-        return fillet_stack_edges(solid, edges, radius, stacked.axis, **options)
+    except StackedPart as error:
+        stacked = error
+    size = _size(solid)
+    axes = [a for axis in stacked.axes for a in (axis, axis.Reversed())]
+    for axis in axes:  # the first axis the part stands on as whole walls; else the first one's refusal
+        try:
+            _walls(solid, _frame(solid, axis), size)
+        except NoSolutionError:
+            continue
+        return fillet_stack_edges(solid, edges, radius, axis, **options)
+    return fillet_stack_edges(solid, edges, radius, axes[0], **options)
+
+
+def _checked_options(radius: Any, options: dict[str, Any]) -> None:
+    """ValueError naming a radius, transition or shape that no fillet takes."""
+    value = as_float(radius, "radius")
+    if not (value > 0.0 and math.isfinite(value)):
+        raise ValueError(f"radius must be a positive finite number; got {radius!r:.40}")
+    transition = as_float(options.get("transition", 0.5), "transition")
+    if not 0.0 < transition <= 1.0:
+        raise ValueError(f"transition must lie in (0, 1]; got {options.get('transition')!r:.40}")
+    shape_code(options.get("shape", DEFAULT_SHAPE))
+
+
+class _NoRadius(NoSolutionError):
+    """A refusal no radius mends (a selection that cannot be rounded): no advice is searched."""
 
 
 @dataclass
@@ -72,6 +101,7 @@ class _Rims:
     bottom: TopoDS_Wire
     top: TopoDS_Wire
     foot: bool
+    head: bool
     loop: list[Segment]
     name: str = ""
 
@@ -107,14 +137,14 @@ def fillet_stack_edges(
 
     Raises:
         NoSolutionError: a face neither horizontal nor vertical, walls of different heights meeting on
-            one rim (a step reaching the outline), an overhang, a rim partly chosen — named by point;
+            one rim (a step reaching the outline), a rim partly chosen — named by point;
             rolls that do not fit — with the largest radius that builds.
     """
     frame, size = _frame(solid, axis), _size(solid)
     walls = _walls(solid, frame, size)
     chosen, corners = _chosen(solid, edges, walls, frame, size)
     options: dict[str, Any] = dict(transition=transition, same_sense=same_sense, shape=shape)
-    at = lambda x, y: _where(_lifted_point(frame, (x, y), 0.0))  # noqa: E731  (plan → the part's bottom)
+    at = lambda x, y, z: _where(_lifted_point(frame, (x, y), z))  # noqa: E731  (plan → the part)
 
     def plans(r: float) -> list[Wall]:
         reach = float(roll_profile(r, transition=transition, shape=shape)[-1].end[0])
@@ -130,29 +160,34 @@ def fillet_stack_edges(
             if top or bottom:
                 for a, b in zip(loop, loop[1:] + loop[:1]):
                     if _turns(a, b):
-                        raise NoSolutionError(
+                        raise _NoRadius(
                             f"g2_fillet rolls a rim along a smooth outline; the vertical edge of {wall.name} at "
                             f"{_where(_lifted_point(frame, a.end, wall.low))} is sharp and not chosen: choose it "
                             "too, or leave the rim sharp"
                         )
-            made.append(Wall(loop, wall.low, wall.high, reach if top else 0.0, reach if bottom else 0.0, wall.foot, wall.name))
+            made.append(Wall(loop, wall.low, wall.high, reach if top else 0.0, reach if bottom else 0.0, wall.foot, wall.head, wall.name))
         return made
 
     def problem(r: float) -> str | None:
         try:
             return stack_problem(plans(r), r, "radius", at)
+        except _NoRadius:
+            raise
         except NoSolutionError as error:
             return str(error)
+        except ValueError as error:  # numbers past float64 (a radius of 1e308)
+            return f"radius {r:.6g} is beyond what the part's numbers hold ({error})"
 
     def builds(r: float) -> Slab:
         return fillet_stack_edges(solid, edges, r, axis, **options, tolerance=tolerance, _advise=False)
 
     given = as_float(radius, "radius")
+    upper = min(given, size)  # no roll wider than the part fits in it: the advice is searched below both
     found = problem(given)
     if found is not None:
         if not _advise:
             raise NoSolutionError(found)
-        raise refusal(found, "radius", advice(lambda r: problem(r) is None, builds, given))
+        raise refusal(found, "radius", advice(lambda r: problem(r) is None, builds, upper))
     planned = plans(given)
     tol = 1e-7 * size if tolerance is None else as_float(tolerance, "tolerance")
     try:
@@ -165,7 +200,7 @@ def fillet_stack_edges(
     except NoSolutionError as error:
         if not _advise:
             raise
-        raise refusal(str(error), "radius", advice(lambda r: problem(r) is None and r < given, builds, given)) from None
+        raise refusal(str(error), "radius", advice(lambda r: problem(r) is None and r < given, builds, upper)) from None
     reach = max((max(w.top, w.bottom) for w in planned), default=0.0)
     height = max(w.high for w in planned) - min(w.low for w in planned)
     return Slab(result, approximation, (reach, reach), height)
@@ -273,21 +308,17 @@ def _walls(solid: TopoDS_Shape, frame: gp_Ax3, size: float) -> list[_Rims]:
         if len(ends) != 2 or ends[1][0] - ends[0][0] <= 1e-9 * size:
             raise _uneven(_point(_edges_of(ends[len(ends) // 2][1])[0], 0.0))  # a rim between the ends
         (low, bottom, under), (high, top, over) = ends
-        if not _facing_up(over, axis):
-            raise NoSolutionError(
-                f"g2_fillet rounds 2.5-D parts built up along one axis; the wall at "
-                f"{_where(_point(_edges_of(top)[0], 0.0))} ends under an overhang, which g2_fillet does not round"
-            )
         loop = _plan(bottom, frame, low)
         if not _material_left(solid, loop, frame, low, high, size):
             loop = _reverse(loop)
         faces_here = [f for k, f in enumerate(upright) if root(k) == key]
-        walls.append(_Rims(faces_here, low, high, bottom, top, _facing_up(under, axis), loop))
+        walls.append(_Rims(faces_here, low, high, bottom, top, _facing_up(under, axis), not _facing_up(over, axis), loop))
     walls.sort(key=lambda w: (w.low, -abs(_signed_area(_samples(w.loop)[0]))))
     counts: dict[str, int] = {}
     for wall in walls:
         ccw = _signed_area(_samples(wall.loop)[0]) > 0.0
-        role = ("boss" if wall.foot else "outline") if ccw else ("pocket" if wall.foot else "hole")
+        through = not (wall.foot or wall.head)
+        role = ("outline" if through else "boss") if ccw else ("hole" if through else "pocket")
         k = counts[role] = counts.get(role, -1) + 1
         wall.name = f"{'the outline' if role == 'outline' and k == 0 else f'{role} {k}'}'s rim"
     return walls
@@ -356,6 +387,16 @@ def _chosen(solid: TopoDS_Shape, edges: Sequence[TopoDS_Edge], walls: list[_Rims
     corners = []
     for wall, points in zip(walls, feet):
         found = _corner_vertices(wall.loop, _lifted(frame, wall.low), points, size) if points else []
+        for i in found:
+            before, after = wall.loop[i - 1], wall.loop[i]
+            if not _turns(before, after) and g2_mismatch(before, after, JOIN_TOLERANCE, index=i) is not None:
+                jump = (float(np.ravel(before.curvature(1.0))[0]), float(np.ravel(after.curvature(0.0))[0]))
+                raise NoSolutionError(
+                    f"g2_fillet rounds corners; the vertical edge of {wall.name} at "
+                    f"{_where(_lifted_point(frame, before.end, wall.low))} is a tangent joint, not a corner: the "
+                    f"outline's curvature jumps from {jump[0]:.6g} to {jump[1]:.6g} there, so its faces meet G1; "
+                    "making tangent joints G2 is a separate feature: leave the edge out of the selection"
+                )
         corners.append([i for i in found if _turns(wall.loop[i - 1], wall.loop[i])])
     return [(t, b) for t, b in flags], corners
 

@@ -16,6 +16,7 @@ the smallest face around them. Everything is sewn into one closed shell.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from typing import Any
@@ -30,13 +31,14 @@ from OCP.gp import gp_Pln
 from OCP.TopAbs import TopAbs_REVERSED, TopAbs_SHELL
 from OCP.TopExp import TopExp_Explorer
 from OCP.TopoDS import TopoDS, TopoDS_Face, TopoDS_Solid, TopoDS_Wire
+from scipy.spatial import cKDTree
 
 from ..core._inputs import shown
 from ..core.errors import NoSolutionError
 from ..core.segments import Arc, Segment
 from .roll_surfaces import _along, _along_spans, _faces_of, _plane_face, _record, _rim_wire, _sections, _surface_face
 
-__all__ = ["Wall", "stack_problem", "stack_solid"]
+__all__ = ["Wall", "meeting_problem", "stack_problem", "stack_solid"]
 
 #: Relative slack on "the roll fits" comparisons (equality itself is decided by the construction).
 _FIT_SLACK = 1e-12
@@ -53,6 +55,8 @@ class Wall:
         bottom: the bottom roll's reach (0: sharp).
         foot: the bottom rim meets a face rising on the open side (a pocket's
             floor, the face a boss stands on): rounded with the roll turned over.
+        head: the top rim meets a face hanging over the open side (the floor of
+            a pocket cut from below, a boss under the part): the roll turned over.
         name: how messages name it ("the outline's rim", "pocket 0's rim" …).
     """
 
@@ -62,19 +66,64 @@ class Wall:
     top: float = 0.0
     bottom: float = 0.0
     foot: bool = False
+    head: bool = False
     name: str = "the outline's rim"
 
     def rims(self) -> tuple[tuple[float, bool, float, bool], tuple[float, bool, float, bool]]:
         """Each rim's (z, the face there faces up, the iso-curve's w, the face lies on the loop's right)."""
+        head_w = -self.top if self.head else self.top
         foot_w = -self.bottom if self.foot else self.bottom
-        return (self.high, True, self.top, False), (self.low, self.foot, foot_w, self.foot)
+        return (self.high, not self.head, head_w, self.head), (self.low, self.foot, foot_w, self.foot)
+
+    def reaches(self) -> tuple[float, float]:
+        """How far its rolls reach to the loop's left (the material's side) and to its right."""
+        ws = [w for _, _, w, _ in self.rims()]
+        return max(0.0, *ws), max(0.0, *(-w for w in ws))
 
 
-def _polygon(loop: list[Segment], w: float) -> NDArray[np.float64]:
-    """The plan loop offset by ``w`` to its left, sampled (closing point excluded)."""
-    points, normals, _ = _samples(loop)
-    result: NDArray[np.float64] = points + w * normals
+#: Most turn (radians) between neighbouring samples of a dense plan polygon: chords within 1.25e-5 × the radius.
+_TURN_STEP = 0.01
+
+
+def _polygon(loop: list[Segment], w: float, spacing: float = math.inf) -> NDArray[np.float64]:
+    """The plan loop offset by ``w`` to its left, sampled at most ``spacing`` apart and turning at most
+    ``_TURN_STEP`` between samples (closing point excluded)."""
+    pieces = []
+    for segment in loop:
+        u = np.linspace(0.0, 1.0, 9)
+        kappa = np.broadcast_to(np.asarray(segment.curvature(u), dtype=float), u.shape)
+        tangents = segment.tangent(u)[:, :2]
+        (x0, y0), (x1, y1) = tangents[:-1].T, tangents[1:].T
+        turn = float(np.sum(np.abs(np.arctan2(x0 * y1 - y0 * x1, x0 * x1 + y0 * y1))))
+        stretch = 1.0 + abs(w) * float(np.max(np.abs(kappa)))
+        count = max(
+            2, math.ceil(turn / _TURN_STEP), min(100_000, math.ceil(segment.length * stretch / spacing)) if spacing < math.inf else 0
+        )
+        t = np.linspace(0.0, 1.0, count, endpoint=False)
+        tangent = segment.tangent(t)[:, :2]
+        tangent = tangent / np.linalg.norm(tangent, axis=1)[:, None]
+        pieces.append(segment.point(t)[:, :2] + w * np.stack([-tangent[:, 1], tangent[:, 0]], axis=1))
+    result: NDArray[np.float64] = np.vstack(pieces)
     return result
+
+
+def _gap(p: NDArray[np.float64], q: NDArray[np.float64]) -> tuple[float, NDArray[np.float64]]:
+    """The least distance between two closed polylines (vertices to the other's nearest segments, both
+    ways; exact once the vertices are denser than the distance), and a point of ``p`` where it is."""
+    best, where = math.inf, p[0]
+    for a, b, swap in ((p, q, False), (q, p, True)):
+        nearest = cKDTree(b).query(a)[1]
+        d = np.full(len(a), np.inf)
+        for step in (-1, 1):  # the two segments at each nearest vertex
+            s0, s1 = b[nearest], b[(nearest + step) % len(b)]
+            e = s1 - s0
+            t = np.clip(np.einsum("ij,ij->i", a - s0, e) / np.maximum(np.einsum("ij,ij->i", e, e), 1e-300), 0.0, 1.0)
+            d = np.minimum(d, np.linalg.norm(a - (s0 + t[:, None] * e), axis=1))
+        k = int(np.argmin(d))
+        if d[k] < best:
+            best = float(d[k])
+            where = b[nearest[k]] if swap else a[k]
+    return best, where
 
 
 def _signed_area(polygon: NDArray[np.float64]) -> float:
@@ -202,10 +251,10 @@ def _plane(face: TopoDS_Face) -> gp_Pln | None:
 
 
 def stack_problem(walls: Sequence[Wall], edge_radius: float, name: str,
-                  at: Callable[[float, float], str]) -> str | None:  # fmt: skip
+                  at: Callable[[float, float, float], str]) -> str | None:  # fmt: skip
     """Why the walls' rolls do not fit, or None: each wall's rolls within its height, each offset
     below the loop's radii of curvature on its side and not crossing itself, and no two walls that
-    share a height with rolls crossing or lying in each other's roll."""
+    share a height closer than their rolls reach towards each other. ``at(x, y, z)`` names a point."""
     for wall in walls:
         if wall.top + wall.bottom > (wall.high - wall.low) * (1.0 + _FIT_SLACK):
             both = wall.top > 0.0 and wall.bottom > 0.0
@@ -213,34 +262,52 @@ def stack_problem(walls: Sequence[Wall], edge_radius: float, name: str,
                 f"{name} {shown(edge_radius)} gives rolls {max(wall.top, wall.bottom):.6g} high at {wall.name}; "
                 f"{'together they' if both else 'it'} exceed its height {wall.high - wall.low:.6g}"
             )
-        for sigma, width in ((1.0, wall.top), (-1.0 if wall.foot else 1.0, wall.bottom)):
-            if width > 0.0 and (problem := _fit_problem(wall.loop, sigma, width, edge_radius, name, at)) is not None:
-                return f"{problem} ({wall.name}{', its foot' if sigma < 0.0 else ''})"
-    curves = []
-    for wall in walls:
-        offsets = {0.0, wall.top, -wall.bottom if wall.foot else wall.bottom}
-        curves.append([_polygon(wall.loop, w) for w in sorted(offsets)])
+        for z, _, w, _ in wall.rims():
+            here = lambda x, y, z=z: at(x, y, z)  # noqa: E731
+            if w != 0.0 and (problem := _fit_problem(wall.loop, math.copysign(1.0, w), abs(w), edge_radius, name, here)):
+                return f"{problem} ({wall.name}{'' if w > 0.0 else ', turned over'})"
+    return meeting_problem(walls, edge_radius, name, at)
+
+
+def meeting_problem(walls: Sequence[Wall], edge_radius: float, name: str,
+                    at: Callable[[float, float, float], str]) -> str | None:  # fmt: skip
+    """Why two of the walls that share a height are closer than their rolls reach towards each other
+    (the material between them narrower than both rolls), or None."""
+    reaches = [wall.reaches() for wall in walls]
+    coarse = [_polygon(wall.loop, 0.0) for wall in walls]
+    boxes = [(loop.min(axis=0), loop.max(axis=0)) for loop in coarse]
+    size = max((float(np.max(high - low)) for low, high in boxes), default=0.0)
+    areas = [_signed_area(loop) for loop in coarse]
     for i, a in enumerate(walls):
         for j in range(i + 1, len(walls)):
             b = walls[j]
             if a.low > b.high or b.low > a.high:  # no height in common
                 continue
-            place = next((p for p in (_between(c, d) for c in curves[i] for d in curves[j]) if p is not None), None)
-            if place is None:  # no crossing: one rim's curves lying inside the other's roll
-                place = next((c[0] for one, other in ((i, j), (j, i)) for c in curves[one]
-                              if _in_band(c[0], curves[other], _inside)), None)  # fmt: skip
-            if place is not None:
+            left_of_a = _inside(coarse[j][0], coarse[i]) == (areas[i] > 0.0)  # b on a's material side
+            left_of_b = _inside(coarse[i][0], coarse[j]) == (areas[j] > 0.0)
+            needed = reaches[i][0 if left_of_a else 1] + reaches[j][0 if left_of_b else 1]
+            apart = np.maximum(boxes[i][0] - boxes[j][1], boxes[j][0] - boxes[i][1]).max()
+            if needed == 0.0 or apart > needed:
+                continue
+            gap, place = _least_gap(a.loop, b.loop, needed, size / 64.0)
+            if gap < needed * (1.0 + _FIT_SLACK):
                 return (
-                    f"{name} {shown(edge_radius)} gives rolls {max(a.top, a.bottom, b.top, b.bottom):.6g} wide; those of "
-                    f"{a.name} and {b.name} meet near {at(float(place[0]), float(place[1]))}: the material between "
-                    "them is narrower than the two rolls"
+                    f"{name} {shown(edge_radius)} gives rolls {max(*reaches[i], *reaches[j]):.6g} wide; those of {a.name} "
+                    f"and {b.name} meet near {at(float(place[0]), float(place[1]), min(a.high, b.high))}: the material "
+                    f"between them is {gap:.6g} wide, narrower than the two rolls ({needed:.6g})"
                 )
     return None
 
 
-def _in_band(point: NDArray[np.float64], curves: list[NDArray[np.float64]], inside: Callable[..., bool]) -> bool:
-    """Whether ``point`` lies between a wall's outermost offsets (inside one, outside the other)."""
-    return len(curves) > 1 and inside(point, curves[0]) != inside(point, curves[-1])
+def _least_gap(p: list[Segment], q: list[Segment], needed: float, spacing: float) -> tuple[float, NDArray[np.float64]]:
+    """The least distance between two plan loops, sampled ``spacing`` apart and finer until it is known
+    to be above ``needed`` or within a tenth of it (a distance over samples errs by at most half their
+    spacing), and a point where it is."""
+    while True:
+        gap, place = _gap(_polygon(p, 0.0, spacing), _polygon(q, 0.0, spacing))
+        if gap - spacing / 2.0 > needed or gap < needed or spacing <= needed / 20.0:
+            return gap, place
+        spacing /= 8.0
 
 
 def stack_solid(walls: Sequence[Wall], roll: list[Segment], tolerance: float, size: float) -> tuple[TopoDS_Solid, float]:
@@ -257,15 +324,15 @@ def stack_solid(walls: Sequence[Wall], roll: list[Segment], tolerance: float, si
             d_top, d_bottom = (height / 2.0, height / 2.0) if d_top and d_bottom else (d_top and height, d_bottom and height)
         reach = max(d_top, d_bottom)
         alongs = [span for s in wall.loop for span in _along_spans(_along(s, 1.0, reach, tolerance))]
-        sections = _sections(roll, d_top, d_bottom, wall.low, wall.high, foot=wall.foot)
+        sections = _sections(roll, d_top, d_bottom, wall.low, wall.high, foot=wall.foot, head=wall.head)
         made = [_surface_face(a, sec, 1e-9 * size) for a in alongs for sec in sections]
         faces += [face for face, _ in made]
         for k, (_, key) in enumerate(made):  # so export_step finds the note on parts built from this solid
             _record(key, reach * alongs[k // len(sections)].deviation)
         approximation = max(approximation, reach * max(a.deviation for a in alongs))
-        clamped = Wall(wall.loop, wall.low, wall.high, d_top, d_bottom, wall.foot, wall.name)
+        clamped = Wall(wall.loop, wall.low, wall.high, d_top, d_bottom, wall.foot, wall.head, wall.name)
         for z, up, w, right in clamped.rims():
-            polygon = _polygon(wall.loop, w)
+            polygon = _polygon(wall.loop, w, size / 64.0)
             wire = _rim_wire(alongs, w, z, reverse=right)
             levels.setdefault((z, up), []).append((wire, polygon[::-1] if right else polygon))
     top = None

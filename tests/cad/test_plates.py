@@ -162,7 +162,7 @@ def _suggested(error: pytest.ExceptionInfo) -> float:
 @pytest.mark.slow
 def test_a_wall_thinner_than_the_rolls_is_refused_naming_a_radius_that_builds():
     thin = Box(100, 60, 10) - Pos(45, 0, 0) * Cylinder(4, 10)  # a wall 1 thick between the hole and the side
-    with pytest.raises(NoSolutionError, match=r"hole 0's rim meet near \(4\d\.\d+, .*the wall between them") as error:
+    with pytest.raises(NoSolutionError, match=r"hole 0's rim meet near \((4\d\.\d+|50), .*the material between them is 1 wide") as error:
         g2_fillet(thin.edges(), 1.5)
     radius = _suggested(error)
     reach = float(roll_profile(1.0)[-1].end[0])

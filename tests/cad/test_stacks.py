@@ -13,7 +13,7 @@ import re
 import subprocess
 
 import pytest
-from build123d import Axis, Box, Cylinder, Pos, fillet
+from build123d import Axis, Box, Cylinder, Pos, Rot, fillet
 from helpers import freecad_lib
 from hypothesis import given, settings
 from hypothesis import strategies as st
@@ -43,18 +43,18 @@ def _circle(r: float, x: float, y: float) -> list:
 
 
 def _expected_volume(walls, radius: float) -> float:
-    """Walls as (plan, low, high, material inside, bottom is a foot), every rim rolled: the stack of plan
-    areas less each roll's strip (L·∫w dz − τ/2·∫w² dz, τ the loop's turning with the material on its left)
-    plus each foot's (L·∫w dz + τ/2·∫w² dz)."""
+    """Walls as (plan, low, high, material inside, bottom is a foot[, top is a head]), every rim rolled: the
+    stack of plan areas less each roll's strip (L·∫w dz − τ/2·∫w² dz, τ the loop's turning with the material
+    on its left) plus each foot's or head's (L·∫w dz + τ/2·∫w² dz)."""
     w_dz, w2_dz, _, _ = _profile_integrals(roll_profile(radius))
     total = 0.0
-    for plan, low, high, inside, foot in walls:
+    for plan, low, high, inside, foot, *head in walls:
         area, length = _outline_integrals(plan)
         sign = 1.0 if inside else -1.0
         half_turn = sign * math.pi
         total += sign * area * (high - low)
-        total -= length * w_dz - half_turn * w2_dz  # the top roll
-        total += (length * w_dz + half_turn * w2_dz) if foot else -(length * w_dz - half_turn * w2_dz)
+        for turned_over in (foot, bool(head and head[0])):
+            total += (length * w_dz + half_turn * w2_dz) if turned_over else -(length * w_dz - half_turn * w2_dz)
     return total
 
 
@@ -70,6 +70,9 @@ PARTS = {
     "three steps": (Box(60, 60, 10) + Pos(0, 0, 10) * Box(40, 40, 10) + Pos(0, 0, 20) * Box(20, 20, 10),
                     [(_rectangle(60, 60, 0, 0, R), -5, 5, True, False), (_rectangle(40, 40, 0, 0, R), 5, 15, True, True),
                      (_rectangle(20, 20, 0, 0, R), 15, 25, True, True)]),
+    "pockets on both faces": (BASE - Pos(-20, 0, 3) * Box(30, 20, 4) - Pos(25, 0, -3) * Box(30, 20, 4),
+                              [(_rectangle(100, 60, 0, 0, R), -5, 5, True, False), (_rectangle(30, 20, -20, 0, R), 1, 5, False, True),
+                               (_rectangle(30, 20, 25, 0, R), -5, -1, False, False, True)]),
     "counterbore": (BASE - Pos(0, 0, 3) * Cylinder(8, 4) - Cylinder(4, 10),
                     [(_rectangle(100, 60, 0, 0, R), -5, 5, True, False), (_circle(8, 0, 0), 1, 5, False, True),
                      (_circle(4, 0, 0), -5, 1, False, False)]),
@@ -224,3 +227,73 @@ def test_a_continuous_box_with_holes_rolls_every_rim_and_advises_a_radius_with_t
     with pytest.raises(NoSolutionError, match=r"those of the outline's rim and hole 0's rim meet") as error:
         ContinuousBox(50, 30, 8, 6, edge_radius=3, holes=[_circle(4, 18, 0)])  # a 3 mm wall: too thin for two rolls
     ContinuousBox(50, 30, 8, 6, edge_radius=_suggested(error), holes=[_circle(4, 18, 0)])
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("turn", [Rot(90, 0, 0), Rot(0, 90, 0), Rot(180, 0, 0), Rot(17, 29, 41)])
+def test_a_part_stacked_along_any_axis_either_way_rounds_as_it_does_upright(turn):
+    pocket = BASE - Pos(0, 0, 3) * Box(40, 20, 4)
+    upright = g2_fillet(pocket.edges(), 1.0)
+    turned = g2_fillet((turn * pocket).edges(), 1.0)
+    _one_forward_valid_solid(turned.wrapped)
+    _all_g2(turned.wrapped)
+    assert turned.volume == pytest.approx(upright.volume, rel=1e-9)
+    from_below = g2_fillet((BASE - Pos(0, 0, -3) * Box(40, 20, 4)).edges(), 1.0)  # the same solid, cut from below
+    assert from_below.volume == pytest.approx(upright.volume, rel=1e-9)
+
+
+@pytest.mark.slow
+def test_rolls_near_a_large_arc_are_judged_on_the_arc_not_on_its_chords():
+    """Holes 5.5 mm from a 200 mm disk's rim: at radius 2 the rolls clear each other by 0.47 mm (a polygon of
+    15° chords lies 0.83 mm inside the arc and found them meeting)."""
+    part = Cylinder(100, 10) + Pos(0, 0, 10) * Cylinder(30, 10)
+    for k in range(8):
+        a = math.radians(22.5 + 45 * k)
+        part = part - Pos(90.5 * math.cos(a), 90.5 * math.sin(a), 0) * Cylinder(4, 10)
+    rounded = g2_fillet(part.edges(), 2.0)
+    _one_forward_valid_solid(rounded.wrapped)
+    _all_g2(rounded.wrapped)
+    walls = [(_circle(100, 0, 0), -5, 5, True, False), (_circle(30, 0, 0), 5, 15, True, True)]
+    walls += [(_circle(4, 90.5 * math.cos(math.radians(22.5 + 45 * k)), 90.5 * math.sin(math.radians(22.5 + 45 * k))), -5, 5, False, False)
+              for k in range(8)]  # fmt: skip
+    assert rounded.volume == pytest.approx(_expected_volume(walls, 2.0), rel=1e-9)
+    with pytest.raises(
+        NoSolutionError, match=r"those of the outline's rim and hole \d's rim meet .* between them is 5\.[45]\d* wide"
+    ) as error:
+        g2_fillet(part.edges(), 2.2)  # 2 × 2.765 > the 5.5 mm of material
+    assert 2.14 < _suggested(error) < 2.19  # 2 × reach(r) = 5.5 at r = 2.188
+
+
+def test_a_tangent_joint_chosen_as_a_corner_is_refused_as_on_a_prism():
+    from build123d import BuildSketch, Plane, RectangleRounded, extrude
+
+    with BuildSketch(Plane.XY.offset(5)) as sketch:
+        RectangleRounded(40, 20, 4)  # lines and arcs: tangent, curvature jumping
+    with pytest.raises(NoSolutionError, match=r"vertical edge of pocket 0's rim at .* is a tangent joint, not a corner"):
+        g2_fillet((BASE - extrude(sketch.sketch, -4)).edges(), 1.0)
+
+
+@pytest.mark.parametrize(
+    "options, message",
+    [
+        (dict(radius=0), r"radius must be a positive finite number; got 0"),
+        (dict(radius=-1), r"radius must be a positive finite number"),
+        (dict(radius=1, shape="bogus"), r"shape must be one of 'walton-meek', 'near-linear'; got 'bogus'"),
+        (dict(radius=1, transition="0.5"), r"transition must be a real number"),
+        (dict(radius=1, transition=float("nan")), r"transition must be finite"),
+    ],
+)
+def test_bad_options_are_refused_by_name(options, message):
+    pocket = BASE - Pos(0, 0, 3) * Box(40, 20, 4)
+    radius = options.pop("radius")
+    with pytest.raises(ValueError, match=message) as error:
+        g2_fillet(pocket.edges(), radius, **options)
+    assert error.value.__context__ is None  # not raised while handling the prism's refusal
+
+
+@pytest.mark.slow
+def test_a_radius_past_float64_is_refused_with_a_radius_that_builds():
+    pocket = BASE - Pos(0, 0, 3) * Box(40, 20, 4)
+    with pytest.raises(NoSolutionError, match=r"radius 1.7e\+308 .*; radius up to 1.57\d* fits") as error:
+        g2_fillet(pocket.edges(), 1.7e308)
+    _all_g2(g2_fillet(pocket.edges(), _suggested(error)).wrapped)
