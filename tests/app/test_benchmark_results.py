@@ -38,7 +38,6 @@ NOT_YET_STAMPED = {
     "results_roads.md",
     "results_roads3d.md",
     "results_shapes.md",
-    "results_solids.md",
     "results_step.md",
 }
 
