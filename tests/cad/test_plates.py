@@ -195,16 +195,19 @@ READ = textwrap.dedent(
 
 @pytest.mark.skipif(FREECAD is None, reason="FreeCAD is not installed (Debian/Ubuntu: apt-get install freecad-python3)")
 def test_freecad_reads_the_rounded_plate_as_one_valid_solid(tmp_path):
+    freecad_reads_one_valid_solid(g2_fillet(_four_holes().edges(), 1.5), tmp_path / "plate.step")
+
+
+def freecad_reads_one_valid_solid(part, path) -> None:
+    """FreeCAD reads ``part``'s STEP file (written to ``path``) as one valid solid of the same volume."""
     from spiral_cad.cad.export import export_step
 
-    rounded = g2_fillet(_four_holes().edges(), 1.5)
-    path = tmp_path / "plate.step"
-    export_step(rounded, path)
+    export_step(part, path)
     run = subprocess.run(["/usr/bin/python3", "-c", READ, FREECAD, str(path)], capture_output=True, text=True, timeout=600)
     assert run.returncode == 0, run.stderr[-2000:]
     solids, valid, volume = run.stdout.split()[-3:]
     assert (solids, valid) == ("1", "True")
-    assert float(volume) == pytest.approx(rounded.volume, rel=1e-9)
+    assert float(volume) == pytest.approx(part.volume, rel=1e-9)
 
 
 def test_build123d_circular_fillet_of_the_same_edges_is_only_g1():  # the baseline the G2 plate is measured beside

@@ -10,14 +10,13 @@ from __future__ import annotations
 
 import math
 import re
-import subprocess
 
 import pytest
 from build123d import Axis, Box, Cylinder, Pos, Rot, fillet
 from helpers import freecad_lib
 from hypothesis import given, settings
 from hypothesis import strategies as st
-from test_plates import READ, _all_g2, _one_forward_valid_solid
+from test_plates import _all_g2, _one_forward_valid_solid, freecad_reads_one_valid_solid
 from test_solids import _outline_integrals, _profile_integrals
 
 from spiral_cad import Arc
@@ -170,19 +169,11 @@ FREECAD = freecad_lib()
 
 @pytest.mark.skipif(FREECAD is None, reason="FreeCAD is not installed (Debian/Ubuntu: apt-get install freecad-python3)")
 def test_freecad_reads_a_plate_with_holes_a_pocket_and_a_boss_as_one_valid_solid(tmp_path):
-    from spiral_cad.cad.export import export_step
-
     part = BASE - Pos(0, 0, 3) * Box(40, 20, 4) + Pos(35, 15, 10) * Cylinder(6, 10)
     part = part - [Pos(x, y, 0) * Cylinder(3, 10) for x in (-40, 40) for y in (-22,)]
     rounded = g2_fillet(part.edges(), 1.0)
     _all_g2(rounded.wrapped)
-    path = tmp_path / "part.step"
-    export_step(rounded, path)
-    run = subprocess.run(["/usr/bin/python3", "-c", READ, FREECAD, str(path)], capture_output=True, text=True, timeout=600)
-    assert run.returncode == 0, run.stderr[-2000:]
-    solids, valid, volume = run.stdout.split()[-3:]
-    assert (solids, valid) == ("1", "True")
-    assert float(volume) == pytest.approx(rounded.volume, rel=1e-9)
+    freecad_reads_one_valid_solid(rounded, tmp_path / "part.step")
 
 
 @pytest.mark.slow
