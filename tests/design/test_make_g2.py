@@ -10,12 +10,13 @@ import math
 
 import numpy as np
 import pytest
-from hypothesis import given, settings
+from hypothesis import example, given, settings
 from hypothesis import strategies as st
 
 from spiral_cad import Arc, BezierSpiral, Chain, Line, NoSolutionError
 from spiral_cad.core.chain import g2_mismatch
 from spiral_cad.design import G2Path, make_g2
+from spiral_cad.design._g2_pieces import CHORD_SHARE
 
 # ---------------------------------------------------------------- independent measures
 
@@ -132,10 +133,13 @@ def _size(segments) -> float:
 
 
 def arcs_kept(segments, result: G2Path) -> None:
-    """Every input arc's circle appears in the result as an Arc, concentric, radius within the bound."""
+    """Every input arc's circle appears in the result as an Arc, concentric, radius within the bound, but
+    for an arc within ``CHORD_SHARE`` of the bound of its chord (make_g2 may cut such a short arc as its
+    chord where a kinked joint beside it cannot be absorbed)."""
     out_arcs = [s for c in result.chains for s in c if isinstance(s, Arc)]
     for s in segments:
-        if isinstance(s, Arc):
+        sagitta = abs(s.radius) * (1.0 - math.cos(abs(s.sweep) / 2.0)) if isinstance(s, Arc) and abs(s.sweep) <= math.pi else math.inf
+        if isinstance(s, Arc) and sagitta > CHORD_SHARE * result.max_deviation:
             same = [a for a in out_arcs if np.allclose(a.center, s.center, rtol=0, atol=1e-9 * _size(segments))
                     and abs(abs(a.radius) - abs(s.radius)) <= result.max_deviation]  # fmt: skip
             assert same, f"arc {s} has no true arc in the result"
@@ -418,6 +422,8 @@ _turn = st.tuples(st.just("turn"), st.one_of(st.floats(-2.8, -0.05), st.floats(0
 
 
 @settings(max_examples=60)
+@example(moves=[("arc", 0.015625, 0.125), ("turn", -2.0, 0.0), ("arc", 2.0, 1.0)], scale_exp=1.0, bound_exp=-4.0,
+         shape="near-linear")  # a newcomer's run: the short arc beside the kink cut as its chord  # fmt: skip
 @given(
     moves=st.lists(st.one_of(_line, _arc, _turn), min_size=2, max_size=7),
     scale_exp=st.floats(-3.0, 6.0),
