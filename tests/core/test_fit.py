@@ -8,7 +8,7 @@ import math
 
 import numpy as np
 import pytest
-from hypothesis import example, given, settings
+from hypothesis import assume, example, given, settings
 from hypothesis import strategies as st
 
 from spiral_cad import Arc, Chain, Line, NoSolutionError, PointFit, fit_points, line_to_circle, line_to_line
@@ -379,13 +379,21 @@ def solver_chain(kind: str, shape: str, radius: float, shift: float, turn: float
 # A newcomer's run found it: two points on a short corner pair sit far from its apex, so the
 # first guess of the pair's curvature was 0.46 (in log) off and the search window around it too narrow.
 @example(kind="corner", shape="walton-meek", radius=30.0, shift=0.5, turn=0.3125, per_piece=20, exponent=-4.0)
+# Another newcomer's run: at 1e-6 of the size the corner pair is not found and 85 pieces come back (4 at
+# 10^-5.5); issue 45 (the fit) until it is mended.
+@example(kind="corner", shape="walton-meek", radius=49.0, shift=1.0, turn=1.5, per_piece=20, exponent=-6.0).xfail(
+    raises=AssertionError, reason="issue 45: the corner pair is not found at 1e-6 of the size"
+)
 def test_solver_chains_come_back_within_their_own_pieces(kind, shape, radius, shift, turn, per_piece, exponent):
     """Random chains of our solvers in either shape, sampled at a random density and fitted (in
     their own shape) at a random tolerance and ten times it: never more pieces than their own, never
     more at the looser tolerance, every point within the tolerance by an independent measure."""
     if shape == "near-linear":
         shift = min(shift, 0.1 * radius)  # its spirals reach circles only up to d/r < 1.115 (line_to_circle)
-    chain = solver_chain(kind, shape, radius, shift, turn)
+    try:
+        chain = solver_chain(kind, shape, radius, shift, turn)
+    except NoSolutionError:  # a corner too wide for its 200 legs has no chain to fit (a newcomer's run drew one)
+        assume(False)
     points = chain.point_at(np.linspace(0.0, chain.length, per_piece * len(chain)))
     tolerance = 10.0**exponent * chain.size
     fits = [fit_points(points, t, shape=shape) for t in (tolerance, 10.0 * tolerance)]
