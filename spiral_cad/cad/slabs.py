@@ -33,7 +33,7 @@ from ..core.units import DEFAULT_UNITS, length_unit
 from ..design.fillets import TANGENT_TOL, continuous_rectangle
 from .advice import advice, refusal
 from .roll_surfaces import roll_profile
-from .stacks import _FIT_SLACK, Wall, _between, _fit_problem, _inside, _plain, _samples, meeting_problem, stack_solid
+from .stacks import _FIT_SLACK, Wall, _between, _fit_problem, _inside, _plain, _samples, _signed_area, meeting_problem, stack_solid
 
 __all__ = [
     "Slab",
@@ -124,9 +124,7 @@ def outline_segments(outline: Any, *, corners: bool = False) -> list[Segment]:
 
 def _inward(segments: list[Segment]) -> float:
     """+1 when the outline runs counterclockwise (its inward normal is the left one), else −1."""
-    points, _, _ = _samples(segments)
-    area = 0.5 * float(np.sum(points[:, 0] * np.roll(points[:, 1], -1) - np.roll(points[:, 0], -1) * points[:, 1]))
-    return 1.0 if area > 0.0 else -1.0
+    return 1.0 if _signed_area(_samples(segments)[0]) > 0.0 else -1.0
 
 
 def _reverse(segments: list[Segment]) -> list[Segment]:
