@@ -168,6 +168,18 @@ def iges_names(path) -> tuple[str, list[str]]:
     return sender, names
 
 
+def linuxcnc_rs274(program: Path | str, output: Path | str, **options) -> subprocess.CompletedProcess:
+    """LinuxCNC's rs274 run on ``program`` (its canonical calls in ``output``) as a user runs it, but in a home of its
+    own beside ``output``: rs274 empties ``$HOME/.tool.mmap``, so runs sharing a home break each other."""
+    from spiral_cad.io import rs274
+
+    home = Path(output).parent / "rs274_home"
+    home.mkdir(exist_ok=True)
+    options = {"capture_output": True, "text": True, "stdin": subprocess.DEVNULL, "timeout": 120} | options
+    return subprocess.run([rs274.rs274_executable(), "-g", str(program), str(output)],
+                          env={**os.environ, "HOME": str(home)}, **options)  # fmt: skip
+
+
 def tools_python() -> str:
     """The python of the OpenDRIVE tools environment that `make test` builds (numpy < 2: not ours)."""
     path = os.environ.get("SPIRAL_CAD_XODR_TOOLS") or str(REPO / ".venv-tools" / "bin" / "python")

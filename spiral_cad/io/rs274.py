@@ -90,8 +90,8 @@ MAX_OUTPUT = 4 << 30
 #: How long rs274 may run (seconds) before the program is taken for one that never ends (an O-word loop).
 TIMEOUT = 600.0
 
-#: Runs of rs274 at most when it dies by a signal saying nothing (LinuxCNC's interpreter sometimes dies by
-#: SIGBUS beside another rs274, on programs it reads on the next run).
+#: Runs of rs274 at most when it dies by a signal saying nothing (a crash of the interpreter, not the program's
+#: fault: it was seen when two runs shared a tool table, before each run had its own home).
 SIGNAL_RUNS = 3
 
 
@@ -147,6 +147,13 @@ def rs274_pieces(
     return pieces, feeds, path.units
 
 
+def _private_home(folder: str) -> dict[str, str]:
+    """The environment rs274 runs in: its home in ``folder``. rs274 opens its tool table as ``$HOME/.tool.mmap``
+    and empties it first, so with a shared home two runs break each other (SIGBUS, "tool 1 not found") and a run
+    would empty the tool table of a LinuxCNC running on the same account."""
+    return {**os.environ, "HOME": folder}
+
+
 @contextmanager
 def _canonical(text: str, source: str, timeout: float | None, run_in: str | os.PathLike | None,
                units: str | None) -> Iterator[tuple[IO[str], str | None]]:  # fmt: skip
@@ -174,7 +181,7 @@ def _canonical(text: str, source: str, timeout: float | None, run_in: str | os.P
         for _ in range(SIGNAL_RUNS):
             with ticking(f"rs274 reading {source}"), open(os.path.join(folder, "errors.txt"), "w+") as errors:
                 process = subprocess.Popen([executable, "-g", program, output], cwd=cwd, stdin=subprocess.DEVNULL,
-                                           stdout=subprocess.DEVNULL, stderr=errors)  # fmt: skip
+                                           stdout=subprocess.DEVNULL, stderr=errors, env=_private_home(folder))  # fmt: skip
                 started = time.monotonic()
                 try:
                     while process.poll() is None:  # a loop that never ends would fill the disk: watch time and size

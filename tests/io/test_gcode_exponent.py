@@ -8,10 +8,10 @@ rewriter (``spiral-cad g2``) and the built-in reader behind ``build --from-gcode
 from __future__ import annotations
 
 import os
-import subprocess
 import tempfile
 
 import pytest
+from helpers import linuxcnc_rs274
 
 from spiral_cad.app.cli import main
 from spiral_cad.io import rs274
@@ -59,8 +59,7 @@ def test_rs274_refuses_the_same_line():
         path = os.path.join(folder, "p.ngc")
         with open(path, "w") as f:
             f.write(_program("G1 X1e3 F500"))
-        done = subprocess.run([rs274.rs274_executable(), "-g", path, os.path.join(folder, "out")], capture_output=True, text=True,
-                              stdin=subprocess.DEVNULL, cwd=folder, timeout=60)  # fmt: skip
+        done = linuxcnc_rs274(path, os.path.join(folder, "out"), cwd=folder)
     assert "E word" in done.stderr + done.stdout
 
 

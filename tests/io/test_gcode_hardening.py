@@ -3,11 +3,10 @@ tolerances and coarse decimals are refused by name, a G5 cubic's curvature is it
 as with G1, and every line of a program fits LinuxCNC's 255 characters."""
 
 import re
-import subprocess
 
 import numpy as np
 import pytest
-from helpers import distance_to_chain
+from helpers import distance_to_chain, linuxcnc_rs274
 
 from spiral_cad.app.cli import main
 from spiral_cad.app.designfile import build, write
@@ -191,8 +190,7 @@ def test_linuxcnc_reads_the_feeds_and_a_long_named_program(tmp_path):
     program = tmp_path / "p.ngc"
     program.write_text(gcode_program(chain, name="x" * 400, feed=700, feeds=[np.nan] * 6 + [250.0] * 7).text)
     canon = tmp_path / "canon.txt"
-    done = subprocess.run([rs274.rs274_executable(), "-g", str(program), str(canon)], stdin=subprocess.DEVNULL,
-                          capture_output=True, text=True, timeout=60)  # fmt: skip
+    done = linuxcnc_rs274(program, canon)
     assert done.returncode == 0 and "too long" not in done.stdout + done.stderr
     feeds = [float(f) for f in re.findall(r"SET_FEED_RATE\(([0-9.]+)\)", canon.read_text())]
     assert [f for f in feeds if f] == [700.0, 250.0]

@@ -2,11 +2,11 @@
 
 import math
 import random
-import subprocess
 from pathlib import Path
 
 import numpy as np
 import pytest
+from helpers import linuxcnc_rs274
 
 from spiral_cad.core.segments import Arc, Line
 from spiral_cad.io import rs274
@@ -40,7 +40,7 @@ def canonical_arcs(text: str, folder) -> list[list[float]]:
     """rs274's own ARC_FEED calls of ``text``: (first end, second end, first centre, second centre, rotation, normal end)."""
     program = folder / "p.ngc"
     program.write_text(text)
-    subprocess.run([rs274.rs274_executable(), "-g", str(program), str(folder / "c.txt")], check=True, capture_output=True)
+    linuxcnc_rs274(program, folder / "c.txt", check=True)
     calls = [line for line in (folder / "c.txt").read_text().splitlines() if "ARC_FEED(" in line]
     return [[float(v) for v in line.split("ARC_FEED(")[1].rstrip(")").split(",")[:6]] for line in calls]
 

@@ -1,6 +1,7 @@
 """Full NGC through LinuxCNC's own interpreter rs274, cross-checked against the built-in reader."""
 
 import random
+from concurrent.futures import ThreadPoolExecutor
 
 import numpy as np
 import pytest
@@ -167,6 +168,22 @@ def test_a_program_that_never_names_its_unit_is_refused_as_by_the_built_in_reade
     with pytest.raises(ValueError, match=r"never says G20 \(inches\) or G21 \(mm\)"):
         parse_gcode(text, interpreter="rs274")
     assert parse_gcode("G 2 1 G90 F10\nG1 X1 Y0\nX2 Y1\nM30\n", interpreter="rs274").units == "mm"
+
+
+@needs_rs274
+def test_rs274_runs_in_its_own_home_so_runs_side_by_side_and_a_running_linuxcnc_keep_their_tool_tables(tmp_path, monkeypatch):
+    """rs274 opens ``$HOME/.tool.mmap`` and empties it: in the user's home a run would empty the tool table of a
+    LinuxCNC running there, and two runs at once break each other (SIGBUS, "Requested tool 1 not found")."""
+    home = tmp_path / "home"
+    home.mkdir()
+    table = home / ".tool.mmap"
+    table.write_bytes(b"a running LinuxCNC's tool table")
+    monkeypatch.setenv("HOME", str(home))
+    program = "G21 G90 G17\nT1 M6\nG0 X0 Y0\nG1 X10 Y0 F100\nG1 X10 Y5\nM2\n"
+    with ThreadPoolExecutor(8) as pool:
+        paths = list(pool.map(lambda _: rs274.run_rs274(program), range(24)))
+    assert all(np.allclose(path.points[-1][:2], (10, 5)) for path in paths)
+    assert table.read_bytes() == b"a running LinuxCNC's tool table"
 
 
 @pytest.mark.parametrize("deaths", [1, 2, 3])

@@ -2,12 +2,11 @@
 checked by LinuxCNC's rs274 and its interpreter library, and read back by our own reader."""
 
 import re
-import subprocess
 from pathlib import Path
 
 import numpy as np
 import pytest
-from helpers import distance_to_chain, helix_chain, linuxcnc_preview
+from helpers import distance_to_chain, helix_chain, linuxcnc_preview, linuxcnc_rs274
 
 import spiral_cad as sc
 from spiral_cad import Arc, BezierSpiral, Chain
@@ -147,7 +146,7 @@ def test_rs274_reads_our_programs(tmp_path, dialect):
     program = gcode_program(chain, dialect=dialect, arc_tolerance=0.005)
     path = tmp_path / "robot.ngc"
     path.write_text(program.text)
-    done = subprocess.run([rs274.rs274_executable(), "-g", str(path), str(tmp_path / "canon.txt")], capture_output=True, text=True)
+    done = linuxcnc_rs274(path, tmp_path / "canon.txt")
     assert done.returncode == 0 and "error" not in done.stderr.lower(), done.stderr
     canon = (tmp_path / "canon.txt").read_text()
     assert canon.count("NURBS_FEED(4, ...)") == program.counts["G5"]  # rs274 prints each G5 as a 4-point spline
@@ -340,7 +339,7 @@ def test_no_arc_below_linuxcncs_least_radius_is_written_and_rs274_reads_the_prog
         assert program.arc_error <= 0.001 and program.chord_error <= 0.001
         path = tmp_path / "tiny.ngc"
         path.write_text(program.text)
-        done = subprocess.run([rs274.rs274_executable(), "-g", str(path), str(tmp_path / "canon.txt")], capture_output=True, text=True)
+        done = linuxcnc_rs274(path, tmp_path / "canon.txt")
         assert done.returncode == 0 and "error" not in done.stderr.lower() and "radius" not in done.stderr.lower(), done.stderr
         moves = rs274.run_rs274(program.text, arc_tolerance=1e-4)
         points = moves.points[~moves.rapid][:, : chain.dim]

@@ -2,12 +2,11 @@
 program's path within --max-deviation, and every design's program read back by rs274 onto its chain."""
 
 import re
-import subprocess
 from pathlib import Path
 
 import numpy as np
 import pytest
-from helpers import distance_to_chain
+from helpers import distance_to_chain, linuxcnc_rs274
 
 from spiral_cad.app.cli import _parser, gcode_design, main
 from spiral_cad.app.designfile import build
@@ -23,11 +22,7 @@ CANON_PLANES = {"CANON_PLANE_XY": (0, 1, 2), "CANON_PLANE_XZ": (2, 0, 1), "CANON
 
 def canonical_ends(program: Path, folder: Path) -> np.ndarray:
     """The end of every feed move and rapid (x, y, z, in the program's unit) as rs274 executes ``program``."""
-    for _ in range(3):  # rs274 itself dies now and then by SIGBUS beside another rs274 (seen on good programs): run it again
-        done = subprocess.run([rs274.rs274_executable(), "-g", str(program), str(folder / "canon.txt")], capture_output=True,
-                              text=True, cwd=program.parent)  # fmt: skip
-        if done.returncode >= 0:
-            break
+    done = linuxcnc_rs274(program, folder / "canon.txt", cwd=program.parent)
     assert done.returncode == 0 and "error" not in done.stderr.lower(), done.stderr
     plane, ends = (0, 1, 2), []
     for name, arguments in re.findall(
