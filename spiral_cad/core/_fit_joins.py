@@ -36,10 +36,10 @@ def _join(p: _Primitive, q: _Primitive, points: NDArray[np.float64], shape: str,
     pair's peak curvature is the one whose spirals hold ``points`` best, at most ``kmax``;
     ``shape="auto"``: the shape whose transition holds them best."""
     if shape != _AUTO:
-        return _join_shaped(p, q, points, shape, p_from, q_to, kmax)
+        return _join_shaped(p, q, points, shape, tolerance, p_from, q_to, kmax)
     best: tuple[float, Transition | None] = (math.inf, None)
     for each in _SHAPES:
-        t = _join_shaped(p, q, points, each, p_from, q_to, kmax)
+        t = _join_shaped(p, q, points, each, tolerance, p_from, q_to, kmax)
         if t is not None:
             miss = _transition_miss(p, q, t, points)
             if miss < best[0] or best[1] is None:
@@ -59,12 +59,12 @@ def _transition_miss(p: _Primitive, q: _Primitive, transition: Transition, local
     return float(_nearest(pieces, local).max())
 
 
-def _join_shaped(p: _Primitive, q: _Primitive, points: NDArray[np.float64], shape: str, p_from: NDArray[np.float64],
-                 q_to: NDArray[np.float64], kmax: float | None = None) -> Transition | None:  # fmt: skip
+def _join_shaped(p: _Primitive, q: _Primitive, points: NDArray[np.float64], shape: str, tolerance: float,
+                 p_from: NDArray[np.float64], q_to: NDArray[np.float64], kmax: float | None = None) -> Transition | None:  # fmt: skip
     """The exact transition from ``p`` to ``q`` in one spiral shape (None where none exists)."""
     try:
         if p.line and q.line:
-            return _corner(p, q, points, shape, p_from, q_to, kmax)
+            return _corner(p, q, points, shape, tolerance, p_from, q_to, kmax)
         if p.line:
             return line_to_circle(tuple(p.point.tolist()), tuple(p.direction.tolist()), tuple(q.center.tolist()), abs(q.radius), shape)
         if q.line:
@@ -78,10 +78,11 @@ def _join_shaped(p: _Primitive, q: _Primitive, points: NDArray[np.float64], shap
         return None
 
 
-def _corner(p: _Primitive, q: _Primitive, points: NDArray[np.float64], shape: str, p_from: NDArray[np.float64],
-            q_to: NDArray[np.float64], kmax: float | None = None) -> Transition | None:  # fmt: skip
+def _corner(p: _Primitive, q: _Primitive, points: NDArray[np.float64], shape: str, tolerance: float,
+            p_from: NDArray[np.float64], q_to: NDArray[np.float64], kmax: float | None = None) -> Transition | None:  # fmt: skip
     """line_to_line between two fitted lines, its curvature chosen (from the largest pair the runs
-    allow up to 1000× its curvature, and up to ``kmax``) to hold ``points`` best."""
+    allow up to 1000× its curvature, and up to ``kmax``) to hold ``points`` best, finely enough that
+    the pair's points move by less than a fraction of ``tolerance`` within the last step."""
     cross = p.direction[0] * q.direction[1] - p.direction[1] * q.direction[0]
     if abs(cross) < 1e-12:
         return None
@@ -111,15 +112,19 @@ def _corner(p: _Primitive, q: _Primitive, points: NDArray[np.float64], shape: st
     # The pair scales as 1/κ about the corner: the κ whose apex lies as near the corner as the
     # nearest point does is the first guess. Sparse points may sit well away from the apex, so the
     # window around it walks downhill (doubling its step) until the least miss lies inside, then a
-    # golden-section search on log κ narrows it.
+    # golden-section search on log κ narrows it until a step in log κ moves the pair's farthest
+    # point (its start, ``reach`` from the corner at the widest) by a small part of the tolerance.
     apex = math.hypot(*(np.asarray(widest.joint) - corner))
+    reach = math.hypot(*(np.asarray(widest.start) - corner))
     nearest = float(np.hypot(*(points - corner).T).min())
     guess = min(math.log(max(apex / max(nearest, 1e-300), 1.0)), top)
     lo, hi = _bracket(lambda x: attempt(x)[0], guess, 0.3, 0.0, top)
     ratio = (math.sqrt(5.0) - 1.0) / 2.0
     x1, x2 = hi - ratio * (hi - lo), lo + ratio * (hi - lo)
     f1, f2 = attempt(x1)[0], attempt(x2)[0]
-    for _ in range(16):
+    for _ in range(_GOLDEN_STEPS):
+        if (hi - lo) * reach * math.exp(-lo) <= _CORNER_PRECISION * tolerance:
+            break
         if f1 <= f2:
             hi, x2, f2 = x2, x1, f1
             x1 = hi - ratio * (hi - lo)
@@ -130,6 +135,10 @@ def _corner(p: _Primitive, q: _Primitive, points: NDArray[np.float64], shape: st
             f2 = attempt(x2)[0]
     candidates = [(attempt(guess)[0], guess), (attempt(0.0)[0], 0.0), (f1, x1), (f2, x2)]
     return attempt(min(candidates)[1])[1]
+
+
+#: The most golden-section steps of a corner's search, and the part of the tolerance its last step may move the pair.
+_GOLDEN_STEPS, _CORNER_PRECISION = 60, 1.0 / 32.0
 
 
 def _bracket(cost: Callable[[float], float], middle: float, step: float, low: float, high: float) -> tuple[float, float]:

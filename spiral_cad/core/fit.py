@@ -117,12 +117,12 @@ def _positive(value: Any, name: str) -> float:
 def _check_scale(points: NDArray[np.float64], tolerance: float) -> None:
     """ValueError where the points or the tolerance lie outside what float64 geometry resolves."""
     magnitude = float(np.abs(points).max())
-    extent = float(np.hypot(*(points.max(axis=0) - points.min(axis=0))))
     if magnitude > _LARGEST or tolerance > _LARGEST:
         raise ValueError(
             f"points and tolerance must lie within ±{_LARGEST:g}; got coordinates up to {magnitude:g} and tolerance {tolerance:g} "
             f"(scale them, e.g. with other units)"
         )
+    extent = float(np.hypot(*(points.max(axis=0) - points.min(axis=0))))  # within ±_LARGEST: no overflow
     if extent < _SMALLEST or tolerance < _SMALLEST:
         raise ValueError(
             f"the points span {extent:g} with tolerance {tolerance:g}: both must be at least {_SMALLEST:g} (scale them, e.g. with other units)"
