@@ -3,11 +3,15 @@
 This namespace is the numeric core's face: segments, the Bézier spiral, the
 five transitions, chains, fitting points (``fit_points``), and ``batch`` (the
 same solvers over arrays). It
-needs only numpy, scipy and numba. Design tools live in ``spiral_cad.design``;
+needs only numpy, scipy and numba. ``export`` and ``read`` (``spiral_cad.app.files``, loaded on first
+use) write and read every format, chosen by the file's suffix. Design tools live in ``spiral_cad.design``;
 build123d objects in ``spiral_cad.build123d`` and the CadQuery plugin in
 ``spiral_cad.cadquery`` (these two import OCP).
 """
 
+from typing import TYPE_CHECKING, Any
+
+from ._version import __version__ as __version__
 from .core import batch
 from .core.chain import Chain
 from .core.errors import NoSolutionError, Status
@@ -16,6 +20,9 @@ from .core.segments import Arc, Circle, Join, Line, Segment
 from .core.space import PlaneFrame
 from .core.spiral import BezierSpiral
 from .core.transitions import Transition, circle_in_circle, circle_to_circle, line_to_circle, line_to_line
+
+if TYPE_CHECKING:
+    from .app.files import export, read
 
 __all__ = [
     "Arc",
@@ -33,8 +40,18 @@ __all__ = [
     "batch",
     "circle_in_circle",
     "circle_to_circle",
+    "export",
     "fit_points",
     "line_to_circle",
     "line_to_line",
+    "read",
 ]
-__version__ = "0.2.0"
+
+
+def __getattr__(name: str) -> Any:
+    """``export`` and ``read`` on first use: the file formats' modules load only when a file is written or read."""
+    if name in ("export", "read"):
+        from .app import files
+
+        return getattr(files, name)
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

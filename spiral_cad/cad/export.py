@@ -52,7 +52,7 @@ __all__ = [
 
 def originating_system() -> str:
     """``spiral_cad <version>``: the originating system written into every file."""
-    from .. import __version__
+    from .._version import __version__
 
     return f"spiral_cad {__version__}"
 

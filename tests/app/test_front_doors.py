@@ -2,10 +2,18 @@
 
 from __future__ import annotations
 
+import subprocess
+import sys
+import xml.etree.ElementTree as ET
+from pathlib import Path
+
 import ezdxf
 import pytest
 
+import spiral_cad as sc
+from spiral_cad import Chain, line_to_circle
 from spiral_cad.app.cli import main
+from spiral_cad.app.files import EXPORTS
 from spiral_cad.io.gcode import read_gcode
 
 PROGRAM = "G21\nG0 X0 Y0 Z1\nG1 Z-1 F100\nG1 X10 F300\nG3 X20 Y10 I0 J10\nG0 Z1\nM2\n"
@@ -70,3 +78,72 @@ def test_check_advises_a_bound_to_use_and_it_builds(tmp_path, capsys):
     segments, closed = wire_path(wire.wrapped, planar_frame(wire.wrapped))
     made = make_g2(segments, use, closed=closed)
     assert made.deviation <= use and all(j.kind != "split" for j in made.joints)
+
+
+def _road() -> Chain:
+    return Chain.join([line_to_circle((0, 0), (1, 0), (50, 40), 30)], start=(-100, 0), units="m")
+
+
+def test_export_writes_every_format_by_its_suffix_and_their_own_readers_take_them(tmp_path):
+    """One verb for every format written; each file judged by a reader we did not write."""
+    import ifcopenshell
+    import xmlschema
+    from OCP.IFSelect import IFSelect_RetDone
+    from OCP.IGESControl import IGESControl_Reader
+    from OCP.STEPControl import STEPControl_Reader
+
+    chain = _road()
+    suffixes = {s for suffixes, _ in EXPORTS.values() for s in suffixes[:1]}
+    for suffix in sorted(suffixes):
+        options = {"step": 1.0} if suffix == ".csv" else {}
+        sc.export(chain, tmp_path / f"road{suffix}", **options)
+    for reader in (STEPControl_Reader(), IGESControl_Reader()):
+        path = tmp_path / ("road.step" if isinstance(reader, STEPControl_Reader) else "road.iges")
+        assert reader.ReadFile(str(path)) == IFSelect_RetDone and reader.TransferRoots() > 0
+    assert {e.dxftype() for e in ezdxf.readfile(tmp_path / "road.dxf").modelspace()} == {"LINE", "SPLINE"}
+    xmlschema.XMLSchema(str(Path(__file__).parents[1] / "data" / "landxml" / "LandXML-1.2.xsd")).validate(str(tmp_path / "road.xml"))
+    assert len(ifcopenshell.open(str(tmp_path / "road.ifc")).by_type("IfcAlignment")) == 1
+    assert ET.parse(tmp_path / "road.xodr").getroot().tag == "OpenDRIVE"
+    assert ET.parse(tmp_path / "road.svg").getroot().tag.endswith("svg")
+    assert "G21" in (tmp_path / "road.nc").read_text() and (tmp_path / "road.csv").read_text().count("\n") > 100
+
+
+def test_read_reads_every_format_by_its_suffix_or_the_format_named(tmp_path):
+    chain = _road()
+    for suffix in (".step", ".ngc", ".xml", ".xodr", ".ifc"):
+        sc.export(chain, tmp_path / f"road{suffix}")
+    assert type(sc.read(tmp_path / "road.step")).__name__ == "TopoDS_Shape"
+    assert sc.read(tmp_path / "road.ngc").length == pytest.approx(chain.length * 1000.0, rel=1e-6)  # a program in mm
+    for suffix in (".xml", ".xodr", ".ifc"):
+        (road,) = sc.read(tmp_path / f"road{suffix}")
+    (tmp_path / "road.xml").rename(tmp_path / "road.landxml")
+    (alignment,) = sc.read(tmp_path / "road.landxml", format="landxml")
+    assert alignment.chain.length == pytest.approx(chain.length, rel=1e-9)
+    assert sc.read(tmp_path / "road.step", units="m") is not None  # the reader's own option, passed on
+
+
+@pytest.mark.parametrize(
+    ("call", "message"),
+    [
+        (
+            lambda p: sc.export(_road(), p / "road.pdf"),
+            r"export 'road.pdf': the suffix '.pdf' names no format export knows \(.*\.step.*\.xodr",
+        ),
+        (
+            lambda p: sc.export(_road(), p / "road.step", format="parasolid"),
+            r"format must be one of step, iges, .* for export; got 'parasolid'",
+        ),
+        (lambda p: sc.export(_road(), p / "road.dxf", units="m"), r"'road.dxf': export_dxf takes the options name; got 'units'"),
+        (lambda p: sc.read(p / "road", format=None), r"read 'road': the suffix '\(none\)' names no format read knows"),
+        (lambda p: sc.read(p / "road.svg"), r"the suffix '.svg' names no format read knows"),
+    ],
+)
+def test_the_verbs_refuse_by_name_with_what_they_take(tmp_path, call, message):
+    with pytest.raises(ValueError, match=message):
+        call(tmp_path)
+
+
+def test_the_verbs_load_the_formats_only_when_used():
+    done = subprocess.run([sys.executable, "-c", "import sys, spiral_cad; print('spiral_cad.app.files' in sys.modules); "
+                           "spiral_cad.export; print('spiral_cad.app.files' in sys.modules)"], capture_output=True, text=True)  # fmt: skip
+    assert done.stdout.split() == ["False", "True"], done.stderr
