@@ -4,4 +4,48 @@
 
 Every module here imports OCP (through build123d or CadQuery where named so), but ``sandbox``
 (child processes for native code and slow writers), which builds use without the ``cad`` extra too.
+This namespace names the exporters, readers, checkers and G2 makers (``from spiral_cad.cad import
+check_faces``); each loads with its module on first use, so importing the namespace imports no OCP.
 """
+
+from importlib import import_module
+from typing import Any
+
+#: The names of this namespace and the module each lives in (loaded on first use: each needs OCP).
+_HOMES = {
+    "export_step": "export",
+    "export_iges": "export",
+    "export_dxf": "export",
+    "export_svg": "export",
+    "export_samples": "export",
+    "export_opendrive": "export",
+    "read_shape": "readers",
+    "ReadError": "readers",
+    "check_continuity": "continuity",
+    "curvature_comb": "continuity",
+    "ContinuityReport": "continuity",
+    "check_faces": "faces",
+    "FaceReport": "faces",
+    "g2_slab": "slabs",
+    "continuous_box": "slabs",
+    "fillet_part_edges": "stack_fillet",
+    "fillet_prism_edges": "prism_fillet",
+    "fillet_wire": "fillet",
+    "fillet_face": "fillet",
+    "g2_wire": "g2wire",
+    "g2_face": "g2wire",
+    "rewrite_step_g2": "step_g2",
+    "rewrite_iges_g2": "step_g2",
+}
+__all__ = sorted(_HOMES)
+
+
+def __getattr__(name: str) -> Any:
+    """A name of ``__all__`` from its module, imported on first use."""
+    if name in _HOMES:
+        return getattr(import_module(f".{_HOMES[name]}", __name__), name)
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+
+
+def __dir__() -> list[str]:
+    return sorted(set(globals()) | set(__all__))

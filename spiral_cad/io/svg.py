@@ -81,5 +81,10 @@ def svg_text(chains: Sequence[Chain], name: str, units: str, margin: float = 0.0
 
 
 def write_svg(chains: Sequence[Chain], path: str | os.PathLike, name: str, units: str, margin: float = 0.05) -> None:
+    """Write ``svg_text(chains, name, units, margin)`` to ``path`` (UTF-8); ``cad.export.export_svg`` checks the arguments first.
+
+    Raises:
+        OSError: the file could not be written.
+    """
     with open(path, "w", encoding="utf-8") as handle:
         handle.write(svg_text(chains, name, units, margin))

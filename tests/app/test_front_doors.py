@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import importlib
 import subprocess
 import sys
 import xml.etree.ElementTree as ET
@@ -147,3 +148,15 @@ def test_the_verbs_load_the_formats_only_when_used():
     done = subprocess.run([sys.executable, "-c", "import sys, spiral_cad; print('spiral_cad.app.files' in sys.modules); "
                            "spiral_cad.export; print('spiral_cad.app.files' in sys.modules)"], capture_output=True, text=True)  # fmt: skip
     assert done.stdout.split() == ["False", "True"], done.stderr
+
+
+@pytest.mark.parametrize("namespace", ["spiral_cad.io", "spiral_cad.cad"])
+def test_the_namespaces_name_their_doors_each_from_its_own_module_loaded_on_first_use(namespace):
+    module = importlib.import_module(namespace)
+    for name in module.__all__:
+        found = getattr(module, name)
+        home = importlib.import_module(f"{namespace}.{module._HOMES[name]}")
+        assert found is getattr(home, name) and found.__doc__, name
+    done = subprocess.run([sys.executable, "-c", f"import sys, {namespace}; print(sorted(m for m in sys.modules if m.startswith('{namespace}.') or m == 'OCP'))"],
+                          capture_output=True, text=True)  # fmt: skip
+    assert done.stdout.strip() == "[]", done.stderr
