@@ -37,6 +37,7 @@ MEASURES = (
     "spiral_cad.cad.face_sampling",
     "spiral_cad.cad.face_projection",
     "spiral_cad.cad.batch_geometry",
+    "spiral_cad.cad.batch_bspline",
     "spiral_cad.cad.readers",
     "spiral_cad.cad.mesh",
     "spiral_cad.app.zebra",

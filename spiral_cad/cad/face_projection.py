@@ -47,6 +47,7 @@ from OCP.TColStd import TColStd_Array1OfReal
 from OCP.TopAbs import TopAbs_IN
 from OCP.TopoDS import TopoDS_Face
 
+from spiral_cad.cad.batch_bspline import BSplineSurfaces, bspline_derivatives, bspline_surfaces
 from spiral_cad.cad.batch_geometry import surface_derivatives, surface_frame
 
 __all__ = [
@@ -305,15 +306,29 @@ class FaceTable:
         self.width, self.periods = np.array([d.width for d in domains]), np.array([d.periods for d in domains])
         self.closed = np.array([d.frame is not None for d in domains])
         self.frames = np.array([np.zeros(17) if d.frame is None else d.frame for d in domains])
+        # B-spline surfaces that are not periodic, one table per degree pair (batch_bspline)
+        splines = [k for k, d in enumerate(domains) if d.frame is None and d.bspline is not None]
+        self.tables: list[BSplineSurfaces] = []
+        self.group, self.slot = np.full(len(domains), -1), np.zeros(len(domains), dtype=int)
+        for table, members in bspline_surfaces([domains[k].bspline for k in splines]).values():
+            faces = [splines[m] for m in members]
+            self.group[faces], self.slot[faces] = len(self.tables), np.arange(len(faces))
+            self.tables.append(table)
 
     def derivatives(self, owner: NDArray, uvs: NDArray) -> NDArray:
         """Derivatives (n × 18) at ``uvs``, each on the face ``owner``: elementary surfaces all at once in
-        closed form, the others point by point through OCCT."""
+        closed form, B-spline surfaces that are not periodic all at once per degree pair, the others point by
+        point through OCCT."""
         out = np.empty((len(uvs), 18))
         closed = self.closed[owner]
         if closed.any():
             out[closed] = surface_derivatives(self.frames[owner[closed]], uvs[closed])
-        rest = np.flatnonzero(~closed)
+        group = self.group[owner]
+        for g, table in enumerate(self.tables):
+            rows = np.flatnonzero(group == g)
+            if len(rows):
+                out[rows] = bspline_derivatives(table, self.slot[owner[rows]], uvs[rows])
+        rest = np.flatnonzero(~closed & (group < 0))
         for f in np.unique(owner[rest]).tolist():
             rows = rest[owner[rest] == f]
             found = np.empty((len(rows), 18))
