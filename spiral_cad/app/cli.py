@@ -179,13 +179,13 @@ GCODE_ONLY = ("max_deviation", "interpreter", "arc_tolerance", "feed")
 
 def _build(args: argparse.Namespace) -> int:
     suffix = "" if args.design is None else Path(args.design).suffix.lower()
-    if args.g2 is not None or suffix in (".dxf", ".xodr") or (suffix == ".xml" and args.max_deviation is not None):
-        return _build_g2(args, suffix)  # --g2 and --max-deviation: one bound, either name
+    if suffix in (".dxf", ".xodr") or (suffix == ".xml" and args.max_deviation is not None):
+        return _build_g2(args, suffix)
     landxml = [o for o, given in (("--max-offset", args.max_offset is not None), ("--directions", args.directions != "auto")) if given]
     if landxml and (args.design is None or Path(args.design).suffix.lower() != ".xml"):
         raise ValueError(f"{', '.join(landxml)}: only with a LandXML file (.xml)")
     if args.allow_splits:
-        raise ValueError("--allow-splits: only with a path made G2 (a DXF drawing, or LandXML/OpenDRIVE with --g2); "
+        raise ValueError("--allow-splits: only with a path made G2 (a DXF drawing, or LandXML/OpenDRIVE with --max-deviation); "
                          "a G-code build splits the path where it folds back by design (for the program made G2 "
                          "in place: spiral-cad g2 PROGRAM)")  # fmt: skip
     if args.from_points is not None:
@@ -209,28 +209,24 @@ def _build(args: argparse.Namespace) -> int:
         return _write_design(gcode_design(args), Path(args.out), plots=not args.no_plots)
 
 
-#: ``build`` options a DXF drawing or ``--g2`` takes (the rest are refused by name).
+#: ``build`` options a DXF drawing or an alignment file made G2 takes (the rest are refused by name).
 G2_OPTIONS = ("max_deviation", "units", "shape", "name")
 
 
 def _build_g2(args: argparse.Namespace, suffix: str) -> int:
-    """``build FILE.dxf --max-deviation D`` and ``build FILE.xml|.xodr --g2 D``: lines and arcs made G2 (``g2_build``)."""
+    """``build FILE.dxf|.xml|.xodr --max-deviation D``: lines and arcs made G2 (``g2_build``)."""
     from .g2_build import g2_designs
 
-    if suffix not in (".dxf", ".xml", ".xodr"):
-        raise ValueError("--g2: only with a DXF (.dxf), LandXML (.xml) or OpenDRIVE (.xodr) file")
-    if suffix == ".xodr" and args.g2 is None and args.max_deviation is None:
-        raise ValueError("an OpenDRIVE file is built with --g2 D or --max-deviation D (its lines and arcs made G2 within D); "
+    if suffix == ".xodr" and args.max_deviation is None:
+        raise ValueError("an OpenDRIVE file is built with --max-deviation D (its lines and arcs made G2 within D); "
                          "check it with spiral-cad check")  # fmt: skip
-    if args.g2 is not None and args.max_deviation is not None:
-        raise ValueError("give --g2 or --max-deviation (the same bound), not both")
-    deviation = args.g2 if args.g2 is not None else args.max_deviation
+    deviation = args.max_deviation
     if deviation is None:
         raise ValueError(
             f"{Path(args.design).name}: give --max-deviation (the largest distance between the drawing's path and the G2 path)"
         )
     if not 0.0 < deviation < math.inf:
-        raise ValueError(f"--{'g2' if args.g2 is not None else 'max-deviation'} must be a positive finite number; got {deviation}")
+        raise ValueError(f"--max-deviation must be a positive finite number; got {deviation}")
     others = [
         f"--{o.replace('_', '-')}"
         for o in (*GCODE_OPTIONS, *POINTS_OPTIONS)
@@ -239,7 +235,7 @@ def _build_g2(args: argparse.Namespace, suffix: str) -> int:
     others += [o for o, given in (("--from-gcode", args.from_gcode), ("--from-points", args.from_points),
                                   ("--max-offset", args.max_offset is not None), ("--directions", args.directions != "auto")) if given]  # fmt: skip
     if others:
-        raise ValueError(f"{', '.join(others)}: not with a {'DXF drawing' if suffix == '.dxf' else '--g2 build'}")
+        raise ValueError(f"{', '.join(others)}: not with a {'DXF drawing' if suffix == '.dxf' else 'road file made G2'}")
     if args.shape == "g2cbs":
         raise ValueError("--shape g2cbs rounds corners; make_g2's spirals are near-linear (default) or walton-meek")
     # the file's own unit unless --units is given (a DXF drawing is converted, a unitless one read in it)
@@ -606,6 +602,11 @@ def _build_inputs(args: argparse.Namespace) -> int:
     """
     from ..io.gcode import SUFFIXES as GCODE_SUFFIXES
 
+    if args.g2 is not None:  # the old name of the bound, kept for one release
+        if args.max_deviation is not None:
+            raise ValueError("give --max-deviation only (--g2 is its old name, the same bound)")
+        print("warning: --g2 is deprecated and will be removed: the same bound is --max-deviation D", file=sys.stderr)
+        args.max_deviation, args.g2 = args.g2, None
     designs: list[str] = args.design
     field, inputs = "design", designs
     suffixes: tuple[str, ...] = (".json", ".xml", ".dxf", ".xodr")
@@ -720,7 +721,7 @@ def _parser() -> argparse.ArgumentParser:
         nargs="*",
         help="the design file (.json), a LandXML file (.xml: every alignment), a DXF drawing (.dxf: its "
         "lines and arcs chained into paths, made G2 within --max-deviation; --units for a unitless drawing) or an OpenDRIVE "
-        "file (.xodr, with --g2), a CNC program (.nc .ngc .gcode .tap: as --from-gcode) or points (.csv .txt .xyz: as --from-points); "
+        "file (.xodr, with --max-deviation), a CNC program (.nc .ngc .gcode .tap: as --from-gcode) or points (.csv .txt .xyz: as --from-points); "
         "several files, folders or glob patterns are built in parallel, each into OUT/ its name (see --workers)",
     )
     build.add_argument("-o", "--out", default="out", help="output folder (default: out)")
@@ -728,10 +729,7 @@ def _parser() -> argparse.ArgumentParser:
     build.add_argument("--max-offset", type=float, metavar="LENGTH",
                        help="LandXML: the largest offset accepted between a file's element and ours, in the file's unit "
                             "(default: 5%% of each element's length; inf accepts any)")  # fmt: skip
-    build.add_argument("--g2", type=float, metavar="D",
-                       help="LandXML or OpenDRIVE: make every alignment of lines and arcs G2 within D (its unit; "
-                            "make_g2: arcs kept true arcs, spirals between), one design per alignment or road; "
-                            "--max-deviation D is the same bound")  # fmt: skip
+    build.add_argument("--g2", type=float, metavar="D", help="deprecated: the old name of --max-deviation")
     build.add_argument("--allow-splits", action="store_true",
                        help="DXF, LandXML, OpenDRIVE (made G2): accept a path split into G2 parts (at a reversal or a corner "
                             "too sharp; G0 where the parts meet) and exit 0; without it such a build exits 1")  # fmt: skip
@@ -745,8 +743,10 @@ def _parser() -> argparse.ArgumentParser:
         "NAME_2, ... per G2 path. A program with G5 splines is read as the exact path it states; other codes are\n"
         "refused by name and line (README: the G-code subset)")  # fmt: skip
     gcode.add_argument("--from-gcode", metavar="FILE.nc", help="the program to round (instead of a design file)")
-    gcode.add_argument("--max-deviation", type=float,
-                       help="the largest distance between the program's path and the G2 path (at corners and tangent joints)")  # fmt: skip
+    gcode.add_argument("--max-deviation", type=float, metavar="D",
+                       help="the largest distance between the input's path and the G2 path, in its unit: a program's (at "
+                            "corners and tangent joints), a DXF drawing's, or a LandXML or OpenDRIVE file's alignments of "
+                            "lines and arcs (made G2: arcs kept true arcs, spirals between; one design per alignment or road)")  # fmt: skip
     gcode.add_argument("--max-curvature", type=float, help="the curvature bound (1/unit)")
     gcode.add_argument("--shape", choices=["walton-meek", "near-linear", "g2cbs"], help="spiral shape (default walton-meek)")
     gcode.add_argument("--sample-step", type=float, help="samples at most this far apart along the path")

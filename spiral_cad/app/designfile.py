@@ -667,7 +667,7 @@ def _write_others(b: Built, stage: Path, units: str, missing: list[str], plots: 
                 names += _road_3d(b, profile, stage, units)
     if isinstance(b, BuiltLandXML):
         names += _landxml_report(b, stage)
-    elif getattr(b, "road", False):  # an alignment made G2 (build FILE.xml --g2): also its OpenDRIVE
+    elif getattr(b, "road", False):  # an alignment made G2 (build FILE.xml --max-deviation D): also its OpenDRIVE
         from ..cad.export import export_opendrive
 
         export_opendrive(b.chain, stage / f"{b.name}.xodr", name=b.name)

@@ -1,5 +1,5 @@
-"""Lines and arcs from a drawing or an alignment file made G2: ``build FILE.dxf``, ``build FILE.xml --g2 D``,
-``build FILE.xodr --g2 D`` and the design type ``g2_path``.
+"""Lines and arcs from a drawing or an alignment file made G2: ``build FILE.dxf``, ``build FILE.xml --max-deviation D``,
+``build FILE.xodr --max-deviation D`` and the design type ``g2_path``.
 
 Every path is made G2 by ``spiral_cad.design.make_g2`` within the stated deviation, its arcs kept
 true arcs: a DXF drawing's chained paths (``spiral_cad.io.dxf_read``), a LandXML alignment of lines
@@ -218,8 +218,8 @@ def _landxml(source: Path) -> list[tuple[str, list, bool, str]]:
         segments = [s for chain in alignment.chains for s in chain]
         spirals = [type(s).__name__ for s in segments if not isinstance(s, (Line, Arc))]
         if spirals:
-            raise ValueError(f"alignment {alignment.name!r} has spirals ({len(spirals)}): --g2 makes alignments of lines "
-                             "and arcs G2; build it without --g2")  # fmt: skip
+            raise ValueError(f"alignment {alignment.name!r} has spirals ({len(spirals)}): --max-deviation makes alignments "
+                             "of lines and arcs G2; build it without --max-deviation")  # fmt: skip
         out.append((_stem(alignment.name, f"alignment{k + 1}"), segments, False, alignment.units))
     return out
 
@@ -232,7 +232,10 @@ def _opendrive(source: Path) -> list[tuple[str, list, bool, str]]:
     for road in read_opendrive(source):
         kinds = [g.kind for g in road.geometries if g.kind not in ("line", "arc")]
         if kinds:
-            raise ValueError(f"road {road.id} has {kinds[0]} geometries: --g2 makes roads of lines and arcs G2; build it without --g2")
+            raise ValueError(
+                f"road {road.id} has {kinds[0]} geometries: --max-deviation makes roads of lines and arcs G2; "
+                "check it with spiral-cad check"
+            )
         segments = [g.segment() for g in road.geometries]
         out.append((_stem(road.name or f"road{road.id}", f"road{road.id}"), segments, False, "m"))
     return out

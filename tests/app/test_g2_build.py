@@ -1,4 +1,4 @@
-"""`build FILE.dxf`, `build FILE.xml --g2 D`, `build FILE.xodr --g2 D` and the design type g2_path: lines and arcs
+"""`build FILE.dxf`, `build FILE.xml --max-deviation D`, `build FILE.xodr --max-deviation D` and the design type g2_path: lines and arcs
 made G2 by make_g2, arcs kept true arcs, the input within the bound (measured here on the input's own geometry)."""
 
 import json
@@ -127,12 +127,14 @@ def test_a_landxml_alignment_of_lines_and_arcs_is_made_g2(tmp_path, capsys):
     arcs_in = sum(isinstance(s, Arc) for c in alignment.chains for s in c)
     assert sum(isinstance(s, Arc) for s in chain) == arcs_in  # every arc kept an arc
     out = tmp_path / "out"
-    assert main(["build", str(source), "--g2", "0.1", "--no-plots", "--out", str(out)]) == 0
+    assert main(["build", str(source), "--max-deviation", "0.1", "--no-plots", "--out", str(out)]) == 0
     assert (out / f"{built[0].name}.xodr").exists() and (out / f"{built[0].name}.step").exists()
+    capsys.readouterr()
     assert main(["build", str(source), "--g2", "0.1", "--max-deviation", "0.1", "--out", str(out)]) == 2
-    assert "give --g2 or --max-deviation" in capsys.readouterr().err
-    again = tmp_path / "again"  # one bound by either name
-    assert main(["build", str(source), "--max-deviation", "0.1", "--no-plots", "--out", str(again)]) == 0
+    assert "give --max-deviation only (--g2 is its old name, the same bound)" in capsys.readouterr().err
+    again = tmp_path / "again"  # the old name still works for one release, and says so
+    assert main(["build", str(source), "--g2", "0.1", "--no-plots", "--out", str(again)]) == 0
+    assert "warning: --g2 is deprecated and will be removed: the same bound is --max-deviation D" in capsys.readouterr().err
     undated = [re.sub(r' date="[^"]*"', "", (folder / f"{built[0].name}.xodr").read_text()) for folder in (again, out)]
     assert undated[0] == undated[1]  # the same file, but for the time it was written
 
@@ -153,16 +155,15 @@ def test_opendrive_roads_of_lines_and_arcs_are_made_g2_and_spirals_refused(tmp_p
     arc = np.column_stack([100 + 50 * np.cos(angle), 50 + 50 * np.sin(angle)])
     up = np.column_stack([np.full(200, 150.0), np.linspace(50, 150, 200)])
     file_points = np.concatenate([line, arc, up])
-    assert main(["build", str(tmp_path / "g1.xodr"), "--g2", "0.05", "--no-plots", "--out", str(tmp_path / "out")]) == 0
+    assert main(["build", str(tmp_path / "g1.xodr"), "--max-deviation", "0.05", "--no-plots", "--out", str(tmp_path / "out")]) == 0
     units, built = g2_designs(tmp_path / "g1.xodr", 0.05)
     chain = built[0].chain
     assert units == "m" and distance_to_chain(chain, file_points, 0.2).max() <= 0.05 * (1 + 1e-6)
     assert [type(s).__name__ for s in chain].count("Arc") == 1
-    assert main(["build", str(DATA / "esmini_lane_offset_junction.xodr"), "--g2", "0.05", "--out", str(tmp_path / "x")]) == 2
-    assert "has spiral geometries: --g2 makes roads of lines and arcs G2" in capsys.readouterr().err
+    assert main(["build", str(DATA / "esmini_lane_offset_junction.xodr"), "--max-deviation", "0.05", "--out", str(tmp_path / "x")]) == 2
+    assert "has spiral geometries: --max-deviation makes roads of lines and arcs G2" in capsys.readouterr().err
     assert main(["build", str(tmp_path / "g1.xodr"), "--out", str(tmp_path / "x")]) == 2
-    assert "an OpenDRIVE file is built with --g2 D or --max-deviation D" in capsys.readouterr().err
-    assert main(["build", str(tmp_path / "g1.xodr"), "--max-deviation", "0.05", "--no-plots", "--out", str(tmp_path / "y")]) == 0
+    assert "an OpenDRIVE file is built with --max-deviation D" in capsys.readouterr().err
 
 
 def test_the_design_type_g2_path(tmp_path):
