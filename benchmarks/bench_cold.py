@@ -27,11 +27,11 @@ import time
 from timing import Report, Timing, arguments
 
 #: The modules whose code these numbers measure (stamped into the results: ``timing.code_stamp``).
-MEASURES = ("spiral_cad", "spiral_cad.core._jit", "spiral_cad.core.transitions", "spiral_cad.core.batch")
+MEASURES = ("spiral_cad", "spiral_cad.core.jit", "spiral_cad.core.transitions", "spiral_cad.core.batch")
 
 FIRST_CALL = "import spiral_cad; spiral_cad.line_to_circle((0, 0), (1, 0), (10, 5), 3)"
 COMPILE_ALL = (
-    "import spiral_cad; from spiral_cad.core._jit import SCALAR_CALLS_BEFORE_COMPILING as n\n"
+    "import spiral_cad; from spiral_cad.core.jit import SCALAR_CALLS_BEFORE_COMPILING as n\n"
     "for _ in range(n + 2): spiral_cad.line_to_circle((0, 0), (1, 0), (10, 5), 3)"
 )
 BATCH_CALL = "import numpy as np, spiral_cad; spiral_cad.batch.line_to_circle(np.zeros((4, 2)), [[1, 0]] * 4, [[10, 5]] * 4, [3] * 4)"

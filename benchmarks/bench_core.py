@@ -21,8 +21,8 @@ from spiral_cad.core import batch
 #: The modules whose code these numbers measure (stamped into the results: ``timing.code_stamp``).
 MEASURES = (
     "spiral_cad.core._kernels",
-    "spiral_cad.core._jit",
-    "spiral_cad.core._threads",
+    "spiral_cad.core.jit",
+    "spiral_cad.core.threads",
     "spiral_cad.core.batch",
     "spiral_cad.core.transitions",
     "spiral_cad.core.bezier",

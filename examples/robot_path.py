@@ -28,7 +28,7 @@ kappa_max = 4.0  # 1/m: a 0.25 m minimum turning radius
 
 fig, axes = plt.subplots(2, 2, figsize=(12, 7), height_ratios=[3, 2])
 for column, method in enumerate(("walton-meek", "g2cbs")):
-    path = round_corners(waypoints, max_curvature=kappa_max, method=method)
+    path = round_corners(waypoints, max_curvature=kappa_max, shape=method)
     s = np.linspace(0, path.chain.length, 20001)
     peak = np.abs(path.chain.curvature_at(s)).max()
     assert peak <= kappa_max * (1 + 1e-9), (method, peak)

@@ -319,11 +319,11 @@ def _check(args: argparse.Namespace) -> int:
     if suffix not in CHECK_SUFFIXES and Path(args.file).exists():
         from ..io.gcode import SUFFIXES as GCODE_SUFFIXES
 
-        documents = {".dxf": "a DXF drawing", ".xml": "a LandXML file", **dict.fromkeys(GCODE_SUFFIXES, "a CNC program")}
+        documents = {".xml": "a LandXML file", **dict.fromkeys(GCODE_SUFFIXES, "a CNC program")}
         kind = (
             f"{documents[suffix]}: spiral-cad g2 makes it G2 in place and reports every path left below G2" if suffix in documents else ""
         )
-        raise ValueError(f"{Path(args.file).name}: check judges STEP/IGES (.step .stp .igs .iges) and OpenDRIVE (.xodr) files"
+        raise ValueError(f"{Path(args.file).name}: check judges STEP/IGES (.step .stp .igs .iges), DXF (.dxf) and OpenDRIVE (.xodr) files"
                          + (f"; for {kind}" if kind else ""))  # fmt: skip
     if suffix == ".xodr":
         _wire_tolerances(args)
@@ -341,9 +341,15 @@ def _check(args: argparse.Namespace) -> int:
     if find_spec("OCP") is None:
         print(f"error: spiral-cad check reads STEP/IGES with OCCT, which comes with the CAD extra: {PIP_CAD}", file=sys.stderr)
         return 2
+    picture = _picture_options(args)  # refused before anything is read
+    if suffix == ".dxf":
+        if args.zebra or args.curvature_map:
+            print("error: --zebra and --curvature-map draw faces; a DXF drawing holds curves", file=sys.stderr)
+            return 2
+        _wire_tolerances(args)
+        return _check_drawing(args)
     from ..cad.faces import holds_faces
 
-    picture = _picture_options(args)  # refused before anything is read
     if holds_faces(args.file):
         from .faces_check import check_face_file
 
@@ -393,6 +399,27 @@ def _check_shape_file(args: argparse.Namespace) -> int:
     return _print_report(report, args)
 
 
+def _check_drawing(args: argparse.Namespace) -> int:
+    """``spiral-cad check`` of a DXF drawing: its curves as drawn (``cad.dxf_shape``), joint by joint, as
+    a STEP file's wires; the same exit statuses."""
+    from ..cad.continuity import check_continuity, curvature_comb
+    from ..cad.dxf_shape import DRAWING_UNITS, dxf_shape
+    from ..cad.export import export_step
+
+    name = Path(args.file).name
+    shape, units, notes = dxf_shape(args.file)
+    if args.comb and units == DRAWING_UNITS:
+        raise ValueError(f"--comb: {name} states no unit ($INSUNITS), and a STEP file needs one")
+    report = check_continuity(shape, gap_tol=args.gap_tol, angle_tol=args.angle_tol, curvature_tol=args.curvature_tol,
+                              snap=args.snap, units=None if units == DRAWING_UNITS else units, label=name)  # fmt: skip
+    for note in notes:
+        print(f"note: {note}")
+    if args.comb:
+        export_step(curvature_comb(shape, units=units), _comb_path(args.comb, args.file), name=f"{name} curvature comb", units=units)
+    advice = f"make_g2: spiral-cad g2 {name} -o OUT.dxf --max-deviation D makes its paths of lines and arcs G2, every other entity kept"
+    return _print_report(report, args, advice)
+
+
 def _advice_lines(file: str, units: str) -> list[str]:
     from ..cad.g2wire import g2_advice
     from ..cad.readers import read_shape
@@ -429,14 +456,18 @@ def _comb_path(comb: str, checked: str) -> Path:
     return path
 
 
-def _print_report(report: ContinuityReport, args: argparse.Namespace) -> int:
-    """Print ``report`` for ``spiral-cad check``; exit status 0 ok, 1 below ``--require`` or not ``--pieces`` pieces."""
+def _print_report(report: ContinuityReport, args: argparse.Namespace, advice: str | None = None) -> int:
+    """Print ``report`` for ``spiral-cad check``; exit status 0 ok, 1 below ``--require`` or not ``--pieces`` pieces.
+    Below G2, ``advice`` is printed (default: make_g2's bound for each wire of the STEP/IGES file)."""
     print(report.format_table())
     note_worst(str(report.min_level))
     if getattr(args, "timing", False) and report.timing is not None:
         print(report.timing_line())
     if report.min_level < Continuity.G2:  # before the verdict, which stays the last line
-        _print_g2_advice(args.file, report.units)
+        if advice is None:
+            _print_g2_advice(args.file, report.units)
+        else:
+            print(advice)
     if not args.require:
         return 0
     expected = 1 if args.pieces is None else args.pieces
@@ -483,14 +514,15 @@ def _print_opendrive_report(report: OpenDriveReport, args: argparse.Namespace) -
 def _add_check(sub: argparse._SubParsersAction) -> None:
     check = sub.add_parser(
         "check",
-        help="report G0/G1/G2 continuity at every joint of a STEP, IGES or OpenDRIVE file",
+        help="report G0/G1/G2 continuity at every joint of a STEP, IGES, DXF or OpenDRIVE file",
         description="Report G0/G1/G2 continuity at every joint, in the unit the file declares; a STEP/IGES file that holds "
-        "faces is judged face to face at every edge they share (sharp features listed, not failed). An OpenDRIVE file is "
+        "faces is judged face to face at every edge they share (sharp features listed, not failed). A DXF drawing's curves "
+        "(lines, arcs, circles, ellipses, splines, polylines, blocks) are judged as drawn, chained by their ends. An OpenDRIVE file is "
         "judged road by road (its planView, its elevation and superelevation in s) and link by link. Exit status: 0 ok, "
         "1 below --require, --profiles or --links (or not --pieces pieces), 2 unreadable file or bad option, "
         "141 output pipe closed early.",
     )
-    check.add_argument("file", nargs="+", help="a .step/.stp, .igs/.iges or .xodr file (OpenDRIVE: one piece per road); several "
+    check.add_argument("file", nargs="+", help="a .step/.stp, .igs/.iges, .dxf or .xodr file (OpenDRIVE: one piece per road); several "
                        "files, folders or glob patterns are checked in parallel (see --workers)")  # fmt: skip
     check.add_argument(
         "--require", choices=["G0", "G1", "G2"],
@@ -506,7 +538,7 @@ def _add_check(sub: argparse._SubParsersAction) -> None:
                        "lane centre, as a driver follows them; road links reference line to reference line)")  # fmt: skip
     check.add_argument("--snap", type=float, help="chain loose ends closer than this (model units; default 1%% of the model size)")
     check.add_argument("--comb", metavar="OUT.step",
-                       help="also write the curvature comb of every edge as STEP (STEP/IGES input; never the checked file)")  # fmt: skip
+                       help="also write the curvature comb of every edge as STEP (STEP, IGES or DXF input; never the checked file)")  # fmt: skip
     check.add_argument("--timing", action="store_true",
                        help="also print where the check spent its time: the reader's share, and whether it limits the check")  # fmt: skip
     check.add_argument(
@@ -534,7 +566,7 @@ def _add_check(sub: argparse._SubParsersAction) -> None:
 
 
 #: The files ``check`` looks for in a folder it is given.
-CHECK_SUFFIXES = (".step", ".stp", ".igs", ".iges", ".xodr")
+CHECK_SUFFIXES = (".step", ".stp", ".igs", ".iges", ".dxf", ".xodr")
 #: The options of ``many.py``: none of them changes what a file gives.
 MANY_OPTIONS = ("workers", "scheduler", "summary")
 

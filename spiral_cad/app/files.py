@@ -16,8 +16,9 @@ points     .csv .txt .xyz (read)           —                                  
 =========  ==============================  ======================================  ===================================
 
 The options are the per-format function's own keyword options (``name``, ``units``, ``dialect`` …), passed on
-as given; an option the format does not take is refused by name with the ones it does. The per-format
-functions stay the documented lower level.
+as given; an option the format does not take is refused by name with the ones it does. ``format=`` chooses
+the format for a file whose suffix names none (``road.landxml``); a suffix that names another format is
+refused rather than overridden. The per-format functions stay the documented lower level.
 """
 
 from __future__ import annotations
@@ -76,8 +77,13 @@ def export(obj: Any, path: str | os.PathLike, *, format: str | None = None, **op
         ValueError: an unknown suffix or format, an option the format does not take, or what the writer
             refuses (a name, a unit, an object it does not hold).
     """
-    writer = _chosen(EXPORTS, "export", path, format)
-    return writer(obj, path, **_checked(writer, options, path))
+    target = _path(path, "export")
+    if target.is_dir():
+        raise ValueError(f"export {target.name!r:.80}: is a folder; give a file's path")
+    if not target.parent.is_dir():
+        raise ValueError(f"export {target.name!r:.80}: its folder {str(target.parent)!r:.120} does not exist")
+    writer = _chosen(EXPORTS, "export", target, format)
+    return writer(obj, target, **_checked(writer, options, target))
 
 
 def read(path: str | os.PathLike, *, format: str | None = None, **options: Any) -> Any:
@@ -95,19 +101,35 @@ def read(path: str | os.PathLike, *, format: str | None = None, **options: Any) 
         ValueError: an unknown suffix or format, an option the format does not take, or what the reader
             refuses (a missing or malformed file, named with the reason).
     """
-    reader = _chosen(READS, "read", path, format)
-    return reader(path, **_checked(reader, options, path))
+    source = _path(path, "read")
+    if not source.is_file():
+        what = "is a folder" if source.is_dir() else "is not a regular file" if source.exists() else "does not exist"
+        raise ValueError(f"read {source.name!r:.80}: the file {what}")
+    reader = _chosen(READS, "read", source, format)
+    return reader(source, **_checked(reader, options, source))
+
+
+def _path(path: Any, verb: str) -> Path:
+    """``path`` as a ``Path`` (``~`` expanded), or ValueError naming what was given instead."""
+    if not isinstance(path, (str, os.PathLike)) or isinstance(path, bytes):
+        raise ValueError(f"{verb}: path must be a file's path (str or os.PathLike); got {type(path).__name__}")
+    return Path(path).expanduser()
 
 
 def _chosen(formats: dict[str, tuple[tuple[str, ...], str]], verb: str, path: str | os.PathLike, format: str | None) -> Callable[..., Any]:
-    """The function of ``format``, or of the format whose suffixes hold ``path``'s."""
+    """The function of ``format`` (any case, a leading dot allowed), or of the format whose suffixes hold
+    ``path``'s; a suffix that names another format than ``format`` is refused."""
+    suffix = Path(path).suffix.lower()
+    found = [name for name, (suffixes, _) in formats.items() if suffix in suffixes]
     if format is not None:
-        if format not in formats:
+        chosen = format.lower().lstrip(".") if isinstance(format, str) else ""
+        chosen = next((name for name, (suffixes, _) in formats.items() if f".{chosen}" in suffixes), chosen)
+        if chosen not in formats:
             raise ValueError(f"format must be one of {', '.join(formats)} for {verb}; got {format!r:.40}")
-        chosen = format
+        if found and chosen not in found:
+            raise ValueError(f"{verb} {Path(path).name!r:.80}: format={format!r} but the suffix {suffix!r} names "
+                             f"{' or '.join(found)}; rename the file or leave format= out")  # fmt: skip
     else:
-        suffix = Path(path).suffix.lower()
-        found = [name for name, (suffixes, _) in formats.items() if suffix in suffixes]
         if not found:
             known = " ".join(s for suffixes, _ in formats.values() for s in suffixes)
             raise ValueError(f"{verb} {Path(path).name!r:.80}: the suffix {suffix or '(none)'!r} names no format {verb} knows "

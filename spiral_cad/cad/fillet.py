@@ -26,8 +26,8 @@ from OCP.TopExp import TopExp_Explorer
 from OCP.TopoDS import TopoDS, TopoDS_Face, TopoDS_Wire
 
 from ..check.joints import Continuity
-from ..core._inputs import as_float
 from ..core.errors import NoSolutionError
+from ..core.inputs import as_float
 from ..core.segments import Arc, Line, Segment
 from ..core.spiral import BezierSpiral
 from ..design.fillets import FilletedPath, fillet_path

@@ -38,7 +38,7 @@ from OCP.TColStd import TColStd_Array1OfInteger, TColStd_Array1OfReal
 from OCP.TopoDS import TopoDS_Compound, TopoDS_Edge, TopoDS_Shape, TopoDS_Vertex, TopoDS_Wire
 
 from ..check.joints import ROUNDING_ULPS, norms
-from ..core._chain_kernels import ARC, LINE, SPIRAL
+from ..core.kinds import ARC, LINE, SPIRAL
 from ..core.rows import SegmentRows
 from ..core.segments import Segment, row_frames
 from .readers import read_shape

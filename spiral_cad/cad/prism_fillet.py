@@ -28,9 +28,9 @@ from OCP.TopExp import TopExp, TopExp_Explorer
 from OCP.TopoDS import TopoDS, TopoDS_Edge, TopoDS_Face, TopoDS_Shape
 from OCP.TopTools import TopTools_IndexedDataMapOfShapeListOfShape
 
-from ..core._inputs import as_float, shown
 from ..core.chain import JOIN_TOLERANCE, g2_mismatch
 from ..core.errors import NoSolutionError
+from ..core.inputs import as_float, shown
 from ..core.segments import Segment
 from ..core.shapes import DEFAULT_SHAPE
 from ..design.fillets import fillet_path

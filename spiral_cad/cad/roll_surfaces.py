@@ -51,8 +51,8 @@ from OCP.TopLoc import TopLoc_Location
 from OCP.TopoDS import TopoDS, TopoDS_Face, TopoDS_Shape, TopoDS_Wire
 
 from ..core import bezier
-from ..core._inputs import as_float, shown
 from ..core.errors import NoSolutionError
+from ..core.inputs import as_float, shown
 from ..core.nurbs import chain_to_nurbs
 from ..core.segments import Arc, Line, Segment
 from ..core.shapes import DEFAULT_SHAPE

@@ -24,9 +24,9 @@ from OCP.TopAbs import TopAbs_FORWARD, TopAbs_SHELL, TopAbs_SOLID
 from OCP.TopExp import TopExp_Explorer
 from OCP.TopoDS import TopoDS, TopoDS_Shape, TopoDS_Solid
 
-from ..core._inputs import as_float, shown
 from ..core.chain import JOIN_TOLERANCE, Chain, g2_mismatch
 from ..core.errors import NoSolutionError
+from ..core.inputs import as_float, shown
 from ..core.segments import Segment
 from ..core.shapes import DEFAULT_SHAPE
 from ..core.units import DEFAULT_UNITS, length_unit

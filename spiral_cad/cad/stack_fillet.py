@@ -26,9 +26,9 @@ from OCP.TopExp import TopExp
 from OCP.TopoDS import TopoDS, TopoDS_Edge, TopoDS_Face, TopoDS_Shape, TopoDS_Wire
 from OCP.TopTools import TopTools_IndexedDataMapOfShapeListOfShape
 
-from ..core._inputs import as_float
 from ..core.chain import JOIN_TOLERANCE, g2_mismatch
 from ..core.errors import NoSolutionError
+from ..core.inputs import as_float
 from ..core.segments import Segment
 from ..core.shapes import DEFAULT_SHAPE, shape_code
 from ..design.fillets import fillet_path

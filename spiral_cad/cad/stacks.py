@@ -33,8 +33,8 @@ from OCP.TopExp import TopExp_Explorer
 from OCP.TopoDS import TopoDS, TopoDS_Face, TopoDS_Solid, TopoDS_Wire
 from scipy.spatial import cKDTree
 
-from ..core._inputs import shown
 from ..core.errors import NoSolutionError
+from ..core.inputs import shown
 from ..core.segments import Arc, Segment
 from .roll_surfaces import _along, _along_spans, _faces_of, _plane_face, _record, _rim_wire, _sections, _surface_face
 

@@ -24,7 +24,8 @@ from __future__ import annotations
 import math
 from typing import TYPE_CHECKING
 
-from ._jit import Kernels
+from .jit import Kernels
+from .kinds import ARC, LINE
 
 if TYPE_CHECKING:  # annotations only: the kernels' namespace (what numba compiles against) stays as it is
     from typing import TypeAlias
@@ -38,7 +39,6 @@ if TYPE_CHECKING:  # annotations only: the kernels' namespace (what numba compil
 KERNELS = Kernels(globals())
 jit = KERNELS.jit
 
-LINE, ARC, SPIRAL = 0, 1, 2
 TAU = 2.0 * math.pi
 EPS = 2.220446049250313e-16
 #: Rounding allowance (angle, relative curvature) of an arc whose plane basis is not the xy axes.

@@ -38,8 +38,8 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from ._jit import Kernels
 from .errors import Status
+from .jit import Kernels
 
 if TYPE_CHECKING:  # annotations only: the kernels' namespace (what numba compiles against) stays as it is
     from typing import TypeAlias

@@ -16,11 +16,11 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from . import _kernels as K
-from ._inputs import as_real_array
-from ._threads import run_split
 from .errors import MALFORMED, NoSolutionError, Status
+from .inputs import as_real_array
 from .messages import describe
 from .shapes import CORNER_SHAPES, DEFAULT_SHAPE, TRANSITION_SHAPES, shape_code
+from .threads import run_split
 
 __all__ = ["BatchResult", "circle_in_circle", "circle_to_circle", "line_to_circle", "line_to_line"]
 

@@ -16,9 +16,9 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from . import _chain_kernels as CK
-from ._chain_kernels import ARC, LINE, SPIRAL
-from ._inputs import as_float, as_point, as_real_array
 from .errors import JointError
+from .inputs import as_float, as_point, as_real_array
+from .kinds import ARC, LINE, SPIRAL
 from .rows import SegmentRows
 from .segments import _XY_BASIS, Arc, Join, Line, Segment, curvature_scales, joint_table, lifted
 from .space import PlaneFrame

@@ -10,7 +10,7 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from ._inputs import as_real_array
+from .inputs import as_real_array
 
 
 def polynomial(coefficients: NDArray[np.float64], x: NDArray[np.float64], derivative: int = 0) -> NDArray[np.float64]:

@@ -18,7 +18,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from . import bezier
-from ._chain_kernels import ARC, LINE, SPIRAL
+from .kinds import ARC, LINE, SPIRAL
 from .segments import _XY_BASIS, Arc, Line, Segment, row_frames
 from .shapes import SHAPE_CODES, SHAPE_NAMES
 from .space import place

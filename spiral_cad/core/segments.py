@@ -24,7 +24,8 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from . import _chain_kernels as CK
-from ._inputs import as_float, as_point, as_xy
+from .inputs import as_float, as_point, as_xy
+from .kinds import ARC, LINE
 from .space import PlaneFrame
 
 TAU = 2.0 * math.pi
@@ -243,7 +244,7 @@ class Line(Segment):
     def _row(self) -> tuple[int, NDArray[np.float64], tuple[float, float, float]]:
         geometry = np.zeros((4, 3))
         geometry[0, : self._dim], geometry[1, : self._dim] = self._a, self._b
-        return CK.LINE, geometry, (0.0, 0.0, 0.0)
+        return LINE, geometry, (0.0, 0.0, 0.0)
 
     def outline(self) -> list[tuple[float, ...]]:
         return [tuple(self._a.tolist()), tuple(self._b.tolist())]
@@ -422,7 +423,7 @@ class Arc(Segment):
         geometry = np.zeros((4, 3))
         geometry[0, : self._dim] = self._c
         geometry[1:3] = _XY_BASIS if self._basis is None else self._basis
-        return CK.ARC, geometry, (self._r, self._a0, self._sweep)
+        return ARC, geometry, (self._r, self._a0, self._sweep)
 
     @property
     def center(self) -> NDArray[np.float64]:

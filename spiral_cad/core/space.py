@@ -19,9 +19,9 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from . import _kernels as K
-from ._inputs import as_float, as_real_array
-from ._jit import Kernels
-from ._threads import run_split
+from .inputs import as_float, as_real_array
+from .jit import Kernels
+from .threads import run_split
 from .units import COLLINEAR_TOL
 
 #: This module's kernels (placing and verifying points in their planes), compiled into this module.

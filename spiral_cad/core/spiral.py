@@ -10,9 +10,9 @@ from numpy.typing import ArrayLike, NDArray
 
 from . import _kernels as K
 from . import bezier
-from ._chain_kernels import SPIRAL
-from ._inputs import as_float, as_xy
 from .errors import Status
+from .inputs import as_float, as_xy
+from .kinds import SPIRAL
 from .messages import error_for
 from .segments import EPS, PLANE_TOL, Segment, piece_range
 from .shapes import DEFAULT_SHAPE, SHAPE_CODES, TRANSITION_SHAPES, shape_code

@@ -17,7 +17,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from . import _kernels as K
-from ._inputs import as_float, as_xy
+from .inputs import as_float, as_xy
 from .messages import error_for
 from .segments import Arc, Circle, Join, Line, Ray, Segment, measure_join
 from .shapes import CORNER_SHAPES, DEFAULT_SHAPE, shape_code

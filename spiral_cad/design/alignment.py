@@ -19,13 +19,13 @@ from numpy.typing import ArrayLike, NDArray
 
 from ..core import _kernels as K
 from ..core import batch
-from ..core._chain_kernels import SPIRAL
-from ..core._inputs import as_float, as_points, as_real_array, per_item
 from ..core.bezier import peak_curvature_rate
 from ..core.chain import JOIN_TOLERANCE, Chain, PartCircles, join_rows, join_tolerance
 from ..core.errors import JointError, NoSolutionError
 from ..core.factors import WALTON_MEEK_SEARCH_MAX, length_factor, peak_rate_factor, search_range
 from ..core.fit import PointFit
+from ..core.inputs import as_float, as_points, as_real_array, per_item
+from ..core.kinds import SPIRAL
 from ..core.rows import SegmentRows
 from ..core.segments import Circle, Ray
 from ..core.shapes import SHAPE_CODES, TRANSITION_SHAPES, shape_code, shape_limits

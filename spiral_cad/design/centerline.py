@@ -37,7 +37,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from ..core import bezier
-from ..core._inputs import as_float
+from ..core.inputs import as_float
 from ..core.nurbs import MAX_ARC_PIECE, _pieces
 from ..core.segments import Arc, Line
 from .profile import Profile, check_coverage

@@ -32,9 +32,9 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ..core import batch
-from ..core._inputs import as_float, as_xy, shown
 from ..core.chain import Chain
 from ..core.errors import JointError, NoSolutionError
+from ..core.inputs import as_float, as_xy, shown
 from ..core.segments import TAU, Circle
 from ..core.shapes import DEFAULT_SHAPE, TRANSITION_SHAPES, shape_code
 from ..core.spiral import BezierSpiral

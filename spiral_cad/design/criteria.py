@@ -47,8 +47,8 @@ from typing import Any, cast
 import numpy as np
 from numpy.typing import NDArray
 
-from ..core._inputs import as_float, shown
 from ..core.factors import length_factor, peak_rate_factor, search_range, shift_factor
+from ..core.inputs import as_float, shown
 from ..core.units import FOOT, IMPERIAL, speed_unit, to_metres
 
 GRAVITY = 9.80665

@@ -42,9 +42,9 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ..core import _kernels as K
-from ..core._inputs import as_float, as_points, shown
 from ..core.chain import JOIN_TOLERANCE, Chain, g2_mismatch, join_tolerance
 from ..core.errors import NoSolutionError
+from ..core.inputs import as_float, as_points, shown
 from ..core.segments import Arc, Circle, Line, Ray, Segment
 from ..core.shapes import DEFAULT_SHAPE, SHAPE_CODES, TRANSITION_SHAPES, shape_code, shape_limits
 from ..core.transitions import Transition, circle_in_circle, circle_to_circle, line_to_circle

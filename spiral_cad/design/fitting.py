@@ -19,9 +19,9 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from ..core._inputs import as_real_array
 from ..core.errors import NoSolutionError
 from ..core.fit import PointFit, chain_distances, douglas_peucker, fit_points
+from ..core.inputs import as_real_array
 from ..core.segments import Arc, Line
 from ..core.spiral import BezierSpiral
 from ..core.units import DEFAULT_UNITS

@@ -43,9 +43,9 @@ from typing import Any
 
 import numpy as np
 
-from ..core._inputs import as_float, as_real_array
 from ..core.chain import JOIN_TOLERANCE, Chain, g2_mismatch, join_tolerance
 from ..core.errors import JointError, NoSolutionError
+from ..core.inputs import as_float, as_real_array
 from ..core.segments import TAU, Arc, Line, Segment
 from ..core.shapes import SHAPE_CODES, TRANSITION_SHAPES, shape_code
 from ..core.space import PlaneFrame

@@ -46,8 +46,8 @@ from typing import Any, cast
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from ..core._inputs import as_float, as_points, as_real_array, per_item, shown
 from ..core.errors import NoSolutionError
+from ..core.inputs import as_float, as_points, as_real_array, per_item, shown
 from ..core.piecewise import inside, piece_at, piecewise_at, polynomial
 from ..core.units import DEFAULT_UNITS, FOOT, IMPERIAL, length_unit, speed_unit, to_metres
 from .alignment import Alignment

@@ -31,7 +31,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from ..core._inputs import as_float, as_real_array, shown
+from ..core.inputs import as_float, as_real_array, shown
 from .centerline import FIT_SAMPLES, REPORT_SAMPLES, check_profile, float_floor, refine
 from .profile import Profile
 from .superelevation import Superelevation

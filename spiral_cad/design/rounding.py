@@ -29,6 +29,7 @@ from __future__ import annotations
 
 import math
 import re
+import warnings
 from collections.abc import Iterable
 from dataclasses import dataclass
 from typing import Any
@@ -39,17 +40,17 @@ from numpy.typing import ArrayLike, NDArray
 from ..core import _chain_kernels as CK
 from ..core import _kernels as K
 from ..core import batch
-from ..core._inputs import as_float, as_real_array
-from ..core._jit import Kernels
-from ..core._threads import run_split
 from ..core.chain import JOIN_TOLERANCE, ROUNDING_CAP, Chain, PartCircles, join_rows, join_tolerance
 from ..core.errors import JointError, NoSolutionError, Status
 from ..core.factors import length_factor
+from ..core.inputs import as_float, as_real_array
+from ..core.jit import Kernels
 from ..core.rows import SegmentRows
 from ..core.segments import Line, Segment
 from ..core.shapes import CORNER_SHAPES, DEFAULT_SHAPE, SHAPE_CODES, shape_code
 from ..core.space import PlaneFrame, corner_frames, norms, place, placed_pair_residuals
 from ..core.spiral import BezierSpiral
+from ..core.threads import run_split
 from ..core.units import DEFAULT_UNITS, length_unit
 from .fillets import FilletCorner, _vertex_indices, fillet_path, first_broken_corner
 
@@ -106,12 +107,15 @@ def deviation_factor(theta_sin: ArrayLike, theta_cos: ArrayLike, shape: str) -> 
         return end_leg * sin_t / cos_t
 
 
-def corner_shape(shape: str, method: str | None) -> str:
-    """The corner shape from ``shape`` or from ``method`` (its former name), checked."""
+def corner_shape(shape: str | None, method: str | None) -> str:
+    """The corner shape from ``shape`` (None: ``DEFAULT_SHAPE``) or from ``method`` (its former name,
+    deprecated: it warns), checked; both given and different is refused."""
     if method is None:
+        shape = DEFAULT_SHAPE if shape is None else shape
         shape_code(shape, CORNER_SHAPES)
         return shape
-    if shape != DEFAULT_SHAPE and shape != method:
+    warnings.warn("method= is deprecated and will be removed: the same choice is shape=", DeprecationWarning, stacklevel=3)
+    if shape is not None and shape != method:
         raise ValueError(f"give shape or method (its former name), not both; got shape={shape!r}, method={method!r}")
     shape_code(method, CORNER_SHAPES, "method")
     return method
@@ -408,7 +412,7 @@ def round_corners_batch(
     max_curvature: ArrayLike | None = None,
     max_deviation: ArrayLike | None = None,
     spiral_lengths: ArrayLike | None = None,
-    shape: str = DEFAULT_SHAPE,
+    shape: str | None = None,
     method: str | None = None,
     tolerance: float = JOIN_TOLERANCE,
 ) -> CornerBatch:
@@ -435,9 +439,9 @@ def round_corners_batch(
             the bound. With ``max_curvature`` as well, that pair's curvature
             must respect κmax, else the row fails (``LEGS_TOO_SHORT``).
         spiral_lengths: the arc length of each spiral (scalar or (N,)).
-        shape: ``"walton-meek"`` (Theorem 4.4), ``"near-linear"`` or
+        shape: ``"walton-meek"`` (Theorem 4.4; the default), ``"near-linear"`` or
             ``"g2cbs"`` (Yang & Sukkarieh).
-        method: the former name of ``shape``.
+        method: the former name of ``shape`` (deprecated: it warns; refused when it differs from ``shape``).
         tolerance: the relative join tolerance of the chains the corners will be
             part of: each corner's joints must pass ``Chain``'s joint test with it
             (else ``UNVERIFIED``), so ``round_corners`` refuses exactly what this refuses.
@@ -783,7 +787,7 @@ def round_corners(
     max_curvature: ArrayLike | None = None,
     max_deviation: ArrayLike | None = None,
     spiral_lengths: ArrayLike | None = None,
-    shape: str = DEFAULT_SHAPE,
+    shape: str | None = None,
     method: str | None = None,
     tolerance: float = JOIN_TOLERANCE,
     units: str = DEFAULT_UNITS,
@@ -805,11 +809,11 @@ def round_corners(
             largest pair within it and its legs. With ``max_curvature`` too,
             that pair's curvature must also respect κmax.
         spiral_lengths: the arc length of each corner's spirals.
-        shape: ``"walton-meek"`` (Theorem 4.4), ``"near-linear"`` (curvature
+        shape: ``"walton-meek"`` (Theorem 4.4; the default), ``"near-linear"`` (curvature
             almost linear in arc length; deflections up to 100°) or ``"g2cbs"``
             (Yang & Sukkarieh: about 24 % lower peak curvature for the same
             corner distance).
-        method: the former name of ``shape``.
+        method: the former name of ``shape`` (deprecated: it warns; refused when it differs from ``shape``).
         tolerance: the chain's relative join tolerance (``Chain``).
         units: length unit of the points (default mm); curvatures are per unit.
 

@@ -29,7 +29,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from ..core._inputs import as_real_array, shown
+from ..core.inputs import as_real_array, shown
 from ..core.piecewise import inside, piece_at, piecewise_at
 from .criteria import RailCriteria
 

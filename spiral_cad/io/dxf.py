@@ -24,8 +24,8 @@ from typing import cast
 
 import numpy as np
 
-from ..core._chain_kernels import ARC, SPIRAL
 from ..core.chain import Chain
+from ..core.kinds import ARC, SPIRAL
 from ..core.segments import Arc, Line, Segment
 from ..core.spiral import BezierSpiral
 from ..core.units import IMPERIAL

@@ -47,7 +47,7 @@ from .dxf import _add
 from .dxf_curves import CURVES, curve_parts
 from .dxf_read import DXF_UNITS, JOIN_TOLERANCE, READ, _chains, _entity_parts, _segment
 
-__all__ = ["ATTRIBUTES", "rewrite_dxf_g2"]
+__all__ = ["ATTRIBUTES", "open_drawing", "rewrite_dxf_g2"]
 
 #: The graphic attributes a G2 path takes from its path's first entity (besides the layer).
 ATTRIBUTES = ("color", "true_color", "linetype", "lineweight", "ltscale", "transparency", "invisible")
@@ -61,8 +61,12 @@ MEET = 1e-6
 EXPLODE_DEPTH = 8
 
 
-def _open(source: Path) -> tuple[Any, str]:
-    """The drawing, and a note when only ezdxf's recover mode reads it."""
+def open_drawing(source: Path) -> tuple[Any, str]:
+    """The drawing, and a note when only ezdxf's recover mode reads it ("" when the plain reader does).
+
+    Raises:
+        ValueError: a missing file or a folder, or a file neither of ezdxf's readers reads (both reasons).
+    """
     import ezdxf
     from ezdxf import recover
 
@@ -75,7 +79,7 @@ def _open(source: Path) -> tuple[Any, str]:
             doc, auditor = recover.readfile(source)
         except (ezdxf.DXFError, UnicodeDecodeError, OSError) as error:
             raise ValueError(f"{source.name}: not a DXF file ezdxf can read ({plain}; recover: {error})") from None
-        return doc, f"read with ezdxf's recover mode ({plain}; {len(auditor.fixes)} fix(es)); written as a plain DXF"
+        return doc, f"read with ezdxf's recover mode ({plain}; {len(auditor.fixes)} fix(es))"
     except OSError as error:  # ezdxf says "not a DXF file" with an OSError
         raise ValueError(f"{source.name}: not a DXF file ezdxf can read ({error})") from None
 
@@ -308,10 +312,10 @@ def rewrite_dxf_g2(
     """
     source, target = Path(source), Path(target)
     label = source.name
-    doc, recovered = _open(source)
+    doc, recovered = open_drawing(source)
     bound, unit_name, g2_units, notes = _bound(doc, max_deviation, units, label)
     if recovered:
-        notes.insert(0, recovered)
+        notes.insert(0, f"{recovered}; written as a plain DXF")
     issues, count, first = _issues(source, bool(recovered))
     doc = _as_r2000(doc, issues, notes)
     msp = doc.modelspace()

@@ -47,8 +47,8 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ..core import bezier
-from ..core._chain_kernels import ARC, LINE, SPIRAL
 from ..core.chain import Chain
+from ..core.kinds import ARC, LINE, SPIRAL
 from ..core.segments import Arc
 from ..core.units import MM_PER_UNIT
 from .samples import sample_path

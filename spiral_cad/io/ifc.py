@@ -55,8 +55,8 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from ..core._chain_kernels import ARC, LINE, SPIRAL
 from ..core.chain import Chain
+from ..core.kinds import ARC, LINE, SPIRAL
 from ..core.units import length_unit, to_metres
 from .names import check_name
 from .opendrive import plan_records
@@ -454,9 +454,11 @@ def _ifc_text(alignments: Any, *, units: str | None, profile: Any, names: Sequen
     alignments' entities appended as text (``_Step``)."""
     from ..design.alignment import Alignment
 
-    given = [alignments] if isinstance(alignments, (Alignment, Chain)) else list(alignments)
+    given = (
+        [alignments] if isinstance(alignments, (Alignment, Chain)) else list(alignments) if isinstance(alignments, (list, tuple)) else []
+    )
     if not given or not all(isinstance(a, (Alignment, Chain)) for a in given):
-        raise ValueError("alignments must be an Alignment or a plane Chain, or a non-empty list of them")
+        raise ValueError(f"alignments must be an Alignment or a plane Chain, or a non-empty list of them; got {type(alignments).__name__}")
     items: list[Alignment | _Stationed] = [_Stationed(a, 0.0, a.length) if isinstance(a, Chain) else a for a in given]
     profiles = list(profile) if isinstance(profile, (list, tuple)) else [profile] * len(items)
     if len(profiles) != len(items):

@@ -44,10 +44,10 @@ from xml.sax.saxutils import escape
 import numpy as np
 from numpy.typing import NDArray
 
-from ..core._chain_kernels import ARC, LINE, SPIRAL
 from ..core.bezier import curvature, monotone_pieces
 from ..core.chain import Chain
 from ..core.clothoid import clothoid_frames
+from ..core.kinds import ARC, LINE, SPIRAL
 from ..core.rows import NO_SHAPE
 from ..core.segments import row_frames
 from ..core.shapes import SHAPE_NAMES
@@ -112,6 +112,8 @@ _NOT_XML = re.compile("[^\t\n\r\x20-\ud7ff\ue000-\ufffd\U00010000-\U0010ffff]")
 
 def _check_name(text: str, what: str) -> None:
     """Refuse a name XML cannot hold, naming the character and where it is."""
+    if not isinstance(text, str):
+        raise ValueError(f"{what} must be text; got {type(text).__name__}")
     bad = _NOT_XML.search(text)
     if bad:
         raise ValueError(f"{what} {text!r}: the character U+{ord(bad.group()):04X} at position {bad.start()} cannot be "
@@ -379,15 +381,30 @@ def landxml_text(alignments: Sequence[AlignmentToWrite], units: str, name: str =
     return "\n".join(lines)
 
 
+def _record(item: Any, name: str, profile: Any, place: int) -> AlignmentToWrite:
+    """``item`` as an alignment to write: a record as it is, a chain or an alignment (its chain and start
+    station) named ``name``; anything else refused naming its place."""
+    if isinstance(item, AlignmentToWrite):
+        return item
+    if isinstance(item, Chain):
+        return AlignmentToWrite(item, name, 0.0, profile)
+    if isinstance(getattr(item, "chain", None), Chain) and hasattr(item, "start_station"):
+        return AlignmentToWrite(item.chain, name, float(item.start_station), profile)
+    raise ValueError(f"alignment {place + 1} must be a Chain, an Alignment or an AlignmentToWrite; got {type(item).__name__}")
+
+
 def write_landxml(alignments: Sequence[AlignmentToWrite] | Any, path: str | os.PathLike, units: str | None = None, *,
                   name: str = "spiral_cad", survey_feet: bool = False, profile: Any = None) -> None:  # fmt: skip
     """Write alignments as one LandXML 1.2 file (UTF-8).
 
     Args:
-        alignments: ``AlignmentToWrite`` records, or one ``spiral_cad.design.Alignment``
-            (with ``profile``, its vertical alignment) or one plane ``Chain``.
+        alignments: one plane ``Chain`` or ``spiral_cad.design.Alignment`` (with
+            ``profile``, its vertical alignment), or a list of them or of
+            ``AlignmentToWrite`` records (a chain or alignment in a list is named
+            ``name`` and its place, ``"spiral_cad 2"``).
         path: the file to write.
-        units: the chains' unit (default: the first chain's).
+        units: the chains' unit, only as a check: the chains are written in
+            their own unit, which they must share (nothing is rescaled).
         name: the collection's name (and the alignment's, for a single one).
         survey_feet: write lengths in US survey feet.
         profile: the ``Profile`` of a single alignment.
@@ -396,14 +413,23 @@ def write_landxml(alignments: Sequence[AlignmentToWrite] | Any, path: str | os.P
     renamed onto it: an existing file is replaced only by a complete one.
 
     Raises:
-        ValueError: see ``landxml_text`` (then nothing was written).
+        ValueError: no alignment, something that is not one (naming its place
+            and type), chains in different units or in another unit than
+            ``units``, or see ``landxml_text`` (then nothing was written).
     """
-    if isinstance(alignments, Chain):
-        alignments = [AlignmentToWrite(alignments, name, 0.0, profile)]
-    elif hasattr(alignments, "chain") and hasattr(alignments, "start_station"):
-        alignments = [AlignmentToWrite(alignments.chain, name, alignments.start_station, profile)]
-    alignments = list(alignments)
-    units = units or (alignments[0].chain.units if alignments else "m")
+    _check_name(name, "the collection name")
+    single = isinstance(alignments, Chain) or hasattr(alignments, "start_station")
+    items = [alignments] if single else list(alignments) if isinstance(alignments, (list, tuple)) else None
+    if not items:
+        raise ValueError(f"write_landxml needs a Chain or an Alignment, or a non-empty list of them; got {type(alignments).__name__}")
+    records = [_record(item, name if single else f"{name} {k + 1}", profile if single else None, k) for k, item in enumerate(items)]
+    found = {a.chain.units for a in records}
+    if len(found) > 1:
+        raise ValueError(f"the alignments of one LandXML file must share a unit; got {', '.join(sorted(found))}")
+    (own,) = found
+    if units is not None and units != own:
+        raise ValueError(f"the chains are in {own}; units={units!r} would mislabel them (nothing is rescaled)")
+    alignments, units = records, own
     data = landxml_text(alignments, units, name, survey_feet=survey_feet).encode("utf-8")
     target = os.fspath(path)
     handle, temporary = tempfile.mkstemp(prefix=f".{os.path.basename(target)}.", suffix=".tmp", dir=os.path.dirname(target) or ".")

@@ -46,9 +46,9 @@ from xml.sax.saxutils import escape
 import numpy as np
 from numpy.typing import NDArray
 
-from ..core._chain_kernels import ARC, LINE, SPIRAL
-from ..core._inputs import shown
 from ..core.chain import Chain
+from ..core.inputs import shown
+from ..core.kinds import ARC, LINE, SPIRAL
 from ..core.segments import row_frames
 from ..core.units import to_metres
 from .decimals import shortest_decimal

@@ -33,9 +33,9 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ..core import bezier
-from ..core._chain_kernels import ARC, LINE, SPIRAL
-from ..core._inputs import as_float
 from ..core.chain import Chain
+from ..core.inputs import as_float
+from ..core.kinds import ARC, LINE, SPIRAL
 
 #: Columns and their dimensions (``L``: the chain's length unit).
 COLUMNS = (("s", "L"), ("x", "L"), ("y", "L"), ("z", "L"), ("tx", "1"), ("ty", "1"), ("tz", "1"), ("curvature", "1/L"))

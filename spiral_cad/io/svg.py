@@ -11,6 +11,7 @@ and of the path; with several chains each path's id is ``NAME-k``.
 from __future__ import annotations
 
 import math
+import numbers
 import os
 from collections.abc import Sequence
 from xml.sax.saxutils import escape, quoteattr
@@ -58,7 +59,13 @@ def svg_path(chain: Chain) -> str:
 
 
 def svg_text(chains: Sequence[Chain], name: str, units: str, margin: float = 0.05) -> str:
-    """The SVG document (see the module docstring); ``margin`` is a fraction of the drawing's size."""
+    """The SVG document (see the module docstring); ``margin`` is a fraction of the drawing's size.
+
+    Raises:
+        ValueError: a margin that is not a finite number ≥ 0.
+    """
+    if isinstance(margin, bool) or not isinstance(margin, numbers.Real) or not 0.0 <= margin < math.inf:
+        raise ValueError(f"margin must be a finite number ≥ 0 (a fraction of the drawing's size); got {margin!r:.40}")
     points = np.vstack([c.sample(64) for c in chains])
     lo, hi = points.min(axis=0), points.max(axis=0)
     size = float(np.hypot(*(hi - lo))) or 1.0
@@ -83,8 +90,12 @@ def svg_text(chains: Sequence[Chain], name: str, units: str, margin: float = 0.0
 def write_svg(chains: Sequence[Chain], path: str | os.PathLike, name: str, units: str, margin: float = 0.05) -> None:
     """Write ``svg_text(chains, name, units, margin)`` to ``path`` (UTF-8); ``cad.export.export_svg`` checks the arguments first.
 
+    The text is made before the file is opened: a refused argument leaves an existing file as it was.
+
     Raises:
+        ValueError: as ``svg_text``.
         OSError: the file could not be written.
     """
+    text = svg_text(chains, name, units, margin)
     with open(path, "w", encoding="utf-8") as handle:
-        handle.write(svg_text(chains, name, units, margin))
+        handle.write(text)

@@ -31,14 +31,60 @@ def test_build_takes_a_program_or_points_by_their_suffix(tmp_path, capsys):
     assert any((tmp_path / "fit").glob("survey*.step"))
 
 
-@pytest.mark.parametrize(("name", "kind"), [("plate.nc", "a CNC program"), ("plan.dxf", "a DXF drawing"), ("road.xml", "a LandXML file")])
+@pytest.mark.parametrize(("name", "kind"), [("plate.nc", "a CNC program"), ("road.xml", "a LandXML file")])
 def test_check_names_what_it_judges_and_the_verb_for_other_documents(tmp_path, capsys, name, kind):
     path = tmp_path / name
     path.write_text(PROGRAM if name.endswith(".nc") else "x")
     assert main(["check", str(path)]) == 2
     err = capsys.readouterr().err
-    assert err.startswith(f"error: {name}: check judges STEP/IGES") and ".xodr" in err
+    assert err.startswith(f"error: {name}: check judges STEP/IGES") and ".xodr" in err and "DXF (.dxf)" in err
     assert f"for {kind}: spiral-cad g2" in err
+
+
+def test_check_judges_a_drawing_as_drawn(tmp_path, capsys):
+    """A DXF drawing's curves, exact, chained by their ends: our own G2 export passes G2; a drawing made with
+    ezdxf's own entities (a slot of bulged polyline arcs, a mirrored arc, an ellipse, a spline, a rotated
+    block of a circle) is judged at each joint for what it is."""
+    g2 = tmp_path / "g2.dxf"
+    enter = line_to_circle((0, 0), (1, 0), (100, 60), 50.0)
+    leave = line_to_circle((300, 150), (-1, -1), (100, 60), 50.0).reversed()
+    sc.export(Chain.join([enter, leave], start=(-20, 0), end=(400, 250), units="mm"), g2)  # line, spiral, arc, spiral, line
+    assert main(["check", str(g2), "--require", "G2"]) == 0
+    assert "OK: 1 loose piece of 5 edges, every joint at least G2" in capsys.readouterr().out
+
+    doc = ezdxf.new("R2010")
+    doc.header["$INSUNITS"] = 4
+    msp = doc.modelspace()
+    # a slot: lines and half circles as bulges, tangent (G1: the curvature jumps from 0 to 1/5)
+    msp.add_lwpolyline([(0, 0, 0, 0, 0), (20, 0, 0, 0, 1), (20, 10, 0, 0, 0), (0, 10, 0, 0, 1)], format="xyseb", close=True)
+    # a line, then a clockwise arc drawn in a mirrored coordinate system (extrusion -z), tangent to it
+    msp.add_line((100, 0), (110, 0))
+    msp.add_arc((-110, -5), 5, 90, 180, dxfattribs={"extrusion": (0, 0, -1)})  # OCS x is −WCS x: centre (110, −5), clockwise
+    msp.add_ellipse((200, 0), (10, 0, 0), 0.5)  # whole: closed, G2 all round
+    block = doc.blocks.new("HOLE")
+    block.add_circle((0, 0), 3)
+    msp.add_blockref("HOLE", (300, 0), dxfattribs={"rotation": 30, "xscale": 2, "yscale": 2})
+    drawing = tmp_path / "drawing.dxf"
+    doc.saveas(drawing)
+    assert main(["check", str(drawing), "--require", "G1", "--pieces", "4"]) == 0
+    out = capsys.readouterr().out
+    assert "4 loose pieces" in out and "worst joint G1" in out and "gap 1e-07 mm" in out
+    assert main(["check", str(drawing), "--require", "G2", "--pieces", "4"]) == 1
+    out = capsys.readouterr().out
+    assert "make_g2: spiral-cad g2 drawing.dxf -o OUT.dxf --max-deviation D" in out and "FAIL: worst joint is G1" in out
+
+    from spiral_cad.cad.continuity import check_continuity
+    from spiral_cad.cad.dxf_shape import dxf_shape
+
+    shape, units, notes = dxf_shape(drawing)
+    report = check_continuity(shape, units=units)
+    slot, line_arc, *whole = report.wires  # the pieces in the drawing's order
+    assert units == "mm" and notes == [] and len(slot.joints) == 4 and slot.closed and len(whole) == 2
+    assert [str(j.level) for j in slot.joints] == ["G1"] * 4  # tangent, the curvature 0 then 1/5
+    assert [str(j.level) for j in line_arc.joints] == ["G1"] and line_arc.joints[0].gap < 1e-9  # the mirrored arc in place
+    assert all(str(w.min_level) == "G2" and not w.joints for w in whole)  # the ellipse and the placed circle: one curve each
+    assert main(["check", str(drawing), "--zebra", str(tmp_path / "z.png")]) == 2
+    assert "a DXF drawing holds curves" in capsys.readouterr().err
 
 
 def test_a_unitless_drawing_is_named_once_and_told_the_flag(tmp_path, capsys):
@@ -121,6 +167,19 @@ def test_read_reads_every_format_by_its_suffix_or_the_format_named(tmp_path):
     (alignment,) = sc.read(tmp_path / "road.landxml", format="landxml")
     assert alignment.chain.length == pytest.approx(chain.length, rel=1e-9)
     assert sc.read(tmp_path / "road.step", units="m") is not None  # the reader's own option, passed on
+    assert sc.read(tmp_path / "road.step", format="STEP") is not None and sc.read(tmp_path / "road.step", format=".stp") is not None
+    sc.export([chain, chain], tmp_path / "two.xml")  # a list of chains: one alignment each, named by place
+    assert [a.name for a in sc.read(tmp_path / "two.xml")] == ["spiral_cad 1", "spiral_cad 2"]
+
+
+def test_a_refused_svg_leaves_the_file_it_would_have_replaced(tmp_path):
+    path = tmp_path / "road.svg"
+    sc.export(_road(), path)
+    before = path.read_bytes()
+    for margin in ("x", float("nan"), -1.0):
+        with pytest.raises(ValueError, match=r"margin must be a finite number ≥ 0"):
+            sc.export(_road(), path, margin=margin)
+    assert path.read_bytes() == before
 
 
 @pytest.mark.parametrize(
@@ -137,9 +196,19 @@ def test_read_reads_every_format_by_its_suffix_or_the_format_named(tmp_path):
         (lambda p: sc.export(_road(), p / "road.dxf", units="m"), r"'road.dxf': export_dxf takes the options name; got 'units'"),
         (lambda p: sc.read(p / "road", format=None), r"read 'road': the suffix '\(none\)' names no format read knows"),
         (lambda p: sc.read(p / "road.svg"), r"the suffix '.svg' names no format read knows"),
+        (lambda p: sc.read(p / "road.step", format="iges"), r"'road.step': format='iges' but the suffix '.step' names step"),
+        (lambda p: sc.read(p / "gone.xml"), r"read 'gone.xml': the file does not exist"),
+        (lambda p: sc.read(p), r"read '.*': the file is a folder"),
+        (lambda p: sc.read(None), r"read: path must be a file's path \(str or os.PathLike\); got NoneType"),
+        (lambda p: sc.export(_road(), p / "no" / "road.dxf"), r"export 'road.dxf': its folder .* does not exist"),
+        (lambda p: sc.export(_road(), p / "road.dxf", format=["dxf"]), r"format must be one of .* got \['dxf'\]"),
+        (lambda p: sc.export([], p / "road.xml"), r"write_landxml needs a Chain or an Alignment, or a non-empty list"),
+        (lambda p: sc.export(_road(), p / "road.xml", units="mm"), r"the chains are in m; units='mm' would mislabel them"),
     ],
 )
 def test_the_verbs_refuse_by_name_with_what_they_take(tmp_path, call, message):
+    for name in ("road", "road.svg", "road.step"):
+        (tmp_path / name).write_text("x")
     with pytest.raises(ValueError, match=message):
         call(tmp_path)
 

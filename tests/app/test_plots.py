@@ -121,7 +121,7 @@ def test_clothoid_points_turn_and_length():
 
 
 def test_rounded_path_plots(tmp_path):
-    path = round_corners([(0, 0), (2, 0), (3, 1), (5, 1)], method="g2cbs")
+    path = round_corners([(0, 0), (2, 0), (3, 1), (5, 1)], shape="g2cbs")
     fig = plots.plot_plan(path.chain)
     assert saved(fig, tmp_path, "rounded.png")
 

@@ -188,7 +188,7 @@ def test_vectorised_rows_are_the_general_rows_bit_for_bit(shape):
 
 def test_batches_split_over_threads_give_the_bits_of_one_call():
     from spiral_cad.core import _kernels as K
-    from spiral_cad.core._threads import ROWS_PER_THREAD
+    from spiral_cad.core.threads import ROWS_PER_THREAD
 
     n = 2 * ROWS_PER_THREAD + 17
     r = np.random.default_rng(5)

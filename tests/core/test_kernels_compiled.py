@@ -1,6 +1,6 @@
 """Kernels are compiled where they are declared: no kernel may run as plain Python by accident.
 
-Every module that declares numba kernels has its own ``Kernels`` (``spiral_cad.core._jit``); once a
+Every module that declares numba kernels has its own ``Kernels`` (``spiral_cad.core.jit``); once a
 process compiles, each kernel's name in the module that declared it holds a numba dispatcher, so
 that module's own Python code and every kernel calling it run compiled code. The plain-Python copies
 (``Kernels.python``) serve the scalar API alone, until its process compiles.
@@ -22,12 +22,12 @@ PACKAGE = Path(__file__).resolve().parents[2] / "spiral_cad"
 PRELUDE = """
 import importlib, pkgutil, sys
 import spiral_cad
-from spiral_cad.core import _jit
+from spiral_cad.core import jit as kernels_jit
 for package in ("core", "design", "check", "io"):
     root = importlib.import_module(f"spiral_cad.{package}")
     for info in pkgutil.walk_packages(root.__path__, root.__name__ + "."):
         importlib.import_module(info.name)
-registries = {r.module: r for r in _jit.REGISTRIES}
+registries = {r.module: r for r in kernels_jit.REGISTRIES}
 """
 
 
@@ -121,7 +121,7 @@ def test_the_scalar_api_compiles_after_its_budget_of_plain_python_calls():
         from numba.core.registry import CPUDispatcher
         from spiral_cad import line_to_circle
         from spiral_cad.core import _kernels as K
-        from spiral_cad.core._jit import SCALAR_CALLS_BEFORE_COMPILING
+        from spiral_cad.core.jit import SCALAR_CALLS_BEFORE_COMPILING
 
         for _ in range(SCALAR_CALLS_BEFORE_COMPILING):
             line_to_circle((0, 0), (1, 0), (10, 5), 3)

@@ -306,7 +306,7 @@ def test_round_corners_with_every_corner_shape_respects_the_bound():
                 assert np.abs(kappa).max() <= 3.0 * (1 + 1e-9)
     with pytest.raises(sc.NoSolutionError, match=r"corner 1 .*deflection 120° is beyond what near-linear"):
         round_corners([(0, 0), (4, 0), (2, 3.4641016151377544)], shape="near-linear")
-    with pytest.raises(ValueError, match="give shape or method"):
+    with pytest.raises(ValueError, match="give shape or method"), pytest.warns(DeprecationWarning, match="method= is deprecated"):
         round_corners(points, shape="near-linear", method="g2cbs")
 
 

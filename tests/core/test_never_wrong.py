@@ -216,7 +216,7 @@ def test_round_corners_refuses_a_curvature_float64_cannot_hold():
     points = [(0, 0), (1.0, 0.1), (1.4, 0.9), (2.4, 1.0)]
     for method in ("walton-meek", "g2cbs"):
         with pytest.raises(sc.NoSolutionError, match=r"corner 1 .*float64 at these coordinates: .*use a lower curvature$"):
-            round_corners(points, max_curvature=1e15, method=method)
+            round_corners(points, max_curvature=1e15, shape=method)
     with pytest.raises(sc.NoSolutionError, match=r"would start .*e-301 from the corner.* cannot be told apart; use a lower curvature$"):
         round_corners(points, max_curvature=1e300)
     with pytest.raises(sc.NoSolutionError, match=r"float64 at these coordinates: .*; use a larger max_deviation$"):
@@ -241,7 +241,7 @@ def test_round_corners_refuses_a_curvature_float64_cannot_hold():
         (lambda: sc.Chain(None), "segments must be a list"),
         (lambda: sc.Chain.join(sc.line_to_circle((0, 0), (1, 0), (0, 105), 100)), "wrap one part in a list"),
         (lambda: Alignment.from_pis([(0, 0), (100, 0), (200, 50)], {}, spiral_angles=0.1), "radii must"),
-        (lambda: round_corners([(0, 0), (1, 0), (1, 1)], method=["g2cbs"]), "method must be one of"),
+        (lambda: round_corners([(0, 0), (1, 0), (1, 1)], shape=["g2cbs"]), "shape must be one of"),
         (lambda: circle_chain([None, ((0, 0), 1)]), "circle 0 must be"),
     ],
 )

@@ -189,7 +189,7 @@ def test_round_corners_returns_a_checked_chain_or_refuses(outcome, log_scale, ox
     pts = placed(points, log_scale, ox, oy)
     scale = 10.0**log_scale
     curvature = None if log_curvature is None else 10.0**log_curvature / scale
-    result = outcome(lambda: round_corners(pts, max_curvature=curvature, method=method))
+    result = outcome(lambda: round_corners(pts, max_curvature=curvature, shape=method))
     if result is not None:
         assert_rechecked(result.chain)
         assert_at(result.chain.start, pts[0], result.chain.size)

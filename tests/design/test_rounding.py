@@ -28,7 +28,7 @@ def assert_g2(chain, tol=1e-12):
 
 @pytest.mark.parametrize("method", ["walton-meek", "g2cbs"])
 def test_joins_are_g2_and_curvature_monotone(method):
-    path = round_corners(ZIGZAG, method=method)
+    path = round_corners(ZIGZAG, shape=method)
     assert_g2(path.chain)
     assert [c.index for c in path.corners] == [1, 2, 3, 4]
     for corner in path.corners:
@@ -51,8 +51,8 @@ def test_g2cbs_constants_and_lower_peak():
     assert G2CBS_C4 == pytest.approx(1.12249, abs=1e-5)
     # Same corner distance d → ~24 % lower peak than Walton–Meek.
     p0, corner, p1 = np.array([[-3.0, 0.0]]), np.array([[0.0, 0.0]]), np.array([[2.0, 2.5]])
-    wm = round_corners_batch(p0, corner, p1, method="walton-meek")
-    yang = round_corners_batch(p0, corner, p1, method="g2cbs")
+    wm = round_corners_batch(p0, corner, p1, shape="walton-meek")
+    yang = round_corners_batch(p0, corner, p1, shape="g2cbs")
     assert wm.distance[0] == yang.distance[0] == pytest.approx(3.0)  # the shorter leg
     peaks = [
         max(float(np.max(np.abs(BezierSpiral.from_control_points(cp).curvature(U)))) for cp in r.control_points[0]) for r in (wm, yang)
@@ -62,7 +62,7 @@ def test_g2cbs_constants_and_lower_peak():
 
 
 def test_g2cbs_legs_have_yang_sukkarieh_ratios():
-    path = round_corners([(0, 0), (5, 0), (7, 4)], method="g2cbs")
+    path = round_corners([(0, 0), (5, 0), (7, 4)], shape="g2cbs")
     cp = path.corners[0].spirals[0].control_points
     g, h, k = (np.hypot(*(cp[i + 1] - cp[i])) for i in range(3))
     theta = path.corners[0].theta
@@ -107,21 +107,21 @@ def test_straight_polyline_is_one_line():
 
 @pytest.mark.parametrize("method", ["walton-meek", "g2cbs"])
 def test_curvature_too_small_names_corner_and_needed_curvature(method):
-    fit = round_corners(ZIGZAG, method=method)
+    fit = round_corners(ZIGZAG, shape=method)
     bound = 0.8 * fit.max_curvature
     # The first corner (in travel order) that needs more than the bound is reported.
     first = next(c for c in fit.corners if c.curvature > bound)
     with pytest.raises(NoSolutionError, match=rf"corner {first.index}\b") as info:
-        round_corners(ZIGZAG, max_curvature=bound, method=method)
+        round_corners(ZIGZAG, max_curvature=bound, shape=method)
     needed = float(re.search(r"needs curvature ≥ ([0-9.e+-]+)", str(info.value)).group(1))
     assert needed == pytest.approx(first.curvature, rel=1e-5)
 
 
 @pytest.mark.parametrize("method", ["walton-meek", "g2cbs"])
 def test_joint_curvature_is_exact(method):
-    fit = round_corners(ZIGZAG, method=method)
+    fit = round_corners(ZIGZAG, shape=method)
     k = 1.01 * fit.max_curvature
-    path = round_corners(ZIGZAG, curvature=k, method=method)
+    path = round_corners(ZIGZAG, curvature=k, shape=method)
     for c in path.corners:
         assert abs(c.spirals[0].end_curvature) == pytest.approx(k, rel=1e-12)
     assert measured_peak(path.chain) == pytest.approx(k, rel=1e-9)
@@ -141,13 +141,13 @@ def test_max_curvature_bound_is_respected(steps, factor, method):
     for length, turn, sign in [(1.0, 0.0, 1.0), *steps]:
         heading += sign * turn
         pts.append(pts[-1] + length * np.array([math.cos(heading), math.sin(heading)]))
-    fit = round_corners(np.array(pts), method=method)
+    fit = round_corners(np.array(pts), shape=method)
     if not fit.corners:
         return
     kmax = factor * fit.max_curvature
     # Tight bounds make tiny pairs at gentle corners, whose join curvature is
     # only as exact as ε·|coordinates|/(g·h·sin θ): check G2 to 1e-7 here.
-    path = round_corners(np.array(pts), max_curvature=kmax, method=method)
+    path = round_corners(np.array(pts), max_curvature=kmax, shape=method)
     assert measured_peak(path.chain) <= kmax * (1 + 1e-9)
     for c in path.corners:
         assert c.curvature == pytest.approx(kmax, rel=1e-12)
@@ -173,8 +173,8 @@ def test_malformed_input():
         round_corners([(0, 0), (1, 0), (1, 0), (2, 1)])
     with pytest.raises(ValueError, match="folds straight back at point 1"):
         round_corners([(0, 0), (1, 0), (0.5, 0)])
-    with pytest.raises(ValueError, match="method"):
-        round_corners(ZIGZAG, method="clothoid")
+    with pytest.raises(ValueError, match="shape must be one of 'walton-meek', 'near-linear', 'g2cbs'; got 'clothoid'"):
+        round_corners(ZIGZAG, shape="clothoid")
     with pytest.raises(ValueError, match="not both"):
         round_corners(ZIGZAG, curvature=1.0, max_curvature=2.0)
     with pytest.raises(ValueError, match="max_curvature must be positive"):
@@ -185,3 +185,17 @@ def test_a_bad_per_corner_value_names_the_corner_as_geometry_errors_do():
     points = [[0, 0], [10, 0], [10, 10], [20, 10], [20, 20]]  # corners 1, 2, 3: the interior points
     with pytest.raises(ValueError, match=r"max_deviation must be positive and finite; got nan \(corner 2\)"):
         round_corners(points, max_deviation=[0.1, float("nan"), 0.1])
+
+
+def test_method_is_the_deprecated_name_of_shape_and_never_overrides_it():
+    """``method=`` still works for one release and warns; given beside a different ``shape`` (the default's
+    own name included) it is refused, where it used to win silently."""
+    with pytest.warns(DeprecationWarning, match=r"method= is deprecated and will be removed: the same choice is shape="):
+        old = round_corners(ZIGZAG, method="g2cbs")
+    assert old.chain.length == round_corners(ZIGZAG, shape="g2cbs").chain.length
+    for shape in ("walton-meek", "near-linear"):
+        with pytest.warns(DeprecationWarning), pytest.raises(ValueError, match=rf"got shape='{shape}', method='g2cbs'"):
+            round_corners(ZIGZAG, shape=shape, method="g2cbs")
+    with pytest.warns(DeprecationWarning):
+        same = round_corners_batch([(0, 0)], [(5, 0)], [(7, 4)], shape="g2cbs", method="g2cbs")
+    assert same.ok.all()

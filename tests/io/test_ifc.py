@@ -9,7 +9,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from spiral_cad.core._chain_kernels import ARC, LINE, SPIRAL
+from spiral_cad.core.kinds import ARC, LINE, SPIRAL
 from spiral_cad.design import Alignment, Profile
 from spiral_cad.io.ifc import GRAPH_TOLERANCE, graph_polynomials, ifc_file, layout_segments, read_ifc_alignments, write_ifc
 

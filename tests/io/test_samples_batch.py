@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 from spiral_cad.core import bezier
-from spiral_cad.core._chain_kernels import SPIRAL
+from spiral_cad.core.kinds import SPIRAL
 from spiral_cad.design import Alignment, round_corners
 from spiral_cad.io.samples import COLUMNS, _Rows, sample_path, write_samples
 

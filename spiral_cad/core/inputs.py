@@ -18,6 +18,8 @@ from typing import Any, cast
 import numpy as np
 from numpy.typing import NDArray
 
+__all__ = ["as_float", "as_point", "as_points", "as_real_array", "as_unit", "as_xy", "per_item", "shown"]
+
 #: Array dtype kinds that hold real numbers (signed, unsigned, floating).
 _REAL_KINDS = "iuf"
 

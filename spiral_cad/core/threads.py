@@ -14,6 +14,8 @@ from typing import Any
 
 import numpy as np
 
+__all__ = ["ROWS_PER_THREAD", "run_split", "thread_count"]
+
 #: Rows per thread from which a batch of transition rows is split (about a millisecond of work).
 ROWS_PER_THREAD = 16_384
 

@@ -30,6 +30,8 @@ from typing import Any, TypeVar, cast
 
 import numpy as np
 
+__all__ = ["Kernels", "REGISTRIES", "SCALAR_CALLS_BEFORE_COMPILING"]
+
 #: A kernel function: the decorators return it unchanged, signature included.
 F = TypeVar("F", bound=Callable[..., Any])
 
