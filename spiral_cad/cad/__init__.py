@@ -8,8 +8,7 @@ This namespace names the exporters, readers, checkers and G2 makers (``from spir
 check_faces``); each loads with its module on first use, so importing the namespace imports no OCP.
 """
 
-from importlib import import_module
-from typing import Any
+from ..core.namespaces import lazy_names
 
 #: The names of this namespace and the module each lives in (loaded on first use: each needs OCP).
 _HOMES = {
@@ -39,13 +38,4 @@ _HOMES = {
 }
 __all__ = sorted(_HOMES)
 
-
-def __getattr__(name: str) -> Any:
-    """A name of ``__all__`` from its module, imported on first use."""
-    if name in _HOMES:
-        return getattr(import_module(f".{_HOMES[name]}", __name__), name)
-    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
-
-
-def __dir__() -> list[str]:
-    return sorted(set(globals()) | set(__all__))
+__getattr__, __dir__ = lazy_names(__name__, _HOMES)

@@ -10,8 +10,7 @@ readers, writers and rewriters (``from spiral_cad.io import read_dxf_paths``); e
 on first use.
 """
 
-from importlib import import_module
-from typing import Any
+from ..core.namespaces import lazy_names
 
 #: The names of this namespace and the module each lives in (loaded on first use: the package itself imports nothing).
 _HOMES = {
@@ -49,13 +48,4 @@ _HOMES = {
 }
 __all__ = sorted(_HOMES)
 
-
-def __getattr__(name: str) -> Any:
-    """A name of ``__all__`` from its module, imported on first use."""
-    if name in _HOMES:
-        return getattr(import_module(f".{_HOMES[name]}", __name__), name)
-    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
-
-
-def __dir__() -> list[str]:
-    return sorted(set(globals()) | set(__all__))
+__getattr__, __dir__ = lazy_names(__name__, _HOMES)
