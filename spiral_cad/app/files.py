@@ -34,6 +34,8 @@ from ..io.gcode import SUFFIXES as GCODE_SUFFIXES
 
 __all__ = ["EXPORTS", "READS", "export", "read"]
 
+#: The longest file name (bytes) the usual file systems hold (ext4, APFS, NTFS in UTF-16 units).
+_LONGEST_NAME = 255
 #: ``export``'s formats: name → (suffixes, "module:function" of the writer).
 EXPORTS: dict[str, tuple[tuple[str, ...], str]] = {
     "step": ((".step", ".stp"), "spiral_cad.cad.export:export_step"),
@@ -78,6 +80,9 @@ def export(obj: Any, path: str | os.PathLike, *, format: str | None = None, **op
             refuses (a name, a unit, an object it does not hold).
     """
     target = _path(path, "export")
+    if len(os.fsencode(target.name)) > _LONGEST_NAME:
+        raise ValueError(f"export {target.name!r:.80}…: a file name of {len(os.fsencode(target.name))} bytes; "
+                         f"file systems hold at most {_LONGEST_NAME}")  # fmt: skip
     if target.is_dir():
         raise ValueError(f"export {target.name!r:.80}: is a folder; give a file's path")
     if not target.parent.is_dir():

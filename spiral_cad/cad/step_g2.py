@@ -29,7 +29,6 @@ from __future__ import annotations
 
 import math
 import os
-import tempfile
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from pathlib import Path
@@ -54,6 +53,7 @@ from ..check.joints import Continuity
 from ..core.units import MM_PER_UNIT
 from ..design.g2 import GAP_SHARE
 from ..io.document_report import DocumentReport, PathReport
+from ..io.staging import temporary_beside
 from .continuity import SNAP_FRACTION, check_continuity
 from .g2wire import g2_wire
 from .readers import IGES_SUFFIXES, STEP_SUFFIXES, read_file
@@ -292,8 +292,7 @@ def _write_document(doc: Any, target: Path, kind: str, check: Callable[[str], No
     from .console import captured_messages
     from .occ import print_model
 
-    handle, temporary = tempfile.mkstemp(prefix=f".{target.name}.", suffix=target.suffix, dir=target.parent)
-    os.close(handle)
+    temporary = temporary_beside(target, target.suffix)
     try:
         with captured_messages():
             if kind == "STEP":

@@ -46,6 +46,7 @@ from .document_report import DocumentReport, PathReport
 from .dxf import _add
 from .dxf_curves import CURVES, curve_parts
 from .dxf_read import DXF_UNITS, JOIN_TOLERANCE, READ, _chains, _entity_parts, _segment
+from .staging import temporary_beside
 
 __all__ = ["ATTRIBUTES", "open_drawing", "rewrite_dxf_g2"]
 
@@ -255,8 +256,7 @@ def _save(doc, target: Path, issues: set[tuple[int, str]], label: str, notes: li
 
     _unique_handles(doc, notes)
     expected = _contents(doc.modelspace())
-    handle, temporary = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".dxf", dir=target.parent)
-    os.close(handle)
+    temporary = temporary_beside(target, ".dxf")
     try:
         try:
             doc.saveas(temporary)

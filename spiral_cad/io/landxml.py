@@ -34,7 +34,6 @@ import contextlib
 import math
 import os
 import re
-import tempfile
 from collections.abc import Sequence
 from dataclasses import dataclass
 from datetime import UTC, datetime
@@ -52,6 +51,7 @@ from ..core.rows import NO_SHAPE
 from ..core.segments import row_frames
 from ..core.shapes import SHAPE_NAMES
 from ..core.units import to_metres
+from .staging import temporary_beside
 
 __all__ = [
     "METRIC_UNITS",
@@ -432,9 +432,9 @@ def write_landxml(alignments: Sequence[AlignmentToWrite] | Any, path: str | os.P
     alignments, units = records, own
     data = landxml_text(alignments, units, name, survey_feet=survey_feet).encode("utf-8")
     target = os.fspath(path)
-    handle, temporary = tempfile.mkstemp(prefix=f".{os.path.basename(target)}.", suffix=".tmp", dir=os.path.dirname(target) or ".")
+    temporary = temporary_beside(target, ".tmp")
     try:
-        with os.fdopen(handle, "wb") as stream:
+        with open(temporary, "wb") as stream:
             stream.write(data)
         os.chmod(temporary, 0o666 & ~_umask())  # mkstemp makes it private: give it an ordinary file's mode
         os.replace(temporary, target)  # atomic on one file system: the old file or the whole new one

@@ -21,7 +21,6 @@ from __future__ import annotations
 
 import math
 import os
-import tempfile
 import xml.etree.ElementTree as ET
 from pathlib import Path
 
@@ -32,6 +31,7 @@ from .document_report import DocumentReport, PathReport
 from .g2_ends import straight_ends
 from .landxml import _coord_geom, _text
 from .landxml_read import _child, _children, _local, _Reader, read_landxml
+from .staging import temporary_beside
 
 __all__ = ["GEOMETRY", "parse_keeping", "rewrite_landxml_g2", "write_tree"]
 
@@ -64,8 +64,7 @@ def parse_keeping(source: Path) -> ET.ElementTree[ET.Element]:
 def write_tree(tree: ET.ElementTree[ET.Element], target: Path) -> None:
     """Write an XML document whole or not at all: an existing target (the source itself, in place) is replaced
     only by a complete file (UTF-8, with an XML declaration)."""
-    handle, temporary = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".tmp", dir=target.parent)
-    os.close(handle)
+    temporary = temporary_beside(target, ".tmp")
     try:
         tree.write(temporary, encoding="utf-8", xml_declaration=True)
         os.replace(temporary, target)

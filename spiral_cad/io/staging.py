@@ -36,6 +36,16 @@ BACKUP = ".backup"
 _FOLDER = re.compile(re.escape(PREFIX) + r"(\d+)-[A-Za-z0-9_]+")
 
 
+def temporary_beside(target: str | os.PathLike, suffix: str) -> str:
+    """A new empty file beside ``target`` (in its folder: one file system, so a rename replaces ``target``
+    whole), hidden and named after it; the name is cut to 64 characters, so that a target whose name is
+    near the file system's 255 still has one."""
+    place = Path(target)
+    handle, temporary = tempfile.mkstemp(prefix=f".{place.name[:64]}.", suffix=suffix, dir=place.parent)
+    os.close(handle)
+    return temporary
+
+
 class OutputError(ValueError):
     """The output folder or a destination in it cannot take the new files; nothing was changed."""
 

@@ -229,3 +229,16 @@ def test_the_namespaces_name_their_doors_each_from_its_own_module_loaded_on_firs
     done = subprocess.run([sys.executable, "-c", f"import sys, {namespace}; print(sorted(m for m in sys.modules if m.startswith('{namespace}.') or m == 'OCP'))"],
                           capture_output=True, text=True)  # fmt: skip
     assert done.stdout.strip() == "[]", done.stderr
+
+
+def test_names_near_the_file_systems_limit_are_written_and_longer_ones_refused(tmp_path):
+    """A file named with 250 characters is written in every format whose writer replaces a file whole (its
+    temporary name beside it is cut short); a name past 255 bytes is refused by name, never an OSError."""
+    chain = _road()
+    for suffix in (".xml", ".nc", ".ifc", ".dxf", ".step"):
+        path = tmp_path / ("r" * (250 - len(suffix)) + suffix)
+        sc.export(chain, path)
+        assert path.stat().st_size > 0
+    assert sorted(p.name[:1] for p in tmp_path.iterdir()) == ["r"] * 5  # no temporary file left
+    with pytest.raises(ValueError, match=r"a file name of 303 bytes; file systems hold at most 255"):
+        sc.export(chain, tmp_path / ("r" * 300 + ".nc"))
