@@ -25,8 +25,8 @@ def first_curve() -> None:
     from spiral_cad.app.plots import plot_plan
 
     enter = sc.line_to_circle((0, 0), (1, 0), (100, 60), 50.0)
-    leave = sc.line_to_circle((300, 150), (-1, -1), (100, 60), 50.0).reversed()
-    chain = sc.Chain.join([enter, leave], start=(-20, 0), end=(400, 250), units="mm")
+    leave = sc.line_to_circle((-20, 120), (1, 0), (100, 60), 50.0).reversed()
+    chain = sc.Chain.join([enter, leave], start=(-20, 0), end=(-20, 120), units="mm")
     plot_plan(chain, comb=True).savefig(IMAGES / "first_curve.png")
 
 
