@@ -75,14 +75,15 @@ def open_drawing(source: Path) -> tuple[Any, str]:
         raise ValueError(f"{source.name}: the DXF file is {'a folder' if source.is_dir() else 'missing'}")
     try:
         return ezdxf.readfile(source), ""
-    except (ezdxf.DXFError, UnicodeDecodeError) as plain:
-        try:
-            doc, auditor = recover.readfile(source)
-        except (ezdxf.DXFError, UnicodeDecodeError, OSError) as error:
-            raise ValueError(f"{source.name}: not a DXF file ezdxf can read ({plain}; recover: {error})") from None
-        return doc, f"read with ezdxf's recover mode ({plain}; {len(auditor.fixes)} fix(es))"
     except OSError as error:  # ezdxf says "not a DXF file" with an OSError
         raise ValueError(f"{source.name}: not a DXF file ezdxf can read ({error})") from None
+    except Exception as plain:  # noqa: BLE001 - any fault of the plain reader (a DXFError, a KeyError on a bad handle): recover
+        try:
+            doc, auditor = recover.readfile(source)
+        except Exception as error:  # noqa: BLE001 - the recover reader failing too: named, never a crash
+            raise ValueError(f"{source.name}: not a DXF file ezdxf can read ({plain or type(plain).__name__}; recover: "
+                             f"{error or type(error).__name__})") from None  # fmt: skip
+        return doc, f"read with ezdxf's recover mode ({plain or type(plain).__name__}; {len(auditor.fixes)} fix(es))"
 
 
 def _as_r2000(doc, issues: set[tuple[int, str]], notes: list[str]) -> Any:

@@ -82,7 +82,8 @@ def test_check_judges_a_drawing_as_drawn(tmp_path, capsys):
     assert units == "mm" and notes == [] and len(slot.joints) == 4 and slot.closed and len(whole) == 2
     assert [str(j.level) for j in slot.joints] == ["G1"] * 4  # tangent, the curvature 0 then 1/5
     assert [str(j.level) for j in line_arc.joints] == ["G1"] and line_arc.joints[0].gap < 1e-9  # the mirrored arc in place
-    assert all(str(w.min_level) == "G2" and not w.joints for w in whole)  # the ellipse and the placed circle: one curve each
+    # the ellipse and the placed circle: each in two halves, so that its closing point is judged too
+    assert all(w.closed and len(w.joints) == 2 and str(w.min_level) == "G2" for w in whole)
     assert main(["check", str(drawing), "--zebra", str(tmp_path / "z.png")]) == 2
     assert "a DXF drawing holds curves" in capsys.readouterr().err
 
