@@ -1,11 +1,15 @@
 """A DXF drawing's curves as exact OCCT edges, so that the STEP checker judges a drawing as it is drawn.
 
 Read from the model space through ezdxf, every curve exactly as it is stored: ``LINE``, ``ARC`` and
-``CIRCLE`` (in their object coordinate system: a mirrored arc stays clockwise), ``ELLIPSE`` (its arc),
-``SPLINE`` (its control points, knots and weights: a B-spline curve as written), ``LWPOLYLINE`` and
-``POLYLINE`` (their lines and bulge arcs), and block references (``INSERT``: their curves placed, nested
-blocks included). Text, dimensions, hatches, points and other annotation are left out. The drawing's
-unit is its ``$INSUNITS`` (``io.dxf_read.DXF_UNITS``); a unitless drawing is in drawing units.
+``CIRCLE`` (in their object coordinate system: a mirrored arc stays clockwise), ``ELLIPSE`` (its arc; a
+ratio above 1 as the same ellipse with its axes swapped), ``SPLINE`` (its control points, knots and
+weights: a B-spline curve as written), ``LWPOLYLINE`` and ``POLYLINE`` (their lines and bulge arcs), and
+block references (``INSERT`` and MINSERT grids: their curves placed, nested blocks included). Text,
+dimensions, hatches, points and other annotation are left out. The drawing's unit is its ``$INSUNITS``
+(``io.dxf_read.DXF_UNITS``); a unitless drawing is in drawing units.
+
+The checker judges joints between edges, so every point where a curve may be less than G2 is made one:
+a spline is cut at its inner knots below C2, and a curve that closes on itself is cut in two halves.
 """
 
 from __future__ import annotations
