@@ -32,7 +32,7 @@ from pathlib import Path
 from typing import Any
 
 from ..core.chain import Chain
-from ..core.units import DEFAULT_UNITS, length_unit
+from ..core.units import DEFAULT_UNITS, length_unit, shared_unit
 from ..io.names import MAX_TEXT_LENGTH, check_name
 from ..io.opendrive import CrossSection
 
@@ -85,13 +85,7 @@ def _units(chains: list[Chain] | None, units: str | None) -> str:
     """The file's unit: the chains' own (they must agree, and ``units`` may only confirm it), else ``units`` or mm."""
     if chains is None:
         return DEFAULT_UNITS if units is None else length_unit(units)
-    found = {c.units for c in chains}
-    if len(found) > 1:
-        raise ValueError(f"chains in one file must share a unit; got {', '.join(sorted(found))}")
-    (own,) = found
-    if units is not None and length_unit(units) != own:
-        raise ValueError(f"the chain is in {own}; units={units!r} would mislabel it (nothing is rescaled)")
-    return own
+    return shared_unit((c.units for c in chains), units)
 
 
 def export_step(obj: Any, path: PathLike, *, name: str | None = None, units: str | None = None) -> None:

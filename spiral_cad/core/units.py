@@ -8,6 +8,7 @@ readers expect (see ``spiral_cad.cad.export``); nothing is rescaled on the way.
 
 from __future__ import annotations
 
+from collections.abc import Iterable
 from typing import Any
 
 #: Size of one unit in millimetres, per unit name.
@@ -27,6 +28,22 @@ def length_unit(value: Any, name: str = "units") -> str:
     if not isinstance(value, str) or value not in MM_PER_UNIT:
         raise ValueError(f"{name} must be one of {', '.join(UNITS)}; got {value!r:.80}")
     return value
+
+
+def shared_unit(found: Iterable[str], units: str | None = None) -> str:
+    """The one length unit of the chains written to one file (``found``: each chain's unit), checked against
+    ``units``, which may only confirm it: nothing is rescaled, so another unit would mislabel the file.
+
+    Raises:
+        ValueError: chains in different units, or ``units`` another unit than theirs (or not a unit).
+    """
+    kinds = set(found)
+    if len(kinds) != 1:
+        raise ValueError(f"chains in one file must share a unit; got {', '.join(sorted(kinds)) or 'none'}")
+    (own,) = kinds
+    if units is not None and length_unit(units) != own:
+        raise ValueError(f"the chains are in {own}; units={units!r} would mislabel them (nothing is rescaled)")
+    return own
 
 
 def to_metres(units: str) -> float:

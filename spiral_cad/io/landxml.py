@@ -50,7 +50,7 @@ from ..core.kinds import ARC, LINE, SPIRAL
 from ..core.rows import NO_SHAPE
 from ..core.segments import row_frames
 from ..core.shapes import SHAPE_NAMES
-from ..core.units import to_metres
+from ..core.units import shared_unit, to_metres
 from .staging import temporary_beside
 
 __all__ = [
@@ -417,20 +417,13 @@ def write_landxml(alignments: Sequence[AlignmentToWrite] | Any, path: str | os.P
             and type), chains in different units or in another unit than
             ``units``, or see ``landxml_text`` (then nothing was written).
     """
-    _check_name(name, "the collection name")
     single = isinstance(alignments, Chain) or hasattr(alignments, "start_station")
     items = [alignments] if single else list(alignments) if isinstance(alignments, (list, tuple)) else None
     if not items:
         raise ValueError(f"write_landxml needs a Chain or an Alignment, or a non-empty list of them; got {type(alignments).__name__}")
     records = [_record(item, name if single else f"{name} {k + 1}", profile if single else None, k) for k, item in enumerate(items)]
-    found = {a.chain.units for a in records}
-    if len(found) > 1:
-        raise ValueError(f"the alignments of one LandXML file must share a unit; got {', '.join(sorted(found))}")
-    (own,) = found
-    if units is not None and units != own:
-        raise ValueError(f"the chains are in {own}; units={units!r} would mislabel them (nothing is rescaled)")
-    alignments, units = records, own
-    data = landxml_text(alignments, units, name, survey_feet=survey_feet).encode("utf-8")
+    units = shared_unit((a.chain.units for a in records), units)
+    data = landxml_text(records, units, name, survey_feet=survey_feet).encode("utf-8")
     target = os.fspath(path)
     temporary = temporary_beside(target, ".tmp")
     try:
