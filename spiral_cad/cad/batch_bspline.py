@@ -1,7 +1,8 @@
-"""Points and derivatives of B-spline surfaces, rational or not, many surfaces and parameters at once.
+"""Points and derivatives of B-spline surfaces and curves, rational or not, many of them and many
+parameters at once.
 
-OCCT evaluates a B-spline surface one point per call (``D2``); here the samples of every surface of one
-degree pair are a few numpy expressions: the basis functions and their first two derivatives at every
+OCCT evaluates a B-spline one point per call (``D2``, ``D1``); here the samples of every surface of one
+degree pair (every curve of one degree) are a few numpy expressions: the basis functions and their first two derivatives at every
 sample (Piegl and Tiller, *The NURBS Book*, algorithm A2.3, each sample on its own surface's knots), their
 tensor product with the homogeneous poles, and the quotient rule of a rational surface (A4.4). Each sample
 is evaluated on the polynomial span that holds it: ``U[i] ≤ u < U[i+1]``, the last span at the end of the
@@ -15,9 +16,10 @@ from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import NDArray
-from OCP.Geom import Geom_BSplineSurface
+from OCP.Geom import Geom_BSplineCurve, Geom_BSplineSurface
 
-__all__ = ["BSplineSurfaces", "bspline_derivatives", "bspline_surfaces"]
+__all__ = ["BSplineCurves", "BSplineSurfaces", "bspline_curve_points", "bspline_curves", "bspline_derivatives",
+           "bspline_surfaces"]  # fmt: skip
 
 
 @dataclass(frozen=True)
@@ -154,3 +156,63 @@ def bspline_derivatives(table: BSplineSurfaces, which: NDArray, uvs: NDArray) ->
         s02 = (a[:, 0, 2] - 2.0 * w[:, 0, 1] * s01 - w[:, 0, 2] * s00) / w[:, 0, 0]
         s11 = (a[:, 1, 1] - w[:, 1, 0] * s01 - w[:, 0, 1] * s10 - w[:, 1, 1] * s00) / w[:, 0, 0]
     return np.concatenate([s00, s10, s01, s20, s02, s11], axis=1)
+
+
+@dataclass(frozen=True)
+class BSplineCurves:
+    """3-D B-spline curves of one degree as arrays, one row per curve.
+
+    Attributes:
+        degree: their degree.
+        knots: the flat knot vectors (each knot repeated by its multiplicity), padded with inf.
+        spans: the first and the last span index of each curve's flat knots.
+        poles: every curve's homogeneous poles (w·P, w), one after another, rows of 4.
+        first_pole: where each curve's poles start in ``poles``.
+    """
+
+    degree: int
+    knots: NDArray
+    spans: NDArray
+    poles: NDArray
+    first_pole: NDArray
+
+
+def bspline_curves(curves: list[Geom_BSplineCurve]) -> dict[int, tuple[BSplineCurves, list[int]]]:
+    """The curves that are not periodic, grouped by degree: per degree the table and the positions of its
+    curves in ``curves``."""
+    groups: dict[int, list[int]] = {}
+    for k, c in enumerate(curves):
+        if not c.IsPeriodic():
+            groups.setdefault(c.Degree(), []).append(k)
+    found = {}
+    for degree, members in groups.items():
+        knots, poles = [], []
+        for k in members:
+            c = curves[k]
+            count = c.NbKnots()
+            knots.append(np.repeat([c.Knot(i) for i in range(1, count + 1)], [c.Multiplicity(i) for i in range(1, count + 1)]))
+            rational = c.IsRational()
+            block = np.empty((c.NbPoles(), 4))
+            for i in range(c.NbPoles()):
+                w = c.Weight(i + 1) if rational else 1.0
+                block[i] = (*(w * x for x in c.Pole(i + 1).Coord()), w)
+            poles.append(block)
+        sizes = np.array([len(k) for k in knots])
+        first = np.concatenate([[0], np.cumsum([len(b) for b in poles])[:-1]])
+        spans = np.stack([np.full(len(members), degree), sizes - degree - 2])
+        found[degree] = (BSplineCurves(degree, _padded(knots), spans, np.vstack(poles), first), members)
+    return found
+
+
+def bspline_curve_points(table: BSplineCurves, which: NDArray, ts: NDArray) -> tuple[NDArray, NDArray]:
+    """Points and first derivatives (n × 3 each) at ``ts``, each on the curve ``which`` of ``table``."""
+    which, ts = np.asarray(which, dtype=int), np.asarray(ts, dtype=float)
+    knots, p = table.knots[which], table.degree
+    span = np.clip((knots <= ts[:, None]).sum(axis=1) - 1, table.spans[0][which], table.spans[1][which])
+    ders = _basis(knots, p, span, ts)[:, :2]
+    index = table.first_pole[which][:, None] + span[:, None] - p + np.arange(p + 1)
+    ck = np.matmul(ders, table.poles[index])  # (n, 2, 4): the homogeneous point and derivative
+    a, w = ck[..., :3], ck[..., 3:]
+    with np.errstate(all="ignore"):
+        point = a[:, 0] / w[:, 0]
+        return point, (a[:, 1] - w[:, 1] * point) / w[:, 0]

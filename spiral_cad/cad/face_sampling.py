@@ -46,12 +46,14 @@ from numpy.typing import NDArray
 from OCP.BRep import BRep_Tool
 from OCP.BRepAdaptor import BRepAdaptor_Curve, BRepAdaptor_Curve2d, BRepAdaptor_Surface
 from OCP.BRepTools import BRepTools
+from OCP.Geom import Geom_BSplineCurve, Geom_TrimmedCurve
 from OCP.GeomAbs import GeomAbs_Shape
 from OCP.gp import gp_Pnt, gp_Pnt2d, gp_Vec
 from OCP.TColStd import TColStd_Array1OfReal
 from OCP.TopoDS import TopoDS_Edge, TopoDS_Face
 
 from ..check.joints import norms
+from .batch_bspline import bspline_curve_points, bspline_curves
 from .batch_geometry import curve_frame, curve_points
 from .face_projection import KNOT_STEP, FaceDomain, FaceTable, curve_knots, evaluate_on_faces
 
@@ -253,19 +255,30 @@ class EdgeLine(Line):
         self.batch = [None if frame is None else partial(curve_points, np.array(frame)) for frame in frames]
         floor = floor_points(self.lo, self.hi, samples)
         # (a line, circle or ellipse, as ``curve_frame`` found, has no knots)
-        breaks = curve_knots(BRep_Tool.Curve_s(edge, 0.0, 0.0)) if frames[0] is None and BRep_Tool.IsGeometric_s(edge) else []
+        geometric = frames[0] is None and BRep_Tool.IsGeometric_s(edge)
+        three_d = BRep_Tool.Curve_s(edge, 0.0, 0.0) if geometric else None  # located, as the edge
+        while isinstance(three_d, Geom_TrimmedCurve):
+            three_d = three_d.BasisCurve()
+        breaks = curve_knots(three_d) if geometric else []
+        # a B-spline edge between faces whose pcurves are lines, circles or ellipses: located with other such edges
+        self.spline = (three_d if isinstance(three_d, Geom_BSplineCurve) and not three_d.IsPeriodic()
+                       and all(frame is not None for frame in frames[1:]) else None)  # fmt: skip
+        self.pcurve_frames = [x for frame in frames[1:] for x in frame or ()]
         grid, own = None, list(breaks)
         for (domain, oriented), pcurve, on_face, frame in zip(sides, self.pcurves, self.curves_on_faces, frames[1:]):
             # where the knot lines of the face's surface cross the edge, in both directions, pcurve or not
             if pcurve is not None and frame is None:
                 breaks += curve_knots(on_face)
-            if not any(domain.surface_knots):
+            knots = domain.surface_knots
+            if pcurve is not None:  # a pcurve stays within the face's (u, v) bounds: knots on or past them are not crossed
+                knots = ([k for k in knots[0] if domain.lo[0] < k < domain.hi[0]], [k for k in knots[1] if domain.lo[1] < k < domain.hi[1]])
+            if not any(knots):
                 continue
             if grid is None:
                 grid = np.unique(np.array(floor + own + [self.lo, self.hi]))
             uv_of = (partial(_pcurve_points, pcurve) if pcurve is not None
                      else partial(_projected_points, oriented, domain.face))  # fmt: skip
-            breaks += _crossings(uv_of, grid, domain.surface_knots)
+            breaks += _crossings(uv_of, grid, knots)
         self.start = floor + span_points(self.lo, self.hi, breaks)
 
     def locate(self, params: list[float]) -> tuple[NDArray, NDArray, list[NDArray]]:
@@ -396,7 +409,7 @@ class _LineTable:
     """What ``sample_lines`` needs of every line as arrays (one row per line), so that each round
     evaluates all samples together: the faces along every edge are projected on all at once
     (``evaluate_on_faces``), and edges whose curve and pcurves are lines, circles or ellipses are located
-    all at once (``located``)."""
+    all at once (``located``), as are B-spline edges whose pcurves are (``bspline_curve_points``)."""
 
     def __init__(self, lines: list[Line]) -> None:
         self.lines = lines
@@ -406,6 +419,14 @@ class _LineTable:
         self.tolerance = np.array([line.tolerance if isinstance(line, EdgeLine) else 0.0 for line in lines])
         none = [0.0] * 30
         self.frames = np.array([line.closed if isinstance(line, EdgeLine) and line.closed is not None else none for line in lines])
+        splines = [(k, line) for k, line in enumerate(lines) if isinstance(line, EdgeLine) and line.spline is not None]
+        self.splines = bspline_curves([edge.spline for _, edge in splines])
+        self.spline_row = np.full((len(lines), 2), -1)  # (degree, row in its table) of a B-spline edge's curve
+        for degree, (_, members) in self.splines.items():
+            for row, m in enumerate(members):
+                k, edge = splines[m]
+                self.spline_row[k] = degree, row
+                self.frames[k, 12:] = edge.pcurve_frames
         self.face_of = np.zeros((len(lines), 2), dtype=int)
         places: dict[int, int] = {}  # id of a face's domain → its place in ``domains``
         self.domains: list[FaceDomain] = []
@@ -428,7 +449,15 @@ class _LineTable:
         if closed.any():
             at = np.flatnonzero(closed)
             points[at], tangents[at], (uvs[0, at], uvs[1, at]) = located(self.frames[owner[at]], params[at])
-        rest = np.flatnonzero(~closed)
+        degrees = self.spline_row[owner, 0]
+        for degree, (table, _) in self.splines.items():
+            at = np.flatnonzero(degrees == degree)
+            points[at], tangents[at] = bspline_curve_points(table, self.spline_row[owner[at], 1], params[at])
+            with np.errstate(all="ignore"):
+                tangents[at] /= norms(tangents[at])[:, None]
+            frames = self.frames[owner[at]]
+            uvs[0, at], uvs[1, at] = curve_points(frames[:, 12:21], params[at])[0], curve_points(frames[:, 21:], params[at])[0]
+        rest = np.flatnonzero(~closed & (degrees < 0))
         order = rest[np.argsort(owner[rest], kind="stable")]
         ids, starts = np.unique(owner[order], return_index=True)
         for i, a, b in zip(ids.tolist(), starts.tolist(), [*starts[1:].tolist(), len(order)]):

@@ -33,6 +33,7 @@ from ..core.segments import Segment
 from ..core.shapes import DEFAULT_SHAPE, shape_code
 from ..design.fillets import fillet_path
 from .advice import advice, refusal
+from .faces import _shapes
 from .fillet import wire_path
 from .prism_fillet import (
     _SIDE_TOL,
@@ -267,8 +268,7 @@ def _walls(solid: TopoDS_Shape, frame: gp_Ax3, size: float) -> list[_Rims]:
     TopExp.MapShapesAndAncestors_s(solid, TopAbs_EDGE, TopAbs_FACE, neighbours)
 
     def others(edge: TopoDS_Edge, face: TopoDS_Face) -> list[TopoDS_Face]:
-        found = neighbours.FindFromKey(edge)
-        return [TopoDS.Face_s(f) for f in found if not f.IsSame(face)]
+        return [TopoDS.Face_s(f) for f in _shapes(neighbours.FindFromKey(edge)) if not f.IsSame(face)]
 
     group = list(range(len(upright)))  # union–find over the vertical faces joined by vertical edges
 

@@ -221,7 +221,8 @@ def _between(p: NDArray[np.float64], q: NDArray[np.float64]) -> NDArray[np.float
 def _solid(faces: list[TopoDS_Face], tolerance: float, top: TopoDS_Face) -> TopoDS_Solid:
     """The faces sewn into one closed shell and made a FORWARD solid facing out: the shell faces out
     when the top cap (``top``, a plane z = height) does, as the construction knows (no volume needed)."""
-    sewing = BRepBuilderAPI_Sewing(tolerance)
+    # no cutting: the faces' edges match whole, one span to one span (cutting costs a fifth of the sewing)
+    sewing = BRepBuilderAPI_Sewing(tolerance, True, True, False, False)
     for face in faces:
         sewing.Add(face)
     sewing.Perform()
