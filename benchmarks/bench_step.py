@@ -45,7 +45,7 @@ from spiral_cad.cad.continuity import check_continuity
 from spiral_cad.cad.export import export_step
 from spiral_cad.cad.occ import chain_wire
 from spiral_cad.cad.step_occ import write_shape_step
-from spiral_cad.check.joints import ContinuityReport
+from spiral_cad.continuity.joints import ContinuityReport
 from spiral_cad.design import Alignment
 
 #: The modules whose code these numbers measure (stamped into the results: ``timing.code_stamp``).

@@ -4,7 +4,8 @@ This namespace is the numeric core's face: segments, the Bézier spiral, the
 five transitions, chains, fitting points (``fit_points``), and ``batch`` (the
 same solvers over arrays). It
 needs only numpy, scipy and numba. ``export`` and ``read`` (``spiral_cad.app.files``, loaded on first
-use) write and read every format, chosen by the file's suffix. Design tools live in ``spiral_cad.design``;
+use) write and read every format, chosen by the file's suffix, and ``check`` judges G0/G1/G2 in any of
+them or in a shape. Design tools live in ``spiral_cad.design``;
 build123d objects in ``spiral_cad.build123d`` and the CadQuery plugin in
 ``spiral_cad.cadquery`` (these two import OCP).
 """
@@ -22,7 +23,7 @@ from .core.spiral import BezierSpiral
 from .core.transitions import Transition, circle_in_circle, circle_to_circle, line_to_circle, line_to_line
 
 if TYPE_CHECKING:
-    from .app.files import export, read
+    from .app.files import check, export, read
 
 __all__ = [
     "Arc",
@@ -38,6 +39,7 @@ __all__ = [
     "Status",
     "Transition",
     "batch",
+    "check",
     "circle_in_circle",
     "circle_to_circle",
     "export",
@@ -49,8 +51,9 @@ __all__ = [
 
 
 def __getattr__(name: str) -> Any:
-    """``export`` and ``read`` on first use: the file formats' modules load only when a file is written or read."""
-    if name in ("export", "read"):
+    """``check``, ``export`` and ``read`` on first use: the file formats' modules load only when a file is
+    judged, written or read."""
+    if name in ("check", "export", "read"):
         from .app import files
 
         return getattr(files, name)

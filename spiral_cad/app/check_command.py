@@ -1,5 +1,5 @@
-"""``spiral-cad check``: G0/G1/G2 at every joint of a STEP, IGES, DXF or OpenDRIVE file, face to face where a
-STEP/IGES file holds faces; one file, or many at once on dask."""
+"""``spiral-cad check``: G0/G1/G2 at every joint of a STEP, IGES, DXF, OpenDRIVE, LandXML or G-code file, face to
+face where a STEP/IGES file holds faces; one file, or many at once on dask."""
 
 from __future__ import annotations
 
@@ -10,9 +10,10 @@ import sys
 from importlib.util import find_spec
 from pathlib import Path
 
-from ..check.joints import Continuity, ContinuityReport
+from ..continuity.joints import Continuity, ContinuityReport
+from ..io.gcode import SUFFIXES as GCODE_SUFFIXES
 from ..io.opendrive_check import PROFILE_LEVELS, OpenDriveReport
-from .cli_shared import MANY_OPTIONS, PIP_CAD, add_many_options, run_on_many
+from .cli_shared import MANY_OPTIONS, PIP_CAD, add_many_options, run_on_many, summary_only
 from .many_inputs import expand_inputs, wants_many
 from .many_task import note_worst
 
@@ -27,14 +28,8 @@ def check_file(args: argparse.Namespace) -> int:
     """
     suffix = Path(args.file).suffix.lower()
     if suffix not in CHECK_SUFFIXES and Path(args.file).exists():
-        from ..io.gcode import SUFFIXES as GCODE_SUFFIXES
-
-        documents = {".xml": "a LandXML file", **dict.fromkeys(GCODE_SUFFIXES, "a CNC program")}
-        kind = (
-            f"{documents[suffix]}: spiral-cad g2 makes it G2 in place and reports every path left below G2" if suffix in documents else ""
-        )
-        raise ValueError(f"{Path(args.file).name}: check judges STEP/IGES (.step .stp .igs .iges), DXF (.dxf) and OpenDRIVE (.xodr) files"
-                         + (f"; for {kind}" if kind else ""))  # fmt: skip
+        raise ValueError(f"{Path(args.file).name}: check judges STEP/IGES (.step .stp .igs .iges), DXF (.dxf), OpenDRIVE (.xodr), "
+                         f"LandXML (.xml) and G-code ({' '.join(GCODE_SUFFIXES)}) files")  # fmt: skip
     if suffix == ".xodr":
         _wire_tolerances(args)
         if args.comb:
@@ -52,12 +47,16 @@ def check_file(args: argparse.Namespace) -> int:
         print(f"error: spiral-cad check reads STEP/IGES with OCCT, which comes with the CAD extra: {PIP_CAD}", file=sys.stderr)
         return 2
     picture = _picture_options(args)  # refused before anything is read
-    if suffix == ".dxf":
+    if args.units and suffix not in _DOCUMENTS:
+        print(f"error: --units is the unit of a program or drawing that states none; {Path(args.file).name} is neither",
+              file=sys.stderr)  # fmt: skip
+        return 2
+    if suffix in _DOCUMENTS:
         if args.zebra or args.curvature_map:
-            print("error: --zebra and --curvature-map draw faces; a DXF drawing holds curves", file=sys.stderr)
+            print(f"error: --zebra and --curvature-map draw faces; {_DOCUMENTS[suffix]} holds curves", file=sys.stderr)
             return 2
         _wire_tolerances(args)
-        return _check_drawing(args)
+        return _check_document(args)
     from ..cad.faces import holds_faces
 
     if holds_faces(args.file):
@@ -65,7 +64,7 @@ def check_file(args: argparse.Namespace) -> int:
 
         status = check_face_file(args.file, require=args.require, gap_tol=args.gap_tol, angle_tol=args.angle_tol,
                                  curvature_tol=args.curvature_tol, feature_angle=args.feature_angle, zebra=args.zebra,
-                                 curvature_map=args.curvature_map, timing=args.timing, picture=picture)  # fmt: skip
+                                 curvature_map=args.curvature_map, timing=args.timing, picture=picture, quiet=args.quiet)  # fmt: skip
         if status is not None:  # None: the reader found no faces after all, so the wires are judged
             if args.comb:  # the comb of every edge of the part, in mm as build123d and FreeCAD read
                 from ..cad.continuity import curvature_comb
@@ -109,25 +108,30 @@ def _check_shape_file(args: argparse.Namespace) -> int:
     return _print_report(report, args)
 
 
-def _check_drawing(args: argparse.Namespace) -> int:
-    """``spiral-cad check`` of a DXF drawing: its curves as drawn (``cad.dxf_shape``), joint by joint, as
-    a STEP file's wires; the same exit statuses."""
-    from ..cad.continuity import check_continuity, curvature_comb
-    from ..cad.dxf_shape import DRAWING_UNITS, dxf_shape
-    from ..cad.export import export_step
+def _check_document(args: argparse.Namespace) -> int:
+    """``spiral-cad check`` of a DXF drawing (its curves as drawn), a CNC program (its cutting paths) or a
+    LandXML file (its alignments), joint by joint as a STEP file's wires (``spiral_cad.check``); the same
+    exit statuses."""
+    from ..cad.dxf_shape import DRAWING_UNITS
+    from .files import check
 
-    name = Path(args.file).name
-    shape, units, notes = dxf_shape(args.file)
-    if args.comb and units == DRAWING_UNITS:
-        raise ValueError(f"--comb: {name} states no unit ($INSUNITS), and a STEP file needs one")
-    report = check_continuity(shape, gap_tol=args.gap_tol, angle_tol=args.angle_tol, curvature_tol=args.curvature_tol,
-                              snap=args.snap, units=None if units == DRAWING_UNITS else units, label=name)  # fmt: skip
-    for note in notes:
+    name, suffix = Path(args.file).name, Path(args.file).suffix.lower()
+    report = check(args.file, gap_tol=args.gap_tol, angle_tol=args.angle_tol, curvature_tol=args.curvature_tol, snap=args.snap,
+                   units=args.units)  # fmt: skip
+    for note in [] if args.quiet else report.notes:
         print(f"note: {note}")
     if args.comb:
+        from ..cad.continuity import curvature_comb
+        from ..cad.document_shapes import document_shape
+        from ..cad.export import export_step
+
+        shape, units, _ = document_shape(args.file, units=args.units)
+        if units == DRAWING_UNITS:
+            raise ValueError(f"--comb: {name} states no unit ($INSUNITS), and a STEP file needs one")
         export_step(curvature_comb(shape, units=units), _comb_path(args.comb, args.file), name=f"{name} curvature comb", units=units)
-    advice = f"make_g2: spiral-cad g2 {name} -o OUT.dxf --max-deviation D makes its paths of lines and arcs G2, every other entity kept"
-    return _print_report(report, args, advice)
+    done = {".dxf": "makes its paths of lines and arcs G2, every other entity kept",
+            ".xml": "gives its alignments of lines and arcs spirals, the rest kept"}.get(suffix, "makes its runs of cuts G2 in place, every other line kept")  # fmt: skip
+    return _print_report(report, args, f"make_g2: spiral-cad g2 {name} -o OUT{suffix} --max-deviation D {done}")
 
 
 def _advice_lines(file: str, units: str) -> list[str]:
@@ -169,11 +173,11 @@ def _comb_path(comb: str, checked: str) -> Path:
 def _print_report(report: ContinuityReport, args: argparse.Namespace, advice: str | None = None) -> int:
     """Print ``report`` for ``spiral-cad check``; exit status 0 ok, 1 below ``--require`` or not ``--pieces`` pieces.
     Below G2, ``advice`` is printed (default: make_g2's bound for each wire of the STEP/IGES file)."""
-    print(report.format_table())
+    print(summary_only(report.format_table(), args.quiet))
     note_worst(str(report.min_level))
-    if getattr(args, "timing", False) and report.timing is not None:
+    if getattr(args, "timing", False) and report.timing is not None and not args.quiet:
         print(report.timing_line())
-    if report.min_level < Continuity.G2:  # before the verdict, which stays the last line
+    if report.min_level < Continuity.G2 and not args.quiet:  # before the verdict, which stays the last line
         if advice is None:
             _print_g2_advice(args.file, report.units)
         else:
@@ -197,7 +201,7 @@ def _print_opendrive_report(report: OpenDriveReport, args: argparse.Namespace) -
     """Print ``report`` for ``spiral-cad check``: exit 1 when a road's planView is below ``--require``,
     an elevation or superelevation below ``--profiles``, a link below ``--links``, or the file does
     not hold ``--pieces`` roads; else 0."""
-    print(report.format_table())
+    print(summary_only(report.format_table(), args.quiet))
     note_worst(str(report.min_level))
     failures = []
     if args.pieces is not None and report.pieces != args.pieces:
@@ -225,15 +229,16 @@ def add_check(sub: argparse._SubParsersAction) -> None:
     """The ``check`` command and its options."""
     check = sub.add_parser(
         "check",
-        help="report G0/G1/G2 continuity at every joint of a STEP, IGES, DXF or OpenDRIVE file",
+        help="report G0/G1/G2 continuity at every joint of a STEP, IGES, DXF, OpenDRIVE, LandXML or G-code file",
         description="Report G0/G1/G2 continuity at every joint, in the unit the file declares; a STEP/IGES file that holds "
         "faces is judged face to face at every edge they share (sharp features listed, not failed). A DXF drawing's curves "
-        "(lines, arcs, circles, ellipses, splines, polylines, blocks) are judged as drawn, chained by their ends. An OpenDRIVE file is "
-        "judged road by road (its planView, its elevation and superelevation in s) and link by link. Exit status: 0 ok, "
+        "(lines, arcs, circles, ellipses, splines, polylines, blocks) are judged as drawn, chained by their ends. A LandXML file's alignments are judged as "
+        "rebuilt (lines and arcs exact, spirals as cubics within the offset noted). A CNC program's cutting paths are judged "
+        "run by run between rapids (helical moves left out). An OpenDRIVE file is judged road by road (its planView, its elevation and superelevation in s) and link by link. Exit status: 0 ok, "
         "1 below --require, --profiles or --links (or not --pieces pieces), 2 unreadable file or bad option, "
         "141 output pipe closed early.",
     )
-    check.add_argument("file", nargs="+", help="a .step/.stp, .igs/.iges, .dxf or .xodr file (OpenDRIVE: one piece per road); several "
+    check.add_argument("file", nargs="+", help="a .step/.stp, .igs/.iges, .dxf, .xodr (one piece per road), .xml (LandXML) or G-code (.nc .ngc .tap …) file; several "
                        "files, folders or glob patterns are checked in parallel (see --workers)")  # fmt: skip
     check.add_argument(
         "--require", choices=["G0", "G1", "G2"],
@@ -249,7 +254,12 @@ def add_check(sub: argparse._SubParsersAction) -> None:
                        "lane centre, as a driver follows them; road links reference line to reference line)")  # fmt: skip
     check.add_argument("--snap", type=float, help="chain loose ends closer than this (model units; default 1%% of the model size)")
     check.add_argument("--comb", metavar="OUT.step",
-                       help="also write the curvature comb of every edge as STEP (STEP, IGES or DXF input; never the checked file)")  # fmt: skip
+                       help="also write the curvature comb of every edge as STEP (any input but OpenDRIVE; never the checked file)")  # fmt: skip
+    check.add_argument("--units", choices=["mm", "cm", "m", "km", "in", "ft"],
+                       help="the unit of a G-code program that says neither G20 nor G21 (mm or in), or of a DXF drawing "
+                            "without $INSUNITS; a file that states its unit is never relabelled")  # fmt: skip
+    check.add_argument("--quiet", "-q", action="store_true",
+                       help="print each file's one-line summary and the verdict, not the table, notes and advice")  # fmt: skip
     check.add_argument("--timing", action="store_true",
                        help="also print where the check spent its time: the reader's share, and whether it limits the check")  # fmt: skip
     check.add_argument(
@@ -277,7 +287,9 @@ def add_check(sub: argparse._SubParsersAction) -> None:
 
 
 #: The files ``check`` looks for in a folder it is given.
-CHECK_SUFFIXES = (".step", ".stp", ".igs", ".iges", ".dxf", ".xodr")
+#: What each kind of document judged as curves is called in messages.
+_DOCUMENTS = {".dxf": "a DXF drawing", ".xml": "a LandXML file", **dict.fromkeys(GCODE_SUFFIXES, "a CNC program")}
+CHECK_SUFFIXES = (".step", ".stp", ".igs", ".iges", ".xodr", *_DOCUMENTS)
 
 
 def _picture_options(args: argparse.Namespace) -> dict:

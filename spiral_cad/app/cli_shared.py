@@ -8,7 +8,7 @@ from collections.abc import Callable
 
 from .many import PIP_MANY
 
-__all__ = ["MANY_OPTIONS", "PIP_CAD", "add_many_options", "run_on_many"]
+__all__ = ["MANY_OPTIONS", "PIP_CAD", "add_many_options", "run_on_many", "summary_only"]
 
 
 #: How to install the CAD extra, for the commands that need OCCT.
@@ -39,3 +39,8 @@ def run_on_many(
     from .many import run_many
 
     return run_many(task, files, changes, args, verb=verb, workers=args.workers, scheduler=args.scheduler, summary=args.summary)
+
+
+def summary_only(table: str, quiet: bool) -> str:
+    """A check's table, or with ``quiet`` its first line: the summary (``check --quiet``)."""
+    return table.split("\n", 1)[0] if quiet else table

@@ -9,6 +9,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from ..cad.faces import FEATURE_ANGLE, check_faces
+from .cli_shared import summary_only
 from .many import note_worst
 
 if TYPE_CHECKING:
@@ -49,12 +50,14 @@ def _picture(draw: Callable[[], Figure], path: Path, what: str) -> None:
 
 def check_face_file(file: str, *, require: str | None = None, gap_tol: float | None = None, angle_tol: float | None = None,
                     curvature_tol: float | None = None, feature_angle: float | None = None, zebra: str | None = None,
-                    curvature_map: str | None = None, timing: bool = False, picture: dict | None = None) -> int | None:  # fmt: skip
+                    curvature_map: str | None = None, timing: bool = False, picture: dict | None = None,
+                    quiet: bool = False) -> int | None:  # fmt: skip
     """Judge the faces of ``file`` and print the table; draw the pictures asked for.
 
     Tolerances left None take ``check_faces``'s defaults (gap: the file's stated precision and the edges' own tolerances, angle 1e-7 rad, curvature jump 1e-4). ``require`` "G2" or "G1" fails any
     tangent edge below it (and "G0" any gap); sharp features are listed, never failed. ``timing``
-    also prints how long the check took. ``picture`` holds the pictures' options (``view``, ``pixels``;
+    also prints how long the check took; ``quiet`` prints the table's first line (the summary) and the
+    verdict only. ``picture`` holds the pictures' options (``view``, ``pixels``;
     the zebra's ``stripes``), as ``plot_zebra`` and ``plot_curvature_map`` take them.
 
     Returns:
@@ -74,13 +77,13 @@ def check_face_file(file: str, *, require: str | None = None, gap_tol: float | N
     )
     if report.faces == 0:
         return None
-    print(report.table())
+    print(summary_only(report.table(), quiet))
     if report.faces == 1 and not report.edges:
         # a lone face shares no edge: what can be judged is its boundary, the curve chain it is
         print("a lone face shares no edge: its boundary is judged as the curve chain it is")
         return None
     note_worst(report.worst)
-    if timing:
+    if timing and not quiet:
         print(f"time {report.seconds:.3g} s for {report.faces} faces and {len(report.edges)} edges, reading included")
     if zebra_png is not None or map_png is not None:
         from ..cad.mesh import face_mesh

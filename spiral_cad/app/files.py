@@ -1,4 +1,5 @@
-"""One door per verb for files: ``export`` writes and ``read`` reads every format, chosen by the suffix.
+"""One door per verb for files: ``export`` writes, ``read`` reads and ``check`` judges every format, chosen by
+the suffix.
 
 =========  ==============================  ======================================  ===================================
 format     suffixes                        ``export`` writes with                   ``read`` returns (reader)
@@ -14,6 +15,12 @@ ifc        .ifc                            ``io.ifc.write_ifc``                 
 samples    .csv (export)                   ``cad.export.export_samples``           —
 points     .csv .txt .xyz (read)           —                                       a point table (``io.points.read_points``)
 =========  ==============================  ======================================  ===================================
+
+``check`` judges STEP/IGES (face to face where the file holds faces: ``cad.faces.check_faces``, else its
+curves: ``cad.continuity.check_continuity``), DXF, LandXML and G-code (their curves as drawn, rebuilt or
+programmed: ``cad.document_shapes.document_shape``, then ``check_continuity``) and OpenDRIVE
+(``io.opendrive_check.check_opendrive``); an object (a build123d or CadQuery shape, an OCCT shape, a
+``Chain``) is judged face to face when it holds faces, else curve by curve.
 
 The options are the per-format function's own keyword options (``name``, ``units``, ``dialect`` …), passed on
 as given; an option the format does not take is refused by name with the ones it does. ``format=`` chooses
@@ -32,7 +39,7 @@ from typing import Any
 
 from ..io.gcode import SUFFIXES as GCODE_SUFFIXES
 
-__all__ = ["EXPORTS", "READS", "export", "read"]
+__all__ = ["CHECKS", "EXPORTS", "READS", "check", "export", "read"]
 
 #: The longest file name (bytes) the usual file systems hold (ext4, APFS, NTFS in UTF-16 units).
 _LONGEST_NAME = 255
@@ -58,6 +65,15 @@ READS: dict[str, tuple[tuple[str, ...], str]] = {
     "opendrive": ((".xodr",), "spiral_cad.io.opendrive_read:read_opendrive"),
     "ifc": ((".ifc",), "spiral_cad.io.ifc:read_ifc_alignments"),
     "points": ((".csv", ".txt", ".xyz"), "spiral_cad.io.points:read_points"),
+}
+#: ``check``'s formats: name → (suffixes, "module:function" of the checker).
+CHECKS: dict[str, tuple[tuple[str, ...], str]] = {
+    "step": ((".step", ".stp"), "spiral_cad.app.files:_check_cad_file"),
+    "iges": ((".iges", ".igs"), "spiral_cad.app.files:_check_cad_file"),
+    "dxf": ((".dxf",), "spiral_cad.app.files:_check_curves"),
+    "gcode": (GCODE_SUFFIXES, "spiral_cad.app.files:_check_curves"),
+    "landxml": ((".xml",), "spiral_cad.app.files:_check_curves"),
+    "opendrive": ((".xodr",), "spiral_cad.app.files:_check_roads"),
 }
 
 
@@ -112,6 +128,94 @@ def read(path: str | os.PathLike, *, format: str | None = None, **options: Any) 
         raise ValueError(f"read {source.name!r:.80}: the file {what}")
     reader = _chosen(READS, "read", source, format)
     return reader(source, **_checked(reader, options, source))
+
+
+def check(obj_or_path: Any, *, format: str | None = None, **options: Any) -> Any:
+    """Judge G0/G1/G2 at every joint of a file or an object (the table in the module docstring).
+
+    Example:
+        ```python
+        import spiral_cad as sc
+
+        report = sc.check("part.step")          # a FaceReport: face to face
+        report = sc.check("program.nc")         # a ContinuityReport: each cutting path
+        print(report.describe())
+        ```
+
+    Args:
+        obj_or_path: a file's path, or a build123d/CadQuery/OCCT shape, a ``Chain`` or a ``Transition``.
+        format: a file's format (``"step"``, ``"gcode"`` …) where its suffix names none.
+        **options: the chosen checker's keyword options (``gap_tol``, ``angle_tol``, ``curvature_tol`` …);
+            for a program or drawing, ``units`` is the unit of one that states none.
+
+    Returns:
+        ``FaceReport`` for faces, ``ContinuityReport`` for curves (a drawing's, program's or LandXML file's
+        ``notes`` say what was judged), ``OpenDriveReport`` for an OpenDRIVE file.
+
+    Raises:
+        ValueError: an unknown suffix or format, an option the checker does not take, or a file the reader
+            refuses (named with the reason).
+    """
+    if isinstance(obj_or_path, (str, os.PathLike)) and not isinstance(obj_or_path, bytes):
+        source = _path(obj_or_path, "check")
+        if not source.is_file():
+            what = "is a folder" if source.is_dir() else "is not a regular file" if source.exists() else "does not exist"
+            raise ValueError(f"check {source.name!r:.80}: the file {what}")
+        return _chosen(CHECKS, "check", source, format)(source, **options)  # each checker checks its options
+    if format is not None:
+        raise ValueError("check: format= names a file's format; an object is judged as it is")
+    from OCP.TopAbs import TopAbs_FACE
+    from OCP.TopExp import TopExp_Explorer
+
+    from ..cad.continuity import check_continuity
+    from ..cad.faces import check_faces
+    from ..cad.occ import as_occ_shape
+    from ..core.chain import Chain
+    from ..core.transitions import Transition
+
+    if isinstance(obj_or_path, Transition):  # its spirals, joint by joint
+        obj_or_path = Chain(obj_or_path.spirals)
+    try:
+        shape = as_occ_shape(obj_or_path)
+    except ValueError as error:
+        raise ValueError(f"check: {error}") from None
+    checker = check_faces if TopExp_Explorer(shape, TopAbs_FACE).More() else check_continuity
+    options = _checked(checker, options, type(obj_or_path).__name__)
+    options.setdefault("label", type(obj_or_path).__name__)
+    if checker is check_continuity and hasattr(obj_or_path, "units"):  # a Chain's own unit
+        options.setdefault("units", obj_or_path.units)
+    return checker(shape, **options)
+
+
+def _check_cad_file(path: Path, **options: Any) -> Any:
+    """A STEP/IGES file: face to face where it holds faces, else curve by curve."""
+    from ..cad.continuity import check_continuity
+    from ..cad.faces import check_faces, holds_faces
+
+    checker = check_faces if holds_faces(path) else check_continuity
+    return checker(path, **_checked(checker, options, path))
+
+
+def _check_curves(path: Path, **options: Any) -> Any:
+    """A DXF drawing, LandXML file or G-code program: its curves (``document_shape``), joint by joint."""
+    import dataclasses
+
+    from ..cad.continuity import check_continuity
+    from ..cad.document_shapes import document_shape
+    from ..cad.dxf_shape import DRAWING_UNITS
+
+    options = _checked(check_continuity, options, path)
+    shape, units, notes = document_shape(path, units=options.pop("units", None))  # the unit of a file that states none
+    options["units"] = None if units == DRAWING_UNITS else units
+    options.setdefault("label", path.name)
+    return dataclasses.replace(check_continuity(shape, **options), notes=tuple(notes))
+
+
+def _check_roads(path: Path, **options: Any) -> Any:
+    """An OpenDRIVE file: road by road and link by link."""
+    from ..io.opendrive_check import check_opendrive
+
+    return check_opendrive(path, **_checked(check_opendrive, options, path))
 
 
 def _path(path: Any, verb: str) -> Path:

@@ -5,7 +5,7 @@ OCCT's own tools do not answer this question: ``GeomLProp``/``BRepLProp``
 where the curvature is zero — exactly at a spiral's start. So the joint
 quantities are measured here from first and second derivatives.
 
-Measures and classification: ``spiral_cad.check.joints`` (shared with the
+Measures and classification: ``spiral_cad.continuity.joints`` (shared with the
 OpenDRIVE checker). Files are read and measured in a child process
 (``spiral_cad.cad.readers``): only the measured numbers come back.
 
@@ -51,7 +51,7 @@ from OCP.TopoDS import (
 from OCP.TopTools import TopTools_IndexedMapOfShape
 from scipy.spatial import cKDTree
 
-from ..check.joints import (
+from ..continuity.joints import (
     Continuity,
     ContinuityReport,
     Frame,

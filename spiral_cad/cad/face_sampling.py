@@ -52,7 +52,7 @@ from OCP.gp import gp_Pnt, gp_Pnt2d, gp_Vec
 from OCP.TColStd import TColStd_Array1OfReal
 from OCP.TopoDS import TopoDS_Edge, TopoDS_Face
 
-from ..check.joints import norms
+from ..continuity.joints import norms
 from .batch_bspline import bspline_curve_points, bspline_curves
 from .batch_geometry import curve_frame, curve_points
 from .face_projection import KNOT_STEP, FaceDomain, FaceTable, curve_knots, evaluate_on_faces

@@ -72,7 +72,7 @@ from OCP.TopTools import (
     TopTools_ListOfShape,
 )
 
-from ..check.joints import check_tolerances
+from ..continuity.joints import check_tolerances
 from ..core.units import length_unit
 from .face_projection import FaceDomain
 from .face_sampling import FACE_FLOATS, EdgeLine, Line, Tolerances, knot_lines, measures, sample_lines

@@ -25,7 +25,7 @@ from OCP.TopAbs import TopAbs_REVERSED, TopAbs_WIRE
 from OCP.TopExp import TopExp_Explorer
 from OCP.TopoDS import TopoDS, TopoDS_Face, TopoDS_Wire
 
-from ..check.joints import Continuity
+from ..continuity.joints import Continuity
 from ..core.errors import NoSolutionError
 from ..core.inputs import as_float
 from ..core.segments import Arc, Line, Segment

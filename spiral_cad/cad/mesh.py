@@ -32,7 +32,7 @@ from OCP.TopLoc import TopLoc_Location
 from OCP.TopoDS import TopoDS, TopoDS_Shape
 from OCP.TopTools import TopTools_IndexedMapOfShape
 
-from ..check.joints import norms
+from ..continuity.joints import norms
 from ..core.units import length_unit
 from .face_projection import derivatives
 from .occ import as_occ_shape

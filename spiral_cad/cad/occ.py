@@ -37,7 +37,7 @@ from OCP.TColgp import TColgp_Array1OfPnt
 from OCP.TColStd import TColStd_Array1OfInteger, TColStd_Array1OfReal
 from OCP.TopoDS import TopoDS_Compound, TopoDS_Edge, TopoDS_Shape, TopoDS_Vertex, TopoDS_Wire
 
-from ..check.joints import ROUNDING_ULPS, norms
+from ..continuity.joints import ROUNDING_ULPS, norms
 from ..core.kinds import ARC, LINE, SPIRAL
 from ..core.rows import SegmentRows
 from ..core.segments import Segment, row_frames
@@ -278,6 +278,9 @@ def chain_wire(chain: Iterable[Segment], plane: gp_Ax3 | None = None) -> TopoDS_
         make_vertex(vertex, point, vertex_tolerance)
     if closed:
         vertices.append(vertices[0])
+    # a segment that ends where it starts (a whole circle inside the chain) runs from a vertex to itself
+    for i in np.flatnonzero(norms(ends[:, 1] - ends[:, 0]) <= tolerance).tolist():
+        vertices[i + 1] = vertices[i]
     wire = TopoDS_Wire()
     builder.MakeWire(wire)
     for i, ((curve, u0, u1), v0, v1) in enumerate(zip(curves, vertices, vertices[1:])):

@@ -49,7 +49,7 @@ from OCP.TopoDS import TopoDS, TopoDS_Compound, TopoDS_Edge, TopoDS_Iterator, To
 from OCP.TopTools import TopTools_HSequenceOfShape
 from scipy.spatial import cKDTree
 
-from ..check.joints import Continuity
+from ..continuity.joints import Continuity
 from ..core.units import MM_PER_UNIT
 from ..design.g2 import GAP_SHARE
 from ..io.document_report import DocumentReport, PathReport

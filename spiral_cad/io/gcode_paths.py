@@ -27,6 +27,7 @@ from __future__ import annotations
 import math
 import os
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
@@ -35,7 +36,7 @@ from ..core.segments import Arc, Line
 from ..core.units import MM_PER_UNIT, length_unit
 from .toolpath import PLANES, GcodePath, arc_points, arc_sweep
 
-__all__ = ["FOLD_SINE", "PLANE_TOLERANCE", "GcodeMoves", "parse_gcode_moves", "read_gcode_moves"]
+__all__ = ["FOLD_SINE", "PLANE_TOLERANCE", "GcodeMoves", "parse_gcode_moves", "read_gcode_moves", "read_gcode_runs"]
 
 #: A joint where a curve (an arc) meets the next going back along it within this sine of the angle folds back.
 FOLD_SINE = 1e-9
@@ -338,3 +339,53 @@ def _arc(start: list[float], end: list[float], plane: int, ca: float, cb: float,
         axis[normal] = 1.0
         out.append(Arc.in_space(centre * factor, axis, begin * factor, step))
     return out
+
+
+def read_gcode_runs(path: str | os.PathLike, *, units: str | None = None) -> tuple[list[list[Any]], list[list[int]], str, list[str]]:
+    """The exact cutting paths of a G-code file: every run of feed moves between rapids as the curves it
+    states (``parse_gcode_chain``'s: G1 lines, G2/G3 arcs, G5 cubics as spiral pieces), in space and in
+    the program's unit, whether or not they join G2.
+
+    A helical or multi-turn arc parts its run and is counted in the notes (it is no arc of a path).
+
+    Args:
+        path: the program.
+        units: the unit of a program that states neither G20 nor G21 (``"mm"`` or ``"in"``); None refuses one.
+
+    Returns:
+        The runs (lists of segments, in program order), the program line of each segment, the unit and
+        the reader's notes.
+
+    Raises:
+        ValueError: what the built-in reader refuses (naming the line), or no feed move.
+        OSError: the file could not be read.
+    """
+    from .gcode import _piece_segment, _program_text, _read_exact
+    from .toolpath import PLANES
+
+    text, label = _program_text(path)
+    reader = _read_exact(text, label, units)
+    runs: list[list[Any]] = [[]]
+    lines: list[list[int]] = [[]]
+    helical = 0
+    for kind, number, rapid, start, *data in reader.pieces:
+        turning = kind == "arc" and (data[0][PLANES[data[1]][2]] != start[PLANES[data[1]][2]] or abs(data[4]) != 1)
+        if rapid or turning:
+            helical += turning
+            runs.append([])
+            lines.append([])
+            continue
+        try:
+            segments = _piece_segment(kind, start, data, 1.0, 3)
+        except ValueError as error:
+            raise ValueError(f"{label} line {number}: {error}") from None
+        for segment in segments or ():
+            runs[-1].append(segment)
+            lines[-1].append(number)
+    kept = [k for k, run in enumerate(runs) if run]
+    if not kept or reader.units is None:
+        raise ValueError(f"{label}: no feed move (G1, G2, G3, G5) to a new position")
+    notes = list(reader.notes)
+    if helical:
+        notes.append(f"{helical} helical or multi-turn arc(s) left out: each parts its path")
+    return [runs[k] for k in kept], [lines[k] for k in kept], reader.units, notes

@@ -1,7 +1,7 @@
 """Checking OpenDRIVE maps road by road and link by link.
 
 Every road's planView joints (G0/G1/G2, the measures of every checker in
-``spiral_cad.check.joints``), its ``elevation`` and ``superelevation`` in s
+``spiral_cad.continuity.joints``), its ``elevation`` and ``superelevation`` in s
 (C0/C1/C2), and every link between road ends (road links, junction
 connections) measured as a joint — through a junction lane centre to lane
 centre, what a driver follows (``spiral_cad.io.opendrive_lanes``).
@@ -17,7 +17,7 @@ from typing import cast
 import numpy as np
 from numpy.typing import NDArray
 
-from ..check.joints import (
+from ..continuity.joints import (
     Continuity,
     ContinuityReport,
     Frame,
@@ -142,7 +142,7 @@ def check_opendrive(
     and every link between roads (G0/G1/G2), in metres.
 
     Each road is one piece; the measures and tolerances are those of the
-    STEP/IGES checker (``spiral_cad.check.joints``). A profile boundary is
+    STEP/IGES checker (``spiral_cad.continuity.joints``). A profile boundary is
     C0 when the value jumps by at most ``gap_tol`` (elevation, m) or
     ``angle_tol`` (roll angle, rad), C1 when the slope jumps by at most
     ``angle_tol`` too, C2 when the second derivative jumps by at most

@@ -39,7 +39,7 @@ from typing import Any
 
 import numpy as np
 
-from ..check.joints import Continuity, classify_pieces, model_size
+from ..continuity.joints import Continuity, classify_pieces, model_size
 from ..core.chain import Chain
 from ..core.segments import Segment
 from ..design import make_g2

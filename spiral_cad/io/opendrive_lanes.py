@@ -35,7 +35,7 @@ from xml.parsers import expat
 import numpy as np
 from numpy.typing import NDArray
 
-from ..check.joints import Frame
+from ..continuity.joints import Frame
 from .opendrive_read import Geometry, Road, _label, records_at
 
 

@@ -27,7 +27,7 @@ from xml.parsers import expat
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from ..check.joints import Frame
+from ..continuity.joints import Frame
 from ..core.chain import Chain
 from ..core.clothoid import NONE, clothoid_frames, clothoid_method
 from ..core.piecewise import piecewise_at

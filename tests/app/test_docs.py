@@ -99,7 +99,7 @@ def test_the_mathematics_cites_the_paper_and_the_api_pages_render_the_faces():
         "spiral_cad.design",
         "spiral_cad.build123d",
         "spiral_cad.cadquery",
-        "spiral_cad.check",
+        "spiral_cad.continuity",
         "spiral_cad.io",
         "spiral_cad.cad",
         "spiral_cad.app",

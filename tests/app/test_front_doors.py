@@ -31,14 +31,102 @@ def test_build_takes_a_program_or_points_by_their_suffix(tmp_path, capsys):
     assert any((tmp_path / "fit").glob("survey*.step"))
 
 
-@pytest.mark.parametrize(("name", "kind"), [("plate.nc", "a CNC program"), ("road.xml", "a LandXML file")])
-def test_check_names_what_it_judges_and_the_verb_for_other_documents(tmp_path, capsys, name, kind):
-    path = tmp_path / name
-    path.write_text(PROGRAM if name.endswith(".nc") else "x")
+def test_check_judges_a_programs_cutting_paths_run_by_run(tmp_path, capsys):
+    """A CNC program: each run of feed moves between rapids one wire, in program order, in the program's
+    unit. The plunge meets the first cut at a right angle (G0); the cut runs on tangent into a G3 arc of
+    radius 10 (G1: the curvature jumps from 0 to 1/10); the rapid between the runs is not a joint."""
+    path = tmp_path / "plate.nc"
+    path.write_text(PROGRAM.replace("G0 Z1\nM2", "G0 Z1\nG0 X40 Y0\nG1 Z-1\nG2 X40 Y0 I5 J0\nG0 Z1\nM2"))
+    assert main(["check", str(path)]) == 0
+    out = capsys.readouterr().out
+    assert "plate.nc: 2 wires (3, 2 edges); worst joint G0" in out
+    assert "note: wire 0: the moves of program lines 3–5" in out and "note: wire 1: the moves of program lines 8–9" in out
+    rows = [line.split() for line in out.splitlines() if line.startswith("      ")]
+    assert [(row[0], row[-1]) for row in rows] == [("0", "G0"), ("1", "G1"), ("0", "G0")]
+    assert float(rows[0][2]) == pytest.approx(1.5707963, abs=1e-3)  # plunge, then along X (the table's 4 figures)
+    assert float(rows[1][2]) == 0.0 and float(rows[1][4]) == pytest.approx(0.1)  # tangent into the arc of radius 10
+    assert float(rows[2][4]) == pytest.approx(0.2)  # the plunge, then a whole circle of radius 5
+    assert "make_g2: spiral-cad g2 plate.nc -o OUT.nc --max-deviation D" in out
+    assert main(["check", str(path), "--require", "G1"]) == 1
+    assert "2 separate pieces, expected 1" in capsys.readouterr().out
+    circle = tmp_path / "circle.ngc"  # a whole circle at depth, reached by rapids: one closed wire, G2 where it closes
+    circle.write_text("G20\nG0 X0 Y0 Z-0.1\nG2 X0 Y0 I0.5 J0 F10\nG0 Z0.1\nM2\n")
+    assert main(["check", str(circle), "--require", "G2"]) == 0
+    out = capsys.readouterr().out
+    assert "gap 1e-07 in" in out and "closed, 1 joint(s), worst G2" in out and out.splitlines()[-1].startswith("OK: ")
+
+
+@pytest.mark.skipif(
+    __import__("spiral_cad.io.rs274", fromlist=["x"]).rs274_executable() is None,
+    reason="LinuxCNC's rs274 is not installed (Debian: apt-get install linuxcnc-uspace)",
+)
+def test_a_program_the_built_in_reader_refuses_is_read_by_rs274(tmp_path, capsys):
+    """A drilling cycle (G81): LinuxCNC expands it into its feed moves, one cutting path per hole."""
+    path = tmp_path / "drill.ngc"
+    path.write_text("G21 G17 G90\nG0 Z5\nG81 X10 Y0 Z-3 R1 F100\nX20\nX30\nG80\nG0 Z5\nM2\n")
+    assert main(["check", str(path)]) == 0
+    out = capsys.readouterr().out
+    assert "note: read by LinuxCNC's rs274 (the built-in reader refused it: drill.ngc line 3: G81 is refused" in out
+    assert "note: 3 cutting path(s)" in out
+
+
+def test_check_leaves_helical_moves_out_and_says_so(tmp_path, capsys):
+    path = tmp_path / "helix.nc"
+    path.write_text("G21\nG0 X0 Y0 Z1\nG1 X10 Z0 F100\nG2 X10 Y0 Z-2 I-5 J0\nG1 X20\nM2\n")
+    assert main(["check", str(path)]) == 0
+    out = capsys.readouterr().out
+    assert "note: 1 helical or multi-turn arc(s) left out: each parts its path" in out
+    assert "2 wires (1, 1 edges)" in out
+
+
+def test_check_judges_a_landxml_alignment_with_the_files_own_radii(capsys):
+    """Civil 3D's basic road joins lines and arcs without spirals: every joint G1, the curvature after each
+    line the reciprocal of the arc's radius as the file states it (read here with ElementTree)."""
+    path = Path(__file__).parents[1] / "data" / "landxml" / "civil3d_gsg_basic_road.xml"
+    radii = [float(e.get("radius")) for e in ET.parse(path).iter() if e.tag.endswith("}Curve")]
+    assert main(["check", str(path), "--require", "G1"]) == 0
+    out = capsys.readouterr().out
+    rows = [line.split() for line in out.splitlines() if line.startswith("      ")]
+    assert [row[-1] for row in rows] == ["G1"] * 4 and "ft" in out.splitlines()[2]
+    assert len(radii) == 2 and [float(row[4]) for row in rows[::2]] == pytest.approx([1 / r for r in radii], rel=1e-5)
+    spiral = path.with_name("civil3d_spiral_r63.xml")
+    assert main(["check", str(spiral), "--require", "G2"]) == 0
+    assert "note: alignment" in capsys.readouterr().out  # how far the rebuilt spirals are from the file's
+
+
+def test_check_quiet_prints_the_summary_and_the_verdict(tmp_path, capsys):
+    path = tmp_path / "plate.nc"
+    path.write_text(PROGRAM)
+    assert main(["check", str(path), "--quiet", "--require", "G0"]) == 0
+    assert capsys.readouterr().out.splitlines() == ["plate.nc: 1 wire of 3 edges; worst joint G0",
+                                                    "OK: 1 wire of 3 edges, every joint at least G0"]  # fmt: skip
+
+
+def test_the_check_verb_judges_files_and_objects(tmp_path):
+    bd = pytest.importorskip("build123d")
+    program = tmp_path / "plate.nc"
+    program.write_text(PROGRAM)
+    report = sc.check(program)
+    assert report.units == "mm" and len(report.wires) == 1 and report.notes[0].startswith("1 cutting path")
+    assert type(sc.check(bd.fillet(bd.Box(10, 10, 10).edges(), 1))).__name__ == "FaceReport"
+    assert sc.check(line_to_circle((0, 0), (1, 0), (100, 60), 50.0)).min_level.name == "G2"
+    assert sc.check(Chain.join([line_to_circle((0, 0), (1, 0), (100, 60), 50.0)], start=(-20, 0))).units == "mm"
+    roads = Path(__file__).parents[1] / "data" / "esmini_lane_offset_junction.xodr"
+    assert type(sc.check(roads)).__name__ == "OpenDriveReport"
+    with pytest.raises(ValueError, match=r"'plate.nc': check_continuity takes the options gap_tol, .*; got 'feature_angle'"):
+        sc.check(program, feature_angle=5)
+    with pytest.raises(ValueError, match=r"check: expected a Chain, .*; got int"):
+        sc.check(42)
+    with pytest.raises(ValueError, match=r"check: format= names a file's format"):
+        sc.check(Chain.join([line_to_circle((0, 0), (1, 0), (100, 60), 50.0)], start=(-20, 0)), format="step")
+
+
+def test_check_refuses_another_kind_of_file_naming_every_kind_it_judges(tmp_path, capsys):
+    path = tmp_path / "notes.txt"
+    path.write_text("x")
     assert main(["check", str(path)]) == 2
     err = capsys.readouterr().err
-    assert err.startswith(f"error: {name}: check judges STEP/IGES") and ".xodr" in err and "DXF (.dxf)" in err
-    assert f"for {kind}: spiral-cad g2" in err
+    assert err.startswith("error: notes.txt: check judges STEP/IGES") and "LandXML (.xml)" in err and ".ngc" in err
 
 
 def test_check_judges_a_drawing_as_drawn(tmp_path, capsys):
@@ -243,3 +331,28 @@ def test_names_near_the_file_systems_limit_are_written_and_longer_ones_refused(t
     assert sorted(p.name[:1] for p in tmp_path.iterdir()) == ["r"] * 5  # no temporary file left
     with pytest.raises(ValueError, match=r"a file name of 303 bytes; file systems hold at most 255"):
         sc.export(chain, tmp_path / ("r" * 300 + ".nc"))
+
+
+def test_check_takes_the_unit_of_a_program_that_states_none_and_never_relabels_one(tmp_path, capsys):
+    bare = tmp_path / "bare.nc"
+    bare.write_text("G0 X0 Y0\nG1 X10 F100\nM2\n")
+    assert main(["check", str(bare)]) == 2
+    assert "never says G20 (inches) or G21 (mm)" in capsys.readouterr().err
+    assert main(["check", str(bare), "--units", "in", "--require", "G2"]) == 0
+    assert "gap 1e-07 in" in capsys.readouterr().out
+    stated = tmp_path / "stated.nc"
+    stated.write_text(PROGRAM)
+    assert main(["check", str(stated), "--units", "in"]) == 2
+    assert "error: stated.nc states its unit, mm; the unit given (in) would relabel it" in capsys.readouterr().err
+    assert sc.check(bare, units="mm").units == "mm"
+
+
+def test_check_reads_a_program_of_g5_cubics_as_the_curves_it_states(tmp_path, capsys):
+    """Our own LinuxCNC program (spirals as G5 cubics) is judged on its cubics: G2 at every joint."""
+    path = tmp_path / "first.ngc"
+    enter = line_to_circle((0, 0), (1, 0), (100, 60), 50.0)
+    leave = line_to_circle((-20, 120), (1, 0), (100, 60), 50.0).reversed()
+    sc.export(Chain.join([enter, leave], start=(-20, 0), end=(-20, 120), units="mm"), path, feed=800)
+    report = sc.check(path, curvature_tol=1e-4)  # the printed decimals of the cubics
+    assert "G5" in path.read_text() and len(report.wires) == 1 and report.min_level.name == "G2"
+    assert [w.edge_count for w in report.wires] == [5]  # line, spiral, arc, spiral, line

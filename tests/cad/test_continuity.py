@@ -356,7 +356,7 @@ def test_a_g2_highway_at_survey_coordinates_is_g2_and_a_real_kink_there_is_caugh
 
 
 def test_the_rounding_floor_is_capped_so_a_segment_too_small_for_its_coordinates_hides_no_kink(monkeypatch):
-    import spiral_cad.check.joints as joints
+    import spiral_cad.continuity.joints as joints
 
     # a 1 mm spiral at 3e6 m whose start curvature (~1e-3 1/m) is below what rounding can hide there
     x = y = 3e6
@@ -460,7 +460,7 @@ def frame(point=(0.0, 0.0), tangent=(1.0, 0.0), curvature=(0.0, 0.0)):
 
 
 def test_nan_never_passes_and_is_its_own_level():
-    from spiral_cad.check.joints import ContinuityReport, JointReport, WireReport, classify_joint
+    from spiral_cad.continuity.joints import ContinuityReport, JointReport, WireReport, classify_joint
 
     nan, inf = math.nan, math.inf
     grade = lambda a, b: classify_joint(0, a, b, 1e-7, 1e-7, 1e-6, 0.1).level  # noqa: E731
@@ -482,7 +482,7 @@ def test_nan_never_passes_and_is_its_own_level():
 
 
 def test_model_size_names_the_coordinate_it_cannot_measure():
-    from spiral_cad.check.joints import model_size
+    from spiral_cad.continuity.joints import model_size
 
     assert model_size([(0.0, 0.0, 0.0), (3e300, 4e300, 0.0)]) == pytest.approx(5e300)  # no overflow short of the range
     with pytest.raises(ValueError, match=r"f.step: a point of the model is not finite: \(0.0, nan, 0.0\)"):

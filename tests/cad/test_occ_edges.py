@@ -115,6 +115,21 @@ def test_chain_wire_is_valid_and_in_travel_order(name):
     assert np.abs(np.array(starts) - expected).max() <= 1e-12 * chain.size
 
 
+def test_a_whole_circle_inside_a_chain_runs_from_its_vertex_back_to_it():
+    """A program's plunge, a whole circle and a cut away (segments in travel order, not a G2 chain): one
+    valid wire of three edges, the circle's edge closed on one vertex."""
+    plunge = Line((40.0, 0.0, 1.0), (40.0, 0.0, -1.0))
+    circle = Arc.in_space(center=(45.0, 0.0, -1.0), normal=(0.0, 0.0, 1.0), start=(40.0, 0.0, -1.0), sweep=-2 * math.pi)
+    away = Line((40.0, 0.0, -1.0), (30.0, 0.0, -1.0))
+    wire = chain_wire([plunge, circle, away])
+    assert BRepCheck_Analyzer(wire).IsValid()
+    explorer, edges = BRepTools_WireExplorer(wire), []
+    while explorer.More():
+        edges.append(explorer.Current())
+        explorer.Next()
+    assert len(edges) == 3 and BRep_Tool.IsClosed_s(edges[1])
+
+
 def test_bad_inputs_name_the_problem():
     with pytest.raises(ValueError, match="segment must be"):
         segment_edge("not a segment")

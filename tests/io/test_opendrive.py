@@ -416,7 +416,7 @@ def test_any_file_reads_as_verified_chains_or_a_value_error(text):
     import warnings
 
     from spiral_cad import Chain
-    from spiral_cad.check.joints import Continuity
+    from spiral_cad.continuity.joints import Continuity
 
     with tempfile.TemporaryDirectory() as folder:
         path = Path(folder) / "any.xodr"

@@ -214,6 +214,8 @@ class ContinuityReport:
             known, shown as "model units").
         timing: where the check spent its time (STEP/IGES files and shapes;
             ``timing_line()``), or None.
+        notes: what the reader of a drawing, program or LandXML file tells about what was judged
+            (moves or entities left out, how a spiral was rebuilt); not part of the table.
     """
 
     wires: tuple[WireReport, ...]
@@ -226,6 +228,7 @@ class ContinuityReport:
     element: str = "edge"
     units: str = ""
     timing: Timing | None = None
+    notes: tuple[str, ...] = ()
 
     @property
     def joints(self) -> list[JointReport]:

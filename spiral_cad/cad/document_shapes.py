@@ -1,0 +1,159 @@
+"""A CNC program's cutting paths and a LandXML file's alignments as exact OCCT wires, so that the STEP
+checker judges them joint by joint, as it judges a drawing (``dxf_shape``).
+
+A program's feed moves are read as the curves they state (``io.gcode_paths.read_gcode_runs``: G1 lines,
+G2/G3 arcs, G5 cubics; by LinuxCNC's ``rs274`` as lines and arcs where the built-in reader refuses the
+program and rs274 is installed), in the program's unit; every run between two rapids is one wire in program order, so a joint is judged where
+the tool goes on cutting, and never across a rapid. A helical move is not judged: OCCT has no exact
+helix edge (and rs274's chords of one would be kinks of the reading, not of the program); it parts the
+run and is counted in the notes.
+
+A LandXML file's alignments are read as ``read_landxml`` rebuilds them: lines and arcs on the file's
+own carriers, a spiral as the cubic that follows its clothoid (how far, the notes say). Each alignment
+is one wire where its elements meet, else one wire per part; the joints where the file's curvature
+jumps are judged as they are drawn.
+"""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from OCP.BRep import BRep_Builder
+from OCP.TopoDS import TopoDS_Compound
+
+from .occ import chain_wire
+
+__all__ = ["document_shape", "landxml_shape", "program_shape"]
+
+#: The chords a helical move is read as are left out, so any tolerance serves (the program's unit).
+_HELIX_CHORDS = 1e-3
+#: How many cutting paths are named by their program lines.
+_LISTED = 50
+
+
+def document_shape(path: str | os.PathLike, *, units: str | None = None) -> tuple[TopoDS_Compound, str, list[str]]:
+    """The curves of a DXF drawing (``dxf_shape``), a LandXML file (``landxml_shape``) or a G-code program
+    (``program_shape``), chosen by the suffix: the compound, its unit and the notes.
+
+    Args:
+        path: the file.
+        units: the unit of a file that states none (a program without G20/G21: ``"mm"`` or ``"in"``; a
+            drawing without ``$INSUNITS``); a file that states another is refused, never relabelled.
+
+    Raises:
+        ValueError: another suffix, a ``units`` the file contradicts, or what the chosen reader refuses.
+    """
+    from ..core.units import length_unit
+    from ..io.gcode import SUFFIXES
+
+    suffix = Path(path).suffix.lower()
+    if suffix in SUFFIXES:
+        shape, found, notes = program_shape(path, units=units)
+    elif suffix == ".dxf":
+        from .dxf_shape import DRAWING_UNITS, dxf_shape
+
+        shape, found, notes = dxf_shape(path)
+        if found == DRAWING_UNITS and units is not None:
+            return shape, length_unit(units), [*notes, f"the drawing states no unit ($INSUNITS): read in {length_unit(units)} as stated"]
+    elif suffix == ".xml":
+        shape, found, notes = landxml_shape(path)
+    else:
+        raise ValueError(f"{Path(path).name}: a drawing (.dxf), a LandXML file (.xml) or a G-code program ({' '.join(SUFFIXES)}) "
+                         f"was expected; got {suffix or 'no suffix'!r}")  # fmt: skip
+    if units is not None and length_unit(units) != found:
+        raise ValueError(f"{Path(path).name} states its unit, {found}; the unit given ({units}) would relabel it: leave it out")
+    return shape, found, notes
+
+
+def _compound(paths: list[list[Any]]) -> TopoDS_Compound:
+    compound, builder = TopoDS_Compound(), BRep_Builder()
+    builder.MakeCompound(compound)
+    for segments in paths:
+        builder.Add(compound, chain_wire(segments))
+    return compound
+
+
+def program_shape(path: str | os.PathLike, *, units: str | None = None) -> tuple[TopoDS_Compound, str, list[str]]:
+    """The cutting paths of the G-code program ``path`` (each run of feed moves between rapids one wire),
+    their unit and notes for the reader (moves left out, what the reader noted).
+
+    Args:
+        path: the program.
+        units: the unit of a program that states neither G20 nor G21 (``read_gcode_moves``'s ``program_units``).
+
+    Raises:
+        ValueError: a program the reader refuses (naming the line), or one without a feed move.
+    """
+    from ..io.gcode_paths import read_gcode_moves, read_gcode_runs
+    from ..io.rs274 import rs274_executable
+
+    name = Path(path).name
+    try:
+        runs, lines, unit, notes = read_gcode_runs(path, units=units)
+    except ValueError as refused:
+        if rs274_executable() is None:
+            raise ValueError(f"{refused}; LinuxCNC's rs274, which reads more programs, is not installed") from None
+        try:
+            moves = read_gcode_moves(path, interpreter="rs274", program_units=units, helix_tolerance=_HELIX_CHORDS)
+        except ValueError as also:
+            raise ValueError(f"{refused}; LinuxCNC's rs274 did not read it either: {also}") from None
+        chords = moves.chords if moves.chords is not None else np.zeros(len(moves), dtype=bool)
+        runs, lines = [[]], [[]]
+        for segment, line, cut in zip(moves.segments, moves.lines.tolist(), (~moves.rapid & ~chords).tolist()):
+            if cut:
+                runs[-1].append(segment)
+                lines[-1].append(line)
+            elif runs[-1]:
+                runs.append([])
+                lines.append([])
+        runs, lines = [run for run in runs if run], [numbers for numbers in lines if numbers]
+        if not runs:
+            raise ValueError(f"{name}: the program has no feed move (G1, G2, G3) to judge") from None
+        unit = moves.units
+        notes = [f"read by LinuxCNC's rs274 (the built-in reader refused it: {refused})", *moves.notes]
+        if chords.any():
+            notes.append(f"{len({int(k) for k in moves.lines[chords].tolist()})} helical move(s) left out: each parts its path")
+    notes.append(f"{len(runs)} cutting path(s): each run of feed moves between rapids, in program order; rapids are not judged")
+    notes += [f"wire {k}: the moves of program lines {numbers[0]}–{numbers[-1]}" for k, numbers in enumerate(lines[:_LISTED])]
+    if len(lines) > _LISTED:
+        notes.append(f"… and {len(lines) - _LISTED} more cutting paths")
+    return _compound(runs), unit, notes
+
+
+def landxml_shape(path: str | os.PathLike) -> tuple[TopoDS_Compound, str, list[str]]:
+    """The horizontal alignments of the LandXML file ``path`` as wires (one per alignment where its
+    elements meet), their unit and notes for the reader (how far each rebuilt spiral is from the file's
+    clothoid, where the elements part).
+
+    Raises:
+        ValueError: a file ``read_landxml`` refuses, or one without an alignment.
+    """
+    from ..io.landxml_read import read_landxml
+
+    alignments = read_landxml(path)
+    name = Path(path).name
+    if not alignments:
+        raise ValueError(f"{name}: the file holds no alignment")
+    paths: list[list[Any]] = []
+    notes: list[str] = []
+    for alignment in alignments:
+        first = len(paths)
+        for chain in alignment.chains:
+            segments = list(chain)
+            if len(paths) > first and _meet(paths[-1][-1], segments[0], chain.size):
+                paths[-1] += segments
+            else:
+                paths.append(segments)
+        if "Spiral" in alignment.kinds:
+            notes.append(f"alignment {alignment.name!r}: spirals judged as rebuilt cubics; the largest offset from the "
+                         f"file's elements is at {alignment.worst}")  # fmt: skip
+        notes += [f"alignment {alignment.name!r}: {why}" for why in alignment.breaks if "gap" in why]
+    notes.append("horizontal alignments judged; profiles (ProfAlign) are not")
+    return _compound(paths), alignments[0].units, notes
+
+
+def _meet(before: Any, after: Any, size: float) -> bool:
+    return float(np.linalg.norm(np.asarray(before.end, dtype=float) - np.asarray(after.start, dtype=float))) <= 1e-9 * max(size, 1.0)
