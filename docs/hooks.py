@@ -9,7 +9,7 @@
 - MathJax is copied from the ``django-static-mathjax`` package into the site,
   so the mathematics renders with no network.
 - ``SPIRAL_CAD_DOCS_SKIP_API`` (names separated by commas, e.g.
-  ``check,io,cad,app``) leaves those API pages' ``:::`` directives out, for
+  ``continuity,io,cad,app``) leaves those API pages' ``:::`` directives out, for
   builds of a checkout whose package does not have those faces yet.
 """
 

@@ -15,7 +15,8 @@ compiles at ``seal()``. Until then nothing imports numba, so
 whose globals hold the other copies. The scalar API uses it while the kernels
 are not compiled in this process (a first call answers in microseconds rather
 than waiting seconds for a compiler), then compiles them once a process has
-made ``SCALAR_CALLS_BEFORE_COMPILING`` scalar calls. One source, one formula:
+made ``SCALAR_CALLS_BEFORE_COMPILING`` scalar calls (before that, a kernel already compiled for
+another call is used as it is). One source, one formula:
 the two differ only in who executes it. Nothing else runs a kernel as plain
 Python: an array call through a stand-in compiles first.
 """
@@ -30,7 +31,7 @@ from typing import Any, TypeVar, cast
 
 import numpy as np
 
-__all__ = ["Kernels", "REGISTRIES", "SCALAR_CALLS_BEFORE_COMPILING"]
+__all__ = ["COMPILING", "Kernels", "REGISTRIES", "SCALAR_CALLS_BEFORE_COMPILING"]
 
 #: A kernel function: the decorators return it unchanged, signature included.
 F = TypeVar("F", bound=Callable[..., Any])
@@ -108,6 +109,7 @@ class Kernels:
                 return
             from numba import njit
 
+            _announce_compiling()
             for registry in REGISTRIES:
                 if registry.sealed and not registry.compiled:
                     registry._make_dispatchers(njit)
@@ -140,18 +142,52 @@ class Kernels:
         return _Python(self)
 
     def for_scalar_call(self) -> Any:
-        """The kernels a scalar call should use: compiled ones once this process has them, else plain Python.
+        """The kernels a scalar call should use: a kernel this process has compiled code for (or loaded
+        from numba's cache) as it is, any other as plain Python.
 
         A process that keeps making scalar calls compiles them after
         ``SCALAR_CALLS_BEFORE_COMPILING`` calls (once; numba's cache makes
-        that cheap in the next process).
+        that cheap in the next process). Until then a scalar call never waits for a compiler, even
+        after another kernel was compiled for an array call (a solver row takes seconds to compile).
         """
-        if not self.compiled:
+        if self.scalar_calls < SCALAR_CALLS_BEFORE_COMPILING:
             self.scalar_calls += 1
-            if self.scalar_calls <= SCALAR_CALLS_BEFORE_COMPILING:
-                return _Python(self)
-            self.compile()
+            return _Python(self) if not self.compiled else _Ready(self)
+        self.compile()
         return _Compiled(self.namespace)
+
+
+#: The line a person at a terminal reads while the first kernels compile (measured: ``benchmarks/bench_cold.py``).
+COMPILING = ("spiral_cad: compiling the curve kernels for this machine (first run only; numba caches them): "
+             "about 3 s for a first curve or fillet, 15 s for the batch solvers")  # fmt: skip
+_announcing = False
+
+
+def _announce_compiling() -> None:
+    """Print ``COMPILING`` once, on a terminal's stderr, when numba first compiles one of our kernels (a
+    kernel loaded from numba's cache compiles nothing and says nothing; a pipe or a test hears nothing)."""
+    global _announcing
+    if _announcing:
+        return
+    _announcing = True
+    import sys
+
+    from numba.core import event
+
+    class Announce(event.Listener):
+        said = False
+
+        def on_start(self, found: Any) -> None:
+            dispatcher = found.data.get("dispatcher") if isinstance(found.data, dict) else None
+            module = getattr(getattr(dispatcher, "py_func", None), "__module__", "") or ""
+            if not self.said and module.startswith("spiral_cad.") and sys.stderr.isatty():
+                self.said = True
+                print(COMPILING, file=sys.stderr, flush=True)
+
+        def on_end(self, found: Any) -> None:
+            return None
+
+    event.register("numba:compile", Announce())  # type: ignore[no-untyped-call]
 
 
 def _float_semantics(name: str) -> Callable[..., Any]:
@@ -258,6 +294,19 @@ class _Uncompiled:
 
     def __repr__(self) -> str:
         return f"<kernel {self._kernels.module}.{self.__name__}, not compiled yet>"
+
+
+class _Ready(_Python):
+    """The kernels that hold compiled code, and the plain-Python copy of any other."""
+
+    __slots__ = ()
+
+    def __getattr__(self, name: str) -> Callable[..., Any]:
+        dispatcher = self._kernels.namespace[name]
+        if getattr(dispatcher, "signatures", None):
+            found: Callable[..., Any] = dispatcher
+            return found
+        return super().__getattr__(name)
 
 
 class _Compiled:

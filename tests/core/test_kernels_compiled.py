@@ -3,7 +3,8 @@
 Every module that declares numba kernels has its own ``Kernels`` (``spiral_cad.core.jit``); once a
 process compiles, each kernel's name in the module that declared it holds a numba dispatcher, so
 that module's own Python code and every kernel calling it run compiled code. The plain-Python copies
-(``Kernels.python``) serve the scalar API alone, until its process compiles.
+(``Kernels.python``) serve the scalar API alone: a kernel without compiled code in its process, until
+the process has made its budget of scalar calls.
 
 Each check runs in a fresh interpreter: what is compiled is a property of a process.
 """
@@ -23,7 +24,7 @@ PRELUDE = """
 import importlib, pkgutil, sys
 import spiral_cad
 from spiral_cad.core import jit as kernels_jit
-for package in ("core", "design", "check", "io"):
+for package in ("core", "design", "continuity", "io"):
     root = importlib.import_module(f"spiral_cad.{package}")
     for info in pkgutil.walk_packages(root.__path__, root.__name__ + "."):
         importlib.import_module(info.name)
@@ -130,3 +131,64 @@ def test_the_scalar_api_compiles_after_its_budget_of_plain_python_calls():
         assert all(r.compiled for r in registries.values())
         assert isinstance(K.line_to_circle_row, CPUDispatcher)
     """)
+
+
+def test_a_scalar_call_after_an_array_call_runs_plain_python_rather_than_wait_for_its_kernel():
+    """A batch call compiles the kernels it reaches; a scalar call after it uses those, and the plain-Python
+    copy of a solver row nothing has compiled (seconds of compiling saved: the first g2_fillet's case)."""
+    run("""
+        import numpy as np
+        from spiral_cad import line_to_circle
+        from spiral_cad.core import _kernels as K
+        from spiral_cad.design import round_corners_batch
+
+        rng = np.random.default_rng(3)
+        points = np.cumsum(rng.uniform(-1, 1, (50, 3)), axis=0)
+        round_corners_batch(points[:-2], points[1:-1], points[2:])
+        assert K.KERNELS.compiled and not K.line_to_circle_row.signatures
+        plain = line_to_circle((0, 0), (1, 0), (10, 5), 3)
+        assert not K.line_to_circle_row.signatures
+        from spiral_cad.core.jit import SCALAR_CALLS_BEFORE_COMPILING
+        for _ in range(SCALAR_CALLS_BEFORE_COMPILING):
+            compiled = line_to_circle((0, 0), (1, 0), (10, 5), 3)
+        assert K.line_to_circle_row.signatures
+        a, b = plain.spirals[0].control_points, compiled.spirals[0].control_points
+        assert np.abs(np.asarray(a) - np.asarray(b)).max() <= 1e-12 * 10
+    """)
+
+
+def test_a_person_at_a_terminal_is_told_once_that_the_kernels_compile_and_a_pipe_is_not(tmp_path):
+    """With numba's cache empty, a first curve prints ``COMPILING`` once on a terminal's stderr; on a pipe,
+    or with the cache filled, nothing."""
+    import os
+    import pty
+
+    from spiral_cad.core.jit import COMPILING
+
+    code = ("import spiral_cad as sc, numpy as np; sc.batch.line_to_circle(np.zeros((3, 2)), np.tile([1.0, 0.0], (3, 1)), "
+            "np.tile([10.0, 5.0], (3, 1)), np.full(3, 3.0))")  # fmt: skip
+    env = {**os.environ, "NUMBA_CACHE_DIR": str(tmp_path / "cache")}
+
+    def on_terminal() -> str:
+        leader, follower = pty.openpty()
+        done = subprocess.run([sys.executable, "-c", code], stderr=follower, stdout=subprocess.DEVNULL, env=env, timeout=600)
+        os.close(follower)
+        said = b""
+        while True:
+            try:
+                chunk = os.read(leader, 4096)
+            except OSError:
+                break
+            if not chunk:
+                break
+            said += chunk
+        os.close(leader)
+        assert done.returncode == 0, said
+        return said.decode()
+
+    first = on_terminal()
+    assert first.count(COMPILING) == 1, first
+    assert COMPILING not in on_terminal()  # the cache is filled now
+    env["NUMBA_CACHE_DIR"] = str(tmp_path / "other")
+    piped = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, env=env, timeout=600)
+    assert piped.returncode == 0 and COMPILING not in piped.stderr
