@@ -47,6 +47,7 @@ MEASURES = (
     "spiral_cad.io.toolpath",
     "spiral_cad.io.gcode_write",
     "spiral_cad.design.rounding",
+    "spiral_cad.design.rounded_paths",
     "spiral_cad.core.space",
     "spiral_cad.core.chain",
     "spiral_cad.app.designfile",

@@ -34,6 +34,7 @@ from timing import arguments, code_stamp, load, machine, median_time
 #: The modules whose code these numbers measure (stamped into the results: ``timing.code_stamp``).
 MEASURES = (
     "spiral_cad.design.rounding",
+    "spiral_cad.design.rounded_paths",
     "spiral_cad.core.space",
     "spiral_cad.core._chain_kernels",
     "spiral_cad.io.gcode",

@@ -17,6 +17,7 @@ from spiral_cad.design import corner_legs, round_corners_batch
 #: The modules whose code these numbers measure (stamped into the results: ``timing.code_stamp``).
 MEASURES = (
     "spiral_cad.design.rounding",
+    "spiral_cad.design.rounded_paths",
     "spiral_cad.core.space",
     "spiral_cad.core._chain_kernels",
     "spiral_cad.core._kernels",

@@ -57,7 +57,7 @@ from .core.segments import Segment
 from .core.shapes import DEFAULT_SHAPE
 from .core.transitions import Transition, circle_in_circle, circle_to_circle, line_to_circle, line_to_line
 from .design.fillets import continuous_polygon, continuous_rectangle, continuous_slot
-from .design.rounding import curvature_bound, round_corners
+from .design.rounded_paths import curvature_bound, round_corners
 
 if TYPE_CHECKING:
     from cadquery.sketch import Modes

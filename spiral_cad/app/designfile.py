@@ -319,7 +319,7 @@ def _rounded(d: RoundedPolylineDesign, where: str, units: str, base: Path | None
             from .gcode_build import toolpath_designs
 
             return toolpath_designs(d, where, units, program)
-        from ..design.rounding import RoundedPath  # G5: the program states its curves (our own output reads back as its chain)
+        from ..design.rounded_paths import RoundedPath  # G5: the program states its curves (our own output reads back as its chain)
 
         result = RoundedPath(read_gcode_chain(program, units=units), [], d.shape)
         feed = program_feed(*program_feeds(program), units)

@@ -64,7 +64,7 @@ def toolpath_designs(d: RoundedPolylineDesign, where: str, units: str, program: 
         bound = None if deviation is None else deviation - (helix or 0.0) * chorded
         if stop - first == 1 and moves.straight(first, stop):  # one move between folds: a line, nothing to round
             from ..core.chain import Chain
-            from ..design.rounding import RoundedPath
+            from ..design.rounded_paths import RoundedPath
 
             chain = Chain([moves.segments[first]], units=units)
             made.append((chain, RoundedPath(chain, [], d.shape), moves.feeds[first : first + 1] * moves_to_units * to_program))

@@ -12,17 +12,8 @@ from .criteria import CriteriaRow, RailCriteria, RoadCriteria
 from .fillets import FilletCorner, FilletedPath, fillet_path
 from .g2 import G2Joint, G2Path, make_g2, smallest_max_deviation
 from .profile import Profile, ProfileCriteria, VerticalCurve
-from .rounding import (
-    CornerBatch,
-    FilletedPolyline,
-    RoundedCorner,
-    RoundedPath,
-    SpaceFillet,
-    corner_legs,
-    fillet_polyline,
-    round_corners,
-    round_corners_batch,
-)
+from .rounded_paths import FilletedPolyline, RoundedCorner, RoundedPath, SpaceFillet, fillet_polyline, round_corners
+from .rounding import CornerBatch, corner_legs, round_corners_batch
 from .superelevation import Superelevation
 from .survey import SurveyFit, fit_survey
 

@@ -15,7 +15,7 @@ from .progress import ticking
 from .toolpath import GcodePath
 
 if TYPE_CHECKING:
-    from ..design.rounding import RoundedPath
+    from ..design.rounded_paths import RoundedPath
 
 __all__ = ["OCCT_CONFUSION", "ToolpathCorners", "round_toolpath", "round_toolpath_arrays", "segment_feeds", "segment_lines"]
 
@@ -67,7 +67,7 @@ def round_toolpath(path: GcodePath, *, for_occt: bool = True, **options) -> Roun
     Raises:
         ValueError, NoSolutionError: as ``round_corners``, with the line.
     """
-    from ..design.rounding import round_corners
+    from ..design.rounded_paths import round_corners
 
     if "units" in options:
         raise ValueError("units: the program's own (G20/G21); convert the path with GcodePath.in_units first")

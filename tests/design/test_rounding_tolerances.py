@@ -18,7 +18,8 @@ from hypothesis import HealthCheck, event, given, settings
 from hypothesis import strategies as st
 
 from spiral_cad.core.errors import NoSolutionError
-from spiral_cad.design.rounding import round_corners, round_corners_batch
+from spiral_cad.design.rounded_paths import round_corners
+from spiral_cad.design.rounding import round_corners_batch
 
 
 def _path_distance(chain, point: np.ndarray) -> float:
