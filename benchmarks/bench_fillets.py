@@ -27,7 +27,13 @@ from spiral_cad import NoSolutionError
 from spiral_cad.build123d import g2_fillet
 
 #: The modules whose code these numbers measure (stamped into the results: ``timing.code_stamp``).
-MEASURES = ("spiral_cad.build123d", "spiral_cad.cad.fillet")
+MEASURES = (
+    "spiral_cad.build123d",
+    "spiral_cad.build123d._lines",
+    "spiral_cad.build123d._parts",
+    "spiral_cad.build123d._sketches",
+    "spiral_cad.cad.fillet",
+)
 
 
 def zigzag_face(corners: int) -> tuple[bd.Face, float]:

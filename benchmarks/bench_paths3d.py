@@ -41,6 +41,9 @@ MEASURES = (
     "spiral_cad.io.toolpath_rounding",
     "spiral_cad.cad.export",
     "spiral_cad.build123d",
+    "spiral_cad.build123d._lines",
+    "spiral_cad.build123d._parts",
+    "spiral_cad.build123d._sketches",
 )
 
 SIZES = {"corners": 1_000_000, "moves": 100_000, "handrail": 1_000, "scalar": 2_000}

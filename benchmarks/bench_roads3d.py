@@ -32,7 +32,15 @@ from spiral_cad.design import Alignment, Profile
 from spiral_cad.io.opendrive import read_opendrive
 
 #: The modules whose code these numbers measure (stamped into the results: ``timing.code_stamp``).
-MEASURES = ("spiral_cad.design.alignment", "spiral_cad.design.profile", "spiral_cad.build123d", "spiral_cad.io.opendrive")
+MEASURES = (
+    "spiral_cad.design.alignment",
+    "spiral_cad.design.profile",
+    "spiral_cad.build123d",
+    "spiral_cad.build123d._lines",
+    "spiral_cad.build123d._parts",
+    "spiral_cad.build123d._sketches",
+    "spiral_cad.io.opendrive",
+)
 
 
 def zigzag_alignment(count: int, spacing: float = 1000.0, offset: float = 250.0, speed: float = 80.0) -> Alignment:

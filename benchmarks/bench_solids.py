@@ -33,7 +33,7 @@ from spiral_cad.app.gallery import GALLERY
 from spiral_cad.build123d import ContinuousBox, g2_fillet, g2_slab
 
 #: The modules whose code these numbers measure (stamped into the results: ``timing.code_stamp``).
-MEASURES = ("spiral_cad.build123d", "spiral_cad.cad.slabs", "spiral_cad.cad.roll_surfaces", "spiral_cad.cad.stacks",
+MEASURES = ("spiral_cad.build123d", "spiral_cad.build123d._lines", "spiral_cad.build123d._parts", "spiral_cad.build123d._sketches", "spiral_cad.cad.slabs", "spiral_cad.cad.roll_surfaces", "spiral_cad.cad.stacks",
             "spiral_cad.cad.stack_fillet", "spiral_cad.cad.prism_fillet")  # fmt: skip
 
 #: The steps shared by slabs and 2.5-D parts, by the module and function doing each (timed there).
