@@ -25,19 +25,20 @@ from .core.transitions import Transition, circle_in_circle, circle_to_circle, li
 if TYPE_CHECKING:
     from .app.files import check, export, read
 
+#: ``Circle``, ``Line`` and ``Transition`` are ours here too (``sc.Line``, ``from spiral_cad import Line``) but
+#: stay out of ``from spiral_cad import *``: build123d has its own of those names, with other meanings.
+SHADOWING = ("Circle", "Line", "Transition")
+
 __all__ = [
     "Arc",
     "BezierSpiral",
     "Chain",
-    "Circle",
     "Join",
-    "Line",
     "NoSolutionError",
     "PlaneFrame",
     "PointFit",
     "Segment",
     "Status",
-    "Transition",
     "batch",
     "check",
     "circle_in_circle",

@@ -1,4 +1,5 @@
-"""The documentation site: every Python block of its pages runs, every name it gives exists, and it builds and opens.
+"""The documentation site: every Python block of its pages runs, every name, file and command-line option
+it gives exists (the README's too), and it builds and opens.
 
 Each page's ``python`` blocks run top to bottom in one fresh namespace (a
 page is read like one Python session), in a subprocess whose working folder
@@ -291,3 +292,73 @@ def test_the_results_page_gathers_every_benchmark_table():
     for path in (ROOT / "benchmarks").glob("results_*.md"):
         title = path.read_text(encoding="utf-8").splitlines()[0].lstrip("# ")
         assert f"## {title}" in text, path.name
+
+
+README = ROOT / "README.md"
+#: Folders of the repository a page may name a file in (`examples/design.json`).
+_FOLDERS = ("examples", "benchmarks", "docs", "tests", "spiral_cad", "tools")
+
+
+def _texts() -> list[tuple[str, str]]:
+    return [(rel(page), page.read_text(encoding="utf-8")) for page in [*PAGES, README]]
+
+
+def _cli_options() -> dict[str, set[str]]:
+    """Each ``spiral-cad`` command and the options it takes (the parser's own; ``""``: the program's)."""
+    import argparse
+
+    from spiral_cad.app.cli import _parser
+
+    parser = _parser()
+    options = {"": {s for a in parser._actions for s in a.option_strings}}
+    for action in parser._actions:
+        if isinstance(action, argparse._SubParsersAction):
+            for verb, sub in action.choices.items():
+                options[verb] = {s for a in sub._actions for s in a.option_strings}
+    return options
+
+
+def _commands() -> list[tuple[str, str, str]]:
+    """(page, command, option) for every ``--option`` written after ``spiral-cad COMMAND`` on one line."""
+    found = set()
+    for page, text in _texts():
+        for line in text.splitlines():
+            for match in re.finditer(r"spiral-cad ((?:\w|\|)+)([^`\n]*)", line):
+                for verb in match[1].split("|"):
+                    for option in re.findall(r"(?<![\w-])(--[a-z][\w-]*)", match[2].split("spiral-cad ")[0]):
+                        found.add((page, verb, option))
+    return sorted(found)
+
+
+@pytest.mark.parametrize(("page", "verb", "option"), _commands(), ids=lambda x: x)
+def test_every_option_a_page_gives_a_command_is_one_it_takes(page, verb, option):
+    options = _cli_options()
+    assert verb in options, f"{page}: spiral-cad has no command {verb!r}"
+    assert option in options[verb] | options[""], f"{page}: spiral-cad {verb} takes no {option}"
+
+
+def _files() -> list[tuple[str, str]]:
+    found = set()
+    for page, text in _texts():
+        for path in re.findall(rf"`((?:{'|'.join(_FOLDERS)})/[\w./-]*\w)`", text):
+            found.add((page, path))
+    return sorted(found)
+
+
+@pytest.mark.parametrize(("page", "path"), _files(), ids=lambda x: x)
+def test_every_file_a_page_names_exists(page, path):
+    assert (ROOT / path).exists(), f"{page}: {path} does not exist"
+
+
+@pytest.mark.parametrize("dotted", sorted(set(re.findall(r"`(spiral_cad(?:\.\w+)+)", README.read_text(encoding="utf-8")))))
+def test_every_dotted_name_in_the_readme_exists(dotted):
+    problem = unresolved(dotted)
+    assert problem is None, f"README.md: {problem}"
+
+
+def test_the_name_checks_catch_what_does_not_exist(tmp_path):
+    """The extractors find a wrong option, a missing file and a wrong name (so that a rename is caught)."""
+    assert "--max-deviation" in _cli_options()["g2"] and "--g3" not in _cli_options()["check"]
+    assert unresolved("spiral_cad.design.no_such_function") is not None
+    assert any(path == "examples/design.json" for _, path in _files())
+    assert any(verb == "check" and option == "--require" for _, verb, option in _commands())

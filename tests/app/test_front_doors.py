@@ -356,3 +356,18 @@ def test_check_reads_a_program_of_g5_cubics_as_the_curves_it_states(tmp_path, ca
     report = sc.check(path, curvature_tol=1e-4)  # the printed decimals of the cubics
     assert "G5" in path.read_text() and len(report.wires) == 1 and report.min_level.name == "G2"
     assert [w.edge_count for w in report.wires] == [5]  # line, spiral, arc, spiral, line
+
+
+def test_a_star_import_after_build123ds_keeps_build123ds_names():
+    """``from build123d import *; from spiral_cad import *``: build123d's Circle, Line and Transition stay
+    build123d's, and no name the star import brings is one build123d or CadQuery means otherwise."""
+    build123d = pytest.importorskip("build123d")
+    cadquery = pytest.importorskip("cadquery")
+    scope: dict = {}
+    exec("from build123d import *\nfrom spiral_cad import *", scope)
+    assert scope["Circle"] is build123d.Circle and scope["Line"] is build123d.Line and scope["Transition"] is build123d.Transition
+    assert scope["Circle"](5).area == pytest.approx(78.5398, rel=1e-5)
+    theirs = set(dir(build123d)) | set(getattr(cadquery, "__all__", dir(cadquery)))
+    assert not set(sc.__all__) & theirs, set(sc.__all__) & theirs
+    assert {name: getattr(sc, name).__module__ for name in sc.SHADOWING} == {
+        "Circle": "spiral_cad.core.segments", "Line": "spiral_cad.core.segments", "Transition": "spiral_cad.core.transitions"}  # fmt: skip
