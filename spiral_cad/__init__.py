@@ -17,10 +17,13 @@ from .core import batch
 from .core.chain import Chain
 from .core.errors import NoSolutionError, Status
 from .core.fit import PointFit, fit_points
-from .core.segments import Arc, Circle, Join, Line, Segment
+from .core.segments import Arc, Join, Segment
+from .core.segments import Circle as Circle  # out of the star import: SHADOWING
+from .core.segments import Line as Line
 from .core.space import PlaneFrame
 from .core.spiral import BezierSpiral
-from .core.transitions import Transition, circle_in_circle, circle_to_circle, line_to_circle, line_to_line
+from .core.transitions import Transition as Transition
+from .core.transitions import circle_in_circle, circle_to_circle, line_to_circle, line_to_line
 
 if TYPE_CHECKING:
     from .app.files import check, export, read
