@@ -452,7 +452,7 @@ def _parser() -> argparse.ArgumentParser:
         "the G2 program at the program's feed (never over the input). Lines stay lines and arcs (G2/G3, any plane)\n"
         "true arcs; the path is split where it folds straight back (a plunge and its retract): one design NAME_1,\n"
         "NAME_2, ... per G2 path. A program with G5 splines is read as the exact path it states; other codes are\n"
-        "refused by name and line (README: the G-code subset)")  # fmt: skip
+        "refused by name and line (the G-code subset: docs/tutorials/paths.md, G-code in)")  # fmt: skip
     gcode.add_argument("--from-gcode", metavar="FILE.nc", help="the program to round (instead of a design file)")
     gcode.add_argument("--max-deviation", type=float, metavar="D",
                        help="the largest distance between the input's path and the G2 path, in its unit: a program's (at "

@@ -362,3 +362,19 @@ def test_the_name_checks_catch_what_does_not_exist(tmp_path):
     assert unresolved("spiral_cad.design.no_such_function") is not None
     assert any(path == "examples/design.json" for _, path in _files())
     assert any(verb == "check" and option == "--require" for _, verb, option in _commands())
+
+
+def test_every_page_the_command_lines_help_names_exists():
+    import argparse
+
+    from spiral_cad.app.cli import _parser
+
+    parser = _parser()
+    helps = [parser.format_help()]
+    for action in parser._actions:
+        if isinstance(action, argparse._SubParsersAction):
+            helps += [sub.format_help() for sub in action.choices.values()]
+    named = set(re.findall(r"(docs/[\w/.-]+\.md|README\.md|examples/[\w.-]+)", " ".join(helps).replace("\n", " ")))
+    assert "docs/tutorials/paths.md" in named
+    assert all((ROOT / path).exists() for path in named), sorted(p for p in named if not (ROOT / p).exists())
+    assert "README: " not in " ".join(helps)  # a README section the README does not have
