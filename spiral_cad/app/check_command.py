@@ -55,7 +55,8 @@ def check_file(args: argparse.Namespace) -> int:
         if args.zebra or args.curvature_map:
             print(f"error: --zebra and --curvature-map draw faces; {_DOCUMENTS[suffix]} holds curves", file=sys.stderr)
             return 2
-        _wire_tolerances(args)
+        if suffix != ".xml":  # a LandXML file's default tolerances come from its printed decimals
+            _wire_tolerances(args)
         return _check_document(args)
     from ..cad.faces import holds_faces
 
@@ -116,8 +117,8 @@ def _check_document(args: argparse.Namespace) -> int:
     from .files import check
 
     name, suffix = Path(args.file).name, Path(args.file).suffix.lower()
-    report = check(args.file, gap_tol=args.gap_tol, angle_tol=args.angle_tol, curvature_tol=args.curvature_tol, snap=args.snap,
-                   units=args.units)  # fmt: skip
+    given = {k: v for k in ("gap_tol", "angle_tol", "curvature_tol", "snap", "units") if (v := getattr(args, k)) is not None}
+    report = check(args.file, **given)
     for note in [] if args.quiet else report.notes:
         print(f"note: {note}")
     if args.comb:
@@ -233,7 +234,7 @@ def add_check(sub: argparse._SubParsersAction) -> None:
         description="Report G0/G1/G2 continuity at every joint, in the unit the file declares; a STEP/IGES file that holds "
         "faces is judged face to face at every edge they share (sharp features listed, not failed). A DXF drawing's curves "
         "(lines, arcs, circles, ellipses, splines, polylines, blocks) are judged as drawn, chained by their ends. A LandXML file's alignments are judged as "
-        "rebuilt (lines and arcs exact, spirals as cubics within the offset noted). A CNC program's cutting paths are judged "
+        "stated: each element's ends, directions and radii, so a kink or a radius that differs from its neighbour's shows. A CNC program's cutting paths are judged "
         "run by run between rapids (helical moves left out). An OpenDRIVE file is judged road by road (its planView, its elevation and superelevation in s) and link by link. Exit status: 0 ok, "
         "1 below --require, --profiles or --links (or not --pieces pieces), 2 unreadable file or bad option, "
         "141 output pipe closed early.",

@@ -17,9 +17,9 @@ points     .csv .txt .xyz (read)           —                                  
 =========  ==============================  ======================================  ===================================
 
 ``check`` judges STEP/IGES (face to face where the file holds faces: ``cad.faces.check_faces``, else its
-curves: ``cad.continuity.check_continuity``), DXF, LandXML and G-code (their curves as drawn, rebuilt or
-programmed: ``cad.document_shapes.document_shape``, then ``check_continuity``) and OpenDRIVE
-(``io.opendrive_check.check_opendrive``); an object (a build123d or CadQuery shape, an OCCT shape, a
+curves: ``cad.continuity.check_continuity``), DXF and G-code (their curves as drawn or programmed:
+``cad.document_shapes.document_shape``, then ``check_continuity``), LandXML (its elements' own numbers:
+``io.landxml_check.check_landxml``) and OpenDRIVE (``io.opendrive_check.check_opendrive``); an object (a build123d or CadQuery shape, an OCCT shape, a
 ``Chain``) is judged face to face when it holds faces, else curve by curve.
 
 The options are the per-format function's own keyword options (``name``, ``units``, ``dialect`` …), passed on
@@ -72,7 +72,7 @@ CHECKS: dict[str, tuple[tuple[str, ...], str]] = {
     "iges": ((".iges", ".igs"), "spiral_cad.app.files:_check_cad_file"),
     "dxf": ((".dxf",), "spiral_cad.app.files:_check_curves"),
     "gcode": (GCODE_SUFFIXES, "spiral_cad.app.files:_check_curves"),
-    "landxml": ((".xml",), "spiral_cad.app.files:_check_curves"),
+    "landxml": ((".xml",), "spiral_cad.app.files:_check_alignments"),
     "opendrive": ((".xodr",), "spiral_cad.app.files:_check_roads"),
 }
 
@@ -173,6 +173,7 @@ def check(obj_or_path: Any, *, format: str | None = None, **options: Any) -> Any
     from ..core.chain import Chain
     from ..core.transitions import Transition
 
+    label = type(obj_or_path).__name__
     if isinstance(obj_or_path, Transition):  # its spirals, joint by joint
         obj_or_path = Chain(obj_or_path.spirals)
     try:
@@ -180,8 +181,8 @@ def check(obj_or_path: Any, *, format: str | None = None, **options: Any) -> Any
     except ValueError as error:
         raise ValueError(f"check: {error}") from None
     checker = check_faces if TopExp_Explorer(shape, TopAbs_FACE).More() else check_continuity
-    options = _checked(checker, options, type(obj_or_path).__name__)
-    options.setdefault("label", type(obj_or_path).__name__)
+    options = _checked(checker, options, label)
+    options.setdefault("label", label)
     if checker is check_continuity and hasattr(obj_or_path, "units"):  # a Chain's own unit
         options.setdefault("units", obj_or_path.units)
     return checker(shape, **options)
@@ -197,7 +198,7 @@ def _check_cad_file(path: Path, **options: Any) -> Any:
 
 
 def _check_curves(path: Path, **options: Any) -> Any:
-    """A DXF drawing, LandXML file or G-code program: its curves (``document_shape``), joint by joint."""
+    """A DXF drawing or a G-code program: its curves (``document_shape``), joint by joint."""
     import dataclasses
 
     from ..cad.continuity import check_continuity
@@ -209,6 +210,13 @@ def _check_curves(path: Path, **options: Any) -> Any:
     options["units"] = None if units == DRAWING_UNITS else units
     options.setdefault("label", path.name)
     return dataclasses.replace(check_continuity(shape, **options), notes=tuple(notes))
+
+
+def _check_alignments(path: Path, **options: Any) -> Any:
+    """A LandXML file: alignment by alignment, on the file's own numbers."""
+    from ..io.landxml_check import check_landxml
+
+    return check_landxml(path, **_checked(check_landxml, options, path))
 
 
 def _check_roads(path: Path, **options: Any) -> Any:

@@ -382,10 +382,11 @@ def check_continuity(
             is not finite, or a negative/non-finite tolerance.
     """
     tolerances: dict[str, Any] = dict(gap_tol=gap_tol, angle_tol=angle_tol, curvature_tol=curvature_tol, snap=snap)
+    _check_options(**tolerances)
+    tolerances = {name: None if value is None else float(value) for name, value in tolerances.items()}  # 1 as 1.0
     if isinstance(shape_or_path, (str, os.PathLike)):
         with checking(shape_or_path, units=units, label=label, **tolerances) as report:
             return report()
-    _check_options(**tolerances)
     unit = length_unit(units) if units is not None else shape_or_path.units if isinstance(shape_or_path, Chain) else ""
     measured, measuring = _timed_measure(as_occ_shape(shape_or_path))
     return _timed_report(measured, unit, label or type(shape_or_path).__name__, tolerances, Timing(0.0, measuring, 0.0, ""))

@@ -68,11 +68,18 @@ def document_shape(path: str | os.PathLike, *, units: str | None = None) -> tupl
     return shape, found, notes
 
 
-def _compound(paths: list[list[Any]]) -> TopoDS_Compound:
+def _compound(paths: list[list[Any]], lines: list[list[int]] | None = None) -> TopoDS_Compound:
+    """The paths as wires (a program's runs, ``lines`` their program lines: kept open where they end as
+    they began, and a run OCCT cannot make a wire of named by its lines)."""
     compound, builder = TopoDS_Compound(), BRep_Builder()
     builder.MakeCompound(compound)
-    for segments in paths:
-        builder.Add(compound, chain_wire(segments))
+    for k, segments in enumerate(paths):
+        try:
+            builder.Add(compound, chain_wire(segments, closes=lines is None))
+        except ValueError as error:
+            if lines is None:
+                raise
+            raise ValueError(f"the cut of program lines {lines[k][0]}–{lines[k][-1]}: {error}") from None
     return compound
 
 
@@ -91,6 +98,8 @@ def program_shape(path: str | os.PathLike, *, units: str | None = None) -> tuple
     from ..io.rs274 import rs274_executable
 
     name = Path(path).name
+    if units is not None and units not in ("mm", "in"):
+        raise ValueError(f"{name}: a program's unit is mm (G21) or in (G20); got {units!r}")
     try:
         runs, lines, unit, notes = read_gcode_runs(path, units=units)
     except ValueError as refused:
@@ -113,14 +122,16 @@ def program_shape(path: str | os.PathLike, *, units: str | None = None) -> tuple
         if not runs:
             raise ValueError(f"{name}: the program has no feed move (G1, G2, G3) to judge") from None
         unit = moves.units
-        notes = [f"read by LinuxCNC's rs274 (the built-in reader refused it: {refused})", *moves.notes]
+        why = str(refused).split("; use interpreter=")[0].split(" (have the CAM expand")[0]  # rs274 did: no advice to use it
+        notes = [f"read by LinuxCNC's rs274 (the built-in reader refused it: {why})", *moves.notes,
+                 "the first move starts where the machine is, which the program does not say: not judged"]  # fmt: skip
         if chords.any():
             notes.append(f"{len({int(k) for k in moves.lines[chords].tolist()})} helical move(s) left out: each parts its path")
     notes.append(f"{len(runs)} cutting path(s): each run of feed moves between rapids, in program order; rapids are not judged")
     notes += [f"wire {k}: the moves of program lines {numbers[0]}–{numbers[-1]}" for k, numbers in enumerate(lines[:_LISTED])]
     if len(lines) > _LISTED:
         notes.append(f"… and {len(lines) - _LISTED} more cutting paths")
-    return _compound(runs), unit, notes
+    return _compound(runs, lines), unit, notes
 
 
 def landxml_shape(path: str | os.PathLike) -> tuple[TopoDS_Compound, str, list[str]]:

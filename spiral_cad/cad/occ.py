@@ -232,7 +232,7 @@ def plane_ax3(plane: Any) -> gp_Ax3 | None:
     return to_gp_ax3()
 
 
-def chain_wire(chain: Iterable[Segment], plane: gp_Ax3 | None = None) -> TopoDS_Wire:
+def chain_wire(chain: Iterable[Segment], plane: gp_Ax3 | None = None, *, closes: bool = True) -> TopoDS_Wire:
     """One wire of the exact edges of ``chain`` (a ``Chain`` or any segments in travel order).
 
     Consecutive edges share their vertex, and the wire is assembled directly
@@ -242,7 +242,8 @@ def chain_wire(chain: Iterable[Segment], plane: gp_Ax3 | None = None) -> TopoDS_
     tolerance (1e-7) plus the rounding the G2 checker allows at their
     coordinates (``ROUNDING_ULPS`` units in the last place), and each vertex
     carries that tolerance (1e-7 for coordinates up to ~1e8). The ends and
-    their gaps are computed for all joints at once from the segment rows.
+    their gaps are computed for all joints at once from the segment rows. ``closes=False`` keeps a chain
+    that ends where it starts open (a tool's cutting run: it stops there, it does not go on).
 
     Raises:
         ValueError: consecutive segments do not meet, a segment too short
@@ -261,7 +262,7 @@ def chain_wire(chain: Iterable[Segment], plane: gp_Ax3 | None = None) -> TopoDS_
     if apart.size:
         i = int(apart[0])
         raise ValueError(f"segment {i + 1} does not connect to segment {i}: gap {gap[i]:.3g}")
-    closed = bool(gap[-1] <= tolerance[-1])
+    closed = closes and bool(gap[-1] <= tolerance[-1])
     # each vertex at its segment's start (the point a line or spiral starts from exactly), with
     # the tolerance of the joint before it; the first with the closing joint's or its own
     single = Precision.Confusion_s() + ROUNDING_ULPS * np.spacing(np.abs(ends[[0, -1], [0, 1]]).max(axis=1))

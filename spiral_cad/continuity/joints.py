@@ -199,6 +199,10 @@ class Timing:
         return f"time {total:.3g} s: {self.reader} {self.reading:.3g} s ({share:.0%}), {parts}; {verdict}"
 
 
+#: How many pieces' sizes a one-line description lists (a program may have 100 000 runs).
+_LISTED_COUNTS = 12
+
+
 @dataclass(frozen=True)
 class ContinuityReport:
     """Joint continuity of every piece (wire or chain of loose edges) of a shape.
@@ -251,14 +255,18 @@ class ContinuityReport:
         return self.pieces == pieces and self.min_level >= Continuity.parse(required)
 
     def describe(self) -> str:
-        """What was found, e.g. ``"1 wire of 13 edges"`` or ``"1 wire of 5 edges and 2 loose pieces (3, 1 edges)"``."""
+        """What was found, e.g. ``"1 wire of 13 edges"`` or ``"1 wire of 5 edges and 2 loose pieces (3, 1 edges)"``
+        (past 12 pieces, the rest's total: ``"(3, 1, …, … 480 more edges)"``)."""
         parts = []
         for kind in dict.fromkeys(w.kind for w in self.wires):
             counts = [w.edge_count for w in self.wires if w.kind == kind]
             if len(counts) == 1:
                 parts.append(f"1 {kind} of {_count(counts[0], self.element)}")
             else:
-                parts.append(f"{len(counts)} {kind}s ({', '.join(map(str, counts))} {_plural(self.element)})")
+                shown = ", ".join(map(str, counts[:_LISTED_COUNTS])) + (
+                    f", … {sum(counts[_LISTED_COUNTS:])} more" if len(counts) > _LISTED_COUNTS else ""
+                )
+                parts.append(f"{len(counts)} {kind}s ({shown} {_plural(self.element)})")
         return " and ".join(parts) or f"no {_plural(self.element)}"
 
     def largest_plane_change(self) -> tuple[float, int, int] | None:

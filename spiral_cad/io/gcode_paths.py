@@ -322,7 +322,7 @@ def _arc(start: list[float], end: list[float], plane: int, ca: float, cb: float,
     t0, sweep = arc_sweep(start, end, plane, ca, cb, rotation)
     radius = math.hypot(a0 - ca, b0 - cb)
     turns = max(1, math.ceil(abs(sweep) / (2 * math.pi) - 1e-12))
-    step = sweep / turns
+    step = math.copysign(min(abs(sweep) / turns, 2 * math.pi), sweep)  # not past a whole turn by rounding
     out: list[Line | Arc] = []
     for k in range(turns):
         angle = t0 + k * step
@@ -343,10 +343,14 @@ def _arc(start: list[float], end: list[float], plane: int, ca: float, cb: float,
 
 def read_gcode_runs(path: str | os.PathLike, *, units: str | None = None) -> tuple[list[list[Any]], list[list[int]], str, list[str]]:
     """The exact cutting paths of a G-code file: every run of feed moves between rapids as the curves it
-    states (``parse_gcode_chain``'s: G1 lines, G2/G3 arcs, G5 cubics as spiral pieces), in space and in
-    the program's unit, whether or not they join G2.
+    states (G1 lines, G2/G3 arcs, G5 cubics as ``parse_gcode_chain``'s spiral pieces), in space and in the
+    program's unit, whether or not they join G2.
 
-    A helical or multi-turn arc parts its run and is counted in the notes (it is no arc of a path).
+    As ``parse_gcode_moves`` reads them: the first move starts where the machine happens to be, so it is
+    no segment (noted when it is a cut); an arc whose end lies off its circle (within what the program's
+    decimals leave) is the arc about the centre moved onto the bisector of its chord, so that it ends
+    where the move does (noted when that moves its centre); an arc of more than one turn is one turn and
+    the rest (noted); a helical arc is left out and parts its run (counted in the notes).
 
     Args:
         path: the program.
@@ -367,25 +371,39 @@ def read_gcode_runs(path: str | os.PathLike, *, units: str | None = None) -> tup
     reader = _read_exact(text, label, units)
     runs: list[list[Any]] = [[]]
     lines: list[list[int]] = [[]]
+    notes: list[str] = list(reader.notes)
     helical = 0
-    for kind, number, rapid, start, *data in reader.pieces:
-        turning = kind == "arc" and (data[0][PLANES[data[1]][2]] != start[PLANES[data[1]][2]] or abs(data[4]) != 1)
-        if rapid or turning:
-            helical += turning
+    pieces = reader.pieces
+    if pieces and not pieces[0][2]:
+        notes.append(f"line {pieces[0][1]}: the first move starts where the machine is, which the program does not say: not judged")
+    for kind, number, rapid, start, *data in pieces[1:]:
+        helix = kind == "arc" and data[0][PLANES[data[1]][2]] != start[PLANES[data[1]][2]]
+        if rapid or helix:
+            helical += helix
             runs.append([])
             lines.append([])
             continue
         try:
-            segments = _piece_segment(kind, start, data, 1.0, 3)
+            if kind == "arc":
+                end, plane, ca, cb, rotation = data
+                segments = _arc(start, end, plane, ca, cb, max(-2, min(2, rotation)), 1.0, 3, None)
+                a, b, _ = PLANES[plane]
+                r0, r1 = math.hypot(start[a] - ca, start[b] - cb), math.hypot(end[a] - ca, end[b] - cb)
+                if abs(r0 - r1) > 1e-9 * max(r0, r1):
+                    notes.append(f"line {number}: the arc's end lies {abs(r0 - r1):.3g} off its circle: judged about the "
+                                 "centre moved onto the bisector of its chord")  # fmt: skip
+                if abs(rotation) > 1:
+                    notes.append(f"line {number}: an arc of {abs(rotation)} turns, judged as one turn and the rest")
+            else:
+                segments = _piece_segment(kind, start, data, 1.0, 3) or []
         except ValueError as error:
             raise ValueError(f"{label} line {number}: {error}") from None
-        for segment in segments or ():
+        for segment in segments:
             runs[-1].append(segment)
             lines[-1].append(number)
     kept = [k for k, run in enumerate(runs) if run]
     if not kept or reader.units is None:
-        raise ValueError(f"{label}: no feed move (G1, G2, G3, G5) to a new position")
-    notes = list(reader.notes)
+        raise ValueError(f"{label}: no feed move (G1, G2, G3, G5) to a new position after the first move")
     if helical:
-        notes.append(f"{helical} helical or multi-turn arc(s) left out: each parts its path")
+        notes.append(f"{helical} helical arc(s) left out: each parts its path")
     return [runs[k] for k in kept], [lines[k] for k in kept], reader.units, notes

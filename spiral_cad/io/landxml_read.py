@@ -137,6 +137,9 @@ class LandXMLAlignment:
             (counter-clockwise from east) or ``"north-cw"`` (clockwise from north, azimuths);
             ``"unknown"`` when the file tells nothing and no element was placed by its direction.
         file_lengths: per element its length in the file.
+        element_frames: (n, 2, 9) per element its start and end as the file states them: point, unit
+            tangent and curvature vector (z = 0); placed by its Start and direction (else the end of the
+            element before) and run by its length and end curvatures (``check_landxml`` judges these).
     """
 
     name: str
@@ -155,6 +158,7 @@ class LandXMLAlignment:
     owners: tuple[NDArray[np.int64], ...] = field(default=())
     directions: str = "unknown"
     file_lengths: NDArray[np.float64] = field(default_factory=lambda: np.zeros(0))
+    element_frames: NDArray[np.float64] = field(default_factory=lambda: np.zeros((0, 2, 9)))
 
     @property
     def chain(self) -> Chain:
@@ -630,7 +634,21 @@ def _alignment(r: _Reader, a: ET.Element, label: str) -> LandXMLAlignment:
     return LandXMLAlignment(name, tuple(chains), tuple(breaks), start_station, r.units, profile, offsets, tuple(i.kind for i in items),
                             start_station + np.concatenate([[0.0], np.cumsum(ours)[:-1]]), notes,
                             np.array([i.station for i in items]), ours - size,
-                            tuple(methods.get(k, "file") for k in range(len(items))), tuple(owners), r.directions, size)  # fmt: skip
+                            tuple(methods.get(k, "file") for k in range(len(items))), tuple(owners), r.directions, size,
+                            _element_frames(starts, headings, ends, bend, k1))  # fmt: skip
+
+
+def _element_frames(starts: list[NDArray], headings: list[float], ends: list[tuple[NDArray, float]], k0: NDArray,
+                    k1: NDArray) -> NDArray[np.float64]:  # fmt: skip
+    """(n, 2, 9) start and end frames of the file's elements: point, unit tangent, curvature vector κN (z = 0)."""
+    frames = np.zeros((len(starts), 2, 9))
+    for side, points, angles, curvature in ((0, np.array(starts), np.array(headings), k0),
+                                            (1, np.array([p for p, _ in ends]), np.array([h for _, h in ends]), k1)):  # fmt: skip
+        c, s = np.cos(angles), np.sin(angles)
+        frames[:, side, 0:2] = points
+        frames[:, side, 3], frames[:, side, 4] = c, s
+        frames[:, side, 6], frames[:, side, 7] = -s * curvature, c * curvature
+    return frames
 
 
 def _joints(items: list[_Element], starts: list[NDArray], headings: list[float], ends: list[tuple[NDArray, float]], units: str,

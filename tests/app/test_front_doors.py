@@ -70,12 +70,31 @@ def test_a_program_the_built_in_reader_refuses_is_read_by_rs274(tmp_path, capsys
     assert "note: 3 cutting path(s)" in out
 
 
+def test_check_reads_the_programs_cam_systems_write_and_says_how(tmp_path, capsys):
+    """An arc whose end lies 0.001 mm off its circle (rs274 runs it) is judged about the centre on its chord's
+    bisector, and said so; the first move, from wherever the machine is, is not judged; an arc of three
+    turns is one turn and the rest; a run that ends where it began stays open (the tool stops there)."""
+    path = tmp_path / "cam.ngc"
+    path.write_text("G21 G90 G17\nG1 X0 Y0 Z0 F100\nG1 X10\nG3 X20 Y10 I0 J10.001\nG1 Y20\nG2 X20 Y20 I5 J0 P3\n"
+                    "G1 X10 Y30\nG1 X0 Y0\nM2\n")  # fmt: skip
+    report = sc.check(path)
+    notes = " | ".join(report.notes)
+    assert "line 2: the first move starts where the machine is" in notes
+    assert "line 4: the arc's end lies 0.001 off its circle: judged about the centre moved onto the bisector" in notes
+    assert "line 6: an arc of 3 turns, judged as one turn and the rest" in notes
+    (wire,) = report.wires
+    assert not wire.closed and wire.edge_count == 7  # line, arc, line, two halves of the turns, line, line
+    with pytest.raises(ValueError, match=r"a program's unit is mm \(G21\) or in \(G20\); got 'cm'"):
+        sc.check(path, units="cm")
+    assert sc.check(line_to_circle((0, 0), (1, 0), (100, 60), 50.0)).source == "Transition"
+
+
 def test_check_leaves_helical_moves_out_and_says_so(tmp_path, capsys):
     path = tmp_path / "helix.nc"
     path.write_text("G21\nG0 X0 Y0 Z1\nG1 X10 Z0 F100\nG2 X10 Y0 Z-2 I-5 J0\nG1 X20\nM2\n")
     assert main(["check", str(path)]) == 0
     out = capsys.readouterr().out
-    assert "note: 1 helical or multi-turn arc(s) left out: each parts its path" in out
+    assert "note: 1 helical arc(s) left out: each parts its path" in out
     assert "2 wires (1, 1 edges)" in out
 
 
@@ -87,11 +106,42 @@ def test_check_judges_a_landxml_alignment_with_the_files_own_radii(capsys):
     assert main(["check", str(path), "--require", "G1"]) == 0
     out = capsys.readouterr().out
     rows = [line.split() for line in out.splitlines() if line.startswith("      ")]
-    assert [row[-1] for row in rows] == ["G1"] * 4 and "ft" in out.splitlines()[2]
+    assert [row[-1] for row in rows] == ["G1"] * 4 and "ft" in out
     assert len(radii) == 2 and [float(row[4]) for row in rows[::2]] == pytest.approx([1 / r for r in radii], rel=1e-5)
     spiral = path.with_name("civil3d_spiral_r63.xml")
     assert main(["check", str(spiral), "--require", "G2"]) == 0
-    assert "note: alignment" in capsys.readouterr().out  # how far the rebuilt spirals are from the file's
+    assert "note: judged on the file's own numbers" in capsys.readouterr().out
+
+
+LANDXML = (
+    '<LandXML xmlns="http://www.landxml.org/schema/LandXML-1.2">{units}<Alignments><Alignment name="K" staStart="0">'
+    "<CoordGeom>{elements}</CoordGeom></Alignment></Alignments></LandXML>"
+)
+METRES = '<Units><Metric linearUnit="meter" angularUnit="radians" directionUnit="radians"/></Units>'
+
+
+def test_check_finds_a_kink_and_a_radius_jump_the_rebuild_would_smooth(tmp_path):
+    """A kink of 0.004 rad between two lines (the reader rebuilds it as one G2 run) is a G0 joint of that
+    angle; an arc of radius 300 onto one of radius 400, tangent, is a G1 joint whose curvature jumps by
+    1/300 − 1/400 (the file's radii)."""
+    kink = tmp_path / "kink.xml"
+    kink.write_text(LANDXML.format(units=METRES, elements="<Line><Start>0 0</Start><End>0 100</End></Line>"
+                                   "<Line><Start>0 100</Start><End>0.4 200</End></Line>"))  # fmt: skip
+    report = sc.check(kink)
+    (joint,) = report.wires[0].joints
+    assert joint.level.name == "G0" and joint.angle == pytest.approx(0.004, rel=1e-5) and joint.gap == 0.0
+    # two arcs turning left through the joint (northing 0, easting 0), heading north there: radius 300 then 400
+    # (LandXML points are "northing easting"; the centres lie west of the joint)
+    arcs = ('<Curve rot="ccw" radius="300"><Start>-300 -300</Start><Center>0 -300</Center><End>0 0</End></Curve>'
+            '<Curve rot="ccw" radius="400"><Start>0 0</Start><Center>0 -400</Center><End>240 -80</End></Curve>')  # fmt: skip
+    compound = tmp_path / "compound.xml"
+    compound.write_text(LANDXML.format(units=METRES, elements=arcs))
+    report = sc.check(compound)
+    (joint,) = report.wires[0].joints
+    assert joint.level.name == "G1" and joint.curvature_jump == pytest.approx(1 / 300 - 1 / 400, rel=1e-9)
+    bare = tmp_path / "bare.xml"
+    bare.write_text(LANDXML.format(units="", elements="<Line><Start>0 0</Start><End>0 100</End></Line>"))
+    assert "the file states no unit (<Units>): read in m" in sc.check(bare).notes
 
 
 def test_check_quiet_prints_the_summary_and_the_verdict(tmp_path, capsys):
@@ -371,3 +421,12 @@ def test_a_star_import_after_build123ds_keeps_build123ds_names():
     assert not set(sc.__all__) & theirs, set(sc.__all__) & theirs
     assert {name: getattr(sc, name).__module__ for name in sc.SHADOWING} == {
         "Circle": "spiral_cad.core.segments", "Line": "spiral_cad.core.segments", "Transition": "spiral_cad.core.transitions"}  # fmt: skip
+
+
+def test_a_programs_many_runs_keep_the_summary_line_short_and_whole_number_tolerances_are_taken(tmp_path, capsys):
+    path = tmp_path / "holes.ngc"
+    path.write_text("G21\nG0 Z1\n" + "".join(f"G0 X{k} Y0\nG1 Z-1 F100\nG0 Z1\n" for k in range(40)) + "M2\n")
+    assert main(["check", str(path), "--quiet"]) == 0
+    (summary,) = capsys.readouterr().out.splitlines()
+    assert summary.startswith("holes.ngc: 40 wires (1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, … 28 more edges); worst joint")
+    assert sc.check(path, curvature_tol=1, gap_tol=0).wires
