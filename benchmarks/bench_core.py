@@ -15,12 +15,21 @@ from scipy.special import fresnel
 from timing import Report, arguments, compare, growth_exponent, latencies, per_second, table
 
 import spiral_cad as sc
+from spiral_cad.core import _kernel_batches as KB
+from spiral_cad.core import _kernel_circles as KC
+from spiral_cad.core import _kernel_line_circle as KLC
+from spiral_cad.core import _kernel_line_line as KLL
 from spiral_cad.core import _kernels as K
 from spiral_cad.core import batch
 
 #: The modules whose code these numbers measure (stamped into the results: ``timing.code_stamp``).
 MEASURES = (
     "spiral_cad.core._kernels",
+    "spiral_cad.core._kernel_spiral",
+    "spiral_cad.core._kernel_line_circle",
+    "spiral_cad.core._kernel_circles",
+    "spiral_cad.core._kernel_line_line",
+    "spiral_cad.core._kernel_batches",
     "spiral_cad.core.jit",
     "spiral_cad.core.threads",
     "spiral_cad.core.batch",
@@ -130,7 +139,7 @@ def batches(report: Report, n: int, rounds: int, rng: np.random.Generator) -> No
     t = compare({
         "ours": lambda: batch.line_to_circle(p, d, c, r),
         "out=": lambda: batch.line_to_circle(p, d, c, r, out=buffer),
-        "one thread": lambda: K.line_to_circle_batch(p, d, c, r, K.WALTON_MEEK, out, status, theta, measure),
+        "one thread": lambda: KB.line_to_circle_batch(p, d, c, r, K.WALTON_MEEK, out, status, theta, measure),
         "clothoid": lambda: clothoid_line_to_circle(c, r),
         "numpy": lambda: numpy_closed_form_line_to_circle(p, d, c, r),
         "floor": lambda: memory_floor(p, d, c, r),
@@ -168,7 +177,7 @@ def batches(report: Report, n: int, rounds: int, rng: np.random.Generator) -> No
     p1 = corner + rng.uniform(1, 5, n)[:, None] * np.stack([np.cos(turn), np.sin(turn)], 1)
     m = max(n // 20, 1)
     q = rng.uniform(0.1, 0.9, m)
-    low = np.array([K.nested_band_lower(x, K.WALTON_MEEK) for x in q])
+    low = np.array([KC.nested_band_lower(x, K.WALTON_MEEK) for x in q])
     dist = (1 - q) * (low + rng.uniform(0.05, 0.95, m) * (1 - low))
     nested = (c0[:m], 1.0, c0[:m] + dist[:, None] * unit[:m], q)
     t = compare({
@@ -197,13 +206,13 @@ def scalar_calls(report: Report, rounds: int, number: int) -> None:
     code = K.WALTON_MEEK
     t = latencies({
         "line_to_circle": lambda: sc.line_to_circle((0, 0), (1, 0), (0, 1.3), 1.0),
-        "line_to_circle row": lambda: K.line_to_circle_row(0.0, 0.0, 1.0, 0.0, 0.0, 1.3, 1.0, code, out1, 0),
+        "line_to_circle row": lambda: KLC.line_to_circle_row(0.0, 0.0, 1.0, 0.0, 0.0, 1.3, 1.0, code, out1, 0),
         "circle_to_circle": lambda: sc.circle_to_circle((0, 0), -1.0, (4, 0), 1.5),
-        "circle_to_circle row": lambda: K.circle_to_circle_row(0.0, 0.0, -1.0, 4.0, 0.0, 1.5, code, out2, 0),
+        "circle_to_circle row": lambda: KC.circle_to_circle_row(0.0, 0.0, -1.0, 4.0, 0.0, 1.5, code, out2, 0),
         "line_to_line": lambda: sc.line_to_line((0, 0), (10, 0), (15, 8)),
-        "line_to_line row": lambda: K.line_to_line_row(0.0, 0.0, 10.0, 0.0, 15.0, 8.0, np.nan, code, out2, 0),
+        "line_to_line row": lambda: KLL.line_to_line_row(0.0, 0.0, 10.0, 0.0, 15.0, 8.0, np.nan, code, out2, 0),
         "circle_in_circle": lambda: sc.circle_in_circle((0, 0), 1.0, (0, 0.595), 0.4),
-        "circle_in_circle row": lambda: K.circle_in_circle_row(0.0, 0.0, 1.0, 0.0, 0.595, 0.4, code, out1, 0),
+        "circle_in_circle row": lambda: KC.circle_in_circle_row(0.0, 0.0, 1.0, 0.0, 0.595, 0.4, code, out1, 0),
         "BezierSpiral": lambda: sc.BezierSpiral((0, 0), (1, 0), 0.5, 1.0),
     }, rounds, number)  # fmt: skip
     for name in ("line_to_circle", "circle_to_circle", "line_to_line", "circle_in_circle"):

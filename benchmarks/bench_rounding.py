@@ -21,6 +21,8 @@ MEASURES = (
     "spiral_cad.core.space",
     "spiral_cad.core._chain_kernels",
     "spiral_cad.core._kernels",
+    "spiral_cad.core._kernel_spiral",
+    "spiral_cad.core._kernel_line_line",
     "spiral_cad.core.batch",
 )
 

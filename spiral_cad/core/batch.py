@@ -15,7 +15,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from . import _kernels as K
+from . import _kernel_batches as KB
 from .errors import MALFORMED, NoSolutionError, Status
 from .inputs import as_real_array
 from .messages import describe
@@ -160,7 +160,7 @@ def line_to_circle(
             it). No row's values raise: they become that row's status.
     """
     rows = _rows(point=(points, (2,)), direction=(directions, (2,)), center=(centers, (2,)), radius=(radii, ()))
-    return _run("line_to_circle", K.line_to_circle_batch, 1, rows, out, shape)
+    return _run("line_to_circle", KB.line_to_circle_batch, 1, rows, out, shape)
 
 
 def circle_to_circle(
@@ -173,7 +173,7 @@ def circle_to_circle(
 ) -> BatchResult:
     """Theorems 4.2/4.3 for N rows (signed travel-sense radii: C or S per row)."""
     rows = _rows(center0=(centers0, (2,)), radius0=(radii0, ()), center1=(centers1, (2,)), radius1=(radii1, ()))
-    return _run("circle_to_circle", K.circle_to_circle_batch, 2, rows, out, shape)
+    return _run("circle_to_circle", KB.circle_to_circle_batch, 2, rows, out, shape)
 
 
 def line_to_line(
@@ -188,7 +188,7 @@ def line_to_line(
     ``shape`` may also be ``"g2cbs"`` (a corner shape)."""
     k = np.nan if curvatures is None else curvatures
     rows = _rows(p0=(p0, (2,)), corner=(corners, (2,)), p1=(p1, (2,)), curvature=(k, ()))
-    return _run("line_to_line", K.line_to_line_batch, 2, rows, out, shape)
+    return _run("line_to_line", KB.line_to_line_batch, 2, rows, out, shape)
 
 
 def circle_in_circle(
@@ -201,4 +201,4 @@ def circle_in_circle(
 ) -> BatchResult:
     """The fifth case for N rows (nested circles, same-sign radii)."""
     rows = _rows(center0=(centers0, (2,)), radius0=(radii0, ()), center1=(centers1, (2,)), radius1=(radii1, ()))
-    return _run("circle_in_circle", K.circle_in_circle_batch, 1, rows, out, shape, extra=True)
+    return _run("circle_in_circle", KB.circle_in_circle_batch, 1, rows, out, shape, extra=True)

@@ -15,7 +15,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from . import _kernels as K
+from . import _kernel_spiral as KS
 
 #: Gauss–Legendre nodes used by :func:`arc_length` (per panel, 4 panels).
 _GL_NODES, _GL_WEIGHTS = np.polynomial.legendre.leggauss(16)
@@ -55,7 +55,7 @@ def _horner(coefficients: NDArray[np.float64], u: ArrayLike) -> NDArray[np.float
     if coefficients.ndim == 2:  # one curve: a compiled loop, each value in registers
         flat = _parameters(u)
         out = np.empty((flat.size, coefficients.shape[1]))
-        K.polynomial_values(np.ascontiguousarray(coefficients, dtype=float), flat, out)
+        KS.polynomial_values(np.ascontiguousarray(coefficients, dtype=float), flat, out)
         return out.reshape(u.shape + coefficients.shape[1:])
     u = u[..., None]
     terms = coefficients[..., None, :, :]  # an axis for the samples
@@ -103,7 +103,7 @@ def curvature(cp: NDArray[np.float64], u: ArrayLike) -> NDArray[np.float64]:
     scale = _scale(first)
     flat = _parameters(u)
     out = np.empty(flat.size)
-    K.plane_curvatures(first / scale, second / scale, scale, flat, out)
+    KS.plane_curvatures(first / scale, second / scale, scale, flat, out)
     return out.reshape(u.shape)
 
 

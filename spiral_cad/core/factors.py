@@ -27,6 +27,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy.interpolate import CubicSpline
 
+from . import _kernel_spiral as KS
 from . import _kernels as K
 from . import batch
 from .bezier import arc_length, peak_curvature_rate
@@ -43,7 +44,7 @@ def unit_spirals(theta: ArrayLike, shape: str = "walton-meek") -> NDArray[np.flo
     """Control points (N, 4, 2) of spirals of ``shape`` turning left by ``theta`` from the origin along +x to end radius 1."""
     theta = np.asarray(theta, dtype=float).ravel()
     out = np.empty((len(theta), 4, 2))
-    K.unit_spirals_batch(np.sin(theta), np.cos(theta), SHAPE_CODES[shape], out)
+    KS.unit_spirals_batch(np.sin(theta), np.cos(theta), SHAPE_CODES[shape], out)
     return out
 
 

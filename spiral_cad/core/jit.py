@@ -113,6 +113,10 @@ class Kernels:
             for registry in REGISTRIES:
                 if registry.sealed and not registry.compiled:
                     registry._make_dispatchers(njit)
+            for registry in REGISTRIES:  # a kernel another module imported by name: its dispatcher there too
+                for name, value in list(registry.namespace.items()):
+                    if isinstance(value, _Uncompiled) and value._kernels.compiled:
+                        registry.namespace[name] = value._kernels.namespace[value.__name__]
             _compiled_all = True
 
     def _make_dispatchers(self, njit: Callable[..., Any]) -> None:
@@ -126,14 +130,12 @@ class Kernels:
 
     @property
     def python(self) -> SimpleNamespace:
-        """The kernels as plain Python functions calling each other (nothing compiled)."""
+        """The kernels as plain Python functions calling each other (nothing compiled); a kernel another
+        module declared, imported here by name, is that module's plain-Python copy."""
         if self._python is None:
             with _LOCK:
-                scope = {k: v for k, v in self.namespace.items() if k not in self.functions}
-                scope["math"] = _FLOAT_MATH
-                for name, (function, _) in self.functions.items():
-                    scope[name] = FunctionType(function.__code__, scope, name, function.__defaults__, function.__closure__)
-                self._python = SimpleNamespace(**{name: scope[name] for name in self.functions})
+                _python_copies()
+        assert self._python is not None, f"{self.module} is not sealed"
         return self._python
 
     def guarded(self) -> Any:
@@ -161,6 +163,30 @@ class Kernels:
 COMPILING = ("spiral_cad: compiling the curve kernels for this machine (first run only; numba caches them): "
              "about 3 s for a first curve or fillet, 15 s for the batch solvers")  # fmt: skip
 _announcing = False
+
+
+def _python_copies() -> None:
+    """Give every sealed registry without them its plain-Python copies: each kernel a function whose globals
+    are a copy of its module's, where a kernel of any registry imported by name (its stand-in, dispatcher or
+    function) is that kernel's plain-Python copy."""
+    owners: dict[int, tuple[Kernels, str]] = {}
+    for registry in REGISTRIES:
+        for name, (function, _) in registry.functions.items():
+            owners[id(function)] = registry, name
+    scopes = []
+    for registry in REGISTRIES:
+        if registry._python is None and registry.sealed:
+            scope = {k: v for k, v in registry.namespace.items() if k not in registry.functions}
+            scope["math"] = _FLOAT_MATH
+            for name, (function, _) in registry.functions.items():
+                scope[name] = FunctionType(function.__code__, scope, name, function.__defaults__, function.__closure__)
+            registry._python = SimpleNamespace(**{name: scope[name] for name in registry.functions})
+            scopes.append(scope)
+    for scope in scopes:
+        for name, value in list(scope.items()):
+            owner = (value._kernels, value.__name__) if isinstance(value, _Uncompiled) else owners.get(id(getattr(value, "py_func", value)))
+            if owner is not None and owner[0]._python is not None:
+                scope[name] = getattr(owner[0]._python, owner[1])
 
 
 def _announce_compiling() -> None:

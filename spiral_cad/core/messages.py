@@ -6,7 +6,7 @@ import math
 from collections.abc import Mapping
 from typing import Any
 
-from . import _kernels as K
+from . import _kernel_circles as KC
 from .errors import MALFORMED, NoSolutionError, Status
 from .shapes import SHAPE_CODES, shape_limits
 
@@ -75,7 +75,7 @@ def describe(case: str, status: int, measure: float, inputs: Mapping[str, Any]) 
     if status is Status.OUTSIDE_NESTED_BAND:
         big, small = sorted((abs(float(r0)), abs(float(r1))), reverse=True)
         q = small / big
-        lower = float(K.KERNELS.guarded().nested_band_lower(q, SHAPE_CODES[shape]))
+        lower = float(KC.KERNELS.guarded().nested_band_lower(q, SHAPE_CODES[shape]))
         if not lower < 1.0:  # r1/r0 so small (or underflowing) that the band is empty in float64
             return (
                 f"circle_in_circle: a single {shape} spiral needs r1/r0 well above 0; here r1/r0 = {q:.6g} "

@@ -18,6 +18,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from . import _kernel_line_line as KLL
 from . import _kernels as K
 from .inputs import as_float, as_real_array
 from .jit import Kernels
@@ -179,7 +180,7 @@ def _pair_residual(
     scale = K.frame_scale(max(abs(local[0, 0, 0]), abs(outgoing[i, 0]), abs(outgoing[i, 1])))
     inv = 1.0 / scale
     t1x, t1y = K.unit(-outgoing[i, 0], -outgoing[i, 1])  # along the outgoing leg, towards the corner
-    res = K.corner_residual(local, 0.0, 0.0, 1.0, 0.0, t1x, t1y, peak[i] * scale, inv)
+    res = KLL.corner_residual(local, 0.0, 0.0, 1.0, 0.0, t1x, t1y, peak[i] * scale, inv)
     leg = K.norm((local[0, 1, 0] - local[0, 0, 0]) * inv, (local[0, 1, 1] - local[0, 0, 1]) * inv)
     length = min(leg, 1.0 / (peak[i] * scale))
     # Off the plane, each leg may tilt by up to 2 × off / L beside its in-plane angle: the sum bounds the angle in space.

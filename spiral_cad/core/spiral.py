@@ -8,7 +8,7 @@ from typing import Any, cast
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from . import _kernels as K
+from . import _kernel_spiral as KS
 from . import bezier
 from .errors import Status
 from .inputs import as_float, as_xy
@@ -57,7 +57,7 @@ class BezierSpiral(Segment):
         curvature = as_float(curvature, "curvature")
         code = shape_code(shape, TRANSITION_SHAPES)
         out = np.empty((1, 1, 4, 2))
-        status, _, measure, _ = K.KERNELS.for_scalar_call().spiral_row(bx, by, dx, dy, theta, curvature, code, out, 0)
+        status, _, measure, _ = KS.KERNELS.for_scalar_call().spiral_row(bx, by, dx, dy, theta, curvature, code, out, 0)
         if status != Status.OK:
             inputs = dict(start=(bx, by), direction=(dx, dy), theta=theta, curvature=curvature, shape=shape)
             raise error_for("BezierSpiral", status, measure, inputs)

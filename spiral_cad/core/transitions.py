@@ -16,7 +16,9 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from . import _kernels as K
+from . import _kernel_circles as KC
+from . import _kernel_line_circle as KLC
+from . import _kernel_line_line as KLL
 from .inputs import as_float, as_xy
 from .messages import error_for
 from .segments import Arc, Circle, Join, Line, Ray, Segment, measure_join
@@ -167,7 +169,7 @@ def line_to_circle(point: Any, direction: Any, center: Any, radius: float, shape
     cx, cy = as_xy(center, "center")
     r = as_float(radius, "radius")
     out = np.empty((1, 1, 4, 2))
-    status, theta, measure, side = K.KERNELS.for_scalar_call().line_to_circle_row(px, py, dx, dy, cx, cy, r, shape_code(shape), out, 0)
+    status, theta, measure, side = KLC.KERNELS.for_scalar_call().line_to_circle_row(px, py, dx, dy, cx, cy, r, shape_code(shape), out, 0)
     if status:
         inputs = dict(point=(px, py), direction=(dx, dy), center=(cx, cy), radius=r, shape=shape)
         raise error_for("line_to_circle", status, measure, inputs)
@@ -184,7 +186,7 @@ def _two_circles(
     r0 = as_float(radius0, "radius0")
     c1 = as_xy(center1, "center1")
     r1 = as_float(radius1, "radius1")
-    rows = K.KERNELS.for_scalar_call()
+    rows = KC.KERNELS.for_scalar_call()
     row, spirals = (rows.circle_to_circle_row, 2) if case == "circle_to_circle" else (rows.circle_in_circle_row, 1)
     out = np.empty((1, spirals, 4, 2))
     status, theta, measure, extra = row(c0[0], c0[1], r0, c1[0], c1[1], r1, shape_code(shape), out, 0)
@@ -243,7 +245,7 @@ def line_to_line(p0: Any, corner: Any, p1: Any, curvature: float | None = None, 
     k = math.nan if curvature is None else as_float(curvature, "curvature")
     out = np.empty((1, 2, 4, 2))
     code = shape_code(shape, CORNER_SHAPES)
-    status, theta, measure, _ = K.KERNELS.for_scalar_call().line_to_line_row(a[0], a[1], p[0], p[1], b[0], b[1], k, code, out, 0)
+    status, theta, measure, _ = KLL.KERNELS.for_scalar_call().line_to_line_row(a[0], a[1], p[0], p[1], b[0], b[1], k, code, out, 0)
     if status:
         inputs = dict(p0=a, corner=p, p1=b, curvature=curvature, shape=shape)
         raise error_for("line_to_line", status, measure, inputs)

@@ -10,6 +10,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.typing import NDArray
 
+from ..core import _kernel_circles as KC
 from ..core import _kernels as K
 from ..core.segments import TAU, Arc, Line, Segment
 
@@ -148,7 +149,7 @@ def _nested_defect(a: _Piece, b: _Piece, shape: int) -> float:
     rs, rb = sorted((abs(a.r), abs(b.r)))
     if not rb - rs > 1e-12 * rb:
         return math.inf
-    width = (rb - rs) * (1.0 / K.nested_band_lower(rs / rb, shape) - 1.0)
+    width = (rb - rs) * (1.0 / KC.nested_band_lower(rs / rb, shape) - 1.0)
     return abs(math.dist(a.c, b.c) - (rb - rs)) / width
 
 

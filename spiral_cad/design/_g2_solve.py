@@ -9,6 +9,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from ..core import _kernel_circles as KC
 from ..core import _kernels as K
 from ..core import batch
 from ..core.errors import Status
@@ -105,7 +106,7 @@ class _Group:
                     following[k] = not self.needs_shift[k]
                     self.needs_shift[k] = True
         code = SHAPE_CODES[shape]
-        theta_max = K.shape_max_theta(code)
+        theta_max = KC.shape_max_theta(code)
         if code == K.NEAR_LINEAR:
             largest = 0.98 * theta_max
             q_max = 1.0 - 1.0 / K.shape_g1(code, math.sin(largest), math.cos(largest))
@@ -193,7 +194,7 @@ class _Group:
     def _band_width(self, small: int, big: int) -> float:
         """How much more than the larger circle the smaller one may shrink: the nested band's width."""
         rs, rb = abs(self.pieces[small].r), abs(self.pieces[big].r)
-        lower = K.nested_band_lower(rs / rb, SHAPE_CODES[self.shape])
+        lower = KC.nested_band_lower(rs / rb, SHAPE_CODES[self.shape])
         return (rb - rs) * (1.0 / lower - 1.0)
 
     def solve_joints(self, s: list[float]) -> list[_Solved | None]:

@@ -41,6 +41,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from ..core import _kernel_circles as KC
 from ..core import _kernels as K
 from ..core.chain import JOIN_TOLERANCE, Chain, g2_mismatch, join_tolerance
 from ..core.errors import NoSolutionError
@@ -171,7 +172,7 @@ def _center_distance(kind: str, theta: float, side_radius: float, r: float, shap
     if kind == "C":
         return math.hypot((a0 + a1) * g2, (a1 - a0) * g1)
     big, small = max(a0, a1), min(a0, a1)
-    x, y = K.nested_center_offset(theta, big, small, code)[:2]
+    x, y = KC.nested_center_offset(theta, big, small, code)[:2]
     return math.hypot(x, y)
 
 

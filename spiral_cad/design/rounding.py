@@ -35,6 +35,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from ..core import _chain_kernels as CK
+from ..core import _kernel_spiral as KS
 from ..core import _kernels as K
 from ..core import batch
 from ..core.chain import JOIN_TOLERANCE, ROUNDING_CAP, join_tolerance
@@ -93,7 +94,7 @@ def deviation_factor(theta_sin: ArrayLike, theta_cos: ArrayLike, shape: str) -> 
     """
     sin_t, cos_t = np.broadcast_arrays(np.asarray(theta_sin, dtype=float), np.asarray(theta_cos, dtype=float))
     unit = np.empty((sin_t.size, 4, 2))
-    K.unit_spirals_batch(np.ascontiguousarray(sin_t.ravel()), np.ascontiguousarray(cos_t.ravel()), SHAPE_CODES[shape], unit)
+    KS.unit_spirals_batch(np.ascontiguousarray(sin_t.ravel()), np.ascontiguousarray(cos_t.ravel()), SHAPE_CODES[shape], unit)
     end_leg = norms(unit[:, 3] - unit[:, 2]).reshape(sin_t.shape)
     with np.errstate(invalid="ignore", divide="ignore"):
         return end_leg * sin_t / cos_t

@@ -167,14 +167,17 @@ def _ordinary_rows(n):
 def test_vectorised_rows_are_the_general_rows_bit_for_bit(shape):
     """Rows the blocks solve on vectors of rows (``*_fast``) get exactly what the general
     row function (checks, scaled frames, exact residuals) gives them."""
+    from spiral_cad.core import _kernel_circles as KC
+    from spiral_cad.core import _kernel_line_circle as KLC
+    from spiral_cad.core import _kernel_line_line as KLL
     from spiral_cad.core import _kernels as K
 
     code = {"walton-meek": K.WALTON_MEEK, "near-linear": K.NEAR_LINEAR}[shape]
     lc, cc, ll = _ordinary_rows(300)
-    cases = [(batch.line_to_circle(*lc, shape=shape), K.line_to_circle_general, np.column_stack([lc[0], lc[1], lc[2], lc[3]])),
-             (batch.circle_to_circle(*cc, shape=shape), K.circle_to_circle_general,
+    cases = [(batch.line_to_circle(*lc, shape=shape), KLC.line_to_circle_general, np.column_stack([lc[0], lc[1], lc[2], lc[3]])),
+             (batch.circle_to_circle(*cc, shape=shape), KC.circle_to_circle_general,
               np.column_stack([cc[0], cc[1], cc[2], cc[3]])),
-             (batch.line_to_line(*ll, shape=shape), K.line_to_line_general, np.column_stack(ll[:3] + (ll[3],)))]  # fmt: skip
+             (batch.line_to_line(*ll, shape=shape), KLL.line_to_line_general, np.column_stack(ll[:3] + (ll[3],)))]  # fmt: skip
     for result, general, rows in cases:
         assert result.ok.sum() > 100
         for i, row in enumerate(rows.tolist()):
@@ -187,6 +190,7 @@ def test_vectorised_rows_are_the_general_rows_bit_for_bit(shape):
 
 
 def test_batches_split_over_threads_give_the_bits_of_one_call():
+    from spiral_cad.core import _kernel_batches as KB
     from spiral_cad.core import _kernels as K
     from spiral_cad.core.threads import ROWS_PER_THREAD
 
@@ -195,7 +199,7 @@ def test_batches_split_over_threads_give_the_bits_of_one_call():
     p, d, c, radii = r.normal(size=(n, 2)), r.normal(size=(n, 2)), r.normal(size=(n, 2)) * 4, r.uniform(0.2, 3, n)
     split = batch.line_to_circle(p, d, c, radii)
     out, status, theta, measure = np.empty((n, 1, 4, 2)), np.empty(n, np.int8), np.empty(n), np.empty(n)
-    K.line_to_circle_batch(p, d, c, radii, K.WALTON_MEEK, out, status, theta, measure)
+    KB.line_to_circle_batch(p, d, c, radii, K.WALTON_MEEK, out, status, theta, measure)
     assert np.array_equal(split.spirals[0], out[:, 0], equal_nan=True)
     assert np.array_equal(split.status, status) and np.array_equal(split.theta, theta, equal_nan=True)
 

@@ -121,15 +121,15 @@ def test_the_scalar_api_compiles_after_its_budget_of_plain_python_calls():
     run("""
         from numba.core.registry import CPUDispatcher
         from spiral_cad import line_to_circle
-        from spiral_cad.core import _kernels as K
+        from spiral_cad.core import _kernel_line_circle as KLC
         from spiral_cad.core.jit import SCALAR_CALLS_BEFORE_COMPILING
 
         for _ in range(SCALAR_CALLS_BEFORE_COMPILING):
             line_to_circle((0, 0), (1, 0), (10, 5), 3)
-        assert not K.KERNELS.compiled
+        assert not KLC.KERNELS.compiled
         line_to_circle((0, 0), (1, 0), (10, 5), 3)
         assert all(r.compiled for r in registries.values())
-        assert isinstance(K.line_to_circle_row, CPUDispatcher)
+        assert isinstance(KLC.line_to_circle_row, CPUDispatcher)
     """)
 
 
@@ -139,19 +139,20 @@ def test_a_scalar_call_after_an_array_call_runs_plain_python_rather_than_wait_fo
     run("""
         import numpy as np
         from spiral_cad import line_to_circle
+        from spiral_cad.core import _kernel_line_circle as KLC
         from spiral_cad.core import _kernels as K
         from spiral_cad.design import round_corners_batch
 
         rng = np.random.default_rng(3)
         points = np.cumsum(rng.uniform(-1, 1, (50, 3)), axis=0)
         round_corners_batch(points[:-2], points[1:-1], points[2:])
-        assert K.KERNELS.compiled and not K.line_to_circle_row.signatures
+        assert K.KERNELS.compiled and not KLC.line_to_circle_row.signatures
         plain = line_to_circle((0, 0), (1, 0), (10, 5), 3)
-        assert not K.line_to_circle_row.signatures
+        assert not KLC.line_to_circle_row.signatures
         from spiral_cad.core.jit import SCALAR_CALLS_BEFORE_COMPILING
         for _ in range(SCALAR_CALLS_BEFORE_COMPILING):
             compiled = line_to_circle((0, 0), (1, 0), (10, 5), 3)
-        assert K.line_to_circle_row.signatures
+        assert KLC.line_to_circle_row.signatures
         a, b = plain.spirals[0].control_points, compiled.spirals[0].control_points
         assert np.abs(np.asarray(a) - np.asarray(b)).max() <= 1e-12 * 10
     """)

@@ -15,7 +15,7 @@ from hypothesis import strategies as st
 
 import spiral_cad as sc
 from spiral_cad import Status
-from spiral_cad.core import _kernels as K
+from spiral_cad.core import _kernel_batches as KB
 from spiral_cad.core import batch
 from spiral_cad.design import Alignment, circle_chain, round_corners
 
@@ -184,7 +184,7 @@ def test_every_input_mix_uses_one_compiled_kernel():
     mixes.append((full, [1, 0], readonly, 100.0))
     for args in mixes:
         assert batch.line_to_circle(*args).ok.all()
-    assert len(K.line_to_circle_batch.signatures) == 1
+    assert len(KB.line_to_circle_batch.signatures) == 1
 
 
 # ---------------------------------------------------- chains never accept a kink

@@ -9,8 +9,8 @@ from hypothesis import given
 from hypothesis import strategies as st
 
 from spiral_cad import NoSolutionError, circle_in_circle, circle_to_circle, line_to_circle, line_to_line
+from spiral_cad.core._kernel_circles import nested_band_lower as band_lower
 from spiral_cad.core._kernels import WALTON_MEEK
-from spiral_cad.core._kernels import nested_band_lower as band_lower
 
 
 def nested_band_lower(q):
