@@ -47,6 +47,10 @@ def check_file(args: argparse.Namespace) -> int:
         print(f"error: spiral-cad check reads STEP/IGES with OCCT, which comes with the CAD extra: {PIP_CAD}", file=sys.stderr)
         return 2
     picture = _picture_options(args)  # refused before anything is read
+    if args.units and suffix == ".xml":
+        print("error: --units: a LandXML file states its unit in <Units> (one without is read in metres, as LandXML "
+              "readers do)", file=sys.stderr)  # fmt: skip
+        return 2
     if args.units and suffix not in _DOCUMENTS:
         print(f"error: --units is the unit of a program or drawing that states none; {Path(args.file).name} is neither",
               file=sys.stderr)  # fmt: skip

@@ -164,6 +164,9 @@ def check(obj_or_path: Any, *, format: str | None = None, **options: Any) -> Any
         return _chosen(CHECKS, "check", source, format)(source, **options)  # each checker checks its options
     if format is not None:
         raise ValueError("check: format= names a file's format; an object is judged as it is")
+    if isinstance(obj_or_path, (bytes, dict)) or (isinstance(obj_or_path, (list, tuple)) and not obj_or_path):
+        what = f"an empty {type(obj_or_path).__name__}" if not obj_or_path else f"a {type(obj_or_path).__name__}"
+        raise ValueError(f"check: expected a file's path, a shape, a Chain or a Transition (or a list of shapes); got {what}")
     from OCP.TopAbs import TopAbs_FACE
     from OCP.TopExp import TopExp_Explorer
 
@@ -230,6 +233,8 @@ def _path(path: Any, verb: str) -> Path:
     """``path`` as a ``Path`` (``~`` expanded), or ValueError naming what was given instead."""
     if not isinstance(path, (str, os.PathLike)) or isinstance(path, bytes):
         raise ValueError(f"{verb}: path must be a file's path (str or os.PathLike); got {type(path).__name__}")
+    if not os.fspath(path):
+        raise ValueError(f"{verb}: path is empty; give a file's path")
     return Path(path).expanduser()
 
 

@@ -59,6 +59,7 @@ finite, or span more than the float range, is refused (``model_size``).
 from __future__ import annotations
 
 import math
+import numbers
 from collections.abc import Sequence
 from dataclasses import dataclass
 from enum import IntEnum
@@ -256,17 +257,17 @@ class ContinuityReport:
 
     def describe(self) -> str:
         """What was found, e.g. ``"1 wire of 13 edges"`` or ``"1 wire of 5 edges and 2 loose pieces (3, 1 edges)"``
-        (past 12 pieces, the rest's total: ``"(3, 1, …, … 480 more edges)"``)."""
+        (past 12 pieces, the rest's total: ``"40 wires (1, 1, …, 1, … edges; 28 edges in the other 28)"``)."""
         parts = []
         for kind in dict.fromkeys(w.kind for w in self.wires):
             counts = [w.edge_count for w in self.wires if w.kind == kind]
             if len(counts) == 1:
                 parts.append(f"1 {kind} of {_count(counts[0], self.element)}")
             else:
-                shown = ", ".join(map(str, counts[:_LISTED_COUNTS])) + (
-                    f", … {sum(counts[_LISTED_COUNTS:])} more" if len(counts) > _LISTED_COUNTS else ""
-                )
-                parts.append(f"{len(counts)} {kind}s ({shown} {_plural(self.element)})")
+                listed = ", ".join(map(str, counts[:_LISTED_COUNTS]))
+                rest = counts[_LISTED_COUNTS:]
+                more = f"; {_count(sum(rest), self.element)} in the other {len(rest)}" if rest else ""
+                parts.append(f"{len(counts)} {kind}s ({listed}{', …' if rest else ''} {_plural(self.element)}{more})")
         return " and ".join(parts) or f"no {_plural(self.element)}"
 
     def largest_plane_change(self) -> tuple[float, int, int] | None:
@@ -519,5 +520,5 @@ def closes_smoothly(ends: Sequence[tuple[Frame, Frame]] | NDArray, gap_tol: floa
 def check_tolerances(**tolerances: float) -> None:
     """Each tolerance must be a finite number ≥ 0, else ValueError naming it."""
     for name, value in tolerances.items():
-        if not (isinstance(value, (int, float)) and not isinstance(value, bool) and math.isfinite(value) and value >= 0.0):
+        if not (isinstance(value, numbers.Real) and not isinstance(value, (bool, np.bool_)) and math.isfinite(value) and value >= 0.0):
             raise ValueError(f"{name} must be finite and ≥ 0; got {value!r}")

@@ -341,6 +341,21 @@ def _arc(start: list[float], end: list[float], plane: int, ca: float, cb: float,
     return out
 
 
+#: An arc's centre may move onto the bisector of its chord by at most this many times the difference of
+#: its end radii (else no circle through both ends lies near it: a nearly whole turn with its ends apart).
+_BISECTOR_SHIFTS = 10.0
+
+
+def _bisector_shift(start: list[float], end: list[float], plane: int, ca: float, cb: float) -> float:
+    """How far ``_arc`` moves the centre (``ca``, ``cb``) onto the bisector of the chord (0 for no chord)."""
+    first, second, _ = PLANES[plane]
+    a0, b0, a1, b1 = start[first], start[second], end[first], end[second]
+    chord = math.hypot(a1 - a0, b1 - b0)
+    if chord == 0.0:
+        return 0.0
+    return abs(((ca - (a0 + a1) / 2) * (a1 - a0) + (cb - (b0 + b1) / 2) * (b1 - b0)) / chord)
+
+
 def read_gcode_runs(path: str | os.PathLike, *, units: str | None = None) -> tuple[list[list[Any]], list[list[int]], str, list[str]]:
     """The exact cutting paths of a G-code file: every run of feed moves between rapids as the curves it
     states (G1 lines, G2/G3 arcs, G5 cubics as ``parse_gcode_chain``'s spiral pieces), in space and in the
@@ -349,8 +364,10 @@ def read_gcode_runs(path: str | os.PathLike, *, units: str | None = None) -> tup
     As ``parse_gcode_moves`` reads them: the first move starts where the machine happens to be, so it is
     no segment (noted when it is a cut); an arc whose end lies off its circle (within what the program's
     decimals leave) is the arc about the centre moved onto the bisector of its chord, so that it ends
-    where the move does (noted when that moves its centre); an arc of more than one turn is one turn and
-    the rest (noted); a helical arc is left out and parts its run (counted in the notes).
+    where the move does (noted when that moves its centre), unless that moves the centre farther than
+    ``_BISECTOR_SHIFTS`` times the difference of its radii (a nearly whole turn whose ends are apart is
+    no arc: left out, noted); an arc of more than two turns is judged on its last two (noted); a helical
+    arc is left out and parts its run (counted in the notes).
 
     Args:
         path: the program.
@@ -386,14 +403,23 @@ def read_gcode_runs(path: str | os.PathLike, *, units: str | None = None) -> tup
         try:
             if kind == "arc":
                 end, plane, ca, cb, rotation = data
-                segments = _arc(start, end, plane, ca, cb, max(-2, min(2, rotation)), 1.0, 3, None)
                 a, b, _ = PLANES[plane]
                 r0, r1 = math.hypot(start[a] - ca, start[b] - cb), math.hypot(end[a] - ca, end[b] - cb)
+                moved = _bisector_shift(start, end, plane, ca, cb)
+                if moved > _BISECTOR_SHIFTS * abs(r0 - r1) + 1e-12 * max(r0, r1):
+                    # ends so close that no circle through both lies near the centre: not an arc (rs274 runs a spiral)
+                    notes.append(f"line {number}: an arc whose end lies {abs(r0 - r1):.3g} off its circle with ends "
+                                 f"{math.hypot(end[a] - start[a], end[b] - start[b]):.3g} apart is no arc: left out, it parts its path")  # fmt: skip
+                    runs.append([])
+                    lines.append([])
+                    continue
+                segments = _arc(start, end, plane, ca, cb, max(-2, min(2, rotation)), 1.0, 3, None)
                 if abs(r0 - r1) > 1e-9 * max(r0, r1):
                     notes.append(f"line {number}: the arc's end lies {abs(r0 - r1):.3g} off its circle: judged about the "
-                                 "centre moved onto the bisector of its chord")  # fmt: skip
+                                 f"centre moved {moved:.3g} onto the bisector of its chord")  # fmt: skip
                 if abs(rotation) > 1:
-                    notes.append(f"line {number}: an arc of {abs(rotation)} turns, judged as one turn and the rest")
+                    notes.append(f"line {number}: an arc of {abs(rotation)} turns, judged on its last two (the turns before "
+                                 "run on the same circle)")  # fmt: skip
             else:
                 segments = _piece_segment(kind, start, data, 1.0, 3) or []
         except ValueError as error:

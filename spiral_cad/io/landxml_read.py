@@ -139,7 +139,10 @@ class LandXMLAlignment:
         file_lengths: per element its length in the file.
         element_frames: (n, 2, 9) per element its start and end as the file states them: point, unit
             tangent and curvature vector (z = 0); placed by its Start and direction (else the end of the
-            element before) and run by its length and end curvatures (``check_landxml`` judges these).
+            element before), ending at its End (else where its length takes it), turned by its length and
+            end curvatures (``check_landxml`` judges these).
+        end_misses: per element how far its End lies from where its Start, direction, length and
+            curvatures take it (0 without an End).
     """
 
     name: str
@@ -159,6 +162,7 @@ class LandXMLAlignment:
     directions: str = "unknown"
     file_lengths: NDArray[np.float64] = field(default_factory=lambda: np.zeros(0))
     element_frames: NDArray[np.float64] = field(default_factory=lambda: np.zeros((0, 2, 9)))
+    end_misses: NDArray[np.float64] = field(default_factory=lambda: np.zeros(0))
 
     @property
     def chain(self) -> Chain:
@@ -539,6 +543,7 @@ def _alignment(r: _Reader, a: ET.Element, label: str) -> LandXMLAlignment:
         raise ValueError(f"{where}: no CoordGeom (geometry given only as {', '.join(sorted({_local(c.tag) for c in a})) or 'nothing'}); "
                          "only CoordGeom alignments can be rebuilt")  # fmt: skip
     items: list[_Element] = []
+    ends_at: list[NDArray | None] = []
     skipped: list[str] = []
     r.used = 0
     station = start_station
@@ -548,10 +553,12 @@ def _alignment(r: _Reader, a: ET.Element, label: str) -> LandXMLAlignment:
         place = f"{where}, CoordGeom element {index} ({_local(e.tag)}) at station {station:.6g}"
         item = _element(r, e, place)
         item.where = place
+        ends_at.append(r.point(e, "End", place))  # where the file says it ends (None: where its length takes it)
         if item.station is None:
             item.station = station
         if item.length == 0.0:  # MDT writes zero-length curves between spirals: a point, nothing to build
             skipped.append(f"{place}: zero length, skipped")
+            ends_at.pop()
             continue
         if not item.length > 0.0:
             raise ValueError(f"{place}: length {item.length!r} is not positive")
@@ -635,7 +642,9 @@ def _alignment(r: _Reader, a: ET.Element, label: str) -> LandXMLAlignment:
                             start_station + np.concatenate([[0.0], np.cumsum(ours)[:-1]]), notes,
                             np.array([i.station for i in items]), ours - size,
                             tuple(methods.get(k, "file") for k in range(len(items))), tuple(owners), r.directions, size,
-                            _element_frames(starts, headings, ends, bend, k1))  # fmt: skip
+                            _element_frames(starts, headings, [(p if at is None else at, h) for (p, h), at in zip(ends, ends_at)],
+                                            bend, k1),
+                            np.array([0.0 if at is None else float(np.hypot(*(at - p))) for (p, _), at in zip(ends, ends_at)]))  # fmt: skip
 
 
 def _element_frames(starts: list[NDArray], headings: list[float], ends: list[tuple[NDArray, float]], k0: NDArray,

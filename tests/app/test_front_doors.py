@@ -80,8 +80,8 @@ def test_check_reads_the_programs_cam_systems_write_and_says_how(tmp_path, capsy
     report = sc.check(path)
     notes = " | ".join(report.notes)
     assert "line 2: the first move starts where the machine is" in notes
-    assert "line 4: the arc's end lies 0.001 off its circle: judged about the centre moved onto the bisector" in notes
-    assert "line 6: an arc of 3 turns, judged as one turn and the rest" in notes
+    assert "line 4: the arc's end lies 0.001 off its circle: judged about the centre moved 0.000707 onto the bisector" in notes
+    assert "line 6: an arc of 3 turns, judged on its last two (the turns before run on the same circle)" in notes
     (wire,) = report.wires
     assert not wire.closed and wire.edge_count == 7  # line, arc, line, two halves of the turns, line, line
     with pytest.raises(ValueError, match=r"a program's unit is mm \(G21\) or in \(G20\); got 'cm'"):
@@ -428,5 +428,32 @@ def test_a_programs_many_runs_keep_the_summary_line_short_and_whole_number_toler
     path.write_text("G21\nG0 Z1\n" + "".join(f"G0 X{k} Y0\nG1 Z-1 F100\nG0 Z1\n" for k in range(40)) + "M2\n")
     assert main(["check", str(path), "--quiet"]) == 0
     (summary,) = capsys.readouterr().out.splitlines()
-    assert summary.startswith("holes.ngc: 40 wires (1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, … 28 more edges); worst joint")
+    assert summary.startswith("holes.ngc: 40 wires (1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, … edges; 28 edges in the other 28); worst")
     assert sc.check(path, curvature_tol=1, gap_tol=0).wires
+
+
+def test_an_arc_whose_ends_are_too_close_for_any_circle_near_its_centre_is_left_out(tmp_path):
+    """A nearly whole turn whose end lies 0.0004 mm off its circle: no circle through both ends lies near
+    its centre (the chord's bisector is 5 mm away), so it is left out and said so, not judged as a tiny arc."""
+    path = tmp_path / "nearly.ngc"
+    path.write_text("G21\nG0 X0.0004 Y10 Z0\nG1 X0.0004 Y0 F100\nG3 X0 Y0 I4.9996 J0\nG1 X0 Y-10\nM2\n")
+    report = sc.check(path)
+    assert "line 4: an arc whose end lies 0.0004 off its circle with ends 0.0004 apart is no arc: left out" in " | ".join(report.notes)
+    assert [w.edge_count for w in report.wires] == [1, 1] and all(j.curvature_after < 1 for w in report.wires for j in w.joints)
+
+
+def test_a_landxml_check_takes_its_tolerances_from_the_alignments_own_numbers(tmp_path):
+    """Coordinates printed to 3 decimals: a joint the printing leaves 0.0004 apart (its End and the next
+    Start as printed) and a spiral's End as printed are judged within what 3 decimals resolve; a parcel's
+    coarser numbers elsewhere in the file do not loosen them, and a kink of 0.001 rad still shows."""
+    lines = ('<Line><Start>0.000 0.000</Start><End>0.000 100.000</End></Line>'
+             '<Line><Start>0.000 100.000</Start><End>0.000 200.000</End></Line>'
+             '<Line><Start>0.000 200.000</Start><End>0.100 300.000</End></Line>')  # fmt: skip
+    parcel = '<Parcels><Parcel name="P"><CoordGeom><Line><Start>0 0</Start><End>1 1</End></Line></CoordGeom></Parcel></Parcels>'
+    path = tmp_path / "road.xml"
+    path.write_text(LANDXML.format(units=METRES, elements=lines).replace("</Alignments>", "</Alignments>" + parcel))
+    report = sc.check(path)
+    first, second = report.wires[0].joints
+    assert first.level.name == "G2" and second.level.name == "G0" and second.angle == pytest.approx(0.001, rel=1e-3)
+    assert "tolerances from the file's numbers (3 printed decimals) and its size: gap 0.005" in " | ".join(report.notes)
+    assert report.gap_tol == 0.005 and report.angle_tol == pytest.approx(1e-4)
