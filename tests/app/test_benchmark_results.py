@@ -29,7 +29,6 @@ NOT_YET_STAMPED = {
     "results_cad.md",
     "results_chains.md",
     "results_checker.md",
-    "results_cold.md",
     "results_fillets.md",
     "results_fit.md",
     "results_ifc.md",
