@@ -40,7 +40,7 @@ def test_the_cad_operations_keep_their_speed(name):
         ("corners-plane", "spiral_cad.design.rounding", 0.5),
         ("corners-space", "spiral_cad.core.space", 0.5),
         ("chain", "spiral_cad.core._chain_kernels", 0.05),
-        ("transitions", "spiral_cad.core._kernels", 0.05),
+        ("transitions", "spiral_cad.core._kernel_batches", 0.05),
     ],
 )
 def test_the_guard_fails_when_a_kernel_falls_back_to_plain_python(name, module, scale, monkeypatch):
