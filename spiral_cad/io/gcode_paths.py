@@ -26,6 +26,7 @@ from __future__ import annotations
 
 import math
 import os
+import re
 from dataclasses import dataclass
 from typing import Any
 
@@ -356,13 +357,27 @@ def _bisector_shift(start: list[float], end: list[float], plane: int, ca: float,
     return abs(((ca - (a0 + a1) / 2) * (a1 - a0) + (cb - (b0 + b1) / 2) * (b1 - b0)) / chord)
 
 
+def _first_named(text: str) -> dict[str, int]:
+    """The line on which each of X, Y and Z is first named (comments aside)."""
+    from .gcode import _COMMENTS
+
+    found: dict[str, int] = {}
+    for number, line in enumerate(_COMMENTS.sub(" ", text).replace("\r\n", "\n").replace("\r", "\n").split("\n"), 1):
+        for axis in re.findall(r"(?<![A-Z#])([XYZ])\s*[-+.\d]", line.upper()):
+            found.setdefault(axis, number)
+        if len(found) == 3:
+            break
+    return found
+
+
 def read_gcode_runs(path: str | os.PathLike, *, units: str | None = None) -> tuple[list[list[Any]], list[list[int]], str, list[str]]:
     """The exact cutting paths of a G-code file: every run of feed moves between rapids as the curves it
     states (G1 lines, G2/G3 arcs, G5 cubics as ``parse_gcode_chain``'s spiral pieces), in space and in the
     program's unit, whether or not they join G2.
 
-    As ``parse_gcode_moves`` reads them: the first move starts where the machine happens to be, so it is
-    no segment (noted when it is a cut); an arc whose end lies off its circle (within what the program's
+    A move that changes an axis the program has not named on an earlier line starts where the machine
+    happens to be on it (the first move, a first cut after ``G0 Z5``): it is no segment (noted when it is
+    a cut); an arc whose end lies off its circle (within what the program's
     decimals leave) is the arc about the centre moved onto the bisector of its chord, so that it ends
     where the move does (noted when that moves its centre), unless that moves the centre farther than
     ``_BISECTOR_SHIFTS`` times the difference of its radii (a nearly whole turn whose ends are apart is
@@ -390,11 +405,18 @@ def read_gcode_runs(path: str | os.PathLike, *, units: str | None = None) -> tup
     lines: list[list[int]] = [[]]
     notes: list[str] = list(reader.notes)
     helical = 0
-    pieces = reader.pieces
-    if pieces and not pieces[0][2]:
-        notes.append(f"line {pieces[0][1]}: the first move starts where the machine is, which the program does not say: not judged")
-    for kind, number, rapid, start, *data in pieces[1:]:
+    named = _first_named(text)
+    for kind, number, rapid, start, *data in reader.pieces:
         helix = kind == "arc" and data[0][PLANES[data[1]][2]] != start[PLANES[data[1]][2]]
+        ends_at = data[0] if kind != "cubic" else data[0][-1]
+        unknown = [axis for k, axis in enumerate("XYZ") if ends_at[k] != start[k] and not named.get(axis, number) < number]
+        if unknown:  # it starts where the machine happens to be on those axes
+            if not rapid:
+                notes.append(f"line {number}: the move starts where the program has not said ({', '.join(unknown)} not named "
+                             "before it): not judged")  # fmt: skip
+            runs.append([])
+            lines.append([])
+            continue
         if rapid or helix:
             helical += helix
             runs.append([])

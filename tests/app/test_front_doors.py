@@ -72,14 +72,19 @@ def test_a_program_the_built_in_reader_refuses_is_read_by_rs274(tmp_path, capsys
 
 def test_check_reads_the_programs_cam_systems_write_and_says_how(tmp_path, capsys):
     """An arc whose end lies 0.001 mm off its circle (rs274 runs it) is judged about the centre on its chord's
-    bisector, and said so; the first move, from wherever the machine is, is not judged; an arc of three
+    bisector, and said so; a move on an axis not yet named (from wherever the machine is) is not judged; an arc of three
     turns is one turn and the rest; a run that ends where it began stays open (the tool stops there)."""
     path = tmp_path / "cam.ngc"
     path.write_text("G21 G90 G17\nG1 X0 Y0 Z0 F100\nG1 X10\nG3 X20 Y10 I0 J10.001\nG1 Y20\nG2 X20 Y20 I5 J0 P3\n"
                     "G1 X10 Y30\nG1 X0 Y0\nM2\n")  # fmt: skip
     report = sc.check(path)
     notes = " | ".join(report.notes)
-    assert "line 2: the first move starts where the machine is" in notes
+    assert "starts where the program has not said" not in notes  # line 2 names every axis
+    after_lift = tmp_path / "lift.ngc"
+    after_lift.write_text("G21 G90 G17 F100\nG0 Z5\nG1 X10 Y0\nG1 X20 Y0\nG1 X20 Y10\nM2\n")
+    lifted = sc.check(after_lift)  # X and Y are first named on line 3: its move starts where the machine is
+    assert "line 3: the move starts where the program has not said (X not named before it): not judged" in lifted.notes
+    assert [w.edge_count for w in lifted.wires] == [2]
     assert "line 4: the arc's end lies 0.001 off its circle: judged about the centre moved 0.000707 onto the bisector" in notes
     assert "line 6: an arc of 3 turns, judged on its last two (the turns before run on the same circle)" in notes
     (wire,) = report.wires
