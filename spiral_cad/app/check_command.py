@@ -14,6 +14,7 @@ from ..continuity.joints import Continuity, ContinuityReport
 from ..io.gcode import SUFFIXES as GCODE_SUFFIXES
 from ..io.opendrive_check import PROFILE_LEVELS, OpenDriveReport
 from .cli_shared import MANY_OPTIONS, PIP_CAD, add_many_options, run_on_many, summary_only
+from .files import CHECKS
 from .many_inputs import expand_inputs, wants_many
 from .many_task import note_worst
 
@@ -121,6 +122,8 @@ def _check_document(args: argparse.Namespace) -> int:
     from .files import check
 
     name, suffix = Path(args.file).name, Path(args.file).suffix.lower()
+    if args.comb and suffix == ".xml":
+        raise ValueError("--comb draws the curves of STEP, IGES, DXF and G-code files; a LandXML file is judged on its numbers")
     given = {k: v for k in ("gap_tol", "angle_tol", "curvature_tol", "snap", "units") if (v := getattr(args, k)) is not None}
     report = check(args.file, **given)
     for note in [] if args.quiet else report.notes:
@@ -259,7 +262,7 @@ def add_check(sub: argparse._SubParsersAction) -> None:
                        "lane centre, as a driver follows them; road links reference line to reference line)")  # fmt: skip
     check.add_argument("--snap", type=float, help="chain loose ends closer than this (model units; default 1%% of the model size)")
     check.add_argument("--comb", metavar="OUT.step",
-                       help="also write the curvature comb of every edge as STEP (any input but OpenDRIVE; never the checked file)")  # fmt: skip
+                       help="also write the curvature comb of every edge as STEP (STEP, IGES, DXF or G-code input; never the checked file)")  # fmt: skip
     check.add_argument("--units", choices=["mm", "cm", "m", "km", "in", "ft"],
                        help="the unit of a G-code program that says neither G20 nor G21 (mm or in), or of a DXF drawing "
                             "without $INSUNITS; a file that states its unit is never relabelled")  # fmt: skip
@@ -294,7 +297,8 @@ def add_check(sub: argparse._SubParsersAction) -> None:
 #: The files ``check`` looks for in a folder it is given.
 #: What each kind of document judged as curves is called in messages.
 _DOCUMENTS = {".dxf": "a DXF drawing", ".xml": "a LandXML file", **dict.fromkeys(GCODE_SUFFIXES, "a CNC program")}
-CHECK_SUFFIXES = (".step", ".stp", ".igs", ".iges", ".xodr", *_DOCUMENTS)
+#: Every suffix ``check`` judges (``spiral_cad.check``'s table).
+CHECK_SUFFIXES = tuple(suffix for suffixes, _ in CHECKS.values() for suffix in suffixes)
 
 
 def _picture_options(args: argparse.Namespace) -> dict:

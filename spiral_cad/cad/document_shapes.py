@@ -1,5 +1,6 @@
-"""A CNC program's cutting paths and a LandXML file's alignments as exact OCCT wires, so that the STEP
-checker judges them joint by joint, as it judges a drawing (``dxf_shape``).
+"""A CNC program's cutting paths as exact OCCT wires, so that the STEP checker judges them joint by
+joint, as it judges a drawing (``dxf_shape``). (A LandXML file is judged on its own numbers:
+``spiral_cad.io.landxml_check``.)
 
 A program's feed moves are read as the curves they state (``io.gcode_paths.read_gcode_runs``: G1 lines,
 G2/G3 arcs, G5 cubics; by LinuxCNC's ``rs274`` as lines and arcs where the built-in reader refuses the
@@ -7,11 +8,6 @@ program and rs274 is installed), in the program's unit; every run between two ra
 the tool goes on cutting, and never across a rapid. A helical move is not judged: OCCT has no exact
 helix edge (and rs274's chords of one would be kinks of the reading, not of the program); it parts the
 run and is counted in the notes.
-
-A LandXML file's alignments are read as ``read_landxml`` rebuilds them: lines and arcs on the file's
-own carriers, a spiral as the cubic that follows its clothoid (how far, the notes say). Each alignment
-is one wire where its elements meet, else one wire per part; the joints where the file's curvature
-jumps are judged as they are drawn.
 """
 
 from __future__ import annotations
@@ -26,7 +22,7 @@ from OCP.TopoDS import TopoDS_Compound
 
 from .occ import chain_wire
 
-__all__ = ["document_shape", "landxml_shape", "program_shape"]
+__all__ = ["document_shape", "program_shape"]
 
 #: The chords a helical move is read as are left out, so any tolerance serves (the program's unit).
 _HELIX_CHORDS = 1e-3
@@ -35,8 +31,8 @@ _LISTED = 50
 
 
 def document_shape(path: str | os.PathLike, *, units: str | None = None) -> tuple[TopoDS_Compound, str, list[str]]:
-    """The curves of a DXF drawing (``dxf_shape``), a LandXML file (``landxml_shape``) or a G-code program
-    (``program_shape``), chosen by the suffix: the compound, its unit and the notes.
+    """The curves of a DXF drawing (``dxf_shape``) or a G-code program (``program_shape``), chosen by the
+    suffix: the compound, its unit and the notes.
 
     Args:
         path: the file.
@@ -58,11 +54,9 @@ def document_shape(path: str | os.PathLike, *, units: str | None = None) -> tupl
         shape, found, notes = dxf_shape(path)
         if found == DRAWING_UNITS and units is not None:
             return shape, length_unit(units), [*notes, f"the drawing states no unit ($INSUNITS): read in {length_unit(units)} as stated"]
-    elif suffix == ".xml":
-        shape, found, notes = landxml_shape(path)
     else:
-        raise ValueError(f"{Path(path).name}: a drawing (.dxf), a LandXML file (.xml) or a G-code program ({' '.join(SUFFIXES)}) "
-                         f"was expected; got {suffix or 'no suffix'!r}")  # fmt: skip
+        raise ValueError(f"{Path(path).name}: a drawing (.dxf) or a G-code program ({' '.join(SUFFIXES)}) was expected; "
+                         f"got {suffix or 'no suffix'!r}")  # fmt: skip
     if units is not None and length_unit(units) != found:
         raise ValueError(f"{Path(path).name} states its unit, {found}; the unit given ({units}) would relabel it: leave it out")
     return shape, found, notes
@@ -132,39 +126,3 @@ def program_shape(path: str | os.PathLike, *, units: str | None = None) -> tuple
     if len(lines) > _LISTED:
         notes.append(f"… and {len(lines) - _LISTED} more cutting paths")
     return _compound(runs, lines), unit, notes
-
-
-def landxml_shape(path: str | os.PathLike) -> tuple[TopoDS_Compound, str, list[str]]:
-    """The horizontal alignments of the LandXML file ``path`` as wires (one per alignment where its
-    elements meet), their unit and notes for the reader (how far each rebuilt spiral is from the file's
-    clothoid, where the elements part).
-
-    Raises:
-        ValueError: a file ``read_landxml`` refuses, or one without an alignment.
-    """
-    from ..io.landxml_read import read_landxml
-
-    alignments = read_landxml(path)
-    name = Path(path).name
-    if not alignments:
-        raise ValueError(f"{name}: the file holds no alignment")
-    paths: list[list[Any]] = []
-    notes: list[str] = []
-    for alignment in alignments:
-        first = len(paths)
-        for chain in alignment.chains:
-            segments = list(chain)
-            if len(paths) > first and _meet(paths[-1][-1], segments[0], chain.size):
-                paths[-1] += segments
-            else:
-                paths.append(segments)
-        if "Spiral" in alignment.kinds:
-            notes.append(f"alignment {alignment.name!r}: spirals judged as rebuilt cubics; the largest offset from the "
-                         f"file's elements is at {alignment.worst}")  # fmt: skip
-        notes += [f"alignment {alignment.name!r}: {why}" for why in alignment.breaks if "gap" in why]
-    notes.append("horizontal alignments judged; profiles (ProfAlign) are not")
-    return _compound(paths), alignments[0].units, notes
-
-
-def _meet(before: Any, after: Any, size: float) -> bool:
-    return float(np.linalg.norm(np.asarray(before.end, dtype=float) - np.asarray(after.start, dtype=float))) <= 1e-9 * max(size, 1.0)

@@ -122,14 +122,11 @@ def _printed_decimals(root: ET.Element) -> int | None:
     """The decimals the alignments print their coordinates to, where most of them are printed to one fixed
     number of them (as a program writes them), else None (the numbers taken as exact: a hand-written
     ``0 100`` is not a precision of one metre)."""
-    found = []
-    for numbers in (_coordinates(root),):
-        counts = Counter(len(number.split(".", 1)[1]) if "." in number else 0 for number in numbers if "e" not in number.lower())
-        if counts:
-            decimals, seen = counts.most_common(1)[0]
-            if decimals >= 1 and 2 * seen >= sum(counts.values()):
-                found.append(decimals)
-    return min(found) if found else None
+    counts = Counter(len(n.split(".", 1)[1]) if "." in n else 0 for n in _coordinates(root) if "e" not in n.lower())
+    if not counts:
+        return None
+    decimals, seen = counts.most_common(1)[0]
+    return decimals if decimals >= 1 and 2 * seen >= sum(counts.values()) else None
 
 
 def _geometry(root: ET.Element) -> list[ET.Element]:
