@@ -313,13 +313,8 @@ def _arc(start: list[float], end: list[float], plane: int, ca: float, cb: float,
                              "give a tolerance for its chords (helix_tolerance; build: --arc-tolerance)")  # fmt: skip
         corners = [list(start), *arc_points(start, end, plane, ca, cb, rotation, helix_tolerance / factor)]
         return [_line(a, b, factor, dim) for a, b in zip(corners[:-1], corners[1:]) if a != b]
-    a0, b0, a1, b1 = start[first], start[second], end[first], end[second]
-    chord = math.hypot(a1 - a0, b1 - b0)
-    if chord > 0.0:  # the centre on the chord's bisector: the arc ends where the move does
-        na, nb = -(b1 - b0) / chord, (a1 - a0) / chord
-        ma, mb = (a0 + a1) / 2, (b0 + b1) / 2
-        along = (ca - ma) * na + (cb - mb) * nb
-        ca, cb = ma + along * na, mb + along * nb
+    a0, b0 = start[first], start[second]
+    ca, cb, _ = _on_bisector(start, end, plane, ca, cb)  # the arc ends where the move does
     t0, sweep = arc_sweep(start, end, plane, ca, cb, rotation)
     radius = math.hypot(a0 - ca, b0 - cb)
     turns = max(1, math.ceil(abs(sweep) / (2 * math.pi) - 1e-12))
@@ -347,14 +342,17 @@ def _arc(start: list[float], end: list[float], plane: int, ca: float, cb: float,
 _BISECTOR_SHIFTS = 10.0
 
 
-def _bisector_shift(start: list[float], end: list[float], plane: int, ca: float, cb: float) -> float:
-    """How far ``_arc`` moves the centre (``ca``, ``cb``) onto the bisector of the chord (0 for no chord)."""
+def _on_bisector(start: list[float], end: list[float], plane: int, ca: float, cb: float) -> tuple[float, float, float]:
+    """The centre (``ca``, ``cb``) moved to the nearest point of the bisector of the arc's chord, and how far
+    it moved (unmoved without a chord)."""
     first, second, _ = PLANES[plane]
     a0, b0, a1, b1 = start[first], start[second], end[first], end[second]
     chord = math.hypot(a1 - a0, b1 - b0)
     if chord == 0.0:
-        return 0.0
-    return abs(((ca - (a0 + a1) / 2) * (a1 - a0) + (cb - (b0 + b1) / 2) * (b1 - b0)) / chord)
+        return ca, cb, 0.0
+    ta, tb = (a1 - a0) / chord, (b1 - b0) / chord
+    off = (ca - (a0 + a1) / 2) * ta + (cb - (b0 + b1) / 2) * tb  # along the chord: what the move removes
+    return ca - off * ta, cb - off * tb, abs(off)
 
 
 def _first_named(text: str) -> dict[str, int]:
@@ -427,7 +425,7 @@ def read_gcode_runs(path: str | os.PathLike, *, units: str | None = None) -> tup
                 end, plane, ca, cb, rotation = data
                 a, b, _ = PLANES[plane]
                 r0, r1 = math.hypot(start[a] - ca, start[b] - cb), math.hypot(end[a] - ca, end[b] - cb)
-                moved = _bisector_shift(start, end, plane, ca, cb)
+                moved = _on_bisector(start, end, plane, ca, cb)[2]
                 if moved > _BISECTOR_SHIFTS * abs(r0 - r1) + 1e-12 * max(r0, r1):
                     # ends so close that no circle through both lies near the centre: not an arc (rs274 runs a spiral)
                     notes.append(f"line {number}: an arc whose end lies {abs(r0 - r1):.3g} off its circle with ends "
