@@ -50,6 +50,15 @@ def _padded(rows: list[NDArray]) -> NDArray:
     return out
 
 
+def _homogeneous(points: list[tuple[float, float, float]], weights: list[float]) -> NDArray:
+    """Rows (w·P, w) of the poles ``points`` with their ``weights``."""
+    rows = np.empty((len(weights), 4))
+    rows[:, 3] = weights
+    rows[:, :3] = points
+    rows[:, :3] *= rows[:, 3:]
+    return rows
+
+
 def bspline_surfaces(surfaces: list[Geom_BSplineSurface]) -> dict[tuple[int, int], tuple[BSplineSurfaces, list[int]]]:
     """The surfaces that are not periodic, grouped by degree pair: per pair the table and the positions of
     its surfaces in ``surfaces`` (their poles where they are: a located copy gives located ones)."""
@@ -69,12 +78,9 @@ def bspline_surfaces(surfaces: list[Geom_BSplineSurface]) -> dict[tuple[int, int
                 knots[axis].append(np.repeat(values, [multiplicity(i) for i in range(1, count + 1)]))
             rational = s.IsURational() or s.IsVRational()
             nu, nv = s.NbUPoles(), s.NbVPoles()
-            block = np.empty((nu * nv, 4))
-            for i in range(nu):
-                for j in range(nv):
-                    w = s.Weight(i + 1, j + 1) if rational else 1.0
-                    block[i * nv + j] = (*(w * c for c in s.Pole(i + 1, j + 1).Coord()), w)
-            poles.append(block)
+            cells = [(i, j) for i in range(1, nu + 1) for j in range(1, nv + 1)]
+            weights = [s.Weight(i, j) for i, j in cells] if rational else [1.0] * len(cells)
+            poles.append(_homogeneous([s.Pole(i, j).Coord() for i, j in cells], weights))
             columns.append(nv)
         (p, q), sizes = degrees, [np.array([len(k) for k in knots[axis]]) for axis in (0, 1)]
         spans = ((np.full(len(members), p), sizes[0] - p - 2), (np.full(len(members), q), sizes[1] - q - 2))
@@ -191,12 +197,9 @@ def bspline_curves(curves: list[Geom_BSplineCurve]) -> dict[int, tuple[BSplineCu
             c = curves[k]
             count = c.NbKnots()
             knots.append(np.repeat([c.Knot(i) for i in range(1, count + 1)], [c.Multiplicity(i) for i in range(1, count + 1)]))
-            rational = c.IsRational()
-            block = np.empty((c.NbPoles(), 4))
-            for i in range(c.NbPoles()):
-                w = c.Weight(i + 1) if rational else 1.0
-                block[i] = (*(w * x for x in c.Pole(i + 1).Coord()), w)
-            poles.append(block)
+            cells = range(1, c.NbPoles() + 1)
+            weights = [c.Weight(i) for i in cells] if c.IsRational() else [1.0] * len(cells)
+            poles.append(_homogeneous([c.Pole(i).Coord() for i in cells], weights))
         sizes = np.array([len(k) for k in knots])
         first = np.concatenate([[0], np.cumsum([len(b) for b in poles])[:-1]])
         spans = np.stack([np.full(len(members), degree), sizes - degree - 2])

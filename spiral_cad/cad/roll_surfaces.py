@@ -283,10 +283,10 @@ def _surface_face(along: _Along, section: _Section, degenerate: float) -> tuple[
     grid = np.concatenate([xy, np.broadcast_to(z[None, :, None], (rows, cols, 1))], axis=2).astype(float)
     products = along.weights[:, None] * section.weights[None, :]
     poles, weights = TColgp_Array2OfPnt(1, rows, 1, cols), TColStd_Array2OfReal(1, rows, 1, cols)
-    for i in range(rows):
-        for j in range(cols):
-            poles.SetValue(i + 1, j + 1, gp_Pnt(*(float(c) for c in grid[i, j])))
-            weights.SetValue(i + 1, j + 1, float(products[i, j]))
+    for i, (pole_row, weight_row) in enumerate(zip(grid.tolist(), products.tolist()), 1):
+        for j, ((x, y, z), weight) in enumerate(zip(pole_row, weight_row), 1):
+            poles.SetValue(i, j, gp_Pnt(x, y, z))
+            weights.SetValue(i, j, weight)
     surface = Geom_BSplineSurface(
         poles, weights, _reals(along.knots), _reals(section.knots), _ints(along.mults), _ints(section.mults),
         along.degree, section.degree,

@@ -222,7 +222,7 @@ def verify_solid(shape: TopoDS_Shape, what: str = "slab", facing_out: bool = Fal
         raise NoSolutionError(f"the {what} is {count} solids, not one")
     if _first_solid(shape).Orientation() != TopAbs_FORWARD:
         raise NoSolutionError(f"the {what} is a {_first_solid(shape).Orientation().name} solid, not FORWARD (booleans drop it)")
-    if not BRepCheck_Analyzer(shape).IsValid():
+    if not BRepCheck_Analyzer(shape, True, True).IsValid():  # geometry too, in parallel
         raise NoSolutionError(f"the {what} is not a valid solid (BRepCheck_Analyzer)")
     volume = 1.0 if facing_out else _volume(shape)
     if not volume > 0.0:

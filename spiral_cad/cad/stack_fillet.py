@@ -195,7 +195,7 @@ def fillet_stack_edges(
         local, approximation = stack_solid(planned, roll_profile(given, **_roll_options(options)), tol, size)
         placed = BRepBuilderAPI_Transform(local, _to_global(frame), True).Shape()
         result = forward_solid(TopoDS.Solid_s(placed) if placed.ShapeType() == TopAbs_SOLID else _first_solid(placed))
-        verify_solid(result, "rounded part")
+        verify_solid(result, "rounded part", facing_out=True)  # the stack's shell faces out by construction
         levels = [expected_level(wall.loop) for wall in planned]
         verify_faces(result, "G1" if "G1" in levels else "G2", "rounded part")
     except NoSolutionError as error:
