@@ -143,6 +143,24 @@ def make_g2_picture() -> None:
     fig.savefig(IMAGES / "make_g2_curvature.png")
 
 
+def report_page_picture() -> None:
+    """The Faces guide's picture of the web page ``check --html`` writes, as headless Chromium draws it
+    (software WebGL): build123d's box with circular vertical fillets, its G1 edges orange."""
+    import build123d as bd
+
+    import spiral_cad as sc
+
+    with tempfile.TemporaryDirectory() as tmp:
+        page = Path(tmp) / "part.html"
+        sc.check(bd.fillet(bd.Box(60, 40, 10).edges().filter_by(bd.Axis.Z), 12), html=page)
+        subprocess.run(
+            [shutil.which("chromium") or "chromium", "--headless", "--no-sandbox", "--use-angle=swiftshader",
+             "--enable-unsafe-swiftshader", f"--user-data-dir={tmp}/profile", "--virtual-time-budget=8000",
+             "--window-size=1100,720", f"--screenshot={IMAGES / 'report_page.png'}", f"{page.as_uri()}#item=0"],
+            check=True, capture_output=True,
+        )  # fmt: skip
+
+
 def main() -> None:
     IMAGES.mkdir(parents=True, exist_ok=True)
     with tempfile.TemporaryDirectory() as tmp:
@@ -178,6 +196,7 @@ def main() -> None:
         solids_pictures()
         gallery_pictures()
         make_g2_picture()
+        report_page_picture()
     for path in sorted(IMAGES.iterdir()):
         print(path.relative_to(ROOT))
 

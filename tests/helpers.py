@@ -4,6 +4,7 @@ OpenDRIVE tools environment), and the check of plain-number CSV tables."""
 
 from __future__ import annotations
 
+import http.server
 import io
 import json
 import math
@@ -11,7 +12,9 @@ import multiprocessing
 import multiprocessing.context
 import os
 import re
+import shutil
 import subprocess
+import threading
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -422,3 +425,53 @@ def freecad_lib() -> str | None:
     candidates = [os.environ.get("SPIRAL_CAD_FREECAD_LIB", ""), "/usr/lib/freecad-python3/lib", "/usr/lib/freecad/lib",
                   "/usr/local/lib/freecad/lib"]  # fmt: skip
     return next((c for c in candidates if c and (Path(c) / "Import.so").exists()), None)
+
+
+# --- a browser we did not write: headless Chromium, and a local server that logs every request ---------
+
+CHROMIUM_FLAGS = [
+    "--headless",
+    "--no-sandbox",
+    "--disable-gpu",
+    "--disable-quic",
+    "--no-first-run",
+    "--disable-background-networking",
+    "--disable-component-update",
+    "--disable-sync",
+]
+
+
+def chromium() -> str:
+    """The headless browser's command, or the test is skipped saying how to install it."""
+    for name in ("chromium", "chromium-browser", "google-chrome"):
+        if found := shutil.which(name):
+            return found
+    pytest.skip("headless Chromium is not installed (Debian: apt-get install chromium)")
+
+
+class Server(http.server.ThreadingHTTPServer):
+    """A local server of one folder: ``requests`` every path asked for, ``failed`` those not served."""
+
+    requests: list[str]
+    failed: list[str]
+
+
+def serve(root: Path) -> Server:
+    """Serve ``root`` on a free local port until ``shutdown()``."""
+
+    class Handler(http.server.SimpleHTTPRequestHandler):
+        def __init__(self, *args, **kwargs):
+            super().__init__(*args, directory=str(root), **kwargs)
+
+        def log_request(self, code="-", size="-"):
+            self.server.requests.append(self.path)
+            if str(code) not in ("200", "304"):
+                self.server.failed.append(f"{code} {self.path}")
+
+        def log_message(self, *args):
+            pass
+
+    server = Server(("127.0.0.1", 0), Handler)
+    server.requests, server.failed = [], []
+    threading.Thread(target=server.serve_forever, daemon=True).start()
+    return server

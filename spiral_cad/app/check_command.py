@@ -31,6 +31,10 @@ def check_file(args: argparse.Namespace) -> int:
     if suffix not in CHECK_SUFFIXES and Path(args.file).exists():
         raise ValueError(f"{Path(args.file).name}: check judges STEP/IGES (.step .stp .igs .iges), DXF (.dxf), OpenDRIVE (.xodr), "
                          f"LandXML (.xml) and G-code ({' '.join(GCODE_SUFFIXES)}) files")  # fmt: skip
+    if args.html is not None:
+        from .html_report import checked_page_path
+
+        checked_page_path(args.html, args.file)  # refused before the file is read
     if suffix == ".xodr":
         _wire_tolerances(args)
         if args.comb:
@@ -70,7 +74,8 @@ def check_file(args: argparse.Namespace) -> int:
 
         status = check_face_file(args.file, require=args.require, gap_tol=args.gap_tol, angle_tol=args.angle_tol,
                                  curvature_tol=args.curvature_tol, feature_angle=args.feature_angle, zebra=args.zebra,
-                                 curvature_map=args.curvature_map, timing=args.timing, picture=picture, quiet=args.quiet)  # fmt: skip
+                                 curvature_map=args.curvature_map, html=args.html, timing=args.timing, picture=picture,
+                                 quiet=args.quiet)  # fmt: skip
         if status is not None:  # None: the reader found no faces after all, so the wires are judged
             if args.comb:  # the comb of every edge of the part, in mm as build123d and FreeCAD read
                 from ..cad.continuity import curvature_comb
@@ -111,7 +116,18 @@ def _check_shape_file(args: argparse.Namespace) -> int:
     if comb is not None:
         comb_shape = curvature_comb(args.file, units=report.units)  # in the unit the report is in
         export_step(comb_shape, comb, name=f"{report.source} curvature comb", units=report.units)
+    _write_page(args, report)
     return _print_report(report, args)
+
+
+def _write_page(args: argparse.Namespace, report: ContinuityReport) -> None:
+    """``--html``: the curves' page (``spiral_cad.app.html_report``), read in the report's unit."""
+    if args.html is None:
+        return
+    from .html_report import write_html_report
+
+    write_html_report(args.file, args.html, report=report, units=report.units or args.units)
+    print(f"web page written to {args.html}")
 
 
 def _check_document(args: argparse.Namespace) -> int:
@@ -137,6 +153,7 @@ def _check_document(args: argparse.Namespace) -> int:
         if units == DRAWING_UNITS:
             raise ValueError(f"--comb: {name} states no unit ($INSUNITS), and a STEP file needs one")
         export_step(curvature_comb(shape, units=units), _comb_path(args.comb, args.file), name=f"{name} curvature comb", units=units)
+    _write_page(args, report)
     done = {".dxf": "makes its paths of lines and arcs G2, every other entity kept",
             ".xml": "gives its alignments of lines and arcs spirals, the rest kept"}.get(suffix, "makes its runs of cuts G2 in place, every other line kept")  # fmt: skip
     return _print_report(report, args, f"make_g2: spiral-cad g2 {name} -o OUT{suffix} --max-deviation D {done}")
@@ -283,6 +300,10 @@ def add_check(sub: argparse._SubParsersAction) -> None:
                        help="faces: normals further apart (radians) make a sharp feature, listed and not failed (default 5°)")  # fmt: skip
     check.add_argument("--zebra", metavar="OUT.png", help="faces: also draw zebra stripes (reflection lines) of the part as PNG")
     check.add_argument("--curvature-map", metavar="OUT.png", help="faces: also draw the mean curvature of the part as PNG")
+    check.add_argument("--html", metavar="OUT.html",
+                       help="also write the report as one web page to turn and click (self-contained, no network): a part "
+                            "under zebra stripes or its curvature, every edge coloured by its verdict; curves with their "
+                            "comb, every joint coloured by its level (STEP, IGES, DXF, G-code)")  # fmt: skip
     check.add_argument(
         "--view", metavar="X,Y,Z", help="the pictures: direction towards the viewer (default 1,-0.9,0.45: front right, a little above)"
     )
@@ -316,8 +337,10 @@ def _picture_options(args: argparse.Namespace) -> dict:
         options["stripes"] = args.stripes
     if args.pixels is not None:
         options["pixels"] = args.pixels
-    if options and not (args.zebra or args.curvature_map):
-        raise ValueError(f"{', '.join('--' + k for k in options)}: only with --zebra or --curvature-map")
+    drawn = args.zebra or args.curvature_map or (args.html and "pixels" not in options)
+    if options and not drawn:
+        raise ValueError(f"{', '.join('--' + k for k in options)}: only with --zebra or --curvature-map"
+                         + ("" if "pixels" in options else " (--view and --stripes: or --html)"))  # fmt: skip
     if options:
         from .zebra import check_picture_options
 
@@ -331,7 +354,7 @@ def check_inputs(args: argparse.Namespace) -> int:
         args.file = args.file[0]
         return check_file(args)
     files = expand_inputs(args.file, CHECK_SUFFIXES)
-    drawn = [f"--{o.replace('_', '-')}" for o in ("comb", "zebra", "curvature_map") if getattr(args, o)]
+    drawn = [f"--{o.replace('_', '-')}" for o in ("comb", "zebra", "curvature_map", "html") if getattr(args, o)]
     if drawn and len(files) > 1:
         raise ValueError(f"{', '.join(drawn)}: each writes one file; give one file to check")
     where = os.path.abspath if args.scheduler else str  # a remote worker's working folder is not ours

@@ -50,15 +50,16 @@ def _picture(draw: Callable[[], Figure], path: Path, what: str) -> None:
 
 def check_face_file(file: str, *, require: str | None = None, gap_tol: float | None = None, angle_tol: float | None = None,
                     curvature_tol: float | None = None, feature_angle: float | None = None, zebra: str | None = None,
-                    curvature_map: str | None = None, timing: bool = False, picture: dict | None = None,
-                    quiet: bool = False) -> int | None:  # fmt: skip
+                    curvature_map: str | None = None, html: str | None = None, timing: bool = False,
+                    picture: dict | None = None, quiet: bool = False) -> int | None:  # fmt: skip
     """Judge the faces of ``file`` and print the table; draw the pictures asked for.
 
     Tolerances left None take ``check_faces``'s defaults (gap: the file's stated precision and the edges' own tolerances, angle 1e-7 rad, curvature jump 1e-4). ``require`` "G2" or "G1" fails any
     tangent edge below it (and "G0" any gap); sharp features are listed, never failed. ``timing``
     also prints how long the check took; ``quiet`` prints the table's first line (the summary) and the
     verdict only. ``picture`` holds the pictures' options (``view``, ``pixels``;
-    the zebra's ``stripes``), as ``plot_zebra`` and ``plot_curvature_map`` take them.
+    the zebra's ``stripes``), as ``plot_zebra`` and ``plot_curvature_map`` take them; ``html`` the web page
+    to write (``spiral_cad.app.html_report``), which opens with the same view and stripes.
 
     Returns:
         0 ok, 1 below ``require``, None when the reader found no faces or one lone face (no
@@ -68,6 +69,10 @@ def check_face_file(file: str, *, require: str | None = None, gap_tol: float | N
         ValueError: an unreadable file or a bad option (printed as ``error: …`` by the CLI).
     """
     zebra_png, map_png = _png("zebra", zebra), _png("curvature-map", curvature_map)
+    if html is not None:
+        from .html_report import checked_page_path
+
+        checked_page_path(html)  # refused before the file is read
     report = check_faces(
         file,
         gap_tol=gap_tol,
@@ -96,6 +101,12 @@ def check_face_file(file: str, *, require: str | None = None, gap_tol: float | N
             _picture(lambda: plot_zebra(mesh, title=f"{report.source}: zebra", **options, **stripes), zebra_png, "zebra stripes")
         if map_png is not None:
             _picture(lambda: plot_curvature_map(mesh, title=f"{report.source}: mean curvature", **options), map_png, "curvature map")
+    if html is not None:
+        from .html_report import write_html_report
+
+        options = {k: v for k, v in (picture or {}).items() if k in ("view", "stripes")}
+        write_html_report(file, html, report=report, **options)
+        print(f"web page written to {html}")
     if not require:
         return 0
     if not report.edges:

@@ -130,7 +130,7 @@ def read(path: str | os.PathLike, *, format: str | None = None, **options: Any) 
     return reader(source, **_checked(reader, options, source))
 
 
-def check(obj_or_path: Any, *, format: str | None = None, **options: Any) -> Any:
+def check(obj_or_path: Any, *, format: str | None = None, html: str | os.PathLike | None = None, **options: Any) -> Any:
     """Judge G0/G1/G2 at every joint of a file or an object (the table in the module docstring).
 
     Example:
@@ -140,11 +140,15 @@ def check(obj_or_path: Any, *, format: str | None = None, **options: Any) -> Any
         report = sc.check("part.step")          # a FaceReport: face to face
         report = sc.check("program.nc")         # a ContinuityReport: each cutting path
         print(report.describe())
+        sc.check(part, html="part.html")        # also the page to turn and click (faces)
         ```
 
     Args:
         obj_or_path: a file's path, or a build123d/CadQuery/OCCT shape, a ``Chain`` or a ``Transition``.
         format: a file's format (``"step"``, ``"gcode"`` …) where its suffix names none.
+        html: also write the report as one self-contained web page (``spiral_cad.app.html_report``): a
+            part under zebra stripes or its curvature, every edge coloured by its verdict; curves with their
+            comb, every joint coloured by its level (not for LandXML and OpenDRIVE files).
         **options: the chosen checker's keyword options (``gap_tol``, ``angle_tol``, ``curvature_tol`` …);
             for a program or drawing, ``units`` is the unit of one that states none.
 
@@ -156,6 +160,19 @@ def check(obj_or_path: Any, *, format: str | None = None, **options: Any) -> Any
         ValueError: an unknown suffix or format, an option the checker does not take, or a file the reader
             refuses (named with the reason).
     """
+    if html is None:
+        return _check(obj_or_path, format, options)
+    from .html_report import checked_page_path, write_html_report
+
+    page = checked_page_path(html, obj_or_path)  # refused before anything is read
+    report = _check(obj_or_path, format, options)
+    source = _path(obj_or_path, "check") if isinstance(obj_or_path, (str, os.PathLike)) else obj_or_path
+    write_html_report(source, page, report=report, units=options.get("units"))
+    return report
+
+
+def _check(obj_or_path: Any, format: str | None, options: dict[str, Any]) -> Any:
+    """``check`` without its page."""
     if isinstance(obj_or_path, (str, os.PathLike)) and not isinstance(obj_or_path, bytes):
         source = _path(obj_or_path, "check")
         if not source.is_file():

@@ -13,7 +13,7 @@ import io
 import math
 import os
 import re
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from functools import partial
 from typing import Any
 
@@ -21,12 +21,13 @@ import numpy as np
 from numpy.typing import NDArray
 from OCP.Bnd import Bnd_Box
 from OCP.BRep import BRep_Tool
-from OCP.BRepAdaptor import BRepAdaptor_Surface
+from OCP.BRepAdaptor import BRepAdaptor_Curve, BRepAdaptor_Surface
 from OCP.BRepBndLib import BRepBndLib
 from OCP.BRepMesh import BRepMesh_IncrementalMesh
+from OCP.GCPnts import GCPnts_QuasiUniformDeflection
 from OCP.GeomAbs import GeomAbs_SurfaceType
 from OCP.IMeshTools import IMeshTools_Parameters
-from OCP.TopAbs import TopAbs_FACE, TopAbs_REVERSED
+from OCP.TopAbs import TopAbs_EDGE, TopAbs_FACE, TopAbs_REVERSED
 from OCP.TopExp import TopExp, TopExp_Explorer
 from OCP.TopLoc import TopLoc_Location
 from OCP.TopoDS import TopoDS, TopoDS_Shape
@@ -35,10 +36,11 @@ from OCP.TopTools import TopTools_IndexedMapOfShape
 from ..continuity.joints import norms
 from ..core.units import length_unit
 from .face_projection import derivatives
+from .faces import _edge_faces, _sewn
 from .occ import as_occ_shape
 from .readers import read_file
 
-__all__ = ["ANGULAR", "DEFLECTION", "MAX_TRIANGLES", "PIXELS", "REFINED", "RELATIVE", "SLOPE", "FaceMesh", "face_mesh"]
+__all__ = ["ANGULAR", "DEFLECTION", "MAX_TRIANGLES", "PIXELS", "REFINED", "RELATIVE", "SLOPE", "FaceMesh", "edge_lines", "face_mesh"]
 
 #: Pixels along the longer side of the picture a mesh is made for (``spiral_cad.app.zebra``).
 PIXELS = 1000
@@ -66,6 +68,10 @@ class FaceMesh:
         gaussian_curvature: (n,) Gaussian curvature, 1/unit².
         face: (m,) the index of the face each triangle belongs to.
         units: the unit of ``points``.
+        edge_points: (k, 3) points along the edges, edge after edge, within the mesh's deflection of them.
+        edge_starts: (e + 1,) where each edge's points start in ``edge_points`` (and where the last ends);
+            edges are in the order ``spiral_cad.cad.faces.check_faces`` numbers them (``FaceEdge.index``),
+            a degenerate edge with no points.
     """
 
     points: NDArray
@@ -75,6 +81,8 @@ class FaceMesh:
     gaussian_curvature: NDArray
     face: NDArray
     units: str = "mm"
+    edge_points: NDArray = field(default_factory=lambda: np.empty((0, 3)))
+    edge_starts: NDArray = field(default_factory=lambda: np.zeros(1, dtype=np.int64))
 
     @property
     def size(self) -> float:
@@ -90,6 +98,7 @@ def _mesh(shape: TopoDS_Shape, deflection: float | None, angle: float, pixels: i
     box = Bnd_Box()
     BRepBndLib.Add_s(shape, box, False)
     size = 1.0 if box.IsVoid() else math.sqrt(box.SquareExtent())
+    shape = _sewn(shape, size, _edge_faces(shape))[0]  # as the face checker judges it: its edges, its numbering
     faces = TopTools_IndexedMapOfShape()
     TopExp.MapShapes_s(shape, TopAbs_FACE, faces)
     linear = deflection if deflection is not None else DEFLECTION * PIXELS / pixels * size
@@ -135,6 +144,7 @@ def _mesh(shape: TopoDS_Shape, deflection: float | None, angle: float, pixels: i
         owners.append(np.full(len(tri), index))
         offset += len(raw)
         index += 1
+    lines = edge_lines(shape, linear)
     buffer = io.BytesIO()
     empty = np.empty((0, 3))
     np.savez(
@@ -143,8 +153,36 @@ def _mesh(shape: TopoDS_Shape, deflection: float | None, angle: float, pixels: i
         triangles=np.vstack(triangles) if triangles else np.empty((0, 3), dtype=np.int64),
         values=np.vstack(values) if values else np.empty((0, 5)),
         face=np.concatenate(owners) if owners else np.empty(0, dtype=np.int64),
+        edge_points=np.vstack([empty, *lines]),
+        edge_starts=np.concatenate([[0], np.cumsum([len(line) for line in lines], dtype=np.int64)]),
     )
     return buffer.getvalue()
+
+
+#: Most points along one edge (a long edge at a fine deflection is thinned to this many, evenly).
+_EDGE_POINTS = 2_000
+
+
+def edge_lines(shape: TopoDS_Shape, deflection: float) -> list[NDArray]:
+    """Points (k × 3) along every edge of ``shape`` (``TopExp.MapShapes`` order, as the face checker numbers
+    them), within ``deflection`` of the edge; none for a degenerate edge or one without a 3-D curve."""
+    edges = TopTools_IndexedMapOfShape()
+    TopExp.MapShapes_s(shape, TopAbs_EDGE, edges)
+    lines = []
+    for i in range(1, edges.Extent() + 1):
+        edge = TopoDS.Edge_s(edges.FindKey(i))
+        if BRep_Tool.Degenerated_s(edge) or not BRep_Tool.IsGeometric_s(edge):
+            lines.append(np.empty((0, 3)))
+            continue
+        curve = BRepAdaptor_Curve(edge)
+        spaced = GCPnts_QuasiUniformDeflection(curve, deflection)
+        count = spaced.NbPoints() if spaced.IsDone() else 0
+        if 2 <= count <= _EDGE_POINTS:
+            params = [spaced.Parameter(k) for k in range(1, count + 1)]
+        else:  # too fine, or not sampled: evenly in the parameter
+            params = np.linspace(curve.FirstParameter(), curve.LastParameter(), min(max(count, 17), _EDGE_POINTS)).tolist()
+        lines.append(np.array([curve.Value(t).Coord() for t in params], dtype=float).reshape(-1, 3))
+    return lines
 
 
 #: The coarsest angular limit the triangle cap may push a mesh to, radians.
@@ -313,4 +351,5 @@ def face_mesh(shape_or_path: Any, *, deflection: float | None = None, angle: flo
     if len(arrays["triangles"]) == 0:
         raise ValueError("the shape has no faces to mesh")
     values = arrays["values"]
-    return FaceMesh(arrays["points"], arrays["triangles"], values[:, :3], values[:, 3], values[:, 4], arrays["face"], unit)
+    return FaceMesh(arrays["points"], arrays["triangles"], values[:, :3], values[:, 3], values[:, 4], arrays["face"], unit,
+                    arrays["edge_points"], arrays["edge_starts"])  # fmt: skip

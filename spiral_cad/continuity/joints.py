@@ -120,6 +120,7 @@ class JointReport:
         plane_change: angle between the osculating planes before and after
             the joint (radians, [0, π/2]; see the module docstring), NaN when
             no plane is known before it.
+        point: where the joint is: the end of edge ``index`` (NaN where not known).
     """
 
     index: int
@@ -131,6 +132,7 @@ class JointReport:
     curvature_after: float = 0.0
     relative_curvature_jump: float = 0.0
     plane_change: float = math.nan
+    point: tuple[float, float, float] = (math.nan, math.nan, math.nan)
 
 
 @dataclass(frozen=True)
@@ -425,16 +427,19 @@ def plane_changes(frames: NDArray, closed: bool, straight: float) -> NDArray:
 
 def classify_joint(index: int, a: Frame, b: Frame, gap_tol: float, angle_tol: float, curvature_tol: float, floor: float) -> JointReport:
     """Measure and classify the joint from end frame ``a`` to start frame ``b`` (``classify_joints``)."""
-    return _joint_reports([index], classify_joints(np.array([a]), np.array([b]), gap_tol, angle_tol, curvature_tol, floor))[0]
+    joints = classify_joints(np.array([a]), np.array([b]), gap_tol, angle_tol, curvature_tol, floor)
+    return _joint_reports([index], joints, points=np.array([a[:3]], dtype=float))[0]
 
 
-def _joint_reports(indices: Sequence[int], measures: tuple[NDArray, ...], planes: NDArray | None = None) -> list[JointReport]:
+def _joint_reports(indices: Sequence[int], measures: tuple[NDArray, ...], planes: NDArray | None = None,
+                   points: NDArray | None = None) -> list[JointReport]:  # fmt: skip
     gap, angle, jump, level, ka, kb, relative = (m.tolist() for m in measures)
     plane = [math.nan] * len(gap) if planes is None else planes.tolist()
+    where = [(math.nan,) * 3] * len(gap) if points is None else [tuple(p) for p in points.tolist()]
     levels = [Continuity(v) for v in range(-1, 4)]
     return [
-        JointReport(i, g, an, j, levels[lv + 1], x, y, r, pc)
-        for i, g, an, j, lv, x, y, r, pc in zip(indices, gap, angle, jump, level, ka, kb, relative, plane)
+        JointReport(i, g, an, j, levels[lv + 1], x, y, r, pc, p)
+        for i, g, an, j, lv, x, y, r, pc, p in zip(indices, gap, angle, jump, level, ka, kb, relative, plane, where)
     ]
 
 
@@ -490,7 +495,8 @@ def classify_pieces(
             frames = np.asarray(ends, dtype=float)  # (edges, 2: start and end, frame)
             after = np.roll(frames[:, 0], -1, axis=0)[:pairs]
             measures = classify_joints(frames[:pairs, 1], after, gap_tol, angle_tol, curvature_tol, floor)
-            joints = tuple(_joint_reports(range(pairs), measures, plane_changes(frames, closed, curvature_tol * floor)))
+            planes = plane_changes(frames, closed, curvature_tol * floor)
+            joints = tuple(_joint_reports(range(pairs), measures, planes, points=frames[:pairs, 1, :3]))
         wires.append(WireReport(w, len(ends), closed, joints, kind, name[0] if name else "", reverses=reverses))
     return ContinuityReport(tuple(wires), gap_tol, angle_tol, curvature_tol, size, snap, source, element, units)
 

@@ -17,19 +17,16 @@ answered and no error on the console.
 from __future__ import annotations
 
 import ast
-import http.server
 import importlib
 import importlib.util
 import os
 import re
-import shutil
 import subprocess
 import sys
-import threading
 from pathlib import Path
 
 import pytest
-from helpers import Block, python_blocks, run_blocks, unresolved
+from helpers import CHROMIUM_FLAGS, Block, chromium, python_blocks, run_blocks, serve, unresolved
 
 ROOT = Path(__file__).resolve().parents[2]
 DOCS = ROOT / "docs"
@@ -111,25 +108,6 @@ def test_the_mathematics_cites_the_paper_and_the_api_pages_render_the_faces():
 
 # --- the built site, opened in a browser -------------------------------------------------------
 
-CHROMIUM_FLAGS = [
-    "--headless",
-    "--no-sandbox",
-    "--disable-gpu",
-    "--disable-quic",
-    "--no-first-run",
-    "--disable-background-networking",
-    "--disable-component-update",
-    "--disable-sync",
-]
-
-
-def _chromium() -> str:
-    for name in ("chromium", "chromium-browser", "google-chrome"):
-        if found := shutil.which(name):
-            return found
-    pytest.skip("headless Chromium is not installed (Debian: apt-get install chromium)")
-
-
 #: Written into site/ by ``make docs`` once ``mkdocs build --strict`` succeeded (mkdocs keeps dot files).
 BUILT_MARK = ".strict-build"
 
@@ -196,33 +174,11 @@ def site(tmp_path_factory) -> Path:
     return out
 
 
-class _Server(http.server.ThreadingHTTPServer):
-    failed: list[str]
-
-
-def _serve(root: Path) -> _Server:
-    class Handler(http.server.SimpleHTTPRequestHandler):
-        def __init__(self, *args, **kwargs):
-            super().__init__(*args, directory=str(root), **kwargs)
-
-        def log_request(self, code="-", size="-"):
-            if str(code) not in ("200", "304"):
-                self.server.failed.append(f"{code} {self.path}")
-
-        def log_message(self, *args):
-            pass
-
-    server = _Server(("127.0.0.1", 0), Handler)
-    server.failed = []
-    threading.Thread(target=server.serve_forever, daemon=True).start()
-    return server
-
-
 def _open(url: str, tmp_path: Path) -> tuple[str, str]:
     """The DOM Chromium built for ``url`` and the console lines it logged."""
     done = subprocess.run(
         [
-            _chromium(),
+            chromium(),
             *CHROMIUM_FLAGS,
             f"--user-data-dir={tmp_path / 'profile'}",
             "--enable-logging=stderr",
@@ -251,7 +207,7 @@ def _open(url: str, tmp_path: Path) -> tuple[str, str]:
     ],
 )
 def test_the_site_opens_in_a_browser(site, tmp_path, path, title, text):
-    server = _serve(site)
+    server = serve(site)
     try:
         dom, console = _open(f"http://127.0.0.1:{server.server_address[1]}/{path}", tmp_path)
     finally:

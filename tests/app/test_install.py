@@ -113,6 +113,14 @@ def test_the_metadata_declares_the_license_as_an_spdx_expression_with_its_text(c
     assert found["text"] == (REPO / "LICENSE").read_text() and found["text"].startswith("MIT License")
 
 
+def test_the_wheel_carries_the_web_pages_viewer(core_env):
+    """``check --html`` embeds ``viewer.js``, a file beside the modules: the installed package has it."""
+    code = "import importlib.resources as r; print(r.files('spiral_cad.app').joinpath('viewer.js').read_text()[:400])"
+    done = subprocess.run([str(core_env.python), "-c", code], capture_output=True, text=True, cwd="/")
+    assert done.returncode == 0, done.stderr[-2000:]
+    assert "spiral_cad" in done.stdout and "WebGL" in done.stdout
+
+
 def test_demo_without_the_cad_extra_names_the_extra_and_writes_the_rest(core_env, tmp_path):
     out = tmp_path / "out"
     spiral_cad = str(core_env.venv / "bin" / "spiral-cad")
