@@ -10,6 +10,7 @@ build123d objects in ``spiral_cad.build123d`` and the CadQuery plugin in
 ``spiral_cad.cadquery`` (these two import OCP).
 """
 
+import sys
 from typing import TYPE_CHECKING, Any
 
 from ._version import __version__ as __version__
@@ -27,6 +28,8 @@ from .core.transitions import circle_in_circle, circle_to_circle, line_to_circle
 
 if TYPE_CHECKING:
     from .app.files import check, export, read
+
+sys.modules[f"{__name__}.batch"] = batch  # `import spiral_cad.batch` too, as `import os.path`
 
 #: ``Circle``, ``Line`` and ``Transition`` are ours here too (``sc.Line``, ``from spiral_cad import Line``) but
 #: stay out of ``from spiral_cad import *``: build123d has its own of those names, with other meanings.

@@ -45,7 +45,7 @@ from .curve_biarcs import BIARC_SHARE
 from .document_report import DocumentReport, PathReport
 from .dxf import _add
 from .dxf_curves import CURVES, curve_parts
-from .dxf_read import DXF_UNITS, JOIN_TOLERANCE, READ, _chains, _entity_parts, _segment
+from .dxf_read import DXF_UNITS, JOIN_TOLERANCE, READ, _chains, _entity_parts, _segment, drop_unstated_units
 from .staging import temporary_beside
 
 __all__ = ["ATTRIBUTES", "open_drawing", "rewrite_dxf_g2"]
@@ -74,7 +74,7 @@ def open_drawing(source: Path) -> tuple[Any, str]:
     if not source.is_file():
         raise ValueError(f"{source.name}: the DXF file is {'a folder' if source.is_dir() else 'missing'}")
     try:
-        return ezdxf.readfile(source), ""
+        doc, note = ezdxf.readfile(source), ""
     except OSError as error:  # ezdxf says "not a DXF file" with an OSError
         raise ValueError(f"{source.name}: not a DXF file ezdxf can read ({error})") from None
     except Exception as plain:  # noqa: BLE001 - any fault of the plain reader (a DXFError, a KeyError on a bad handle): recover
@@ -83,7 +83,9 @@ def open_drawing(source: Path) -> tuple[Any, str]:
         except Exception as error:  # noqa: BLE001 - the recover reader failing too: named, never a crash
             raise ValueError(f"{source.name}: not a DXF file ezdxf can read ({plain or type(plain).__name__}; recover: "
                              f"{error or type(error).__name__})") from None  # fmt: skip
-        return doc, f"read with ezdxf's recover mode ({plain or type(plain).__name__}; {len(auditor.fixes)} fix(es))"
+        note = f"read with ezdxf's recover mode ({plain or type(plain).__name__}; {len(auditor.fixes)} fix(es))"
+    drop_unstated_units(doc, source)
+    return doc, note
 
 
 def _as_r2000(doc, issues: set[tuple[int, str]], notes: list[str]) -> Any:

@@ -20,16 +20,18 @@ entity).
 from __future__ import annotations
 
 import math
+import mmap
 import os
 from collections import Counter
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
 from ..core.segments import Arc, Line
 from ..core.units import MM_PER_UNIT, length_unit
 
-__all__ = ["DXF_UNITS", "JOIN_TOLERANCE", "DxfPath", "DxfPaths", "read_dxf_paths"]
+__all__ = ["DXF_UNITS", "JOIN_TOLERANCE", "DxfPath", "DxfPaths", "drop_unstated_units", "read_dxf_paths"]
 
 #: ``$INSUNITS`` codes read, and their units.
 DXF_UNITS = {1: "in", 2: "ft", 4: "mm", 5: "cm", 6: "m", 7: "km"}
@@ -74,6 +76,21 @@ class DxfPaths:
         return len(self.paths)
 
 
+def drop_unstated_units(doc: Any, path: str | os.PathLike) -> None:
+    """Take out of ``doc``'s header the ``$INSUNITS`` and ``$MEASUREMENT`` its file at ``path`` never stated.
+
+    ezdxf gives a file without a HEADER section (many R12 writers leave it out) a header of its own defaults,
+    ``$INSUNITS`` 6 (metres) among them: read as it comes, such a drawing would be measured, rewritten and
+    reported in metres although it states no unit. The file's bytes are searched for the variable's name."""
+    names = [name for name in ("$INSUNITS", "$MEASUREMENT") if name in doc.header]
+    if not names:
+        return
+    with open(path, "rb") as file, mmap.mmap(file.fileno(), 0, access=mmap.ACCESS_READ) as data:
+        for name in names:
+            if data.find(name.encode("ascii")) < 0:
+                del doc.header[name]
+
+
 def read_dxf_paths(path: str | os.PathLike, *, units: str | None = None, drawing_units: str | None = None,
                    join_tolerance: float = JOIN_TOLERANCE) -> DxfPaths:  # fmt: skip
     """The lines and arcs of a DXF file chained into paths (see the module docstring).
@@ -102,6 +119,7 @@ def read_dxf_paths(path: str | os.PathLike, *, units: str | None = None, drawing
         doc = ezdxf.readfile(name)
     except (ezdxf.DXFError, UnicodeDecodeError, OSError) as error:  # ezdxf says "not a DXF file" with an OSError
         raise ValueError(f"{label}: not a DXF file ezdxf can read ({error})") from None
+    drop_unstated_units(doc, name)
     target = None if units is None else length_unit(units)
     code = int(doc.header.get("$INSUNITS", 0))
     if code == 0:

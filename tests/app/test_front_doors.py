@@ -375,6 +375,14 @@ def test_the_namespaces_name_their_doors_each_from_its_own_module_loaded_on_firs
     assert done.stdout.strip() == "[]", done.stderr
 
 
+def test_batch_imports_as_a_module_and_continuity_names_its_measures():
+    done = subprocess.run([sys.executable, "-c", "import spiral_cad.batch as b, spiral_cad; from spiral_cad.batch import line_to_circle; "
+                           "print(b is spiral_cad.batch, callable(line_to_circle))"], capture_output=True, text=True)  # fmt: skip
+    assert done.stdout.split() == ["True", "True"], done.stderr
+    continuity = importlib.import_module("spiral_cad.continuity")
+    assert continuity.__all__ and all(getattr(continuity, name).__doc__ for name in continuity.__all__)
+
+
 def test_names_near_the_file_systems_limit_are_written_and_longer_ones_refused(tmp_path):
     """A file named with 250 characters is written in every format whose writer replaces a file whole (its
     temporary name beside it is cut short); a name past 255 bytes is refused by name, never an OSError."""

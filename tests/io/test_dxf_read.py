@@ -92,6 +92,25 @@ def test_an_r12_drawing_of_lines_and_arcs_is_unitless_until_its_unit_is_stated(t
     assert len(second.segments) == 1
 
 
+def test_a_drawing_without_a_header_states_no_unit_wherever_it_is_read(tmp_path, capsys):
+    """Many R12 writers leave the HEADER section out; ezdxf then fills in its own defaults, $INSUNITS 6
+    (metres) among them. Such a drawing states no unit: read, checked, built and rewritten, it is unitless."""
+    from spiral_cad.app.cli import main
+
+    bare = tmp_path / "bare.dxf"
+    lines = ["0", "SECTION", "2", "ENTITIES", "0", "LINE", "8", "0", "10", "0", "20", "0", "30", "0", "11", "40", "21", "0", "31", "0"]
+    bare.write_text("\n".join([*lines, "0", "ENDSEC", "0", "EOF", ""]), encoding="ascii")
+    assert ezdxf.readfile(bare).header.get("$INSUNITS") == 6  # what ezdxf assumes
+    with pytest.raises(ValueError, match="the drawing is unitless"):
+        read_dxf_paths(bare)
+    assert read_dxf_paths(bare, drawing_units="in").units == "in"
+    assert main(["check", str(bare)]) == 0
+    assert "model size 40 (model units)" in capsys.readouterr().out
+    assert main(["g2", str(bare), "--max-deviation", "0.1", "-o", str(tmp_path / "out.dxf")]) == 0
+    assert "drawing units" in capsys.readouterr().out
+    assert "$INSUNITS" not in (tmp_path / "out.dxf").read_text(encoding="ascii", errors="replace")
+
+
 def test_refusals_name_the_entity(tmp_path):
     doc, msp = drawing()
     msp.add_line((0, 0), (1, 0))
