@@ -33,6 +33,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 from numpy.typing import NDArray
 
+from ..cad.faces import CLASS_COLOURS
 from .zebra import DISTANCE, STRIPES, VIEW
 
 if TYPE_CHECKING:
@@ -42,18 +43,13 @@ if TYPE_CHECKING:
 
 __all__ = ["COLOURS", "checked_page_path", "curves_report_html", "part_report_html", "write_html_report"]
 
-#: The colour of each verdict on the page — the face checker's edge classes (``EDGE_CLASSES``) and the
+#: The colour of each verdict on the page — the face checker's edge classes (``CLASS_COLOURS``) and the
 #: curve checker's joint levels — and of the lines that are no verdict: an edge of one face only (``free``),
 #: a degenerate or unjudged one (``other``), a curve (``curve``) and its curvature comb (``comb``).
 COLOURS = {
-    "G2": "#1a9850",
-    "G1": "#f28e2b",
-    "G0": "#d62728",
-    "crease": "#d62728",
-    "gap": "#c51b7d",
-    "none": "#c51b7d",
-    "unmeasurable": "#7b3294",
-    "sharp": "#3c3c3c",
+    **CLASS_COLOURS,
+    "G0": CLASS_COLOURS["crease"],
+    "none": CLASS_COLOURS["gap"],
     "free": "#9e9e9e",
     "other": "#bdbdbd",
     "curve": "#222222",

@@ -10,7 +10,8 @@ outside a builder the result lies on ``Plane.XY``. Spirals become exact
 ``G2Polyline`` is build123d's ``Polyline`` with every corner rounded by a
 G2 spiral pair, in the plane or in space (robot and CNC paths, handrails,
 cable and pipe runs), and ``g2_fillet`` also rounds a 3-D wire of lines,
-each corner in the plane of its two edges.
+each corner in the plane of its two edges. ``show_continuity`` shows what the
+face checker finds in OCP CAD Viewer.
 
 Example:
     >>> with BuildLine(Plane.XZ) as path:
@@ -32,6 +33,7 @@ from ._lines import (
 )
 from ._parts import ContinuousBox, g2_fillet, g2_slab
 from ._sketches import ContinuousPolygon, ContinuousRectangle, ContinuousSlot, curvature_comb, make_g2
+from ._viewer import show_continuity
 
 __all__ = [
     "chain_edges",
@@ -53,4 +55,5 @@ __all__ = [
     "g2_fillet",
     "g2_slab",
     "make_g2",
+    "show_continuity",
 ]

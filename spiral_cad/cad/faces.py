@@ -79,7 +79,7 @@ from .face_sampling import FACE_FLOATS, EdgeLine, Line, Tolerances, knot_lines, 
 from .occ import as_occ_shape
 from .readers import IGES_SUFFIXES, STEP_SUFFIXES, read_file
 
-__all__ = ["EDGE_CLASSES", "FEATURE_ANGLE", "SEW_TOL", "FaceEdge", "FaceReport", "check_faces", "holds_faces"]
+__all__ = ["CLASS_COLOURS", "EDGE_CLASSES", "FEATURE_ANGLE", "SEW_TOL", "FaceEdge", "FaceReport", "check_faces", "holds_faces"]
 
 #: Normals further apart than this (radians, 5°) make an edge a sharp feature
 #: (a box's edge), listed and never failed; between ``angle_tol`` and this the
@@ -89,6 +89,8 @@ FEATURE_ANGLE = math.radians(5.0)
 #: Edge classes, worst first. ``"sharp"`` is a feature and sits apart: it is
 #: never compared with the required class.
 EDGE_CLASSES = ("unmeasurable", "gap", "crease", "G1", "G2", "sharp")
+#: The colour each class is drawn in (the web page of ``check --html``, ``show_continuity`` in OCP CAD Viewer).
+CLASS_COLOURS = {"G2": "#1a9850", "G1": "#f28e2b", "crease": "#d62728", "gap": "#c51b7d", "unmeasurable": "#7b3294", "sharp": "#3c3c3c"}
 _RANK = {"unmeasurable": 0, "gap": 0, "crease": 1, "G1": 2, "G2": 3}
 
 #: Free edges that coincide within this distance, relative to the model size, are sewn together
