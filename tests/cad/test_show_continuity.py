@@ -16,8 +16,14 @@ import pytest
 from helpers import CHROMIUM_FLAGS, chromium
 
 bd = pytest.importorskip("build123d")
+pytest.importorskip("ocp_vscode", reason='OCP CAD Viewer\'s client is not installed (pip install "spiral_cad[viewer]")')
 # the viewer's own advice for a user who kept the camera (its default), not a fault of what is shown
-pytestmark = [pytest.mark.cad, pytest.mark.slow, pytest.mark.subprocess, pytest.mark.filterwarnings("ignore:reset_camera is set to KEEP")]
+pytestmark = [
+    pytest.mark.cad,
+    pytest.mark.slow,
+    pytest.mark.subprocess,
+    pytest.mark.filterwarnings("ignore::ocp_viewer_core.utils.CameraKeepWarning"),
+]
 
 from spiral_cad.build123d import ContinuousRectangle, show_continuity  # noqa: E402
 from spiral_cad.cad.faces import CLASS_COLOURS  # noqa: E402
@@ -36,22 +42,23 @@ def viewer(tmp_path_factory):
         port = probe.getsockname()[1]
     log = folder / "server.log"
     env = {**os.environ, "HOME": str(folder)}  # its settings file, not the user's
-    server = subprocess.Popen(
-        [sys.executable, "-m", "ocp_viewer", "--port", str(port)], stdout=log.open("w"), stderr=subprocess.STDOUT, env=env
-    )
-    browser = None
-    try:
-        _wait(lambda: _listening(port), "the viewer's server to listen")
-        browser = subprocess.Popen([browser_command, *CHROMIUM_FLAGS, "--use-angle=swiftshader", "--enable-unsafe-swiftshader",
-                                    f"--user-data-dir={folder / 'profile'}", "--window-size=1200,800", f"http://127.0.0.1:{port}/viewer"],
-                                   stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)  # fmt: skip
-        _wait(lambda: "registered" in log.read_text(), "the browser to join the viewer")
-        yield port, folder
-    finally:
-        for process in (browser, server):
-            if process is not None:
-                process.terminate()
-                process.wait(timeout=30)
+    with log.open("w") as output:
+        server = subprocess.Popen(
+            [sys.executable, "-m", "ocp_viewer", "--port", str(port)], stdout=output, stderr=subprocess.STDOUT, env=env
+        )
+        browser = None
+        try:
+            _wait(lambda: _listening(port), "the viewer's server to listen")
+            browser = subprocess.Popen([browser_command, *CHROMIUM_FLAGS, "--use-angle=swiftshader", "--enable-unsafe-swiftshader",
+                                        f"--user-data-dir={folder / 'profile'}", "--window-size=1200,800", f"http://127.0.0.1:{port}/viewer"],
+                                       stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)  # fmt: skip
+            _wait(lambda: "registered" in log.read_text(), "the browser to join the viewer")
+            yield port, folder
+        finally:
+            for process in (browser, server):
+                if process is not None:
+                    process.terminate()
+                    process.wait(timeout=30)
 
 
 def _listening(port: int) -> bool:
