@@ -459,7 +459,9 @@ def _parser() -> argparse.ArgumentParser:
                             "corners and tangent joints), a DXF drawing's, or a LandXML or OpenDRIVE file's alignments of "
                             "lines and arcs (made G2: arcs kept true arcs, spirals between; one design per alignment or road)")  # fmt: skip
     gcode.add_argument("--max-curvature", type=float, help="the curvature bound (1/unit)")
-    gcode.add_argument("--shape", choices=["walton-meek", "near-linear", "g2cbs"], help="spiral shape (default walton-meek)")
+    gcode.add_argument("--shape", choices=["walton-meek", "near-linear", "g2cbs"],
+                       help="spiral shape (default near-linear for a drawing, a road file and --from-points; walton-meek for "
+                            "--from-gcode, whose corners may turn further than near-linear pairs reach, 100°)")  # fmt: skip
     gcode.add_argument("--sample-step", type=float, help="samples at most this far apart along the path")
     gcode.add_argument("--chord-tolerance", type=float,
                        help="samples close enough that the path strays at most this far from their chords "

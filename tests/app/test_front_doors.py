@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import importlib
+import re
 import subprocess
 import sys
 import xml.etree.ElementTree as ET
@@ -373,6 +374,16 @@ def test_the_namespaces_name_their_doors_each_from_its_own_module_loaded_on_firs
     done = subprocess.run([sys.executable, "-c", f"import sys, {namespace}; print(sorted(m for m in sys.modules if m.startswith('{namespace}.') or m == 'OCP'))"],
                           capture_output=True, text=True)  # fmt: skip
     assert done.stdout.strip() == "[]", done.stderr
+
+
+def test_build_help_states_the_default_shape_of_each_input(capsys):
+    """A newcomer found "default walton-meek" in `build --help` while a drawing was built near-linear."""
+    from spiral_cad.app.cli import main
+
+    with pytest.raises(SystemExit):
+        main(["build", "--help"])
+    text = re.sub(r"-\s+", "-", " ".join(capsys.readouterr().out.split()))  # argparse wraps lines after a hyphen
+    assert "default near-linear for a drawing, a road file and --from-points; walton-meek for --from-gcode" in text
 
 
 def test_batch_imports_as_a_module_and_continuity_names_its_measures():
