@@ -61,8 +61,8 @@ def check_file(args: argparse.Namespace) -> int:
               file=sys.stderr)  # fmt: skip
         return 2
     if suffix in _DOCUMENTS:
-        if args.zebra or args.curvature_map:
-            print(f"error: --zebra and --curvature-map draw faces; {_DOCUMENTS[suffix]} holds curves", file=sys.stderr)
+        if args.zebra or args.curvature_map or args.stripes is not None:
+            print(f"error: --zebra, --curvature-map and --stripes draw faces; {_DOCUMENTS[suffix]} holds curves", file=sys.stderr)
             return 2
         if suffix != ".xml":  # a LandXML file's default tolerances come from its printed decimals
             _wire_tolerances(args)
@@ -126,7 +126,9 @@ def _write_page(args: argparse.Namespace, report: ContinuityReport) -> None:
         return
     from .html_report import write_html_report
 
-    write_html_report(args.file, args.html, report=report, units=report.units or args.units)
+    view = _picture_options(args).get("view")  # checked before the file was read
+    write_html_report(args.file, args.html, report=report, units=report.units or args.units, view=view,
+                      **({"stripes": args.stripes} if args.stripes is not None else {}))  # fmt: skip
     print(f"web page written to {args.html}")
 
 

@@ -164,7 +164,7 @@ def check(obj_or_path: Any, *, format: str | None = None, html: str | os.PathLik
         return _check(obj_or_path, format, options)
     from .html_report import checked_page_path, write_html_report
 
-    page = checked_page_path(html, obj_or_path)  # refused before anything is read
+    page = checked_page_path(html, obj_or_path, format)  # refused before anything is read
     report = _check(obj_or_path, format, options)
     source = _path(obj_or_path, "check") if isinstance(obj_or_path, (str, os.PathLike)) else obj_or_path
     write_html_report(source, page, report=report, units=options.get("units"))

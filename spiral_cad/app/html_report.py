@@ -15,8 +15,8 @@ inside it, nothing fetched from anywhere, so it opens from a mail or an archive 
   angle between the normals, the jump of normal curvature and where each is largest;
 * the summary and a table of every edge, so that the numbers are there without WebGL too.
 
-The address's hash chooses how it opens (``#mode=curvature&item=12&stripes=40&view=1,-1,0.5``), so a
-link can point at one edge.
+The address's hash chooses how it opens (``#mode=curvature&edge=12&stripes=40&view=1,-1,0.5``: ``edge`` the
+face checker's edge number, ``item`` instead the page's own row, worst first), so a link can point at one edge.
 """
 
 from __future__ import annotations
@@ -26,6 +26,7 @@ import html
 import json
 import math
 import os
+import tempfile
 from importlib import resources
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
@@ -41,7 +42,7 @@ if TYPE_CHECKING:
     from ..cad.mesh import FaceMesh
     from ..continuity.joints import ContinuityReport, JointReport
 
-__all__ = ["COLOURS", "checked_page_path", "curves_report_html", "part_report_html", "write_html_report"]
+__all__ = ["COLOURS", "COMB_TEETH", "LISTED", "checked_page_path", "curves_report_html", "part_report_html", "write_html_report"]
 
 #: The colour of each verdict on the page — the face checker's edge classes (``CLASS_COLOURS``) and the
 #: curve checker's joint levels — and of the lines that are no verdict: an edge of one face only (``free``),
@@ -55,8 +56,10 @@ COLOURS = {
     "curve": "#222222",
     "comb": "#6baed6",
 }
-#: Most edges listed one by one in the page's table of all edges (the judged ones below G2 are always listed).
-_LISTED = 5_000
+#: Most rows in each of the page's tables, and most G2 joints of curves drawn as points to click.
+LISTED = 5_000
+#: Most teeth of a curve page's curvature comb in all.
+COMB_TEETH = 100_000
 
 
 def _packed(values: NDArray, dtype: Any) -> str:
@@ -129,11 +132,12 @@ def part_report_html(report: FaceReport, mesh: FaceMesh, *, title: str | None = 
         if edge.index >= 0 and mesh.edge_starts[edge.index + 1] - mesh.edge_starts[edge.index] >= 2:
             items[-1]["line"] = edge.index
             worst_of_line.setdefault(edge.index, item)  # the first in ``order`` is the worst of that edge
-        else:  # a knot line inside a face, or an edge without points: a marker where it is worst
+        else:  # a knot line inside a face, or an edge without points: a marker where it is worst (if measured)
             at = np.array(edge.jump_at if edge.level != "gap" else edge.gap_at) - centre
-            items[-1]["point"] = at.tolist()
-            markers.append(at)
-            marker_items.append(item)
+            if np.isfinite(at).all():
+                items[-1]["point"] = at.tolist()
+                markers.append(at)
+                marker_items.append(item)
     for line, item in worst_of_line.items():
         line_item[line] = item
     free = {index for index, _ in report.free_at}
@@ -166,28 +170,39 @@ def part_report_html(report: FaceReport, mesh: FaceMesh, *, title: str | None = 
     return _page(data, report.describe(), controls, "edge", "Tangent edges below G2", "Every tangent edge is G2 (or the part has none).")
 
 
-def curves_report_html(report: ContinuityReport, shape: Any, *, title: str | None = None) -> str:
+def curves_report_html(report: ContinuityReport, shape: Any, *, title: str | None = None,
+                       view: tuple[float, float, float] | None = None) -> str:  # fmt: skip
     """The page of a curve check: ``report`` (``check_continuity``) over the curves of ``shape`` (a shape
     with edges, in the report's unit), each joint a point coloured by its level, with the curvature comb.
+
+    A long program stays a page a browser opens: the comb has at most ``COMB_TEETH`` teeth in all (fewer per
+    edge), and beyond ``LISTED`` G2 joints only those below G2 are points to click (the page says how many
+    are not).
 
     Args:
         report: the curve check.
         shape: the curves judged (a build123d, CadQuery or OCCT shape, or a ``Chain``).
         title: the page's heading (default: the report's source).
+        view: the direction towards the viewer to start from (default: from above for flat curves, else ``VIEW``).
     """
     from ..cad.continuity import curvature_comb
     from ..cad.mesh import edge_lines
     from ..cad.occ import as_occ_shape
+    from ..continuity.joints import Continuity
 
     occ = as_occ_shape(shape)
     curves = [line for line in edge_lines(occ, max(report.size, 1e-300) / 4000.0) if len(line) >= 2]
-    comb = [line for line in edge_lines(curvature_comb(occ), max(report.size, 1e-300) / 4000.0) if len(line) >= 2]
+    teeth = max(2, min(24, COMB_TEETH // max(len(curves), 1)))
+    comb = [line for line in edge_lines(curvature_comb(occ, per_edge=teeth), max(report.size, 1e-300) / 4000.0) if len(line) >= 2]
     everything = np.vstack([*curves, *comb]) if curves or comb else np.zeros((1, 3))
     low, high = everything.min(axis=0), everything.max(axis=0)
     centre, size = (low + high) / 2.0, float(np.linalg.norm(high - low)) or 1.0
     units = report.units
     joints = [(w, j) for w in report.wires for j in w.joints]
     order = sorted(range(len(joints)), key=lambda k: (int(joints[k][1].level), -joints[k][1].relative_curvature_jump))
+    below = sum(1 for _, joint in joints if joint.level != Continuity.G2)
+    left_out = max(0, len(order) - max(below, LISTED))
+    order = order[: len(order) - left_out]  # the worst first: only G2 joints are left out
     items, markers = [], []
     for k in order:
         wire, joint = joints[k]
@@ -202,7 +217,7 @@ def curves_report_html(report: ContinuityReport, shape: Any, *, title: str | Non
         "title": title or report.source,
         "units": units,
         "size": size,
-        "view": [0.0, 0.0, 1.0] if flat else [float(v) for v in VIEW],  # a drawing from above, as drawn
+        "view": [float(v) for v in (view if view is not None else (0.0, 0.0, 1.0) if flat else VIEW)],  # a drawing from above
         "stripes": STRIPES,
         "distance": DISTANCE,
         "palette": COLOURS,
@@ -216,7 +231,8 @@ def curves_report_html(report: ContinuityReport, shape: Any, *, title: str | Non
         "markers": {"points": _packed(np.array([markers[k] for k in known]).reshape(-1, 3), np.float32), "items": known},
         "items": items,
     }
-    return _page(data, report.describe(), _CURVES, "joint", "Joints below G2", "Every joint is G2 (or the curves have none).")
+    summary = report.describe() + (f"; {left_out} of its G2 joints are not drawn as points (the page shows {LISTED})" if left_out else "")
+    return _page(data, summary, _CURVES, "joint", "Joints below G2", "Every joint is G2 (or the curves have none).")
 
 
 def _joint_rows(joint: JointReport, units: str) -> list[tuple[str, str]]:
@@ -243,18 +259,21 @@ def _page(data: dict[str, Any], summary: str, controls: str, what: str, below_ti
         for level, count in sorted(counts.items(), key=lambda kv: _RANK.get(kv[0], 9))
     )
     below = [k for k, item in enumerate(items) if item["level"] not in ("G2", "sharp")]
-    listed = list(range(min(len(items), _LISTED)))
+    more_below = f"<p>… and {len(below) - LISTED} more below G2.</p>" if len(below) > LISTED else ""
+    below = below[:LISTED]  # the worst first
+    listed = list(range(min(len(items), LISTED)))
     return _PAGE.format(
         title=html.escape(str(data["title"])),
         summary=html.escape(summary),
         legend=legend,
         controls=controls,
         below_title=html.escape(below_title),
-        below=_table(items, below, what) if below else f"<p>{html.escape(all_good)}</p>",
+        below=_table(items, below, what) + more_below if below else f"<p>{html.escape(all_good)}</p>",
         every=f"Every {what} judged",
         all_items=_table(items, listed, what),
         more=f"<p>… and {len(items) - len(listed)} more.</p>" if len(items) > len(listed) else "",
-        data=json.dumps(data, separators=(",", ":"), allow_nan=False).replace("</", "<\\/"),
+        # every "<" escaped: no text in the data ("</script>", "<!--<script>" in a name) can end its block
+        data=json.dumps(data, separators=(",", ":"), allow_nan=False).replace("<", "\\u003c"),
         script=resources.files(__package__).joinpath("viewer.js").read_text(encoding="utf-8").replace("</", "<\\/"),
     )
 
@@ -286,7 +305,7 @@ def _table(items: list[dict[str, Any]], which: list[int], what: str) -> str:
 _MODES = """<label><input type="radio" name="mode" id="mode-zebra"> zebra</label>
 <label><input type="radio" name="mode" id="mode-curvature"> mean curvature ({curvature_scale}: red convex, blue concave)</label>
 <label><input type="radio" name="mode" id="mode-shaded"> shaded</label>
-<label>stripes <input type="range" id="stripes" min="4" max="96" step="2"></label>
+<label>stripes <input type="range" id="stripes" min="1" max="200" step="1"></label>
 <label><input type="checkbox" id="lines" checked> edges</label>
 <span>drag to turn, wheel to zoom, click an edge</span>"""
 #: The controls of a curve's page.
@@ -328,10 +347,14 @@ table.items tr[data-item]:hover {{ background: #f3f7ff; }}
 """
 
 
-def checked_page_path(path: str | os.PathLike, source: Any = None) -> Path:
-    """``path`` as the page to write of ``source``: a .html (or .htm) file whose folder exists, of something
-    the page draws (not a LandXML or OpenDRIVE file); else ValueError naming it."""
-    if isinstance(source, (str, os.PathLike)) and Path(source).suffix.lower() in (".xml", ".xodr"):
+def checked_page_path(path: str | os.PathLike, source: Any = None, format: str | None = None) -> Path:
+    """``path`` as the page to write of ``source`` (read as ``format``, if given): a .html (or .htm) file whose
+    folder exists, not the source itself, of something the page draws (not a LandXML or OpenDRIVE file); else
+    ValueError naming it."""
+    named = str(format).lower().lstrip(".") if format is not None else ""
+    if named in ("landxml", "xml", "opendrive", "xodr") or (
+        isinstance(source, (str, os.PathLike)) and Path(source).suffix.lower() in (".xml", ".xodr")
+    ):
         raise ValueError(f"html: {Path(source).name!r:.80} is judged on its own numbers (spiral-cad check prints them); "
                          "the page draws STEP/IGES parts and curves, DXF drawings and G-code programs")  # fmt: skip
     if not isinstance(path, (str, os.PathLike)) or isinstance(path, bytes) or not os.fspath(path):
@@ -341,11 +364,13 @@ def checked_page_path(path: str | os.PathLike, source: Any = None) -> Path:
         raise ValueError(f"html {str(path)!r:.80}: the report is a web page; give a .html file")
     if target.is_dir() or not target.parent.is_dir():
         raise ValueError(f"html {str(path)!r:.80}: " + ("is a folder" if target.is_dir() else f"no folder {str(target.parent)!r:.80}"))
+    if isinstance(source, (str, os.PathLike)) and target.exists() and Path(source).exists() and os.path.samefile(target, source):
+        raise ValueError(f"html {str(path)!r:.80} is the file being checked (by another name); give another file")
     return target
 
 
-def write_html_report(source: Any, path: str | os.PathLike, *, report: Any = None, units: str | None = None, stripes: int = STRIPES,
-                      view: tuple[float, float, float] = VIEW, **check_options: Any) -> Any:  # fmt: skip
+def write_html_report(source: Any, path: str | os.PathLike, *, report: Any = None, units: str | None = None,
+                      stripes: int | None = None, view: tuple[float, float, float] | None = None, **check_options: Any) -> Any:  # fmt: skip
     """Judge ``source`` and write its page to ``path``: a part's faces (``part_report_html``), or curves joint
     by joint (``curves_report_html``).
 
@@ -355,7 +380,9 @@ def write_html_report(source: Any, path: str | os.PathLike, *, report: Any = Non
         report: the check of ``source`` when already made (else ``spiral_cad.check`` makes it here with
             ``check_options``).
         units: for a file, the unit to read it in (None: the unit it declares); for a shape, its unit (mm).
-        stripes, view: how a part's page opens (``plot_zebra``'s meaning).
+        stripes: the zebra's stripe pairs a part's page opens with (1–200, default ``STRIPES``).
+        view: the direction towards the viewer the page opens from (default: ``VIEW`` for a part, from
+            above for flat curves).
         **check_options: the checker's tolerances.
 
     Returns:
@@ -370,8 +397,8 @@ def write_html_report(source: Any, path: str | os.PathLike, *, report: Any = Non
     from ..continuity.joints import ContinuityReport
 
     target = checked_page_path(path, source)
-    if not (isinstance(stripes, int) and not isinstance(stripes, bool) and 2 <= stripes <= 200):
-        raise ValueError(f"stripes must be a whole number from 2 to 200; got {stripes!r:.40}")
+    if stripes is not None and not (isinstance(stripes, int) and not isinstance(stripes, bool) and 1 <= stripes <= 200):
+        raise ValueError(f"stripes must be a whole number from 1 to 200; got {stripes!r:.40}")
     is_file = isinstance(source, (str, os.PathLike))
     if report is None:
         from .files import check
@@ -381,16 +408,30 @@ def write_html_report(source: Any, path: str | os.PathLike, *, report: Any = Non
         if report.faces == 0:
             raise ValueError(f"html: {report.source or 'the shape'} holds no faces to draw")
         mesh = face_mesh(source, units=report.units or None) if is_file else face_mesh(source, units=units or report.units or "mm")
-        page = part_report_html(report, mesh, stripes=stripes, view=view)
+        page = part_report_html(report, mesh, stripes=STRIPES if stripes is None else stripes, view=VIEW if view is None else view)
     elif isinstance(report, ContinuityReport):
-        page = curves_report_html(report, _curves_of(source, units) if is_file else source)
+        if stripes is not None:
+            raise ValueError("stripes: the zebra is drawn on a part's faces; a page of curves has none")
+        page = curves_report_html(report, _curves_of(source, units) if is_file else source, view=view)
     else:
         raise ValueError(f"html: a {type(report).__name__} is not drawn; the page draws parts and curves")
-    try:
-        target.write_text(page, encoding="utf-8")
-    except OSError as error:
-        raise ValueError(f"cannot write the report to {str(target)!r}: {error.strerror or error}") from None
+    _write_whole(target, page)
     return report
+
+
+def _write_whole(target: Path, page: str) -> None:
+    """Write ``page`` to ``target`` all or nothing: a temporary file beside it, then renamed over it (a page
+    already there is kept if writing fails; a link at ``target`` is replaced, never written through)."""
+    data = page.encode("utf-8", errors="replace")  # a name that is no UTF-8 (a file system's raw bytes) shows as "?"
+    handle, temporary = tempfile.mkstemp(prefix=".page-", suffix=".html", dir=target.parent)
+    try:
+        with os.fdopen(handle, "wb") as file:
+            file.write(data)
+        os.chmod(temporary, 0o644)
+        os.replace(temporary, target)
+    except OSError as error:
+        Path(temporary).unlink(missing_ok=True)
+        raise ValueError(f"cannot write the report to {str(target)!r}: {error.strerror or error}") from None
 
 
 def _curves_of(path: str | os.PathLike, units: str | None) -> Any:

@@ -2,7 +2,7 @@
 // One self-contained page: the data in <script id="spiral-data">, this script, no network.
 // WebGL 2: the part's triangles with zebra stripes (reflection lines of light tubes fixed to the view),
 // mean curvature or plain shading; the edges (or a curve's pieces) coloured by their verdict, clickable.
-// The hash sets the starting state: #mode=zebra|curvature|shaded&item=K&stripes=N&view=x,y,z
+// The hash sets the state: #mode=zebra|curvature|shaded&edge=N (or item=K)&stripes=N&view=x,y,z
 (function () {
   "use strict";
   const data = JSON.parse(document.getElementById("spiral-data").textContent);
@@ -16,13 +16,21 @@
     return new Type(bytes.buffer);
   }
 
+  function decoded(text) {
+    try { return decodeURIComponent(text); } catch (error) { return ""; }  // a malformed %-code: as if not given
+  }
   function hashState() {
     const state = {};
     for (const part of location.hash.replace(/^#/, "").split("&")) {
       const [key, value] = part.split("=");
-      if (key) state[decodeURIComponent(key)] = decodeURIComponent(value || "");
+      if (key) state[decoded(key)] = decoded(value || "");
     }
     return state;
+  }
+  // #edge=N: the item of the checker's edge N (a part's page); #item=K: the page's K-th item, worst first
+  function chosenItem(hash) {
+    if (hash.edge !== undefined && hash.edge !== "") return data.items.findIndex((item) => item.label === `edge ${hash.edge}`);
+    return hash.item !== undefined && hash.item !== "" ? parseInt(hash.item, 10) : -1;
   }
 
   // ------------------------------------------------------------------ small matrix algebra (column-major)
@@ -51,12 +59,12 @@
   const state = {
     mode: modes.includes(start.mode) ? start.mode : (data.mesh ? "zebra" : "shaded"),
     stripes: Math.min(Math.max(parseInt(start.stripes || data.stripes, 10) || data.stripes, 2), 200),
-    selected: start.item !== undefined && start.item !== "" ? parseInt(start.item, 10) : -1,
+    selected: chosenItem(start),
     showLines: true,
   };
   const given = (start.view || "").split(",").map(Number);
   let direction = normalize(given.length === 3 && given.every(Number.isFinite) && Math.hypot(...given) > 0 ? given : data.view);
-  let distance = 1.6 * data.size;  // the part fills most of the view (a 30° field)
+  let distance = 2.0 * data.size;  // the bounding sphere (half the diagonal) inside a 30° field
   const target = [0, 0, 0];
 
   // ------------------------------------------------------------------ WebGL
@@ -240,9 +248,11 @@
       gl.drawArrays(gl.POINTS, 0, markers.count);
     }
     if (highlight) {
-      gl.disable(gl.DEPTH_TEST);  // the chosen edge shows even behind the part
+      gl.disable(gl.DEPTH_TEST);  // the chosen edge shows even behind the part, as a line of dots (lines are one pixel)
+      gl.uniform1f(gl.getUniformLocation(lineProgram, "pointSize"), 5 * (window.devicePixelRatio || 1));
       gl.bindVertexArray(highlight.vao);
-      gl.drawArrays(highlight.points ? gl.POINTS : gl.LINES, 0, highlight.count);
+      if (!highlight.points) gl.drawArrays(gl.LINES, 0, highlight.count);
+      gl.drawArrays(gl.POINTS, 0, highlight.count);
     }
     gl.bindVertexArray(null);
     document.body.dataset.ready = "yes";
@@ -371,6 +381,17 @@
     row.addEventListener("click", () => show(Number(row.dataset.item)));
   }
   window.addEventListener("resize", redraw);
+  window.addEventListener("hashchange", () => {
+    const hash = hashState();
+    if (modes.includes(hash.mode) && (data.mesh || hash.mode === "shaded")) {
+      state.mode = hash.mode;
+      const button = document.getElementById(`mode-${hash.mode}`);
+      if (button) button.checked = true;
+    }
+    const chosen = chosenItem(hash);
+    if (chosen !== state.selected) show(chosen);
+    redraw();
+  });
   show(state.selected);
   draw();
 })();

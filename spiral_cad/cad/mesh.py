@@ -24,9 +24,10 @@ from OCP.BRep import BRep_Tool
 from OCP.BRepAdaptor import BRepAdaptor_Curve, BRepAdaptor_Surface
 from OCP.BRepBndLib import BRepBndLib
 from OCP.BRepMesh import BRepMesh_IncrementalMesh
-from OCP.GCPnts import GCPnts_QuasiUniformDeflection
+from OCP.GCPnts import GCPnts_TangentialDeflection
 from OCP.GeomAbs import GeomAbs_SurfaceType
 from OCP.IMeshTools import IMeshTools_Parameters
+from OCP.Precision import Precision
 from OCP.TopAbs import TopAbs_EDGE, TopAbs_FACE, TopAbs_REVERSED
 from OCP.TopExp import TopExp, TopExp_Explorer
 from OCP.TopLoc import TopLoc_Location
@@ -102,6 +103,7 @@ def _mesh(shape: TopoDS_Shape, deflection: float | None, angle: float, pixels: i
     faces = TopTools_IndexedMapOfShape()
     TopExp.MapShapes_s(shape, TopAbs_FACE, faces)
     linear = deflection if deflection is not None else DEFLECTION * PIXELS / pixels * size
+    linear = max(linear, 2.0 * Precision.Confusion_s())  # OCCT meshes nothing finer than its own tolerance (a part of 1e-4 mm)
     # the angular limit alone gives ~2 000 vertices a curved face whatever its size: coarser for many faces
     coarsest = max(angle, _COARSEST)
     angular = min(angle * max(1.0, math.sqrt(faces.Extent() / _FACES_AT_FINEST)), coarsest)
@@ -174,15 +176,32 @@ def edge_lines(shape: TopoDS_Shape, deflection: float) -> list[NDArray]:
         if BRep_Tool.Degenerated_s(edge) or not BRep_Tool.IsGeometric_s(edge):
             lines.append(np.empty((0, 3)))
             continue
-        curve = BRepAdaptor_Curve(edge)
-        spaced = GCPnts_QuasiUniformDeflection(curve, deflection)
-        count = spaced.NbPoints() if spaced.IsDone() else 0
-        if 2 <= count <= _EDGE_POINTS:
-            params = [spaced.Parameter(k) for k in range(1, count + 1)]
-        else:  # too fine, or not sampled: evenly in the parameter
-            params = np.linspace(curve.FirstParameter(), curve.LastParameter(), min(max(count, 17), _EDGE_POINTS)).tolist()
-        lines.append(np.array([curve.Value(t).Coord() for t in params], dtype=float).reshape(-1, 3))
+        lines.append(_edge_points(BRepAdaptor_Curve(edge), deflection))
     return lines
+
+
+def _edge_points(curve: BRepAdaptor_Curve, deflection: float) -> NDArray:
+    """Points along ``curve`` whose chords stay within ``deflection`` of it: OCCT's tangential deflection to
+    start (it may give a helix of high degree two points, its ends), then every span whose middle lies
+    farther than ``deflection`` from its chord's halved, up to ``_EDGE_POINTS`` points."""
+    lo, hi = curve.FirstParameter(), curve.LastParameter()
+    spaced = GCPnts_TangentialDeflection(curve, 0.1, deflection, 9)
+    params = np.array([spaced.Parameter(k) for k in range(1, spaced.NbPoints() + 1)] if spaced.NbPoints() >= 2 else [lo, hi])
+    if params[0] > params[-1]:
+        params = params[::-1]
+    if len(params) > _EDGE_POINTS:
+        params = params[np.linspace(0, len(params) - 1, _EDGE_POINTS).round().astype(int)]
+    points = np.array([curve.Value(float(t)).Coord() for t in params], dtype=float)
+    while len(params) < _EDGE_POINTS:
+        middles = 0.5 * (params[:-1] + params[1:])
+        at = np.array([curve.Value(float(t)).Coord() for t in middles], dtype=float)
+        far = np.linalg.norm(at - 0.5 * (points[:-1] + points[1:]), axis=1) > deflection
+        far &= np.flatnonzero(far).size + len(params) <= _EDGE_POINTS  # never past the cap
+        if not far.any():
+            break
+        params = np.insert(params, np.flatnonzero(far) + 1, middles[far])
+        points = np.insert(points, np.flatnonzero(far) + 1, at[far], axis=0)
+    return points
 
 
 #: The coarsest angular limit the triangle cap may push a mesh to, radians.
@@ -346,7 +365,13 @@ def face_mesh(shape_or_path: Any, *, deflection: float | None = None, angle: flo
             message = re.sub(r"^the (STEP|IGES) reader failed on", "reading and meshing failed on", str(error))
             raise ValueError(f"meshing for the picture: {message}") from None
     else:
-        unit, data = (length_unit(units) if units is not None else ""), extract(as_occ_shape(shape_or_path))
+        unit, shape = (length_unit(units) if units is not None else ""), as_occ_shape(shape_or_path)
+        try:
+            data = extract(shape)
+        except ValueError:
+            raise
+        except Exception as error:  # noqa: BLE001 - OCCT's Standard_Failure (a part too small to mesh): named, as for a file
+            raise ValueError(f"meshing for the picture failed: {type(error).__name__}: {error or 'no message'}") from None
     arrays = np.load(io.BytesIO(data))
     if len(arrays["triangles"]) == 0:
         raise ValueError("the shape has no faces to mesh")

@@ -338,8 +338,13 @@ def _arc(start: list[float], end: list[float], plane: int, ca: float, cb: float,
 
 
 #: An arc's centre may move onto the bisector of its chord by at most this many times the difference of
-#: its end radii (else no circle through both ends lies near it: a nearly whole turn with its ends apart).
+#: its end radii, or by ``_BISECTOR_PATH`` (else no circle through both ends lies near it: a nearly whole
+#: turn with its ends apart).
 _BISECTOR_SHIFTS = 10.0
+#: ... or by LinuxCNC's path tolerance (``TOLERANCE_MM``, ``TOLERANCE_INCH`` of rs274ngc), in the program's
+#: unit: a short arc printed to a few decimals needs its centre moved many times its ends' radius difference
+#: (1e-5 mm for an arc of 1.5° and radius 10 printed to 6 decimals), which moves the path no more than that.
+_BISECTOR_PATH = {"mm": 0.005, "in": 0.0005}
 
 
 def _on_bisector(start: list[float], end: list[float], plane: int, ca: float, cb: float) -> tuple[float, float, float]:
@@ -378,8 +383,8 @@ def read_gcode_runs(path: str | os.PathLike, *, units: str | None = None) -> tup
     a cut); an arc whose end lies off its circle (within what the program's
     decimals leave) is the arc about the centre moved onto the bisector of its chord, so that it ends
     where the move does (noted when that moves its centre), unless that moves the centre farther than
-    ``_BISECTOR_SHIFTS`` times the difference of its radii (a nearly whole turn whose ends are apart is
-    no arc: left out, noted); an arc of more than two turns is judged on its last two (noted); a helical
+    ``_BISECTOR_SHIFTS`` times the difference of its radii and than LinuxCNC's path tolerance (0.005 mm,
+    0.0005 in) both (a nearly whole turn whose ends are apart is no arc: left out, noted); an arc of more than two turns is judged on its last two (noted); a helical
     arc is left out and parts its run (counted in the notes).
 
     Args:
@@ -426,7 +431,7 @@ def read_gcode_runs(path: str | os.PathLike, *, units: str | None = None) -> tup
                 a, b, _ = PLANES[plane]
                 r0, r1 = math.hypot(start[a] - ca, start[b] - cb), math.hypot(end[a] - ca, end[b] - cb)
                 moved = _on_bisector(start, end, plane, ca, cb)[2]
-                if moved > _BISECTOR_SHIFTS * abs(r0 - r1) + 1e-12 * max(r0, r1):
+                if moved > max(_BISECTOR_SHIFTS * abs(r0 - r1) + 1e-12 * max(r0, r1), _BISECTOR_PATH.get(reader.units or "mm", 0.005)):
                     # ends so close that no circle through both lies near the centre: not an arc (rs274 runs a spiral)
                     notes.append(f"line {number}: an arc whose end lies {abs(r0 - r1):.3g} off its circle with ends "
                                  f"{math.hypot(end[a] - start[a], end[b] - start[b]):.3g} apart is no arc: left out, it parts its path")  # fmt: skip

@@ -466,6 +466,25 @@ def test_an_arc_whose_ends_are_too_close_for_any_circle_near_its_centre_is_left_
     assert [w.edge_count for w in report.wires] == [1, 1] and all(j.curvature_after < 1 for w in report.wires for j in w.joints)
 
 
+def test_short_arcs_printed_to_a_few_decimals_are_read_as_arcs(tmp_path):
+    """A half circle of radius 10 in 120 arcs of 1.5°, printed to 6 decimals (as CAM writes them): each end
+    lies up to 7e-7 off its circle, and the centre must move 1e-5 onto the chord's bisector — many times the
+    radius difference, far within LinuxCNC's path tolerance (0.005 mm). Every arc is read; none parts the path."""
+    import numpy as np
+
+    angles = np.linspace(0.0, np.pi, 121)
+    arcs = [
+        f"G3 X{10 * np.cos(a):.6f} Y{10 * np.sin(a):.6f} I{-10 * np.cos(b):.6f} J{-10 * np.sin(b):.6f}"
+        for b, a in zip(angles[:-1], angles[1:])
+    ]
+    path = tmp_path / "arcs.ngc"
+    path.write_text("G21 G17 G90\nG0 X10 Y0 Z0\nG1 Z-1 F100\n" + "\n".join(arcs) + "\nM2\n", encoding="ascii")
+    report = sc.check(path, angle_tol=1e-4, curvature_tol=1e-3)
+    assert not any("is no arc" in note for note in report.notes), report.notes[:3]
+    assert [w.edge_count for w in report.wires] == [121]  # the plunge and the 120 arcs
+    assert all(str(j.level) == "G2" for j in report.wires[0].joints[1:])
+
+
 def test_a_landxml_check_takes_its_tolerances_from_the_alignments_own_numbers(tmp_path):
     """Coordinates printed to 3 decimals: a joint the printing leaves 0.0004 apart (its End and the next
     Start as printed) and a spiral's End as printed are judged within what 3 decimals resolve; a parcel's

@@ -69,7 +69,7 @@ def test_refusals_name_the_value(tmp_path):
         (tmp_path / "folder.html").mkdir()
         write_html_report(part, tmp_path / "folder.html")
     with pytest.raises(ValueError, match="stripes"):
-        write_html_report(part, tmp_path / "out.html", stripes=1)
+        write_html_report(part, tmp_path / "out.html", stripes=0)
     with pytest.raises(ValueError, match="judged on its own numbers"):  # refused before the file is read
         sc.check(tmp_path / "road.xml", html=tmp_path / "road.html")
     with pytest.raises(ValueError, match=r"give a \.html file"):  # refused before the part is judged
@@ -91,6 +91,56 @@ def test_check_writes_the_page_of_a_step_file(tmp_path, capsys):
     assert "the page draws STEP/IGES parts and curves" in capsys.readouterr().err
     assert main(["check", str(step), "--pixels", "300", "--html", str(tmp_path / "p.html")]) == 2
     assert "--pixels: only with --zebra or --curvature-map" in capsys.readouterr().err
+
+
+def test_names_links_and_tiny_parts_cannot_break_the_page(tmp_path):
+    """What a hostile tester found: a name holding "<!--<script>" kept the viewer from running; a link named as
+    the page wrote over the checked file; a part of 1e-4 mm could not be meshed; a helix was drawn as a line."""
+    part = _g1_part()
+    sc.check(part, html=tmp_path / "named.html", label="b<!--<script>x</script>")
+    page = (tmp_path / "named.html").read_text(encoding="utf-8")
+    assert page.count("</script>") == 2 and "<!--" not in page.split('id="spiral-data">')[1]
+    assert _data(page)["title"] == "b<!--<script>x</script>"
+    step = tmp_path / "victim.step"
+    bd.export_step(part, str(step))
+    before = step.read_bytes()
+    (tmp_path / "link.html").symlink_to(step)
+    with pytest.raises(ValueError, match="is the file being checked"):
+        sc.check(step, html=tmp_path / "link.html")
+    assert step.read_bytes() == before
+    with pytest.raises(ValueError, match="judged on its own numbers"):  # a LandXML file by format=, before it is read
+        sc.check(tmp_path / "road.txt", format="landxml", html=tmp_path / "road.html")
+    tiny = bd.fillet(bd.Box(1e-4, 1e-4, 1e-4).edges().filter_by(bd.Axis.Z), 2e-5)
+    assert sc.check(tiny, html=tmp_path / "tiny.html").faces == 10
+    coil = bd.Wire(bd.Helix(10, 40, 5).edges())
+    sc.check(coil, html=tmp_path / "coil.html")
+    data = _data((tmp_path / "coil.html").read_text(encoding="utf-8"))
+    points = np.frombuffer(base64.b64decode(data["lines"]["points"]), dtype=np.float32).reshape(-1, 3)
+    helix = points[: data["lines"]["starts"][1]]
+    assert np.ptp(helix[:, 0]) > 9.9 and np.ptp(helix[:, 1]) > 9.9  # its turns, not the chord between its ends
+
+
+def test_a_long_program_keeps_its_page_small(tmp_path, monkeypatch):
+    """Beyond ``LISTED`` G2 joints only those below G2 are points to click, and the comb has at most
+    ``COMB_TEETH`` teeth: LinuxCNC's 169 000-line stellabee1.ngc had made a 298 MB page."""
+    import spiral_cad.app.html_report as page_module
+
+    monkeypatch.setattr(page_module, "LISTED", 40)
+    monkeypatch.setattr(page_module, "COMB_TEETH", 300)
+    arcs = [f"G3 X{10 * np.cos(a):.6f} Y{10 * np.sin(a):.6f} I{-10 * np.cos(b):.6f} J{-10 * np.sin(b):.6f}"
+            for b, a in zip(np.linspace(0, np.pi, 121)[:-1], np.linspace(0, np.pi, 121)[1:])]  # fmt: skip
+    program = tmp_path / "arcs.ngc"
+    program.write_text("G21 G17 G90\nG0 X10 Y0 Z0\nG1 Z-1 F100\n" + "\n".join(arcs) + "\nG1 X-20 Y-5\nG0 Z5\nM2\n", encoding="ascii")
+    report = sc.check(program, html=tmp_path / "arcs.html", angle_tol=1e-4, curvature_tol=1e-3)  # what 6 decimals resolve
+    joints = [j for w in report.wires for j in w.joints]
+    below = [j for j in joints if str(j.level) != "G2"]
+    assert len(joints) > 100 and 1 <= len(below) < 40
+    text = (tmp_path / "arcs.html").read_text(encoding="utf-8")
+    data = _data(text)
+    assert len(data["items"]) == 40 and {"G2"} < {i["level"] for i in data["items"]}
+    assert f"{len(joints) - 40} of its G2 joints are not drawn as points" in text
+    comb = [k for k, kind in enumerate(data["lines"]["kinds"]) if kind == "comb"]
+    assert 0 < len(comb) <= 2 * 300 + 2 * len(joints)  # teeth (2 a joint-spaced edge at least) and envelopes
 
 
 def test_a_drawings_page_holds_every_joint_where_it_is(tmp_path):
@@ -148,16 +198,14 @@ def test_the_page_draws_in_a_browser_and_an_edge_click_shows_its_numbers(tmp_pat
     the address names shown with its numbers."""
     report = write_html_report(_g1_part(), tmp_path / "g1.html")
     g1 = next(e for e in report.edges if e.level == "G1")
-    item = next(
-        k for k, i in enumerate(_data((tmp_path / "g1.html").read_text(encoding="utf-8"))["items"]) if i["label"] == f"edge {g1.index}"
-    )
     drawing = sc.check(Path(__file__).resolve().parents[2] / "examples" / "plate.dxf", html=tmp_path / "plate.html")
     server = serve(tmp_path)
     try:
         root = f"http://127.0.0.1:{server.server_address[1]}"
         consoles = [_shot(f"{root}/g1.html#mode={mode}", tmp_path / f"{mode}.png", tmp_path) for mode in ("zebra", "curvature")]
         consoles.append(_shot(f"{root}/plate.html", tmp_path / "plate.png", tmp_path))
-        dom = _dom(f"{root}/g1.html#item={item}", tmp_path)
+        dom = _dom(f"{root}/g1.html#edge={g1.index}", tmp_path)
+        consoles.append(_shot(f"{root}/g1.html#item=%&edge=%E0%A4%A", tmp_path / "bad.png", tmp_path))  # a malformed hash
         drawing_dom = _dom(f"{root}/plate.html#item=0", tmp_path)
     finally:
         server.shutdown()
