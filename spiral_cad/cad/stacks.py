@@ -219,36 +219,22 @@ def _between(p: NDArray[np.float64], q: NDArray[np.float64]) -> NDArray[np.float
     return result
 
 
-def _solid(patches: list[TopoDS_Face], caps: list[TopoDS_Face], tolerance: float, top: TopoDS_Face) -> TopoDS_Solid:
-    """The faces sewn into one closed shell and made a FORWARD solid facing out: the shell faces out
-    when the top cap (``top``, a plane z = height) does, as the construction knows (no volume needed)."""
-    # The patches are whole B-spline spans that meet their neighbours edge to edge with the same
-    # parameters, which is what OCCT's fast sewing assumes (a sixth of the general sewing's time);
-    # only the trimmed caps need the general one.
-    fast = BRepBuilderAPI_FastSewing(tolerance)
-    taken = all([fast.Add(face) for face in patches])
-    # no cutting: the caps' edges match the patches' whole, one span to one span
-    sewing = BRepBuilderAPI_Sewing(tolerance, True, True, False, False)
-    if taken:
-        fast.Perform()
-        sewing.Add(fast.GetResult())
-    else:  # pragma: no cover - a patch OCCT's fast sewing does not take is sewn the general way
-        for face in patches:
-            sewing.Add(face)
-    for face in caps:
-        sewing.Add(face)
-    sewing.Perform()
-    sewn = sewing.SewedShape()
-    shells = TopExp_Explorer(sewn, TopAbs_SHELL)
-    count = 0
-    shell = None
-    while shells.More():
-        count += 1
-        shell = TopoDS.Shell_s(shells.Current())
-        shells.Next()
-    if count != 1 or shell is None or not BRep_Tool.IsClosed_s(shell):
-        raise NoSolutionError(f"the slab's {len(patches) + len(caps)} faces did not sew into one closed shell ({count} shell(s))")
-    sewn_top = sewing.Modified(top)
+#: OCCT's fast sewing joins patch corners this close, relative to the model size: the patches' corners are the
+#: same numbers where they meet, so a tolerance far below the general sewing's keeps every edge's own tolerance
+#: small (the face checker allows twice it) and never merges two walls that merely come close.
+_FAST_SEWING = 1e-9
+
+
+def _solid(patches: list[TopoDS_Face], caps: list[TopoDS_Face], size: float, top: TopoDS_Face, *, fast: bool = True) -> TopoDS_Solid:
+    """The faces sewn into one closed shell (``_shell``) and made a FORWARD solid facing out: the shell faces
+    out when the top cap (``top``, a plane z = height) does, as the construction knows (no volume needed).
+    The patches are fast-sewn where ``fast``, and sewn the general way if that does not close the shell."""
+    try:
+        shell, sewn_top = _shell(patches, caps, size, top, fast=fast)
+    except NoSolutionError:
+        if not fast:
+            raise
+        shell, sewn_top = _shell(patches, caps, size, top, fast=False)
     cap = next((f for f in _faces_of(shell) if f.IsSame(sewn_top)), None)
     if cap is None or (plane := _plane(cap)) is None:
         raise NoSolutionError("the slab's top cap is not a plane of the sewn shell")
@@ -256,6 +242,37 @@ def _solid(patches: list[TopoDS_Face], caps: list[TopoDS_Face], tolerance: float
     if up < 0.0:  # the shell faces in: the solid of the turned shell (a fresh solid is FORWARD)
         shell = TopoDS.Shell_s(shell.Reversed())
     return BRepBuilderAPI_MakeSolid(shell).Solid()
+
+
+def _shell(patches: list[TopoDS_Face], caps: list[TopoDS_Face], size: float, top: TopoDS_Face, *, fast: bool) -> tuple[Any, Any]:
+    """The one closed shell of the faces and its top cap as sewn, or NoSolutionError.
+
+    The patches are whole B-spline spans meeting their neighbours edge to edge with the same parameters, what
+    OCCT's fast sewing assumes (a sixth of the general sewing's time); it pairs edges by their two corners,
+    so it is only asked (``fast``) where no two spans join the same two corners. The trimmed caps are always
+    sewn the general way (1e-7 × size), without cutting: their edges match the patches' whole."""
+    sewing = BRepBuilderAPI_Sewing(1e-7 * size, True, True, False, False)
+    joined = BRepBuilderAPI_FastSewing(_FAST_SEWING * size) if fast else None
+    if joined is not None and all([joined.Add(face) for face in patches]):
+        joined.Perform()
+        sewing.Add(joined.GetResult())
+    else:
+        for face in patches:
+            sewing.Add(face)
+    for face in caps:
+        sewing.Add(face)
+    sewing.Perform()
+    shells = TopExp_Explorer(sewing.SewedShape(), TopAbs_SHELL)
+    found = []
+    while shells.More():
+        found.append(TopoDS.Shell_s(shells.Current()))
+        shells.Next()
+    if len(found) != 1 or not BRep_Tool.IsClosed_s(found[0]):
+        raise NoSolutionError(f"the slab's {len(patches) + len(caps)} faces did not sew into one closed shell ({len(found)} shell(s))")
+    sewn_top = sewing.Modified(top)
+    if not any(f.IsSame(sewn_top) for f in _faces_of(found[0])):
+        raise NoSolutionError("the slab's top cap is not a face of the sewn shell")
+    return found[0], sewn_top
 
 
 def _plane(face: TopoDS_Face) -> gp_Pln | None:
@@ -336,6 +353,7 @@ def stack_solid(walls: Sequence[Wall], roll: list[Segment], tolerance: float, si
     reach 1 per unit w, scaled to each rim's reach), and the largest deviation of a patch over a spiral
     from the exact sweep. Sewn with tolerance 1e-7 × ``size``; not yet verified."""
     patches: list[TopoDS_Face] = []
+    fast = True
     levels: dict[tuple[float, bool], list[tuple[TopoDS_Wire, NDArray[np.float64]]]] = {}
     approximation = 0.0
     for wall in walls:
@@ -345,6 +363,7 @@ def stack_solid(walls: Sequence[Wall], roll: list[Segment], tolerance: float, si
             d_top, d_bottom = (height / 2.0, height / 2.0) if d_top and d_bottom else (d_top and height, d_bottom and height)
         reach = max(d_top, d_bottom)
         alongs = [span for s in wall.loop for span in _along_spans(_along(s, 1.0, reach, tolerance))]
+        fast = fast and len(alongs) > 2  # two spans between the same two corners (a D: a chord and an arc) look alike to it
         sections = _sections(roll, d_top, d_bottom, wall.low, wall.high, foot=wall.foot, head=wall.head)
         made = [_surface_face(a, sec, 1e-9 * size) for a in alongs for sec in sections]
         patches += [face for face, _ in made]
@@ -362,7 +381,7 @@ def stack_solid(walls: Sequence[Wall], roll: list[Segment], tolerance: float, si
             caps.append(face)
             top = face if up else top
     assert top is not None
-    return _solid(patches, caps, 1e-7 * size, top), approximation
+    return _solid(patches, caps, size, top, fast=fast), approximation
 
 
 def _level_faces(z: float, rims: list[tuple[TopoDS_Wire, NDArray[np.float64]]]) -> list[TopoDS_Face]:

@@ -288,3 +288,42 @@ def test_a_radius_past_float64_is_refused_with_a_radius_that_builds():
     with pytest.raises(NoSolutionError, match=r"radius 1.7e\+308 .*; radius up to 1.57\d* fits") as error:
         g2_fillet(pocket.edges(), 1.7e308)
     _all_g2(g2_fillet(pocket.edges(), _suggested(error)).wrapped)
+
+
+def test_walls_of_two_spans_folds_and_near_walls_sew_as_they_did():
+    """What a hostile tester found when the roll patches were first fast-sewn (OCCT pairs their edges by their
+    corners, within its tolerance): a sharp D-shaped hole (a chord and an arc: two spans between the same two
+    corners), a roll within 5e-6 of the largest that fits (an inner offset shorter than the tolerance) and two
+    holes 5e-6 apart were refused or merged. Each builds one valid solid whose edges keep their own small
+    tolerances, and its STEP reads back with the same volume."""
+    import tempfile
+    from pathlib import Path
+
+    from build123d import Edge, GeomType, Plane, Wire, export_step, extrude, import_step, make_face
+    from OCP.BRep import BRep_Tool
+
+    c = 10 * math.cos(math.radians(45))
+    d_prism = extrude(make_face(Wire([Edge.make_line((c, c, 0), (c, -c, 0)), Edge.make_circle(10, Plane.XY, -45, 45)])), 20)
+    plate = Box(100, 60, 10) - Pos(0, 0, -10) * d_prism - Pos(-25, 0, 0) * Cylinder(5, 10)
+    boss = Box(100, 60, 10) + Pos(0, 0, 15) * Cylinder(9, 20)
+    reach = float(roll_profile(1.0)[-1].end[0])  # per unit radius
+    close = (
+        Box(100, 60, 10)
+        - Pos(-10.0000025, 0, 0) * Box(20, 20, 10)
+        - Pos(10.0000025, 0, 0) * Box(20, 20, 10)
+        - Pos(35, 0, 0) * Cylinder(5, 10)
+    )
+    cases = [
+        (plate, [e for e in plate.edges() if e.geom_type == GeomType.CIRCLE and e.center().X < -15], 1.0),
+        (boss, boss.edges().filter_by(GeomType.CIRCLE).group_by(Axis.Z)[-1], (9 - 5e-6) / reach),  # its offset 5e-6 across
+        (close, [e for e in close.edges() if e.geom_type == GeomType.CIRCLE], 1.0),
+    ]
+    for sharp, edges, radius in cases:
+        rounded = g2_fillet(edges, radius)
+        _one_forward_valid_solid(rounded.wrapped)
+        assert 0 < rounded.volume < sharp.volume
+        assert max(BRep_Tool.Tolerance_s(e.wrapped) for e in rounded.edges()) <= 1e-6
+        with tempfile.TemporaryDirectory() as folder:
+            path = Path(folder) / "part.step"
+            export_step(rounded, str(path))
+            assert import_step(str(path)).volume == pytest.approx(rounded.volume, rel=1e-9)
