@@ -108,7 +108,7 @@ def part_report_html(report: FaceReport, mesh: FaceMesh, *, title: str | None = 
     edges_in_mesh = len(mesh.edge_starts) - 1
     if any(e.index >= edges_in_mesh for e in report.edges):
         raise ValueError(f"the mesh holds {edges_in_mesh} edges but the report numbers edge "
-                         f"{max(e.index for e in report.edges)}: mesh the shape the report judged")  # fmt: skip
+                         f"{max(e.index for e in report.edges)}: mesh the shape the report judged, with face_mesh(…, edges=True)")  # fmt: skip
     units = report.units or mesh.units
     points = mesh.points
     low, high = (points.min(axis=0), points.max(axis=0)) if len(points) else (np.zeros(3), np.ones(3))
@@ -407,7 +407,8 @@ def write_html_report(source: Any, path: str | os.PathLike, *, report: Any = Non
     if isinstance(report, FaceReport):
         if report.faces == 0:
             raise ValueError(f"html: {report.source or 'the shape'} holds no faces to draw")
-        mesh = face_mesh(source, units=report.units or None) if is_file else face_mesh(source, units=units or report.units or "mm")
+        unit = (report.units or None) if is_file else (units or report.units or "mm")
+        mesh = face_mesh(source, units=unit, edges=True)
         page = part_report_html(report, mesh, stripes=STRIPES if stripes is None else stripes, view=VIEW if view is None else view)
     elif isinstance(report, ContinuityReport):
         if stripes is not None:

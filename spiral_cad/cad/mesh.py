@@ -72,7 +72,7 @@ class FaceMesh:
         edge_points: (k, 3) points along the edges, edge after edge, within the mesh's deflection of them.
         edge_starts: (e + 1,) where each edge's points start in ``edge_points`` (and where the last ends);
             edges are in the order ``spiral_cad.cad.faces.check_faces`` numbers them (``FaceEdge.index``),
-            a degenerate edge with no points.
+            a degenerate edge with no points; only when asked for (``face_mesh(…, edges=True)``).
     """
 
     points: NDArray
@@ -91,7 +91,7 @@ class FaceMesh:
         return float(np.linalg.norm(self.points.max(axis=0) - self.points.min(axis=0))) if len(self.points) else 0.0
 
 
-def _mesh(shape: TopoDS_Shape, deflection: float | None, angle: float, pixels: int, max_triangles: int) -> bytes:
+def _mesh(shape: TopoDS_Shape, deflection: float | None, angle: float, pixels: int, max_triangles: int, edges: bool = False) -> bytes:
     """Mesh ``shape`` and evaluate its surfaces at the vertices: the arrays of a ``FaceMesh`` as
     ``np.savez`` bytes (plain data: runs in the reader's child for a file)."""
     from OCP.BRepTools import BRepTools
@@ -146,7 +146,7 @@ def _mesh(shape: TopoDS_Shape, deflection: float | None, angle: float, pixels: i
         owners.append(np.full(len(tri), index))
         offset += len(raw)
         index += 1
-    lines = edge_lines(shape, linear)
+    lines = edge_lines(shape, linear) if edges else []
     buffer = io.BytesIO()
     empty = np.empty((0, 3))
     np.savez(
@@ -328,7 +328,7 @@ def _curvatures(raw: NDArray, sign: float) -> NDArray:
 
 
 def face_mesh(shape_or_path: Any, *, deflection: float | None = None, angle: float = ANGULAR, units: str | None = "mm",
-              pixels: int = PIXELS, max_triangles: int = MAX_TRIANGLES) -> FaceMesh:  # fmt: skip
+              pixels: int = PIXELS, max_triangles: int = MAX_TRIANGLES, edges: bool = False) -> FaceMesh:  # fmt: skip
     """Mesh the faces of a part with the surfaces' own normals and curvatures at the vertices.
 
     Args:
@@ -344,6 +344,8 @@ def face_mesh(shape_or_path: Any, *, deflection: float | None = None, angle: flo
         pixels: the longer side of the picture the mesh is for.
         max_triangles: above this many triangles the part is meshed again with both limits
             doubled (up to an angular limit of 0.5 rad), so that memory stays bounded.
+        edges: also the points along every edge (``FaceMesh.edge_points``), within the deflection; else
+            ``edge_starts`` holds one 0 (no edge sampled).
 
     Raises:
         ValueError: an unreadable file, a ``deflection`` or ``angle`` that is not a positive number,
@@ -356,7 +358,7 @@ def face_mesh(shape_or_path: Any, *, deflection: float | None = None, angle: flo
     for name, value in (("pixels", pixels), ("max_triangles", max_triangles)):
         if isinstance(value, bool) or not isinstance(value, int) or value < 1:
             raise ValueError(f"{name} must be a positive integer; got {value!r:.40}")
-    extract = partial(_mesh, deflection=deflection, angle=angle, pixels=pixels, max_triangles=max_triangles)
+    extract = partial(_mesh, deflection=deflection, angle=angle, pixels=pixels, max_triangles=max_triangles, edges=edges)
     if isinstance(shape_or_path, (str, os.PathLike)):
         try:
             unit, data = read_file(shape_or_path, units, extract)
