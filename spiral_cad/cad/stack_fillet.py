@@ -184,7 +184,10 @@ def fillet_stack_edges(
 
     given = as_float(radius, "radius")
     upper = min(given, size)  # no roll wider than the part fits in it: the advice is searched below both
-    found = problem(given)
+    try:
+        found = problem(given)
+    except _NoRadius as error:  # the user sees the public class
+        raise NoSolutionError(str(error)) from None
     if found is not None:
         if not _advise:
             raise NoSolutionError(found)
