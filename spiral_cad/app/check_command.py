@@ -127,7 +127,7 @@ def _write_page(args: argparse.Namespace, report: ContinuityReport) -> None:
     from .html_report import write_html_report
 
     view = _picture_options(args).get("view")  # checked before the file was read
-    write_html_report(args.file, args.html, report=report, units=report.units or args.units, view=view,
+    write_html_report(report, args.file, args.html, units=report.units or args.units, view=view,
                       **({"stripes": args.stripes} if args.stripes is not None else {}))  # fmt: skip
     print(f"web page written to {args.html}")
 

@@ -59,7 +59,8 @@ def check_face_file(file: str, *, require: str | None = None, gap_tol: float | N
     also prints how long the check took; ``quiet`` prints the table's first line (the summary) and the
     verdict only. ``picture`` holds the pictures' options (``view``, ``pixels``;
     the zebra's ``stripes``), as ``plot_zebra`` and ``plot_curvature_map`` take them; ``html`` the web page
-    to write (``spiral_cad.app.html_report``), which opens with the same view and stripes.
+    to write (``spiral_cad.app.html_report``; its path checked by the caller before the file is read), which
+    opens with the same view and stripes.
 
     Returns:
         0 ok, 1 below ``require``, None when the reader found no faces or one lone face (no
@@ -69,10 +70,6 @@ def check_face_file(file: str, *, require: str | None = None, gap_tol: float | N
         ValueError: an unreadable file or a bad option (printed as ``error: …`` by the CLI).
     """
     zebra_png, map_png = _png("zebra", zebra), _png("curvature-map", curvature_map)
-    if html is not None:
-        from .html_report import checked_page_path
-
-        checked_page_path(html)  # refused before the file is read
     report = check_faces(
         file,
         gap_tol=gap_tol,
@@ -105,7 +102,7 @@ def check_face_file(file: str, *, require: str | None = None, gap_tol: float | N
         from .html_report import write_html_report
 
         options = {k: v for k, v in (picture or {}).items() if k in ("view", "stripes")}
-        write_html_report(file, html, report=report, **options)
+        write_html_report(report, file, html, **options)
         print(f"web page written to {html}")
     if not require:
         return 0

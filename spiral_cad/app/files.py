@@ -167,7 +167,7 @@ def check(obj_or_path: Any, *, format: str | None = None, html: str | os.PathLik
     page = checked_page_path(html, obj_or_path, format)  # refused before anything is read
     report = _check(obj_or_path, format, options)
     source = _path(obj_or_path, "check") if isinstance(obj_or_path, (str, os.PathLike)) else obj_or_path
-    write_html_report(source, page, report=report, units=options.get("units"))
+    write_html_report(report, source, page, units=options.get("units"))
     return report
 
 

@@ -1,8 +1,8 @@
 """A continuity report as one HTML page to turn and click: the part under zebra stripes or its curvature,
 every edge coloured by its verdict, its numbers a click away.
 
-``write_html_report`` (and ``spiral-cad check PART.step --html OUT.html``, ``spiral_cad.check(…, html=…)``)
-writes one self-contained file: the numbers as JSON in the page, the viewer (``viewer.js``, WebGL 2)
+``spiral_cad.check(…, html=…)`` and ``spiral-cad check PART.step --html OUT.html`` (``write_html_report`` of a
+check already made) write one self-contained file: the numbers as JSON in the page, the viewer (``viewer.js``, WebGL 2)
 inside it, nothing fetched from anywhere, so it opens from a mail or an archive years later. The page:
 
 * the part's faces (``spiral_cad.cad.mesh.face_mesh``: the surfaces' own normals and mean curvature at
@@ -26,7 +26,6 @@ import html
 import json
 import math
 import os
-import tempfile
 from importlib import resources
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
@@ -34,6 +33,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 from numpy.typing import NDArray
 
+from ..cad.continuity import COMB_COLOUR
 from ..cad.faces import CLASS_COLOURS
 from .zebra import DISTANCE, STRIPES, VIEW
 
@@ -54,7 +54,7 @@ COLOURS = {
     "free": "#9e9e9e",
     "other": "#bdbdbd",
     "curve": "#222222",
-    "comb": "#6baed6",
+    "comb": COMB_COLOUR,
 }
 #: Most rows in each of the page's tables, and most G2 joints of curves drawn as points to click.
 LISTED = 5_000
@@ -114,9 +114,7 @@ def part_report_html(report: FaceReport, mesh: FaceMesh, *, title: str | None = 
     low, high = (points.min(axis=0), points.max(axis=0)) if len(points) else (np.zeros(3), np.ones(3))
     centre = (low + high) / 2.0
     size = float(np.linalg.norm(high - low)) or 1.0
-    curvature = np.abs(mesh.mean_curvature[np.isfinite(mesh.mean_curvature)])
-    curved = curvature[curvature > 1e-9 / size]
-    scale = float(np.percentile(curved, 95)) if len(curved) else 1.0 / size
+    scale = mesh.curvature_scale
 
     order = sorted(
         range(len(report.edges)),
@@ -369,28 +367,26 @@ def checked_page_path(path: str | os.PathLike, source: Any = None, format: str |
     return target
 
 
-def write_html_report(source: Any, path: str | os.PathLike, *, report: Any = None, units: str | None = None,
-                      stripes: int | None = None, view: tuple[float, float, float] | None = None, **check_options: Any) -> Any:  # fmt: skip
-    """Judge ``source`` and write its page to ``path``: a part's faces (``part_report_html``), or curves joint
-    by joint (``curves_report_html``).
+def write_html_report(report: Any, source: Any, path: str | os.PathLike, *, units: str | None = None,
+                      stripes: int | None = None, view: tuple[float, float, float] | None = None) -> None:  # fmt: skip
+    """Write the page of ``report``, the check of ``source``, to ``path``: a part's faces (``part_report_html``)
+    or curves joint by joint (``curves_report_html``). ``spiral_cad.check(source, html=path)`` judges and
+    writes it in one call.
 
     Args:
-        source: a STEP/IGES, DXF or G-code path, or a build123d, CadQuery or OCCT shape, a ``Chain``.
-        path: the page to write (.html or .htm; its folder must exist).
-        report: the check of ``source`` when already made (else ``spiral_cad.check`` makes it here with
-            ``check_options``).
-        units: for a file, the unit to read it in (None: the unit it declares); for a shape, its unit (mm).
+        report: the check of ``source``: a ``FaceReport`` or a ``ContinuityReport``.
+        source: what was judged: a STEP/IGES, DXF or G-code path, or a build123d, CadQuery or OCCT shape,
+            a ``Chain``.
+        path: the page to write (.html or .htm; its folder must exist), written whole or not at all.
+        units: for a file, the unit it was read in (None: the unit it declares); for a shape, its unit (mm).
         stripes: the zebra's stripe pairs a part's page opens with (1–200, default ``STRIPES``).
         view: the direction towards the viewer the page opens from (default: ``VIEW`` for a part, from
             above for flat curves).
-        **check_options: the checker's tolerances.
-
-    Returns:
-        The check drawn: a ``FaceReport`` or a ``ContinuityReport``.
 
     Raises:
         ValueError: a path that is not .html, a folder that does not exist, a LandXML or OpenDRIVE file
-            (judged on its numbers, not drawn here), or what the reader or the checker refuses.
+            (judged on its numbers, not drawn here), a report of no faces and no curves, or what the reader
+            refuses.
     """
     from ..cad.faces import FaceReport
     from ..cad.mesh import face_mesh
@@ -400,10 +396,6 @@ def write_html_report(source: Any, path: str | os.PathLike, *, report: Any = Non
     if stripes is not None and not (isinstance(stripes, int) and not isinstance(stripes, bool) and 1 <= stripes <= 200):
         raise ValueError(f"stripes must be a whole number from 1 to 200; got {stripes!r:.40}")
     is_file = isinstance(source, (str, os.PathLike))
-    if report is None:
-        from .files import check
-
-        report = check(source, **({"units": units} if units is not None else {}), **check_options)
     if isinstance(report, FaceReport):
         if report.faces == 0:
             raise ValueError(f"html: {report.source or 'the shape'} holds no faces to draw")
@@ -417,17 +409,17 @@ def write_html_report(source: Any, path: str | os.PathLike, *, report: Any = Non
     else:
         raise ValueError(f"html: a {type(report).__name__} is not drawn; the page draws parts and curves")
     _write_whole(target, page)
-    return report
 
 
 def _write_whole(target: Path, page: str) -> None:
-    """Write ``page`` to ``target`` all or nothing: a temporary file beside it, then renamed over it (a page
-    already there is kept if writing fails; a link at ``target`` is replaced, never written through)."""
-    data = page.encode("utf-8", errors="replace")  # a name that is no UTF-8 (a file system's raw bytes) shows as "?"
-    handle, temporary = tempfile.mkstemp(prefix=".page-", suffix=".html", dir=target.parent)
+    """Write ``page`` to ``target`` all or nothing: a temporary file beside it (``io.staging.temporary_beside``),
+    then renamed over it (a page already there is kept if writing fails; a link at ``target`` is replaced,
+    never written through)."""
+    from ..io.staging import temporary_beside
+
+    temporary = temporary_beside(target, ".html")
     try:
-        with os.fdopen(handle, "wb") as file:
-            file.write(data)
+        Path(temporary).write_bytes(page.encode("utf-8", errors="replace"))  # a name that is no UTF-8 shows "?"
         os.chmod(temporary, 0o644)
         os.replace(temporary, target)
     except OSError as error:

@@ -12,15 +12,12 @@ from OCP.TopExp import TopExp
 from OCP.TopoDS import TopoDS
 from OCP.TopTools import TopTools_IndexedMapOfShape
 
-from ..cad.continuity import curvature_comb
+from ..cad.continuity import COMB_COLOUR, curvature_comb
 from ..cad.faces import CLASS_COLOURS, FaceReport, check_faces
 from ..cad.mesh import face_mesh
 from ..cad.occ import as_occ_shape
 
 __all__ = ["show_continuity"]
-
-#: The colour of the curvature comb.
-COMB_COLOUR = "#6baed6"
 
 
 def _diverging(value: float) -> str:
@@ -72,9 +69,7 @@ def show_continuity(part: Any, *, port: int | None = None, comb: bool = True, **
     np.add.at(per_face, mesh.face, corners)
     counts = np.bincount(mesh.face, minlength=faces.Extent())[: faces.Extent()]
     per_face = np.divide(per_face, counts, out=np.zeros_like(per_face), where=counts > 0)
-    curved = np.abs(mesh.mean_curvature[np.isfinite(mesh.mean_curvature)])
-    curved = curved[curved > 1e-9 / max(report.size, 1e-300)]
-    scale = float(np.percentile(curved, 95)) if len(curved) else 1.0
+    scale = mesh.curvature_scale
     objects: list[Any] = []
     names: list[str] = []
     colours: list[str] = []

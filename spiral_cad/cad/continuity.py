@@ -73,7 +73,7 @@ from ..core.units import length_unit
 from .occ import as_occ_shape
 from .readers import STEP_SUFFIXES, finish_reading, read_file, start_reading
 
-__all__ = ["Continuity", "ContinuityReport", "JointReport", "WireReport", "check_continuity", "curvature_comb"]
+__all__ = ["COMB_COLOUR", "Continuity", "ContinuityReport", "JointReport", "WireReport", "check_continuity", "curvature_comb"]
 
 #: Loose edges whose ends lie closer than this fraction of the model size are
 #: chained into one piece (and their gap is then judged against ``gap_tol``).
@@ -448,6 +448,10 @@ def _report(measured: Measured, unit: str, source: str, gap_tol: float, angle_to
 
 
 # ------------------------------------------------------------------ comb
+
+
+#: The colour a curvature comb is drawn in (the web page of ``check --html``, ``show_continuity``).
+COMB_COLOUR = "#6baed6"
 
 
 def curvature_comb(shape_or_path: Any, *, scale: float | None = None, per_edge: int = 24, units: str = "mm"):

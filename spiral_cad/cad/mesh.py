@@ -86,6 +86,15 @@ class FaceMesh:
     edge_starts: NDArray = field(default_factory=lambda: np.zeros(1, dtype=np.int64))
 
     @property
+    def curvature_scale(self) -> float:
+        """The mean curvature a colour map shows at full strength: the 95th percentile of its size over the
+        curved vertices (so that a few sharp spots do not wash out the rest), 1/size where nothing is curved."""
+        size = max(self.size, 1e-300)
+        found = np.abs(self.mean_curvature[np.isfinite(self.mean_curvature)])
+        curved = found[found > 1e-9 / size]
+        return float(np.percentile(curved, 95)) if len(curved) else 1.0 / size
+
+    @property
     def size(self) -> float:
         """Diagonal of the bounding box of the vertices."""
         return float(np.linalg.norm(self.points.max(axis=0) - self.points.min(axis=0))) if len(self.points) else 0.0

@@ -19,6 +19,7 @@ pytestmark = pytest.mark.cad
 import spiral_cad as sc  # noqa: E402
 from spiral_cad.app.html_report import COLOURS, write_html_report  # noqa: E402
 from spiral_cad.build123d import ContinuousRectangle  # noqa: E402
+from spiral_cad.cad.faces import check_faces  # noqa: E402
 
 
 def _g1_part():
@@ -37,7 +38,7 @@ def _data(page: str) -> dict:
 
 def test_the_page_holds_every_edge_and_its_verdict_and_fetches_nothing(tmp_path):
     page_path = tmp_path / "g1.html"
-    report = write_html_report(_g1_part(), page_path)
+    report = sc.check(_g1_part(), html=page_path)
     page = page_path.read_text(encoding="utf-8")
     data = _data(page)
     assert len(data["items"]) == len(report.edges)
@@ -61,15 +62,16 @@ def test_the_page_holds_every_edge_and_its_verdict_and_fetches_nothing(tmp_path)
 
 def test_refusals_name_the_value(tmp_path):
     part = _g1_part()
+    judged = check_faces(part)
     with pytest.raises(ValueError, match=r"give a \.html file"):
-        write_html_report(part, tmp_path / "out.png")
+        write_html_report(judged, part, tmp_path / "out.png")
     with pytest.raises(ValueError, match="no folder"):
-        write_html_report(part, tmp_path / "missing" / "out.html")
+        write_html_report(judged, part, tmp_path / "missing" / "out.html")
     with pytest.raises(ValueError, match="is a folder"):
         (tmp_path / "folder.html").mkdir()
-        write_html_report(part, tmp_path / "folder.html")
+        write_html_report(judged, part, tmp_path / "folder.html")
     with pytest.raises(ValueError, match="stripes"):
-        write_html_report(part, tmp_path / "out.html", stripes=0)
+        write_html_report(judged, part, tmp_path / "out.html", stripes=0)
     with pytest.raises(ValueError, match="judged on its own numbers"):  # refused before the file is read
         sc.check(tmp_path / "road.xml", html=tmp_path / "road.html")
     with pytest.raises(ValueError, match=r"give a \.html file"):  # refused before the part is judged
@@ -196,7 +198,7 @@ def test_the_page_draws_in_a_browser_and_an_edge_click_shows_its_numbers(tmp_pat
     """Headless Chromium with software WebGL: no console error, nothing requested but the page, a picture
     of the part (not blank) that differs between the zebra and the curvature modes, and the G1 edge that
     the address names shown with its numbers."""
-    report = write_html_report(_g1_part(), tmp_path / "g1.html")
+    report = sc.check(_g1_part(), html=tmp_path / "g1.html")
     g1 = next(e for e in report.edges if e.level == "G1")
     drawing = sc.check(Path(__file__).resolve().parents[2] / "examples" / "plate.dxf", html=tmp_path / "plate.html")
     server = serve(tmp_path)
