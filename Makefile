@@ -9,7 +9,7 @@ DOCS_STAMP := $(VENV)/.docs-installed
 TOOLS       := .venv-tools
 TOOLS_STAMP := $(TOOLS)/.installed
 
-.PHONY: setup demo test check nightly lint bench pictures clean rs274 freecad chromium
+.PHONY: setup demo test check nightly lint bench pictures clean rs274 freecad chromium xvfb
 
 $(STAMP): requirements.lock pyproject.toml
 	test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
@@ -50,6 +50,15 @@ chromium:
 	            || { apt-get update -q >/dev/null && DEBIAN_FRONTEND=noninteractive apt-get install -y -q --no-install-recommends chromium >/dev/null; }; }; } \
 	  || echo "Chromium not installed (apt-get install chromium): the rendered-site tests are skipped"
 
+# A virtual X display for CQ-editor, whose 3-D view tests/cad/test_show_continuity_cq_editor.py reads back.
+# Installed from the distribution when apt-get can (root, Debian); otherwise that test skips, naming why.
+xvfb:
+	-@command -v xvfb-run >/dev/null \
+	  || { command -v apt-get >/dev/null && [ "$$(id -u)" = 0 ] \
+	       && { DEBIAN_FRONTEND=noninteractive apt-get install -y -q --no-install-recommends xvfb xauth >/dev/null \
+	            || { apt-get update -q >/dev/null && DEBIAN_FRONTEND=noninteractive apt-get install -y -q --no-install-recommends xvfb xauth >/dev/null; }; }; } \
+	  || echo "Xvfb not installed (apt-get install xvfb xauth): the CQ-editor test is skipped"
+
 # pytest on every core (pytest-xdist); the tests sharing an expensive module fixture stay on one
 # worker (tests/conftest.py, shared_fixture_group). PYTEST_WORKERS=0 runs in one process.
 PYTEST_WORKERS ?= auto
@@ -57,7 +66,7 @@ XDIST := -n $(PYTEST_WORKERS) --dist loadgroup
 
 # Everything CI runs: lint and the documentation site (--strict) side by side, then every test (the docs
 # tests reuse that site/). -O keeps each one's output in one piece.
-test: $(STAMP) $(TOOLS_STAMP) $(DOCS_STAMP) rs274 freecad chromium
+test: $(STAMP) $(TOOLS_STAMP) $(DOCS_STAMP) rs274 freecad chromium xvfb
 	$(MAKE) --no-print-directory -j2 -O lint docs
 	SPIRAL_CAD_XODR_TOOLS=$(abspath $(TOOLS))/bin/python $(BIN)/python -m pytest -q $(XDIST) --durations=30
 

@@ -11,7 +11,7 @@ outside a builder the result lies on ``Plane.XY``. Spirals become exact
 G2 spiral pair, in the plane or in space (robot and CNC paths, handrails,
 cable and pipe runs), and ``g2_fillet`` also rounds a 3-D wire of lines,
 each corner in the plane of its two edges. ``show_continuity`` shows what the
-face checker finds in OCP CAD Viewer.
+face checker finds in OCP CAD Viewer or CQ-editor.
 
 Example:
     >>> with BuildLine(Plane.XZ) as path:

@@ -130,7 +130,18 @@ def _alive(pid: int) -> bool:
         pass
     except OverflowError:  # not a pid this system can have
         return False
-    return True
+    return not _zombie(pid)
+
+
+def _zombie(pid: int) -> bool:
+    """True for a process that has ended but is not yet reaped by its parent (Linux; elsewhere False):
+    a worker the command has just killed is one until its cluster is closed."""
+    try:
+        with open(f"/proc/{pid}/stat", "rb") as handle:
+            state = handle.read().rpartition(b")")[2].split()[:1]  # the name in parentheses may hold spaces
+    except OSError:
+        return False
+    return state == [b"Z"]
 
 
 class Staging:

@@ -171,6 +171,29 @@ def test_only_our_marked_folders_of_ended_processes_are_removed(out):
     assert link.is_symlink()
 
 
+@pytest.mark.skipif(not os.path.isdir("/proc/self"), reason="zombies are seen through /proc")
+def test_the_folder_of_a_killed_process_not_yet_reaped_is_removed(out):
+    """A worker the command has just killed is a zombie until its cluster is closed: it holds no folder."""
+    import subprocess
+    import sys
+    import time
+
+    child = subprocess.Popen([sys.executable, "-c", "import time; time.sleep(60)"])
+    try:
+        folder = stale_folder(out, f"{staging.PREFIX}{child.pid}-abc", staging._marker_text(child.pid))
+        assert remove_stale(out) == []  # running: kept
+        os.kill(child.pid, signal.SIGKILL)
+        deadline = time.monotonic() + 10
+        while not staging._zombie(child.pid) and time.monotonic() < deadline:
+            time.sleep(0.01)
+        assert staging._zombie(child.pid)
+        assert remove_stale(out) == [folder]
+    finally:
+        child.kill()
+        child.wait()
+    assert not staging._zombie(child.pid)
+
+
 def test_a_failed_build_removes_the_output_folders_it_created(tmp_path):
     out = tmp_path / "new" / "out"
     with pytest.raises(RuntimeError):
