@@ -8,7 +8,7 @@ step       .step .stp                      ``cad.export.export_step``           
 iges       .iges .igs                      ``cad.export.export_iges``              an OCCT shape (``cad.readers.read_shape``)
 dxf        .dxf                            ``cad.export.export_dxf``               its paths (``io.dxf_read.read_dxf_paths``)
 svg        .svg                            ``cad.export.export_svg``               (not read)
-gcode      .nc .ngc .gcode .tap …          ``io.gcode_write.write_gcode``          its exact path (``io.gcode.read_gcode_chain``)
+gcode      .nc .ngc .gcode .tap …          ``io.gcode_write.write_gcode``          its cutting paths (``io.gcode_paths.read_gcode_runs``)
 landxml    .xml                            ``io.landxml.write_landxml``            its alignments (``io.landxml_read.read_landxml``)
 opendrive  .xodr                           ``cad.export.export_opendrive``         its roads (``io.opendrive_read.read_opendrive``)
 ifc        .ifc                            ``io.ifc.write_ifc``                    its alignments (``io.ifc.read_ifc_alignments``)
@@ -60,7 +60,7 @@ READS: dict[str, tuple[tuple[str, ...], str]] = {
     "step": ((".step", ".stp"), "spiral_cad.cad.readers:read_shape"),
     "iges": ((".iges", ".igs"), "spiral_cad.cad.readers:read_shape"),
     "dxf": ((".dxf",), "spiral_cad.io.dxf_read:read_dxf_paths"),
-    "gcode": (GCODE_SUFFIXES, "spiral_cad.io.gcode:read_gcode_chain"),
+    "gcode": (GCODE_SUFFIXES, "spiral_cad.io.gcode_paths:read_gcode_runs"),
     "landxml": ((".xml",), "spiral_cad.io.landxml_read:read_landxml"),
     "opendrive": ((".xodr",), "spiral_cad.io.opendrive_read:read_opendrive"),
     "ifc": ((".ifc",), "spiral_cad.io.ifc:read_ifc_alignments"),

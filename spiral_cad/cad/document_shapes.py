@@ -95,7 +95,8 @@ def program_shape(path: str | os.PathLike, *, units: str | None = None) -> tuple
     if units is not None and units not in ("mm", "in"):
         raise ValueError(f"{name}: a program's unit is mm (G21) or in (G20); got {units!r}")
     try:
-        runs, lines, unit, notes = read_gcode_runs(path, units=units)
+        read = read_gcode_runs(path, units=units)
+        runs, lines, unit, notes = [list(r) for r in read.runs], [list(n) for n in read.lines], read.units, list(read.notes)
     except ValueError as refused:
         if rs274_executable() is None:
             raise ValueError(f"{refused}; LinuxCNC's rs274, which reads more programs, is not installed") from None

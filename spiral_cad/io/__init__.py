@@ -23,6 +23,8 @@ _HOMES = {
     "read_gcode_chain": "gcode",
     "parse_gcode_moves": "gcode_paths",
     "read_gcode_moves": "gcode_paths",
+    "read_gcode_runs": "gcode_paths",
+    "GcodeRuns": "gcode_paths",
     "write_gcode": "gcode_write",
     "gcode_program": "gcode_write",
     "rewrite_gcode_g2": "gcode_inplace",

@@ -45,7 +45,7 @@ from .curve_biarcs import BIARC_SHARE
 from .document_report import DocumentReport, PathReport
 from .dxf import _add
 from .dxf_curves import CURVES, curve_parts
-from .dxf_read import DXF_UNITS, JOIN_TOLERANCE, READ, _chains, _entity_parts, _segment, drop_unstated_units
+from .dxf_read import DXF_UNITS, JOIN_TOLERANCE, READ, _chains, _entity_parts, _segments, drop_unstated_units
 from .staging import temporary_beside
 
 __all__ = ["ATTRIBUTES", "open_drawing", "rewrite_dxf_g2"]
@@ -412,7 +412,7 @@ def _path(msp, pieces: list, owners: list, order: list[tuple[int, bool]], closed
     flat = all(p[1][2] == 0.0 and p[2][2] == 0.0 and (p[0] == "line" or abs(p[3][1][:2]).max() == 0.0) for p, _ in parts)
     segments = []
     for part, reverse in parts:
-        segment = _segment(part, 1.0, 2 if flat else 3)
+        (segment,) = _segments(part, 1.0, 2 if flat else 3)  # a line or an arc: one segment
         segments.append(segment.reversed() if reverse else segment)
     joints = len(segments) - (0 if closed else 1)
     if not joints:

@@ -2,9 +2,13 @@
 
 What is read, from the model space: ``LINE``, ``ARC``, ``CIRCLE``, ``LWPOLYLINE`` and ``POLYLINE``
 (2-D with bulges, and 3-D polylines), in any object coordinate system (a mirrored arc, extrusion
-(0, 0, -1), is a clockwise arc). ``SPLINE``, ``ELLIPSE``, ``HELIX``, block references (``INSERT``)
-and polyface or mesh polylines are refused by name and handle; text, dimensions, hatches, points and
-the other annotation are left out (``DxfPaths.notes`` counts them).
+(0, 0, -1), is a clockwise arc), and ``SPLINE`` s of degree 1 to 3 given by control points with equal
+weights in a plane parallel to XY (as ``export_dxf`` writes a spiral, and most drawing programs a
+free-form curve): each is cut into its Bézier pieces, and each piece at its inflections and curvature
+extrema (``bezier.monotone_pieces``) into spiral pieces (``BezierSpiral``), so a spiral written by us
+comes back as itself. ``ELLIPSE``, ``HELIX``, block references (``INSERT``), rational splines, splines
+given by fit points only and polyface or mesh polylines are refused by name and handle; text,
+dimensions, hatches, points and the other annotation are left out (``DxfPaths.notes`` counts them).
 
 The unit is the header's ``$INSUNITS`` (1 in, 2 ft, 4 mm, 5 cm, 6 m, 7 km); a unitless drawing (0,
 or an R12 file, which has no ``$INSUNITS``) is refused unless its unit is stated (``units=``;
@@ -28,7 +32,9 @@ from typing import Any
 
 import numpy as np
 
+from ..core import bezier
 from ..core.segments import Arc, Line
+from ..core.spiral import BezierSpiral
 from ..core.units import MM_PER_UNIT, length_unit
 
 __all__ = ["DXF_UNITS", "JOIN_TOLERANCE", "DxfPath", "DxfPaths", "drop_unstated_units", "read_dxf_paths"]
@@ -39,13 +45,14 @@ DXF_UNITS = {1: "in", 2: "ft", 4: "mm", 5: "cm", 6: "m", 7: "km"}
 JOIN_TOLERANCE = 1e-6
 #: Entities refused by name, and why.
 REFUSED = {
-    "SPLINE": "a SPLINE (a free-form curve, not a line or an arc)",
     "ELLIPSE": "an ELLIPSE (not a line or a circular arc)",
     "HELIX": "a HELIX (not a plane curve)",
     "INSERT": "a block reference (INSERT): explode the block first",
 }
 #: Entities read as geometry.
 READ = ("LINE", "ARC", "CIRCLE", "LWPOLYLINE", "POLYLINE")
+#: Entities read as their Bézier pieces (the in-place rewrite, ``dxf_g2``, reads them as biarcs instead).
+CUBICS = ("SPLINE",)
 
 
 @dataclass(frozen=True)
@@ -140,8 +147,10 @@ def read_dxf_paths(path: str | os.PathLike, *, units: str | None = None, drawing
         kind = entity.dxftype()
         handle = str(entity.dxf.handle)
         if kind in REFUSED:
-            raise ValueError(f"{label}: entity {handle} is {REFUSED[kind]}; only LINE, ARC, CIRCLE, LWPOLYLINE and POLYLINE are read")
-        if kind not in READ:
+            raise ValueError(
+                f"{label}: entity {handle} is {REFUSED[kind]}; only LINE, ARC, CIRCLE, LWPOLYLINE, POLYLINE and SPLINE are read"
+            )
+        if kind not in READ and kind not in CUBICS:
             skipped[kind] += 1
             continue
         try:
@@ -151,11 +160,14 @@ def read_dxf_paths(path: str | os.PathLike, *, units: str | None = None, drawing
         if parts:
             pieces.append((parts, handle))
     if not pieces:
-        raise ValueError(f"{label}: no LINE, ARC, CIRCLE or polyline in the model space")
+        raise ValueError(f"{label}: no LINE, ARC, CIRCLE, polyline or SPLINE in the model space")
     ends = np.array([p for parts, _ in pieces for part in (parts[0], parts[-1]) for p in (part[1], part[2])])
     size = float(np.linalg.norm(ends.max(axis=0) - ends.min(axis=0))) or 1.0
-    flat = all(abs(p[1][2]) == 0.0 and abs(p[2][2]) == 0.0 and (p[0] == "line" or abs(p[3][1][:2]).max() == 0.0)
-               for parts, _ in pieces for p in parts)  # fmt: skip
+    flat = all(
+        abs(p[1][2]) == 0.0 and abs(p[2][2]) == 0.0 and (p[0] == "line" or p[0] == "cubic" or abs(p[3][1][:2]).max() == 0.0)
+        for parts, _ in pieces
+        for p in parts
+    )  # fmt: skip (a cubic lies at one z: its ends')
     dim = 2 if flat else 3
     paths = []
     for order, closed in _chains(pieces, join_tolerance * size):
@@ -163,7 +175,7 @@ def read_dxf_paths(path: str | os.PathLike, *, units: str | None = None, drawing
         for index, reverse in order:
             parts, handle = pieces[index]
             try:
-                made = [_segment(part, factor, dim) for part in parts]
+                made = [segment for part in parts for segment in _segments(part, factor, dim)]
             except ValueError as error:
                 raise ValueError(f"{label}: entity {handle}: {error}") from None
             if reverse:
@@ -185,6 +197,8 @@ def _entity_parts(entity, kind: str) -> list[tuple]:
     if kind == "LINE":
         start, end = np.array(entity.dxf.start, dtype=float), np.array(entity.dxf.end, dtype=float)
         return [] if np.array_equal(start, end) else [("line", start, end, None)]
+    if kind == "SPLINE":
+        return _spline_parts(entity)
     extrusion = Vec3(entity.dxf.get("extrusion", (0.0, 0.0, 1.0)))
     ocs = OCS(extrusion)
     normal = np.array(extrusion.normalize(), dtype=float)
@@ -231,18 +245,58 @@ def _entity_parts(entity, kind: str) -> list[tuple]:
     return parts
 
 
-def _segment(part: tuple, factor: float, dim: int) -> Line | Arc:
-    """A part as a segment in the paths' unit, in the plane (``dim`` 2) or in space."""
-    kind, start, end, arc = part
+def _spline_parts(spline: Any) -> list[tuple]:
+    """A SPLINE's Bézier pieces, in world coordinates: ``("cubic", start, end, (4, 3) control points)``
+    (degree 1 and 2 pieces raised to degree 3, exactly)."""
+    if not len(spline.control_points):
+        raise ValueError("a SPLINE given by fit points only: its curve is the writer's interpolation, not stated; "
+                         "save it with control points")  # fmt: skip
+    weights = list(spline.weights)
+    if weights and max(weights) != min(weights):
+        raise ValueError(f"a rational SPLINE (weights from {min(weights):g} to {max(weights):g}): a conic, not a cubic")
+    degree = int(spline.dxf.degree)
+    if degree not in (1, 2, 3):
+        raise ValueError(f"a SPLINE of degree {degree}: only degrees 1 to 3 are read")
+    heights = {float(p[2]) for p in spline.control_points}
+    if len(heights) > 1:
+        raise ValueError(f"a SPLINE off the XY plane (control points at z from {min(heights):g} to {max(heights):g})")
+    try:
+        pieces = list(spline.construction_tool().bezier_decomposition())
+    except Exception as error:  # an unclamped (periodic) knot vector, or knots ezdxf cannot split
+        raise ValueError(f"a SPLINE ezdxf cannot cut into Bézier pieces ({type(error).__name__}: {error})") from None
+    parts = []
+    for piece in pieces:
+        cp = np.array(piece, dtype=float)
+        if degree == 1:  # a line as a cubic: its thirds
+            cp = np.array([cp[0], (2 * cp[0] + cp[1]) / 3, (cp[0] + 2 * cp[1]) / 3, cp[1]])
+        elif degree == 2:  # degree elevation: the same curve
+            cp = np.array([cp[0], cp[0] + 2 / 3 * (cp[1] - cp[0]), cp[2] + 2 / 3 * (cp[1] - cp[2]), cp[2]])
+        if not np.any(np.diff(cp, axis=0)):
+            continue  # a piece that goes nowhere
+        parts.append(("cubic", cp[0], cp[-1], cp))
+    return parts
+
+
+def _segments(part: tuple, factor: float, dim: int) -> list[Line | Arc | BezierSpiral]:
+    """A part as segments in the paths' unit, in the plane (``dim`` 2) or in space: one line or arc, or a
+    cubic's spiral pieces."""
+    kind, start, end, data = part
     if kind == "line":
         line = Line(start[:dim] * factor, end[:dim] * factor)
-        return Line._of(start * factor, end * factor) if line.dim != dim else line
-    centre, normal, sweep = arc
+        return [Line._of(start * factor, end * factor) if line.dim != dim else line]
+    if kind == "cubic":
+        cubic = data * factor
+        pieces = []
+        for u0, u1 in bezier.monotone_pieces(cubic[:, :2]):
+            piece = cubic[:, :2] if (u0, u1) == (0.0, 1.0) else bezier.split(cubic[:, :2], u0, u1)
+            pieces.append(BezierSpiral.from_control_points(np.column_stack([piece, cubic[:, 2]])[:, :dim]))
+        return pieces
+    centre, normal, sweep = data
     if dim == 2:
         angle = math.atan2(start[1] - centre[1], start[0] - centre[0])
         radius = math.hypot(start[0] - centre[0], start[1] - centre[1]) * factor
-        return Arc(centre[:2] * factor, math.copysign(radius, normal[2]), angle, sweep)
-    return Arc.in_space(centre * factor, normal, start * factor, sweep)
+        return [Arc(centre[:2] * factor, math.copysign(radius, normal[2]), angle, sweep)]
+    return [Arc.in_space(centre * factor, normal, start * factor, sweep)]
 
 
 def _chains(pieces: list, tolerance: float) -> list[tuple[list[tuple[int, bool]], bool]]:

@@ -37,12 +37,40 @@ from ..core.segments import Arc, Line
 from ..core.units import MM_PER_UNIT, length_unit
 from .toolpath import PLANES, GcodePath, arc_points, arc_sweep
 
-__all__ = ["FOLD_SINE", "PLANE_TOLERANCE", "GcodeMoves", "parse_gcode_moves", "read_gcode_moves", "read_gcode_runs"]
+__all__ = ["FOLD_SINE", "PLANE_TOLERANCE", "GcodeMoves", "GcodeRuns", "parse_gcode_moves", "read_gcode_moves", "read_gcode_runs"]
 
 #: A joint where a curve (an arc) meets the next going back along it within this sine of the angle folds back.
 FOLD_SINE = 1e-9
 #: Points within this share of the path's size of a plane lie in it (``GcodeMoves.plane_runs``).
 PLANE_TOLERANCE = 1e-10
+
+
+@dataclass(frozen=True)
+class GcodeRuns:
+    """The cutting paths of a G-code program as the curves it states (``read_gcode_runs``).
+
+    Attributes:
+        runs: every run of feed moves between rapids, in program order: its ``Line``, ``Arc`` and (for
+            ``G5``) ``BezierSpiral`` segments end to start, in space and in ``units``, G2 or not.
+        lines: the program line of each segment, run by run.
+        units: the program's unit (``"mm"`` or ``"in"``).
+        source: the file's name, for messages.
+        notes: what was left out or read with care (a tool change, an arc moved onto its chord's bisector).
+    """
+
+    runs: tuple[tuple[Any, ...], ...]
+    lines: tuple[tuple[int, ...], ...]
+    units: str
+    source: str
+    notes: tuple[str, ...] = ()
+
+    def __len__(self) -> int:
+        return len(self.runs)
+
+    @property
+    def length(self) -> float:
+        """The length of every run together, in ``units``."""
+        return float(sum(segment.length for run in self.runs for segment in run))
 
 
 @dataclass(frozen=True)
@@ -373,7 +401,7 @@ def _first_named(text: str) -> dict[str, int]:
     return found
 
 
-def read_gcode_runs(path: str | os.PathLike, *, units: str | None = None) -> tuple[list[list[Any]], list[list[int]], str, list[str]]:
+def read_gcode_runs(path: str | os.PathLike, *, units: str | None = None) -> GcodeRuns:
     """The exact cutting paths of a G-code file: every run of feed moves between rapids as the curves it
     states (G1 lines, G2/G3 arcs, G5 cubics as ``parse_gcode_chain``'s spiral pieces), in space and in the
     program's unit, whether or not they join G2.
@@ -392,8 +420,7 @@ def read_gcode_runs(path: str | os.PathLike, *, units: str | None = None) -> tup
         units: the unit of a program that states neither G20 nor G21 (``"mm"`` or ``"in"``); None refuses one.
 
     Returns:
-        The runs (lists of segments, in program order), the program line of each segment, the unit and
-        the reader's notes.
+        The runs (``GcodeRuns``): their segments, the program line of each, the unit and the reader's notes.
 
     Raises:
         ValueError: what the built-in reader refuses (naming the line), or no feed move.
@@ -457,4 +484,4 @@ def read_gcode_runs(path: str | os.PathLike, *, units: str | None = None) -> tup
         raise ValueError(f"{label}: no feed move (G1, G2, G3, G5) to a new position after the first move")
     if helical:
         notes.append(f"{helical} helical arc(s) left out: each parts its path")
-    return [runs[k] for k in kept], [lines[k] for k in kept], reader.units, notes
+    return GcodeRuns(tuple(tuple(runs[k]) for k in kept), tuple(tuple(lines[k]) for k in kept), reader.units, label, tuple(notes))

@@ -8,7 +8,9 @@ The format, as surveys, GPS exports and digitisers write it:
   ``east``/``e``, ``y``/``northing``/``north``/``n``, ``z``/``elevation``/
   ``elev``/``height``/``h``; a name may carry its unit in brackets
   (``x [m]``, as the CSV files of this package write it). Without a header the
-  columns are x, y[, z];
+  columns are x, y[, z]. The other columns of this package's samples files
+  (``s``, ``tx``, ``ty``, ``tz``, ``curvature``) are read and set aside, so a
+  samples file reads back as its points;
 - ``#`` starts a comment; a comment line ``# units: m`` states the unit of
   the numbers (as does a unit in the header). A file that states none is in
   the unit the caller gives.
@@ -31,6 +33,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ..core.units import MM_PER_UNIT, UNITS, length_unit
+from .samples import COLUMNS as SAMPLE_COLUMNS
 
 __all__ = ["COLUMN_NAMES", "MAX_POINTS_BYTES", "PointTable", "parse_points", "read_points"]
 
@@ -44,6 +47,9 @@ COLUMN_NAMES = {
 MAX_POINTS_BYTES = 1_000_000_000
 
 _COLUMN_OF = {name: column for column, names in COLUMN_NAMES.items() for name in names}
+#: The other columns of a samples file (``export_samples``: station, tangent, curvature), read and set aside,
+#: each with its dimension (``L``: the file's length unit).
+_SET_ASIDE = {name: dimension for name, dimension in SAMPLE_COLUMNS if name not in _COLUMN_OF}
 _UNITS_LINE = re.compile(r"#\s*units?\s*[:=]\s*(\S+)\s*$", re.IGNORECASE)
 _HEADER_NAME = re.compile(r"(?P<name>[^\[\]()]*?)\s*(?:[\[(]\s*(?P<unit>[^\]\)]*?)\s*[\])])?")
 
@@ -219,21 +225,32 @@ def _header(line: str, separator: str | None, number: int, source: str) -> tuple
     if any(_is_number(cell) for cell in cells):
         return None, None
     order, units = [], set()
+    per_length = set()
     for cell in cells:
         match = _HEADER_NAME.fullmatch(cell)
         name = match.group("name").strip().lower() if match else cell.lower()
-        if name not in _COLUMN_OF:
+        unit = match.group("unit").strip() if match and match.group("unit") else None
+        column = _COLUMN_OF.get(name, name if name in _SET_ASIDE else None)
+        if column is None:
             known = "; ".join("/".join(names) for names in COLUMN_NAMES.values())
-            raise ValueError(f"{source}: line {number}: column {cell!r} is not a coordinate ({known})")
-        if _COLUMN_OF[name] in order:
-            raise ValueError(f"{source}: line {number}: column {cell!r} names {_COLUMN_OF[name]} a second time")
-        order.append(_COLUMN_OF[name])
-        if match and match.group("unit"):
-            units.add(match.group("unit").strip())
+            raise ValueError(f"{source}: line {number}: column {cell!r} is not a coordinate ({known}) nor a column of a "
+                             f"samples file ({', '.join(_SET_ASIDE)})")  # fmt: skip
+        if column in order:
+            raise ValueError(f"{source}: line {number}: column {cell!r} names {column} a second time")
+        order.append(column)
+        dimension = _SET_ASIDE.get(column, "L")
+        if unit is None or dimension == "1":
+            continue
+        if dimension == "1/L":  # a curvature: its unit is one over the lengths'
+            if not unit.startswith("1/"):
+                raise ValueError(f"{source}: line {number}: column {cell!r} states {unit!r}, not one over a length")
+            per_length.add(unit[2:].strip())
+        else:
+            units.add(unit)
     if "x" not in order or "y" not in order:
         raise ValueError(f"{source}: line {number}: the header {line!r} needs an x and a y column")
-    if len(units) > 1:
-        raise ValueError(f"{source}: line {number}: the header states several units ({', '.join(sorted(units))})")
+    if len(units | per_length) > 1:
+        raise ValueError(f"{source}: line {number}: the header states several units ({', '.join(sorted(units | per_length))})")
     return tuple(order), units.pop() if units else None
 
 

@@ -306,6 +306,10 @@ def test_read_reads_every_format_by_its_suffix_or_the_format_named(tmp_path):
         sc.export(chain, tmp_path / f"road{suffix}")
     assert type(sc.read(tmp_path / "road.step")).__name__ == "TopoDS_Shape"
     assert sc.read(tmp_path / "road.ngc").length == pytest.approx(chain.length * 1000.0, rel=1e-6)  # a program in mm
+    (tmp_path / "ring.nc").write_text((Path(__file__).parents[2] / "examples" / "pocket.nc").read_text(encoding="utf-8"), encoding="utf-8")
+    pocket = sc.read(tmp_path / "ring.nc")  # an ordinary program: its square corners are read, not refused
+    assert len(pocket) == 1 and pocket.units == "mm" and pocket.lines[0][0] == 9
+    assert pocket.length == pytest.approx(3 + 2 * (50 + 40) + 1 + 50 + 40 + 50 + 35)  # plunge, first ring, plunge, second ring
     for suffix in (".xml", ".xodr", ".ifc"):
         (road,) = sc.read(tmp_path / f"road{suffix}")
     (tmp_path / "road.xml").rename(tmp_path / "road.landxml")

@@ -107,10 +107,10 @@ def test_build_dxf_writes_every_output_and_refuses_by_name(tmp_path, capsys):
     assert main(["build", str(r12), "--max-deviation", "0.001", "--units", "in", "--no-plots", "--out", str(tmp_path / "r12")]) == 0
     assert "read in in as stated" in capsys.readouterr().out
     doc = ezdxf.new("R2010")
-    doc.modelspace().add_spline([(0, 0), (1, 1), (2, 0), (3, 1)])
+    doc.modelspace().add_spline([(0, 0), (1, 1), (2, 0), (3, 1)])  # fit points: the curve is not stated
     doc.saveas(tmp_path / "spline.dxf")
     assert main(["build", str(tmp_path / "spline.dxf"), "--max-deviation", "0.01", "--units", "mm", "--out", str(out)]) == 2
-    assert "is a SPLINE" in capsys.readouterr().err
+    assert "a SPLINE given by fit points only" in capsys.readouterr().err
 
 
 def test_a_landxml_alignment_of_lines_and_arcs_is_made_g2(tmp_path, capsys):

@@ -114,10 +114,28 @@ def test_a_drawing_without_a_header_states_no_unit_wherever_it_is_read(tmp_path,
 def test_refusals_name_the_entity(tmp_path):
     doc, msp = drawing()
     msp.add_line((0, 0), (1, 0))
-    spline = msp.add_spline([(0, 0), (1, 1), (2, 0), (3, 1)])
+    spline = msp.add_rational_spline([(0, 0), (1, 1), (2, 0)], [1, 0.5, 1], degree=2)
     doc.saveas(tmp_path / "spline.dxf")
-    with pytest.raises(ValueError, match=rf"spline.dxf: entity {spline.dxf.handle} is a SPLINE .*only LINE, ARC, CIRCLE"):
+    with pytest.raises(ValueError, match=rf"spline.dxf: SPLINE {spline.dxf.handle}: a rational SPLINE \(weights from 0.5 to 1\)"):
         read_dxf_paths(tmp_path / "spline.dxf")
+    for made, message in (
+        (lambda m: m.add_spline(fit_points=[(0, 0), (1, 1), (2, 0), (3, 1)]), "given by fit points only"),
+        (
+            lambda m: m.add_open_spline([(0, 0, 0), (1, 1, 0), (2, 0, 1), (3, 1, 0)]),
+            r"off the XY plane \(control points at z from 0 to 1\)",
+        ),
+        (lambda m: m.add_open_spline([(k, k % 2) for k in range(6)], degree=4), "a SPLINE of degree 4"),
+    ):
+        doc, msp = drawing()
+        handle = made(msp).dxf.handle
+        doc.saveas(tmp_path / "spline.dxf")
+        with pytest.raises(ValueError, match=rf"SPLINE {handle}: .*{message}"):
+            read_dxf_paths(tmp_path / "spline.dxf")
+    doc, msp = drawing()
+    msp.add_ellipse((0, 0), (2, 0), 0.5)
+    doc.saveas(tmp_path / "ellipse.dxf")
+    with pytest.raises(ValueError, match=r"is an ELLIPSE .*only LINE, ARC, CIRCLE, LWPOLYLINE, POLYLINE and SPLINE are read"):
+        read_dxf_paths(tmp_path / "ellipse.dxf")
     doc, msp = drawing(insunits=3)  # miles
     msp.add_line((0, 0), (1, 0))
     doc.saveas(tmp_path / "miles.dxf")
@@ -148,3 +166,48 @@ def test_3d_polylines_and_elevations_are_paths_in_space(tmp_path):
     assert len(read) == 1 and read.paths[0].segments[0].dim == 3 and joined(read.paths[0], False) < 1e-9
     arc = read.paths[0].segments[-1]
     assert isinstance(arc, Arc) and np.allclose(arc.end, (20, 10, 4))
+
+
+def test_our_own_drawing_reads_back_as_its_chain(tmp_path):
+    """``export_dxf`` writes lines, arcs and each spiral as a cubic SPLINE: read back, the same segments."""
+    import spiral_cad as sc
+    from spiral_cad import Chain, line_to_circle
+    from spiral_cad.core.spiral import BezierSpiral
+
+    centre, radius, turn = np.array([100.0, 40.5]), 40.0, 1.0
+    enter = line_to_circle((0, 0), (1, 0), tuple(centre), radius)
+    total = turn + 2.0 * abs(enter.spirals[0].theta)
+    out = np.array([math.cos(total), math.sin(total)])
+    exit_point = centre + 40.5 * np.array([math.sin(total), -math.cos(total)])
+    leave = line_to_circle(tuple(exit_point), tuple(-out), tuple(centre), radius).reversed()
+    chain = Chain.join([enter, leave], start=(-50.0, 0.0), end=tuple(leave.end + 60.0 * out))
+    assert {type(s) for s in chain.segments} == {Line, BezierSpiral, Arc}
+    sc.export(chain, tmp_path / "road.dxf")
+    (path,) = sc.read(tmp_path / "road.dxf").paths
+    assert [type(s) for s in path.segments] == [type(s) for s in chain.segments]
+    for ours, back in zip(chain.segments, path.segments):
+        assert np.allclose(back.start, ours.start, rtol=0, atol=1e-12) and np.allclose(back.end, ours.end, rtol=0, atol=1e-12)
+        if isinstance(ours, BezierSpiral):
+            assert np.array_equal(back.control_points, ours.control_points)  # exactly as written
+
+
+def test_a_free_form_spline_is_cut_into_spiral_pieces_on_ezdxf_s_curve(tmp_path):
+    """A cubic B-spline with an inflection and curvature peaks (as drawing programs write one) comes back as
+    spiral pieces, end to start, every piece on ezdxf's own curve, its curvature monotone."""
+    from spiral_cad.core import bezier
+
+    doc, msp = drawing()
+    spline = msp.add_open_spline([(0, 0), (10, 10), (20, 0), (30, 10), (40, 0), (50, 20)], degree=3)
+    msp.add_line((50, 20), (60, 20))
+    doc.saveas(tmp_path / "wave.dxf")
+    (path,) = read_dxf_paths(tmp_path / "wave.dxf").paths
+    curve = spline.construction_tool()
+    pieces = [s for s in path.segments if not isinstance(s, Line)]
+    assert len(pieces) > 3 and joined(path, closed=False) < 1e-12
+    assert np.allclose(path.segments[0].start, (0, 0)) and np.allclose(path.segments[-1].end, (60, 20))
+    for piece in pieces:
+        for point in piece.point(np.linspace(0, 1, 9)):
+            on = curve.point(curve.point_inversion(point.tolist()))  # ezdxf's nearest point of its curve
+            assert math.dist(point, tuple(on)[:2]) < 1e-7  # ezdxf's Newton stops near 1e-9
+        kappa = bezier.curvature(piece.control_points, np.linspace(0, 1, 50))
+        assert np.all(np.diff(np.abs(kappa)) >= -1e-9) or np.all(np.diff(np.abs(kappa)) <= 1e-9)

@@ -55,6 +55,9 @@ def test_lines_name_points_and_units_convert():
         ("x,easting\n0,0\n", "line 1: column 'easting' names x a second time"),
         ("x,z\n0,0\n", "needs an x and a y column"),
         ("x [m],y [ft]\n0,0\n", "the header states several units (ft, m)"),
+        ("x [m],y [m],curvature [1/ft]\n0,0,0\n", "the header states several units (ft, m)"),
+        ("x [m],y [m],curvature [m]\n0,0,0\n", "column 'curvature [m]' states 'm', not one over a length"),
+        ("s,x,y,tx,tx\n0,0,0,1,1\n", "column 'tx' names tx a second time"),
         ("# units: m\n# units: ft\n0,0\n", "line 2: unit ft differs from m stated on line 1"),
         ("# units: parsec\n0,0\n", "line 1: unit 'parsec' is not one of mm, cm, m, km, in, ft"),
         ("# units: m\nx [ft],y [ft]\n0,0\n", "line 2: unit ft differs from m"),
@@ -66,6 +69,20 @@ def test_malformed_lines_are_named(text, message):
     with pytest.raises(ValueError) as info:
         parse_points(text, source="survey.csv")
     assert str(info.value).startswith("survey.csv: ") and message in str(info.value)
+
+
+def test_a_samples_file_reads_back_as_its_points(tmp_path):
+    """``export_samples`` writes station, point, tangent and curvature, each with its unit: the points come
+    back, in that unit, and the other columns are set aside."""
+    from spiral_cad import Chain, line_to_circle
+    from spiral_cad.io.samples import write_samples
+
+    chain = Chain(line_to_circle((0, 0), (1, 0), (50, 40), 30).spirals, units="m")
+    write_samples(chain, tmp_path / "path.csv", step=1.0)
+    table = read_points(tmp_path / "path.csv")
+    written = np.loadtxt(tmp_path / "path.csv", delimiter=",", skiprows=1)
+    assert table.units == "m" and table.dim == 3 and len(table) == len(written) > 50
+    assert np.array_equal(table.points, written[:, 1:4])  # x, y, z as printed, in file order
 
 
 def test_unreadable_files_are_named(tmp_path):
