@@ -60,12 +60,12 @@ class DxfPath:
     """One chained path of a drawing.
 
     Attributes:
-        segments: the lines and arcs, end to start (in the paths' unit).
+        segments: the lines, arcs and spiral pieces (of SPLINEs), end to start (in the paths' unit).
         closed: whether the path's last end meets its first start.
         handles: the DXF handle of every segment's entity (for messages).
     """
 
-    segments: tuple[Line | Arc, ...]
+    segments: tuple[Line | Arc | BezierSpiral, ...]
     closed: bool
     handles: tuple[str, ...]
 
@@ -286,7 +286,7 @@ def _segments(part: tuple, factor: float, dim: int) -> list[Line | Arc | BezierS
         return [Line._of(start * factor, end * factor) if line.dim != dim else line]
     if kind == "cubic":
         cubic = data * factor
-        pieces = []
+        pieces: list[Line | Arc | BezierSpiral] = []
         for u0, u1 in bezier.monotone_pieces(cubic[:, :2]):
             piece = cubic[:, :2] if (u0, u1) == (0.0, 1.0) else bezier.split(cubic[:, :2], u0, u1)
             pieces.append(BezierSpiral.from_control_points(np.column_stack([piece, cubic[:, 2]])[:, :dim]))
