@@ -5,7 +5,9 @@ five transitions, chains, fitting points (``fit_points``), and ``batch`` (the
 same solvers over arrays). It
 needs only numpy, scipy and numba. ``export`` and ``read`` (``spiral_cad.app.files``, loaded on first
 use) write and read every format, chosen by the file's suffix, and ``check`` judges G0/G1/G2 in any of
-them or in a shape. Design tools live in ``spiral_cad.design``;
+them or in a shape; ``make_g2`` and ``round_corners`` (from ``spiral_cad.design``) and ``plot`` (from
+``spiral_cad.app.plots``, with the ``cad`` extra's matplotlib) load on first use too. The other design
+tools live in ``spiral_cad.design``;
 build123d objects in ``spiral_cad.build123d`` and the CadQuery plugin in
 ``spiral_cad.cadquery`` (these two import OCP).
 """
@@ -28,6 +30,9 @@ from .core.transitions import circle_in_circle, circle_to_circle, line_to_circle
 
 if TYPE_CHECKING:
     from .app.files import check, export, read
+    from .app.plots import plot
+    from .design.g2 import make_g2
+    from .design.rounded_paths import round_corners
 
 sys.modules[f"{__name__}.batch"] = batch  # `import spiral_cad.batch` too, as `import os.path`
 
@@ -53,15 +58,33 @@ __all__ = [
     "fit_points",
     "line_to_circle",
     "line_to_line",
+    "make_g2",
+    "plot",
     "read",
+    "round_corners",
 ]
+#: The names loaded on first use, and their modules: the file formats' modules, the design tools and the
+#: plots load only when used.
+_LAZY = {
+    "check": "app.files",
+    "export": "app.files",
+    "read": "app.files",
+    "make_g2": "design.g2",
+    "round_corners": "design.rounded_paths",
+    "plot": "app.plots",
+}
 
 
 def __getattr__(name: str) -> Any:
-    """``check``, ``export`` and ``read`` on first use: the file formats' modules load only when a file is
-    judged, written or read."""
-    if name in ("check", "export", "read"):
-        from .app import files
+    """The names of ``_LAZY`` on first use."""
+    if name in _LAZY:
+        import importlib
 
-        return getattr(files, name)
+        try:
+            module = importlib.import_module(f"{__name__}.{_LAZY[name]}")
+        except ModuleNotFoundError as missing:
+            if missing.name is None or not missing.name.startswith("matplotlib"):
+                raise
+            raise ModuleNotFoundError(f'spiral_cad.{name} draws with matplotlib: pip install "spiral_cad[cad]"') from None
+        return getattr(module, name)
     raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

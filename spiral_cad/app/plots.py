@@ -8,9 +8,10 @@ returns the figure so callers can ``fig.savefig(...)``.
 from __future__ import annotations
 
 import math
+import os
 from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import cast
+from typing import Any, cast
 
 import numpy as np
 from matplotlib.axes import Axes
@@ -148,7 +149,8 @@ def plot_plan(chain: Chain, comb: bool = True, ax: Axes | None = None, per_segme
     unit = f" ({chain.units})"
     ax.set_xlabel("x" + unit)
     ax.set_ylabel("y" + unit)
-    title = f"{'Plan' if chain.dim == 2 else 'Plan (projected onto XY)'}: {len(chain)} segments, length {chain.length:.6g} {chain.units}"
+    count = f"{len(chain)} segment{'s' * (len(chain) != 1)}"
+    title = f"{'Plan' if chain.dim == 2 else 'Plan (projected onto XY)'}: {count}, length {chain.length:.6g} {chain.units}"
     if data is not None:
         title += f" (comb: {data.scale:.3g} {chain.units}² per unit curvature)"
     ax.set_title(title)
@@ -175,6 +177,47 @@ def plot_curvature(chain: Chain, ax: Axes | None = None, per_segment: int | None
     ax.set_title("Curvature profile")
     ax.legend(loc="best", fontsize="small")
     ax.grid(True, alpha=0.3)
+    return fig
+
+
+def plot(obj: Any, path: str | os.PathLike | None = None, *, comb: bool = True) -> Figure:
+    """The plan (with its curvature comb) and the curvature profile of a chain, side by side.
+
+    Args:
+        obj: a ``Chain``, a ``Transition`` (its spirals), or what holds one chain: ``.chain`` (an
+            ``Alignment``, a rounded path) or ``.chains`` with one (``make_g2``'s result).
+        path: also save the figure there (any format matplotlib writes, by suffix: .png, .svg, .pdf).
+        comb: draw the curvature comb on the plan.
+
+    Returns:
+        The figure (``plot_plan`` beside ``plot_curvature``).
+
+    Raises:
+        ValueError: ``obj`` holds no chain, or several; a ``path`` matplotlib cannot write.
+    """
+    from ..core.transitions import Transition
+
+    chain = obj
+    if isinstance(obj, Transition):
+        chain = Chain(obj.spirals)
+    elif not isinstance(obj, Chain) and isinstance(getattr(obj, "chain", None), Chain):
+        chain = obj.chain
+    elif not isinstance(obj, Chain) and isinstance(getattr(obj, "chains", None), list):
+        if len(obj.chains) != 1:
+            raise ValueError(f"plot: the {type(obj).__name__} holds {len(obj.chains)} chains; plot each of .chains")
+        chain = obj.chains[0]
+    if not isinstance(chain, Chain):
+        raise ValueError(f"plot: expected a Chain, a Transition or what holds one chain (.chain, .chains); got {type(obj).__name__}")
+    fig, (plan, profile) = _axes_pair(None)
+    plot_plan(chain, comb=comb, ax=plan)
+    plan.set_title(plan.get_title().replace(" (comb:", "\n(comb:"), fontsize="medium")  # two lines: it fits its half
+    plot_curvature(chain, ax=profile)
+    fig.tight_layout()
+    if path is not None:
+        try:
+            fig.savefig(os.fspath(path))
+        except ValueError as error:  # "Format 'xyz' is not supported"
+            raise ValueError(f"plot: cannot save {os.fspath(path)!r}: {error}") from None
     return fig
 
 

@@ -366,6 +366,40 @@ def test_the_verbs_load_the_formats_only_when_used():
     done = subprocess.run([sys.executable, "-c", "import sys, spiral_cad; print('spiral_cad.app.files' in sys.modules); "
                            "spiral_cad.export; print('spiral_cad.app.files' in sys.modules)"], capture_output=True, text=True)  # fmt: skip
     assert done.stdout.split() == ["False", "True"], done.stderr
+    loaded = ("'spiral_cad.app.files' in sys.modules, 'spiral_cad.design.g2' in sys.modules, "
+              "'spiral_cad.design.rounded_paths' in sys.modules, 'matplotlib' in sys.modules")  # fmt: skip
+    done = subprocess.run([sys.executable, "-c", f"import sys, spiral_cad; print({loaded}); spiral_cad.make_g2, spiral_cad.round_corners, "
+                           f"spiral_cad.plot; print({loaded})"], capture_output=True, text=True)  # fmt: skip
+    assert done.stdout.split() == ["False"] * 4 + ["False", "True", "True", "True"], done.stderr
+
+
+def test_the_first_verbs_are_at_the_top_level_each_from_its_home():
+    from spiral_cad.app.plots import plot
+    from spiral_cad.design import make_g2, round_corners
+
+    assert sc.make_g2 is make_g2 and sc.round_corners is round_corners and sc.plot is plot
+    assert {"make_g2", "round_corners", "plot", "check", "export", "read"} <= set(sc.__all__)
+
+
+def test_plot_draws_the_plan_with_its_comb_beside_the_curvature_and_saves_by_suffix(tmp_path):
+    from PIL import Image
+
+    chain = _road()
+    figure = sc.plot(chain, tmp_path / "road.png")
+    plan, profile = figure.axes
+    kinds = {type(s).__name__ for s in chain.segments}
+    assert {c.get_gid() for c in plan.collections} == {f"{part}-{k}" for part in ("plan", "comb", "envelope") for k in kinds}
+    assert {c.get_gid() for c in profile.collections} == {f"curvature-{k}" for k in kinds}
+    assert Image.open(tmp_path / "road.png").size == (1100, 450)
+    sc.plot(sc.make_g2([(0, 0), (10, 0), (10, 10)], 0.1), tmp_path / "corner.svg", comb=False)  # make_g2's one chain
+    assert ET.parse(tmp_path / "corner.svg").getroot().tag.endswith("svg")
+    transition = sc.line_to_circle((0, 0), (1, 0), (50, 40), 30)
+    assert len(sc.plot(transition).axes[1].collections) == 1  # its spiral
+    with pytest.raises(ValueError, match="plot: expected a Chain, a Transition or what holds one chain .*; got int"):
+        sc.plot(5)
+    with pytest.raises(ValueError, match=r"plot: cannot save '.*road.xyz': Format 'xyz' is not supported"):
+        sc.plot(chain, tmp_path / "road.xyz")
+    assert not (tmp_path / "road.xyz").exists()
 
 
 @pytest.mark.parametrize("namespace", ["spiral_cad.io", "spiral_cad.cad"])
