@@ -23,6 +23,7 @@ from scipy.special import fresnel
 from ..core import bezier
 from ..core.chain import Chain
 from ..core.factors import length_factor, peak_rate_factor, search_range
+from ..core.namespaces import lazy_names
 from ..core.shapes import shape_limits
 from ..core.spiral import BezierSpiral
 
@@ -67,7 +68,7 @@ class Comb:
     scale: float
 
 
-def curvature_comb(chain: Chain, per_segment: int = 24, scale: float | None = None) -> Comb:
+def comb_samples(chain: Chain, per_segment: int = 24, scale: float | None = None) -> Comb:
     """Comb samples, ``per_segment`` per segment (ends included); in space the teeth
     stand against the curvature vector κN, in the osculating plane.
 
@@ -131,7 +132,7 @@ def plot_plan(chain: Chain, comb: bool = True, ax: Axes | None = None, per_segme
     """
     fig, ax = _axes(ax, figsize=(8, 5))
     per_segment = _samples(chain, per_segment, 48)
-    data = curvature_comb(chain, per_segment) if comb else None
+    data = comb_samples(chain, per_segment) if comb else None
     u = np.linspace(0.0, 1.0, per_segment)
     for kind, index in _by_kind(chain).items():
         color = SEGMENT_COLORS.get(kind, "k")
@@ -164,7 +165,7 @@ def plot_curvature(chain: Chain, ax: Axes | None = None, per_segment: int | None
     ``LineCollection`` per segment type (gid ``curvature-KIND``, one polyline per segment)."""
     fig, ax = _axes(ax, figsize=(8, 4))
     per_segment = _samples(chain, per_segment, 64)
-    data = curvature_comb(chain, per_segment, scale=0.0)
+    data = comb_samples(chain, per_segment, scale=0.0)
     profile = np.stack([data.stations, data.curvature], axis=1).reshape(len(chain), per_segment, 2)
     for kind, index in _by_kind(chain).items():
         ax.add_collection(
@@ -376,3 +377,7 @@ def plot_jerk_length(
     right.legend(loc="best", fontsize="small")
     right.grid(True, alpha=0.3)
     return fig
+
+
+#: ``curvature_comb`` is ``comb_samples``'s old name (the comb as edges is ``spiral_cad.cad.curvature_comb``).
+__getattr__, _ = lazy_names(__name__, {}, renamed={"curvature_comb": "comb_samples"})

@@ -36,7 +36,7 @@ from OCP.TopoDS import TopoDS
 from ..cad.fillet import fillet_face, fillet_wire, planar_frame
 from ..cad.occ import chain_wire
 from ..cad.slabs import Slab, continuous_box
-from ..cad.slabs import g2_slab as _slab
+from ..cad.slabs import rolled_slab as _slab
 from ..cad.stack_fillet import fillet_part_edges
 from ..core.segments import Segment
 from ..core.shapes import DEFAULT_SHAPE
@@ -215,7 +215,7 @@ def g2_slab(
     smallest radius of curvature ``edge_radius``) is swept along the outline:
     exact over its lines and arcs, over spirals within ``tolerance`` (the
     measured deviation is the part's ``approximation`` attribute and goes into
-    the STEP description). See ``spiral_cad.cad.slabs.g2_slab``.
+    the STEP description). See ``spiral_cad.cad.slabs.rolled_slab``.
 
     Args:
         outline: a ``ContinuousRectangle``/``ContinuousPolygon``/``ContinuousSlot``, a

@@ -25,7 +25,7 @@ _HOMES = {
     "ContinuityReport": "continuity",
     "check_faces": "faces",
     "FaceReport": "faces",
-    "g2_slab": "slabs",
+    "rolled_slab": "slabs",
     "continuous_box": "slabs",
     "fillet_part_edges": "stack_fillet",
     "fillet_prism_edges": "prism_fillet",
@@ -38,4 +38,5 @@ _HOMES = {
 }
 __all__ = sorted(_HOMES)
 
-__getattr__, __dir__ = lazy_names(__name__, _HOMES)
+#: Old names, for one release: ``g2_slab`` is build123d's (a ``Part``); this layer's (a ``Slab``) is ``rolled_slab``.
+__getattr__, __dir__ = lazy_names(__name__, _HOMES, renamed={"g2_slab": "rolled_slab"})

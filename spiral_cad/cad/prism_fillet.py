@@ -1,5 +1,5 @@
 """G2 fillets of a right prism's straight edges: side edges as exact extrusions of the plan's G2 corners,
-cap edges rolled as a G2 slab (``slabs.g2_slab``).
+cap edges rolled as a G2 slab (``slabs.rolled_slab``).
 """
 
 from __future__ import annotations
@@ -47,7 +47,7 @@ from .slabs import (
     _volume,
     expected_level,
     forward_solid,
-    g2_slab,
+    rolled_slab,
     verify_faces,
     verify_solid,
 )
@@ -203,7 +203,7 @@ def fillet_prism_edges(
     Side edges (along the prism's axis, between two planar faces, any
     dihedral angle, convex or concave) become exact extrusions of the 2-D G2
     corner of the cap's outline; when every edge of a cap is chosen too, the
-    cap's edge is rolled by the G2 profile of the same radius (``g2_slab``),
+    cap's edge is rolled by the G2 profile of the same radius (``rolled_slab``),
     and the chosen side corners are rounded with ``plan_radius(radius)`` so
     the roll fits inside them (``radius`` stays the smallest radius of
     curvature of every rounded edge).
@@ -215,7 +215,7 @@ def fillet_prism_edges(
             one or both caps).
         radius: the smallest radius of curvature of each rounded edge.
         transition, same_sense, shape: as in ``design.fillets.fillet_path``.
-        tolerance: for a slab's sweep over spirals, as in ``g2_slab``.
+        tolerance: for a slab's sweep over spirals, as in ``rolled_slab``.
 
     Raises:
         NoSolutionError: an edge that is not straight, not between planar faces, a part that
@@ -373,7 +373,7 @@ def fillet_prism_edges(
                         "not chosen: choose it too (a roll cannot turn a sharp corner), or leave that rim sharp"
                     )
         try:  # with chosen side edges the plan changes with the radius: a suggestion is built from the start
-            slab = g2_slab(
+            slab = rolled_slab(
                 planned[0],
                 prism.height,
                 radius,

@@ -41,7 +41,7 @@ __all__ = [
     "continuous_box",
     "expected_level",
     "forward_solid",
-    "g2_slab",
+    "rolled_slab",
     "outline_segments",
     "verify_faces",
     "verify_solid",
@@ -246,10 +246,10 @@ def continuous_box(
     holes: Sequence[Any] = (),
     _advise: bool = True,
 ) -> Slab:
-    """A box with every edge and corner G2: ``g2_slab`` of a ``continuous_rectangle`` (centred on the origin,
+    """A box with every edge and corner G2: ``rolled_slab`` of a ``continuous_rectangle`` (centred on the origin,
     z from 0 to ``height``). ``edge_radius`` None: the roll half as wide as the smaller of ``radius`` and
     ``height``/2 allows; ``holes``: through holes in the box's plan, centred like it. Other arguments and
-    errors as ``g2_slab`` and ``continuous_rectangle``."""
+    errors as ``rolled_slab`` and ``continuous_rectangle``."""
     for value, name in ((length, "length"), (width, "width"), (height, "height")):
         if not as_float(value, name) > 0.0:
             raise ValueError(f"{name} must be positive; got {shown(value)}")
@@ -264,7 +264,7 @@ def continuous_box(
     if edge_radius is None:  # the roll's extent is proportional to its radius
         unit = float(roll_profile(1.0, profile=profile, transition=transition, shape=shape)[-1].end[0])
         edge_radius = 0.5 * min(as_float(radius, "radius"), as_float(height, "height") / 2.0) / unit
-    return g2_slab(plan, height, edge_radius, top=top, bottom=bottom, profile=profile, transition=transition,
+    return rolled_slab(plan, height, edge_radius, top=top, bottom=bottom, profile=profile, transition=transition,
                    shape=shape, tolerance=tolerance, units=units, holes=holes, _advise=_advise)  # fmt: skip
 
 
@@ -332,7 +332,7 @@ def verify_faces(shape: TopoDS_Shape, level: str, what: str = "slab", units: str
     )
 
 
-def g2_slab(
+def rolled_slab(
     outline: Any,
     height: float,
     edge_radius: float,
@@ -421,13 +421,13 @@ def _slab_advice(segments: list[Segment], height: float, radius: float, given_he
     """The largest roll radius below ``radius`` a refusal may name: it fits with a margin and builds."""
     return advice(
         lambda r: _roll_problem(segments, height, r, given_height, name, **_fit_options(options)) is None,
-        lambda r: g2_slab(segments, height, r, **_slab_options(options), tolerance=tolerance, units=units, _advise=False),
+        lambda r: rolled_slab(segments, height, r, **_slab_options(options), tolerance=tolerance, units=units, _advise=False),
         radius,
     )
 
 
 def _slab_options(options: dict[str, Any]) -> dict[str, Any]:
-    """``g2_slab``'s keyword arguments from the fit checks' ``options``."""
+    """``rolled_slab``'s keyword arguments from the fit checks' ``options``."""
     rest = {k: v for k, v in options.items() if k not in ("holes", "rolled", "at", "verify")}
     return dict(rest, holes=options.get("holes", ()), _rolled=options.get("rolled"), _at=options.get("at", _plain))
 
@@ -439,7 +439,7 @@ def _fit_options(options: dict[str, Any]) -> dict[str, Any]:
 
 def _built_slab(segments: list[Segment], height: float, edge_radius: float, options: dict[str, Any],
                 tolerance: float | None, units: str) -> Slab:  # fmt: skip
-    """The slab of rolls that fit, verified (``g2_slab`` after its fit checks)."""
+    """The slab of rolls that fit, verified (``rolled_slab`` after its fit checks)."""
     top, bottom, profile, transition, shape = (options[k] for k in ("top", "bottom", "profile", "transition", "shape"))
     loops = _loops(segments, options.get("holes", ()))
     flags = options.get("rolled") or [(top, bottom)] * len(loops)

@@ -2,7 +2,7 @@
 
 One import for the three parts of the G2 solids, each documented in its own module:
 ``roll_surfaces`` (the roll profile swept along the outline as NURBS surfaces, and
-what a STEP note says of them), ``slabs`` (``g2_slab``, ``continuous_box``, the
+what a STEP note says of them), ``slabs`` (``rolled_slab``, ``continuous_box``, the
 checks of the solid) and ``prism_fillet`` (G2 fillets of a right prism's straight edges).
 """
 
@@ -16,7 +16,7 @@ from .slabs import (
     continuous_box,
     expected_level,
     forward_solid,
-    g2_slab,
+    rolled_slab,
     outline_segments,
     verify_faces,
     verify_solid,
@@ -29,7 +29,7 @@ __all__ = [
     "continuous_box",
     "fillet_prism_edges",
     "forward_solid",
-    "g2_slab",
+    "rolled_slab",
     "outline_segments",
     "expected_level",
     "plan_radius",

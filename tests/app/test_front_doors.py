@@ -538,3 +538,13 @@ def test_a_landxml_check_takes_its_tolerances_from_the_alignments_own_numbers(tm
     assert first.level.name == "G2" and second.level.name == "G0" and second.angle == pytest.approx(0.001, rel=1e-3)
     assert "tolerances from the file's numbers (3 printed decimals) and its size: gap 0.005" in " | ".join(report.notes)
     assert report.gap_tol == 0.005 and report.angle_tol == pytest.approx(1e-4)
+
+
+def test_old_names_work_for_one_release_with_a_warning():
+    """The OCCT layer's slab maker was g2_slab, build123d's name for a Part: it is rolled_slab now."""
+    import spiral_cad.cad as cad
+    from spiral_cad.cad.slabs import rolled_slab
+
+    with pytest.warns(DeprecationWarning, match=r"spiral_cad.cad.g2_slab is now rolled_slab; the old name goes in the next release"):
+        assert cad.g2_slab is rolled_slab
+    assert "g2_slab" not in cad.__all__ and "rolled_slab" in cad.__all__

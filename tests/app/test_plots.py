@@ -53,7 +53,7 @@ def test_plan_without_comb_on_given_axes(chain):
 
 
 def test_comb_matches_chain_curvature(chain):
-    comb = plots.curvature_comb(chain, per_segment=16)
+    comb = plots.comb_samples(chain, per_segment=16)
     inside = (comb.stations > 0) & (comb.stations < chain.length)
     assert np.allclose(comb.curvature[inside], chain.curvature_at(comb.stations[inside]), rtol=1e-9, atol=1e-12)
     assert np.allclose(comb.points[inside], chain.point_at(comb.stations[inside]), atol=1e-6)
@@ -151,7 +151,7 @@ def test_chains_in_space_plot_as_a_plan_projection_and_a_curvature_magnitude(tmp
     path = round_corners([(0, 0, 0), (1, 0, 0), (1, 1, 1), (2, 1, 2)], max_curvature=5.0)
     chain = path.chain
     assert chain.dim == 3
-    comb = plots.curvature_comb(chain, per_segment=16)
+    comb = plots.comb_samples(chain, per_segment=16)
     inside = (comb.stations > 0) & (comb.stations < chain.length)
     assert np.allclose(comb.curvature[inside], chain.curvature_at(comb.stations[inside]), rtol=1e-9, atol=1e-12)
     vectors = chain.curvature_vector_at(comb.stations[inside])
@@ -172,3 +172,13 @@ def test_axes_in_a_subfigure_give_back_the_savable_root_figure(chain, tmp_path):
     assert fig is root and saved(fig, tmp_path, "plan.png")
     pair = plots.plot_vs_clothoid(0.3, 0.01, ax=right.subplots(1, 2))
     assert pair is root and saved(pair, tmp_path, "pair.png")
+
+
+def test_the_old_name_of_comb_samples_works_for_one_release_with_a_warning():
+    with pytest.warns(
+        DeprecationWarning, match="spiral_cad.app.plots.curvature_comb is now comb_samples; the old name goes in the next release"
+    ):
+        old = plots.curvature_comb
+    assert old is plots.comb_samples
+    with pytest.raises(AttributeError, match="has no attribute 'nothing'"):
+        plots.nothing  # noqa: B018
