@@ -16,8 +16,8 @@ from .slabs import (
     continuous_box,
     expected_level,
     forward_solid,
-    rolled_slab,
     outline_segments,
+    rolled_slab,
     verify_faces,
     verify_solid,
 )

@@ -27,8 +27,8 @@ from spiral_cad import Arc
 from spiral_cad.build123d import ContinuousRectangle, g2_fillet, g2_slab
 from spiral_cad.cad.faces import check_faces
 from spiral_cad.cad.prism_fillet import plan_radius
-from spiral_cad.cad.solids import rolled_slab as occ_slab
 from spiral_cad.cad.solids import roll_profile
+from spiral_cad.cad.solids import rolled_slab as occ_slab
 from spiral_cad.core.errors import NoSolutionError
 from spiral_cad.design.fillets import continuous_rectangle
 

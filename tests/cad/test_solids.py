@@ -64,8 +64,8 @@ from OCP.TopTools import TopTools_IndexedDataMapOfShapeListOfShape
 from spiral_cad import Arc, Line
 from spiral_cad.build123d import ContinuousBox, ContinuousPolygon, ContinuousRectangle, g2_fillet, g2_slab
 from spiral_cad.cad.export import export_step
-from spiral_cad.cad.solids import rolled_slab as occ_slab
 from spiral_cad.cad.solids import roll_profile
+from spiral_cad.cad.solids import rolled_slab as occ_slab
 from spiral_cad.core.errors import NoSolutionError
 from spiral_cad.core.spiral import BezierSpiral
 from spiral_cad.design.fillets import continuous_rectangle
