@@ -1,4 +1,4 @@
-"""``spiral-cad check``: G0/G1/G2 at every joint of a STEP, IGES, DXF, OpenDRIVE, LandXML or G-code file, face to
+"""``spiral-cad check``: G0/G1/G2 at every joint of a STEP, IGES, DXF, OpenDRIVE, LandXML, IFC or G-code file, face to
 face where a STEP/IGES file holds faces; one file, or many at once on dask."""
 
 from __future__ import annotations
@@ -30,7 +30,7 @@ def check_file(args: argparse.Namespace) -> int:
     suffix = Path(args.file).suffix.lower()
     if suffix not in CHECK_SUFFIXES and Path(args.file).exists():
         raise ValueError(f"{Path(args.file).name}: check judges STEP/IGES (.step .stp .igs .iges), DXF (.dxf), OpenDRIVE (.xodr), "
-                         f"LandXML (.xml) and G-code ({' '.join(GCODE_SUFFIXES)}) files")  # fmt: skip
+                         f"LandXML (.xml), IFC 4.3 (.ifc) and G-code ({' '.join(GCODE_SUFFIXES)}) files")  # fmt: skip
     if args.html is not None:
         from .html_report import checked_page_path
 
@@ -56,6 +56,9 @@ def check_file(args: argparse.Namespace) -> int:
         print("error: --units: a LandXML file states its unit in <Units> (one without is read in metres, as LandXML "
               "readers do)", file=sys.stderr)  # fmt: skip
         return 2
+    if args.units and suffix == ".ifc":
+        print("error: --units: an IFC file states its unit (IfcUnitAssignment)", file=sys.stderr)
+        return 2
     if args.units and suffix not in _DOCUMENTS:
         print(f"error: --units is the unit of a program or drawing that states none; {Path(args.file).name} is neither",
               file=sys.stderr)  # fmt: skip
@@ -64,7 +67,7 @@ def check_file(args: argparse.Namespace) -> int:
         if args.zebra or args.curvature_map or args.stripes is not None:
             print(f"error: --zebra, --curvature-map and --stripes draw faces; {_DOCUMENTS[suffix]} holds curves", file=sys.stderr)
             return 2
-        if suffix != ".xml":  # a LandXML file's default tolerances come from its printed decimals
+        if suffix not in (".xml", ".ifc"):  # a LandXML or IFC file's default tolerances come from its own numbers
             _wire_tolerances(args)
         return _check_document(args)
     from ..cad.faces import holds_faces
@@ -140,8 +143,8 @@ def _check_document(args: argparse.Namespace) -> int:
     from .files import check
 
     name, suffix = Path(args.file).name, Path(args.file).suffix.lower()
-    if args.comb and suffix == ".xml":
-        raise ValueError("--comb draws the curves of STEP, IGES, DXF and G-code files; a LandXML file is judged on its numbers")
+    if args.comb and suffix in (".xml", ".ifc"):
+        raise ValueError(f"--comb draws the curves of STEP, IGES, DXF and G-code files; {_DOCUMENTS[suffix]} is judged on its numbers")
     given = {k: v for k in ("gap_tol", "angle_tol", "curvature_tol", "snap", "units") if (v := getattr(args, k)) is not None}
     report = check(args.file, **given)
     for note in [] if args.quiet else report.notes:
@@ -156,6 +159,11 @@ def _check_document(args: argparse.Namespace) -> int:
             raise ValueError(f"--comb: {name} states no unit ($INSUNITS), and a STEP file needs one")
         export_step(curvature_comb(shape, units=units), _comb_path(args.comb, args.file), name=f"{name} curvature comb", units=units)
     _write_page(args, report)
+    if suffix == ".ifc":  # no rewrite in place: the alignment is designed again
+        if args.pieces is None:  # its pieces are its alignments' plans and profiles, however many: as OpenDRIVE's roads
+            args.pieces = report.pieces
+        return _print_report(report, args, "make_g2: an alignment of lines and arcs becomes G2 with spirals between them: "
+                                           "Alignment.from_pis, then spiral_cad.export(alignment, 'road.ifc')")  # fmt: skip
     done = {".dxf": "makes its paths of lines and arcs G2, every other entity kept",
             ".xml": "gives its alignments of lines and arcs spirals, the rest kept"}.get(suffix, "makes its runs of cuts G2 in place, every other line kept")  # fmt: skip
     return _print_report(report, args, f"make_g2: spiral-cad g2 {name} -o OUT{suffix} --max-deviation D {done}")
@@ -256,16 +264,17 @@ def add_check(sub: argparse._SubParsersAction) -> None:
     """The ``check`` command and its options."""
     check = sub.add_parser(
         "check",
-        help="report G0/G1/G2 continuity at every joint of a STEP, IGES, DXF, OpenDRIVE, LandXML or G-code file",
+        help="report G0/G1/G2 continuity at every joint of a STEP, IGES, DXF, OpenDRIVE, LandXML, IFC or G-code file",
         description="Report G0/G1/G2 continuity at every joint, in the unit the file declares; a STEP/IGES file that holds "
         "faces is judged face to face at every edge they share (sharp features listed, not failed). A DXF drawing's curves "
         "(lines, arcs, circles, ellipses, splines, polylines, blocks) are judged as drawn, chained by their ends. A LandXML file's alignments are judged as "
         "stated: each element's ends, directions and radii, so a kink or a radius that differs from its neighbour's shows. A CNC program's cutting paths are judged "
-        "run by run between rapids (helical moves left out). An OpenDRIVE file is judged road by road (its planView, its elevation and superelevation in s) and link by link. Exit status: 0 ok, "
+        "run by run between rapids (helical moves left out). An IFC 4.3 file's alignments are judged plan and profile: the plan as its curve's "
+        "segments run, with the curvatures its layout states, the profile on its vertical segments' own numbers. An OpenDRIVE file is judged road by road (its planView, its elevation and superelevation in s) and link by link. Exit status: 0 ok, "
         "1 below --require, --profiles or --links (or not --pieces pieces), 2 unreadable file or bad option, "
         "141 output pipe closed early.",
     )
-    check.add_argument("file", nargs="+", help="a .step/.stp, .igs/.iges, .dxf, .xodr (one piece per road), .xml (LandXML) or G-code (.nc .ngc .tap …) file; several "
+    check.add_argument("file", nargs="+", help="a .step/.stp, .igs/.iges, .dxf, .xodr (one piece per road), .xml (LandXML), .ifc or G-code (.nc .ngc .tap …) file; several "
                        "files, folders or glob patterns are checked in parallel (see --workers)")  # fmt: skip
     check.add_argument(
         "--require", choices=["G0", "G1", "G2"],
@@ -319,7 +328,7 @@ def add_check(sub: argparse._SubParsersAction) -> None:
 
 #: The files ``check`` looks for in a folder it is given.
 #: What each kind of document judged as curves is called in messages.
-_DOCUMENTS = {".dxf": "a DXF drawing", ".xml": "a LandXML file", **dict.fromkeys(GCODE_SUFFIXES, "a CNC program")}
+_DOCUMENTS = {".dxf": "a DXF drawing", ".xml": "a LandXML file", ".ifc": "an IFC file", **dict.fromkeys(GCODE_SUFFIXES, "a CNC program")}
 #: Every suffix ``check`` judges (``spiral_cad.check``'s table).
 CHECK_SUFFIXES = tuple(suffix for suffixes, _ in CHECKS.values() for suffix in suffixes)
 

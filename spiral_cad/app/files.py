@@ -19,7 +19,8 @@ points     .csv .txt .xyz (read)           —                                  
 ``check`` judges STEP/IGES (face to face where the file holds faces: ``cad.faces.check_faces``, else its
 curves: ``cad.continuity.check_continuity``), DXF and G-code (their curves as drawn or programmed:
 ``cad.document_shapes.document_shape``, then ``check_continuity``), LandXML (its elements' own numbers:
-``io.landxml_check.check_landxml``) and OpenDRIVE (``io.opendrive_check.check_opendrive``); an object (a build123d or CadQuery shape, an OCCT shape, a
+``io.landxml_check.check_landxml``), OpenDRIVE (``io.opendrive_check.check_opendrive``) and IFC 4.3
+(``io.ifc_check.check_ifc``: each alignment's plan and profile); an object (a build123d or CadQuery shape, an OCCT shape, a
 ``Chain``) is judged face to face when it holds faces, else curve by curve.
 
 The options are the per-format function's own keyword options (``name``, ``units``, ``dialect`` …), passed on
@@ -74,6 +75,7 @@ CHECKS: dict[str, tuple[tuple[str, ...], str]] = {
     "gcode": (GCODE_SUFFIXES, "spiral_cad.app.files:_check_curves"),
     "landxml": ((".xml",), "spiral_cad.app.files:_check_alignments"),
     "opendrive": ((".xodr",), "spiral_cad.app.files:_check_roads"),
+    "ifc": ((".ifc",), "spiral_cad.app.files:_check_ifc"),
 }
 
 
@@ -244,6 +246,13 @@ def _check_roads(path: Path, **options: Any) -> Any:
     from ..io.opendrive_check import check_opendrive
 
     return check_opendrive(path, **_checked(check_opendrive, options, path))
+
+
+def _check_ifc(path: Path, **options: Any) -> Any:
+    """An IFC 4.3 file: each alignment's plan as its geometry runs and its profile on its own numbers."""
+    from ..io.ifc_check import check_ifc
+
+    return check_ifc(path, **_checked(check_ifc, options, path))
 
 
 def _path(path: Any, verb: str) -> Path:

@@ -347,11 +347,11 @@ table.items tr[data-item]:hover {{ background: #f3f7ff; }}
 
 def checked_page_path(path: str | os.PathLike, source: Any = None, format: str | None = None) -> Path:
     """``path`` as the page to write of ``source`` (read as ``format``, if given): a .html (or .htm) file whose
-    folder exists, not the source itself, of something the page draws (not a LandXML or OpenDRIVE file); else
+    folder exists, not the source itself, of something the page draws (not a LandXML, OpenDRIVE or IFC file); else
     ValueError naming it."""
     named = str(format).lower().lstrip(".") if format is not None else ""
-    if named in ("landxml", "xml", "opendrive", "xodr") or (
-        isinstance(source, (str, os.PathLike)) and Path(source).suffix.lower() in (".xml", ".xodr")
+    if named in ("landxml", "xml", "opendrive", "xodr", "ifc") or (
+        isinstance(source, (str, os.PathLike)) and Path(source).suffix.lower() in (".xml", ".xodr", ".ifc")
     ):
         raise ValueError(f"html: {Path(source).name!r:.80} is judged on its own numbers (spiral-cad check prints them); "
                          "the page draws STEP/IGES parts and curves, DXF drawings and G-code programs")  # fmt: skip

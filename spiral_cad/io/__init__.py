@@ -38,6 +38,8 @@ _HOMES = {
     "check_opendrive": "opendrive",
     "rewrite_opendrive_g2": "opendrive_g2",
     "read_ifc_alignments": "ifc",
+    "check_ifc": "ifc_check",
+    "check_landxml": "landxml_check",
     "write_ifc": "ifc",
     "read_points": "points",
     "parse_points": "points",
