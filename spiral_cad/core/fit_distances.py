@@ -74,28 +74,31 @@ def _piece_distance(
         return np.hypot(*(points - foot).T), phi * abs(r)
     assert isinstance(piece, BezierSpiral)
     cp = piece.control_points
-    # Power basis about B0 (the points moved by −B0 too, so survey coordinates keep their digits).
+    # Power basis about B0 (the points moved by −B0 too, so survey coordinates keep their digits); x and y
+    # apart, as plain arrays: a sum over a pair of columns costs more than the arithmetic it adds up.
     c1, c2, c3 = 3.0 * (cp[1] - cp[0]), 3.0 * (cp[0] - 2.0 * cp[1] + cp[2]), cp[3] - cp[0] + 3.0 * (cp[1] - cp[2])
-    rel = points - cp[0]
+    (c1x, c1y), (c2x, c2y), (c3x, c3y) = c1.tolist(), c2.tolist(), c3.tolist()
+    rx, ry = points[:, 0] - cp[0, 0], points[:, 1] - cp[0, 1]
     if u0 is None:
         grid = np.linspace(0.0, 1.0, 17)
-        samples = ((c3 * grid[:, None] + c2) * grid[:, None] + c1) * grid[:, None]
-        gap = (rel[:, None, 0] - samples[None, :, 0]) ** 2 + (rel[:, None, 1] - samples[None, :, 1]) ** 2
+        sx, sy = ((c3x * grid + c2x) * grid + c1x) * grid, ((c3y * grid + c2y) * grid + c1y) * grid
+        gap = (rx[:, None] - sx[None, :]) ** 2 + (ry[:, None] - sy[None, :]) ** 2
         u = grid[np.argmin(gap, axis=1)]
     else:
         u = u0.copy()
     for _ in range(6):  # Newton on (B(u) − p)·B'(u) = 0
-        uu = u[:, None]
-        offset = ((c3 * uu + c2) * uu + c1) * uu - rel
-        d1 = (3.0 * c3 * uu + 2.0 * c2) * uu + c1
-        d2 = 6.0 * c3 * uu + 2.0 * c2
-        f = (offset * d1).sum(axis=1)
-        df = (d1 * d1).sum(axis=1) + (offset * d2).sum(axis=1)
-        u = np.clip(u - f / np.where(df > 0, df, 1.0), 0.0, 1.0)
-    uu = u[:, None]
-    offset = ((c3 * uu + c2) * uu + c1) * uu - rel
+        ox, oy = ((c3x * u + c2x) * u + c1x) * u - rx, ((c3y * u + c2y) * u + c1y) * u - ry
+        d1x, d1y = (3.0 * c3x * u + 2.0 * c2x) * u + c1x, (3.0 * c3y * u + 2.0 * c2y) * u + c1y
+        d2x, d2y = 6.0 * c3x * u + 2.0 * c2x, 6.0 * c3y * u + 2.0 * c2y
+        f = ox * d1x + oy * d1y
+        df = (d1x * d1x + d1y * d1y) + (ox * d2x + oy * d2y)
+        step = np.clip(u - f / np.where(df > 0, df, 1.0), 0.0, 1.0)
+        if np.array_equal(step, u):  # every foot settled: the steps left would change nothing
+            break
+        u = step
+    ox, oy = ((c3x * u + c2x) * u + c1x) * u - rx, ((c3y * u + c2y) * u + c1y) * u - ry
     along = _spiral_stations(cp, c1, c2, c3, u) if stations else u
-    return np.hypot(offset[:, 0], offset[:, 1]), along
+    return np.hypot(ox, oy), along
 
 
 #: Nodes of the arc length table a spiral's stations are interpolated from.
