@@ -251,9 +251,8 @@ def monotone_pieces(cp: ArrayLike, samples: int = 513) -> list[tuple[float, floa
         noise = 1e-9 * float(np.abs(values).max())
         signs = np.where(np.abs(values) <= noise, 0.0, np.sign(values))
         kept = np.flatnonzero(signs)
-        for a, b in zip(kept[:-1], kept[1:], strict=True):
-            if signs[a] == signs[b]:
-                continue
+        flips = np.flatnonzero(signs[kept[:-1]] != signs[kept[1:]])  # consecutive signed samples that differ
+        for a, b in zip(kept[flips].tolist(), kept[flips + 1].tolist(), strict=True):
             lo, hi = float(grid[a]), float(grid[b])
             for _ in range(60):  # bisection: the bracket halves to ~1e-15 in u
                 middle = 0.5 * (lo + hi)
@@ -266,3 +265,30 @@ def monotone_pieces(cp: ArrayLike, samples: int = 513) -> list[tuple[float, floa
     kept_ends = [ends[0]] + [u for previous, u in zip(ends[:-1], ends[1:], strict=True) if u - previous > 1e-9]
     kept_ends[-1] = 1.0
     return list(zip(kept_ends[:-1], kept_ends[1:], strict=True))
+
+
+def plain_spirals(cps: NDArray, samples: int = 513) -> NDArray[np.bool_]:
+    """Which cubics (N, 4, 2) are one spiral piece on ``monotone_pieces``' own grid: no cusp, and neither
+    the curvature nor its rate changes sign there (values within 1e-9 of the largest are rounding) — where
+    monotone_pieces finds nothing to cut. All at once, in blocks; the others go through monotone_pieces."""
+    u = np.linspace(0.0, 1.0, samples)
+    basis1 = 3.0 * np.stack([(1.0 - u) ** 2, 2.0 * u * (1.0 - u), u * u])  # Q' on the legs
+    basis2 = 6.0 * np.stack([1.0 - u, u])  # Q'' on the second differences
+    out = np.zeros(len(cps), dtype=bool)
+    for block in np.array_split(np.arange(len(cps)), max(1, -(-len(cps) // 512))):
+        legs, bends = np.diff(cps[block], axis=1), np.diff(cps[block], 2, axis=1)  # (B, 3, 2), (B, 2, 2)
+        x1, y1 = legs[..., 0] @ basis1, legs[..., 1] @ basis1
+        x2, y2 = bends[..., 0] @ basis2, bends[..., 1] @ basis2
+        x3, y3 = (6.0 * (bends[:, 1] - bends[:, 0])).T[:, :, None]
+        speed2 = x1 * x1 + y1 * y1
+        cross12 = x1 * y2 - y1 * x2
+        with np.errstate(invalid="ignore", divide="ignore"):
+            kappa = cross12 / (speed2 * np.sqrt(speed2))
+            rate = ((x1 * y3 - y1 * x3) * speed2 - 3.0 * cross12 * (x1 * x2 + y1 * y2)) / (speed2 * speed2 * speed2)
+        plain = speed2[:, 1:-1].min(axis=1) > 1e-18 * speed2.max(axis=1)  # |Q'| above 1e-9 of its largest
+        for values in (kappa, rate):
+            values = np.nan_to_num(values, nan=0.0, posinf=0.0, neginf=0.0)
+            noise = 1e-9 * np.abs(values).max(axis=1, keepdims=True)
+            plain &= ~((values > noise).any(axis=1) & (values < -noise).any(axis=1))
+        out[block] = plain
+    return out

@@ -689,12 +689,13 @@ def parse_gcode_chain(text: str, source: str = "G-code", *, units: str | None = 
     dim = 2 if flat else 3
     segments: list[Line | Arc | BezierSpiral] = []
     owners: list[int] = []
-    for kind, number, rapid, start, *data in pieces:
+    plain = _plain_cubics(pieces, factor)
+    for k, (kind, number, rapid, start, *data) in enumerate(pieces):
         if rapid:
             raise ValueError(f"{source} line {number}: a rapid move (G0) between feed moves; the path is the feed moves "
                              "after the rapids to its start")  # fmt: skip
         try:
-            segment = _piece_segment(kind, start, data, factor, dim)
+            segment = _piece_segment(kind, start, data, factor, dim, k in plain)
         except ValueError as error:
             raise ValueError(f"{source} line {number}: {error}") from None
         for piece in segment or ():
@@ -748,8 +749,19 @@ def program_feeds(path: str | os.PathLike) -> tuple[tuple[float, ...], str | Non
     return tuple(reader.feeds), reader.units
 
 
-def _piece_segment(kind: str, start: list[float], data: list[Any], factor: float, dim: int) -> Any:
-    """The chain segments of one move read in exact mode (None for a move that goes nowhere)."""
+def _plain_cubics(pieces: list[Any], factor: float) -> set[int]:
+    """The places in ``pieces`` of the G5 cubics that are one spiral piece as they are (``bezier.plain_spirals``,
+    all at once): the others are cut by ``bezier.monotone_pieces``, one by one."""
+    at = [k for k, piece in enumerate(pieces) if piece[0] == "cubic"]
+    if not at:
+        return set()
+    cubics = np.array([np.asarray(pieces[k][4], dtype=float)[:, :2] * factor for k in at])
+    return {at[i] for i in np.flatnonzero(bezier.plain_spirals(cubics)).tolist()}
+
+
+def _piece_segment(kind: str, start: list[float], data: list[Any], factor: float, dim: int, plain: bool = False) -> Any:
+    """The chain segments of one move read in exact mode (None for a move that goes nowhere); a ``plain`` cubic
+    is one spiral piece (``_plain_cubics``)."""
     from ..core.segments import Arc, Line
     from ..core.spiral import BezierSpiral
 
@@ -776,7 +788,7 @@ def _piece_segment(kind: str, start: list[float], data: list[Any], factor: float
     if not np.any(np.diff(cubic, axis=0)):
         return None
     pieces = []
-    for u0, u1 in bezier.monotone_pieces(cubic):
+    for u0, u1 in [(0.0, 1.0)] if plain else bezier.monotone_pieces(cubic):
         piece = cp.copy() if (u0, u1) == (0.0, 1.0) else np.column_stack([bezier.split(cubic, u0, u1), cp[:, 2]])
         pieces.append(BezierSpiral.from_control_points(piece[:, :dim]))
     return pieces

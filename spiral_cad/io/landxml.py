@@ -43,7 +43,7 @@ from xml.sax.saxutils import escape
 import numpy as np
 from numpy.typing import NDArray
 
-from ..core.bezier import curvature, monotone_pieces
+from ..core.bezier import curvature, monotone_pieces, plain_spirals
 from ..core.chain import Chain
 from ..core.clothoid import clothoid_frames
 from ..core.kinds import ARC, LINE, SPIRAL
@@ -213,33 +213,6 @@ def spiral_offsets(chain: Chain, samples: int = OFFSET_SAMPLES) -> NDArray[np.fl
 _CHECK = np.linspace(0.0, 1.0, 33)
 
 
-def _plain_spirals(cps: NDArray, samples: int = 513) -> NDArray[np.bool_]:
-    """Which cubics (N, 4, 2) are one spiral piece on ``bezier.monotone_pieces``' own grid: no cusp, and neither
-    the curvature nor its rate changes sign there (values within 1e-9 of the largest are rounding) — where
-    monotone_pieces finds nothing to cut. All at once, in blocks; the others go through monotone_pieces."""
-    u = np.linspace(0.0, 1.0, samples)
-    basis1 = 3.0 * np.stack([(1.0 - u) ** 2, 2.0 * u * (1.0 - u), u * u])  # Q' on the legs
-    basis2 = 6.0 * np.stack([1.0 - u, u])  # Q'' on the second differences
-    out = np.zeros(len(cps), dtype=bool)
-    for block in np.array_split(np.arange(len(cps)), max(1, -(-len(cps) // 512))):
-        legs, bends = np.diff(cps[block], axis=1), np.diff(cps[block], 2, axis=1)  # (B, 3, 2), (B, 2, 2)
-        x1, y1 = legs[..., 0] @ basis1, legs[..., 1] @ basis1
-        x2, y2 = bends[..., 0] @ basis2, bends[..., 1] @ basis2
-        x3, y3 = (6.0 * (bends[:, 1] - bends[:, 0])).T[:, :, None]
-        speed2 = x1 * x1 + y1 * y1
-        cross12 = x1 * y2 - y1 * x2
-        with np.errstate(invalid="ignore", divide="ignore"):
-            kappa = cross12 / (speed2 * np.sqrt(speed2))
-            rate = ((x1 * y3 - y1 * x3) * speed2 - 3.0 * cross12 * (x1 * x2 + y1 * y2)) / (speed2 * speed2 * speed2)
-        plain = speed2[:, 1:-1].min(axis=1) > 1e-18 * speed2.max(axis=1)  # |Q'| above 1e-9 of its largest
-        for values in (kappa, rate):
-            values = np.nan_to_num(values, nan=0.0, posinf=0.0, neginf=0.0)
-            noise = 1e-9 * np.abs(values).max(axis=1, keepdims=True)
-            plain &= ~((values > noise).any(axis=1) & (values < -noise).any(axis=1))
-        out[block] = plain
-    return out
-
-
 def _check_spiral(cp: NDArray, index: int, unit: str, scale: float) -> None:
     """Refuse a cubic that no LandXML ``Spiral`` describes: its curvature changes sign (an S, an
     inflection) or does not grow or shrink monotonically in size between its ends.
@@ -271,7 +244,7 @@ def _coord_geom(chain: Chain, start_station: float, scale: float, unit: str) -> 
     lengths, stations = chain.lengths, chain.stations[:-1] + start_station
     offsets = spiral_offsets(chain)
     plain = np.zeros(len(kind), dtype=bool)
-    plain[kind == SPIRAL] = _plain_spirals(np.asarray(rows.geometry)[kind == SPIRAL, :, :2])
+    plain[kind == SPIRAL] = plain_spirals(np.asarray(rows.geometry)[kind == SPIRAL, :, :2])
     lines = ["      <CoordGeom>"]
     for i in range(len(kind)):
         p0, p1 = frames[i, 0, :2], frames[i, 1, :2]

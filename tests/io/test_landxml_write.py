@@ -99,10 +99,9 @@ def test_a_spirals_control_points_that_no_longer_fit_it_are_not_used(tmp_path):
 
 
 def test_the_batch_spiral_check_never_passes_what_monotone_pieces_would_cut():
-    """The writer certifies most cubics at once (_plain_spirals) and sends only the rest through
+    """The writer certifies most cubics at once (bezier.plain_spirals) and sends only the rest through
     bezier.monotone_pieces: every cubic it certifies must be one piece there too, and real spirals pass."""
-    from spiral_cad.core.bezier import monotone_pieces
-    from spiral_cad.io.landxml import _plain_spirals
+    from spiral_cad.core.bezier import monotone_pieces, plain_spirals
 
     rng = np.random.default_rng(29)
     spirals = np.array([BezierSpiral((0.0, 0.0), (1.0, 0.0), theta, 0.01, shape).control_points[:, :2]
@@ -110,7 +109,7 @@ def test_the_batch_spiral_check_never_passes_what_monotone_pieces_would_cut():
     # spirals disturbed by up to a tenth of their size: some stay spirals, others gain an inflection or a peak
     size = np.ptp(spirals, axis=1).max(axis=1)[:, None, None]
     cubics = np.concatenate([spirals + rng.normal(size=spirals.shape) * size * scale for scale in (1e-3, 1e-2, 0.1)])
-    plain = _plain_spirals(cubics)
+    plain = plain_spirals(cubics)
     for cp, certified in zip(cubics, plain):
         try:
             pieces = len(monotone_pieces(cp))
@@ -118,4 +117,4 @@ def test_the_batch_spiral_check_never_passes_what_monotone_pieces_would_cut():
             pieces = 0
         assert not certified or pieces == 1
     assert 0 < plain.sum() < len(plain)
-    assert _plain_spirals(spirals).all()
+    assert plain_spirals(spirals).all()
