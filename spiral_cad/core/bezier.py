@@ -267,7 +267,7 @@ def monotone_pieces(cp: ArrayLike, samples: int = 513) -> list[tuple[float, floa
     return list(zip(kept_ends[:-1], kept_ends[1:], strict=True))
 
 
-def plain_spirals(cps: NDArray, samples: int = 513) -> NDArray[np.bool_]:
+def plain_spirals(cps: NDArray[np.float64], samples: int = 513) -> NDArray[np.bool_]:
     """Which cubics (N, 4, 2) are one spiral piece on ``monotone_pieces``' own grid: no cusp, and neither
     the curvature nor its rate changes sign there (values within 1e-9 of the largest are rounding) — where
     monotone_pieces finds nothing to cut. All at once, in blocks; the others go through monotone_pieces."""
