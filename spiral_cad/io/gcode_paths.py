@@ -426,7 +426,7 @@ def read_gcode_runs(path: str | os.PathLike, *, units: str | None = None) -> Gco
         ValueError: what the built-in reader refuses (naming the line), or no feed move.
         OSError: the file could not be read.
     """
-    from .gcode import _piece_segment, _program_text, _read_exact
+    from .gcode import _piece_segment, _plain_cubics, _program_text, _read_exact
     from .toolpath import PLANES
 
     text, label = _program_text(path)
@@ -436,7 +436,8 @@ def read_gcode_runs(path: str | os.PathLike, *, units: str | None = None) -> Gco
     notes: list[str] = list(reader.notes)
     helical = 0
     named = _first_named(text)
-    for kind, number, rapid, start, *data in reader.pieces:
+    plain = _plain_cubics(reader.pieces, 1.0)
+    for k, (kind, number, rapid, start, *data) in enumerate(reader.pieces):
         helix = kind == "arc" and data[0][PLANES[data[1]][2]] != start[PLANES[data[1]][2]]
         ends_at = data[0] if kind != "cubic" else data[0][-1]
         unknown = [axis for k, axis in enumerate("XYZ") if ends_at[k] != start[k] and not named.get(axis, number) < number]
@@ -473,7 +474,7 @@ def read_gcode_runs(path: str | os.PathLike, *, units: str | None = None) -> Gco
                     notes.append(f"line {number}: an arc of {abs(rotation)} turns, judged on its last two (the turns before "
                                  "run on the same circle)")  # fmt: skip
             else:
-                segments = _piece_segment(kind, start, data, 1.0, 3) or []
+                segments = _piece_segment(kind, start, data, 1.0, 3, k in plain) or []
         except ValueError as error:
             raise ValueError(f"{label} line {number}: {error}") from None
         for segment in segments:
