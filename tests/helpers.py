@@ -55,6 +55,17 @@ def around(transition, sweep: float = 0.6) -> Chain:
     return Chain([first, *t.spirals, last])
 
 
+def curve_road(units: str = "mm") -> Chain:
+    """A line, a spiral, an arc of radius 40 turning 1 rad, a spiral and a line (every segment kind)."""
+    centre, radius, turn = np.array([100.0, 40.5]), 40.0, 1.0
+    enter = line_to_circle((0, 0), (1, 0), tuple(centre), radius)
+    total = turn + 2.0 * abs(enter.spirals[0].theta)
+    out = np.array([math.cos(total), math.sin(total)])
+    exit_point = centre + 40.5 * np.array([math.sin(total), -math.cos(total)])
+    leave = line_to_circle(tuple(exit_point), tuple(-out), tuple(centre), radius).reversed()
+    return Chain.join([enter, leave], start=(-50.0, 0.0), end=tuple(leave.end + 60.0 * out), units=units)
+
+
 def transition_chains() -> dict[str, Chain]:
     """One chain per transition kind plus a mixed chain with full-size arcs."""
     nested_distance = (3.0 - 1.2) * 0.9935

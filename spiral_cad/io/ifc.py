@@ -63,7 +63,7 @@ from .opendrive import plan_records
 
 __all__ = [
     "GRAPH_DEGREES", "GRAPH_TOLERANCE", "IFC_SCHEMA", "IfcAlignmentLayout", "LayoutSegment", "graph_polynomials",
-    "ifc_file", "layout_segments", "read_ifc_alignments", "write_ifc",
+    "ifc_file", "layout_segments", "open_alignment_model", "read_ifc_alignments", "write_ifc",
 ]  # fmt: skip
 
 #: The schema written: IFC 4.3 ADD2 (ISO 16739-1:2024).
@@ -601,6 +601,27 @@ def layout_segments(layout: Any) -> list[Any]:
     return out
 
 
+def open_alignment_model(source: Any) -> tuple[Any, float]:
+    """An IFC 4.3 model (read from a path, or an ``ifcopenshell.file`` as given) and its length unit in metres.
+
+    Raises:
+        ValueError: the file cannot be read or is not IFC 4.3 (named).
+    """
+    import ifcopenshell
+    import ifcopenshell.util.unit
+
+    model = source
+    name = "the model" if isinstance(source, ifcopenshell.file) else os.path.basename(os.fspath(source)) or os.fspath(source)
+    if not isinstance(source, ifcopenshell.file):
+        try:
+            model = ifcopenshell.open(os.fspath(source))
+        except (OSError, RuntimeError, ifcopenshell.Error) as error:
+            raise ValueError(f"{name}: not a readable IFC file ({error})") from None
+    if not model.schema.startswith("IFC4X3"):
+        raise ValueError(f"{name}: alignments are IFC 4.3; this file is {model.schema}")
+    return model, float(ifcopenshell.util.unit.calculate_unit_scale(model, "LENGTHUNIT"))
+
+
 def read_ifc_alignments(source: Any) -> list[IfcAlignmentLayout]:
     """Every ``IfcAlignment`` of an IFC 4.3 file (a path or an ``ifcopenshell.file``) with its horizontal
     and vertical layouts, each segment beside the type of its representation's parent curve.
@@ -612,15 +633,7 @@ def read_ifc_alignments(source: Any) -> list[IfcAlignmentLayout]:
     import ifcopenshell.api.alignment
     import ifcopenshell.util.unit
 
-    model = source
-    if not isinstance(source, ifcopenshell.file):
-        try:
-            model = ifcopenshell.open(os.fspath(source))
-        except (OSError, RuntimeError, ifcopenshell.Error) as error:
-            raise ValueError(f"{os.fspath(source)}: not a readable IFC file ({error})") from None
-    if not model.schema.startswith("IFC4X3"):
-        raise ValueError(f"IfcAlignment layouts are IFC 4.3; this file is {model.schema}")
-    scale = float(ifcopenshell.util.unit.calculate_unit_scale(model, "LENGTHUNIT"))
+    model, scale = open_alignment_model(source)
     result = []
     for alignment in model.by_type("IfcAlignment"):
         layouts = [obj for rel in alignment.IsNestedBy for obj in rel.RelatedObjects]

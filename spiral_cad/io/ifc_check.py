@@ -33,7 +33,7 @@ from typing import Any
 import numpy as np
 
 from ..continuity.joints import ContinuityReport, check_tolerances, classify_pieces, model_size
-from .ifc import layout_segments
+from .ifc import _representation_curves, layout_segments, open_alignment_model
 
 __all__ = ["DEFAULT_PRECISION", "RELATIVE_GAP", "check_ifc"]
 
@@ -63,19 +63,10 @@ def check_ifc(path: str | os.PathLike, *, gap_tol: float | None = None, angle_to
         ValueError: not a readable IFC 4.3 file, no alignment with a horizontal layout and its curve, or a
             bad tolerance.
     """
-    import ifcopenshell
-    import ifcopenshell.util.unit
-
     check_tolerances(**{k: v for k, v in (("gap_tol", gap_tol), ("angle_tol", angle_tol), ("curvature_tol", curvature_tol))
                         if v is not None})  # fmt: skip
     source = os.path.basename(os.fspath(path))
-    try:
-        model = ifcopenshell.open(os.fspath(path))
-    except (OSError, RuntimeError, ifcopenshell.Error) as error:
-        raise ValueError(f"{source}: not a readable IFC file ({error})") from None
-    if not model.schema.startswith("IFC4X3"):
-        raise ValueError(f"{source}: alignments are IFC 4.3; this file is {model.schema}")
-    metres = float(ifcopenshell.util.unit.calculate_unit_scale(model, "LENGTHUNIT"))
+    model, metres = open_alignment_model(path)
     units = _unit_name(metres)
     pieces: list[tuple] = []
     lengths: list[float] = []
@@ -86,7 +77,7 @@ def check_ifc(path: str | os.PathLike, *, gap_tol: float | None = None, angle_to
         name = alignment.Name or f"alignment {number}"
         layouts = [obj for rel in alignment.IsNestedBy for obj in rel.RelatedObjects]
         horizontal = next((layout for layout in layouts if layout.is_a("IfcAlignmentHorizontal")), None)
-        curve = _horizontal_curve(alignment)
+        curve = _representation_curves(alignment).get("IfcCompositeCurve")  # the gradient curve's base curve, or its own
         if horizontal is None or curve is None:
             notes.append(f"alignment {name!r}: no horizontal layout with its IfcCompositeCurve: not judged")
             continue
@@ -132,18 +123,6 @@ def _unit_name(metres: float) -> str:
         if math.isclose(mm / 1000.0, metres, rel_tol=1e-12):
             return name
     return f"{metres:g} m"
-
-
-def _horizontal_curve(alignment: Any) -> Any:
-    """The alignment's horizontal ``IfcCompositeCurve`` (the base curve of its gradient curve, else its own), or None."""
-    shape = alignment.Representation
-    for rep in shape.Representations if shape is not None else ():
-        for item in rep.Items:
-            while item is not None:
-                if item.is_a() == "IfcCompositeCurve":
-                    return item
-                item = getattr(item, "BaseCurve", None)
-    return None
 
 
 def _precision(curve: Any, model: Any) -> float:

@@ -170,17 +170,12 @@ def test_3d_polylines_and_elevations_are_paths_in_space(tmp_path):
 
 def test_our_own_drawing_reads_back_as_its_chain(tmp_path):
     """``export_dxf`` writes lines, arcs and each spiral as a cubic SPLINE: read back, the same segments."""
+    from helpers import curve_road
+
     import spiral_cad as sc
-    from spiral_cad import Chain, line_to_circle
     from spiral_cad.core.spiral import BezierSpiral
 
-    centre, radius, turn = np.array([100.0, 40.5]), 40.0, 1.0
-    enter = line_to_circle((0, 0), (1, 0), tuple(centre), radius)
-    total = turn + 2.0 * abs(enter.spirals[0].theta)
-    out = np.array([math.cos(total), math.sin(total)])
-    exit_point = centre + 40.5 * np.array([math.sin(total), -math.cos(total)])
-    leave = line_to_circle(tuple(exit_point), tuple(-out), tuple(centre), radius).reversed()
-    chain = Chain.join([enter, leave], start=(-50.0, 0.0), end=tuple(leave.end + 60.0 * out))
+    chain = curve_road()
     assert {type(s) for s in chain.segments} == {Line, BezierSpiral, Arc}
     sc.export(chain, tmp_path / "road.dxf")
     (path,) = sc.read(tmp_path / "road.dxf").paths

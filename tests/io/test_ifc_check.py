@@ -10,11 +10,11 @@ from types import SimpleNamespace
 
 import numpy as np
 import pytest
+from helpers import curve_road
 
 ifcopenshell = pytest.importorskip("ifcopenshell")
 
 import spiral_cad as sc  # noqa: E402
-from spiral_cad import Chain, line_to_circle  # noqa: E402
 from spiral_cad.app.cli import main  # noqa: E402
 from spiral_cad.continuity import Continuity  # noqa: E402
 from spiral_cad.io.ifc_check import _profile_frames, check_ifc  # noqa: E402
@@ -47,19 +47,9 @@ def test_buildingsmarts_break_in_vertical_gradient_is_a_kink_in_the_profile():
     assert _levels(clean, "plan") == ["G2", "G2"] and clean.units == "m"
 
 
-def _road(units: str = "m") -> Chain:
-    centre, radius, turn = np.array([100.0, 40.5]), 40.0, 1.0
-    enter = line_to_circle((0, 0), (1, 0), tuple(centre), radius)
-    total = turn + 2.0 * abs(enter.spirals[0].theta)
-    out = np.array([math.cos(total), math.sin(total)])
-    exit_point = centre + 40.5 * np.array([math.sin(total), -math.cos(total)])
-    leave = line_to_circle(tuple(exit_point), tuple(-out), tuple(centre), radius).reversed()
-    return Chain.join([enter, leave], start=(-50.0, 0.0), end=tuple(leave.end + 60.0 * out), units=units)
-
-
 @pytest.mark.parametrize("units", ["m", "ft"])
 def test_our_alignment_is_g2_at_every_joint_where_the_chain_joins(tmp_path, units):
-    chain = _road(units)
+    chain = curve_road(units)
     sc.export(chain, tmp_path / "road.ifc")
     report = sc.check(tmp_path / "road.ifc")
     (plan,) = report.wires
@@ -69,7 +59,7 @@ def test_our_alignment_is_g2_at_every_joint_where_the_chain_joins(tmp_path, unit
 
 
 def test_an_edited_radius_is_a_curvature_jump_and_a_moved_segment_a_gap(tmp_path):
-    chain = _road()
+    chain = curve_road("m")
     sc.export(chain, tmp_path / "road.ifc")
     model = ifcopenshell.open(str(tmp_path / "road.ifc"))
     arc = next(p for p in model.by_type("IfcAlignmentHorizontalSegment") if p.PredefinedType == "CIRCULARARC")
