@@ -5,11 +5,14 @@ Each ``IfcAlignment`` gives up to two pieces:
 
 * **the plan**: one element per segment of the horizontal ``IfcCompositeCurve`` (its representation), placed
   and run as ifcopenshell's geometry evaluates it (every parent curve IFC 4.3 allows: lines, circles,
-  clothoids, the polynomial and trigonometric spirals), so a gap or a kink between segments is what a
-  reader of the geometry meets. The curvature at each end is the one the matching
-  ``IfcAlignmentHorizontalSegment`` states (``StartRadiusOfCurvature``, ``EndRadiusOfCurvature``; 0 is
-  straight, positive turns left): the design's own numbers, exact where the geometry's would be a
-  difference quotient.
+  clothoids, the polynomial and trigonometric spirals), so a gap, a kink or a curvature jump between
+  segments is what a reader of the geometry meets. The curvature at each end is the curve's: 0 on a line,
+  1/radius on a circle, else the difference quotient of its heading (extrapolated); where the matching
+  ``IfcAlignmentHorizontalSegment`` (``StartRadiusOfCurvature``, ``EndRadiusOfCurvature``; positive turns
+  left) states a curvature that agrees with the quotient, the stated number is taken (exact), and where it
+  does not, the curve's is judged and the notes name both. A layout whose segments do not match the curve's
+  one for one (a Helmert curve drawn as two) gives no numbers; an alignment whose curve ifcopenshell cannot
+  evaluate is named in the notes and not judged.
 * **the profile**: one element per ``IfcAlignmentVerticalSegment``, in the plane (distance along, height),
   from its own numbers: it starts at ``StartDistAlong``, ``StartHeight`` with ``StartGradient`` and ends
   ``HorizontalLength`` further where its type takes it (a constant gradient, a parabolic arc from
@@ -60,8 +63,8 @@ def check_ifc(path: str | os.PathLike, *, gap_tol: float | None = None, angle_to
         ``notes`` saying how the file was read and which tolerances were used.
 
     Raises:
-        ValueError: not a readable IFC 4.3 file, no alignment with a horizontal layout and its curve, or a
-            bad tolerance.
+        ValueError: not a readable IFC 4.3 file, no alignment with a plan or a profile to judge, or a bad
+            tolerance.
     """
     check_tolerances(**{k: v for k, v in (("gap_tol", gap_tol), ("angle_tol", angle_tol), ("curvature_tol", curvature_tol))
                         if v is not None})  # fmt: skip
@@ -79,12 +82,15 @@ def check_ifc(path: str | os.PathLike, *, gap_tol: float | None = None, angle_to
         horizontal = next((layout for layout in layouts if layout.is_a("IfcAlignmentHorizontal")), None)
         curve = _representation_curves(alignment).get("IfcCompositeCurve")  # the gradient curve's base curve, or its own
         if horizontal is None or curve is None:
-            notes.append(f"alignment {name!r}: no horizontal layout with its IfcCompositeCurve: not judged")
-            continue
-        precisions.append(_precision(curve, model))
-        frames, stated = _plan_frames(curve, layout_segments(horizontal), metres, name, notes)
-        pieces.append(("plan", frames, False, f"{name} plan"))
-        lengths += stated
+            notes.append(f"alignment {name!r}: no horizontal layout with its IfcCompositeCurve: its plan is not judged")
+        else:
+            try:
+                frames, stated = _plan_frames(curve, layout_segments(horizontal), metres, name, notes)
+                precisions.append(_precision(curve, model))
+                pieces.append(("plan", frames, False, f"{name} plan"))
+                lengths += stated
+            except ValueError as error:
+                notes.append(str(error))
         vertical = next((layout for layout in layouts if layout.is_a("IfcAlignmentVertical")), None)
         if vertical is not None:
             frames, stated = _profile_frames(layout_segments(vertical), name, notes)
@@ -92,9 +98,9 @@ def check_ifc(path: str | os.PathLike, *, gap_tol: float | None = None, angle_to
                 pieces.append(("profile", frames, False, f"{name} profile"))
                 lengths += stated
     if not pieces:
-        raise ValueError(f"{source}: no alignment with a horizontal layout and its curve to judge")
+        raise ValueError(f"{source}: no alignment with a plan or a profile to judge" + (f" ({'; '.join(notes)})" if notes else ""))
     points = np.array([frame[:3] for _, frames, *_ in pieces for pair in frames for frame in pair])
-    size = model_size(points, source)
+    size = model_size(points[np.isfinite(points).all(axis=1)], source)  # a segment not measured has no end point
     stated_tolerances = []
     if gap_tol is None:
         precision = max(precisions, default=DEFAULT_PRECISION / metres)
@@ -108,8 +114,8 @@ def check_ifc(path: str | os.PathLike, *, gap_tol: float | None = None, angle_to
         curvature_tol = 1e-6
     report = classify_pieces(pieces, size, gap_tol=gap_tol, angle_tol=angle_tol, curvature_tol=curvature_tol, source=source,
                              element="segment", units=units)  # fmt: skip
-    notes.insert(0, "the plan as ifcopenshell evaluates its curve's segments, with the curvatures its layout states; "
-                    "the profile from its vertical segments' own numbers")  # fmt: skip
+    notes.insert(0, "the plan as ifcopenshell evaluates its curve's segments; the profile from its vertical segments' "
+                    "own numbers")  # fmt: skip
     if stated_tolerances:
         notes.append(f"tolerances from the file: {', '.join(stated_tolerances)}; give them to judge otherwise")
     return replace(report, notes=tuple(notes))
@@ -137,38 +143,91 @@ def _precision(curve: Any, model: Any) -> float:
     return DEFAULT_PRECISION
 
 
+#: Where the layout's curvature and the curve's (by differences) disagree by more than this share of the larger
+#: (or of 1/size), the curve's is judged: ifcopenshell measures distance along a polynomial curve to ~1e-8, so its
+#: difference quotients there hold ~1e-4; the layout's numbers, where they agree, are exact.
+_DESIGN_AGREES = 1e-3
+
+
 def _plan_frames(curve: Any, design: list[Any], metres: float, name: str, notes: list[str]) -> tuple[list, list[float]]:
-    """Per non-zero segment of ``curve``, its (start, end) frames in the file's unit (curvature from ``design``)."""
+    """Per non-zero segment of ``curve``, its (start, end) frames in the file's unit: position and tangent as
+    ifcopenshell evaluates it, curvature as the curve has it (a line's 0, a circle's 1/radius exactly; other
+    curves by differences, or the layout's number where it agrees with them).
+
+    Raises:
+        ValueError: a segment ifcopenshell cannot evaluate (an IFC 4 ``IfcCompositeCurveSegment``), named.
+    """
     import ifcopenshell.geom
     import ifcopenshell.ifcopenshell_wrapper as wrapper
 
     settings = ifcopenshell.geom.settings()
     segments = list(curve.Segments)
-    if len(design) != len(segments):
-        notes.append(f"alignment {name!r}: {len(design)} horizontal segments for {len(segments)} curve segments: "
-                     "curvatures taken in order")  # fmt: skip
+    stated = [d if d is not None and d.is_a("IfcAlignmentHorizontalSegment") else None for d in design]
+    if len(stated) != len(segments):  # a Helmert curve is two curve segments, say: the layout cannot be matched
+        notes.append(f"alignment {name!r}: {len(stated)} horizontal segments for {len(segments)} curve segments: the plan's "
+                     "curvatures are the curve's own, by differences")  # fmt: skip
+        stated = [None] * len(segments)
     frames, lengths = [], []
     for k, segment in enumerate(segments):
         function = wrapper.map_shape(settings, segment)
+        if function is None:
+            raise ValueError(f"alignment {name!r}: plan segment {k} ({segment.is_a()}) is not a curve segment ifcopenshell "
+                             "evaluates: the plan is not judged")  # fmt: skip
         length = float(function.length())
         if length == 0.0:
             continue
         evaluate = wrapper.function_item_evaluator(settings, function).evaluate
-        radii = (
-            (float(design[k].StartRadiusOfCurvature or 0.0), float(design[k].EndRadiusOfCurvature or 0.0))
-            if k < len(design)
-            else (math.nan, math.nan)
-        )
+        parent = segment.ParentCurve.is_a() if segment.is_a("IfcCurveSegment") else ""
         ends = []
-        for at, radius in ((0.0, radii[0]), (length, radii[1])):
+        for end, at in enumerate((0.0, length)):
             matrix = np.array(evaluate(at))
             point, tangent = matrix[:3, 3] / metres, matrix[:3, 0] / np.linalg.norm(matrix[:3, 0])
-            curvature = 0.0 if radius == 0.0 else 1.0 / radius * metres  # 1/unit; positive turns left
+            measured = _turning(evaluate, at, length, end == 1) * metres  # 1/unit; positive turns left
+            if parent == "IfcLine":
+                curvature = 0.0
+            elif parent == "IfcCircle":
+                curvature = math.copysign(1.0 / float(segment.ParentCurve.Radius), measured)
+            else:
+                curvature = measured
+            design_says = _stated_curvature(stated[k], end)
+            floor = max(abs(curvature), metres / abs(length))  # 1/length: the segment's own scale of curvature
+            if design_says is not None and abs(design_says - curvature) > _DESIGN_AGREES * max(floor, abs(design_says)):
+                notes.append(f"alignment {name!r}: plan segment {k} {('starts', 'ends')[end]} with curvature {curvature:.6g}, not "
+                             f"the {design_says:.6g} its layout states: the curve's is judged")  # fmt: skip
+            elif design_says is not None and parent not in ("IfcLine", "IfcCircle"):
+                curvature = design_says  # exact, where the curve's difference quotient agrees with it
             normal = np.array([-tangent[1], tangent[0], 0.0])
             ends.append((*point.tolist(), *tangent.tolist(), *(curvature * normal).tolist()))
         frames.append(tuple(ends))
-        lengths.append(length / metres)
+        lengths.append(abs(length) / metres)
     return frames, lengths
+
+
+def _stated_curvature(design: Any, end: int) -> float | None:
+    """The curvature a horizontal layout segment states at its start (0) or end (1), in 1/its unit (None: none)."""
+    if design is None:
+        return None
+    radius = design.StartRadiusOfCurvature if end == 0 else design.EndRadiusOfCurvature
+    return None if radius is None else (0.0 if float(radius) == 0.0 else 1.0 / float(radius))
+
+
+def _turning(evaluate: Any, at: float, length: float, backwards: bool) -> float:
+    """The curvature (1/metre) at ``at`` of a segment of ``length`` evaluated by ifcopenshell: the one-sided
+    three-point difference quotient of its heading over a thousandth of the segment, and over half that,
+    extrapolated (Richardson: exact for headings of degree 3 in distance, a clothoid's and a Helmert curve's)."""
+
+    def heading(t: float) -> float:
+        matrix = np.array(evaluate(t))
+        return math.atan2(matrix[1, 0], matrix[0, 0])
+
+    def quotient(h: float) -> float:
+        step = -h if backwards else h
+        a, b, c = heading(at), heading(at + step), heading(at + 2 * step)
+        turns = np.unwrap([a, b, c])
+        return float(-3 * turns[0] + 4 * turns[1] - turns[2]) / (2 * step)
+
+    h = 1e-3 * length
+    return (4.0 * quotient(h / 2) - quotient(h)) / 3.0
 
 
 def _profile_frames(design: list[Any], name: str, notes: list[str]) -> tuple[list, list[float]]:
@@ -176,6 +235,9 @@ def _profile_frames(design: list[Any], name: str, notes: list[str]) -> tuple[lis
     frames, lengths = [], []
     unmeasured = set()
     for segment in design:
+        if segment is None or not segment.is_a("IfcAlignmentVerticalSegment"):
+            notes.append(f"alignment {name!r}: its vertical layout nests a {getattr(segment, 'is_a', lambda: 'nothing')()}: left out")
+            continue
         length = float(segment.HorizontalLength)
         if length == 0.0:
             continue

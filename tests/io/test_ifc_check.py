@@ -58,15 +58,23 @@ def test_our_alignment_is_g2_at_every_joint_where_the_chain_joins(tmp_path, unit
     assert np.abs(joints - chain.point_at(chain.stations[1:-1])).max() < 1e-6 * chain.length
 
 
-def test_an_edited_radius_is_a_curvature_jump_and_a_moved_segment_a_gap(tmp_path):
+def test_an_edited_circle_is_a_curvature_jump_an_edited_layout_a_note_and_a_moved_segment_a_gap(tmp_path):
     chain = curve_road("m")
     sc.export(chain, tmp_path / "road.ifc")
     model = ifcopenshell.open(str(tmp_path / "road.ifc"))
+    (circle,) = model.by_type("IfcCircle")
+    circle.Radius = circle.Radius * 1.01  # the curve's arc is another than the spirals end on
+    model.write(str(tmp_path / "circle.ifc"))
+    report = check_ifc(tmp_path / "circle.ifc")
+    assert _levels(report, "plan")[1] == "G1"
+    assert report.wires[0].joints[1].curvature_jump == pytest.approx(1 / 40 - 1 / 40.4, rel=1e-6)
+    model = ifcopenshell.open(str(tmp_path / "road.ifc"))
     arc = next(p for p in model.by_type("IfcAlignmentHorizontalSegment") if p.PredefinedType == "CIRCULARARC")
-    arc.StartRadiusOfCurvature = arc.StartRadiusOfCurvature * 1.01  # the design says another radius than the spiral's end
+    arc.StartRadiusOfCurvature = arc.StartRadiusOfCurvature * 1.01  # the layout says another radius than its curve
     model.write(str(tmp_path / "radius.ifc"))
-    levels = _levels(check_ifc(tmp_path / "radius.ifc"), "plan")
-    assert levels == ["G2", "G1", "G2", "G2"]
+    report = check_ifc(tmp_path / "radius.ifc")
+    assert _levels(report, "plan") == ["G2"] * 4  # the curve is judged: it is continuous
+    assert any("plan segment 2 starts with curvature 0.025, not the 0.0247525 its layout states" in n for n in report.notes)
     model = ifcopenshell.open(str(tmp_path / "road.ifc"))
     segment = model.by_type("IfcCompositeCurve")[0].Segments[2]  # the arc's curve segment, moved 1 mm
     location = segment.Placement.Location
@@ -77,13 +85,80 @@ def test_an_edited_radius_is_a_curvature_jump_and_a_moved_segment_a_gap(tmp_path
     assert report.wires[0].joints[1].gap == pytest.approx(0.001, rel=1e-3)
 
 
+@pytest.mark.parametrize("units", ["m", "mm", "ft"])
+def test_curvature_is_in_the_files_unit_and_a_jump_of_a_large_radius_is_found(tmp_path, units):
+    """A line, an arc of radius 200 km and one of 100 km: κ jumps 0 → 1/R → 2/R, per the file's unit (in mm,
+    5e-9 against 1/size: found, not lost in a unit's factor)."""
+    import ifcopenshell.api.alignment as alignment_api
+    import ifcopenshell.api.context
+    import ifcopenshell.api.root
+    import ifcopenshell.api.unit
+
+    scale = {"m": 1.0, "mm": 1000.0, "ft": 1 / 0.3048}[units]
+    model = ifcopenshell.file(schema="IFC4X3_ADD2")
+    ifcopenshell.api.root.create_entity(model, ifc_class="IfcProject", name="P")
+    unit = (ifcopenshell.api.unit.add_conversion_based_unit(model, name="foot") if units == "ft"
+            else ifcopenshell.api.unit.add_si_unit(model, unit_type="LENGTHUNIT", prefix="MILLI" if units == "mm" else None))  # fmt: skip
+    ifcopenshell.api.unit.assign_unit(model, units=[unit])
+    ifcopenshell.api.context.add_context(model, context_type="Model")
+    layout = alignment_api.get_horizontal_layout(alignment_api.create(model, "A"))
+    radius, x, y, heading = 200_000 * scale, 0.0, 0.0, 0.0
+    for kind, r in (("LINE", 0.0), ("CIRCULARARC", radius), ("CIRCULARARC", radius / 2)):
+        design = model.createIfcAlignmentHorizontalSegment(StartPoint=model.createIfcCartesianPoint((x, y)), StartDirection=heading,
+                                                           StartRadiusOfCurvature=r, EndRadiusOfCurvature=r, SegmentLength=50 * scale,
+                                                           PredefinedType=kind)  # fmt: skip
+        end = alignment_api.create_layout_segment(model, layout, design)
+        x, y, heading = (
+            end[0][3] / (1 if units == "m" else 0.001 if units == "mm" else 0.3048),
+            end[1][3] / (1 if units == "m" else 0.001 if units == "mm" else 0.3048),
+            math.atan2(end[1][0], end[0][0]),
+        )
+    model.write(str(tmp_path / "arcs.ifc"))
+    report = check_ifc(tmp_path / "arcs.ifc")
+    (plan,) = report.wires
+    assert report.units == units and [str(j.level) for j in plan.joints] == ["G1", "G1"]
+    measured = [k for j in plan.joints for k in (j.curvature_before, j.curvature_after)]
+    assert measured == pytest.approx([0.0, 1 / radius, 1 / radius, 2 / radius], rel=1e-9)
+
+
+def test_a_helmert_curve_drawn_as_two_curve_segments_is_judged_on_its_curve(tmp_path):
+    """IFC 4.3 draws a HELMERTCURVE layout segment as two IfcSecondOrderPolynomialSpiral: the layout no longer
+    matches the curve one for one, and the curve's own curvatures are judged (G2 into the arc, G1 between arcs)."""
+    import ifcopenshell.api.alignment as alignment_api
+    import ifcopenshell.api.context
+    import ifcopenshell.api.root
+    import ifcopenshell.api.unit
+
+    model = ifcopenshell.file(schema="IFC4X3_ADD2")
+    ifcopenshell.api.root.create_entity(model, ifc_class="IfcProject", name="P")
+    ifcopenshell.api.unit.assign_unit(model, units=[ifcopenshell.api.unit.add_si_unit(model, unit_type="LENGTHUNIT")])
+    ifcopenshell.api.context.add_context(model, context_type="Model")
+    layout = alignment_api.get_horizontal_layout(alignment_api.create(model, "H"))
+    x, y, heading = 0.0, 0.0, 0.0
+    for kind, r0, r1, length in (
+        ("LINE", 0, 0, 100),
+        ("HELMERTCURVE", 0, 300, 60),
+        ("CIRCULARARC", 300, 300, 80),
+        ("CIRCULARARC", 500, 500, 80),
+    ):
+        design = model.createIfcAlignmentHorizontalSegment(StartPoint=model.createIfcCartesianPoint((x, y)), StartDirection=heading,
+                                                           StartRadiusOfCurvature=float(r0), EndRadiusOfCurvature=float(r1),
+                                                           SegmentLength=float(length), PredefinedType=kind)  # fmt: skip
+        end = alignment_api.create_layout_segment(model, layout, design)
+        x, y, heading = end[0][3], end[1][3], math.atan2(end[1][0], end[0][0])
+    model.write(str(tmp_path / "helmert.ifc"))
+    report = check_ifc(tmp_path / "helmert.ifc")
+    assert [str(j.level) for j in report.wires[0].joints] == ["G2", "G2", "G2", "G1"]
+    assert any("horizontal segments for 6 curve segments" in n for n in report.notes)
+
+
 def test_a_vertical_circular_arc_ends_where_its_circle_takes_it():
     """A crest of radius 2000 from +2 % to −3 %: its end height and curvature are the circle's."""
     radius, g0, g1 = 2000.0, 0.02, -0.03
     t0, t1 = math.atan(g0), math.atan(g1)
     length = radius * (math.sin(t0) - math.sin(t1))
     arc = SimpleNamespace(HorizontalLength=length, StartDistAlong=100.0, StartHeight=50.0, StartGradient=g0, EndGradient=g1,
-                          PredefinedType="CIRCULARARC")  # fmt: skip
+                          PredefinedType="CIRCULARARC", is_a=lambda kind: kind == "IfcAlignmentVerticalSegment")  # fmt: skip
     ((start, end),), lengths = _profile_frames([arc], "crest", [])
     assert lengths == [length]
     assert end[1] == pytest.approx(50.0 + radius * (math.cos(t1) - math.cos(t0)), rel=1e-12)
