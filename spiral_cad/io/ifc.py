@@ -601,6 +601,19 @@ def layout_segments(layout: Any) -> list[Any]:
     return out
 
 
+def _cut_short(path: str) -> bool:
+    """Whether the IFC text file at ``path`` lacks the ``END-ISO-10303-21;`` that ends every whole one (a zipped
+    or XML file is not judged)."""
+    try:
+        with open(path, "rb") as file:
+            if not file.read(16).lstrip().startswith(b"ISO-10303-21"):
+                return False
+            file.seek(max(0, os.fstat(file.fileno()).st_size - 4096))
+            return b"END-ISO-10303-21" not in file.read()
+    except OSError:
+        return False
+
+
 def open_alignment_model(source: Any) -> tuple[Any, float]:
     """An IFC 4.3 model (read from a path, or an ``ifcopenshell.file`` as given) and its length unit in metres.
 
@@ -617,6 +630,8 @@ def open_alignment_model(source: Any) -> tuple[Any, float]:
             model = ifcopenshell.open(os.fspath(source))
         except (OSError, RuntimeError, ifcopenshell.Error) as error:
             raise ValueError(f"{name}: not a readable IFC file ({error})") from None
+        if _cut_short(os.fspath(source)):
+            raise ValueError(f"{name}: the file ends before END-ISO-10303-21; (cut short): what it held is not all there")
     if not model.schema.startswith("IFC4X3"):
         raise ValueError(f"{name}: alignments are IFC 4.3; this file is {model.schema}")
     return model, float(ifcopenshell.util.unit.calculate_unit_scale(model, "LENGTHUNIT"))

@@ -13,16 +13,19 @@ Each ``IfcAlignment`` gives up to two pieces:
   does not, the curve's is judged and the notes name both. A layout whose segments do not match the curve's
   one for one (a Helmert curve drawn as two) gives no numbers; an alignment whose curve ifcopenshell cannot
   evaluate is named in the notes and not judged.
-* **the profile**: one element per ``IfcAlignmentVerticalSegment``, in the plane (distance along, height),
-  from its own numbers: it starts at ``StartDistAlong``, ``StartHeight`` with ``StartGradient`` and ends
-  ``HorizontalLength`` further where its type takes it (a constant gradient, a parabolic arc from
-  ``StartGradient`` to ``EndGradient``, a circular arc between them); its curvature is that of the curve
-  z(s) there. Other types (a vertical clothoid) are not measured: their joints are "unmeasurable".
+* **the profile**: one element per segment of the ``IfcGradientCurve``, in the plane (distance along, height),
+  evaluated the same way, its curvature that of the curve z(s) (the vertical segment's own number where it
+  agrees: 0 on a constant gradient, z''/(1 + z'²)^1.5 at the ends of a parabolic arc, (sin θ1 − sin θ0)/L
+  along a circular arc between gradient angles θ0 and θ1). A profile without its gradient curve is judged on
+  the vertical segments' numbers alone (from ``StartDistAlong``, ``StartHeight`` and ``StartGradient`` to
+  where its kind takes it, ``HorizontalLength`` further); a kind they do not measure (a vertical clothoid) has
+  unmeasurable joints.
 
 Zero-length segments (the one that ends every layout) are left out; the joint is across them. The
 measures and tolerances are those of every checker (``spiral_cad.continuity.joints``): by default a gap of
 the file's geometric precision (its representation context's ``Precision``, 1e-5 m where it states none)
-or 1e-6 of the model's size if larger, an angle of twice that gap over the shortest segment, and a
+or 1e-6 of the model's size (its largest piece's extent: a plan in map coordinates is not measured from a
+profile at 0) if larger, an angle of twice that gap over the shortest segment, and a
 relative curvature jump of 1e-6. Lengths are in the file's unit.
 """
 
@@ -80,42 +83,50 @@ def check_ifc(path: str | os.PathLike, *, gap_tol: float | None = None, angle_to
         name = alignment.Name or f"alignment {number}"
         layouts = [obj for rel in alignment.IsNestedBy for obj in rel.RelatedObjects]
         horizontal = next((layout for layout in layouts if layout.is_a("IfcAlignmentHorizontal")), None)
-        curve = _representation_curves(alignment).get("IfcCompositeCurve")  # the gradient curve's base curve, or its own
-        if horizontal is None or curve is None:
+        vertical = next((layout for layout in layouts if layout.is_a("IfcAlignmentVertical")), None)
+        curves = _representation_curves(alignment)
+        plan = curves.get("IfcCompositeCurve")  # the gradient curve's base curve, or its own
+        if horizontal is None or plan is None:
             notes.append(f"alignment {name!r}: no horizontal layout with its IfcCompositeCurve: its plan is not judged")
         else:
-            try:
-                frames, stated = _plan_frames(curve, layout_segments(horizontal), metres, name, notes)
-                precisions.append(_precision(curve, model))
-                pieces.append(("plan", frames, False, f"{name} plan"))
-                lengths += stated
-            except ValueError as error:
-                notes.append(str(error))
-        vertical = next((layout for layout in layouts if layout.is_a("IfcAlignmentVertical")), None)
-        if vertical is not None:
+            judged = _judged(plan, _horizontal_curvatures(layout_segments(horizontal)), metres, f"alignment {name!r}: plan", notes)
+            if judged is not None:
+                precisions.append(_precision(plan, model))
+                pieces.append(("plan", judged[0], False, f"{name} plan"))
+                lengths += judged[1]
+        profile = curves.get("IfcGradientCurve")
+        if vertical is not None and profile is not None:  # the profile as its curve runs, in (distance along, height)
+            judged = _judged(profile, _vertical_curvatures(layout_segments(vertical)), metres, f"alignment {name!r}: profile", notes)
+            if judged is not None:
+                pieces.append(("profile", judged[0], False, f"{name} profile"))
+                lengths += judged[1]
+        elif vertical is not None:  # no curve drawn: the layout's own numbers
             frames, stated = _profile_frames(layout_segments(vertical), name, notes)
             if frames:
                 pieces.append(("profile", frames, False, f"{name} profile"))
                 lengths += stated
+            else:
+                notes.append(f"alignment {name!r}: its vertical layout holds no segment of length: no profile to judge")
     if not pieces:
         raise ValueError(f"{source}: no alignment with a plan or a profile to judge" + (f" ({'; '.join(notes)})" if notes else ""))
-    points = np.array([frame[:3] for _, frames, *_ in pieces for pair in frames for frame in pair])
-    size = model_size(points[np.isfinite(points).all(axis=1)], source)  # a segment not measured has no end point
+    # the model's size: its largest piece's (a plan in map coordinates and a profile from 0 are apart, not one model)
+    size = max(_size(frames, source) for _, frames, *_ in pieces)
     stated_tolerances = []
     if gap_tol is None:
         precision = max(precisions, default=DEFAULT_PRECISION / metres)
         gap_tol = max(1e-7, precision, RELATIVE_GAP * size)
         stated_tolerances.append(f"gap {gap_tol:.3g} (the file's precision {precision:.3g}, or 1e-6 of its size)")
     if angle_tol is None:
-        real = [length for length in lengths if length > _SLIVER_SHARE * max(lengths)]
+        longest = max(lengths)
+        real = [length for length in lengths if length > _SLIVER_SHARE * longest]
         angle_tol = max(1e-7, 2.0 * gap_tol / min(real))
         stated_tolerances.append(f"angle {angle_tol:.3g} rad")
     if curvature_tol is None:
         curvature_tol = 1e-6
     report = classify_pieces(pieces, size, gap_tol=gap_tol, angle_tol=angle_tol, curvature_tol=curvature_tol, source=source,
                              element="segment", units=units)  # fmt: skip
-    notes.insert(0, "the plan as ifcopenshell evaluates its curve's segments; the profile from its vertical segments' "
-                    "own numbers")  # fmt: skip
+    notes.insert(0, "the plan and the profile as ifcopenshell evaluates their curves' segments (a profile without its "
+                    "IfcGradientCurve from its vertical segments' own numbers)")  # fmt: skip
     if stated_tolerances:
         notes.append(f"tolerances from the file: {', '.join(stated_tolerances)}; give them to judge otherwise")
     return replace(report, notes=tuple(notes))
@@ -149,10 +160,32 @@ def _precision(curve: Any, model: Any) -> float:
 _DESIGN_AGREES = 1e-3
 
 
-def _plan_frames(curve: Any, design: list[Any], metres: float, name: str, notes: list[str]) -> tuple[list, list[float]]:
-    """Per non-zero segment of ``curve``, its (start, end) frames in the file's unit: position and tangent as
-    ifcopenshell evaluates it, curvature as the curve has it (a line's 0, a circle's 1/radius exactly; other
-    curves by differences, or the layout's number where it agrees with them).
+def _size(frames: list, source: str) -> float:
+    """The diagonal of the box of a piece's segment ends (those measured)."""
+    points = np.array([frame[:3] for pair in frames for frame in pair])
+    return model_size(points[np.isfinite(points).all(axis=1)], source)
+
+
+def _judged(curve: Any, stated: list[tuple[float | None, float | None]], metres: float, what: str,
+            notes: list[str]) -> tuple[list, list[float]] | None:  # fmt: skip
+    """``_curve_frames`` of ``curve``, or None with a note where there is nothing to judge."""
+    try:
+        frames, lengths = _curve_frames(curve, stated, metres, what, notes)
+    except ValueError as error:
+        notes.append(str(error))
+        return None
+    if not frames:
+        notes.append(f"{what}: no segment of length: not judged")
+        return None
+    return frames, lengths
+
+
+def _curve_frames(curve: Any, stated: list[tuple[float | None, float | None]], metres: float, what: str,
+                  notes: list[str]) -> tuple[list, list[float]]:  # fmt: skip
+    """Per segment of length of ``curve`` (a plan's composite curve, or a gradient curve in (distance along,
+    height)), its (start, end) frames in the file's unit: position and tangent as ifcopenshell evaluates it,
+    curvature as the curve has it (a line's 0, a circle's 1/radius exactly; other curves by differences, or the
+    layout's number in ``stated`` where it agrees with them).
 
     Raises:
         ValueError: a segment ifcopenshell cannot evaluate (an IFC 4 ``IfcCompositeCurveSegment``), named.
@@ -162,40 +195,36 @@ def _plan_frames(curve: Any, design: list[Any], metres: float, name: str, notes:
 
     settings = ifcopenshell.geom.settings()
     segments = list(curve.Segments)
-    stated = [d if d is not None and d.is_a("IfcAlignmentHorizontalSegment") else None for d in design]
     if len(stated) != len(segments):  # a Helmert curve is two curve segments, say: the layout cannot be matched
-        notes.append(f"alignment {name!r}: {len(stated)} horizontal segments for {len(segments)} curve segments: the plan's "
-                     "curvatures are the curve's own, by differences")  # fmt: skip
-        stated = [None] * len(segments)
+        notes.append(f"{what}: {len(stated)} layout segments for {len(segments)} curve segments: its curvatures are the "
+                     "curve's own, by differences")  # fmt: skip
+        stated = [(None, None)] * len(segments)
     frames, lengths = [], []
     for k, segment in enumerate(segments):
         function = wrapper.map_shape(settings, segment)
         if function is None:
-            raise ValueError(f"alignment {name!r}: plan segment {k} ({segment.is_a()}) is not a curve segment ifcopenshell "
-                             "evaluates: the plan is not judged")  # fmt: skip
+            raise ValueError(f"{what} segment {k} ({segment.is_a()}) is not a curve segment ifcopenshell evaluates: not judged")
         length = float(function.length())
         if length == 0.0:
             continue
         evaluate = wrapper.function_item_evaluator(settings, function).evaluate
-        parent = segment.ParentCurve.is_a() if segment.is_a("IfcCurveSegment") else ""
+        parent = segment.ParentCurve if segment.is_a("IfcCurveSegment") else None
+        line = parent is not None and parent.is_a("IfcLine")
+        radius = float(parent.Radius or 0.0) if parent is not None and parent.is_a("IfcCircle") else 0.0
         ends = []
         for end, at in enumerate((0.0, length)):
             matrix = np.array(evaluate(at))
             point, tangent = matrix[:3, 3] / metres, matrix[:3, 0] / np.linalg.norm(matrix[:3, 0])
             measured = _turning(evaluate, at, length, end == 1) * metres  # 1/unit; positive turns left
-            if parent == "IfcLine":
-                curvature = 0.0
-            elif parent == "IfcCircle":
-                curvature = math.copysign(1.0 / float(segment.ParentCurve.Radius), measured)
-            else:
-                curvature = measured
-            design_says = _stated_curvature(stated[k], end)
+            exact = line or radius > 0.0
+            curvature = (0.0 if line else math.copysign(1.0 / radius, measured)) if exact else measured
+            says = stated[k][end]
             floor = max(abs(curvature), metres / abs(length))  # 1/length: the segment's own scale of curvature
-            if design_says is not None and abs(design_says - curvature) > _DESIGN_AGREES * max(floor, abs(design_says)):
-                notes.append(f"alignment {name!r}: plan segment {k} {('starts', 'ends')[end]} with curvature {curvature:.6g}, not "
-                             f"the {design_says:.6g} its layout states: the curve's is judged")  # fmt: skip
-            elif design_says is not None and parent not in ("IfcLine", "IfcCircle"):
-                curvature = design_says  # exact, where the curve's difference quotient agrees with it
+            if says is not None and abs(says - curvature) > _DESIGN_AGREES * max(floor, abs(says)):
+                notes.append(f"{what} segment {k} {('starts', 'ends')[end]} with curvature {curvature:.6g}, not the "
+                             f"{says:.6g} its layout states: the curve's is judged")  # fmt: skip
+            elif says is not None and not exact:
+                curvature = says  # exact, where the curve's difference quotient agrees with it
             normal = np.array([-tangent[1], tangent[0], 0.0])
             ends.append((*point.tolist(), *tangent.tolist(), *(curvature * normal).tolist()))
         frames.append(tuple(ends))
@@ -203,12 +232,42 @@ def _plan_frames(curve: Any, design: list[Any], metres: float, name: str, notes:
     return frames, lengths
 
 
-def _stated_curvature(design: Any, end: int) -> float | None:
-    """The curvature a horizontal layout segment states at its start (0) or end (1), in 1/its unit (None: none)."""
-    if design is None:
-        return None
-    radius = design.StartRadiusOfCurvature if end == 0 else design.EndRadiusOfCurvature
-    return None if radius is None else (0.0 if float(radius) == 0.0 else 1.0 / float(radius))
+def _horizontal_curvatures(design: list[Any]) -> list[tuple[float | None, float | None]]:
+    """The curvatures (1/unit) a horizontal layout states at the start and end of each segment (None: not stated)."""
+
+    def of(radius: Any) -> float | None:
+        return None if radius is None else (0.0 if float(radius) == 0.0 else 1.0 / float(radius))
+
+    return [(of(d.StartRadiusOfCurvature), of(d.EndRadiusOfCurvature)) if d is not None and d.is_a("IfcAlignmentHorizontalSegment")
+            else (None, None) for d in design]  # fmt: skip
+
+
+def _vertical_curvatures(design: list[Any]) -> list[tuple[float | None, float | None]]:
+    """The curvatures (1/unit) of the profile z(s) at the start and end of each vertical segment, from its numbers
+    (None where they do not say: another kind of segment, a number missing)."""
+    return [_vertical_bend(d) if d is not None and d.is_a("IfcAlignmentVerticalSegment") else (None, None) for d in design]
+
+
+def _vertical_bend(segment: Any) -> tuple[float | None, float | None]:
+    """The end curvatures of one vertical segment of the profile z(s): 0 on a constant gradient, z''/(1+z'²)^1.5 on
+    a parabola, (sin θ1 − sin θ0)/L on a circular arc (θ the gradients' angles); None where not known."""
+    try:
+        length, g0 = float(segment.HorizontalLength), float(segment.StartGradient)
+        g1 = float(segment.EndGradient) if segment.EndGradient is not None else g0
+    except (TypeError, ValueError):
+        return None, None
+    kind = segment.PredefinedType
+    if kind == "CONSTANTGRADIENT":
+        return 0.0, 0.0
+    if length == 0.0:
+        return None, None
+    if kind == "PARABOLICARC":
+        second = (g1 - g0) / length
+        return second / (1 + g0 * g0) ** 1.5, second / (1 + g1 * g1) ** 1.5
+    if kind == "CIRCULARARC" and g1 != g0:
+        bend = (math.sin(math.atan(g1)) - math.sin(math.atan(g0))) / length
+        return bend, bend
+    return None, None
 
 
 def _turning(evaluate: Any, at: float, length: float, backwards: bool) -> float:
@@ -231,34 +290,39 @@ def _turning(evaluate: Any, at: float, length: float, backwards: bool) -> float:
 
 
 def _profile_frames(design: list[Any], name: str, notes: list[str]) -> tuple[list, list[float]]:
-    """Per non-zero vertical segment, its (start, end) frames in the plane (distance along, height)."""
+    """Per non-zero vertical segment, its (start, end) frames in the plane (distance along, height), from its
+    numbers alone (an alignment whose profile has no ``IfcGradientCurve``)."""
     frames, lengths = [], []
     unmeasured = set()
     for segment in design:
         if segment is None or not segment.is_a("IfcAlignmentVerticalSegment"):
             notes.append(f"alignment {name!r}: its vertical layout nests a {getattr(segment, 'is_a', lambda: 'nothing')()}: left out")
             continue
-        length = float(segment.HorizontalLength)
+        try:
+            length, s0, h0 = float(segment.HorizontalLength), float(segment.StartDistAlong), float(segment.StartHeight)
+            g0 = float(segment.StartGradient)
+            g1 = float(segment.EndGradient) if segment.EndGradient is not None else g0
+        except (TypeError, ValueError):
+            notes.append(f"alignment {name!r}: a vertical segment without its numbers (#{segment.id()}): left out")
+            continue
         if length == 0.0:
             continue
-        s0, h0 = float(segment.StartDistAlong), float(segment.StartHeight)
-        g0, g1 = float(segment.StartGradient), float(segment.EndGradient)
         kind = segment.PredefinedType
+        bend = _vertical_bend(segment)
         if kind == "CONSTANTGRADIENT":
-            rise, g1, bend = g0 * length, g0, (0.0, 0.0)
-        elif kind == "PARABOLICARC":  # z'' = (g1 − g0) / L, constant
-            second = (g1 - g0) / length
-            rise, bend = 0.5 * (g0 + g1) * length, (second / (1 + g0 * g0) ** 1.5, second / (1 + g1 * g1) ** 1.5)
-        elif kind == "CIRCULARARC" and g1 != g0:  # κ = (sin θ1 − sin θ0) / L along a circle from θ0 to θ1
+            rise, g1 = g0 * length, g0
+        elif kind == "PARABOLICARC":
+            rise = 0.5 * (g0 + g1) * length
+        elif kind == "CIRCULARARC" and bend[0]:
             t0, t1 = math.atan(g0), math.atan(g1)
-            k = (math.sin(t1) - math.sin(t0)) / length
-            rise, bend = (math.cos(t0) - math.cos(t1)) / k, (k, k)
+            rise = (math.cos(t0) - math.cos(t1)) / bend[0]
         else:
             unmeasured.add(str(kind))
-            rise, bend = math.nan, (math.nan, math.nan)
+            rise = math.nan
         ends = []
         for point, gradient, kappa in (((s0, h0), g0, bend[0]), ((s0 + length, h0 + rise), g1, bend[1])):
             tangent = np.array([1.0, gradient, 0.0]) / math.hypot(1.0, gradient)
+            kappa = math.nan if kappa is None else kappa
             ends.append((point[0], point[1], 0.0, *tangent.tolist(), *(kappa * np.array([-tangent[1], tangent[0], 0.0])).tolist()))
         frames.append(tuple(ends))
         lengths.append(length)

@@ -47,6 +47,36 @@ def test_buildingsmarts_break_in_vertical_gradient_is_a_kink_in_the_profile():
     assert _levels(clean, "plan") == ["G2", "G2"] and clean.units == "m"
 
 
+def test_a_profile_is_judged_on_its_gradient_curve_not_only_its_numbers():
+    """ALS017's imperial failing file: the vertical segments' numbers meet, the gradient curve's segments do not."""
+    report = check_ifc(DATA / "fail-als017-scenario02-imperial_break_in_direction_angle.ifc")
+    (profile,) = [w for w in report.wires if w.kind == "profile"]
+    gaps = [j.gap * 0.3048 for j in profile.joints]  # ft to m
+    assert [str(j.level) for j in profile.joints][1::2] == ["none"] * 4
+    assert max(gaps) == pytest.approx(0.0408, abs=5e-4) and min(gaps[1::2]) > 0.018
+
+
+def test_a_georeferenced_plan_keeps_its_tolerance_beside_a_profile_from_zero(tmp_path):
+    """The plan at 5e6 m and the profile at 0 are two pieces, not one 7e6 m model: a 0.5 m gap is still found."""
+    model = ifcopenshell.open(str(DATA / "pass-als016-scenario01-metric_continuous.ifc"))
+    (curve,) = [c for c in model.by_type("IfcCompositeCurve") if c.is_a() == "IfcCompositeCurve"]
+    for k, segment in enumerate(curve.Segments):
+        location = segment.Placement.Location
+        shift = 0.5 if k >= 2 else 0.0  # the arc and what follows 0.5 m east: a gap where the clothoid ends
+        location.Coordinates = (location.Coordinates[0] + 5e6 + shift, location.Coordinates[1] + 5e6)
+    model.write(str(tmp_path / "far.ifc"))
+    report = check_ifc(tmp_path / "far.ifc")
+    assert {w.kind for w in report.wires} == {"plan", "profile"}
+    assert report.size < 1e3 and report.gap_tol < 1e-3 and _levels(report, "plan") == ["G2", "none"]
+
+
+def test_a_file_cut_short_is_refused_not_judged_on_what_is_left(tmp_path):
+    text = (DATA / "pass-als017-scenario01-imperial_continuous.ifc").read_bytes()
+    (tmp_path / "cut.ifc").write_bytes(text[: len(text) // 2])
+    with pytest.raises(ValueError, match=r"cut.ifc: the file ends before END-ISO-10303-21; \(cut short\)"):
+        check_ifc(tmp_path / "cut.ifc")
+
+
 @pytest.mark.parametrize("units", ["m", "ft"])
 def test_our_alignment_is_g2_at_every_joint_where_the_chain_joins(tmp_path, units):
     chain = curve_road(units)
@@ -149,7 +179,7 @@ def test_a_helmert_curve_drawn_as_two_curve_segments_is_judged_on_its_curve(tmp_
     model.write(str(tmp_path / "helmert.ifc"))
     report = check_ifc(tmp_path / "helmert.ifc")
     assert [str(j.level) for j in report.wires[0].joints] == ["G2", "G2", "G2", "G1"]
-    assert any("horizontal segments for 6 curve segments" in n for n in report.notes)
+    assert any("plan: 5 layout segments for 6 curve segments" in n for n in report.notes)
 
 
 def test_a_vertical_circular_arc_ends_where_its_circle_takes_it():
