@@ -220,6 +220,36 @@ def peak_curvature_rate(cp: ArrayLike, samples: int = 257) -> tuple[Any, Any]:
     return (float(best_rate[0]), float(best_u[0])) if single else (best_rate, best_u)
 
 
+#: A cubic whose speed |B'| dips inside below this share of its largest is near a cusp: its curvature peaks there,
+#: and may turn, within a small part of a grid step, so ``monotone_pieces`` samples about the dip ever closer.
+NEAR_CUSP = 1e-2
+
+
+def _refined_at_dips(cp: NDArray[np.float64], grid: NDArray[np.float64], speed: NDArray[np.float64], top: float) -> NDArray[np.float64]:
+    """``grid`` with, about each interior minimum of ``speed`` below ``NEAR_CUSP`` of ``top``, the minimum itself (found
+    by golden sections) and points at halving distances from it down to 1e-15: the curvature's peak and any turn
+    near it lie between two of them."""
+    inner = speed[1:-1]
+    dips = np.flatnonzero((inner <= speed[:-2]) & (inner <= speed[2:]) & (inner < NEAR_CUSP * top)) + 1
+    if not len(dips):
+        return grid
+    ratio = 0.5 * (math.sqrt(5.0) - 1.0)
+    added = []
+    for i in dips.tolist():
+        lo, hi = float(grid[i - 1]), float(grid[i + 1])
+        for _ in range(80):  # golden sections on the speed (smooth, one minimum in the bracket): to ~1e-16
+            a, b = hi - ratio * (hi - lo), lo + ratio * (hi - lo)
+            if np.linalg.norm(derivative(cp, a)) <= np.linalg.norm(derivative(cp, b)):
+                hi = b
+            else:
+                lo = a
+        at = 0.5 * (lo + hi)
+        steps = (grid[i + 1] - grid[i - 1]) * 2.0 ** -np.arange(0.0, 50.0, 0.25)
+        added.append(np.concatenate([[at], at - steps, at + steps]))
+    both = np.concatenate([grid, *added])
+    return np.unique(both[(both >= 0.0) & (both <= 1.0)])
+
+
 def monotone_pieces(cp: ArrayLike, samples: int = 513) -> list[tuple[float, float]]:
     """Parameter intervals [u0, u1] covering [0, 1] on which a plane cubic's curvature is one-signed and monotone.
 
@@ -241,14 +271,19 @@ def monotone_pieces(cp: ArrayLike, samples: int = 513) -> list[tuple[float, floa
     grid = np.linspace(0.0, 1.0, samples)
     speed = np.linalg.norm(derivative(cp, grid), axis=-1)
     top = float(speed.max())
+    if top > 0.0:
+        grid = _refined_at_dips(cp, grid, speed, top)
+        speed = np.linalg.norm(derivative(cp, grid), axis=-1)
     if top == 0.0 or float(speed[1:-1].min(initial=top)) <= 1e-9 * top:
-        at = float(grid[1 + int(np.argmin(speed[1:-1]))]) if samples > 2 else 0.0
+        at = float(grid[1 + int(np.argmin(speed[1:-1]))]) if len(grid) > 2 else 0.0
         raise ValueError(f"the cubic {cp.tolist()} has a cusp: its tangent vanishes near u = {at:.6g}, where its curvature is unbounded")
     cuts: list[float] = []
+    coarse = np.isin(grid, np.linspace(0.0, 1.0, samples))  # the even grid: its values set the rounding's scale
     for function in (curvature, curvature_rate):
         with np.errstate(invalid="ignore", divide="ignore"):  # a leg of zero length: no tangent at that end
             values = np.nan_to_num(np.asarray(function(cp, grid), dtype=float), nan=0.0, posinf=0.0, neginf=0.0)
-        noise = 1e-9 * float(np.abs(values).max())
+        # (not the near-cusp samples': a peak of 1e11 there does not make a real peak of 100 elsewhere rounding)
+        noise = 1e-9 * float(np.abs(values[coarse]).max())
         signs = np.where(np.abs(values) <= noise, 0.0, np.sign(values))
         kept = np.flatnonzero(signs)
         flips = np.flatnonzero(signs[kept[:-1]] != signs[kept[1:]])  # consecutive signed samples that differ
@@ -286,6 +321,9 @@ def plain_spirals(cps: NDArray[np.float64], samples: int = 513) -> NDArray[np.bo
             kappa = cross12 / (speed2 * np.sqrt(speed2))
             rate = ((x1 * y3 - y1 * x3) * speed2 - 3.0 * cross12 * (x1 * x2 + y1 * y2)) / (speed2 * speed2 * speed2)
         plain = speed2[:, 1:-1].min(axis=1) > 1e-18 * speed2.max(axis=1)  # |Q'| above 1e-9 of its largest
+        inner = speed2[:, 1:-1]
+        dips = (inner <= speed2[:, :-2]) & (inner <= speed2[:, 2:]) & (inner < NEAR_CUSP**2 * speed2.max(axis=1, keepdims=True))
+        plain &= ~dips.any(axis=1)  # near a cusp: monotone_pieces samples closer there
         for values in (kappa, rate):
             values = np.nan_to_num(values, nan=0.0, posinf=0.0, neginf=0.0)
             noise = 1e-9 * np.abs(values).max(axis=1, keepdims=True)

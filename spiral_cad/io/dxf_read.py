@@ -126,6 +126,8 @@ def read_dxf_paths(path: str | os.PathLike, *, units: str | None = None, drawing
         doc = ezdxf.readfile(name)
     except (ezdxf.DXFError, UnicodeDecodeError, OSError) as error:  # ezdxf says "not a DXF file" with an OSError
         raise ValueError(f"{label}: not a DXF file ezdxf can read ({error})") from None
+    except Exception as error:  # a malformed tag ezdxf's loader trips on ('inf' as a colour, a broken VIEWPORT)
+        raise ValueError(f"{label}: not a DXF file ezdxf can read ({type(error).__name__}: {error})") from None
     drop_unstated_units(doc, name)
     target = None if units is None else length_unit(units)
     code = int(doc.header.get("$INSUNITS", 0))
@@ -162,7 +164,9 @@ def read_dxf_paths(path: str | os.PathLike, *, units: str | None = None, drawing
     if not pieces:
         raise ValueError(f"{label}: no LINE, ARC, CIRCLE, polyline or SPLINE in the model space")
     ends = np.array([p for parts, _ in pieces for part in (parts[0], parts[-1]) for p in (part[1], part[2])])
-    size = float(np.linalg.norm(ends.max(axis=0) - ends.min(axis=0))) or 1.0
+    extent = ends.max(axis=0) - ends.min(axis=0)
+    widest = float(np.abs(extent).max())
+    size = widest * float(np.linalg.norm(extent / widest)) if widest > 0.0 else 1.0  # no overflow at 1e200
     flat = all(
         abs(p[1][2]) == 0.0 and abs(p[2][2]) == 0.0 and (p[0] == "line" or p[0] == "cubic" or abs(p[3][1][:2]).max() == 0.0)
         for parts, _ in pieces
@@ -246,33 +250,51 @@ def _entity_parts(entity, kind: str) -> list[tuple]:
 
 
 def _spline_parts(spline: Any) -> list[tuple]:
-    """A SPLINE's Bézier pieces, in world coordinates: ``("cubic", start, end, (4, 3) control points)``
-    (degree 1 and 2 pieces raised to degree 3, exactly)."""
+    """A SPLINE's Bézier pieces, in world coordinates: ``("cubic", start, end, (4, 3) control points)`` (degree 2
+    pieces raised to degree 3, exactly), or ``("line", start, end, None)`` for a straight one."""
+    from ezdxf.math import BSpline
+
     if not len(spline.control_points):
         raise ValueError("a SPLINE given by fit points only: its curve is the writer's interpolation, not stated; "
                          "save it with control points")  # fmt: skip
+    points = np.array(spline.control_points, dtype=float).reshape(-1, 3)
+    if not np.isfinite(points).all():
+        raise ValueError(f"control point {int(np.flatnonzero(~np.isfinite(points).all(axis=1))[0])} is not finite")
     weights = list(spline.weights)
     if weights and max(weights) != min(weights):
         raise ValueError(f"a rational SPLINE (weights from {min(weights):g} to {max(weights):g}): a conic, not a cubic")
     degree = int(spline.dxf.degree)
     if degree not in (1, 2, 3):
         raise ValueError(f"a SPLINE of degree {degree}: only degrees 1 to 3 are read")
-    heights = {float(p[2]) for p in spline.control_points}
-    if len(heights) > 1:
-        raise ValueError(f"a SPLINE off the XY plane (control points at z from {min(heights):g} to {max(heights):g})")
-    try:
-        pieces = list(spline.construction_tool().bezier_decomposition())
+    extent = float(np.ptp(points, axis=0).max()) if len(points) > 1 else 0.0
+    if np.ptp(points[:, 2]) > 1e-12 * max(extent, abs(points[:, 2]).max()):
+        raise ValueError(f"a SPLINE off the XY plane (control points at z from {points[:, 2].min():g} to {points[:, 2].max():g})")
+    knots = np.array(spline.knots, dtype=float)
+    if len(knots) != len(points) + degree + 1 or not np.isfinite(knots).all() or np.any(np.diff(knots) < 0.0):
+        raise ValueError(f"a SPLINE whose {len(knots)} knots are not {len(points) + degree + 1} non-decreasing numbers")
+    _, repeats = np.unique(knots[degree + 1 : len(knots) - degree - 1], return_counts=True)
+    if len(repeats) and repeats.max() > degree:
+        raise ValueError(f"a SPLINE with an inner knot repeated {repeats.max()} times (more than its degree {degree}: "
+                         "the curve breaks there)")  # fmt: skip
+    try:  # equal weights: the same curve as none (ezdxf's decomposition takes no weights)
+        pieces = list(BSpline(points.tolist(), order=degree + 1, knots=knots.tolist()).bezier_decomposition())
     except Exception as error:  # an unclamped (periodic) knot vector, or knots ezdxf cannot split
         raise ValueError(f"a SPLINE ezdxf cannot cut into Bézier pieces ({type(error).__name__}: {error})") from None
-    parts = []
+    parts: list[tuple] = []
     for piece in pieces:
         cp = np.array(piece, dtype=float)
-        if degree == 1:  # a line as a cubic: its thirds
-            cp = np.array([cp[0], (2 * cp[0] + cp[1]) / 3, (cp[0] + 2 * cp[1]) / 3, cp[1]])
-        elif degree == 2:  # degree elevation: the same curve
-            cp = np.array([cp[0], cp[0] + 2 / 3 * (cp[1] - cp[0]), cp[2] + 2 / 3 * (cp[1] - cp[2]), cp[2]])
         if not np.any(np.diff(cp, axis=0)):
             continue  # a piece that goes nowhere
+        chord = cp[-1] - cp[0]
+        along = (cp - cp[0]) @ chord
+        off = np.linalg.norm(np.cross(cp - cp[0], chord), axis=-1)
+        if along.min() >= 0.0 and along.max() <= chord @ chord and off.max() <= 1e-12 * (chord @ chord):
+            parts.append(("line", cp[0], cp[-1], None))  # straight and never back: a line (its curvature is rounding)
+            continue
+        if degree == 1:
+            raise ValueError("a degree-1 piece that doubles back along itself")  # cannot happen: straight, handled above
+        if degree == 2:  # degree elevation: the same curve
+            cp = np.array([cp[0], cp[0] + 2 / 3 * (cp[1] - cp[0]), cp[2] + 2 / 3 * (cp[1] - cp[2]), cp[2]])
         parts.append(("cubic", cp[0], cp[-1], cp))
     return parts
 
@@ -305,8 +327,9 @@ def _chains(pieces: list, tolerance: float) -> list[tuple[list[tuple[int, bool]]
 
     count = len(pieces)
     ends = np.array([point for parts, _ in pieces for point in (parts[0][1], parts[-1][2])])  # 2k: start, 2k+1: end
-    tree = cKDTree(ends)
-    near = tree.query_ball_point(ends, tolerance)
+    scale = float(np.abs(ends).max()) or 1.0  # the tree squares distances: coordinates of 1e200 must not overflow
+    tree = cKDTree(ends / scale)
+    near = tree.query_ball_point(ends / scale, tolerance / scale)
     mates: list[int | None] = []
     for k, found in enumerate(near):
         others = [j for j in found if j != k]

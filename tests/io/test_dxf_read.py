@@ -206,3 +206,70 @@ def test_a_free_form_spline_is_cut_into_spiral_pieces_on_ezdxf_s_curve(tmp_path)
             assert math.dist(point, tuple(on)[:2]) < 1e-7  # ezdxf's Newton stops near 1e-9
         kappa = bezier.curvature(piece.control_points, np.linspace(0, 1, 50))
         assert np.all(np.diff(np.abs(kappa)) >= -1e-9) or np.all(np.diff(np.abs(kappa)) <= 1e-9)
+
+
+def test_a_malformed_drawing_ezdxf_trips_on_is_a_named_refusal(tmp_path):
+    doc, msp = drawing()
+    msp.add_line((0, 0), (1, 0), dxfattribs={"color": 1})
+    doc.saveas(tmp_path / "inf.dxf")
+    text = (tmp_path / "inf.dxf").read_text().splitlines()
+    at = next(k for k in range(text.index("LINE"), len(text)) if text[k].strip() == "62")  # the colour, a whole number
+    text[at + 1] = "inf"
+    (tmp_path / "inf.dxf").write_text("\n".join(text) + "\n")
+    with pytest.raises(ValueError, match=r"inf.dxf: not a DXF file ezdxf can read \(OverflowError"):
+        read_dxf_paths(tmp_path / "inf.dxf")
+
+
+def test_splines_as_drawing_programs_write_them_and_the_broken_ones_refused(tmp_path):
+    """A polyline-like degree-1 SPLINE is its lines; equal weights are no weights; a knot vector that breaks the
+    curve (an inner knot repeated past the degree, knots that go back) is refused by the entity's handle."""
+    rng = np.random.default_rng(1)
+    points = np.column_stack([np.arange(20.0), rng.normal(0.0, 5.0, 20)])
+    doc, msp = drawing()
+    polyline = msp.add_spline(degree=1)
+    polyline.control_points, polyline.knots = points.tolist(), [0.0, *map(float, range(20)), 19.0]
+    doc.saveas(tmp_path / "poly.dxf")
+    (path,) = read_dxf_paths(tmp_path / "poly.dxf").paths
+    assert [type(s) for s in path.segments] == [Line] * 19  # not cut where rounding makes a straight cubic "turn"
+    assert np.allclose([s.start for s in path.segments], points[:-1], atol=1e-12)
+    doc, msp = drawing()
+    msp.add_rational_spline([(0, 0), (1, 1), (2, 0), (3, 1)], [2.0] * 4)  # equal weights: no weights
+    doc.saveas(tmp_path / "weights.dxf")
+    assert read_dxf_paths(tmp_path / "weights.dxf").paths[0].segments[0].start.tolist() == [0.0, 0.0]
+    for knots, message in (([0, 0, 0, 0, 1, 1, 1, 1, 2, 2, 2, 2], "an inner knot repeated 4 times"),
+                           ([0, 0, 0, 0, 2, 1, 1, 1, 1], "knots are not 9 non-decreasing numbers")):  # fmt: skip
+        doc, msp = drawing()
+        spline = msp.add_spline(degree=3)
+        spline.control_points = [(0, 0), (1, 1), (2, 0), (3, 1), (10, 10), (11, 9), (12, 10), (13, 9)][: len(knots) - 4]
+        spline.knots = [float(k) for k in knots]
+        doc.saveas(tmp_path / "broken.dxf")
+        with pytest.raises(ValueError, match=rf"SPLINE {spline.dxf.handle}: a SPLINE .*{message}"):
+            read_dxf_paths(tmp_path / "broken.dxf")
+
+
+@pytest.mark.parametrize("eps", [0.01, 0.001, -0.01])
+def test_a_spline_near_a_cusp_comes_back_in_pieces_each_one_signed_and_monotone(tmp_path, eps):
+    """The curvature turns and peaks within a small part of a grid step there: the pieces are cut about it."""
+    from spiral_cad.core import bezier
+
+    doc, msp = drawing()
+    spline = msp.add_spline(degree=3)
+    spline.control_points, spline.knots = [(0, 0), (2, 2), (0, 2 + eps), (2, 0)], [0.0] * 4 + [1.0] * 4
+    doc.saveas(tmp_path / "cusp.dxf")
+    (path,) = read_dxf_paths(tmp_path / "cusp.dxf").paths
+    assert len(path.segments) == 6
+    for piece in path.segments:
+        kappa = np.asarray(bezier.curvature(piece.control_points, np.linspace(0.0, 1.0, 20_001)))
+        floor = 1e-6 * np.abs(kappa).max()
+        assert kappa.min() >= -floor or kappa.max() <= floor  # one sign
+        step = np.diff(np.abs(kappa))
+        assert (step >= -floor).all() or (step <= floor).all()  # monotone
+
+
+def test_coordinates_near_the_float_range_are_chained(tmp_path):
+    doc, msp = drawing()
+    msp.add_line((1e200, 0), (2e200, 0))
+    msp.add_line((2e200, 0), (2e200, 1e200))
+    doc.saveas(tmp_path / "huge.dxf")
+    (path,) = read_dxf_paths(tmp_path / "huge.dxf").paths
+    assert len(path.segments) == 2
