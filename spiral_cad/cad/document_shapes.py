@@ -16,7 +16,6 @@ import os
 from pathlib import Path
 from typing import Any
 
-import numpy as np
 from OCP.BRep import BRep_Builder
 from OCP.TopoDS import TopoDS_Compound
 
@@ -24,8 +23,6 @@ from .occ import chain_wire
 
 __all__ = ["document_shape", "program_shape"]
 
-#: The chords a helical move is read as are left out, so any tolerance serves (the program's unit).
-_HELIX_CHORDS = 1e-3
 #: How many cutting paths are named by their program lines.
 _LISTED = 50
 
@@ -88,40 +85,13 @@ def program_shape(path: str | os.PathLike, *, units: str | None = None) -> tuple
     Raises:
         ValueError: a program the reader refuses (naming the line), or one without a feed move.
     """
-    from ..io.gcode_paths import read_gcode_moves, read_gcode_runs
-    from ..io.rs274 import rs274_executable
+    from ..io.gcode_paths import read_gcode_runs
 
     name = Path(path).name
     if units is not None and units not in ("mm", "in"):
         raise ValueError(f"{name}: a program's unit is mm (G21) or in (G20); got {units!r}")
-    try:
-        read = read_gcode_runs(path, units=units)
-        runs, lines, unit, notes = [list(r) for r in read.runs], [list(n) for n in read.lines], read.units, list(read.notes)
-    except ValueError as refused:
-        if rs274_executable() is None:
-            raise ValueError(f"{refused}; LinuxCNC's rs274, which reads more programs, is not installed") from None
-        try:
-            moves = read_gcode_moves(path, interpreter="rs274", program_units=units, helix_tolerance=_HELIX_CHORDS)
-        except ValueError as also:
-            raise ValueError(f"{refused}; LinuxCNC's rs274 did not read it either: {also}") from None
-        chords = moves.chords if moves.chords is not None else np.zeros(len(moves), dtype=bool)
-        runs, lines = [[]], [[]]
-        for segment, line, cut in zip(moves.segments, moves.lines.tolist(), (~moves.rapid & ~chords).tolist()):
-            if cut:
-                runs[-1].append(segment)
-                lines[-1].append(line)
-            elif runs[-1]:
-                runs.append([])
-                lines.append([])
-        runs, lines = [run for run in runs if run], [numbers for numbers in lines if numbers]
-        if not runs:
-            raise ValueError(f"{name}: the program has no feed move (G1, G2, G3) to judge") from None
-        unit = moves.units
-        why = str(refused).split("; use interpreter=")[0].split(" (have the CAM expand")[0]  # rs274 did: no advice to use it
-        notes = [f"read by LinuxCNC's rs274 (the built-in reader refused it: {why})", *moves.notes,
-                 "the first move starts where the machine is, which the program does not say: not judged"]  # fmt: skip
-        if chords.any():
-            notes.append(f"{len({int(k) for k in moves.lines[chords].tolist()})} helical move(s) left out: each parts its path")
+    read = read_gcode_runs(path, units=units)  # LinuxCNC's rs274 reads what the built-in reader refuses
+    runs, lines, unit, notes = [list(r) for r in read.runs], [list(n) for n in read.lines], read.units, list(read.notes)
     notes.append(f"{len(runs)} cutting path(s): each run of feed moves between rapids, in program order; rapids are not judged")
     notes += [f"wire {k}: the moves of program lines {numbers[0]}–{numbers[-1]}" for k, numbers in enumerate(lines[:_LISTED])]
     if len(lines) > _LISTED:

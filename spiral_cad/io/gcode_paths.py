@@ -27,7 +27,7 @@ from __future__ import annotations
 import math
 import os
 import re
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Any
 
 import numpy as np
@@ -56,6 +56,8 @@ class GcodeRuns:
         units: the program's unit (``"mm"`` or ``"in"``).
         source: the file's name, for messages.
         notes: what was left out or read with care (a tool change, an arc moved onto its chord's bisector).
+        turns_left_out: the length of the whole turns an arc of more than two turns runs before the two its
+            segments hold (the same circle again), in ``units``.
     """
 
     runs: tuple[tuple[Any, ...], ...]
@@ -63,14 +65,15 @@ class GcodeRuns:
     units: str
     source: str
     notes: tuple[str, ...] = ()
+    turns_left_out: float = 0.0
 
     def __len__(self) -> int:
         return len(self.runs)
 
     @property
     def length(self) -> float:
-        """The length of every run together, in ``units``."""
-        return float(sum(segment.length for run in self.runs for segment in run))
+        """The length of every run together, in ``units`` (with ``turns_left_out``)."""
+        return float(sum(segment.length for run in self.runs for segment in run)) + self.turns_left_out
 
 
 @dataclass(frozen=True)
@@ -402,6 +405,83 @@ def _first_named(text: str) -> dict[str, int]:
 
 
 def read_gcode_runs(path: str | os.PathLike, *, units: str | None = None) -> GcodeRuns:
+    """The exact cutting paths of a G-code file (``_built_in_runs``); a program the built-in reader refuses (a
+    subroutine call, a canned cycle) is read by LinuxCNC's ``rs274`` where it is installed, as lines and arcs
+    (``read_gcode_moves``), its helical moves left out. The segments of one run are all in the plane or all in
+    space.
+
+    Raises:
+        ValueError: what both readers refuse (or the built-in one, naming rs274's absence), or no feed move.
+        OSError: the file could not be read.
+    """
+    from .rs274 import rs274_executable
+
+    try:
+        read = _built_in_runs(path, units=units)
+    except ValueError as refused:
+        if rs274_executable() is None:
+            raise ValueError(f"{refused}; LinuxCNC's rs274, which reads more programs, is not installed") from None
+        read = _rs274_runs(path, units, refused)
+    return replace(read, runs=tuple(_one_dimension(run) for run in read.runs))
+
+
+#: The chords rs274's helical moves are read as are left out, so any tolerance serves (the program's unit).
+_HELIX_CHORDS = 1e-3
+
+
+def _rs274_runs(path: str | os.PathLike, units: str | None, refused: ValueError) -> GcodeRuns:
+    """The runs of feed moves of a program as LinuxCNC's rs274 runs it (lines and arcs; helices left out)."""
+    name = os.path.basename(os.fspath(path))
+    try:
+        moves = read_gcode_moves(path, interpreter="rs274", program_units=units, helix_tolerance=_HELIX_CHORDS)
+    except ValueError as also:
+        raise ValueError(f"{refused}; LinuxCNC's rs274 did not read it either: {also}") from None
+    chords = moves.chords if moves.chords is not None else np.zeros(len(moves), dtype=bool)
+    runs: list[list[Any]] = [[]]
+    lines: list[list[int]] = [[]]
+    for segment, line, cut in zip(moves.segments, moves.lines.tolist(), (~moves.rapid & ~chords).tolist()):
+        if cut:
+            runs[-1].append(segment)
+            lines[-1].append(line)
+        elif runs[-1]:
+            runs.append([])
+            lines.append([])
+    kept = [k for k, run in enumerate(runs) if run]
+    if not kept:
+        raise ValueError(f"{name}: the program has no feed move (G1, G2, G3) to judge") from None
+    why = str(refused).split("; use interpreter=")[0].split(" (have the CAM expand")[0]  # rs274 did: no advice to use it
+    notes = [f"read by LinuxCNC's rs274 (the built-in reader refused it: {why})", *moves.notes,
+             "the first move starts where the machine is, which the program does not say: not judged"]  # fmt: skip
+    if chords.any():
+        notes.append(f"{len({int(k) for k in moves.lines[chords].tolist()})} helical move(s) left out: each parts its path")
+    return GcodeRuns(tuple(tuple(runs[k]) for k in kept), tuple(tuple(lines[k]) for k in kept), moves.units, name, tuple(notes))
+
+
+def _one_dimension(run: tuple[Any, ...]) -> tuple[Any, ...]:
+    """``run`` with every segment in the plane when all lie in z = 0 (an XY arc read in space among plane lines),
+    else every line and arc in space."""
+    if all(segment.dim == 2 for segment in run):
+        return run
+    flat = all(segment.dim == 2 or (not segment.start[2] and not segment.end[2] and (not isinstance(segment, Arc)
+               or abs(segment.normal[2]) == 1.0)) for segment in run)  # fmt: skip
+    out = []
+    for segment in run:
+        if flat and isinstance(segment, Arc) and segment.dim == 3:
+            turn = float(segment.normal[2])  # +1: counterclockwise seen from +z
+            angle = math.atan2(segment.start[1] - segment.center[1], segment.start[0] - segment.center[0])
+            segment = Arc(segment.center[:2], math.copysign(abs(segment.radius), turn), angle, segment.sweep)
+        elif flat and isinstance(segment, Line) and segment.dim == 3:
+            segment = Line(segment.start[:2], segment.end[:2])
+        elif not flat and isinstance(segment, Line) and segment.dim == 2:
+            segment = Line._of(np.r_[segment.start, 0.0], np.r_[segment.end, 0.0])
+        elif not flat and isinstance(segment, Arc) and segment.dim == 2:
+            segment = Arc.in_space(np.r_[segment.center, 0.0], (0.0, 0.0, math.copysign(1.0, segment.radius)),
+                                   np.r_[segment.start, 0.0], segment.sweep)  # fmt: skip
+        out.append(segment)
+    return tuple(out)
+
+
+def _built_in_runs(path: str | os.PathLike, *, units: str | None = None) -> GcodeRuns:
     """The exact cutting paths of a G-code file: every run of feed moves between rapids as the curves it
     states (G1 lines, G2/G3 arcs, G5 cubics as ``parse_gcode_chain``'s spiral pieces), in space and in the
     program's unit, whether or not they join G2.
@@ -435,6 +515,7 @@ def read_gcode_runs(path: str | os.PathLike, *, units: str | None = None) -> Gco
     lines: list[list[int]] = [[]]
     notes: list[str] = list(reader.notes)
     helical = 0
+    left_out = 0.0
     named = _first_named(text)
     plain = _plain_cubics(reader.pieces, 1.0)
     for k, (kind, number, rapid, start, *data) in enumerate(reader.pieces):
@@ -473,6 +554,7 @@ def read_gcode_runs(path: str | os.PathLike, *, units: str | None = None) -> Gco
                 if abs(rotation) > 1:
                     notes.append(f"line {number}: an arc of {abs(rotation)} turns, judged on its last two (the turns before "
                                  "run on the same circle)")  # fmt: skip
+                    left_out += max(0, abs(rotation) - 2) * 2.0 * math.pi * 0.5 * (r0 + r1)
             else:
                 segments = _piece_segment(kind, start, data, 1.0, 3, k in plain) or []
         except ValueError as error:
@@ -485,4 +567,5 @@ def read_gcode_runs(path: str | os.PathLike, *, units: str | None = None) -> Gco
         raise ValueError(f"{label}: no feed move (G1, G2, G3, G5) to a new position after the first move")
     if helical:
         notes.append(f"{helical} helical arc(s) left out: each parts its path")
-    return GcodeRuns(tuple(tuple(runs[k]) for k in kept), tuple(tuple(lines[k]) for k in kept), reader.units, label, tuple(notes))
+    return GcodeRuns(tuple(tuple(runs[k]) for k in kept), tuple(tuple(lines[k]) for k in kept), reader.units, label, tuple(notes),
+                     left_out)  # fmt: skip

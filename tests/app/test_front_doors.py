@@ -3,7 +3,9 @@
 from __future__ import annotations
 
 import importlib
+import math
 import re
+import shutil
 import subprocess
 import sys
 import xml.etree.ElementTree as ET
@@ -548,3 +550,22 @@ def test_old_names_work_for_one_release_with_a_warning():
     with pytest.warns(DeprecationWarning, match=r"spiral_cad.cad.g2_slab is now rolled_slab; the old name goes in the next release"):
         assert cad.g2_slab is rolled_slab
     assert "g2_slab" not in cad.__all__ and "rolled_slab" in cad.__all__
+
+
+def test_read_of_a_program_counts_every_turn_keeps_a_run_in_one_dimension_and_takes_what_rs274_reads(tmp_path):
+    """An arc of three turns is three turns long (as LinuxCNC runs it); a run at z = 0 with an arc is all in the
+    plane; a program with parameters (the built-in reader refuses) is read by LinuxCNC's rs274 where installed."""
+    (tmp_path / "turns.nc").write_text("G21 G17 G90\nG0 X0 Y0 Z0\nG1 X5 Y0 F100\nG2 X5 Y0 I-5 J0 P3\nG1 X5 Y-1\nM2\n")
+    read = sc.read(tmp_path / "turns.nc")
+    assert read.length == pytest.approx(5 + 3 * 2 * math.pi * 5 + 1, rel=1e-12)
+    assert {segment.dim for run in read.runs for segment in run} == {2}
+    program = tmp_path / "oword.ngc"
+    program.write_text(
+        "G21 G90\n#1 = 5\nG0 X1 Y1 Z0\nG0 X0 Y0\nG1 X[#1] Y0 F100\nG1 X[#1] Y[#1]\nM2\n"
+    )  # the first move: from where the machine is
+    if shutil.which("rs274") is None:
+        with pytest.raises(ValueError, match="rs274, which reads more programs, is not installed"):
+            sc.read(program)
+        return
+    read = sc.read(program)
+    assert read.length == pytest.approx(10.0) and read.notes[0].startswith("read by LinuxCNC's rs274")
