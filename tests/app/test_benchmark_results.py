@@ -30,7 +30,6 @@ NOT_YET_STAMPED = {
     "results_chains.md",
     "results_checker.md",
     "results_fillets.md",
-    "results_fit.md",
     "results_ifc.md",
     "results_landxml.md",
     "results_points.md",
