@@ -39,7 +39,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any, TextIO
 
 from ..io.signals import raise_if_interrupted
-from ..io.staging import remove_stale
+from ..io.staging import remove_stale, wait_ended
 from .many_inputs import expand_inputs, shown, wants_many
 from .many_task import NOT_RUN, FileResult, note_worst, run_alone, run_one
 
@@ -84,6 +84,8 @@ def _client(workers: int | None, scheduler: str | None, files: int) -> Any:
 
 
 _INTERRUPTS = {signal.SIGINT}
+#: Seconds the command waits for the workers it killed to end before it removes their staging folders.
+KILLED_WAIT = 10.0
 
 
 @contextlib.contextmanager
@@ -303,12 +305,13 @@ def _on_cluster(task: Callable[[argparse.Namespace], int], files: Sequence[str],
         client = _client(workers, scheduler, len(files))
     cluster = client.cluster if scheduler is None else None
     alone: list[int] = []
+    killed: list[int] = []
     try:
         try:
             _interrupts_released()  # a Ctrl-C during the start arrives here, where the cluster is closed
             lost = _dispatch(client, task, files, changes, args, results, stop, alone)
         except BaseException:
-            _stop_workers(stop, cluster)
+            killed = _stop_workers(stop, cluster)
             raise
         finally:
             _close(client, cluster)
@@ -322,6 +325,7 @@ def _on_cluster(task: Callable[[argparse.Namespace], int], files: Sequence[str],
             Path(stop).touch()
         raise
     finally:
+        wait_ended(killed, KILLED_WAIT)  # a killed worker may still be ending: its folder is removed once it has
         for index, result in enumerate(results.results):  # staging folders of workers that were stopped
             out = changes[index].get("out")
             if result is None and out is not None and os.path.isdir(out):
@@ -386,15 +390,18 @@ def _threads(client: Any) -> int:
         return 1
 
 
-def _stop_workers(stop: str, cluster: Any) -> None:
-    """Interrupted: workers commit nothing more (the stop file), and a local cluster's are killed now."""
+def _stop_workers(stop: str, cluster: Any) -> list[int]:
+    """Interrupted: workers commit nothing more (the stop file), and a local cluster's are killed now; their pids."""
     with contextlib.suppress(OSError):
         Path(stop).touch()
+    killed = []
     for nanny in list(getattr(cluster, "workers", {}).values()):
         pid = getattr(getattr(getattr(nanny, "process", None), "process", None), "pid", None)
         if pid:
             with contextlib.suppress(OSError):
                 os.kill(pid, signal.SIGKILL)  # its reader children end with it (die_with_parent)
+                killed.append(pid)
+    return killed
 
 
 def _close(client: Any, cluster: Any) -> None:

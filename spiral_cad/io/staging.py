@@ -121,6 +121,16 @@ def _is_stale(folder: Path) -> bool:
     return not _alive(pid)
 
 
+def wait_ended(pids: list[int], seconds: float) -> None:
+    """Wait (at most ``seconds``) until every process of ``pids`` has ended (or is a zombie): a process killed a
+    moment ago still holds its folder while the system ends it."""
+    import time
+
+    deadline = time.monotonic() + seconds
+    while any(_alive(pid) for pid in pids) and time.monotonic() < deadline:
+        time.sleep(0.02)
+
+
 def _alive(pid: int) -> bool:
     try:
         os.kill(pid, 0)
