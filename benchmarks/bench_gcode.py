@@ -43,6 +43,7 @@ from spiral_cad.io.gcode_processes import processes as forked
 MEASURES = (
     "spiral_cad.io.gcode",
     "spiral_cad.io.gcode_paths",
+    "spiral_cad.io.gcode_pieces",
     "spiral_cad.io.toolpath_rounding",
     "spiral_cad.io.toolpath",
     "spiral_cad.io.gcode_write",

@@ -269,8 +269,8 @@ def add_check(sub: argparse._SubParsersAction) -> None:
         "faces is judged face to face at every edge they share (sharp features listed, not failed). A DXF drawing's curves "
         "(lines, arcs, circles, ellipses, splines, polylines, blocks) are judged as drawn, chained by their ends. A LandXML file's alignments are judged as "
         "stated: each element's ends, directions and radii, so a kink or a radius that differs from its neighbour's shows. A CNC program's cutting paths are judged "
-        "run by run between rapids (helical moves left out). An IFC 4.3 file's alignments are judged plan and profile: the plan as its curve's "
-        "segments run, with the curvatures its layout states, the profile on its vertical segments' own numbers. An OpenDRIVE file is judged road by road (its planView, its elevation and superelevation in s) and link by link. Exit status: 0 ok, "
+        "run by run between rapids (helical moves left out). An IFC 4.3 file's alignments are judged plan and profile, as ifcopenshell evaluates "
+        "their curves' segments (a profile without its gradient curve on its vertical segments' own numbers). An OpenDRIVE file is judged road by road (its planView, its elevation and superelevation in s) and link by link. Exit status: 0 ok, "
         "1 below --require, --profiles or --links (or not --pieces pieces), 2 unreadable file or bad option, "
         "141 output pipe closed early.",
     )

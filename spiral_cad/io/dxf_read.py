@@ -289,10 +289,8 @@ def _spline_parts(spline: Any) -> list[tuple]:
         along = (cp - cp[0]) @ chord
         off = np.linalg.norm(np.cross(cp - cp[0], chord), axis=-1)
         if along.min() >= 0.0 and along.max() <= chord @ chord and off.max() <= 1e-12 * (chord @ chord):
-            parts.append(("line", cp[0], cp[-1], None))  # straight and never back: a line (its curvature is rounding)
+            parts.append(("line", cp[0], cp[-1], None))  # straight and never back (every degree-1 piece): a line
             continue
-        if degree == 1:
-            raise ValueError("a degree-1 piece that doubles back along itself")  # cannot happen: straight, handled above
         if degree == 2:  # degree elevation: the same curve
             cp = np.array([cp[0], cp[0] + 2 / 3 * (cp[1] - cp[0]), cp[2] + 2 / 3 * (cp[1] - cp[2]), cp[2]])
         parts.append(("cubic", cp[0], cp[-1], cp))

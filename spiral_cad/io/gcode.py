@@ -73,9 +73,9 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from ..core import bezier
+from .gcode_pieces import piece_segments, plain_cubics
 from .progress import Progress
-from .toolpath import PLANES, GcodePath, arc_points, arc_sweep, in_program_unit, spline_points
+from .toolpath import PLANES, GcodePath, arc_points, in_program_unit, spline_points
 
 if TYPE_CHECKING:
     from ..core.chain import Chain
@@ -689,13 +689,13 @@ def parse_gcode_chain(text: str, source: str = "G-code", *, units: str | None = 
     dim = 2 if flat else 3
     segments: list[Line | Arc | BezierSpiral] = []
     owners: list[int] = []
-    plain = _plain_cubics(pieces, factor)
+    plain = plain_cubics(pieces, factor)
     for k, (kind, number, rapid, start, *data) in enumerate(pieces):
         if rapid:
             raise ValueError(f"{source} line {number}: a rapid move (G0) between feed moves; the path is the feed moves "
                              "after the rapids to its start")  # fmt: skip
         try:
-            segment = _piece_segment(kind, start, data, factor, dim, k in plain)
+            segment = piece_segments(kind, start, data, factor, dim, k in plain)
         except ValueError as error:
             raise ValueError(f"{source} line {number}: {error}") from None
         for piece in segment or ():
@@ -747,51 +747,6 @@ def program_feeds(path: str | os.PathLike) -> tuple[tuple[float, ...], str | Non
     text, label = _program_text(path)
     reader = _read_exact(text, label)
     return tuple(reader.feeds), reader.units
-
-
-def _plain_cubics(pieces: list[Any], factor: float) -> set[int]:
-    """The places in ``pieces`` of the G5 cubics that are one spiral piece as they are (``bezier.plain_spirals``,
-    all at once): the others are cut by ``bezier.monotone_pieces``, one by one."""
-    at = [k for k, piece in enumerate(pieces) if piece[0] == "cubic"]
-    if not at:
-        return set()
-    cubics = np.array([np.asarray(pieces[k][4], dtype=float)[:, :2] * factor for k in at])
-    return {at[i] for i in np.flatnonzero(bezier.plain_spirals(cubics)).tolist()}
-
-
-def _piece_segment(kind: str, start: list[float], data: list[Any], factor: float, dim: int, plain: bool = False) -> Any:
-    """The chain segments of one move read in exact mode (None for a move that goes nowhere); a ``plain`` cubic
-    is one spiral piece (``_plain_cubics``)."""
-    from ..core.segments import Arc, Line
-    from ..core.spiral import BezierSpiral
-
-    begin = np.array(start) * factor
-    if kind == "line":
-        end = np.array(data[0]) * factor
-        return None if np.array_equal(begin, end) else [Line(begin[:dim], end[:dim])]
-    if kind == "arc":
-        end, plane, ca, cb, rotation = data
-        a, b, normal = PLANES[plane]
-        if end[normal] != start[normal] or abs(rotation) != 1:
-            raise ValueError("a helical or multi-turn arc is not one arc of a chain")
-        t0, sweep = arc_sweep(start, end, plane, ca, cb, rotation)
-        radius = math.hypot(start[a] - ca, start[b] - cb) * factor
-        if dim == 2:
-            return [Arc((ca * factor, cb * factor), math.copysign(radius, sweep), t0, abs(sweep))]
-        centre = begin.copy()
-        centre[a], centre[b] = ca * factor, cb * factor
-        axis = np.zeros(3)
-        axis[normal] = 1.0
-        return [Arc.in_space(centre, axis, begin, sweep)]
-    cp = np.asarray(data[0]) * factor
-    cubic = cp[:, :2]
-    if not np.any(np.diff(cubic, axis=0)):
-        return None
-    pieces = []
-    for u0, u1 in [(0.0, 1.0)] if plain else bezier.monotone_pieces(cubic):
-        piece = cp.copy() if (u0, u1) == (0.0, 1.0) else np.column_stack([bezier.split(cubic, u0, u1), cp[:, 2]])
-        pieces.append(BezierSpiral.from_control_points(piece[:, :dim]))
-    return pieces
 
 
 def read_gcode_chain(path: str | os.PathLike, *, units: str | None = None, tolerance: float = 1e-6) -> Chain:

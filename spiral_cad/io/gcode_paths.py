@@ -51,7 +51,8 @@ class GcodeRuns:
 
     Attributes:
         runs: every run of feed moves between rapids, in program order: its ``Line``, ``Arc`` and (for
-            ``G5``) ``BezierSpiral`` segments end to start, in space and in ``units``, G2 or not.
+            ``G5``) ``BezierSpiral`` segments end to start, in ``units``, G2 or not; a run's segments all in
+            the plane when it lies in z = 0, else its lines and arcs in space.
         lines: the program line of each segment, run by run.
         units: the program's unit (``"mm"`` or ``"in"``).
         source: the file's name, for messages.
@@ -506,7 +507,8 @@ def _built_in_runs(path: str | os.PathLike, *, units: str | None = None) -> Gcod
         ValueError: what the built-in reader refuses (naming the line), or no feed move.
         OSError: the file could not be read.
     """
-    from .gcode import _piece_segment, _plain_cubics, _program_text, _read_exact
+    from .gcode import _program_text, _read_exact
+    from .gcode_pieces import piece_segments, plain_cubics
     from .toolpath import PLANES
 
     text, label = _program_text(path)
@@ -517,7 +519,7 @@ def _built_in_runs(path: str | os.PathLike, *, units: str | None = None) -> Gcod
     helical = 0
     left_out = 0.0
     named = _first_named(text)
-    plain = _plain_cubics(reader.pieces, 1.0)
+    plain = plain_cubics(reader.pieces, 1.0)
     for k, (kind, number, rapid, start, *data) in enumerate(reader.pieces):
         helix = kind == "arc" and data[0][PLANES[data[1]][2]] != start[PLANES[data[1]][2]]
         ends_at = data[0] if kind != "cubic" else data[0][-1]
@@ -556,7 +558,7 @@ def _built_in_runs(path: str | os.PathLike, *, units: str | None = None) -> Gcod
                                  "run on the same circle)")  # fmt: skip
                     left_out += max(0, abs(rotation) - 2) * 2.0 * math.pi * 0.5 * (r0 + r1)
             else:
-                segments = _piece_segment(kind, start, data, 1.0, 3, k in plain) or []
+                segments = piece_segments(kind, start, data, 1.0, 3, k in plain) or []
         except ValueError as error:
             raise ValueError(f"{label} line {number}: {error}") from None
         for segment in segments:
