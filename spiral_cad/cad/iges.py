@@ -38,6 +38,13 @@ def _text(text: str) -> TCollection_HAsciiString:
     return TCollection_HAsciiString(iges_text(text))
 
 
+def _global_text(text: str) -> TCollection_HAsciiString:
+    """A global-section string, given in Hollerith form: OCCT's writer takes any string that starts like one
+    (``12Habc``, a name ``0H0``) as already written so and keeps only what follows the H."""
+    ascii_text = iges_text(text)
+    return TCollection_HAsciiString(f"{len(ascii_text)}H{ascii_text}")
+
+
 def _name_entity(writer: IGESControl_Writer, entity: Any, name: str) -> None:
     """Give ``entity`` the label and the name property ``name`` (as OCCT's XDE writer does)."""
     entity.SetLabel(_text(name[:8]), -1)
@@ -65,12 +72,12 @@ def write_iges(obj: Any, path: str | os.PathLike, name: str, units: str, origina
     model = writer.Model()
     header = model.GlobalSection()
     header.SetCascadeUnit(MM_PER_UNIT[units])  # the shape is already in the file unit: no rescaling
-    header.SetSendName(_text(name))
+    header.SetSendName(_global_text(name))
     # OCCT's writer overruns a buffer on strings of ~1300 characters: the file name is capped like a name
-    header.SetFileName(_text(os.path.basename(os.fspath(path))[:MAX_NAME_LENGTH]))
-    header.SetSystemId(_text(originating_system))
-    header.SetInterfaceVersion(_text(originating_system))
-    header.SetReceiveName(_text(name))
+    header.SetFileName(_global_text(os.path.basename(os.fspath(path))[:MAX_NAME_LENGTH]))
+    header.SetSystemId(_global_text(originating_system))
+    header.SetInterfaceVersion(_global_text(originating_system))
+    header.SetReceiveName(_global_text(name))
     header.SetAuthorName(TCollection_HAsciiString(""))
     header.SetCompanyName(TCollection_HAsciiString(""))
     model.SetGlobalSection(header)

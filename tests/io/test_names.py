@@ -8,7 +8,7 @@ import sys
 import xml.etree.ElementTree as ET
 
 import pytest
-from hypothesis import HealthCheck, given, settings
+from hypothesis import HealthCheck, example, given, settings
 from hypothesis import strategies as st
 
 pytest.importorskip("OCP")
@@ -237,6 +237,10 @@ def _passes_the_policy(name: str) -> bool:
 
 @settings(max_examples=30, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
 @given(st.text(min_size=1, max_size=40).filter(_passes_the_policy))
+# A newcomer's run found it: OCCT's IGES writer took a name that starts like a Hollerith string as one
+# ("0H0" came back "0"); the global section's strings are given in Hollerith form now.
+@example(name="0H0")
+@example(name="12Habc")
 def test_any_name_the_policy_passes_reads_back_from_every_file(tmp_path, name):
     export_step(CHAIN, tmp_path / "a.step", name=name)
     read_shape(tmp_path / "a.step")
